@@ -1,0 +1,58 @@
+// Forward kinematics, control-frame Jacobians and centre of mass of a
+// RobotModel, with Eigen.
+//
+// Thread safety: a Kinematics object is not thread-safe (Update() writes its
+// buffers); use one per thread. All buffers are allocated in the constructor,
+// so Update() and the pose accessors do not allocate.
+#pragma once
+
+#include "robotalk/robot_model.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <span>
+#include <vector>
+
+namespace robotalk {
+
+/// 6×N geometric Jacobian: rows 0-2 the linear velocity of the frame origin,
+/// rows 3-5 the angular velocity, both in world coordinates; one column per
+/// dof of the model (N = RobotModel::num_dofs()).
+using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+class Kinematics {
+ public:
+  /// `model` must outlive this object. Poses start at q = 0.
+  explicit Kinematics(const RobotModel& model);
+
+  /// Computes every link pose for joint positions `q` (size num_dofs(), in
+  /// dof_offset order). `root_poses`, if not empty, gives one world pose per
+  /// RobotModel::roots() entry (same order); otherwise the model's are used.
+  /// Throws std::invalid_argument naming the bad size or the non-finite entry.
+  void Update(const Eigen::Ref<const Eigen::VectorXd>& q,
+              std::span<const Eigen::Isometry3d> root_poses = {});
+
+  /// World pose of a link's frame (not its COM) for the last Update().
+  const Eigen::Isometry3d& link_pose(int link) const;
+  /// World pose of a control frame for the last Update().
+  Eigen::Isometry3d frame_pose(int frame) const;
+  /// Geometric Jacobian of a control frame's origin (see Jacobian).
+  Jacobian FrameJacobian(int frame) const;
+  /// Geometric Jacobian of a point fixed to `link`, given in the link frame.
+  Jacobian PointJacobian(int link, const Eigen::Vector3d& point_in_link) const;
+  /// Whole-body centre of mass in the world, m. Zero vector if the robot is massless.
+  Eigen::Vector3d CenterOfMass() const;
+
+  const RobotModel& model() const { return model_; }
+
+ private:
+  const RobotModel& model_;
+  std::vector<Eigen::Isometry3d> link_poses_;
+  // Per dof, for the Jacobian: world axis and a point on it.
+  std::vector<Eigen::Vector3d> dof_axes_, dof_points_;
+};
+
+/// Fills the dofs of mimic joints from their leaders: q[m] = k * q[leader] + c.
+void ApplyMimics(const RobotModel& model, Eigen::Ref<Eigen::VectorXd> q);
+
+}  // namespace robotalk
