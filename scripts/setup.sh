@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages RoboTalk needs (only those missing) and
+# configures + builds the project in ./build. Used by demo.sh and test.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  liblcm-dev liblcm-bin liblcm-java liblcm-lua libglib2.0-dev
+  libeigen3-dev libode-dev liburdfdom-dev libtinyxml-dev
+  libgtest-dev libgmock-dev
+  default-jdk-headless lua5.2
+  iproute2 util-linux python3 python3-matplotlib
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "robotalk: installing missing Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBOTALK_WERROR=ON >/dev/null
+cmake --build "$BUILD_DIR" -j"$(nproc)"

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# robotalk-describe from the outside: tables, JSON, and one clear error line
+# with a non-zero exit for each kind of bad file.
+#   describe_cli_test.sh PATH/TO/robotalk-describe MODELS_DIR
+set -u
+describe=$1
+models=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+pass=0
+
+check() {  # check NAME CONDITION-COMMAND...
+  local name=$1; shift
+  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
+}
+
+# A good file: a table naming the robot, its head joint and its total mass.
+"$describe" "$models/pioneer2dx_pantilt.urdf" >"$tmp/out" 2>"$tmp/err"
+check "good file exits 0" test $? -eq 0
+check "table names the robot" grep -q "^Robot '" "$tmp/out"
+check "table lists links and joints" grep -q "^Links" "$tmp/out"
+check "table shows total mass" grep -q "total mass" "$tmp/out"
+check "shipped model has no warnings" test ! -s "$tmp/err"
+
+# JSON parses and carries the same robot.
+"$describe" --json "$models/pioneer2dx_pantilt.urdf" >"$tmp/json"
+check "json exits 0" test $? -eq 0
+check "json is valid" python3 -c "import json,sys; d=json.load(open('$tmp/json')); sys.exit(0 if d['links'] and d['num_dofs']>0 else 1)"
+
+# --merge-chains makes the pan-tilt head one 2-dof joint.
+"$describe" --json --merge-chains "$models/pioneer2dx_pantilt.urdf" >"$tmp/merged"
+check "merged head has a 2-dof joint" python3 -c "import json,sys; d=json.load(open('$tmp/merged')); sys.exit(0 if any(len(j['dofs'])==2 for j in d['joints']) else 1)"
+
+bad() {  # bad NAME EXPECTED-FRAGMENT FILE
+  local name=$1 fragment=$2 file=$3
+  "$describe" "$file" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  check "$name: non-zero exit" test $rc -eq 1
+  check "$name: exactly one line" test "$(wc -l <"$tmp/err")" -eq 1
+  check "$name: message names '$fragment'" grep -qi -- "$fragment" "$tmp/err"
+}
+
+bad "missing file" "no_such_file.urdf" "$tmp/no_such_file.urdf"
+printf '<robot name="x"><link name="a">' >"$tmp/malformed.urdf"
+bad "malformed XML" "malformed.urdf" "$tmp/malformed.urdf"
+cat >"$tmp/unknown_link.urdf" <<'XML'
+<robot name="x"><link name="a"/><link name="b"/>
+<joint name="j" type="fixed"><parent link="a"/><child link="ghost"/></joint></robot>
+XML
+bad "unknown link" "ghost" "$tmp/unknown_link.urdf"
+cat >"$tmp/negative_mass.urdf" <<'XML'
+<robot name="x"><link name="heavy"><inertial><mass value="-2"/>
+<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>
+XML
+bad "negative mass" "heavy" "$tmp/negative_mass.urdf"
+
+"$describe" >/dev/null 2>&1
+check "no argument is a usage error" test $? -eq 2
+"$describe" --bogus x.urdf >/dev/null 2>&1
+check "unknown option is a usage error" test $? -eq 2
+
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
