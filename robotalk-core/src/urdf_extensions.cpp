@@ -1,1 +1,223 @@
-// Placeholder: implemented in a follow-up commit.
+#include "urdf_extensions.h"
+
+#include "robotalk/error.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <set>
+#include <sstream>
+
+namespace robotalk::urdf_detail {
+
+void Refuse(const std::string& source, const std::string& what) { throw UrdfError(source + ": " + what); }
+
+std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+namespace {
+
+std::string At(const TiXmlElement& e) { return " (line " + std::to_string(e.Row()) + ")"; }
+
+std::string Describe(const TiXmlElement& e) {
+  const char* name = e.Attribute("name");
+  std::string d = "<" + std::string(e.Value()) + ">";
+  if (name != nullptr) d += " " + Quote(name);
+  return d;
+}
+
+// The user's own block: a misspelt attribute must not pass silently.
+void RequireOnlyAttributes(const TiXmlElement& e, std::initializer_list<const char*> allowed,
+                           const std::string& source) {
+  for (const TiXmlAttribute* a = e.FirstAttribute(); a != nullptr; a = a->Next()) {
+    bool known = false;
+    for (const char* name : allowed) known = known || std::string(a->Name()) == name;
+    if (!known) {
+      std::string expected;
+      for (const char* name : allowed) expected += (expected.empty() ? "" : ", ") + std::string(name);
+      Refuse(source, "<robotalk>: " + Describe(e) + At(e) + ": unknown attribute " + Quote(a->Name()) +
+                         (expected.empty() ? " (it takes none)" : " (expected " + expected + ")"));
+    }
+  }
+}
+
+std::string RequiredAttribute(const TiXmlElement& e, const char* name, const std::string& source) {
+  const char* value = e.Attribute(name);
+  if (value == nullptr || *value == '\0') {
+    Refuse(source, "<robotalk>: " + Describe(e) + At(e) + ": missing attribute " + Quote(name));
+  }
+  return value;
+}
+
+Eigen::Vector3d ParseTriple(const TiXmlElement& e, const char* attribute, const std::string& source) {
+  const char* text = e.Attribute(attribute);
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  if (text == nullptr) return v;
+  const char* p = text;
+  for (int i = 0; i < 3; ++i) {
+    char* end = nullptr;
+    errno = 0;
+    v[i] = std::strtod(p, &end);
+    if (end == p || errno == ERANGE || !std::isfinite(v[i])) {
+      Refuse(source, "<robotalk>: <" + std::string(e.Value()) + "> " + attribute + "=" + Quote(text) + At(e) +
+                         " is not three finite numbers");
+    }
+    p = end;
+  }
+  while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r') ++p;
+  if (*p != '\0') {
+    Refuse(source, "<robotalk>: <" + std::string(e.Value()) + "> " + attribute + "=" + Quote(text) + At(e) +
+                       " has more than three numbers");
+  }
+  return v;
+}
+
+// URDF's rpy convention: fixed-axis roll about x, then pitch about y, then
+// yaw about z, i.e. R = Rz(yaw) * Ry(pitch) * Rx(roll).
+Eigen::Quaterniond FromRpy(const Eigen::Vector3d& rpy) {
+  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+      .normalized();
+}
+
+// An optional single <origin xyz rpy> child; `owner` takes no other children.
+Pose ParseOriginChild(const TiXmlElement& owner, const std::string& source) {
+  Pose pose;
+  bool seen = false;
+  for (const TiXmlElement* c = owner.FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+    if (std::string(c->Value()) != "origin") {
+      Refuse(source, "<robotalk>: " + Describe(owner) + At(owner) + ": unknown child element <" +
+                         std::string(c->Value()) + "> (expected <origin>)");
+    }
+    if (seen) Refuse(source, "<robotalk>: " + Describe(owner) + At(owner) + ": more than one <origin>");
+    seen = true;
+    RequireOnlyAttributes(*c, {"xyz", "rpy"}, source);
+    pose.translation = ParseTriple(*c, "xyz", source);
+    pose.rotation = FromRpy(ParseTriple(*c, "rpy", source));
+  }
+  return pose;
+}
+
+void RequireNoChildren(const TiXmlElement& e, const std::string& source) {
+  if (const TiXmlElement* c = e.FirstChildElement()) {
+    Refuse(source, "<robotalk>: " + Describe(e) + At(e) + ": unexpected child element <" +
+                       std::string(c->Value()) + ">");
+  }
+}
+
+ServoTypes ParseServo(const TiXmlElement& e, const char* attribute, const std::string& source) {
+  const std::string text = RequiredAttribute(e, attribute, source);
+  try {
+    return ServoTypes::Parse(text);
+  } catch (const ModelError& error) {
+    Refuse(source, "<robotalk>: " + Describe(e) + At(e) + ": " + error.what());
+  }
+}
+
+}  // namespace
+
+XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source) {
+  XmlScan scan;
+  std::map<std::string, int> link_lines;
+  for (const TiXmlElement* e = robot.FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+    const std::string tag = e->Value();
+    if (tag != "link" && tag != "joint") continue;
+    const char* name = e->Attribute("name");
+    if (name == nullptr || *name == '\0') Refuse(source, "<" + tag + ">" + At(*e) + " has no name");
+    if (tag == "link") {
+      auto [it, fresh] = link_lines.emplace(name, e->Row());
+      if (!fresh) {
+        Refuse(source, "duplicate link name " + Quote(name) + " (lines " + std::to_string(it->second) + " and " +
+                           std::to_string(e->Row()) + ")");
+      }
+      scan.links.emplace_back(name);
+      continue;
+    }
+    XmlJoint info;
+    info.line = e->Row();
+    if (const TiXmlElement* limit = e->FirstChildElement("limit")) {
+      info.has_limit = true;
+      info.has_lower = limit->Attribute("lower") != nullptr;
+      info.has_upper = limit->Attribute("upper") != nullptr;
+    }
+    auto [it, fresh] = scan.joint_info.emplace(name, info);
+    if (!fresh) {
+      Refuse(source, "duplicate joint name " + Quote(name) + " (lines " + std::to_string(it->second.line) +
+                         " and " + std::to_string(e->Row()) + ")");
+    }
+    scan.joints.emplace_back(name);
+  }
+  return scan;
+}
+
+Extensions ParseExtensions(const TiXmlElement& robot, const std::string& source) {
+  Extensions ext;
+  const TiXmlElement* block = robot.FirstChildElement("robotalk");
+  if (block == nullptr) return ext;
+  if (const TiXmlElement* second = block->NextSiblingElement("robotalk")) {
+    Refuse(source, "more than one <robotalk> block (lines " + std::to_string(block->Row()) + " and " +
+                       std::to_string(second->Row()) + ")");
+  }
+  RequireOnlyAttributes(*block, {"version"}, source);
+  if (const char* version = block->Attribute("version"); version != nullptr && std::string(version) != "1") {
+    Refuse(source, "<robotalk version=" + Quote(version) + ">" + At(*block) + ": unsupported version (expected 1)");
+  }
+  std::set<std::string> frame_names, servo_joints;
+  for (const TiXmlElement* e = block->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+    const std::string tag = e->Value();
+    if (tag == "control_frame") {
+      RequireOnlyAttributes(*e, {"name", "link", "servo"}, source);
+      Extensions::Frame frame;
+      frame.name = RequiredAttribute(*e, "name", source);
+      frame.link = RequiredAttribute(*e, "link", source);
+      if (e->Attribute("servo") != nullptr) frame.servo = ParseServo(*e, "servo", source);
+      frame.pose = ParseOriginChild(*e, source);
+      frame.line = e->Row();
+      if (!frame_names.insert(frame.name).second) {
+        Refuse(source, "<robotalk>: duplicate control frame name " + Quote(frame.name) + At(*e));
+      }
+      ext.frames.push_back(std::move(frame));
+    } else if (tag == "servo") {
+      RequireOnlyAttributes(*e, {"joint", "types"}, source);
+      RequireNoChildren(*e, source);
+      Extensions::Servo servo;
+      servo.joint = RequiredAttribute(*e, "joint", source);
+      servo.types = ParseServo(*e, "types", source);
+      servo.line = e->Row();
+      if (!servo_joints.insert(servo.joint).second) {
+        Refuse(source, "<robotalk>: joint " + Quote(servo.joint) + " has a second <servo>" + At(*e));
+      }
+      ext.servos.push_back(std::move(servo));
+    } else if (tag == "base") {
+      if (ext.base) {
+        Refuse(source, "<robotalk>: more than one <base> (lines " + std::to_string(ext.base->line) + " and " +
+                           std::to_string(e->Row()) + ")");
+      }
+      RequireOnlyAttributes(*e, {"link", "type"}, source);
+      Extensions::Base base;
+      if (const char* link = e->Attribute("link")) base.link = link;
+      const std::string type = RequiredAttribute(*e, "type", source);
+      try {
+        base.type = ParseBaseType(type);
+      } catch (const ModelError& error) {
+        Refuse(source, "<robotalk>: <base>" + At(*e) + ": " + error.what());
+      }
+      base.pose = ParseOriginChild(*e, source);
+      base.line = e->Row();
+      ext.base = std::move(base);
+    } else {
+      Refuse(source, "<robotalk>: unknown element <" + tag + ">" + At(*e) +
+                         " (expected <base>, <control_frame> or <servo>)");
+    }
+  }
+  return ext;
+}
+
+}  // namespace robotalk::urdf_detail

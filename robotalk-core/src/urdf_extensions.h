@@ -1,0 +1,79 @@
+// Private to urdf_import.cpp: the tinyxml side of URDF import. It reads what
+// urdfdom forgets (the file order of links and joints, which <limit>
+// attributes were actually written) and the RoboTalk extension block
+// (docs/urdf_import.md, "The <robotalk> block").
+//
+// Every function throws UrdfError whose message starts with the source name.
+#pragma once
+
+#include "robotalk/model_types.h"
+
+#include <tinyxml.h>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace robotalk::urdf_detail {
+
+/// Throws UrdfError("<source>: <what>").
+[[noreturn]] void Refuse(const std::string& source, const std::string& what);
+
+/// "'name'".
+std::string Quote(const std::string& s);
+
+/// A number as a short text ("2.775", "inf").
+std::string Num(double v);
+
+/// What the XML says about one <joint> that urdfdom does not keep.
+struct XmlJoint {
+  int line = 0;
+  bool has_limit = false;  ///< a <limit> child is present
+  bool has_lower = false;  ///< <limit lower=...> written
+  bool has_upper = false;  ///< <limit upper=...> written
+};
+
+/// The direct children <link> and <joint> of <robot>, in file order.
+struct XmlScan {
+  std::vector<std::string> links;
+  std::vector<std::string> joints;
+  std::map<std::string, XmlJoint> joint_info;
+};
+
+/// Reads names and limit attributes. Refuses an unnamed or duplicated link or
+/// joint (urdfdom would too, but with a less useful message).
+XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source);
+
+/// The parsed <robotalk> block. Names are not resolved yet (the importer
+/// checks them against the model); `line` points the user at the element.
+struct Extensions {
+  struct Frame {
+    std::string name;
+    std::string link;
+    Pose pose;
+    ServoTypes servo = ServoType::kSetPoint;
+    int line = 0;
+  };
+  struct Servo {
+    std::string joint;
+    ServoTypes types;
+    int line = 0;
+  };
+  struct Base {
+    std::optional<std::string> link;  ///< when given, must be the root link
+    BaseType type = BaseType::kFixed;
+    Pose pose;  ///< of the root link frame in the world
+    int line = 0;
+  };
+  std::vector<Frame> frames;
+  std::vector<Servo> servos;
+  std::optional<Base> base;
+};
+
+/// Parses the top-level <robotalk> element of <robot>, if any. Refuses
+/// unknown elements and attributes, malformed numbers, unknown servo or base
+/// types, a second <robotalk>, <base> or <servo> for the same joint.
+Extensions ParseExtensions(const TiXmlElement& robot, const std::string& source);
+
+}  // namespace robotalk::urdf_detail
