@@ -1,0 +1,83 @@
+// Commands, queries and replies as C++ values, and their checks against a
+// robot model. The wire forms are robotalk_msgs::command_t / query_t / reply_t
+// (docs/protocol.md); protocol_codec.h converts.
+#pragma once
+
+#include "robotalk/clock.h"
+#include "robotalk/robot_model.h"
+#include "robotalk/signal.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace robotalk {
+
+using CommandId = std::int64_t;
+
+enum class CommandType : std::int8_t {
+  kJointSetPoint = 1,  ///< target joint; one position per dof (rad | m)
+  kJointSpeed = 2,     ///< target joint; one velocity per dof (rad/s | m/s)
+  kJointForce = 3,     ///< target joint; one effort per dof (N·m | N)
+  kFrameSetPoint = 4,  ///< target control frame; x y z qw qx qy qz in the world
+  kGoto = 5,           ///< base: x y θ in the world (m, m, rad)
+  kSetSpeed = 6,       ///< base: v ω, or vx vy ω (m/s, rad/s)
+  kStop = 7,           ///< stop every motion
+  kPanicReset = 8,     ///< leave the panic state
+};
+
+enum class QueryType : std::int8_t {
+  kConfig = 1,      ///< the robot description (published on the CONFIG channel)
+  kJointState = 2,  ///< positions, velocities, efforts of every dof (or of one joint)
+  kLinkPoses = 3,   ///< world pose of every link (or one): x y z qw qx qy qz each
+  kFramePoses = 4,  ///< world pose of every control frame (or one)
+  kBasePose = 5,    ///< x y θ v ω of the first root link
+  kClock = 6,       ///< server time, for clock synchronisation
+};
+
+const char* ToString(CommandType t);
+const char* ToString(QueryType t);
+/// Parses the names printed by ToString ("JOINT_SETPOINT", "GOTO", ...), case-insensitive.
+std::optional<CommandType> ParseCommandType(const std::string& name);
+std::optional<QueryType> ParseQueryType(const std::string& name);
+
+struct Command {
+  CommandId id = 0;
+  CommandType type = CommandType::kStop;
+  /// Server-clock start time; nullopt = execute at once (wire value 0).
+  std::optional<TimePoint> start_time;
+  std::string target;  ///< joint or control-frame name; empty for base / whole-robot commands
+  std::vector<double> values;
+};
+
+struct Query {
+  CommandId id = 0;
+  QueryType type = QueryType::kJointState;
+  std::string target;  ///< one joint / link / frame name, or empty for all
+};
+
+struct Reply {
+  CommandId id = 0;
+  Signal signal = Signal::kSuccess;
+  std::string message;
+  TimePoint exec_time{};
+  Duration lateness{0};
+  std::vector<double> values;
+};
+
+/// True for the commands that move the robot (all but STOP and PANIC_RESET).
+bool IsMotionCommand(CommandType t);
+
+/// Checks a command against a model before it is queued. Returns the ERROR or
+/// NA reply text ("JOINT_SETPOINT: robot 'pioneer' has no joint named 'nek'",
+/// "JOINT_SETPOINT 'pan_tilt': expected 2 values (one per dof), got 3",
+/// "JOINT_SETPOINT 'pan_tilt': value 1 is NaN"), or nullopt when well-formed.
+/// `signal` receives kError for malformed requests and kNa for a servo type or
+/// base command the robot does not support.
+std::optional<std::string> CheckCommand(const RobotModel& model, const Command& command, Signal* signal);
+
+/// Same for queries (unknown target names, unknown type).
+std::optional<std::string> CheckQuery(const RobotModel& model, const Query& query);
+
+}  // namespace robotalk

@@ -1,0 +1,173 @@
+#include "robotalk/command.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace robotalk {
+namespace {
+
+constexpr double kQuaternionTolerance = 1e-3;
+
+std::string Upper(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  std::replace(s.begin(), s.end(), '-', '_');
+  return s;
+}
+
+std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+// "JOINT_SETPOINT 'neck'" or "GOTO".
+std::string Label(const Command& c) {
+  return c.target.empty() ? ToString(c.type) : std::string(ToString(c.type)) + " " + Quote(c.target);
+}
+
+std::optional<std::string> CheckValueCount(const Command& c, size_t expected, const char* what) {
+  if (c.values.size() == expected) return std::nullopt;
+  return Label(c) + ": expected " + std::to_string(expected) + " value" + (expected == 1 ? "" : "s") + what +
+         ", got " + std::to_string(c.values.size());
+}
+
+std::optional<std::string> CheckFinite(const Command& c) {
+  for (size_t i = 0; i < c.values.size(); ++i) {
+    if (!std::isfinite(c.values[i])) {
+      return Label(c) + ": value " + std::to_string(i) + " is " + (std::isnan(c.values[i]) ? "NaN" : "infinite");
+    }
+  }
+  return std::nullopt;
+}
+
+ServoType ServoOf(CommandType t) {
+  switch (t) {
+    case CommandType::kJointSpeed: return ServoType::kSpeed;
+    case CommandType::kJointForce: return ServoType::kForce;
+    default: return ServoType::kSetPoint;
+  }
+}
+
+}  // namespace
+
+const char* ToString(CommandType t) {
+  switch (t) {
+    case CommandType::kJointSetPoint: return "JOINT_SETPOINT";
+    case CommandType::kJointSpeed: return "JOINT_SPEED";
+    case CommandType::kJointForce: return "JOINT_FORCE";
+    case CommandType::kFrameSetPoint: return "FRAME_SETPOINT";
+    case CommandType::kGoto: return "GOTO";
+    case CommandType::kSetSpeed: return "SETSPEED";
+    case CommandType::kStop: return "STOP";
+    case CommandType::kPanicReset: return "PANIC_RESET";
+  }
+  return "UNKNOWN_COMMAND";
+}
+
+const char* ToString(QueryType t) {
+  switch (t) {
+    case QueryType::kConfig: return "CONFIG";
+    case QueryType::kJointState: return "JOINT_STATE";
+    case QueryType::kLinkPoses: return "LINK_POSES";
+    case QueryType::kFramePoses: return "FRAME_POSES";
+    case QueryType::kBasePose: return "BASE_POSE";
+    case QueryType::kClock: return "CLOCK";
+  }
+  return "UNKNOWN_QUERY";
+}
+
+std::optional<CommandType> ParseCommandType(const std::string& name) {
+  const std::string n = Upper(name);
+  for (int t = 1; t <= 8; ++t) {
+    auto type = static_cast<CommandType>(t);
+    if (n == ToString(type)) return type;
+  }
+  if (n == "SET_SPEED") return CommandType::kSetSpeed;
+  return std::nullopt;
+}
+
+std::optional<QueryType> ParseQueryType(const std::string& name) {
+  const std::string n = Upper(name);
+  for (int t = 1; t <= 6; ++t) {
+    auto type = static_cast<QueryType>(t);
+    if (n == ToString(type)) return type;
+  }
+  return std::nullopt;
+}
+
+bool IsMotionCommand(CommandType t) { return t != CommandType::kStop && t != CommandType::kPanicReset; }
+
+std::optional<std::string> CheckCommand(const RobotModel& model, const Command& c, Signal* signal) {
+  *signal = Signal::kError;
+  if (auto bad = CheckFinite(c)) return bad;
+  switch (c.type) {
+    case CommandType::kJointSetPoint:
+    case CommandType::kJointSpeed:
+    case CommandType::kJointForce: {
+      auto j = model.FindJoint(c.target);
+      if (!j) return std::string(ToString(c.type)) + ": robot " + Quote(model.name()) + " has no joint named " + Quote(c.target);
+      const Joint& joint = model.joint(*j);
+      if (joint.dofs.empty()) return Label(c) + ": the joint is fixed (0 dofs)";
+      if (auto bad = CheckValueCount(c, joint.dofs.size(), " (one per dof)")) return bad;
+      if (joint.mimic) {
+        *signal = Signal::kNa;
+        return Label(c) + ": the joint follows " + Quote(model.joint(joint.mimic->leader_joint).name) + " (mimic)";
+      }
+      if (!joint.servo_types.Has(ServoOf(c.type))) {
+        *signal = Signal::kNa;
+        return Label(c) + ": the joint accepts only " + joint.servo_types.ToString() + " commands";
+      }
+      return std::nullopt;
+    }
+    case CommandType::kFrameSetPoint: {
+      auto f = model.FindFrame(c.target);
+      if (!f) return std::string("FRAME_SETPOINT: robot ") + Quote(model.name()) + " has no control frame named " + Quote(c.target);
+      if (auto bad = CheckValueCount(c, 7, " (x y z qw qx qy qz)")) return bad;
+      const double norm = std::sqrt(c.values[3] * c.values[3] + c.values[4] * c.values[4] +
+                                    c.values[5] * c.values[5] + c.values[6] * c.values[6]);
+      if (std::abs(norm - 1) > kQuaternionTolerance) {
+        return Label(c) + ": orientation quaternion has norm " + std::to_string(norm) + ", expected 1";
+      }
+      if (!model.frame(*f).servo_types.Has(ServoType::kSetPoint)) {
+        *signal = Signal::kNa;
+        return Label(c) + ": the control frame accepts no set-point commands";
+      }
+      return std::nullopt;
+    }
+    case CommandType::kGoto:
+    case CommandType::kSetSpeed: {
+      if (!c.target.empty()) return Label(c) + ": a base command takes no target";
+      if (c.type == CommandType::kGoto) {
+        if (auto bad = CheckValueCount(c, 3, " (x y theta)")) return bad;
+      } else if (c.values.size() != 2 && c.values.size() != 3) {
+        return Label(c) + ": expected 2 values (v omega) or 3 (vx vy omega), got " + std::to_string(c.values.size());
+      }
+      if (model.roots().front().base == BaseType::kFixed) {
+        *signal = Signal::kNa;
+        return Label(c) + ": robot " + Quote(model.name()) + " has a fixed base";
+      }
+      return std::nullopt;
+    }
+    case CommandType::kStop:
+    case CommandType::kPanicReset:
+      if (!c.target.empty()) return Label(c) + ": takes no target";
+      return CheckValueCount(c, 0, "");
+  }
+  return "unknown command type " + std::to_string(static_cast<int>(c.type));
+}
+
+std::optional<std::string> CheckQuery(const RobotModel& model, const Query& q) {
+  if (q.target.empty()) return std::nullopt;
+  switch (q.type) {
+    case QueryType::kJointState:
+      if (!model.FindJoint(q.target)) return std::string("JOINT_STATE: robot ") + Quote(model.name()) + " has no joint named " + Quote(q.target);
+      return std::nullopt;
+    case QueryType::kLinkPoses:
+      if (!model.FindLink(q.target)) return std::string("LINK_POSES: robot ") + Quote(model.name()) + " has no link named " + Quote(q.target);
+      return std::nullopt;
+    case QueryType::kFramePoses:
+      if (!model.FindFrame(q.target)) return std::string("FRAME_POSES: robot ") + Quote(model.name()) + " has no control frame named " + Quote(q.target);
+      return std::nullopt;
+    default:
+      return std::string(ToString(q.type)) + ": takes no target (got " + Quote(q.target) + ")";
+  }
+}
+
+}  // namespace robotalk
