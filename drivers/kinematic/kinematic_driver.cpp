@@ -1,0 +1,1 @@
+// Placeholder: the kinematic driver lands in a follow-up commit.
