@@ -147,12 +147,32 @@ XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source) {
       info.has_lower = limit->Attribute("lower") != nullptr;
       info.has_upper = limit->Attribute("upper") != nullptr;
     }
+    auto link_of = [&](const char* role) {
+      const TiXmlElement* r = e->FirstChildElement(role);
+      const char* link = r != nullptr ? r->Attribute("link") : nullptr;
+      return std::string(link != nullptr ? link : "");
+    };
+    info.parent = link_of("parent");
+    info.child = link_of("child");
     auto [it, fresh] = scan.joint_info.emplace(name, info);
     if (!fresh) {
       Refuse(source, "duplicate joint name " + Quote(name) + " (lines " + std::to_string(it->second.line) +
                          " and " + std::to_string(e->Row()) + ")");
     }
     scan.joints.emplace_back(name);
+  }
+  for (const std::string& joint : scan.joints) {
+    const XmlJoint& info = scan.joint_info.at(joint);
+    for (const auto& [role, link] : {std::pair{"parent", &info.parent}, std::pair{"child", &info.child}}) {
+      if (link->empty()) {
+        Refuse(source, "joint " + Quote(joint) + " (line " + std::to_string(info.line) + "): no <" + role +
+                           " link=...>");
+      }
+      if (!link_lines.contains(*link)) {
+        Refuse(source, "joint " + Quote(joint) + " (line " + std::to_string(info.line) + "): unknown " + role +
+                           " link " + Quote(*link));
+      }
+    }
   }
   return scan;
 }

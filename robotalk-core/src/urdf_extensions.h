@@ -32,6 +32,8 @@ struct XmlJoint {
   bool has_limit = false;  ///< a <limit> child is present
   bool has_lower = false;  ///< <limit lower=...> written
   bool has_upper = false;  ///< <limit upper=...> written
+  std::string parent;      ///< <parent link=...>, empty when absent
+  std::string child;       ///< <child link=...>, empty when absent
 };
 
 /// The direct children <link> and <joint> of <robot>, in file order.
@@ -42,7 +44,8 @@ struct XmlScan {
 };
 
 /// Reads names and limit attributes. Refuses an unnamed or duplicated link or
-/// joint (urdfdom would too, but with a less useful message).
+/// joint and a joint naming an unknown link (urdfdom would too, but with a
+/// less useful message).
 XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source);
 
 /// The parsed <robotalk> block. Names are not resolved yet (the importer

@@ -513,7 +513,7 @@ void Importer::MergeMasslessChains() {
     }
     for (size_t i2 = 0; i2 < drafts_.size() && !merged; ++i2) {
       const Draft& j2 = drafts_[i2];
-      const std::string& m = j2.parent;
+      const std::string m = j2.parent;  // a copy: j2 is erased below
       const int i1 = [&] {
         for (size_t k = 0; k < drafts_.size(); ++k) {
           if (drafts_[k].child == m) return static_cast<int>(k);
