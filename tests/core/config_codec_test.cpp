@@ -1,11 +1,15 @@
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
 #include "robotalk/robot_model.h"
+#include "robotalk/urdf_import.h"
+#include "test_paths.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
+#include <iostream>
 #include <functional>
 #include <random>
 #include <set>
@@ -175,6 +179,37 @@ TEST(ConfigCodec, RoundTripsThroughTheMessage) {
   const msgs::robot_config_t msg = ToMessage(model);
   EXPECT_TRUE(FromMessage(msg) == model);
   EXPECT_EQ(static_cast<std::uint64_t>(msg.header.hash), ConfigHash(model));
+}
+
+// LCM 1.3.1 loses fragmented UDP messages above ~64 KB when fragments
+// reorder; a configuration must stay well below.
+constexpr size_t kMaxSafeConfigBytes = 60000;
+
+TEST(ConfigCodec, RoundTripsEverySharedRobotUnderTheSizeLimit) {
+  ROBOTALK_REQUIRE_SHARED_ROBOTS();
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(testing::SharedRobot(""))) {
+    if (entry.path().extension() == ".urdf") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  ASSERT_FALSE(files.empty());
+  size_t biggest = 0;
+  std::string biggest_name;
+  for (const auto& file : files) {
+    SCOPED_TRACE(file.filename().string());
+    const RobotModel model = LoadUrdfFile(file.string()).model;
+    const std::vector<std::uint8_t> bytes = EncodeConfig(model);
+    const RobotModel back = DecodeConfig(bytes);
+    EXPECT_TRUE(back == model);
+    EXPECT_EQ(ConfigHash(back), ConfigHash(model));
+    EXPECT_EQ(EncodeConfig(back), bytes);
+    EXPECT_LT(bytes.size(), kMaxSafeConfigBytes);
+    if (bytes.size() > biggest) {
+      biggest = bytes.size();
+      biggest_name = file.filename().string();
+    }
+  }
+  std::cout << "largest encoded configuration: " << biggest_name << ", " << biggest << " bytes\n";
 }
 
 TEST(ConfigCodec, WritesQuaternionsWxyzAndInertiaAsSixValues) {
