@@ -1,7 +1,12 @@
 // Import of URDF robot descriptions through urdfdom, with the RoboTalk
 // extension block (<robotalk>) for control frames, servo types and the base.
-// The defect policy (what is repaired with a warning, what is refused) is in
-// docs/specification.md, "URDF import".
+// docs/urdf_import.md has the frame conventions, the extension block reference
+// and the defect policy (what is repaired with a warning, what is refused).
+//
+// Thread safety: the functions may be called from several threads; the
+// urdfdom call inside is serialised, because urdfdom reports through
+// console_bridge's process-wide output handler, which the import captures
+// (urdfdom never writes to stderr during an import).
 #pragma once
 
 #include "robotalk/robot_model.h"
@@ -15,8 +20,9 @@ struct UrdfImportOptions {
   /// Every warning becomes an error (UrdfError listing all of them).
   bool strict = false;
   /// Merge chains of joints joined by massless intermediate links that share
-  /// the joint origin into one multi-dof joint (a pan-tilt unit becomes one
-  /// 2-dof joint). The intermediate links disappear from the model.
+  /// the joint origin into one multi-dof joint named "J1+J2" (a pan-tilt unit
+  /// becomes one 2-dof joint). The intermediate links disappear from the
+  /// model. Fixed and mimic joints are never merged.
   bool merge_massless_chains = false;
   /// Replaces the <robot name="..."> when not empty.
   std::string robot_name;
@@ -29,9 +35,10 @@ struct UrdfImportResult {
   std::vector<std::string> warnings;
 };
 
-/// Reads and imports a URDF file. Throws UrdfError naming the file and what is
-/// wrong (missing file, malformed XML, a joint naming an unknown link, a cycle,
-/// negative mass, ...); in strict mode also for any warning.
+/// Reads and imports a URDF file. Links and joints keep the file order as
+/// indices. Throws UrdfError naming the file and what is wrong (missing file,
+/// malformed XML, a joint naming an unknown link, a cycle, negative mass, a
+/// typo in the <robotalk> block, ...); in strict mode also for any warning.
 UrdfImportResult LoadUrdfFile(const std::string& path, const UrdfImportOptions& options = {});
 
 /// Same, from the XML text. `source_name` is used in messages.
