@@ -1,1 +1,0 @@
-// Placeholder: the client library lands in a follow-up commit.

@@ -1,0 +1,48 @@
+// A client's command queue: a min-heap ordered by start time, ties in arrival
+// order (paper §IV-A). Items due "now" (no start time) sort before any timed
+// item. Pure data structure, no locking: the owner (RobotService) locks.
+#pragma once
+
+#include "robotalk/clock.h"
+#include "robotalk/command.h"
+#include "robotalk/driver.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace robotalk {
+
+/// A command or query waiting for its start time.
+struct QueuedItem {
+  TimePoint start = TimePoint::min();  ///< TimePoint::min() = at once
+  std::uint64_t arrival = 0;           ///< server-wide arrival counter
+  std::int64_t client_id = 0;          ///< 0 = the server itself (watchdog STOP)
+  bool has_start_time = false;         ///< false = "now" (no lateness to report)
+  bool is_query = false;
+  DriverCommand command;               ///< when !is_query; command.id is the client's id
+  QueryType query = QueryType::kJointState;
+  int query_target = -1;               ///< joint / link / frame index, -1 = all
+
+  /// Earlier start first; equal starts in arrival order.
+  bool RunsBefore(const QueuedItem& o) const {
+    return start != o.start ? start < o.start : arrival < o.arrival;
+  }
+};
+
+class CommandQueue {
+ public:
+  void Push(QueuedItem item);
+  bool empty() const { return heap_.empty(); }
+  size_t size() const { return heap_.size(); }
+  /// The item that runs first. REQUIRES: !empty().
+  const QueuedItem& Top() const { return heap_.front(); }
+  /// Removes and returns Top(). REQUIRES: !empty().
+  QueuedItem Pop();
+  /// Removes every item, appending them to `out` in run order.
+  void Flush(std::vector<QueuedItem>& out);
+
+ private:
+  std::vector<QueuedItem> heap_;  // std::push_heap order with RunsAfter as "less"
+};
+
+}  // namespace robotalk

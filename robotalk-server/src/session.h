@@ -1,0 +1,53 @@
+// One client's state on the server (the paper's CClientConnection): its
+// command queue, its return queue (replies waiting to be sent, in issuance
+// order), the sequences it has sent, and the final replies of its recent
+// packages for re-sending to a retransmission. Pure data; RobotService locks.
+#pragma once
+
+#include "command_queue.h"
+#include "sequence_window.h"
+#include "robotalk/command.h"
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace robotalk {
+
+/// Final replies of a client's recent packages, by package sequence.
+class ReplyCache {
+ public:
+  explicit ReplyCache(size_t max_packages = 1024) : max_packages_(max_packages) {}
+  /// Remembers which item ids a package carried (evicts the oldest package).
+  void RecordPackage(std::int64_t sequence, std::vector<CommandId> ids);
+  /// Remembers a final reply (ignored unless its id belongs to a recorded package).
+  void RecordReply(const Reply& reply);
+  /// The final replies known for a package's items (for a retransmission).
+  std::vector<Reply> RepliesFor(std::int64_t sequence) const;
+
+ private:
+  size_t max_packages_;
+  std::deque<std::int64_t> order_;                                     // oldest first
+  std::unordered_map<std::int64_t, std::vector<CommandId>> packages_;  // sequence -> item ids
+  std::unordered_map<CommandId, std::optional<Reply>> replies_;        // id -> final reply once known
+};
+
+struct Session {
+  Session(std::int64_t id, TimePoint now) : client_id(id), created(now), last_heard(now) {}
+
+  std::int64_t client_id;
+  TimePoint created;
+  TimePoint last_heard;
+  CommandQueue commands;
+  std::vector<Reply> return_queue;  ///< replies not yet sent, in issuance order
+  SequenceWindow seen;
+  ReplyCache replies;
+  /// Set by a motion command of this client, cleared by any STOP: the
+  /// watchdog stops the robot when a session that moved it expires.
+  bool moved_robot = false;
+};
+
+}  // namespace robotalk
