@@ -1,0 +1,25 @@
+// Exceptions thrown by the RoboTalk client (robot_client.h), beside the core
+// hierarchy of robotalk/error.h.
+#pragma once
+
+#include "robotalk/error.h"
+
+namespace robotalk {
+
+/// A blocking call did not get its answer in time: the reply did not arrive
+/// before the call's timeout, or the client gave up retransmitting a package the
+/// server never answered (server gone, network down). The message names the
+/// call, the id or robot and the time waited.
+class TimeoutError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// The client cannot do what was asked: not connected, already connected, LCM
+/// could not be initialised, a package too large, or the client is closing.
+class ClientError : public Error {
+ public:
+  using Error::Error;
+};
+
+}  // namespace robotalk

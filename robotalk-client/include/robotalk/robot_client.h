@@ -1,0 +1,225 @@
+// RobotClient: the C++ client of a RoboTalk server over LCM (docs/client.md,
+// docs/protocol.md; the paper's CRobotClient, §IV-B).
+//
+//   robotalk::RobotClient client;            // ClientOptions{} = LCM default URL
+//   client.Connect("pioneer");               // CONFIG + clock sync
+//   robotalk::Reply r = client.Goto(1.0, 0.0, 0.0);   // blocks until the final reply
+//   auto pending = client.Send(cmd);         // non-blocking; pending.Wait(...) later
+//
+// A ReadDaemon thread files every reply in a return cache keyed by command
+// id, processes acknowledgements, retransmits unacknowledged packages (same
+// sequence; the server executes each command once) and sends a heartbeat when
+// the client has sent nothing for `heartbeat_interval`.
+//
+// Thread safety: every method may be called from any thread concurrently.
+// A PendingReply handle is not itself thread-safe; use one handle per thread.
+//
+// Errors: blocking calls throw TimeoutError (client_errors.h) when no final
+// reply arrives in time, ClientError when the client is not usable (not
+// connected, closing). A reply with a non-success signal is NOT an exception:
+// inspect Reply::signal. An unexpected failure inside the ReadDaemon is stored
+// and rethrown by the next blocking call.
+#pragma once
+
+#include "robotalk/client_errors.h"
+#include "robotalk/clock.h"
+#include "robotalk/command.h"
+#include "robotalk/robot_model.h"
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace lcm {
+class LCM;
+}
+
+namespace robotalk {
+
+namespace client {
+class ReturnCache;
+}
+
+struct ClientOptions {
+  /// LCM URL; "" = LCM's default (the LCM_DEFAULT_URL environment variable, or
+  /// udpm://239.255.76.67:7667?ttl=0).
+  std::string lcm_url;
+  /// Use this LCM instance instead of creating one from `lcm_url` (tests with
+  /// memq://, embedding). It must outlive the client, and nobody else may call
+  /// handle() on it: the client's ReadDaemon dispatches ALL its subscriptions.
+  lcm::LCM* shared_lcm = nullptr;
+  /// Each blocking call waits at most this long for its final reply, counted
+  /// from the later of the call and the command's start time.
+  Duration timeout = std::chrono::seconds(5);
+  /// Connect() gives up after this long (clock sync + configuration).
+  Duration connect_timeout = std::chrono::seconds(5);
+  /// First resend of an unacknowledged package after this; then ×backoff.
+  Duration retransmit_interval = std::chrono::milliseconds(100);
+  double retransmit_backoff = 2.0;
+  /// Longest interval between resends of one package.
+  Duration retransmit_max_interval = std::chrono::seconds(1);
+  /// Stop resending a package the server has said nothing about for this long;
+  /// its waiters fail with TimeoutError.
+  Duration give_up_after = std::chrono::seconds(5);
+  /// An idle client sends an empty package this often (server session watchdog).
+  Duration heartbeat_interval = std::chrono::milliseconds(250);
+  /// CLOCK round trips at Connect(); the one with the smallest round trip wins.
+  int clock_sync_rounds = 8;
+  /// LCM receive-queue capacity of the client's subscriptions (messages).
+  int lcm_queue_capacity = 1000;
+  /// Answered but never collected replies kept at most (oldest evicted).
+  std::size_t return_cache_capacity = 10000;
+  /// The client id; 0 = random non-zero (std::random_device).
+  std::int64_t client_id = 0;
+
+  // --- Fault injection, for tests: applied to every request package sent.
+  double drop_probability = 0.0;       ///< package silently not sent
+  double duplicate_probability = 0.0;  ///< package sent twice
+  std::uint64_t fault_seed = 1;
+};
+
+/// The handle of a non-blocking call. Movable, not copyable. Destroying it
+/// without collecting the reply tells the client nobody waits for it (a late
+/// reply is then dropped); the command still executes.
+class PendingReply {
+ public:
+  PendingReply(PendingReply&&) noexcept;
+  PendingReply& operator=(PendingReply&&) noexcept;
+  PendingReply(const PendingReply&) = delete;
+  PendingReply& operator=(const PendingReply&) = delete;
+  ~PendingReply();
+
+  CommandId id() const { return id_; }
+  /// The reply if it has arrived (it stays available). Throws TimeoutError if
+  /// the client gave up on it.
+  std::optional<Reply> Poll();
+  /// Waits at most `timeout` for the reply; throws TimeoutError.
+  Reply Wait(Duration timeout);
+
+ private:
+  friend class RobotClient;
+  PendingReply(CommandId id, std::shared_ptr<client::ReturnCache> cache, std::string what);
+
+  CommandId id_ = 0;
+  std::shared_ptr<client::ReturnCache> cache_;
+  std::string what_;  // "GOTO 12" for messages
+  std::optional<Reply> reply_;
+};
+
+/// A robot offered by a server, from its announce message.
+struct AnnouncedRobot {
+  std::string name;
+  std::string driver;
+  std::uint64_t config_hash = 0;
+  int total_dofs = 0;
+  int base_type = 0;  ///< robotalk_msgs::root_link_t BASE_*
+  bool panic = false;
+  int num_clients = 0;
+  std::int64_t server_id = 0;
+  std::string url_hint;
+};
+
+/// Listens to ROBOTALK/ANNOUNCE for `listen` and returns every robot heard,
+/// once per (server id, name), sorted by name. Servers announce once a second.
+std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen);
+
+/// Client counters, for diagnostics and tests.
+struct ClientStats {
+  std::uint64_t packages_sent = 0;       ///< first sends (heartbeats included)
+  std::uint64_t retransmissions = 0;
+  std::uint64_t heartbeats = 0;
+  std::uint64_t replies_filed = 0;
+  std::uint64_t replies_ignored = 0;     ///< duplicates, unknown ids
+  std::uint64_t malformed_packages = 0;  ///< undecodable reply packages dropped
+  std::uint64_t gave_up = 0;             ///< packages abandoned
+};
+
+class RobotClient {
+ public:
+  /// Opens LCM and starts the ReadDaemon. Throws ClientError when LCM cannot
+  /// be initialised.
+  explicit RobotClient(ClientOptions options = {});
+  /// Stops the ReadDaemon (joins it) and fails every pending wait with
+  /// ClientError... as a TimeoutError-free "client closed" failure. Sends
+  /// nothing: in particular, no STOP (the server's watchdog stops a robot
+  /// whose client went quiet).
+  ~RobotClient();
+  RobotClient(const RobotClient&) = delete;
+  RobotClient& operator=(const RobotClient&) = delete;
+  RobotClient(RobotClient&&) = delete;
+  RobotClient& operator=(RobotClient&&) = delete;
+
+  /// Connects to `robot`: subscribes its REPLY channel, synchronises the
+  /// clocks (`clock_sync_rounds` CLOCK queries) and loads its configuration
+  /// (CONFIG query; the description is cached in memory by hash). Throws
+  /// TimeoutError when the robot does not answer within `connect_timeout`,
+  /// ClientError when already connected, ProtocolError/ModelError for a bad
+  /// description.
+  void Connect(const std::string& robot);
+  bool connected() const;
+  const std::string& robot() const;
+  std::int64_t client_id() const;
+
+  /// The connected robot's description. REQUIRES: connected.
+  const RobotModel& model() const;
+  /// Re-reads the configuration (CONFIG query) and returns it.
+  const RobotModel& ReloadModel();
+
+  // --- Clock -----------------------------------------------------------------
+  /// Server clock now (estimated), and conversions of client <-> server time.
+  TimePoint ServerNow() const;
+  TimePoint ServerTime(TimePoint client_time) const;
+  TimePoint ClientTime(TimePoint server_time) const;
+  /// server − client, and the round trip of the sample it came from.
+  Duration clock_offset() const;
+  Duration clock_round_trip() const;
+  /// Runs `rounds` more CLOCK round trips (keeps the best sample overall).
+  void SyncClock(int rounds);
+
+  // --- Blocking calls ----------------------------------------------------------
+  /// Sends one command (the client assigns its id; `command.id` is ignored) and
+  /// waits for its final reply. `start_time` is on the SERVER clock (use
+  /// ServerNow() + delay); nullopt = now.
+  Reply Execute(Command command);
+  Reply Query(QueryType type, const std::string& target = "");
+  Reply Query(robotalk::Query query);
+
+  // --- Non-blocking calls ----------------------------------------------------
+  PendingReply Send(Command command);
+  PendingReply SendQuery(robotalk::Query query);
+  /// Several commands in ONE package (executed in start-time order by the
+  /// server). Throws ClientError when the package would exceed ~60 KB.
+  std::vector<PendingReply> SendBatch(std::vector<Command> commands);
+
+  // --- Panic -----------------------------------------------------------------
+  /// Sends a panic package and waits for its acknowledgement (TimeoutError
+  /// after `timeout`). Every command of every client is refused until
+  /// ResetPanic().
+  void Panic();
+  /// PANIC_RESET; returns its reply.
+  Reply ResetPanic();
+
+  // --- Convenience (blocking; `start` on the server clock) ---------------------
+  Reply SetJoint(const std::string& joint, std::vector<double> positions,
+                 std::optional<TimePoint> start = std::nullopt);
+  Reply JointSpeed(const std::string& joint, std::vector<double> velocities,
+                   std::optional<TimePoint> start = std::nullopt);
+  Reply Goto(double x, double y, double theta, std::optional<TimePoint> start = std::nullopt);
+  Reply SetSpeed(double v, double omega, std::optional<TimePoint> start = std::nullopt);
+  Reply Stop(std::optional<TimePoint> start = std::nullopt);
+  /// JOINT_STATE of every dof (or one joint): positions, velocities, efforts.
+  Reply JointState(const std::string& joint = "");
+  /// BASE_POSE: x y θ v ω.
+  Reply BasePose();
+
+  ClientStats stats() const;
+  const ClientOptions& options() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace robotalk

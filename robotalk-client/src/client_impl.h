@@ -1,0 +1,99 @@
+// RobotClient::Impl: the state behind RobotClient, shared by the caller
+// threads and the ReadDaemon thread (read_daemon.cpp).
+//
+// Locking: `mu_` guards everything marked GUARDED_BY(mu_); the ReturnCache
+// has its own lock and is never called with `mu_` held in a way that could
+// wait. Nothing is published to LCM while `mu_` is held.
+#pragma once
+
+#include "clock_sync.h"
+#include "outstanding_packages.h"
+#include "return_cache.h"
+#include "robotalk/robot_client.h"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <condition_variable>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace robotalk {
+
+/// The client id as it appears in channel names: 16 lowercase hex digits.
+std::string ClientIdHex(std::int64_t client_id);
+
+class RobotClient::Impl {
+ public:
+  explicit Impl(ClientOptions options);
+  ~Impl();
+
+  struct Sent {
+    std::int64_t sequence = 0;
+    std::vector<CommandId> ids;
+  };
+  enum class Track { kNone, kRetransmit };
+  /// Builds, registers and publishes one package. Assigns the ids of
+  /// `commands` / `queries` (returned in order). Throws ClientError.
+  Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries, bool panic, Track track,
+                   bool clock_query = false);
+  PendingReply MakePending(CommandId id, std::string what);
+
+  /// Subscribes the robot's channels (REPLY/<client>, CONFIG).
+  void Attach(const std::string& robot);
+  /// Blocks until the panic package `sequence` is acknowledged; false on timeout.
+  bool WaitAck(std::int64_t sequence, std::chrono::steady_clock::time_point deadline);
+  /// Waits until a configuration with `hash` has been received.
+  std::shared_ptr<const RobotModel> WaitModel(std::uint64_t hash, std::chrono::steady_clock::time_point deadline);
+  void RethrowDaemonError();
+  std::string LastConfigError() const;
+
+  const ClientOptions options_;
+  SteadyClock clock_;
+  std::int64_t client_id_ = 0;
+  std::shared_ptr<client::ReturnCache> cache_;
+
+  mutable std::mutex mu_;
+  std::condition_variable cv_;                 // acks, configurations
+  client::OutstandingPackages outstanding_;    // GUARDED_BY(mu_)
+  client::ClockSync clock_sync_;               // GUARDED_BY(mu_)
+  std::int64_t next_sequence_ = 1;             // GUARDED_BY(mu_)
+  CommandId next_id_ = 1;                      // GUARDED_BY(mu_)
+  TimePoint last_send_{};                      // GUARDED_BY(mu_)
+  std::string robot_;                          // GUARDED_BY(mu_); set once by Attach
+  std::string request_channel_;                // GUARDED_BY(mu_)
+  bool connected_ = false;                     // GUARDED_BY(mu_)
+  std::shared_ptr<const RobotModel> model_;    // GUARDED_BY(mu_)
+  std::unordered_map<std::uint64_t, std::shared_ptr<const RobotModel>> models_;  // GUARDED_BY(mu_)
+  std::string last_config_error_;              // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> clock_packages_;  // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> ack_waited_;      // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> acked_;           // GUARDED_BY(mu_)
+  std::exception_ptr daemon_error_;            // GUARDED_BY(mu_)
+  ClientStats stats_;                          // GUARDED_BY(mu_)
+
+ private:
+  void Run();  // the ReadDaemon
+  void Tick(TimePoint now);
+  void Publish(const std::string& channel, const std::vector<std::uint8_t>& bytes);
+  void OnReplyPackage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnConfig(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  std::vector<std::uint8_t> EncodeHeartbeat(TimePoint now);  // REQUIRES: mu_ held
+
+  std::unique_ptr<lcm::LCM> own_lcm_;
+  lcm::LCM* lcm_ = nullptr;
+  std::vector<lcm::Subscription*> subscriptions_;  // GUARDED_BY(mu_)
+  std::mutex fault_mu_;
+  std::mt19937_64 fault_rng_;  // GUARDED_BY(fault_mu_)
+  std::atomic<bool> stop_{false};
+  std::thread daemon_;
+};
+
+}  // namespace robotalk

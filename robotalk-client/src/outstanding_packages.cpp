@@ -1,0 +1,134 @@
+#include "outstanding_packages.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace robotalk::client {
+
+Duration OutstandingPackages::IntervalAt(int step) const {
+  const double factor = std::pow(std::max(1.0, policy_.backoff), step);
+  const double ns = static_cast<double>(policy_.interval.count()) * factor;
+  if (ns >= static_cast<double>(policy_.max_interval.count())) return policy_.max_interval;
+  return std::max(policy_.interval, Duration(static_cast<Duration::rep>(ns)));
+}
+
+TimePoint OutstandingPackages::EarliestStart(const Package& p, TimePoint fallback) {
+  std::optional<TimePoint> earliest;
+  for (const auto& [id, start] : p.pending) {
+    const TimePoint s = start.value_or(fallback);
+    if (!earliest || s < *earliest) earliest = s;
+  }
+  return earliest.value_or(fallback);
+}
+
+void OutstandingPackages::Add(std::int64_t sequence, std::vector<std::uint8_t> bytes, std::vector<Item> items,
+                              TimePoint now) {
+  assert(!Contains(sequence));
+  Package p;
+  p.bytes = std::move(bytes);
+  for (const Item& item : items) {
+    p.pending.emplace(item.id, item.start);
+    owner_[item.id] = sequence;
+  }
+  p.first_send = now;
+  p.last_heard = now;
+  p.next_send = now + IntervalAt(0);
+  packages_.emplace(sequence, std::move(p));
+}
+
+OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, TimePoint now) {
+  AckInfo info;
+  auto it = packages_.find(sequence);
+  if (it == packages_.end()) return info;
+  Package& p = it->second;
+  info.known = true;
+  info.first = !p.acked;
+  info.retransmitted = p.sends > 1;
+  info.first_send = p.first_send;
+  p.last_heard = now;
+  if (!p.acked) {
+    p.acked = true;
+    // Replies are not due before the items' start times: ask again only after.
+    p.backoff_step = 0;
+    p.next_send = std::max(now, EarliestStart(p, now)) + IntervalAt(0);
+  }
+  if (p.pending.empty()) {
+    packages_.erase(it);
+    info.completed = true;
+  }
+  return info;
+}
+
+std::optional<std::int64_t> OutstandingPackages::OnReply(CommandId id, TimePoint now) {
+  auto owner = owner_.find(id);
+  if (owner == owner_.end()) return std::nullopt;
+  const std::int64_t sequence = owner->second;
+  owner_.erase(owner);
+  auto it = packages_.find(sequence);
+  if (it == packages_.end()) return std::nullopt;
+  Package& p = it->second;
+  p.pending.erase(id);
+  p.last_heard = now;
+  // A reply proves the package arrived even if its ack was lost.
+  if (!p.acked) {
+    p.acked = true;
+    p.backoff_step = 0;
+  }
+  if (p.pending.empty()) {
+    packages_.erase(it);
+    return sequence;
+  }
+  p.next_send = std::max(p.next_send, std::max(now, EarliestStart(p, now)) + IntervalAt(0));
+  return std::nullopt;
+}
+
+std::vector<OutstandingPackages::Resend> OutstandingPackages::TakeDue(TimePoint now) {
+  std::vector<Resend> due;
+  for (auto& [sequence, p] : packages_) {
+    if (now < p.next_send) continue;
+    due.push_back({sequence, p.bytes});
+    ++p.sends;
+    ++retransmissions_;
+    ++p.backoff_step;
+    p.next_send = now + IntervalAt(p.backoff_step);
+  }
+  return due;
+}
+
+std::vector<OutstandingPackages::Expired> OutstandingPackages::TakeExpired(TimePoint now) {
+  std::vector<Expired> expired;
+  for (auto it = packages_.begin(); it != packages_.end();) {
+    const Package& p = it->second;
+    // Once acknowledged, silence counts only from when an answer is due.
+    const TimePoint since = p.acked ? std::max(p.last_heard, EarliestStart(p, p.last_heard)) : p.last_heard;
+    if (now - since <= policy_.give_up_after) {
+      ++it;
+      continue;
+    }
+    Expired e{.sequence = it->first, .acked = p.acked};
+    for (const auto& [id, start] : p.pending) {
+      e.unanswered.push_back(id);
+      owner_.erase(id);
+    }
+    std::sort(e.unanswered.begin(), e.unanswered.end());
+    expired.push_back(std::move(e));
+    it = packages_.erase(it);
+  }
+  return expired;
+}
+
+std::vector<CommandId> OutstandingPackages::Clear() {
+  std::vector<CommandId> ids;
+  for (const auto& [id, sequence] : owner_) ids.push_back(id);
+  owner_.clear();
+  packages_.clear();
+  return ids;
+}
+
+bool OutstandingPackages::IsAcked(std::int64_t sequence) const {
+  auto it = packages_.find(sequence);
+  return it != packages_.end() && it->second.acked;
+}
+
+}  // namespace robotalk::client

@@ -1,0 +1,108 @@
+// OutstandingPackages: the client's retransmission bookkeeping
+// (docs/protocol.md "Reliability"). A package stays outstanding until the
+// server has acknowledged it AND every query and command in it has its final
+// reply. Pure: no I/O; callers pass the client-clock time.
+//
+// Policy:
+//  - Unacknowledged: resend after `interval`, then interval·backoff,
+//    interval·backoff², ... capped at `max_interval`.
+//  - Acknowledged but items unanswered: ask again (resend the same sequence;
+//    the server re-sends the replies it has) only once the earliest unanswered
+//    item's start time has passed, starting again from `interval` and backing
+//    off the same way. A running GOTO is thus re-asked about every
+//    `max_interval`, and the server re-acks each time.
+//  - Give up when the server has said nothing about a package (no ack, no reply
+//    to one of its items) for `give_up_after` while it was due an answer
+//    (measured from the later of the last word and the earliest unanswered start
+//    time once acknowledged). Its unanswered items are returned by TakeExpired()
+//    so their waiters fail with a timeout.
+//
+// Thread safety: not thread-safe; RobotClient guards it with its mutex.
+#pragma once
+
+#include "robotalk/clock.h"
+#include "robotalk/command.h"
+
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+namespace robotalk::client {
+
+struct RetransmitPolicy {
+  Duration interval = std::chrono::milliseconds(100);
+  double backoff = 2.0;
+  Duration max_interval = std::chrono::seconds(1);
+  Duration give_up_after = std::chrono::seconds(5);
+};
+
+class OutstandingPackages {
+ public:
+  struct Item {
+    CommandId id = 0;
+    /// Client-clock time at which the item is due to run; nullopt = now.
+    std::optional<TimePoint> start;
+  };
+  struct AckInfo {
+    bool known = false;          ///< the sequence is outstanding
+    bool first = false;          ///< first ack of it
+    bool retransmitted = false;  ///< it was sent more than once
+    TimePoint first_send{};      ///< when it was first sent
+    bool completed = false;      ///< the package is now complete and forgotten
+  };
+  struct Resend {
+    std::int64_t sequence = 0;
+    std::vector<std::uint8_t> bytes;
+  };
+  struct Expired {
+    std::int64_t sequence = 0;
+    bool acked = false;
+    std::vector<CommandId> unanswered;
+  };
+
+  explicit OutstandingPackages(RetransmitPolicy policy = {}) : policy_(policy) {}
+
+  /// Registers a package just sent at `now` (its encoded bytes for resending).
+  /// REQUIRES: `sequence` not already outstanding.
+  void Add(std::int64_t sequence, std::vector<std::uint8_t> bytes, std::vector<Item> items, TimePoint now);
+  /// The server acknowledged `sequence`.
+  AckInfo OnAck(std::int64_t sequence, TimePoint now);
+  /// A final reply for `id` arrived; returns the package it completed, if any.
+  std::optional<std::int64_t> OnReply(CommandId id, TimePoint now);
+
+  /// Packages to resend now; schedules their next resend.
+  std::vector<Resend> TakeDue(TimePoint now);
+  /// Packages given up at `now`, removed from the bookkeeping.
+  std::vector<Expired> TakeExpired(TimePoint now);
+  /// Removes every package (client closing); returns their unanswered items.
+  std::vector<CommandId> Clear();
+
+  bool Contains(std::int64_t sequence) const { return packages_.count(sequence) != 0; }
+  bool IsAcked(std::int64_t sequence) const;
+  std::size_t size() const { return packages_.size(); }
+  /// Total resends so far.
+  std::uint64_t retransmissions() const { return retransmissions_; }
+
+ private:
+  struct Package {
+    std::vector<std::uint8_t> bytes;
+    std::unordered_map<CommandId, std::optional<TimePoint>> pending;  // id -> start
+    bool acked = false;
+    int sends = 1;
+    int backoff_step = 0;
+    TimePoint first_send{};
+    TimePoint next_send{};
+    TimePoint last_heard{};
+  };
+  Duration IntervalAt(int step) const;
+  /// Earliest start among unanswered items (now-items count as `fallback`).
+  static TimePoint EarliestStart(const Package& p, TimePoint fallback);
+
+  RetransmitPolicy policy_;
+  std::unordered_map<std::int64_t, Package> packages_;
+  std::unordered_map<CommandId, std::int64_t> owner_;  // unanswered item -> its package
+  std::uint64_t retransmissions_ = 0;
+};
+
+}  // namespace robotalk::client

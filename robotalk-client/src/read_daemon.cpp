@@ -1,0 +1,348 @@
+// RobotClient::Impl: LCM set-up, package sending, and the ReadDaemon thread
+// (replies -> ReturnCache, acks, clock samples, retransmission, heartbeats).
+#include "client_impl.h"
+
+#include "robotalk/config_codec.h"
+#include "robotalk/protocol_codec.h"
+
+#include <cstdio>
+#include <random>
+#include <utility>
+
+namespace robotalk {
+namespace {
+
+constexpr std::size_t kMaxPackageBytes = 60000;  // docs/protocol.md "Limits"
+constexpr int kPollMillis = 10;                  // ReadDaemon tick
+
+std::int64_t RandomClientId() {
+  std::random_device rd;
+  std::uint64_t id = 0;
+  while (id == 0 || static_cast<std::int64_t>(id) == 0) id = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
+  return static_cast<std::int64_t>(id);
+}
+
+client::RetransmitPolicy PolicyOf(const ClientOptions& o) {
+  return {.interval = o.retransmit_interval,
+          .backoff = o.retransmit_backoff,
+          .max_interval = o.retransmit_max_interval,
+          .give_up_after = o.give_up_after};
+}
+
+std::vector<std::uint8_t> Encode(const robotalk_msgs::package_t& p) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(p.getEncodedSize()));
+  p.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+}  // namespace
+
+std::string ClientIdHex(std::int64_t client_id) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(static_cast<std::uint64_t>(client_id)));
+  return buf;
+}
+
+RobotClient::Impl::Impl(ClientOptions options)
+    : options_(std::move(options)),
+      client_id_(options_.client_id != 0 ? options_.client_id : RandomClientId()),
+      cache_(std::make_shared<client::ReturnCache>(options_.return_cache_capacity)),
+      outstanding_(PolicyOf(options_)),
+      fault_rng_(options_.fault_seed) {
+  if (options_.shared_lcm) {
+    lcm_ = options_.shared_lcm;
+  } else {
+    own_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
+    lcm_ = own_lcm_.get();
+  }
+  if (!lcm_->good()) {
+    throw ClientError("RobotClient: cannot initialise LCM with URL '" + options_.lcm_url + "'");
+  }
+  last_send_ = clock_.Now();
+  daemon_ = std::thread([this] { Run(); });
+}
+
+RobotClient::Impl::~Impl() {
+  stop_ = true;
+  if (daemon_.joinable()) daemon_.join();
+  {
+    std::lock_guard lock(mu_);
+    // A shared LCM outlives us: its handlers must not call into a dead Impl.
+    for (lcm::Subscription* s : subscriptions_) lcm_->unsubscribe(s);
+    subscriptions_.clear();
+    outstanding_.Clear();
+  }
+  cache_->FailAll("RobotClient closed before the reply arrived", /*timed_out=*/false);
+}
+
+void RobotClient::Impl::Attach(const std::string& robot) {
+  std::lock_guard lock(mu_);
+  robot_ = robot;
+  request_channel_ = "ROBOTALK/" + robot + "/REQUEST";
+  const std::string reply_channel = "ROBOTALK/" + robot + "/REPLY/" + ClientIdHex(client_id_);
+  const std::string config_channel = "ROBOTALK/" + robot + "/CONFIG";
+  lcm::Subscription* reply = lcm_->subscribe(reply_channel, &Impl::OnReplyPackage, this);
+  lcm::Subscription* config = lcm_->subscribe(config_channel, &Impl::OnConfig, this);
+  if (!reply || !config) throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel);
+  reply->setQueueCapacity(options_.lcm_queue_capacity);
+  config->setQueueCapacity(8);
+  subscriptions_ = {reply, config};
+}
+
+RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries,
+                                                       bool panic, Track track, bool clock_query) {
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = client_id_;
+  p.header.panic = panic;
+  const bool is_commands = !commands.empty();
+  p.header.payload_type = is_commands ? robotalk_msgs::package_header_t::PAYLOAD_COMMANDS
+                                      : robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
+  p.header.payload_size = static_cast<std::int32_t>(is_commands ? commands.size() : queries.size());
+  for (const Command& c : commands) p.commands.push_back(ToWire(c));
+  for (const robotalk::Query& q : queries) p.queries.push_back(ToWire(q));
+  p.num_commands = static_cast<std::int32_t>(p.commands.size());
+  p.num_queries = static_cast<std::int32_t>(p.queries.size());
+  if (const int size = p.getEncodedSize(); static_cast<std::size_t>(size) > kMaxPackageBytes) {
+    throw ClientError("RobotClient: a package of " + std::to_string(p.header.payload_size) + " items would be " +
+                      std::to_string(size) + " bytes, over the " + std::to_string(kMaxPackageBytes) +
+                      "-byte limit; send fewer per batch");
+  }
+
+  Sent sent;
+  std::vector<std::uint8_t> bytes;
+  std::string channel;
+  {
+    std::lock_guard lock(mu_);
+    if (daemon_error_) std::rethrow_exception(std::exchange(daemon_error_, nullptr));
+    if (robot_.empty()) throw ClientError("RobotClient: not connected (call Connect first)");
+    channel = request_channel_;
+    const TimePoint now = clock_.Now();
+    sent.sequence = next_sequence_++;
+    p.header.sequence = sent.sequence;
+    p.header.send_time_us = ToWireMicros(now);
+    std::vector<client::OutstandingPackages::Item> items;
+    for (std::size_t i = 0; i < commands.size(); ++i) {
+      const CommandId id = next_id_++;
+      p.commands[i].id = id;
+      sent.ids.push_back(id);
+      std::optional<TimePoint> start;
+      if (commands[i].start_time) start = clock_sync_.ClientTime(*commands[i].start_time);
+      items.push_back({id, start});
+    }
+    for (auto& q : p.queries) {
+      q.id = next_id_++;
+      sent.ids.push_back(q.id);
+      items.push_back({q.id, std::nullopt});
+    }
+    bytes = Encode(p);
+    for (CommandId id : sent.ids) cache_->Expect(id);
+    if (track == Track::kRetransmit) outstanding_.Add(sent.sequence, bytes, std::move(items), now);
+    if (clock_query) clock_packages_.insert(sent.sequence);
+    if (panic) ack_waited_.insert(sent.sequence);
+    last_send_ = now;
+    ++stats_.packages_sent;
+  }
+  Publish(channel, bytes);
+  return sent;
+}
+
+PendingReply RobotClient::Impl::MakePending(CommandId id, std::string what) {
+  return PendingReply(id, cache_, std::move(what));
+}
+
+void RobotClient::Impl::Publish(const std::string& channel, const std::vector<std::uint8_t>& bytes) {
+  int copies = 1;
+  if (options_.drop_probability > 0 || options_.duplicate_probability > 0) {
+    std::lock_guard lock(fault_mu_);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    if (u(fault_rng_) < options_.drop_probability) {
+      copies = 0;
+    } else if (u(fault_rng_) < options_.duplicate_probability) {
+      copies = 2;
+    }
+  }
+  for (int i = 0; i < copies; ++i) lcm_->publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+}
+
+bool RobotClient::Impl::WaitAck(std::int64_t sequence, std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mu_);
+  const bool acked = cv_.wait_until(lock, deadline, [&] { return acked_.count(sequence) != 0; });
+  acked_.erase(sequence);
+  ack_waited_.erase(sequence);
+  return acked;
+}
+
+std::shared_ptr<const RobotModel> RobotClient::Impl::WaitModel(std::uint64_t hash,
+                                                               std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mu_);
+  cv_.wait_until(lock, deadline, [&] { return models_.count(hash) != 0; });
+  auto it = models_.find(hash);
+  return it == models_.end() ? nullptr : it->second;
+}
+
+void RobotClient::Impl::RethrowDaemonError() {
+  std::lock_guard lock(mu_);
+  if (daemon_error_) std::rethrow_exception(std::exchange(daemon_error_, nullptr));
+}
+
+std::string RobotClient::Impl::LastConfigError() const {
+  std::lock_guard lock(mu_);
+  return last_config_error_;
+}
+
+// ---------------------------------------------------------------------------
+// The ReadDaemon.
+
+void RobotClient::Impl::Run() {
+  bool reported = false;
+  while (!stop_) {
+    if (lcm_->handleTimeout(kPollMillis) < 0) {
+      // LCM failed (socket gone): report once and keep ticking so that waits
+      // still time out rather than hang.
+      if (!reported) {
+        std::lock_guard lock(mu_);
+        daemon_error_ = std::make_exception_ptr(ClientError("RobotClient: LCM handle() failed"));
+        reported = true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(kPollMillis));
+    }
+    try {
+      Tick(clock_.Now());
+    } catch (...) {
+      std::lock_guard lock(mu_);
+      daemon_error_ = std::current_exception();
+    }
+  }
+}
+
+void RobotClient::Impl::Tick(TimePoint now) {
+  std::vector<client::OutstandingPackages::Resend> resends;
+  std::vector<client::OutstandingPackages::Expired> expired;
+  std::vector<std::uint8_t> heartbeat;
+  std::string channel;
+  {
+    std::lock_guard lock(mu_);
+    if (robot_.empty()) return;
+    channel = request_channel_;
+    resends = outstanding_.TakeDue(now);
+    expired = outstanding_.TakeExpired(now);
+    stats_.retransmissions += resends.size();
+    stats_.gave_up += expired.size();
+    for (const auto& e : expired) clock_packages_.erase(e.sequence);
+    if (!resends.empty()) last_send_ = now;
+    if (now - last_send_ >= options_.heartbeat_interval) {
+      heartbeat = EncodeHeartbeat(now);
+      last_send_ = now;
+      ++stats_.heartbeats;
+      ++stats_.packages_sent;
+    }
+  }
+  for (const auto& r : resends) Publish(channel, r.bytes);
+  if (!heartbeat.empty()) Publish(channel, heartbeat);
+  for (const auto& e : expired) {
+    const std::string why = "no answer from robot about package " + std::to_string(e.sequence) + " (" +
+                            (e.acked ? "acknowledged" : "never acknowledged") + ") for " +
+                            std::to_string(ToSeconds(options_.give_up_after)) + " s; gave up retransmitting";
+    for (CommandId id : e.unanswered) cache_->Fail(id, "id " + std::to_string(id) + ": " + why);
+  }
+}
+
+std::vector<std::uint8_t> RobotClient::Impl::EncodeHeartbeat(TimePoint now) {
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = client_id_;
+  p.header.sequence = next_sequence_++;
+  p.header.send_time_us = ToWireMicros(now);
+  p.header.panic = false;
+  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
+  p.header.payload_size = 0;
+  return Encode(p);
+}
+
+void RobotClient::Impl::OnReplyPackage(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  // Never throw through LCM's C callback: protocol errors are counted, anything
+  // else is stored and rethrown to the next blocking call.
+  try {
+    const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
+    robotalk_msgs::reply_package_t pkg;
+    try {
+      pkg = DecodeReplyPackage({data, rbuf->data_size});
+    } catch (const ProtocolError&) {
+      std::lock_guard lock(mu_);
+      ++stats_.malformed_packages;
+      return;
+    }
+    const TimePoint now = clock_.Now();
+    std::vector<Reply> replies;
+    replies.reserve(pkg.replies.size());
+    std::uint64_t bad = 0;
+    for (const auto& w : pkg.replies) {
+      try {
+        replies.push_back(FromWire(w));
+      } catch (const ProtocolError&) {
+        ++bad;  // unknown signal: the id's waiter will time out rather than see garbage
+      }
+    }
+    bool notify = false;
+    {
+      std::lock_guard lock(mu_);
+      stats_.malformed_packages += bad;
+      if (pkg.client_id != client_id_ || pkg.protocol_version != kProtocolVersion) {
+        ++stats_.malformed_packages;
+        return;
+      }
+      if (pkg.ack_sequence > 0) {
+        const auto info = outstanding_.OnAck(pkg.ack_sequence, now);
+        if (info.known && info.first && clock_packages_.erase(pkg.ack_sequence) != 0 && !info.retransmitted) {
+          // Only a never-resent package gives an unambiguous t1.
+          clock_sync_.AddSample(info.first_send, FromWireMicros(pkg.server_receive_us),
+                                FromWireMicros(pkg.server_send_us), now);
+        }
+        if (ack_waited_.count(pkg.ack_sequence) != 0) {
+          acked_.insert(pkg.ack_sequence);
+          notify = true;
+        }
+      }
+      for (const Reply& r : replies) outstanding_.OnReply(r.id, now);
+    }
+    if (notify) cv_.notify_all();
+    std::uint64_t filed = 0, ignored = 0;
+    for (const Reply& r : replies) (cache_->Put(r) ? filed : ignored)++;
+    std::lock_guard lock(mu_);
+    stats_.replies_filed += filed;
+    stats_.replies_ignored += ignored;
+  } catch (...) {
+    std::lock_guard lock(mu_);
+    daemon_error_ = std::current_exception();
+  }
+}
+
+void RobotClient::Impl::OnConfig(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  try {
+    const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
+    std::uint64_t hash = 0;
+    try {
+      hash = static_cast<std::uint64_t>(DecodeConfigHeader(bytes).hash);
+      {
+        std::lock_guard lock(mu_);
+        if (models_.count(hash) != 0) return;  // cached: skip decoding the blocks
+      }
+      auto model = std::make_shared<const RobotModel>(DecodeConfig(bytes));
+      {
+        std::lock_guard lock(mu_);
+        models_.emplace(hash, std::move(model));
+      }
+      cv_.notify_all();
+    } catch (const Error& e) {
+      std::lock_guard lock(mu_);
+      ++stats_.malformed_packages;
+      last_config_error_ = e.what();
+    }
+  } catch (...) {
+    std::lock_guard lock(mu_);
+    daemon_error_ = std::current_exception();
+  }
+}
+
+}  // namespace robotalk

@@ -1,0 +1,381 @@
+// RobotClient's public calls: connection, blocking / non-blocking calls,
+// panic and convenience wrappers. The machinery is in read_daemon.cpp.
+#include "robotalk/robot_client.h"
+
+#include "client_impl.h"
+#include "robotalk_msgs/announce_t.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+
+namespace robotalk {
+namespace {
+
+using SteadyPoint = std::chrono::steady_clock::time_point;
+
+SteadyPoint SteadyNow() { return std::chrono::steady_clock::now(); }
+SteadyPoint SteadyAfter(Duration d) {
+  return SteadyNow() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
+}
+
+std::string Describe(const Command& c) {
+  std::string s = ToString(c.type);
+  if (!c.target.empty()) s += " '" + c.target + "'";
+  return s;
+}
+std::string Describe(const Query& q) {
+  std::string s = std::string("query ") + ToString(q.type);
+  if (!q.target.empty()) s += " '" + q.target + "'";
+  return s;
+}
+
+}  // namespace
+
+// --- PendingReply ------------------------------------------------------------
+
+PendingReply::PendingReply(CommandId id, std::shared_ptr<client::ReturnCache> cache, std::string what)
+    : id_(id), cache_(std::move(cache)), what_(std::move(what)) {}
+
+PendingReply::PendingReply(PendingReply&& o) noexcept
+    : id_(o.id_), cache_(std::move(o.cache_)), what_(std::move(o.what_)), reply_(std::move(o.reply_)) {}
+
+PendingReply& PendingReply::operator=(PendingReply&& o) noexcept {
+  if (this != &o) {
+    if (cache_ && !reply_) cache_->Forget(id_);
+    id_ = o.id_;
+    cache_ = std::move(o.cache_);
+    what_ = std::move(o.what_);
+    reply_ = std::move(o.reply_);
+  }
+  return *this;
+}
+
+PendingReply::~PendingReply() {
+  if (cache_ && !reply_) cache_->Forget(id_);
+}
+
+namespace {
+// Turns a collected outcome into a reply or the matching exception.
+std::optional<Reply> Resolve(client::ReturnCache::Outcome o, CommandId id, const std::string& what) {
+  using Kind = client::ReturnCache::Outcome::Kind;
+  switch (o.kind) {
+    case Kind::kReply: return std::move(o.reply);
+    case Kind::kFailed:
+      if (o.timed_out) throw TimeoutError(what + " (id " + std::to_string(id) + "): " + o.failure);
+      throw ClientError(what + " (id " + std::to_string(id) + "): " + o.failure);
+    case Kind::kUnknown:
+      throw ClientError(what + " (id " + std::to_string(id) + "): no such pending reply (already collected?)");
+    case Kind::kPending: break;
+  }
+  return std::nullopt;
+}
+}  // namespace
+
+std::optional<Reply> PendingReply::Poll() {
+  if (reply_) return reply_;
+  if (!cache_) throw ClientError("PendingReply::Poll: moved-from handle");
+  reply_ = Resolve(cache_->Take(id_), id_, what_);
+  return reply_;
+}
+
+Reply PendingReply::Wait(Duration timeout) {
+  if (reply_) return *reply_;
+  if (!cache_) throw ClientError("PendingReply::Wait: moved-from handle");
+  reply_ = Resolve(cache_->WaitTake(id_, SteadyAfter(timeout)), id_, what_);
+  if (!reply_) {
+    throw TimeoutError(what_ + " (id " + std::to_string(id_) + "): no reply within " +
+                       std::to_string(ToSeconds(timeout)) + " s");
+  }
+  return *reply_;
+}
+
+// --- ListRobots --------------------------------------------------------------
+
+std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen) {
+  std::unique_ptr<lcm::LCM> own;
+  lcm::LCM* lcm = options.shared_lcm;
+  if (!lcm) {
+    own = std::make_unique<lcm::LCM>(options.lcm_url);
+    lcm = own.get();
+  }
+  if (!lcm->good()) throw ClientError("ListRobots: cannot initialise LCM with URL '" + options.lcm_url + "'");
+  struct Collector {
+    std::vector<AnnouncedRobot> robots;
+    std::uint64_t malformed = 0;
+    void On(const lcm::ReceiveBuffer* rbuf, const std::string&, const robotalk_msgs::announce_t* msg) {
+      for (const auto& r : msg->robots) {
+        const bool seen = std::any_of(robots.begin(), robots.end(), [&](const AnnouncedRobot& a) {
+          return a.server_id == msg->server_id && a.name == r.name;
+        });
+        if (seen) continue;
+        robots.push_back({.name = r.name,
+                          .driver = r.driver,
+                          .config_hash = static_cast<std::uint64_t>(r.config_hash),
+                          .total_dofs = r.total_dofs,
+                          .base_type = r.base_type,
+                          .panic = r.panic != 0,
+                          .num_clients = r.num_clients,
+                          .server_id = msg->server_id,
+                          .url_hint = msg->url_hint});
+      }
+      (void)rbuf;
+    }
+  } collector;
+  // announce_t holds no unbounded arrays a hostile sender could abuse beyond
+  // the datagram itself, so LCM's typed decoder is acceptable here.
+  lcm::Subscription* sub = lcm->subscribe("ROBOTALK/ANNOUNCE", &Collector::On, &collector);
+  sub->setQueueCapacity(100);
+  const SteadyPoint deadline = SteadyAfter(listen);
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyNow()).count();
+    if (left <= 0) break;
+    lcm->handleTimeout(static_cast<int>(std::min<long long>(left, 50)));
+  }
+  lcm->unsubscribe(sub);
+  std::sort(collector.robots.begin(), collector.robots.end(), [](const AnnouncedRobot& a, const AnnouncedRobot& b) {
+    return a.name != b.name ? a.name < b.name : a.server_id < b.server_id;
+  });
+  return collector.robots;
+}
+
+// --- RobotClient -------------------------------------------------------------
+
+RobotClient::RobotClient(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+RobotClient::~RobotClient() = default;
+
+void RobotClient::Connect(const std::string& robot) {
+  if (robot.empty() || robot.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+                           std::string::npos) {
+    throw ClientError("RobotClient::Connect: invalid robot name '" + robot + "' (letters, digits, _ and - only)");
+  }
+  {
+    std::lock_guard lock(impl_->mu_);
+    if (!impl_->robot_.empty()) {
+      throw ClientError("RobotClient::Connect('" + robot + "'): already attached to '" + impl_->robot_ + "'");
+    }
+  }
+  impl_->Attach(robot);
+  const Duration connect_timeout = impl_->options_.connect_timeout;
+  const SteadyPoint deadline = SteadyAfter(connect_timeout);
+  auto timeout = [&](const std::string& what) {
+    return TimeoutError("RobotClient::Connect('" + robot + "'): " + what + " within " +
+                        std::to_string(ToSeconds(connect_timeout)) + " s (is a server offering it?)");
+  };
+
+  // 1. Clock: `clock_sync_rounds` CLOCK round trips, more if none counted
+  //    (a resent package gives no sample).
+  const int rounds = std::max(1, impl_->options_.clock_sync_rounds);
+  for (int i = 0; SteadyNow() < deadline; ++i) {
+    {
+      std::lock_guard lock(impl_->mu_);
+      if (i >= rounds && impl_->clock_sync_.synced()) break;
+    }
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false, Impl::Track::kRetransmit, true);
+    PendingReply p = impl_->MakePending(sent.ids[0], "CLOCK");
+    try {
+      p.Wait(std::chrono::duration_cast<Duration>(deadline - SteadyNow()));
+    } catch (const TimeoutError&) {
+      break;
+    }
+  }
+  {
+    std::lock_guard lock(impl_->mu_);
+    if (!impl_->clock_sync_.synced()) throw timeout("no CLOCK answer");
+  }
+
+  // 2. Configuration: ask, learn its hash from the reply, wait for the
+  //    description on the CONFIG channel; ask again if that message was lost.
+  std::shared_ptr<const RobotModel> model;
+  while (!model && SteadyNow() < deadline) {
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false, Impl::Track::kRetransmit);
+    PendingReply p = impl_->MakePending(sent.ids[0], "CONFIG");
+    Reply r;
+    try {
+      r = p.Wait(std::chrono::duration_cast<Duration>(deadline - SteadyNow()));
+    } catch (const TimeoutError&) {
+      break;
+    }
+    if (!Succeeded(r.signal)) {
+      throw ClientError("RobotClient::Connect('" + robot + "'): CONFIG answered " + std::string(ToString(r.signal)) +
+                        ": " + r.message);
+    }
+    std::uint64_t hash = 0;
+    try {
+      hash = std::stoull(r.message, nullptr, 16);
+    } catch (const std::exception&) {
+      throw ProtocolError("RobotClient::Connect('" + robot + "'): CONFIG reply message '" + r.message +
+                          "' is not a hexadecimal hash");
+    }
+    model = impl_->WaitModel(hash, std::min(deadline, SteadyAfter(std::chrono::milliseconds(500))));
+  }
+  if (!model) {
+    const std::string err = impl_->LastConfigError();
+    throw timeout("no configuration received" + (err.empty() ? std::string() : " (last error: " + err + ")"));
+  }
+  std::lock_guard lock(impl_->mu_);
+  impl_->model_ = std::move(model);
+  impl_->connected_ = true;
+}
+
+bool RobotClient::connected() const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->connected_;
+}
+
+const std::string& RobotClient::robot() const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->robot_;  // set once by Connect, then constant
+}
+
+std::int64_t RobotClient::client_id() const { return impl_->client_id_; }
+
+const RobotModel& RobotClient::model() const {
+  std::lock_guard lock(impl_->mu_);
+  if (!impl_->model_) throw ClientError("RobotClient::model: not connected");
+  return *impl_->model_;  // kept alive in models_ for the client's lifetime
+}
+
+const RobotModel& RobotClient::ReloadModel() {
+  Reply r = Query(QueryType::kConfig);
+  if (!Succeeded(r.signal)) {
+    throw ClientError("RobotClient::ReloadModel: CONFIG answered " + std::string(ToString(r.signal)) + ": " +
+                      r.message);
+  }
+  auto model = impl_->WaitModel(std::stoull(r.message, nullptr, 16), SteadyAfter(impl_->options_.timeout));
+  if (!model) throw TimeoutError("RobotClient::ReloadModel: no configuration received");
+  std::lock_guard lock(impl_->mu_);
+  impl_->model_ = model;
+  return *model;
+}
+
+TimePoint RobotClient::ServerNow() const { return ServerTime(impl_->clock_.Now()); }
+TimePoint RobotClient::ServerTime(TimePoint client_time) const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->clock_sync_.ServerTime(client_time);
+}
+TimePoint RobotClient::ClientTime(TimePoint server_time) const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->clock_sync_.ClientTime(server_time);
+}
+Duration RobotClient::clock_offset() const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->clock_sync_.offset();
+}
+Duration RobotClient::clock_round_trip() const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->clock_sync_.best_round_trip().value_or(Duration::zero());
+}
+
+void RobotClient::SyncClock(int rounds) {
+  for (int i = 0; i < rounds; ++i) {
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false, Impl::Track::kRetransmit,
+                                   true);
+    impl_->MakePending(sent.ids[0], "CLOCK").Wait(impl_->options_.timeout);
+  }
+}
+
+namespace {
+void RequireConnected(const RobotClient& c, const char* call) {
+  if (!c.connected()) throw ClientError(std::string("RobotClient::") + call + ": not connected (call Connect first)");
+}
+}  // namespace
+
+Reply RobotClient::Execute(Command command) {
+  RequireConnected(*this, "Execute");
+  impl_->RethrowDaemonError();
+  // The reply of a command scheduled ahead cannot come before its start.
+  Duration wait = impl_->options_.timeout;
+  if (command.start_time) wait += std::max(Duration::zero(), *command.start_time - ServerNow());
+  PendingReply p = Send(std::move(command));
+  try {
+    return p.Wait(wait);
+  } catch (const TimeoutError&) {
+    impl_->RethrowDaemonError();
+    throw;
+  }
+}
+
+Reply RobotClient::Query(QueryType type, const std::string& target) {
+  return Query(robotalk::Query{.type = type, .target = target});
+}
+
+Reply RobotClient::Query(robotalk::Query query) {
+  RequireConnected(*this, "Query");
+  impl_->RethrowDaemonError();
+  PendingReply p = SendQuery(std::move(query));
+  try {
+    return p.Wait(impl_->options_.timeout);
+  } catch (const TimeoutError&) {
+    impl_->RethrowDaemonError();
+    throw;
+  }
+}
+
+PendingReply RobotClient::Send(Command command) {
+  RequireConnected(*this, "Send");
+  const std::string what = Describe(command);
+  auto sent = impl_->SendPackage({std::move(command)}, {}, false, Impl::Track::kRetransmit);
+  return impl_->MakePending(sent.ids[0], what);
+}
+
+PendingReply RobotClient::SendQuery(robotalk::Query query) {
+  RequireConnected(*this, "SendQuery");
+  const std::string what = Describe(query);
+  auto sent = impl_->SendPackage({}, {std::move(query)}, false, Impl::Track::kRetransmit);
+  return impl_->MakePending(sent.ids[0], what);
+}
+
+std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands) {
+  RequireConnected(*this, "SendBatch");
+  if (commands.empty()) return {};
+  std::vector<std::string> what;
+  for (const Command& c : commands) what.push_back(Describe(c));
+  auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit);
+  std::vector<PendingReply> pending;
+  for (std::size_t i = 0; i < sent.ids.size(); ++i) pending.push_back(impl_->MakePending(sent.ids[i], what[i]));
+  return pending;
+}
+
+void RobotClient::Panic() {
+  RequireConnected(*this, "Panic");
+  auto sent = impl_->SendPackage({}, {}, /*panic=*/true, Impl::Track::kRetransmit);
+  if (!impl_->WaitAck(sent.sequence, SteadyAfter(impl_->options_.timeout))) {
+    throw TimeoutError("RobotClient::Panic: panic package " + std::to_string(sent.sequence) +
+                       " not acknowledged by robot '" + robot() + "' within " +
+                       std::to_string(ToSeconds(impl_->options_.timeout)) + " s");
+  }
+}
+
+Reply RobotClient::ResetPanic() { return Execute(Command{.type = CommandType::kPanicReset}); }
+
+Reply RobotClient::SetJoint(const std::string& joint, std::vector<double> positions, std::optional<TimePoint> start) {
+  return Execute(Command{
+      .type = CommandType::kJointSetPoint, .start_time = start, .target = joint, .values = std::move(positions)});
+}
+Reply RobotClient::JointSpeed(const std::string& joint, std::vector<double> velocities,
+                              std::optional<TimePoint> start) {
+  return Execute(Command{
+      .type = CommandType::kJointSpeed, .start_time = start, .target = joint, .values = std::move(velocities)});
+}
+Reply RobotClient::Goto(double x, double y, double theta, std::optional<TimePoint> start) {
+  return Execute(Command{.type = CommandType::kGoto, .start_time = start, .values = {x, y, theta}});
+}
+Reply RobotClient::SetSpeed(double v, double omega, std::optional<TimePoint> start) {
+  return Execute(Command{.type = CommandType::kSetSpeed, .start_time = start, .values = {v, omega}});
+}
+Reply RobotClient::Stop(std::optional<TimePoint> start) {
+  return Execute(Command{.type = CommandType::kStop, .start_time = start});
+}
+Reply RobotClient::JointState(const std::string& joint) { return Query(QueryType::kJointState, joint); }
+Reply RobotClient::BasePose() { return Query(QueryType::kBasePose); }
+
+ClientStats RobotClient::stats() const {
+  std::lock_guard lock(impl_->mu_);
+  ClientStats s = impl_->stats_;
+  s.replies_ignored = std::max(s.replies_ignored, impl_->cache_->ignored());
+  return s;
+}
+
+const ClientOptions& RobotClient::options() const { return impl_->options_; }
+
+}  // namespace robotalk
