@@ -112,7 +112,7 @@ Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* name, void (*
 }  // namespace
 
 robotalk_msgs::command_t ToWire(const Command& c) {
-  robotalk_msgs::command_t w;
+  robotalk_msgs::command_t w{};
   w.id = c.id;
   w.type = static_cast<std::int8_t>(c.type);
   w.start_time_us = c.start_time ? ToWireMicros(*c.start_time) : 0;
@@ -123,7 +123,7 @@ robotalk_msgs::command_t ToWire(const Command& c) {
 }
 
 robotalk_msgs::query_t ToWire(const Query& q) {
-  robotalk_msgs::query_t w;
+  robotalk_msgs::query_t w{};
   w.id = q.id;
   w.type = static_cast<std::int8_t>(q.type);
   w.target = q.target;
@@ -131,7 +131,7 @@ robotalk_msgs::query_t ToWire(const Query& q) {
 }
 
 robotalk_msgs::reply_t ToWire(const Reply& r) {
-  robotalk_msgs::reply_t w;
+  robotalk_msgs::reply_t w{};
   w.id = r.id;
   w.signal = static_cast<std::int8_t>(r.signal);
   w.message = r.message;

@@ -68,7 +68,11 @@ void RobotService::Stop() {
     running_ = false;
   }
   wake_.notify_all();
-  if (daemon_.joinable()) daemon_.join();
+  if (!daemon_.joinable()) return;
+  daemon_.join();
+  // The daemon is gone, so this thread may act as it: run what the server
+  // itself queued last (the shutdown STOP), so no robot is left moving.
+  RunOnce(clock_.Now());
 }
 
 void RobotService::DaemonLoop() {
@@ -341,7 +345,7 @@ void RobotService::StopRobot(const std::string& reason) {
 }
 
 robotalk_msgs::robot_info_t RobotService::Info() const {
-  robotalk_msgs::robot_info_t info;
+  robotalk_msgs::robot_info_t info{};
   info.name = name_;
   info.driver = driver_name_;
   info.config_hash = static_cast<std::int64_t>(config_hash_);

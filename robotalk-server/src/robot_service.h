@@ -43,7 +43,7 @@ struct RobotServiceOptions {
 
 /// What the ServerDaemon sends back at once for a received package.
 struct ImmediateAnswer {
-  robotalk_msgs::reply_package_t package;  ///< ack + immediate replies; send_us filled by the sender
+  robotalk_msgs::reply_package_t package{};  ///< ack + immediate replies; send_us filled by the sender
   bool send = true;            ///< false for packages that cannot be answered (no client id)
   bool publish_config = false; ///< a CONFIG query asked for the configuration message
 };
@@ -68,8 +68,8 @@ class RobotService {
   const std::vector<std::uint8_t>& encoded_config() const { return encoded_config_; }
   std::uint64_t config_hash() const { return config_hash_; }
 
-  /// Starts / stops the RobotDaemon thread. Stop() halts no motion by itself;
-  /// call StopRobot() first on shutdown.
+  /// Starts / stops the RobotDaemon thread. Stop() runs one last iteration
+  /// after joining, so a STOP queued by StopRobot() just before still executes.
   void Start();
   void Stop();
 

@@ -1,0 +1,70 @@
+// The RoboTalk server: serves one or more robots, each bound to a driver, on
+// one LCM URL (docs/protocol.md).
+//
+// Threads: one ServerDaemon (receives and parses packages, sends replies,
+// announces, expires sessions) and one RobotDaemon per robot (executes
+// commands at their start times). Start() launches them; Stop() or the
+// destructor stops every robot's motion and joins them.
+#pragma once
+
+#include "robotalk/clock.h"
+#include "robotalk/driver.h"
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace robotalk {
+
+/// One robot to serve: `--robot NAME=DRIVER:URDF[,key=value...]`.
+struct RobotSpec {
+  std::string name;
+  std::string driver;
+  std::string urdf_path;
+  std::map<std::string, std::string> options;
+
+  /// Parses "pioneer=kinematic:models/p.urdf,period_ms=5". Throws Error naming what is wrong.
+  static RobotSpec Parse(const std::string& text);
+};
+
+struct ServerOptions {
+  /// LCM provider URL; "" uses LCM's default (or $LCM_DEFAULT_URL).
+  std::string lcm_url;
+  /// A client session silent for this long expires; the robot is stopped if it moved it.
+  Duration session_timeout = std::chrono::seconds(2);
+  /// Most commands one client may have queued.
+  size_t max_queue = 10000;
+  /// Start times further ahead than this are refused with ERROR.
+  Duration max_future = std::chrono::hours(1);
+  /// Period of the ROBOTALK/ANNOUNCE message.
+  Duration announce_period = std::chrono::seconds(1);
+  /// Test fault injection on outgoing reply packages (seeded): probability
+  /// that one is dropped, and that one is sent twice.
+  double reply_drop_probability = 0.0;
+  double reply_duplicate_probability = 0.0;
+  std::uint64_t fault_seed = 1;
+};
+
+class Server {
+ public:
+  /// Creates every robot's driver from `registry`. Throws Error naming the
+  /// robot and what failed (unknown driver, bad URDF, duplicate robot name, LCM URL).
+  Server(ServerOptions options, const std::vector<RobotSpec>& robots, const DriverRegistry& registry,
+         const Clock& clock);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  void Start();
+  /// Stops every robot (STOP), then the threads. Idempotent.
+  void Stop();
+
+  std::vector<std::string> robot_names() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace robotalk

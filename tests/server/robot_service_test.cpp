@@ -1,0 +1,289 @@
+#include "robot_service.h"
+
+#include "fake_driver.h"
+#include "robotalk/protocol_codec.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace robotalk {
+namespace {
+
+using ::testing::HasSubstr;
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using testing::FakeDriver;
+using testing::PanRobot;
+
+constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
+
+Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std::string target = "",
+            std::optional<TimePoint> start = std::nullopt) {
+  return Command{id, type, start, std::move(target), std::move(values)};
+}
+
+robotalk_msgs::package_t Package(std::int64_t client, std::int64_t seq, const std::vector<Command>& commands,
+                                 bool panic = false) {
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = client;
+  p.header.sequence = seq;
+  p.header.panic = panic;
+  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
+  for (const Command& c : commands) p.commands.push_back(ToWire(c));
+  p.num_commands = static_cast<std::int32_t>(p.commands.size());
+  p.header.payload_size = p.num_commands;
+  return p;
+}
+
+robotalk_msgs::package_t Queries(std::int64_t client, std::int64_t seq, const std::vector<Query>& queries) {
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = client;
+  p.header.sequence = seq;
+  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
+  for (const Query& q : queries) p.queries.push_back(ToWire(q));
+  p.num_queries = static_cast<std::int32_t>(p.queries.size());
+  p.header.payload_size = p.num_queries;
+  return p;
+}
+
+class RobotServiceTest : public ::testing::Test {
+ protected:
+  explicit RobotServiceTest(BaseType base = BaseType::kDifferential) {
+    auto driver = std::make_unique<FakeDriver>(PanRobot(base));
+    fake_ = driver.get();
+    service_ = std::make_unique<RobotService>("bot", "fake", std::move(driver), clock_);
+  }
+
+  // Immediate replies of a package, by id.
+  std::map<CommandId, Reply> Handle(const robotalk_msgs::package_t& p) {
+    std::map<CommandId, Reply> out;
+    last_ = service_->HandlePackage(p, clock_.Now());
+    for (const auto& r : last_.package.replies) out[r.id] = FromWire(r);
+    return out;
+  }
+  // Runs the RobotDaemon once at the current time and collects the replies it produced.
+  void Run() { service_->RunOnce(clock_.Now()); }
+  std::map<CommandId, Reply> Replies(std::int64_t client) {
+    std::vector<OutgoingReplies> out;
+    service_->TakeReplies(out);
+    for (auto& o : out) {
+      for (auto& r : o.replies) collected_[o.client_id][r.id] = r;
+    }
+    return collected_[client];
+  }
+
+  ManualClock clock_;
+  FakeDriver* fake_ = nullptr;
+  std::unique_ptr<RobotService> service_;
+  ImmediateAnswer last_;
+  std::map<std::int64_t, std::map<CommandId, Reply>> collected_;
+};
+
+TEST_F(RobotServiceTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
+  const TimePoint start = clock_.Now() + seconds(2);
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan", start)}));
+  EXPECT_EQ(last_.package.ack_sequence, 1);
+  Run();
+  EXPECT_TRUE(fake_->calls.empty()) << "ran before its start time";
+  EXPECT_EQ(service_->RunOnce(clock_.Now()), std::min(start, clock_.Now() + milliseconds(10)));
+  clock_.Set(start + milliseconds(3));
+  Run();
+  ASSERT_EQ(fake_->calls.size(), 1u);
+  EXPECT_EQ(fake_->calls[0].at, start + milliseconds(3));
+  const Reply r = Replies(kAlice).at(1);
+  EXPECT_EQ(r.signal, Signal::kSuccess);
+  EXPECT_EQ(r.lateness, milliseconds(3));
+}
+
+TEST_F(RobotServiceTest, OrdersCommandsOfAllClientsByStartTimeThenArrival) {
+  const TimePoint t = clock_.Now() + seconds(1);
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kStop, {}, "", t + seconds(40))}));
+  Handle(Package(kBob, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0}, "", t + seconds(20))}));
+  Handle(Package(kBob, 2, {Cmd(2, CommandType::kJointSetPoint, {0.1}, "pan", t + seconds(20))}));
+  clock_.Set(t + seconds(60));
+  Run();
+  ASSERT_EQ(fake_->calls.size(), 3u);
+  EXPECT_EQ(fake_->calls[0].type, CommandType::kGoto);
+  EXPECT_EQ(fake_->calls[1].type, CommandType::kJointSetPoint);
+  EXPECT_EQ(fake_->calls[2].type, CommandType::kStop);
+}
+
+TEST_F(RobotServiceTest, NeverExecutesADuplicatedPackageTwiceAndResendsItsReply) {
+  const auto p = Package(kAlice, 7, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")});
+  Handle(p);
+  Run();
+  ASSERT_EQ(Replies(kAlice).at(1).signal, Signal::kSuccess);
+  auto again = Handle(p);  // the client did not see the reply and retransmits
+  Run();
+  EXPECT_EQ(fake_->calls.size(), 1u);
+  EXPECT_EQ(last_.package.ack_sequence, 7);
+  ASSERT_EQ(again.count(1), 1u);
+  EXPECT_EQ(again.at(1).signal, Signal::kSuccess);
+}
+
+TEST_F(RobotServiceTest, AnswersEverySignal) {
+  // SUCCESS, MODIFIED (the driver clamps), ERROR (unknown joint, NaN, too far ahead).
+  auto immediate = Handle(Package(kAlice, 1,
+                                  {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan"),
+                                   Cmd(2, CommandType::kJointSetPoint, {3.0}, "pan"),
+                                   Cmd(3, CommandType::kJointSetPoint, {0.5}, "nek"),
+                                   Cmd(4, CommandType::kJointSetPoint, {std::nan("")}, "pan"),
+                                   Cmd(5, CommandType::kJointSpeed, {0.1}, "pan"),
+                                   Cmd(6, CommandType::kStop, {}, "", clock_.Now() + std::chrono::hours(2))}));
+  EXPECT_EQ(immediate.at(3).signal, Signal::kError);
+  EXPECT_THAT(immediate.at(3).message, HasSubstr("no joint named 'nek'"));
+  EXPECT_EQ(immediate.at(4).signal, Signal::kError);
+  EXPECT_THAT(immediate.at(4).message, HasSubstr("NaN"));
+  EXPECT_EQ(immediate.at(5).signal, Signal::kNa) << "pan accepts only set-points";
+  EXPECT_EQ(immediate.at(6).signal, Signal::kError);
+  EXPECT_THAT(immediate.at(6).message, HasSubstr("ahead of the server clock"));
+  Run();
+  auto replies = Replies(kAlice);
+  EXPECT_EQ(replies.at(1).signal, Signal::kSuccess);
+  EXPECT_EQ(replies.at(2).signal, Signal::kModified);
+  // BUSY and INTERRUPTED: a GOTO is running, a second one is refused, STOP interrupts the first.
+  Handle(Package(kAlice, 2, {Cmd(10, CommandType::kGoto, {1, 0, 0}), Cmd(11, CommandType::kGoto, {2, 0, 0})}));
+  Run();
+  EXPECT_EQ(Replies(kAlice).at(11).signal, Signal::kBusy);
+  EXPECT_EQ(Replies(kAlice).count(10), 0u) << "the GOTO is still running";
+  Handle(Package(kAlice, 3, {Cmd(12, CommandType::kStop)}));
+  Run();
+  EXPECT_EQ(Replies(kAlice).at(10).signal, Signal::kInterrupted);
+  EXPECT_EQ(Replies(kAlice).at(12).signal, Signal::kSuccess);
+  // PANIC.
+  Handle(Package(kBob, 1, {}, /*panic=*/true));
+  auto refused = Handle(Package(kAlice, 4, {Cmd(13, CommandType::kJointSetPoint, {0.1}, "pan")}));
+  EXPECT_EQ(refused.at(13).signal, Signal::kPanic);
+}
+
+TEST_F(RobotServiceTest, CompletesAGotoWhenTheDriverReportsIt) {
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 2, 0})}));
+  for (int i = 0; i < 5; ++i) {
+    clock_.Advance(milliseconds(10));
+    Run();
+  }
+  EXPECT_EQ(Replies(kAlice).at(1).signal, Signal::kSuccess);
+}
+
+TEST_F(RobotServiceTest, AnswersNaToABaseCommandOnAFixedBase) {
+  auto driver = std::make_unique<FakeDriver>(PanRobot(BaseType::kFixed));
+  RobotService fixed("arm", "fake", std::move(driver), clock_);
+  auto answer = fixed.HandlePackage(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}), clock_.Now());
+  ASSERT_EQ(answer.package.replies.size(), 1u);
+  EXPECT_EQ(answer.package.replies[0].signal, static_cast<std::int8_t>(Signal::kNa));
+  EXPECT_THAT(answer.package.replies[0].message, HasSubstr("fixed base"));
+}
+
+TEST_F(RobotServiceTest, RefusesAMixedPackageWithErrorForEveryItem) {
+  auto p = Package(kAlice, 1, {Cmd(1, CommandType::kStop)});
+  p.queries.push_back(ToWire(Query{2, QueryType::kJointState, ""}));
+  p.num_queries = 1;
+  const std::string reason = CheckPackageHeader(p);
+  ASSERT_THAT(reason, HasSubstr("mixes"));
+  auto answer = service_->RefusePackage(p, clock_.Now(), reason);
+  ASSERT_EQ(answer.package.replies.size(), 2u);
+  for (const auto& r : answer.package.replies) EXPECT_EQ(r.signal, static_cast<std::int8_t>(Signal::kError));
+  Run();
+  EXPECT_TRUE(fake_->calls.empty());
+}
+
+TEST_F(RobotServiceTest, RefusesCommandsBeyondTheQueueLimit) {
+  auto driver = std::make_unique<FakeDriver>(PanRobot());
+  RobotService small("bot", "fake", std::move(driver), clock_, RobotServiceOptions{.max_queue = 2});
+  const TimePoint later = clock_.Now() + seconds(10);
+  auto answer = small.HandlePackage(Package(kAlice, 1,
+                                            {Cmd(1, CommandType::kStop, {}, "", later), Cmd(2, CommandType::kStop, {}, "", later),
+                                             Cmd(3, CommandType::kStop, {}, "", later)}),
+                                    clock_.Now());
+  ASSERT_EQ(answer.package.replies.size(), 1u);
+  EXPECT_EQ(answer.package.replies[0].id, 3);
+  EXPECT_THAT(answer.package.replies[0].message, HasSubstr("is full (2 items)"));
+}
+
+TEST_F(RobotServiceTest, PanicFlushesEveryQueueHaltsTheDriverAndRefusesUntilReset) {
+  const TimePoint later = clock_.Now() + seconds(5);
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}));
+  Run();  // the GOTO is in progress
+  Handle(Package(kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.5}, "pan", later)}));
+  Handle(Package(kBob, 1, {Cmd(1, CommandType::kStop, {}, "", later)}));
+
+  auto panic = Handle(Package(kBob, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan")}, /*panic=*/true));
+  EXPECT_EQ(panic.at(2).signal, Signal::kPanic) << "a panic package is never executed";
+  EXPECT_TRUE(service_->in_panic());
+  // Flushed at once, before the RobotDaemon runs.
+  EXPECT_EQ(Replies(kAlice).at(2).signal, Signal::kInterrupted);
+  EXPECT_EQ(Replies(kBob).at(1).signal, Signal::kInterrupted);
+  Run();
+  EXPECT_TRUE(fake_->halted);
+  EXPECT_EQ(Replies(kAlice).at(1).signal, Signal::kInterrupted) << "the GOTO in progress";
+
+  auto refused = Handle(Package(kAlice, 3, {Cmd(3, CommandType::kJointSetPoint, {0.1}, "pan")}));
+  EXPECT_EQ(refused.at(3).signal, Signal::kPanic);
+  // Queries are still answered during a panic.
+  Handle(Queries(kAlice, 4, {Query{4, QueryType::kJointState, ""}}));
+  Run();
+  EXPECT_EQ(Replies(kAlice).at(4).signal, Signal::kSuccess);
+
+  // Any client may reset; the robot then accepts commands again.
+  auto reset = Handle(Package(kAlice, 5, {Cmd(5, CommandType::kPanicReset)}));
+  EXPECT_EQ(reset.at(5).signal, Signal::kSuccess);
+  Run();
+  EXPECT_FALSE(fake_->halted);
+  Handle(Package(kBob, 3, {Cmd(3, CommandType::kJointSetPoint, {0.3}, "pan")}));
+  Run();
+  EXPECT_EQ(Replies(kBob).at(3).signal, Signal::kSuccess);
+  EXPECT_DOUBLE_EQ(fake_->position, 0.3);
+}
+
+TEST_F(RobotServiceTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
+  Handle(Queries(kBob, 1, {Query{1, QueryType::kJointState, ""}}));
+  Run();
+  clock_.Advance(seconds(1));
+  Handle(Queries(kBob, 2, {}));  // Bob keeps his session alive with a heartbeat
+  clock_.Advance(milliseconds(1500));
+  const auto expired = service_->ExpireSessions(clock_.Now());
+  ASSERT_EQ(expired, std::vector<std::int64_t>{kAlice});
+  Run();
+  ASSERT_FALSE(fake_->calls.empty());
+  EXPECT_EQ(fake_->calls.back().type, CommandType::kStop);
+}
+
+TEST_F(RobotServiceTest, DoesNotStopTheRobotWhenAQueryOnlyClientVanishes) {
+  Handle(Queries(kBob, 1, {Query{1, QueryType::kJointState, ""}}));
+  Run();
+  clock_.Advance(seconds(3));
+  EXPECT_EQ(service_->ExpireSessions(clock_.Now()).size(), 1u);
+  Run();
+  EXPECT_TRUE(fake_->calls.empty());
+}
+
+TEST_F(RobotServiceTest, AnswersClockAndConfigQueriesOnReceipt) {
+  auto r = Handle(Queries(kAlice, 1, {Query{1, QueryType::kClock, ""}, Query{2, QueryType::kConfig, ""}}));
+  EXPECT_EQ(r.at(1).signal, Signal::kSuccess);
+  EXPECT_EQ(r.at(1).exec_time, clock_.Now());
+  EXPECT_EQ(last_.package.server_receive_us, ToWireMicros(clock_.Now()));
+  EXPECT_TRUE(last_.publish_config);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(service_->config_hash()));
+  EXPECT_EQ(r.at(2).message, hex);
+}
+
+TEST_F(RobotServiceTest, AnswersJointStateAndPoseQueries) {
+  fake_->position = 0.5;
+  Handle(Queries(kAlice, 1,
+                 {Query{1, QueryType::kJointState, "pan"}, Query{2, QueryType::kLinkPoses, "head"},
+                  Query{3, QueryType::kBasePose, ""}, Query{4, QueryType::kFramePoses, "nope"}}));
+  EXPECT_EQ(last_.package.replies.size(), 1u) << "only the bad frame name is answered at once";
+  Run();
+  auto replies = Replies(kAlice);
+  EXPECT_EQ(replies.at(1).values, (std::vector<double>{0.5, 0.25, -0.5}));
+  ASSERT_EQ(replies.at(2).values.size(), 7u);
+  EXPECT_NEAR(replies.at(2).values[3], std::cos(0.25), 1e-12) << "qw of a 0.5 rad yaw";
+  EXPECT_EQ(replies.at(3).values.size(), 5u);
+}
+
+}  // namespace
+}  // namespace robotalk
