@@ -1,1 +1,577 @@
-// Placeholder: the kinematic driver lands in a follow-up commit.
+#include "kinematic_driver.h"
+
+#include "robotalk/error.h"
+#include "robotalk/urdf_import.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <utility>
+
+namespace robotalk {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double WrapAngle(double a) {
+  a = std::remainder(a, 2 * kPi);  // (-pi, pi]
+  return a;
+}
+
+// Numbers in reply messages: short and exact enough to read ("0.5411").
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
+
+std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+DriverResult Answer(Signal s, std::string message = {}) {
+  return DriverResult{.signal = s, .in_progress = false, .message = std::move(message)};
+}
+
+[[noreturn]] void BadOption(const std::string& key, const std::string& value, const char* expected) {
+  throw Error("kinematic driver: option " + key + "='" + value + "': expected " + expected);
+}
+
+double ParsePositive(const std::string& key, const std::string& value, const char* expected) {
+  const char* begin = value.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (value.empty() || end != begin + value.size() || !std::isfinite(v) || v <= 0) {
+    BadOption(key, value, expected);
+  }
+  return v;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- options
+
+KinematicDriverOptions KinematicDriverOptions::FromMap(const std::map<std::string, std::string>& options) {
+  KinematicDriverOptions o;
+  for (const auto& [key, value] : options) {
+    if (key == "merge_chains") {
+      if (value == "true" || value == "1") {
+        o.merge_chains = true;
+      } else if (value == "false" || value == "0") {
+        o.merge_chains = false;
+      } else {
+        BadOption(key, value, "true or false");
+      }
+    } else if (key == "period_ms") {
+      o.period = FromSeconds(ParsePositive(key, value, "a number of milliseconds > 0") / 1000.0);
+      if (o.period <= Duration::zero()) BadOption(key, value, "a number of milliseconds > 0");
+    } else if (key == "default_velocity") {
+      o.default_velocity = ParsePositive(key, value, "a speed > 0 (rad/s or m/s)");
+    } else if (key == "base_max_v") {
+      o.base_max_v = ParsePositive(key, value, "a speed > 0 (m/s)");
+    } else if (key == "base_max_omega") {
+      o.base_max_omega = ParsePositive(key, value, "a yaw rate > 0 (rad/s)");
+    } else if (key == "goto_tolerance") {
+      o.goto_tolerance = ParsePositive(key, value, "a distance > 0 (m)");
+    } else {
+      throw Error("kinematic driver: unknown option '" + key +
+                  "' (known: base_max_omega, base_max_v, default_velocity, goto_tolerance, merge_chains, "
+                  "period_ms)");
+    }
+  }
+  return o;
+}
+
+void KinematicDriverOptions::Validate() const {
+  auto check = [](const char* name, double v) {
+    if (!std::isfinite(v) || v <= 0) throw Error(std::string("KinematicDriver: ") + name + " = " + Num(v) + ", expected > 0");
+  };
+  if (period <= Duration::zero()) {
+    throw Error("KinematicDriver: period = " + Num(ToSeconds(period)) + " s, expected > 0");
+  }
+  check("default_velocity", default_velocity);
+  check("base_max_v", base_max_v);
+  check("base_max_omega", base_max_omega);
+  check("goto_tolerance", goto_tolerance);
+}
+
+// ---------------------------------------------------------------- construction
+
+KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions& options)
+    : model_(std::move(model)), options_(options), kin_(model_) {
+  options_.Validate();
+  const int n = model_.num_dofs();
+  for (Eigen::VectorXd* v : {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_, &ik_q_, &ik_best_, &ik_dq_}) {
+    v->setZero(n);
+  }
+  mode_.assign(static_cast<size_t>(n), DofMode::kPosition);
+  mimic_leader_dof_.assign(static_cast<size_t>(n), -1);
+  mimic_multiplier_.assign(static_cast<size_t>(n), 0.0);
+  ik_jac_.setZero(6, n);
+
+  const auto joints = model_.joints();
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
+    const Joint& joint = joints[static_cast<size_t>(j)];
+    for (size_t k = 0; k < joint.dofs.size(); ++k) {
+      const int i = model_.dof_offset(j) + static_cast<int>(k);
+      const DofLimits& lim = joint.dofs[k].limits;
+      lower_[i] = lim.lower;
+      upper_[i] = lim.upper;
+      vmax_[i] = std::isfinite(lim.velocity) ? lim.velocity : options_.default_velocity;
+      q_[i] = std::clamp(0.0, lim.lower, lim.upper);
+    }
+    if (joint.mimic) {  // RobotModel guarantees 1-dof joint and leader
+      const auto i = static_cast<size_t>(model_.dof_offset(j));
+      mimic_leader_dof_[i] = model_.dof_offset(joint.mimic->leader_joint);
+      mimic_multiplier_[i] = joint.mimic->multiplier;
+    }
+  }
+  ApplyMimics(model_, q_);
+  target_ = q_;
+
+  // Per control frame, the dofs its IK may move: set-point joints on the path
+  // to the root. Mimic joints follow their leaders instead.
+  for (const ControlFrame& frame : model_.frames()) {
+    std::vector<std::uint8_t> mask(static_cast<size_t>(n), 0);
+    for (int j = model_.parent_joint(frame.parent_link); j >= 0; j = model_.parent_joint(model_.joint(j).parent_link)) {
+      const Joint& joint = model_.joint(j);
+      if (joint.mimic || !joint.servo_types.Has(ServoType::kSetPoint)) continue;
+      for (size_t k = 0; k < joint.dofs.size(); ++k) mask[static_cast<size_t>(model_.dof_offset(j)) + k] = 1;
+    }
+    frame_dofs_.push_back(std::move(mask));
+  }
+
+  // The first root's model pose = planar part (x, y, yaw) * residual (height,
+  // roll, pitch); the base moves the planar part only.
+  const RootLink& root = model_.roots().front();
+  base_type_ = root.base;
+  const Eigen::Matrix3d r = root.pose_in_world.rotation.normalized().toRotationMatrix();
+  theta_ = std::atan2(r(1, 0), r(0, 0));
+  base_residual_ = Eigen::AngleAxisd(-theta_, Eigen::Vector3d::UnitZ()) * root.pose_in_world.rotation.normalized();
+  x_ = root.pose_in_world.translation.x();
+  y_ = root.pose_in_world.translation.y();
+  z_ = root.pose_in_world.translation.z();
+  root_world_.resize(model_.roots().size(), Eigen::Isometry3d::Identity());
+  UpdateRootPoses();
+}
+
+void KinematicDriver::UpdateRootPoses() const {
+  const auto roots = model_.roots();
+  for (size_t i = 1; i < roots.size(); ++i) root_world_[i] = roots[i].pose_in_world.ToIsometry();
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
+  base.translation() << x_, y_, z_;
+  base.linear() = (Eigen::AngleAxisd(theta_, Eigen::Vector3d::UnitZ()) * base_residual_).toRotationMatrix();
+  root_world_[0] = base;
+}
+
+// ---------------------------------------------------------------- time
+
+void KinematicDriver::Update(TimePoint now, std::vector<Completion>& completed) { Advance(now, completed); }
+
+void KinematicDriver::Advance(TimePoint now, std::vector<Completion>& completed) {
+  if (!last_time_) {  // the first call only sets the time base
+    last_time_ = now;
+    return;
+  }
+  if (now <= *last_time_) return;  // no motion for a repeated (or earlier) time
+  const double dt = ToSeconds(now - *last_time_);
+  last_time_ = now;
+  StepDofs(dt);
+  StepBase(dt, completed);
+}
+
+void KinematicDriver::StepDofs(double dt) {
+  const Eigen::Index n = q_.size();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (mimic_leader_dof_[static_cast<size_t>(i)] >= 0) continue;
+    const double q0 = q_[i];
+    if (mode_[static_cast<size_t>(i)] == DofMode::kPosition) {
+      const double d = target_[i] - q0;
+      const double step = vmax_[i] * dt;
+      if (std::abs(d) <= step) {
+        q_[i] = target_[i];
+      } else {
+        q_[i] = q0 + std::copysign(step, d);
+      }
+    } else {
+      double q1 = q0 + speed_[i] * dt;
+      // A speed command stops at a position limit and holds there.
+      if (q1 >= upper_[i] || q1 <= lower_[i]) {
+        q1 = std::clamp(q1, lower_[i], upper_[i]);
+        mode_[static_cast<size_t>(i)] = DofMode::kPosition;
+        target_[i] = q1;
+        speed_[i] = 0;
+      }
+      q_[i] = q1;
+    }
+    qd_[i] = (q_[i] - q0) / dt;
+  }
+  ApplyMimics(model_, q_);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int leader = mimic_leader_dof_[static_cast<size_t>(i)];
+    if (leader >= 0) qd_[i] = mimic_multiplier_[static_cast<size_t>(i)] * qd_[leader];
+  }
+}
+
+// ---------------------------------------------------------------- base
+
+void KinematicDriver::IntegrateBase(double vx, double vy, double omega, double dt) {
+  // Exact integration of a constant body twist: the body-frame displacement
+  // is the integral of R(omega t) (vx, vy) over [0, dt].
+  const double phi = omega * dt;
+  double bx = vx * dt, by = vy * dt;
+  if (std::abs(phi) > 1e-12) {
+    const double s = std::sin(phi) / omega, c = (1 - std::cos(phi)) / omega;
+    bx = s * vx - c * vy;
+    by = c * vx + s * vy;
+  }
+  const double ct = std::cos(theta_), st = std::sin(theta_);
+  x_ += ct * bx - st * by;
+  y_ += st * bx + ct * by;
+  theta_ = WrapAngle(theta_ + phi);
+  v_ = vx;
+  vy_ = vy;
+  omega_ = omega;
+}
+
+void KinematicDriver::StepBase(double dt, std::vector<Completion>& completed) {
+  switch (base_mode_) {
+    case BaseMode::kIdle:
+      v_ = vy_ = omega_ = 0;
+      return;
+    case BaseMode::kSpeed:
+      IntegrateBase(cmd_vx_, cmd_vy_, cmd_omega_, dt);
+      return;
+    case BaseMode::kGoto:
+      break;
+  }
+  // Turn toward the goal, drive to it, turn to the goal heading; every phase
+  // at the maximum speed, the last step of each shortened so as not to
+  // overshoot. One phase change may happen within a step (turn -> drive).
+  const double tol = options_.goto_tolerance, wmax = options_.base_max_omega;
+  const double dx = goal_x_ - x_, dy = goal_y_ - y_;
+  const double dist = std::hypot(dx, dy);
+  if (dist <= tol) goto_phase_ = GotoPhase::kFinalTurn;
+  const double heading_error = WrapAngle(std::atan2(dy, dx) - theta_);
+  if (goto_phase_ == GotoPhase::kDrive && std::abs(heading_error) > wmax * dt) goto_phase_ = GotoPhase::kTurnToGoal;
+  if (goto_phase_ == GotoPhase::kTurnToGoal && std::abs(heading_error) <= wmax * dt) goto_phase_ = GotoPhase::kDrive;
+  switch (goto_phase_) {
+    case GotoPhase::kTurnToGoal:
+      IntegrateBase(0, 0, std::copysign(wmax, heading_error), dt);
+      break;
+    case GotoPhase::kDrive:
+      // Corrects the remaining heading error within the step (|error| <= wmax dt).
+      IntegrateBase(std::min(options_.base_max_v, dist / dt), 0, heading_error / dt, dt);
+      break;
+    case GotoPhase::kFinalTurn: {
+      const double e = WrapAngle(goal_theta_ - theta_);
+      IntegrateBase(0, 0, std::clamp(e / dt, -wmax, wmax), dt);
+      break;
+    }
+  }
+  if (std::hypot(goal_x_ - x_, goal_y_ - y_) <= tol &&
+      std::abs(WrapAngle(goal_theta_ - theta_)) <= kGotoHeadingTolerance) {
+    completed.push_back(Completion{.id = goto_id_, .signal = Signal::kSuccess, .message = {}});
+    base_mode_ = BaseMode::kIdle;
+    v_ = vy_ = omega_ = 0;
+  }
+}
+
+DriverResult KinematicDriver::SetSpeed(const DriverCommand& c) {
+  if (c.num_values != 2 && c.num_values != 3) {
+    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " + std::to_string(c.num_values));
+  }
+  if (base_mode_ == BaseMode::kGoto) {
+    return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
+  }
+  double vx = c.values[0];
+  double vy = c.num_values == 3 ? c.values[1] : 0.0;
+  double w = c.values[static_cast<size_t>(c.num_values - 1)];
+  std::string note;
+  auto add = [&note](const std::string& s) { note += (note.empty() ? "" : "; ") + s; };
+  if (vy != 0 && base_type_ == BaseType::kDifferential) {
+    add("lateral speed vy = " + Num(vy) + " m/s dropped (differential base)");
+    vy = 0;
+  }
+  const double planar = std::hypot(vx, vy);
+  if (planar > options_.base_max_v) {
+    const double k = options_.base_max_v / planar;
+    add("speed " + Num(planar) + " m/s clamped to base_max_v " + Num(options_.base_max_v) + " m/s");
+    vx *= k;
+    vy *= k;
+  }
+  if (std::abs(w) > options_.base_max_omega) {
+    add("yaw rate " + Num(w) + " rad/s clamped to base_max_omega " + Num(options_.base_max_omega) + " rad/s");
+    w = std::copysign(options_.base_max_omega, w);
+  }
+  cmd_vx_ = vx;
+  cmd_vy_ = vy;
+  cmd_omega_ = w;
+  base_mode_ = (vx == 0 && vy == 0 && w == 0) ? BaseMode::kIdle : BaseMode::kSpeed;
+  return note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + note);
+}
+
+DriverResult KinematicDriver::Goto(const DriverCommand& c) {
+  if (c.num_values != 3) {
+    return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
+  }
+  if (base_mode_ == BaseMode::kGoto) {
+    return Answer(Signal::kBusy, "GOTO: GOTO in progress (command " + std::to_string(goto_id_) + ")");
+  }
+  goal_x_ = c.values[0];
+  goal_y_ = c.values[1];
+  goal_theta_ = WrapAngle(c.values[2]);
+  cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
+  if (std::hypot(goal_x_ - x_, goal_y_ - y_) <= options_.goto_tolerance &&
+      std::abs(WrapAngle(goal_theta_ - theta_)) <= kGotoHeadingTolerance) {
+    base_mode_ = BaseMode::kIdle;  // already there
+    return Answer(Signal::kSuccess);
+  }
+  base_mode_ = BaseMode::kGoto;
+  goto_id_ = c.id;
+  goto_phase_ = GotoPhase::kTurnToGoal;
+  DriverResult r;
+  r.in_progress = true;
+  return r;
+}
+
+// ---------------------------------------------------------------- joints
+
+DriverResult KinematicDriver::JointSetPoint(const DriverCommand& c) {
+  const Joint& joint = model_.joint(c.target);
+  std::string note;
+  for (int k = 0; k < c.num_values; ++k) {
+    const int i = model_.dof_offset(c.target) + k;
+    const double want = c.values[static_cast<size_t>(k)];
+    const double got = std::clamp(want, lower_[i], upper_[i]);
+    if (got != want) {
+      const char* unit = Unit(joint.dofs[static_cast<size_t>(k)].type);
+      note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " + unit +
+              " clamped to the " + (want > got ? "upper" : "lower") + " limit " + Num(got) + " " + unit;
+    }
+    mode_[static_cast<size_t>(i)] = DofMode::kPosition;
+    target_[i] = got;
+    speed_[i] = 0;
+  }
+  if (note.empty()) return Answer(Signal::kSuccess);
+  return Answer(Signal::kModified, "JOINT_SETPOINT " + Quote(joint.name) + ": " + note);
+}
+
+DriverResult KinematicDriver::JointSpeed(const DriverCommand& c) {
+  const Joint& joint = model_.joint(c.target);
+  std::string note;
+  for (int k = 0; k < c.num_values; ++k) {
+    const int i = model_.dof_offset(c.target) + k;
+    const Dof& dof = joint.dofs[static_cast<size_t>(k)];
+    const double want = c.values[static_cast<size_t>(k)];
+    const double limit = dof.limits.velocity;  // infinite: not clamped
+    const double got = std::clamp(want, -limit, limit);
+    if (got != want) {
+      note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " +
+              Unit(dof.type) + "/s clamped to the velocity limit " + Num(limit) + " " + Unit(dof.type) + "/s";
+    }
+    mode_[static_cast<size_t>(i)] = DofMode::kVelocity;
+    speed_[i] = got;
+  }
+  if (note.empty()) return Answer(Signal::kSuccess);
+  return Answer(Signal::kModified, "JOINT_SPEED " + Quote(joint.name) + ": " + note);
+}
+
+DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
+  const ControlFrame& frame = model_.frame(c.target);
+  const std::vector<std::uint8_t>& mask = frame_dofs_[static_cast<size_t>(c.target)];
+  if (std::find(mask.begin(), mask.end(), 1) == mask.end()) {
+    return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
+                                   ": no joint between the frame and its root accepts set-points");
+  }
+  const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
+  const Eigen::Quaterniond goal_r = Eigen::Quaterniond(c.values[3], c.values[4], c.values[5], c.values[6]).normalized();
+  UpdateRootPoses();
+
+  // Damped least squares on a copy of q: dq = J^T (J J^T + lambda^2 I)^-1 e,
+  // with the step capped and the limits enforced after each step. Keeps the
+  // best pose seen (position error plus 0.1 m per rad of orientation error).
+  constexpr double kLambda = 0.05, kMaxStep = 0.3, kMetrePerRad = 0.1;
+  constexpr int kPatience = 30;  // iterations without improvement before giving up
+  ik_q_ = q_;
+  ik_best_ = q_;
+  double best_cost = std::numeric_limits<double>::infinity(), best_p = 0, best_r = 0;
+  int since_best = 0;
+  const Eigen::Index n = q_.size();
+  for (int it = 0; it < kIkMaxIterations && since_best < kPatience; ++it) {
+    kin_.Update(ik_q_, root_world_);
+    const Eigen::Isometry3d x = kin_.frame_pose(c.target);
+    Eigen::Matrix<double, 6, 1> e;
+    e.head<3>() = goal_p - x.translation();
+    const Eigen::AngleAxisd rot_error(goal_r.toRotationMatrix() * x.linear().transpose());
+    e.tail<3>() = rot_error.angle() * rot_error.axis();
+    const double pe = e.head<3>().norm(), re = e.tail<3>().norm();
+    const double cost = pe + kMetrePerRad * re;
+    if (cost < best_cost - 1e-12) {
+      best_cost = cost;
+      best_p = pe;
+      best_r = re;
+      ik_best_ = ik_q_;
+      since_best = 0;
+    } else {
+      ++since_best;
+    }
+    if (pe < 1e-7 && re < 1e-7) break;
+
+    ik_jac_ = kin_.FrameJacobian(c.target);
+    for (Eigen::Index i = 0; i < n; ++i) {  // a mimic dof moves with its leader
+      const int leader = mimic_leader_dof_[static_cast<size_t>(i)];
+      if (leader >= 0) ik_jac_.col(leader) += mimic_multiplier_[static_cast<size_t>(i)] * ik_jac_.col(i);
+    }
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (!mask[static_cast<size_t>(i)]) ik_jac_.col(i).setZero();
+    }
+    Eigen::Matrix<double, 6, 6> a;
+    a.noalias() = ik_jac_ * ik_jac_.transpose();
+    a.diagonal().array() += kLambda * kLambda;
+    const Eigen::Matrix<double, 6, 1> y = a.ldlt().solve(e);
+    ik_dq_.noalias() = ik_jac_.transpose() * y;
+    const double step = ik_dq_.norm();
+    if (step > kMaxStep) ik_dq_ *= kMaxStep / step;
+    ik_q_ += ik_dq_;
+    ik_q_ = ik_q_.cwiseMax(lower_).cwiseMin(upper_);
+    ApplyMimics(model_, ik_q_);
+  }
+
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!mask[static_cast<size_t>(i)]) continue;
+    mode_[static_cast<size_t>(i)] = DofMode::kPosition;
+    target_[i] = ik_best_[i];
+    speed_[i] = 0;
+  }
+  if (best_p <= kIkPositionTolerance && best_r <= kIkOrientationTolerance) return Answer(Signal::kSuccess);
+  return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame.name) +
+                                       ": pose not reachable; moving to the closest found, " + Num(best_p) +
+                                       " m and " + Num(best_r) + " rad away");
+}
+
+// ---------------------------------------------------------------- commands
+
+DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed) {
+  Advance(now, completed);
+  const char* name = ToString(c.type);
+  if (c.type == CommandType::kStop) {
+    StopAll("interrupted by STOP", completed);
+    return Answer(Signal::kSuccess);
+  }
+  if (c.type == CommandType::kPanicReset) {  // normally handled by the server
+    Resume();
+    return Answer(Signal::kSuccess);
+  }
+  if (halted_) {
+    return Answer(Signal::kPanic, std::string(name) + ": the robot is halted (panic) until PANIC_RESET");
+  }
+  if (c.num_values < 0 || c.num_values > static_cast<int>(c.values.size())) {
+    return Answer(Signal::kError, std::string(name) + ": bad value count " + std::to_string(c.num_values));
+  }
+  switch (c.type) {
+    case CommandType::kJointSetPoint:
+    case CommandType::kJointSpeed:
+    case CommandType::kJointForce: {
+      // The server checked these (CheckCommand); re-checked because a driver
+      // must not index out of its arrays whatever it is given.
+      if (c.target < 0 || c.target >= static_cast<int>(model_.joints().size())) {
+        return Answer(Signal::kError, std::string(name) + ": no joint with index " + std::to_string(c.target));
+      }
+      const Joint& joint = model_.joint(c.target);
+      if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
+        return Answer(Signal::kError, std::string(name) + " " + Quote(joint.name) + ": expected " +
+                                          std::to_string(joint.dofs.size()) + " values (one per dof), got " +
+                                          std::to_string(c.num_values));
+      }
+      if (c.type == CommandType::kJointForce) {
+        return Answer(Signal::kNa, "JOINT_FORCE " + Quote(joint.name) + ": the kinematic driver simulates no dynamics");
+      }
+      if (joint.mimic) {
+        return Answer(Signal::kNa, std::string(name) + " " + Quote(joint.name) + ": the joint follows " +
+                                       Quote(model_.joint(joint.mimic->leader_joint).name) + " (mimic)");
+      }
+      return c.type == CommandType::kJointSetPoint ? JointSetPoint(c) : JointSpeed(c);
+    }
+    case CommandType::kFrameSetPoint:
+      if (c.target < 0 || c.target >= static_cast<int>(model_.frames().size())) {
+        return Answer(Signal::kError, "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
+      }
+      if (c.num_values != 7) {
+        return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " + std::to_string(c.num_values));
+      }
+      return FrameSetPoint(c);
+    case CommandType::kGoto:
+    case CommandType::kSetSpeed:
+      if (!mobile_base()) {
+        return Answer(Signal::kNa, std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
+      }
+      return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
+    case CommandType::kStop:
+    case CommandType::kPanicReset:
+      break;  // handled above
+  }
+  return Answer(Signal::kError, "unknown command type " + std::to_string(static_cast<int>(c.type)));
+}
+
+void KinematicDriver::StopAll(const char* why, std::vector<Completion>& completed) {
+  if (base_mode_ == BaseMode::kGoto) {
+    completed.push_back(Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
+  }
+  base_mode_ = BaseMode::kIdle;
+  cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
+  v_ = vy_ = omega_ = 0;
+  std::fill(mode_.begin(), mode_.end(), DofMode::kPosition);
+  target_ = q_;
+  speed_.setZero();
+  qd_.setZero();
+}
+
+void KinematicDriver::Halt(std::vector<Completion>& interrupted) {
+  StopAll("interrupted by panic", interrupted);
+  halted_ = true;
+}
+
+void KinematicDriver::Resume() { halted_ = false; }
+
+// ---------------------------------------------------------------- state
+
+void KinematicDriver::ReadState(RobotState& state) const {
+  state.position = q_;
+  state.velocity = qd_;
+  state.effort = effort_;
+  UpdateRootPoses();
+  if (state.root_poses.size() != root_world_.size()) state.root_poses.resize(root_world_.size());
+  for (size_t i = 0; i < root_world_.size(); ++i) state.root_poses[i] = Pose::FromIsometry(root_world_[i]);
+  state.base_v = v_;
+  state.base_omega = omega_;
+  bool moving = base_mode_ != BaseMode::kIdle || v_ != 0 || vy_ != 0 || omega_ != 0;
+  for (Eigen::Index i = 0; i < q_.size() && !moving; ++i) {
+    if (mimic_leader_dof_[static_cast<size_t>(i)] >= 0) continue;  // follows its leader
+    moving = qd_[i] != 0 || (mode_[static_cast<size_t>(i)] == DofMode::kPosition ? q_[i] != target_[i] : speed_[i] != 0);
+  }
+  state.moving = moving;
+}
+
+// ---------------------------------------------------------------- registry
+
+void RegisterKinematicDriver(DriverRegistry& registry) {
+  registry.Register("kinematic", [](const DriverConfig& config) -> std::unique_ptr<Driver> {
+    const KinematicDriverOptions options = KinematicDriverOptions::FromMap(config.options);
+    if (config.urdf_path.empty()) {
+      throw Error("kinematic driver for robot '" + config.robot_name + "': no URDF file (DriverConfig::urdf_path)");
+    }
+    UrdfImportOptions import;
+    import.merge_massless_chains = options.merge_chains;
+    import.robot_name = config.robot_name;
+    UrdfImportResult result = LoadUrdfFile(config.urdf_path, import);
+    return std::make_unique<KinematicDriver>(std::move(result.model), options);
+  });
+}
+
+}  // namespace robotalk
