@@ -1,0 +1,138 @@
+#include "outstanding_packages.h"
+
+#include <gtest/gtest.h>
+
+namespace robotalk::client {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+const TimePoint kT0(seconds(1000));
+
+RetransmitPolicy Policy() {
+  return {.interval = milliseconds(100), .backoff = 2.0, .max_interval = milliseconds(400), .give_up_after = seconds(2)};
+}
+std::vector<std::uint8_t> Bytes(std::uint8_t b) { return {b, b, b}; }
+
+// Times at which a package is resent when nothing ever answers, over `span`.
+std::vector<Duration> ResendTimes(OutstandingPackages& o, Duration span) {
+  std::vector<Duration> times;
+  for (Duration t{0}; t <= span; t += milliseconds(10)) {
+    if (!o.TakeDue(kT0 + t).empty()) times.push_back(t);
+  }
+  return times;
+}
+
+TEST(OutstandingPackages, ResendsAnUnackedPackageWithBackoff) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}}, kT0);
+  const auto times = ResendTimes(o, milliseconds(1500));
+  const std::vector<Duration> expected = {milliseconds(100), milliseconds(300), milliseconds(700),
+                                          milliseconds(1100), milliseconds(1500)};
+  EXPECT_EQ(times, expected);
+  EXPECT_EQ(o.retransmissions(), 5u);
+}
+
+TEST(OutstandingPackages, ResendUsesTheSameBytes) {
+  OutstandingPackages o(Policy());
+  o.Add(7, Bytes(7), {{.id = 1}}, kT0);
+  auto due = o.TakeDue(kT0 + milliseconds(100));
+  ASSERT_EQ(due.size(), 1u);
+  EXPECT_EQ(due[0].sequence, 7);
+  EXPECT_EQ(due[0].bytes, Bytes(7));
+}
+
+TEST(OutstandingPackages, AckedAndAnsweredPackageIsForgotten) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}, {.id = 11}}, kT0);
+  auto ack = o.OnAck(1, kT0 + milliseconds(5));
+  EXPECT_TRUE(ack.known);
+  EXPECT_TRUE(ack.first);
+  EXPECT_FALSE(ack.retransmitted);
+  EXPECT_FALSE(ack.completed);
+  EXPECT_FALSE(o.OnReply(11, kT0 + milliseconds(6)).has_value());
+  EXPECT_EQ(o.OnReply(10, kT0 + milliseconds(7)), 1);
+  EXPECT_EQ(o.size(), 0u);
+  EXPECT_TRUE(o.TakeDue(kT0 + seconds(10)).empty());
+}
+
+TEST(OutstandingPackages, PackageWithoutItemsCompletesOnItsAck) {
+  OutstandingPackages o(Policy());
+  o.Add(3, Bytes(3), {}, kT0);  // a panic package
+  EXPECT_TRUE(o.OnAck(3, kT0 + milliseconds(1)).completed);
+  EXPECT_FALSE(o.Contains(3));
+}
+
+TEST(OutstandingPackages, SecondAckIsNotFirstAndRetransmissionIsReported) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}}, kT0);
+  o.TakeDue(kT0 + milliseconds(100));
+  auto a1 = o.OnAck(1, kT0 + milliseconds(120));
+  EXPECT_TRUE(a1.first);
+  EXPECT_TRUE(a1.retransmitted);
+  EXPECT_FALSE(o.OnAck(1, kT0 + milliseconds(130)).first);
+  EXPECT_FALSE(o.OnAck(99, kT0).known);
+}
+
+TEST(OutstandingPackages, AckedPackageWaitsForTheStartTimeBeforeAskingAgain) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10, .start = kT0 + seconds(3)}}, kT0);
+  o.OnAck(1, kT0 + milliseconds(10));
+  // Nothing before the start time (+ one interval).
+  for (Duration t = milliseconds(20); t < seconds(3) + milliseconds(100); t += milliseconds(10)) {
+    ASSERT_TRUE(o.TakeDue(kT0 + t).empty()) << "resent at " << ToSeconds(t);
+  }
+  EXPECT_EQ(o.TakeDue(kT0 + seconds(3) + milliseconds(100)).size(), 1u);
+  // Not given up while waiting for the start either.
+  EXPECT_TRUE(o.TakeExpired(kT0 + seconds(3)).empty());
+}
+
+TEST(OutstandingPackages, UnackedFutureCommandIsResentAtOnce) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10, .start = kT0 + seconds(30)}}, kT0);
+  EXPECT_EQ(o.TakeDue(kT0 + milliseconds(100)).size(), 1u);
+}
+
+TEST(OutstandingPackages, AReplyCountsAsAnAck) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}, {.id = 11}}, kT0);
+  o.OnReply(10, kT0 + milliseconds(50));
+  EXPECT_TRUE(o.IsAcked(1));
+}
+
+TEST(OutstandingPackages, GivesUpOnASilentServerAndReturnsTheUnansweredItems) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 11}, {.id = 10}, {.id = 12}}, kT0);
+  o.OnReply(12, kT0 + milliseconds(10));
+  EXPECT_TRUE(o.TakeExpired(kT0 + seconds(2)).empty());
+  auto expired = o.TakeExpired(kT0 + seconds(2) + milliseconds(20));
+  ASSERT_EQ(expired.size(), 1u);
+  EXPECT_EQ(expired[0].sequence, 1);
+  EXPECT_TRUE(expired[0].acked);
+  EXPECT_EQ(expired[0].unanswered, (std::vector<CommandId>{10, 11}));
+  EXPECT_EQ(o.size(), 0u);
+  // A late reply for a given-up item belongs to nothing.
+  EXPECT_FALSE(o.OnReply(10, kT0 + seconds(3)).has_value());
+}
+
+TEST(OutstandingPackages, AnAckKeepsAPackageAlive) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}}, kT0);  // a long GOTO: acked again on every resend
+  for (int s = 1; s <= 10; ++s) {
+    o.OnAck(1, kT0 + seconds(s));
+    EXPECT_TRUE(o.TakeExpired(kT0 + seconds(s) + milliseconds(500)).empty());
+  }
+}
+
+TEST(OutstandingPackages, ClearReturnsEveryUnansweredItem) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 1}, {.id = 2}}, kT0);
+  o.Add(2, Bytes(2), {{.id = 3}}, kT0);
+  auto ids = o.Clear();
+  std::sort(ids.begin(), ids.end());
+  EXPECT_EQ(ids, (std::vector<CommandId>{1, 2, 3}));
+  EXPECT_EQ(o.size(), 0u);
+}
+
+}  // namespace
+}  // namespace robotalk::client
