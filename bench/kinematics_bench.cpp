@@ -13,6 +13,7 @@
 
 namespace {
 
+using Eigen::Vector3d;
 using robotalk::ControlFrame;
 using robotalk::Dof;
 using robotalk::DofType;
@@ -20,7 +21,6 @@ using robotalk::Joint;
 using robotalk::Link;
 using robotalk::RobotModel;
 using robotalk::RobotModelBuilder;
-using Eigen::Vector3d;
 
 Link Body(const std::string& name, const Vector3d& com) {
   Link link{.name = name, .mass = 1.0, .com = com};

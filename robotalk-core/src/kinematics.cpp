@@ -70,7 +70,8 @@ void Kinematics::Update(const Eigen::Ref<const Eigen::VectorXd>& q,
   }
 
   for (size_t r = 0; r < roots.size(); ++r) {
-    link_poses_[static_cast<size_t>(roots[r].link)] = root_poses.empty() ? default_root_poses_[r] : root_poses[r];
+    link_poses_[static_cast<size_t>(roots[r].link)] =
+        root_poses.empty() ? default_root_poses_[r] : root_poses[r];
   }
   const auto joints = model_.joints();
   for (const int j : model_.topological_joint_order()) {
@@ -113,7 +114,8 @@ Jacobian Kinematics::FrameJacobian(int frame) const {
 Jacobian Kinematics::PointJacobian(int link, const Eigen::Vector3d& point_in_link) const {
   const Eigen::Vector3d p = link_pose(link) * point_in_link;
   Jacobian jac = Jacobian::Zero(6, model_.num_dofs());
-  for (int l = link, j = model_.parent_joint(l); j >= 0; l = model_.joint(j).parent_link, j = model_.parent_joint(l)) {
+  for (int l = link, j = model_.parent_joint(l); j >= 0;
+       l = model_.joint(j).parent_link, j = model_.parent_joint(l)) {
     const Joint& joint = model_.joint(j);
     for (int k = 0; k < static_cast<int>(joint.dofs.size()); ++k) {
       const int dof = model_.dof_offset(j) + k;
@@ -141,8 +143,9 @@ Eigen::Vector3d Kinematics::CenterOfMass() const {
 
 void ApplyMimics(const RobotModel& model, Eigen::Ref<Eigen::VectorXd> q) {
   if (q.size() != model.num_dofs()) {
-    throw std::invalid_argument("ApplyMimics (robot '" + model.name() + "'): q has " + std::to_string(q.size()) +
-                                " entries, expected " + std::to_string(model.num_dofs()));
+    throw std::invalid_argument("ApplyMimics (robot '" + model.name() + "'): q has " +
+                                std::to_string(q.size()) + " entries, expected " +
+                                std::to_string(model.num_dofs()));
   }
   const auto joints = model.joints();
   for (int j = 0; j < static_cast<int>(joints.size()); ++j) {

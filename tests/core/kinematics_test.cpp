@@ -33,22 +33,24 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace robotalk {
 namespace {
 
-using ::testing::HasSubstr;
 using Eigen::Vector3d;
+using ::testing::HasSubstr;
 constexpr double kTol = 1e-12;
 constexpr double kPi = std::numbers::pi;
 
-Link Body(const std::string& name, double mass = 1.0, Vector3d com = Vector3d::Zero()) {
+Link Body(const std::string& name, double mass = 1.0, const Vector3d& com = Vector3d::Zero()) {
   Link link{.name = name, .mass = mass, .com = com};
   link.inertia = Eigen::Matrix3d::Identity() * 0.01 * mass;
   return link;
 }
 
-Dof Revolute(Vector3d axis = Vector3d::UnitZ()) { return Dof{.type = DofType::kRevolute, .axis = axis}; }
-Dof Prismatic(Vector3d axis) { return Dof{.type = DofType::kPrismatic, .axis = axis}; }
+Dof Revolute(const Vector3d& axis = Vector3d::UnitZ()) {
+  return Dof{.type = DofType::kRevolute, .axis = axis};
+}
+Dof Prismatic(const Vector3d& axis) { return Dof{.type = DofType::kPrismatic, .axis = axis}; }
 
-Joint MakeJoint(const std::string& name, std::vector<Dof> dofs, Vector3d inboard = Vector3d::Zero(),
-                Vector3d outboard = Vector3d::Zero()) {
+Joint MakeJoint(const std::string& name, std::vector<Dof> dofs, const Vector3d& inboard = Vector3d::Zero(),
+                const Vector3d& outboard = Vector3d::Zero()) {
   return Joint{.name = name, .inboard = inboard, .outboard = outboard, .dofs = std::move(dofs)};
 }
 
@@ -75,7 +77,8 @@ void ExpectPlanarArmMatchesClosedForm(bool offset_coms) {
   const double l1 = 0.7, l2 = 0.45;
   const RobotModel model = PlanarArm(l1, l2, offset_coms);
   Kinematics kin(model);
-  for (const auto& [q1, q2] : {std::pair{0.0, 0.0}, {0.3, -0.8}, {-2.1, 1.4}, {kPi / 2, kPi / 2}, {3.0, 3.0}}) {
+  for (const auto& [q1, q2] :
+       {std::pair{0.0, 0.0}, {0.3, -0.8}, {-2.1, 1.4}, {kPi / 2, kPi / 2}, {3.0, 3.0}}) {
     SCOPED_TRACE(::testing::Message() << "q = (" << q1 << ", " << q2 << ")");
     kin.Update(Eigen::Vector2d(q1, q2));
     const double c1 = std::cos(q1), s1 = std::sin(q1), c12 = std::cos(q1 + q2), s12 = std::sin(q1 + q2);
@@ -126,8 +129,9 @@ TEST(Kinematics, PanTiltJointPointsCameraWhereHandComputationSays) {
   const double h = 1.2, d = 0.1;
   RobotModelBuilder b("ptu");
   b.AddLink(Body("base")).AddLink(Body("head", 0.5));
-  b.AddJoint(MakeJoint("pan_tilt", {Revolute(Vector3d::UnitZ()), Revolute(Vector3d::UnitY())}, Vector3d(0, 0, h)),
-             "base", "head");
+  b.AddJoint(
+      MakeJoint("pan_tilt", {Revolute(Vector3d::UnitZ()), Revolute(Vector3d::UnitY())}, Vector3d(0, 0, h)),
+      "base", "head");
   b.AddControlFrame(ControlFrame{.name = "camera", .pose_in_link = {.translation = {d, 0, 0}}}, "head");
   const RobotModel model = b.Build();
   Kinematics kin(model);
@@ -160,7 +164,8 @@ TEST(Kinematics, RootPoseMovesEverythingRigidly) {
   Eigen::Isometry3d root = Eigen::Isometry3d::Identity();
   root.translate(Vector3d(1, -2, 0.5)).rotate(Rot(0.7, Vector3d(1, 2, 3)));
   kin.Update(q, std::span(&root, 1));
-  for (int l = 0; l < 3; ++l) EXPECT_TRUE(kin.link_pose(l).isApprox(root * before[static_cast<size_t>(l)], kTol));
+  for (int l = 0; l < 3; ++l)
+    EXPECT_TRUE(kin.link_pose(l).isApprox(root * before[static_cast<size_t>(l)], kTol));
   EXPECT_TRUE(kin.frame_pose(0).isApprox(root * tool_before, kTol));
   EXPECT_TRUE(kin.CenterOfMass().isApprox(root * com_before, kTol));
   // Without root poses the model's own (identity) pose applies again.
@@ -182,11 +187,15 @@ TEST(Kinematics, UsesTheModelRootPoseByDefault) {
 
 TEST(Kinematics, PosesEachRootOfAMultiRootModel) {
   RobotModelBuilder b("two_arms");
-  b.AddLink(Body("left_base")).AddLink(Body("left_arm")).AddLink(Body("right_base")).AddLink(Body("right_arm"));
+  b.AddLink(Body("left_base"))
+      .AddLink(Body("left_arm"))
+      .AddLink(Body("right_base"))
+      .AddLink(Body("right_arm"));
   b.AddJoint(MakeJoint("left_j", {Revolute()}, Vector3d(0.5, 0, 0)), "left_base", "left_arm");
   b.AddJoint(MakeJoint("right_j", {Revolute()}, Vector3d(0.5, 0, 0)), "right_base", "right_arm");
   b.AddControlFrame(ControlFrame{.name = "left_tip", .pose_in_link = {.translation = {1, 0, 0}}}, "left_arm");
-  b.AddControlFrame(ControlFrame{.name = "right_tip", .pose_in_link = {.translation = {1, 0, 0}}}, "right_arm");
+  b.AddControlFrame(ControlFrame{.name = "right_tip", .pose_in_link = {.translation = {1, 0, 0}}},
+                    "right_arm");
   b.SetRoot("left_base", Pose{.translation = {0, 1, 0}});
   b.SetRoot("right_base", Pose{.translation = {0, -1, 0}});
   const RobotModel model = b.Build();
@@ -194,7 +203,8 @@ TEST(Kinematics, PosesEachRootOfAMultiRootModel) {
   Kinematics kin(model);
   kin.Update(Eigen::Vector2d(kPi / 2, 0));
   EXPECT_TRUE(kin.frame_pose(model.FrameIndex("left_tip")).translation().isApprox(Vector3d(0.5, 2, 0), kTol));
-  EXPECT_TRUE(kin.frame_pose(model.FrameIndex("right_tip")).translation().isApprox(Vector3d(1.5, -1, 0), kTol));
+  EXPECT_TRUE(
+      kin.frame_pose(model.FrameIndex("right_tip")).translation().isApprox(Vector3d(1.5, -1, 0), kTol));
   // Each tip depends only on its own arm's dof.
   const Jacobian left = kin.FrameJacobian(model.FrameIndex("left_tip"));
   EXPECT_TRUE(left.col(1).isZero());
@@ -238,7 +248,8 @@ TEST(Kinematics, CenterOfMassIsTheMassWeightedMeanOfLinkComs) {
   EXPECT_DOUBLE_EQ(model.total_mass(), 3);
   Kinematics kin(model);
   kin.Update(Eigen::VectorXd::Constant(1, kPi / 2));
-  EXPECT_TRUE(kin.CenterOfMass().isApprox(Vector3d(0, 0.5 / 3, 0.2 / 3), kTol)) << kin.CenterOfMass().transpose();
+  EXPECT_TRUE(kin.CenterOfMass().isApprox(Vector3d(0, 0.5 / 3, 0.2 / 3), kTol))
+      << kin.CenterOfMass().transpose();
 }
 
 TEST(Kinematics, MasslessRobotHasZeroCenterOfMass) {

@@ -37,9 +37,10 @@ class Kinematics {
   /// Computes every link pose for joint positions `q` (size num_dofs(), in
   /// dof_offset order). `root_poses`, if not empty, gives one world pose per
   /// RobotModel::roots() entry (same order); otherwise the model's are used.
-  /// Throws std::invalid_argument naming the bad size or the non-finite entry.
-  void Update(const Eigen::Ref<const Eigen::VectorXd>& q,
-              std::span<const Eigen::Isometry3d> root_poses = {});
+  /// Throws std::invalid_argument naming the bad size, the non-finite entry or
+  /// the bad root-pose count. Pass a vector or a contiguous block: an Eigen
+  /// expression would be evaluated into a temporary, which allocates.
+  void Update(const Eigen::Ref<const Eigen::VectorXd>& q, std::span<const Eigen::Isometry3d> root_poses = {});
 
   /// World pose of a link's frame (not its COM) for the last Update().
   /// The reference stays valid for the object's lifetime.
