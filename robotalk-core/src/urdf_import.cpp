@@ -174,6 +174,17 @@ UrdfImportResult Importer::Run(const std::string& xml) {
   }
   scan_ = urdf_detail::ScanRobot(*robot, source_);
   urdf::ModelInterfaceSharedPtr model = ParseWithUrdfdom(xml);
+  // In a file with a cycle urdfdom's links own each other through
+  // child_links, and the model would leak; cut those links when done.
+  struct CutTree {
+    urdf::ModelInterface& model;
+    ~CutTree() {
+      for (auto& [name, link] : model.links_) {
+        link->child_links.clear();
+        link->child_joints.clear();
+      }
+    }
+  } cut_tree{*model};
   ext_ = urdf_detail::ParseExtensions(*robot, source_);
 
   ImportLinks(*model);
