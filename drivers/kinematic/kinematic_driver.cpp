@@ -89,7 +89,8 @@ KinematicDriverOptions KinematicDriverOptions::FromMap(const std::map<std::strin
 
 void KinematicDriverOptions::Validate() const {
   auto check = [](const char* name, double v) {
-    if (!std::isfinite(v) || v <= 0) throw Error(std::string("KinematicDriver: ") + name + " = " + Num(v) + ", expected > 0");
+    if (!std::isfinite(v) || v <= 0)
+      throw Error(std::string("KinematicDriver: ") + name + " = " + Num(v) + ", expected > 0");
   };
   if (period <= Duration::zero()) {
     throw Error("KinematicDriver: period = " + Num(ToSeconds(period)) + " s, expected > 0");
@@ -106,7 +107,8 @@ KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions&
     : model_(std::move(model)), options_(options), kin_(model_) {
   options_.Validate();
   const int n = model_.num_dofs();
-  for (Eigen::VectorXd* v : {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_, &ik_q_, &ik_best_, &ik_dq_}) {
+  for (Eigen::VectorXd* v :
+       {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_, &ik_q_, &ik_best_, &ik_dq_}) {
     v->setZero(n);
   }
   mode_.assign(static_cast<size_t>(n), DofMode::kPosition);
@@ -138,7 +140,8 @@ KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions&
   // to the root. Mimic joints follow their leaders instead.
   for (const ControlFrame& frame : model_.frames()) {
     std::vector<std::uint8_t> mask(static_cast<size_t>(n), 0);
-    for (int j = model_.parent_joint(frame.parent_link); j >= 0; j = model_.parent_joint(model_.joint(j).parent_link)) {
+    for (int j = model_.parent_joint(frame.parent_link); j >= 0;
+         j = model_.parent_joint(model_.joint(j).parent_link)) {
       const Joint& joint = model_.joint(j);
       if (joint.mimic || !joint.servo_types.Has(ServoType::kSetPoint)) continue;
       for (size_t k = 0; k < joint.dofs.size(); ++k) mask[static_cast<size_t>(model_.dof_offset(j)) + k] = 1;
@@ -152,7 +155,8 @@ KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions&
   base_type_ = root.base;
   const Eigen::Matrix3d r = root.pose_in_world.rotation.normalized().toRotationMatrix();
   theta_ = std::atan2(r(1, 0), r(0, 0));
-  base_residual_ = Eigen::AngleAxisd(-theta_, Eigen::Vector3d::UnitZ()) * root.pose_in_world.rotation.normalized();
+  base_residual_ =
+      Eigen::AngleAxisd(-theta_, Eigen::Vector3d::UnitZ()) * root.pose_in_world.rotation.normalized();
   x_ = root.pose_in_world.translation.x();
   y_ = root.pose_in_world.translation.y();
   z_ = root.pose_in_world.translation.z();
@@ -258,8 +262,10 @@ void KinematicDriver::StepBase(double dt, std::vector<Completion>& completed) {
   const double dist = std::hypot(dx, dy);
   if (dist <= tol) goto_phase_ = GotoPhase::kFinalTurn;
   const double heading_error = WrapAngle(std::atan2(dy, dx) - theta_);
-  if (goto_phase_ == GotoPhase::kDrive && std::abs(heading_error) > wmax * dt) goto_phase_ = GotoPhase::kTurnToGoal;
-  if (goto_phase_ == GotoPhase::kTurnToGoal && std::abs(heading_error) <= wmax * dt) goto_phase_ = GotoPhase::kDrive;
+  if (goto_phase_ == GotoPhase::kDrive && std::abs(heading_error) > wmax * dt)
+    goto_phase_ = GotoPhase::kTurnToGoal;
+  if (goto_phase_ == GotoPhase::kTurnToGoal && std::abs(heading_error) <= wmax * dt)
+    goto_phase_ = GotoPhase::kDrive;
   switch (goto_phase_) {
     case GotoPhase::kTurnToGoal:
       IntegrateBase(0, 0, std::copysign(wmax, heading_error), dt);
@@ -284,7 +290,8 @@ void KinematicDriver::StepBase(double dt, std::vector<Completion>& completed) {
 
 DriverResult KinematicDriver::SetSpeed(const DriverCommand& c) {
   if (c.num_values != 2 && c.num_values != 3) {
-    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " + std::to_string(c.num_values));
+    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
+                                      std::to_string(c.num_values));
   }
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
@@ -351,8 +358,9 @@ DriverResult KinematicDriver::JointSetPoint(const DriverCommand& c) {
     const double got = std::clamp(want, lower_[i], upper_[i]);
     if (got != want) {
       const char* unit = Unit(joint.dofs[static_cast<size_t>(k)].type);
-      note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " + unit +
-              " clamped to the " + (want > got ? "upper" : "lower") + " limit " + Num(got) + " " + unit;
+      note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " +
+              unit + " clamped to the " + (want > got ? "upper" : "lower") + " limit " + Num(got) + " " +
+              unit;
     }
     mode_[static_cast<size_t>(i)] = DofMode::kPosition;
     target_[i] = got;
@@ -390,7 +398,8 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
                                    ": no joint between the frame and its root accepts set-points");
   }
   const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
-  const Eigen::Quaterniond goal_r = Eigen::Quaterniond(c.values[3], c.values[4], c.values[5], c.values[6]).normalized();
+  const Eigen::Quaterniond goal_r =
+      Eigen::Quaterniond(c.values[3], c.values[4], c.values[5], c.values[6]).normalized();
   UpdateRootPoses();
 
   // Damped least squares on a copy of q: dq = J^T (J J^T + lambda^2 I)^-1 e,
@@ -457,7 +466,8 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
 
 // ---------------------------------------------------------------- commands
 
-DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed) {
+DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
+                                      std::vector<Completion>& completed) {
   Advance(now, completed);
   const char* name = ToString(c.type);
   if (c.type == CommandType::kStop) {
@@ -481,7 +491,8 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now, std
       // The server checked these (CheckCommand); re-checked because a driver
       // must not index out of its arrays whatever it is given.
       if (c.target < 0 || c.target >= static_cast<int>(model_.joints().size())) {
-        return Answer(Signal::kError, std::string(name) + ": no joint with index " + std::to_string(c.target));
+        return Answer(Signal::kError,
+                      std::string(name) + ": no joint with index " + std::to_string(c.target));
       }
       const Joint& joint = model_.joint(c.target);
       if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
@@ -490,7 +501,8 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now, std
                                           std::to_string(c.num_values));
       }
       if (c.type == CommandType::kJointForce) {
-        return Answer(Signal::kNa, "JOINT_FORCE " + Quote(joint.name) + ": the kinematic driver simulates no dynamics");
+        return Answer(Signal::kNa,
+                      "JOINT_FORCE " + Quote(joint.name) + ": the kinematic driver simulates no dynamics");
       }
       if (joint.mimic) {
         return Answer(Signal::kNa, std::string(name) + " " + Quote(joint.name) + ": the joint follows " +
@@ -500,16 +512,19 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now, std
     }
     case CommandType::kFrameSetPoint:
       if (c.target < 0 || c.target >= static_cast<int>(model_.frames().size())) {
-        return Answer(Signal::kError, "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
+        return Answer(Signal::kError,
+                      "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
       }
       if (c.num_values != 7) {
-        return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " + std::to_string(c.num_values));
+        return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " +
+                                          std::to_string(c.num_values));
       }
       return FrameSetPoint(c);
     case CommandType::kGoto:
     case CommandType::kSetSpeed:
       if (!mobile_base()) {
-        return Answer(Signal::kNa, std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
+        return Answer(Signal::kNa,
+                      std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
       }
       return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
     case CommandType::kStop:
@@ -521,7 +536,8 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now, std
 
 void KinematicDriver::StopAll(const char* why, std::vector<Completion>& completed) {
   if (base_mode_ == BaseMode::kGoto) {
-    completed.push_back(Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
+    completed.push_back(
+        Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
   }
   base_mode_ = BaseMode::kIdle;
   cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
@@ -553,7 +569,8 @@ void KinematicDriver::ReadState(RobotState& state) const {
   bool moving = base_mode_ != BaseMode::kIdle || v_ != 0 || vy_ != 0 || omega_ != 0;
   for (Eigen::Index i = 0; i < q_.size() && !moving; ++i) {
     if (mimic_leader_dof_[static_cast<size_t>(i)] >= 0) continue;  // follows its leader
-    moving = qd_[i] != 0 || (mode_[static_cast<size_t>(i)] == DofMode::kPosition ? q_[i] != target_[i] : speed_[i] != 0);
+    moving = qd_[i] != 0 ||
+             (mode_[static_cast<size_t>(i)] == DofMode::kPosition ? q_[i] != target_[i] : speed_[i] != 0);
   }
   state.moving = moving;
 }
@@ -564,7 +581,8 @@ void RegisterKinematicDriver(DriverRegistry& registry) {
   registry.Register("kinematic", [](const DriverConfig& config) -> std::unique_ptr<Driver> {
     const KinematicDriverOptions options = KinematicDriverOptions::FromMap(config.options);
     if (config.urdf_path.empty()) {
-      throw Error("kinematic driver for robot '" + config.robot_name + "': no URDF file (DriverConfig::urdf_path)");
+      throw Error("kinematic driver for robot '" + config.robot_name +
+                  "': no URDF file (DriverConfig::urdf_path)");
     }
     UrdfImportOptions import;
     import.merge_massless_chains = options.merge_chains;

@@ -31,9 +31,9 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace robotalk {
 namespace {
 
-using ::testing::HasSubstr;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
+using ::testing::HasSubstr;
 constexpr double kPi = std::numbers::pi;
 constexpr auto kPeriod = milliseconds(10);
 
@@ -45,11 +45,13 @@ DriverCommand Cmd(CommandId id, CommandType type, int target, std::initializer_l
 }
 
 RobotModel Pioneer(bool merge = false) {
-  return LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf"), {.merge_massless_chains = merge}).model;
+  return LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf"), {.merge_massless_chains = merge})
+      .model;
 }
 
 Dof Revolute(double lower, double upper, double velocity) {
-  return Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitZ(),
+  return Dof{.type = DofType::kRevolute,
+             .axis = Eigen::Vector3d::UnitZ(),
              .limits = {.lower = lower, .upper = upper, .velocity = velocity}};
 }
 
@@ -60,12 +62,15 @@ RobotModel TwoLinkArm(BaseType base = BaseType::kFixed, const Pose& root_pose = 
   b.AddLink({.name = "base"}).AddLink({.name = "upper"}).AddLink({.name = "lower"});
   b.AddJoint(Joint{.name = "shoulder", .dofs = {Revolute(-kPi, kPi, 1.0)}, .servo_types = ServoTypes::All()},
              "base", "upper");
-  b.AddJoint(Joint{.name = "elbow", .inboard = {0.5, 0, 0}, .dofs = {Revolute(0.0, 2.5, 1.0)},
+  b.AddJoint(Joint{.name = "elbow",
+                   .inboard = {0.5, 0, 0},
+                   .dofs = {Revolute(0.0, 2.5, 1.0)},
                    .servo_types = ServoTypes::All()},
              "upper", "lower");
-  b.AddControlFrame(ControlFrame{.name = "tool", .pose_in_link = {.translation = {0.4, 0, 0}},
-                                 .servo_types = ServoType::kSetPoint},
-                    "lower");
+  b.AddControlFrame(
+      ControlFrame{
+          .name = "tool", .pose_in_link = {.translation = {0.4, 0, 0}}, .servo_types = ServoType::kSetPoint},
+      "lower");
   b.SetRoot("base", root_pose, base);
   return b.Build();
 }
@@ -193,7 +198,8 @@ TEST(KinematicDriver, SpeedAboveTheVelocityLimitIsClampedWithModified) {
 TEST(KinematicDriver, JointWithoutVelocityLimitMovesAtTheDefaultVelocity) {
   RobotModelBuilder b("slider");
   b.AddLink({.name = "a"}).AddLink({.name = "b"});
-  b.AddJoint(Joint{.name = "x", .dofs = {Dof{.type = DofType::kPrismatic, .axis = Eigen::Vector3d::UnitX()}},
+  b.AddJoint(Joint{.name = "x",
+                   .dofs = {Dof{.type = DofType::kPrismatic, .axis = Eigen::Vector3d::UnitX()}},
                    .servo_types = ServoTypes::All()},
              "a", "b");
   KinematicDriver d(b.Build(), {.default_velocity = 0.25});
@@ -214,7 +220,8 @@ TEST(KinematicDriver, JointForceAnswersNaBecauseThereAreNoDynamics) {
 TEST(KinematicDriver, MimicJointFollowsItsLeader) {
   RobotModelBuilder b("gripper");
   b.AddLink({.name = "palm"}).AddLink({.name = "left"}).AddLink({.name = "right"});
-  b.AddJoint(Joint{.name = "l", .dofs = {Revolute(-1, 1, 1.0)}, .servo_types = ServoTypes::All()}, "palm", "left");
+  b.AddJoint(Joint{.name = "l", .dofs = {Revolute(-1, 1, 1.0)}, .servo_types = ServoTypes::All()}, "palm",
+             "left");
   b.AddJoint(Joint{.name = "r", .dofs = {Revolute(-1, 1, 1.0)}}, "palm", "right");
   b.SetMimic("r", "l", -1.0, 0.0);
   KinematicDriver d(b.Build());
@@ -293,7 +300,8 @@ TEST(KinematicDriver, RootPoseComposesThePlanarPoseWithTheModelRootPose) {
   // Root 0.2 m up, rolled by 0.1 rad and yawed by pi/2 in the model.
   const Eigen::Quaterniond yaw(Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitZ()));
   const Eigen::Quaterniond roll(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()));
-  KinematicDriver d(TwoLinkArm(BaseType::kDifferential, {.translation = {1, 2, 0.2}, .rotation = yaw * roll}));
+  KinematicDriver d(
+      TwoLinkArm(BaseType::kDifferential, {.translation = {1, 2, 0.2}, .rotation = yaw * roll}));
   Sim sim(d);
   sim.Run(Cmd(1, CommandType::kSetSpeed, -1, {0.5, 0.0}));
   sim.Advance(seconds(1));  // drives along world +y
@@ -476,8 +484,10 @@ TEST(KinematicDriver, FrameSetPointReachesAPoseOnTheIiwa14) {
   std::vector<ControlFrame> frames(iiwa.frames().begin(), iiwa.frames().end());
   const int last = iiwa.LinkIndex("iiwa_link_7");
   const int tool = static_cast<int>(frames.size());
-  frames.push_back(ControlFrame{.name = "tool", .parent_link = last,
-                                .pose_in_link = {.translation = {0, 0, 0.1}}, .servo_types = ServoType::kSetPoint});
+  frames.push_back(ControlFrame{.name = "tool",
+                                .parent_link = last,
+                                .pose_in_link = {.translation = {0, 0, 0.1}},
+                                .servo_types = ServoType::kSetPoint});
   std::vector<Link> links(iiwa.links().begin(), iiwa.links().end());
   std::vector<Joint> joints(iiwa.joints().begin(), iiwa.joints().end());
   std::vector<RootLink> roots(iiwa.roots().begin(), iiwa.roots().end());
@@ -528,15 +538,17 @@ TEST(KinematicDriver, RegistryCreatesTheKinematicDriverFromThePioneerUrdf) {
   DriverRegistry registry;
   RegisterKinematicDriver(registry);
   EXPECT_THAT(registry.names(), ::testing::Contains("kinematic"));
-  const DriverConfig config{.robot_name = "pioneer",
-                            .urdf_path = testing::ProjectModel("pioneer2dx_pantilt.urdf"),
-                            .options = {{"merge_chains", "true"}, {"period_ms", "20"}, {"base_max_v", "0.5"}}};
+  const DriverConfig config{
+      .robot_name = "pioneer",
+      .urdf_path = testing::ProjectModel("pioneer2dx_pantilt.urdf"),
+      .options = {{"merge_chains", "true"}, {"period_ms", "20"}, {"base_max_v", "0.5"}}};
   const std::unique_ptr<Driver> d = registry.Create("kinematic", config);
   EXPECT_EQ(d->model().name(), "pioneer");
   EXPECT_TRUE(d->model().FindJoint("pan+tilt").has_value());
   EXPECT_EQ(d->period(), milliseconds(20));
   std::vector<Completion> done;
-  const DriverResult r = d->Execute(Cmd(1, CommandType::kSetSpeed, -1, {0.6, 0.0}), TimePoint(seconds(1)), done);
+  const DriverResult r =
+      d->Execute(Cmd(1, CommandType::kSetSpeed, -1, {0.6, 0.0}), TimePoint(seconds(1)), done);
   EXPECT_EQ(r.signal, Signal::kModified);  // base_max_v = 0.5
 }
 
