@@ -1,6 +1,7 @@
 #include "robotalk/config_codec.h"
 
 #include "robotalk/error.h"
+#include "wire_scanner.h"
 
 #include <algorithm>
 #include <cinttypes>
@@ -24,7 +25,6 @@ constexpr std::size_t kFingerprintSize = 8;
 constexpr std::size_t kHashOffset = kFingerprintSize + 4;
 constexpr std::size_t kHashSize = 8;
 // An LCM string is an int32 length (including the trailing NUL), the bytes, a NUL.
-constexpr std::int64_t kStringOverhead = 4 + 1;
 constexpr std::uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
 constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 
@@ -83,7 +83,7 @@ struct Offsets {
 Offsets BlockOffsets(const msgs::robot_config_t& msg) {
   Offsets o{};
   std::int64_t pos = static_cast<std::int64_t>(kFingerprintSize) + msg.header._getEncodedSizeNoHash() +
-                     kStringOverhead + static_cast<std::int64_t>(msg.robot_name.size());
+                     kLcmStringOverhead + static_cast<std::int64_t>(msg.robot_name.size());
   o.links = pos;
   pos += 4;
   for (const auto& l : msg.links) pos += l._getEncodedSizeNoHash();
@@ -137,14 +137,14 @@ struct ElementSizes {
 const ElementSizes& Sizes() {
   static const ElementSizes sizes = [] {
     ElementSizes s{};
-    s.link_fixed = msgs::link_t{}._getEncodedSizeNoHash() - kStringOverhead;
+    s.link_fixed = msgs::link_t{}._getEncodedSizeNoHash() - kLcmStringOverhead;
     s.dof = msgs::dof_t{}._getEncodedSizeNoHash();
-    s.frame_fixed = msgs::control_frame_t{}._getEncodedSizeNoHash() - kStringOverhead;
+    s.frame_fixed = msgs::control_frame_t{}._getEncodedSizeNoHash() - kLcmStringOverhead;
     s.root = msgs::root_link_t{}._getEncodedSizeNoHash();
     s.header = msgs::config_header_t{}._getEncodedSizeNoHash();
     // The scanner hard-codes joint_t's layout around its dof array; a change
     // of joint_t.lcm without a change here is a programming error.
-    if (msgs::joint_t{}._getEncodedSizeNoHash() != kStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs) {
+    if (msgs::joint_t{}._getEncodedSizeNoHash() != kLcmStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs) {
       std::fprintf(stderr, "robotalk: config_codec.cpp scanner is out of date with joint_t.lcm\n");
       std::abort();
     }
@@ -153,86 +153,7 @@ const ElementSizes& Sizes() {
   return sizes;
 }
 
-class Scanner {
- public:
-  Scanner(const char* function, std::span<const std::uint8_t> bytes) : function_(function), bytes_(bytes) {}
-
-  std::size_t pos() const { return pos_; }
-  std::size_t left() const { return bytes_.size() - pos_; }
-  // The element being scanned, for messages ("links[3]").
-  void SetContext(std::string context) { context_ = std::move(context); }
-
-  void Skip(std::int64_t n, const char* field) {
-    Need(n, field);
-    pos_ += static_cast<std::size_t>(n);
-  }
-
-  std::int64_t Int64(const char* field) {
-    Need(8, field);
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v = (v << 8) | bytes_[pos_++];
-    return static_cast<std::int64_t>(v);
-  }
-
-  std::int32_t Int32(const char* field) {
-    Need(4, field);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v = (v << 8) | bytes_[pos_++];
-    return static_cast<std::int32_t>(v);
-  }
-
-  std::int8_t Int8(const char* field) {
-    Need(1, field);
-    return static_cast<std::int8_t>(bytes_[pos_++]);
-  }
-
-  void String(const char* field) {
-    const std::size_t at = pos_;
-    const std::int32_t len = Int32(field);
-    if (len < 1 || static_cast<std::size_t>(len) > left()) {
-      Fail(field, "string length " + std::to_string(len) + " at byte " + std::to_string(at) + " is outside [1, " +
-                      std::to_string(left()) + "] (the bytes left)");
-    }
-    const auto* begin = bytes_.data() + pos_;
-    if (begin[len - 1] != 0) Fail(field, "string at byte " + std::to_string(at) + " lacks its terminating NUL");
-    if (std::memchr(begin, 0, static_cast<std::size_t>(len - 1)) != nullptr) {
-      Fail(field, "string at byte " + std::to_string(at) + " contains a NUL byte");
-    }
-    pos_ += static_cast<std::size_t>(len);
-  }
-
-  // A block count: non-negative, and its elements (each at least
-  // `min_element` bytes) must fit in what is left.
-  std::int32_t Count(const char* field, std::int64_t min_element) {
-    const std::size_t at = pos_;
-    const std::int32_t n = Int32(field);
-    if (n < 0 || static_cast<std::int64_t>(n) * min_element > static_cast<std::int64_t>(left())) {
-      Fail(field, std::to_string(n) + " at byte " + std::to_string(at) + " is negative or cannot fit in the " +
-                      std::to_string(left()) + " bytes left (each element takes at least " +
-                      std::to_string(min_element) + ")");
-    }
-    return n;
-  }
-
-  [[noreturn]] void Fail(const char* field, const std::string& what) const {
-    Protocol(function_, (context_.empty() ? std::string() : context_ + ".") + field + ": " + what);
-  }
-
- private:
-  void Need(std::int64_t n, const char* field) const {
-    if (n > static_cast<std::int64_t>(left())) {
-      Fail(field, "truncated: needs " + std::to_string(n) + " bytes at byte " + std::to_string(pos_) + ", " +
-                      std::to_string(left()) + " left of " + std::to_string(bytes_.size()));
-    }
-  }
-
-  const char* function_;
-  std::span<const std::uint8_t> bytes_;
-  std::size_t pos_ = 0;
-  std::string context_;
-};
-
-void CheckFingerprint(Scanner& s) {
+void CheckFingerprint(WireScanner& s) {
   const std::int64_t fingerprint = s.Int64("fingerprint");
   if (fingerprint != msgs::robot_config_t::getHash()) {
     s.Fail("fingerprint", Hex(static_cast<std::uint64_t>(fingerprint)) + " is not robot_config_t's " +
@@ -243,19 +164,19 @@ void CheckFingerprint(Scanner& s) {
 // Walks a whole robot_config_t; returns its length. Throws ProtocolError.
 std::size_t ScanConfig(std::span<const std::uint8_t> bytes) {
   const ElementSizes& z = Sizes();
-  Scanner s("DecodeConfig", bytes);
+  WireScanner s("DecodeConfig", bytes);
   CheckFingerprint(s);
   s.Skip(z.header, "header");
   s.String("robot_name");
 
-  const std::int32_t num_links = s.Count("num_links", kStringOverhead + z.link_fixed);
+  const std::int32_t num_links = s.Count("num_links", kLcmStringOverhead + z.link_fixed);
   for (std::int32_t i = 0; i < num_links; ++i) {
     s.SetContext(Element("links", static_cast<std::size_t>(i)));
     s.String("name");
     s.Skip(z.link_fixed, "mass, com, inertia");
   }
   s.SetContext({});
-  const std::int32_t num_joints = s.Count("num_joints", kStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs);
+  const std::int32_t num_joints = s.Count("num_joints", kLcmStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs);
   for (std::int32_t i = 0; i < num_joints; ++i) {
     s.SetContext(Element("joints", static_cast<std::size_t>(i)));
     s.String("name");
@@ -268,7 +189,7 @@ std::size_t ScanConfig(std::span<const std::uint8_t> bytes) {
     s.Skip(kJointAfterDofs, "mimic");
   }
   s.SetContext({});
-  const std::int32_t num_frames = s.Count("num_frames", kStringOverhead + z.frame_fixed);
+  const std::int32_t num_frames = s.Count("num_frames", kLcmStringOverhead + z.frame_fixed);
   for (std::int32_t i = 0; i < num_frames; ++i) {
     s.SetContext(Element("frames", static_cast<std::size_t>(i)));
     s.String("name");
@@ -582,7 +503,7 @@ RobotModel DecodeConfig(std::span<const std::uint8_t> bytes) {
 
 robotalk_msgs::config_header_t DecodeConfigHeader(std::span<const std::uint8_t> bytes) {
   const ElementSizes& z = Sizes();
-  Scanner s("DecodeConfigHeader", bytes);
+  WireScanner s("DecodeConfigHeader", bytes);
   CheckFingerprint(s);
   const std::size_t start = s.pos();
   s.Skip(z.header, "header");

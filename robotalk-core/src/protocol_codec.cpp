@@ -1,110 +1,55 @@
 #include "robotalk/protocol_codec.h"
 
 #include "robotalk/error.h"
+#include "wire_scanner.h"
 
-#include <cstring>
+#include <climits>
 
 namespace robotalk {
 namespace {
 
-// Walks LCM's big-endian encoding with bounds checks (see the header).
-class WireWalker {
- public:
-  WireWalker(std::span<const std::uint8_t> bytes, const char* message) : bytes_(bytes), message_(message) {}
+// Smallest encodings of the array elements (an empty string takes 5 bytes).
+constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead;
+constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2;
+constexpr std::int64_t kMinReplyBytes = 8 + 1 + kLcmStringOverhead + 8 + 8 + 4;
 
-  void Skip(size_t n, const char* field) {
-    if (n > bytes_.size() - pos_) Fail(std::string(field) + " needs " + std::to_string(n) + " bytes");
-    pos_ += n;
+void ScanPackage(WireScanner& s) {
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4, "header");
+  const std::int32_t nq = s.Count("num_queries", kMinQueryBytes);
+  for (std::int32_t i = 0; i < nq; ++i) {
+    s.Skip(8 + 1, "query");
+    s.String("query.target");
   }
-  std::int64_t ReadInt(size_t n, const char* field) {
-    if (n > bytes_.size() - pos_) Fail(std::string(field) + " needs " + std::to_string(n) + " bytes");
-    std::uint64_t v = 0;
-    for (size_t i = 0; i < n; ++i) v = (v << 8) | bytes_[pos_ + i];
-    pos_ += n;
-    // Sign-extend from n bytes.
-    const unsigned shift = static_cast<unsigned>(64 - 8 * n);
-    return static_cast<std::int64_t>(v << shift) >> shift;
+  const std::int32_t nc = s.Count("num_commands", kMinCommandBytes);
+  for (std::int32_t i = 0; i < nc; ++i) {
+    s.Skip(8 + 1 + 8, "command");
+    s.String("command.target");
+    s.Skip(std::int64_t{8} * s.Count16("command.num_values", 8), "command.values");
   }
-  void SkipString(const char* field) {
-    const std::int64_t len = ReadInt(4, field);
-    if (len < 1) Fail(std::string(field) + " has invalid length " + std::to_string(len));
-    Skip(static_cast<size_t>(len), field);
-  }
-  // An array count: non-negative and small enough that every element (at
-  // least `min_element_bytes` each) can still fit in what is left.
-  std::int64_t ReadCount(size_t n, const char* field, size_t min_element_bytes) {
-    const std::int64_t count = ReadInt(n, field);
-    if (count < 0) Fail(std::string(field) + " is negative (" + std::to_string(count) + ")");
-    if (static_cast<std::uint64_t>(count) * min_element_bytes > bytes_.size() - pos_) {
-      Fail(std::string(field) + " = " + std::to_string(count) + " does not fit in the " +
-           std::to_string(bytes_.size() - pos_) + " bytes left");
-    }
-    return count;
-  }
-  void ExpectEnd() {
-    if (pos_ != bytes_.size()) Fail(std::to_string(bytes_.size() - pos_) + " trailing bytes");
-  }
-  [[noreturn]] void Fail(const std::string& what) const {
-    throw ProtocolError(std::string(message_) + ": malformed message (" + std::to_string(bytes_.size()) +
-                        " bytes): " + what);
-  }
-
- private:
-  std::span<const std::uint8_t> bytes_;
-  size_t pos_ = 0;
-  const char* message_;
-};
-
-// Smallest encodings: id + type + empty string ("\0" with length 1) ...
-constexpr size_t kMinQueryBytes = 8 + 1 + 5;
-constexpr size_t kMinCommandBytes = 8 + 1 + 8 + 5 + 2;
-constexpr size_t kMinReplyBytes = 8 + 1 + 5 + 8 + 8 + 4;
-
-void WalkPackage(WireWalker& w) {
-  w.Skip(8, "fingerprint");
-  w.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4, "header");
-  const std::int64_t nq = w.ReadCount(4, "num_queries", kMinQueryBytes);
-  for (std::int64_t i = 0; i < nq; ++i) {
-    w.Skip(8 + 1, "query");
-    w.SkipString("query.target");
-  }
-  const std::int64_t nc = w.ReadCount(4, "num_commands", kMinCommandBytes);
-  for (std::int64_t i = 0; i < nc; ++i) {
-    w.Skip(8 + 1 + 8, "command");
-    w.SkipString("command.target");
-    const std::int64_t nv = w.ReadCount(2, "command.num_values", 8);
-    w.Skip(static_cast<size_t>(nv) * 8, "command.values");
-  }
-  w.ExpectEnd();
 }
 
-void WalkReplyPackage(WireWalker& w) {
-  w.Skip(8, "fingerprint");
-  w.Skip(2 + 8 + 8 + 8 + 8, "header");
-  const std::int64_t nr = w.ReadCount(4, "num_replies", kMinReplyBytes);
-  for (std::int64_t i = 0; i < nr; ++i) {
-    w.Skip(8 + 1, "reply");
-    w.SkipString("reply.message");
-    w.Skip(8 + 8, "reply times");
-    const std::int64_t nv = w.ReadCount(4, "reply.num_values", 8);
-    w.Skip(static_cast<size_t>(nv) * 8, "reply.values");
+void ScanReplyPackage(WireScanner& s) {
+  s.Skip(2 + 8 + 8 + 8 + 8, "header");
+  const std::int32_t nr = s.Count("num_replies", kMinReplyBytes);
+  for (std::int32_t i = 0; i < nr; ++i) {
+    s.Skip(8 + 1, "reply");
+    s.String("reply.message");
+    s.Skip(8 + 8, "reply times");
+    s.Skip(std::int64_t{8} * s.Count("reply.num_values", 8), "reply.values");
   }
-  w.ExpectEnd();
 }
 
 template <typename Msg>
-Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* name, void (*walk)(WireWalker&)) {
-  if (bytes.size() > static_cast<size_t>(INT32_MAX)) throw ProtocolError(std::string(name) + ": message too large");
-  WireWalker walker(bytes, name);
+Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* function, void (*scan)(WireScanner&)) {
+  if (bytes.size() > static_cast<size_t>(INT32_MAX)) throw ProtocolError(std::string(function) + ": message too large");
+  WireScanner s(function, bytes);
   // The fingerprint first: a message of another type gives a clear error.
-  if (bytes.size() < 8) walker.Fail("shorter than LCM's 8-byte fingerprint");
-  std::int64_t fingerprint = 0;
-  for (int i = 0; i < 8; ++i) fingerprint = (fingerprint << 8) | bytes[static_cast<size_t>(i)];
-  if (fingerprint != Msg::getHash()) walker.Fail("fingerprint does not match (another message type?)");
-  walk(walker);
-  Msg msg;
+  if (s.Int64("fingerprint") != Msg::getHash()) s.Fail("fingerprint", "does not match (another message type?)");
+  scan(s);
+  s.ExpectEnd();
+  Msg msg{};
   if (msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
-    walker.Fail("LCM decode failed");
+    s.Fail("message", "LCM decode failed");
   }
   return msg;
 }
@@ -179,11 +124,11 @@ Reply FromWire(const robotalk_msgs::reply_t& w) {
 }
 
 robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes) {
-  return DecodeChecked<robotalk_msgs::package_t>(bytes, "package_t", &WalkPackage);
+  return DecodeChecked<robotalk_msgs::package_t>(bytes, "DecodePackage", &ScanPackage);
 }
 
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes) {
-  return DecodeChecked<robotalk_msgs::reply_package_t>(bytes, "reply_package_t", &WalkReplyPackage);
+  return DecodeChecked<robotalk_msgs::reply_package_t>(bytes, "DecodeReplyPackage", &ScanReplyPackage);
 }
 
 std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {

@@ -134,8 +134,8 @@ XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source) {
     if (tag == "link") {
       auto [it, fresh] = link_lines.emplace(name, e->Row());
       if (!fresh) {
-        Refuse(source, "duplicate link name " + Quote(name) + " (lines " + std::to_string(it->second) + " and " +
-                           std::to_string(e->Row()) + ")");
+        Refuse(source, "duplicate link name " + Quote(name) + " (lines " + std::to_string(it->second) +
+                           " and " + std::to_string(e->Row()) + ")");
       }
       scan.links.emplace_back(name);
       continue;
@@ -169,8 +169,8 @@ XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source) {
                            " link=...>");
       }
       if (!link_lines.contains(*link)) {
-        Refuse(source, "joint " + Quote(joint) + " (line " + std::to_string(info.line) + "): unknown " + role +
-                           " link " + Quote(*link));
+        Refuse(source, "joint " + Quote(joint) + " (line " + std::to_string(info.line) + "): unknown " +
+                           role + " link " + Quote(*link));
       }
     }
   }
@@ -187,7 +187,8 @@ Extensions ParseExtensions(const TiXmlElement& robot, const std::string& source)
   }
   RequireOnlyAttributes(*block, {"version"}, source);
   if (const char* version = block->Attribute("version"); version != nullptr && std::string(version) != "1") {
-    Refuse(source, "<robotalk version=" + Quote(version) + ">" + At(*block) + ": unsupported version (expected 1)");
+    Refuse(source,
+           "<robotalk version=" + Quote(version) + ">" + At(*block) + ": unsupported version (expected 1)");
   }
   std::set<std::string> frame_names, servo_joints;
   for (const TiXmlElement* e = block->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {

@@ -47,7 +47,8 @@ class CaptureHandler : public console_bridge::OutputHandler {
 
   void log(const std::string& text, console_bridge::LogLevel level, const char* filename, int line) override {
     if (std::this_thread::get_id() != owner_.load()) {
-      if (console_bridge::OutputHandler* previous = previous_.load()) previous->log(text, level, filename, line);
+      if (console_bridge::OutputHandler* previous = previous_.load())
+        previous->log(text, level, filename, line);
       return;
     }
     if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
@@ -105,9 +106,13 @@ std::string Join(const std::vector<std::string>& items, const std::string& separ
 
 Eigen::Vector3d ToEigen(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
 
-Eigen::Quaterniond ToEigen(const urdf::Rotation& r) { return Eigen::Quaterniond(r.w, r.x, r.y, r.z).normalized(); }
+Eigen::Quaterniond ToEigen(const urdf::Rotation& r) {
+  return Eigen::Quaterniond(r.w, r.x, r.y, r.z).normalized();
+}
 
-std::string Vec(const Eigen::Vector3d& v) { return "(" + Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z()) + ")"; }
+std::string Vec(const Eigen::Vector3d& v) {
+  return "(" + Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z()) + ")";
+}
 
 // A joint on its way into the model, links still named.
 struct Draft {
@@ -122,7 +127,8 @@ struct Draft {
 
 class Importer {
  public:
-  Importer(const UrdfImportOptions& options, std::string source) : options_(options), source_(std::move(source)) {}
+  Importer(const UrdfImportOptions& options, std::string source)
+      : options_(options), source_(std::move(source)) {}
 
   UrdfImportResult Run(const std::string& xml);
 
@@ -164,8 +170,8 @@ UrdfImportResult Importer::Run(const std::string& xml) {
   TiXmlDocument doc;
   doc.Parse(xml.c_str(), nullptr, TIXML_ENCODING_UTF8);
   if (doc.Error()) {
-    Fail("malformed XML at line " + std::to_string(doc.ErrorRow()) + ", column " + std::to_string(doc.ErrorCol()) +
-         ": " + doc.ErrorDesc());
+    Fail("malformed XML at line " + std::to_string(doc.ErrorRow()) + ", column " +
+         std::to_string(doc.ErrorCol()) + ": " + doc.ErrorDesc());
   }
   const TiXmlElement* robot = doc.RootElement();
   if (robot == nullptr || std::string(robot->Value()) != "robot") {
@@ -195,7 +201,8 @@ UrdfImportResult Importer::Run(const std::string& xml) {
   if (options_.merge_massless_chains) MergeMasslessChains();
   RobotModel built = Build(options_.robot_name.empty() ? model->getName() : options_.robot_name);
   if (options_.strict && !warnings_.empty()) {
-    Fail("strict import refuses " + std::to_string(warnings_.size()) + " warning(s): " + Join(warnings_, "; "));
+    Fail("strict import refuses " + std::to_string(warnings_.size()) +
+         " warning(s): " + Join(warnings_, "; "));
   }
   return UrdfImportResult{std::move(built), std::move(warnings_)};
 }
@@ -216,7 +223,8 @@ urdf::ModelInterfaceSharedPtr Importer::ParseWithUrdfdom(const std::string& xml)
   // urdfdom logs an error yet returns a model for some defects (an <inertial>
   // without <inertia> is dropped); a dropped mass is not a repair we accept.
   if (!model || !sink.errors.empty()) {
-    Fail("urdfdom rejected the file: " + (sink.errors.empty() ? std::string("no reason given") : Join(sink.errors, "; ")));
+    Fail("urdfdom rejected the file: " +
+         (sink.errors.empty() ? std::string("no reason given") : Join(sink.errors, "; ")));
   }
   for (const std::string& w : sink.warnings) Warn("urdfdom: " + w);
   return model;
@@ -235,7 +243,8 @@ void Importer::ImportLinks(const urdf::ModelInterface& model) {
       link.com = ToEigen(in->origin.position);
       Eigen::Matrix3d inertia;
       inertia << in->ixx, in->ixy, in->ixz, in->ixy, in->iyy, in->iyz, in->ixz, in->iyz, in->izz;
-      if (!link.com.allFinite() || !inertia.allFinite()) Fail(what + "inertial origin or inertia is not finite");
+      if (!link.com.allFinite() || !inertia.allFinite())
+        Fail(what + "inertial origin or inertia is not finite");
       const Eigen::Quaterniond q = ToEigen(in->origin.rotation);
       if (q.coeffs() != Eigen::Quaterniond::Identity().coeffs()) {
         // URDF gives the inertia in the inertial frame; RoboTalk wants it in
@@ -248,8 +257,9 @@ void Importer::ImportLinks(const urdf::ModelInterface& model) {
       if (link.mass > 0) {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(link.inertia, Eigen::EigenvaluesOnly);
         if (eig.eigenvalues().minCoeff() <= 0) {
-          Fail(what + "mass " + Num(link.mass) + " kg but the inertia is not positive-definite (principal moments " +
-               Vec(eig.eigenvalues()) + ")");
+          Fail(what + "mass " + Num(link.mass) +
+               " kg but the inertia is not positive-definite (principal moments " + Vec(eig.eigenvalues()) +
+               ")");
         }
       }
     }
@@ -268,13 +278,16 @@ void Importer::CheckTree(const urdf::ModelInterface& model) {
     if (!j) Fail("urdfdom lost joint " + Quote(name));
     auto p = link_index_.find(j->parent_link_name);
     auto c = link_index_.find(j->child_link_name);
-    if (p == link_index_.end()) Fail("joint " + Quote(name) + ": unknown parent link " + Quote(j->parent_link_name));
-    if (c == link_index_.end()) Fail("joint " + Quote(name) + ": unknown child link " + Quote(j->child_link_name));
-    if (p->second == c->second) Fail("joint " + Quote(name) + " joins link " + Quote(p->first) + " to itself");
+    if (p == link_index_.end())
+      Fail("joint " + Quote(name) + ": unknown parent link " + Quote(j->parent_link_name));
+    if (c == link_index_.end())
+      Fail("joint " + Quote(name) + ": unknown child link " + Quote(j->child_link_name));
+    if (p->second == c->second)
+      Fail("joint " + Quote(name) + " joins link " + Quote(p->first) + " to itself");
     const size_t child = static_cast<size_t>(c->second);
     if (parent[child] >= 0) {
-      Fail("not a tree: link " + Quote(c->first) + " has two parent joints, " + Quote(parent_joint[child]) + " and " +
-           Quote(name));
+      Fail("not a tree: link " + Quote(c->first) + " has two parent joints, " + Quote(parent_joint[child]) +
+           " and " + Quote(name));
     }
     parent[child] = p->second;
     parent_joint[child] = name;
@@ -360,7 +373,8 @@ std::vector<Dof> Importer::MakeDofs(const urdf::Joint& j, const urdf_detail::Xml
     if (!axis.allFinite()) Fail(what + "axis " + Vec(axis) + " is not finite");
     const double norm = axis.norm();
     if (norm == 0) Fail(what + "zero axis");
-    if (std::abs(norm - 1) > kAxisTolerance) Warn(what + "axis " + Vec(axis) + " is not a unit vector; normalised");
+    if (std::abs(norm - 1) > kAxisTolerance)
+      Warn(what + "axis " + Vec(axis) + " is not a unit vector; normalised");
     return axis / norm;
   };
   switch (j.type) {
@@ -410,7 +424,8 @@ void Importer::ImportJoints(const urdf::ModelInterface& model) {
     d.child = j.child_link_name;
     d.origin = ToEigen(j.parent_to_joint_origin_transform.position);
     const Eigen::Quaterniond rest = ToEigen(j.parent_to_joint_origin_transform.rotation);
-    if (!d.origin.allFinite() || !rest.coeffs().allFinite()) Fail("joint " + Quote(name) + ": origin is not finite");
+    if (!d.origin.allFinite() || !rest.coeffs().allFinite())
+      Fail("joint " + Quote(name) + ": origin is not finite");
     d.joint.name = name;
     d.joint.inboard = d.origin - links_[static_cast<size_t>(LinkIndex(d.parent))].com;
     d.joint.outboard = -links_[static_cast<size_t>(LinkIndex(d.child))].com;
@@ -438,7 +453,8 @@ void Importer::ResolveMimics() {
     } else if (&drafts_[static_cast<size_t>(leader)] == &d) {
       reason = "names the joint itself";
     } else if (drafts_[static_cast<size_t>(leader)].joint.dofs.size() != 1) {
-      reason = "needs a 1-dof leader; it has " + std::to_string(drafts_[static_cast<size_t>(leader)].joint.dofs.size());
+      reason = "needs a 1-dof leader; it has " +
+               std::to_string(drafts_[static_cast<size_t>(leader)].joint.dofs.size());
     } else if (d.joint.dofs.size() != 1) {
       reason = "needs a 1-dof joint; this one has " + std::to_string(d.joint.dofs.size());
     } else if (!std::isfinite(d.multiplier) || !std::isfinite(d.offset)) {
@@ -481,12 +497,14 @@ void Importer::ApplyExtensions() {
     d.joint.servo_types = types;
   }
   for (const urdf_detail::Extensions::Servo& s : ext_.servos) {
-    const std::string at = "<robotalk>: <servo joint=" + Quote(s.joint) + "> (line " + std::to_string(s.line) + "): ";
+    const std::string at =
+        "<robotalk>: <servo joint=" + Quote(s.joint) + "> (line " + std::to_string(s.line) + "): ";
     const int index = FindDraft(s.joint);
     if (index < 0) Fail(at + "unknown joint " + Quote(s.joint));
     Draft& d = drafts_[static_cast<size_t>(index)];
     if (!s.types.empty() && d.joint.dofs.empty()) Fail(at + "a fixed joint takes no servo commands");
-    if (!s.types.empty() && d.leader) Fail(at + "a mimic joint takes no servo commands (it follows " + Quote(*d.leader) + ")");
+    if (!s.types.empty() && d.leader)
+      Fail(at + "a mimic joint takes no servo commands (it follows " + Quote(*d.leader) + ")");
     d.joint.servo_types = s.types;
   }
   for (const urdf_detail::Extensions::Frame& f : ext_.frames) {
@@ -567,7 +585,8 @@ RobotModel Importer::Build(const std::string& robot_name) {
     if (d.leader) builder.SetMimic(d.joint.name, *d.leader, d.multiplier, d.offset);
   }
   for (const auto& f : ext_.frames) {
-    builder.AddControlFrame(ControlFrame{.name = f.name, .pose_in_link = f.pose, .servo_types = f.servo}, f.link);
+    builder.AddControlFrame(ControlFrame{.name = f.name, .pose_in_link = f.pose, .servo_types = f.servo},
+                            f.link);
   }
   if (ext_.base) {
     builder.SetRoot(root_, ext_.base->pose, ext_.base->type);
@@ -592,7 +611,8 @@ UrdfImportResult LoadUrdfFile(const std::string& path, const UrdfImportOptions& 
   return ParseUrdf(text.str(), options, path);
 }
 
-UrdfImportResult ParseUrdf(const std::string& xml, const UrdfImportOptions& options, const std::string& source_name) {
+UrdfImportResult ParseUrdf(const std::string& xml, const UrdfImportOptions& options,
+                           const std::string& source_name) {
   return Importer(options, source_name).Run(xml);
 }
 

@@ -61,6 +61,8 @@ class ServoTypes {
   std::uint8_t bits_ = 0;
 };
 
+constexpr ServoTypes operator|(ServoType a, ServoType b) { return ServoTypes(a) | ServoTypes(b); }
+
 /// A rigid transform stored as translation + unit quaternion, so that it
 /// survives encoding bit for bit (an Isometry3d's matrix would not).
 struct Pose {
