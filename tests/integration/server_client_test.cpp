@@ -60,7 +60,7 @@ class ServerClientTest : public ::testing::Test {
       return std::make_unique<CountingDriver>(registry_.Create("kinematic", config), log);
     });
     options.lcm_url = kUrl;
-    RobotSpec spec{"pioneer", "counting", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {{"merge_chains", "true"}}};
+    RobotSpec spec{"pioneer", "counting", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
     server_ = std::make_unique<Server>(options, std::vector<RobotSpec>{spec}, registry_, clock_);
     server_->Start();
   }
@@ -84,7 +84,7 @@ TEST_F(ServerClientTest, ConnectsLoadsTheConfigurationAndSynchronisesClocks) {
   StartServer();
   auto client = Connect();
   const RobotModel local =
-      LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf"), {.merge_massless_chains = true}).model;
+      LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model;
   EXPECT_EQ(client->model().num_dofs(), local.num_dofs());
   EXPECT_EQ(client->model().links().size(), local.links().size());
   // Same machine, same steady clock: the estimated offset is within the round trip.
@@ -95,7 +95,6 @@ TEST_F(ServerClientTest, ConnectsLoadsTheConfigurationAndSynchronisesClocks) {
 TEST_F(ServerClientTest, DrivesTheRobotInDirectMode) {
   StartServer();
   auto client = Connect();
-  const std::string head = client->model().joint(client->model().topological_joint_order().back()).name;
   Reply r = client->Goto(0.3, 0.0, 0.0);
   ASSERT_EQ(r.signal, Signal::kSuccess) << r.message;
   Reply pose = client->BasePose();
@@ -126,7 +125,7 @@ TEST_F(ServerClientTest, ExecutesEachCommandExactlyOnceDespiteLossAndDuplication
   client_options.connect_timeout = seconds(20);
   client_options.timeout = seconds(20);
   auto client = Connect(client_options);
-  const std::string pan = "ptu_pan";
+  const std::string pan = "pan";
   ASSERT_TRUE(client->model().FindJoint(pan)) << "the demo robot's pan joint";
   ASSERT_EQ(client->model().joint(client->model().JointIndex(pan)).dofs.size(), 1u);
 
