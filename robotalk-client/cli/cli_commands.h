@@ -1,0 +1,30 @@
+// The subcommands of the `robotalk` CLI (docs/client.md). Each returns the
+// process exit status: 0 when every reply is SUCCESS or MODIFIED, 1 for any
+// other signal, a timeout or a client error; usage errors throw UsageError
+// (exit 2, handled by main).
+#pragma once
+
+#include "robotalk/robot_client.h"
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace robotalk::cli {
+
+struct GlobalOptions {
+  std::string url;         ///< --url; "" = LCM default
+  double timeout_s = 5.0;  ///< --timeout
+};
+
+/// `<id> <SIGNAL> "<message>" [values]` on one line.
+void PrintReply(const Reply& r, std::ostream& out);
+
+int RunRobots(const GlobalOptions& g, const std::vector<std::string>& args);
+int RunDescribe(const GlobalOptions& g, const std::vector<std::string>& args);
+int RunQuery(const GlobalOptions& g, const std::vector<std::string>& args);
+int RunSend(const GlobalOptions& g, const std::vector<std::string>& args);
+int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args);
+int RunReset(const GlobalOptions& g, const std::vector<std::string>& args);
+
+}  // namespace robotalk::cli

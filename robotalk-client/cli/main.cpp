@@ -1,0 +1,80 @@
+// robotalk: command-line client of a RoboTalk server (docs/client.md).
+#include "cli_commands.h"
+#include "sequence_file.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] COMMAND ...
+
+  robots [--listen S]                 robots announced on ROBOTALK/ANNOUNCE (default 1.5 s)
+  describe ROBOT [--json]             the robot's description (links, joints, frames)
+  query ROBOT TYPE [TARGET]           TYPE: joint_state | link_poses | frame_poses | base_pose
+  send ROBOT COMMAND ARGS... [--at S] one command, e.g.
+                                        send pioneer goto 1 0 0
+                                        send pioneer joint_setpoint pan_tilt 0.5 0.2
+                                        send pioneer setspeed 0.2 0.1
+                                        send pioneer stop --at 2
+                                      --at S: start S seconds from now (server clock)
+  send ROBOT --file SEQ.txt           a timed sequence (format: docs/client.md)
+  panic ROBOT                         panic: stop everything, refuse commands
+  reset ROBOT                         PANIC_RESET
+
+Global options:
+  --url URL      LCM URL (default: $LCM_DEFAULT_URL or LCM's default)
+  --timeout S    seconds to wait for each reply (default 5)
+  --help         this text (also after a command)
+
+Each reply prints as: <id> <SIGNAL> "<message>" [values]
+Exit status: 0 SUCCESS/MODIFIED, 1 any other signal or a timeout, 2 usage error.
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace robotalk::cli;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || std::find_if(args.begin(), args.end(), [](const std::string& a) {
+                        return a == "--help" || a == "-h";
+                      }) != args.end()) {
+    std::cout << kUsage;
+    return args.empty() ? 2 : 0;
+  }
+  try {
+    GlobalOptions g;
+    if (const char* env = std::getenv("LCM_DEFAULT_URL")) g.url = env;
+    std::vector<std::string> rest;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+      if (args[i] == "--url" || args[i] == "--timeout") {
+        if (i + 1 == args.size()) throw UsageError(args[i] + " needs a value");
+        if (args[i] == "--url") {
+          g.url = args[++i];
+        } else {
+          g.timeout_s = ParseNumber(args[++i], "--timeout");
+          if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");
+        }
+      } else {
+        rest.push_back(args[i]);
+      }
+    }
+    if (rest.empty()) throw UsageError("missing command");
+    const std::string command = rest.front();
+    rest.erase(rest.begin());
+    const std::map<std::string, int (*)(const GlobalOptions&, const std::vector<std::string>&)> commands = {
+        {"robots", &RunRobots}, {"describe", &RunDescribe}, {"query", &RunQuery},
+        {"send", &RunSend},     {"panic", &RunPanic},       {"reset", &RunReset}};
+    auto it = commands.find(command);
+    if (it == commands.end()) throw UsageError("unknown command '" + command + "'");
+    return it->second(g, rest);
+  } catch (const UsageError& e) {
+    std::cerr << "robotalk: " << e.what() << "\n(robotalk --help for usage)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "robotalk: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,47 @@
+// Parsing of command arguments for the `robotalk` CLI and of sequence files
+// (docs/client.md "Sequence files"): one command per line,
+//
+//   <start seconds> <command> [target] values...
+//
+// with `#` comments and blank lines. <start seconds> is relative to the send
+// time of the sequence (>= 0). Pure; no I/O beyond the text given.
+#pragma once
+
+#include "robotalk/command.h"
+#include "robotalk/error.h"
+
+#include <string>
+#include <vector>
+
+namespace robotalk::cli {
+
+/// A malformed command line or sequence file; the message names the line.
+class UsageError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// Builds a command from its CLI words: name (case-insensitive, e.g. "goto",
+/// "JOINT_SETPOINT"), then a target for JOINT_* and FRAME_SETPOINT, then values.
+/// Checks the number of values where the protocol fixes it (GOTO 3, SETSPEED 2
+/// or 3, FRAME_SETPOINT 7, STOP and PANIC_RESET none, JOINT_* at least 1) and
+/// that every value is a finite number. Throws UsageError.
+Command ParseCommandWords(const std::vector<std::string>& words);
+
+/// Parses a number (the whole word); throws UsageError naming `what`.
+double ParseNumber(const std::string& word, const std::string& what);
+
+struct SequenceEntry {
+  int line = 0;          ///< 1-based line number in the file
+  double offset_s = 0;   ///< seconds after the sequence's send time
+  Command command;       ///< start_time unset; id 0
+};
+
+/// Parses a sequence file's text. Throws UsageError "<source>:<line>: what"
+/// for the first bad line; an empty sequence is an error too.
+std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::string& source);
+
+/// Splits on blanks (no quoting).
+std::vector<std::string> SplitWords(const std::string& line);
+
+}  // namespace robotalk::cli
