@@ -2,11 +2,17 @@
 
 #include "robotalk/error.h"
 
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 namespace robotalk::urdf_detail {
 
@@ -22,6 +28,65 @@ std::string Num(double v) {
 }
 
 namespace {
+
+// urdfdom reports through console_bridge's global output handler. While one
+// thread parses, the handler below collects that thread's messages and
+// forwards everyone else's to the handler that was installed before. It is
+// never destroyed: console_bridge keeps a "previous handler" pointer to it.
+class CaptureHandler : public console_bridge::OutputHandler {
+ public:
+  using Sink = UrdfdomMessages;
+
+  void log(const std::string& text, console_bridge::LogLevel level, const char* filename, int line) override {
+    if (std::this_thread::get_id() != owner_.load()) {
+      if (console_bridge::OutputHandler* previous = previous_.load())
+        previous->log(text, level, filename, line);
+      return;
+    }
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      sink_->errors.push_back(text);
+    } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+      sink_->warnings.push_back(text);
+    }
+  }
+
+  // Installs the handler for the calling thread until the guard dies.
+  class Guard {
+   public:
+    explicit Guard(Sink& sink) : lock_(Mutex()) {
+      CaptureHandler& h = Instance();
+      h.sink_ = &sink;
+      h.previous_.store(console_bridge::getOutputHandler());
+      h.owner_.store(std::this_thread::get_id());
+      console_bridge::useOutputHandler(&h);
+    }
+    ~Guard() {
+      CaptureHandler& h = Instance();
+      console_bridge::useOutputHandler(h.previous_.load());
+      h.owner_.store(std::thread::id());
+      h.sink_ = nullptr;
+    }
+    Guard(const Guard&) = delete;
+    Guard& operator=(const Guard&) = delete;
+
+   private:
+    std::lock_guard<std::mutex> lock_;
+  };
+
+ private:
+  static CaptureHandler& Instance() {
+    static CaptureHandler* instance = new CaptureHandler;  // intentionally immortal
+    return *instance;
+  }
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+
+  std::atomic<std::thread::id> owner_{};
+  std::atomic<console_bridge::OutputHandler*> previous_{nullptr};
+  Sink* sink_ = nullptr;
+};
 
 std::string At(const TiXmlElement& e) { return " (line " + std::to_string(e.Row()) + ")"; }
 
@@ -122,6 +187,16 @@ ServoTypes ParseServo(const TiXmlElement& e, const char* attribute, const std::s
 }
 
 }  // namespace
+
+urdf::ModelInterfaceSharedPtr ParseQuietly(const std::string& xml, UrdfdomMessages& messages) {
+  CaptureHandler::Guard guard(messages);
+  try {
+    return urdf::parseURDF(xml);
+  } catch (const std::exception& e) {  // e.g. a malformed version attribute
+    messages.errors.emplace_back(e.what());
+    return nullptr;
+  }
+}
 
 XmlScan ScanRobot(const TiXmlElement& robot, const std::string& source) {
   XmlScan scan;

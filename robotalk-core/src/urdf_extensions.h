@@ -1,7 +1,7 @@
-// Private to urdf_import.cpp: the tinyxml side of URDF import. It reads what
-// urdfdom forgets (the file order of links and joints, which <limit>
-// attributes were actually written) and the RoboTalk extension block
-// (docs/urdf_import.md, "The <robotalk> block").
+// Private to urdf_import.cpp: the parsing side of URDF import. urdfdom runs
+// with its console_bridge output captured; tinyxml reads what urdfdom forgets
+// (the file order of links and joints, which <limit> attributes were actually
+// written) and the RoboTalk extension block (docs/urdf_import.md).
 //
 // Every function throws UrdfError whose message starts with the source name.
 #pragma once
@@ -9,6 +9,8 @@
 #include "robotalk/model_types.h"
 
 #include <tinyxml.h>
+#include <urdf_model/model.h>
+#include <urdf_world/types.h>
 
 #include <map>
 #include <optional>
@@ -19,6 +21,18 @@ namespace robotalk::urdf_detail {
 
 /// Throws UrdfError("<source>: <what>").
 [[noreturn]] void Refuse(const std::string& source, const std::string& what);
+
+/// What urdfdom said through console_bridge during one parse.
+struct UrdfdomMessages {
+  std::vector<std::string> errors;
+  std::vector<std::string> warnings;
+};
+
+/// urdf::parseURDF with console_bridge's output captured into `messages`
+/// (nothing reaches stderr). Imports are serialised here: the output handler
+/// is process-wide. Messages other threads log meanwhile go to the handler
+/// installed before. Returns nullptr when urdfdom refuses or throws.
+urdf::ModelInterfaceSharedPtr ParseQuietly(const std::string& xml, UrdfdomMessages& messages);
 
 /// "'name'".
 std::string Quote(const std::string& s);

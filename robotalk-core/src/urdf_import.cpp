@@ -10,18 +10,14 @@
 #include "robotalk/error.h"
 #include "urdf_extensions.h"
 
-#include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
-#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <mutex>
 #include <set>
 #include <sstream>
-#include <thread>
 
 namespace robotalk {
 namespace {
@@ -31,70 +27,6 @@ using urdf_detail::Quote;
 using urdf_detail::Refuse;
 
 constexpr double kAxisTolerance = 1e-6;  // same as RobotModel's unit check
-
-// --- console_bridge capture ------------------------------------------------
-
-// urdfdom reports through console_bridge's global output handler. While one
-// thread parses, the handler below collects that thread's messages and
-// forwards everyone else's to the handler that was installed before. It is
-// never destroyed: console_bridge keeps a "previous handler" pointer to it.
-class CaptureHandler : public console_bridge::OutputHandler {
- public:
-  struct Sink {
-    std::vector<std::string> errors;
-    std::vector<std::string> warnings;
-  };
-
-  void log(const std::string& text, console_bridge::LogLevel level, const char* filename, int line) override {
-    if (std::this_thread::get_id() != owner_.load()) {
-      if (console_bridge::OutputHandler* previous = previous_.load())
-        previous->log(text, level, filename, line);
-      return;
-    }
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
-      sink_->errors.push_back(text);
-    } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
-      sink_->warnings.push_back(text);
-    }
-  }
-
-  // Installs the handler for the calling thread until the guard dies.
-  class Guard {
-   public:
-    explicit Guard(Sink& sink) : lock_(Mutex()) {
-      CaptureHandler& h = Instance();
-      h.sink_ = &sink;
-      h.previous_.store(console_bridge::getOutputHandler());
-      h.owner_.store(std::this_thread::get_id());
-      console_bridge::useOutputHandler(&h);
-    }
-    ~Guard() {
-      CaptureHandler& h = Instance();
-      console_bridge::useOutputHandler(h.previous_.load());
-      h.owner_.store(std::thread::id());
-      h.sink_ = nullptr;
-    }
-    Guard(const Guard&) = delete;
-    Guard& operator=(const Guard&) = delete;
-
-   private:
-    std::lock_guard<std::mutex> lock_;
-  };
-
- private:
-  static CaptureHandler& Instance() {
-    static CaptureHandler* instance = new CaptureHandler;  // intentionally immortal
-    return *instance;
-  }
-  static std::mutex& Mutex() {
-    static std::mutex mutex;
-    return mutex;
-  }
-
-  std::atomic<std::thread::id> owner_{};
-  std::atomic<console_bridge::OutputHandler*> previous_{nullptr};
-  Sink* sink_ = nullptr;
-};
 
 std::string Join(const std::vector<std::string>& items, const std::string& separator) {
   std::string s;
@@ -208,25 +140,15 @@ UrdfImportResult Importer::Run(const std::string& xml) {
 }
 
 urdf::ModelInterfaceSharedPtr Importer::ParseWithUrdfdom(const std::string& xml) {
-  CaptureHandler::Sink sink;
-  urdf::ModelInterfaceSharedPtr model;
-  std::string exception;
-  {
-    CaptureHandler::Guard guard(sink);
-    try {
-      model = urdf::parseURDF(xml);
-    } catch (const std::exception& e) {
-      exception = e.what();
-    }
-  }
-  if (!exception.empty()) sink.errors.push_back(exception);
+  urdf_detail::UrdfdomMessages messages;
+  urdf::ModelInterfaceSharedPtr model = urdf_detail::ParseQuietly(xml, messages);
   // urdfdom logs an error yet returns a model for some defects (an <inertial>
   // without <inertia> is dropped); a dropped mass is not a repair we accept.
-  if (!model || !sink.errors.empty()) {
+  if (!model || !messages.errors.empty()) {
     Fail("urdfdom rejected the file: " +
-         (sink.errors.empty() ? std::string("no reason given") : Join(sink.errors, "; ")));
+         (messages.errors.empty() ? std::string("no reason given") : Join(messages.errors, "; ")));
   }
-  for (const std::string& w : sink.warnings) Warn("urdfdom: " + w);
+  for (const std::string& w : messages.warnings) Warn("urdfdom: " + w);
   return model;
 }
 

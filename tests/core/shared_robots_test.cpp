@@ -57,11 +57,20 @@ TEST_P(SharedRobots, LoadsAndMatchesTheCountsOfSources) {
   int revolute = 0, prismatic = 0, fixed = 0, floating = 0, planar = 0;
   for (const Joint& j : m.joints()) {
     switch (j.dofs.size()) {
-      case 0: ++fixed; break;
-      case 1: ++(j.dofs[0].type == DofType::kRevolute ? revolute : prismatic); break;
-      case 3: ++planar; break;
-      case 6: ++floating; break;
-      default: ADD_FAILURE() << "joint '" << j.name << "' has " << j.dofs.size() << " dofs";
+      case 0:
+        ++fixed;
+        break;
+      case 1:
+        ++(j.dofs[0].type == DofType::kRevolute ? revolute : prismatic);
+        break;
+      case 3:
+        ++planar;
+        break;
+      case 6:
+        ++floating;
+        break;
+      default:
+        ADD_FAILURE() << "joint '" << j.name << "' has " << j.dofs.size() << " dofs";
     }
   }
   EXPECT_EQ(revolute, c.revolute);

@@ -25,8 +25,8 @@ std::string Links(std::initializer_list<const char*> names) {
 
 std::string JointXml(const std::string& name, const std::string& type, const std::string& parent,
                      const std::string& child, const std::string& extra = "") {
-  return "<joint name=\"" + name + "\" type=\"" + type + "\"><parent link=\"" + parent + "\"/><child link=\"" + child +
-         "\"/>" + extra + "</joint>";
+  return "<joint name=\"" + name + "\" type=\"" + type + "\"><parent link=\"" + parent +
+         "\"/><child link=\"" + child + "\"/>" + extra + "</joint>";
 }
 
 const std::string kLimit = "<limit lower=\"-1\" upper=\"2\" effort=\"3\" velocity=\"4\"/>";
@@ -56,11 +56,11 @@ bool HasWarning(const UrdfImportResult& r, const std::string& part) {
   return false;
 }
 
-#define EXPECT_REFUSED(xml, part)                                              \
-  do {                                                                         \
-    const std::string message_ = ErrorOf(xml);                                 \
-    EXPECT_NE(message_.find("test.urdf: "), std::string::npos) << message_;    \
-    EXPECT_NE(message_.find(part), std::string::npos) << message_;             \
+#define EXPECT_REFUSED(xml, part)                                           \
+  do {                                                                      \
+    const std::string message_ = ErrorOf(xml);                              \
+    EXPECT_NE(message_.find("test.urdf: "), std::string::npos) << message_; \
+    EXPECT_NE(message_.find(part), std::string::npos) << message_;          \
   } while (0)
 
 // X_parent_child(q) as model_types.h defines it.
@@ -82,8 +82,9 @@ Eigen::Isometry3d JointTransform(const RobotModel& m, const Joint& j, const std:
 // --- joint types and conventions -------------------------------------------
 
 TEST(UrdfImport, KeepsTheFileOrderOfLinksAndJoints) {
-  const auto r = Import(Robot(Links({"zeta", "alpha", "mid"}) + JointXml("z_joint", "fixed", "zeta", "alpha") +
-                              JointXml("a_joint", "fixed", "zeta", "mid")));
+  const auto r =
+      Import(Robot(Links({"zeta", "alpha", "mid"}) + JointXml("z_joint", "fixed", "zeta", "alpha") +
+                   JointXml("a_joint", "fixed", "zeta", "mid")));
   ASSERT_EQ(r.model.links().size(), 3u);
   EXPECT_EQ(r.model.link(0).name, "zeta");
   EXPECT_EQ(r.model.link(1).name, "alpha");
@@ -94,7 +95,8 @@ TEST(UrdfImport, KeepsTheFileOrderOfLinksAndJoints) {
 }
 
 TEST(UrdfImport, ConvertsARevoluteJointToOneRevoluteDof) {
-  const auto r = Import(TwoLinks("revolute", "<origin xyz=\"1 2 3\" rpy=\"0 0 1.5\"/><axis xyz=\"0 1 0\"/>" + kLimit));
+  const auto r =
+      Import(TwoLinks("revolute", "<origin xyz=\"1 2 3\" rpy=\"0 0 1.5\"/><axis xyz=\"0 1 0\"/>" + kLimit));
   const Joint& j = r.model.joint(0);
   ASSERT_EQ(j.dofs.size(), 1u);
   EXPECT_EQ(j.dofs[0].type, DofType::kRevolute);
@@ -167,9 +169,10 @@ TEST(UrdfImport, ConvertsAFloatingJointToThreeTranslationsThenThreeRotations) {
 }
 
 TEST(UrdfImport, RotatesTheInertiaIntoLinkAxesAndKeepsItSymmetric) {
-  const auto r = Import(Robot(
-      "<link name=\"a\"><inertial><origin xyz=\"0.1 0.2 0.3\" rpy=\"0 0 1.5707963267948966\"/><mass value=\"2\"/>"
-      "<inertia ixx=\"1\" ixy=\"0.1\" ixz=\"0\" iyy=\"2\" iyz=\"0\" izz=\"3\"/></inertial></link>"));
+  const auto r = Import(
+      Robot("<link name=\"a\"><inertial><origin xyz=\"0.1 0.2 0.3\" rpy=\"0 0 1.5707963267948966\"/><mass "
+            "value=\"2\"/>"
+            "<inertia ixx=\"1\" ixy=\"0.1\" ixz=\"0\" iyy=\"2\" iyz=\"0\" izz=\"3\"/></inertial></link>"));
   const Link& l = r.model.link(0);
   EXPECT_EQ(l.mass, 2);
   EXPECT_EQ(l.com, Eigen::Vector3d(0.1, 0.2, 0.3));
@@ -180,12 +183,12 @@ TEST(UrdfImport, RotatesTheInertiaIntoLinkAxesAndKeepsItSymmetric) {
 }
 
 TEST(UrdfImport, PlacesJointsRelativeToTheCentresOfMass) {
-  const auto r = Import(Robot(
-      "<link name=\"a\"><inertial><origin xyz=\"0.1 0 0\"/><mass value=\"1\"/>"
-      "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>"
-      "<link name=\"b\"><inertial><origin xyz=\"0 0 0.5\"/><mass value=\"1\"/>"
-      "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>" +
-      JointXml("j", "revolute", "a", "b", "<origin xyz=\"1 0 0\" rpy=\"0.3 0 0\"/>" + kLimit)));
+  const auto r = Import(
+      Robot("<link name=\"a\"><inertial><origin xyz=\"0.1 0 0\"/><mass value=\"1\"/>"
+            "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>"
+            "<link name=\"b\"><inertial><origin xyz=\"0 0 0.5\"/><mass value=\"1\"/>"
+            "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>" +
+            JointXml("j", "revolute", "a", "b", "<origin xyz=\"1 0 0\" rpy=\"0.3 0 0\"/>" + kLimit)));
   const Joint& j = r.model.joint(0);
   EXPECT_TRUE(j.inboard.isApprox(Eigen::Vector3d(0.9, 0, 0)));
   EXPECT_EQ(j.outboard, Eigen::Vector3d(0, 0, -0.5));
@@ -209,7 +212,8 @@ TEST(UrdfImport, ReplacesTheRobotNameWhenAsked) {
 // --- repaired defects -------------------------------------------------------
 
 TEST(UrdfImport, SwapsInvertedLimitsWithAWarning) {
-  const auto r = Import(TwoLinks("revolute", "<limit lower=\"2.775\" upper=\"-2.775\" effort=\"1\" velocity=\"1\"/>"));
+  const auto r =
+      Import(TwoLinks("revolute", "<limit lower=\"2.775\" upper=\"-2.775\" effort=\"1\" velocity=\"1\"/>"));
   EXPECT_EQ(r.model.joint(0).dofs[0].limits.lower, -2.775);
   EXPECT_EQ(r.model.joint(0).dofs[0].limits.upper, 2.775);
   EXPECT_TRUE(HasWarning(r, "joint 'j': lower limit 2.775 > upper -2.775; swapped"));
@@ -234,13 +238,15 @@ TEST(UrdfImport, IgnoresLimitsOnAFixedJointWithAWarning) {
 }
 
 TEST(UrdfImport, IgnoresLowerAndUpperOnAContinuousJointWithAWarning) {
-  const auto r = Import(TwoLinks("continuous", "<limit lower=\"-6.28\" upper=\"6.28\" effort=\"1\" velocity=\"1\"/>"));
+  const auto r =
+      Import(TwoLinks("continuous", "<limit lower=\"-6.28\" upper=\"6.28\" effort=\"1\" velocity=\"1\"/>"));
   EXPECT_EQ(r.model.joint(0).dofs[0].limits.upper, DofLimits::kInf);
   EXPECT_TRUE(HasWarning(r, "joint 'j': lower/upper limits on a continuous joint ignored"));
 }
 
 TEST(UrdfImport, TakesZeroVelocityAndEffortAsUnlimitedWithAWarning) {
-  const auto r = Import(TwoLinks("revolute", "<limit lower=\"-1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>"));
+  const auto r =
+      Import(TwoLinks("revolute", "<limit lower=\"-1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>"));
   const DofLimits& l = r.model.joint(0).dofs[0].limits;
   EXPECT_EQ(l.velocity, DofLimits::kInf);
   EXPECT_EQ(l.effort, DofLimits::kInf);
@@ -269,32 +275,36 @@ TEST(UrdfImport, RefusesAZeroAxis) {
 }
 
 TEST(UrdfImport, RefusesNegativeMass) {
-  EXPECT_REFUSED(Robot("<link name=\"heavy\"><inertial><mass value=\"-1\"/>"
-                       "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>"),
-                 "link 'heavy': negative mass -1 kg");
+  EXPECT_REFUSED(
+      Robot("<link name=\"heavy\"><inertial><mass value=\"-1\"/>"
+            "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>"),
+      "link 'heavy': negative mass -1 kg");
 }
 
 TEST(UrdfImport, RefusesAMassiveLinkWithANonPositiveDefiniteInertia) {
-  EXPECT_REFUSED(Robot("<link name=\"flat\"><inertial><mass value=\"1\"/>"
-                       "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"0\"/></inertial></link>"),
-                 "link 'flat': mass 1 kg but the inertia is not positive-definite");
+  EXPECT_REFUSED(
+      Robot("<link name=\"flat\"><inertial><mass value=\"1\"/>"
+            "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"0\"/></inertial></link>"),
+      "link 'flat': mass 1 kg but the inertia is not positive-definite");
 }
 
 TEST(UrdfImport, AcceptsAMasslessLinkWithAZeroInertia) {
-  const auto r = Import(Robot("<link name=\"frame\"><inertial><mass value=\"0\"/>"
-                              "<inertia ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"/></inertial></link>"));
+  const auto r = Import(
+      Robot("<link name=\"frame\"><inertial><mass value=\"0\"/>"
+            "<inertia ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"/></inertial></link>"));
   EXPECT_TRUE(r.warnings.empty());
 }
 
 TEST(UrdfImport, RefusesALinkWithTwoParentJoints) {
   // urdfdom accepts this file and builds a tree whose walk never ends.
-  EXPECT_REFUSED(Robot(Links({"a", "b", "c"}) + JointXml("ab", "fixed", "a", "b") + JointXml("bc", "fixed", "b", "c") +
-                       JointXml("cb", "fixed", "c", "b")),
+  EXPECT_REFUSED(Robot(Links({"a", "b", "c"}) + JointXml("ab", "fixed", "a", "b") +
+                       JointXml("bc", "fixed", "b", "c") + JointXml("cb", "fixed", "c", "b")),
                  "link 'b' has two parent joints, 'ab' and 'cb'");
 }
 
 TEST(UrdfImport, RefusesACycle) {
-  EXPECT_REFUSED(Robot(Links({"root", "b", "c"}) + JointXml("bc", "fixed", "b", "c") + JointXml("cb", "fixed", "c", "b")),
+  EXPECT_REFUSED(Robot(Links({"root", "b", "c"}) + JointXml("bc", "fixed", "b", "c") +
+                       JointXml("cb", "fixed", "c", "b")),
                  "cycle through links 'b' <- 'c' <- 'b'");
 }
 
@@ -303,12 +313,14 @@ TEST(UrdfImport, RefusesDuplicateLinkNames) {
 }
 
 TEST(UrdfImport, RefusesDuplicateJointNames) {
-  EXPECT_REFUSED(Robot(Links({"a", "b", "c"}) + JointXml("j", "fixed", "a", "b") + JointXml("j", "fixed", "a", "c")),
-                 "duplicate joint name 'j'");
+  EXPECT_REFUSED(
+      Robot(Links({"a", "b", "c"}) + JointXml("j", "fixed", "a", "b") + JointXml("j", "fixed", "a", "c")),
+      "duplicate joint name 'j'");
 }
 
 TEST(UrdfImport, RefusesAJointNamingAnUnknownLink) {
-  EXPECT_REFUSED(Robot(Links({"a"}) + JointXml("j", "fixed", "a", "ghost")), "joint 'j' (line 1): unknown child link 'ghost'");
+  EXPECT_REFUSED(Robot(Links({"a"}) + JointXml("j", "fixed", "a", "ghost")),
+                 "joint 'j' (line 1): unknown child link 'ghost'");
 }
 
 TEST(UrdfImport, RefusesMalformedXmlWithItsLine) {
@@ -323,8 +335,9 @@ TEST(UrdfImport, SaysWhatUrdfdomComplainedAboutAndKeepsStderrQuiet) {
   ::testing::internal::CaptureStderr();
   const std::string message = ErrorOf(TwoLinks("revolute", ""));
   const std::string err = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(message.find("urdfdom rejected the file: Joint [j] is of type REVOLUTE but it does not specify limits"),
-            std::string::npos)
+  EXPECT_NE(
+      message.find("urdfdom rejected the file: Joint [j] is of type REVOLUTE but it does not specify limits"),
+      std::string::npos)
       << message;
   EXPECT_EQ(err, "");
 }
@@ -345,9 +358,10 @@ TEST(UrdfImport, RefusesAMissingFile) {
 // --- strict mode ------------------------------------------------------------
 
 TEST(UrdfImport, StrictModeTurnsEveryWarningIntoOneError) {
-  const std::string xml = Robot(Links({"a", "b", "c"}) +
-                                JointXml("j", "revolute", "a", "b", "<limit lower=\"1\" upper=\"0\" effort=\"1\" velocity=\"1\"/>") +
-                                JointXml("k", "fixed", "a", "c", kLimit));
+  const std::string xml = Robot(
+      Links({"a", "b", "c"}) +
+      JointXml("j", "revolute", "a", "b", "<limit lower=\"1\" upper=\"0\" effort=\"1\" velocity=\"1\"/>") +
+      JointXml("k", "fixed", "a", "c", kLimit));
   const std::string message = ErrorOf(xml, {.strict = true});
   EXPECT_NE(message.find("test.urdf: strict import refuses 2 warning(s)"), std::string::npos) << message;
   EXPECT_NE(message.find("joint 'j': lower limit 1 > upper 0; swapped"), std::string::npos) << message;
@@ -363,7 +377,8 @@ TEST(UrdfImport, StrictModeAcceptsACleanFile) {
 
 TEST(UrdfImport, RecordsAMimicJointWithoutServoTypes) {
   const auto r = Import(Robot(Links({"a", "b", "c"}) + JointXml("lead", "revolute", "a", "b", kLimit) +
-                              JointXml("follow", "revolute", "a", "c", kLimit + "<mimic joint=\"lead\" multiplier=\"-2\" offset=\"0.5\"/>")));
+                              JointXml("follow", "revolute", "a", "c",
+                                       kLimit + "<mimic joint=\"lead\" multiplier=\"-2\" offset=\"0.5\"/>")));
   const Joint& j = r.model.joint(1);
   ASSERT_TRUE(j.mimic.has_value());
   EXPECT_EQ(*j.mimic, (Mimic{.leader_joint = 0, .multiplier = -2, .offset = 0.5}));
@@ -394,8 +409,10 @@ TEST(UrdfImport, DropsAMimicOnAPlanarJointWithAWarning) {
 
 TEST(UrdfImport, FlattensAChainOfMimicsOntoTheFirstLeader) {
   const auto r = Import(Robot(Links({"a", "b", "c", "d"}) + JointXml("lead", "revolute", "a", "b", kLimit) +
-                              JointXml("mid", "revolute", "a", "c", kLimit + "<mimic joint=\"lead\" multiplier=\"2\" offset=\"1\"/>") +
-                              JointXml("end", "revolute", "a", "d", kLimit + "<mimic joint=\"mid\" multiplier=\"3\" offset=\"0.5\"/>")));
+                              JointXml("mid", "revolute", "a", "c",
+                                       kLimit + "<mimic joint=\"lead\" multiplier=\"2\" offset=\"1\"/>") +
+                              JointXml("end", "revolute", "a", "d",
+                                       kLimit + "<mimic joint=\"mid\" multiplier=\"3\" offset=\"0.5\"/>")));
   ASSERT_TRUE(r.model.joint(2).mimic.has_value());
   EXPECT_EQ(*r.model.joint(2).mimic, (Mimic{.leader_joint = 0, .multiplier = 6, .offset = 3.5}));
   EXPECT_TRUE(HasWarning(r, "joint 'end': mimics 'mid', itself a mimic of 'lead'"));
@@ -405,18 +422,21 @@ TEST(UrdfImport, FlattensAChainOfMimicsOntoTheFirstLeader) {
 
 const std::string kPanTilt =
     Links({"base", "pan_link", "head"}) +
-    JointXml("pan", "revolute", "base", "pan_link", "<origin xyz=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/>" + kLimit) +
-    JointXml("tilt", "revolute", "pan_link", "head", "<origin xyz=\"0 0 0\" rpy=\"0 0 0.4\"/><axis xyz=\"0 1 0\"/>" + kLimit);
+    JointXml("pan", "revolute", "base", "pan_link",
+             "<origin xyz=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/>" + kLimit) +
+    JointXml("tilt", "revolute", "pan_link", "head",
+             "<origin xyz=\"0 0 0\" rpy=\"0 0 0.4\"/><axis xyz=\"0 1 0\"/>" + kLimit);
 
 TEST(UrdfImport, ReadsControlFramesServoTypesAndTheBaseFromTheRobotalkBlock) {
-  const auto r = Import(Robot(kPanTilt +
-                              "<robotalk version=\"1\">"
-                              "<base link=\"base\" type=\"differential\"><origin xyz=\"1 2 0\" rpy=\"0 0 0.5\"/></base>"
-                              "<control_frame name=\"camera\" link=\"head\" servo=\"setpoint speed\">"
-                              "<origin xyz=\"0 0 0.05\" rpy=\"0 0 0\"/></control_frame>"
-                              "<control_frame name=\"marker\" link=\"base\"/>"
-                              "<servo joint=\"pan\" types=\"setpoint\"/>"
-                              "</robotalk>"));
+  const auto r =
+      Import(Robot(kPanTilt +
+                   "<robotalk version=\"1\">"
+                   "<base link=\"base\" type=\"differential\"><origin xyz=\"1 2 0\" rpy=\"0 0 0.5\"/></base>"
+                   "<control_frame name=\"camera\" link=\"head\" servo=\"setpoint speed\">"
+                   "<origin xyz=\"0 0 0.05\" rpy=\"0 0 0\"/></control_frame>"
+                   "<control_frame name=\"marker\" link=\"base\"/>"
+                   "<servo joint=\"pan\" types=\"setpoint\"/>"
+                   "</robotalk>"));
   const RobotModel& m = r.model;
   ASSERT_EQ(m.frames().size(), 2u);
   EXPECT_EQ(m.frame(0).name, "camera");
@@ -448,9 +468,11 @@ TEST(UrdfImport, RefusesAnUnknownElementInTheRobotalkBlock) {
 TEST(UrdfImport, RefusesAnUnknownAttributeInTheRobotalkBlock) {
   EXPECT_REFUSED(Robot(kPanTilt + "<robotalk><servo joint=\"pan\" type=\"speed\"/></robotalk>"),
                  "unknown attribute 'type'");
-  EXPECT_REFUSED(Robot(kPanTilt + "<robotalk><control_frame name=\"c\" link=\"head\"><origin xyz=\"0 0 0\" rpy=\"0 0 0\" "
-                                  "quat=\"1 0 0 0\"/></control_frame></robotalk>"),
-                 "unknown attribute 'quat'");
+  EXPECT_REFUSED(
+      Robot(kPanTilt +
+            "<robotalk><control_frame name=\"c\" link=\"head\"><origin xyz=\"0 0 0\" rpy=\"0 0 0\" "
+            "quat=\"1 0 0 0\"/></control_frame></robotalk>"),
+      "unknown attribute 'quat'");
 }
 
 TEST(UrdfImport, RefusesAControlFrameOnAnUnknownLink) {
@@ -459,7 +481,8 @@ TEST(UrdfImport, RefusesAControlFrameOnAnUnknownLink) {
 }
 
 TEST(UrdfImport, RefusesServoTypesForAnUnknownJoint) {
-  EXPECT_REFUSED(Robot(kPanTilt + "<robotalk><servo joint=\"pann\" types=\"speed\"/></robotalk>"), "unknown joint 'pann'");
+  EXPECT_REFUSED(Robot(kPanTilt + "<robotalk><servo joint=\"pann\" types=\"speed\"/></robotalk>"),
+                 "unknown joint 'pann'");
 }
 
 TEST(UrdfImport, RefusesAnUnknownServoType) {
@@ -481,7 +504,8 @@ TEST(UrdfImport, RefusesABaseOnALinkThatIsNotTheRoot) {
 }
 
 TEST(UrdfImport, RefusesAnUnknownBaseType) {
-  EXPECT_REFUSED(Robot(kPanTilt + "<robotalk><base type=\"legged\"/></robotalk>"), "unknown base type 'legged'");
+  EXPECT_REFUSED(Robot(kPanTilt + "<robotalk><base type=\"legged\"/></robotalk>"),
+                 "unknown base type 'legged'");
 }
 
 TEST(UrdfImport, RefusesMalformedNumbersInTheRobotalkBlock) {
@@ -521,7 +545,8 @@ TEST(UrdfImport, MergesLongerChainsAndKeepsTheOtherJoints) {
                               JointXml("j1", "revolute", "a", "m1", "<origin xyz=\"0 0 1\"/>" + kLimit) +
                               JointXml("j2", "prismatic", "m1", "m2", "<axis xyz=\"1 0 0\"/>" + kLimit) +
                               JointXml("side", "fixed", "a", "side") +
-                              JointXml("j3", "continuous", "m2", "tip", "<axis xyz=\"0 1 0\"/><limit effort=\"1\" velocity=\"1\"/>")),
+                              JointXml("j3", "continuous", "m2", "tip",
+                                       "<axis xyz=\"0 1 0\"/><limit effort=\"1\" velocity=\"1\"/>")),
                         {.merge_massless_chains = true});
   ASSERT_EQ(r.model.joints().size(), 2u);
   EXPECT_EQ(r.model.joint(0).name, "j1+j2+j3");
@@ -533,19 +558,23 @@ TEST(UrdfImport, MergesLongerChainsAndKeepsTheOtherJoints) {
 TEST(UrdfImport, DoesNotMergeAcrossALinkWithMass) {
   const std::string xml = Robot(
       "<link name=\"base\"/><link name=\"pan_link\"><inertial><mass value=\"0.1\"/>"
-      "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link><link name=\"head\"/>" +
-      JointXml("pan", "revolute", "base", "pan_link", kLimit) + JointXml("tilt", "revolute", "pan_link", "head", kLimit));
+      "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link><link "
+      "name=\"head\"/>" +
+      JointXml("pan", "revolute", "base", "pan_link", kLimit) +
+      JointXml("tilt", "revolute", "pan_link", "head", kLimit));
   EXPECT_EQ(Import(xml, {.merge_massless_chains = true}).model.joints().size(), 2u);
 }
 
 TEST(UrdfImport, DoesNotMergeWhenTheSecondJointIsOffset) {
-  const std::string xml = Robot(Links({"base", "pan_link", "head"}) + JointXml("pan", "revolute", "base", "pan_link", kLimit) +
-                                JointXml("tilt", "revolute", "pan_link", "head", "<origin xyz=\"0 0 0.1\"/>" + kLimit));
+  const std::string xml =
+      Robot(Links({"base", "pan_link", "head"}) + JointXml("pan", "revolute", "base", "pan_link", kLimit) +
+            JointXml("tilt", "revolute", "pan_link", "head", "<origin xyz=\"0 0 0.1\"/>" + kLimit));
   EXPECT_EQ(Import(xml, {.merge_massless_chains = true}).model.joints().size(), 2u);
 }
 
 TEST(UrdfImport, DoesNotMergeAcrossALinkCarryingAControlFrame) {
-  const std::string xml = Robot(kPanTilt + "<robotalk><control_frame name=\"f\" link=\"pan_link\"/></robotalk>");
+  const std::string xml =
+      Robot(kPanTilt + "<robotalk><control_frame name=\"f\" link=\"pan_link\"/></robotalk>");
   EXPECT_EQ(Import(xml, {.merge_massless_chains = true}).model.joints().size(), 2u);
 }
 
