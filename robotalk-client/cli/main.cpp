@@ -16,7 +16,7 @@ constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] COMM
   query ROBOT TYPE [TARGET]           TYPE: joint_state | link_poses | frame_poses | base_pose
   send ROBOT COMMAND ARGS... [--at S] one command, e.g.
                                         send pioneer goto 1 0 0
-                                        send pioneer joint_setpoint pan_tilt 0.5 0.2
+                                        send pioneer joint_setpoint pan 0.5
                                         send pioneer setspeed 0.2 0.1
                                         send pioneer stop --at 2
                                       --at S: start S seconds from now (server clock)

@@ -69,7 +69,7 @@ TEST(SequenceFile, TheExampleSquareParses) {
   std::stringstream text;
   text << in.rdbuf();
   const auto entries = ParseSequence(text.str(), "square.txt");
-  EXPECT_EQ(entries.size(), 9u);
+  EXPECT_EQ(entries.size(), 10u);
   EXPECT_EQ(entries.back().command.type, CommandType::kStop);
 }
 
