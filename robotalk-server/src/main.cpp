@@ -24,6 +24,7 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --inject-reply-drop P           test only: drop each reply package with probability P
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
+  --log-executions                print one line per executed command (diagnostics)
   --list-drivers                  print the known drivers and exit
 On SIGINT or SIGTERM every robot is stopped before the server exits.
 )";
@@ -59,6 +60,8 @@ int main(int argc, char** argv) {
       } else if (arg == "--list-drivers") {
         for (const std::string& name : registry.names()) std::cout << name << "\n";
         return 0;
+      } else if (arg == "--log-executions") {
+        options.log_executions = true;
       } else if (arg == "--robot") {
         robots.push_back(robotalk::RobotSpec::Parse(value()));
       } else if (arg == "--url") {

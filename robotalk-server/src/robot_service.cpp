@@ -440,6 +440,11 @@ void RobotService::Execute(const QueuedItem& item, TimePoint now) {
   DriverCommand command = item.command;
   command.id = next_driver_id_++;
   const DriverResult result = driver_->Execute(command, now, completions_);
+  if (options_.log_executions) {
+    std::fprintf(stderr, "robotalk-server: robot '%s': executed client %s command %" PRId64 " %s -> %s\n",
+                 name_.c_str(), Hex(item.client_id).c_str(), item.command.id, ToString(item.command.type),
+                 result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
+  }
   if (result.in_progress) {
     in_progress_[command.id] = Owner{item.client_id, item.command.id, now, r.lateness};
     return;

@@ -39,6 +39,9 @@ struct RobotServiceOptions {
   size_t max_queue = 10000;
   /// Start times further ahead than this are refused.
   Duration max_future = std::chrono::hours(1);
+  /// Print one line per executed command to stderr (a diagnostic audit log;
+  /// it does I/O on the RobotDaemon, so leave it off on a real-time system).
+  bool log_executions = false;
 };
 
 /// What the ServerDaemon sends back at once for a received package.

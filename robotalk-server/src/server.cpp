@@ -76,7 +76,8 @@ class Server::Impl {
         faults_(options_.reply_drop_probability, options_.reply_duplicate_probability, options_.fault_seed) {
     if (!lcm_.good()) throw Error("Server: cannot open LCM URL '" + options_.lcm_url + "'");
     if (specs.empty()) throw Error("Server: no robot to serve");
-    RobotServiceOptions service_options{options_.session_timeout, options_.max_queue, options_.max_future};
+    RobotServiceOptions service_options{options_.session_timeout, options_.max_queue, options_.max_future,
+                                        options_.log_executions};
     for (const RobotSpec& spec : specs) {
       if (robots_.count(spec.name)) throw Error("Server: robot name '" + spec.name + "' is given twice");
       DriverConfig config{spec.name, spec.urdf_path, spec.options};

@@ -37,6 +37,8 @@ struct ServerOptions {
   size_t max_queue = 10000;
   /// Start times further ahead than this are refused with ERROR.
   Duration max_future = std::chrono::hours(1);
+  /// Print one stderr line per executed command (diagnostics; not for real-time use).
+  bool log_executions = false;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
   /// Test fault injection on outgoing reply packages (seeded): probability

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs a command inside a private network namespace whose loopback carries
 # multicast (DESIGN.md §4), so LCM tests never send traffic anywhere else:
-#   tests/netns_run.sh COMMAND [ARGS...]
+#   scripts/netns_run.sh COMMAND [ARGS...]
 # Use LCM URLs like udpm://239.255.76.67:PORT?ttl=0 inside. Exits 77 (CTest's
 # SKIP_RETURN_CODE) when namespaces cannot be created (not root, no unshare).
 set -u
