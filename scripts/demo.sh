@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
-# The README's main command: installs what is missing, builds, and shows
-# RoboTalk on the project's own robot model.
+# The README's main command: installs what is missing, builds, then runs a
+# robotalk-server with a simulated Pioneer and drives it with the robotalk CLI
+# from other processes (scripts/demo_session.sh). It runs inside a private
+# network namespace when it can (root), so no multicast leaves the machine;
+# otherwise on this host with ttl=0.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
-MODEL=models/pioneer2dx_pantilt.urdf
-
-echo "== The motion specification of $MODEL (robotalk-describe)"
-"$BUILD_DIR"/tools/describe/robotalk-describe "$MODEL"
-echo
-echo "== The same robot with its pan-tilt chain merged into one 2-dof joint (--merge-chains)"
-"$BUILD_DIR"/tools/describe/robotalk-describe --merge-chains "$MODEL" | sed -n '/^Joints/,/^$/p'
+if unshare -n true 2>/dev/null; then
+  exec scripts/netns_run.sh scripts/demo_session.sh
+fi
+echo "(no network namespace available: running on this host with ttl=0)"
+exec scripts/demo_session.sh

@@ -22,6 +22,7 @@ struct QueuedItem {
   DriverCommand command;               ///< when !is_query; command.id is the client's id
   QueryType query = QueryType::kJointState;
   int query_target = -1;               ///< joint / link / frame index, -1 = all
+  bool only_if_moving = false;         ///< the watchdog's STOP: skipped if the robot is still
 
   /// Earlier start first; equal starts in arrival order.
   bool RunsBefore(const QueuedItem& o) const {

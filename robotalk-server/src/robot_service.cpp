@@ -314,8 +314,8 @@ void RobotService::TakeReplies(std::vector<OutgoingReplies>& out) {
   }
 }
 
-std::vector<std::int64_t> RobotService::ExpireSessions(TimePoint now) {
-  std::vector<std::int64_t> expired;
+std::vector<ExpiredSession> RobotService::ExpireSessions(TimePoint now) {
+  std::vector<ExpiredSession> expired;
   bool stop = false;
   {
     std::lock_guard lock(mutex_);
@@ -324,21 +324,25 @@ std::vector<std::int64_t> RobotService::ExpireSessions(TimePoint now) {
         ++it;
         continue;
       }
-      expired.push_back(it->first);
+      expired.push_back({it->first, it->second.commands.size(), it->second.moved_robot});
       stop = stop || it->second.moved_robot;
       it = sessions_.erase(it);
     }
   }
-  if (stop) StopRobot("a client that moved the robot vanished");
+  if (stop) QueueStop("a client that moved the robot vanished", /*only_if_moving=*/true);
   return expired;
 }
 
-void RobotService::StopRobot(const std::string& reason) {
+void RobotService::StopRobot(const std::string& reason) { QueueStop(reason, /*only_if_moving=*/false); }
+
+void RobotService::QueueStop(const std::string& reason, bool only_if_moving) {
   std::lock_guard lock(mutex_);
-  std::fprintf(stderr, "robotalk-server: robot '%s': STOP (%s)\n", name_.c_str(), reason.c_str());
+  std::fprintf(stderr, "robotalk-server: robot '%s': STOP%s (%s)\n", name_.c_str(),
+               only_if_moving ? " if moving" : "", reason.c_str());
   QueuedItem stop;
   stop.arrival = ++arrivals_;
   stop.command.type = CommandType::kStop;
+  stop.only_if_moving = only_if_moving;
   server_queue_.push_back(stop);
   wake_flag_ = true;
   wake_.notify_one();
@@ -430,6 +434,11 @@ void RobotService::Execute(const QueuedItem& item, TimePoint now) {
     AnswerQuery(item, r);
     produced_.push_back({item.client_id, std::move(r)});
     return;
+  }
+  if (item.only_if_moving) {
+    // The watchdog's STOP: a set-point that already arrived needs none.
+    driver_->ReadState(state_);
+    if (!state_.moving) return;
   }
   if (panic_ && item.command.type != CommandType::kStop) {
     r.signal = Signal::kInterrupted;

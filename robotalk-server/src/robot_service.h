@@ -51,6 +51,13 @@ struct ImmediateAnswer {
   bool publish_config = false; ///< a CONFIG query asked for the configuration message
 };
 
+/// A client session the watchdog removed.
+struct ExpiredSession {
+  std::int64_t client_id = 0;
+  size_t dropped_commands = 0;  ///< queued commands that will never run
+  bool moved_robot = false;     ///< it had set the robot moving (a STOP follows if still moving)
+};
+
 /// Replies for one client, ready to send.
 struct OutgoingReplies {
   std::int64_t client_id = 0;
@@ -84,9 +91,9 @@ class RobotService {
                                 const std::string& reason);
   /// Moves every reply waiting in the return queues into `out`.
   void TakeReplies(std::vector<OutgoingReplies>& out);
-  /// Expires silent sessions; stops the robot for any that had moved it.
-  /// Returns the ids of the expired clients.
-  std::vector<std::int64_t> ExpireSessions(TimePoint now);
+  /// Expires silent sessions. If one had set the robot moving and the robot
+  /// is still moving when the RobotDaemon looks, it is stopped.
+  std::vector<ExpiredSession> ExpireSessions(TimePoint now);
   /// Queues a STOP from the server itself (watchdog, shutdown).
   void StopRobot(const std::string& reason);
   robotalk_msgs::robot_info_t Info() const;
@@ -122,6 +129,7 @@ class RobotService {
   void Execute(const QueuedItem& item, TimePoint now);   // RobotDaemon, no lock
   void AnswerQuery(const QueuedItem& item, Reply& reply);  // RobotDaemon, no lock
   void DaemonLoop();
+  void QueueStop(const std::string& reason, bool only_if_moving);
 
   const std::string name_;
   const std::string driver_name_;

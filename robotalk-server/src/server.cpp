@@ -148,9 +148,11 @@ class Server::Impl {
       const TimePoint now = clock_.Now();
       if (now >= next_expiry) {
         for (auto& [name, robot] : robots_) {
-          for (std::int64_t client : robot->ExpireSessions(now)) {
-            std::fprintf(stderr, "robotalk-server: robot '%s': session of client %s expired\n", name.c_str(),
-                         Hex(client).c_str());
+          for (const ExpiredSession& e : robot->ExpireSessions(now)) {
+            // Quiet for the ordinary case: a short-lived client (the CLI) that is done.
+            if (e.dropped_commands == 0 && !e.moved_robot) continue;
+            std::fprintf(stderr, "robotalk-server: robot '%s': client %s went silent; %zu queued commands dropped\n",
+                         name.c_str(), Hex(e.client_id).c_str(), e.dropped_commands);
           }
         }
         next_expiry = now + std::chrono::milliseconds(100);

@@ -72,6 +72,7 @@ class FakeDriver : public Driver {
     s.position[0] = position;
     s.velocity[0] = 0.25;
     s.effort[0] = -0.5;
+    s.moving = moving;
   }
   void Halt(std::vector<Completion>& interrupted) override {
     halted = true;

@@ -245,10 +245,22 @@ TEST_F(RobotServiceTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
   Handle(Queries(kBob, 2, {}));  // Bob keeps his session alive with a heartbeat
   clock_.Advance(milliseconds(1500));
   const auto expired = service_->ExpireSessions(clock_.Now());
-  ASSERT_EQ(expired, std::vector<std::int64_t>{kAlice});
+  ASSERT_EQ(expired.size(), 1u);
+  EXPECT_EQ(expired[0].client_id, kAlice);
+  EXPECT_TRUE(expired[0].moved_robot);
   Run();
   ASSERT_FALSE(fake_->calls.empty());
   EXPECT_EQ(fake_->calls.back().type, CommandType::kStop);
+}
+
+TEST_F(RobotServiceTest, LeavesAStillRobotAloneWhenTheClientThatMovedItVanishes) {
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
+  Run();
+  fake_->moving = false;  // the set-point has been reached
+  clock_.Advance(seconds(3));
+  ASSERT_EQ(service_->ExpireSessions(clock_.Now()).size(), 1u);
+  Run();
+  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "no STOP was needed";
 }
 
 TEST_F(RobotServiceTest, DoesNotStopTheRobotWhenAQueryOnlyClientVanishes) {
