@@ -1,0 +1,47 @@
+// Command-line options of robotalk-lcm-relay, parsed without I/O so they can
+// be tested. See docs/lcm_relay.md for the user's view.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "impaired_channel.h"
+
+namespace robotalk::relay {
+
+/// One direction: its impairments and which channels it forwards.
+struct DirectionOptions {
+  ImpairmentParams impairment;
+  std::string channels = ".*";  ///< ECMAScript regex matched against the whole channel name
+};
+
+struct RelayOptions {
+  std::string url_a;  ///< client side
+  std::string url_b;  ///< server side
+  DirectionOptions a2b;
+  DirectionOptions b2a;
+  std::uint64_t seed = 1;   ///< a2b uses seed, b2a a seed derived from it
+  double duration_s = 0.0;  ///< 0: run until SIGINT/SIGTERM
+  bool stats = false;       ///< print counters at exit
+  Duration echo_window = std::chrono::seconds(2);
+  bool help = false;
+};
+
+/// Parses argv[1..]. Unprefixed impairment options set both directions;
+/// --a2b-X / --b2a-X set one and win over --X wherever they appear.
+/// Throws std::invalid_argument naming the option and the bad value.
+RelayOptions ParseRelayOptions(const std::vector<std::string>& args);
+
+/// The --help text.
+std::string RelayUsage();
+
+/// Seed of the b2a channel: a splitmix64 step of `seed`, so both directions
+/// are independent but fixed by the one --seed.
+std::uint64_t DerivedSeed(std::uint64_t seed);
+
+/// "udpm://239.255.76.67:7667?ttl=0" -> 7667 (7667 when no port); -1 if the
+/// URL is not udpm.
+int UdpmPort(const std::string& url);
+
+}  // namespace robotalk::relay
