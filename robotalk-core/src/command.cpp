@@ -69,6 +69,8 @@ const char* ToString(QueryType t) {
     case QueryType::kFramePoses: return "FRAME_POSES";
     case QueryType::kBasePose: return "BASE_POSE";
     case QueryType::kClock: return "CLOCK";
+    case QueryType::kStateStream: return "STATE_STREAM";
+    case QueryType::kStateStreamCancel: return "STATE_STREAM_CANCEL";
   }
   return "UNKNOWN_QUERY";
 }
@@ -85,7 +87,7 @@ std::optional<CommandType> ParseCommandType(const std::string& name) {
 
 std::optional<QueryType> ParseQueryType(const std::string& name) {
   const std::string n = Upper(name);
-  for (int t = 1; t <= 6; ++t) {
+  for (int t = 1; t <= 8; ++t) {
     auto type = static_cast<QueryType>(t);
     if (n == ToString(type)) return type;
   }
@@ -154,6 +156,10 @@ std::optional<std::string> CheckCommand(const RobotModel& model, const Command& 
 }
 
 std::optional<std::string> CheckQuery(const RobotModel& model, const Query& q) {
+  if (q.type == QueryType::kStateStream && (q.period < kMinStreamPeriod || q.period > kMaxStreamPeriod)) {
+    return "STATE_STREAM: period " + std::to_string(ToSeconds(q.period)) + " s is outside [" +
+           std::to_string(ToSeconds(kMinStreamPeriod)) + ", " + std::to_string(ToSeconds(kMaxStreamPeriod)) + "] s";
+  }
   if (q.target.empty()) return std::nullopt;
   switch (q.type) {
     case QueryType::kJointState:

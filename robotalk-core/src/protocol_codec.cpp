@@ -9,16 +9,17 @@ namespace robotalk {
 namespace {
 
 // Smallest encodings of the array elements (an empty string takes 5 bytes).
-constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead;
+constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead + 8;
 constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2;
 constexpr std::int64_t kMinReplyBytes = 8 + 1 + kLcmStringOverhead + 8 + 8 + 4;
 
 void ScanPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8, "header");
   const std::int32_t nq = s.Count("num_queries", kMinQueryBytes);
   for (std::int32_t i = 0; i < nq; ++i) {
     s.Skip(8 + 1, "query");
     s.String("query.target");
+    s.Skip(8, "query.period_us");
   }
   const std::int32_t nc = s.Count("num_commands", kMinCommandBytes);
   for (std::int32_t i = 0; i < nc; ++i) {
@@ -72,6 +73,7 @@ robotalk_msgs::query_t ToWire(const Query& q) {
   w.id = q.id;
   w.type = static_cast<std::int8_t>(q.type);
   w.target = q.target;
+  w.period_us = ToWireMicros(q.period);
   return w;
 }
 
@@ -104,10 +106,13 @@ Command FromWire(const robotalk_msgs::command_t& w) {
 }
 
 Query FromWire(const robotalk_msgs::query_t& w) {
-  if (w.type < 1 || w.type > static_cast<std::int8_t>(QueryType::kClock)) {
+  if (w.type < 1 || w.type > static_cast<std::int8_t>(QueryType::kStateStreamCancel)) {
     throw ProtocolError("query " + std::to_string(w.id) + ": unknown query type " + std::to_string(w.type));
   }
-  return Query{w.id, static_cast<QueryType>(w.type), w.target};
+  if (w.period_us < 0) {
+    throw ProtocolError("query " + std::to_string(w.id) + ": negative period " + std::to_string(w.period_us) + " us");
+  }
+  return Query{w.id, static_cast<QueryType>(w.type), w.target, std::chrono::microseconds(w.period_us)};
 }
 
 Reply FromWire(const robotalk_msgs::reply_t& w) {
@@ -138,6 +143,15 @@ std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
            std::to_string(kProtocolVersion) + ")";
   }
   if (h.client_id == 0) return "package: client id 0 is reserved";
+  if (h.mode < robotalk_msgs::package_header_t::MODE_DIRECT || h.mode > robotalk_msgs::package_header_t::MODE_PLAYBACK) {
+    return "package: unknown mode " + std::to_string(h.mode);
+  }
+  if (h.mode == robotalk_msgs::package_header_t::MODE_PLAYBACK) {
+    if (p.num_queries > 0) return "package: a PLAYBACK package carries commands only";
+    if (h.playback_frames < 1) return "package: PLAYBACK declares " + std::to_string(h.playback_frames) + " frames";
+    if (h.playback_duration_us < 0) return "package: PLAYBACK declares a negative duration";
+    if (h.playback_id == 0) return "package: PLAYBACK id 0 is reserved";
+  }
   if (h.sequence <= 0) return "package: sequence " + std::to_string(h.sequence) + " is not positive";
   if (p.num_queries > 0 && p.num_commands > 0) {
     return "package: mixes " + std::to_string(p.num_queries) + " queries and " + std::to_string(p.num_commands) +

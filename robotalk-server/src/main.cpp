@@ -21,6 +21,10 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --max-queue N                   most queued commands per client (default 10000)
   --max-future S                  refuse start times more than S seconds ahead (default 3600)
   --duration S                    exit after S seconds (default: run until SIGINT/SIGTERM)
+  --congestion-max-pause S        the paper's congestion injector: pause a random time in
+                                  [0, S] s in the ServerDaemon after each received package
+  --playback-min-frames N         frames playback mode waits for before estimating (default 5;
+                                  also at least 10% of the declared sequence)
   --inject-reply-drop P           test only: drop each reply package with probability P
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
@@ -72,6 +76,10 @@ int main(int argc, char** argv) {
         options.max_queue = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e7));
       } else if (arg == "--max-future") {
         options.max_future = robotalk::FromSeconds(ParseNumber(arg, value(), 0, 86400 * 7));
+      } else if (arg == "--congestion-max-pause") {
+        options.congestion_max_pause = robotalk::FromSeconds(ParseNumber(arg, value(), 0, 10));
+      } else if (arg == "--playback-min-frames") {
+        options.playback_min_frames = static_cast<size_t>(ParseNumber(arg, value(), 2, 1e6));
       } else if (arg == "--duration") {
         duration = ParseNumber(arg, value(), 0, 1e9);
       } else if (arg == "--inject-reply-drop") {

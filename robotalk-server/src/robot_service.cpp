@@ -115,6 +115,9 @@ ImmediateAnswer RobotService::HandlePackage(const robotalk_msgs::package_t& pack
     std::vector<CommandId> ids;
     for (const auto& q : package.queries) ids.push_back(q.id);
     for (const auto& c : package.commands) ids.push_back(c.id);
+    // The playback delay reply (id = playback id) may come with any of its packages.
+    const bool playback = h.mode == robotalk_msgs::package_header_t::MODE_PLAYBACK;
+    if (playback) ids.push_back(h.playback_id);
     session.replies.RecordPackage(h.sequence, ids);
 
     if (h.panic) {
@@ -122,6 +125,8 @@ ImmediateAnswer RobotService::HandlePackage(const robotalk_msgs::package_t& pack
       for (CommandId id : ids) {
         immediate.push_back(MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", received));
       }
+    } else if (playback) {
+      EnqueuePlayback(session, package, received, immediate);
     } else {
       for (const auto& q : package.queries) EnqueueQuery(session, q, received, immediate, answer.publish_config);
       for (const auto& c : package.commands) EnqueueCommand(session, c, received, immediate);
@@ -180,6 +185,22 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
     immediate.push_back(MakeReply(q.id, Signal::kSuccess, "", now));
     return;
   }
+  if (q.type == QueryType::kStateStream || q.type == QueryType::kStateStreamCancel) {
+    if (q.type == QueryType::kStateStream) {
+      stream_requests_[s.client_id] = q.period;
+    } else {
+      stream_requests_.erase(s.client_id);
+    }
+    UpdateStream(now);
+    Reply r = MakeReply(q.id, Signal::kSuccess,
+                        stream_period_.count() == 0
+                            ? "no state stream"
+                            : "state every " + std::to_string(ToSeconds(stream_period_)) + " s on ROBOTALK/" + name_ + "/STATE",
+                        now);
+    r.values = {ToSeconds(stream_period_)};
+    immediate.push_back(std::move(r));
+    return;
+  }
   if (q.type == QueryType::kConfig) {
     publish_config = true;
     immediate.push_back(MakeReply(q.id, Signal::kSuccess, Hex(static_cast<std::int64_t>(config_hash_)), now));
@@ -211,14 +232,14 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
   wake_.notify_one();
 }
 
-void RobotService::EnqueueCommand(Session& s, const robotalk_msgs::command_t& wire, TimePoint now,
-                                  std::vector<Reply>& immediate) {
+std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotalk_msgs::command_t& wire,
+                                                       TimePoint now, std::vector<Reply>& immediate, bool playback) {
   Command c;
   try {
     c = FromWire(wire);
   } catch (const ProtocolError& e) {
     immediate.push_back(MakeReply(wire.id, Signal::kError, e.what(), now));
-    return;
+    return std::nullopt;
   }
   if (c.type == CommandType::kPanicReset) {
     Signal signal = Signal::kSuccess;
@@ -234,32 +255,38 @@ void RobotService::EnqueueCommand(Session& s, const robotalk_msgs::command_t& wi
     } else {
       immediate.push_back(MakeReply(c.id, Signal::kSuccess, "the robot was not in panic", now));
     }
-    return;
+    return std::nullopt;
   }
   if (panic_) {
     immediate.push_back(MakeReply(c.id, Signal::kPanic,
                                   "robot '" + name_ + "' is in panic; nothing executes until PANIC_RESET", now));
-    return;
+    return std::nullopt;
   }
   Signal signal = Signal::kError;
   if (auto bad = CheckCommand(model(), c, &signal)) {
     immediate.push_back(MakeReply(c.id, signal, *bad, now));
-    return;
+    return std::nullopt;
   }
-  if (c.start_time && *c.start_time - now > options_.max_future) {
-    immediate.push_back(MakeReply(
-        c.id, Signal::kError,
-        std::string(ToString(c.type)) + ": start time is " + std::to_string(ToSeconds(*c.start_time - now)) +
-            " s ahead of the server clock; the limit is " + std::to_string(ToSeconds(options_.max_future)) + " s",
-        now));
-    return;
+  // A playback frame's start time is its offset from the sequence start.
+  const Duration ahead = !c.start_time ? Duration(0)
+                         : playback    ? c.start_time->time_since_epoch()
+                                       : *c.start_time - now;
+  if (ahead > options_.max_future) {
+    immediate.push_back(MakeReply(c.id, Signal::kError,
+                                  std::string(ToString(c.type)) + ": start time is " + std::to_string(ToSeconds(ahead)) +
+                                      " s ahead" + (playback ? " of the sequence start" : " of the server clock") +
+                                      "; the limit is " + std::to_string(ToSeconds(options_.max_future)) + " s",
+                                  now));
+    return std::nullopt;
   }
-  if (s.commands.size() >= options_.max_queue) {
+  size_t queued = s.commands.size();
+  for (const auto& [id, seq] : s.playbacks) queued += seq.frames.size();
+  if (queued >= options_.max_queue) {
     immediate.push_back(MakeReply(c.id, Signal::kError,
                                   "queue of client " + Hex(s.client_id) + " is full (" +
                                       std::to_string(options_.max_queue) + " items); command not queued",
                                   now));
-    return;
+    return std::nullopt;
   }
   QueuedItem item;
   item.arrival = ++arrivals_;
@@ -276,9 +303,99 @@ void RobotService::EnqueueCommand(Session& s, const robotalk_msgs::command_t& wi
   // CheckCommand bounds the count: at most 6 dofs, 7 pose values, 3 base values.
   item.command.num_values = static_cast<int>(c.values.size());
   std::copy(c.values.begin(), c.values.end(), item.command.values.begin());
-  s.commands.Push(std::move(item));
+  return item;
+}
+
+void RobotService::EnqueueCommand(Session& s, const robotalk_msgs::command_t& wire, TimePoint now,
+                                  std::vector<Reply>& immediate) {
+  std::optional<QueuedItem> item = PrepareCommand(s, wire, now, immediate, /*playback=*/false);
+  if (!item) return;
+  s.commands.Push(std::move(*item));
   wake_flag_ = true;
   wake_.notify_one();
+}
+
+void RobotService::EnqueuePlayback(Session& s, const robotalk_msgs::package_t& package, TimePoint now,
+                                   std::vector<Reply>& immediate) {
+  const auto& h = package.header;
+  const Duration duration = std::chrono::microseconds(h.playback_duration_us);
+  auto [it, created] = s.playbacks.try_emplace(h.playback_id, static_cast<size_t>(h.playback_frames), duration,
+                                               options_.playback);
+  PlaybackSequence& seq = it->second;
+  const auto refuse_all = [&](const std::string& why) {
+    for (const auto& c : package.commands) immediate.push_back(MakeReply(c.id, Signal::kError, why, now));
+  };
+  if (!created && (seq.total != static_cast<size_t>(h.playback_frames) || seq.duration != duration)) {
+    refuse_all("PLAYBACK " + std::to_string(h.playback_id) + ": declared " + std::to_string(seq.total) + " frames over " +
+               std::to_string(ToSeconds(seq.duration)) + " s before, now " + std::to_string(h.playback_frames) +
+               " over " + std::to_string(ToSeconds(duration)) + " s");
+    return;
+  }
+  if (!seq.first_arrival) seq.first_arrival = now;
+  for (const auto& wire : package.commands) {
+    std::optional<QueuedItem> item = PrepareCommand(s, wire, now, immediate, /*playback=*/true);
+    if (!item) continue;
+    const Duration offset = item->start == TimePoint::min() ? Duration(0) : item->start.time_since_epoch();
+    if (offset > seq.duration || ++seq.received > seq.total) {
+      immediate.push_back(MakeReply(wire.id, Signal::kError,
+                                    "PLAYBACK " + std::to_string(h.playback_id) + ": frame at " +
+                                        std::to_string(ToSeconds(offset)) + " s is beyond the declared " +
+                                        std::to_string(seq.total) + " frames over " + std::to_string(ToSeconds(seq.duration)) + " s",
+                                    now));
+      continue;
+    }
+    item->has_start_time = true;
+    if (seq.start) {  // already playing: straight to the command queue
+      item->start = *seq.start + offset;
+      s.commands.Push(std::move(*item));
+    } else {
+      seq.estimator.Add(offset, now);
+      item->start = TimePoint(offset);
+      seq.frames.push_back(std::move(*item));
+    }
+  }
+  if (!seq.start && seq.estimator.ready()) {
+    seq.start = seq.estimator.StartTime();
+    for (QueuedItem& frame : seq.frames) {
+      frame.start = *seq.start + frame.start.time_since_epoch();
+      s.commands.Push(std::move(frame));
+    }
+    seq.frames.clear();
+    const Duration delay = *seq.start - *seq.first_arrival;
+    Reply r = MakeReply(h.playback_id, Signal::kSuccess,
+                        "playback of " + std::to_string(seq.total) + " frames starts " + std::to_string(ToSeconds(delay)) +
+                            " s after its first frame arrived (mean " +
+                            std::to_string(ToSeconds(seq.estimator.mean_command_interval())) + " s between commands, " +
+                            std::to_string(ToSeconds(seq.estimator.mean_arrival_interval())) + " s between arrivals)",
+                        now);
+    r.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
+    immediate.push_back(std::move(r));
+  }
+  wake_flag_ = true;
+  wake_.notify_one();
+}
+
+void RobotService::UpdateStream(TimePoint now) {
+  Duration period{0};
+  for (const auto& [client, p] : stream_requests_) period = period.count() == 0 ? p : std::min(period, p);
+  if (period == stream_period_) return;
+  // A new or faster stream starts sampling now; slower keeps its phase.
+  if (stream_period_.count() == 0 || period < stream_period_) next_sample_ = now;
+  stream_period_ = period;
+  ++stream_generation_;
+  wake_flag_ = true;
+  wake_.notify_one();
+}
+
+Duration RobotService::stream_period() const {
+  std::lock_guard lock(mutex_);
+  return stream_period_;
+}
+
+void RobotService::TakeStates(std::vector<robotalk_msgs::robot_state_t>& out) {
+  std::lock_guard lock(mutex_);
+  for (auto& m : state_outbox_) out.push_back(std::move(m));
+  state_outbox_.clear();
 }
 
 void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
@@ -286,7 +403,13 @@ void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
   std::fprintf(stderr, "robotalk-server: robot '%s': PANIC from client %s%s\n", name_.c_str(), Hex(client_id).c_str(),
                first ? "" : " (already in panic)");
   std::vector<QueuedItem> flushed;
-  for (auto& [id, session] : sessions_) session.commands.Flush(flushed);
+  for (auto& [id, session] : sessions_) {
+    session.commands.Flush(flushed);
+    for (auto& [pid, seq] : session.playbacks) {
+      for (QueuedItem& frame : seq.frames) flushed.push_back(std::move(frame));
+    }
+    session.playbacks.clear();
+  }
   server_queue_.clear();
   for (const QueuedItem& item : flushed) {
     Deliver(item.client_id, MakeReply(item.command.id, Signal::kInterrupted,
@@ -326,8 +449,10 @@ std::vector<ExpiredSession> RobotService::ExpireSessions(TimePoint now) {
       }
       expired.push_back({it->first, it->second.commands.size(), it->second.moved_robot});
       stop = stop || it->second.moved_robot;
+      stream_requests_.erase(it->first);
       it = sessions_.erase(it);
     }
+    if (!expired.empty()) UpdateStream(now);
   }
   if (stop) QueueStop("a client that moved the robot vanished", /*only_if_moving=*/true);
   return expired;
@@ -366,8 +491,14 @@ robotalk_msgs::robot_info_t RobotService::Info() const {
 TimePoint RobotService::RunOnce(TimePoint now) {
   bool halt = false, resume = false;
   due_.clear();
+  Duration stream_period{0};
+  TimePoint next_sample{};
+  std::uint64_t stream_generation = 0;
   {
     std::lock_guard lock(mutex_);
+    stream_period = stream_period_;
+    next_sample = next_sample_;
+    stream_generation = stream_generation_;
     halt = std::exchange(halt_requested_, false);
     resume = std::exchange(resume_requested_, false);
     for (QueuedItem& item : server_queue_) due_.push_back(std::move(item));
@@ -395,6 +526,14 @@ TimePoint RobotService::RunOnce(TimePoint now) {
     next_update_ = next_update_ == TimePoint::min() ? now + period : next_update_ + period;
     if (next_update_ <= now) next_update_ = now + period;  // overran: skip, don't burst
   }
+  // Broadcast (paper §V-D): the state query re-inserts itself one period
+  // later. Deadlines are absolute (t0 + k·period), so the stream never
+  // drifts; samples missed while the daemon was late are skipped, not burst.
+  sampled_.clear();
+  if (stream_period.count() > 0 && now >= next_sample) {
+    SampleState(now, stream_period);
+    next_sample += stream_period * ((now - next_sample) / stream_period + 1);
+  }
   for (const Completion& c : completions_) {
     auto owner = in_progress_.find(c.id);
     if (owner == in_progress_.end()) continue;
@@ -416,13 +555,60 @@ TimePoint RobotService::RunOnce(TimePoint now) {
       }
     }
     for (Produced& p : produced_) Deliver(p.client_id, std::move(p.reply));
+    for (auto& m : sampled_) state_outbox_.push_back(std::move(m));
+    if (stream_generation == stream_generation_ && stream_period_.count() > 0) {
+      next_sample_ = next_sample;
+      next = std::min(next, next_sample_);
+    } else if (stream_period_.count() > 0) {
+      next = now;  // the stream changed meanwhile: look again at once
+    }
     for (auto& [id, session] : sessions_) {
       if (!session.commands.empty() && session.commands.Top().start < next) next = session.commands.Top().start;
     }
     if (!server_queue_.empty() || halt_requested_ || resume_requested_) next = now;
   }
-  if (!produced_.empty() && replies_ready_) replies_ready_();
+  if ((!produced_.empty() || !sampled_.empty()) && replies_ready_) replies_ready_();
   return next;
+}
+
+void RobotService::SampleState(TimePoint now, Duration period) {
+  const RobotModel& m = model();
+  driver_->ReadState(state_);
+  robotalk_msgs::robot_state_t msg{};
+  msg.server_time_us = ToWireMicros(now);
+  msg.period_us = ToWireMicros(period);
+  msg.sample = ++samples_;
+  msg.robot = name_;
+  msg.config_hash = static_cast<std::int64_t>(config_hash_);
+  msg.panic = panic_.load();
+  msg.moving = state_.moving;
+  msg.num_dofs = m.num_dofs();
+  msg.position.assign(state_.position.data(), state_.position.data() + m.num_dofs());
+  msg.velocity.assign(state_.velocity.data(), state_.velocity.data() + m.num_dofs());
+  msg.effort.assign(state_.effort.data(), state_.effort.data() + m.num_dofs());
+  const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
+  msg.base[0] = base.translation().x();
+  msg.base[1] = base.translation().y();
+  msg.base[2] = std::atan2(base.linear()(1, 0), base.linear()(0, 0));
+  msg.base[3] = state_.base_v;
+  msg.base[4] = state_.base_omega;
+  msg.num_frames = static_cast<std::int32_t>(m.frames().size());
+  if (msg.num_frames > 0) {
+    std::vector<Eigen::Isometry3d> roots;
+    for (const Pose& p : state_.root_poses) roots.push_back(p.ToIsometry());
+    try {
+      kinematics_.Update(state_.position, roots);
+      for (int f = 0; f < msg.num_frames; ++f) {
+        std::vector<double> pose;
+        AppendPose(kinematics_.frame_pose(f), pose);
+        msg.frame_poses.push_back(pose);
+      }
+    } catch (const std::exception&) {
+      msg.num_frames = 0;  // a driver reporting a non-finite state: send the rest
+      msg.frame_poses.clear();
+    }
+  }
+  sampled_.push_back(std::move(msg));
 }
 
 void RobotService::Execute(const QueuedItem& item, TimePoint now) {

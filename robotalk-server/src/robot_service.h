@@ -18,6 +18,7 @@
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
 #include "robotalk_msgs/robot_info_t.hpp"
+#include "robotalk_msgs/robot_state_t.hpp"
 
 #include <atomic>
 #include <condition_variable>
@@ -25,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -39,6 +41,8 @@ struct RobotServiceOptions {
   size_t max_queue = 10000;
   /// Start times further ahead than this are refused.
   Duration max_future = std::chrono::hours(1);
+  /// When playback mode has seen enough frames to estimate its delay.
+  PlaybackEstimatorOptions playback;
   /// Print one line per executed command to stderr (a diagnostic audit log;
   /// it does I/O on the RobotDaemon, so leave it off on a real-time system).
   bool log_executions = false;
@@ -91,6 +95,10 @@ class RobotService {
                                 const std::string& reason);
   /// Moves every reply waiting in the return queues into `out`.
   void TakeReplies(std::vector<OutgoingReplies>& out);
+  /// Moves the broadcast state samples taken since the last call into `out`.
+  void TakeStates(std::vector<robotalk_msgs::robot_state_t>& out);
+  /// The broadcast period now (shortest asked for), or 0 when nobody asks.
+  Duration stream_period() const;
   /// Expires silent sessions. If one had set the robot moving and the robot
   /// is still moving when the RobotDaemon looks, it is stopped.
   std::vector<ExpiredSession> ExpireSessions(TimePoint now);
@@ -120,8 +128,15 @@ class RobotService {
   };
 
   Session& SessionFor(std::int64_t client_id, TimePoint now);  // REQUIRES: mutex_ held
+  // Checks a command; returns it ready to queue, or answers it in `immediate`.
+  std::optional<QueuedItem> PrepareCommand(Session& s, const robotalk_msgs::command_t& wire, TimePoint now,
+                                           std::vector<Reply>& immediate, bool playback);  // REQUIRES: mutex_ held
   void EnqueueCommand(Session& s, const robotalk_msgs::command_t& wire, TimePoint now,
                       std::vector<Reply>& immediate);  // REQUIRES: mutex_ held
+  void EnqueuePlayback(Session& s, const robotalk_msgs::package_t& package, TimePoint now,
+                       std::vector<Reply>& immediate);  // REQUIRES: mutex_ held
+  void UpdateStream(TimePoint now);                     // REQUIRES: mutex_ held
+  void SampleState(TimePoint now, Duration period);     // RobotDaemon, no lock
   void EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, TimePoint now, std::vector<Reply>& immediate,
                     bool& publish_config);  // REQUIRES: mutex_ held
   void PanicNow(std::int64_t client_id, TimePoint now);  // REQUIRES: mutex_ held
@@ -150,6 +165,12 @@ class RobotService {
   bool resume_requested_ = false;             // GUARDED_BY(mutex_)
   bool wake_flag_ = false;                    // GUARDED_BY(mutex_)
   bool running_ = false;                      // GUARDED_BY(mutex_)
+  // Broadcast: one stream at the shortest period any client asked for.
+  std::map<std::int64_t, Duration> stream_requests_;         // GUARDED_BY(mutex_)
+  Duration stream_period_{0};                                // GUARDED_BY(mutex_); 0 = off
+  TimePoint next_sample_{};                                  // GUARDED_BY(mutex_)
+  std::uint64_t stream_generation_ = 0;                      // GUARDED_BY(mutex_)
+  std::vector<robotalk_msgs::robot_state_t> state_outbox_;   // GUARDED_BY(mutex_)
   std::atomic<bool> panic_{false};
 
   // RobotDaemon only (preallocated).
@@ -162,6 +183,8 @@ class RobotService {
   RobotState state_;
   Kinematics kinematics_;
   TimePoint next_update_ = TimePoint::min();
+  std::int64_t samples_ = 0;
+  std::vector<robotalk_msgs::robot_state_t> sampled_;
 };
 
 }  // namespace robotalk

@@ -77,6 +77,7 @@ class Server::Impl {
     if (!lcm_.good()) throw Error("Server: cannot open LCM URL '" + options_.lcm_url + "'");
     if (specs.empty()) throw Error("Server: no robot to serve");
     RobotServiceOptions service_options{options_.session_timeout, options_.max_queue, options_.max_future,
+                                        PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction},
                                         options_.log_executions};
     for (const RobotSpec& spec : specs) {
       if (robots_.count(spec.name)) throw Error("Server: robot name '" + spec.name + "' is given twice");
@@ -139,7 +140,13 @@ class Server::Impl {
     pollfd fds[2] = {{lcm_.getFileno(), POLLIN, 0}, {event_fd_, POLLIN, 0}};
     while (running_) {
       const int ready = poll(fds, 2, 50);
-      if (ready > 0 && (fds[0].revents & POLLIN)) lcm_.handleTimeout(0);
+      if (ready > 0 && (fds[0].revents & POLLIN)) {
+        lcm_.handleTimeout(0);
+        // The paper's congestion injector (§VI-B): a random pause after each receive.
+        if (options_.congestion_max_pause.count() > 0) {
+          std::this_thread::sleep_for(FromSeconds(congestion_(congestion_rng_) * ToSeconds(options_.congestion_max_pause)));
+        }
+      }
       if (ready > 0 && (fds[1].revents & POLLIN)) {
         std::uint64_t count;
         [[maybe_unused]] ssize_t n = read(event_fd_, &count, sizeof count);
@@ -196,6 +203,9 @@ class Server::Impl {
 
   void SendReplies() {
     for (auto& [name, robot] : robots_) {
+      states_.clear();
+      robot->TakeStates(states_);
+      for (const auto& state : states_) lcm_.publish(kPrefix + name + "/STATE", &state);
       outgoing_.clear();
       robot->TakeReplies(outgoing_);
       for (OutgoingReplies& out : outgoing_) {
@@ -242,6 +252,9 @@ class Server::Impl {
   FaultInjector faults_;
   std::map<std::string, std::unique_ptr<RobotService>> robots_;
   std::vector<OutgoingReplies> outgoing_;
+  std::vector<robotalk_msgs::robot_state_t> states_;
+  std::mt19937_64 congestion_rng_{options_.fault_seed};
+  std::uniform_real_distribution<double> congestion_{0.0, 1.0};
   int event_fd_ = -1;
   std::int64_t server_id_ = 0;
   std::atomic<bool> running_{false};

@@ -5,11 +5,13 @@
 #pragma once
 
 #include "command_queue.h"
+#include "playback_estimator.h"
 #include "sequence_window.h"
 #include "robotalk/command.h"
 
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <optional>
 #include <unordered_map>
 #include <utility>
@@ -35,6 +37,21 @@ class ReplyCache {
   std::unordered_map<CommandId, std::optional<Reply>> replies_;        // id -> final reply once known
 };
 
+/// One playback sequence of a client (paper §V-C): its frames wait in the
+/// playback queue until the delay is estimated, then move to the command queue.
+struct PlaybackSequence {
+  PlaybackSequence(std::size_t total_frames, Duration duration, PlaybackEstimatorOptions options)
+      : estimator(total_frames, duration, options), total(total_frames), duration(duration) {}
+
+  PlaybackEstimator estimator;
+  std::vector<QueuedItem> frames;  ///< the playback queue; `start` holds each frame's offset
+  std::optional<TimePoint> start;  ///< when offset 0 plays, once estimated
+  std::optional<TimePoint> first_arrival;
+  std::size_t total;
+  Duration duration;
+  std::size_t received = 0;
+};
+
 struct Session {
   Session(std::int64_t id, TimePoint now) : client_id(id), created(now), last_heard(now) {}
 
@@ -45,6 +62,7 @@ struct Session {
   std::vector<Reply> return_queue;  ///< replies not yet sent, in issuance order
   SequenceWindow seen;
   ReplyCache replies;
+  std::map<std::int64_t, PlaybackSequence> playbacks;  ///< by playback id
   /// Set by a motion command of this client, cleared by any STOP: the
   /// watchdog stops the robot when a session that moved it expires.
   bool moved_robot = false;

@@ -85,8 +85,7 @@ TEST(ProtocolCodec, RefusesEveryTruncationOfAPackage) {
 
 TEST(ProtocolCodec, RefusesHostileCountsWithoutAllocating) {
   const auto bytes = Encode(SamplePackage());
-  // num_commands sits right after the header (8 + 32 bytes) and num_queries (4).
-  const size_t num_commands_at = 8 + 32 + 4;
+  const size_t num_commands_at = 8 + 53 + 4;  // fingerprint, header, num_queries
   for (std::uint32_t hostile : {0x7fffffffu, 0x80000000u, 0xffffffffu, 100000u}) {
     auto bad = bytes;
     for (int i = 0; i < 4; ++i) bad[num_commands_at + static_cast<size_t>(i)] = static_cast<std::uint8_t>(hostile >> (24 - 8 * i));

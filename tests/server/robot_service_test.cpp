@@ -48,6 +48,16 @@ robotalk_msgs::package_t Queries(std::int64_t client, std::int64_t seq, const st
   return p;
 }
 
+robotalk_msgs::package_t Playback(std::int64_t client, std::int64_t seq, std::int64_t playback_id, int frames,
+                                  Duration duration, const std::vector<Command>& commands) {
+  robotalk_msgs::package_t p = Package(client, seq, commands);
+  p.header.mode = robotalk_msgs::package_header_t::MODE_PLAYBACK;
+  p.header.playback_id = playback_id;
+  p.header.playback_frames = frames;
+  p.header.playback_duration_us = ToWireMicros(duration);
+  return p;
+}
+
 class RobotServiceTest : public ::testing::Test {
  protected:
   explicit RobotServiceTest(BaseType base = BaseType::kDifferential) {
@@ -295,6 +305,100 @@ TEST_F(RobotServiceTest, AnswersJointStateAndPoseQueries) {
   ASSERT_EQ(replies.at(2).values.size(), 7u);
   EXPECT_NEAR(replies.at(2).values[3], std::cos(0.25), 1e-12) << "qw of a 0.5 rad yaw";
   EXPECT_EQ(replies.at(3).values.size(), 5u);
+}
+
+TEST_F(RobotServiceTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTiming) {
+  // 20 frames every 100 ms; the channel delivers one every 150 ms (slower).
+  // One timeline in 1 ms steps: frames arrive, the RobotDaemon runs.
+  constexpr int kFrames = 20;
+  constexpr std::int64_t kPlayback = 9000;
+  const Duration period = milliseconds(100), duration = period * (kFrames - 1);
+  const TimePoint first_arrival = clock_.Now();
+  std::optional<Reply> delay_reply;
+  int sent = 0;
+  for (TimePoint t = first_arrival; t < first_arrival + seconds(5); t += milliseconds(1)) {
+    clock_.Set(t);
+    if (sent < kFrames && t >= first_arrival + milliseconds(150) * sent) {
+      const Command frame = Cmd(sent + 1, CommandType::kJointSetPoint, {0.01 * sent}, "pan", TimePoint(period * sent));
+      auto immediate = Handle(Playback(kAlice, sent + 1, kPlayback, kFrames, duration, {frame}));
+      if (immediate.count(kPlayback)) delay_reply = immediate.at(kPlayback);
+      ++sent;
+      if (sent < 5) {
+        EXPECT_FALSE(delay_reply) << "still estimating after " << sent << " frames";
+      }
+    }
+    Run();
+    if (!delay_reply) {
+      EXPECT_TRUE(fake_->calls.empty()) << "frames wait in the playback queue";
+    }
+  }
+  ASSERT_TRUE(delay_reply) << "the client learns the delay";
+  EXPECT_EQ(delay_reply->signal, Signal::kSuccess);
+  // The backlog grows 50 ms per frame: 19 x 50 ms = 0.95 s, plus the margin.
+  EXPECT_GE(FromSeconds(delay_reply->values.at(0)), milliseconds(950));
+  const TimePoint start = FromWireMicros(static_cast<std::int64_t>(delay_reply->values.at(1)));
+  // Every frame ran at start + its offset (within one 1 ms step), never
+  // before it arrived: the inter-frame timing is kept exactly.
+  ASSERT_EQ(fake_->calls.size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    const Duration late = fake_->calls[static_cast<size_t>(i)].at - (start + period * i);
+    EXPECT_GE(late, Duration(0)) << "frame " << i;
+    EXPECT_LT(late, milliseconds(1) + std::chrono::microseconds(1)) << "frame " << i;
+    EXPECT_GE(fake_->calls[static_cast<size_t>(i)].at, first_arrival + milliseconds(150) * i) << "frame " << i;
+  }
+}
+
+TEST_F(RobotServiceTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
+  auto r = Handle(Playback(kAlice, 1, 77, 2, seconds(1),
+                           {Cmd(1, CommandType::kStop, {}, "", TimePoint(seconds(2)))}));
+  EXPECT_EQ(r.at(1).signal, Signal::kError);
+  EXPECT_THAT(r.at(1).message, HasSubstr("beyond the declared"));
+}
+
+TEST_F(RobotServiceTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) {
+  auto r = Handle(Queries(kAlice, 1, {Query{1, QueryType::kStateStream, "", milliseconds(100)}}));
+  ASSERT_EQ(r.at(1).signal, Signal::kSuccess);
+  const TimePoint t0 = clock_.Now();
+  std::vector<robotalk_msgs::robot_state_t> states;
+  // A minute of daemon iterations at an irregular 7 ms step.
+  while (clock_.Now() < t0 + seconds(60)) {
+    Run();
+    service_->TakeStates(states);
+    clock_.Advance(milliseconds(7));
+    if ((clock_.Now() - t0) % seconds(1) < milliseconds(7)) Handle(Queries(kAlice, 100 + states.size(), {}));  // heartbeat
+  }
+  ASSERT_EQ(states.size(), 600u);
+  for (size_t k = 0; k < states.size(); ++k) {
+    const TimePoint due = t0 + milliseconds(100) * static_cast<int>(k);
+    const TimePoint sampled = FromWireMicros(states[k].server_time_us);
+    ASSERT_GE(sampled, due) << "sample " << k;
+    ASSERT_LT(sampled, due + milliseconds(7)) << "sample " << k << " drifted";
+  }
+  EXPECT_EQ(states.back().sample, 600);
+  EXPECT_EQ(states.back().num_dofs, 1);
+  EXPECT_EQ(states.back().robot, "bot");
+
+  Handle(Queries(kAlice, 9999, {Query{2, QueryType::kStateStreamCancel, ""}}));
+  states.clear();
+  for (int i = 0; i < 50; ++i) {
+    clock_.Advance(milliseconds(10));
+    Run();
+  }
+  service_->TakeStates(states);
+  EXPECT_TRUE(states.empty()) << "cancelled";
+}
+
+TEST_F(RobotServiceTest, SharesOneStreamAtTheShortestPeriodAndEndsItWithTheSessions) {
+  Handle(Queries(kAlice, 1, {Query{1, QueryType::kStateStream, "", milliseconds(200)}}));
+  Handle(Queries(kBob, 1, {Query{1, QueryType::kStateStream, "", milliseconds(50)}}));
+  EXPECT_EQ(service_->stream_period(), milliseconds(50));
+  Handle(Queries(kBob, 2, {Query{2, QueryType::kStateStreamCancel, ""}}));
+  EXPECT_EQ(service_->stream_period(), milliseconds(200));
+  clock_.Advance(seconds(3));
+  service_->ExpireSessions(clock_.Now());
+  EXPECT_EQ(service_->stream_period(), Duration(0)) << "nobody left to ask";
+  auto bad = Handle(Queries(kAlice, 2, {Query{3, QueryType::kStateStream, "", Duration(0)}}));
+  EXPECT_EQ(bad.at(3).signal, Signal::kError);
 }
 
 }  // namespace

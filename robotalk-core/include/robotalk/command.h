@@ -34,6 +34,8 @@ enum class QueryType : std::int8_t {
   kFramePoses = 4,  ///< world pose of every control frame (or one)
   kBasePose = 5,    ///< x y θ v ω of the first root link
   kClock = 6,       ///< server time, for clock synchronisation
+  kStateStream = 7,        ///< broadcast: robot_state_t on ROBOTALK/<robot>/STATE every `period`
+  kStateStreamCancel = 8,  ///< ends this client's STATE_STREAM request
 };
 
 const char* ToString(CommandType t);
@@ -55,7 +57,12 @@ struct Query {
   CommandId id = 0;
   QueryType type = QueryType::kJointState;
   std::string target;  ///< one joint / link / frame name, or empty for all
+  Duration period{0};  ///< STATE_STREAM: the sampling period
 };
+
+/// Shortest and longest broadcast periods a server accepts.
+inline constexpr Duration kMinStreamPeriod = std::chrono::milliseconds(1);
+inline constexpr Duration kMaxStreamPeriod = std::chrono::hours(1);
 
 struct Reply {
   CommandId id = 0;
@@ -77,7 +84,7 @@ bool IsMotionCommand(CommandType t);
 /// base command the robot does not support.
 std::optional<std::string> CheckCommand(const RobotModel& model, const Command& command, Signal* signal);
 
-/// Same for queries (unknown target names, unknown type).
+/// Same for queries (unknown target names, a STATE_STREAM period out of range).
 std::optional<std::string> CheckQuery(const RobotModel& model, const Query& query);
 
 }  // namespace robotalk

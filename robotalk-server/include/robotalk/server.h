@@ -41,6 +41,12 @@ struct ServerOptions {
   bool log_executions = false;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
+  /// The paper's congestion injector (§VI-B): after each received package the
+  /// ServerDaemon pauses a random time uniform in [0, this]. 0 = off.
+  Duration congestion_max_pause{0};
+  /// Frames playback mode waits for before estimating its delay.
+  std::size_t playback_min_frames = 5;
+  double playback_fraction = 0.1;
   /// Test fault injection on outgoing reply packages (seeded): probability
   /// that one is dropped, and that one is sent twice.
   double reply_drop_probability = 0.0;
