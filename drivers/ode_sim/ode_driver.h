@@ -1,0 +1,149 @@
+// The `ode` driver: any RobotModel simulated with the Open Dynamics Engine.
+// One ODE body per link (links joined by fixed joints fused into one body,
+// massless ones given a small virtual mass), hinge/slider chains per joint
+// with the model's limits, collision shapes from the URDF against a ground
+// plane, gravity. Joints are servoed by ODE velocity motors bounded by the
+// effort limits; a differential base is driven through its wheel joints; a
+// floating or holonomic first root is moved kinematically. The physics steps
+// at a fixed rate on its own simulated time. docs/ode_sim.md describes the
+// physics mapping, controllers, gains and tolerances.
+//
+// Threading contract (driver.h): every method is called from one thread, the
+// server's RobotDaemon; the class has no locks and is not thread-safe. ODE's
+// per-thread data is allocated in whichever thread calls first. Per-dof
+// buffers are allocated in the constructor; Update()/ReadState() allocate
+// nothing of their own (ODE's step uses its internal arenas); Execute()
+// allocates only for reply messages.
+//
+// Copy/move: neither (owns ODE handles behind a private implementation).
+#pragma once
+
+#include "collision_shapes.h"
+#include "robotalk/driver.h"
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace robotalk {
+
+/// Options of the ode driver; as key=value strings they are parsed by FromMap().
+struct OdeDriverOptions {
+  /// Physics rate, steps per simulated second. Key "step_hz", > 0.
+  double step_hz = 1000;
+  /// Period at which the RobotDaemon should call Update(). Key "period_ms", > 0.
+  Duration period = std::chrono::milliseconds(10);
+  /// Gravity, m/s² along -z. Key "gravity", >= 0.
+  double gravity = 9.81;
+  /// Ground friction coefficient (contacts of caster links use 0). Key "friction", >= 0.
+  double friction = 1.0;
+  /// Seed of ODE's random numbers (used by the quickstep solver). Key "seed", integer.
+  std::uint32_t seed = 1;
+  /// "step" (dWorldStep, exact LCP, default) or "quickstep" (iterative). Key "solver".
+  std::string solver = "step";
+  /// Set-point gain: motor velocity = kp * (target - q), 1/s. Key "kp", > 0.
+  double kp = 20.0;
+  /// Speed of dofs whose velocity limit is infinite, rad/s or m/s. Key "default_velocity", > 0.
+  double default_velocity = 1.0;
+  /// Motor force of dofs whose effort limit is infinite, N·m or N. Key "default_effort", > 0.
+  double default_effort = 200.0;
+  /// Largest base speed, m/s. Key "base_max_v", > 0.
+  double base_max_v = 0.7;
+  /// Largest base yaw rate, rad/s. Key "base_max_omega", > 0.
+  double base_max_omega = 2.0;
+  /// A GOTO succeeds this close to its goal, m. Key "goto_tolerance", > 0.
+  double goto_tolerance = 0.02;
+  /// ... and this close to its heading, rad. Key "goto_heading_tolerance", > 0.
+  double goto_heading_tolerance = 0.02;
+  /// Wheel joints of a differential base. Keys "left_wheel", "right_wheel".
+  std::string left_wheel = "left_wheel_joint";
+  std::string right_wheel = "right_wheel_joint";
+  /// Wheel radius, m; 0 = from the wheel's collision cylinder/sphere, else the
+  /// wheel joint's height above the ground. Key "wheel_radius", >= 0.
+  double wheel_radius = 0;
+  /// Distance between the wheels, m; 0 = between the wheel joints' origins.
+  /// Key "wheel_separation", >= 0.
+  double wheel_separation = 0;
+  /// Links whose ground contacts are frictionless (ball casters). Key
+  /// "casters", link names separated by '+'; "" for none.
+  std::vector<std::string> casters = {"caster"};
+  /// Overrides the first root's base type ("fixed", "differential",
+  /// "holonomic", "floating"); empty = the model's. Key "base".
+  std::string base;
+  /// Import option: merge massless chains (UrdfImportOptions). Key "merge_chains".
+  bool merge_chains = false;
+  /// Most simulated time one Update() catches up, ms; beyond it the simulation
+  /// drops time (counted by dropped_time()). Key "max_catchup_ms", > 0.
+  double max_catchup_ms = 100;
+  /// Mass of massless bodies (virtual), kg. Key "virtual_mass", > 0.
+  double virtual_mass = 0.05;
+  /// Gait of a floating base while it moves: hip and knee pitch joints (1 dof)
+  /// of each leg, '+'-separated "left_hip+left_knee+right_hip+right_knee";
+  /// empty = guessed from common names. Key "gait_joints".
+  std::string gait_joints;
+
+  /// Parses DriverConfig::options. Throws Error naming an unknown key (and the
+  /// known ones) or a bad value: "ode driver: option step_hz='0': expected a rate > 0 (Hz)".
+  static OdeDriverOptions FromMap(const std::map<std::string, std::string>& options);
+  /// Throws Error naming the first field that is out of range.
+  void Validate() const;
+};
+
+class OdeDriver final : public Driver {
+ public:
+  /// Builds the simulation. `shapes` are the model's collision shapes
+  /// (LoadCollisionShapes); without them nothing touches the ground. Joints
+  /// start at q = 0 clamped into the limits; a mobile first root is placed so
+  /// that its lowest shape rests on the ground. Throws Error for bad options,
+  /// a base type override that is unknown, or a differential base whose wheel
+  /// joints are not in the model.
+  OdeDriver(RobotModel model, const OdeDriverOptions& options = {}, std::vector<CollisionShape> shapes = {});
+  ~OdeDriver() override;
+  OdeDriver(const OdeDriver&) = delete;
+  OdeDriver& operator=(const OdeDriver&) = delete;
+
+  const RobotModel& model() const override;
+  Duration period() const override;
+
+  /// Advances the simulation to `now` first, then starts `command`.
+  DriverResult Execute(const DriverCommand& command, TimePoint now, std::vector<Completion>& completed) override;
+  /// Steps the physics as many fixed steps as fit up to `now` (at most
+  /// max_catchup_ms of them); the first call only sets the time base.
+  void Update(TimePoint now, std::vector<Completion>& completed) override;
+  void ReadState(RobotState& state) const override;
+  void Halt(std::vector<Completion>& interrupted) override;
+  void Resume() override;
+
+  /// As fast as possible: `n` fixed steps now, whatever the clock says (the
+  /// simulated time moves on by n steps). Completions go to `completed`.
+  void Step(int n, std::vector<Completion>& completed);
+  /// Steps until the simulated time reaches `t`, without the catch-up limit.
+  void AdvanceTo(TimePoint t, std::vector<Completion>& completed);
+  /// The simulated time (after the first Update/Execute/Step).
+  TimePoint sim_time() const;
+  /// Simulated time dropped because Update() fell behind by more than max_catchup_ms.
+  Duration dropped_time() const;
+  /// World pose of a link's frame, from the physics.
+  Eigen::Isometry3d LinkPose(int link) const;
+  /// Bodies, geoms and fused links of the simulation (for docs and tests).
+  struct Stats {
+    int bodies = 0, geoms = 0, fused_links = 0, mesh_boxes = 0, skipped_meshes = 0;
+    std::int64_t steps = 0;
+  };
+  Stats stats() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Registers "ode": loads DriverConfig::urdf_path with LoadUrdfFile (renamed to
+/// DriverConfig::robot_name) and its collision shapes, options parsed by
+/// OdeDriverOptions::FromMap. Throws Error (UrdfError for the file).
+void RegisterOdeDriver(DriverRegistry& registry);
+
+}  // namespace robotalk
