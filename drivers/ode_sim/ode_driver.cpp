@@ -163,6 +163,21 @@ OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::ve
   wo.seed = options_.seed;
   wo.kinematic_first_root = base == BaseType::kHolonomic || base == BaseType::kFloating;
   wo.place_on_ground = base != BaseType::kFixed;
+  if (base == BaseType::kDifferential) {
+    // A wheel touches the ground at one point: its collision cylinder becomes
+    // a sphere of the same radius (a cylinder's rim contacts scrub when the
+    // base turns, which widens the effective track by ~15 %).
+    for (const std::string& w : {options_.left_wheel, options_.right_wheel}) {
+      const std::optional<int> j = model_.FindJoint(w);
+      if (!j) continue;
+      const std::string& link = model_.link(model_.joint(*j).child_link).name;
+      for (CollisionShape& s : shapes) {
+        if (s.link != link || s.kind != CollisionShape::Kind::kCylinder) continue;
+        s.kind = CollisionShape::Kind::kSphere;
+        s.size = {s.size.x(), 0, 0};
+      }
+    }
+  }
   world_ = std::make_unique<OdeWorld>(model_, shapes, wo, q0);
   if (base == BaseType::kDifferential) {
     SetupWheels(shapes);
@@ -380,12 +395,13 @@ void OdeDriver::Impl::StopAll(const char* why, std::vector<Completion>& complete
   base_mode_ = BaseMode::kIdle;
   cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
   world_->SetRootVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-  // Every actuator holds where it is: motors at zero velocity with their full force.
+  // Every actuator stops at once: motors at zero velocity with their full
+  // force (a position hold would drive back over the braking distance).
   const Eigen::VectorXd& q = world_->q();
   for (size_t i = 0; i < mode_.size(); ++i) {
     const auto e = static_cast<Eigen::Index>(i);
     if (mode_[i] == Mode::kMimic || mode_[i] == Mode::kPassive) continue;
-    mode_[i] = Mode::kPosition;
+    mode_[i] = Mode::kVelocity;
     target_[e] = std::clamp(q[e], lower_[e], upper_[e]);
     speed_[e] = 0;
     force_[e] = 0;

@@ -199,7 +199,7 @@ TEST(OdeDriver, GotoReachesItsTargetOnPhysics) {
   EXPECT_NEAR(std::hypot(s.Base().x() - 1.0, s.Base().y() - 0.5), 0.0, 0.03);
 }
 
-TEST(OdeDriver, StopInterruptsAGotoAndHolochnomicRequestsAreModified) {
+TEST(OdeDriver, StopInterruptsAGotoAndHolonomicRequestsAreModified) {
   Sim s(MakeDriver(Pioneer()));
   const DriverResult lateral = s.Exec(CommandType::kSetSpeed, "", {0.2, 0.1, 0.0});
   EXPECT_EQ(lateral.signal, Signal::kModified);
@@ -264,10 +264,9 @@ TEST(OdeDriver, HaltStopsEveryActuatorAtOnce) {
 
 TEST(OdeDriver, UpdateCatchesUpAtMostMaxCatchupAndStepRunsAsFastAsAsked) {
   Sim s(MakeDriver(Pioneer(), {{"max_catchup_ms", "50"}}));
-  const TimePoint start = s.d->sim_time();
   s.t += 1s;
   s.d->Update(s.t, s.done);
-  EXPECT_LE(s.d->sim_time() - start, 51ms);
+  EXPECT_LE(s.d->stats().steps, 51);
   EXPECT_GE(s.d->dropped_time(), 949ms);
   EXPECT_EQ(s.d->sim_time(), s.t);  // dropped time keeps the clocks aligned
   const std::int64_t steps = s.d->stats().steps;
