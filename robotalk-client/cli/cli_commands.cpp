@@ -4,6 +4,9 @@
 #include "sequence_file.h"
 
 #include <algorithm>
+#include <cinttypes>
+#include <condition_variable>
+#include <mutex>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -113,40 +116,59 @@ int RunQuery(const GlobalOptions& g, const std::vector<std::string>& args) {
 
 namespace {
 
-int SendFile(const GlobalOptions& g, const std::string& robot, const std::string& path) {
+struct SequenceFlags {
+  SequenceOptions options;
+  bool any = false;  // a mode flag was given (only valid with --file)
+};
+
+// --mode direct|delay|playback, --delay S, --paced.
+SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
+  SequenceFlags f;
+  f.options.mode = CommandMode::kDelay;
+  f.options.delay = Duration(0);
+  f.options.paced = false;
+  std::string mode, delay;
+  if (TakeOption(args, "--mode", &mode)) {
+    auto m = ParseCommandMode(mode);
+    if (!m) throw UsageError("--mode " + mode + ": expected direct, delay or playback");
+    f.options.mode = *m;
+    f.any = true;
+  }
+  if (TakeOption(args, "--delay", &delay)) {
+    const double d = ParseNumber(delay, "--delay");
+    if (d < 0) throw UsageError("--delay " + delay + " is negative");
+    if (f.options.mode != CommandMode::kDelay) throw UsageError("--delay goes with --mode delay");
+    f.options.delay = FromSeconds(d);
+    f.any = true;
+  }
+  if (TakeOption(args, "--paced", nullptr)) {
+    f.options.paced = true;
+    f.any = true;
+  }
+  if (f.options.mode == CommandMode::kDirect) f.options.paced = true;  // a handshake per frame, at its time
+  return f;
+}
+
+int SendFile(const GlobalOptions& g, const std::string& robot, const std::string& path, const SequenceOptions& options) {
   std::ifstream file(path);
   if (!file) throw UsageError("cannot read sequence file '" + path + "'");
   std::stringstream text;
   text << file.rdbuf();
   const auto entries = ParseSequence(text.str(), path);  // all lines checked before connecting
+  std::vector<TimedCommand> frames;
+  for (const auto& e : entries) frames.push_back({FromSeconds(e.offset_s), e.command});
 
   RobotClient client(MakeOptions(g));
   client.Connect(robot);
-  const TimePoint base = client.ServerNow();
-  // Several packages when the sequence is long (each must stay under ~60 KB).
-  constexpr std::size_t kPerPackage = 200;
-  std::vector<PendingReply> pending;
-  for (std::size_t first = 0; first < entries.size(); first += kPerPackage) {
-    std::vector<Command> batch;
-    for (std::size_t i = first; i < std::min(entries.size(), first + kPerPackage); ++i) {
-      Command c = entries[i].command;
-      c.start_time = base + FromSeconds(entries[i].offset_s);
-      batch.push_back(std::move(c));
-    }
-    for (auto& p : client.SendBatch(std::move(batch))) pending.push_back(std::move(p));
+  const SequenceResult result = client.RunSequence(std::move(frames), options);
+  if (result.playback_delay) {
+    std::cerr << "robotalk: playback: the server starts the sequence " << ToSeconds(*result.playback_delay)
+              << " s after its first frame arrived\n";
   }
   int status = 0;
-  for (std::size_t i = 0; i < pending.size(); ++i) {
-    const Duration until_start = std::max(Duration::zero(), base + FromSeconds(entries[i].offset_s) - client.ServerNow());
-    try {
-      const Reply r = pending[i].Wait(until_start + client.options().timeout);
-      PrintReply(r, std::cout);
-      std::cout.flush();
-      status = std::max(status, ExitStatus(r));
-    } catch (const TimeoutError& e) {
-      std::cerr << "robotalk: " << path << ":" << entries[i].line << ": " << e.what() << "\n";
-      status = 1;
-    }
+  for (const Reply& r : result.replies) {
+    PrintReply(r, std::cout);
+    status = std::max(status, ExitStatus(r));
   }
   return status;
 }
@@ -158,12 +180,16 @@ int RunSend(const GlobalOptions& g, const std::vector<std::string>& in) {
   std::string file, at;
   const bool has_file = TakeOption(args, "--file", &file);
   const bool has_at = TakeOption(args, "--at", &at);
+  const SequenceFlags sequence = TakeSequenceFlags(args);
   RejectOptions(args);
-  if (args.empty()) throw UsageError("usage: robotalk send ROBOT COMMAND ARGS... [--at S] | send ROBOT --file SEQ.txt");
+  if (args.empty()) {
+    throw UsageError("usage: robotalk send ROBOT COMMAND ARGS... [--at S] | send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced]");
+  }
   if (has_file) {
     if (args.size() != 1 || has_at) throw UsageError("send ROBOT --file SEQ.txt takes nothing else");
-    return SendFile(g, args[0], file);
+    return SendFile(g, args[0], file, sequence.options);
   }
+  if (sequence.any) throw UsageError("--mode, --delay and --paced go with --file");
   Command c = ParseCommandWords({args.begin() + 1, args.end()});
   std::optional<double> delay;
   if (has_at) {
@@ -196,6 +222,53 @@ int RunReset(const GlobalOptions& g, const std::vector<std::string>& args) {
   const Reply r = client.ResetPanic();
   PrintReply(r, std::cout);
   return ExitStatus(r);
+}
+
+}  // namespace robotalk::cli
+
+namespace robotalk::cli {
+
+int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
+  std::vector<std::string> args = in;
+  std::string period = "0.1", duration, count;
+  TakeOption(args, "--period", &period);
+  const bool has_duration = TakeOption(args, "--duration", &duration);
+  const bool has_count = TakeOption(args, "--count", &count);
+  RejectOptions(args);
+  if (args.size() != 1) throw UsageError("usage: robotalk watch ROBOT [--period S] [--duration S] [--count N]");
+  const double period_s = ParseNumber(period, "--period");
+  const double duration_s = has_duration ? ParseNumber(duration, "--duration") : 1e9;
+  const double max_samples = has_count ? ParseNumber(count, "--count") : 1e18;
+  if (period_s < 0.001 || duration_s <= 0 || max_samples < 1) {
+    throw UsageError("watch: --period must be >= 0.001 s, --duration and --count positive");
+  }
+  RobotClient client(MakeOptions(g));
+  client.Connect(args[0]);
+  std::cerr << "robotalk: watching ROBOTALK/" << args[0] << "/STATE (asked every " << period_s << " s)\n";
+  std::mutex mu;
+  std::condition_variable done_cv;
+  double samples = 0;
+  const Duration actual = client.StartStateStream(FromSeconds(period_s), [&](const robotalk_msgs::robot_state_t& s) {
+    std::lock_guard lock(mu);
+    if (samples >= max_samples) return;
+    char line[160];
+    std::snprintf(line, sizeof line, "%" PRId64 " t=%.3f base %.4f %.4f %.4f v=%.3f w=%.3f%s q", s.sample,
+                  static_cast<double>(s.server_time_us) * 1e-6, s.base[0], s.base[1], s.base[2], s.base[3], s.base[4],
+                  s.panic ? " PANIC" : "");
+    std::cout << line;
+    for (double q : s.position) std::cout << ' ' << q;
+    std::cout << '\n' << std::flush;
+    if (++samples >= max_samples) done_cv.notify_all();
+  });
+  if (actual != FromSeconds(period_s)) {
+    std::cerr << "robotalk: the stream runs every " << ToSeconds(actual) << " s (another client asked for faster)\n";
+  }
+  {
+    std::unique_lock lock(mu);
+    done_cv.wait_for(lock, FromSeconds(duration_s), [&] { return samples >= max_samples; });
+  }
+  client.StopStateStream();
+  return 0;
 }
 
 }  // namespace robotalk::cli

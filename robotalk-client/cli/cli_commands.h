@@ -26,5 +26,6 @@ int RunQuery(const GlobalOptions& g, const std::vector<std::string>& args);
 int RunSend(const GlobalOptions& g, const std::vector<std::string>& args);
 int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args);
 int RunReset(const GlobalOptions& g, const std::vector<std::string>& args);
+int RunWatch(const GlobalOptions& g, const std::vector<std::string>& args);
 
 }  // namespace robotalk::cli

@@ -20,7 +20,14 @@ constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] COMM
                                         send pioneer setspeed 0.2 0.1
                                         send pioneer stop --at 2
                                       --at S: start S seconds from now (server clock)
-  send ROBOT --file SEQ.txt           a timed sequence (format: docs/client.md)
+  send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced]
+                                      a timed sequence (format: docs/client.md); M is
+                                      direct (a handshake per frame), delay (start =
+                                      server clock + S, default 0) or playback (the
+                                      server picks the delay); --paced sends each frame
+                                      at its time instead of all at once
+  watch ROBOT [--period S] [--duration S] [--count N]
+                                      broadcast mode: print the state stream (default 0.1 s)
   panic ROBOT                         panic: stop everything, refuse commands
   reset ROBOT                         PANIC_RESET
 
@@ -66,7 +73,8 @@ int main(int argc, char** argv) {
     rest.erase(rest.begin());
     const std::map<std::string, int (*)(const GlobalOptions&, const std::vector<std::string>&)> commands = {
         {"robots", &RunRobots}, {"describe", &RunDescribe}, {"query", &RunQuery},
-        {"send", &RunSend},     {"panic", &RunPanic},       {"reset", &RunReset}};
+        {"send", &RunSend},     {"panic", &RunPanic},       {"reset", &RunReset},
+        {"watch", &RunWatch}};
     auto it = commands.find(command);
     if (it == commands.end()) throw UsageError("unknown command '" + command + "'");
     return it->second(g, rest);

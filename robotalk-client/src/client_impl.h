@@ -30,6 +30,13 @@ namespace robotalk {
 /// The client id as it appears in channel names: 16 lowercase hex digits.
 std::string ClientIdHex(std::int64_t client_id);
 
+/// Header fields of a PLAYBACK package (id 0: an ordinary package).
+struct PlaybackHeader {
+  std::int64_t id = 0;
+  std::int32_t frames = 0;
+  Duration duration{0};
+};
+
 class RobotClient::Impl {
  public:
   explicit Impl(ClientOptions options);
@@ -40,10 +47,16 @@ class RobotClient::Impl {
     std::vector<CommandId> ids;
   };
   enum class Track { kNone, kRetransmit };
+  using Playback = PlaybackHeader;
   /// Builds, registers and publishes one package. Assigns the ids of
   /// `commands` / `queries` (returned in order). Throws ClientError.
   Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries, bool panic, Track track,
-                   bool clock_query = false);
+                   bool clock_query = false, const Playback& playback = {});
+  /// A fresh id from the client's command-id space (for a playback sequence).
+  CommandId NewId();
+  void OnState(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  /// Subscribes ROBOTALK/<robot>/STATE (once) and sets the sample callback.
+  void SubscribeState(std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);
   PendingReply MakePending(CommandId id, std::string what);
 
   /// Subscribes the robot's channels (REPLY/<client>, CONFIG).
@@ -78,6 +91,8 @@ class RobotClient::Impl {
   std::unordered_set<std::int64_t> acked_;           // GUARDED_BY(mu_)
   std::exception_ptr daemon_error_;            // GUARDED_BY(mu_)
   ClientStats stats_;                          // GUARDED_BY(mu_)
+  lcm::Subscription* state_subscription_ = nullptr;  // GUARDED_BY(mu_)
+  std::function<void(const robotalk_msgs::robot_state_t&)> on_state_;  // GUARDED_BY(mu_)
 
  private:
   void Run();  // the ReadDaemon

@@ -90,7 +90,8 @@ void RobotClient::Impl::Attach(const std::string& robot) {
 }
 
 RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries,
-                                                       bool panic, Track track, bool clock_query) {
+                                                       bool panic, Track track, bool clock_query,
+                                                       const Playback& playback) {
   robotalk_msgs::package_t p{};
   p.header.protocol_version = kProtocolVersion;
   p.header.client_id = client_id_;
@@ -99,6 +100,12 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
   p.header.payload_type = is_commands ? robotalk_msgs::package_header_t::PAYLOAD_COMMANDS
                                       : robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
   p.header.payload_size = static_cast<std::int32_t>(is_commands ? commands.size() : queries.size());
+  if (playback.id != 0) {
+    p.header.mode = robotalk_msgs::package_header_t::MODE_PLAYBACK;
+    p.header.playback_id = playback.id;
+    p.header.playback_frames = playback.frames;
+    p.header.playback_duration_us = ToWireMicros(playback.duration);
+  }
   for (const Command& c : commands) p.commands.push_back(ToWire(c));
   for (const robotalk::Query& q : queries) p.queries.push_back(ToWire(q));
   p.num_commands = static_cast<std::int32_t>(p.commands.size());
@@ -126,8 +133,8 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
       const CommandId id = next_id_++;
       p.commands[i].id = id;
       sent.ids.push_back(id);
-      std::optional<TimePoint> start;
-      if (commands[i].start_time) start = clock_sync_.ClientTime(*commands[i].start_time);
+      std::optional<TimePoint> start;  // a playback frame's start is an offset: not a time to wait for
+      if (commands[i].start_time && playback.id == 0) start = clock_sync_.ClientTime(*commands[i].start_time);
       items.push_back({id, start});
     }
     for (auto& q : p.queries) {

@@ -40,6 +40,17 @@ void ScanReplyPackage(WireScanner& s) {
   }
 }
 
+void ScanRobotState(WireScanner& s) {
+  s.Skip(8 + 8 + 8, "times");
+  s.String("robot");
+  s.Skip(8 + 1 + 1, "config_hash, panic, moving");
+  const std::int32_t dofs = s.Count("num_dofs", 3 * 8);
+  s.Skip(std::int64_t{3 * 8} * dofs, "position, velocity, effort");
+  s.Skip(5 * 8, "base");
+  const std::int32_t frames = s.Count("num_frames", 7 * 8);
+  s.Skip(std::int64_t{7 * 8} * frames, "frame_poses");
+}
+
 template <typename Msg>
 Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* function, void (*scan)(WireScanner&)) {
   if (bytes.size() > static_cast<size_t>(INT32_MAX)) throw ProtocolError(std::string(function) + ": message too large");
@@ -134,6 +145,10 @@ robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes) {
 
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes) {
   return DecodeChecked<robotalk_msgs::reply_package_t>(bytes, "DecodeReplyPackage", &ScanReplyPackage);
+}
+
+robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes) {
+  return DecodeChecked<robotalk_msgs::robot_state_t>(bytes, "DecodeRobotState", &ScanRobotState);
 }
 
 std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {

@@ -25,8 +25,10 @@
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 #include "robotalk/robot_model.h"
+#include "robotalk_msgs/robot_state_t.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -106,6 +108,43 @@ class PendingReply {
   std::shared_ptr<client::ReturnCache> cache_;
   std::string what_;  // "GOTO 12" for messages
   std::optional<Reply> reply_;
+};
+
+/// How a sequence of timed commands travels (paper §V, Table I). The same
+/// commands work in every mode.
+enum class CommandMode {
+  kDirect,    ///< blocking handshake: each frame waits for its reply before the next goes
+  kDelay,     ///< start = synchronised server clock + a chosen delay; non-blocking
+  kPlayback,  ///< offsets only; the server estimates the delay; no clock sync needed
+};
+const char* ToString(CommandMode mode);
+/// "direct", "delay", "playback"; nullopt otherwise.
+std::optional<CommandMode> ParseCommandMode(const std::string& name);
+
+/// One frame of a sequence: a command and when it should run, relative to the
+/// sequence start (its own start_time is ignored).
+struct TimedCommand {
+  Duration offset{0};
+  Command command;
+};
+
+struct SequenceOptions {
+  CommandMode mode = CommandMode::kDelay;
+  /// Delay mode: how far ahead of the synchronised server clock the sequence
+  /// starts, i.e. the congestion it survives. 0 is allowed.
+  Duration delay = std::chrono::seconds(1);
+  /// Send each frame when its offset comes (a live stream, as a planner or a
+  /// teleoperator produces it); false sends the whole sequence at once.
+  bool paced = true;
+  /// Frames per package when not paced (direct mode always sends one).
+  std::size_t batch = 200;
+};
+
+struct SequenceResult {
+  std::vector<Reply> replies;              ///< one per frame, in the order given
+  TimePoint first_sent{};                  ///< client clock, when the first frame left
+  std::optional<TimePoint> server_start;   ///< server time of offset 0 (delay, playback)
+  std::optional<Duration> playback_delay;  ///< playback: the delay the server chose after its first frame
 };
 
 /// A robot offered by a server, from its announce message.
@@ -192,6 +231,22 @@ class RobotClient {
   /// Several commands in ONE package (executed in start-time order by the
   /// server). Throws ClientError when the package would exceed ~60 KB.
   std::vector<PendingReply> SendBatch(std::vector<Command> commands);
+
+  // --- Command modes (docs/client.md, "Modes") ---------------------------------
+  /// Sends `frames` in `options.mode` and waits for every reply (each at most
+  /// ClientOptions::timeout after its start). Returns the replies in the order
+  /// given. Throws TimeoutError, ClientError.
+  SequenceResult RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options);
+
+  /// Broadcast mode: asks the server to publish the robot's state every
+  /// `period` on ROBOTALK/<robot>/STATE (one stream per robot, shared with
+  /// every other subscriber, at the shortest period anyone asked for) and
+  /// calls `on_sample` with each sample, on the ReadDaemon thread (keep it
+  /// short). Returns the period the stream runs at. Calling it again changes
+  /// the period and the callback.
+  Duration StartStateStream(Duration period, std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);
+  /// Cancels this client's stream request (the stream goes on while others want it).
+  void StopStateStream();
 
   // --- Panic -----------------------------------------------------------------
   /// Sends a panic package and waits for its acknowledgement (TimeoutError

@@ -10,6 +10,7 @@
 #include "robotalk/command.h"
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
+#include "robotalk_msgs/robot_state_t.hpp"
 
 #include <cstdint>
 #include <span>
@@ -33,6 +34,9 @@ Reply FromWire(const robotalk_msgs::reply_t& r);
 robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes);
 /// Decodes a server reply package; same guarantees.
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes);
+
+/// Decodes a broadcast state sample; same guarantees.
+robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes);
 
 /// Checks a decoded package's header against its payload: version, client id,
 /// sequence, payload type and size, never both queries and commands. Returns
