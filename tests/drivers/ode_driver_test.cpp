@@ -278,3 +278,55 @@ TEST(OdeDriver, UpdateCatchesUpAtMostMaxCatchupAndStepRunsAsFastAsAsked) {
 
 }  // namespace
 }  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// ---------------------------------------------------------------- humanoids
+
+TEST(OdeDriver, SimpleHumanoidStandsOnItsFeetAndTracksHeadSetPoints) {
+  Sim s(MakeDriver(ProjectModel("simple_humanoid.urdf")));
+  EXPECT_NEAR(s.State().root_poses.front().translation.z(), 0.78, 1e-6);  // feet on the ground
+  EXPECT_EQ(s.Exec(CommandType::kJointSetPoint, "pan", {0.6}).signal, Signal::kSuccess);
+  EXPECT_EQ(s.Exec(CommandType::kJointSetPoint, "tilt", {-0.3}).signal, Signal::kSuccess);
+  EXPECT_EQ(s.Exec(CommandType::kJointSetPoint, "left_elbow", {-1.0}).signal, Signal::kSuccess);
+  s.Run(1.5);
+  EXPECT_NEAR(s.Q("pan"), 0.6, 2e-3);
+  EXPECT_NEAR(s.Q("tilt"), -0.3, 2e-3);
+  EXPECT_NEAR(s.Q("left_elbow"), -1.0, 2e-3);
+}
+
+TEST(OdeDriver, HumanoidGotoMovesTheRootKinematicallyAndAnswersModified) {
+  Sim s(MakeDriver(ProjectModel("simple_humanoid.urdf")));
+  EXPECT_TRUE(s.Exec(CommandType::kGoto, "", {0.6, 0.3, 0.5}).in_progress);
+  s.Run(0.5);
+  const double hip = s.Q("left_hip_pitch");
+  EXPECT_NE(hip, 0.0);  // the legs follow the gait
+  for (int i = 0; i < 1500 && s.done.empty(); ++i) s.Run(0.01);
+  ASSERT_EQ(s.done.size(), 1u);
+  EXPECT_EQ(s.done[0].signal, Signal::kModified);
+  EXPECT_NE(s.done[0].message.find("kinematically"), std::string::npos) << s.done[0].message;
+  const Eigen::Vector3d p = s.Base();
+  EXPECT_NEAR(std::hypot(p.x() - 0.6, p.y() - 0.3), 0.0, 0.02);
+  EXPECT_NEAR(p.z(), 0.5, 0.02);
+  const DriverResult lateral = s.Exec(CommandType::kSetSpeed, "", {0.1, 0.1, 0.0});
+  EXPECT_EQ(lateral.signal, Signal::kModified);
+}
+
+TEST(OdeDriver, AtlasAsAFloatingBaseTracksJointSetPoints) {
+  ROBOTALK_REQUIRE_SHARED_ROBOTS();
+  Sim s(MakeDriver(SharedRobot("atlas.urdf"), {{"base", "floating"}}));
+  EXPECT_GT(s.d->stats().geoms, 10);  // primitives, and meshes as inertia boxes
+  EXPECT_EQ(s.Exec(CommandType::kJointSetPoint, "l_arm_elx", {1.0}).signal, Signal::kSuccess);
+  EXPECT_EQ(s.Exec(CommandType::kJointSetPoint, "neck_ay", {0.3}).signal, Signal::kSuccess);
+  s.Run(0.7);
+  EXPECT_NEAR(s.Q("l_arm_elx"), 1.0, 5e-3);
+  EXPECT_NEAR(s.Q("neck_ay"), 0.3, 5e-3);
+  EXPECT_TRUE(s.Exec(CommandType::kGoto, "", {0.1, 0.0, 0.0}).in_progress);
+  for (int i = 0; i < 300 && s.done.empty(); ++i) s.Run(0.01);
+  ASSERT_EQ(s.done.size(), 1u);
+  EXPECT_EQ(s.done[0].signal, Signal::kModified);
+}
+
+}  // namespace
+}  // namespace robotalk
