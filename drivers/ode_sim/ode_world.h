@@ -43,7 +43,6 @@ struct OdeWorldOptions {
   bool kinematic_first_root = false;  ///< a mobile first root moved by velocity, not dynamics
   bool place_on_ground = false;  ///< shift the first root in z so its lowest shape touches the ground
   std::uint32_t seed = 1;        ///< dRand state (used by quickstep)
-  double mesh_box_fallback = 0;  ///< unused; meshes become inertia boxes
 };
 
 class OdeWorld {
