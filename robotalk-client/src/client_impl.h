@@ -35,6 +35,9 @@ struct PlaybackHeader {
   std::int64_t id = 0;
   std::int32_t frames = 0;
   Duration duration{0};
+  /// This package also waits for the server's delay reply (id = `id`): the
+  /// client re-asks through it until that reply is in.
+  bool ask_for_delay = false;
 };
 
 class RobotClient::Impl {
@@ -54,6 +57,8 @@ class RobotClient::Impl {
                    bool clock_query = false, const Playback& playback = {});
   /// A fresh id from the client's command-id space (for a playback sequence).
   CommandId NewId();
+  /// Tells the retransmission bookkeeping when items will run (server clock).
+  void SetStartTimes(const std::vector<std::pair<CommandId, TimePoint>>& server_starts);
   void OnState(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   /// Subscribes ROBOTALK/<robot>/STATE (once) and sets the sample callback.
   void SubscribeState(std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);

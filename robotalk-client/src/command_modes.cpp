@@ -34,6 +34,12 @@ std::optional<CommandMode> ParseCommandMode(const std::string& name) {
   return std::nullopt;
 }
 
+void RobotClient::Impl::SetStartTimes(const std::vector<std::pair<CommandId, TimePoint>>& server_starts) {
+  std::lock_guard lock(mu_);
+  const TimePoint now = clock_.Now();
+  for (const auto& [id, start] : server_starts) outstanding_.UpdateStart(id, clock_sync_.ClientTime(start), now);
+}
+
 CommandId RobotClient::Impl::NewId() {
   std::lock_guard lock(mu_);
   return next_id_++;
@@ -72,7 +78,7 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   Impl::Playback playback;
   TimePoint server_start{};
   if (options.mode == CommandMode::kPlayback) {
-    playback = {impl_->NewId(), static_cast<std::int32_t>(frames.size()), duration};
+    playback = {impl_->NewId(), static_cast<std::int32_t>(frames.size()), duration, /*ask_for_delay=*/true};
     impl_->cache_->Expect(playback.id);
     delay_reply = impl_->MakePending(playback.id, "PLAYBACK " + std::to_string(playback.id));
   } else {
@@ -94,6 +100,7 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       commands.push_back(std::move(c));
     }
     auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit, false, playback);
+    playback.ask_for_delay = false;  // only the first package asks
     for (std::size_t j = k; j < end; ++j) {
       pending[order[j]] = impl_->MakePending(sent.ids[j - k], "sequence frame " + std::to_string(order[j]));
     }
@@ -106,6 +113,11 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       result.playback_delay = FromSeconds(r.values[0]);
       result.server_start = FromWireMicros(static_cast<std::int64_t>(r.values[1]));
       server_start = *result.server_start;
+      std::vector<std::pair<CommandId, TimePoint>> starts;
+      for (std::size_t i = 0; i < frames.size(); ++i) {
+        if (pending[i]) starts.emplace_back(pending[i]->id(), server_start + frames[i].offset);
+      }
+      impl_->SetStartTimes(starts);
     }
   }
   for (std::size_t i = 0; i < frames.size(); ++i) {

@@ -6,11 +6,43 @@
 
 namespace robotalk::client {
 
+Duration OutstandingPackages::retransmit_timeout() const {
+  // RFC 6298: srtt + 4 rttvar, never below the configured interval. A slow
+  // (congested) server thus gets resends no faster than it can answer, instead
+  // of a storm of duplicates that would congest it further.
+  if (!srtt_) return policy_.interval;
+  return std::max(policy_.interval, *srtt_ + 4 * rttvar_);
+}
+
 Duration OutstandingPackages::IntervalAt(int step) const {
+  const Duration base = retransmit_timeout();
   const double factor = std::pow(std::max(1.0, policy_.backoff), step);
-  const double ns = static_cast<double>(policy_.interval.count()) * factor;
-  if (ns >= static_cast<double>(policy_.max_interval.count())) return policy_.max_interval;
-  return std::max(policy_.interval, Duration(static_cast<Duration::rep>(ns)));
+  const double ns = static_cast<double>(base.count()) * factor;
+  // The cap never undercuts the measured round trip.
+  const Duration cap = std::max(policy_.max_interval, base);
+  if (ns >= static_cast<double>(cap.count())) return cap;
+  return std::max(base, Duration(static_cast<Duration::rep>(ns)));
+}
+
+void OutstandingPackages::AddRoundTrip(Duration rtt) {
+  if (!srtt_) {
+    srtt_ = rtt;
+    rttvar_ = rtt / 2;
+    return;
+  }
+  const Duration error = rtt > *srtt_ ? rtt - *srtt_ : *srtt_ - rtt;
+  rttvar_ = (3 * rttvar_ + error) / 4;
+  *srtt_ = (7 * *srtt_ + rtt) / 8;
+}
+
+void OutstandingPackages::UpdateStart(CommandId id, TimePoint start, TimePoint now) {
+  auto owner = owner_.find(id);
+  if (owner == owner_.end()) return;
+  auto it = packages_.find(owner->second);
+  if (it == packages_.end()) return;
+  Package& p = it->second;
+  p.pending[id] = start;
+  if (p.acked) p.next_send = std::max(now, EarliestStart(p, now)) + IntervalAt(0);
 }
 
 TimePoint OutstandingPackages::EarliestStart(const Package& p, TimePoint fallback) {
@@ -49,6 +81,8 @@ OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, T
   p.last_heard = now;
   if (!p.acked) {
     p.acked = true;
+    // Karn's rule: only a package sent once gives an unambiguous round trip.
+    if (p.sends == 1) AddRoundTrip(now - p.first_send);
     // Replies are not due before the items' start times: ask again only after.
     p.backoff_step = 0;
     p.next_send = std::max(now, EarliestStart(p, now)) + IntervalAt(0);
@@ -70,7 +104,8 @@ std::optional<std::int64_t> OutstandingPackages::OnReply(CommandId id, TimePoint
   Package& p = it->second;
   p.pending.erase(id);
   p.last_heard = now;
-  // A reply proves the package arrived even if its ack was lost.
+  // A reply proves the package arrived even if its ack was lost (it is no
+  // round-trip sample: a scheduled command's reply waits for its start).
   if (!p.acked) {
     p.acked = true;
     p.backoff_step = 0;

@@ -4,8 +4,10 @@
 // reply. Pure: no I/O; callers pass the client-clock time.
 //
 // Policy:
-//  - Unacknowledged: resend after `interval`, then interval·backoff,
-//    interval·backoff², ... capped at `max_interval`.
+//  - Unacknowledged: resend after the retransmission timeout (RTO), then
+//    RTO·backoff, RTO·backoff², ... capped at max(`max_interval`, RTO). The RTO
+//    adapts to the measured round trips as in TCP (RFC 6298: smoothed RTT +
+//    4 × its variation, Karn's rule), never below `interval`.
 //  - Acknowledged but items unanswered: ask again (resend the same sequence;
 //    the server re-sends the replies it has) only once the earliest unanswered
 //    item's start time has passed, starting again from `interval` and backing
@@ -71,6 +73,9 @@ class OutstandingPackages {
   /// A final reply for `id` arrived; returns the package it completed, if any.
   std::optional<std::int64_t> OnReply(CommandId id, TimePoint now);
 
+  /// The start time of an unanswered item became known (a playback frame once
+  /// the server chose its delay): re-asking waits for it.
+  void UpdateStart(CommandId id, TimePoint start, TimePoint now);
   /// Packages to resend now; schedules their next resend.
   std::vector<Resend> TakeDue(TimePoint now);
   /// Packages given up at `now`, removed from the bookkeeping.
@@ -81,6 +86,8 @@ class OutstandingPackages {
   bool Contains(std::int64_t sequence) const { return packages_.count(sequence) != 0; }
   bool IsAcked(std::int64_t sequence) const;
   std::size_t size() const { return packages_.size(); }
+  /// The current base retransmission timeout (see the policy above).
+  Duration retransmit_timeout() const;
   /// Total resends so far.
   std::uint64_t retransmissions() const { return retransmissions_; }
 
@@ -96,6 +103,9 @@ class OutstandingPackages {
     TimePoint last_heard{};
   };
   Duration IntervalAt(int step) const;
+  void AddRoundTrip(Duration rtt);
+  std::optional<Duration> srtt_;
+  Duration rttvar_{0};
   /// Earliest start among unanswered items (now-items count as `fallback`).
   static TimePoint EarliestStart(const Package& p, TimePoint fallback);
 

@@ -133,10 +133,19 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
       const CommandId id = next_id_++;
       p.commands[i].id = id;
       sent.ids.push_back(id);
-      std::optional<TimePoint> start;  // a playback frame's start is an offset: not a time to wait for
-      if (commands[i].start_time && playback.id == 0) start = clock_sync_.ClientTime(*commands[i].start_time);
+      std::optional<TimePoint> start;
+      if (playback.id != 0) {
+        // A playback frame's start is an offset; when it runs is known only
+        // once the server has chosen the delay (SetStartTimes). Until then,
+        // do not re-ask an acknowledged frame before the whole sequence could
+        // have played: re-asks would only load a congested server.
+        start = now + playback.duration + options_.timeout;
+      } else if (commands[i].start_time) {
+        start = clock_sync_.ClientTime(*commands[i].start_time);
+      }
       items.push_back({id, start});
     }
+    if (playback.ask_for_delay) items.push_back({playback.id, std::nullopt});
     for (auto& q : p.queries) {
       q.id = next_id_++;
       sent.ids.push_back(q.id);

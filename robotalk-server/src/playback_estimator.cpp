@@ -28,6 +28,25 @@ Duration PlaybackEstimator::mean_arrival_interval() const {
   return (hi->arrival - lo->arrival) / static_cast<Duration::rep>(frames_.size() - 1);
 }
 
+Duration PlaybackEstimator::arrival_interval_bound() const {
+  // Few frames give a noisy mean: take its upper confidence bound (mean +
+  // z · s / sqrt(n)), since running dry is worse than starting a little later.
+  if (frames_.size() < 3) return mean_arrival_interval();
+  std::vector<TimePoint> arrivals;
+  arrivals.reserve(frames_.size());
+  for (const Frame& f : frames_) arrivals.push_back(f.arrival);
+  std::sort(arrivals.begin(), arrivals.end());
+  const double n = static_cast<double>(arrivals.size() - 1);
+  const double mean = ToSeconds(arrivals.back() - arrivals.front()) / n;
+  double variance = 0;
+  for (std::size_t i = 1; i < arrivals.size(); ++i) {
+    const double gap = ToSeconds(arrivals[i] - arrivals[i - 1]);
+    variance += (gap - mean) * (gap - mean);
+  }
+  variance /= n - 1;
+  return FromSeconds(mean + options_.confidence_z * std::sqrt(variance / n));
+}
+
 TimePoint PlaybackEstimator::StartTime() const {
   // Each frame seen must be there before it plays: start >= a_i - o_i ("lag").
   const Frame* first = &frames_.front();
@@ -38,7 +57,7 @@ TimePoint PlaybackEstimator::StartTime() const {
   // If the channel is slower than the sequence, the lag grows by (T_a - T_c)
   // per frame: project it to the last of the declared frames.
   const Duration command_interval = mean_command_interval();
-  const Duration growth = std::max(Duration(0), mean_arrival_interval() - command_interval);
+  const Duration growth = std::max(Duration(0), arrival_interval_bound() - command_interval);
   const auto line = [&](const Frame& f) {
     const double index = command_interval.count() > 0 ? ToSeconds(f.offset - first->offset) / ToSeconds(command_interval) : 0.0;
     return first_lag + FromSeconds(ToSeconds(growth) * index);

@@ -8,7 +8,9 @@
 // slower (T_a > T_c) the backlog grows by (T_a - T_c) per frame, so the last
 // of the N declared frames arrives about (N-1)(T_a - T_c) after the first one
 // would have had to play. The start must also clear every frame already seen
-// (start + o_i >= a_i), plus a margin for the jitter seen so far.
+// (start + o_i >= a_i), plus a margin for the jitter seen so far. T_a is taken
+// at the upper bound of its confidence interval: a few frames give a noisy
+// mean, and running dry costs more than starting a little later.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -25,6 +27,9 @@ struct PlaybackEstimatorOptions {
   double fraction = 0.1;
   /// Added to the estimate, on top of the jitter observed.
   Duration margin = std::chrono::milliseconds(100);
+  /// The arrival rate is taken at the upper bound of its confidence interval,
+  /// mean + z · standard error (2 ≈ 97.5 % one-sided for many frames).
+  double confidence_z = 2.0;
 };
 
 class PlaybackEstimator {
@@ -43,6 +48,8 @@ class PlaybackEstimator {
   /// Average time between commands and between arrivals over the frames seen.
   Duration mean_command_interval() const;
   Duration mean_arrival_interval() const;
+  /// The arrival interval used for the projection (upper confidence bound).
+  Duration arrival_interval_bound() const;
 
  private:
   struct Frame {

@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -26,7 +27,8 @@ constexpr const char* kUrl = "udpm://239.255.76.67:7711?ttl=0";
 // Records every set-point the driver executes, to prove exactly-once delivery.
 struct ExecutionLog {
   std::mutex mutex;
-  std::map<double, int> setpoints;  // pan value -> times executed
+  std::map<double, int> setpoints;               // pan value -> times executed
+  std::map<double, TimePoint> setpoint_times;    // pan value -> when it executed
 };
 
 class CountingDriver final : public Driver {
@@ -39,6 +41,7 @@ class CountingDriver final : public Driver {
     if (c.type == CommandType::kJointSetPoint) {
       std::lock_guard lock(log_->mutex);
       ++log_->setpoints[c.values[0]];
+      log_->setpoint_times[c.values[0]] = now;
     }
     return inner_->Execute(c, now, done);
   }
@@ -187,6 +190,100 @@ TEST_F(ServerClientTest, TimesOutConnectingToARobotNobodyServes) {
   options.connect_timeout = milliseconds(500);
   RobotClient client(options);
   EXPECT_THROW(client.Connect("nobody"), TimeoutError);
+}
+
+// Frames every 100 ms setting the pan joint to a distinct value each.
+std::vector<TimedCommand> PanFrames(int n) {
+  std::vector<TimedCommand> frames;
+  for (int i = 0; i < n; ++i) {
+    frames.push_back({milliseconds(100) * i, Command{0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.01 * (i + 1)}}});
+  }
+  return frames;
+}
+
+TEST_F(ServerClientTest, DelayModeRunsEveryCommandAtItsStartTimeDespiteCongestion) {
+  ServerOptions options;
+  options.congestion_max_pause = milliseconds(80);  // the paper's injector
+  StartServer(options);
+  auto client = Connect();
+  const SequenceResult result = client->RunSequence(PanFrames(20), {.mode = CommandMode::kDelay, .delay = seconds(1)});
+  ASSERT_TRUE(result.server_start);
+  std::lock_guard lock(log_->mutex);
+  for (int i = 0; i < 20; ++i) {
+    EXPECT_EQ(result.replies[static_cast<size_t>(i)].signal, Signal::kSuccess);
+    const TimePoint due = *result.server_start + milliseconds(100) * i;
+    const Duration late = log_->setpoint_times.at(0.01 * (i + 1)) - due;
+    EXPECT_GE(late, Duration(0)) << "frame " << i << " ran early";
+    EXPECT_LT(late, milliseconds(30)) << "frame " << i << " ran late (RobotDaemon wake-up on a shared machine)";
+    // The reply says how late it ran (the wire carries microseconds).
+    EXPECT_LE(std::chrono::abs(result.replies[static_cast<size_t>(i)].lateness - late), std::chrono::microseconds(1));
+  }
+}
+
+TEST_F(ServerClientTest, PlaybackKeepsTheInterFrameTimingUnderCongestionAndLoss) {
+  ServerOptions options;
+  options.congestion_max_pause = milliseconds(300);  // mean 150 ms per package: the backlog grows
+  StartServer(options);
+  ClientOptions client_options;
+  client_options.drop_probability = 0.1;
+  client_options.fault_seed = 5;
+  client_options.timeout = seconds(20);
+  client_options.give_up_after = seconds(20);
+  auto client = Connect(client_options);
+  constexpr int kFrames = 20;
+  const SequenceResult result = client->RunSequence(PanFrames(kFrames), {.mode = CommandMode::kPlayback});
+  ASSERT_TRUE(result.playback_delay) << "the client learns the delay";
+  ASSERT_TRUE(result.server_start);
+  EXPECT_GT(*result.playback_delay, milliseconds(100));
+  std::lock_guard lock(log_->mutex);
+  ASSERT_EQ(log_->setpoint_times.size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    EXPECT_EQ(result.replies[static_cast<size_t>(i)].signal, Signal::kSuccess);
+    const Duration late = log_->setpoint_times.at(0.01 * (i + 1)) - (*result.server_start + milliseconds(100) * i);
+    EXPECT_GE(late, -std::chrono::microseconds(1)) << "frame " << i;
+    EXPECT_LT(late, milliseconds(30)) << "frame " << i << ": the sequence ran dry";
+  }
+}
+
+TEST_F(ServerClientTest, DirectModeWaitsForEachReplyBeforeTheNextFrame) {
+  StartServer();
+  auto client = Connect();
+  const SequenceResult result = client->RunSequence(PanFrames(5), {.mode = CommandMode::kDirect});
+  for (const Reply& r : result.replies) EXPECT_EQ(r.signal, Signal::kSuccess);
+  EXPECT_FALSE(result.server_start) << "direct mode runs each frame on receipt";
+}
+
+TEST_F(ServerClientTest, BroadcastKeepsItsPeriodAndStopsOnCancel) {
+  StartServer();
+  auto client = Connect();
+  auto watcher = Connect();
+  std::mutex mu;
+  std::vector<std::int64_t> times;
+  const Duration period = client->StartStateStream(milliseconds(50), [&](const robotalk_msgs::robot_state_t& s) {
+    std::lock_guard lock(mu);
+    times.push_back(s.server_time_us);
+  });
+  EXPECT_EQ(period, milliseconds(50));
+  // Another subscriber sees the same stream without asking (as lcm-spy would).
+  std::atomic<int> seen_by_watcher{0};
+  watcher->StartStateStream(milliseconds(500), [&](const robotalk_msgs::robot_state_t&) { ++seen_by_watcher; });
+  std::this_thread::sleep_for(seconds(2));
+  client->StopStateStream();
+  watcher->StopStateStream();
+  std::this_thread::sleep_for(milliseconds(300));
+  std::lock_guard lock(mu);
+  ASSERT_GE(times.size(), 35u);
+  ASSERT_LE(times.size(), 42u);
+  // Absolute deadlines: sample k is due at t0 + k x 50 ms, never drifting.
+  for (size_t k = 0; k < times.size(); ++k) {
+    const std::int64_t late_us = times[k] - times[0] - static_cast<std::int64_t>(k) * 50000;
+    EXPECT_GE(late_us, 0) << "sample " << k;
+    EXPECT_LT(late_us, 20000) << "sample " << k;
+  }
+  EXPECT_GT(seen_by_watcher.load(), 30) << "one shared stream at the shortest period";
+  const size_t after_cancel = times.size();
+  std::this_thread::sleep_for(milliseconds(300));
+  EXPECT_EQ(times.size(), after_cancel) << "no samples after every client cancelled";
 }
 
 }  // namespace
