@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The demo itself (scripts/demo.sh runs it, in a private network namespace
-# when it can): a robotalk-server with the kinematic Pioneer, driven by the
-# robotalk CLI from other processes.
+# when it can): a robotalk-server with the Pioneer simulated on ODE physics,
+# driven by the robotalk CLI from other processes.
 set -uo pipefail
 BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
 URL=${ROBOTALK_DEMO_URL:-"udpm://239.255.76.67:7667?ttl=0"}
@@ -13,11 +13,11 @@ step() { printf '\n\033[1m== %s\033[0m\n' "$*"; }
 show() { printf '$ robotalk %s\n' "$*"; robotalk "$@"; echo "(exit status $?)"; }
 
 log=$(mktemp)
-"$server_bin" --robot "pioneer=kinematic:$MODEL" --url "$URL" --duration 120 2>"$log" &
+"$server_bin" --robot "pioneer=ode:$MODEL" --url "$URL" --duration 120 2>"$log" &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null; rm -f "$log"' EXIT
 for _ in $(seq 50); do grep -q "serving robot" "$log" && break; sleep 0.1; done
-step "A server with one robot: robotalk-server --robot pioneer=kinematic:$MODEL"
+step "A server with one robot on ODE physics: robotalk-server --robot pioneer=ode:$MODEL"
 cat "$log"
 
 step "Which robots are announced?"
@@ -33,9 +33,13 @@ show query pioneer joint_state pan
 step "Errors name what was wrong"
 show send pioneer joint_setpoint neck 0.1
 show send pioneer joint_force pan 1.0
-step "A timed sequence (examples/demo_arcs.txt): the server plays it at its start times"
-cat examples/demo_arcs.txt | grep -v '^#'
-show send pioneer --file examples/demo_arcs.txt
+step "A timed sequence (examples/demo_arcs.txt) in playback mode, frames paced as a live stream,"
+echo "   while another client watches the broadcast state stream (x y theta v omega every 0.5 s)"
+grep -v '^#' examples/demo_arcs.txt
+robotalk watch pioneer --period 0.5 --duration 8 &
+watcher=$!
+show send pioneer --file examples/demo_arcs.txt --mode playback --paced
+wait $watcher
 show query pioneer base_pose
 step "Panic from one client: every command of every client is refused until a reset"
 show panic pioneer

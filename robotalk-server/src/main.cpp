@@ -1,6 +1,7 @@
 // robotalk-server: serves robots over LCM.
 //   robotalk-server --robot pioneer=kinematic:models/pioneer2dx_pantilt.urdf [--url URL] ...
 #include "kinematic_driver.h"
+#include "ode_driver.h"
 #include "robotalk/error.h"
 #include "robotalk/server.h"
 
@@ -48,6 +49,7 @@ double ParseNumber(const std::string& flag, const char* text, double min, double
 int main(int argc, char** argv) {
   robotalk::DriverRegistry registry;
   robotalk::RegisterKinematicDriver(registry);
+  robotalk::RegisterOdeDriver(registry);
   robotalk::ServerOptions options;
   std::vector<robotalk::RobotSpec> robots;
   double duration = -1;

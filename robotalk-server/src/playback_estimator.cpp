@@ -28,48 +28,53 @@ Duration PlaybackEstimator::mean_arrival_interval() const {
   return (hi->arrival - lo->arrival) / static_cast<Duration::rep>(frames_.size() - 1);
 }
 
-Duration PlaybackEstimator::arrival_interval_bound() const {
-  // Few frames give a noisy mean: take its upper confidence bound (mean +
-  // z · s / sqrt(n)), since running dry is worse than starting a little later.
-  if (frames_.size() < 3) return mean_arrival_interval();
-  std::vector<TimePoint> arrivals;
-  arrivals.reserve(frames_.size());
-  for (const Frame& f : frames_) arrivals.push_back(f.arrival);
-  std::sort(arrivals.begin(), arrivals.end());
-  const double n = static_cast<double>(arrivals.size() - 1);
-  const double mean = ToSeconds(arrivals.back() - arrivals.front()) / n;
-  double variance = 0;
-  for (std::size_t i = 1; i < arrivals.size(); ++i) {
-    const double gap = ToSeconds(arrivals[i] - arrivals[i - 1]);
-    variance += (gap - mean) * (gap - mean);
+double PlaybackEstimator::lag_growth_bound() const {
+  // Each frame's lag behind its own offset, l_i = a_i - o_i, as a line in the
+  // offset: l(o) = l0 + b·o. A channel that keeps up has b ≈ 0; a slower one
+  // b = T_a/T_c - 1 > 0. Bursts (several frames at one offset, one package)
+  // do not disturb it, unlike a mean of arrival gaps. The slope is taken at
+  // the upper bound of its confidence interval: a few frames give a noisy
+  // slope, and running dry costs more than starting a little later.
+  const double n = static_cast<double>(frames_.size());
+  if (frames_.size() < 2) return 0.0;
+  double mean_o = 0, mean_l = 0;
+  for (const Frame& f : frames_) {
+    mean_o += ToSeconds(f.offset) / n;
+    mean_l += ToSeconds(f.arrival.time_since_epoch() - f.offset) / n;
   }
-  variance /= n - 1;
-  return FromSeconds(mean + options_.confidence_z * std::sqrt(variance / n));
+  double sxx = 0, sxy = 0;
+  for (const Frame& f : frames_) {
+    const double dx = ToSeconds(f.offset) - mean_o;
+    sxx += dx * dx;
+    sxy += dx * (ToSeconds(f.arrival.time_since_epoch() - f.offset) - mean_l);
+  }
+  if (sxx <= 0) return 0.0;  // every frame at one offset: no rate to see yet
+  const double slope = sxy / sxx;
+  double standard_error = 0;
+  if (frames_.size() > 2) {
+    double residuals = 0;
+    for (const Frame& f : frames_) {
+      const double r = ToSeconds(f.arrival.time_since_epoch() - f.offset) - mean_l - slope * (ToSeconds(f.offset) - mean_o);
+      residuals += r * r;
+    }
+    standard_error = std::sqrt(residuals / (n - 2) / sxx);
+  }
+  return std::max(0.0, slope + options_.confidence_z * standard_error);
 }
 
 TimePoint PlaybackEstimator::StartTime() const {
-  // Each frame seen must be there before it plays: start >= a_i - o_i ("lag").
-  const Frame* first = &frames_.front();
-  for (const Frame& f : frames_) {
-    if (f.offset < first->offset) first = &f;
-  }
-  const TimePoint first_lag = first->arrival - first->offset;
-  // If the channel is slower than the sequence, the lag grows by (T_a - T_c)
-  // per frame: project it to the last of the declared frames.
-  const Duration command_interval = mean_command_interval();
-  const Duration growth = std::max(Duration(0), arrival_interval_bound() - command_interval);
-  const auto line = [&](const Frame& f) {
-    const double index = command_interval.count() > 0 ? ToSeconds(f.offset - first->offset) / ToSeconds(command_interval) : 0.0;
-    return first_lag + FromSeconds(ToSeconds(growth) * index);
-  };
-  // Jitter: how far any frame lagged behind that line.
-  Duration jitter{0};
-  TimePoint lag = first_lag;
+  // Frames seen must be there before they play: start >= a_i - o_i.
+  TimePoint lag = TimePoint::min();
+  Duration last_offset = Duration::min();
   for (const Frame& f : frames_) {
     lag = std::max(lag, f.arrival - f.offset);
-    jitter = std::max(jitter, (f.arrival - f.offset) - line(f));
+    last_offset = std::max(last_offset, f.offset);
   }
-  const TimePoint projected = first_lag + growth * static_cast<Duration::rep>(total_ - 1);
-  return std::max(lag, projected + jitter) + options_.margin;
+  // Frames still to come lag more if the channel is slower than the sequence:
+  // project the worst lag so far along the growth bound to the last frame.
+  const double growth = lag_growth_bound();
+  const TimePoint projected = lag + FromSeconds(growth * ToSeconds(duration_ - std::min(duration_, last_offset)));
+  return projected + options_.margin;
 }
+
 }  // namespace robotalk

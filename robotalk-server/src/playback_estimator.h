@@ -3,14 +3,15 @@
 // frame; once enough frames are in, it says when offset 0 must play so that
 // the whole declared sequence plays without running dry.
 //
-// Model: with k frames seen, T_c is the average time between commands
-// (their offsets) and T_a the average time between arrivals. If arrivals are
-// slower (T_a > T_c) the backlog grows by (T_a - T_c) per frame, so the last
-// of the N declared frames arrives about (N-1)(T_a - T_c) after the first one
-// would have had to play. The start must also clear every frame already seen
-// (start + o_i >= a_i), plus a margin for the jitter seen so far. T_a is taken
-// at the upper bound of its confidence interval: a few frames give a noisy
-// mean, and running dry costs more than starting a little later.
+// Model (paper §V-C): T_c is the average time between commands (their
+// offsets), T_a the average time between arrivals. If arrivals are slower
+// (T_a > T_c) every frame lags further behind its offset, by (T_a/T_c - 1)
+// per second of sequence, so the last frame, at offset D, lags about
+// D·(T_a/T_c - 1) more than the first. The estimator fits each frame's lag
+// l_i = a_i - o_i against its offset, takes the slope at the upper bound of
+// its confidence interval, projects the worst lag seen so far to D, and adds
+// a margin. Every frame seen is thus there before it plays, and the ones to
+// come are expected to be.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -48,8 +49,9 @@ class PlaybackEstimator {
   /// Average time between commands and between arrivals over the frames seen.
   Duration mean_command_interval() const;
   Duration mean_arrival_interval() const;
-  /// The arrival interval used for the projection (upper confidence bound).
-  Duration arrival_interval_bound() const;
+  /// How much a frame's lag behind its offset grows per second of offset
+  /// (0 when the channel keeps up), at its upper confidence bound.
+  double lag_growth_bound() const;
 
  private:
   struct Frame {

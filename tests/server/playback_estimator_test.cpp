@@ -61,6 +61,18 @@ TEST(PlaybackEstimator, CoversRandomCongestionLikeThePapers) {
   EXPECT_TRUE(PlaysWithoutRunningDry(arrivals.size(), milliseconds(100), [&](std::size_t i) { return arrivals[i]; }));
 }
 
+TEST(PlaybackEstimator, IsNotFooledByBurstsOfFramesAtOneOffset) {
+  // Pairs of commands per instant (a base speed and a head set-point), every
+  // 2.5 s, arriving on time: nothing to wait for but the margin.
+  PlaybackEstimator est(7, milliseconds(6500), {.min_frames = 5, .fraction = 0.1, .margin = milliseconds(100)});
+  for (int i = 0; i < 5; ++i) {
+    const Duration offset = milliseconds(2500) * (i / 2);
+    est.Add(offset, kT0 + offset + milliseconds(2));
+  }
+  ASSERT_TRUE(est.ready());
+  EXPECT_LT(est.StartTime() - kT0, milliseconds(110));
+}
+
 TEST(PlaybackEstimator, ReportsTheMeanIntervals) {
   PlaybackEstimator est(10, milliseconds(900));
   for (int i = 0; i < 5; ++i) est.Add(milliseconds(100) * i, kT0 + milliseconds(120) * i);
