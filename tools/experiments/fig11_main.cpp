@@ -264,6 +264,10 @@ int Run(const Options& o) {
               "late %d (max %.3f s), not-success %d, deviation mean %.4f m max %.4f m, end error %.4f m (%zu samples)\n",
               o.label.c_str(), ToString(o.mode), start_latency, playback_delay, ToSeconds(exec_last - exec0),
               profile.duration, max_sched, late, max_late, not_ok, dev.mean, dev.max, end_error, dev.samples);
+  const ClientStats st = client.stats();
+  std::fprintf(stderr, "robotalk-fig11: client sent %llu packages (%llu heartbeats, %llu retransmissions, %llu given up)\n",
+               static_cast<unsigned long long>(st.packages_sent), static_cast<unsigned long long>(st.heartbeats),
+               static_cast<unsigned long long>(st.retransmissions), static_cast<unsigned long long>(st.gave_up));
   return not_ok == 0 ? 0 : 1;
 }
 
