@@ -6,25 +6,29 @@
 
 namespace robotalk::client {
 
-Duration OutstandingPackages::retransmit_timeout() const {
-  // RFC 6298: srtt + 4 rttvar, never below the configured interval. A slow
-  // (congested) server thus gets resends no faster than it can answer, instead
-  // of a storm of duplicates that would congest it further.
-  if (!srtt_) return policy_.interval;
-  return std::max(policy_.interval, *srtt_ + 4 * rttvar_);
+Duration OutstandingPackages::BaseTimeout() const {
+  // RFC 6298: srtt + 4 rttvar, never below the configured interval.
+  return srtt_ ? std::max(policy_.interval, *srtt_ + 4 * rttvar_) : policy_.interval;
 }
 
+Duration OutstandingPackages::retransmit_timeout() const { return BaseTimeout() * (1 << timer_backoff_); }
+
 Duration OutstandingPackages::IntervalAt(int step) const {
-  const Duration base = retransmit_timeout();
-  const double factor = std::pow(std::max(1.0, policy_.backoff), step);
+  // A package backs off on its own resends (step) and with every package
+  // after a timeout (timer_backoff_): the larger of the two counts. A slow
+  // (congested) server thus gets resends no faster than it answers, instead
+  // of a storm of duplicates that would congest it further.
+  const Duration base = BaseTimeout();
+  const double factor = std::pow(std::max(1.0, policy_.backoff), std::max(step, timer_backoff_));
   const double ns = static_cast<double>(base.count()) * factor;
-  // The cap never undercuts the measured round trip.
-  const Duration cap = std::max(policy_.max_interval, base);
+  // The usual cap never undercuts the measured round trip or the timer back-off.
+  const Duration cap = std::max(policy_.max_interval, retransmit_timeout());
   if (ns >= static_cast<double>(cap.count())) return cap;
   return std::max(base, Duration(static_cast<Duration::rep>(ns)));
 }
 
 void OutstandingPackages::AddRoundTrip(Duration rtt) {
+  timer_backoff_ = 0;
   if (!srtt_) {
     srtt_ = rtt;
     rttvar_ = rtt / 2;
@@ -120,14 +124,20 @@ std::optional<std::int64_t> OutstandingPackages::OnReply(CommandId id, TimePoint
 
 std::vector<OutstandingPackages::Resend> OutstandingPackages::TakeDue(TimePoint now) {
   std::vector<Resend> due;
+  bool timed_out = false;
   for (auto& [sequence, p] : packages_) {
     if (now < p.next_send) continue;
     due.push_back({sequence, p.bytes});
+    timed_out = timed_out || !p.acked;
     ++p.sends;
     ++retransmissions_;
     ++p.backoff_step;
     p.next_send = now + IntervalAt(p.backoff_step);
   }
+  // RFC 6298 §5.5: an acknowledgement that did not come in time backs the
+  // timer off for every package until a fresh round-trip sample arrives, so a
+  // congested server is not fed duplicates faster than it answers.
+  if (timed_out && timer_backoff_ < kMaxTimerBackoff) ++timer_backoff_;
   return due;
 }
 

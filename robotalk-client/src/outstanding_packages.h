@@ -7,7 +7,8 @@
 //  - Unacknowledged: resend after the retransmission timeout (RTO), then
 //    RTO·backoff, RTO·backoff², ... capped at max(`max_interval`, RTO). The RTO
 //    adapts to the measured round trips as in TCP (RFC 6298: smoothed RTT +
-//    4 × its variation, Karn's rule), never below `interval`.
+//    4 × its variation, Karn's rule), never below `interval`, and doubles
+//    after each timeout until a fresh round-trip sample (§5.5).
 //  - Acknowledged but items unanswered: ask again (resend the same sequence;
 //    the server re-sends the replies it has) only once the earliest unanswered
 //    item's start time has passed, starting again from `interval` and backing
@@ -86,7 +87,7 @@ class OutstandingPackages {
   bool Contains(std::int64_t sequence) const { return packages_.count(sequence) != 0; }
   bool IsAcked(std::int64_t sequence) const;
   std::size_t size() const { return packages_.size(); }
-  /// The current base retransmission timeout (see the policy above).
+  /// The current retransmission timeout, timer back-off included (see above).
   Duration retransmit_timeout() const;
   /// Total resends so far.
   std::uint64_t retransmissions() const { return retransmissions_; }
@@ -103,9 +104,12 @@ class OutstandingPackages {
     TimePoint last_heard{};
   };
   Duration IntervalAt(int step) const;
+  Duration BaseTimeout() const;
   void AddRoundTrip(Duration rtt);
   std::optional<Duration> srtt_;
   Duration rttvar_{0};
+  static constexpr int kMaxTimerBackoff = 6;  // at most 64 × the RTO
+  int timer_backoff_ = 0;
   /// Earliest start among unanswered items (now-items count as `fallback`).
   static TimePoint EarliestStart(const Package& p, TimePoint fallback);
 

@@ -28,53 +28,56 @@ Duration PlaybackEstimator::mean_arrival_interval() const {
   return (hi->arrival - lo->arrival) / static_cast<Duration::rep>(frames_.size() - 1);
 }
 
-double PlaybackEstimator::lag_growth_bound() const {
-  // Each frame's lag behind its own offset, l_i = a_i - o_i, as a line in the
-  // offset: l(o) = l0 + b·o. A channel that keeps up has b ≈ 0; a slower one
-  // b = T_a/T_c - 1 > 0. Bursts (several frames at one offset, one package)
-  // do not disturb it, unlike a mean of arrival gaps. The slope is taken at
-  // the upper bound of its confidence interval: a few frames give a noisy
-  // slope, and running dry costs more than starting a little later.
-  const double n = static_cast<double>(frames_.size());
-  if (frames_.size() < 2) return 0.0;
-  double mean_o = 0, mean_l = 0;
-  for (const Frame& f : frames_) {
-    mean_o += ToSeconds(f.offset) / n;
-    mean_l += ToSeconds(f.arrival.time_since_epoch() - f.offset) / n;
+Duration PlaybackEstimator::ExtraLagBound(Duration remaining) const {
+  // Each frame's lag behind its own offset, l_i = a_i - o_i, grows like a
+  // queue's backlog: a random walk in the offset with drift mu (0 when the
+  // channel keeps up, T_a/T_c - 1 when arrivals are slower) and variance
+  // sigma^2 per second of offset. Both come from successive frames (sorted by
+  // offset; a burst of frames at one offset counts once). Over the `remaining`
+  // R seconds the lag grows by mu R +- sigma sqrt(R); mu itself is uncertain
+  // by sigma / sqrt(T) after T seconds seen. Both at z standard deviations:
+  // running dry costs more than starting a little later.
+  std::vector<const Frame*> sorted;
+  sorted.reserve(frames_.size());
+  for (const Frame& f : frames_) sorted.push_back(&f);
+  std::sort(sorted.begin(), sorted.end(), [](const Frame* a, const Frame* b) { return a->offset < b->offset; });
+  double seen = 0, growth = 0;  // seconds of offset covered, lag gained over them
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    seen += ToSeconds(sorted[i]->offset - sorted[i - 1]->offset);
+    growth += ToSeconds((sorted[i]->arrival - sorted[i]->offset) - (sorted[i - 1]->arrival - sorted[i - 1]->offset));
   }
-  double sxx = 0, sxy = 0;
-  for (const Frame& f : frames_) {
-    const double dx = ToSeconds(f.offset) - mean_o;
-    sxx += dx * dx;
-    sxy += dx * (ToSeconds(f.arrival.time_since_epoch() - f.offset) - mean_l);
+  if (seen <= 0) return Duration(0);  // every frame at one offset: no rate to see yet
+  const double mu = growth / seen;
+  double variance = 0;
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    const double dt = ToSeconds(sorted[i]->offset - sorted[i - 1]->offset);
+    const double dl =
+        ToSeconds((sorted[i]->arrival - sorted[i]->offset) - (sorted[i - 1]->arrival - sorted[i - 1]->offset));
+    variance += (dl - mu * dt) * (dl - mu * dt);
   }
-  if (sxx <= 0) return 0.0;  // every frame at one offset: no rate to see yet
-  const double slope = sxy / sxx;
-  double standard_error = 0;
-  if (frames_.size() > 2) {
-    double residuals = 0;
-    for (const Frame& f : frames_) {
-      const double r = ToSeconds(f.arrival.time_since_epoch() - f.offset) - mean_l - slope * (ToSeconds(f.offset) - mean_o);
-      residuals += r * r;
-    }
-    standard_error = std::sqrt(residuals / (n - 2) / sxx);
-  }
-  return std::max(0.0, slope + options_.confidence_z * standard_error);
+  const double sigma = std::sqrt(variance / seen);
+  const double z = options_.confidence_z;
+  const double r = ToSeconds(remaining);
+  const double mu_bound = std::max(0.0, mu + z * sigma / std::sqrt(seen));
+  return FromSeconds(mu_bound * r + z * sigma * std::sqrt(r));
 }
 
 TimePoint PlaybackEstimator::StartTime() const {
   // Frames seen must be there before they play: start >= a_i - o_i.
   TimePoint lag = TimePoint::min();
-  Duration last_offset = Duration::min();
+  Duration first_offset = Duration::max(), last_offset = Duration::min();
+  TimePoint decided = TimePoint::min();  // the estimate is made when the last frame seen arrived
   for (const Frame& f : frames_) {
     lag = std::max(lag, f.arrival - f.offset);
+    first_offset = std::min(first_offset, f.offset);
     last_offset = std::max(last_offset, f.offset);
+    decided = std::max(decided, f.arrival);
   }
-  // Frames still to come lag more if the channel is slower than the sequence:
-  // project the worst lag so far along the growth bound to the last frame.
-  const double growth = lag_growth_bound();
-  const TimePoint projected = lag + FromSeconds(growth * ToSeconds(duration_ - std::min(duration_, last_offset)));
-  return projected + options_.margin;
+  // Frames still to come lag more if the channel is slower than the sequence.
+  const TimePoint projected = lag + ExtraLagBound(duration_ - std::min(duration_, last_offset));
+  // Nothing may be scheduled before the decision: the waiting for enough
+  // frames is playback's start latency (paper Table I).
+  return std::max(projected, decided - first_offset) + options_.margin;
 }
 
 }  // namespace robotalk

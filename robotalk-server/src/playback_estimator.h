@@ -7,11 +7,11 @@
 // offsets), T_a the average time between arrivals. If arrivals are slower
 // (T_a > T_c) every frame lags further behind its offset, by (T_a/T_c - 1)
 // per second of sequence, so the last frame, at offset D, lags about
-// D·(T_a/T_c - 1) more than the first. The estimator fits each frame's lag
-// l_i = a_i - o_i against its offset, takes the slope at the upper bound of
-// its confidence interval, projects the worst lag seen so far to D, and adds
-// a margin. Every frame seen is thus there before it plays, and the ones to
-// come are expected to be.
+// D·(T_a/T_c - 1) more than the first. A congested channel makes that growth
+// a random walk (a queue's backlog), so the estimator projects the worst lag
+// seen so far to D with the drift and the spread of the walk, both at an
+// upper confidence bound (ExtraLagBound), adds a margin, and never starts
+// before the moment it decides (playback's start latency).
 #pragma once
 
 #include "robotalk/clock.h"
@@ -49,9 +49,9 @@ class PlaybackEstimator {
   /// Average time between commands and between arrivals over the frames seen.
   Duration mean_command_interval() const;
   Duration mean_arrival_interval() const;
-  /// How much a frame's lag behind its offset grows per second of offset
-  /// (0 when the channel keeps up), at its upper confidence bound.
-  double lag_growth_bound() const;
+  /// How much more than the worst lag seen so far the last frame may lag,
+  /// `remaining` seconds of sequence later (upper confidence bound).
+  Duration ExtraLagBound(Duration remaining) const;
 
  private:
   struct Frame {

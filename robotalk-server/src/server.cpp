@@ -140,13 +140,7 @@ class Server::Impl {
     pollfd fds[2] = {{lcm_.getFileno(), POLLIN, 0}, {event_fd_, POLLIN, 0}};
     while (running_) {
       const int ready = poll(fds, 2, 50);
-      if (ready > 0 && (fds[0].revents & POLLIN)) {
-        lcm_.handleTimeout(0);
-        // The paper's congestion injector (§VI-B): a random pause after each receive.
-        if (options_.congestion_max_pause.count() > 0) {
-          std::this_thread::sleep_for(FromSeconds(congestion_(congestion_rng_) * ToSeconds(options_.congestion_max_pause)));
-        }
-      }
+      if (ready > 0 && (fds[0].revents & POLLIN)) lcm_.handleTimeout(0);
       if (ready > 0 && (fds[1].revents & POLLIN)) {
         std::uint64_t count;
         [[maybe_unused]] ssize_t n = read(event_fd_, &count, sizeof count);
@@ -193,6 +187,11 @@ class Server::Impl {
                      static_cast<unsigned>(robot.encoded_config().size()));
       }
       if (answer.send) Publish(robot_name, answer.package);
+      // The paper's congestion injector (§VI-B): a random pause after each
+      // received package, during which nothing else is received.
+      if (options_.congestion_max_pause.count() > 0) {
+        std::this_thread::sleep_for(FromSeconds(congestion_(congestion_rng_) * ToSeconds(options_.congestion_max_pause)));
+      }
     } catch (const std::exception& e) {
       // Undecodable bytes carry no trustworthy client id to answer: count and log.
       ++malformed_;

@@ -26,11 +26,33 @@ std::vector<Duration> ResendTimes(OutstandingPackages& o, Duration span) {
 TEST(OutstandingPackages, ResendsAnUnackedPackageWithBackoff) {
   OutstandingPackages o(Policy());
   o.Add(1, Bytes(1), {{.id = 10}}, kT0);
-  const auto times = ResendTimes(o, milliseconds(1500));
+  const auto times = ResendTimes(o, milliseconds(2000));
+  // 100 ms, then doubling, capped at max_interval (400 ms) -- until the timer
+  // back-off of unanswered timeouts (RFC 6298 §5.5) lifts the cap to 800 ms.
   const std::vector<Duration> expected = {milliseconds(100), milliseconds(300), milliseconds(700),
-                                          milliseconds(1100), milliseconds(1500)};
+                                          milliseconds(1100), milliseconds(1900)};
   EXPECT_EQ(times, expected);
   EXPECT_EQ(o.retransmissions(), 5u);
+}
+
+TEST(OutstandingPackages, AFreshRoundTripResetsTheTimerBackoff) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}}, kT0);
+  ResendTimes(o, milliseconds(1200));
+  EXPECT_GT(o.retransmit_timeout(), milliseconds(100)) << "timeouts backed the timer off";
+  o.Add(2, Bytes(2), {{.id = 20}}, kT0 + milliseconds(1300));
+  o.OnAck(2, kT0 + milliseconds(1330));  // sent once: a valid 30 ms sample
+  EXPECT_EQ(o.retransmit_timeout(), milliseconds(100)) << "srtt + 4 rttvar = 90 ms, floored at the interval";
+}
+
+TEST(OutstandingPackages, AdaptsTheTimeoutToASlowServer) {
+  OutstandingPackages o(Policy());
+  for (int i = 0; i < 20; ++i) {
+    const TimePoint sent = kT0 + seconds(i);
+    o.Add(i + 1, Bytes(1), {{.id = i + 1}}, sent);
+    o.OnAck(i + 1, sent + milliseconds(600));  // a congested server answers in 600 ms
+  }
+  EXPECT_GE(o.retransmit_timeout(), milliseconds(600)) << "no resend before an answer could come";
 }
 
 TEST(OutstandingPackages, ResendUsesTheSameBytes) {
