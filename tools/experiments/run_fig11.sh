@@ -100,5 +100,9 @@ for condition in none congestion; do
 done
 
 "$client" --print-ideal "$runs/ideal.csv" --length $length --duration $duration >&2 || status=1
-python3 "$here/plot_fig11.py" --runs "$runs" --png "$out/$name.png" --table "$out/${name}_metrics.csv" || status=1
+# Debian's python3-matplotlib (scripts/setup.sh) lives under /usr/bin/python3,
+# which another python3 earlier on PATH (pyenv, a venv) may not see.
+python=python3
+python3 -c 'import matplotlib' 2>/dev/null || python=/usr/bin/python3
+"$python" "$here/plot_fig11.py" --runs "$runs" --png "$out/$name.png" --table "$out/${name}_metrics.csv" || status=1
 exit $status
