@@ -105,6 +105,12 @@ OdeWorld::OdeWorld(const RobotModel& model, const std::vector<CollisionShape>& s
     : model_(model), options_(options) {
   EnsureOdeThread();
   world_ = dWorldCreate();
+  // ODE's default stepping runs on one process-wide threading object with
+  // fake mutexes: two worlds stepped from two RobotDaemon threads corrupt its
+  // job list (ODE INTERNAL ERROR in ReleaseAJob, seen with the Pioneer and
+  // the humanoid in one server). Each world gets its own.
+  threading_ = dThreadingAllocateSelfThreadedImplementation();
+  dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_), threading_);
   contacts_ = dJointGroupCreate(0);
   dWorldSetGravity(world_, 0, 0, -options_.gravity);
   dWorldSetQuickStepNumIterations(world_, options_.quickstep_iterations);
@@ -131,6 +137,7 @@ OdeWorld::~OdeWorld() {
   if (ground_) dGeomDestroy(ground_);
   dJointGroupDestroy(contacts_);
   dWorldDestroy(world_);  // bodies and joints with it
+  dThreadingFreeImplementation(threading_);
 }
 
 // A link whose parent joint has no dof belongs to its parent's group.

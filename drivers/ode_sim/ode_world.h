@@ -113,6 +113,7 @@ class OdeWorld {
   const RobotModel& model_;
   OdeWorldOptions options_;
   dWorldID world_ = nullptr;
+  dThreadingImplementationID threading_ = nullptr;  // this world's own (see the constructor)
   dJointGroupID contacts_ = nullptr;
   dGeomID ground_ = nullptr;
 

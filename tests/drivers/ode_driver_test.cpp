@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include <cmath>
 #include <numbers>
 
@@ -216,6 +218,22 @@ TEST(OdeDriver, StopInterruptsAGotoAndHolonomicRequestsAreModified) {
 }
 
 // ---------------------------------------------------------------- determinism and panic
+
+// The server steps each robot from its own RobotDaemon thread. ODE's default
+// threading object is process-wide and unsynchronised: two worlds stepped
+// concurrently aborted with "ODE INTERNAL ERROR 1 ... ReleaseAJob" until each
+// world got its own.
+TEST(OdeDriver, TwoRobotsStepSafelyFromTwoThreads) {
+  Sim pioneer(MakeDriver(Pioneer()));
+  Sim humanoid(MakeDriver(ProjectModel("simple_humanoid.urdf")));
+  pioneer.Exec(CommandType::kSetSpeed, "", {0.3, 0.2});
+  std::thread a([&] { pioneer.Run(3.0); });
+  std::thread b([&] { humanoid.Run(3.0); });
+  a.join();
+  b.join();
+  EXPECT_GT(pioneer.Base().head<2>().norm(), 0.5) << "the Pioneer drove while the humanoid stepped";
+  EXPECT_TRUE(humanoid.State().position.allFinite());
+}
 
 TEST(OdeDriver, SameSeedAndCommandsGiveTheSameTrajectory) {
   auto run = [](const std::string& solver) {
