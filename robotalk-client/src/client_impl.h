@@ -9,6 +9,7 @@
 #include "clock_sync.h"
 #include "outstanding_packages.h"
 #include "return_cache.h"
+#include "robotalk/channels.h"
 #include "robotalk/robot_client.h"
 
 #include <lcm/lcm-cpp.hpp>
@@ -27,8 +28,6 @@
 
 namespace robotalk {
 
-/// The client id as it appears in channel names: 16 lowercase hex digits.
-std::string ClientIdHex(std::int64_t client_id);
 
 /// Header fields of a PLAYBACK package (id 0: an ordinary package).
 struct PlaybackHeader {

@@ -150,8 +150,8 @@ void RobotClient::Impl::SubscribeState(std::function<void(const robotalk_msgs::r
   std::lock_guard lock(mu_);
   on_state_ = std::move(on_sample);
   if (state_subscription_) return;
-  state_subscription_ = lcm_->subscribe("ROBOTALK/" + robot_ + "/STATE", &Impl::OnState, this);
-  if (!state_subscription_) throw ClientError("RobotClient: cannot subscribe to ROBOTALK/" + robot_ + "/STATE");
+  state_subscription_ = lcm_->subscribe(StateChannel(robot_), &Impl::OnState, this);
+  if (!state_subscription_) throw ClientError("RobotClient: cannot subscribe to " + StateChannel(robot_));
   state_subscription_->setQueueCapacity(options_.lcm_queue_capacity);
 }
 

@@ -37,12 +37,6 @@ std::vector<std::uint8_t> Encode(const robotalk_msgs::package_t& p) {
 
 }  // namespace
 
-std::string ClientIdHex(std::int64_t client_id) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(static_cast<std::uint64_t>(client_id)));
-  return buf;
-}
-
 RobotClient::Impl::Impl(ClientOptions options)
     : options_(std::move(options)),
       client_id_(options_.client_id != 0 ? options_.client_id : RandomClientId()),
@@ -78,9 +72,9 @@ RobotClient::Impl::~Impl() {
 void RobotClient::Impl::Attach(const std::string& robot) {
   std::lock_guard lock(mu_);
   robot_ = robot;
-  request_channel_ = "ROBOTALK/" + robot + "/REQUEST";
-  const std::string reply_channel = "ROBOTALK/" + robot + "/REPLY/" + ClientIdHex(client_id_);
-  const std::string config_channel = "ROBOTALK/" + robot + "/CONFIG";
+  request_channel_ = RequestChannel(robot);
+  const std::string reply_channel = ReplyChannel(robot, client_id_);
+  const std::string config_channel = ConfigChannel(robot);
   lcm::Subscription* reply = lcm_->subscribe(reply_channel, &Impl::OnReplyPackage, this);
   lcm::Subscription* config = lcm_->subscribe(config_channel, &Impl::OnConfig, this);
   if (!reply || !config) throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel);

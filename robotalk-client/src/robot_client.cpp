@@ -123,7 +123,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
   } collector;
   // announce_t holds no unbounded arrays a hostile sender could abuse beyond
   // the datagram itself, so LCM's typed decoder is acceptable here.
-  lcm::Subscription* sub = lcm->subscribe("ROBOTALK/ANNOUNCE", &Collector::On, &collector);
+  lcm::Subscription* sub = lcm->subscribe(kAnnounceChannel, &Collector::On, &collector);
   sub->setQueueCapacity(100);
   const SteadyPoint deadline = SteadyAfter(listen);
   for (;;) {

@@ -1,5 +1,6 @@
 #include "robot_service.h"
 
+#include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
 #include "robotalk/protocol_codec.h"
@@ -10,12 +11,6 @@
 
 namespace robotalk {
 namespace {
-
-std::string Hex(std::int64_t v) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016" PRIx64, static_cast<std::uint64_t>(v));
-  return buf;
-}
 
 Reply MakeReply(CommandId id, Signal signal, std::string message, TimePoint now) {
   Reply r;
@@ -203,12 +198,12 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
   }
   if (q.type == QueryType::kConfig) {
     publish_config = true;
-    immediate.push_back(MakeReply(q.id, Signal::kSuccess, Hex(static_cast<std::int64_t>(config_hash_)), now));
+    immediate.push_back(MakeReply(q.id, Signal::kSuccess, Hex64(config_hash_), now));
     return;
   }
   if (s.commands.size() >= options_.max_queue) {
     immediate.push_back(MakeReply(q.id, Signal::kError,
-                                  "queue of client " + Hex(s.client_id) + " is full (" +
+                                  "queue of client " + Hex64(static_cast<std::uint64_t>(s.client_id)) + " is full (" +
                                       std::to_string(options_.max_queue) + " items); query not queued",
                                   now));
     return;
@@ -250,7 +245,7 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
       wake_flag_ = true;
       wake_.notify_one();
       std::fprintf(stderr, "robotalk-server: robot '%s': panic reset by client %s\n", name_.c_str(),
-                   Hex(s.client_id).c_str());
+                   Hex64(static_cast<std::uint64_t>(s.client_id)).c_str());
       immediate.push_back(MakeReply(c.id, Signal::kSuccess, "panic reset", now));
     } else {
       immediate.push_back(MakeReply(c.id, Signal::kSuccess, "the robot was not in panic", now));
@@ -283,7 +278,7 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
   for (const auto& [id, seq] : s.playbacks) queued += seq.frames.size();
   if (queued >= options_.max_queue) {
     immediate.push_back(MakeReply(c.id, Signal::kError,
-                                  "queue of client " + Hex(s.client_id) + " is full (" +
+                                  "queue of client " + Hex64(static_cast<std::uint64_t>(s.client_id)) + " is full (" +
                                       std::to_string(options_.max_queue) + " items); command not queued",
                                   now));
     return std::nullopt;
@@ -400,7 +395,7 @@ void RobotService::TakeStates(std::vector<robotalk_msgs::robot_state_t>& out) {
 
 void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
   const bool first = !panic_.exchange(true);
-  std::fprintf(stderr, "robotalk-server: robot '%s': PANIC from client %s%s\n", name_.c_str(), Hex(client_id).c_str(),
+  std::fprintf(stderr, "robotalk-server: robot '%s': PANIC from client %s%s\n", name_.c_str(), Hex64(static_cast<std::uint64_t>(client_id)).c_str(),
                first ? "" : " (already in panic)");
   std::vector<QueuedItem> flushed;
   for (auto& [id, session] : sessions_) {
@@ -413,7 +408,7 @@ void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
   server_queue_.clear();
   for (const QueuedItem& item : flushed) {
     Deliver(item.client_id, MakeReply(item.command.id, Signal::kInterrupted,
-                                      "flushed by panic from client " + Hex(client_id), now));
+                                      "flushed by panic from client " + Hex64(static_cast<std::uint64_t>(client_id)), now));
   }
   halt_requested_ = true;
   wake_flag_ = true;
@@ -637,7 +632,7 @@ void RobotService::Execute(const QueuedItem& item, TimePoint now) {
   const DriverResult result = driver_->Execute(command, now, completions_);
   if (options_.log_executions) {
     std::fprintf(stderr, "robotalk-server: robot '%s': executed client %s command %" PRId64 " %s -> %s\n",
-                 name_.c_str(), Hex(item.client_id).c_str(), item.command.id, ToString(item.command.type),
+                 name_.c_str(), Hex64(static_cast<std::uint64_t>(item.client_id)).c_str(), item.command.id, ToString(item.command.type),
                  result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
   }
   if (result.in_progress) {

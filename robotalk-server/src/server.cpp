@@ -2,6 +2,7 @@
 
 #include "fault_injector.h"
 #include "robot_service.h"
+#include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk_msgs/announce_t.hpp"
@@ -21,13 +22,6 @@ namespace robotalk {
 namespace {
 
 constexpr size_t kMaxRepliesBytes = 30000;  // split reply packages well under LCM's 64 KB
-constexpr const char* kPrefix = "ROBOTALK/";
-
-std::string Hex(std::int64_t v) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016" PRIx64, static_cast<std::uint64_t>(v));
-  return buf;
-}
 
 bool ValidRobotName(const std::string& name) {
   return !name.empty() && std::regex_match(name, std::regex("[A-Za-z0-9_-]+"));
@@ -153,7 +147,7 @@ class Server::Impl {
             // Quiet for the ordinary case: a short-lived client (the CLI) that is done.
             if (e.dropped_commands == 0 && !e.moved_robot) continue;
             std::fprintf(stderr, "robotalk-server: robot '%s': client %s went silent; %zu queued commands dropped\n",
-                         name.c_str(), Hex(e.client_id).c_str(), e.dropped_commands);
+                         name.c_str(), Hex64(static_cast<std::uint64_t>(e.client_id)).c_str(), e.dropped_commands);
           }
         }
         next_expiry = now + std::chrono::milliseconds(100);
@@ -180,10 +174,10 @@ class Server::Impl {
                                            : robot.RefusePackage(package, received, bad);
       if (!bad.empty()) {
         std::fprintf(stderr, "robotalk-server: robot '%s': refused package from client %s: %s\n", robot_name.c_str(),
-                     Hex(package.header.client_id).c_str(), bad.c_str());
+                     Hex64(static_cast<std::uint64_t>(package.header.client_id)).c_str(), bad.c_str());
       }
       if (answer.publish_config) {
-        lcm_.publish(kPrefix + robot_name + "/CONFIG", robot.encoded_config().data(),
+        lcm_.publish(ConfigChannel(robot_name), robot.encoded_config().data(),
                      static_cast<unsigned>(robot.encoded_config().size()));
       }
       if (answer.send) Publish(robot_name, answer.package);
@@ -204,7 +198,7 @@ class Server::Impl {
     for (auto& [name, robot] : robots_) {
       states_.clear();
       robot->TakeStates(states_);
-      for (const auto& state : states_) lcm_.publish(kPrefix + name + "/STATE", &state);
+      for (const auto& state : states_) lcm_.publish(StateChannel(name), &state);
       outgoing_.clear();
       robot->TakeReplies(outgoing_);
       for (OutgoingReplies& out : outgoing_) {
@@ -230,7 +224,7 @@ class Server::Impl {
   void Publish(const std::string& robot, robotalk_msgs::reply_package_t& package) {
     package.num_replies = static_cast<std::int32_t>(package.replies.size());
     package.server_send_us = ToWireMicros(clock_.Now());
-    const std::string channel = kPrefix + robot + "/REPLY/" + Hex(package.client_id);
+    const std::string channel = ReplyChannel(robot, package.client_id);
     for (int copies = faults_.Copies(); copies > 0; --copies) lcm_.publish(channel, &package);
   }
 
@@ -242,7 +236,7 @@ class Server::Impl {
     a.url_hint = options_.lcm_url;
     for (auto& [name, robot] : robots_) a.robots.push_back(robot->Info());
     a.num_robots = static_cast<std::int32_t>(a.robots.size());
-    lcm_.publish("ROBOTALK/ANNOUNCE", &a);
+    lcm_.publish(kAnnounceChannel, &a);
   }
 
   ServerOptions options_;
