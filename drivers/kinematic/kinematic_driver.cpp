@@ -3,14 +3,13 @@
 #include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
 #include <memory>
 #include <numbers>
+#include <span>
 #include <utility>
 
 namespace robotalk {
@@ -104,17 +103,16 @@ void KinematicDriverOptions::Validate() const {
 // ---------------------------------------------------------------- construction
 
 KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions& options)
-    : model_(std::move(model)), options_(options), kin_(model_) {
+    : model_(std::move(model)), options_(options), ik_(model_) {
   options_.Validate();
   const int n = model_.num_dofs();
   for (Eigen::VectorXd* v :
-       {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_, &ik_q_, &ik_best_, &ik_dq_}) {
+       {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_}) {
     v->setZero(n);
   }
   mode_.assign(static_cast<size_t>(n), DofMode::kPosition);
   mimic_leader_dof_.assign(static_cast<size_t>(n), -1);
   mimic_multiplier_.assign(static_cast<size_t>(n), 0.0);
-  ik_jac_.setZero(6, n);
 
   const auto joints = model_.joints();
   for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
@@ -135,19 +133,6 @@ KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions&
   }
   ApplyMimics(model_, q_);
   target_ = q_;
-
-  // Per control frame, the dofs its IK may move: set-point joints on the path
-  // to the root. Mimic joints follow their leaders instead.
-  for (const ControlFrame& frame : model_.frames()) {
-    std::vector<std::uint8_t> mask(static_cast<size_t>(n), 0);
-    for (int j = model_.parent_joint(frame.parent_link); j >= 0;
-         j = model_.parent_joint(model_.joint(j).parent_link)) {
-      const Joint& joint = model_.joint(j);
-      if (joint.mimic || !joint.servo_types.Has(ServoType::kSetPoint)) continue;
-      for (size_t k = 0; k < joint.dofs.size(); ++k) mask[static_cast<size_t>(model_.dof_offset(j)) + k] = 1;
-    }
-    frame_dofs_.push_back(std::move(mask));
-  }
 
   // The first root's model pose = planar part (x, y, yaw) * residual (height,
   // roll, pitch); the base moves the planar part only.
@@ -392,76 +377,30 @@ DriverResult KinematicDriver::JointSpeed(const DriverCommand& c) {
 
 DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
   const ControlFrame& frame = model_.frame(c.target);
-  const std::vector<std::uint8_t>& mask = frame_dofs_[static_cast<size_t>(c.target)];
-  if (std::find(mask.begin(), mask.end(), 1) == mask.end()) {
+  if (!ik_.HasMovableDofs(c.target)) {
     return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
                                    ": no joint between the frame and its root accepts set-points");
   }
   const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
-  const Eigen::Quaterniond goal_r =
-      Eigen::Quaterniond(c.values[3], c.values[4], c.values[5], c.values[6]).normalized();
-  UpdateRootPoses();
-
-  // Damped least squares on a copy of q: dq = J^T (J J^T + lambda^2 I)^-1 e,
-  // with the step capped and the limits enforced after each step. Keeps the
-  // best pose seen (position error plus 0.1 m per rad of orientation error).
-  constexpr double kLambda = 0.05, kMaxStep = 0.3, kMetrePerRad = 0.1;
-  constexpr int kPatience = 30;  // iterations without improvement before giving up
-  ik_q_ = q_;
-  ik_best_ = q_;
-  double best_cost = std::numeric_limits<double>::infinity(), best_p = 0, best_r = 0;
-  int since_best = 0;
-  const Eigen::Index n = q_.size();
-  for (int it = 0; it < kIkMaxIterations && since_best < kPatience; ++it) {
-    kin_.Update(ik_q_, root_world_);
-    const Eigen::Isometry3d x = kin_.frame_pose(c.target);
-    Eigen::Matrix<double, 6, 1> e;
-    e.head<3>() = goal_p - x.translation();
-    const Eigen::AngleAxisd rot_error(goal_r.toRotationMatrix() * x.linear().transpose());
-    e.tail<3>() = rot_error.angle() * rot_error.axis();
-    const double pe = e.head<3>().norm(), re = e.tail<3>().norm();
-    const double cost = pe + kMetrePerRad * re;
-    if (cost < best_cost - 1e-12) {
-      best_cost = cost;
-      best_p = pe;
-      best_r = re;
-      ik_best_ = ik_q_;
-      since_best = 0;
-    } else {
-      ++since_best;
-    }
-    if (pe < 1e-7 && re < 1e-7) break;
-
-    ik_jac_ = kin_.FrameJacobian(c.target);
-    for (Eigen::Index i = 0; i < n; ++i) {  // a mimic dof moves with its leader
-      const int leader = mimic_leader_dof_[static_cast<size_t>(i)];
-      if (leader >= 0) ik_jac_.col(leader) += mimic_multiplier_[static_cast<size_t>(i)] * ik_jac_.col(i);
-    }
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (!mask[static_cast<size_t>(i)]) ik_jac_.col(i).setZero();
-    }
-    Eigen::Matrix<double, 6, 6> a;
-    a.noalias() = ik_jac_ * ik_jac_.transpose();
-    a.diagonal().array() += kLambda * kLambda;
-    const Eigen::Matrix<double, 6, 1> y = a.ldlt().solve(e);
-    ik_dq_.noalias() = ik_jac_.transpose() * y;
-    const double step = ik_dq_.norm();
-    if (step > kMaxStep) ik_dq_ *= kMaxStep / step;
-    ik_q_ += ik_dq_;
-    ik_q_ = ik_q_.cwiseMax(lower_).cwiseMin(upper_);
-    ApplyMimics(model_, ik_q_);
+  const Eigen::Quaterniond goal_r(c.values[3], c.values[4], c.values[5], c.values[6]);
+  if (!(goal_r.norm() > 1e-9)) {  // CheckCommand wants a unit quaternion; a driver re-checks
+    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) + ": orientation quaternion has norm " +
+                                      Num(goal_r.norm()) + ", expected 1");
   }
-
-  for (Eigen::Index i = 0; i < n; ++i) {
+  UpdateRootPoses();
+  const InverseKinematics::Result r = ik_.Solve(c.target, goal_p, goal_r, q_, root_world_);
+  const std::span<const std::uint8_t> mask = ik_.default_mask(c.target);
+  const Eigen::VectorXd& best = ik_.solution();
+  for (Eigen::Index i = 0; i < q_.size(); ++i) {
     if (!mask[static_cast<size_t>(i)]) continue;
     mode_[static_cast<size_t>(i)] = DofMode::kPosition;
-    target_[i] = ik_best_[i];
+    target_[i] = best[i];
     speed_[i] = 0;
   }
-  if (best_p <= kIkPositionTolerance && best_r <= kIkOrientationTolerance) return Answer(Signal::kSuccess);
+  if (r.within_tolerance) return Answer(Signal::kSuccess);
   return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame.name) +
-                                       ": pose not reachable; moving to the closest found, " + Num(best_p) +
-                                       " m and " + Num(best_r) + " rad away");
+                                       ": pose not reachable; moving to the closest found, " +
+                                       Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
 }
 
 // ---------------------------------------------------------------- commands

@@ -1,7 +1,7 @@
 // The `kinematic` driver: an ideal, velocity-limited kinematic simulation of
 // any RobotModel. Joints move toward their set-points at their velocity limit
 // (or run at a commanded speed until a position limit); control-frame
-// set-points are solved by damped-least-squares inverse kinematics; a mobile
+// set-points are solved by InverseKinematics (damped least squares); a mobile
 // first root (differential or holonomic) integrates SETSPEED exactly and
 // drives to a GOTO goal with a turn-drive-turn controller. There are no
 // dynamics: JOINT_FORCE answers NA. docs/drivers.md describes the behaviour.
@@ -12,13 +12,13 @@
 // do not allocate (ReadState() only if `state` was not sized for the model);
 // Execute() allocates only to build a reply message (MODIFIED/NA/BUSY/...
 // texts) and, for FRAME_SETPOINT, the Jacobian that Kinematics::FrameJacobian
-// returns on each of at most `ik_max_iterations` iterations.
+// returns on each of at most kIkMaxIterations IK iterations.
 //
-// Copy/move: neither (the Kinematics member refers to the owned model).
+// Copy/move: neither (the InverseKinematics member refers to the owned model).
 #pragma once
 
 #include "robotalk/driver.h"
-#include "robotalk/kinematics.h"
+#include "robotalk/inverse_kinematics.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -80,10 +80,10 @@ class KinematicDriver final : public Driver {
   void Resume() override;
 
   /// Cap on damped-least-squares iterations per FRAME_SETPOINT.
-  static constexpr int kIkMaxIterations = 200;
+  static constexpr int kIkMaxIterations = InverseKinematics::kMaxIterations;
   /// A FRAME_SETPOINT is SUCCESS when the solution is this close (m, rad).
-  static constexpr double kIkPositionTolerance = 1e-3;
-  static constexpr double kIkOrientationTolerance = 1e-2;
+  static constexpr double kIkPositionTolerance = InverseKinematics::kPositionTolerance;
+  static constexpr double kIkOrientationTolerance = InverseKinematics::kOrientationTolerance;
   /// A GOTO's final heading tolerance, rad.
   static constexpr double kGotoHeadingTolerance = 1e-2;
 
@@ -112,19 +112,13 @@ class KinematicDriver final : public Driver {
 
   RobotModel model_;
   KinematicDriverOptions options_;
-  mutable Kinematics kin_;  // used by FRAME_SETPOINT only
+  InverseKinematics ik_;  // FRAME_SETPOINT; its default masks say which dofs move
 
   // Per dof (size num_dofs), allocated in the constructor.
   Eigen::VectorXd q_, qd_, effort_, target_, speed_, vmax_, lower_, upper_;
   std::vector<DofMode> mode_;
   std::vector<int> mimic_leader_dof_;  // -1 unless the dof follows a leader
   std::vector<double> mimic_multiplier_;
-  // Per control frame: which dofs its IK may move (set-point joints between
-  // the frame and its root, mimics excluded); 1 = yes.
-  std::vector<std::vector<std::uint8_t>> frame_dofs_;
-  // IK scratch.
-  Eigen::VectorXd ik_q_, ik_best_, ik_dq_;
-  Jacobian ik_jac_;
 
   // Base (first root). x, y, theta: the root's planar pose in the world;
   // base_residual_ the rest of its model pose (height, roll, pitch).
