@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <map>
 #include <mutex>
@@ -275,12 +276,18 @@ TEST_F(ServerClientTest, BroadcastKeepsItsPeriodAndStopsOnCancel) {
   std::lock_guard lock(mu);
   ASSERT_GE(times.size(), 35u);
   ASSERT_LE(times.size(), 42u);
-  // Absolute deadlines: sample k is due at t0 + k x 50 ms, never drifting.
+  // Absolute deadlines: sample k is due at t0 + k x 50 ms. Measured from the
+  // first sample (itself a little late), each is within a wake-up of its due
+  // time (generous: the machine is shared), and the lateness does not grow.
+  std::vector<std::int64_t> late_us;
   for (size_t k = 0; k < times.size(); ++k) {
-    const std::int64_t late_us = times[k] - times[0] - static_cast<std::int64_t>(k) * 50000;
-    EXPECT_GE(late_us, 0) << "sample " << k;
-    EXPECT_LT(late_us, 20000) << "sample " << k;
+    late_us.push_back(times[k] - times[0] - static_cast<std::int64_t>(k) * 50000);
+    EXPECT_GE(late_us.back(), -2000) << "sample " << k << " early";
+    EXPECT_LT(late_us.back(), 50000) << "sample " << k << " late";
   }
+  std::vector<std::int64_t> last(late_us.end() - 10, late_us.end());
+  std::nth_element(last.begin(), last.begin() + 5, last.end());
+  EXPECT_LT(last[5], 10000) << "median lateness of the last 10 samples: the stream drifted";
   EXPECT_GT(seen_by_watcher.load(), 30) << "one shared stream at the shortest period";
   const size_t after_cancel = times.size();
   std::this_thread::sleep_for(milliseconds(300));
