@@ -106,8 +106,7 @@ KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions&
     : model_(std::move(model)), options_(options), ik_(model_) {
   options_.Validate();
   const int n = model_.num_dofs();
-  for (Eigen::VectorXd* v :
-       {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_}) {
+  for (Eigen::VectorXd* v : {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_}) {
     v->setZero(n);
   }
   mode_.assign(static_cast<size_t>(n), DofMode::kPosition);
@@ -384,8 +383,9 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
   const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
   const Eigen::Quaterniond goal_r(c.values[3], c.values[4], c.values[5], c.values[6]);
   if (!(goal_r.norm() > 1e-9)) {  // CheckCommand wants a unit quaternion; a driver re-checks
-    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) + ": orientation quaternion has norm " +
-                                      Num(goal_r.norm()) + ", expected 1");
+    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) +
+                                      ": orientation quaternion has norm " + Num(goal_r.norm()) +
+                                      ", expected 1");
   }
   UpdateRootPoses();
   const InverseKinematics::Result r = ik_.Solve(c.target, goal_p, goal_r, q_, root_world_);
@@ -400,7 +400,8 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
   if (r.within_tolerance) return Answer(Signal::kSuccess);
   return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame.name) +
                                        ": pose not reachable; moving to the closest found, " +
-                                       Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
+                                       Num(r.position_error) + " m and " + Num(r.orientation_error) +
+                                       " rad away");
 }
 
 // ---------------------------------------------------------------- commands

@@ -1,7 +1,6 @@
 #include "ode_driver.h"
 
-#include "base_controller.h"
-#include "ode_world.h"
+#include "ode_driver_impl.h"
 #include "robotalk/error.h"
 #include "robotalk/kinematics.h"
 #include "robotalk/urdf_import.h"
@@ -14,23 +13,14 @@
 
 namespace robotalk {
 
+using ode_detail::Answer;
 using ode_detail::GotoController;
+using ode_detail::Num;
 using ode_detail::OdeWorld;
 using ode_detail::Twist2;
 using ode_detail::WrapAngle;
 
 namespace {
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
-std::string Quote(const std::string& s) { return "'" + s + "'"; }
-DriverResult Answer(Signal s, std::string message = {}) {
-  return DriverResult{.signal = s, .in_progress = false, .message = std::move(message)};
-}
 
 // The model with its first root's base type replaced (option "base").
 RobotModel WithBase(RobotModel model, const std::string& base) {
@@ -38,8 +28,8 @@ RobotModel WithBase(RobotModel model, const std::string& base) {
   std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
   roots.front().base = ParseBaseType(base);
   return RobotModel(model.name(), {model.links().begin(), model.links().end()},
-                    {model.joints().begin(), model.joints().end()}, {model.frames().begin(), model.frames().end()},
-                    std::move(roots));
+                    {model.joints().begin(), model.joints().end()},
+                    {model.frames().begin(), model.frames().end()}, std::move(roots));
 }
 
 std::optional<int> FindAny(const RobotModel& m, std::initializer_list<const char*> names) {
@@ -49,76 +39,15 @@ std::optional<int> FindAny(const RobotModel& m, std::initializer_list<const char
   return std::nullopt;
 }
 
-constexpr double kMovingSpeed = 1e-3;     // rad/s or m/s: below this a dof counts as still
-constexpr double kTargetReached = 2e-3;   // rad or m: a set-point counts as reached
-constexpr double kGaitStride = 0.5;       // m of root travel per gait cycle
+constexpr double kMovingSpeed = 1e-3;               // rad/s or m/s: below this a dof counts as still
+constexpr double kTargetReached = 2e-3;             // rad or m: a set-point counts as reached
+constexpr double kGaitStride = 0.5;                 // m of root travel per gait cycle
 constexpr double kGaitHip = 0.35, kGaitKnee = 0.6;  // rad: gait amplitudes
 
 }  // namespace
 
-class OdeDriver::Impl {
- public:
-  Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes);
-
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed);
-  void Advance(TimePoint now, bool limit, std::vector<Completion>& completed);
-  void Step(int n, std::vector<Completion>& completed);
-  void ReadState(RobotState& state) const;
-  void Halt(std::vector<Completion>& interrupted) {
-    StopAll("interrupted by panic", interrupted);
-    halted_ = true;
-  }
-  void Resume() { halted_ = false; }
-
-  RobotModel model_;
-  OdeDriverOptions options_;
-  std::unique_ptr<OdeWorld> world_;
-  Duration step_{};
-  std::optional<TimePoint> origin_;  // simulated time of step 0
-  std::int64_t steps_ = 0;
-  Duration dropped_{0};
-
- private:
-  enum class Mode : std::uint8_t { kPosition, kVelocity, kForce, kPassive, kMimic };
-  enum class BaseKind : std::uint8_t { kFixed, kWheels, kKinematic };
-  enum class BaseMode : std::uint8_t { kIdle, kSpeed, kGoto };
-
-  void ControlStep(std::vector<Completion>& completed);
-  void StopAll(const char* why, std::vector<Completion>& completed);
-  void SetWheels(double v, double omega);
-  void BasePose(double* x, double* y, double* theta) const;
-  void SetupWheels(const std::vector<CollisionShape>& shapes);
-  void SetupGait();
-  DriverResult JointCommand(const DriverCommand& c);
-  DriverResult SetSpeed(const DriverCommand& c);
-  DriverResult Goto(const DriverCommand& c);
-  bool IsWheel(int joint) const {
-    return base_kind_ == BaseKind::kWheels && (joint == wheel_joint_[0] || joint == wheel_joint_[1]);
-  }
-
-  // Per dof.
-  std::vector<Mode> mode_;
-  Eigen::VectorXd target_, speed_, force_, vmax_, fmax_, lower_, upper_;
-  std::vector<int> leader_;  // mimic leader dof, or -1
-  std::vector<double> mimic_k_, mimic_c_;
-
-  // Base.
-  BaseKind base_kind_ = BaseKind::kFixed;
-  BaseMode base_mode_ = BaseMode::kIdle;
-  int wheel_joint_[2] = {-1, -1};  // left, right
-  int wheel_dof_[2] = {-1, -1};
-  double wheel_sign_[2] = {1, 1};
-  double wheel_radius_ = 0, wheel_separation_ = 0;
-  double cmd_vx_ = 0, cmd_vy_ = 0, cmd_omega_ = 0;  // SETSPEED, body frame
-  GotoController goto_;
-  CommandId goto_id_ = 0;
-  int gait_dof_[4] = {-1, -1, -1, -1};  // left hip, left knee, right hip, right knee
-  double gait_phase_ = 0;
-  bool halted_ = false;
-};
-
 OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes)
-    : model_(WithBase(std::move(model), options.base)), options_(options) {
+    : model_(WithBase(std::move(model), options.base)), options_(options), ik_(model_) {
   options_.Validate();
   step_ = FromSeconds(1.0 / options_.step_hz);
   if (step_ <= Duration::zero()) throw Error("OdeDriver: step_hz " + Num(options_.step_hz) + " is too high");
@@ -128,6 +57,7 @@ OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::ve
   leader_.assign(static_cast<size_t>(n), -1);
   mimic_k_.assign(static_cast<size_t>(n), 0);
   mimic_c_.assign(static_cast<size_t>(n), 0);
+  root_poses_.assign(model_.roots().size(), Eigen::Isometry3d::Identity());
   Eigen::VectorXd q0 = Eigen::VectorXd::Zero(n);
   for (int j = 0; j < static_cast<int>(model_.joints().size()); ++j) {
     const Joint& joint = model_.joint(j);
@@ -188,11 +118,14 @@ OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::ve
 }
 
 void OdeDriver::Impl::SetupWheels(const std::vector<CollisionShape>& shapes) {
-  const std::optional<int> l = model_.FindJoint(options_.left_wheel), r = model_.FindJoint(options_.right_wheel);
+  const std::optional<int> l = model_.FindJoint(options_.left_wheel),
+                           r = model_.FindJoint(options_.right_wheel);
   for (const auto& [found, name] : {std::pair{l, options_.left_wheel}, std::pair{r, options_.right_wheel}}) {
-    if (!found || model_.joint(*found).dofs.size() != 1 || model_.joint(*found).dofs[0].type != DofType::kRevolute) {
-      throw Error("OdeDriver: robot '" + model_.name() + "' has a differential base but no 1-dof revolute wheel joint '" +
-                  name + "' (options left_wheel, right_wheel)");
+    if (!found || model_.joint(*found).dofs.size() != 1 ||
+        model_.joint(*found).dofs[0].type != DofType::kRevolute) {
+      throw Error("OdeDriver: robot '" + model_.name() +
+                  "' has a differential base but no 1-dof revolute wheel joint '" + name +
+                  "' (options left_wheel, right_wheel)");
     }
   }
   Kinematics kin(model_);
@@ -218,9 +151,11 @@ void OdeDriver::Impl::SetupWheels(const std::vector<CollisionShape>& shapes) {
       const std::string& child = model_.link(joint.child_link).name;
       for (const CollisionShape& s : shapes) {
         if (s.link != child) continue;
-        if (s.kind == CollisionShape::Kind::kCylinder || s.kind == CollisionShape::Kind::kSphere) wheel_radius_ = s.size.x();
+        if (s.kind == CollisionShape::Kind::kCylinder || s.kind == CollisionShape::Kind::kSphere)
+          wheel_radius_ = s.size.x();
       }
-      if (wheel_radius_ == 0) wheel_radius_ = frame.translation().z();  // axle height above the ground (z = 0)
+      if (wheel_radius_ == 0)
+        wheel_radius_ = frame.translation().z();  // axle height above the ground (z = 0)
     }
   }
   if (y[0] < y[1]) {  // the left wheel is the one at +y
@@ -358,8 +293,8 @@ void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
     const auto u = static_cast<size_t>(i);
     switch (mode_[u]) {
       case Mode::kPosition:
-        world_->SetMotor(static_cast<int>(i), std::clamp(options_.kp * (target_[i] - q[i]), -vmax_[i], vmax_[i]),
-                         fmax_[i]);
+        world_->SetMotor(static_cast<int>(i),
+                         std::clamp(options_.kp * (target_[i] - q[i]), -vmax_[i], vmax_[i]), fmax_[i]);
         break;
       case Mode::kVelocity:
         if ((q[i] >= upper_[i] && speed_[i] > 0) || (q[i] <= lower_[i] && speed_[i] < 0)) {
@@ -381,7 +316,8 @@ void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
         const auto l = static_cast<Eigen::Index>(leader_[u]);
         const double want = mimic_k_[u] * q[l] + mimic_c_[u];
         world_->SetMotor(static_cast<int>(i),
-                         std::clamp(mimic_k_[u] * qd[l] + options_.kp * (want - q[i]), -vmax_[i], vmax_[i]), fmax_[i]);
+                         std::clamp(mimic_k_[u] * qd[l] + options_.kp * (want - q[i]), -vmax_[i], vmax_[i]),
+                         fmax_[i]);
         break;
       }
     }
@@ -390,7 +326,8 @@ void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
 
 void OdeDriver::Impl::StopAll(const char* why, std::vector<Completion>& completed) {
   if (base_mode_ == BaseMode::kGoto) {
-    completed.push_back(Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
+    completed.push_back(
+        Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
   }
   base_mode_ = BaseMode::kIdle;
   cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
@@ -409,183 +346,6 @@ void OdeDriver::Impl::StopAll(const char* why, std::vector<Completion>& complete
   }
 }
 
-// ---------------------------------------------------------------- commands
-
-DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed) {
-  Advance(now, true, completed);
-  const char* name = ToString(c.type);
-  if (c.type == CommandType::kStop) {
-    StopAll("interrupted by STOP", completed);
-    return Answer(Signal::kSuccess);
-  }
-  if (c.type == CommandType::kPanicReset) {
-    Resume();
-    return Answer(Signal::kSuccess);
-  }
-  if (halted_) return Answer(Signal::kPanic, std::string(name) + ": the robot is halted (panic) until PANIC_RESET");
-  if (c.num_values < 0 || c.num_values > static_cast<int>(c.values.size())) {
-    return Answer(Signal::kError, std::string(name) + ": bad value count " + std::to_string(c.num_values));
-  }
-  switch (c.type) {
-    case CommandType::kJointSetPoint:
-    case CommandType::kJointSpeed:
-    case CommandType::kJointForce:
-      return JointCommand(c);
-    case CommandType::kFrameSetPoint:
-      return Answer(Signal::kNa, "FRAME_SETPOINT: not supported by the ode driver yet (use joint set-points)");
-    case CommandType::kGoto:
-    case CommandType::kSetSpeed:
-      if (base_kind_ == BaseKind::kFixed) {
-        return Answer(Signal::kNa, std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
-      }
-      return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
-    case CommandType::kStop:
-    case CommandType::kPanicReset:
-      break;
-  }
-  return Answer(Signal::kError, "unknown command type " + std::to_string(static_cast<int>(c.type)));
-}
-
-DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
-  const std::string name = ToString(c.type);
-  if (c.target < 0 || c.target >= static_cast<int>(model_.joints().size())) {
-    return Answer(Signal::kError, name + ": no joint with index " + std::to_string(c.target));
-  }
-  const robotalk::Joint& joint = model_.joint(c.target);
-  if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
-    return Answer(Signal::kError, name + " " + Quote(joint.name) + ": expected " + std::to_string(joint.dofs.size()) +
-                                      " values (one per dof), got " + std::to_string(c.num_values));
-  }
-  if (joint.mimic) {
-    return Answer(Signal::kNa, name + " " + Quote(joint.name) + ": the joint follows " +
-                                   Quote(model_.joint(joint.mimic->leader_joint).name) + " (mimic)");
-  }
-  if (IsWheel(c.target)) {
-    if (base_mode_ == BaseMode::kGoto) {
-      return Answer(Signal::kBusy, name + " " + Quote(joint.name) + ": the wheel is driven by a GOTO in progress (command " +
-                                       std::to_string(goto_id_) + ")");
-    }
-    base_mode_ = BaseMode::kIdle;  // a wheel command takes the wheels over from SETSPEED
-    cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
-  }
-  std::string note;
-  for (int k = 0; k < c.num_values; ++k) {
-    const auto i = static_cast<Eigen::Index>(model_.dof_offset(c.target) + k);
-    const Dof& dof = joint.dofs[static_cast<size_t>(k)];
-    const double want = c.values[static_cast<size_t>(k)];
-    double got = want;
-    std::string unit = Unit(dof.type);
-    const char* what = "";
-    if (c.type == CommandType::kJointSetPoint) {
-      got = std::clamp(want, lower_[i], upper_[i]);
-      what = want > got ? "the upper limit" : "the lower limit";
-      mode_[static_cast<size_t>(i)] = Mode::kPosition;
-      target_[i] = got;
-    } else if (c.type == CommandType::kJointSpeed) {
-      got = std::clamp(want, -dof.limits.velocity, dof.limits.velocity);
-      unit += "/s";
-      what = "the velocity limit";
-      mode_[static_cast<size_t>(i)] = Mode::kVelocity;
-      speed_[i] = got;
-    } else {
-      got = std::clamp(want, -fmax_[i], fmax_[i]);
-      unit = dof.type == DofType::kRevolute ? "N m" : "N";
-      what = "the effort limit";
-      mode_[static_cast<size_t>(i)] = Mode::kForce;
-      force_[i] = got;
-    }
-    if (got != want) {
-      note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " + unit +
-              " clamped to " + what + " " + Num(got) + " " + unit;
-    }
-  }
-  if (note.empty()) return Answer(Signal::kSuccess);
-  return Answer(Signal::kModified, name + " " + Quote(joint.name) + ": " + note);
-}
-
-DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
-  if (c.num_values != 2 && c.num_values != 3) {
-    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
-                                      std::to_string(c.num_values));
-  }
-  if (base_mode_ == BaseMode::kGoto) {
-    return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
-  }
-  double vx = c.values[0];
-  double vy = c.num_values == 3 ? c.values[1] : 0.0;
-  double w = c.values[static_cast<size_t>(c.num_values - 1)];
-  std::string note;
-  auto add = [&note](const std::string& s) { note += (note.empty() ? "" : "; ") + s; };
-  const BaseType type = model_.roots().front().base;
-  if (vy != 0 && type == BaseType::kDifferential) {
-    add("lateral speed vy = " + Num(vy) + " m/s dropped (differential base)");
-    vy = 0;
-  }
-  const double planar = std::hypot(vx, vy);
-  if (planar > options_.base_max_v) {
-    add("speed " + Num(planar) + " m/s clamped to base_max_v " + Num(options_.base_max_v) + " m/s");
-    vx *= options_.base_max_v / planar;
-    vy *= options_.base_max_v / planar;
-  }
-  if (std::abs(w) > options_.base_max_omega) {
-    add("yaw rate " + Num(w) + " rad/s clamped to base_max_omega " + Num(options_.base_max_omega) + " rad/s");
-    w = std::copysign(options_.base_max_omega, w);
-  }
-  if (base_kind_ == BaseKind::kWheels) {  // the wheels' own speed limit
-    const double b = 0.5 * wheel_separation_;
-    double k = 1;
-    for (int s = 0; s < 2; ++s) {
-      const double rate = std::abs((vx + (s == 0 ? -b : b) * w) / wheel_radius_);
-      const double lim = vmax_[static_cast<Eigen::Index>(wheel_dof_[s])];
-      if (rate > lim) k = std::min(k, lim / rate);
-    }
-    if (k < 1) {
-      add("scaled by " + Num(k) + " to the wheels' velocity limit");
-      vx *= k;
-      w *= k;
-    }
-  } else {
-    add("the root moves kinematically (" + std::string(ToString(type)) + " base)");
-  }
-  cmd_vx_ = vx;
-  cmd_vy_ = vy;
-  cmd_omega_ = w;
-  base_mode_ = (vx == 0 && vy == 0 && w == 0) ? BaseMode::kIdle : BaseMode::kSpeed;
-  if (base_kind_ == BaseKind::kWheels) SetWheels(vx, w);
-  if (base_mode_ == BaseMode::kIdle) world_->SetRootVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-  return note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + note);
-}
-
-DriverResult OdeDriver::Impl::Goto(const DriverCommand& c) {
-  if (c.num_values != 3) {
-    return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
-  }
-  if (base_mode_ == BaseMode::kGoto) {
-    return Answer(Signal::kBusy, "GOTO: GOTO in progress (command " + std::to_string(goto_id_) + ")");
-  }
-  GotoController::Gains g;
-  g.max_v = options_.base_max_v;
-  g.max_omega = options_.base_max_omega;
-  g.tolerance = options_.goto_tolerance;
-  g.heading_tolerance = options_.goto_heading_tolerance;
-  goto_.Start(c.values[0], c.values[1], c.values[2], g);
-  cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
-  double x, y, th;
-  BasePose(&x, &y, &th);
-  goto_.Update(x, y, th);
-  if (goto_.done()) {  // already there
-    base_mode_ = BaseMode::kIdle;
-    if (base_kind_ == BaseKind::kWheels) SetWheels(0, 0);
-    return Answer(Signal::kSuccess);
-  }
-  goto_.Start(c.values[0], c.values[1], c.values[2], g);
-  base_mode_ = BaseMode::kGoto;
-  goto_id_ = c.id;
-  DriverResult r;
-  r.in_progress = true;
-  return r;
-}
-
 // ---------------------------------------------------------------- state
 
 void OdeDriver::Impl::ReadState(RobotState& state) const {
@@ -594,7 +354,8 @@ void OdeDriver::Impl::ReadState(RobotState& state) const {
   state.effort = world_->effort();
   const auto roots = model_.roots();
   if (state.root_poses.size() != roots.size()) state.root_poses.resize(roots.size());
-  for (size_t i = 0; i < roots.size(); ++i) state.root_poses[i] = Pose::FromIsometry(world_->LinkPose(roots[i].link));
+  for (size_t i = 0; i < roots.size(); ++i)
+    state.root_poses[i] = Pose::FromIsometry(world_->LinkPose(roots[i].link));
   const int root = roots.front().link;
   const Eigen::Isometry3d p = world_->LinkPose(root);
   const Eigen::Vector3d v = world_->LinkLinearVelocity(root);
@@ -630,10 +391,13 @@ OdeDriver::OdeDriver(RobotModel model, const OdeDriverOptions& options, std::vec
 OdeDriver::~OdeDriver() = default;
 const RobotModel& OdeDriver::model() const { return impl_->model_; }
 Duration OdeDriver::period() const { return impl_->options_.period; }
-DriverResult OdeDriver::Execute(const DriverCommand& command, TimePoint now, std::vector<Completion>& completed) {
+DriverResult OdeDriver::Execute(const DriverCommand& command, TimePoint now,
+                                std::vector<Completion>& completed) {
   return impl_->Execute(command, now, completed);
 }
-void OdeDriver::Update(TimePoint now, std::vector<Completion>& completed) { impl_->Advance(now, true, completed); }
+void OdeDriver::Update(TimePoint now, std::vector<Completion>& completed) {
+  impl_->Advance(now, true, completed);
+}
 void OdeDriver::ReadState(RobotState& state) const { impl_->ReadState(state); }
 void OdeDriver::Halt(std::vector<Completion>& interrupted) { impl_->Halt(interrupted); }
 void OdeDriver::Resume() { impl_->Resume(); }
@@ -641,7 +405,9 @@ void OdeDriver::Step(int n, std::vector<Completion>& completed) {
   if (!impl_->origin_) impl_->origin_ = TimePoint{};
   impl_->Step(n, completed);
 }
-void OdeDriver::AdvanceTo(TimePoint t, std::vector<Completion>& completed) { impl_->Advance(t, false, completed); }
+void OdeDriver::AdvanceTo(TimePoint t, std::vector<Completion>& completed) {
+  impl_->Advance(t, false, completed);
+}
 TimePoint OdeDriver::sim_time() const {
   return impl_->origin_.value_or(TimePoint{}) + impl_->dropped_ + impl_->steps_ * impl_->step_;
 }
@@ -649,8 +415,12 @@ Duration OdeDriver::dropped_time() const { return impl_->dropped_; }
 Eigen::Isometry3d OdeDriver::LinkPose(int link) const { return impl_->world_->LinkPose(link); }
 OdeDriver::Stats OdeDriver::stats() const {
   const OdeWorld& w = *impl_->world_;
-  return Stats{.bodies = w.num_bodies(), .geoms = w.num_geoms(), .fused_links = w.num_fused_links(),
-               .mesh_boxes = w.num_mesh_boxes(), .skipped_meshes = w.num_skipped_meshes(), .steps = w.steps()};
+  return Stats{.bodies = w.num_bodies(),
+               .geoms = w.num_geoms(),
+               .fused_links = w.num_fused_links(),
+               .mesh_boxes = w.num_mesh_boxes(),
+               .skipped_meshes = w.num_skipped_meshes(),
+               .steps = w.steps()};
 }
 
 void RegisterOdeDriver(DriverRegistry& registry) {
@@ -663,7 +433,8 @@ void RegisterOdeDriver(DriverRegistry& registry) {
     import.merge_massless_chains = options.merge_chains;
     import.robot_name = config.robot_name;
     UrdfImportResult result = LoadUrdfFile(config.urdf_path, import);
-    return std::make_unique<OdeDriver>(std::move(result.model), options, LoadCollisionShapes(config.urdf_path));
+    return std::make_unique<OdeDriver>(std::move(result.model), options,
+                                       LoadCollisionShapes(config.urdf_path));
   });
 }
 

@@ -3,8 +3,9 @@
 // massless ones given a small virtual mass), hinge/slider chains per joint
 // with the model's limits, collision shapes from the URDF against a ground
 // plane, gravity. Joints are servoed by ODE velocity motors bounded by the
-// effort limits; a differential base is driven through its wheel joints; a
-// floating or holonomic first root is moved kinematically. The physics steps
+// effort limits (control-frame set-points through inverse kinematics); a
+// differential base is driven through its wheel joints; a floating or
+// holonomic first root is moved kinematically. The physics steps
 // at a fixed rate on its own simulated time. docs/ode_sim.md describes the
 // physics mapping, controllers, gains and tolerances.
 //
@@ -13,7 +14,9 @@
 // per-thread data is allocated in whichever thread calls first. Per-dof
 // buffers are allocated in the constructor; Update()/ReadState() allocate
 // nothing of their own (ODE's step uses its internal arenas); Execute()
-// allocates only for reply messages.
+// allocates only for reply messages and, for FRAME_SETPOINT (solved by
+// InverseKinematics from the measured state), the Jacobian that
+// Kinematics::FrameJacobian returns on each of at most 200 IK iterations.
 //
 // Copy/move: neither (owns ODE handles behind a private implementation).
 #pragma once
@@ -110,7 +113,8 @@ class OdeDriver final : public Driver {
   Duration period() const override;
 
   /// Advances the simulation to `now` first, then starts `command`.
-  DriverResult Execute(const DriverCommand& command, TimePoint now, std::vector<Completion>& completed) override;
+  DriverResult Execute(const DriverCommand& command, TimePoint now,
+                       std::vector<Completion>& completed) override;
   /// Steps the physics as many fixed steps as fit up to `now` (at most
   /// max_catchup_ms of them); the first call only sets the time base.
   void Update(TimePoint now, std::vector<Completion>& completed) override;

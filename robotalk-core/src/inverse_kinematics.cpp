@@ -9,7 +9,9 @@
 namespace robotalk {
 namespace {
 
-std::string Where(const RobotModel& model) { return "InverseKinematics::Solve (robot '" + model.name() + "'): "; }
+std::string Where(const RobotModel& model) {
+  return "InverseKinematics::Solve (robot '" + model.name() + "'): ";
+}
 
 }  // namespace
 
@@ -72,8 +74,8 @@ InverseKinematics::Result InverseKinematics::Solve(int frame, const Eigen::Vecto
   }
   if (mask.empty()) mask = default_masks_[static_cast<size_t>(frame)];
   if (static_cast<Eigen::Index>(mask.size()) != n) {
-    throw std::invalid_argument(Where(model_) + "mask has " + std::to_string(mask.size()) + " entries, expected " +
-                                std::to_string(n));
+    throw std::invalid_argument(Where(model_) + "mask has " + std::to_string(mask.size()) +
+                                " entries, expected " + std::to_string(n));
   }
   if (!position.allFinite()) {
     throw std::invalid_argument(Where(model_) + "goal position is not finite");

@@ -87,8 +87,8 @@ class InverseKinematics {
   /// whatever the mask says. Dofs outside the mask keep their start value,
   /// except that every dof is clamped into its position limits.
   Result Solve(int frame, const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation,
-               const Eigen::Ref<const Eigen::VectorXd>& q_start, std::span<const Eigen::Isometry3d> root_poses = {},
-               std::span<const std::uint8_t> mask = {});
+               const Eigen::Ref<const Eigen::VectorXd>& q_start,
+               std::span<const Eigen::Isometry3d> root_poses = {}, std::span<const std::uint8_t> mask = {});
 
   /// The best q of the last Solve() (size num_dofs(); zeros before the
   /// first). Within the position limits, mimics applied. Overwritten by the
@@ -107,8 +107,8 @@ class InverseKinematics {
  private:
   const RobotModel& model_;
   Kinematics kin_;
-  Eigen::VectorXd lower_, upper_;      // per dof, position limits
-  std::vector<int> mimic_leader_;      // per dof: leader dof, -1 unless a mimic
+  Eigen::VectorXd lower_, upper_;  // per dof, position limits
+  std::vector<int> mimic_leader_;  // per dof: leader dof, -1 unless a mimic
   std::vector<double> mimic_multiplier_;
   std::vector<std::vector<std::uint8_t>> default_masks_;  // per frame
   // Scratch.

@@ -1,0 +1,243 @@
+// OdeDriver's command handlers: Execute() and the joint, frame and base
+// commands. The controllers that carry them out each step are in
+// ode_driver.cpp; docs/ode_sim.md describes the behaviour.
+#include "ode_driver_impl.h"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <string>
+
+namespace robotalk {
+
+using ode_detail::Answer;
+using ode_detail::GotoController;
+using ode_detail::Num;
+using ode_detail::Quote;
+using ode_detail::Unit;
+
+DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
+                                      std::vector<Completion>& completed) {
+  Advance(now, true, completed);
+  const char* name = ToString(c.type);
+  if (c.type == CommandType::kStop) {
+    StopAll("interrupted by STOP", completed);
+    return Answer(Signal::kSuccess);
+  }
+  if (c.type == CommandType::kPanicReset) {
+    Resume();
+    return Answer(Signal::kSuccess);
+  }
+  if (halted_)
+    return Answer(Signal::kPanic, std::string(name) + ": the robot is halted (panic) until PANIC_RESET");
+  if (c.num_values < 0 || c.num_values > static_cast<int>(c.values.size())) {
+    return Answer(Signal::kError, std::string(name) + ": bad value count " + std::to_string(c.num_values));
+  }
+  switch (c.type) {
+    case CommandType::kJointSetPoint:
+    case CommandType::kJointSpeed:
+    case CommandType::kJointForce:
+      return JointCommand(c);
+    case CommandType::kFrameSetPoint:
+      if (c.target < 0 || c.target >= static_cast<int>(model_.frames().size())) {
+        return Answer(Signal::kError,
+                      "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
+      }
+      if (c.num_values != 7) {
+        return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " +
+                                          std::to_string(c.num_values));
+      }
+      return FrameSetPoint(c);
+    case CommandType::kGoto:
+    case CommandType::kSetSpeed:
+      if (base_kind_ == BaseKind::kFixed) {
+        return Answer(Signal::kNa,
+                      std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
+      }
+      return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
+    case CommandType::kStop:
+    case CommandType::kPanicReset:
+      break;
+  }
+  return Answer(Signal::kError, "unknown command type " + std::to_string(static_cast<int>(c.type)));
+}
+
+DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
+  const std::string name = ToString(c.type);
+  if (c.target < 0 || c.target >= static_cast<int>(model_.joints().size())) {
+    return Answer(Signal::kError, name + ": no joint with index " + std::to_string(c.target));
+  }
+  const robotalk::Joint& joint = model_.joint(c.target);
+  if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
+    return Answer(Signal::kError, name + " " + Quote(joint.name) + ": expected " +
+                                      std::to_string(joint.dofs.size()) + " values (one per dof), got " +
+                                      std::to_string(c.num_values));
+  }
+  if (joint.mimic) {
+    return Answer(Signal::kNa, name + " " + Quote(joint.name) + ": the joint follows " +
+                                   Quote(model_.joint(joint.mimic->leader_joint).name) + " (mimic)");
+  }
+  if (IsWheel(c.target)) {
+    if (base_mode_ == BaseMode::kGoto) {
+      return Answer(Signal::kBusy, name + " " + Quote(joint.name) +
+                                       ": the wheel is driven by a GOTO in progress (command " +
+                                       std::to_string(goto_id_) + ")");
+    }
+    base_mode_ = BaseMode::kIdle;  // a wheel command takes the wheels over from SETSPEED
+    cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
+  }
+  std::string note;
+  for (int k = 0; k < c.num_values; ++k) {
+    const auto i = static_cast<Eigen::Index>(model_.dof_offset(c.target) + k);
+    const Dof& dof = joint.dofs[static_cast<size_t>(k)];
+    const double want = c.values[static_cast<size_t>(k)];
+    double got = want;
+    std::string unit = Unit(dof.type);
+    const char* what = "";
+    if (c.type == CommandType::kJointSetPoint) {
+      got = std::clamp(want, lower_[i], upper_[i]);
+      what = want > got ? "the upper limit" : "the lower limit";
+      mode_[static_cast<size_t>(i)] = Mode::kPosition;
+      target_[i] = got;
+    } else if (c.type == CommandType::kJointSpeed) {
+      got = std::clamp(want, -dof.limits.velocity, dof.limits.velocity);
+      unit += "/s";
+      what = "the velocity limit";
+      mode_[static_cast<size_t>(i)] = Mode::kVelocity;
+      speed_[i] = got;
+    } else {
+      got = std::clamp(want, -fmax_[i], fmax_[i]);
+      unit = dof.type == DofType::kRevolute ? "N m" : "N";
+      what = "the effort limit";
+      mode_[static_cast<size_t>(i)] = Mode::kForce;
+      force_[i] = got;
+    }
+    if (got != want) {
+      note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " +
+              unit + " clamped to " + what + " " + Num(got) + " " + unit;
+    }
+  }
+  if (note.empty()) return Answer(Signal::kSuccess);
+  return Answer(Signal::kModified, name + " " + Quote(joint.name) + ": " + note);
+}
+
+// Solved from the measured joint positions and root poses, as the kinematic
+// driver solves from its state; the solution becomes the set-points of the
+// joints' position servos (ControlStep), which track it on physics.
+DriverResult OdeDriver::Impl::FrameSetPoint(const DriverCommand& c) {
+  const ControlFrame& frame = model_.frame(c.target);
+  if (!ik_.HasMovableDofs(c.target)) {
+    return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
+                                   ": no joint between the frame and its root accepts set-points");
+  }
+  const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
+  const Eigen::Quaterniond goal_r(c.values[3], c.values[4], c.values[5], c.values[6]);
+  if (!(goal_r.norm() > 1e-9)) {  // CheckCommand wants a unit quaternion; a driver re-checks
+    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) +
+                                      ": orientation quaternion has norm " + Num(goal_r.norm()) +
+                                      ", expected 1");
+  }
+  const auto roots = model_.roots();
+  for (size_t i = 0; i < roots.size(); ++i) root_poses_[i] = world_->LinkPose(roots[i].link);
+  const InverseKinematics::Result r = ik_.Solve(c.target, goal_p, goal_r, world_->q(), root_poses_);
+  const std::span<const std::uint8_t> mask = ik_.default_mask(c.target);
+  const Eigen::VectorXd& best = ik_.solution();
+  for (Eigen::Index i = 0; i < best.size(); ++i) {
+    if (!mask[static_cast<size_t>(i)]) continue;
+    mode_[static_cast<size_t>(i)] = Mode::kPosition;
+    target_[i] = best[i];
+    speed_[i] = 0;
+    force_[i] = 0;
+  }
+  if (r.within_tolerance) return Answer(Signal::kSuccess);
+  return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame.name) +
+                                       ": pose not reachable; moving to the closest found, " +
+                                       Num(r.position_error) + " m and " + Num(r.orientation_error) +
+                                       " rad away");
+}
+
+DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
+  if (c.num_values != 2 && c.num_values != 3) {
+    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
+                                      std::to_string(c.num_values));
+  }
+  if (base_mode_ == BaseMode::kGoto) {
+    return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
+  }
+  double vx = c.values[0];
+  double vy = c.num_values == 3 ? c.values[1] : 0.0;
+  double w = c.values[static_cast<size_t>(c.num_values - 1)];
+  std::string note;
+  auto add = [&note](const std::string& s) { note += (note.empty() ? "" : "; ") + s; };
+  const BaseType type = model_.roots().front().base;
+  if (vy != 0 && type == BaseType::kDifferential) {
+    add("lateral speed vy = " + Num(vy) + " m/s dropped (differential base)");
+    vy = 0;
+  }
+  const double planar = std::hypot(vx, vy);
+  if (planar > options_.base_max_v) {
+    add("speed " + Num(planar) + " m/s clamped to base_max_v " + Num(options_.base_max_v) + " m/s");
+    vx *= options_.base_max_v / planar;
+    vy *= options_.base_max_v / planar;
+  }
+  if (std::abs(w) > options_.base_max_omega) {
+    add("yaw rate " + Num(w) + " rad/s clamped to base_max_omega " + Num(options_.base_max_omega) + " rad/s");
+    w = std::copysign(options_.base_max_omega, w);
+  }
+  if (base_kind_ == BaseKind::kWheels) {  // the wheels' own speed limit
+    const double b = 0.5 * wheel_separation_;
+    double k = 1;
+    for (int s = 0; s < 2; ++s) {
+      const double rate = std::abs((vx + (s == 0 ? -b : b) * w) / wheel_radius_);
+      const double lim = vmax_[static_cast<Eigen::Index>(wheel_dof_[s])];
+      if (rate > lim) k = std::min(k, lim / rate);
+    }
+    if (k < 1) {
+      add("scaled by " + Num(k) + " to the wheels' velocity limit");
+      vx *= k;
+      w *= k;
+    }
+  } else {
+    add("the root moves kinematically (" + std::string(ToString(type)) + " base)");
+  }
+  cmd_vx_ = vx;
+  cmd_vy_ = vy;
+  cmd_omega_ = w;
+  base_mode_ = (vx == 0 && vy == 0 && w == 0) ? BaseMode::kIdle : BaseMode::kSpeed;
+  if (base_kind_ == BaseKind::kWheels) SetWheels(vx, w);
+  if (base_mode_ == BaseMode::kIdle)
+    world_->SetRootVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  return note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + note);
+}
+
+DriverResult OdeDriver::Impl::Goto(const DriverCommand& c) {
+  if (c.num_values != 3) {
+    return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
+  }
+  if (base_mode_ == BaseMode::kGoto) {
+    return Answer(Signal::kBusy, "GOTO: GOTO in progress (command " + std::to_string(goto_id_) + ")");
+  }
+  GotoController::Gains g;
+  g.max_v = options_.base_max_v;
+  g.max_omega = options_.base_max_omega;
+  g.tolerance = options_.goto_tolerance;
+  g.heading_tolerance = options_.goto_heading_tolerance;
+  goto_.Start(c.values[0], c.values[1], c.values[2], g);
+  cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
+  double x, y, th;
+  BasePose(&x, &y, &th);
+  goto_.Update(x, y, th);
+  if (goto_.done()) {  // already there
+    base_mode_ = BaseMode::kIdle;
+    if (base_kind_ == BaseKind::kWheels) SetWheels(0, 0);
+    return Answer(Signal::kSuccess);
+  }
+  goto_.Start(c.values[0], c.values[1], c.values[2], g);
+  base_mode_ = BaseMode::kGoto;
+  goto_id_ = c.id;
+  DriverResult r;
+  r.in_progress = true;
+  return r;
+}
+
+}  // namespace robotalk

@@ -1,0 +1,106 @@
+// Private to drivers/ode_sim: OdeDriver's implementation class, shared by
+// ode_driver.cpp (construction, stepping, controllers, state) and
+// ode_commands.cpp (the command handlers), and the reply-message helpers.
+// Threading and allocation as in ode_driver.h: one thread, buffers allocated
+// in the constructor.
+#pragma once
+
+#include "base_controller.h"
+#include "ode_driver.h"
+#include "ode_world.h"
+#include "robotalk/inverse_kinematics.h"
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace robotalk {
+namespace ode_detail {
+
+// Numbers in reply messages: short and exact enough to read ("0.5411").
+inline std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+inline const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
+inline std::string Quote(const std::string& s) { return "'" + s + "'"; }
+inline DriverResult Answer(Signal s, std::string message = {}) {
+  return DriverResult{.signal = s, .in_progress = false, .message = std::move(message)};
+}
+
+}  // namespace ode_detail
+
+class OdeDriver::Impl {
+ public:
+  Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes);
+
+  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed);
+  void Advance(TimePoint now, bool limit, std::vector<Completion>& completed);
+  void Step(int n, std::vector<Completion>& completed);
+  void ReadState(RobotState& state) const;
+  void Halt(std::vector<Completion>& interrupted) {
+    StopAll("interrupted by panic", interrupted);
+    halted_ = true;
+  }
+  void Resume() { halted_ = false; }
+
+  RobotModel model_;
+  OdeDriverOptions options_;
+  std::unique_ptr<ode_detail::OdeWorld> world_;
+  Duration step_{};
+  std::optional<TimePoint> origin_;  // simulated time of step 0
+  std::int64_t steps_ = 0;
+  Duration dropped_{0};
+
+ private:
+  enum class Mode : std::uint8_t { kPosition, kVelocity, kForce, kPassive, kMimic };
+  enum class BaseKind : std::uint8_t { kFixed, kWheels, kKinematic };
+  enum class BaseMode : std::uint8_t { kIdle, kSpeed, kGoto };
+
+  void ControlStep(std::vector<Completion>& completed);
+  void StopAll(const char* why, std::vector<Completion>& completed);
+  void SetWheels(double v, double omega);
+  void BasePose(double* x, double* y, double* theta) const;
+  void SetupWheels(const std::vector<CollisionShape>& shapes);
+  void SetupGait();
+  DriverResult JointCommand(const DriverCommand& c);
+  DriverResult FrameSetPoint(const DriverCommand& c);
+  DriverResult SetSpeed(const DriverCommand& c);
+  DriverResult Goto(const DriverCommand& c);
+  bool IsWheel(int joint) const {
+    return base_kind_ == BaseKind::kWheels && (joint == wheel_joint_[0] || joint == wheel_joint_[1]);
+  }
+
+  // Per dof.
+  std::vector<Mode> mode_;
+  Eigen::VectorXd target_, speed_, force_, vmax_, fmax_, lower_, upper_;
+  std::vector<int> leader_;  // mimic leader dof, or -1
+  std::vector<double> mimic_k_, mimic_c_;
+
+  // Base.
+  BaseKind base_kind_ = BaseKind::kFixed;
+  BaseMode base_mode_ = BaseMode::kIdle;
+  int wheel_joint_[2] = {-1, -1};  // left, right
+  int wheel_dof_[2] = {-1, -1};
+  double wheel_sign_[2] = {1, 1};
+  double wheel_radius_ = 0, wheel_separation_ = 0;
+  double cmd_vx_ = 0, cmd_vy_ = 0, cmd_omega_ = 0;  // SETSPEED, body frame
+  ode_detail::GotoController goto_;
+  CommandId goto_id_ = 0;
+  int gait_dof_[4] = {-1, -1, -1, -1};  // left hip, left knee, right hip, right knee
+  double gait_phase_ = 0;
+  bool halted_ = false;
+
+  // FRAME_SETPOINT: the solver (its default masks say which dofs move) and
+  // the measured root poses it starts from, one per RobotModel::roots() entry.
+  InverseKinematics ik_;
+  std::vector<Eigen::Isometry3d> root_poses_;
+};
+
+}  // namespace robotalk
