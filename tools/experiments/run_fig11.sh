@@ -15,6 +15,7 @@
 #   --out DIR    where the figure and tables go (default docs/figures)
 #   --pause S    the congestion injector's maximum pause (default 0.4: see docs/experiment.md)
 #   --seed N     the injector's seed (default 1)
+#   --only L,..  run only these labels (e.g. congestion_direct), keep the other runs' files
 #
 # Exit status: 0 all runs succeeded; 1 a run failed; 2 usage; 77 no namespace.
 set -u
@@ -25,7 +26,7 @@ if [ "${FIG11_IN_NETNS:-}" != 1 ]; then
   FIG11_IN_NETNS=1 exec "$root/scripts/netns_run.sh" "$0" "$@"
 fi
 
-quick=0 build="$root/build" out="$root/docs/figures" pause=0.4 seed=1
+quick=0 build="$root/build" out="$root/docs/figures" pause=0.4 seed=1 only=
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=1 ;;
@@ -33,7 +34,8 @@ while [ $# -gt 0 ]; do
     --out) out=$2; shift ;;
     --pause) pause=$2; shift ;;
     --seed) seed=$2; shift ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    --only) only=",$2,"; shift ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) echo "run_fig11.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -76,8 +78,13 @@ for condition in none congestion; do
       playback) mode_args=(--mode playback) ;;
     esac
     label="${condition}_$run"
-    # Bounds: the slowest run (congestion) takes about 2.2x the profile plus the delay.
-    limit=$(awk -v d="$duration" 'BEGIN { printf "%d", 3 * d + 60 }')
+    if [ -n "$only" ] && [[ "$only" != *",$label,"* ]]; then continue; fi
+    # Bounds: under congestion delay and playback take about 2x the profile
+    # plus their delay; direct mode, whose every frame waits for a reply
+    # (and heartbeats join the queue while it waits), about 5.5x.
+    factor=3
+    [ $run = direct ] && factor=8
+    limit=$(awk -v d="$duration" -v f=$factor 'BEGIN { printf "%d", f * d + 60 }')
     "$server" --robot pioneer=kinematic:"$root"/models/pioneer2dx_pantilt.urdf --url "$url" \
       --duration $((limit + 10)) "${server_args[@]}" 2>"$logs/server_$label.log" &
     spid=$!
