@@ -1,5 +1,7 @@
 #include "kinematic_driver.h"
 
+#include "robotalk/driver_support.h"
+
 #include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 
@@ -22,20 +24,10 @@ double WrapAngle(double a) {
   return a;
 }
 
-// Numbers in reply messages: short and exact enough to read ("0.5411").
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
-
-std::string Quote(const std::string& s) { return "'" + s + "'"; }
-
-DriverResult Answer(Signal s, std::string message = {}) {
-  return DriverResult{.signal = s, .in_progress = false, .message = std::move(message)};
-}
+using driver_support::Answer;
+using driver_support::Num;
+using driver_support::Quote;
+using driver_support::Unit;
 
 [[noreturn]] void BadOption(const std::string& key, const std::string& value, const char* expected) {
   throw Error("kinematic driver: option " + key + "='" + value + "': expected " + expected);
@@ -375,18 +367,9 @@ DriverResult KinematicDriver::JointSpeed(const DriverCommand& c) {
 }
 
 DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
-  const ControlFrame& frame = model_.frame(c.target);
-  if (!ik_.HasMovableDofs(c.target)) {
-    return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
-                                   ": no joint between the frame and its root accepts set-points");
-  }
-  const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
-  const Eigen::Quaterniond goal_r(c.values[3], c.values[4], c.values[5], c.values[6]);
-  if (!(goal_r.norm() > 1e-9)) {  // CheckCommand wants a unit quaternion; a driver re-checks
-    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) +
-                                      ": orientation quaternion has norm " + Num(goal_r.norm()) +
-                                      ", expected 1");
-  }
+  if (auto refused = driver_support::CheckFrameSetPoint(model_, ik_, c)) return *refused;
+  const Eigen::Vector3d goal_p = driver_support::FrameGoalPosition(c);
+  const Eigen::Quaterniond goal_r = driver_support::FrameGoalOrientation(c);
   UpdateRootPoses();
   const InverseKinematics::Result r = ik_.Solve(c.target, goal_p, goal_r, q_, root_world_);
   const std::span<const std::uint8_t> mask = ik_.default_mask(c.target);
@@ -397,11 +380,7 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
     target_[i] = best[i];
     speed_[i] = 0;
   }
-  if (r.within_tolerance) return Answer(Signal::kSuccess);
-  return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame.name) +
-                                       ": pose not reachable; moving to the closest found, " +
-                                       Num(r.position_error) + " m and " + Num(r.orientation_error) +
-                                       " rad away");
+  return driver_support::AnswerFrameSetPoint(model_.frame(c.target).name, r);
 }
 
 // ---------------------------------------------------------------- commands

@@ -125,18 +125,9 @@ DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
 // driver solves from its state; the solution becomes the set-points of the
 // joints' position servos (ControlStep), which track it on physics.
 DriverResult OdeDriver::Impl::FrameSetPoint(const DriverCommand& c) {
-  const ControlFrame& frame = model_.frame(c.target);
-  if (!ik_.HasMovableDofs(c.target)) {
-    return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
-                                   ": no joint between the frame and its root accepts set-points");
-  }
-  const Eigen::Vector3d goal_p(c.values[0], c.values[1], c.values[2]);
-  const Eigen::Quaterniond goal_r(c.values[3], c.values[4], c.values[5], c.values[6]);
-  if (!(goal_r.norm() > 1e-9)) {  // CheckCommand wants a unit quaternion; a driver re-checks
-    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) +
-                                      ": orientation quaternion has norm " + Num(goal_r.norm()) +
-                                      ", expected 1");
-  }
+  if (auto refused = driver_support::CheckFrameSetPoint(model_, ik_, c)) return *refused;
+  const Eigen::Vector3d goal_p = driver_support::FrameGoalPosition(c);
+  const Eigen::Quaterniond goal_r = driver_support::FrameGoalOrientation(c);
   const auto roots = model_.roots();
   for (size_t i = 0; i < roots.size(); ++i) root_poses_[i] = world_->LinkPose(roots[i].link);
   const InverseKinematics::Result r = ik_.Solve(c.target, goal_p, goal_r, world_->q(), root_poses_);
@@ -149,11 +140,7 @@ DriverResult OdeDriver::Impl::FrameSetPoint(const DriverCommand& c) {
     speed_[i] = 0;
     force_[i] = 0;
   }
-  if (r.within_tolerance) return Answer(Signal::kSuccess);
-  return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame.name) +
-                                       ": pose not reachable; moving to the closest found, " +
-                                       Num(r.position_error) + " m and " + Num(r.orientation_error) +
-                                       " rad away");
+  return driver_support::AnswerFrameSetPoint(model_.frame(c.target).name, r);
 }
 
 DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {

@@ -12,6 +12,8 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include "robotalk/driver_support.h"
+
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -22,17 +24,10 @@
 namespace robotalk {
 namespace ode_detail {
 
-// Numbers in reply messages: short and exact enough to read ("0.5411").
-inline std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-inline const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
-inline std::string Quote(const std::string& s) { return "'" + s + "'"; }
-inline DriverResult Answer(Signal s, std::string message = {}) {
-  return DriverResult{.signal = s, .in_progress = false, .message = std::move(message)};
-}
+using driver_support::Answer;
+using driver_support::Num;
+using driver_support::Quote;
+using driver_support::Unit;
 
 }  // namespace ode_detail
 

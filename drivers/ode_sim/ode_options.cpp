@@ -1,5 +1,6 @@
 // OdeDriverOptions: parsing of the driver's key=value options and checks.
 #include "ode_driver.h"
+#include "robotalk/driver_support.h"
 #include "robotalk/error.h"
 
 #include <cmath>
@@ -37,11 +38,7 @@ std::vector<std::string> SplitPlus(const std::string& s) {
   return out;
 }
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+using driver_support::Num;
 
 }  // namespace
 

@@ -1,0 +1,48 @@
+#include "robotalk/driver_support.h"
+
+#include <cstdio>
+
+namespace robotalk::driver_support {
+
+DriverResult Answer(Signal signal, std::string message) {
+  return DriverResult{.signal = signal, .in_progress = false, .message = std::move(message)};
+}
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
+
+std::string Quote(const std::string& name) { return "'" + name + "'"; }
+
+Eigen::Vector3d FrameGoalPosition(const DriverCommand& c) { return {c.values[0], c.values[1], c.values[2]}; }
+
+Eigen::Quaterniond FrameGoalOrientation(const DriverCommand& c) {
+  return Eigen::Quaterniond(c.values[3], c.values[4], c.values[5], c.values[6]);
+}
+
+std::optional<DriverResult> CheckFrameSetPoint(const RobotModel& model, const InverseKinematics& ik,
+                                               const DriverCommand& c) {
+  const ControlFrame& frame = model.frame(c.target);
+  if (!ik.HasMovableDofs(c.target)) {
+    return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
+                                   ": no joint between the frame and its root accepts set-points");
+  }
+  const double norm = FrameGoalOrientation(c).norm();
+  if (!(norm > 1e-9) || !std::isfinite(norm)) {  // CheckCommand wants a unit quaternion; a driver re-checks
+    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) + ": orientation quaternion has norm " +
+                                      Num(norm) + ", expected 1");
+  }
+  return std::nullopt;
+}
+
+DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinematics::Result& r) {
+  if (r.within_tolerance) return Answer(Signal::kSuccess);
+  return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame) + ": pose not reachable; moving to the closest found, " +
+                                       Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
+}
+
+}  // namespace robotalk::driver_support
