@@ -1,5 +1,7 @@
 #include "robot_service.h"
 
+#include "robot_service_helpers.h"
+
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
@@ -10,23 +12,8 @@
 #include <cstdio>
 
 namespace robotalk {
-namespace {
-
-Reply MakeReply(CommandId id, Signal signal, std::string message, TimePoint now) {
-  Reply r;
-  r.id = id;
-  r.signal = signal;
-  r.message = std::move(message);
-  r.exec_time = now;
-  return r;
-}
-
-void AppendPose(const Eigen::Isometry3d& x, std::vector<double>& out) {
-  const Eigen::Quaterniond q(x.linear());
-  out.insert(out.end(), {x.translation().x(), x.translation().y(), x.translation().z(), q.w(), q.x(), q.y(), q.z()});
-}
-
-}  // namespace
+using service_detail::AppendPose;
+using service_detail::MakeReply;
 
 RobotService::RobotService(std::string name, std::string driver_name, std::unique_ptr<Driver> driver,
                            const Clock& clock, RobotServiceOptions options)
@@ -310,89 +297,6 @@ void RobotService::EnqueueCommand(Session& s, const robotalk_msgs::command_t& wi
   wake_.notify_one();
 }
 
-void RobotService::EnqueuePlayback(Session& s, const robotalk_msgs::package_t& package, TimePoint now,
-                                   std::vector<Reply>& immediate) {
-  const auto& h = package.header;
-  const Duration duration = std::chrono::microseconds(h.playback_duration_us);
-  auto [it, created] = s.playbacks.try_emplace(h.playback_id, static_cast<size_t>(h.playback_frames), duration,
-                                               options_.playback);
-  PlaybackSequence& seq = it->second;
-  const auto refuse_all = [&](const std::string& why) {
-    for (const auto& c : package.commands) immediate.push_back(MakeReply(c.id, Signal::kError, why, now));
-  };
-  if (!created && (seq.total != static_cast<size_t>(h.playback_frames) || seq.duration != duration)) {
-    refuse_all("PLAYBACK " + std::to_string(h.playback_id) + ": declared " + std::to_string(seq.total) + " frames over " +
-               std::to_string(ToSeconds(seq.duration)) + " s before, now " + std::to_string(h.playback_frames) +
-               " over " + std::to_string(ToSeconds(duration)) + " s");
-    return;
-  }
-  if (!seq.first_arrival) seq.first_arrival = now;
-  for (const auto& wire : package.commands) {
-    std::optional<QueuedItem> item = PrepareCommand(s, wire, now, immediate, /*playback=*/true);
-    if (!item) continue;
-    const Duration offset = item->start == TimePoint::min() ? Duration(0) : item->start.time_since_epoch();
-    if (offset > seq.duration || ++seq.received > seq.total) {
-      immediate.push_back(MakeReply(wire.id, Signal::kError,
-                                    "PLAYBACK " + std::to_string(h.playback_id) + ": frame at " +
-                                        std::to_string(ToSeconds(offset)) + " s is beyond the declared " +
-                                        std::to_string(seq.total) + " frames over " + std::to_string(ToSeconds(seq.duration)) + " s",
-                                    now));
-      continue;
-    }
-    item->has_start_time = true;
-    if (seq.start) {  // already playing: straight to the command queue
-      item->start = *seq.start + offset;
-      s.commands.Push(std::move(*item));
-    } else {
-      seq.estimator.Add(offset, now);
-      item->start = TimePoint(offset);
-      seq.frames.push_back(std::move(*item));
-    }
-  }
-  if (!seq.start && seq.estimator.ready()) {
-    seq.start = seq.estimator.StartTime();
-    for (QueuedItem& frame : seq.frames) {
-      frame.start = *seq.start + frame.start.time_since_epoch();
-      s.commands.Push(std::move(frame));
-    }
-    seq.frames.clear();
-    const Duration delay = *seq.start - *seq.first_arrival;
-    Reply r = MakeReply(h.playback_id, Signal::kSuccess,
-                        "playback of " + std::to_string(seq.total) + " frames starts " + std::to_string(ToSeconds(delay)) +
-                            " s after its first frame arrived (mean " +
-                            std::to_string(ToSeconds(seq.estimator.mean_command_interval())) + " s between commands, " +
-                            std::to_string(ToSeconds(seq.estimator.mean_arrival_interval())) + " s between arrivals)",
-                        now);
-    r.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
-    immediate.push_back(std::move(r));
-  }
-  wake_flag_ = true;
-  wake_.notify_one();
-}
-
-void RobotService::UpdateStream(TimePoint now) {
-  Duration period{0};
-  for (const auto& [client, p] : stream_requests_) period = period.count() == 0 ? p : std::min(period, p);
-  if (period == stream_period_) return;
-  // A new or faster stream starts sampling now; slower keeps its phase.
-  if (stream_period_.count() == 0 || period < stream_period_) next_sample_ = now;
-  stream_period_ = period;
-  ++stream_generation_;
-  wake_flag_ = true;
-  wake_.notify_one();
-}
-
-Duration RobotService::stream_period() const {
-  std::lock_guard lock(mutex_);
-  return stream_period_;
-}
-
-void RobotService::TakeStates(std::vector<robotalk_msgs::robot_state_t>& out) {
-  std::lock_guard lock(mutex_);
-  for (auto& m : state_outbox_) out.push_back(std::move(m));
-  state_outbox_.clear();
-}
-
 void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
   const bool first = !panic_.exchange(true);
   std::fprintf(stderr, "robotalk-server: robot '%s': PANIC from client %s%s\n", name_.c_str(), Hex64(static_cast<std::uint64_t>(client_id)).c_str(),
@@ -566,132 +470,5 @@ TimePoint RobotService::RunOnce(TimePoint now) {
   return next;
 }
 
-void RobotService::SampleState(TimePoint now, Duration period) {
-  const RobotModel& m = model();
-  driver_->ReadState(state_);
-  robotalk_msgs::robot_state_t msg{};
-  msg.server_time_us = ToWireMicros(now);
-  msg.period_us = ToWireMicros(period);
-  msg.sample = ++samples_;
-  msg.robot = name_;
-  msg.config_hash = static_cast<std::int64_t>(config_hash_);
-  msg.panic = panic_.load();
-  msg.moving = state_.moving;
-  msg.num_dofs = m.num_dofs();
-  msg.position.assign(state_.position.data(), state_.position.data() + m.num_dofs());
-  msg.velocity.assign(state_.velocity.data(), state_.velocity.data() + m.num_dofs());
-  msg.effort.assign(state_.effort.data(), state_.effort.data() + m.num_dofs());
-  const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
-  msg.base[0] = base.translation().x();
-  msg.base[1] = base.translation().y();
-  msg.base[2] = std::atan2(base.linear()(1, 0), base.linear()(0, 0));
-  msg.base[3] = state_.base_v;
-  msg.base[4] = state_.base_omega;
-  msg.num_frames = static_cast<std::int32_t>(m.frames().size());
-  if (msg.num_frames > 0) {
-    std::vector<Eigen::Isometry3d> roots;
-    for (const Pose& p : state_.root_poses) roots.push_back(p.ToIsometry());
-    try {
-      kinematics_.Update(state_.position, roots);
-      for (int f = 0; f < msg.num_frames; ++f) {
-        std::vector<double> pose;
-        AppendPose(kinematics_.frame_pose(f), pose);
-        msg.frame_poses.push_back(pose);
-      }
-    } catch (const std::exception&) {
-      msg.num_frames = 0;  // a driver reporting a non-finite state: send the rest
-      msg.frame_poses.clear();
-    }
-  }
-  sampled_.push_back(std::move(msg));
-}
-
-void RobotService::Execute(const QueuedItem& item, TimePoint now) {
-  Reply r;
-  r.id = item.command.id;
-  r.exec_time = now;
-  if (item.has_start_time && now > item.start) r.lateness = now - item.start;
-  if (item.is_query) {
-    AnswerQuery(item, r);
-    produced_.push_back({item.client_id, std::move(r)});
-    return;
-  }
-  if (item.only_if_moving) {
-    // The watchdog's STOP: a set-point that already arrived needs none.
-    driver_->ReadState(state_);
-    if (!state_.moving) return;
-  }
-  if (panic_ && item.command.type != CommandType::kStop) {
-    r.signal = Signal::kInterrupted;
-    r.message = "the robot entered panic before the command ran";
-    produced_.push_back({item.client_id, std::move(r)});
-    return;
-  }
-  DriverCommand command = item.command;
-  command.id = next_driver_id_++;
-  const DriverResult result = driver_->Execute(command, now, completions_);
-  if (options_.log_executions) {
-    std::fprintf(stderr, "robotalk-server: robot '%s': executed client %s command %" PRId64 " %s -> %s\n",
-                 name_.c_str(), Hex64(static_cast<std::uint64_t>(item.client_id)).c_str(), item.command.id, ToString(item.command.type),
-                 result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
-  }
-  if (result.in_progress) {
-    in_progress_[command.id] = Owner{item.client_id, item.command.id, now, r.lateness};
-    return;
-  }
-  r.signal = result.signal;
-  r.message = result.message;
-  produced_.push_back({item.client_id, std::move(r)});
-}
-
-void RobotService::AnswerQuery(const QueuedItem& item, Reply& reply) {
-  const RobotModel& m = model();
-  try {
-    driver_->ReadState(state_);
-    auto& v = reply.values;
-    switch (item.query) {
-      case QueryType::kJointState: {
-        int first = 0, count = m.num_dofs();
-        if (item.query_target >= 0) {
-          first = m.dof_offset(item.query_target);
-          count = static_cast<int>(m.joint(item.query_target).dofs.size());
-        }
-        for (const Eigen::VectorXd* vec : {&state_.position, &state_.velocity, &state_.effort}) {
-          v.insert(v.end(), vec->data() + first, vec->data() + first + count);
-        }
-        break;
-      }
-      case QueryType::kLinkPoses:
-      case QueryType::kFramePoses: {
-        std::vector<Eigen::Isometry3d> roots;
-        roots.reserve(state_.root_poses.size());
-        for (const Pose& p : state_.root_poses) roots.push_back(p.ToIsometry());
-        kinematics_.Update(state_.position, roots);
-        const bool links = item.query == QueryType::kLinkPoses;
-        const int n = static_cast<int>(links ? m.links().size() : m.frames().size());
-        for (int i = 0; i < n; ++i) {
-          if (item.query_target >= 0 && i != item.query_target) continue;
-          AppendPose(links ? kinematics_.link_pose(i) : kinematics_.frame_pose(i), v);
-        }
-        break;
-      }
-      case QueryType::kBasePose: {
-        const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
-        const double yaw = std::atan2(base.linear()(1, 0), base.linear()(0, 0));
-        v = {base.translation().x(), base.translation().y(), yaw, state_.base_v, state_.base_omega};
-        break;
-      }
-      default:
-        reply.signal = Signal::kError;
-        reply.message = std::string(ToString(item.query)) + " is answered on receipt, not queued";
-        return;
-    }
-    reply.signal = Signal::kSuccess;
-  } catch (const std::exception& e) {
-    reply.signal = Signal::kError;
-    reply.message = std::string(ToString(item.query)) + ": " + e.what();
-    reply.values.clear();
-  }
-}
 
 }  // namespace robotalk
