@@ -470,5 +470,92 @@ TimePoint RobotService::RunOnce(TimePoint now) {
   return next;
 }
 
+void RobotService::Execute(const QueuedItem& item, TimePoint now) {
+  Reply r;
+  r.id = item.command.id;
+  r.exec_time = now;
+  if (item.has_start_time && now > item.start) r.lateness = now - item.start;
+  if (item.is_query) {
+    AnswerQuery(item, r);
+    produced_.push_back({item.client_id, std::move(r)});
+    return;
+  }
+  if (item.only_if_moving) {
+    // The watchdog's STOP: a set-point that already arrived needs none.
+    driver_->ReadState(state_);
+    if (!state_.moving) return;
+  }
+  if (panic_ && item.command.type != CommandType::kStop) {
+    r.signal = Signal::kInterrupted;
+    r.message = "the robot entered panic before the command ran";
+    produced_.push_back({item.client_id, std::move(r)});
+    return;
+  }
+  DriverCommand command = item.command;
+  command.id = next_driver_id_++;
+  const DriverResult result = driver_->Execute(command, now, completions_);
+  if (options_.log_executions) {
+    std::fprintf(stderr, "robotalk-server: robot '%s': executed client %s command %" PRId64 " %s -> %s\n",
+                 name_.c_str(), Hex64(static_cast<std::uint64_t>(item.client_id)).c_str(), item.command.id, ToString(item.command.type),
+                 result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
+  }
+  if (result.in_progress) {
+    in_progress_[command.id] = Owner{item.client_id, item.command.id, now, r.lateness};
+    return;
+  }
+  r.signal = result.signal;
+  r.message = result.message;
+  produced_.push_back({item.client_id, std::move(r)});
+}
+
+void RobotService::AnswerQuery(const QueuedItem& item, Reply& reply) {
+  const RobotModel& m = model();
+  try {
+    driver_->ReadState(state_);
+    auto& v = reply.values;
+    switch (item.query) {
+      case QueryType::kJointState: {
+        int first = 0, count = m.num_dofs();
+        if (item.query_target >= 0) {
+          first = m.dof_offset(item.query_target);
+          count = static_cast<int>(m.joint(item.query_target).dofs.size());
+        }
+        for (const Eigen::VectorXd* vec : {&state_.position, &state_.velocity, &state_.effort}) {
+          v.insert(v.end(), vec->data() + first, vec->data() + first + count);
+        }
+        break;
+      }
+      case QueryType::kLinkPoses:
+      case QueryType::kFramePoses: {
+        std::vector<Eigen::Isometry3d> roots;
+        roots.reserve(state_.root_poses.size());
+        for (const Pose& p : state_.root_poses) roots.push_back(p.ToIsometry());
+        kinematics_.Update(state_.position, roots);
+        const bool links = item.query == QueryType::kLinkPoses;
+        const int n = static_cast<int>(links ? m.links().size() : m.frames().size());
+        for (int i = 0; i < n; ++i) {
+          if (item.query_target >= 0 && i != item.query_target) continue;
+          AppendPose(links ? kinematics_.link_pose(i) : kinematics_.frame_pose(i), v);
+        }
+        break;
+      }
+      case QueryType::kBasePose: {
+        const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
+        const double yaw = std::atan2(base.linear()(1, 0), base.linear()(0, 0));
+        v = {base.translation().x(), base.translation().y(), yaw, state_.base_v, state_.base_omega};
+        break;
+      }
+      default:
+        reply.signal = Signal::kError;
+        reply.message = std::string(ToString(item.query)) + " is answered on receipt, not queued";
+        return;
+    }
+    reply.signal = Signal::kSuccess;
+  } catch (const std::exception& e) {
+    reply.signal = Signal::kError;
+    reply.message = std::string(ToString(item.query)) + ": " + e.what();
+    reply.values.clear();
+  }
+}
 
 }  // namespace robotalk
