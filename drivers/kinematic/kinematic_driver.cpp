@@ -272,26 +272,10 @@ DriverResult KinematicDriver::SetSpeed(const DriverCommand& c) {
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }
-  double vx = c.values[0];
-  double vy = c.num_values == 3 ? c.values[1] : 0.0;
-  double w = c.values[static_cast<size_t>(c.num_values - 1)];
-  std::string note;
-  auto add = [&note](const std::string& s) { note += (note.empty() ? "" : "; ") + s; };
-  if (vy != 0 && base_type_ == BaseType::kDifferential) {
-    add("lateral speed vy = " + Num(vy) + " m/s dropped (differential base)");
-    vy = 0;
-  }
-  const double planar = std::hypot(vx, vy);
-  if (planar > options_.base_max_v) {
-    const double k = options_.base_max_v / planar;
-    add("speed " + Num(planar) + " m/s clamped to base_max_v " + Num(options_.base_max_v) + " m/s");
-    vx *= k;
-    vy *= k;
-  }
-  if (std::abs(w) > options_.base_max_omega) {
-    add("yaw rate " + Num(w) + " rad/s clamped to base_max_omega " + Num(options_.base_max_omega) + " rad/s");
-    w = std::copysign(options_.base_max_omega, w);
-  }
+  const driver_support::BaseTwist t =
+      driver_support::ShapeBaseSpeed(c, base_type_, options_.base_max_v, options_.base_max_omega);
+  const double vx = t.vx, vy = t.vy, w = t.omega;
+  const std::string& note = t.note;
   cmd_vx_ = vx;
   cmd_vy_ = vy;
   cmd_omega_ = w;

@@ -151,26 +151,12 @@ DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }
-  double vx = c.values[0];
-  double vy = c.num_values == 3 ? c.values[1] : 0.0;
-  double w = c.values[static_cast<size_t>(c.num_values - 1)];
-  std::string note;
-  auto add = [&note](const std::string& s) { note += (note.empty() ? "" : "; ") + s; };
-  const BaseType type = model_.roots().front().base;
-  if (vy != 0 && type == BaseType::kDifferential) {
-    add("lateral speed vy = " + Num(vy) + " m/s dropped (differential base)");
-    vy = 0;
-  }
-  const double planar = std::hypot(vx, vy);
-  if (planar > options_.base_max_v) {
-    add("speed " + Num(planar) + " m/s clamped to base_max_v " + Num(options_.base_max_v) + " m/s");
-    vx *= options_.base_max_v / planar;
-    vy *= options_.base_max_v / planar;
-  }
-  if (std::abs(w) > options_.base_max_omega) {
-    add("yaw rate " + Num(w) + " rad/s clamped to base_max_omega " + Num(options_.base_max_omega) + " rad/s");
-    w = std::copysign(options_.base_max_omega, w);
-  }
+  driver_support::BaseTwist t =
+      driver_support::ShapeBaseSpeed(c, model_.roots().front().base, options_.base_max_v, options_.base_max_omega);
+  double& vx = t.vx;
+  double& vy = t.vy;
+  double& w = t.omega;
+  const auto add = [&t](const std::string& what) { t.Note(what); };
   if (base_kind_ == BaseKind::kWheels) {  // the wheels' own speed limit
     const double b = 0.5 * wheel_separation_;
     double k = 1;
@@ -185,7 +171,7 @@ DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
       w *= k;
     }
   } else {
-    add("the root moves kinematically (" + std::string(ToString(type)) + " base)");
+    add("the root moves kinematically (" + std::string(ToString(model_.roots().front().base)) + " base)");
   }
   cmd_vx_ = vx;
   cmd_vy_ = vy;
@@ -194,7 +180,7 @@ DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
   if (base_kind_ == BaseKind::kWheels) SetWheels(vx, w);
   if (base_mode_ == BaseMode::kIdle)
     world_->SetRootVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-  return note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + note);
+  return t.note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + t.note);
 }
 
 DriverResult OdeDriver::Impl::Goto(const DriverCommand& c) {

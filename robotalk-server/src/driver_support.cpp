@@ -1,5 +1,6 @@
 #include "robotalk/driver_support.h"
 
+#include <cmath>
 #include <cstdio>
 
 namespace robotalk::driver_support {
@@ -43,6 +44,28 @@ DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinemati
   if (r.within_tolerance) return Answer(Signal::kSuccess);
   return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame) + ": pose not reachable; moving to the closest found, " +
                                        Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
+}
+
+BaseTwist ShapeBaseSpeed(const DriverCommand& c, BaseType base, double max_v, double max_omega) {
+  BaseTwist t;
+  t.vx = c.values[0];
+  t.vy = c.num_values == 3 ? c.values[1] : 0.0;
+  t.omega = c.values[static_cast<size_t>(c.num_values - 1)];
+  if (t.vy != 0 && base == BaseType::kDifferential) {
+    t.Note("lateral speed vy = " + Num(t.vy) + " m/s dropped (differential base)");
+    t.vy = 0;
+  }
+  const double planar = std::hypot(t.vx, t.vy);
+  if (planar > max_v) {
+    t.Note("speed " + Num(planar) + " m/s clamped to base_max_v " + Num(max_v) + " m/s");
+    t.vx *= max_v / planar;
+    t.vy *= max_v / planar;
+  }
+  if (std::abs(t.omega) > max_omega) {
+    t.Note("yaw rate " + Num(t.omega) + " rad/s clamped to base_max_omega " + Num(max_omega) + " rad/s");
+    t.omega = std::copysign(max_omega, t.omega);
+  }
+  return t;
 }
 
 }  // namespace robotalk::driver_support

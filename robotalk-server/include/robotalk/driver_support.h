@@ -30,4 +30,16 @@ Eigen::Quaterniond FrameGoalOrientation(const DriverCommand& command);
 /// After solving: SUCCESS within the solver's tolerance, else MODIFIED with the residual.
 DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinematics::Result& result);
 
+/// A SETSPEED request shaped to the base: the lateral speed of a holonomic
+/// request dropped on a differential base, the planar speed and the yaw rate
+/// clamped to the base's limits. `note` says what was changed ("" = nothing,
+/// so SUCCESS; otherwise the driver answers MODIFIED with it).
+struct BaseTwist {
+  double vx = 0, vy = 0, omega = 0;  ///< m/s, m/s, rad/s in the base frame
+  std::string note;
+  void Note(const std::string& what) { note += (note.empty() ? "" : "; ") + what; }
+};
+/// REQUIRES: `command` is a SETSPEED with 2 (v ω) or 3 (vx vy ω) values.
+BaseTwist ShapeBaseSpeed(const DriverCommand& command, BaseType base, double max_v, double max_omega);
+
 }  // namespace robotalk::driver_support
