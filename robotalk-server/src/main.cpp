@@ -4,10 +4,14 @@
 #include "ode_driver.h"
 #include "robotalk/error.h"
 #include "robotalk/server.h"
+#include "robotalk/simulation.h"
+#include "sequence_file.h"
 
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <string>
 
@@ -30,6 +34,11 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
   --log-executions                print one line per executed command (diagnostics)
+  --simulate SEQ.txt              instead of serving: run the sequence file (docs/client.md
+                                  format) on the one --robot as fast as possible on a
+                                  simulated clock for --duration S (default 10) and print
+                                  its state every --sample-period S (default 0.01) as CSV:
+                                  t,x,y,theta,v,omega,q0,q1,...; replies go to stderr
   --list-drivers                  print the known drivers and exit
 On SIGINT or SIGTERM every robot is stopped before the server exits.
 )";
@@ -44,6 +53,48 @@ double ParseNumber(const std::string& flag, const char* text, double min, double
   return v;
 }
 
+// --simulate: the server core on a simulated clock, as fast as possible.
+int Simulate(const robotalk::DriverRegistry& registry, const std::vector<robotalk::RobotSpec>& robots,
+             const std::string& path, double duration_s, double sample_period_s) {
+  try {
+    if (robots.size() != 1) throw robotalk::Error("--simulate runs exactly one --robot");
+    std::ifstream file(path);
+    if (!file) throw robotalk::Error("cannot read sequence file '" + path + "'");
+    std::stringstream text;
+    text << file.rdbuf();
+    std::vector<robotalk::SimulatedCommand> commands;
+    for (const auto& e : robotalk::cli::ParseSequence(text.str(), path)) {
+      commands.push_back({robotalk::FromSeconds(e.offset_s), e.command});
+    }
+    const robotalk::RobotSpec& spec = robots.front();
+    auto driver = registry.Create(spec.driver, robotalk::DriverConfig{spec.name, spec.urdf_path, spec.options});
+    const robotalk::SimulationResult r = robotalk::RunSimulation(
+        spec.name, spec.driver, std::move(driver), commands,
+        {.duration = robotalk::FromSeconds(duration_s), .sample_period = robotalk::FromSeconds(sample_period_s)});
+    for (const robotalk::Reply& reply : r.replies) {
+      std::cerr << reply.id - 1 << " " << robotalk::ToString(reply.signal) << " \"" << reply.message << "\"\n";
+    }
+    std::cout << "t,x,y,theta,v,omega";
+    if (!r.states.empty()) {
+      for (int i = 0; i < r.states.front().num_dofs; ++i) std::cout << ",q" << i;
+    }
+    std::cout << "\n";
+    const std::int64_t t0 = r.states.empty() ? 0 : r.states.front().server_time_us;
+    for (const auto& s : r.states) {
+      std::cout << (s.server_time_us - t0) * 1e-6;
+      for (double b : s.base) std::cout << ',' << b;
+      for (double q : s.position) std::cout << ',' << q;
+      std::cout << '\n';
+    }
+    std::cerr << "robotalk-server: simulated " << duration_s << " s in " << robotalk::ToSeconds(r.wall_time)
+              << " s of wall time\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "robotalk-server: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -53,6 +104,8 @@ int main(int argc, char** argv) {
   robotalk::ServerOptions options;
   std::vector<robotalk::RobotSpec> robots;
   double duration = -1;
+  std::string simulate;
+  double sample_period = 0.01;
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -66,6 +119,10 @@ int main(int argc, char** argv) {
       } else if (arg == "--list-drivers") {
         for (const std::string& name : registry.names()) std::cout << name << "\n";
         return 0;
+      } else if (arg == "--simulate") {
+        simulate = value();
+      } else if (arg == "--sample-period") {
+        sample_period = ParseNumber(arg, value(), 0.001, 3600);
       } else if (arg == "--log-executions") {
         options.log_executions = true;
       } else if (arg == "--robot") {
@@ -103,6 +160,8 @@ int main(int argc, char** argv) {
     std::cerr << "robotalk-server: " << e.what() << "\n";
     return 2;
   }
+
+  if (!simulate.empty()) return Simulate(registry, robots, simulate, duration < 0 ? 10.0 : duration, sample_period);
 
   // Signals are taken synchronously by this thread; the daemons never see them.
   sigset_t signals;

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# robotalk-server --simulate: a sequence on physics, as fast as possible,
+# twice with the same seed -> byte-identical CSV.
+#   simulate_cli_test.sh SERVER MODELS_DIR EXAMPLES_DIR
+set -u
+server=$1 models=$2 examples=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0 failures=0
+check() { local name=$1; shift; if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi; }
+for run in a b; do
+  "$server" --robot "pioneer=ode:$models/pioneer2dx_pantilt.urdf,seed=5" --simulate "$examples/demo_arcs.txt" \
+    --duration 8 --sample-period 0.05 >"$tmp/$run.csv" 2>"$tmp/$run.err"
+  check "run $run exits 0" test $? -eq 0
+done
+check "CSV header" grep -q "^t,x,y,theta,v,omega,q0" "$tmp/a.csv"
+check "161 samples over 8 s" test "$(($(wc -l <"$tmp/a.csv") - 1))" -eq 161
+check "every command answered SUCCESS" test "$(grep -c SUCCESS "$tmp/a.err")" -eq 7
+check "same seed, same trajectory" cmp -s "$tmp/a.csv" "$tmp/b.csv"
+check "the robot drove" awk -F, 'END { exit !($2 > 1.0) }' "$tmp/a.csv"
+"$server" --robot "a=ode:$models/pioneer2dx_pantilt.urdf" --robot "b=ode:$models/pioneer2dx_pantilt.urdf" \
+  --simulate "$examples/demo_arcs.txt" >/dev/null 2>"$tmp/two.err"
+check "two robots refused" grep -q "exactly one --robot" "$tmp/two.err"
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
