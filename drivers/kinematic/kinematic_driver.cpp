@@ -51,13 +51,9 @@ KinematicDriverOptions KinematicDriverOptions::FromMap(const std::map<std::strin
   KinematicDriverOptions o;
   for (const auto& [key, value] : options) {
     if (key == "merge_chains") {
-      if (value == "true" || value == "1") {
-        o.merge_chains = true;
-      } else if (value == "false" || value == "0") {
-        o.merge_chains = false;
-      } else {
-        BadOption(key, value, "true or false");
-      }
+      const std::optional<bool> b = driver_support::ParseBool(value);
+      if (!b) BadOption(key, value, "true or false");
+      o.merge_chains = *b;
     } else if (key == "period_ms") {
       o.period = FromSeconds(ParsePositive(key, value, "a number of milliseconds > 0") / 1000.0);
       if (o.period <= Duration::zero()) BadOption(key, value, "a number of milliseconds > 0");
@@ -414,15 +410,7 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
       return c.type == CommandType::kJointSetPoint ? JointSetPoint(c) : JointSpeed(c);
     }
     case CommandType::kFrameSetPoint:
-      if (c.target < 0 || c.target >= static_cast<int>(model_.frames().size())) {
-        return Answer(Signal::kError,
-                      "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
-      }
-      if (c.num_values != 7) {
-        return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " +
-                                          std::to_string(c.num_values));
-      }
-      return FrameSetPoint(c);
+      return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks its arguments
     case CommandType::kGoto:
     case CommandType::kSetSpeed:
       if (!mobile_base()) {

@@ -39,15 +39,7 @@ DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
     case CommandType::kJointForce:
       return JointCommand(c);
     case CommandType::kFrameSetPoint:
-      if (c.target < 0 || c.target >= static_cast<int>(model_.frames().size())) {
-        return Answer(Signal::kError,
-                      "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
-      }
-      if (c.num_values != 7) {
-        return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " +
-                                          std::to_string(c.num_values));
-      }
-      return FrameSetPoint(c);
+      return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks its arguments
     case CommandType::kGoto:
     case CommandType::kSetSpeed:
       if (base_kind_ == BaseKind::kFixed) {

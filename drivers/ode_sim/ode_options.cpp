@@ -91,13 +91,9 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       }
       o.base = value;
     } else if (key == "merge_chains") {
-      if (value == "true" || value == "1") {
-        o.merge_chains = true;
-      } else if (value == "false" || value == "0") {
-        o.merge_chains = false;
-      } else {
-        BadOption(key, value, "true or false");
-      }
+      const std::optional<bool> b = driver_support::ParseBool(value);
+      if (!b) BadOption(key, value, "true or false");
+      o.merge_chains = *b;
     } else if (key == "max_catchup_ms") {
       o.max_catchup_ms = ParseNumber(key, value, 0, false, "a number of milliseconds > 0");
     } else if (key == "virtual_mass") {

@@ -27,6 +27,13 @@ Eigen::Quaterniond FrameGoalOrientation(const DriverCommand& c) {
 
 std::optional<DriverResult> CheckFrameSetPoint(const RobotModel& model, const InverseKinematics& ik,
                                                const DriverCommand& c) {
+  if (c.target < 0 || c.target >= static_cast<int>(model.frames().size())) {
+    return Answer(Signal::kError, "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
+  }
+  if (c.num_values != 7) {
+    return Answer(Signal::kError,
+                  "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " + std::to_string(c.num_values));
+  }
   const ControlFrame& frame = model.frame(c.target);
   if (!ik.HasMovableDofs(c.target)) {
     return Answer(Signal::kNa, "FRAME_SETPOINT " + Quote(frame.name) +
@@ -44,6 +51,12 @@ DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinemati
   if (r.within_tolerance) return Answer(Signal::kSuccess);
   return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame) + ": pose not reachable; moving to the closest found, " +
                                        Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
+}
+
+std::optional<bool> ParseBool(const std::string& value) {
+  if (value == "true" || value == "1") return true;
+  if (value == "false" || value == "0") return false;
+  return std::nullopt;
 }
 
 BaseTwist ShapeBaseSpeed(const DriverCommand& c, BaseType base, double max_v, double max_omega) {

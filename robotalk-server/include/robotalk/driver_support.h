@@ -20,13 +20,17 @@ const char* Unit(DofType t);
 /// 'name'
 std::string Quote(const std::string& name);
 
-/// Before solving a FRAME_SETPOINT: NA when no set-point joint moves the
-/// frame, ERROR for a zero or non-finite orientation; nullopt to go on.
+/// Before solving a FRAME_SETPOINT: ERROR for a frame index out of range, a
+/// value count other than 7 or a zero or non-finite orientation; NA when no
+/// set-point joint moves the frame; nullopt to go on.
 std::optional<DriverResult> CheckFrameSetPoint(const RobotModel& model, const InverseKinematics& ik,
                                                const DriverCommand& command);
 /// The goal of a FRAME_SETPOINT: x y z and the orientation qw qx qy qz.
 Eigen::Vector3d FrameGoalPosition(const DriverCommand& command);
 Eigen::Quaterniond FrameGoalOrientation(const DriverCommand& command);
+/// "true"/"1" or "false"/"0" of a driver option; nullopt for anything else.
+std::optional<bool> ParseBool(const std::string& value);
+
 /// After solving: SUCCESS within the solver's tolerance, else MODIFIED with the residual.
 DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinematics::Result& result);
 
