@@ -59,7 +59,8 @@ void RealTimeFactor(const Robot& r) {
     if (joint.dofs.size() != 1 || joint.mimic || !joint.servo_types.Has(ServoType::kSetPoint)) continue;
     d->Execute(Cmd(m, CommandType::kJointSetPoint, joint.name, {0.3}), t, done);
   }
-  if (m.roots().front().base != BaseType::kFixed) d->Execute(Cmd(m, CommandType::kSetSpeed, "", {0.3, 0.3}), t, done);
+  if (m.roots().front().base != BaseType::kFixed)
+    d->Execute(Cmd(m, CommandType::kSetSpeed, "", {0.3, 0.3}), t, done);
   constexpr int kSteps = 3000;
   const auto a = WallClock::now();
   d->Step(kSteps, done);
@@ -77,8 +78,8 @@ void RealTimeFactor(const Robot& r) {
     std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
     roots.front().base = ParseBaseType(r.options.at("base"));
     model = RobotModel(model.name(), {model.links().begin(), model.links().end()},
-                       {model.joints().begin(), model.joints().end()}, {model.frames().begin(), model.frames().end()},
-                       std::move(roots));
+                       {model.joints().begin(), model.joints().end()},
+                       {model.frames().begin(), model.frames().end()}, std::move(roots));
   }
   ode_detail::OdeWorldOptions wo;
   wo.caster_links = {"caster"};
@@ -111,9 +112,9 @@ void RealTimeFactor(const Robot& r) {
     bare_s = std::min(bare_s, WallSeconds(WallClock::now() - b0) / 600);
   }
   const OdeDriver::Stats st = d->stats();
-  std::printf("| %-27s | %3d | %3d | %3d | %7.1f | %6.1f | %7.1f | %7.1f | %+5.1f %% |\n", r.label.c_str(), m.num_dofs(),
-              st.bodies, st.geoms, 1e6 * moving_s, 1e-3 / moving_s, 1e6 * driver_s, 1e6 * bare_s,
-              100 * (driver_s - bare_s) / bare_s);
+  std::printf("| %-27s | %3d | %3d | %3d | %7.1f | %6.1f | %7.1f | %7.1f | %+5.1f %% |\n", r.label.c_str(),
+              m.num_dofs(), st.bodies, st.geoms, 1e6 * moving_s, 1e-3 / moving_s, 1e6 * driver_s,
+              1e6 * bare_s, 100 * (driver_s - bare_s) / bare_s);
 }
 
 // iiwa14: step set-points every second, and a 0.5 Hz sine streamed at 100 Hz.
@@ -130,7 +131,8 @@ void ArmTracking(const std::string& path) {
   double worst = 0, sum2 = 0;
   int n = 0;
   for (const auto& g : goals) {
-    for (int j = 0; j < 7; ++j) d->Execute(Cmd(m, CommandType::kJointSetPoint, "iiwa_joint_" + std::to_string(j + 1), {g[j]}), t, done);
+    for (int j = 0; j < 7; ++j)
+      d->Execute(Cmd(m, CommandType::kJointSetPoint, "iiwa_joint_" + std::to_string(j + 1), {g[j]}), t, done);
     t += std::chrono::seconds(2);
     d->AdvanceTo(t, done);
     d->ReadState(st);
@@ -163,8 +165,9 @@ void ArmTracking(const std::string& path) {
       ++n;
     }
   }
-  std::printf("iiwa14 0.5 Hz, 0.5 rad sine streamed at 100 Hz: max lag error %.3f rad, RMS %.3f rad (kp = 20/s)\n", worst,
-              std::sqrt(sum2 / n));
+  std::printf(
+      "iiwa14 0.5 Hz, 0.5 rad sine streamed at 100 Hz: max lag error %.3f rad, RMS %.3f rad (kp = 20/s)\n",
+      worst, std::sqrt(sum2 / n));
 }
 
 void PioneerGoto(const std::string& path) {
@@ -186,11 +189,14 @@ void PioneerGoto(const std::string& path) {
     const Pose& p = st.root_poses.front();
     const Eigen::Vector3d fwd = p.rotation.toRotationMatrix().col(0);
     worst_p = std::max(worst_p, std::hypot(p.translation.x() - g[0], p.translation.y() - g[1]));
-    worst_h = std::max(worst_h, std::abs(std::remainder(std::atan2(fwd.y(), fwd.x()) - g[2], 2 * std::numbers::pi)));
-    std::printf("  GOTO %g %g %g: %s\n", g[0], g[1], g[2], done.empty() ? "timeout" : std::string(ToString(done[0].signal)).c_str());
+    worst_h = std::max(worst_h,
+                       std::abs(std::remainder(std::atan2(fwd.y(), fwd.x()) - g[2], 2 * std::numbers::pi)));
+    std::printf("  GOTO %g %g %g: %s\n", g[0], g[1], g[2],
+                done.empty() ? "timeout" : std::string(ToString(done[0].signal)).c_str());
   }
-  std::printf("Pioneer 1 m square of GOTOs: %.1f s, worst end-pose error 0.5 s after SUCCESS %.4f m, %.4f rad\n", total,
-              worst_p, worst_h);
+  std::printf(
+      "Pioneer 1 m square of GOTOs: %.1f s, worst end-pose error 0.5 s after SUCCESS %.4f m, %.4f rad\n",
+      total, worst_p, worst_h);
 }
 
 }  // namespace
@@ -198,14 +204,18 @@ void PioneerGoto(const std::string& path) {
 int main(int argc, char** argv) {
   const std::string models = argc > 1 ? argv[1] : "models";
   const std::string shared = argc > 2 ? argv[2] : "../shared/robots";
-  std::printf("| robot | dofs | bodies | geoms | moving: us/step | real-time factor | holding: driver us/step | bare ODE us/step | overhead |\n");
+  std::printf(
+      "| robot | dofs | bodies | geoms | moving: us/step | real-time factor | holding: driver us/step | bare "
+      "ODE us/step | overhead |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   RealTimeFactor({"pioneer2dx_pantilt", models + "/pioneer2dx_pantilt.urdf", {}});
   RealTimeFactor({"simple_humanoid", models + "/simple_humanoid.urdf", {}});
   if (std::filesystem::exists(shared + "/iiwa14.urdf")) {
     RealTimeFactor({"iiwa14", shared + "/iiwa14.urdf", {}});
     RealTimeFactor({"atlas (base=floating)", shared + "/atlas.urdf", {{"base", "floating"}}});
-    RealTimeFactor({"atlas (floating, quickstep)", shared + "/atlas.urdf", {{"base", "floating"}, {"solver", "quickstep"}}});
+    RealTimeFactor({"atlas (floating, quickstep)",
+                    shared + "/atlas.urdf",
+                    {{"base", "floating"}, {"solver", "quickstep"}}});
   }
   std::printf("\n");
   if (std::filesystem::exists(shared + "/iiwa14.urdf")) ArmTracking(shared + "/iiwa14.urdf");

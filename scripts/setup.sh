@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config clang-format
   liblcm-dev liblcm-bin liblcm-java liblcm-lua libglib2.0-dev
   libeigen3-dev libode-dev liburdfdom-dev libtinyxml-dev
   libgtest-dev libgmock-dev

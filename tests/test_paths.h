@@ -20,8 +20,8 @@ inline bool HaveSharedRobots() { return std::filesystem::is_directory(ROBOTALK_S
 }  // namespace robotalk::testing
 
 /// Skips the current test when ../shared/robots is absent (a user's clone).
-#define ROBOTALK_REQUIRE_SHARED_ROBOTS()                                                     \
-  do {                                                                                       \
-    if (!::robotalk::testing::HaveSharedRobots())                                            \
-      GTEST_SKIP() << "shared robot descriptions not found at " ROBOTALK_SHARED_ROBOTS;      \
+#define ROBOTALK_REQUIRE_SHARED_ROBOTS()                                                \
+  do {                                                                                  \
+    if (!::robotalk::testing::HaveSharedRobots())                                       \
+      GTEST_SKIP() << "shared robot descriptions not found at " ROBOTALK_SHARED_ROBOTS; \
   } while (0)

@@ -19,12 +19,12 @@ struct Twist2 {
 class GotoController {
  public:
   struct Gains {
-    double k_v = 1.5;       ///< 1/s: forward speed per metre of distance
-    double k_omega = 3.0;   ///< 1/s: yaw rate per radian of heading error
-    double max_v = 0.7;     ///< m/s
-    double max_omega = 2.0; ///< rad/s
-    double tolerance = 0.02;         ///< m
-    double heading_tolerance = 0.02; ///< rad
+    double k_v = 1.5;                 ///< 1/s: forward speed per metre of distance
+    double k_omega = 3.0;             ///< 1/s: yaw rate per radian of heading error
+    double max_v = 0.7;               ///< m/s
+    double max_omega = 2.0;           ///< rad/s
+    double tolerance = 0.02;          ///< m
+    double heading_tolerance = 0.02;  ///< rad
   };
   static constexpr double kTurnCone = 0.6;   ///< rad: drive only when the goal is this close to ahead
   static constexpr double kDriveCone = 0.1;  ///< rad: start driving once aligned this well

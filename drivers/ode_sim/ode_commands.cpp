@@ -143,8 +143,8 @@ DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }
-  driver_support::BaseTwist t =
-      driver_support::ShapeBaseSpeed(c, model_.roots().front().base, options_.base_max_v, options_.base_max_omega);
+  driver_support::BaseTwist t = driver_support::ShapeBaseSpeed(c, model_.roots().front().base,
+                                                               options_.base_max_v, options_.base_max_omega);
   double& vx = t.vx;
   double& vy = t.vy;
   double& w = t.omega;

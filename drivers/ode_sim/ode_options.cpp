@@ -19,7 +19,8 @@ double ParseNumber(const std::string& key, const std::string& value, double min,
   const char* begin = value.c_str();
   char* end = nullptr;
   const double v = std::strtod(begin, &end);
-  if (value.empty() || end != begin + value.size() || !std::isfinite(v) || v < min || (!min_inclusive && v == min)) {
+  if (value.empty() || end != begin + value.size() || !std::isfinite(v) || v < min ||
+      (!min_inclusive && v == min)) {
     BadOption(key, value, expected);
   }
   return v;
@@ -102,11 +103,12 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       if (SplitPlus(value).size() != 4) BadOption(key, value, "left_hip+left_knee+right_hip+right_knee");
       o.gait_joints = value;
     } else {
-      throw Error("ode driver: unknown option '" + key +
-                  "' (known: base, base_max_omega, base_max_v, casters, default_effort, default_velocity, friction, "
-                  "gait_joints, goto_heading_tolerance, goto_tolerance, gravity, kp, left_wheel, max_catchup_ms, "
-                  "merge_chains, period_ms, right_wheel, seed, solver, step_hz, virtual_mass, wheel_radius, "
-                  "wheel_separation)");
+      throw Error(
+          "ode driver: unknown option '" + key +
+          "' (known: base, base_max_omega, base_max_v, casters, default_effort, default_velocity, friction, "
+          "gait_joints, goto_heading_tolerance, goto_tolerance, gravity, kp, left_wheel, max_catchup_ms, "
+          "merge_chains, period_ms, right_wheel, seed, solver, step_hz, virtual_mass, wheel_radius, "
+          "wheel_separation)");
     }
   }
   return o;
@@ -114,13 +116,16 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
 
 void OdeDriverOptions::Validate() const {
   auto positive = [](const char* name, double v) {
-    if (!std::isfinite(v) || v <= 0) throw Error(std::string("OdeDriver: ") + name + " = " + Num(v) + ", expected > 0");
+    if (!std::isfinite(v) || v <= 0)
+      throw Error(std::string("OdeDriver: ") + name + " = " + Num(v) + ", expected > 0");
   };
   auto non_negative = [](const char* name, double v) {
-    if (!std::isfinite(v) || v < 0) throw Error(std::string("OdeDriver: ") + name + " = " + Num(v) + ", expected >= 0");
+    if (!std::isfinite(v) || v < 0)
+      throw Error(std::string("OdeDriver: ") + name + " = " + Num(v) + ", expected >= 0");
   };
   positive("step_hz", step_hz);
-  if (period <= Duration::zero()) throw Error("OdeDriver: period = " + Num(ToSeconds(period)) + " s, expected > 0");
+  if (period <= Duration::zero())
+    throw Error("OdeDriver: period = " + Num(ToSeconds(period)) + " s, expected > 0");
   non_negative("gravity", gravity);
   non_negative("friction", friction);
   positive("kp", kp);
@@ -134,7 +139,8 @@ void OdeDriverOptions::Validate() const {
   non_negative("wheel_separation", wheel_separation);
   positive("max_catchup_ms", max_catchup_ms);
   positive("virtual_mass", virtual_mass);
-  if (solver != "step" && solver != "quickstep") throw Error("OdeDriver: solver = '" + solver + "', expected step or quickstep");
+  if (solver != "step" && solver != "quickstep")
+    throw Error("OdeDriver: solver = '" + solver + "', expected step or quickstep");
 }
 
 }  // namespace robotalk

@@ -67,7 +67,8 @@ double LowestZ(CollisionShape::Kind kind, const Eigen::Vector3d& size, const Eig
   const double z = x.translation().z();
   switch (kind) {
     case CollisionShape::Kind::kBox:
-      return z - 0.5 * (std::abs(r(2, 0)) * size.x() + std::abs(r(2, 1)) * size.y() + std::abs(r(2, 2)) * size.z());
+      return z - 0.5 * (std::abs(r(2, 0)) * size.x() + std::abs(r(2, 1)) * size.y() +
+                        std::abs(r(2, 2)) * size.z());
     case CollisionShape::Kind::kCylinder: {
       const double c = std::abs(r(2, 2));
       return z - (c * 0.5 * size.y() + size.x() * std::sqrt(std::max(0.0, 1 - c * c)));
@@ -151,7 +152,8 @@ void OdeWorld::BuildGroups() {
     if (!joint.dofs.empty()) continue;
     const Link& p = model_.link(joint.parent_link);
     const Link& c = model_.link(joint.child_link);
-    const Eigen::Isometry3d x = Translation(p.com + joint.inboard) * Eigen::Isometry3d(joint.rest.normalized()) *
+    const Eigen::Isometry3d x = Translation(p.com + joint.inboard) *
+                                Eigen::Isometry3d(joint.rest.normalized()) *
                                 Translation(-(c.com + joint.outboard));
     const auto pl = static_cast<size_t>(joint.parent_link), cl = static_cast<size_t>(joint.child_link);
     group_of_[cl] = group_of_[pl];
@@ -219,8 +221,8 @@ void OdeWorld::BuildBodies(const Eigen::VectorXd& q0) {
     }
     dBodyID b = dBodyCreate(world_);
     dMass m;
-    dMassSetParameters(&m, mass, 0, 0, 0, inertia(0, 0), inertia(1, 1), inertia(2, 2), inertia(0, 1), inertia(0, 2),
-                       inertia(1, 2));
+    dMassSetParameters(&m, mass, 0, 0, 0, inertia(0, 0), inertia(1, 1), inertia(2, 2), inertia(0, 1),
+                       inertia(0, 2), inertia(1, 2));
     dBodySetMass(b, &m);
     const Eigen::Isometry3d primary = kin.link_pose(static_cast<int>(g));
     SetPose(b, primary * com, primary.linear());
@@ -230,7 +232,8 @@ void OdeWorld::BuildBodies(const Eigen::VectorXd& q0) {
       for (const RootLink& r : model_.roots()) {
         if (r.link == static_cast<int>(g) && r.base != BaseType::kFixed) kinematic = false;
       }
-      if (static_cast<int>(g) == first_root && first_base != BaseType::kFixed && options_.kinematic_first_root) {
+      if (static_cast<int>(g) == first_root && first_base != BaseType::kFixed &&
+          options_.kinematic_first_root) {
         kinematic = true;
       }
       if (kinematic) dBodySetKinematic(b);
@@ -278,13 +281,14 @@ void OdeWorld::BuildGeoms(const std::vector<CollisionShape>& shapes) {
     const auto primary = static_cast<size_t>(group_of_[li]);
     dBodyID b = body_of_[primary];
     dGeomSetBody(g, b);
-    const Eigen::Isometry3d offset = Translation(-group_com_[primary]) * primary_to_link_[li] * origin.ToIsometry();
+    const Eigen::Isometry3d offset =
+        Translation(-group_com_[primary]) * primary_to_link_[li] * origin.ToIsometry();
     dGeomSetOffsetPosition(g, offset.translation().x(), offset.translation().y(), offset.translation().z());
     const Eigen::Quaterniond r(offset.linear());
     const dQuaternion dq = {r.w(), r.x(), r.y(), r.z()};
     dGeomSetOffsetQuaternion(g, dq);
-    const bool caster =
-        std::find(options_.caster_links.begin(), options_.caster_links.end(), s.link) != options_.caster_links.end();
+    const bool caster = std::find(options_.caster_links.begin(), options_.caster_links.end(), s.link) !=
+                        options_.caster_links.end();
     geoms_.push_back(Geom{.geom = g, .frictionless = caster});
   }
 }
@@ -328,7 +332,8 @@ void OdeWorld::BuildJoints(const Eigen::VectorXd& q0) {
       if (d.revolute) {
         d.joint = dJointCreateHinge(world_, nullptr);
         dJointAttach(d.joint, prev, child);
-        dJointSetHingeAnchor(d.joint, frame.translation().x(), frame.translation().y(), frame.translation().z());
+        dJointSetHingeAnchor(d.joint, frame.translation().x(), frame.translation().y(),
+                             frame.translation().z());
         dJointSetHingeAxis(d.joint, axis.x(), axis.y(), axis.z());
       } else {
         d.joint = dJointCreateSlider(world_, nullptr);
@@ -407,7 +412,8 @@ void OdeWorld::Step() {
     for (const Geom& g : geoms_) {
       dBodyID b = dGeomGetBody(g.geom);
       if (dBodyIsKinematic(b)) continue;  // the ground cannot move it
-      const int n = dCollide(g.geom, ground_, kMaxContactsPerGeom, contact_scratch_.data(), sizeof(dContactGeom));
+      const int n =
+          dCollide(g.geom, ground_, kMaxContactsPerGeom, contact_scratch_.data(), sizeof(dContactGeom));
       for (int c = 0; c < n; ++c) {
         dContact contact{};
         contact.geom = contact_scratch_[static_cast<size_t>(c)];

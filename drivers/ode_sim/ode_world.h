@@ -28,21 +28,21 @@
 namespace robotalk::ode_detail {
 
 struct OdeWorldOptions {
-  double step = 1e-3;            ///< s
-  double gravity = 9.81;         ///< m/s², along -z
-  double friction = 1.0;         ///< Coulomb coefficient (pyramid approximation)
+  double step = 1e-3;     ///< s
+  double gravity = 9.81;  ///< m/s², along -z
+  double friction = 1.0;  ///< Coulomb coefficient (pyramid approximation)
   double contact_erp = 0.2;
   double contact_cfm = 1e-5;
-  bool quickstep = false;        ///< dWorldQuickStep instead of dWorldStep
+  bool quickstep = false;  ///< dWorldQuickStep instead of dWorldStep
   int quickstep_iterations = 50;
-  double virtual_mass = 0.05;    ///< kg, of massless groups and joint-chain bodies
-  double virtual_radius = 0.03;  ///< m, their inertia is a solid sphere's
+  double virtual_mass = 0.05;             ///< kg, of massless groups and joint-chain bodies
+  double virtual_radius = 0.03;           ///< m, their inertia is a solid sphere's
   std::vector<std::string> caster_links;  ///< links whose contacts are frictionless
   bool ground = true;
   double ground_z = 0.0;
   bool kinematic_first_root = false;  ///< a mobile first root moved by velocity, not dynamics
-  bool place_on_ground = false;  ///< shift the first root in z so its lowest shape touches the ground
-  std::uint32_t seed = 1;        ///< dRand state (used by quickstep)
+  bool place_on_ground = false;       ///< shift the first root in z so its lowest shape touches the ground
+  std::uint32_t seed = 1;             ///< dRand state (used by quickstep)
 };
 
 class OdeWorld {
@@ -90,9 +90,9 @@ class OdeWorld {
   struct DofJoint {
     dJointID joint = nullptr;
     bool revolute = true;
-    double q0 = 0;          // q at creation (ODE's zero)
-    double last_raw = 0;    // last ODE angle, for unwrapping
-    double unwrapped = 0;   // accumulated ODE angle / position
+    double q0 = 0;         // q at creation (ODE's zero)
+    double last_raw = 0;   // last ODE angle, for unwrapping
+    double unwrapped = 0;  // accumulated ODE angle / position
     bool effort_mode = false;
     double effort_cmd = 0;
     dJointFeedback feedback{};

@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <cinttypes>
 #include <condition_variable>
-#include <mutex>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 
 namespace robotalk::cli {
@@ -75,8 +75,8 @@ int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
     std::cerr << "robotalk: no robot announced itself within " << seconds << " s\n";
     return 0;
   }
-  std::printf("%-20s %-10s %5s %-16s %-5s %7s %s\n", "ROBOT", "DRIVER", "DOFS", "CONFIG_HASH", "PANIC", "CLIENTS",
-              "SERVER");
+  std::printf("%-20s %-10s %5s %-16s %-5s %7s %s\n", "ROBOT", "DRIVER", "DOFS", "CONFIG_HASH", "PANIC",
+              "CLIENTS", "SERVER");
   for (const auto& r : robots) {
     std::printf("%-20s %-10s %5d %016llx %-5s %7d %016llx\n", r.name.c_str(), r.driver.c_str(), r.total_dofs,
                 static_cast<unsigned long long>(r.config_hash), r.panic ? "yes" : "no", r.num_clients,
@@ -106,7 +106,8 @@ int RunQuery(const GlobalOptions& g, const std::vector<std::string>& args) {
     throw UsageError("usage: robotalk query ROBOT joint_state|link_poses|frame_poses|base_pose [TARGET]");
   }
   const auto type = ParseQueryType(args[1]);
-  if (!type) throw UsageError("unknown query '" + args[1] + "' (joint_state, link_poses, frame_poses, base_pose)");
+  if (!type)
+    throw UsageError("unknown query '" + args[1] + "' (joint_state, link_poses, frame_poses, base_pose)");
   RobotClient client(MakeOptions(g));
   client.Connect(args[0]);
   const Reply r = client.Query(*type, args.size() == 3 ? args[2] : "");
@@ -149,7 +150,8 @@ SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
   return f;
 }
 
-int SendFile(const GlobalOptions& g, const std::string& robot, const std::string& path, const SequenceOptions& options) {
+int SendFile(const GlobalOptions& g, const std::string& robot, const std::string& path,
+             const SequenceOptions& options) {
   std::ifstream file(path);
   if (!file) throw UsageError("cannot read sequence file '" + path + "'");
   std::stringstream text;
@@ -183,7 +185,9 @@ int RunSend(const GlobalOptions& g, const std::vector<std::string>& in) {
   const SequenceFlags sequence = TakeSequenceFlags(args);
   RejectOptions(args);
   if (args.empty()) {
-    throw UsageError("usage: robotalk send ROBOT COMMAND ARGS... [--at S] | send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced]");
+    throw UsageError(
+        "usage: robotalk send ROBOT COMMAND ARGS... [--at S] | send ROBOT --file SEQ.txt [--mode M] [--delay "
+        "S] [--paced]");
   }
   if (has_file) {
     if (args.size() != 1 || has_at) throw UsageError("send ROBOT --file SEQ.txt takes nothing else");
@@ -235,7 +239,8 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   const bool has_duration = TakeOption(args, "--duration", &duration);
   const bool has_count = TakeOption(args, "--count", &count);
   RejectOptions(args);
-  if (args.size() != 1) throw UsageError("usage: robotalk watch ROBOT [--period S] [--duration S] [--count N]");
+  if (args.size() != 1)
+    throw UsageError("usage: robotalk watch ROBOT [--period S] [--duration S] [--count N]");
   const double period_s = ParseNumber(period, "--period");
   const double duration_s = has_duration ? ParseNumber(duration, "--duration") : 1e9;
   const double max_samples = has_count ? ParseNumber(count, "--count") : 1e18;
@@ -248,20 +253,22 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   std::mutex mu;
   std::condition_variable done_cv;
   double samples = 0;
-  const Duration actual = client.StartStateStream(FromSeconds(period_s), [&](const robotalk_msgs::robot_state_t& s) {
-    std::lock_guard lock(mu);
-    if (samples >= max_samples) return;
-    char line[160];
-    std::snprintf(line, sizeof line, "%" PRId64 " t=%.3f base %.4f %.4f %.4f v=%.3f w=%.3f%s q", s.sample,
-                  static_cast<double>(s.server_time_us) * 1e-6, s.base[0], s.base[1], s.base[2], s.base[3], s.base[4],
-                  s.panic ? " PANIC" : "");
-    std::cout << line;
-    for (double q : s.position) std::cout << ' ' << q;
-    std::cout << '\n' << std::flush;
-    if (++samples >= max_samples) done_cv.notify_all();
-  });
+  const Duration actual =
+      client.StartStateStream(FromSeconds(period_s), [&](const robotalk_msgs::robot_state_t& s) {
+        std::lock_guard lock(mu);
+        if (samples >= max_samples) return;
+        char line[160];
+        std::snprintf(line, sizeof line, "%" PRId64 " t=%.3f base %.4f %.4f %.4f v=%.3f w=%.3f%s q", s.sample,
+                      static_cast<double>(s.server_time_us) * 1e-6, s.base[0], s.base[1], s.base[2],
+                      s.base[3], s.base[4], s.panic ? " PANIC" : "");
+        std::cout << line;
+        for (double q : s.position) std::cout << ' ' << q;
+        std::cout << '\n' << std::flush;
+        if (++samples >= max_samples) done_cv.notify_all();
+      });
   if (actual != FromSeconds(period_s)) {
-    std::cerr << "robotalk: the stream runs every " << ToSeconds(actual) << " s (another client asked for faster)\n";
+    std::cerr << "robotalk: the stream runs every " << ToSeconds(actual)
+              << " s (another client asked for faster)\n";
   }
   {
     std::unique_lock lock(mu);

@@ -72,9 +72,8 @@ int main(int argc, char** argv) {
     const std::string command = rest.front();
     rest.erase(rest.begin());
     const std::map<std::string, int (*)(const GlobalOptions&, const std::vector<std::string>&)> commands = {
-        {"robots", &RunRobots}, {"describe", &RunDescribe}, {"query", &RunQuery},
-        {"send", &RunSend},     {"panic", &RunPanic},       {"reset", &RunReset},
-        {"watch", &RunWatch}};
+        {"robots", &RunRobots}, {"describe", &RunDescribe}, {"query", &RunQuery}, {"send", &RunSend},
+        {"panic", &RunPanic},   {"reset", &RunReset},       {"watch", &RunWatch}};
     auto it = commands.find(command);
     if (it == commands.end()) throw UsageError("unknown command '" + command + "'");
     return it->second(g, rest);

@@ -78,7 +78,8 @@ Command ParseCommandWords(const std::vector<std::string>& words) {
     i = 2;
   }
   for (; i < words.size(); ++i) {
-    c.values.push_back(ParseNumber(words[i], std::string(ToString(*type)) + " value " + std::to_string(c.values.size() + 1)));
+    c.values.push_back(ParseNumber(
+        words[i], std::string(ToString(*type)) + " value " + std::to_string(c.values.size() + 1)));
   }
   CheckCount(*type, c.values.size());
   return c;

@@ -32,9 +32,9 @@ Command ParseCommandWords(const std::vector<std::string>& words);
 double ParseNumber(const std::string& word, const std::string& what);
 
 struct SequenceEntry {
-  int line = 0;          ///< 1-based line number in the file
-  double offset_s = 0;   ///< seconds after the sequence's send time
-  Command command;       ///< start_time unset; id 0
+  int line = 0;         ///< 1-based line number in the file
+  double offset_s = 0;  ///< seconds after the sequence's send time
+  Command command;      ///< start_time unset; id 0
 };
 
 /// Parses a sequence file's text. Throws UsageError "<source>:<line>: what"

@@ -28,7 +28,6 @@
 
 namespace robotalk {
 
-
 /// Header fields of a PLAYBACK package (id 0: an ordinary package).
 struct PlaybackHeader {
   std::int64_t id = 0;
@@ -52,8 +51,8 @@ class RobotClient::Impl {
   using Playback = PlaybackHeader;
   /// Builds, registers and publishes one package. Assigns the ids of
   /// `commands` / `queries` (returned in order). Throws ClientError.
-  Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries, bool panic, Track track,
-                   bool clock_query = false, const Playback& playback = {});
+  Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries, bool panic,
+                   Track track, bool clock_query = false, const Playback& playback = {});
   /// A fresh id from the client's command-id space (for a playback sequence).
   CommandId NewId();
   /// Tells the retransmission bookkeeping when items will run (server clock).
@@ -68,7 +67,8 @@ class RobotClient::Impl {
   /// Blocks until the panic package `sequence` is acknowledged; false on timeout.
   bool WaitAck(std::int64_t sequence, std::chrono::steady_clock::time_point deadline);
   /// Waits until a configuration with `hash` has been received.
-  std::shared_ptr<const RobotModel> WaitModel(std::uint64_t hash, std::chrono::steady_clock::time_point deadline);
+  std::shared_ptr<const RobotModel> WaitModel(std::uint64_t hash,
+                                              std::chrono::steady_clock::time_point deadline);
   void RethrowDaemonError();
   std::string LastConfigError() const;
 
@@ -78,25 +78,25 @@ class RobotClient::Impl {
   std::shared_ptr<client::ReturnCache> cache_;
 
   mutable std::mutex mu_;
-  std::condition_variable cv_;                 // acks, configurations
-  client::OutstandingPackages outstanding_;    // GUARDED_BY(mu_)
-  client::ClockSync clock_sync_;               // GUARDED_BY(mu_)
-  std::int64_t next_sequence_ = 1;             // GUARDED_BY(mu_)
-  CommandId next_id_ = 1;                      // GUARDED_BY(mu_)
-  TimePoint last_send_{};                      // GUARDED_BY(mu_)
-  std::string robot_;                          // GUARDED_BY(mu_); set once by Attach
-  std::string request_channel_;                // GUARDED_BY(mu_)
-  bool connected_ = false;                     // GUARDED_BY(mu_)
-  std::shared_ptr<const RobotModel> model_;    // GUARDED_BY(mu_)
+  std::condition_variable cv_;               // acks, configurations
+  client::OutstandingPackages outstanding_;  // GUARDED_BY(mu_)
+  client::ClockSync clock_sync_;             // GUARDED_BY(mu_)
+  std::int64_t next_sequence_ = 1;           // GUARDED_BY(mu_)
+  CommandId next_id_ = 1;                    // GUARDED_BY(mu_)
+  TimePoint last_send_{};                    // GUARDED_BY(mu_)
+  std::string robot_;                        // GUARDED_BY(mu_); set once by Attach
+  std::string request_channel_;              // GUARDED_BY(mu_)
+  bool connected_ = false;                   // GUARDED_BY(mu_)
+  std::shared_ptr<const RobotModel> model_;  // GUARDED_BY(mu_)
   std::unordered_map<std::uint64_t, std::shared_ptr<const RobotModel>> models_;  // GUARDED_BY(mu_)
-  std::string last_config_error_;              // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> clock_packages_;  // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> ack_waited_;      // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> acked_;           // GUARDED_BY(mu_)
-  std::exception_ptr daemon_error_;            // GUARDED_BY(mu_)
-  ClientStats stats_;                          // GUARDED_BY(mu_)
-  lcm::Subscription* state_subscription_ = nullptr;  // GUARDED_BY(mu_)
-  std::function<void(const robotalk_msgs::robot_state_t&)> on_state_;  // GUARDED_BY(mu_)
+  std::string last_config_error_;                                                // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> clock_packages_;                              // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> ack_waited_;                                  // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> acked_;                                       // GUARDED_BY(mu_)
+  std::exception_ptr daemon_error_;                                              // GUARDED_BY(mu_)
+  ClientStats stats_;                                                            // GUARDED_BY(mu_)
+  lcm::Subscription* state_subscription_ = nullptr;                              // GUARDED_BY(mu_)
+  std::function<void(const robotalk_msgs::robot_state_t&)> on_state_;            // GUARDED_BY(mu_)
 
  private:
   void Run();  // the ReadDaemon

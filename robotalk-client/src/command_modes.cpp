@@ -20,9 +20,12 @@ void WaitUntil(const Clock& clock, TimePoint t) {
 
 const char* ToString(CommandMode mode) {
   switch (mode) {
-    case CommandMode::kDirect: return "direct";
-    case CommandMode::kDelay: return "delay";
-    case CommandMode::kPlayback: return "playback";
+    case CommandMode::kDirect:
+      return "direct";
+    case CommandMode::kDelay:
+      return "delay";
+    case CommandMode::kPlayback:
+      return "playback";
   }
   return "unknown";
 }
@@ -37,7 +40,8 @@ std::optional<CommandMode> ParseCommandMode(const std::string& name) {
 void RobotClient::Impl::SetStartTimes(const std::vector<std::pair<CommandId, TimePoint>>& server_starts) {
   std::lock_guard lock(mu_);
   const TimePoint now = clock_.Now();
-  for (const auto& [id, start] : server_starts) outstanding_.UpdateStart(id, clock_sync_.ClientTime(start), now);
+  for (const auto& [id, start] : server_starts)
+    outstanding_.UpdateStart(id, clock_sync_.ClientTime(start), now);
 }
 
 CommandId RobotClient::Impl::NewId() {
@@ -56,7 +60,8 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   // Frames leave in offset order; replies are returned in the order given.
   std::vector<std::size_t> order(frames.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return frames[a].offset < frames[b].offset; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return frames[a].offset < frames[b].offset; });
   const Duration duration = frames[order.back()].offset;
   const Clock& clock = impl_->clock_;
   const TimePoint t0 = clock.Now();
@@ -96,7 +101,7 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       Command c = std::move(frames[order[j]].command);
       // Playback carries the offset itself; delay mode an absolute server time.
       c.start_time = options.mode == CommandMode::kPlayback ? TimePoint(frames[order[j]].offset)
-                                                             : server_start + frames[order[j]].offset;
+                                                            : server_start + frames[order[j]].offset;
       commands.push_back(std::move(c));
     }
     auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit, false, playback);
@@ -134,7 +139,8 @@ Duration RobotClient::StartStateStream(Duration period,
   impl_->SubscribeState(std::move(on_sample));
   const Reply r = Query(robotalk::Query{.type = QueryType::kStateStream, .period = period});
   if (r.signal != Signal::kSuccess) {
-    throw ClientError("RobotClient::StartStateStream: " + std::string(robotalk::ToString(r.signal)) + ": " + r.message);
+    throw ClientError("RobotClient::StartStateStream: " + std::string(robotalk::ToString(r.signal)) + ": " +
+                      r.message);
   }
   return r.values.empty() ? period : FromSeconds(r.values[0]);
 }

@@ -83,8 +83,9 @@ void RobotClient::Impl::Attach(const std::string& robot) {
   subscriptions_ = {reply, config};
 }
 
-RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries,
-                                                       bool panic, Track track, bool clock_query,
+RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands,
+                                                       std::vector<robotalk::Query> queries, bool panic,
+                                                       Track track, bool clock_query,
                                                        const Playback& playback) {
   robotalk_msgs::package_t p{};
   p.header.protocol_version = kProtocolVersion;
@@ -105,9 +106,9 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
   p.num_commands = static_cast<std::int32_t>(p.commands.size());
   p.num_queries = static_cast<std::int32_t>(p.queries.size());
   if (const int size = p.getEncodedSize(); static_cast<std::size_t>(size) > kMaxPackageBytes) {
-    throw ClientError("RobotClient: a package of " + std::to_string(p.header.payload_size) + " items would be " +
-                      std::to_string(size) + " bytes, over the " + std::to_string(kMaxPackageBytes) +
-                      "-byte limit; send fewer per batch");
+    throw ClientError("RobotClient: a package of " + std::to_string(p.header.payload_size) +
+                      " items would be " + std::to_string(size) + " bytes, over the " +
+                      std::to_string(kMaxPackageBytes) + "-byte limit; send fewer per batch");
   }
 
   Sent sent;
@@ -183,8 +184,8 @@ bool RobotClient::Impl::WaitAck(std::int64_t sequence, std::chrono::steady_clock
   return acked;
 }
 
-std::shared_ptr<const RobotModel> RobotClient::Impl::WaitModel(std::uint64_t hash,
-                                                               std::chrono::steady_clock::time_point deadline) {
+std::shared_ptr<const RobotModel> RobotClient::Impl::WaitModel(
+    std::uint64_t hash, std::chrono::steady_clock::time_point deadline) {
   std::unique_lock lock(mu_);
   cv_.wait_until(lock, deadline, [&] { return models_.count(hash) != 0; });
   auto it = models_.find(hash);

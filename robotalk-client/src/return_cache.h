@@ -30,8 +30,8 @@ class ReturnCache {
   /// The outcome of one id as a waiter sees it.
   struct Outcome {
     enum class Kind { kPending, kReply, kFailed, kUnknown } kind = Kind::kPending;
-    Reply reply;          ///< valid for kReply
-    std::string failure;  ///< valid for kFailed: why no reply will come
+    Reply reply;            ///< valid for kReply
+    std::string failure;    ///< valid for kFailed: why no reply will come
     bool timed_out = true;  ///< kFailed: given up on (true) or client closed (false)
   };
 

@@ -59,13 +59,16 @@ namespace {
 std::optional<Reply> Resolve(client::ReturnCache::Outcome o, CommandId id, const std::string& what) {
   using Kind = client::ReturnCache::Outcome::Kind;
   switch (o.kind) {
-    case Kind::kReply: return std::move(o.reply);
+    case Kind::kReply:
+      return std::move(o.reply);
     case Kind::kFailed:
       if (o.timed_out) throw TimeoutError(what + " (id " + std::to_string(id) + "): " + o.failure);
       throw ClientError(what + " (id " + std::to_string(id) + "): " + o.failure);
     case Kind::kUnknown:
-      throw ClientError(what + " (id " + std::to_string(id) + "): no such pending reply (already collected?)");
-    case Kind::kPending: break;
+      throw ClientError(what + " (id " + std::to_string(id) +
+                        "): no such pending reply (already collected?)");
+    case Kind::kPending:
+      break;
   }
   return std::nullopt;
 }
@@ -132,9 +135,10 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
     lcm->handleTimeout(static_cast<int>(std::min<long long>(left, 50)));
   }
   lcm->unsubscribe(sub);
-  std::sort(collector.robots.begin(), collector.robots.end(), [](const AnnouncedRobot& a, const AnnouncedRobot& b) {
-    return a.name != b.name ? a.name < b.name : a.server_id < b.server_id;
-  });
+  std::sort(collector.robots.begin(), collector.robots.end(),
+            [](const AnnouncedRobot& a, const AnnouncedRobot& b) {
+              return a.name != b.name ? a.name < b.name : a.server_id < b.server_id;
+            });
   return collector.robots;
 }
 
@@ -144,9 +148,11 @@ RobotClient::RobotClient(ClientOptions options) : impl_(std::make_unique<Impl>(s
 RobotClient::~RobotClient() = default;
 
 void RobotClient::Connect(const std::string& robot) {
-  if (robot.empty() || robot.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
-                           std::string::npos) {
-    throw ClientError("RobotClient::Connect: invalid robot name '" + robot + "' (letters, digits, _ and - only)");
+  if (robot.empty() ||
+      robot.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+          std::string::npos) {
+    throw ClientError("RobotClient::Connect: invalid robot name '" + robot +
+                      "' (letters, digits, _ and - only)");
   }
   {
     std::lock_guard lock(impl_->mu_);
@@ -170,7 +176,8 @@ void RobotClient::Connect(const std::string& robot) {
       std::lock_guard lock(impl_->mu_);
       if (i >= rounds && impl_->clock_sync_.synced()) break;
     }
-    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false, Impl::Track::kRetransmit, true);
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false,
+                                   Impl::Track::kRetransmit, true);
     PendingReply p = impl_->MakePending(sent.ids[0], "CLOCK");
     try {
       p.Wait(std::chrono::duration_cast<Duration>(deadline - SteadyNow()));
@@ -187,7 +194,8 @@ void RobotClient::Connect(const std::string& robot) {
   //    description on the CONFIG channel; ask again if that message was lost.
   std::shared_ptr<const RobotModel> model;
   while (!model && SteadyNow() < deadline) {
-    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false, Impl::Track::kRetransmit);
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false,
+                                   Impl::Track::kRetransmit);
     PendingReply p = impl_->MakePending(sent.ids[0], "CONFIG");
     Reply r;
     try {
@@ -196,8 +204,8 @@ void RobotClient::Connect(const std::string& robot) {
       break;
     }
     if (!Succeeded(r.signal)) {
-      throw ClientError("RobotClient::Connect('" + robot + "'): CONFIG answered " + std::string(ToString(r.signal)) +
-                        ": " + r.message);
+      throw ClientError("RobotClient::Connect('" + robot + "'): CONFIG answered " +
+                        std::string(ToString(r.signal)) + ": " + r.message);
     }
     std::uint64_t hash = 0;
     try {
@@ -268,15 +276,16 @@ Duration RobotClient::clock_round_trip() const {
 
 void RobotClient::SyncClock(int rounds) {
   for (int i = 0; i < rounds; ++i) {
-    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false, Impl::Track::kRetransmit,
-                                   true);
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false,
+                                   Impl::Track::kRetransmit, true);
     impl_->MakePending(sent.ids[0], "CLOCK").Wait(impl_->options_.timeout);
   }
 }
 
 namespace {
 void RequireConnected(const RobotClient& c, const char* call) {
-  if (!c.connected()) throw ClientError(std::string("RobotClient::") + call + ": not connected (call Connect first)");
+  if (!c.connected())
+    throw ClientError(std::string("RobotClient::") + call + ": not connected (call Connect first)");
 }
 }  // namespace
 
@@ -332,7 +341,8 @@ std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands) 
   for (const Command& c : commands) what.push_back(Describe(c));
   auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit);
   std::vector<PendingReply> pending;
-  for (std::size_t i = 0; i < sent.ids.size(); ++i) pending.push_back(impl_->MakePending(sent.ids[i], what[i]));
+  for (std::size_t i = 0; i < sent.ids.size(); ++i)
+    pending.push_back(impl_->MakePending(sent.ids[i], what[i]));
   return pending;
 }
 
@@ -348,14 +358,19 @@ void RobotClient::Panic() {
 
 Reply RobotClient::ResetPanic() { return Execute(Command{.type = CommandType::kPanicReset}); }
 
-Reply RobotClient::SetJoint(const std::string& joint, std::vector<double> positions, std::optional<TimePoint> start) {
-  return Execute(Command{
-      .type = CommandType::kJointSetPoint, .start_time = start, .target = joint, .values = std::move(positions)});
+Reply RobotClient::SetJoint(const std::string& joint, std::vector<double> positions,
+                            std::optional<TimePoint> start) {
+  return Execute(Command{.type = CommandType::kJointSetPoint,
+                         .start_time = start,
+                         .target = joint,
+                         .values = std::move(positions)});
 }
 Reply RobotClient::JointSpeed(const std::string& joint, std::vector<double> velocities,
                               std::optional<TimePoint> start) {
-  return Execute(Command{
-      .type = CommandType::kJointSpeed, .start_time = start, .target = joint, .values = std::move(velocities)});
+  return Execute(Command{.type = CommandType::kJointSpeed,
+                         .start_time = start,
+                         .target = joint,
+                         .values = std::move(velocities)});
 }
 Reply RobotClient::Goto(double x, double y, double theta, std::optional<TimePoint> start) {
   return Execute(Command{.type = CommandType::kGoto, .start_time = start, .values = {x, y, theta}});

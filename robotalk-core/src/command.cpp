@@ -10,7 +10,8 @@ namespace {
 constexpr double kQuaternionTolerance = 1e-3;
 
 std::string Upper(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   std::replace(s.begin(), s.end(), '-', '_');
   return s;
 }
@@ -31,7 +32,8 @@ std::optional<std::string> CheckValueCount(const Command& c, size_t expected, co
 std::optional<std::string> CheckFinite(const Command& c) {
   for (size_t i = 0; i < c.values.size(); ++i) {
     if (!std::isfinite(c.values[i])) {
-      return Label(c) + ": value " + std::to_string(i) + " is " + (std::isnan(c.values[i]) ? "NaN" : "infinite");
+      return Label(c) + ": value " + std::to_string(i) + " is " +
+             (std::isnan(c.values[i]) ? "NaN" : "infinite");
     }
   }
   return std::nullopt;
@@ -39,9 +41,12 @@ std::optional<std::string> CheckFinite(const Command& c) {
 
 ServoType ServoOf(CommandType t) {
   switch (t) {
-    case CommandType::kJointSpeed: return ServoType::kSpeed;
-    case CommandType::kJointForce: return ServoType::kForce;
-    default: return ServoType::kSetPoint;
+    case CommandType::kJointSpeed:
+      return ServoType::kSpeed;
+    case CommandType::kJointForce:
+      return ServoType::kForce;
+    default:
+      return ServoType::kSetPoint;
   }
 }
 
@@ -49,28 +54,44 @@ ServoType ServoOf(CommandType t) {
 
 const char* ToString(CommandType t) {
   switch (t) {
-    case CommandType::kJointSetPoint: return "JOINT_SETPOINT";
-    case CommandType::kJointSpeed: return "JOINT_SPEED";
-    case CommandType::kJointForce: return "JOINT_FORCE";
-    case CommandType::kFrameSetPoint: return "FRAME_SETPOINT";
-    case CommandType::kGoto: return "GOTO";
-    case CommandType::kSetSpeed: return "SETSPEED";
-    case CommandType::kStop: return "STOP";
-    case CommandType::kPanicReset: return "PANIC_RESET";
+    case CommandType::kJointSetPoint:
+      return "JOINT_SETPOINT";
+    case CommandType::kJointSpeed:
+      return "JOINT_SPEED";
+    case CommandType::kJointForce:
+      return "JOINT_FORCE";
+    case CommandType::kFrameSetPoint:
+      return "FRAME_SETPOINT";
+    case CommandType::kGoto:
+      return "GOTO";
+    case CommandType::kSetSpeed:
+      return "SETSPEED";
+    case CommandType::kStop:
+      return "STOP";
+    case CommandType::kPanicReset:
+      return "PANIC_RESET";
   }
   return "UNKNOWN_COMMAND";
 }
 
 const char* ToString(QueryType t) {
   switch (t) {
-    case QueryType::kConfig: return "CONFIG";
-    case QueryType::kJointState: return "JOINT_STATE";
-    case QueryType::kLinkPoses: return "LINK_POSES";
-    case QueryType::kFramePoses: return "FRAME_POSES";
-    case QueryType::kBasePose: return "BASE_POSE";
-    case QueryType::kClock: return "CLOCK";
-    case QueryType::kStateStream: return "STATE_STREAM";
-    case QueryType::kStateStreamCancel: return "STATE_STREAM_CANCEL";
+    case QueryType::kConfig:
+      return "CONFIG";
+    case QueryType::kJointState:
+      return "JOINT_STATE";
+    case QueryType::kLinkPoses:
+      return "LINK_POSES";
+    case QueryType::kFramePoses:
+      return "FRAME_POSES";
+    case QueryType::kBasePose:
+      return "BASE_POSE";
+    case QueryType::kClock:
+      return "CLOCK";
+    case QueryType::kStateStream:
+      return "STATE_STREAM";
+    case QueryType::kStateStreamCancel:
+      return "STATE_STREAM_CANCEL";
   }
   return "UNKNOWN_QUERY";
 }
@@ -104,13 +125,16 @@ std::optional<std::string> CheckCommand(const RobotModel& model, const Command& 
     case CommandType::kJointSpeed:
     case CommandType::kJointForce: {
       auto j = model.FindJoint(c.target);
-      if (!j) return std::string(ToString(c.type)) + ": robot " + Quote(model.name()) + " has no joint named " + Quote(c.target);
+      if (!j)
+        return std::string(ToString(c.type)) + ": robot " + Quote(model.name()) + " has no joint named " +
+               Quote(c.target);
       const Joint& joint = model.joint(*j);
       if (joint.dofs.empty()) return Label(c) + ": the joint is fixed (0 dofs)";
       if (auto bad = CheckValueCount(c, joint.dofs.size(), " (one per dof)")) return bad;
       if (joint.mimic) {
         *signal = Signal::kNa;
-        return Label(c) + ": the joint follows " + Quote(model.joint(joint.mimic->leader_joint).name) + " (mimic)";
+        return Label(c) + ": the joint follows " + Quote(model.joint(joint.mimic->leader_joint).name) +
+               " (mimic)";
       }
       if (!joint.servo_types.Has(ServoOf(c.type))) {
         *signal = Signal::kNa;
@@ -120,7 +144,9 @@ std::optional<std::string> CheckCommand(const RobotModel& model, const Command& 
     }
     case CommandType::kFrameSetPoint: {
       auto f = model.FindFrame(c.target);
-      if (!f) return std::string("FRAME_SETPOINT: robot ") + Quote(model.name()) + " has no control frame named " + Quote(c.target);
+      if (!f)
+        return std::string("FRAME_SETPOINT: robot ") + Quote(model.name()) + " has no control frame named " +
+               Quote(c.target);
       if (auto bad = CheckValueCount(c, 7, " (x y z qw qx qy qz)")) return bad;
       const double norm = std::sqrt(c.values[3] * c.values[3] + c.values[4] * c.values[4] +
                                     c.values[5] * c.values[5] + c.values[6] * c.values[6]);
@@ -139,7 +165,8 @@ std::optional<std::string> CheckCommand(const RobotModel& model, const Command& 
       if (c.type == CommandType::kGoto) {
         if (auto bad = CheckValueCount(c, 3, " (x y theta)")) return bad;
       } else if (c.values.size() != 2 && c.values.size() != 3) {
-        return Label(c) + ": expected 2 values (v omega) or 3 (vx vy omega), got " + std::to_string(c.values.size());
+        return Label(c) + ": expected 2 values (v omega) or 3 (vx vy omega), got " +
+               std::to_string(c.values.size());
       }
       if (model.roots().front().base == BaseType::kFixed) {
         *signal = Signal::kNa;
@@ -158,18 +185,25 @@ std::optional<std::string> CheckCommand(const RobotModel& model, const Command& 
 std::optional<std::string> CheckQuery(const RobotModel& model, const Query& q) {
   if (q.type == QueryType::kStateStream && (q.period < kMinStreamPeriod || q.period > kMaxStreamPeriod)) {
     return "STATE_STREAM: period " + std::to_string(ToSeconds(q.period)) + " s is outside [" +
-           std::to_string(ToSeconds(kMinStreamPeriod)) + ", " + std::to_string(ToSeconds(kMaxStreamPeriod)) + "] s";
+           std::to_string(ToSeconds(kMinStreamPeriod)) + ", " + std::to_string(ToSeconds(kMaxStreamPeriod)) +
+           "] s";
   }
   if (q.target.empty()) return std::nullopt;
   switch (q.type) {
     case QueryType::kJointState:
-      if (!model.FindJoint(q.target)) return std::string("JOINT_STATE: robot ") + Quote(model.name()) + " has no joint named " + Quote(q.target);
+      if (!model.FindJoint(q.target))
+        return std::string("JOINT_STATE: robot ") + Quote(model.name()) + " has no joint named " +
+               Quote(q.target);
       return std::nullopt;
     case QueryType::kLinkPoses:
-      if (!model.FindLink(q.target)) return std::string("LINK_POSES: robot ") + Quote(model.name()) + " has no link named " + Quote(q.target);
+      if (!model.FindLink(q.target))
+        return std::string("LINK_POSES: robot ") + Quote(model.name()) + " has no link named " +
+               Quote(q.target);
       return std::nullopt;
     case QueryType::kFramePoses:
-      if (!model.FindFrame(q.target)) return std::string("FRAME_POSES: robot ") + Quote(model.name()) + " has no control frame named " + Quote(q.target);
+      if (!model.FindFrame(q.target))
+        return std::string("FRAME_POSES: robot ") + Quote(model.name()) + " has no control frame named " +
+               Quote(q.target);
       return std::nullopt;
     default:
       return std::string(ToString(q.type)) + ": takes no target (got " + Quote(q.target) + ")";

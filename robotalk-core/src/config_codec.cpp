@@ -36,7 +36,9 @@ std::string Hex(std::uint64_t v) {
 
 std::string Quote(std::string_view s) { return "'" + std::string(s) + "'"; }
 
-std::string Element(const char* block, std::size_t i) { return std::string(block) + "[" + std::to_string(i) + "]"; }
+std::string Element(const char* block, std::size_t i) {
+  return std::string(block) + "[" + std::to_string(i) + "]";
+}
 
 [[noreturn]] void Protocol(const char* function, const std::string& what) {
   throw ProtocolError(std::string(function) + ": " + what);
@@ -128,7 +130,7 @@ void PutQuaternion(double (&out)[4], const Eigen::Quaterniond& q) {
 // Fixed parts of the element types, from robotalk_msgs/*.lcm. The name string
 // comes first in link_t, joint_t and control_frame_t.
 constexpr std::int64_t kJointBeforeNumDofs = 4 + 4 + 8 * (3 + 3 + 4) + 1;  // links, geometry, servo_types
-constexpr std::int64_t kJointAfterDofs = 4 + 8 + 8;                       // mimic leader, multiplier, offset
+constexpr std::int64_t kJointAfterDofs = 4 + 8 + 8;                        // mimic leader, multiplier, offset
 
 struct ElementSizes {
   std::int64_t link_fixed, dof, frame_fixed, root, header;
@@ -144,7 +146,8 @@ const ElementSizes& Sizes() {
     s.header = msgs::config_header_t{}._getEncodedSizeNoHash();
     // The scanner hard-codes joint_t's layout around its dof array; a change
     // of joint_t.lcm without a change here is a programming error.
-    if (msgs::joint_t{}._getEncodedSizeNoHash() != kLcmStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs) {
+    if (msgs::joint_t{}._getEncodedSizeNoHash() !=
+        kLcmStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs) {
       std::fprintf(stderr, "robotalk: config_codec.cpp scanner is out of date with joint_t.lcm\n");
       std::abort();
     }
@@ -176,7 +179,8 @@ std::size_t ScanConfig(std::span<const std::uint8_t> bytes) {
     s.Skip(z.link_fixed, "mass, com, inertia");
   }
   s.SetContext({});
-  const std::int32_t num_joints = s.Count("num_joints", kLcmStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs);
+  const std::int32_t num_joints =
+      s.Count("num_joints", kLcmStringOverhead + kJointBeforeNumDofs + 1 + kJointAfterDofs);
   for (std::int32_t i = 0; i < num_joints; ++i) {
     s.SetContext(Element("joints", static_cast<std::size_t>(i)));
     s.String("name");
@@ -242,7 +246,8 @@ void CheckIndex(std::int32_t index, std::size_t size, const std::string& field, 
 
 void CheckServo(std::int8_t bits, const std::string& field) {
   if ((static_cast<std::uint8_t>(bits) & ~0x7u) != 0) {
-    Protocol(kFrom, field + " = " + std::to_string(bits) + " has bits outside SERVO_SETPOINT|SPEED|FORCE (0..7)");
+    Protocol(kFrom,
+             field + " = " + std::to_string(bits) + " has bits outside SERVO_SETPOINT|SPEED|FORCE (0..7)");
   }
 }
 
@@ -254,8 +259,8 @@ Eigen::Quaterniond Quat(const double (&q)[4]) { return {q[0], q[1], q[2], q[3]};
 void CheckEnvelope(const msgs::robot_config_t& msg) {
   const msgs::config_header_t& h = msg.header;
   if (h.format_version != kFormatVersion) {
-    Protocol(kFrom, "header.format_version = " + std::to_string(h.format_version) + " is not supported (this build reads " +
-                        std::to_string(kFormatVersion) + ")");
+    Protocol(kFrom, "header.format_version = " + std::to_string(h.format_version) +
+                        " is not supported (this build reads " + std::to_string(kFormatVersion) + ")");
   }
   CheckCount("links", h.num_links, msg.num_links, msg.links.size());
   CheckCount("joints", h.num_joints, msg.num_joints, msg.joints.size());
@@ -264,7 +269,8 @@ void CheckEnvelope(const msgs::robot_config_t& msg) {
 
   CheckWireName(msg.robot_name, "robot_name");
   std::int64_t total_dofs = 0;
-  for (std::size_t i = 0; i < msg.links.size(); ++i) CheckWireName(msg.links[i].name, Element("links", i) + ".name");
+  for (std::size_t i = 0; i < msg.links.size(); ++i)
+    CheckWireName(msg.links[i].name, Element("links", i) + ".name");
   for (std::size_t i = 0; i < msg.joints.size(); ++i) {
     const msgs::joint_t& j = msg.joints[i];
     const std::string what = Element("joints", i);
@@ -278,7 +284,8 @@ void CheckEnvelope(const msgs::robot_config_t& msg) {
     }
     total_dofs += j.num_dofs;
   }
-  for (std::size_t i = 0; i < msg.frames.size(); ++i) CheckWireName(msg.frames[i].name, Element("frames", i) + ".name");
+  for (std::size_t i = 0; i < msg.frames.size(); ++i)
+    CheckWireName(msg.frames[i].name, Element("frames", i) + ".name");
   if (h.total_dofs != total_dofs) {
     Protocol(kFrom, "header.total_dofs = " + std::to_string(h.total_dofs) + " but the joints have " +
                         std::to_string(total_dofs) + " dofs");
@@ -292,8 +299,8 @@ void CheckEnvelope(const msgs::robot_config_t& msg) {
 
   const std::uint64_t hash = HashOfEncoding(EncodeMessage(msg));
   if (static_cast<std::uint64_t>(h.hash) != hash) {
-    Protocol(kFrom, "header.hash = " + Hex(static_cast<std::uint64_t>(h.hash)) + " but the message hashes to " +
-                        Hex(hash));
+    Protocol(kFrom, "header.hash = " + Hex(static_cast<std::uint64_t>(h.hash)) +
+                        " but the message hashes to " + Hex(hash));
   }
 }
 
@@ -375,7 +382,8 @@ robotalk_msgs::robot_config_t ToMessage(const RobotModel& model) {
   h.num_frames = msg.num_frames;
   h.num_roots = msg.num_roots;
   const Offsets o = BlockOffsets(msg);
-  if (o.roots > INT32_MAX) throw ModelError("ToMessage: robot " + Quote(model.name()) + " is too big to encode");
+  if (o.roots > INT32_MAX)
+    throw ModelError("ToMessage: robot " + Quote(model.name()) + " is too big to encode");
   h.link_block_offset = static_cast<std::int32_t>(o.links);
   h.joint_block_offset = static_cast<std::int32_t>(o.joints);
   h.frame_block_offset = static_cast<std::int32_t>(o.frames);
@@ -397,7 +405,7 @@ RobotModel FromMessage(const robotalk_msgs::robot_config_t& msg) {
     l.name = m.name;
     l.mass = m.mass;
     l.com = Vec3(m.com);
-    const double* I = m.inertia;  // ixx ixy ixz iyy iyz izz
+    const double* I = m.inertia;    // ixx ixy ixz iyy iyz izz
     l.inertia << I[0], I[1], I[2],  //
         I[1], I[3], I[4],           //
         I[2], I[4], I[5];
@@ -425,18 +433,22 @@ RobotModel FromMessage(const robotalk_msgs::robot_config_t& msg) {
         Protocol(kFrom, what + ".dofs[" + std::to_string(k) + "].type = " + std::to_string(d.type) +
                             " is neither REVOLUTE (0) nor PRISMATIC (1)");
       }
-      j.dofs.push_back(Dof{.type = static_cast<DofType>(d.type),
-                           .axis = Vec3(d.axis),
-                           .limits = {.lower = d.lower, .upper = d.upper, .velocity = d.velocity, .effort = d.effort}});
+      j.dofs.push_back(
+          Dof{.type = static_cast<DofType>(d.type),
+              .axis = Vec3(d.axis),
+              .limits = {.lower = d.lower, .upper = d.upper, .velocity = d.velocity, .effort = d.effort}});
     }
     if (m.mimic_leader == -1) {
       if (m.mimic_multiplier != 1.0 || m.mimic_offset != 0.0) {
-        Protocol(kFrom, what + ": mimic_leader = -1 (no mimic) needs mimic_multiplier = 1 and mimic_offset = 0, has " +
-                            std::to_string(m.mimic_multiplier) + " and " + std::to_string(m.mimic_offset));
+        Protocol(kFrom,
+                 what +
+                     ": mimic_leader = -1 (no mimic) needs mimic_multiplier = 1 and mimic_offset = 0, has " +
+                     std::to_string(m.mimic_multiplier) + " and " + std::to_string(m.mimic_offset));
       }
     } else {
       CheckIndex(m.mimic_leader, num_joints, what + ".mimic_leader", "joints (or -1)");
-      j.mimic = Mimic{.leader_joint = m.mimic_leader, .multiplier = m.mimic_multiplier, .offset = m.mimic_offset};
+      j.mimic =
+          Mimic{.leader_joint = m.mimic_leader, .multiplier = m.mimic_multiplier, .offset = m.mimic_offset};
     }
   }
 
@@ -447,10 +459,11 @@ RobotModel FromMessage(const robotalk_msgs::robot_config_t& msg) {
     const std::string what = Element("frames", i);
     CheckIndex(m.parent_link, num_links, what + ".parent_link", "links");
     CheckServo(m.servo_types, what + ".servo_types");
-    frames.push_back(ControlFrame{.name = m.name,
-                                  .parent_link = m.parent_link,
-                                  .pose_in_link = {Vec3(m.position), Quat(m.orientation)},
-                                  .servo_types = ServoTypes::FromBits(static_cast<std::uint8_t>(m.servo_types))});
+    frames.push_back(
+        ControlFrame{.name = m.name,
+                     .parent_link = m.parent_link,
+                     .pose_in_link = {Vec3(m.position), Quat(m.orientation)},
+                     .servo_types = ServoTypes::FromBits(static_cast<std::uint8_t>(m.servo_types))});
   }
 
   std::vector<RootLink> roots;
@@ -473,13 +486,15 @@ RobotModel FromMessage(const robotalk_msgs::robot_config_t& msg) {
   // one hash. RobotModel appends a fixed root for every unlisted parentless
   // link; a message must list them all.
   if (model.roots().size() != msg.roots.size()) {
-    Protocol(kFrom, "num_roots = " + std::to_string(msg.num_roots) + " but robot " + Quote(msg.robot_name) + " has " +
-                        std::to_string(model.roots().size()) + " parentless links; every one must be listed");
+    Protocol(kFrom, "num_roots = " + std::to_string(msg.num_roots) + " but robot " + Quote(msg.robot_name) +
+                        " has " + std::to_string(model.roots().size()) +
+                        " parentless links; every one must be listed");
   }
   const std::uint64_t canonical = ConfigHash(model);
   if (canonical != static_cast<std::uint64_t>(msg.header.hash)) {
-    Protocol(kFrom, "the message is not the canonical encoding of robot " + Quote(msg.robot_name) + " (header.hash " +
-                        Hex(static_cast<std::uint64_t>(msg.header.hash)) + ", canonical " + Hex(canonical) + ")");
+    Protocol(kFrom, "the message is not the canonical encoding of robot " + Quote(msg.robot_name) +
+                        " (header.hash " + Hex(static_cast<std::uint64_t>(msg.header.hash)) + ", canonical " +
+                        Hex(canonical) + ")");
   }
   return model;
 }
@@ -513,7 +528,8 @@ robotalk_msgs::config_header_t DecodeConfigHeader(std::span<const std::uint8_t> 
   }
   if (header.format_version != kFormatVersion) {
     Protocol("DecodeConfigHeader", "header.format_version = " + std::to_string(header.format_version) +
-                                       " is not supported (this build reads " + std::to_string(kFormatVersion) + ")");
+                                       " is not supported (this build reads " +
+                                       std::to_string(kFormatVersion) + ")");
   }
   return header;
 }

@@ -47,7 +47,8 @@ std::string ServoTypes::ToString() const {
 
 ServoTypes ServoTypes::Parse(const std::string& text) {
   std::string cleaned = text;
-  std::replace_if(cleaned.begin(), cleaned.end(), [](char c) { return c == ',' || c == '|'; }, ' ');
+  std::replace_if(
+      cleaned.begin(), cleaned.end(), [](char c) { return c == ',' || c == '|'; }, ' ');
   std::istringstream words(cleaned);
   ServoTypes result;
   std::string word;
@@ -68,23 +69,24 @@ ServoTypes ServoTypes::Parse(const std::string& text) {
   return result;
 }
 
-const char* ToString(DofType t) {
-  return t == DofType::kPrismatic ? "prismatic" : "revolute";
-}
+const char* ToString(DofType t) { return t == DofType::kPrismatic ? "prismatic" : "revolute"; }
 
 const char* ToString(BaseType t) {
   switch (t) {
-    case BaseType::kFixed: return "fixed";
-    case BaseType::kDifferential: return "differential";
-    case BaseType::kHolonomic: return "holonomic";
-    case BaseType::kFloating: return "floating";
+    case BaseType::kFixed:
+      return "fixed";
+    case BaseType::kDifferential:
+      return "differential";
+    case BaseType::kHolonomic:
+      return "holonomic";
+    case BaseType::kFloating:
+      return "floating";
   }
   return "unknown";
 }
 
 BaseType ParseBaseType(const std::string& text) {
-  for (BaseType t : {BaseType::kFixed, BaseType::kDifferential, BaseType::kHolonomic,
-                     BaseType::kFloating}) {
+  for (BaseType t : {BaseType::kFixed, BaseType::kDifferential, BaseType::kHolonomic, BaseType::kFloating}) {
     if (text == ToString(t)) return t;
   }
   throw ModelError("ParseBaseType: unknown base type '" + text +

@@ -53,10 +53,12 @@ void ScanRobotState(WireScanner& s) {
 
 template <typename Msg>
 Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* function, void (*scan)(WireScanner&)) {
-  if (bytes.size() > static_cast<size_t>(INT32_MAX)) throw ProtocolError(std::string(function) + ": message too large");
+  if (bytes.size() > static_cast<size_t>(INT32_MAX))
+    throw ProtocolError(std::string(function) + ": message too large");
   WireScanner s(function, bytes);
   // The fingerprint first: a message of another type gives a clear error.
-  if (s.Int64("fingerprint") != Msg::getHash()) s.Fail("fingerprint", "does not match (another message type?)");
+  if (s.Int64("fingerprint") != Msg::getHash())
+    s.Fail("fingerprint", "does not match (another message type?)");
   scan(s);
   s.ExpectEnd();
   Msg msg{};
@@ -102,10 +104,12 @@ robotalk_msgs::reply_t ToWire(const Reply& r) {
 
 Command FromWire(const robotalk_msgs::command_t& w) {
   if (w.type < 1 || w.type > static_cast<std::int8_t>(CommandType::kPanicReset)) {
-    throw ProtocolError("command " + std::to_string(w.id) + ": unknown command type " + std::to_string(w.type));
+    throw ProtocolError("command " + std::to_string(w.id) + ": unknown command type " +
+                        std::to_string(w.type));
   }
   if (w.start_time_us < 0) {
-    throw ProtocolError("command " + std::to_string(w.id) + ": negative start time " + std::to_string(w.start_time_us) + " us");
+    throw ProtocolError("command " + std::to_string(w.id) + ": negative start time " +
+                        std::to_string(w.start_time_us) + " us");
   }
   Command c;
   c.id = w.id;
@@ -121,14 +125,16 @@ Query FromWire(const robotalk_msgs::query_t& w) {
     throw ProtocolError("query " + std::to_string(w.id) + ": unknown query type " + std::to_string(w.type));
   }
   if (w.period_us < 0) {
-    throw ProtocolError("query " + std::to_string(w.id) + ": negative period " + std::to_string(w.period_us) + " us");
+    throw ProtocolError("query " + std::to_string(w.id) + ": negative period " + std::to_string(w.period_us) +
+                        " us");
   }
   return Query{w.id, static_cast<QueryType>(w.type), w.target, std::chrono::microseconds(w.period_us)};
 }
 
 Reply FromWire(const robotalk_msgs::reply_t& w) {
   auto signal = SignalFromWire(w.signal);
-  if (!signal) throw ProtocolError("reply " + std::to_string(w.id) + ": unknown signal " + std::to_string(w.signal));
+  if (!signal)
+    throw ProtocolError("reply " + std::to_string(w.id) + ": unknown signal " + std::to_string(w.signal));
   Reply r;
   r.id = w.id;
   r.signal = *signal;
@@ -154,34 +160,38 @@ robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> byte
 std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
   const auto& h = p.header;
   if (h.protocol_version != kProtocolVersion) {
-    return "package: protocol version " + std::to_string(h.protocol_version) + " is not supported (server speaks " +
-           std::to_string(kProtocolVersion) + ")";
+    return "package: protocol version " + std::to_string(h.protocol_version) +
+           " is not supported (server speaks " + std::to_string(kProtocolVersion) + ")";
   }
   if (h.client_id == 0) return "package: client id 0 is reserved";
-  if (h.mode < robotalk_msgs::package_header_t::MODE_DIRECT || h.mode > robotalk_msgs::package_header_t::MODE_PLAYBACK) {
+  if (h.mode < robotalk_msgs::package_header_t::MODE_DIRECT ||
+      h.mode > robotalk_msgs::package_header_t::MODE_PLAYBACK) {
     return "package: unknown mode " + std::to_string(h.mode);
   }
   if (h.mode == robotalk_msgs::package_header_t::MODE_PLAYBACK) {
     if (p.num_queries > 0) return "package: a PLAYBACK package carries commands only";
-    if (h.playback_frames < 1) return "package: PLAYBACK declares " + std::to_string(h.playback_frames) + " frames";
+    if (h.playback_frames < 1)
+      return "package: PLAYBACK declares " + std::to_string(h.playback_frames) + " frames";
     if (h.playback_duration_us < 0) return "package: PLAYBACK declares a negative duration";
     if (h.playback_id == 0) return "package: PLAYBACK id 0 is reserved";
   }
   if (h.sequence <= 0) return "package: sequence " + std::to_string(h.sequence) + " is not positive";
   if (p.num_queries > 0 && p.num_commands > 0) {
-    return "package: mixes " + std::to_string(p.num_queries) + " queries and " + std::to_string(p.num_commands) +
-           " commands; a package carries one or the other";
+    return "package: mixes " + std::to_string(p.num_queries) + " queries and " +
+           std::to_string(p.num_commands) + " commands; a package carries one or the other";
   }
   const bool panic_only = h.panic && p.num_queries == 0 && p.num_commands == 0;
   if (h.payload_type == robotalk_msgs::package_header_t::PAYLOAD_QUERIES) {
     if (p.num_commands > 0) return "package: payload type QUERIES but it carries commands";
     if (h.payload_size != p.num_queries) {
-      return "package: header payload size " + std::to_string(h.payload_size) + " but " + std::to_string(p.num_queries) + " queries";
+      return "package: header payload size " + std::to_string(h.payload_size) + " but " +
+             std::to_string(p.num_queries) + " queries";
     }
   } else if (h.payload_type == robotalk_msgs::package_header_t::PAYLOAD_COMMANDS) {
     if (p.num_queries > 0) return "package: payload type COMMANDS but it carries queries";
     if (h.payload_size != p.num_commands) {
-      return "package: header payload size " + std::to_string(h.payload_size) + " but " + std::to_string(p.num_commands) + " commands";
+      return "package: header payload size " + std::to_string(h.payload_size) + " but " +
+             std::to_string(p.num_commands) + " commands";
     }
   } else if (!panic_only) {
     return "package: unknown payload type " + std::to_string(h.payload_type);

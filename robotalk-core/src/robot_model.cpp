@@ -54,8 +54,8 @@ void ValidateLink(const std::string& robot, const Link& link) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(link.inertia, Eigen::EigenvaluesOnly);
     const Eigen::Vector3d ev = eig.eigenvalues();
     if (ev.minCoeff() <= 0) {
-      Fail(robot, what + "inertia is not positive-definite for a link of mass " +
-                      std::to_string(link.mass) + " kg (principal moments " + Vec(ev) + ")");
+      Fail(robot, what + "inertia is not positive-definite for a link of mass " + std::to_string(link.mass) +
+                      " kg (principal moments " + Vec(ev) + ")");
     }
   }
 }
@@ -83,7 +83,8 @@ void ValidateDof(const std::string& robot, const Joint& joint, size_t k, const D
     Fail(robot, what + "lower limit " + std::to_string(l.lower) + " is above upper limit " +
                     std::to_string(l.upper));
   }
-  if (!(l.velocity > 0)) Fail(robot, what + "velocity limit " + std::to_string(l.velocity) + " is not positive");
+  if (!(l.velocity > 0))
+    Fail(robot, what + "velocity limit " + std::to_string(l.velocity) + " is not positive");
   if (!(l.effort > 0)) Fail(robot, what + "effort limit " + std::to_string(l.effort) + " is not positive");
 }
 
@@ -122,18 +123,24 @@ void RobotModel::Validate() {
   for (int j = 0; j < num_joints; ++j) {
     const Joint& joint = joints_[static_cast<size_t>(j)];
     const std::string what = "joint " + Quote(joint.name) + ": ";
-    if (!valid_link(joint.parent_link)) Fail(name_, what + "unknown parent link index " + std::to_string(joint.parent_link));
-    if (!valid_link(joint.child_link)) Fail(name_, what + "unknown child link index " + std::to_string(joint.child_link));
+    if (!valid_link(joint.parent_link))
+      Fail(name_, what + "unknown parent link index " + std::to_string(joint.parent_link));
+    if (!valid_link(joint.child_link))
+      Fail(name_, what + "unknown child link index " + std::to_string(joint.child_link));
     const std::string& child = links_[static_cast<size_t>(joint.child_link)].name;
-    if (joint.parent_link == joint.child_link) Fail(name_, what + "joins link " + Quote(child) + " to itself");
+    if (joint.parent_link == joint.child_link)
+      Fail(name_, what + "joins link " + Quote(child) + " to itself");
     int& parent_of_child = parent_joint_[static_cast<size_t>(joint.child_link)];
     if (parent_of_child >= 0) {
       Fail(name_, "not a tree: link " + Quote(child) + " has two parent joints, " +
-                      Quote(joints_[static_cast<size_t>(parent_of_child)].name) + " and " + Quote(joint.name));
+                      Quote(joints_[static_cast<size_t>(parent_of_child)].name) + " and " +
+                      Quote(joint.name));
     }
     parent_of_child = j;
-    if (!AllFinite(joint.inboard)) Fail(name_, what + "inboard position " + Vec(joint.inboard) + " is not finite");
-    if (!AllFinite(joint.outboard)) Fail(name_, what + "outboard position " + Vec(joint.outboard) + " is not finite");
+    if (!AllFinite(joint.inboard))
+      Fail(name_, what + "inboard position " + Vec(joint.inboard) + " is not finite");
+    if (!AllFinite(joint.outboard))
+      Fail(name_, what + "outboard position " + Vec(joint.outboard) + " is not finite");
     if (!IsUnit(joint.rest)) Fail(name_, what + "rest rotation is not a unit quaternion");
     if (joint.dofs.size() > kMaxDofsPerJoint) {
       Fail(name_, what + "has " + std::to_string(joint.dofs.size()) + " dofs; a joint has at most 6");
@@ -147,7 +154,8 @@ void RobotModel::Validate() {
     if (!joint.mimic) continue;
     const std::string what = "joint " + Quote(joint.name) + ": mimic ";
     const int leader = joint.mimic->leader_joint;
-    if (leader < 0 || leader >= num_joints) Fail(name_, what + "names unknown joint index " + std::to_string(leader));
+    if (leader < 0 || leader >= num_joints)
+      Fail(name_, what + "names unknown joint index " + std::to_string(leader));
     const Joint& lead = joints_[static_cast<size_t>(leader)];
     if (&lead == &joint) Fail(name_, what + "names the joint itself");
     if (joint.dofs.size() != 1 || lead.dofs.size() != 1) {
@@ -162,7 +170,8 @@ void RobotModel::Validate() {
 
   for (const ControlFrame& frame : frames_) {
     const std::string what = "control frame " + Quote(frame.name) + ": ";
-    if (!valid_link(frame.parent_link)) Fail(name_, what + "unknown parent link index " + std::to_string(frame.parent_link));
+    if (!valid_link(frame.parent_link))
+      Fail(name_, what + "unknown parent link index " + std::to_string(frame.parent_link));
     if (!AllFinite(frame.pose_in_link.translation)) Fail(name_, what + "position is not finite");
     if (!IsUnit(frame.pose_in_link.rotation)) Fail(name_, what + "orientation is not a unit quaternion");
   }
@@ -174,8 +183,9 @@ void RobotModel::Validate() {
     if (!valid_link(root.link)) Fail(name_, "root: unknown link index " + std::to_string(root.link));
     const std::string& link = links_[static_cast<size_t>(root.link)].name;
     if (parent_joint_[static_cast<size_t>(root.link)] >= 0) {
-      Fail(name_, "root link " + Quote(link) + " has a parent joint " +
-                      Quote(joints_[static_cast<size_t>(parent_joint_[static_cast<size_t>(root.link)])].name));
+      Fail(name_,
+           "root link " + Quote(link) + " has a parent joint " +
+               Quote(joints_[static_cast<size_t>(parent_joint_[static_cast<size_t>(root.link)])].name));
     }
     if (is_root[static_cast<size_t>(root.link)]) Fail(name_, "root link " + Quote(link) + " is listed twice");
     if (!AllFinite(root.pose_in_world.translation) || !IsUnit(root.pose_in_world.rotation)) {
@@ -188,12 +198,14 @@ void RobotModel::Validate() {
       roots_.push_back(RootLink{.link = l, .pose_in_world = {}, .base = BaseType::kFixed});
     }
   }
-  if (roots_.empty()) Fail(name_, "has no root link (every link has a parent joint, so the joints form a cycle)");
+  if (roots_.empty())
+    Fail(name_, "has no root link (every link has a parent joint, so the joints form a cycle)");
 
   // Depth-first sweep from the roots: parents before children. A link never
   // reached has a parent but no root above it, so it sits on a cycle.
   std::vector<std::vector<int>> child_joints(links_.size());
-  for (int j = 0; j < num_joints; ++j) child_joints[static_cast<size_t>(joints_[static_cast<size_t>(j)].parent_link)].push_back(j);
+  for (int j = 0; j < num_joints; ++j)
+    child_joints[static_cast<size_t>(joints_[static_cast<size_t>(j)].parent_link)].push_back(j);
   joint_order_.clear();
   root_of_.assign(links_.size(), -1);
   std::vector<int> stack;
@@ -204,7 +216,8 @@ void RobotModel::Validate() {
       stack.pop_back();
       root_of_[static_cast<size_t>(l)] = root.link;
       const auto& children = child_joints[static_cast<size_t>(l)];
-      for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(joints_[static_cast<size_t>(*it)].child_link);
+      for (auto it = children.rbegin(); it != children.rend(); ++it)
+        stack.push_back(joints_[static_cast<size_t>(*it)].child_link);
       // Record in forward order; children are visited in joint order.
       if (l != root.link) joint_order_.push_back(parent_joint_[static_cast<size_t>(l)]);
     }
@@ -322,7 +335,8 @@ RobotModel RobotModelBuilder::Build() const {
     auto follower = joint_index.find(m.joint);
     if (follower == joint_index.end()) Fail(name_, "mimic: unknown joint " + Quote(m.joint));
     auto leader = joint_index.find(m.leader);
-    if (leader == joint_index.end()) Fail(name_, "joint " + Quote(m.joint) + ": mimic names unknown joint " + Quote(m.leader));
+    if (leader == joint_index.end())
+      Fail(name_, "joint " + Quote(m.joint) + ": mimic names unknown joint " + Quote(m.leader));
     joints[static_cast<size_t>(follower->second)].mimic = Mimic{leader->second, m.multiplier, m.offset};
   }
   std::vector<ControlFrame> frames;

@@ -4,13 +4,20 @@ namespace robotalk {
 
 std::string_view ToString(Signal s) {
   switch (s) {
-    case Signal::kSuccess: return "SUCCESS";
-    case Signal::kModified: return "MODIFIED";
-    case Signal::kNa: return "NA";
-    case Signal::kBusy: return "BUSY";
-    case Signal::kInterrupted: return "INTERRUPTED";
-    case Signal::kError: return "ERROR";
-    case Signal::kPanic: return "PANIC";
+    case Signal::kSuccess:
+      return "SUCCESS";
+    case Signal::kModified:
+      return "MODIFIED";
+    case Signal::kNa:
+      return "NA";
+    case Signal::kBusy:
+      return "BUSY";
+    case Signal::kInterrupted:
+      return "INTERRUPTED";
+    case Signal::kError:
+      return "ERROR";
+    case Signal::kPanic:
+      return "PANIC";
   }
   return "UNKNOWN";
 }

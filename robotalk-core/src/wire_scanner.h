@@ -19,7 +19,8 @@ inline constexpr std::int64_t kLcmStringOverhead = 4 + 1;
 
 class WireScanner {
  public:
-  WireScanner(const char* function, std::span<const std::uint8_t> bytes) : function_(function), bytes_(bytes) {}
+  WireScanner(const char* function, std::span<const std::uint8_t> bytes)
+      : function_(function), bytes_(bytes) {}
 
   std::size_t pos() const { return pos_; }
   std::size_t left() const { return bytes_.size() - pos_; }
@@ -40,11 +41,12 @@ class WireScanner {
     const std::size_t at = pos_;
     const std::int32_t len = Int32(field);
     if (len < 1 || static_cast<std::size_t>(len) > left()) {
-      Fail(field, "string length " + std::to_string(len) + " at byte " + std::to_string(at) + " is outside [1, " +
-                      std::to_string(left()) + "] (the bytes left)");
+      Fail(field, "string length " + std::to_string(len) + " at byte " + std::to_string(at) +
+                      " is outside [1, " + std::to_string(left()) + "] (the bytes left)");
     }
     const auto* begin = bytes_.data() + pos_;
-    if (begin[len - 1] != 0) Fail(field, "string at byte " + std::to_string(at) + " lacks its terminating NUL");
+    if (begin[len - 1] != 0)
+      Fail(field, "string at byte " + std::to_string(at) + " lacks its terminating NUL");
     if (std::memchr(begin, 0, static_cast<std::size_t>(len - 1)) != nullptr) {
       Fail(field, "string at byte " + std::to_string(at) + " contains a NUL byte");
     }
@@ -69,8 +71,8 @@ class WireScanner {
   }
 
   [[noreturn]] void Fail(const char* field, const std::string& what) const {
-    throw ProtocolError(std::string(function_) + ": " + (context_.empty() ? std::string() : context_ + ".") + field +
-                        ": " + what);
+    throw ProtocolError(std::string(function_) + ": " + (context_.empty() ? std::string() : context_ + ".") +
+                        field + ": " + what);
   }
 
  private:
@@ -82,9 +84,9 @@ class WireScanner {
   }
   std::int32_t CheckCount(const char* field, std::size_t at, std::int32_t n, std::int64_t min_element) const {
     if (n < 0 || static_cast<std::int64_t>(n) * min_element > static_cast<std::int64_t>(left())) {
-      Fail(field, std::to_string(n) + " at byte " + std::to_string(at) + " is negative or cannot fit in the " +
-                      std::to_string(left()) + " bytes left (each element takes at least " +
-                      std::to_string(min_element) + ")");
+      Fail(field, std::to_string(n) + " at byte " + std::to_string(at) +
+                      " is negative or cannot fit in the " + std::to_string(left()) +
+                      " bytes left (each element takes at least " + std::to_string(min_element) + ")");
     }
     return n;
   }

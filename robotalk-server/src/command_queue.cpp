@@ -21,7 +21,8 @@ QueuedItem CommandQueue::Pop() {
 }
 
 void CommandQueue::Flush(std::vector<QueuedItem>& out) {
-  std::sort(heap_.begin(), heap_.end(), [](const QueuedItem& a, const QueuedItem& b) { return a.RunsBefore(b); });
+  std::sort(heap_.begin(), heap_.end(),
+            [](const QueuedItem& a, const QueuedItem& b) { return a.RunsBefore(b); });
   for (QueuedItem& item : heap_) out.push_back(std::move(item));
   heap_.clear();
 }

@@ -19,10 +19,10 @@ struct QueuedItem {
   std::int64_t client_id = 0;          ///< 0 = the server itself (watchdog STOP)
   bool has_start_time = false;         ///< false = "now" (no lateness to report)
   bool is_query = false;
-  DriverCommand command;               ///< when !is_query; command.id is the client's id
+  DriverCommand command;  ///< when !is_query; command.id is the client's id
   QueryType query = QueryType::kJointState;
-  int query_target = -1;               ///< joint / link / frame index, -1 = all
-  bool only_if_moving = false;         ///< the watchdog's STOP: skipped if the robot is still
+  int query_target = -1;        ///< joint / link / frame index, -1 = all
+  bool only_if_moving = false;  ///< the watchdog's STOP: skipped if the robot is still
 
   /// Earlier start first; equal starts in arrival order.
   bool RunsBefore(const QueuedItem& o) const {

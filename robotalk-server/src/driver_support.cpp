@@ -31,8 +31,8 @@ std::optional<DriverResult> CheckFrameSetPoint(const RobotModel& model, const In
     return Answer(Signal::kError, "FRAME_SETPOINT: no control frame with index " + std::to_string(c.target));
   }
   if (c.num_values != 7) {
-    return Answer(Signal::kError,
-                  "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " + std::to_string(c.num_values));
+    return Answer(Signal::kError, "FRAME_SETPOINT: expected 7 values (x y z qw qx qy qz), got " +
+                                      std::to_string(c.num_values));
   }
   const ControlFrame& frame = model.frame(c.target);
   if (!ik.HasMovableDofs(c.target)) {
@@ -41,16 +41,17 @@ std::optional<DriverResult> CheckFrameSetPoint(const RobotModel& model, const In
   }
   const double norm = FrameGoalOrientation(c).norm();
   if (!(norm > 1e-9) || !std::isfinite(norm)) {  // CheckCommand wants a unit quaternion; a driver re-checks
-    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) + ": orientation quaternion has norm " +
-                                      Num(norm) + ", expected 1");
+    return Answer(Signal::kError, "FRAME_SETPOINT " + Quote(frame.name) +
+                                      ": orientation quaternion has norm " + Num(norm) + ", expected 1");
   }
   return std::nullopt;
 }
 
 DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinematics::Result& r) {
   if (r.within_tolerance) return Answer(Signal::kSuccess);
-  return Answer(Signal::kModified, "FRAME_SETPOINT " + Quote(frame) + ": pose not reachable; moving to the closest found, " +
-                                       Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
+  return Answer(Signal::kModified,
+                "FRAME_SETPOINT " + Quote(frame) + ": pose not reachable; moving to the closest found, " +
+                    Num(r.position_error) + " m and " + Num(r.orientation_error) + " rad away");
 }
 
 std::optional<bool> ParseBool(const std::string& value) {

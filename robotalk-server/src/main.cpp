@@ -11,13 +11,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: robotalk-server --robot NAME=DRIVER:URDF[,key=value...] [--robot ...] [options]
+constexpr const char* kUsage =
+    R"(usage: robotalk-server --robot NAME=DRIVER:URDF[,key=value...] [--robot ...] [options]
 Serves one or more robots over LCM (see docs/protocol.md).
   --robot NAME=DRIVER:URDF[,k=v]  a robot: its name, driver (e.g. kinematic) and URDF file,
                                   then driver options (see docs/drivers.md)
@@ -67,12 +68,15 @@ int Simulate(const robotalk::DriverRegistry& registry, const std::vector<robotal
       commands.push_back({robotalk::FromSeconds(e.offset_s), e.command});
     }
     const robotalk::RobotSpec& spec = robots.front();
-    auto driver = registry.Create(spec.driver, robotalk::DriverConfig{spec.name, spec.urdf_path, spec.options});
-    const robotalk::SimulationResult r = robotalk::RunSimulation(
-        spec.name, spec.driver, std::move(driver), commands,
-        {.duration = robotalk::FromSeconds(duration_s), .sample_period = robotalk::FromSeconds(sample_period_s)});
+    auto driver =
+        registry.Create(spec.driver, robotalk::DriverConfig{spec.name, spec.urdf_path, spec.options});
+    const robotalk::SimulationResult r =
+        robotalk::RunSimulation(spec.name, spec.driver, std::move(driver), commands,
+                                {.duration = robotalk::FromSeconds(duration_s),
+                                 .sample_period = robotalk::FromSeconds(sample_period_s)});
     for (const robotalk::Reply& reply : r.replies) {
-      std::cerr << reply.id - 1 << " " << robotalk::ToString(reply.signal) << " \"" << reply.message << "\"\n";
+      std::cerr << reply.id - 1 << " " << robotalk::ToString(reply.signal) << " \"" << reply.message
+                << "\"\n";
     }
     std::cout << "t,x,y,theta,v,omega";
     if (!r.states.empty()) {
@@ -161,7 +165,8 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  if (!simulate.empty()) return Simulate(registry, robots, simulate, duration < 0 ? 10.0 : duration, sample_period);
+  if (!simulate.empty())
+    return Simulate(registry, robots, simulate, duration < 0 ? 10.0 : duration, sample_period);
 
   // Signals are taken synchronously by this thread; the daemons never see them.
   sigset_t signals;
@@ -176,7 +181,8 @@ int main(int argc, char** argv) {
     server.Start();
     int received = 0;
     if (duration >= 0) {
-      const timespec timeout{static_cast<time_t>(duration), static_cast<long>((duration - static_cast<time_t>(duration)) * 1e9)};
+      const timespec timeout{static_cast<time_t>(duration),
+                             static_cast<long>((duration - static_cast<time_t>(duration)) * 1e9)};
       received = sigtimedwait(&signals, nullptr, &timeout);
     } else {
       sigwait(&signals, &received);

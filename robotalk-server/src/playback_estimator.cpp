@@ -5,9 +5,11 @@
 
 namespace robotalk {
 
-PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration, PlaybackEstimatorOptions options)
+PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration,
+                                     PlaybackEstimatorOptions options)
     : total_(std::max<std::size_t>(total_frames, 1)), duration_(duration), options_(options) {
-  const auto by_fraction = static_cast<std::size_t>(std::ceil(options_.fraction * static_cast<double>(total_)));
+  const auto by_fraction =
+      static_cast<std::size_t>(std::ceil(options_.fraction * static_cast<double>(total_)));
   needed_ = std::min(total_, std::max(options_.min_frames, by_fraction));
   frames_.reserve(needed_);
 }
@@ -40,19 +42,21 @@ Duration PlaybackEstimator::ExtraLagBound(Duration remaining) const {
   std::vector<const Frame*> sorted;
   sorted.reserve(frames_.size());
   for (const Frame& f : frames_) sorted.push_back(&f);
-  std::sort(sorted.begin(), sorted.end(), [](const Frame* a, const Frame* b) { return a->offset < b->offset; });
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Frame* a, const Frame* b) { return a->offset < b->offset; });
   double seen = 0, growth = 0;  // seconds of offset covered, lag gained over them
   for (std::size_t i = 1; i < sorted.size(); ++i) {
     seen += ToSeconds(sorted[i]->offset - sorted[i - 1]->offset);
-    growth += ToSeconds((sorted[i]->arrival - sorted[i]->offset) - (sorted[i - 1]->arrival - sorted[i - 1]->offset));
+    growth += ToSeconds((sorted[i]->arrival - sorted[i]->offset) -
+                        (sorted[i - 1]->arrival - sorted[i - 1]->offset));
   }
   if (seen <= 0) return Duration(0);  // every frame at one offset: no rate to see yet
   const double mu = growth / seen;
   double variance = 0;
   for (std::size_t i = 1; i < sorted.size(); ++i) {
     const double dt = ToSeconds(sorted[i]->offset - sorted[i - 1]->offset);
-    const double dl =
-        ToSeconds((sorted[i]->arrival - sorted[i]->offset) - (sorted[i - 1]->arrival - sorted[i - 1]->offset));
+    const double dl = ToSeconds((sorted[i]->arrival - sorted[i]->offset) -
+                                (sorted[i - 1]->arrival - sorted[i - 1]->offset));
     variance += (dl - mu * dt) * (dl - mu * dt);
   }
   const double sigma = std::sqrt(variance / seen);

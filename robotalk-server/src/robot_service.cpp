@@ -105,12 +105,14 @@ ImmediateAnswer RobotService::HandlePackage(const robotalk_msgs::package_t& pack
     if (h.panic) {
       PanicNow(h.client_id, received);
       for (CommandId id : ids) {
-        immediate.push_back(MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", received));
+        immediate.push_back(
+            MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", received));
       }
     } else if (playback) {
       EnqueuePlayback(session, package, received, immediate);
     } else {
-      for (const auto& q : package.queries) EnqueueQuery(session, q, received, immediate, answer.publish_config);
+      for (const auto& q : package.queries)
+        EnqueueQuery(session, q, received, immediate, answer.publish_config);
       for (const auto& c : package.commands) EnqueueCommand(session, c, received, immediate);
     }
     for (const Reply& r : immediate) session.replies.RecordReply(r);
@@ -174,11 +176,12 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
       stream_requests_.erase(s.client_id);
     }
     UpdateStream(now);
-    Reply r = MakeReply(q.id, Signal::kSuccess,
-                        stream_period_.count() == 0
-                            ? "no state stream"
-                            : "state every " + std::to_string(ToSeconds(stream_period_)) + " s on ROBOTALK/" + name_ + "/STATE",
-                        now);
+    Reply r =
+        MakeReply(q.id, Signal::kSuccess,
+                  stream_period_.count() == 0 ? "no state stream"
+                                              : "state every " + std::to_string(ToSeconds(stream_period_)) +
+                                                    " s on ROBOTALK/" + name_ + "/STATE",
+                  now);
     r.values = {ToSeconds(stream_period_)};
     immediate.push_back(std::move(r));
     return;
@@ -190,8 +193,9 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
   }
   if (s.commands.size() >= options_.max_queue) {
     immediate.push_back(MakeReply(q.id, Signal::kError,
-                                  "queue of client " + Hex64(static_cast<std::uint64_t>(s.client_id)) + " is full (" +
-                                      std::to_string(options_.max_queue) + " items); query not queued",
+                                  "queue of client " + Hex64(static_cast<std::uint64_t>(s.client_id)) +
+                                      " is full (" + std::to_string(options_.max_queue) +
+                                      " items); query not queued",
                                   now));
     return;
   }
@@ -203,10 +207,17 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
   item.command.id = q.id;
   if (!q.target.empty()) {
     switch (q.type) {
-      case QueryType::kJointState: item.query_target = *model().FindJoint(q.target); break;
-      case QueryType::kLinkPoses: item.query_target = *model().FindLink(q.target); break;
-      case QueryType::kFramePoses: item.query_target = *model().FindFrame(q.target); break;
-      default: break;
+      case QueryType::kJointState:
+        item.query_target = *model().FindJoint(q.target);
+        break;
+      case QueryType::kLinkPoses:
+        item.query_target = *model().FindLink(q.target);
+        break;
+      case QueryType::kFramePoses:
+        item.query_target = *model().FindFrame(q.target);
+        break;
+      default:
+        break;
     }
   }
   s.commands.Push(std::move(item));
@@ -215,7 +226,8 @@ void RobotService::EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, 
 }
 
 std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotalk_msgs::command_t& wire,
-                                                       TimePoint now, std::vector<Reply>& immediate, bool playback) {
+                                                       TimePoint now, std::vector<Reply>& immediate,
+                                                       bool playback) {
   Command c;
   try {
     c = FromWire(wire);
@@ -240,8 +252,8 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
     return std::nullopt;
   }
   if (panic_) {
-    immediate.push_back(MakeReply(c.id, Signal::kPanic,
-                                  "robot '" + name_ + "' is in panic; nothing executes until PANIC_RESET", now));
+    immediate.push_back(MakeReply(
+        c.id, Signal::kPanic, "robot '" + name_ + "' is in panic; nothing executes until PANIC_RESET", now));
     return std::nullopt;
   }
   Signal signal = Signal::kError;
@@ -254,19 +266,21 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
                          : playback    ? c.start_time->time_since_epoch()
                                        : *c.start_time - now;
   if (ahead > options_.max_future) {
-    immediate.push_back(MakeReply(c.id, Signal::kError,
-                                  std::string(ToString(c.type)) + ": start time is " + std::to_string(ToSeconds(ahead)) +
-                                      " s ahead" + (playback ? " of the sequence start" : " of the server clock") +
-                                      "; the limit is " + std::to_string(ToSeconds(options_.max_future)) + " s",
-                                  now));
+    immediate.push_back(
+        MakeReply(c.id, Signal::kError,
+                  std::string(ToString(c.type)) + ": start time is " + std::to_string(ToSeconds(ahead)) +
+                      " s ahead" + (playback ? " of the sequence start" : " of the server clock") +
+                      "; the limit is " + std::to_string(ToSeconds(options_.max_future)) + " s",
+                  now));
     return std::nullopt;
   }
   size_t queued = s.commands.size();
   for (const auto& [id, seq] : s.playbacks) queued += seq.frames.size();
   if (queued >= options_.max_queue) {
     immediate.push_back(MakeReply(c.id, Signal::kError,
-                                  "queue of client " + Hex64(static_cast<std::uint64_t>(s.client_id)) + " is full (" +
-                                      std::to_string(options_.max_queue) + " items); command not queued",
+                                  "queue of client " + Hex64(static_cast<std::uint64_t>(s.client_id)) +
+                                      " is full (" + std::to_string(options_.max_queue) +
+                                      " items); command not queued",
                                   now));
     return std::nullopt;
   }
@@ -299,8 +313,8 @@ void RobotService::EnqueueCommand(Session& s, const robotalk_msgs::command_t& wi
 
 void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
   const bool first = !panic_.exchange(true);
-  std::fprintf(stderr, "robotalk-server: robot '%s': PANIC from client %s%s\n", name_.c_str(), Hex64(static_cast<std::uint64_t>(client_id)).c_str(),
-               first ? "" : " (already in panic)");
+  std::fprintf(stderr, "robotalk-server: robot '%s': PANIC from client %s%s\n", name_.c_str(),
+               Hex64(static_cast<std::uint64_t>(client_id)).c_str(), first ? "" : " (already in panic)");
   std::vector<QueuedItem> flushed;
   for (auto& [id, session] : sessions_) {
     session.commands.Flush(flushed);
@@ -311,8 +325,9 @@ void RobotService::PanicNow(std::int64_t client_id, TimePoint now) {
   }
   server_queue_.clear();
   for (const QueuedItem& item : flushed) {
-    Deliver(item.client_id, MakeReply(item.command.id, Signal::kInterrupted,
-                                      "flushed by panic from client " + Hex64(static_cast<std::uint64_t>(client_id)), now));
+    Deliver(item.client_id,
+            MakeReply(item.command.id, Signal::kInterrupted,
+                      "flushed by panic from client " + Hex64(static_cast<std::uint64_t>(client_id)), now));
   }
   halt_requested_ = true;
   wake_flag_ = true;
@@ -462,7 +477,8 @@ TimePoint RobotService::RunOnce(TimePoint now) {
       next = now;  // the stream changed meanwhile: look again at once
     }
     for (auto& [id, session] : sessions_) {
-      if (!session.commands.empty() && session.commands.Top().start < next) next = session.commands.Top().start;
+      if (!session.commands.empty() && session.commands.Top().start < next)
+        next = session.commands.Top().start;
     }
     if (!server_queue_.empty() || halt_requested_ || resume_requested_) next = now;
   }
@@ -496,7 +512,8 @@ void RobotService::Execute(const QueuedItem& item, TimePoint now) {
   const DriverResult result = driver_->Execute(command, now, completions_);
   if (options_.log_executions) {
     std::fprintf(stderr, "robotalk-server: robot '%s': executed client %s command %" PRId64 " %s -> %s\n",
-                 name_.c_str(), Hex64(static_cast<std::uint64_t>(item.client_id)).c_str(), item.command.id, ToString(item.command.type),
+                 name_.c_str(), Hex64(static_cast<std::uint64_t>(item.client_id)).c_str(), item.command.id,
+                 ToString(item.command.type),
                  result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
   }
   if (result.in_progress) {

@@ -11,7 +11,6 @@
 // ManualClock.
 #pragma once
 
-#include "session.h"
 #include "robotalk/clock.h"
 #include "robotalk/driver.h"
 #include "robotalk/kinematics.h"
@@ -19,6 +18,7 @@
 #include "robotalk_msgs/reply_package_t.hpp"
 #include "robotalk_msgs/robot_info_t.hpp"
 #include "robotalk_msgs/robot_state_t.hpp"
+#include "session.h"
 
 #include <atomic>
 #include <condition_variable>
@@ -51,8 +51,8 @@ struct RobotServiceOptions {
 /// What the ServerDaemon sends back at once for a received package.
 struct ImmediateAnswer {
   robotalk_msgs::reply_package_t package{};  ///< ack + immediate replies; send_us filled by the sender
-  bool send = true;            ///< false for packages that cannot be answered (no client id)
-  bool publish_config = false; ///< a CONFIG query asked for the configuration message
+  bool send = true;                          ///< false for packages that cannot be answered (no client id)
+  bool publish_config = false;               ///< a CONFIG query asked for the configuration message
 };
 
 /// A client session the watchdog removed.
@@ -130,18 +130,20 @@ class RobotService {
   Session& SessionFor(std::int64_t client_id, TimePoint now);  // REQUIRES: mutex_ held
   // Checks a command; returns it ready to queue, or answers it in `immediate`.
   std::optional<QueuedItem> PrepareCommand(Session& s, const robotalk_msgs::command_t& wire, TimePoint now,
-                                           std::vector<Reply>& immediate, bool playback);  // REQUIRES: mutex_ held
+                                           std::vector<Reply>& immediate,
+                                           bool playback);  // REQUIRES: mutex_ held
   void EnqueueCommand(Session& s, const robotalk_msgs::command_t& wire, TimePoint now,
                       std::vector<Reply>& immediate);  // REQUIRES: mutex_ held
   void EnqueuePlayback(Session& s, const robotalk_msgs::package_t& package, TimePoint now,
                        std::vector<Reply>& immediate);  // REQUIRES: mutex_ held
   void UpdateStream(TimePoint now);                     // REQUIRES: mutex_ held
   void SampleState(TimePoint now, Duration period);     // RobotDaemon, no lock
-  void EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, TimePoint now, std::vector<Reply>& immediate,
-                    bool& publish_config);  // REQUIRES: mutex_ held
-  void PanicNow(std::int64_t client_id, TimePoint now);  // REQUIRES: mutex_ held
-  void Deliver(std::int64_t client_id, Reply reply);     // REQUIRES: mutex_ held
-  void Execute(const QueuedItem& item, TimePoint now);   // RobotDaemon, no lock
+  void EnqueueQuery(Session& s, const robotalk_msgs::query_t& wire, TimePoint now,
+                    std::vector<Reply>& immediate,
+                    bool& publish_config);                 // REQUIRES: mutex_ held
+  void PanicNow(std::int64_t client_id, TimePoint now);    // REQUIRES: mutex_ held
+  void Deliver(std::int64_t client_id, Reply reply);       // REQUIRES: mutex_ held
+  void Execute(const QueuedItem& item, TimePoint now);     // RobotDaemon, no lock
   void AnswerQuery(const QueuedItem& item, Reply& reply);  // RobotDaemon, no lock
   void DaemonLoop();
   void QueueStop(const std::string& reason, bool only_if_moving);
@@ -166,11 +168,11 @@ class RobotService {
   bool wake_flag_ = false;                    // GUARDED_BY(mutex_)
   bool running_ = false;                      // GUARDED_BY(mutex_)
   // Broadcast: one stream at the shortest period any client asked for.
-  std::map<std::int64_t, Duration> stream_requests_;         // GUARDED_BY(mutex_)
-  Duration stream_period_{0};                                // GUARDED_BY(mutex_); 0 = off
-  TimePoint next_sample_{};                                  // GUARDED_BY(mutex_)
-  std::uint64_t stream_generation_ = 0;                      // GUARDED_BY(mutex_)
-  std::vector<robotalk_msgs::robot_state_t> state_outbox_;   // GUARDED_BY(mutex_)
+  std::map<std::int64_t, Duration> stream_requests_;        // GUARDED_BY(mutex_)
+  Duration stream_period_{0};                               // GUARDED_BY(mutex_); 0 = off
+  TimePoint next_sample_{};                                 // GUARDED_BY(mutex_)
+  std::uint64_t stream_generation_ = 0;                     // GUARDED_BY(mutex_)
+  std::vector<robotalk_msgs::robot_state_t> state_outbox_;  // GUARDED_BY(mutex_)
   std::atomic<bool> panic_{false};
 
   // RobotDaemon only (preallocated).

@@ -21,7 +21,8 @@ inline Reply MakeReply(CommandId id, Signal signal, std::string message, TimePoi
 /// Appends x y z qw qx qy qz.
 inline void AppendPose(const Eigen::Isometry3d& x, std::vector<double>& out) {
   const Eigen::Quaterniond q(x.linear());
-  out.insert(out.end(), {x.translation().x(), x.translation().y(), x.translation().z(), q.w(), q.x(), q.y(), q.z()});
+  out.insert(out.end(),
+             {x.translation().x(), x.translation().y(), x.translation().z(), q.w(), q.x(), q.y(), q.z()});
 }
 
 }  // namespace robotalk::service_detail

@@ -18,16 +18,16 @@ void RobotService::EnqueuePlayback(Session& s, const robotalk_msgs::package_t& p
                                    std::vector<Reply>& immediate) {
   const auto& h = package.header;
   const Duration duration = std::chrono::microseconds(h.playback_duration_us);
-  auto [it, created] = s.playbacks.try_emplace(h.playback_id, static_cast<size_t>(h.playback_frames), duration,
-                                               options_.playback);
+  auto [it, created] = s.playbacks.try_emplace(h.playback_id, static_cast<size_t>(h.playback_frames),
+                                               duration, options_.playback);
   PlaybackSequence& seq = it->second;
   const auto refuse_all = [&](const std::string& why) {
     for (const auto& c : package.commands) immediate.push_back(MakeReply(c.id, Signal::kError, why, now));
   };
   if (!created && (seq.total != static_cast<size_t>(h.playback_frames) || seq.duration != duration)) {
-    refuse_all("PLAYBACK " + std::to_string(h.playback_id) + ": declared " + std::to_string(seq.total) + " frames over " +
-               std::to_string(ToSeconds(seq.duration)) + " s before, now " + std::to_string(h.playback_frames) +
-               " over " + std::to_string(ToSeconds(duration)) + " s");
+    refuse_all("PLAYBACK " + std::to_string(h.playback_id) + ": declared " + std::to_string(seq.total) +
+               " frames over " + std::to_string(ToSeconds(seq.duration)) + " s before, now " +
+               std::to_string(h.playback_frames) + " over " + std::to_string(ToSeconds(duration)) + " s");
     return;
   }
   if (!seq.first_arrival) seq.first_arrival = now;
@@ -39,7 +39,8 @@ void RobotService::EnqueuePlayback(Session& s, const robotalk_msgs::package_t& p
       immediate.push_back(MakeReply(wire.id, Signal::kError,
                                     "PLAYBACK " + std::to_string(h.playback_id) + ": frame at " +
                                         std::to_string(ToSeconds(offset)) + " s is beyond the declared " +
-                                        std::to_string(seq.total) + " frames over " + std::to_string(ToSeconds(seq.duration)) + " s",
+                                        std::to_string(seq.total) + " frames over " +
+                                        std::to_string(ToSeconds(seq.duration)) + " s",
                                     now));
       continue;
     }
@@ -61,12 +62,13 @@ void RobotService::EnqueuePlayback(Session& s, const robotalk_msgs::package_t& p
     }
     seq.frames.clear();
     const Duration delay = *seq.start - *seq.first_arrival;
-    Reply r = MakeReply(h.playback_id, Signal::kSuccess,
-                        "playback of " + std::to_string(seq.total) + " frames starts " + std::to_string(ToSeconds(delay)) +
-                            " s after its first frame arrived (mean " +
-                            std::to_string(ToSeconds(seq.estimator.mean_command_interval())) + " s between commands, " +
-                            std::to_string(ToSeconds(seq.estimator.mean_arrival_interval())) + " s between arrivals)",
-                        now);
+    Reply r = MakeReply(
+        h.playback_id, Signal::kSuccess,
+        "playback of " + std::to_string(seq.total) + " frames starts " + std::to_string(ToSeconds(delay)) +
+            " s after its first frame arrived (mean " +
+            std::to_string(ToSeconds(seq.estimator.mean_command_interval())) + " s between commands, " +
+            std::to_string(ToSeconds(seq.estimator.mean_arrival_interval())) + " s between arrivals)",
+        now);
     r.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
     immediate.push_back(std::move(r));
   }

@@ -18,9 +18,9 @@ class SequenceWindow {
   static constexpr std::int64_t kWindow = 4096;
 
  private:
-  std::int64_t contiguous_ = 0;      // every sequence <= this has been seen
+  std::int64_t contiguous_ = 0;  // every sequence <= this has been seen
   std::int64_t highest_ = 0;
-  std::set<std::int64_t> ahead_;     // seen sequences > contiguous_ + 1
+  std::set<std::int64_t> ahead_;  // seen sequences > contiguous_ + 1
 };
 
 }  // namespace robotalk

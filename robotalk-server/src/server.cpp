@@ -7,10 +7,10 @@
 #include "robotalk/protocol_codec.h"
 #include "robotalk_msgs/announce_t.hpp"
 
-#include <lcm/lcm-cpp.hpp>
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <cinttypes>
 #include <cstdio>
@@ -32,7 +32,8 @@ bool ValidRobotName(const std::string& name) {
 RobotSpec RobotSpec::Parse(const std::string& text) {
   const auto eq = text.find('=');
   const auto colon = eq == std::string::npos ? std::string::npos : text.find(':', eq);
-  if (colon == std::string::npos) throw Error("--robot '" + text + "': expected NAME=DRIVER:URDF[,key=value...]");
+  if (colon == std::string::npos)
+    throw Error("--robot '" + text + "': expected NAME=DRIVER:URDF[,key=value...]");
   RobotSpec spec;
   spec.name = text.substr(0, eq);
   spec.driver = text.substr(eq + 1, colon - eq - 1);
@@ -70,14 +71,16 @@ class Server::Impl {
         faults_(options_.reply_drop_probability, options_.reply_duplicate_probability, options_.fault_seed) {
     if (!lcm_.good()) throw Error("Server: cannot open LCM URL '" + options_.lcm_url + "'");
     if (specs.empty()) throw Error("Server: no robot to serve");
-    RobotServiceOptions service_options{options_.session_timeout, options_.max_queue, options_.max_future,
-                                        PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction},
-                                        options_.log_executions};
+    RobotServiceOptions service_options{
+        options_.session_timeout, options_.max_queue, options_.max_future,
+        PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction},
+        options_.log_executions};
     for (const RobotSpec& spec : specs) {
       if (robots_.count(spec.name)) throw Error("Server: robot name '" + spec.name + "' is given twice");
       DriverConfig config{spec.name, spec.urdf_path, spec.options};
       std::unique_ptr<Driver> driver = registry.Create(spec.driver, config);
-      auto service = std::make_unique<RobotService>(spec.name, spec.driver, std::move(driver), clock_, service_options);
+      auto service =
+          std::make_unique<RobotService>(spec.name, spec.driver, std::move(driver), clock_, service_options);
       service->set_replies_ready_callback([this] { Signal(); });
       robots_.emplace(spec.name, std::move(service));
     }
@@ -100,9 +103,10 @@ class Server::Impl {
     running_ = true;
     daemon_ = std::thread([this] { DaemonLoop(); });
     for (auto& [name, robot] : robots_) {
-      std::fprintf(stderr, "robotalk-server: serving robot '%s' (%zu links, %d dofs, config %016" PRIx64 ") on '%s'\n",
-                   name.c_str(), robot->model().links().size(), robot->model().num_dofs(), robot->config_hash(),
-                   options_.lcm_url.empty() ? "LCM default" : options_.lcm_url.c_str());
+      std::fprintf(
+          stderr, "robotalk-server: serving robot '%s' (%zu links, %d dofs, config %016" PRIx64 ") on '%s'\n",
+          name.c_str(), robot->model().links().size(), robot->model().num_dofs(), robot->config_hash(),
+          options_.lcm_url.empty() ? "LCM default" : options_.lcm_url.c_str());
     }
   }
 
@@ -146,8 +150,9 @@ class Server::Impl {
           for (const ExpiredSession& e : robot->ExpireSessions(now)) {
             // Quiet for the ordinary case: a short-lived client (the CLI) that is done.
             if (e.dropped_commands == 0 && !e.moved_robot) continue;
-            std::fprintf(stderr, "robotalk-server: robot '%s': client %s went silent; %zu queued commands dropped\n",
-                         name.c_str(), Hex64(static_cast<std::uint64_t>(e.client_id)).c_str(), e.dropped_commands);
+            std::fprintf(
+                stderr, "robotalk-server: robot '%s': client %s went silent; %zu queued commands dropped\n",
+                name.c_str(), Hex64(static_cast<std::uint64_t>(e.client_id)).c_str(), e.dropped_commands);
           }
         }
         next_expiry = now + std::chrono::milliseconds(100);
@@ -170,11 +175,12 @@ class Server::Impl {
       const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
       robotalk_msgs::package_t package = DecodePackage({data, rbuf->data_size});
       const std::string bad = CheckPackageHeader(package);
-      ImmediateAnswer answer = bad.empty() ? robot.HandlePackage(package, received)
-                                           : robot.RefusePackage(package, received, bad);
+      ImmediateAnswer answer =
+          bad.empty() ? robot.HandlePackage(package, received) : robot.RefusePackage(package, received, bad);
       if (!bad.empty()) {
-        std::fprintf(stderr, "robotalk-server: robot '%s': refused package from client %s: %s\n", robot_name.c_str(),
-                     Hex64(static_cast<std::uint64_t>(package.header.client_id)).c_str(), bad.c_str());
+        std::fprintf(stderr, "robotalk-server: robot '%s': refused package from client %s: %s\n",
+                     robot_name.c_str(), Hex64(static_cast<std::uint64_t>(package.header.client_id)).c_str(),
+                     bad.c_str());
       }
       if (answer.publish_config) {
         lcm_.publish(ConfigChannel(robot_name), robot.encoded_config().data(),
@@ -184,13 +190,14 @@ class Server::Impl {
       // The paper's congestion injector (§VI-B): a random pause after each
       // received package, during which nothing else is received.
       if (options_.congestion_max_pause.count() > 0) {
-        std::this_thread::sleep_for(FromSeconds(congestion_(congestion_rng_) * ToSeconds(options_.congestion_max_pause)));
+        std::this_thread::sleep_for(
+            FromSeconds(congestion_(congestion_rng_) * ToSeconds(options_.congestion_max_pause)));
       }
     } catch (const std::exception& e) {
       // Undecodable bytes carry no trustworthy client id to answer: count and log.
       ++malformed_;
-      std::fprintf(stderr, "robotalk-server: robot '%s': dropped a malformed package on %s: %s\n", robot_name.c_str(),
-                   channel.c_str(), e.what());
+      std::fprintf(stderr, "robotalk-server: robot '%s': dropped a malformed package on %s: %s\n",
+                   robot_name.c_str(), channel.c_str(), e.what());
     }
   }
 

@@ -6,8 +6,8 @@
 
 #include "command_queue.h"
 #include "playback_estimator.h"
-#include "sequence_window.h"
 #include "robotalk/command.h"
+#include "sequence_window.h"
 
 #include <cstdint>
 #include <deque>

@@ -7,8 +7,9 @@
 
 namespace robotalk {
 
-SimulationResult RunSimulation(std::string robot_name, std::string driver_name, std::unique_ptr<Driver> driver,
-                               const std::vector<SimulatedCommand>& commands, const SimulationOptions& options) {
+SimulationResult RunSimulation(std::string robot_name, std::string driver_name,
+                               std::unique_ptr<Driver> driver, const std::vector<SimulatedCommand>& commands,
+                               const SimulationOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   ManualClock clock;
   RobotService service(std::move(robot_name), std::move(driver_name), std::move(driver), clock);
@@ -29,12 +30,14 @@ SimulationResult RunSimulation(std::string robot_name, std::string driver_name, 
   };
   robotalk_msgs::package_t stream{};
   stream.header = header(1, robotalk_msgs::package_header_t::PAYLOAD_QUERIES, 1);
-  stream.queries.push_back(ToWire(Query{.id = 1, .type = QueryType::kStateStream, .period = options.sample_period}));
+  stream.queries.push_back(
+      ToWire(Query{.id = 1, .type = QueryType::kStateStream, .period = options.sample_period}));
   stream.num_queries = 1;
   service.HandlePackage(stream, t0);
 
   robotalk_msgs::package_t sequence{};
-  sequence.header = header(2, robotalk_msgs::package_header_t::PAYLOAD_COMMANDS, static_cast<std::int32_t>(commands.size()));
+  sequence.header = header(2, robotalk_msgs::package_header_t::PAYLOAD_COMMANDS,
+                           static_cast<std::int32_t>(commands.size()));
   for (std::size_t i = 0; i < commands.size(); ++i) {
     Command c = commands[i].command;
     c.id = static_cast<CommandId>(i) + 2;

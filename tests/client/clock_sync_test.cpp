@@ -55,7 +55,7 @@ TEST(ClockSync, KeepsTheSampleWithTheSmallestRoundTrip) {
 
 TEST(ClockSync, IgnoresInconsistentSamples) {
   ClockSync s;
-  EXPECT_FALSE(s.AddSample(kT0, kT0, kT0, kT0 - milliseconds(1)));                   // t4 < t1
+  EXPECT_FALSE(s.AddSample(kT0, kT0, kT0, kT0 - milliseconds(1)));                    // t4 < t1
   EXPECT_FALSE(s.AddSample(kT0, kT0 + milliseconds(5), kT0, kT0 + milliseconds(9)));  // t3 < t2
   // Server claims 10 ms of processing inside a 5 ms round trip.
   EXPECT_FALSE(s.AddSample(kT0, kT0, kT0 + milliseconds(10), kT0 + milliseconds(5)));

@@ -15,8 +15,8 @@ std::string Hex(std::uint64_t v) {
   return buf;
 }
 
-robotalk_msgs::reply_t MakeReply(std::int64_t id, std::int8_t signal, std::string message, std::int64_t now_us,
-                                 std::vector<double> values = {}) {
+robotalk_msgs::reply_t MakeReply(std::int64_t id, std::int8_t signal, std::string message,
+                                 std::int64_t now_us, std::vector<double> values = {}) {
   robotalk_msgs::reply_t r{};
   r.id = id;
   r.signal = signal;
@@ -104,7 +104,8 @@ void FakeServer::SendLocked(robotalk_msgs::reply_package_t p) {
   p.server_send_us = ServerNowUs();
   p.num_replies = static_cast<std::int32_t>(p.replies.size());
   if (std::uniform_real_distribution<double>(0, 1)(rng_) < options_.reply_drop_probability) return;
-  const std::string channel = "ROBOTALK/" + model_.name() + "/REPLY/" + Hex(static_cast<std::uint64_t>(p.client_id));
+  const std::string channel =
+      "ROBOTALK/" + model_.name() + "/REPLY/" + Hex(static_cast<std::uint64_t>(p.client_id));
   lcm_.publish(channel, &p);
   if (options_.duplicate_replies) lcm_.publish(channel, &p);
 }
@@ -147,14 +148,18 @@ void FakeServer::OnRequest(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     switch (q.type) {
       case robotalk_msgs::query_t::CONFIG: {
         const auto bytes = EncodeConfig(model_);
-        lcm_.publish("ROBOTALK/" + model_.name() + "/CONFIG", bytes.data(), static_cast<unsigned>(bytes.size()));
+        lcm_.publish("ROBOTALK/" + model_.name() + "/CONFIG", bytes.data(),
+                     static_cast<unsigned>(bytes.size()));
         r = MakeReply(q.id, 0, Hex(ConfigHash(model_)), receive_us);
         break;
       }
       case robotalk_msgs::query_t::JOINT_STATE:
-        r = MakeReply(q.id, 0, "", receive_us, std::vector<double>(3 * static_cast<size_t>(model_.num_dofs()), 0.0));
+        r = MakeReply(q.id, 0, "", receive_us,
+                      std::vector<double>(3 * static_cast<size_t>(model_.num_dofs()), 0.0));
         break;
-      default: r = MakeReply(q.id, 0, "", receive_us); break;
+      default:
+        r = MakeReply(q.id, 0, "", receive_us);
+        break;
     }
     now_replies.push_back(r);
   }
@@ -169,7 +174,8 @@ void FakeServer::OnRequest(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     } else if (panic_) {
       now_replies.push_back(MakeReply(c.id, robotalk_msgs::reply_t::PANIC, "robot in panic", receive_us));
     } else if (c.start_time_us > receive_us) {
-      delayed_.push_back({c.start_time_us, h.client_id, MakeReply(c.id, 0, "cmd " + std::to_string(c.id), 0)});
+      delayed_.push_back(
+          {c.start_time_us, h.client_id, MakeReply(c.id, 0, "cmd " + std::to_string(c.id), 0)});
     } else {
       now_replies.push_back(MakeReply(c.id, 0, "cmd " + std::to_string(c.id), receive_us));
     }

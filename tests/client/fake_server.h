@@ -76,7 +76,7 @@ class FakeServer {
   mutable std::mutex mu_;
   std::mt19937_64 rng_;
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::int64_t>> seen_;  // (client, seq) -> ids
-  std::map<std::int64_t, robotalk_msgs::reply_t> finals_;  // id -> final reply
+  std::map<std::int64_t, robotalk_msgs::reply_t> finals_;                            // id -> final reply
   std::map<std::int64_t, int> executions_;
   std::vector<Delayed> delayed_;
   bool panic_ = false;

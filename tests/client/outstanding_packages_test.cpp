@@ -10,7 +10,10 @@ using std::chrono::seconds;
 const TimePoint kT0(seconds(1000));
 
 RetransmitPolicy Policy() {
-  return {.interval = milliseconds(100), .backoff = 2.0, .max_interval = milliseconds(400), .give_up_after = seconds(2)};
+  return {.interval = milliseconds(100),
+          .backoff = 2.0,
+          .max_interval = milliseconds(400),
+          .give_up_after = seconds(2)};
 }
 std::vector<std::uint8_t> Bytes(std::uint8_t b) { return {b, b, b}; }
 

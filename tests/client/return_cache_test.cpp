@@ -20,7 +20,8 @@ std::chrono::steady_clock::time_point In(milliseconds d) { return std::chrono::s
 TEST(ReturnCache, FilesRepliesArrivingOutOfOrder) {
   ReturnCache cache;
   for (CommandId id = 1; id <= 5; ++id) cache.Expect(id);
-  for (CommandId id = 5; id >= 1; --id) EXPECT_TRUE(cache.Put(MakeReply(id, Signal::kSuccess, std::to_string(id))));
+  for (CommandId id = 5; id >= 1; --id)
+    EXPECT_TRUE(cache.Put(MakeReply(id, Signal::kSuccess, std::to_string(id))));
   for (CommandId id = 1; id <= 5; ++id) {
     auto o = cache.Take(id);
     ASSERT_EQ(o.kind, Kind::kReply);

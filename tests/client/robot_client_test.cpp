@@ -1,8 +1,8 @@
 // RobotClient against FakeServer on one in-process memq:// LCM: acks,
 // duplicates, dropped packages, reordering, scheduling, panic, timeouts.
+#include "robotalk/robot_client.h"
 #include "fake_server.h"
 #include "robotalk/config_codec.h"
-#include "robotalk/robot_client.h"
 #include "robotalk/urdf_import.h"
 
 #include <gtest/gtest.h>
@@ -30,7 +30,9 @@ class RobotClientTest : public ::testing::Test {
     o.connect_timeout = std::chrono::seconds(5);
     return o;
   }
-  void StartServer(FakeServerOptions options = {}) { server_ = std::make_unique<FakeServer>(lcm_, model_, options); }
+  void StartServer(FakeServerOptions options = {}) {
+    server_ = std::make_unique<FakeServer>(lcm_, model_, options);
+  }
   std::unique_ptr<RobotClient> Connected(ClientOptions o) {
     auto c = std::make_unique<RobotClient>(o);
     c->Connect(model_.name());
@@ -50,7 +52,8 @@ TEST_F(RobotClientTest, ConnectSynchronisesTheClockAndLoadsTheModel) {
   // The fake server's clock runs 1000 s ahead; in-process round trips are short.
   EXPECT_NEAR(ToSeconds(client->clock_offset()), 1000.0, 0.01);
   EXPECT_LT(client->clock_round_trip(), milliseconds(50));
-  const double skew = ToSeconds(client->ServerNow().time_since_epoch()) * 1e6 - static_cast<double>(server_->ServerNowUs());
+  const double skew =
+      ToSeconds(client->ServerNow().time_since_epoch()) * 1e6 - static_cast<double>(server_->ServerNowUs());
   EXPECT_LT(std::abs(skew), 20000.0);
 }
 
@@ -83,7 +86,8 @@ TEST_F(RobotClientTest, SurvivesDroppedAndDuplicatedPackagesEachCommandOnce) {
   o.retransmit_max_interval = milliseconds(100);
   auto client = Connected(o);
   std::vector<PendingReply> pending;
-  for (int i = 0; i < 40; ++i) pending.push_back(client->Send(Command{.type = CommandType::kSetSpeed, .values = {0.1, 0.0}}));
+  for (int i = 0; i < 40; ++i)
+    pending.push_back(client->Send(Command{.type = CommandType::kSetSpeed, .values = {0.1, 0.0}}));
   for (auto& p : pending) {
     Reply r = p.Wait(std::chrono::seconds(10));
     EXPECT_EQ(r.signal, Signal::kSuccess);
@@ -101,7 +105,8 @@ TEST_F(RobotClientTest, BatchRepliesInReverseOrderReachTheirOwnCallers) {
   StartServer({.reverse_batches = true});
   auto client = Connected(Options());
   std::vector<Command> batch;
-  for (int i = 0; i < 5; ++i) batch.push_back(Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.1 * i}});
+  for (int i = 0; i < 5; ++i)
+    batch.push_back(Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.1 * i}});
   auto pending = client->SendBatch(batch);
   ASSERT_EQ(pending.size(), 5u);
   for (auto& p : pending) {

@@ -38,16 +38,18 @@ TEST(SequenceFile, ParsesCommandsCommentsAndBlankLines) {
 }
 
 TEST(SequenceFile, ErrorsNameTheLine) {
-  EXPECT_EQ(ErrorOf("0 stop\n\n1 jump 3\n"),
-            "seq.txt:3: unknown command 'jump' (joint_setpoint, joint_speed, joint_force, frame_setpoint, goto, "
-            "setspeed, stop, panic_reset)");
+  EXPECT_EQ(
+      ErrorOf("0 stop\n\n1 jump 3\n"),
+      "seq.txt:3: unknown command 'jump' (joint_setpoint, joint_speed, joint_force, frame_setpoint, goto, "
+      "setspeed, stop, panic_reset)");
   EXPECT_EQ(ErrorOf("# c\nsoon goto 1 0 0\n"), "seq.txt:2: start time: 'soon' is not a number");
   EXPECT_EQ(ErrorOf("-1 stop\n"), "seq.txt:1: start time -1 is negative");
   EXPECT_EQ(ErrorOf("0 goto 1 0\n"), "seq.txt:1: GOTO takes 3 values (x y theta), got 2");
   EXPECT_EQ(ErrorOf("0 goto 1 0 x\n"), "seq.txt:1: GOTO value 3: 'x' is not a number");
   EXPECT_EQ(ErrorOf("0 setspeed nan 0\n"), "seq.txt:1: SETSPEED value 1: 'nan' is not finite");
   EXPECT_EQ(ErrorOf("0 joint_setpoint\n"), "seq.txt:1: JOINT_SETPOINT needs a target name");
-  EXPECT_EQ(ErrorOf("0 joint_speed pan\n"), "seq.txt:1: JOINT_SPEED takes one value per dof of the joint, got 0");
+  EXPECT_EQ(ErrorOf("0 joint_speed pan\n"),
+            "seq.txt:1: JOINT_SPEED takes one value per dof of the joint, got 0");
   EXPECT_EQ(ErrorOf("0 stop 1\n"), "seq.txt:1: STOP takes no values, got 1");
   EXPECT_EQ(ErrorOf("1.5\n"), "seq.txt:1: missing command after the start time");
   EXPECT_EQ(ErrorOf("# nothing\n\n"), "seq.txt: no commands");

@@ -9,8 +9,8 @@
 
 #include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <functional>
+#include <iostream>
 #include <random>
 #include <set>
 
@@ -67,22 +67,25 @@ RobotModel EverythingModel() {
              "finger_l");
   b.AddJoint(MakeJoint("finger_r_joint", {Pris(-Eigen::Vector3d::UnitY())}, ServoType::kForce), "arm",
              "finger_r");
-  b.AddJoint(MakeJoint("lift_joint", {Pris(Eigen::Vector3d::UnitZ(), {-kInf, 1.0, 0.2, kInf})}), "base", "lift");
+  b.AddJoint(MakeJoint("lift_joint", {Pris(Eigen::Vector3d::UnitZ(), {-kInf, 1.0, 0.2, kInf})}), "base",
+             "lift");
   b.AddJoint(MakeJoint("tray_fixed", {}), "lift", "tray");
   const Eigen::Vector3d diag = Eigen::Vector3d(1, 1, 1).normalized();
   b.AddJoint(MakeJoint("tether", {Pris(Eigen::Vector3d::UnitX(), DofLimits{}), Pris(Eigen::Vector3d::UnitY()),
-                                   Pris(Eigen::Vector3d::UnitZ()), Rev(Eigen::Vector3d::UnitX()),
-                                   Rev(diag), Rev(Eigen::Vector3d::UnitZ(), {-kInf, 0.5, 1.0, 2.0})}),
+                                  Pris(Eigen::Vector3d::UnitZ()), Rev(Eigen::Vector3d::UnitX()), Rev(diag),
+                                  Rev(Eigen::Vector3d::UnitZ(), {-kInf, 0.5, 1.0, 2.0})}),
              "drone", "payload");
   b.SetMimic("finger_r_joint", "finger_l_joint", -1.0, 0.001);
   b.AddControlFrame(ControlFrame{.name = "camera",
-                                 .pose_in_link = {{0.05, 0.0, 0.1},
-                                                  Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5)},
+                                 .pose_in_link = {{0.05, 0.0, 0.1}, Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5)},
                                  .servo_types = ServoType::kNone},
                     "head");
-  b.AddControlFrame(ControlFrame{.name = "tool", .pose_in_link = {{0, 0, 0.3}, Eigen::Quaterniond::Identity()}, .servo_types = ServoTypes::All()},
+  b.AddControlFrame(ControlFrame{.name = "tool",
+                                 .pose_in_link = {{0, 0, 0.3}, Eigen::Quaterniond::Identity()},
+                                 .servo_types = ServoTypes::All()},
                     "arm");
-  b.SetRoot("base", Pose{{1.0, 2.0, 0.0}, Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()))},
+  b.SetRoot("base",
+            Pose{{1.0, 2.0, 0.0}, Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()))},
             BaseType::kDifferential);
   b.SetRoot("drone", Pose{{0, 0, 3.0}, Eigen::Quaterniond::Identity()}, BaseType::kFloating);
   b.SetRoot("table", Pose{{-2.0, 0.5, 0.75}, Eigen::Quaterniond::Identity()}, BaseType::kFixed);
@@ -99,7 +102,9 @@ RobotModel SmallModel() {
   Joint joint1 = MakeJoint("joint1", {Rev(Eigen::Vector3d::UnitZ())}, ServoType::kSetPoint);
   joint1.rest = Eigen::Quaterniond(0.6, 0.8, 0.0, 0.0);
   b.AddJoint(joint1, "base", "link1");
-  b.AddControlFrame(ControlFrame{.name = "tip", .pose_in_link = {{0, 0, 0.5}, Eigen::Quaterniond::Identity()}, .servo_types = ServoType::kSetPoint},
+  b.AddControlFrame(ControlFrame{.name = "tip",
+                                 .pose_in_link = {{0, 0, 0.5}, Eigen::Quaterniond::Identity()},
+                                 .servo_types = ServoType::kSetPoint},
                     "link1");
   return b.Build();
 }
@@ -123,7 +128,9 @@ std::vector<std::uint8_t> Encode(const msgs::robot_config_t& msg) {
 
 // Recomputes the header hash of an edited message, as a careless (or hostile)
 // client would, so that the check under test is not the hash check.
-void Reseal(msgs::robot_config_t& msg) { msg.header.hash = static_cast<std::int64_t>(DocumentedHash(Encode(msg))); }
+void Reseal(msgs::robot_config_t& msg) {
+  msg.header.hash = static_cast<std::int64_t>(DocumentedHash(Encode(msg)));
+}
 
 std::int32_t BigEndian32(const std::vector<std::uint8_t>& b, size_t at) {
   return static_cast<std::int32_t>((std::uint32_t{b[at]} << 24) | (std::uint32_t{b[at + 1]} << 16) |
@@ -346,8 +353,10 @@ TEST(ConfigCodec, ChangingAnyOneFieldChangesTheHash) {
   };
   for (int k = 0; k < 3; ++k) {
     edits.emplace_back("link com " + std::to_string(k), [=](Parts& p) { p.links[2].com[k] += d; });
-    edits.emplace_back("joint inboard " + std::to_string(k), [=](Parts& p) { p.joints[neck].inboard[k] += d; });
-    edits.emplace_back("joint outboard " + std::to_string(k), [=](Parts& p) { p.joints[neck].outboard[k] += d; });
+    edits.emplace_back("joint inboard " + std::to_string(k),
+                       [=](Parts& p) { p.joints[neck].inboard[k] += d; });
+    edits.emplace_back("joint outboard " + std::to_string(k),
+                       [=](Parts& p) { p.joints[neck].outboard[k] += d; });
     edits.emplace_back("frame position " + std::to_string(k),
                        [=](Parts& p) { p.frames[1].pose_in_link.translation[k] += d; });
     edits.emplace_back("root position " + std::to_string(k),
@@ -380,8 +389,8 @@ TEST(ConfigCodec, ChangingAnyOneFieldChangesTheHash) {
 
 TEST(ConfigCodec, FromMessageNamesTheHeaderFieldThatDisagrees) {
   const msgs::robot_config_t good = ToMessage(EverythingModel());
-  auto expect = [&](std::function<void(msgs::robot_config_t&)> edit, std::initializer_list<const char*> fragments,
-                    bool reseal = true) {
+  auto expect = [&](std::function<void(msgs::robot_config_t&)> edit,
+                    std::initializer_list<const char*> fragments, bool reseal = true) {
     msgs::robot_config_t msg = good;
     edit(msg);
     if (reseal) Reseal(msg);
@@ -399,7 +408,8 @@ TEST(ConfigCodec, FromMessageNamesTheHeaderFieldThatDisagrees) {
 
 TEST(ConfigCodec, FromMessageRefusesUnknownEnumsIndicesAndBadDofCounts) {
   const msgs::robot_config_t good = ToMessage(EverythingModel());
-  auto expect = [&](std::function<void(msgs::robot_config_t&)> edit, std::initializer_list<const char*> fragments) {
+  auto expect = [&](std::function<void(msgs::robot_config_t&)> edit,
+                    std::initializer_list<const char*> fragments) {
     msgs::robot_config_t msg = good;
     edit(msg);
     Reseal(msg);
@@ -484,8 +494,9 @@ TEST(ConfigCodec, HostileCountsAreRefusedBeforeAllocating) {
   const std::uint32_t values[] = {0x7fffffffu, 0x80000000u, 0xffffffffu, 0x10000000u, 100000u};
   for (std::int32_t at : offsets) {
     const std::int32_t count = BigEndian32(bytes, static_cast<size_t>(at));
-    for (std::uint32_t v : {values[0], values[1], values[2], values[3], values[4], static_cast<std::uint32_t>(count + 1),
-                            static_cast<std::uint32_t>(count - 1), 0u}) {
+    for (std::uint32_t v :
+         {values[0], values[1], values[2], values[3], values[4], static_cast<std::uint32_t>(count + 1),
+          static_cast<std::uint32_t>(count - 1), 0u}) {
       std::vector<std::uint8_t> bad = bytes;
       PutBigEndian32(bad, static_cast<size_t>(at), v);
       EXPECT_EQ(TryDecode(bad), Outcome::kProtocolError) << "count at " << at << " = " << v;
@@ -509,7 +520,8 @@ TEST(ConfigCodec, HostileStringLengthsAndDofCountsAreRefused) {
   ExpectProtocolError([&] { DecodeConfig(bad); }, {"robot_name", "NUL"});
   // joints[0] ("torso_fixed"): count, name string, 89 fixed bytes, then num_dofs.
   const msgs::config_header_t h = DecodeConfigHeader(bytes);
-  const size_t num_dofs_at = static_cast<size_t>(h.joint_block_offset) + 4 + 4 + std::strlen("torso_fixed") + 1 + 89;
+  const size_t num_dofs_at =
+      static_cast<size_t>(h.joint_block_offset) + 4 + 4 + std::strlen("torso_fixed") + 1 + 89;
   ASSERT_EQ(bytes[num_dofs_at], 0);
   for (std::uint8_t v : {0x7f, 0x80, 0xff, 0x07}) {
     bad = bytes;

@@ -1,5 +1,5 @@
-#include "robotalk/error.h"
 #include "robotalk/protocol_codec.h"
+#include "robotalk/error.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -17,8 +17,10 @@ robotalk_msgs::package_t SamplePackage() {
   p.header.client_id = 42;
   p.header.sequence = 7;
   p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
-  p.commands.push_back(ToWire(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan_tilt", {0.5, -0.25}}));
-  p.commands.push_back(ToWire(Command{2, CommandType::kGoto, TimePoint(std::chrono::seconds(12)), "", {1, 2, 3}}));
+  p.commands.push_back(
+      ToWire(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan_tilt", {0.5, -0.25}}));
+  p.commands.push_back(
+      ToWire(Command{2, CommandType::kGoto, TimePoint(std::chrono::seconds(12)), "", {1, 2, 3}}));
   p.num_commands = 2;
   p.header.payload_size = 2;
   return p;
@@ -31,7 +33,10 @@ std::vector<std::uint8_t> Encode(const robotalk_msgs::package_t& p) {
 }
 
 TEST(ProtocolCodec, RoundTripsCommandsQueriesAndReplies) {
-  const Command c{9, CommandType::kFrameSetPoint, TimePoint(std::chrono::microseconds(123456789)), "camera",
+  const Command c{9,
+                  CommandType::kFrameSetPoint,
+                  TimePoint(std::chrono::microseconds(123456789)),
+                  "camera",
                   {1, 2, 3, 1, 0, 0, 0}};
   const Command back = FromWire(ToWire(c));
   EXPECT_EQ(back.id, c.id);
@@ -45,7 +50,9 @@ TEST(ProtocolCodec, RoundTripsCommandsQueriesAndReplies) {
   EXPECT_EQ(FromWire(ToWire(q)).target, "head");
   EXPECT_EQ(FromWire(ToWire(q)).type, QueryType::kLinkPoses);
 
-  Reply r{4, Signal::kModified, "clamped", TimePoint(std::chrono::seconds(5)), std::chrono::milliseconds(7), {1.5}};
+  Reply r{
+      4,    Signal::kModified, "clamped", TimePoint(std::chrono::seconds(5)), std::chrono::milliseconds(7),
+      {1.5}};
   const Reply rb = FromWire(ToWire(r));
   EXPECT_EQ(rb.signal, Signal::kModified);
   EXPECT_EQ(rb.message, "clamped");
@@ -88,7 +95,8 @@ TEST(ProtocolCodec, RefusesHostileCountsWithoutAllocating) {
   const size_t num_commands_at = 8 + 53 + 4;  // fingerprint, header, num_queries
   for (std::uint32_t hostile : {0x7fffffffu, 0x80000000u, 0xffffffffu, 100000u}) {
     auto bad = bytes;
-    for (int i = 0; i < 4; ++i) bad[num_commands_at + static_cast<size_t>(i)] = static_cast<std::uint8_t>(hostile >> (24 - 8 * i));
+    for (int i = 0; i < 4; ++i)
+      bad[num_commands_at + static_cast<size_t>(i)] = static_cast<std::uint8_t>(hostile >> (24 - 8 * i));
     try {
       DecodePackage(bad);
       ADD_FAILURE() << "accepted num_commands " << hostile;
@@ -173,7 +181,8 @@ TEST(CheckCommand, AcceptsWellFormedCommandsAndNamesWhatIsWrongOtherwise) {
   EXPECT_EQ(Check(m, {1, CommandType::kJointSetPoint, {}, "pan_tilt", {0.1, 0.2}}).first, Signal::kSuccess);
   EXPECT_EQ(Check(m, {1, CommandType::kGoto, {}, "", {1, 2, 0}}).first, Signal::kSuccess);
   EXPECT_EQ(Check(m, {1, CommandType::kSetSpeed, {}, "", {0.1, 0.0, 0.2}}).first, Signal::kSuccess);
-  EXPECT_EQ(Check(m, {1, CommandType::kFrameSetPoint, {}, "camera", {0, 0, 1, 1, 0, 0, 0}}).first, Signal::kSuccess);
+  EXPECT_EQ(Check(m, {1, CommandType::kFrameSetPoint, {}, "camera", {0, 0, 1, 1, 0, 0, 0}}).first,
+            Signal::kSuccess);
 
   auto [s1, m1] = Check(m, {1, CommandType::kJointSetPoint, {}, "pan_tilt", {0.1}});
   EXPECT_EQ(s1, Signal::kError);

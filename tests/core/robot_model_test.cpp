@@ -1,5 +1,5 @@
-#include "robotalk/error.h"
 #include "robotalk/robot_model.h"
+#include "robotalk/error.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

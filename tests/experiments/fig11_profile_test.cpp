@@ -19,9 +19,10 @@ TEST(Fig11Profile, ShapeAndTiming) {
   ASSERT_EQ(p.frames.size(), 8u * 38u + 1u);
   EXPECT_NEAR(p.radius, 6.0 / (8 * kPi), 1e-12);
   EXPECT_NEAR(p.speed * p.duration, 6.0, 1e-9);  // constant speed over the whole length
-  for (std::size_t i = 0; i < p.frames.size(); ++i) EXPECT_NEAR(p.frames[i].offset, 0.1 * static_cast<double>(i), 1e-9);
-  EXPECT_GT(p.frames.front().omega, 0);                    // first small half circle turns left
-  EXPECT_LT(p.frames[38].omega, 0);                        // second turns right
+  for (std::size_t i = 0; i < p.frames.size(); ++i)
+    EXPECT_NEAR(p.frames[i].offset, 0.1 * static_cast<double>(i), 1e-9);
+  EXPECT_GT(p.frames.front().omega, 0);  // first small half circle turns left
+  EXPECT_LT(p.frames[38].omega, 0);      // second turns right
   EXPECT_NEAR(p.frames[4 * 38].omega, -p.speed / (4 * p.radius), 1e-12);  // large, right
   EXPECT_EQ(p.frames.back().v, 0.0);
   EXPECT_EQ(p.frames.back().omega, 0.0);
@@ -63,15 +64,16 @@ TEST(Fig11Profile, DistanceToArcs) {
   const Arc arc{{0, 0, 0}, 1.0, 1.0, kPi / 2};
   EXPECT_NEAR(arc.End().x, 1.0, 1e-12);
   EXPECT_NEAR(arc.End().y, 1.0, 1e-12);
-  EXPECT_NEAR(arc.Distance(0, 1), 1.0, 1e-12);                         // centre
+  EXPECT_NEAR(arc.Distance(0, 1), 1.0, 1e-12);                               // centre
   EXPECT_NEAR(arc.Distance(std::sqrt(2.0), 1 - std::sqrt(2.0)), 1.0, 1e-9);  // 2 from the centre, mid-sweep
-  EXPECT_NEAR(arc.Distance(-1, 1), std::sqrt(2.0), 1e-9);              // outside the sweep: nearest end (0, 0)
-  EXPECT_NEAR(arc.Distance(0, -0.5), 0.5, 1e-12);                      // on the start ray: 0.5 below the start
-  const Arc right{{0, 0, 0}, 1.0, -1.0, kPi / 2};                      // turning right, centre (0, -1)
+  EXPECT_NEAR(arc.Distance(-1, 1), std::sqrt(2.0), 1e-9);  // outside the sweep: nearest end (0, 0)
+  EXPECT_NEAR(arc.Distance(0, -0.5), 0.5, 1e-12);          // on the start ray: 0.5 below the start
+  const Arc right{{0, 0, 0}, 1.0, -1.0, kPi / 2};          // turning right, centre (0, -1)
   EXPECT_NEAR(right.End().y, -1.0, 1e-12);
   EXPECT_NEAR(right.Distance(1, -1), 0.0, 1e-12);
-  EXPECT_NEAR(right.Distance(1, 1), std::hypot(1, 2) - 1, 1e-9);      // (1, 1) is at 63° around the centre: within the sweep
-  const Arc line{{0, 0, kPi / 2}, 2.0, 0.0, 1.0};                      // straight up to (0, 2)
+  EXPECT_NEAR(right.Distance(1, 1), std::hypot(1, 2) - 1,
+              1e-9);                               // (1, 1) is at 63° around the centre: within the sweep
+  const Arc line{{0, 0, kPi / 2}, 2.0, 0.0, 1.0};  // straight up to (0, 2)
   EXPECT_NEAR(line.Distance(0.3, 1.0), 0.3, 1e-12);
   EXPECT_NEAR(line.Distance(0, 3), 1.0, 1e-12);
 }
@@ -83,7 +85,8 @@ TEST(Fig11Profile, DeviationOfTheIdealSamplesIsZero) {
   for (int i = 0; i <= 720; ++i) {
     const Pose2 q = path.At(i * 0.02);
     on.push_back(q);
-    off.push_back({q.x + 0.01 * std::cos(q.theta + kPi / 2), q.y + 0.01 * std::sin(q.theta + kPi / 2), q.theta});
+    off.push_back(
+        {q.x + 0.01 * std::cos(q.theta + kPi / 2), q.y + 0.01 * std::sin(q.theta + kPi / 2), q.theta});
   }
   const Deviation d0 = MeasureDeviation(path, on);
   EXPECT_EQ(d0.samples, 721u);

@@ -19,17 +19,17 @@
 namespace robotalk {
 namespace {
 
-using ::testing::HasSubstr;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
+using ::testing::HasSubstr;
 
 constexpr const char* kUrl = "udpm://239.255.76.67:7711?ttl=0";
 
 // Records every set-point the driver executes, to prove exactly-once delivery.
 struct ExecutionLog {
   std::mutex mutex;
-  std::map<double, int> setpoints;               // pan value -> times executed
-  std::map<double, TimePoint> setpoint_times;    // pan value -> when it executed
+  std::map<double, int> setpoints;             // pan value -> times executed
+  std::map<double, TimePoint> setpoint_times;  // pan value -> when it executed
 };
 
 class CountingDriver final : public Driver {
@@ -87,8 +87,7 @@ class ServerClientTest : public ::testing::Test {
 TEST_F(ServerClientTest, ConnectsLoadsTheConfigurationAndSynchronisesClocks) {
   StartServer();
   auto client = Connect();
-  const RobotModel local =
-      LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model;
+  const RobotModel local = LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model;
   EXPECT_EQ(client->model().num_dofs(), local.num_dofs());
   EXPECT_EQ(client->model().links().size(), local.links().size());
   // Same machine, same steady clock: the estimated offset is within the round trip.
@@ -136,7 +135,8 @@ TEST_F(ServerClientTest, ExecutesEachCommandExactlyOnceDespiteLossAndDuplication
   constexpr int kCommands = 120;
   std::vector<PendingReply> pending;
   for (int i = 0; i < kCommands; ++i) {
-    pending.push_back(client->Send(Command{0, CommandType::kJointSetPoint, std::nullopt, pan, {0.001 * (i + 1)}}));
+    pending.push_back(
+        client->Send(Command{0, CommandType::kJointSetPoint, std::nullopt, pan, {0.001 * (i + 1)}}));
   }
   for (PendingReply& p : pending) {
     const Reply r = p.Wait(seconds(30));
@@ -197,7 +197,8 @@ TEST_F(ServerClientTest, TimesOutConnectingToARobotNobodyServes) {
 std::vector<TimedCommand> PanFrames(int n) {
   std::vector<TimedCommand> frames;
   for (int i = 0; i < n; ++i) {
-    frames.push_back({milliseconds(100) * i, Command{0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.01 * (i + 1)}}});
+    frames.push_back({milliseconds(100) * i,
+                      Command{0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.01 * (i + 1)}}});
   }
   return frames;
 }
@@ -207,7 +208,8 @@ TEST_F(ServerClientTest, DelayModeRunsEveryCommandAtItsStartTimeDespiteCongestio
   options.congestion_max_pause = milliseconds(80);  // the paper's injector
   StartServer(options);
   auto client = Connect();
-  const SequenceResult result = client->RunSequence(PanFrames(20), {.mode = CommandMode::kDelay, .delay = seconds(1)});
+  const SequenceResult result =
+      client->RunSequence(PanFrames(20), {.mode = CommandMode::kDelay, .delay = seconds(1)});
   ASSERT_TRUE(result.server_start);
   std::lock_guard lock(log_->mutex);
   for (int i = 0; i < 20; ++i) {
@@ -215,9 +217,11 @@ TEST_F(ServerClientTest, DelayModeRunsEveryCommandAtItsStartTimeDespiteCongestio
     const TimePoint due = *result.server_start + milliseconds(100) * i;
     const Duration late = log_->setpoint_times.at(0.01 * (i + 1)) - due;
     EXPECT_GE(late, Duration(0)) << "frame " << i << " ran early";
-    EXPECT_LT(late, milliseconds(30)) << "frame " << i << " ran late (RobotDaemon wake-up on a shared machine)";
+    EXPECT_LT(late, milliseconds(30))
+        << "frame " << i << " ran late (RobotDaemon wake-up on a shared machine)";
     // The reply says how late it ran (the wire carries microseconds).
-    EXPECT_LE(std::chrono::abs(result.replies[static_cast<size_t>(i)].lateness - late), std::chrono::microseconds(1));
+    EXPECT_LE(std::chrono::abs(result.replies[static_cast<size_t>(i)].lateness - late),
+              std::chrono::microseconds(1));
   }
 }
 
@@ -241,7 +245,8 @@ TEST_F(ServerClientTest, PlaybackKeepsTheInterFrameTimingUnderCongestion) {
   ASSERT_EQ(log_->setpoint_times.size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) {
     EXPECT_EQ(result.replies[static_cast<size_t>(i)].signal, Signal::kSuccess);
-    const Duration late = log_->setpoint_times.at(0.01 * (i + 1)) - (*result.server_start + milliseconds(100) * i);
+    const Duration late =
+        log_->setpoint_times.at(0.01 * (i + 1)) - (*result.server_start + milliseconds(100) * i);
     EXPECT_GE(late, -std::chrono::microseconds(1)) << "frame " << i;
     EXPECT_LT(late, milliseconds(30)) << "frame " << i << ": the sequence ran dry";
   }
@@ -261,14 +266,16 @@ TEST_F(ServerClientTest, BroadcastKeepsItsPeriodAndStopsOnCancel) {
   auto watcher = Connect();
   std::mutex mu;
   std::vector<std::int64_t> times;
-  const Duration period = client->StartStateStream(milliseconds(50), [&](const robotalk_msgs::robot_state_t& s) {
-    std::lock_guard lock(mu);
-    times.push_back(s.server_time_us);
-  });
+  const Duration period =
+      client->StartStateStream(milliseconds(50), [&](const robotalk_msgs::robot_state_t& s) {
+        std::lock_guard lock(mu);
+        times.push_back(s.server_time_us);
+      });
   EXPECT_EQ(period, milliseconds(50));
   // Another subscriber sees the same stream without asking (as lcm-spy would).
   std::atomic<int> seen_by_watcher{0};
-  watcher->StartStateStream(milliseconds(500), [&](const robotalk_msgs::robot_state_t&) { ++seen_by_watcher; });
+  watcher->StartStateStream(milliseconds(500),
+                            [&](const robotalk_msgs::robot_state_t&) { ++seen_by_watcher; });
   std::this_thread::sleep_for(seconds(2));
   client->StopStateStream();
   watcher->StopStateStream();

@@ -24,16 +24,20 @@ robotalk::RobotModel BindingBot() {
   finger_b.name = "finger_b";
 
   Joint pan_tilt{.name = "pan_tilt", .inboard = {0.0, 0.0, 0.3}, .servo_types = ServoTypes::All()};
-  pan_tilt.dofs = {Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitZ()},
-                   Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitY(), .limits = {-0.5, 0.5, 1.0, 2.0}}};
+  pan_tilt.dofs = {
+      Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitZ()},
+      Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitY(), .limits = {-0.5, 0.5, 1.0, 2.0}}};
   Joint grip_a{.name = "grip_a", .servo_types = ServoType::kForce};
-  grip_a.dofs = {Dof{.type = DofType::kPrismatic, .axis = Eigen::Vector3d::UnitY(), .limits = {0.0, 0.04, 0.1, 20.0}}};
+  grip_a.dofs = {
+      Dof{.type = DofType::kPrismatic, .axis = Eigen::Vector3d::UnitY(), .limits = {0.0, 0.04, 0.1, 20.0}}};
   Joint grip_b = grip_a;
   grip_b.name = "grip_b";
 
   RobotModelBuilder b("binding_bot");
   b.AddLink(body).AddLink(head).AddLink(finger_a).AddLink(finger_b);
-  b.AddJoint(pan_tilt, "body", "head").AddJoint(grip_a, "head", "finger_a").AddJoint(grip_b, "head", "finger_b");
+  b.AddJoint(pan_tilt, "body", "head")
+      .AddJoint(grip_a, "head", "finger_a")
+      .AddJoint(grip_b, "head", "finger_b");
   b.SetMimic("grip_b", "grip_a", 1.0, 0.0);
   b.AddControlFrame(ControlFrame{.name = "camera",
                                  .pose_in_link = {{0.05, 0.0, 0.0}, Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5)},
@@ -58,7 +62,8 @@ int main(int argc, char** argv) {
     std::cerr << argv[0] << ": cannot write " << argv[1] << "\n";
     return 1;
   }
-  std::printf("robot=%s links=%zu joints=%zu frames=%zu roots=%zu dofs=%d hash=0x%016" PRIx64 " verified=yes\n",
+  std::printf("robot=%s links=%zu joints=%zu frames=%zu roots=%zu dofs=%d hash=0x%016" PRIx64
+              " verified=yes\n",
               model.name().c_str(), model.links().size(), model.joints().size(), model.frames().size(),
               model.roots().size(), model.num_dofs(), robotalk::ConfigHash(model));
   return 0;

@@ -18,7 +18,8 @@ inline RobotModel PanRobot(BaseType base = BaseType::kDifferential) {
   head.inertia = Eigen::Matrix3d::Identity() * 0.01;
   b.AddLink(body).AddLink(head);
   Joint pan{.name = "pan"};
-  pan.dofs.push_back(Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitZ(), .limits = {-1, 1, 1, 1}});
+  pan.dofs.push_back(
+      Dof{.type = DofType::kRevolute, .axis = Eigen::Vector3d::UnitZ(), .limits = {-1, 1, 1, 1}});
   pan.servo_types = ServoType::kSetPoint;
   b.AddJoint(pan, "base", "head");
   b.SetRoot("base", Pose{}, base);

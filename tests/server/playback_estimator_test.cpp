@@ -16,7 +16,8 @@ const TimePoint kT0(std::chrono::seconds(100));
 // start, every frame is there before it has to play.
 template <typename Arrival>
 bool PlaysWithoutRunningDry(std::size_t n, Duration period, Arrival arrival, TimePoint* start_out = nullptr) {
-  PlaybackEstimator est(n, period * static_cast<int>(n - 1), {.min_frames = 5, .fraction = 0.1, .margin = milliseconds(50)});
+  PlaybackEstimator est(n, period * static_cast<int>(n - 1),
+                        {.min_frames = 5, .fraction = 0.1, .margin = milliseconds(50)});
   std::size_t i = 0;
   for (; i < n && !est.ready(); ++i) est.Add(period * static_cast<int>(i), arrival(i));
   const TimePoint start = est.StartTime();
@@ -35,7 +36,9 @@ TEST(PlaybackEstimator, NeedsTenPercentOfTheFramesButAtLeastFive) {
 
 TEST(PlaybackEstimator, StartsAfterTheMarginOnAnIdealChannel) {
   TimePoint start;
-  ASSERT_TRUE(PlaysWithoutRunningDry(100, milliseconds(100), [](std::size_t i) { return kT0 + milliseconds(100) * static_cast<int>(i); }, &start));
+  ASSERT_TRUE(PlaysWithoutRunningDry(
+      100, milliseconds(100), [](std::size_t i) { return kT0 + milliseconds(100) * static_cast<int>(i); },
+      &start));
   // The channel keeps up: the start waits only for the 10 frames the estimate
   // needs (playback's start latency) and the margin.
   EXPECT_EQ(start, kT0 + milliseconds(900) + milliseconds(50));
@@ -60,13 +63,15 @@ TEST(PlaybackEstimator, CoversRandomCongestionLikeThePapers) {
     busy = std::max(busy, sent) + FromSeconds(pause(rng));
     arrivals.push_back(busy);
   }
-  EXPECT_TRUE(PlaysWithoutRunningDry(arrivals.size(), milliseconds(100), [&](std::size_t i) { return arrivals[i]; }));
+  EXPECT_TRUE(
+      PlaysWithoutRunningDry(arrivals.size(), milliseconds(100), [&](std::size_t i) { return arrivals[i]; }));
 }
 
 TEST(PlaybackEstimator, IsNotFooledByBurstsOfFramesAtOneOffset) {
   // Pairs of commands per instant (a base speed and a head set-point), every
   // 2.5 s, arriving on time.
-  PlaybackEstimator est(7, milliseconds(6500), {.min_frames = 5, .fraction = 0.1, .margin = milliseconds(100)});
+  PlaybackEstimator est(7, milliseconds(6500),
+                        {.min_frames = 5, .fraction = 0.1, .margin = milliseconds(100)});
   for (int i = 0; i < 5; ++i) {
     const Duration offset = milliseconds(2500) * (i / 2);
     est.Add(offset, kT0 + offset + milliseconds(2));

@@ -9,10 +9,10 @@
 namespace robotalk {
 namespace {
 
-using ::testing::HasSubstr;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 using testing::FakeDriver;
+using ::testing::HasSubstr;
 using testing::PanRobot;
 
 constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
@@ -135,13 +135,13 @@ TEST_F(RobotServiceTest, NeverExecutesADuplicatedPackageTwiceAndResendsItsReply)
 
 TEST_F(RobotServiceTest, AnswersEverySignal) {
   // SUCCESS, MODIFIED (the driver clamps), ERROR (unknown joint, NaN, too far ahead).
-  auto immediate = Handle(Package(kAlice, 1,
-                                  {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan"),
-                                   Cmd(2, CommandType::kJointSetPoint, {3.0}, "pan"),
-                                   Cmd(3, CommandType::kJointSetPoint, {0.5}, "nek"),
-                                   Cmd(4, CommandType::kJointSetPoint, {std::nan("")}, "pan"),
-                                   Cmd(5, CommandType::kJointSpeed, {0.1}, "pan"),
-                                   Cmd(6, CommandType::kStop, {}, "", clock_.Now() + std::chrono::hours(2))}));
+  auto immediate = Handle(Package(
+      kAlice, 1,
+      {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan"), Cmd(2, CommandType::kJointSetPoint, {3.0}, "pan"),
+       Cmd(3, CommandType::kJointSetPoint, {0.5}, "nek"),
+       Cmd(4, CommandType::kJointSetPoint, {std::nan("")}, "pan"),
+       Cmd(5, CommandType::kJointSpeed, {0.1}, "pan"),
+       Cmd(6, CommandType::kStop, {}, "", clock_.Now() + std::chrono::hours(2))}));
   EXPECT_EQ(immediate.at(3).signal, Signal::kError);
   EXPECT_THAT(immediate.at(3).message, HasSubstr("no joint named 'nek'"));
   EXPECT_EQ(immediate.at(4).signal, Signal::kError);
@@ -154,7 +154,8 @@ TEST_F(RobotServiceTest, AnswersEverySignal) {
   EXPECT_EQ(replies.at(1).signal, Signal::kSuccess);
   EXPECT_EQ(replies.at(2).signal, Signal::kModified);
   // BUSY and INTERRUPTED: a GOTO is running, a second one is refused, STOP interrupts the first.
-  Handle(Package(kAlice, 2, {Cmd(10, CommandType::kGoto, {1, 0, 0}), Cmd(11, CommandType::kGoto, {2, 0, 0})}));
+  Handle(
+      Package(kAlice, 2, {Cmd(10, CommandType::kGoto, {1, 0, 0}), Cmd(11, CommandType::kGoto, {2, 0, 0})}));
   Run();
   EXPECT_EQ(Replies(kAlice).at(11).signal, Signal::kBusy);
   EXPECT_EQ(Replies(kAlice).count(10), 0u) << "the GOTO is still running";
@@ -180,7 +181,8 @@ TEST_F(RobotServiceTest, CompletesAGotoWhenTheDriverReportsIt) {
 TEST_F(RobotServiceTest, AnswersNaToABaseCommandOnAFixedBase) {
   auto driver = std::make_unique<FakeDriver>(PanRobot(BaseType::kFixed));
   RobotService fixed("arm", "fake", std::move(driver), clock_);
-  auto answer = fixed.HandlePackage(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}), clock_.Now());
+  auto answer =
+      fixed.HandlePackage(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}), clock_.Now());
   ASSERT_EQ(answer.package.replies.size(), 1u);
   EXPECT_EQ(answer.package.replies[0].signal, static_cast<std::int8_t>(Signal::kNa));
   EXPECT_THAT(answer.package.replies[0].message, HasSubstr("fixed base"));
@@ -203,10 +205,11 @@ TEST_F(RobotServiceTest, RefusesCommandsBeyondTheQueueLimit) {
   auto driver = std::make_unique<FakeDriver>(PanRobot());
   RobotService small("bot", "fake", std::move(driver), clock_, RobotServiceOptions{.max_queue = 2});
   const TimePoint later = clock_.Now() + seconds(10);
-  auto answer = small.HandlePackage(Package(kAlice, 1,
-                                            {Cmd(1, CommandType::kStop, {}, "", later), Cmd(2, CommandType::kStop, {}, "", later),
-                                             Cmd(3, CommandType::kStop, {}, "", later)}),
-                                    clock_.Now());
+  auto answer = small.HandlePackage(
+      Package(kAlice, 1,
+              {Cmd(1, CommandType::kStop, {}, "", later), Cmd(2, CommandType::kStop, {}, "", later),
+               Cmd(3, CommandType::kStop, {}, "", later)}),
+      clock_.Now());
   ASSERT_EQ(answer.package.replies.size(), 1u);
   EXPECT_EQ(answer.package.replies[0].id, 3);
   EXPECT_THAT(answer.package.replies[0].message, HasSubstr("is full (2 items)"));
@@ -319,7 +322,8 @@ TEST_F(RobotServiceTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTimi
   for (TimePoint t = first_arrival; t < first_arrival + seconds(5); t += milliseconds(1)) {
     clock_.Set(t);
     if (sent < kFrames && t >= first_arrival + milliseconds(150) * sent) {
-      const Command frame = Cmd(sent + 1, CommandType::kJointSetPoint, {0.01 * sent}, "pan", TimePoint(period * sent));
+      const Command frame =
+          Cmd(sent + 1, CommandType::kJointSetPoint, {0.01 * sent}, "pan", TimePoint(period * sent));
       auto immediate = Handle(Playback(kAlice, sent + 1, kPlayback, kFrames, duration, {frame}));
       if (immediate.count(kPlayback)) delay_reply = immediate.at(kPlayback);
       ++sent;
@@ -344,13 +348,14 @@ TEST_F(RobotServiceTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTimi
     const Duration late = fake_->calls[static_cast<size_t>(i)].at - (start + period * i);
     EXPECT_GE(late, Duration(0)) << "frame " << i;
     EXPECT_LT(late, milliseconds(1) + std::chrono::microseconds(1)) << "frame " << i;
-    EXPECT_GE(fake_->calls[static_cast<size_t>(i)].at, first_arrival + milliseconds(150) * i) << "frame " << i;
+    EXPECT_GE(fake_->calls[static_cast<size_t>(i)].at, first_arrival + milliseconds(150) * i)
+        << "frame " << i;
   }
 }
 
 TEST_F(RobotServiceTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
-  auto r = Handle(Playback(kAlice, 1, 77, 2, seconds(1),
-                           {Cmd(1, CommandType::kStop, {}, "", TimePoint(seconds(2)))}));
+  auto r = Handle(
+      Playback(kAlice, 1, 77, 2, seconds(1), {Cmd(1, CommandType::kStop, {}, "", TimePoint(seconds(2)))}));
   EXPECT_EQ(r.at(1).signal, Signal::kError);
   EXPECT_THAT(r.at(1).message, HasSubstr("beyond the declared"));
 }
@@ -365,7 +370,8 @@ TEST_F(RobotServiceTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) {
     Run();
     service_->TakeStates(states);
     clock_.Advance(milliseconds(7));
-    if ((clock_.Now() - t0) % seconds(1) < milliseconds(7)) Handle(Queries(kAlice, 100 + states.size(), {}));  // heartbeat
+    if ((clock_.Now() - t0) % seconds(1) < milliseconds(7))
+      Handle(Queries(kAlice, 100 + states.size(), {}));  // heartbeat
   }
   ASSERT_EQ(states.size(), 600u);
   for (size_t k = 0; k < states.size(); ++k) {

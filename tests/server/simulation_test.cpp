@@ -1,6 +1,6 @@
+#include "robotalk/simulation.h"
 #include "kinematic_driver.h"
 #include "ode_driver.h"
-#include "robotalk/simulation.h"
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
 
@@ -24,12 +24,15 @@ std::vector<SimulatedCommand> Arc() {
 std::unique_ptr<Driver> Ode(const std::string& seed) {
   DriverRegistry registry;
   RegisterOdeDriver(registry);
-  return registry.Create("ode", {"pioneer", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {{"seed", seed}}});
+  return registry.Create("ode",
+                         {"pioneer", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {{"seed", seed}}});
 }
 
 TEST(Simulation, RunsTheServerCoreOnSimulatedTimeWithTheKinematicDriver) {
-  auto driver = std::make_unique<KinematicDriver>(LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model);
-  const SimulationResult r = RunSimulation("pioneer", "kinematic", std::move(driver), Arc(), {.duration = seconds(4)});
+  auto driver =
+      std::make_unique<KinematicDriver>(LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model);
+  const SimulationResult r =
+      RunSimulation("pioneer", "kinematic", std::move(driver), Arc(), {.duration = seconds(4)});
   ASSERT_EQ(r.replies.size(), 3u);
   for (const Reply& reply : r.replies) EXPECT_EQ(reply.signal, Signal::kSuccess) << reply.message;
   // Samples every 10 ms of simulated time, exactly on their grid.

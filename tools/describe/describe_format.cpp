@@ -38,11 +38,21 @@ std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -74,8 +84,8 @@ std::string JsonQuat(const Eigen::Quaterniond& q) {
 std::string JsonServo(ServoTypes t) {
   std::string s = "[";
   bool first = true;
-  for (auto [type, word] : {std::pair{ServoType::kSetPoint, "setpoint"}, std::pair{ServoType::kSpeed, "speed"},
-                            std::pair{ServoType::kForce, "force"}}) {
+  for (auto [type, word] : {std::pair{ServoType::kSetPoint, "setpoint"},
+                            std::pair{ServoType::kSpeed, "speed"}, std::pair{ServoType::kForce, "force"}}) {
     if (!t.Has(type)) continue;
     s += (first ? "\"" : ", \"") + std::string(word) + "\"";
     first = false;
@@ -87,8 +97,8 @@ std::string JsonServo(ServoTypes t) {
 
 void PrintModelTable(const RobotModel& m, std::ostream& out) {
   out << "Robot '" << m.name() << "': " << m.links().size() << " links, " << m.joints().size() << " joints, "
-      << m.num_dofs() << " dofs, " << m.frames().size() << " control frames, total mass " << Num(m.total_mass(), 6)
-      << " kg\n";
+      << m.num_dofs() << " dofs, " << m.frames().size() << " control frames, total mass "
+      << Num(m.total_mass(), 6) << " kg\n";
   for (const RootLink& r : m.roots()) {
     out << "Root '" << m.link(r.link).name << "' (" << ToString(r.base) << " base) at "
         << Vec(r.pose_in_world.translation) << "\n";
@@ -99,13 +109,14 @@ void PrintModelTable(const RobotModel& m, std::ostream& out) {
       << "COM [m]\n";
   for (size_t i = 0; i < m.links().size(); ++i) {
     const Link& l = m.links()[i];
-    out << std::left << std::setw(4) << i << std::setw(28) << l.name << std::setw(11) << Num(l.mass) << Vec(l.com)
-        << "\n";
+    out << std::left << std::setw(4) << i << std::setw(28) << l.name << std::setw(11) << Num(l.mass)
+        << Vec(l.com) << "\n";
   }
 
   out << "\nJoints (dofs: R revolute / P prismatic with axis; limits in rad|m, rad/s|m/s, N·m|N)\n";
   out << std::left << std::setw(4) << "#" << std::setw(28) << "name" << std::setw(44) << "parent -> child"
-      << std::setw(22) << "servo" << "dofs and limits\n";
+      << std::setw(22) << "servo"
+      << "dofs and limits\n";
   for (size_t i = 0; i < m.joints().size(); ++i) {
     const Joint& j = m.joints()[i];
     std::string servo = j.servo_types.ToString();
@@ -124,8 +135,9 @@ void PrintModelTable(const RobotModel& m, std::ostream& out) {
   if (m.frames().empty()) out << "(none)\n";
   for (size_t i = 0; i < m.frames().size(); ++i) {
     const ControlFrame& f = m.frames()[i];
-    out << std::left << std::setw(4) << i << std::setw(28) << f.name << std::setw(28) << m.link(f.parent_link).name
-        << std::setw(22) << f.servo_types.ToString() << Vec(f.pose_in_link.translation) << "\n";
+    out << std::left << std::setw(4) << i << std::setw(28) << f.name << std::setw(28)
+        << m.link(f.parent_link).name << std::setw(22) << f.servo_types.ToString()
+        << Vec(f.pose_in_link.translation) << "\n";
   }
 }
 
@@ -135,10 +147,10 @@ void PrintModelJson(const RobotModel& m, const std::vector<std::string>& warning
   for (size_t i = 0; i < m.links().size(); ++i) {
     const Link& l = m.links()[i];
     const Eigen::Matrix3d& I = l.inertia;
-    out << (i ? ",\n    " : "\n    ") << "{\"name\": " << JsonString(l.name) << ", \"mass\": " << JsonNum(l.mass)
-        << ", \"com\": " << JsonVec(l.com) << ", \"inertia\": [" << JsonNum(I(0, 0)) << ", " << JsonNum(I(0, 1))
-        << ", " << JsonNum(I(0, 2)) << ", " << JsonNum(I(1, 1)) << ", " << JsonNum(I(1, 2)) << ", "
-        << JsonNum(I(2, 2)) << "]}";
+    out << (i ? ",\n    " : "\n    ") << "{\"name\": " << JsonString(l.name)
+        << ", \"mass\": " << JsonNum(l.mass) << ", \"com\": " << JsonVec(l.com) << ", \"inertia\": ["
+        << JsonNum(I(0, 0)) << ", " << JsonNum(I(0, 1)) << ", " << JsonNum(I(0, 2)) << ", "
+        << JsonNum(I(1, 1)) << ", " << JsonNum(I(1, 2)) << ", " << JsonNum(I(2, 2)) << "]}";
   }
   out << "\n  ],\n  \"joints\": [";
   for (size_t i = 0; i < m.joints().size(); ++i) {
@@ -158,8 +170,8 @@ void PrintModelJson(const RobotModel& m, const std::vector<std::string>& warning
     out << "]";
     if (j.mimic) {
       out << ", \"mimic\": {\"joint\": " << JsonString(m.joint(j.mimic->leader_joint).name)
-          << ", \"multiplier\": " << JsonNum(j.mimic->multiplier) << ", \"offset\": " << JsonNum(j.mimic->offset)
-          << "}";
+          << ", \"multiplier\": " << JsonNum(j.mimic->multiplier)
+          << ", \"offset\": " << JsonNum(j.mimic->offset) << "}";
     }
     out << "}";
   }
@@ -169,8 +181,8 @@ void PrintModelJson(const RobotModel& m, const std::vector<std::string>& warning
     out << (i ? ",\n    " : "\n    ") << "{\"name\": " << JsonString(f.name)
         << ", \"link\": " << JsonString(m.link(f.parent_link).name)
         << ", \"position\": " << JsonVec(f.pose_in_link.translation)
-        << ", \"orientation\": " << JsonQuat(f.pose_in_link.rotation) << ", \"servo\": " << JsonServo(f.servo_types)
-        << "}";
+        << ", \"orientation\": " << JsonQuat(f.pose_in_link.rotation)
+        << ", \"servo\": " << JsonServo(f.servo_types) << "}";
   }
   out << "\n  ],\n  \"roots\": [";
   for (size_t i = 0; i < m.roots().size(); ++i) {

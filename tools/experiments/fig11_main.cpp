@@ -15,6 +15,7 @@
 #include "fig11_profile.h"
 #include "robotalk/robot_client.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -28,7 +29,6 @@
 #include <optional>
 #include <string>
 #include <thread>
-#include <unistd.h>
 #include <vector>
 
 namespace {
@@ -176,7 +176,8 @@ int Run(const Options& o) {
   if (!o.print_ideal.empty()) {
     WriteIdeal(o.print_ideal, profile);
     std::printf("ideal path: r = %.4f m, v = %.4f m/s, %d frames per small half circle, %.1f s, %zu frames\n",
-                profile.radius, profile.speed, profile.frames_per_small, profile.duration, profile.frames.size());
+                profile.radius, profile.speed, profile.frames_per_small, profile.duration,
+                profile.frames.size());
     return 0;
   }
 
@@ -191,17 +192,21 @@ int Run(const Options& o) {
   client.Connect(o.robot);
 
   Recorder recorder;
-  client.StartStateStream(FromSeconds(o.state_period), [&](const robotalk_msgs::robot_state_t& s) { recorder.Add(s); });
-  if (!recorder.WaitCount(3, std::chrono::seconds(20))) throw std::runtime_error("no STATE samples within 20 s");
+  client.StartStateStream(FromSeconds(o.state_period),
+                          [&](const robotalk_msgs::robot_state_t& s) { recorder.Add(s); });
+  if (!recorder.WaitCount(3, std::chrono::seconds(20)))
+    throw std::runtime_error("no STATE samples within 20 s");
 
   std::vector<TimedCommand> frames;
   for (const SpeedFrame& f : profile.frames) {
-    frames.push_back({FromSeconds(f.offset), Command{.type = CommandType::kSetSpeed, .values = {f.v, f.omega}}});
+    frames.push_back(
+        {FromSeconds(f.offset), Command{.type = CommandType::kSetSpeed, .values = {f.v, f.omega}}});
   }
   const Pose2 start = recorder.Take().back().pose;
   SequenceOptions so{.mode = o.mode, .delay = FromSeconds(o.delay), .paced = true};
   std::fprintf(stderr, "robotalk-fig11: %s%s, %zu frames over %.1f s, start (%.3f, %.3f, %.3f)\n",
-               ToString(o.mode), o.mode == CommandMode::kDelay ? (" " + std::to_string(o.delay) + " s").c_str() : "",
+               ToString(o.mode),
+               o.mode == CommandMode::kDelay ? (" " + std::to_string(o.delay) + " s").c_str() : "",
                frames.size(), profile.duration, start.x, start.y, start.theta);
   const SequenceResult result = client.RunSequence(std::move(frames), so);
 
@@ -246,28 +251,36 @@ int Run(const Options& o) {
   traj << "t,x,y,theta\n";
   char line[256];
   for (const Sample& s : samples) {
-    std::snprintf(line, sizeof line, "%.4f,%.6f,%.6f,%.6f\n", ToSeconds(s.t - sent0), s.pose.x, s.pose.y, s.pose.theta);
+    std::snprintf(line, sizeof line, "%.4f,%.6f,%.6f,%.6f\n", ToSeconds(s.t - sent0), s.pose.x, s.pose.y,
+                  s.pose.theta);
     traj << line;
   }
   if (!traj) throw std::runtime_error("cannot write " + o.out + "_traj.csv");
 
   std::ofstream metrics(o.out + "_metrics.csv");
   metrics << "label,congestion,mode,delay_s,frames,profile_s,start_latency_s,playback_delay_s,actual_s,"
-             "max_schedule_error_s,late_frames,max_lateness_s,not_success,samples,mean_dev_m,max_dev_m,end_error_m\n";
-  std::snprintf(line, sizeof line, "%s,%s,%s,%.3f,%zu,%.1f,%.3f,%.3f,%.3f,%.4f,%d,%.3f,%d,%zu,%.5f,%.5f,%.5f\n",
-                o.label.c_str(), o.congestion.c_str(), ToString(o.mode), o.mode == CommandMode::kDelay ? o.delay : 0.0,
-                profile.frames.size(), profile.duration, start_latency, playback_delay, ToSeconds(exec_last - exec0),
-                max_sched, late, max_late, not_ok, dev.samples, dev.mean, dev.max, end_error);
+             "max_schedule_error_s,late_frames,max_lateness_s,not_success,samples,mean_dev_m,max_dev_m,end_"
+             "error_m\n";
+  std::snprintf(
+      line, sizeof line, "%s,%s,%s,%.3f,%zu,%.1f,%.3f,%.3f,%.3f,%.4f,%d,%.3f,%d,%zu,%.5f,%.5f,%.5f\n",
+      o.label.c_str(), o.congestion.c_str(), ToString(o.mode), o.mode == CommandMode::kDelay ? o.delay : 0.0,
+      profile.frames.size(), profile.duration, start_latency, playback_delay, ToSeconds(exec_last - exec0),
+      max_sched, late, max_late, not_ok, dev.samples, dev.mean, dev.max, end_error);
   metrics << line;
   if (!metrics) throw std::runtime_error("cannot write " + o.out + "_metrics.csv");
-  std::printf("%s %s: start latency %.3f s, playback delay %.3f s, ran %.2f s (profile %.1f s), schedule error max %.4f s, "
-              "late %d (max %.3f s), not-success %d, deviation mean %.4f m max %.4f m, end error %.4f m (%zu samples)\n",
-              o.label.c_str(), ToString(o.mode), start_latency, playback_delay, ToSeconds(exec_last - exec0),
-              profile.duration, max_sched, late, max_late, not_ok, dev.mean, dev.max, end_error, dev.samples);
+  std::printf(
+      "%s %s: start latency %.3f s, playback delay %.3f s, ran %.2f s (profile %.1f s), schedule error max "
+      "%.4f s, "
+      "late %d (max %.3f s), not-success %d, deviation mean %.4f m max %.4f m, end error %.4f m (%zu "
+      "samples)\n",
+      o.label.c_str(), ToString(o.mode), start_latency, playback_delay, ToSeconds(exec_last - exec0),
+      profile.duration, max_sched, late, max_late, not_ok, dev.mean, dev.max, end_error, dev.samples);
   const ClientStats st = client.stats();
-  std::fprintf(stderr, "robotalk-fig11: client sent %llu packages (%llu heartbeats, %llu retransmissions, %llu given up)\n",
-               static_cast<unsigned long long>(st.packages_sent), static_cast<unsigned long long>(st.heartbeats),
-               static_cast<unsigned long long>(st.retransmissions), static_cast<unsigned long long>(st.gave_up));
+  std::fprintf(
+      stderr,
+      "robotalk-fig11: client sent %llu packages (%llu heartbeats, %llu retransmissions, %llu given up)\n",
+      static_cast<unsigned long long>(st.packages_sent), static_cast<unsigned long long>(st.heartbeats),
+      static_cast<unsigned long long>(st.retransmissions), static_cast<unsigned long long>(st.gave_up));
   return not_ok == 0 ? 0 : 1;
 }
 

@@ -14,7 +14,8 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2 * std::numbers::pi;
 
 void CheckPositive(const char* name, double v) {
-  if (!std::isfinite(v) || v <= 0) throw std::invalid_argument(std::string("Fig11Params: ") + name + " must be > 0");
+  if (!std::isfinite(v) || v <= 0)
+    throw std::invalid_argument(std::string("Fig11Params: ") + name + " must be > 0");
 }
 
 // a mod 2π in [0, 2π).
@@ -35,7 +36,8 @@ Fig11Profile MakeFig11Profile(const Fig11Params& params) {
   CheckPositive("frame_period", params.frame_period);
   Fig11Profile p;
   p.params = params;
-  p.frames_per_small = std::max(1, static_cast<int>(std::lround(params.duration / (8 * params.frame_period))));
+  p.frames_per_small =
+      std::max(1, static_cast<int>(std::lround(params.duration / (8 * params.frame_period))));
   const int n = p.frames_per_small;
   p.radius = params.length / (8 * kPi);
   const double t_small = n * params.frame_period;

@@ -47,10 +47,10 @@ struct SpeedFrame {
 
 struct Fig11Profile {
   Fig11Params params;
-  int frames_per_small = 0;  ///< n: frames of one small half circle
-  double radius = 0;         ///< r (m)
-  double speed = 0;          ///< v (m/s)
-  double duration = 0;       ///< 8 n frame_period (s): when the final stop frame plays
+  int frames_per_small = 0;        ///< n: frames of one small half circle
+  double radius = 0;               ///< r (m)
+  double speed = 0;                ///< v (m/s)
+  double duration = 0;             ///< 8 n frame_period (s): when the final stop frame plays
   std::vector<SpeedFrame> frames;  ///< 8n moving frames, then the stop frame
 };
 

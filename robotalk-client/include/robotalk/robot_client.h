@@ -166,7 +166,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
 
 /// Client counters, for diagnostics and tests.
 struct ClientStats {
-  std::uint64_t packages_sent = 0;       ///< first sends (heartbeats included)
+  std::uint64_t packages_sent = 0;  ///< first sends (heartbeats included)
   std::uint64_t retransmissions = 0;
   std::uint64_t heartbeats = 0;
   std::uint64_t replies_filed = 0;
@@ -244,7 +244,8 @@ class RobotClient {
   /// calls `on_sample` with each sample, on the ReadDaemon thread (keep it
   /// short). Returns the period the stream runs at. Calling it again changes
   /// the period and the callback.
-  Duration StartStateStream(Duration period, std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);
+  Duration StartStateStream(Duration period,
+                            std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);
   /// Cancels this client's stream request (the stream goes on while others want it).
   void StopStateStream();
 

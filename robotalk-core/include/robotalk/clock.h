@@ -32,7 +32,8 @@ class SteadyClock final : public Clock {
 /// A clock that moves only when told to: for tests and simulated time.
 class ManualClock final : public Clock {
  public:
-  explicit ManualClock(TimePoint start = TimePoint(std::chrono::seconds(1000))) : now_(start.time_since_epoch().count()) {}
+  explicit ManualClock(TimePoint start = TimePoint(std::chrono::seconds(1000)))
+      : now_(start.time_since_epoch().count()) {}
   TimePoint Now() const override { return TimePoint(Duration(now_.load())); }
   void Set(TimePoint t) { now_.store(t.time_since_epoch().count()); }
   void Advance(Duration d) { now_.fetch_add(d.count()); }

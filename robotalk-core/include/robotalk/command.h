@@ -28,12 +28,12 @@ enum class CommandType : std::int8_t {
 };
 
 enum class QueryType : std::int8_t {
-  kConfig = 1,      ///< the robot description (published on the CONFIG channel)
-  kJointState = 2,  ///< positions, velocities, efforts of every dof (or of one joint)
-  kLinkPoses = 3,   ///< world pose of every link (or one): x y z qw qx qy qz each
-  kFramePoses = 4,  ///< world pose of every control frame (or one)
-  kBasePose = 5,    ///< x y θ v ω of the first root link
-  kClock = 6,       ///< server time, for clock synchronisation
+  kConfig = 1,             ///< the robot description (published on the CONFIG channel)
+  kJointState = 2,         ///< positions, velocities, efforts of every dof (or of one joint)
+  kLinkPoses = 3,          ///< world pose of every link (or one): x y z qw qx qy qz each
+  kFramePoses = 4,         ///< world pose of every control frame (or one)
+  kBasePose = 5,           ///< x y θ v ω of the first root link
+  kClock = 6,              ///< server time, for clock synchronisation
   kStateStream = 7,        ///< broadcast: robot_state_t on ROBOTALK/<robot>/STATE every `period`
   kStateStreamCancel = 8,  ///< ends this client's STATE_STREAM request
 };

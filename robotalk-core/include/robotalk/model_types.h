@@ -77,9 +77,9 @@ struct Pose {
 /// A rigid body. Mass 0 means a massless frame-like link (no inertia needed).
 struct Link {
   std::string name;
-  double mass = 0.0;                                     ///< kg, >= 0
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();         ///< m, in the link frame
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();     ///< kg·m², about the COM
+  double mass = 0.0;                                  ///< kg, >= 0
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();      ///< m, in the link frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  ///< kg·m², about the COM
   bool operator==(const Link&) const = default;
 };
 
@@ -89,10 +89,10 @@ enum class DofType : std::uint8_t { kRevolute = 0, kPrismatic = 1 };
 /// joint has infinite position limits.
 struct DofLimits {
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  double lower = -kInf;     ///< rad or m
-  double upper = kInf;      ///< rad or m
-  double velocity = kInf;   ///< rad/s or m/s, > 0
-  double effort = kInf;     ///< N·m or N, > 0
+  double lower = -kInf;    ///< rad or m
+  double upper = kInf;     ///< rad or m
+  double velocity = kInf;  ///< rad/s or m/s, > 0
+  double effort = kInf;    ///< N·m or N, > 0
   bool operator==(const DofLimits&) const = default;
 };
 
@@ -116,10 +116,10 @@ struct Mimic {
 /// A joint with 0 (fixed) to 6 (free) dofs.
 struct Joint {
   std::string name;
-  int parent_link = -1;  ///< index into RobotModel::links()
-  int child_link = -1;   ///< index into RobotModel::links()
-  Eigen::Vector3d inboard = Eigen::Vector3d::Zero();   ///< m, parent COM -> joint, parent axes
-  Eigen::Vector3d outboard = Eigen::Vector3d::Zero();  ///< m, child COM -> joint, child axes
+  int parent_link = -1;                                      ///< index into RobotModel::links()
+  int child_link = -1;                                       ///< index into RobotModel::links()
+  Eigen::Vector3d inboard = Eigen::Vector3d::Zero();         ///< m, parent COM -> joint, parent axes
+  Eigen::Vector3d outboard = Eigen::Vector3d::Zero();        ///< m, child COM -> joint, child axes
   Eigen::Quaterniond rest = Eigen::Quaterniond::Identity();  ///< rotation at q = 0
   std::vector<Dof> dofs;
   ServoTypes servo_types;
@@ -131,7 +131,7 @@ struct Joint {
 struct ControlFrame {
   std::string name;
   int parent_link = -1;  ///< index into RobotModel::links()
-  Pose pose_in_link;  ///< in the link frame
+  Pose pose_in_link;     ///< in the link frame
   ServoTypes servo_types;
   bool operator==(const ControlFrame&) const = default;
 };
@@ -146,7 +146,7 @@ enum class BaseType : std::uint8_t {
 
 /// A link without parent joint, posed in the world frame.
 struct RootLink {
-  int link = -1;  ///< index into RobotModel::links()
+  int link = -1;       ///< index into RobotModel::links()
   Pose pose_in_world;  ///< of its link frame
   BaseType base = BaseType::kFixed;
   bool operator==(const RootLink&) const = default;

@@ -97,11 +97,9 @@ class RobotModelBuilder {
   RobotModelBuilder& AddJoint(Joint joint, std::string parent_link, std::string child_link);
   /// `frame.parent_link` is ignored; the name is resolved in Build().
   RobotModelBuilder& AddControlFrame(ControlFrame frame, std::string parent_link);
-  RobotModelBuilder& SetRoot(std::string link, const Pose& pose_in_world,
-                             BaseType base = BaseType::kFixed);
+  RobotModelBuilder& SetRoot(std::string link, const Pose& pose_in_world, BaseType base = BaseType::kFixed);
   /// Makes 1-dof `joint` follow 1-dof `leader`: q = multiplier * q_leader + offset.
-  RobotModelBuilder& SetMimic(std::string joint, std::string leader, double multiplier,
-                              double offset);
+  RobotModelBuilder& SetMimic(std::string joint, std::string leader, double multiplier, double offset);
 
   /// Resolves names and validates. Throws ModelError, e.g.
   /// "joint 'elbow': unknown child link 'forearm'".

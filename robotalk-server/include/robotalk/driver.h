@@ -50,13 +50,13 @@ struct Completion {
 
 /// The robot's measured state. Sized by the server from the model once.
 struct RobotState {
-  Eigen::VectorXd position;  ///< per dof (rad | m)
-  Eigen::VectorXd velocity;  ///< per dof (rad/s | m/s)
-  Eigen::VectorXd effort;    ///< per dof (N·m | N)
+  Eigen::VectorXd position;      ///< per dof (rad | m)
+  Eigen::VectorXd velocity;      ///< per dof (rad/s | m/s)
+  Eigen::VectorXd effort;        ///< per dof (N·m | N)
   std::vector<Pose> root_poses;  ///< per RobotModel::roots() entry, in the world
-  double base_v = 0.0;       ///< forward speed of the first root, m/s
-  double base_omega = 0.0;   ///< yaw rate of the first root, rad/s
-  bool moving = false;       ///< any actuator or the base is commanded to move
+  double base_v = 0.0;           ///< forward speed of the first root, m/s
+  double base_omega = 0.0;       ///< yaw rate of the first root, rad/s
+  bool moving = false;           ///< any actuator or the base is commanded to move
 };
 
 class Driver {
@@ -88,7 +88,7 @@ class Driver {
 /// What a driver factory receives.
 struct DriverConfig {
   std::string robot_name;
-  std::string urdf_path;                      ///< the file the model came from
+  std::string urdf_path;                       ///< the file the model came from
   std::map<std::string, std::string> options;  ///< driver-specific key=value options
 };
 

@@ -40,7 +40,8 @@ struct SimulationResult {
 /// Runs `commands` on `driver` for `options.duration` of simulated time.
 /// Throws Error when a command is refused before it could run (its reply
 /// is still returned for commands the robot answered).
-SimulationResult RunSimulation(std::string robot_name, std::string driver_name, std::unique_ptr<Driver> driver,
-                               const std::vector<SimulatedCommand>& commands, const SimulationOptions& options);
+SimulationResult RunSimulation(std::string robot_name, std::string driver_name,
+                               std::unique_ptr<Driver> driver, const std::vector<SimulatedCommand>& commands,
+                               const SimulationOptions& options);
 
 }  // namespace robotalk
