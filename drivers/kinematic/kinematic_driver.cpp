@@ -367,50 +367,20 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
 
 DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {
+  // The server checked the command against the model (driver.h): a motion
+  // command, a valid target of the right kind, its value count, finite values.
   Advance(now, completed);
   const char* name = ToString(c.type);
-  if (c.type == CommandType::kStop) {
-    StopAll("interrupted by STOP", completed);
-    return Answer(Signal::kSuccess);
-  }
-  if (c.type == CommandType::kPanicReset) {  // normally handled by the server
-    Resume();
-    return Answer(Signal::kSuccess);
-  }
-  if (halted_) {
-    return Answer(Signal::kPanic, std::string(name) + ": the robot is halted (panic) until PANIC_RESET");
-  }
-  if (c.num_values < 0 || c.num_values > static_cast<int>(c.values.size())) {
-    return Answer(Signal::kError, std::string(name) + ": bad value count " + std::to_string(c.num_values));
-  }
   switch (c.type) {
     case CommandType::kJointSetPoint:
+      return JointSetPoint(c);
     case CommandType::kJointSpeed:
-    case CommandType::kJointForce: {
-      // The server checked these (CheckCommand); re-checked because a driver
-      // must not index out of its arrays whatever it is given.
-      if (c.target < 0 || c.target >= static_cast<int>(model_.joints().size())) {
-        return Answer(Signal::kError,
-                      std::string(name) + ": no joint with index " + std::to_string(c.target));
-      }
-      const Joint& joint = model_.joint(c.target);
-      if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
-        return Answer(Signal::kError, std::string(name) + " " + Quote(joint.name) + ": expected " +
-                                          std::to_string(joint.dofs.size()) + " values (one per dof), got " +
-                                          std::to_string(c.num_values));
-      }
-      if (c.type == CommandType::kJointForce) {
-        return Answer(Signal::kNa,
-                      "JOINT_FORCE " + Quote(joint.name) + ": the kinematic driver simulates no dynamics");
-      }
-      if (joint.mimic) {
-        return Answer(Signal::kNa, std::string(name) + " " + Quote(joint.name) + ": the joint follows " +
-                                       Quote(model_.joint(joint.mimic->leader_joint).name) + " (mimic)");
-      }
-      return c.type == CommandType::kJointSetPoint ? JointSetPoint(c) : JointSpeed(c);
-    }
+      return JointSpeed(c);
+    case CommandType::kJointForce:
+      return Answer(Signal::kNa, "JOINT_FORCE " + Quote(model_.joint(c.target).name) +
+                                     ": the kinematic driver simulates no dynamics");
     case CommandType::kFrameSetPoint:
-      return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks its arguments
+      return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks reachability
     case CommandType::kGoto:
     case CommandType::kSetSpeed:
       if (!mobile_base()) {
@@ -420,9 +390,14 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
       return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
     case CommandType::kStop:
     case CommandType::kPanicReset:
-      break;  // handled above
+      break;  // never sent to a driver (driver.h)
   }
-  return Answer(Signal::kError, "unknown command type " + std::to_string(static_cast<int>(c.type)));
+  return Answer(Signal::kError, std::string(name) + " is not a motion command a driver executes");
+}
+
+void KinematicDriver::Stop(TimePoint now, std::vector<Completion>& interrupted) {
+  Advance(now, interrupted);
+  StopAll("interrupted by STOP", interrupted);
 }
 
 void KinematicDriver::StopAll(const char* why, std::vector<Completion>& completed) {
@@ -441,10 +416,9 @@ void KinematicDriver::StopAll(const char* why, std::vector<Completion>& complete
 
 void KinematicDriver::Halt(std::vector<Completion>& interrupted) {
   StopAll("interrupted by panic", interrupted);
-  halted_ = true;
 }
 
-void KinematicDriver::Resume() { halted_ = false; }
+void KinematicDriver::Resume() {}
 
 // ---------------------------------------------------------------- state
 

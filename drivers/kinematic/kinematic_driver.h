@@ -76,6 +76,7 @@ class KinematicDriver final : public Driver {
   /// call only sets the time base. Appends a finished GOTO's completion.
   void Update(TimePoint now, std::vector<Completion>& completed) override;
   void ReadState(RobotState& state) const override;
+  void Stop(TimePoint now, std::vector<Completion>& interrupted) override;
   void Halt(std::vector<Completion>& interrupted) override;
   void Resume() override;
 
@@ -135,7 +136,6 @@ class KinematicDriver final : public Driver {
   mutable std::vector<Eigen::Isometry3d> root_world_;
 
   std::optional<TimePoint> last_time_;
-  bool halted_ = false;
 };
 
 /// Registers "kinematic": a factory that loads DriverConfig::urdf_path with

@@ -18,28 +18,17 @@ using ode_detail::Unit;
 
 DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {
+  // The server checked the command against the model (driver.h): a motion
+  // command, a valid target of the right kind, its value count, finite values.
   Advance(now, true, completed);
   const char* name = ToString(c.type);
-  if (c.type == CommandType::kStop) {
-    StopAll("interrupted by STOP", completed);
-    return Answer(Signal::kSuccess);
-  }
-  if (c.type == CommandType::kPanicReset) {
-    Resume();
-    return Answer(Signal::kSuccess);
-  }
-  if (halted_)
-    return Answer(Signal::kPanic, std::string(name) + ": the robot is halted (panic) until PANIC_RESET");
-  if (c.num_values < 0 || c.num_values > static_cast<int>(c.values.size())) {
-    return Answer(Signal::kError, std::string(name) + ": bad value count " + std::to_string(c.num_values));
-  }
   switch (c.type) {
     case CommandType::kJointSetPoint:
     case CommandType::kJointSpeed:
     case CommandType::kJointForce:
       return JointCommand(c);
     case CommandType::kFrameSetPoint:
-      return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks its arguments
+      return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks reachability
     case CommandType::kGoto:
     case CommandType::kSetSpeed:
       if (base_kind_ == BaseKind::kFixed) {
@@ -49,26 +38,19 @@ DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
       return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
     case CommandType::kStop:
     case CommandType::kPanicReset:
-      break;
+      break;  // never sent to a driver (driver.h)
   }
-  return Answer(Signal::kError, "unknown command type " + std::to_string(static_cast<int>(c.type)));
+  return Answer(Signal::kError, std::string(name) + " is not a motion command a driver executes");
+}
+
+void OdeDriver::Impl::Stop(TimePoint now, std::vector<Completion>& interrupted) {
+  Advance(now, true, interrupted);
+  StopAll("interrupted by STOP", interrupted);
 }
 
 DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
   const std::string name = ToString(c.type);
-  if (c.target < 0 || c.target >= static_cast<int>(model_.joints().size())) {
-    return Answer(Signal::kError, name + ": no joint with index " + std::to_string(c.target));
-  }
-  const robotalk::Joint& joint = model_.joint(c.target);
-  if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
-    return Answer(Signal::kError, name + " " + Quote(joint.name) + ": expected " +
-                                      std::to_string(joint.dofs.size()) + " values (one per dof), got " +
-                                      std::to_string(c.num_values));
-  }
-  if (joint.mimic) {
-    return Answer(Signal::kNa, name + " " + Quote(joint.name) + ": the joint follows " +
-                                   Quote(model_.joint(joint.mimic->leader_joint).name) + " (mimic)");
-  }
+  const robotalk::Joint& joint = model_.joint(c.target);  // checked by the server (driver.h)
   if (IsWheel(c.target)) {
     if (base_mode_ == BaseMode::kGoto) {
       return Answer(Signal::kBusy, name + " " + Quote(joint.name) +

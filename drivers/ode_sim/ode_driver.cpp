@@ -399,6 +399,7 @@ void OdeDriver::Update(TimePoint now, std::vector<Completion>& completed) {
   impl_->Advance(now, true, completed);
 }
 void OdeDriver::ReadState(RobotState& state) const { impl_->ReadState(state); }
+void OdeDriver::Stop(TimePoint now, std::vector<Completion>& interrupted) { impl_->Stop(now, interrupted); }
 void OdeDriver::Halt(std::vector<Completion>& interrupted) { impl_->Halt(interrupted); }
 void OdeDriver::Resume() { impl_->Resume(); }
 void OdeDriver::Step(int n, std::vector<Completion>& completed) {

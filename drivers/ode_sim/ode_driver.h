@@ -119,6 +119,7 @@ class OdeDriver final : public Driver {
   /// max_catchup_ms of them); the first call only sets the time base.
   void Update(TimePoint now, std::vector<Completion>& completed) override;
   void ReadState(RobotState& state) const override;
+  void Stop(TimePoint now, std::vector<Completion>& interrupted) override;
   void Halt(std::vector<Completion>& interrupted) override;
   void Resume() override;
 

@@ -36,14 +36,12 @@ class OdeDriver::Impl {
   Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes);
 
   DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed);
+  void Stop(TimePoint now, std::vector<Completion>& interrupted);
   void Advance(TimePoint now, bool limit, std::vector<Completion>& completed);
   void Step(int n, std::vector<Completion>& completed);
   void ReadState(RobotState& state) const;
-  void Halt(std::vector<Completion>& interrupted) {
-    StopAll("interrupted by panic", interrupted);
-    halted_ = true;
-  }
-  void Resume() { halted_ = false; }
+  void Halt(std::vector<Completion>& interrupted) { StopAll("interrupted by panic", interrupted); }
+  void Resume() {}
 
   RobotModel model_;
   OdeDriverOptions options_;
@@ -90,7 +88,6 @@ class OdeDriver::Impl {
   CommandId goto_id_ = 0;
   int gait_dof_[4] = {-1, -1, -1, -1};  // left hip, left knee, right hip, right knee
   double gait_phase_ = 0;
-  bool halted_ = false;
 
   // FRAME_SETPOINT: the solver (its default masks say which dofs move) and
   // the measured root poses it starts from, one per RobotModel::roots() entry.

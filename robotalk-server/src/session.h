@@ -1,7 +1,8 @@
-// One client's state on the server (the paper's CClientConnection): its
-// command queue, its return queue (replies waiting to be sent, in issuance
-// order), the sequences it has sent, and the final replies of its recent
-// packages for re-sending to a retransmission. Pure data; RobotService locks.
+// One client's state on the server (the paper's CClientConnection), as the
+// ServerDaemon keeps it: the package sequences it has sent, the final replies
+// of its recent packages for re-sending to a retransmission, and its playback
+// sequences still buffering. Its command queue lives in the RobotDaemon's
+// Scheduler. Pure data, used by one thread (the ServerDaemon's RobotSessions).
 #pragma once
 
 #include "command_queue.h"
@@ -44,7 +45,11 @@ struct PlaybackSequence {
       : estimator(total_frames, duration, options), total(total_frames), duration(duration) {}
 
   PlaybackEstimator estimator;
-  std::vector<QueuedItem> frames;  ///< the playback queue; `start` holds each frame's offset
+  struct Frame {
+    Duration offset;  ///< from the sequence start
+    QueuedItem item;  ///< its start is set once the sequence's start is known
+  };
+  std::vector<Frame> frames;       ///< the playback queue
   std::optional<TimePoint> start;  ///< when offset 0 plays, once estimated
   std::optional<TimePoint> first_arrival;
   std::size_t total;
@@ -58,11 +63,15 @@ struct Session {
   std::int64_t client_id;
   TimePoint created;
   TimePoint last_heard;
-  CommandQueue commands;
-  std::vector<Reply> return_queue;  ///< replies not yet sent, in issuance order
   SequenceWindow seen;
   ReplyCache replies;
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< by playback id
+  /// Frames buffered over all playbacks (they count against the queue limit).
+  std::size_t buffered_frames() const {
+    std::size_t n = 0;
+    for (const auto& [id, seq] : playbacks) n += seq.frames.size();
+    return n;
+  }
   /// Set by a motion command of this client, cleared by any STOP: the
   /// watchdog stops the robot when a session that moved it expires.
   bool moved_robot = false;

@@ -1,7 +1,9 @@
 #include "robotalk/simulation.h"
 
-#include "robot_service.h"
-#include "robotalk/protocol_codec.h"
+#include "robot_daemon.h"
+#include "robot_sessions.h"
+#include "robotalk/config_codec.h"
+#include "state_encoding.h"
 
 #include <map>
 
@@ -12,58 +14,48 @@ SimulationResult RunSimulation(std::string robot_name, std::string driver_name,
                                const SimulationOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   ManualClock clock;
-  RobotService service(std::move(robot_name), std::move(driver_name), std::move(driver), clock);
+  // The server's own RobotDaemon and session layer, without the transport
+  // and without threads: one local client speaking C++ requests.
+  RobotDaemon daemon(robot_name, std::move(driver_name), std::move(driver), clock);
+  RobotSessions sessions(daemon, ConfigHash(daemon.model()));
   const TimePoint t0 = clock.Now();
-  constexpr std::int64_t kClient = 1;  // the one, local, client
+  constexpr std::int64_t kClient = 1;
 
-  // The state stream, then the whole sequence as one delay-mode package.
-  const auto header = [&](std::int64_t sequence, std::int8_t payload_type, std::int32_t size) {
-    robotalk_msgs::package_header_t h{};
-    h.protocol_version = kProtocolVersion;
-    h.client_id = kClient;
-    h.sequence = sequence;
-    h.send_time_us = ToWireMicros(t0);
-    h.payload_type = payload_type;
-    h.payload_size = size;
-    h.mode = robotalk_msgs::package_header_t::MODE_DELAY;
-    return h;
-  };
-  robotalk_msgs::package_t stream{};
-  stream.header = header(1, robotalk_msgs::package_header_t::PAYLOAD_QUERIES, 1);
-  stream.queries.push_back(
-      ToWire(Query{.id = 1, .type = QueryType::kStateStream, .period = options.sample_period}));
-  stream.num_queries = 1;
-  service.HandlePackage(stream, t0);
+  Request stream{.client_id = kClient, .sequence = 1, .send_time = t0, .mode = RequestMode::kDelay};
+  stream.queries.push_back(Query{.id = 1, .type = QueryType::kStateStream, .period = options.sample_period});
+  sessions.Handle(stream, t0);
 
-  robotalk_msgs::package_t sequence{};
-  sequence.header = header(2, robotalk_msgs::package_header_t::PAYLOAD_COMMANDS,
-                           static_cast<std::int32_t>(commands.size()));
+  Request sequence{.client_id = kClient, .sequence = 2, .send_time = t0, .mode = RequestMode::kDelay};
   for (std::size_t i = 0; i < commands.size(); ++i) {
     Command c = commands[i].command;
     c.id = static_cast<CommandId>(i) + 2;
     c.start_time = t0 + commands[i].offset;
-    sequence.commands.push_back(ToWire(c));
+    sequence.commands.push_back(std::move(c));
   }
-  sequence.num_commands = static_cast<std::int32_t>(sequence.commands.size());
-
   std::map<CommandId, Reply> replies;
-  std::vector<OutgoingReplies> outgoing;
-  SimulationResult result;
-  const auto collect = [&] {
-    outgoing.clear();
-    service.TakeReplies(outgoing);
-    for (auto& o : outgoing) {
-      for (auto& r : o.replies) replies[r.id] = std::move(r);
-    }
-    service.TakeStates(result.states);
-  };
   if (!commands.empty()) {
-    for (const auto& r : service.HandlePackage(sequence, t0).package.replies) replies[r.id] = FromWire(r);
+    for (Reply& r : sessions.Handle(sequence, t0).batch.replies) replies[r.id] = std::move(r);
   }
-  // From one deadline to the next (a driver period or a start time), with no
-  // sleeping: simulated time runs as fast as the driver can step.
+
+  SimulationResult result;
+  DaemonOutput output;
+  daemon.Preallocate(output);
+  std::vector<ReplyBatch> batches;
+  const auto collect = [&] {
+    daemon.TakeOutput(output);
+    for (std::size_t i = 0; i < output.num_samples; ++i) {
+      result.states.push_back(ToStateSample(robot_name, ConfigHash(daemon.model()), output.samples[i]));
+    }
+    batches.clear();
+    sessions.File(output, batches);
+    for (ReplyBatch& b : batches) {
+      for (Reply& r : b.replies) replies[r.id] = std::move(r);
+    }
+  };
+  // From one deadline to the next (a driver period, a start time, a sample),
+  // with no sleeping: simulated time runs as fast as the driver can step.
   for (TimePoint now = t0; now <= t0 + options.duration;) {
-    const TimePoint next = service.RunOnce(now);
+    const TimePoint next = daemon.RunOnce(now);
     collect();
     now = std::max(next, now + Duration(1));
     clock.Set(now);

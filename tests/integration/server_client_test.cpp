@@ -48,6 +48,7 @@ class CountingDriver final : public Driver {
   }
   void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
   void ReadState(RobotState& s) const override { inner_->ReadState(s); }
+  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
   void Halt(std::vector<Completion>& done) override { inner_->Halt(done); }
   void Resume() override { inner_->Resume(); }
 

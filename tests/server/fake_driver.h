@@ -5,6 +5,8 @@
 #include "robotalk/driver.h"
 
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace robotalk::testing {
@@ -39,20 +41,17 @@ class FakeDriver : public Driver {
   const RobotModel& model() const override { return model_; }
   Duration period() const override { return std::chrono::milliseconds(10); }
 
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed) override {
+  DriverResult Execute(const DriverCommand& c, TimePoint now,
+                       std::vector<Completion>& /*completed*/) override {
     calls.push_back({c.type, now, {c.values.begin(), c.values.begin() + c.num_values}});
-    if (halted) return {Signal::kPanic, false, "halted"};
+    if (halted) throw std::logic_error("FakeDriver: Execute while halted breaks the driver contract");
+    if (throw_on_execute) throw std::runtime_error(*throw_on_execute);
     switch (c.type) {
       case CommandType::kGoto:
         if (goto_id) return {Signal::kBusy, false, "GOTO in progress"};
         goto_id = c.id;
         updates_left = goto_updates;
         return {Signal::kSuccess, true, ""};
-      case CommandType::kStop:
-        if (goto_id) completed.push_back({*goto_id, Signal::kInterrupted, "stopped"});
-        goto_id.reset();
-        moving = false;
-        return {};
       case CommandType::kJointSetPoint:
         if (std::abs(c.values[0]) > 1) return {Signal::kModified, false, "clamped"};
         position = c.values[0];
@@ -61,6 +60,12 @@ class FakeDriver : public Driver {
       default:
         return {};
     }
+  }
+  void Stop(TimePoint now, std::vector<Completion>& interrupted) override {
+    calls.push_back({CommandType::kStop, now, {}});
+    if (goto_id) interrupted.push_back({*goto_id, Signal::kInterrupted, "stopped"});
+    goto_id.reset();
+    moving = false;
   }
   void Update(TimePoint, std::vector<Completion>& completed) override {
     ++updates;
@@ -92,6 +97,7 @@ class FakeDriver : public Driver {
   double position = 0;
   bool halted = false;
   bool moving = false;
+  std::optional<std::string> throw_on_execute;  ///< Execute throws this message
 };
 
 }  // namespace robotalk::testing

@@ -1,12 +1,34 @@
 // The interface a robot or simulator implements to be served by RoboTalk, and
 // the registry of drivers by name. The server core does all networking,
-// queuing, timing and panic handling; a driver only moves the robot.
+// queuing, timing, STOP, halt and panic handling; a driver only moves the robot.
 //
-// Threading contract: the server calls every method of a Driver from one
-// thread, its RobotDaemon, so a driver needs no locking of its own. The
-// RobotDaemon is the real-time path: Execute(), Update() and ReadState() must
-// not block on I/O for longer than a control period and should not allocate
-// (the output vectors come preallocated; push_back within their capacity).
+// What the server guarantees before each call (so a driver need not re-check):
+// - Every method is called from one thread, the robot's RobotDaemon, never
+//   concurrently: a driver needs no locking of its own.
+// - Execute() receives only motion commands (JOINT_SETPOINT / JOINT_SPEED /
+//   JOINT_FORCE / FRAME_SETPOINT / GOTO / SETSPEED): STOP arrives as Stop(),
+//   panic as Halt(), PANIC_RESET as Resume(). The command was checked against
+//   model() (robotalk::CheckCommand): `target` is a valid joint (JOINT_*) or
+//   control-frame (FRAME_SETPOINT) index, never a mimic follower, and the
+//   joint or frame declares that servo type; `num_values` is the joint's dof
+//   count, 7 for FRAME_SETPOINT, 3 for GOTO, 2 or 3 for SETSPEED; every value
+//   is finite. Between Halt() and Resume() Execute() is never called.
+// - `now` never goes backwards between calls.
+//
+// What a driver may do: answer a DriverResult (any signal; in_progress for a
+// command that takes time), append Completions, or throw (any std::exception).
+// A throw is contained by the server: the command answers ERROR naming the
+// driver, the call and the message, the robot is halted (Halt(), itself
+// guarded) and held in panic until PANIC_RESET, and every other robot keeps
+// serving. A call that runs longer than the server's --driver-call-bound is
+// treated the same way as soon as the bound passes (the call's late result is
+// discarded).
+//
+// Real-time: the RobotDaemon is the real-time path. Execute(), Stop(),
+// Update() and ReadState() must not block on I/O for longer than a control
+// period and should not allocate (the output vectors come preallocated;
+// push_back within their capacity; messages of non-SUCCESS answers may
+// allocate).
 #pragma once
 
 #include "robotalk/clock.h"
@@ -68,20 +90,26 @@ class Driver {
   /// Period at which the RobotDaemon calls Update().
   virtual Duration period() const = 0;
 
-  /// Starts `command` at `now`. Instant commands answer their final signal;
-  /// commands that take time answer in_progress and complete later. A command
-  /// this one pre-empts gets a Completion (INTERRUPTED) in `completed`.
+  /// Starts the motion `command` at `now`. Instant commands answer their
+  /// final signal; commands that take time answer in_progress and complete
+  /// later. A command this one pre-empts gets a Completion (INTERRUPTED) in
+  /// `completed`. REQUIRES: the guarantees above (checked, motion, not halted).
   virtual DriverResult Execute(const DriverCommand& command, TimePoint now,
                                std::vector<Completion>& completed) = 0;
+  /// STOP at `now`: every actuator and the base come to rest (and hold);
+  /// every command in progress completes INTERRUPTED (appended). Also called
+  /// by the server's watchdog and at shutdown.
+  virtual void Stop(TimePoint now, std::vector<Completion>& interrupted) = 0;
   /// Advances the robot to `now` (one period after the previous call);
   /// appends the completions of commands that finished.
   virtual void Update(TimePoint now, std::vector<Completion>& completed) = 0;
   /// Fills `state` (already sized for the model).
   virtual void ReadState(RobotState& state) const = 0;
-  /// Panic: stop every actuator at once and refuse motion until Resume().
-  /// Every command in progress completes INTERRUPTED (appended).
+  /// Panic (or a driver fault): stop every actuator at once. Every command in
+  /// progress completes INTERRUPTED (appended). The server calls no Execute()
+  /// until Resume().
   virtual void Halt(std::vector<Completion>& interrupted) = 0;
-  /// Panic reset: accept commands again; the robot stays where it is.
+  /// Panic reset: the robot stays where it is; Execute() may follow.
   virtual void Resume() = 0;
 };
 

@@ -1,14 +1,16 @@
 // The RoboTalk server: serves one or more robots, each bound to a driver, on
-// one LCM URL (docs/protocol.md).
+// one transport (LCM by default; docs/protocol.md, docs/architecture.md).
 //
-// Threads: one ServerDaemon (receives and parses packages, sends replies,
-// announces, expires sessions) and one RobotDaemon per robot (executes
+// Threads: one ServerDaemon (receives and decodes packages, keeps the client
+// sessions, admits commands, sends replies and state, announces, runs the
+// watchdogs) and one RobotDaemon per robot (owns the driver, executes
 // commands at their start times). Start() launches them; Stop() or the
 // destructor stops every robot's motion and joins them.
 #pragma once
 
 #include "robotalk/clock.h"
 #include "robotalk/driver.h"
+#include "robotalk/transport.h"
 
 #include <map>
 #include <memory>
@@ -37,8 +39,13 @@ struct ServerOptions {
   size_t max_queue = 10000;
   /// Start times further ahead than this are refused with ERROR.
   Duration max_future = std::chrono::hours(1);
-  /// Print one stderr line per executed command (diagnostics; not for real-time use).
+  /// Print one stderr line per executed command (diagnostics).
   bool log_executions = false;
+  /// A driver call running longer than this is a driver fault: its command
+  /// answers ERROR and the robot is held in panic (0 = no bound).
+  Duration driver_call_bound = std::chrono::seconds(2);
+  /// Most server log lines per second; the rest are counted and summarised.
+  int log_lines_per_second = 20;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
   /// The paper's congestion injector (§VI-B): after each received package the
@@ -56,10 +63,15 @@ struct ServerOptions {
 
 class Server {
  public:
-  /// Creates every robot's driver from `registry`. Throws Error naming the
-  /// robot and what failed (unknown driver, bad URDF, duplicate robot name, LCM URL).
+  /// Creates every robot's driver from `registry` and serves them on LCM at
+  /// `options.lcm_url`. Throws Error naming the robot and what failed
+  /// (unknown driver, bad URDF, duplicate robot name, LCM URL).
   Server(ServerOptions options, const std::vector<RobotSpec>& robots, const DriverRegistry& registry,
          const Clock& clock);
+  /// The same on a transport of the caller's (in-memory in tests); it must
+  /// outlive the Server. `options.lcm_url` is ignored.
+  Server(Transport& transport, ServerOptions options, const std::vector<RobotSpec>& robots,
+         const DriverRegistry& registry, const Clock& clock);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

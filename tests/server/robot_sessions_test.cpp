@@ -1,7 +1,10 @@
-#include "robot_service.h"
+#include "robot_sessions.h"
 
 #include "fake_driver.h"
+#include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
+#include "state_encoding.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -22,82 +25,85 @@ Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std
   return Command{id, type, start, std::move(target), std::move(values)};
 }
 
-robotalk_msgs::package_t Package(std::int64_t client, std::int64_t seq, const std::vector<Command>& commands,
-                                 bool panic = false) {
-  robotalk_msgs::package_t p{};
-  p.header.protocol_version = kProtocolVersion;
-  p.header.client_id = client;
-  p.header.sequence = seq;
-  p.header.panic = panic;
-  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
-  for (const Command& c : commands) p.commands.push_back(ToWire(c));
-  p.num_commands = static_cast<std::int32_t>(p.commands.size());
-  p.header.payload_size = p.num_commands;
-  return p;
+Request Package(std::int64_t client, std::int64_t seq, const std::vector<Command>& commands,
+                bool panic = false) {
+  Request r{.client_id = client, .sequence = seq, .panic = panic};
+  r.commands = commands;
+  return r;
 }
 
-robotalk_msgs::package_t Queries(std::int64_t client, std::int64_t seq, const std::vector<Query>& queries) {
-  robotalk_msgs::package_t p{};
-  p.header.protocol_version = kProtocolVersion;
-  p.header.client_id = client;
-  p.header.sequence = seq;
-  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
-  for (const Query& q : queries) p.queries.push_back(ToWire(q));
-  p.num_queries = static_cast<std::int32_t>(p.queries.size());
-  p.header.payload_size = p.num_queries;
-  return p;
+Request Queries(std::int64_t client, std::int64_t seq, const std::vector<Query>& queries) {
+  Request r{.client_id = client, .sequence = seq};
+  r.queries = queries;
+  return r;
 }
 
-robotalk_msgs::package_t Playback(std::int64_t client, std::int64_t seq, std::int64_t playback_id, int frames,
-                                  Duration duration, const std::vector<Command>& commands) {
-  robotalk_msgs::package_t p = Package(client, seq, commands);
-  p.header.mode = robotalk_msgs::package_header_t::MODE_PLAYBACK;
-  p.header.playback_id = playback_id;
-  p.header.playback_frames = frames;
-  p.header.playback_duration_us = ToWireMicros(duration);
-  return p;
+// A playback frame's start_time carries its offset from the sequence start.
+Request Playback(std::int64_t client, std::int64_t seq, std::int64_t playback_id, int frames,
+                 Duration duration, const std::vector<Command>& commands) {
+  Request r = Package(client, seq, commands);
+  r.mode = RequestMode::kPlayback;
+  r.playback = {playback_id, frames, duration};
+  return r;
 }
 
-class RobotServiceTest : public ::testing::Test {
+// The ServerDaemon's session layer of one robot and its RobotDaemon, on a
+// manual clock, without threads or a transport.
+class RobotSessionsTest : public ::testing::Test {
  protected:
-  explicit RobotServiceTest(BaseType base = BaseType::kDifferential) {
+  explicit RobotSessionsTest(BaseType base = BaseType::kDifferential, SessionOptions options = {}) {
     auto driver = std::make_unique<FakeDriver>(PanRobot(base));
     fake_ = driver.get();
-    service_ = std::make_unique<RobotService>("bot", "fake", std::move(driver), clock_);
+    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
+    sessions_ = std::make_unique<RobotSessions>(*daemon_, ConfigHash(daemon_->model()), options);
+    daemon_->Preallocate(output_);
   }
 
   // Immediate replies of a package, by id.
-  std::map<CommandId, Reply> Handle(const robotalk_msgs::package_t& p) {
+  std::map<CommandId, Reply> Handle(const Request& p) {
     std::map<CommandId, Reply> out;
-    last_ = service_->HandlePackage(p, clock_.Now());
-    for (const auto& r : last_.package.replies) out[r.id] = FromWire(r);
+    last_ = sessions_->Handle(p, clock_.Now());
+    for (const auto& r : last_.batch.replies) out[r.id] = r;
     return out;
   }
-  // Runs the RobotDaemon once at the current time and collects the replies it produced.
-  void Run() { service_->RunOnce(clock_.Now()); }
-  std::map<CommandId, Reply> Replies(std::int64_t client) {
-    std::vector<OutgoingReplies> out;
-    service_->TakeReplies(out);
-    for (auto& o : out) {
-      for (auto& r : o.replies) collected_[o.client_id][r.id] = r;
+  // Runs the RobotDaemon once at the current time and files what it produced.
+  void Run() {
+    daemon_->RunOnce(clock_.Now());
+    Collect();
+  }
+  void Collect() {
+    daemon_->TakeOutput(output_);
+    for (std::size_t i = 0; i < output_.num_samples; ++i) {
+      states_.push_back(ToStateSample("bot", ConfigHash(daemon_->model()), output_.samples[i]));
     }
+    std::vector<ReplyBatch> batches;
+    sessions_->File(output_, batches);
+    for (auto& b : batches) {
+      for (auto& r : b.replies) collected_[b.client_id][r.id] = r;
+    }
+  }
+  std::map<CommandId, Reply> Replies(std::int64_t client) {
+    Collect();
     return collected_[client];
   }
 
   ManualClock clock_;
   FakeDriver* fake_ = nullptr;
-  std::unique_ptr<RobotService> service_;
+  std::unique_ptr<RobotDaemon> daemon_;
+  std::unique_ptr<RobotSessions> sessions_;
+  DaemonOutput output_;
   ImmediateAnswer last_;
   std::map<std::int64_t, std::map<CommandId, Reply>> collected_;
+  std::vector<robotalk_msgs::robot_state_t> states_;
 };
 
-TEST_F(RobotServiceTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
+TEST_F(RobotSessionsTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
   const TimePoint start = clock_.Now() + seconds(2);
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan", start)}));
-  EXPECT_EQ(last_.package.ack_sequence, 1);
+  EXPECT_EQ(last_.batch.ack_sequence, 1);
   Run();
   EXPECT_TRUE(fake_->calls.empty()) << "ran before its start time";
-  EXPECT_EQ(service_->RunOnce(clock_.Now()), std::min(start, clock_.Now() + milliseconds(10)));
+  EXPECT_EQ(daemon_->RunOnce(clock_.Now()), std::min(start, clock_.Now() + milliseconds(10)));
   clock_.Set(start + milliseconds(3));
   Run();
   ASSERT_EQ(fake_->calls.size(), 1u);
@@ -107,7 +113,7 @@ TEST_F(RobotServiceTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
   EXPECT_EQ(r.lateness, milliseconds(3));
 }
 
-TEST_F(RobotServiceTest, OrdersCommandsOfAllClientsByStartTimeThenArrival) {
+TEST_F(RobotSessionsTest, OrdersCommandsOfAllClientsByStartTimeThenArrival) {
   const TimePoint t = clock_.Now() + seconds(1);
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kStop, {}, "", t + seconds(40))}));
   Handle(Package(kBob, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0}, "", t + seconds(20))}));
@@ -120,7 +126,7 @@ TEST_F(RobotServiceTest, OrdersCommandsOfAllClientsByStartTimeThenArrival) {
   EXPECT_EQ(fake_->calls[2].type, CommandType::kStop);
 }
 
-TEST_F(RobotServiceTest, NeverExecutesADuplicatedPackageTwiceAndResendsItsReply) {
+TEST_F(RobotSessionsTest, NeverExecutesADuplicatedPackageTwiceAndResendsItsReply) {
   const auto p = Package(kAlice, 7, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")});
   Handle(p);
   Run();
@@ -128,12 +134,12 @@ TEST_F(RobotServiceTest, NeverExecutesADuplicatedPackageTwiceAndResendsItsReply)
   auto again = Handle(p);  // the client did not see the reply and retransmits
   Run();
   EXPECT_EQ(fake_->calls.size(), 1u);
-  EXPECT_EQ(last_.package.ack_sequence, 7);
+  EXPECT_EQ(last_.batch.ack_sequence, 7);
   ASSERT_EQ(again.count(1), 1u);
   EXPECT_EQ(again.at(1).signal, Signal::kSuccess);
 }
 
-TEST_F(RobotServiceTest, AnswersEverySignal) {
+TEST_F(RobotSessionsTest, AnswersEverySignal) {
   // SUCCESS, MODIFIED (the driver clamps), ERROR (unknown joint, NaN, too far ahead).
   auto immediate = Handle(Package(
       kAlice, 1,
@@ -169,7 +175,7 @@ TEST_F(RobotServiceTest, AnswersEverySignal) {
   EXPECT_EQ(refused.at(13).signal, Signal::kPanic);
 }
 
-TEST_F(RobotServiceTest, CompletesAGotoWhenTheDriverReportsIt) {
+TEST_F(RobotSessionsTest, CompletesAGotoWhenTheDriverReportsIt) {
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 2, 0})}));
   for (int i = 0; i < 5; ++i) {
     clock_.Advance(milliseconds(10));
@@ -178,44 +184,58 @@ TEST_F(RobotServiceTest, CompletesAGotoWhenTheDriverReportsIt) {
   EXPECT_EQ(Replies(kAlice).at(1).signal, Signal::kSuccess);
 }
 
-TEST_F(RobotServiceTest, AnswersNaToABaseCommandOnAFixedBase) {
-  auto driver = std::make_unique<FakeDriver>(PanRobot(BaseType::kFixed));
-  RobotService fixed("arm", "fake", std::move(driver), clock_);
-  auto answer =
-      fixed.HandlePackage(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}), clock_.Now());
-  ASSERT_EQ(answer.package.replies.size(), 1u);
-  EXPECT_EQ(answer.package.replies[0].signal, static_cast<std::int8_t>(Signal::kNa));
-  EXPECT_THAT(answer.package.replies[0].message, HasSubstr("fixed base"));
+class FixedBaseSessionsTest : public RobotSessionsTest {
+ protected:
+  FixedBaseSessionsTest() : RobotSessionsTest(BaseType::kFixed) {}
+};
+
+TEST_F(FixedBaseSessionsTest, AnswersNaToABaseCommandOnAFixedBase) {
+  auto r = Handle(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}));
+  EXPECT_EQ(r.at(1).signal, Signal::kNa);
+  EXPECT_THAT(r.at(1).message, HasSubstr("fixed base"));
+  Run();
+  EXPECT_TRUE(fake_->calls.empty()) << "refused before it reached the driver";
 }
 
-TEST_F(RobotServiceTest, RefusesAMixedPackageWithErrorForEveryItem) {
-  auto p = Package(kAlice, 1, {Cmd(1, CommandType::kStop)});
+TEST_F(RobotSessionsTest, RefusesAMixedPackageWithErrorForEveryItem) {
+  // A mixed package can only be made on the wire: build it there and decode it.
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = kAlice;
+  p.header.sequence = 1;
+  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
+  p.commands.push_back(ToWire(Cmd(1, CommandType::kStop)));
   p.queries.push_back(ToWire(Query{2, QueryType::kJointState, ""}));
-  p.num_queries = 1;
-  const std::string reason = CheckPackageHeader(p);
-  ASSERT_THAT(reason, HasSubstr("mixes"));
-  auto answer = service_->RefusePackage(p, clock_.Now(), reason);
-  ASSERT_EQ(answer.package.replies.size(), 2u);
-  for (const auto& r : answer.package.replies) EXPECT_EQ(r.signal, static_cast<std::int8_t>(Signal::kError));
+  p.num_commands = p.num_queries = 1;
+  p.header.payload_size = 1;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(p.getEncodedSize()));
+  p.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  const Request request = DecodeRequest(bytes);
+  ASSERT_THAT(request.header_error, HasSubstr("mixes"));
+  auto r = Handle(request);
+  ASSERT_EQ(r.size(), 2u);
+  for (const auto& [id, reply] : r) EXPECT_EQ(reply.signal, Signal::kError);
   Run();
   EXPECT_TRUE(fake_->calls.empty());
 }
 
-TEST_F(RobotServiceTest, RefusesCommandsBeyondTheQueueLimit) {
-  auto driver = std::make_unique<FakeDriver>(PanRobot());
-  RobotService small("bot", "fake", std::move(driver), clock_, RobotServiceOptions{.max_queue = 2});
+class SmallQueueSessionsTest : public RobotSessionsTest {
+ protected:
+  SmallQueueSessionsTest() : RobotSessionsTest(BaseType::kDifferential, SessionOptions{.max_queue = 2}) {}
+};
+
+TEST_F(SmallQueueSessionsTest, RefusesCommandsBeyondTheQueueLimit) {
   const TimePoint later = clock_.Now() + seconds(10);
-  auto answer = small.HandlePackage(
-      Package(kAlice, 1,
-              {Cmd(1, CommandType::kStop, {}, "", later), Cmd(2, CommandType::kStop, {}, "", later),
-               Cmd(3, CommandType::kStop, {}, "", later)}),
-      clock_.Now());
-  ASSERT_EQ(answer.package.replies.size(), 1u);
-  EXPECT_EQ(answer.package.replies[0].id, 3);
-  EXPECT_THAT(answer.package.replies[0].message, HasSubstr("is full (2 items)"));
+  auto r =
+      Handle(Package(kAlice, 1,
+                     {Cmd(1, CommandType::kStop, {}, "", later), Cmd(2, CommandType::kStop, {}, "", later),
+                      Cmd(3, CommandType::kStop, {}, "", later)}));
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_THAT(r.at(3).message, HasSubstr("is full (2 items)"));
+  EXPECT_EQ(daemon_->queued(kAlice), 2u);
 }
 
-TEST_F(RobotServiceTest, PanicFlushesEveryQueueHaltsTheDriverAndRefusesUntilReset) {
+TEST_F(RobotSessionsTest, PanicFlushesEveryQueueHaltsTheDriverAndRefusesUntilReset) {
   const TimePoint later = clock_.Now() + seconds(5);
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0})}));
   Run();  // the GOTO is in progress
@@ -224,7 +244,7 @@ TEST_F(RobotServiceTest, PanicFlushesEveryQueueHaltsTheDriverAndRefusesUntilRese
 
   auto panic = Handle(Package(kBob, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan")}, /*panic=*/true));
   EXPECT_EQ(panic.at(2).signal, Signal::kPanic) << "a panic package is never executed";
-  EXPECT_TRUE(service_->in_panic());
+  EXPECT_TRUE(daemon_->in_panic());
   // Flushed at once, before the RobotDaemon runs.
   EXPECT_EQ(Replies(kAlice).at(2).signal, Signal::kInterrupted);
   EXPECT_EQ(Replies(kBob).at(1).signal, Signal::kInterrupted);
@@ -250,14 +270,14 @@ TEST_F(RobotServiceTest, PanicFlushesEveryQueueHaltsTheDriverAndRefusesUntilRese
   EXPECT_DOUBLE_EQ(fake_->position, 0.3);
 }
 
-TEST_F(RobotServiceTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
+TEST_F(RobotSessionsTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
   Handle(Queries(kBob, 1, {Query{1, QueryType::kJointState, ""}}));
   Run();
   clock_.Advance(seconds(1));
   Handle(Queries(kBob, 2, {}));  // Bob keeps his session alive with a heartbeat
   clock_.Advance(milliseconds(1500));
-  const auto expired = service_->ExpireSessions(clock_.Now());
+  const auto expired = sessions_->Expire(clock_.Now());
   ASSERT_EQ(expired.size(), 1u);
   EXPECT_EQ(expired[0].client_id, kAlice);
   EXPECT_TRUE(expired[0].moved_robot);
@@ -266,42 +286,42 @@ TEST_F(RobotServiceTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
   EXPECT_EQ(fake_->calls.back().type, CommandType::kStop);
 }
 
-TEST_F(RobotServiceTest, LeavesAStillRobotAloneWhenTheClientThatMovedItVanishes) {
+TEST_F(RobotSessionsTest, LeavesAStillRobotAloneWhenTheClientThatMovedItVanishes) {
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
   Run();
   fake_->moving = false;  // the set-point has been reached
   clock_.Advance(seconds(3));
-  ASSERT_EQ(service_->ExpireSessions(clock_.Now()).size(), 1u);
+  ASSERT_EQ(sessions_->Expire(clock_.Now()).size(), 1u);
   Run();
   EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "no STOP was needed";
 }
 
-TEST_F(RobotServiceTest, DoesNotStopTheRobotWhenAQueryOnlyClientVanishes) {
+TEST_F(RobotSessionsTest, DoesNotStopTheRobotWhenAQueryOnlyClientVanishes) {
   Handle(Queries(kBob, 1, {Query{1, QueryType::kJointState, ""}}));
   Run();
   clock_.Advance(seconds(3));
-  EXPECT_EQ(service_->ExpireSessions(clock_.Now()).size(), 1u);
+  EXPECT_EQ(sessions_->Expire(clock_.Now()).size(), 1u);
   Run();
   EXPECT_TRUE(fake_->calls.empty());
 }
 
-TEST_F(RobotServiceTest, AnswersClockAndConfigQueriesOnReceipt) {
+TEST_F(RobotSessionsTest, AnswersClockAndConfigQueriesOnReceipt) {
   auto r = Handle(Queries(kAlice, 1, {Query{1, QueryType::kClock, ""}, Query{2, QueryType::kConfig, ""}}));
   EXPECT_EQ(r.at(1).signal, Signal::kSuccess);
   EXPECT_EQ(r.at(1).exec_time, clock_.Now());
-  EXPECT_EQ(last_.package.server_receive_us, ToWireMicros(clock_.Now()));
+  EXPECT_EQ(last_.batch.server_receive, clock_.Now());
   EXPECT_TRUE(last_.publish_config);
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(service_->config_hash()));
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(ConfigHash(daemon_->model())));
   EXPECT_EQ(r.at(2).message, hex);
 }
 
-TEST_F(RobotServiceTest, AnswersJointStateAndPoseQueries) {
+TEST_F(RobotSessionsTest, AnswersJointStateAndPoseQueries) {
   fake_->position = 0.5;
   Handle(Queries(kAlice, 1,
                  {Query{1, QueryType::kJointState, "pan"}, Query{2, QueryType::kLinkPoses, "head"},
                   Query{3, QueryType::kBasePose, ""}, Query{4, QueryType::kFramePoses, "nope"}}));
-  EXPECT_EQ(last_.package.replies.size(), 1u) << "only the bad frame name is answered at once";
+  EXPECT_EQ(last_.batch.replies.size(), 1u) << "only the bad frame name is answered at once";
   Run();
   auto replies = Replies(kAlice);
   EXPECT_EQ(replies.at(1).values, (std::vector<double>{0.5, 0.25, -0.5}));
@@ -310,7 +330,7 @@ TEST_F(RobotServiceTest, AnswersJointStateAndPoseQueries) {
   EXPECT_EQ(replies.at(3).values.size(), 5u);
 }
 
-TEST_F(RobotServiceTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTiming) {
+TEST_F(RobotSessionsTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTiming) {
   // 20 frames every 100 ms; the channel delivers one every 150 ms (slower).
   // One timeline in 1 ms steps: frames arrive, the RobotDaemon runs.
   constexpr int kFrames = 20;
@@ -353,22 +373,21 @@ TEST_F(RobotServiceTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTimi
   }
 }
 
-TEST_F(RobotServiceTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
+TEST_F(RobotSessionsTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
   auto r = Handle(
       Playback(kAlice, 1, 77, 2, seconds(1), {Cmd(1, CommandType::kStop, {}, "", TimePoint(seconds(2)))}));
   EXPECT_EQ(r.at(1).signal, Signal::kError);
   EXPECT_THAT(r.at(1).message, HasSubstr("beyond the declared"));
 }
 
-TEST_F(RobotServiceTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) {
+TEST_F(RobotSessionsTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) {
   auto r = Handle(Queries(kAlice, 1, {Query{1, QueryType::kStateStream, "", milliseconds(100)}}));
   ASSERT_EQ(r.at(1).signal, Signal::kSuccess);
   const TimePoint t0 = clock_.Now();
-  std::vector<robotalk_msgs::robot_state_t> states;
+  std::vector<robotalk_msgs::robot_state_t>& states = states_;
   // A minute of daemon iterations at an irregular 7 ms step.
   while (clock_.Now() < t0 + seconds(60)) {
     Run();
-    service_->TakeStates(states);
     clock_.Advance(milliseconds(7));
     if ((clock_.Now() - t0) % seconds(1) < milliseconds(7))
       Handle(Queries(kAlice, 100 + states.size(), {}));  // heartbeat
@@ -390,19 +409,18 @@ TEST_F(RobotServiceTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) {
     clock_.Advance(milliseconds(10));
     Run();
   }
-  service_->TakeStates(states);
   EXPECT_TRUE(states.empty()) << "cancelled";
 }
 
-TEST_F(RobotServiceTest, SharesOneStreamAtTheShortestPeriodAndEndsItWithTheSessions) {
+TEST_F(RobotSessionsTest, SharesOneStreamAtTheShortestPeriodAndEndsItWithTheSessions) {
   Handle(Queries(kAlice, 1, {Query{1, QueryType::kStateStream, "", milliseconds(200)}}));
   Handle(Queries(kBob, 1, {Query{1, QueryType::kStateStream, "", milliseconds(50)}}));
-  EXPECT_EQ(service_->stream_period(), milliseconds(50));
+  EXPECT_EQ(daemon_->stream_period(), milliseconds(50));
   Handle(Queries(kBob, 2, {Query{2, QueryType::kStateStreamCancel, ""}}));
-  EXPECT_EQ(service_->stream_period(), milliseconds(200));
+  EXPECT_EQ(daemon_->stream_period(), milliseconds(200));
   clock_.Advance(seconds(3));
-  service_->ExpireSessions(clock_.Now());
-  EXPECT_EQ(service_->stream_period(), Duration(0)) << "nobody left to ask";
+  sessions_->Expire(clock_.Now());
+  EXPECT_EQ(daemon_->stream_period(), Duration(0)) << "nobody left to ask";
   auto bad = Handle(Queries(kAlice, 2, {Query{3, QueryType::kStateStream, "", Duration(0)}}));
   EXPECT_EQ(bad.at(3).signal, Signal::kError);
 }

@@ -1,0 +1,130 @@
+// The codec of whole packages (request.h): the only place besides
+// protocol_codec.cpp that knows the LCM wire structs.
+#include "robotalk/error.h"
+#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
+#include "robotalk_msgs/announce_t.hpp"
+
+namespace robotalk {
+namespace {
+
+template <typename Msg>
+std::vector<std::uint8_t> Encode(const Msg& msg) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  if (msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
+    throw ProtocolError(std::string("encoding ") + Msg::getTypeName() + " failed");
+  }
+  return bytes;
+}
+
+}  // namespace
+
+std::vector<CommandId> Request::item_ids() const {
+  std::vector<CommandId> ids;
+  ids.reserve(queries.size() + commands.size() + malformed.size());
+  for (const Query& q : queries) ids.push_back(q.id);
+  for (const Command& c : commands) ids.push_back(c.id);
+  for (const MalformedItem& m : malformed) ids.push_back(m.id);
+  return ids;
+}
+
+Request DecodeRequest(std::span<const std::uint8_t> bytes) {
+  const robotalk_msgs::package_t p = DecodePackage(bytes);
+  const auto& h = p.header;
+  Request r;
+  r.client_id = h.client_id;
+  r.sequence = h.sequence;
+  r.send_time = FromWireMicros(h.send_time_us);
+  r.panic = h.panic;
+  r.header_error = CheckPackageHeader(p);
+  r.mode = static_cast<RequestMode>(h.mode);
+  if (r.mode == RequestMode::kPlayback && r.header_error.empty()) {
+    r.playback = {h.playback_id, h.playback_frames, std::chrono::microseconds(h.playback_duration_us)};
+  }
+  for (const auto& q : p.queries) {
+    try {
+      r.queries.push_back(FromWire(q));
+    } catch (const ProtocolError& e) {
+      r.malformed.push_back({q.id, e.what()});
+    }
+  }
+  for (const auto& c : p.commands) {
+    try {
+      r.commands.push_back(FromWire(c));
+    } catch (const ProtocolError& e) {
+      r.malformed.push_back({c.id, e.what()});
+    }
+  }
+  return r;
+}
+
+std::vector<std::uint8_t> EncodeRequest(const Request& r) {
+  robotalk_msgs::package_t p{};
+  auto& h = p.header;
+  h.protocol_version = kProtocolVersion;
+  h.client_id = r.client_id;
+  h.sequence = r.sequence;
+  h.send_time_us = ToWireMicros(r.send_time);
+  h.panic = r.panic;
+  h.mode = static_cast<std::int8_t>(r.mode);
+  if (r.mode == RequestMode::kPlayback) {
+    h.playback_id = r.playback.id;
+    h.playback_frames = static_cast<std::int32_t>(r.playback.frames);
+    h.playback_duration_us = ToWireMicros(r.playback.duration);
+  }
+  for (const Query& q : r.queries) p.queries.push_back(ToWire(q));
+  for (const Command& c : r.commands) p.commands.push_back(ToWire(c));
+  p.num_queries = static_cast<std::int32_t>(p.queries.size());
+  p.num_commands = static_cast<std::int32_t>(p.commands.size());
+  h.payload_type = p.num_queries > 0 ? robotalk_msgs::package_header_t::PAYLOAD_QUERIES
+                                     : robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
+  h.payload_size = p.num_queries > 0 ? p.num_queries : p.num_commands;
+  return Encode(p);
+}
+
+std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
+  robotalk_msgs::reply_package_t p{};
+  p.protocol_version = kProtocolVersion;
+  p.client_id = b.client_id;
+  p.ack_sequence = b.ack_sequence;
+  p.server_receive_us = ToWireMicros(b.server_receive);
+  p.server_send_us = ToWireMicros(b.server_send);
+  p.replies.reserve(b.replies.size());
+  for (const Reply& r : b.replies) p.replies.push_back(ToWire(r));
+  p.num_replies = static_cast<std::int32_t>(p.replies.size());
+  return Encode(p);
+}
+
+ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
+  const robotalk_msgs::reply_package_t p = DecodeReplyPackage(bytes);
+  ReplyBatch b;
+  b.client_id = p.client_id;
+  b.ack_sequence = p.ack_sequence;
+  b.server_receive = FromWireMicros(p.server_receive_us);
+  b.server_send = FromWireMicros(p.server_send_us);
+  for (const auto& r : p.replies) b.replies.push_back(FromWire(r));
+  return b;
+}
+
+std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
+  robotalk_msgs::announce_t m{};
+  m.protocol_version = kProtocolVersion;
+  m.server_id = a.server_id;
+  m.server_time_us = ToWireMicros(a.server_time);
+  m.url_hint = a.url_hint;
+  for (const RobotAnnouncement& r : a.robots) {
+    robotalk_msgs::robot_info_t info{};
+    info.name = r.name;
+    info.driver = r.driver;
+    info.config_hash = static_cast<std::int64_t>(r.config_hash);
+    info.total_dofs = r.total_dofs;
+    info.base_type = r.base_type;
+    info.panic = r.panic;
+    info.num_clients = r.num_clients;
+    m.robots.push_back(info);
+  }
+  m.num_robots = static_cast<std::int32_t>(m.robots.size());
+  return Encode(m);
+}
+
+}  // namespace robotalk

@@ -1,0 +1,483 @@
+#include "robot_daemon.h"
+
+#include "robotalk/signal.h"
+
+#include <Eigen/Geometry>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+namespace robotalk {
+namespace {
+
+void WritePose(const Eigen::Isometry3d& x, double* out) {
+  const Eigen::Quaterniond q(x.linear());
+  out[0] = x.translation().x();
+  out[1] = x.translation().y();
+  out[2] = x.translation().z();
+  out[3] = q.w();
+  out[4] = q.x();
+  out[5] = q.y();
+  out[6] = q.z();
+}
+
+double Yaw(const Eigen::Isometry3d& x) { return std::atan2(x.linear()(1, 0), x.linear()(0, 0)); }
+
+std::string Seconds(Duration d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g s", ToSeconds(d));
+  return buf;
+}
+
+}  // namespace
+
+RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::unique_ptr<Driver> driver,
+                         const Clock& clock, RobotDaemonOptions options)
+    : robot_name_(std::move(robot_name)),
+      driver_name_(std::move(driver_name)),
+      driver_(std::move(driver)),
+      clock_(clock),
+      options_(options),
+      kinematics_(driver_->model()) {
+  const RobotModel& m = model();
+  for (Eigen::VectorXd* v : {&state_.position, &state_.velocity, &state_.effort})
+    *v = Eigen::VectorXd::Zero(m.num_dofs());
+  for (const RootLink& r : m.roots()) {
+    state_.root_poses.push_back(r.pose_in_world);
+    roots_.push_back(r.pose_in_world.ToIsometry());
+  }
+  for (Eigen::VectorXd* v : {&sample_.position, &sample_.velocity, &sample_.effort})
+    *v = Eigen::VectorXd::Zero(m.num_dofs());
+  sample_.frame_poses.assign(7 * m.frames().size(), 0.0);
+  due_.reserve(256);
+  completions_.reserve(64);
+  produced_.replies.reserve(256);
+  produced_.executed.reserve(256);
+  Preallocate(outbox_);
+  in_progress_.reserve(64);
+}
+
+RobotDaemon::~RobotDaemon() { Stop(); }
+
+void RobotDaemon::Preallocate(DaemonOutput& out) const {
+  out.replies.reserve(256);
+  out.executed.reserve(256);
+  out.samples.assign(options_.max_buffered_samples, sample_);
+  out.num_samples = 0;
+}
+
+void RobotDaemon::Start() {
+  std::lock_guard lock(mutex_);
+  if (running_) return;
+  running_ = true;
+  thread_ = std::thread([this] { DaemonLoop(); });
+}
+
+void RobotDaemon::Stop() {
+  {
+    std::lock_guard lock(mutex_);
+    running_ = false;
+  }
+  wake_.notify_all();
+  if (!thread_.joinable()) return;
+  thread_.join();
+  // The thread is gone, so this one may act as it: run what the server queued
+  // last (the shutdown STOP), so no robot is left moving.
+  RunOnce(clock_.Now());
+}
+
+void RobotDaemon::DaemonLoop() {
+  std::unique_lock lock(mutex_);
+  while (running_) {
+    lock.unlock();
+    const TimePoint next = RunOnce(clock_.Now());
+    lock.lock();
+    // Absolute deadline: the next start time, driver period or sample.
+    wake_.wait_until(lock, next, [this] { return wake_flag_ || !running_; });
+    wake_flag_ = false;
+  }
+}
+
+// --- ServerDaemon side -------------------------------------------------------
+
+void RobotDaemon::Submit(QueuedItem item) {
+  {
+    std::lock_guard lock(mutex_);
+    scheduler_.Push(std::move(item));
+    wake_flag_ = true;
+  }
+  wake_.notify_one();
+}
+
+std::size_t RobotDaemon::queued(std::int64_t client_id) const {
+  std::lock_guard lock(mutex_);
+  return scheduler_.queued(client_id);
+}
+
+void RobotDaemon::Panic(std::vector<QueuedItem>& flushed) {
+  panic_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    scheduler_.FlushAll(flushed);
+    halt_requested_ = true;
+    wake_flag_ = true;
+  }
+  wake_.notify_one();
+}
+
+bool RobotDaemon::ResetPanic() {
+  if (!panic_.exchange(false)) return false;
+  {
+    std::lock_guard lock(mutex_);
+    fault_.clear();
+    resume_requested_ = true;
+    wake_flag_ = true;
+  }
+  wake_.notify_one();
+  return true;
+}
+
+std::string RobotDaemon::fault() const {
+  std::lock_guard lock(mutex_);
+  return fault_;
+}
+
+void RobotDaemon::FlushClient(std::int64_t client_id, std::vector<QueuedItem>& out) {
+  std::lock_guard lock(mutex_);
+  scheduler_.FlushClient(client_id, out);
+}
+
+Duration RobotDaemon::SetStream(std::int64_t client_id, Duration period) {
+  Duration now_period;
+  {
+    std::lock_guard lock(mutex_);
+    now_period = scheduler_.SetStream(client_id, period, clock_.Now());
+    wake_flag_ = true;
+  }
+  wake_.notify_one();
+  return now_period;
+}
+
+Duration RobotDaemon::stream_period() const {
+  std::lock_guard lock(mutex_);
+  return scheduler_.stream_period();
+}
+
+void RobotDaemon::QueueStop(bool only_if_moving) {
+  QueuedItem stop;
+  stop.client_id = 0;
+  stop.command.type = CommandType::kStop;
+  stop.only_if_moving = only_if_moving;
+  Submit(std::move(stop));
+}
+
+bool RobotDaemon::TakeOutput(DaemonOutput& out) {
+  if (out.samples.size() != options_.max_buffered_samples) Preallocate(out);
+  out.Clear();
+  std::lock_guard lock(mutex_);
+  std::swap(out, outbox_);
+  return !out.replies.empty() || !out.executed.empty() || out.num_samples > 0 || !out.log.empty() ||
+         out.dropped_samples > 0;
+}
+
+bool RobotDaemon::CheckOverrun(TimePoint now) {
+  std::lock_guard call_lock(call_mutex_);
+  if (!call_.name || call_.overran || options_.driver_call_bound.count() <= 0 ||
+      now - call_.started <= options_.driver_call_bound) {
+    return false;
+  }
+  call_.overran = true;
+  const std::string what = "driver '" + driver_name_ + "' " + call_.name + " has run for " +
+                           Seconds(now - call_.started) + " (the bound is " +
+                           Seconds(options_.driver_call_bound) + ")";
+  panic_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    fault_ = what;
+    halt_requested_ = true;
+    wake_flag_ = true;
+    outbox_.log.push_back("robot '" + robot_name_ + "': DRIVER FAULT: " + what +
+                          "; robot held in panic until PANIC_RESET");
+    if (call_.has_command) {
+      Reply r;
+      r.id = call_.command_id;
+      r.signal = Signal::kError;
+      r.message = what + "; robot '" + robot_name_ + "' halted (panic) until PANIC_RESET";
+      r.exec_time = call_.started;
+      outbox_.replies.push_back({call_.client_id, std::move(r)});
+    }
+  }
+  wake_.notify_one();
+  return true;
+}
+
+// --- RobotDaemon side --------------------------------------------------------
+
+template <typename F>
+RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem* item, TimePoint now,
+                                              F&& call) {
+  {
+    std::lock_guard lock(call_mutex_);
+    call_ = CurrentCall{name,
+                        now,
+                        item ? item->client_id : 0,
+                        item ? item->command.id : 0,
+                        item != nullptr && item->client_id != 0,
+                        false};
+  }
+  std::string error;
+  bool threw = false;
+  try {
+    call();
+  } catch (const std::exception& e) {
+    threw = true;
+    error = e.what();
+  } catch (...) {
+    threw = true;
+    error = "an exception that is not a std::exception";
+  }
+  bool overran = false;
+  {
+    std::lock_guard lock(call_mutex_);
+    overran = call_.overran;
+    call_ = CurrentCall{};
+  }
+  if (overran) return CallOutcome::kOverran;
+  if (!threw) return CallOutcome::kOk;
+  Fault("driver '" + driver_name_ + "' threw in " + name + ": " + error, now);
+  return CallOutcome::kThrew;
+}
+
+void RobotDaemon::Fault(const std::string& what, TimePoint /*now*/) {
+  panic_ = true;
+  last_fault_ = what;
+  {
+    std::lock_guard lock(mutex_);
+    fault_ = what;
+  }
+  produced_.log.push_back("robot '" + robot_name_ + "': DRIVER FAULT: " + what +
+                          "; robot halted, in panic until PANIC_RESET");
+  if (halted_) return;
+  halted_ = true;
+  try {
+    driver_->Halt(completions_);
+  } catch (const std::exception& e) {
+    produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ +
+                            "' threw in Halt too: " + e.what());
+  } catch (...) {
+    produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ + "' threw in Halt too");
+  }
+}
+
+void RobotDaemon::Emit(std::int64_t client_id, Reply reply) {
+  if (client_id == 0) return;  // the server's own STOP has nobody to answer
+  produced_.replies.push_back({client_id, std::move(reply)});
+}
+
+TimePoint RobotDaemon::RunOnce(TimePoint now) {
+  bool halt = false, resume = false, sample_due = false;
+  Duration period{0};
+  due_.clear();
+  {
+    std::lock_guard lock(mutex_);
+    halt = std::exchange(halt_requested_, false);
+    resume = std::exchange(resume_requested_, false);
+    scheduler_.TakeDue(now, due_);
+    period = scheduler_.stream_period();
+    sample_due = scheduler_.TakeSampleDue(now);
+  }
+  completions_.clear();
+  produced_.Clear();
+  if (halt && !halted_) {
+    halted_ = true;
+    Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); });
+  }
+  if (resume && halted_ && !panic_) {
+    if (Guarded("Resume", nullptr, now, [&] { driver_->Resume(); }) == CallOutcome::kOk) halted_ = false;
+  }
+  for (const QueuedItem& item : due_) Execute(item, now);
+  if (now >= next_update_) {
+    Guarded("Update", nullptr, now, [&] { driver_->Update(now, completions_); });
+    const Duration p = driver_->period();
+    next_update_ = next_update_ == TimePoint::min() ? now + p : next_update_ + p;
+    if (next_update_ <= now) next_update_ = now + p;  // overran: skip, don't burst
+  }
+  const bool sampled = sample_due && (Sample(now, period), true);
+  for (const Completion& c : completions_) {
+    auto owner = in_progress_.find(c.id);
+    if (owner == in_progress_.end()) continue;
+    Reply r;
+    r.id = owner->second.client_command_id;
+    r.signal = c.signal;
+    r.message = c.message;
+    r.exec_time = owner->second.started;
+    r.lateness = owner->second.lateness;
+    Emit(owner->second.client_id, std::move(r));
+    in_progress_.erase(owner);
+  }
+
+  TimePoint next = next_update_;
+  bool ready = false;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto& a : produced_.replies) outbox_.replies.push_back(std::move(a));
+    for (const auto& e : produced_.executed) outbox_.executed.push_back(e);
+    for (auto& line : produced_.log) outbox_.log.push_back(std::move(line));
+    if (sampled) {
+      if (outbox_.num_samples < outbox_.samples.size()) {
+        outbox_.samples[outbox_.num_samples++] = sample_;  // same sizes: no allocation
+      } else {
+        ++outbox_.dropped_samples;  // the ServerDaemon is behind: drop the newest
+      }
+    }
+    next = std::min(next, scheduler_.NextDeadline());
+    if (halt_requested_ || resume_requested_) next = now;
+    ready = !produced_.replies.empty() || !produced_.executed.empty() || !produced_.log.empty() || sampled;
+  }
+  if (ready && output_ready_) output_ready_();
+  return next;
+}
+
+void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
+  Reply r;
+  r.id = item.command.id;
+  r.exec_time = now;
+  if (item.has_start_time && now > item.start) r.lateness = now - item.start;
+  if (item.is_query) {
+    AnswerQuery(item, r);
+    Emit(item.client_id, std::move(r));
+    return;
+  }
+  const auto driver_call = [&](const char* name, auto&& call) {
+    const CallOutcome outcome = Guarded(name, &item, now, call);
+    if (outcome == CallOutcome::kThrew) {
+      r.signal = Signal::kError;
+      r.message = last_fault_ + "; robot '" + robot_name_ + "' halted (panic) until PANIC_RESET";
+      Emit(item.client_id, std::move(r));
+    }
+    return outcome == CallOutcome::kOk;
+  };
+  if (item.command.type == CommandType::kStop) {
+    if (item.only_if_moving) {
+      // The watchdog's STOP: a robot already at rest needs none.
+      if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
+      if (!state_.moving) return;
+    }
+    if (!driver_call("Stop", [&] { driver_->Stop(now, completions_); })) return;
+    produced_.executed.push_back({item.client_id, CommandType::kStop});
+    r.signal = Signal::kSuccess;
+    Emit(item.client_id, std::move(r));
+    return;
+  }
+  if (panic_ || halted_) {
+    r.signal = Signal::kInterrupted;
+    r.message = "the robot entered panic before the command ran";
+    Emit(item.client_id, std::move(r));
+    return;
+  }
+  DriverCommand command = item.command;
+  command.id = next_driver_id_++;
+  DriverResult result;
+  if (!driver_call("Execute", [&] { result = driver_->Execute(command, now, completions_); })) return;
+  produced_.executed.push_back({item.client_id, item.command.type});
+  if (options_.log_executions) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "robot '%s': executed client %016" PRIx64 " command %" PRId64 " %s -> %s",
+                  robot_name_.c_str(), static_cast<std::uint64_t>(item.client_id), item.command.id,
+                  ToString(item.command.type),
+                  result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
+    produced_.log.emplace_back(line);
+  }
+  if (result.in_progress) {
+    in_progress_[command.id] = Owner{item.client_id, item.command.id, now, r.lateness};
+    return;
+  }
+  r.signal = result.signal;
+  r.message = std::move(result.message);
+  Emit(item.client_id, std::move(r));
+}
+
+void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
+  const RobotModel& m = model();
+  if (Guarded("ReadState", nullptr, reply.exec_time, [&] { driver_->ReadState(state_); }) !=
+      CallOutcome::kOk) {
+    reply.signal = Signal::kError;
+    reply.message = std::string(ToString(item.query)) + ": " + last_fault_;
+    return;
+  }
+  auto& v = reply.values;
+  try {
+    switch (item.query) {
+      case QueryType::kJointState: {
+        int first = 0, count = m.num_dofs();
+        if (item.query_target >= 0) {
+          first = m.dof_offset(item.query_target);
+          count = static_cast<int>(m.joint(item.query_target).dofs.size());
+        }
+        v.reserve(3 * static_cast<std::size_t>(count));
+        for (const Eigen::VectorXd* vec : {&state_.position, &state_.velocity, &state_.effort}) {
+          v.insert(v.end(), vec->data() + first, vec->data() + first + count);
+        }
+        break;
+      }
+      case QueryType::kLinkPoses:
+      case QueryType::kFramePoses: {
+        for (std::size_t i = 0; i < roots_.size(); ++i) roots_[i] = state_.root_poses[i].ToIsometry();
+        kinematics_.Update(state_.position, roots_);
+        const bool links = item.query == QueryType::kLinkPoses;
+        const int n = static_cast<int>(links ? m.links().size() : m.frames().size());
+        for (int i = 0; i < n; ++i) {
+          if (item.query_target >= 0 && i != item.query_target) continue;
+          v.resize(v.size() + 7);
+          WritePose(links ? kinematics_.link_pose(i) : kinematics_.frame_pose(i), v.data() + v.size() - 7);
+        }
+        break;
+      }
+      case QueryType::kBasePose: {
+        const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
+        v = {base.translation().x(), base.translation().y(), Yaw(base), state_.base_v, state_.base_omega};
+        break;
+      }
+      default:
+        reply.signal = Signal::kError;
+        reply.message = std::string(ToString(item.query)) + " is answered on receipt, not queued";
+        return;
+    }
+    reply.signal = Signal::kSuccess;
+  } catch (const std::exception& e) {  // a non-finite state from the driver
+    reply.signal = Signal::kError;
+    reply.message = std::string(ToString(item.query)) + ": " + e.what();
+    v.clear();
+  }
+}
+
+void RobotDaemon::Sample(TimePoint now, Duration period) {
+  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
+  RobotSample& s = sample_;
+  s.time = now;
+  s.period = period;
+  s.sample = ++samples_;
+  s.panic = panic_.load();
+  s.moving = state_.moving;
+  s.position = state_.position;  // same sizes: copies, no allocation
+  s.velocity = state_.velocity;
+  s.effort = state_.effort;
+  const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
+  s.base = {base.translation().x(), base.translation().y(), Yaw(base), state_.base_v, state_.base_omega};
+  s.frames_valid = true;
+  if (!s.frame_poses.empty()) {
+    try {
+      for (std::size_t i = 0; i < roots_.size(); ++i) roots_[i] = state_.root_poses[i].ToIsometry();
+      kinematics_.Update(state_.position, roots_);
+      for (std::size_t f = 0; f < s.frame_poses.size() / 7; ++f) {
+        WritePose(kinematics_.frame_pose(static_cast<int>(f)), s.frame_poses.data() + 7 * f);
+      }
+    } catch (const std::exception&) {
+      s.frames_valid = false;  // a driver reporting a non-finite state: send the rest
+    }
+  }
+}
+
+}  // namespace robotalk

@@ -1,0 +1,213 @@
+// The paper's RobotDaemon for one robot: owns the driver and its thread,
+// takes the due items of every client from the Scheduler at their start
+// times, executes them on the driver, and hands replies and state samples to
+// the ServerDaemon through an outbox.
+//
+// Threads:
+// - the ServerDaemon calls Submit(), FlushAll(), SetStream(), QueueStop(),
+//   RequestHalt()/RequestResume(), TakeOutput() and the accessors; each takes
+//   the short inbox/outbox lock (mutex_) and never waits on the driver;
+// - the RobotDaemon thread (Start()) runs RunOnce() at each deadline (a start
+//   time, a driver period, a state sample), with absolute deadlines. It holds
+//   mutex_ only to take due items and to append to the outbox, never while
+//   calling the driver. It does not log (log lines travel in the outbox) and,
+//   once warmed up, does not allocate except for replies that carry text or
+//   query values (tests/server/robot_daemon_test.cpp counts).
+// Tests leave the thread unstarted and call RunOnce() with a ManualClock.
+//
+// Driver faults (driver.h): an exception from any driver call, or a call
+// still running past `driver_call_bound` (seen by CheckOverrun(), which the
+// ServerDaemon calls), halts the robot and latches panic with the reason;
+// the command answers ERROR naming the driver, the call and the message.
+#pragma once
+
+#include "robotalk/clock.h"
+#include "robotalk/driver.h"
+#include "robotalk/kinematics.h"
+#include "scheduler.h"
+
+#include <Eigen/Core>
+#include <array>
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+namespace robotalk {
+
+struct RobotDaemonOptions {
+  /// Add one log line per executed command to the outbox (diagnostics).
+  bool log_executions = false;
+  /// A driver call running longer than this is a driver fault (0 = no bound).
+  Duration driver_call_bound = std::chrono::seconds(2);
+  /// State samples the outbox holds before the oldest are dropped (counted).
+  std::size_t max_buffered_samples = 64;
+};
+
+/// One broadcast state sample, preallocated for the model.
+struct RobotSample {
+  TimePoint time{};
+  Duration period{0};
+  std::int64_t sample = 0;
+  bool panic = false;
+  bool moving = false;
+  Eigen::VectorXd position, velocity, effort;
+  std::array<double, 5> base{};     ///< x y θ v ω of the first root
+  std::vector<double> frame_poses;  ///< x y z qw qx qy qz per control frame
+  bool frames_valid = true;         ///< false when the state was not finite
+};
+
+/// What the RobotDaemon hands the ServerDaemon. Swapped whole, so buffers
+/// keep their capacity on both sides.
+struct DaemonOutput {
+  struct Answer {
+    std::int64_t client_id = 0;
+    Reply reply;
+  };
+  struct Executed {  ///< a command the driver took (for the watchdog's bookkeeping)
+    std::int64_t client_id = 0;
+    CommandType type = CommandType::kStop;
+  };
+  std::vector<Answer> replies;
+  std::vector<Executed> executed;
+  std::vector<RobotSample> samples;  ///< the first `num_samples` are filled
+  std::size_t num_samples = 0;
+  std::uint64_t dropped_samples = 0;
+  std::vector<std::string> log;  ///< lines for the ServerDaemon to print
+
+  void Clear() {
+    replies.clear();
+    executed.clear();
+    num_samples = 0;
+    dropped_samples = 0;
+    log.clear();
+  }
+};
+
+class RobotDaemon {
+ public:
+  RobotDaemon(std::string robot_name, std::string driver_name, std::unique_ptr<Driver> driver,
+              const Clock& clock, RobotDaemonOptions options = {});
+  ~RobotDaemon();
+  RobotDaemon(const RobotDaemon&) = delete;
+  RobotDaemon& operator=(const RobotDaemon&) = delete;
+
+  const std::string& robot_name() const { return robot_name_; }
+  const std::string& driver_name() const { return driver_name_; }
+  const RobotModel& model() const { return driver_->model(); }
+  /// Sizes a DaemonOutput's sample buffers for this robot (call once).
+  void Preallocate(DaemonOutput& out) const;
+
+  /// Starts / stops the thread. Stop() runs one last iteration after joining,
+  /// so a STOP queued just before (QueueStop) still executes.
+  void Start();
+  void Stop();
+
+  // --- ServerDaemon side (thread-safe) ------------------------------------
+  /// Queues a checked item. REQUIRES: admission checks passed.
+  void Submit(QueuedItem item);
+  std::size_t queued(std::int64_t client_id) const;
+  /// Panic: removes every waiting item (appended to `flushed`), latches
+  /// panic and asks the thread to halt the driver.
+  void Panic(std::vector<QueuedItem>& flushed);
+  /// Panic reset: returns false if the robot was not in panic.
+  bool ResetPanic();
+  bool in_panic() const { return panic_.load(); }
+  /// Why the robot is in panic: "" for a client's panic, else the driver fault.
+  std::string fault() const;
+  /// Removes one client's waiting items (appended to `out`).
+  void FlushClient(std::int64_t client_id, std::vector<QueuedItem>& out);
+  /// Broadcast request of a client (0 cancels); returns the stream period now.
+  Duration SetStream(std::int64_t client_id, Duration period);
+  Duration stream_period() const;
+  /// A STOP from the server itself (watchdog, shutdown); with
+  /// `only_if_moving` it is skipped when the robot is at rest.
+  void QueueStop(bool only_if_moving);
+  /// Swaps the outbox with `out` (cleared first). Returns false when empty.
+  bool TakeOutput(DaemonOutput& out);
+  /// Called from the RobotDaemon thread whenever the outbox has something.
+  void set_output_ready_callback(std::function<void()> callback) { output_ready_ = std::move(callback); }
+  /// Driver-call watchdog: if a call has run past the bound at `now`, latch
+  /// a driver fault and answer its command ERROR. Returns true when it did.
+  bool CheckOverrun(TimePoint now);
+
+  // --- RobotDaemon side ----------------------------------------------------
+  /// One iteration at `now`: halt/resume, every due item in run order, the
+  /// driver's Update when its period is due, a state sample when due.
+  /// Returns when it next has work.
+  TimePoint RunOnce(TimePoint now);
+
+ private:
+  struct Owner {  // whose command a driver command is
+    std::int64_t client_id;
+    CommandId client_command_id;
+    TimePoint started;
+    Duration lateness;
+  };
+  struct CurrentCall {  // GUARDED_BY(call_mutex_): what the driver is doing now
+    const char* name = nullptr;
+    TimePoint started{};
+    std::int64_t client_id = 0;
+    CommandId command_id = 0;
+    bool has_command = false;
+    bool overran = false;
+  };
+
+  void DaemonLoop();
+  void Execute(const QueuedItem& item, TimePoint now);
+  void AnswerQuery(const QueuedItem& item, Reply& reply);
+  void Sample(TimePoint now, Duration period);
+  enum class CallOutcome { kOk, kThrew, kOverran };
+  // Runs one driver call with the fault guard (a throw latches a fault;
+  // an overrun was latched by CheckOverrun and its command answered there).
+  template <typename F>
+  CallOutcome Guarded(const char* name, const QueuedItem* item, TimePoint now, F&& call);
+  void Fault(const std::string& what, TimePoint now);
+  void Emit(std::int64_t client_id, Reply reply);
+
+  const std::string robot_name_;
+  const std::string driver_name_;
+  std::unique_ptr<Driver> driver_;
+  const Clock& clock_;
+  const RobotDaemonOptions options_;
+  std::function<void()> output_ready_;
+
+  // The inbox and outbox, shared with the ServerDaemon.
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  Scheduler scheduler_;            // GUARDED_BY(mutex_)
+  DaemonOutput outbox_;            // GUARDED_BY(mutex_)
+  std::string fault_;              // GUARDED_BY(mutex_)
+  bool halt_requested_ = false;    // GUARDED_BY(mutex_)
+  bool resume_requested_ = false;  // GUARDED_BY(mutex_)
+  bool wake_flag_ = false;         // GUARDED_BY(mutex_)
+  bool running_ = false;           // GUARDED_BY(mutex_)
+  std::atomic<bool> panic_{false};
+
+  mutable std::mutex call_mutex_;
+  CurrentCall call_;  // GUARDED_BY(call_mutex_)
+
+  // RobotDaemon thread only (preallocated).
+  std::thread thread_;
+  std::vector<QueuedItem> due_;
+  std::vector<Completion> completions_;
+  DaemonOutput produced_;
+  std::unordered_map<CommandId, Owner> in_progress_;  // driver command id -> owner
+  CommandId next_driver_id_ = 1;
+  RobotState state_;
+  Kinematics kinematics_;
+  std::vector<Eigen::Isometry3d> roots_;
+  RobotSample sample_;
+  TimePoint next_update_ = TimePoint::min();
+  std::int64_t samples_ = 0;
+  bool halted_ = false;
+  std::string last_fault_;  // the fault a throw latched, for the command's ERROR
+};
+
+}  // namespace robotalk

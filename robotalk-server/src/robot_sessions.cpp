@@ -1,0 +1,361 @@
+#include "robot_sessions.h"
+
+#include "robotalk/channels.h"
+#include "robotalk/protocol_codec.h"
+
+#include <cstdio>
+
+namespace robotalk {
+namespace {
+
+Reply MakeReply(CommandId id, Signal signal, std::string message, TimePoint now) {
+  Reply r;
+  r.id = id;
+  r.signal = signal;
+  r.message = std::move(message);
+  r.exec_time = now;
+  return r;
+}
+
+std::string Seconds(Duration d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g s", ToSeconds(d));
+  return buf;
+}
+
+std::string Client(std::int64_t id) { return "client " + Hex64(static_cast<std::uint64_t>(id)); }
+
+}  // namespace
+
+RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options)
+    : daemon_(daemon), robot_(daemon.robot_name()), config_hash_(config_hash), options_(options) {}
+
+Session& RobotSessions::SessionFor(std::int64_t client_id, TimePoint now) {
+  auto it = sessions_.find(client_id);
+  if (it == sessions_.end()) it = sessions_.emplace(client_id, Session(client_id, now)).first;
+  return it->second;
+}
+
+std::size_t RobotSessions::Waiting(const Session& s) const {
+  return daemon_.queued(s.client_id) + s.buffered_frames();
+}
+
+ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
+  if (!r.header_error.empty()) return Refuse(r, received);
+  ImmediateAnswer answer;
+  answer.batch.client_id = r.client_id;
+  answer.batch.ack_sequence = r.sequence;
+  answer.batch.server_receive = received;
+  std::vector<Reply>& immediate = answer.batch.replies;
+
+  Session& session = SessionFor(r.client_id, received);
+  session.last_heard = received;
+  if (!session.seen.Observe(r.sequence)) {
+    // A retransmission or a duplicate: never execute again; re-send what is known.
+    immediate = session.replies.RepliesFor(r.sequence);
+    return answer;
+  }
+  std::vector<CommandId> ids = r.item_ids();
+  // The playback delay reply (id = playback id) may come with any of its packages.
+  const bool playback = r.mode == RequestMode::kPlayback;
+  if (playback) ids.push_back(r.playback.id);
+  session.replies.RecordPackage(r.sequence, ids);
+
+  for (const MalformedItem& m : r.malformed)
+    immediate.push_back(MakeReply(m.id, Signal::kError, m.reason, received));
+  if (r.panic) {
+    Panic(r.client_id, received);
+    for (CommandId id : r.item_ids()) {
+      immediate.push_back(
+          MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", received));
+    }
+  } else if (playback) {
+    AdmitPlayback(session, r, received, immediate);
+  } else {
+    for (const Query& q : r.queries) AdmitQuery(session, q, received, immediate, answer.publish_config);
+    for (const Command& c : r.commands) {
+      if (auto item = Admit(session, c, received, immediate, /*playback=*/false))
+        daemon_.Submit(std::move(*item));
+    }
+  }
+  for (const Reply& reply : immediate) session.replies.RecordReply(reply);
+  return answer;
+}
+
+ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
+  ImmediateAnswer answer;
+  answer.send = r.client_id != 0;
+  answer.batch.client_id = r.client_id;
+  answer.batch.ack_sequence = r.sequence > 0 ? r.sequence : 0;
+  answer.batch.server_receive = received;
+  const std::vector<CommandId> ids = r.item_ids();
+  for (CommandId id : ids)
+    answer.batch.replies.push_back(MakeReply(id, Signal::kError, r.header_error, received));
+  if (r.client_id != 0 && r.sequence > 0) {
+    // Remember it, so a retransmission of the same bad package gets the same answer.
+    Session& session = SessionFor(r.client_id, received);
+    session.last_heard = received;
+    if (session.seen.Observe(r.sequence)) {
+      session.replies.RecordPackage(r.sequence, ids);
+      for (const Reply& reply : answer.batch.replies) session.replies.RecordReply(reply);
+    }
+  }
+  return answer;
+}
+
+void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::vector<Reply>& immediate,
+                               bool& publish_config) {
+  const RobotModel& model = daemon_.model();
+  if (auto bad = CheckQuery(model, q)) {
+    immediate.push_back(MakeReply(q.id, Signal::kError, *bad, now));
+    return;
+  }
+  switch (q.type) {
+    case QueryType::kClock:
+      immediate.push_back(MakeReply(q.id, Signal::kSuccess, "", now));
+      return;
+    case QueryType::kStateStream:
+    case QueryType::kStateStreamCancel: {
+      const Duration period =
+          daemon_.SetStream(s.client_id, q.type == QueryType::kStateStream ? q.period : Duration(0));
+      Reply r =
+          MakeReply(q.id, Signal::kSuccess,
+                    period.count() == 0 ? "no state stream"
+                                        : "state every " + Seconds(period) + " on " + StateChannel(robot_),
+                    now);
+      r.values = {ToSeconds(period)};
+      immediate.push_back(std::move(r));
+      return;
+    }
+    case QueryType::kConfig:
+      publish_config = true;
+      immediate.push_back(MakeReply(q.id, Signal::kSuccess, Hex64(config_hash_), now));
+      return;
+    default:
+      break;
+  }
+  if (Waiting(s) >= options_.max_queue) {
+    immediate.push_back(MakeReply(q.id, Signal::kError,
+                                  "queue of " + Client(s.client_id) + " is full (" +
+                                      std::to_string(options_.max_queue) + " items); query not queued",
+                                  now));
+    return;
+  }
+  QueuedItem item;
+  item.client_id = s.client_id;
+  item.is_query = true;
+  item.query = q.type;
+  item.command.id = q.id;
+  if (!q.target.empty()) {
+    switch (q.type) {
+      case QueryType::kJointState:
+        item.query_target = *model.FindJoint(q.target);
+        break;
+      case QueryType::kLinkPoses:
+        item.query_target = *model.FindLink(q.target);
+        break;
+      case QueryType::kFramePoses:
+        item.query_target = *model.FindFrame(q.target);
+        break;
+      default:
+        break;
+    }
+  }
+  daemon_.Submit(std::move(item));
+}
+
+std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, TimePoint now,
+                                               std::vector<Reply>& immediate, bool playback) {
+  const RobotModel& model = daemon_.model();
+  if (c.type == CommandType::kPanicReset) {
+    Signal signal = Signal::kSuccess;
+    if (auto bad = CheckCommand(model, c, &signal)) {
+      immediate.push_back(MakeReply(c.id, signal, *bad, now));
+    } else if (daemon_.ResetPanic()) {
+      log_.push_back("robot '" + robot_ + "': panic reset by " + Client(s.client_id));
+      immediate.push_back(MakeReply(c.id, Signal::kSuccess, "panic reset", now));
+    } else {
+      immediate.push_back(MakeReply(c.id, Signal::kSuccess, "the robot was not in panic", now));
+    }
+    return std::nullopt;
+  }
+  if (daemon_.in_panic()) {
+    const std::string fault = daemon_.fault();
+    immediate.push_back(MakeReply(c.id, Signal::kPanic,
+                                  "robot '" + robot_ + "' is in panic" +
+                                      (fault.empty() ? "" : " (" + fault + ")") +
+                                      "; nothing executes until PANIC_RESET",
+                                  now));
+    return std::nullopt;
+  }
+  Signal signal = Signal::kError;
+  if (auto bad = CheckCommand(model, c, &signal)) {
+    immediate.push_back(MakeReply(c.id, signal, *bad, now));
+    return std::nullopt;
+  }
+  // A playback frame's start time is its offset from the sequence start.
+  const Duration ahead = !c.start_time ? Duration(0)
+                         : playback    ? c.start_time->time_since_epoch()
+                                       : *c.start_time - now;
+  if (ahead > options_.max_future) {
+    immediate.push_back(MakeReply(c.id, Signal::kError,
+                                  std::string(ToString(c.type)) + ": start time is " + Seconds(ahead) +
+                                      " ahead" +
+                                      (playback ? " of the sequence start" : " of the server clock") +
+                                      "; the limit is " + Seconds(options_.max_future),
+                                  now));
+    return std::nullopt;
+  }
+  if (Waiting(s) >= options_.max_queue) {
+    immediate.push_back(MakeReply(c.id, Signal::kError,
+                                  "queue of " + Client(s.client_id) + " is full (" +
+                                      std::to_string(options_.max_queue) + " items); command not queued",
+                                  now));
+    return std::nullopt;
+  }
+  QueuedItem item;
+  item.client_id = s.client_id;
+  item.has_start_time = c.start_time.has_value();
+  if (c.start_time && !playback) item.start = *c.start_time;
+  item.command.id = c.id;
+  item.command.type = c.type;
+  if (c.type == CommandType::kFrameSetPoint) {
+    item.command.target = *model.FindFrame(c.target);
+  } else if (!c.target.empty()) {
+    item.command.target = *model.FindJoint(c.target);
+  }
+  // CheckCommand bounds the count: at most 6 dofs, 7 pose values, 3 base values.
+  item.command.num_values = static_cast<int>(c.values.size());
+  std::copy(c.values.begin(), c.values.end(), item.command.values.begin());
+  return item;
+}
+
+void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
+                                  std::vector<Reply>& immediate) {
+  const PlaybackDeclaration& d = r.playback;
+  auto [it, created] =
+      s.playbacks.try_emplace(d.id, static_cast<std::size_t>(d.frames), d.duration, options_.playback);
+  PlaybackSequence& seq = it->second;
+  if (!created && (seq.total != static_cast<std::size_t>(d.frames) || seq.duration != d.duration)) {
+    for (const Command& c : r.commands) {
+      immediate.push_back(MakeReply(c.id, Signal::kError,
+                                    "PLAYBACK " + std::to_string(d.id) + ": declared " +
+                                        std::to_string(seq.total) + " frames over " + Seconds(seq.duration) +
+                                        " before, now " + std::to_string(d.frames) + " over " +
+                                        Seconds(d.duration),
+                                    now));
+    }
+    return;
+  }
+  if (!seq.first_arrival) seq.first_arrival = now;
+  for (const Command& c : r.commands) {
+    std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
+    if (!item) continue;
+    const Duration offset = c.start_time ? c.start_time->time_since_epoch() : Duration(0);
+    if (offset > seq.duration || ++seq.received > seq.total) {
+      immediate.push_back(MakeReply(c.id, Signal::kError,
+                                    "PLAYBACK " + std::to_string(d.id) + ": frame at " + Seconds(offset) +
+                                        " is beyond the declared " + std::to_string(seq.total) +
+                                        " frames over " + Seconds(seq.duration),
+                                    now));
+      continue;
+    }
+    item->has_start_time = true;
+    if (seq.start) {  // already playing: straight to the RobotDaemon
+      item->start = *seq.start + offset;
+      daemon_.Submit(std::move(*item));
+    } else {
+      seq.estimator.Add(offset, now);
+      seq.frames.push_back({offset, std::move(*item)});
+    }
+  }
+  if (seq.start || !seq.estimator.ready()) return;
+  seq.start = seq.estimator.StartTime();
+  for (PlaybackSequence::Frame& frame : seq.frames) {
+    frame.item.start = *seq.start + frame.offset;
+    daemon_.Submit(std::move(frame.item));
+  }
+  seq.frames.clear();
+  const Duration delay = *seq.start - *seq.first_arrival;
+  Reply reply = MakeReply(d.id, Signal::kSuccess,
+                          "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +
+                              " after its first frame arrived (mean " +
+                              Seconds(seq.estimator.mean_command_interval()) + " between commands, " +
+                              Seconds(seq.estimator.mean_arrival_interval()) + " between arrivals)",
+                          now);
+  reply.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
+  immediate.push_back(std::move(reply));
+}
+
+void RobotSessions::Panic(std::int64_t client_id, TimePoint now) {
+  const bool first = !daemon_.in_panic();
+  log_.push_back("robot '" + robot_ + "': PANIC from " + Client(client_id) +
+                 (first ? "" : " (already in panic)"));
+  flushed_.clear();
+  daemon_.Panic(flushed_);
+  for (auto& [id, session] : sessions_) {
+    for (auto& [pid, seq] : session.playbacks) {
+      for (PlaybackSequence::Frame& frame : seq.frames) flushed_.push_back(std::move(frame.item));
+    }
+    session.playbacks.clear();
+  }
+  for (const QueuedItem& item : flushed_) {
+    if (item.client_id == 0) continue;
+    Deliver(item.client_id, MakeReply(item.command.id, Signal::kInterrupted,
+                                      "flushed by panic from " + Client(client_id), now));
+  }
+}
+
+void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {
+  auto it = sessions_.find(client_id);
+  if (it == sessions_.end()) return;  // an expired client
+  it->second.replies.RecordReply(reply);
+  pending_[client_id].push_back(std::move(reply));
+}
+
+void RobotSessions::File(DaemonOutput& output, std::vector<ReplyBatch>& to_send) {
+  for (const DaemonOutput::Executed& e : output.executed) {
+    if (e.type == CommandType::kStop) {
+      for (auto& [id, session] : sessions_) session.moved_robot = false;
+    } else if (auto s = sessions_.find(e.client_id); s != sessions_.end()) {
+      s->second.moved_robot = true;
+    }
+  }
+  for (DaemonOutput::Answer& a : output.replies) Deliver(a.client_id, std::move(a.reply));
+  for (auto& line : output.log) log_.push_back(std::move(line));
+  for (auto& [client, replies] : pending_) {
+    if (replies.empty()) continue;
+    ReplyBatch batch;
+    batch.client_id = client;
+    batch.replies = std::move(replies);
+    to_send.push_back(std::move(batch));
+  }
+  pending_.clear();
+}
+
+std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
+  std::vector<ExpiredSession> expired;
+  bool stop = false;
+  for (auto it = sessions_.begin(); it != sessions_.end();) {
+    if (now - it->second.last_heard <= options_.session_timeout) {
+      ++it;
+      continue;
+    }
+    flushed_.clear();
+    daemon_.FlushClient(it->first, flushed_);
+    expired.push_back({it->first, flushed_.size() + it->second.buffered_frames(), it->second.moved_robot});
+    stop = stop || it->second.moved_robot;
+    daemon_.SetStream(it->first, Duration(0));
+    pending_.erase(it->first);
+    it = sessions_.erase(it);
+  }
+  if (stop) {
+    log_.push_back("robot '" + robot_ + "': STOP if moving (a client that moved the robot vanished)");
+    daemon_.QueueStop(/*only_if_moving=*/true);
+  }
+  return expired;
+}
+
+std::vector<std::string> RobotSessions::TakeLog() { return std::exchange(log_, {}); }
+
+}  // namespace robotalk

@@ -1,0 +1,89 @@
+// The ServerDaemon's side of one robot: every client's session (duplicate
+// detection, acknowledgements, the reply cache), admission (each command and
+// query checked against the model, start times and queue limits checked,
+// panic and PANIC_RESET acted on at once), playback buffering and its delay
+// estimate, and the watchdog that expires silent sessions. Admitted items go
+// to the RobotDaemon (Submit); its output comes back through File().
+//
+// Thread safety: none. One thread, the ServerDaemon, uses it; the only
+// locks it takes are the RobotDaemon's short inbox/outbox locks. Parsing,
+// checks and messages all happen here, outside any lock the RobotDaemon needs.
+#pragma once
+
+#include "robot_daemon.h"
+#include "robotalk/request.h"
+#include "session.h"
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace robotalk {
+
+struct SessionOptions {
+  /// A session that sends nothing for this long expires (watchdog).
+  Duration session_timeout = std::chrono::seconds(2);
+  /// Most items one client may have waiting (queued and buffered playback frames).
+  std::size_t max_queue = 10000;
+  /// Start times further ahead than this are refused.
+  Duration max_future = std::chrono::hours(1);
+  /// When playback mode has seen enough frames to estimate its delay.
+  PlaybackEstimatorOptions playback;
+};
+
+/// What the ServerDaemon sends back at once for a received package.
+struct ImmediateAnswer {
+  ReplyBatch batch;             ///< ack + immediate replies; server_send filled by the sender
+  bool send = true;             ///< false for packages that cannot be answered (no client id)
+  bool publish_config = false;  ///< a CONFIG query asked for the configuration message
+};
+
+/// A client session the watchdog removed.
+struct ExpiredSession {
+  std::int64_t client_id = 0;
+  std::size_t dropped_commands = 0;  ///< queued commands that will never run
+  bool moved_robot = false;          ///< it had set the robot moving (a STOP follows if still moving)
+};
+
+class RobotSessions {
+ public:
+  RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options = {});
+
+  /// Handles one decoded request received at `received`.
+  ImmediateAnswer Handle(const Request& request, TimePoint received);
+  /// Files the RobotDaemon's output (replies into the sessions' caches, the
+  /// watchdog's bookkeeping) and the replies this layer produced outside
+  /// Handle (a panic's flushed items); appends what to send, one batch per client.
+  void File(DaemonOutput& output, std::vector<ReplyBatch>& to_send);
+  /// Expires silent sessions; a STOP follows if one had moved the robot.
+  std::vector<ExpiredSession> Expire(TimePoint now);
+  /// Lines for the server log (panic, reset), taken once.
+  std::vector<std::string> TakeLog();
+
+  std::size_t num_sessions() const { return sessions_.size(); }
+
+ private:
+  Session& SessionFor(std::int64_t client_id, TimePoint now);
+  ImmediateAnswer Refuse(const Request& request, TimePoint received);
+  void AdmitQuery(Session& s, const Query& q, TimePoint now, std::vector<Reply>& immediate,
+                  bool& publish_config);
+  // Checks a command; returns it ready to queue, or answers it in `immediate`.
+  std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
+                                  bool playback);
+  void AdmitPlayback(Session& s, const Request& request, TimePoint now, std::vector<Reply>& immediate);
+  void Panic(std::int64_t client_id, TimePoint now);
+  void Deliver(std::int64_t client_id, Reply reply);
+  std::size_t Waiting(const Session& s) const;
+
+  RobotDaemon& daemon_;
+  const std::string robot_;
+  const std::uint64_t config_hash_;
+  const SessionOptions options_;
+  std::map<std::int64_t, Session> sessions_;
+  std::map<std::int64_t, std::vector<Reply>> pending_;  // replies made outside Handle, by client
+  std::vector<std::string> log_;
+  std::vector<QueuedItem> flushed_;
+};
+
+}  // namespace robotalk

@@ -1,0 +1,231 @@
+#include "server_daemon.h"
+
+#include "robotalk/channels.h"
+#include "robotalk/config_codec.h"
+#include "robotalk/error.h"
+#include "robotalk/protocol_codec.h"
+#include "state_encoding.h"
+
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <random>
+
+namespace robotalk {
+namespace {
+
+constexpr std::size_t kMaxBatchBytes = 30000;  // split reply packages well under LCM's 64 KB
+
+std::vector<std::uint8_t> EncodeSample(const std::string& robot, std::uint64_t config_hash,
+                                       const RobotSample& s) {
+  const robotalk_msgs::robot_state_t msg = ToStateSample(robot, config_hash, s);
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+}  // namespace
+
+ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemonOptions options)
+    : transport_(transport),
+      clock_(clock),
+      options_(options),
+      faults_(options.reply_drop_probability, options.reply_duplicate_probability, options.fault_seed),
+      congestion_rng_(options.fault_seed) {
+  event_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (event_fd_ < 0) throw Error("ServerDaemon: eventfd failed");
+  server_id_ = options_.server_id;
+  if (server_id_ == 0) {
+    std::random_device rd;
+    server_id_ = static_cast<std::int64_t>((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
+  }
+  subscription_ = transport_.Subscribe(
+      kAnyRequestChannelRegex,
+      [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnRequest(channel, bytes); });
+}
+
+ServerDaemon::~ServerDaemon() {
+  Stop();
+  subscription_.reset();
+  if (event_fd_ >= 0) close(event_fd_);
+}
+
+void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
+  const std::string& name = daemon.robot_name();
+  if (robots_.count(name)) throw Error("ServerDaemon: robot name '" + name + "' is given twice");
+  Robot robot{&daemon, nullptr, EncodeConfig(daemon.model()), ConfigHash(daemon.model()), {}};
+  robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options);
+  daemon.Preallocate(robot.output);
+  daemon.set_output_ready_callback([this] { Wake(); });
+  robots_.emplace(name, std::move(robot));
+}
+
+std::vector<std::string> ServerDaemon::robot_names() const {
+  std::vector<std::string> out;
+  for (const auto& [name, robot] : robots_) out.push_back(name);
+  return out;
+}
+
+void ServerDaemon::Start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread([this] {
+    while (running_) RunOnce(std::chrono::milliseconds(50));
+  });
+}
+
+void ServerDaemon::Stop() {
+  if (!running_.exchange(false)) return;
+  Wake();
+  if (thread_.joinable()) thread_.join();
+}
+
+void ServerDaemon::Wake() {
+  const std::uint64_t one = 1;
+  [[maybe_unused]] ssize_t n = write(event_fd_, &one, sizeof one);
+}
+
+void ServerDaemon::RunOnce(Duration timeout) {
+  pollfd fds[2] = {{transport_.fileno(), POLLIN, 0}, {event_fd_, POLLIN, 0}};
+  const int timeout_ms =
+      static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count());
+  const int ready = fds[0].fd >= 0 ? poll(fds, 2, timeout_ms) : poll(fds + 1, 1, timeout_ms);
+  if (ready > 0 && (fds[1].revents & POLLIN)) {
+    std::uint64_t count;
+    [[maybe_unused]] ssize_t n = read(event_fd_, &count, sizeof count);
+  }
+  try {
+    transport_.HandleFor(Duration(0));
+  } catch (const std::exception& e) {
+    Log(std::string("transport: ") + e.what());
+  }
+  Flush();
+  const TimePoint now = clock_.Now();
+  if (now >= next_watchdog_) {
+    Watchdogs(now);
+    next_watchdog_ = now + options_.watchdog_period;
+  }
+  if (now >= next_announce_) {
+    Announce(now);
+    next_announce_ = now + options_.announce_period;
+  }
+}
+
+void ServerDaemon::Flush() {
+  for (auto& [name, robot] : robots_) Drain(robot);
+}
+
+// A transport handler: never throws for bad input (the transport would
+// rethrow it out of RunOnce and end the loop's iteration).
+void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes) {
+  const TimePoint received = clock_.Now();
+  const std::optional<std::string> robot_name = RobotOfRequestChannel(channel);
+  if (!robot_name) return;
+  auto it = robots_.find(*robot_name);
+  if (it == robots_.end()) return;  // another server's robot
+  Robot& robot = it->second;
+  Request request;
+  try {
+    request = DecodeRequest(bytes);
+  } catch (const ProtocolError& e) {
+    // Undecodable bytes carry no trustworthy client id to answer: count and log.
+    ++malformed_;
+    Log("robot '" + *robot_name + "': dropped a malformed package on " + channel + ": " + e.what());
+    return;
+  }
+  ImmediateAnswer answer = robot.sessions->Handle(request, received);
+  if (!request.header_error.empty()) {
+    Log("robot '" + *robot_name + "': refused package from client " +
+        Hex64(static_cast<std::uint64_t>(request.client_id)) + ": " + request.header_error);
+  }
+  if (answer.publish_config) transport_.Publish(ConfigChannel(*robot_name), robot.encoded_config);
+  if (answer.send) Send(*robot_name, answer.batch);
+  Drain(robot);  // a panic's flushed items, at once
+  if (options_.congestion_max_pause.count() > 0) {
+    // The paper's congestion injector (§VI-B): a random pause after each
+    // received package, during which nothing else is received.
+    std::uniform_real_distribution<double> pause(0.0, ToSeconds(options_.congestion_max_pause));
+    std::this_thread::sleep_for(FromSeconds(pause(congestion_rng_)));
+  }
+}
+
+void ServerDaemon::Drain(Robot& robot) {
+  robot.daemon->TakeOutput(robot.output);
+  const std::string& name = robot.daemon->robot_name();
+  for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
+    transport_.Publish(StateChannel(name), EncodeSample(name, robot.config_hash, robot.output.samples[i]));
+  }
+  to_send_.clear();
+  robot.sessions->File(robot.output, to_send_);
+  for (ReplyBatch& batch : to_send_) Send(name, batch);
+  for (const std::string& line : robot.sessions->TakeLog()) Log(line);
+}
+
+void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
+  const std::string channel = ReplyChannel(robot, batch.client_id);
+  const auto publish = [&](ReplyBatch& part) {
+    part.server_send = clock_.Now();
+    const std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
+    for (int copies = faults_.Copies(); copies > 0; --copies) transport_.Publish(channel, bytes);
+  };
+  // Split long batches so each package stays well under LCM's 64 KB.
+  std::size_t bytes = 0;
+  ReplyBatch part{batch.client_id, batch.ack_sequence, batch.server_receive, {}, {}};
+  for (Reply& r : batch.replies) {
+    bytes += 64 + r.message.size() + 8 * r.values.size();
+    part.replies.push_back(std::move(r));
+    if (bytes > kMaxBatchBytes) {
+      publish(part);
+      part.replies.clear();
+      bytes = 0;
+    }
+  }
+  if (!part.replies.empty() || part.ack_sequence != 0) publish(part);
+}
+
+void ServerDaemon::Watchdogs(TimePoint now) {
+  for (auto& [name, robot] : robots_) {
+    if (robot.daemon->CheckOverrun(now)) Drain(robot);
+    for (const ExpiredSession& e : robot.sessions->Expire(now)) {
+      // Quiet for the ordinary case: a short-lived client (the CLI) that is done.
+      if (e.dropped_commands == 0 && !e.moved_robot) continue;
+      Log("robot '" + name + "': client " + Hex64(static_cast<std::uint64_t>(e.client_id)) +
+          " went silent; " + std::to_string(e.dropped_commands) + " queued commands dropped");
+    }
+  }
+}
+
+void ServerDaemon::Announce(TimePoint now) {
+  Announcement a;
+  a.server_id = server_id_;
+  a.server_time = now;
+  a.url_hint = transport_.url();
+  for (const auto& [name, robot] : robots_) {
+    const RobotModel& m = robot.daemon->model();
+    a.robots.push_back({name, robot.daemon->driver_name(), robot.config_hash, m.num_dofs(),
+                        static_cast<std::int8_t>(m.roots().front().base), robot.daemon->in_panic(),
+                        static_cast<int>(robot.sessions->num_sessions())});
+  }
+  transport_.Publish(kAnnounceChannel, EncodeAnnouncement(a));
+}
+
+void ServerDaemon::Log(const std::string& line) {
+  const TimePoint now = clock_.Now();
+  if (now - log_window_ >= std::chrono::seconds(1)) {
+    if (log_suppressed_ > 0) {
+      std::fprintf(stderr, "robotalk-server: (%llu more log lines suppressed in the last second)\n",
+                   static_cast<unsigned long long>(log_suppressed_));
+    }
+    log_window_ = now;
+    log_lines_ = 0;
+    log_suppressed_ = 0;
+  }
+  if (++log_lines_ > options_.log_lines_per_second) {
+    ++log_suppressed_;
+    return;
+  }
+  std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());
+}
+
+}  // namespace robotalk

@@ -1,0 +1,115 @@
+// The paper's ServerDaemon: one thread that receives every client package of
+// the robots this server serves from the transport, decodes it (the codec is
+// the only place that knows the wire), hands it to that robot's
+// RobotSessions (sessions, admission), and sends what comes back: the
+// immediate acknowledgement, the RobotDaemons' replies and state samples, the
+// configuration message, and ROBOTALK/ANNOUNCE once a period. It also runs the
+// session watchdog and the driver-call watchdog.
+//
+// Thread safety: RunOnce() and everything it calls run on one thread (the one
+// Start() launches, or a test's). Wake() may be called from any thread (the
+// RobotDaemons call it when their outbox has something).
+#pragma once
+
+#include "fault_injector.h"
+#include "robot_daemon.h"
+#include "robot_sessions.h"
+#include "robotalk/clock.h"
+#include "robotalk/transport.h"
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace robotalk {
+
+struct ServerDaemonOptions {
+  /// Period of the ROBOTALK/ANNOUNCE message.
+  Duration announce_period = std::chrono::seconds(1);
+  /// How often silent sessions and overrunning driver calls are looked for.
+  Duration watchdog_period = std::chrono::milliseconds(100);
+  /// The paper's congestion injector (§VI-B): after each received package the
+  /// ServerDaemon pauses a random time uniform in [0, this]. 0 = off.
+  Duration congestion_max_pause{0};
+  /// Test fault injection on outgoing reply packages (seeded).
+  double reply_drop_probability = 0.0;
+  double reply_duplicate_probability = 0.0;
+  std::uint64_t fault_seed = 1;
+  /// Most log lines per second; the rest are counted and summarised.
+  int log_lines_per_second = 20;
+  /// The server's instance id in ANNOUNCE (random when 0).
+  std::int64_t server_id = 0;
+};
+
+class ServerDaemon {
+ public:
+  ServerDaemon(Transport& transport, const Clock& clock, ServerDaemonOptions options = {});
+  ~ServerDaemon();
+  ServerDaemon(const ServerDaemon&) = delete;
+  ServerDaemon& operator=(const ServerDaemon&) = delete;
+
+  /// Serves `daemon`'s robot. REQUIRES: before Start(); robot names unique.
+  /// The ServerDaemon does not own the RobotDaemon (the Server does).
+  void AddRobot(RobotDaemon& daemon, SessionOptions options);
+
+  /// One iteration: waits at most `timeout` for a package or a RobotDaemon's
+  /// output, handles what arrived, sends what is ready, and runs the
+  /// watchdogs and ANNOUNCE when due.
+  void RunOnce(Duration timeout);
+  /// Sends whatever the RobotDaemons have produced (used at shutdown).
+  void Flush();
+
+  /// Runs RunOnce() on a thread until Stop().
+  void Start();
+  void Stop();
+  /// Makes a waiting RunOnce() return at once. Thread-safe.
+  void Wake();
+
+  std::vector<std::string> robot_names() const;
+  std::int64_t server_id() const { return server_id_; }
+  /// Packages dropped because their bytes could not be decoded at all.
+  std::uint64_t malformed() const { return malformed_; }
+
+ private:
+  struct Robot {
+    RobotDaemon* daemon;
+    std::unique_ptr<RobotSessions> sessions;
+    std::vector<std::uint8_t> encoded_config;
+    std::uint64_t config_hash;
+    DaemonOutput output;
+  };
+
+  void OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes);
+  void Send(const std::string& robot, ReplyBatch& batch);
+  void Drain(Robot& robot);
+  void Announce(TimePoint now);
+  void Watchdogs(TimePoint now);
+  void Log(const std::string& line);
+
+  Transport& transport_;
+  const Clock& clock_;
+  const ServerDaemonOptions options_;
+  FaultInjector faults_;
+  std::map<std::string, Robot> robots_;
+  std::unique_ptr<Subscription> subscription_;
+  std::vector<ReplyBatch> to_send_;
+  std::mt19937_64 congestion_rng_;
+  int event_fd_ = -1;
+  std::int64_t server_id_ = 0;
+  std::uint64_t malformed_ = 0;
+  TimePoint next_announce_ = TimePoint::min();
+  TimePoint next_watchdog_ = TimePoint::min();
+  // Rate limit of the log.
+  TimePoint log_window_{};
+  int log_lines_ = 0;
+  std::uint64_t log_suppressed_ = 0;
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+};
+
+}  // namespace robotalk

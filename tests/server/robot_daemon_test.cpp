@@ -1,0 +1,176 @@
+#include "robot_daemon.h"
+
+#include "fake_driver.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <new>
+#include <thread>
+
+// Counts heap allocations (operator new) while `g_counting` is set, to show
+// that the RobotDaemon's steady state does not allocate.
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+// GCC cannot see that malloc pairs with free through the replaced operators.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t n) {
+  if (g_counting) ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace robotalk {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using testing::FakeDriver;
+using ::testing::HasSubstr;
+using testing::PanRobot;
+
+constexpr std::int64_t kAlice = 0xA11CE;
+
+QueuedItem Motion(CommandId id, CommandType type, std::vector<double> values, int target = -1) {
+  QueuedItem item;
+  item.client_id = kAlice;
+  item.command.id = id;
+  item.command.type = type;
+  item.command.target = target;
+  item.command.num_values = static_cast<int>(values.size());
+  std::copy(values.begin(), values.end(), item.command.values.begin());
+  return item;
+}
+
+class RobotDaemonTest : public ::testing::Test {
+ protected:
+  RobotDaemonTest() {
+    auto driver = std::make_unique<FakeDriver>(PanRobot());
+    fake_ = driver.get();
+    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_,
+                                            RobotDaemonOptions{.driver_call_bound = milliseconds(200)});
+    daemon_->Preallocate(out_);
+  }
+  std::vector<DaemonOutput::Answer> Run() {
+    daemon_->RunOnce(clock_.Now());
+    daemon_->TakeOutput(out_);
+    return out_.replies;
+  }
+
+  ManualClock clock_;
+  FakeDriver* fake_ = nullptr;
+  std::unique_ptr<RobotDaemon> daemon_;
+  DaemonOutput out_;
+};
+
+TEST_F(RobotDaemonTest, ContainsADriverThatThrowsAnswersErrorNamingItAndHoldsTheRobotInPanic) {
+  fake_->throw_on_execute = "serial port write failed";
+  daemon_->Submit(Motion(7, CommandType::kJointSetPoint, {0.5}, 0));
+  const auto replies = Run();
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].client_id, kAlice);
+  EXPECT_EQ(replies[0].reply.id, 7);
+  EXPECT_EQ(replies[0].reply.signal, Signal::kError);
+  EXPECT_THAT(replies[0].reply.message,
+              HasSubstr("driver 'fake' threw in Execute: serial port write failed"));
+  EXPECT_TRUE(daemon_->in_panic());
+  EXPECT_TRUE(fake_->halted) << "the robot is halted";
+  EXPECT_THAT(daemon_->fault(), HasSubstr("serial port write failed"));
+  ASSERT_FALSE(out_.log.empty());
+  EXPECT_THAT(out_.log[0], HasSubstr("DRIVER FAULT"));
+
+  // Nothing reaches the driver until the panic is reset.
+  fake_->throw_on_execute.reset();
+  daemon_->Submit(Motion(8, CommandType::kJointSetPoint, {0.2}, 0));
+  auto later = Run();
+  ASSERT_EQ(later.size(), 1u);
+  EXPECT_EQ(later[0].reply.signal, Signal::kInterrupted);
+  EXPECT_EQ(fake_->calls.size(), 1u);
+
+  EXPECT_TRUE(daemon_->ResetPanic());
+  Run();
+  EXPECT_FALSE(fake_->halted);
+  daemon_->Submit(Motion(9, CommandType::kJointSetPoint, {0.2}, 0));
+  auto after = Run();
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(after[0].reply.signal, Signal::kSuccess);
+  EXPECT_DOUBLE_EQ(fake_->position, 0.2);
+}
+
+// A driver whose Update blocks until told, to overrun the call bound.
+class BlockingDriver : public FakeDriver {
+ public:
+  using FakeDriver::FakeDriver;
+  void Update(TimePoint, std::vector<Completion>&) override {
+    entered = true;
+    while (!release) std::this_thread::sleep_for(milliseconds(1));
+  }
+  std::atomic<bool> entered{false}, release{false};
+};
+
+TEST(RobotDaemonOverrun, HoldsTheRobotInPanicWhenADriverCallOverrunsItsBound) {
+  ManualClock clock;
+  auto driver = std::make_unique<BlockingDriver>(PanRobot());
+  BlockingDriver* blocking = driver.get();
+  RobotDaemon daemon("bot", "slow", std::move(driver), clock,
+                     RobotDaemonOptions{.driver_call_bound = milliseconds(200)});
+  std::thread robot_daemon([&] { daemon.RunOnce(clock.Now()); });
+  while (!blocking->entered) std::this_thread::sleep_for(milliseconds(1));
+  clock.Advance(milliseconds(100));
+  EXPECT_FALSE(daemon.CheckOverrun(clock.Now())) << "within the bound";
+  clock.Advance(milliseconds(150));
+  EXPECT_TRUE(daemon.CheckOverrun(clock.Now()));
+  EXPECT_FALSE(daemon.CheckOverrun(clock.Now())) << "reported once";
+  EXPECT_TRUE(daemon.in_panic());
+  EXPECT_THAT(daemon.fault(), HasSubstr("driver 'slow' Update has run for 0.25 s (the bound is 0.2 s)"));
+  blocking->release = true;
+  robot_daemon.join();
+  daemon.RunOnce(clock.Now());  // halts the driver after the late return
+  EXPECT_TRUE(blocking->halted);
+}
+
+TEST_F(RobotDaemonTest, DoesNotAllocateInItsSteadyStateOfDriverUpdatesAndStateSamples) {
+  daemon_->SetStream(kAlice, milliseconds(1));
+  // Warm up: the first iterations size the buffers.
+  for (int i = 0; i < 20; ++i) {
+    clock_.Advance(milliseconds(1));
+    Run();
+  }
+  g_allocations = 0;
+  g_counting = true;
+  for (int i = 0; i < 1000; ++i) {
+    clock_.Advance(milliseconds(1));
+    daemon_->RunOnce(clock_.Now());
+    if (i % 10 == 9) {
+      g_counting = false;  // the ServerDaemon's side may allocate; it is not the real-time path
+      daemon_->TakeOutput(out_);
+      g_counting = true;
+    }
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0) << "allocations on the RobotDaemon's path in 1000 iterations";
+  EXPECT_GE(fake_->updates, 100) << "one Update per 10 ms driver period";
+}
+
+TEST_F(RobotDaemonTest, RunsTheWatchdogsStopOnlyWhenTheRobotIsMoving) {
+  daemon_->QueueStop(/*only_if_moving=*/true);
+  Run();
+  EXPECT_TRUE(fake_->calls.empty()) << "at rest: no STOP needed";
+  fake_->moving = true;
+  daemon_->QueueStop(/*only_if_moving=*/true);
+  Run();
+  ASSERT_EQ(fake_->calls.size(), 1u);
+  EXPECT_EQ(fake_->calls[0].type, CommandType::kStop);
+  EXPECT_TRUE(out_.replies.empty()) << "the server's own STOP has nobody to answer";
+}
+
+}  // namespace
+}  // namespace robotalk

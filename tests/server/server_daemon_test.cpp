@@ -1,0 +1,122 @@
+// The ServerDaemon on the in-memory transport: bytes in, bytes out, with the
+// real codec, sessions and RobotDaemon, on a manual clock and no sockets.
+#include "server_daemon.h"
+
+#include "fake_driver.h"
+#include "robotalk/channels.h"
+#include "robotalk/memory_transport.h"
+#include "robotalk/request.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace robotalk {
+namespace {
+
+using std::chrono::milliseconds;
+using testing::FakeDriver;
+using ::testing::HasSubstr;
+using testing::PanRobot;
+
+constexpr std::int64_t kAlice = 0xA11CE;
+
+class ServerDaemonTest : public ::testing::Test {
+ protected:
+  ServerDaemonTest() : server_transport_(bus_), client_(bus_) {
+    for (const char* name : {"bot", "arm"}) {
+      auto driver = std::make_unique<FakeDriver>(PanRobot());
+      fakes_[name] = driver.get();
+      robots_.push_back(std::make_unique<RobotDaemon>(name, "fake", std::move(driver), clock_));
+    }
+    server_ = std::make_unique<ServerDaemon>(server_transport_, clock_, ServerDaemonOptions{.server_id = 42});
+    for (auto& r : robots_) server_->AddRobot(*r, SessionOptions{});
+    reply_sub_ =
+        client_.Subscribe("ROBOTALK/.*", [this](const std::string& channel, std::span<const std::uint8_t> b) {
+          channels_.push_back(channel);
+          if (auto parts = ParseReplyChannel(channel)) {
+            for (Reply& r : DecodeReplyBatch(b).replies) replies_[parts->robot][r.id] = r;
+          }
+        });
+  }
+
+  void Send(const std::string& robot, const Request& r) {
+    client_.Publish(RequestChannel(robot), EncodeRequest(r));
+  }
+  // One ServerDaemon iteration, every RobotDaemon once, another ServerDaemon
+  // iteration to send what they produced, then the client reads.
+  void Step() {
+    server_->RunOnce(Duration(0));
+    for (auto& r : robots_) r->RunOnce(clock_.Now());
+    server_->RunOnce(Duration(0));
+    client_.HandleFor(Duration(0));
+  }
+
+  ManualClock clock_;
+  std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
+  MemoryTransport server_transport_;
+  MemoryTransport client_;
+  std::map<std::string, FakeDriver*> fakes_;
+  std::vector<std::unique_ptr<RobotDaemon>> robots_;
+  std::unique_ptr<ServerDaemon> server_;
+  std::unique_ptr<Subscription> reply_sub_;
+  std::vector<std::string> channels_;
+  std::map<std::string, std::map<CommandId, Reply>> replies_;
+};
+
+TEST_F(ServerDaemonTest, RoutesAPackageToItsRobotAndAnswersOnTheClientsReplyChannel) {
+  Request r{.client_id = kAlice, .sequence = 1};
+  r.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+  Send("arm", r);
+  Step();
+  ASSERT_EQ(replies_["arm"].count(1), 1u);
+  EXPECT_EQ(replies_["arm"][1].signal, Signal::kSuccess);
+  EXPECT_EQ(fakes_["arm"]->calls.size(), 1u);
+  EXPECT_TRUE(fakes_["bot"]->calls.empty()) << "the other robot saw nothing";
+  EXPECT_THAT(channels_, ::testing::Contains(ReplyChannel("arm", kAlice)));
+  EXPECT_THAT(channels_, ::testing::Contains(std::string(kAnnounceChannel)));
+}
+
+TEST_F(ServerDaemonTest, CountsUndecodableBytesAndKeepsServing) {
+  const std::vector<std::uint8_t> garbage(40, 0xAB);
+  client_.Publish(RequestChannel("bot"), garbage);
+  Step();
+  EXPECT_EQ(server_->malformed(), 1u);
+  Request r{.client_id = kAlice, .sequence = 1};
+  r.queries.push_back(Query{5, QueryType::kClock, ""});
+  Send("bot", r);
+  Step();
+  EXPECT_EQ(replies_["bot"].at(5).signal, Signal::kSuccess);
+}
+
+TEST_F(ServerDaemonTest, KeepsServingOtherRobotsWhenOnesDriverThrows) {
+  fakes_["bot"]->throw_on_execute = "serial port write failed";
+  Request r{.client_id = kAlice, .sequence = 1};
+  r.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+  Send("bot", r);
+  Send("arm", r);
+  Step();
+  EXPECT_EQ(replies_["bot"].at(1).signal, Signal::kError);
+  EXPECT_THAT(replies_["bot"].at(1).message,
+              HasSubstr("driver 'fake' threw in Execute: serial port write failed"));
+  EXPECT_EQ(replies_["arm"].at(1).signal, Signal::kSuccess);
+  // The faulted robot refuses motion (PANIC) until reset, naming the fault.
+  Request again{.client_id = kAlice, .sequence = 2};
+  again.commands.push_back(Command{2, CommandType::kJointSetPoint, std::nullopt, "pan", {0.1}});
+  Send("bot", again);
+  Step();
+  EXPECT_EQ(replies_["bot"].at(2).signal, Signal::kPanic);
+  EXPECT_THAT(replies_["bot"].at(2).message, HasSubstr("serial port write failed"));
+}
+
+TEST_F(ServerDaemonTest, PublishesTheConfigurationWhenAskedAndStateWhenStreamed) {
+  Request r{.client_id = kAlice, .sequence = 1};
+  r.queries.push_back(Query{1, QueryType::kConfig, ""});
+  r.queries.push_back(Query{2, QueryType::kStateStream, "", milliseconds(10)});
+  Send("bot", r);
+  Step();
+  EXPECT_THAT(channels_, ::testing::Contains(ConfigChannel("bot")));
+  EXPECT_THAT(channels_, ::testing::Contains(StateChannel("bot")));
+}
+
+}  // namespace
+}  // namespace robotalk
