@@ -1,16 +1,29 @@
 // The LCM channel names of the RoboTalk protocol (docs/protocol.md, Channels),
-// in one place for the server, the client and tools.
+// built AND parsed here, in one place for the server, the client and tools.
+//
+//   ROBOTALK/ANNOUNCE                       every server's robots, once a second
+//   ROBOTALK/<robot>/REQUEST                client -> server packages
+//   ROBOTALK/<robot>/REPLY/<client id hex>  server -> one client
+//   ROBOTALK/<robot>/CONFIG                 the robot's description
+//   ROBOTALK/<robot>/STATE                  broadcast state samples
+//
+// A robot name is one channel segment: non-empty, no '/'. The parsers return
+// nullopt for any other channel (they never throw). Thread-safe (pure).
 #pragma once
 
 #include <cinttypes>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <string_view>
 
 namespace robotalk {
 
 /// Every server announces its robots here once a second.
 inline constexpr const char* kAnnounceChannel = "ROBOTALK/ANNOUNCE";
+/// Subscription regex (LCM: whole-name match) for the REQUEST channel of every robot.
+inline constexpr const char* kAnyRequestChannelRegex = "ROBOTALK/[^/]+/REQUEST";
 
 /// 16 lowercase hex digits: how client ids and configuration hashes are written.
 inline std::string Hex64(std::uint64_t v) {
@@ -25,5 +38,21 @@ inline std::string ReplyChannel(const std::string& robot, std::int64_t client_id
 }
 inline std::string ConfigChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/CONFIG"; }
 inline std::string StateChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/STATE"; }
+
+/// The robot of "ROBOTALK/<robot>/REQUEST"; nullopt for any other channel.
+std::optional<std::string> RobotOfRequestChannel(std::string_view channel);
+/// The robot of "ROBOTALK/<robot>/CONFIG".
+std::optional<std::string> RobotOfConfigChannel(std::string_view channel);
+/// The robot of "ROBOTALK/<robot>/STATE".
+std::optional<std::string> RobotOfStateChannel(std::string_view channel);
+
+struct ReplyChannelParts {
+  std::string robot;
+  std::int64_t client_id = 0;
+  bool operator==(const ReplyChannelParts&) const = default;
+};
+/// Robot and client id of "ROBOTALK/<robot>/REPLY/<16 lowercase hex digits>"
+/// (exactly what ReplyChannel() writes).
+std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel);
 
 }  // namespace robotalk

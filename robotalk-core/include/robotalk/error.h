@@ -31,6 +31,13 @@ class ProtocolError : public Error {
   using Error::Error;
 };
 
+/// A transport (LCM, in-memory, log file) could not start, publish or read:
+/// the message names the URL or file and what failed.
+class TransportError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// A name or index does not exist in a robot model.
 class LookupError : public Error {
  public:

@@ -1,0 +1,57 @@
+#include "robotalk/channels.h"
+
+namespace robotalk {
+namespace {
+
+constexpr std::string_view kPrefix = "ROBOTALK/";
+
+// The robot segment of "ROBOTALK/<robot>/<suffix>", suffix starting with '/'.
+std::optional<std::string> RobotBefore(std::string_view channel, std::string_view suffix) {
+  if (channel.size() <= kPrefix.size() + suffix.size()) return std::nullopt;
+  if (!channel.starts_with(kPrefix) || !channel.ends_with(suffix)) return std::nullopt;
+  const std::string_view robot =
+      channel.substr(kPrefix.size(), channel.size() - kPrefix.size() - suffix.size());
+  if (robot.empty() || robot.find('/') != std::string_view::npos) return std::nullopt;
+  return std::string(robot);
+}
+
+std::optional<std::uint64_t> ParseHex64(std::string_view hex) {
+  if (hex.size() != 16) return std::nullopt;
+  std::uint64_t v = 0;
+  for (char c : hex) {
+    int digit = 0;
+    if (c >= '0' && c <= '9') {
+      digit = c - '0';
+    } else if (c >= 'a' && c <= 'f') {
+      digit = c - 'a' + 10;
+    } else {
+      return std::nullopt;
+    }
+    v = (v << 4) | static_cast<std::uint64_t>(digit);
+  }
+  return v;
+}
+
+}  // namespace
+
+std::optional<std::string> RobotOfRequestChannel(std::string_view channel) {
+  return RobotBefore(channel, "/REQUEST");
+}
+std::optional<std::string> RobotOfConfigChannel(std::string_view channel) {
+  return RobotBefore(channel, "/CONFIG");
+}
+std::optional<std::string> RobotOfStateChannel(std::string_view channel) {
+  return RobotBefore(channel, "/STATE");
+}
+
+std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel) {
+  constexpr std::string_view kReply = "/REPLY/";
+  if (channel.size() < 16) return std::nullopt;
+  auto id = ParseHex64(channel.substr(channel.size() - 16));
+  if (!id) return std::nullopt;
+  auto robot = RobotBefore(channel.substr(0, channel.size() - 16), kReply);
+  if (!robot) return std::nullopt;
+  return ReplyChannelParts{*robot, static_cast<std::int64_t>(*id)};
+}
+
+}  // namespace robotalk
