@@ -293,8 +293,16 @@ class Bench:
             out[name] = json.loads(r.stdout)["benchmarks"] if r.returncode == 0 else {"error": r.stderr[-400:]}
         return {"figure": "micro", "benches": out}
 
+    def ode(self):
+        exe = f"{os.path.abspath(self.args.build)}/bench/robotalk-ode-bench"
+        shared = os.environ.get("ROBOTALK_SHARED_ROBOTS", os.path.join(ROOT, "..", "shared", "robots"))
+        if not os.path.exists(exe):
+            return {"figure": "ode", "error": "robotalk-ode-bench not built"}
+        r = subprocess.run([exe, os.path.join(ROOT, "models"), shared], capture_output=True, text=True, timeout=600)
+        return {"figure": "ode", "output": r.stdout, "rc": r.returncode, "shared_robots": os.path.exists(shared)}
 
-FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "micro"]
+
+FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "micro", "ode"]
 
 
 def main():
@@ -304,7 +312,7 @@ def main():
     ap.add_argument("--only", default="", help="comma-separated figures: " + ",".join(FIGURES))
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "latest"))
     args = ap.parse_args()
-    only = [f for f in args.only.split(",") if f] or FIGURES
+    only = [f for f in args.only.split(",") if f] or [f for f in FIGURES if not (args.quick and f == "ode")]
     os.makedirs(args.out, exist_ok=True)
     b = Bench(args)
     meta = {"date_utc": time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime()), "quick": args.quick,
