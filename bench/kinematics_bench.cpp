@@ -1,12 +1,11 @@
-// Times Kinematics::Update() and FrameJacobian() on a 7-dof arm and a 31-dof
-// humanoid built in code (so the bench needs no robot files), and prints
-// microseconds per call. Usage: robotalk-kinematics-bench [iterations]
+// Google Benchmark of Kinematics::Update(), FrameJacobian() and
+// CenterOfMass() on a 7-dof arm and a 31-dof humanoid built in code (so the
+// bench needs no robot files). Figures: docs/performance.md, "In-process".
+//   robotalk-kinematics-bench [--benchmark_format=json ...]
 #include "robotalk/kinematics.h"
 
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
+#include <benchmark/benchmark.h>
+
 #include <random>
 #include <string>
 #include <vector>
@@ -71,49 +70,57 @@ RobotModel Humanoid() {
   return b.Build();
 }
 
-// Best of 5 runs of `iterations` calls, in microseconds per call.
-template <typename F>
-double MicrosPerCall(int iterations, F call) {
-  double best = 1e300;
-  for (int run = 0; run < 5; ++run) {
-    const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < iterations; ++i) call(i);
-    const std::chrono::duration<double, std::micro> elapsed = std::chrono::steady_clock::now() - start;
-    best = std::min(best, elapsed.count() / iterations);
-  }
-  return best;
-}
-
-void Bench(const RobotModel& model, int iterations) {
-  // Distinct positions per call so nothing is hoisted out of the loop.
+// Distinct positions per call so nothing is hoisted out of the loop.
+std::vector<Eigen::VectorXd> Positions(const RobotModel& model) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> angle(-3, 3);
   std::vector<Eigen::VectorXd> qs(64, Eigen::VectorXd(model.num_dofs()));
   for (auto& q : qs) q = q.unaryExpr([&](double) { return angle(rng); });
+  return qs;
+}
 
+const RobotModel& Model(int which) {
+  static const RobotModel arm = Arm(), humanoid = Humanoid();
+  return which == 0 ? arm : humanoid;
+}
+
+void Label(benchmark::State& state, const RobotModel& model) {
+  state.SetLabel(model.name() + ", " + std::to_string(model.num_dofs()) + " dofs, " +
+                 std::to_string(model.links().size()) + " links");
+}
+
+void BM_KinematicsUpdate(benchmark::State& state) {
+  const RobotModel& model = Model(static_cast<int>(state.range(0)));
+  const auto qs = Positions(model);
   robotalk::Kinematics kin(model);
-  double sink = 0;  // consumed below so the calls cannot be optimized away
-  const double update = MicrosPerCall(iterations, [&](int i) {
-    kin.Update(qs[static_cast<size_t>(i) % qs.size()]);
-    sink += kin.frame_pose(0).translation().x();
-  });
-  const double jacobian = MicrosPerCall(iterations, [&](int) { sink += kin.FrameJacobian(0)(0, 0); });
-  const double com = MicrosPerCall(iterations, [&](int) { sink += kin.CenterOfMass().x(); });
-  volatile double keep = sink;
-  (void)keep;
-  std::printf("%-11s %3d dofs %3zu links  Update %7.3f us  FrameJacobian %7.3f us  CenterOfMass %7.3f us\n",
-              model.name().c_str(), model.num_dofs(), model.links().size(), update, jacobian, com);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    kin.Update(qs[i++ % qs.size()]);
+    benchmark::DoNotOptimize(kin.frame_pose(0).translation().x());
+  }
+  Label(state, model);
+}
+
+void BM_FrameJacobian(benchmark::State& state) {
+  const RobotModel& model = Model(static_cast<int>(state.range(0)));
+  robotalk::Kinematics kin(model);
+  kin.Update(Positions(model)[0]);
+  for (auto _ : state) benchmark::DoNotOptimize(kin.FrameJacobian(0)(0, 0));
+  Label(state, model);
+}
+
+void BM_CenterOfMass(benchmark::State& state) {
+  const RobotModel& model = Model(static_cast<int>(state.range(0)));
+  robotalk::Kinematics kin(model);
+  kin.Update(Positions(model)[0]);
+  for (auto _ : state) benchmark::DoNotOptimize(kin.CenterOfMass().x());
+  Label(state, model);
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  const int iterations = argc > 1 ? std::atoi(argv[1]) : 200000;
-  if (iterations <= 0) {
-    std::fprintf(stderr, "usage: %s [iterations > 0]\n", argv[0]);
-    return 2;
-  }
-  Bench(Arm(), iterations);
-  Bench(Humanoid(), iterations);
-  return 0;
-}
+// Argument 0 = arm7, 1 = humanoid31.
+BENCHMARK(BM_KinematicsUpdate)->Arg(0)->Arg(1);
+BENCHMARK(BM_FrameJacobian)->Arg(0)->Arg(1);
+BENCHMARK(BM_CenterOfMass)->Arg(0)->Arg(1);
+BENCHMARK_MAIN();

@@ -46,6 +46,76 @@ std::unique_ptr<OdeDriver> Make(const Robot& r) {
   return std::unique_ptr<OdeDriver>(static_cast<OdeDriver*>(d.release()));
 }
 
+// The ODE world the ode driver builds for `r` (OdeDriver::Impl's
+// constructor, drivers/ode_sim/ode_driver.cpp), rebuilt here rule by rule so
+// "bare ODE" is the same physics: the same import options, base type, world
+// options (step, gravity, friction, solver, virtual mass, casters, seed), a
+// differential base's wheel cylinders as spheres, a walking humanoid's root
+// left dynamic, and the motors the driver sets when holding still (position
+// servos at their effort limit, passive joints free). Comparing against a
+// world that differs (e.g. cylinder wheels: more contact points, a costlier
+// LCP) measured the difference of the worlds, not the driver: the Pioneer read
+// -25 %.
+struct BareWorld {
+  RobotModel model;
+  std::unique_ptr<ode_detail::OdeWorld> world;
+
+  BareWorld(const Robot& r, bool walks) {
+    const OdeDriverOptions o = OdeDriverOptions::FromMap(r.options);
+    UrdfImportOptions import;
+    import.merge_massless_chains = o.merge_chains;
+    model = LoadUrdfFile(r.path, import).model;
+    if (!o.base.empty()) {
+      std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
+      roots.front().base = ParseBaseType(o.base);
+      model = RobotModel(model.name(), {model.links().begin(), model.links().end()},
+                         {model.joints().begin(), model.joints().end()},
+                         {model.frames().begin(), model.frames().end()}, std::move(roots));
+    }
+    const BaseType base = model.roots().front().base;
+    ode_detail::OdeWorldOptions wo;
+    wo.step = 1.0 / o.step_hz;
+    wo.gravity = o.gravity;
+    wo.friction = o.friction;
+    wo.quickstep = o.solver == "quickstep";
+    wo.virtual_mass = o.virtual_mass;
+    wo.caster_links = o.casters;
+    wo.seed = o.seed;
+    wo.kinematic_first_root = (base == BaseType::kHolonomic || base == BaseType::kFloating) && !walks;
+    wo.place_on_ground = base != BaseType::kFixed;
+    std::vector<CollisionShape> shapes = LoadCollisionShapes(r.path);
+    if (base == BaseType::kDifferential) {
+      for (const std::string& wheel : {o.left_wheel, o.right_wheel}) {
+        const std::optional<int> j = model.FindJoint(wheel);
+        if (!j) continue;
+        const std::string& link = model.link(model.joint(*j).child_link).name;
+        for (CollisionShape& sh : shapes) {
+          if (sh.link != link || sh.kind != CollisionShape::Kind::kCylinder) continue;
+          sh.kind = CollisionShape::Kind::kSphere;
+          sh.size = {sh.size.x(), 0, 0};
+        }
+      }
+    }
+    Eigen::VectorXd q0 = Eigen::VectorXd::Zero(model.num_dofs());
+    for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
+      for (size_t k = 0; k < model.joint(j).dofs.size(); ++k) {
+        const DofLimits& l = model.joint(j).dofs[k].limits;
+        q0[model.dof_offset(j) + static_cast<int>(k)] = std::clamp(0.0, l.lower, l.upper);
+      }
+    }
+    world = std::make_unique<ode_detail::OdeWorld>(model, shapes, wo, q0);
+    for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
+      const Joint& joint = model.joint(j);
+      const bool passive = joint.servo_types.empty() && !joint.mimic;
+      for (size_t k = 0; k < joint.dofs.size(); ++k) {
+        const double e = joint.dofs[k].limits.effort;
+        world->SetMotor(model.dof_offset(j) + static_cast<int>(k), 0,
+                        passive ? 0.0 : (std::isfinite(e) ? e : o.default_effort));
+      }
+    }
+  }
+};
+
 // Real-time factor with the robot in motion, and the bare world's step cost.
 void RealTimeFactor(const Robot& r) {
   auto d = Make(r);
@@ -70,36 +140,10 @@ void RealTimeFactor(const Robot& r) {
   auto idle = Make(r);
   idle->Step(1, done);
 
-  // The bare loop: the same ODE world (bodies, joints, contacts, read-out)
-  // stepped with constant motors, no controllers.
-  UrdfImportResult imp = LoadUrdfFile(r.path);
-  RobotModel model = std::move(imp.model);
-  if (r.options.count("base")) {
-    std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
-    roots.front().base = ParseBaseType(r.options.at("base"));
-    model = RobotModel(model.name(), {model.links().begin(), model.links().end()},
-                       {model.joints().begin(), model.joints().end()},
-                       {model.frames().begin(), model.frames().end()}, std::move(roots));
-  }
-  ode_detail::OdeWorldOptions wo;
-  wo.caster_links = {"caster"};
-  wo.quickstep = r.options.count("solver") && r.options.at("solver") == "quickstep";
-  wo.kinematic_first_root = model.roots().front().base == BaseType::kFloating;
-  wo.place_on_ground = model.roots().front().base != BaseType::kFixed;
-  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(model.num_dofs());
-  for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
-    for (size_t k = 0; k < model.joint(j).dofs.size(); ++k) {
-      const DofLimits& l = model.joint(j).dofs[k].limits;
-      q0[model.dof_offset(j) + static_cast<int>(k)] = std::clamp(0.0, l.lower, l.upper);
-    }
-  }
-  ode_detail::OdeWorld w(model, LoadCollisionShapes(r.path), wo, q0);
-  for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
-    for (size_t k = 0; k < model.joint(j).dofs.size(); ++k) {
-      const double e = model.joint(j).dofs[k].limits.effort;
-      w.SetMotor(model.dof_offset(j) + static_cast<int>(k), 0, std::isfinite(e) ? e : 200.0);
-    }
-  }
+  // The bare loop: the ODE world the driver builds, built the same way
+  // (BareWorld), stepped with constant motors and no controllers.
+  BareWorld bare(r, idle->walk_status().has_value());
+  ode_detail::OdeWorld& w = *bare.world;
   // Alternate the two, 5 rounds of 600 steps, and keep each one's fastest
   // round: the machine is shared, so the minimum is the cost.
   double driver_s = 1e9, bare_s = 1e9;

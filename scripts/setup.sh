@@ -8,7 +8,7 @@ PACKAGES=(
   build-essential cmake pkg-config clang-format
   liblcm-dev liblcm-bin liblcm-java liblcm-lua libglib2.0-dev
   libeigen3-dev libode-dev liburdfdom-dev libtinyxml-dev
-  libgtest-dev libgmock-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless lua5.2
   iproute2 util-linux python3 python3-matplotlib
 )

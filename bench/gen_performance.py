@@ -1,0 +1,282 @@
+#!/usr/bin/env python3
+"""Writes the measured tables of docs/performance.md and its figures from bench/results.
+
+    python3 bench/gen_performance.py [--latest DIR] [--before DIR] [--doc FILE] [--figdir DIR]
+                                     [--freeze-before]
+
+Reads bench/results/latest/*.json (the last run of bench/run_bench.py) and
+bench/results/before/*.json (the frozen BEFORE run, measured on the code before
+issue 11's changes); replaces the text between the markers
+<!-- bench:begin --> and <!-- bench:end --> of the doc. --freeze-before
+first copies latest/ over before/ (done once, for the BEFORE column).
+Every figure is a median over the runs of one bench run; ratios are
+RoboTalk / floor from the SAME run. Python 3 standard library + matplotlib.
+"""
+import argparse
+import glob
+import json
+import os
+import shutil
+import statistics
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
+
+
+def load(d):
+    out = {}
+    for f in glob.glob(os.path.join(d, "*.json")):
+        with open(f) as fh:
+            r = json.load(fh)
+        out[r.get("figure", os.path.basename(f)[:-5])] = r
+    return out
+
+
+def med(xs):
+    xs = [x for x in xs if x is not None]
+    return statistics.median(xs) if xs else None
+
+
+def get(d, *path):
+    for p in path:
+        if not isinstance(d, dict) or p not in d:
+            return None
+        d = d[p]
+    return d
+
+
+def fmt(x, unit="", digits=0):
+    if x is None:
+        return "—"
+    if digits == 0 and abs(x) >= 1000 and unit in ("", "cmd/s", "/s"):
+        return f"{x / 1000:.1f}k{(' ' + unit) if unit else ''}"
+    return f"{x:.{digits}f}{(' ' + unit) if unit else ''}"
+
+
+def per_s(x):
+    return "—" if x is None else f"{x / 1000:.1f}k/s"
+
+
+def us(x):
+    """Microseconds, shown as ms from 10 ms up."""
+    if x is None:
+        return "—"
+    return f"{x:.0f} µs" if abs(x) < 10000 else f"{x / 1000:.1f} ms"
+
+
+def ratio(a, b, digits=2):
+    return f"{a / b:.{digits}f}" if a is not None and b not in (None, 0) else "—"
+
+
+def pair(r, a, b, key):
+    """Median p50 / p99 (µs) of runs[i][a][key] and runs[i][b][key] over r['runs']:
+    (RoboTalk text, floor text, ratio text)."""
+    runs = r.get("runs", [])
+    a50, a99 = med([get(x, a, key, "p50") for x in runs]), med([get(x, a, key, "p99") for x in runs])
+    b50, b99 = med([get(x, b, key, "p50") for x in runs]), med([get(x, b, key, "p99") for x in runs])
+    return f"{us(a50)} / {us(a99)}", f"{us(b50)} / {us(b99)}", f"{ratio(a50, b50)} / {ratio(a99, b99)}"
+
+
+def rows_for(res):
+    """[(figure, robotalk, floor-with-name, ratio)] for one bench run."""
+    rows = []
+    q = res.get("query", {})
+    a, b, r = pair(q, "robotalk", "raw", "rtt_us")
+    rows.append(("direct query round trip p50 / p99 (BASE_POSE)", a, f"raw LCM ping-pong, same bytes: {b}", r))
+    t = res.get("timed", {})
+    for label, key in (("1 kHz timed commands, lateness p50 / p99", "runs"),
+                       ("same, other core loaded (busy loop)", "loaded_runs")):
+        sub = {"runs": t.get(key, [])}
+        a, b, r = pair(sub, "robotalk", "bare_default", "lateness_us")
+        _, c, r2 = pair(sub, "robotalk", "bare_1ns", "lateness_us")
+        rows.append((label, a, f"bare `clock_nanosleep` loop: {b}; with 1 ns slack: {c}", f"{r} (vs 1 ns: {r2})"))
+    p = res.get("panic", {})
+    runs = p.get("runs", [])
+    a50, a99 = med([get(x, "robotalk", "ack_us", "p50") for x in runs]), med([get(x, "robotalk", "ack_us", "p99") for x in runs])
+    b50, b99 = med([get(x, "raw", "rtt_us", "p50") for x in runs]), med([get(x, "raw", "rtt_us", "p99") for x in runs])
+    rows.append((f"PANIC acknowledgement p50 / p99, {p.get('streamers', 8)} clients streaming at 100 Hz",
+                 f"{us(a50)} / {us(a99)}", f"raw ping-pong 64 B, same load: {us(b50)} / {us(b99)}",
+                 f"{ratio(a50, b50)} / {ratio(a99, b99)}"))
+    th = res.get("throughput", {})
+    runs = th.get("runs", [])
+    a100 = med([get(x, "robotalk", "per_s") for x in runs])
+    b100 = med([get(x, "raw", "per_s") for x in runs])
+    rows.append(("throughput, 1 client, 100 commands in flight (one package each)", per_s(a100).replace("/s", " cmd/s"),
+                 f"raw LCM echo, 100 in flight: {per_s(b100)}", ratio(a100, b100)))
+    big = th.get("inflight1000_runs", [])
+    if big:
+        per = ", ".join(fmt(get(x, "robotalk", "per_s")) + (" (cap hit)" if get(x, "robotalk", "timed_out") else "")
+                        for x in big)
+        lost = sum(get(x, "robotalk", "gave_up") or 0 for x in big)
+        rtx = sum(get(x, "robotalk", "retransmissions") or 0 for x in big)
+        a1k = med([get(x, "robotalk", "per_s") for x in big])
+        b1k = med([get(x, "raw", "per_s") for x in big])
+        rows.append((f"throughput, 1,000 single-command packages in flight ({len(big)} runs, {th.get('count')} "
+                     f"commands, cap {th.get('cap_s')} s)",
+                     f"{per} cmd/s; {lost} gave up, {rtx} retransmissions",
+                     f"raw LCM echo, 1,000 in flight: {per_s(b1k)}",
+                     f"{ratio(a1k, b1k)} (vs own 100-in-flight: {ratio(a1k, a100)})"))
+    for lvl in res.get("scale", {}).get("levels", []):
+        cl = lvl["per_client"]
+        ok = [c for c in cl if "sent" in c]
+        sent = sum(c["sent"] for c in ok)
+        to = sum(c["timeouts"] for c in ok)
+        p99s = [get(c, "lateness_us", "p99") for c in ok if get(c, "lateness_us", "n")]
+        cpu = med([c.get("cpu_pct") for c in ok])
+        fails = len(cl) - len(ok)
+        rows.append((f"scale: {lvl['clients']} clients × 100 Hz, delay mode (100 ms), {lvl['seconds']} s",
+                     f"{100.0 * to / sent if sent else 0:.1f} % timed out; lateness p99 median {us(med(p99s))},"
+                     f" worst {us(max(p99s) if p99s else None)}; client CPU {fmt(cpu, '%', 1)} each,"
+                     f" server {fmt(lvl['server_cpu_pct'], '%')}" + (f"; {fails} clients failed to connect" if fails else ""),
+                     "—", "—"))
+    c = res.get("cli", {})
+    a = med([med(x["robotalk_ms"]) for x in c.get("runs", [])])
+    b = med([med(x["raw_ms"]) for x in c.get("runs", [])])
+    rows.append(("CLI `robotalk query pioneer base_pose`, wall time", fmt(a, "ms", 1),
+                 f"new process + LCM + one raw round trip: {fmt(b, 'ms', 1)}", ratio(a, b)))
+    m = res.get("memory", {})
+    if m.get("levels"):
+        rows.append(("memory per idle session (server RSS)",
+                     "; ".join(f"{l['sessions']}: {l['per_session_kb']:.2f} KiB" for l in m["levels"]),
+                     f"server RSS with none: {m['levels'][0]['base_rss_kb'] / 1024:.1f} MiB", "—"))
+    j = res.get("jitter", {})
+    a, b, r = pair(j, "robotalk", "raw", "deviation_us")
+    rows.append(("STATE stream at 1 kHz: \\|inter-arrival − 1 ms\\| p50 / p99", a,
+                 f"raw LCM 1 kHz publisher (`clock_nanosleep`): {b}", r))
+    for lv, (ch, hs, late, n) in playback_levels(res).items():
+        rows.append((f"playback start latency, relay congestion U[0, {lv}] ms per message",
+                     f"{fmt(ch, 's', 3)} (late frames: {late} of {n})",
+                     f"hindsight minimum: {fmt(hs, 's', 3)}", ratio(ch, hs, 1) + " (floor near 0: ratio not meaningful)" if hs is not None and hs < 0.005 else ratio(ch, hs, 1)))
+    return rows
+
+
+def playback_levels(res):
+    out = {}
+    runs = res.get("playback", {}).get("runs", [])
+    for lv in sorted({r["congestion_max_ms"] for r in runs}):
+        rs = [r for r in runs if r["congestion_max_ms"] == lv]
+        ch = med([get(r, "robotalk", "chosen_delay_s") for r in rs])
+        hs = med([get(r, "arrivals", "hindsight_min_s") for r in rs])
+        late = sum(get(r, "robotalk", "late_frames") or 0 for r in rs)
+        n = sum(get(r, "robotalk", "lateness_us", "n") or 0 for r in rs)
+        out[lv] = (ch, hs, int(late), int(n))
+    return out
+
+
+def micro_rows(res):
+    rows = []
+    for bench, items in get(res, "micro", "benches").items() if get(res, "micro", "benches") else []:
+        if not isinstance(items, list):
+            rows.append((bench, "not run", items.get("error", "")))
+            continue
+        for b in items:
+            if b.get("aggregate_name") != "median":
+                continue
+            unit = {"ns": 1e-3, "us": 1, "ms": 1e3}[b["time_unit"]]
+            name = b["run_name"].replace("BM_", "")
+            rows.append((name, f"{b['real_time'] * unit:.3f} µs", b.get("label", "")))
+    return rows
+
+
+def plot(res, figdir):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    runs = res.get("playback", {}).get("runs", [])
+    if runs:
+        fig, ax = plt.subplots(figsize=(6, 3.8))
+        xs = [r["congestion_max_ms"] for r in runs]
+        ax.scatter(xs, [get(r, "robotalk", "chosen_delay_s") for r in runs], label="server's chosen delay", marker="o")
+        ax.scatter(xs, [get(r, "arrivals", "hindsight_min_s") for r in runs],
+                   label="hindsight minimum (from the arrival log)", marker="x")
+        lv = playback_levels(res)
+        ax.plot(list(lv), [v[0] for v in lv.values()], alpha=0.5)
+        ax.plot(list(lv), [v[1] for v in lv.values()], alpha=0.5)
+        ax.set_xlabel("relay congestion: service time U[0, X] ms per message (client → server)")
+        ax.set_ylabel("start latency after the first frame (s)")
+        ax.set_title("Playback start latency, 10 Hz sequence", fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(figdir, "perf_playback.png"), dpi=110)
+        plt.close(fig)
+    levels = res.get("scale", {}).get("levels", [])
+    if levels:
+        fig, ax1 = plt.subplots(figsize=(6, 3.8))
+        ns = [l["clients"] for l in levels]
+        tos, cpus = [], []
+        for l in levels:
+            ok = [c for c in l["per_client"] if "sent" in c]
+            sent = sum(c["sent"] for c in ok)
+            tos.append(100.0 * sum(c["timeouts"] for c in ok) / sent if sent else 0)
+            cpus.append(med([c.get("cpu_pct") for c in ok]) or 0)
+        ax1.plot(ns, tos, "o-", label="commands timed out (%)")
+        ax1.plot(ns, cpus, "s--", label="CPU per client process (%)")
+        ax1.set_xscale("log", base=2)
+        ax1.set_xticks(ns, [str(n) for n in ns])
+        ax1.set_xlabel("clients, each 100 Hz in delay mode")
+        ax1.set_ylabel("%")
+        ax1.set_title("Scale on one LCM bus", fontsize=10)
+        ax1.grid(alpha=0.3)
+        ax1.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(figdir, "perf_scale.png"), dpi=110)
+        plt.close(fig)
+
+
+def describe(res):
+    meta = next((r["meta"] for r in res.values() if "meta" in r), {})
+    if not meta:
+        return "no run"
+    return (f"{meta.get('date_utc')} UTC, commit {meta.get('commit')}, {'quick' if meta.get('quick') else 'full'} mode, "
+            f"{meta.get('runs')} runs, load average at start {meta.get('loadavg_start', [0])[0]:.1f} on "
+            f"{meta.get('nproc')} CPUs")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--latest", default=os.path.join(ROOT, "bench", "results", "latest"))
+    ap.add_argument("--before", default=os.path.join(ROOT, "bench", "results", "before"))
+    ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "performance.md"))
+    ap.add_argument("--figdir", default=os.path.join(ROOT, "docs", "figures"))
+    ap.add_argument("--freeze-before", action="store_true")
+    args = ap.parse_args()
+    if args.freeze_before:
+        shutil.rmtree(args.before, ignore_errors=True)
+        shutil.copytree(args.latest, args.before)
+    before, latest = load(args.before), load(args.latest)
+    same = describe(before) == describe(latest)
+    lines = [f"BEFORE: {describe(before)}.  ", f"Latest: {describe(latest)}" + (" (the BEFORE run)." if same else "."), ""]
+    lines += ["| figure | BEFORE: RoboTalk | BEFORE: floor, same run | BEFORE: ratio | latest: RoboTalk | latest: ratio |",
+              "|---|---|---|---|---|---|"]
+    rb, rl = rows_for(before), rows_for(latest)
+    latest_by = {r[0]: r for r in rl}
+    for row in rb:
+        l = latest_by.get(row[0])
+        lr, lratio = ("same run", "") if same else ((l[1], l[3]) if l else ("—", "—"))
+        lines.append(f"| {row[0]} | {row[1]} | {row[2]} | {row[3]} | {lr} | {lratio} |")
+    for row in rl:  # figures the BEFORE run did not have
+        if not any(r[0] == row[0] for r in rb):
+            lines.append(f"| {row[0]} | — | {row[2]} | — | {row[1]} | {row[3]} |")
+    lines += ["", "In-process (Google Benchmark, median of 3 repetitions, latest run):", "",
+              "| benchmark | time per call | what |", "|---|---|---|"]
+    lines += [f"| {n} | {t} | {w} |" for n, t, w in micro_rows(latest)]
+    ode = get(latest, "ode", "output")
+    if ode:
+        lines += ["", "The ode driver (`robotalk-ode-bench`, latest run; method in docs/ode_sim.md; the bare world is",
+                  "now built exactly as the driver builds it, see bench/ode_bench.cpp):", "", ode.strip()]
+    with open(args.doc) as f:
+        doc = f.read()
+    if BEGIN not in doc or END not in doc:
+        raise SystemExit(f"{args.doc}: markers {BEGIN} / {END} not found")
+    head, rest = doc.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    with open(args.doc, "w") as f:
+        f.write(head + BEGIN + "\n" + "\n".join(lines) + "\n" + END + tail)
+    os.makedirs(args.figdir, exist_ok=True)
+    plot(latest if latest else before, args.figdir)
+    print(f"gen_performance: wrote {args.doc} and {args.figdir}/perf_*.png")
+
+
+if __name__ == "__main__":
+    main()

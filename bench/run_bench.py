@@ -1,0 +1,341 @@
+#!/usr/bin/env python3
+"""Runs RoboTalk's multi-process benchmark suite and writes bench/results/latest/*.json.
+
+Run it inside a private network namespace (scripts/bench.sh does:
+scripts/netns_run.sh python3 bench/run_bench.py ...). Every RoboTalk figure is
+measured beside its floor (raw LCM, a bare timer loop) in the same run,
+interleaved A B A B, N runs; the JSON keeps every run, the generator
+(bench/gen_performance.py) takes medians.
+
+    python3 bench/run_bench.py --build build [--quick] [--only NAME,...] [--out DIR]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+URL = "udpm://239.255.76.67:7990?ttl=0"
+URL_A = "udpm://239.255.76.67:7992?ttl=0"  # playback: client side of the relay
+URL_B = "udpm://239.255.76.67:7993?ttl=0"  # playback: server side
+ROBOT = "pioneer"
+
+
+class Bench:
+    def __init__(self, args):
+        self.args = args
+        self.quick = args.quick
+        self.runs = 3 if args.quick else 5
+        b = os.path.abspath(args.build)
+        self.server_bin = f"{b}/robotalk-server/robotalk-server"
+        self.cli_bin = f"{b}/robotalk-client/robotalk"
+        self.raw = f"{b}/bench/robotalk-bench-raw"
+        self.timer = f"{b}/bench/robotalk-bench-timer"
+        self.client = f"{b}/bench/robotalk-bench-client"
+        self.relay = f"{b}/tools/lcm_relay/robotalk-lcm-relay"
+        self.model = f"{ROOT}/models/pioneer2dx_pantilt.urdf"
+        self.tmp = tempfile.mkdtemp(prefix="robotalk-bench-")
+        self.server = None
+        self.children = []
+
+    # --- processes -----------------------------------------------------------
+    def start(self, cmd, stdout=subprocess.PIPE):
+        p = subprocess.Popen(cmd, stdout=stdout, stderr=subprocess.PIPE, text=True)
+        self.children.append(p)
+        return p
+
+    @staticmethod
+    def parse(out, what):
+        for line in reversed((out or "").strip().splitlines()):
+            if line.startswith("{"):
+                return json.loads(line)
+        raise RuntimeError(f"{what}: no JSON result in output: {out[-500:] if out else ''}")
+
+    def collect(self, p, timeout, what):
+        try:
+            out, err = p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            out, err = p.communicate()
+            return {"error": f"{what}: killed after {timeout} s", "stderr": err[-400:]}
+        try:
+            return self.parse(out, what)
+        except RuntimeError as e:
+            return {"error": str(e), "stderr": (err or "")[-400:], "rc": p.returncode}
+
+    def run(self, cmd, timeout=120):
+        return self.collect(self.start(cmd), timeout, os.path.basename(cmd[0]) + " " + cmd[1])
+
+    def stop(self, p, grace=3):
+        if p.poll() is None:
+            p.terminate()
+            try:
+                p.wait(grace)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+    def start_server(self, url=URL, extra=()):
+        self.stop_server()
+        log = open(f"{self.tmp}/server.log", "w+")
+        self.server = subprocess.Popen(
+            [self.server_bin, "--robot", f"{ROBOT}=kinematic:{self.model}", "--url", url,
+             "--duration", "3600", *extra], stdout=subprocess.DEVNULL, stderr=log, text=True)
+        for _ in range(100):
+            log.seek(0)
+            if "serving robot" in log.read():
+                return self.server
+            time.sleep(0.05)
+        raise RuntimeError("robotalk-server did not start: " + open(log.name).read()[-500:])
+
+    def stop_server(self):
+        if self.server:
+            self.stop(self.server)
+            self.server = None
+
+    def start_echo(self, url=URL):
+        return self.start([self.raw, "echo", "--url", url, "--duration", "3600"])
+
+    def cpu_ticks(self, pid):
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return int(fields[11]) + int(fields[12])  # utime + stime
+
+    def rss_kb(self, pid):
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1])
+        return 0
+
+    def cleanup(self):
+        self.stop_server()
+        for p in self.children:
+            if p.poll() is None:
+                self.stop(p, 1)
+
+    # --- figures -------------------------------------------------------------
+    def query(self):
+        n = 300 if self.quick else 2000
+        self.start_server()
+        echo = self.start_echo()
+        runs = []
+        for _ in range(self.runs):
+            a = self.run([self.client, "query", "--url", URL, "--count", str(n)])
+            b = self.run([self.raw, "ping", "--url", URL, "--count", str(n)])
+            runs.append({"robotalk": a, "raw": b})
+        self.stop(echo)
+        return {"figure": "query", "count": n, "runs": runs}
+
+    def timed_once(self, n):
+        return {
+            "robotalk": self.run([self.client, "timed", "--url", URL, "--count", str(n)]),
+            "bare_default": self.run([self.timer, "sleeploop", "--count", str(n)]),
+            "bare_1ns": self.run([self.timer, "sleeploop", "--count", str(n), "--slack-ns", "1"]),
+        }
+
+    def timed(self):
+        n = 1000 if self.quick else 2000
+        self.start_server()
+        idle, loaded = [], []
+        for _ in range(self.runs):
+            idle.append(self.timed_once(n))
+            burn = self.start([self.timer, "burn", "--seconds", "60"])
+            time.sleep(0.2)
+            loaded.append(self.timed_once(n))
+            self.stop(burn)
+        return {"figure": "timed", "count": n, "runs": idle, "loaded_runs": loaded}
+
+    def panic(self):
+        n = 30 if self.quick else 100
+        self.start_server()
+        echo = self.start_echo()
+        streamers = [self.start([self.client, "stream", "--url", URL, "--seconds", "600", "--rate", "100"])
+                     for _ in range(8)]
+        time.sleep(2.0)
+        runs = []
+        for _ in range(self.runs):
+            a = self.run([self.client, "panic", "--url", URL, "--count", str(n), "--gap-ms", "20"])
+            b = self.run([self.raw, "ping", "--url", URL, "--count", str(n), "--gap-us", "20000",
+                          "--req", "64", "--rep", "64", "--warmup", "5"])
+            runs.append({"robotalk": a, "raw": b})
+        for s in streamers:
+            self.stop(s, 1)
+        self.stop(echo)
+        return {"figure": "panic", "count": n, "streamers": 8, "runs": runs}
+
+    def throughput(self):
+        n = 5000 if self.quick else 20000
+        sizes = self.run([self.raw, "sizes"])
+        req, rep = str(int(sizes["base_pose_request"])), str(int(sizes["base_pose_reply"]))
+        self.start_server()
+        echo = self.start_echo()
+        runs = []
+        for _ in range(self.runs):
+            a = self.run([self.client, "pipe", "--url", URL, "--inflight", "100", "--count", str(n), "--cap", "60"])
+            b = self.run([self.raw, "pipe", "--url", URL, "--inflight", "100", "--count", str(n),
+                          "--req", req, "--rep", rep, "--cap", "60"])
+            runs.append({"robotalk": a, "raw": b})
+        big = []
+        cap = 20 if self.quick else 45
+        for _ in range(1 if self.quick else 3):
+            self.start_server()  # a collapsed run must not leave its backlog to the next
+            a = self.run([self.client, "pipe", "--url", URL, "--inflight", "1000", "--count", str(n),
+                          "--cap", str(cap)], timeout=cap + 30)
+            b = self.run([self.raw, "pipe", "--url", URL, "--inflight", "1000", "--count", str(n),
+                          "--req", req, "--rep", rep, "--cap", str(cap)], timeout=cap + 30)
+            big.append({"robotalk": a, "raw": b})
+        self.stop(echo)
+        return {"figure": "throughput", "count": n, "cap_s": cap, "runs": runs, "inflight1000_runs": big}
+
+    def scale(self):
+        seconds = 5 if self.quick else 30
+        levels = []
+        for n in (8, 16, 32, 64):
+            srv = self.start_server()
+            allowance = 2.0 + 0.1 * n
+            start_at = time.monotonic_ns() + int(allowance * 1e9)
+            procs = [self.start([self.client, "stream", "--url", URL, "--seconds", str(seconds), "--rate", "100",
+                                 "--delay-ms", "100", "--start-at", str(start_at)]) for _ in range(n)]
+            time.sleep(max(0.0, (start_at - time.monotonic_ns()) / 1e9))
+            t0, c0 = time.monotonic(), self.cpu_ticks(srv.pid)
+            time.sleep(seconds)
+            server_pct = 100.0 * (self.cpu_ticks(srv.pid) - c0) / os.sysconf("SC_CLK_TCK") / (time.monotonic() - t0)
+            clients = [self.collect(p, seconds + allowance + 20, "stream") for p in procs]
+            levels.append({"clients": n, "seconds": seconds, "server_cpu_pct": server_pct, "per_client": clients})
+        return {"figure": "scale", "levels": levels}
+
+    def cli(self):
+        k = 5 if self.quick else 10
+        self.start_server()
+        echo = self.start_echo()
+        runs = []
+        for _ in range(self.runs):
+            a, b = [], []
+            for _ in range(k):
+                for cmd, dst in (([self.cli_bin, "--url", URL, "query", ROBOT, "base_pose"], a),
+                                 ([self.raw, "once", "--url", URL], b)):
+                    t0 = time.perf_counter_ns()
+                    rc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=30).returncode
+                    dst.append((time.perf_counter_ns() - t0) / 1e6 if rc == 0 else None)
+            runs.append({"robotalk_ms": a, "raw_ms": b})
+        self.stop(echo)
+        return {"figure": "cli", "runs": runs}
+
+    def memory(self):
+        srv = self.start_server()
+        time.sleep(1.0)
+        base = self.rss_kb(srv.pid)
+        levels = []
+        for k in ((100, 500) if self.quick else (100, 1000, 3000)):
+            p = self.start([self.raw, "sessions", "--url", URL, "--robot", ROBOT, "--count", str(k), "--seconds", "4"])
+            time.sleep(3.5)
+            rss = self.rss_kb(srv.pid)
+            self.collect(p, 30, "sessions")
+            levels.append({"sessions": k, "rss_kb": rss, "base_rss_kb": base,
+                           "per_session_kb": (rss - base) / k})
+            time.sleep(3.0)  # the sessions expire (2 s watchdog)
+        return {"figure": "memory", "levels": levels}
+
+    def jitter(self):
+        n = 1000 if self.quick else 3000
+        self.start_server()
+        runs = []
+        for _ in range(self.runs):
+            a = self.run([self.client, "watch", "--url", URL, "--count", str(n), "--period-us", "1000"])
+            w = self.start([self.raw, "watch", "--url", URL, "--count", str(n), "--period-us", "1000"])
+            time.sleep(0.2)
+            s = self.run([self.raw, "stream", "--url", URL, "--count", str(n + 50), "--period-us", "1000",
+                          "--bytes", "700"])
+            b = self.collect(w, 60, "watch")
+            runs.append({"robotalk": a, "raw": b, "raw_stream": s})
+        return {"figure": "jitter", "count": n, "runs": runs}
+
+    def playback(self):
+        frames = 20 if self.quick else 40
+        levels = (0, 100) if self.quick else (0, 50, 100, 150)
+        reps = 1 if self.quick else 2
+        self.start_server(url=URL_B)
+        runs = []
+        seed = 1
+        for x in levels:
+            for _ in range(reps):
+                relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, "--a2b-congestion-max-ms", str(x),
+                                    "--seed", str(seed), "--duration", "120"])
+                seed += 1
+                time.sleep(0.3)
+                log = self.start([self.raw, "arrivals", "--url", URL_B, "--robot", ROBOT, "--frames", str(frames),
+                                  "--timeout", "90"])
+                a = self.run([self.client, "playback", "--url", URL_A, "--frames", str(frames),
+                              "--period-ms", "100"], timeout=100)
+                arr = self.collect(log, 10, "arrivals")
+                self.stop(relay)
+                runs.append({"congestion_max_ms": x, "robotalk": a, "arrivals": arr})
+                # Let the server's playback state and the client's session go before the next run.
+                time.sleep(2.5)
+        return {"figure": "playback", "frames": frames, "period_ms": 100, "runs": runs}
+
+    def micro(self):
+        out = {}
+        for name in ("robotalk-kinematics-bench", "robotalk-codec-bench"):
+            exe = f"{os.path.abspath(self.args.build)}/bench/{name}"
+            if not os.path.exists(exe):
+                out[name] = {"error": "not built (libbenchmark-dev missing?)"}
+                continue
+            r = subprocess.run([exe, "--benchmark_format=json", "--benchmark_repetitions=3",
+                                "--benchmark_report_aggregates_only=true",
+                                f"--benchmark_min_time={0.05 if self.quick else 0.2}"],
+                               capture_output=True, text=True, timeout=300)
+            out[name] = json.loads(r.stdout)["benchmarks"] if r.returncode == 0 else {"error": r.stderr[-400:]}
+        return {"figure": "micro", "benches": out}
+
+    def ode(self):
+        exe = f"{os.path.abspath(self.args.build)}/bench/robotalk-ode-bench"
+        shared = os.environ.get("ROBOTALK_SHARED_ROBOTS", os.path.join(ROOT, "..", "shared", "robots"))
+        if not os.path.exists(exe):
+            return {"figure": "ode", "error": "robotalk-ode-bench not built"}
+        r = subprocess.run([exe, os.path.join(ROOT, "models"), shared], capture_output=True, text=True, timeout=600)
+        return {"figure": "ode", "output": r.stdout, "rc": r.returncode, "shared_robots": os.path.exists(shared)}
+
+
+FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "micro", "ode"]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--quick", action="store_true", help="a ~2 minute smoke run (fewer, shorter runs)")
+    ap.add_argument("--only", default="", help="comma-separated figures: " + ",".join(FIGURES))
+    ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "latest"))
+    args = ap.parse_args()
+    only = [f for f in args.only.split(",") if f] or [f for f in FIGURES if not (args.quick and f == "ode")]
+    os.makedirs(args.out, exist_ok=True)
+    b = Bench(args)
+    meta = {"date_utc": time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime()), "quick": args.quick,
+            "runs": b.runs, "nproc": os.cpu_count(), "loadavg_start": os.getloadavg(),
+            "commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                                     capture_output=True, text=True).stdout.strip()}
+    try:
+        for name in only:
+            t0 = time.monotonic()
+            print(f"bench: {name} ...", file=sys.stderr, flush=True)
+            try:
+                result = getattr(b, name)()
+            except Exception as e:  # one broken figure must not lose the others
+                result = {"figure": name, "error": repr(e)}
+            result["wall_s"] = round(time.monotonic() - t0, 1)
+            result["loadavg"] = os.getloadavg()
+            result["meta"] = meta
+            with open(os.path.join(args.out, f"{name}.json"), "w") as f:
+                json.dump(result, f, indent=1)
+            print(f"bench: {name} done in {result['wall_s']} s", file=sys.stderr, flush=True)
+    finally:
+        b.cleanup()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,48 @@
+#include "robotalk/channels.h"
+
+#include <gtest/gtest.h>
+
+namespace robotalk {
+namespace {
+
+TEST(Channels, BuildsTheDocumentedNames) {
+  EXPECT_EQ(RequestChannel("pioneer"), "ROBOTALK/pioneer/REQUEST");
+  EXPECT_EQ(ReplyChannel("pioneer", 0x2a), "ROBOTALK/pioneer/REPLY/000000000000002a");
+  EXPECT_EQ(ReplyChannel("arm", -1), "ROBOTALK/arm/REPLY/ffffffffffffffff");
+  EXPECT_EQ(ConfigChannel("pioneer"), "ROBOTALK/pioneer/CONFIG");
+  EXPECT_EQ(StateChannel("pioneer"), "ROBOTALK/pioneer/STATE");
+  EXPECT_STREQ(kAnnounceChannel, "ROBOTALK/ANNOUNCE");
+}
+
+TEST(Channels, ParsesWhatItBuilds) {
+  for (const char* robot : {"pioneer", "a", "asimo_2", "x.y-z"}) {
+    EXPECT_EQ(RobotOfRequestChannel(RequestChannel(robot)), robot);
+    EXPECT_EQ(RobotOfConfigChannel(ConfigChannel(robot)), robot);
+    EXPECT_EQ(RobotOfStateChannel(StateChannel(robot)), robot);
+    for (std::int64_t id : {std::int64_t{1}, std::int64_t{0x7fffffffffffffff}, std::int64_t{-5}}) {
+      EXPECT_EQ(ParseReplyChannel(ReplyChannel(robot, id)), (ReplyChannelParts{robot, id}));
+    }
+  }
+}
+
+TEST(Channels, RefusesChannelsOfAnotherShape) {
+  EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK//REQUEST"));
+  EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK/a/b/REQUEST"));
+  EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK/REQUEST"));
+  EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK/a/REQUESTX"));
+  EXPECT_FALSE(RobotOfRequestChannel("XROBOTALK/a/REQUEST"));
+  EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK/a/STATE"));
+  EXPECT_FALSE(RobotOfStateChannel("ROBOTALK/a/REQUEST"));
+  EXPECT_FALSE(RobotOfConfigChannel(kAnnounceChannel));
+  EXPECT_FALSE(RobotOfStateChannel(""));
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK/a/REPLY/2a"));                // not 16 digits
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK/a/REPLY/000000000000002A"));  // upper case
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK/a/REPLY/00000000000000g0"));
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK//REPLY/000000000000002a"));
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK/a/b/REPLY/000000000000002a"));
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK/a/REPLY/0000000000000002a"));  // 17 digits
+  EXPECT_FALSE(ParseReplyChannel("ROBOTALK/a/REQUEST"));
+}
+
+}  // namespace
+}  // namespace robotalk

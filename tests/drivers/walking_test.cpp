@@ -1,0 +1,202 @@
+// Tests of the walking controller's pure part (drivers/ode_sim/walking):
+// footstep plans within the step limits that reach their goals, ZMP preview
+// control tracking its reference, a whole walk's ZMP inside the support
+// polygon of the planned steps, and the leg IK on the simple humanoid.
+#include "robotalk/urdf_import.h"
+#include "test_paths.h"
+#include "walking/footstep_planner.h"
+#include "walking/leg_ik.h"
+#include "walking/walk_pattern.h"
+#include "walking/zmp_preview.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace robotalk::walking {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Every step of a plan within the limits, seen from the centre before it.
+void ExpectWithinLimits(const Pose2& start, const std::vector<PlannedStep>& plan, const GaitParams& g) {
+  Pose2 c = start;
+  for (size_t i = 0; i < plan.size(); ++i) {
+    const Pose2& n = plan[i].centre;
+    const double co = std::cos(c.theta), si = std::sin(c.theta);
+    const double dx = co * (n.x - c.x) + si * (n.y - c.y), dy = -si * (n.x - c.x) + co * (n.y - c.y);
+    EXPECT_LE(dx, g.step_forward + 1e-9) << "step " << i;
+    EXPECT_GE(dx, -g.step_back - 1e-9) << "step " << i;
+    EXPECT_LE(std::abs(dy), g.step_side + 1e-9) << "step " << i;
+    EXPECT_GE(dy * SideSign(plan[i].step.side), -1e-9) << "step " << i << " steps toward the stance foot";
+    EXPECT_LE(std::abs(Wrap(n.theta - c.theta)), g.step_yaw + 1e-9) << "step " << i;
+    if (i > 0) {
+      EXPECT_NE(plan[i].step.side, plan[i - 1].step.side) << "feet alternate";
+    }
+    c = n;
+  }
+}
+
+TEST(FootstepPlanner, TwentySeededGoalsAreReachedWithinTheStepLimits) {
+  const GaitParams g;
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> r(0, 2), a(-kPi, kPi);
+  for (int i = 0; i < 20; ++i) {
+    const double d = r(rng), bearing = a(rng);
+    const Pose2 goal{d * std::cos(bearing), d * std::sin(bearing), a(rng)};
+    bool reached = false;
+    const std::vector<PlannedStep> plan = PlanFootsteps({}, goal, g, 400, &reached);
+    ASSERT_TRUE(reached) << "goal " << i;
+    ExpectWithinLimits({}, plan, g);
+    const Pose2& end = plan.back().centre;
+    EXPECT_NEAR(end.x, goal.x, 1e-9);
+    EXPECT_NEAR(end.y, goal.y, 1e-9);
+    EXPECT_NEAR(Wrap(end.theta - goal.theta), 0, 1e-9);
+    // Both feet end around the goal.
+    const Footstep& a1 = plan[plan.size() - 1].step;
+    const Footstep& a2 = plan[plan.size() - 2].step;
+    EXPECT_NE(a1.side, a2.side);
+    for (const Footstep* f : {&a1, &a2}) {
+      const Pose2 want = FootAt(goal, f->side, g);
+      EXPECT_NEAR(std::hypot(f->pose.x - want.x, f->pose.y - want.y), 0, 1e-9);
+    }
+    // Turn, walk, turn: a 2 m goal takes at most ~ 2/0.1 + 2 pi/0.25 + a few steps.
+    EXPECT_LT(plan.size(), 60u);
+  }
+}
+
+TEST(FootstepPlanner, AGoalToTheLeftStepsLeftFirstAndOnlyOutward) {
+  const GaitParams g;
+  const std::vector<PlannedStep> plan = PlanFootsteps({}, {0, 0.12, 0}, g);
+  ASSERT_GE(plan.size(), 3u);
+  EXPECT_EQ(plan[0].step.side, Side::kLeft);
+  ExpectWithinLimits({}, plan, g);
+  EXPECT_TRUE(PlanFootsteps({1, 2, 3}, {1, 2, 3}, g).empty()) << "already there";
+}
+
+TEST(FootstepPlanner, StepByClampsAndSaysSo) {
+  const GaitParams g;
+  bool clamped = false;
+  const Pose2 p = StepBy({}, 1.0, 0.0, 0.0, Side::kLeft, g, &clamped);
+  EXPECT_TRUE(clamped);
+  EXPECT_NEAR(p.x, g.step_forward, 1e-12);
+  StepBy({}, 0.05, 0.0, 0.1, Side::kLeft, g, &clamped);
+  EXPECT_FALSE(clamped);
+  const Pose2 q = StepBy({}, 0.0, -0.03, 0.0, Side::kLeft, g, &clamped);
+  EXPECT_TRUE(clamped) << "a left swing cannot step right";
+  EXPECT_EQ(q.y, 0.0);
+}
+
+TEST(ZmpPreview, TheZmpFollowsAStepOfItsReferenceAndTheCoMSettlesThere) {
+  ZmpPreview p(0.005, 0.7, 9.81, 1.6);
+  EXPECT_EQ(p.horizon_samples(), 320);
+  p.Reset(0);
+  std::vector<double> future(320);
+  double worst_before = 0;
+  for (int k = 0; k < 1200; ++k) {  // the reference steps to 0.1 m at t = 2 s
+    for (int j = 0; j < 320; ++j) future[static_cast<size_t>(j)] = (k + j + 1) * 0.005 >= 2.0 ? 0.1 : 0.0;
+    const double now = k * 0.005 >= 2.0 ? 0.1 : 0.0;
+    p.Step(now, future);
+    if (k * 0.005 < 1.0) worst_before = std::max(worst_before, std::abs(p.zmp()));
+  }
+  EXPECT_LT(worst_before, 1e-3) << "the preview starts moving well before the step, not a second early";
+  EXPECT_NEAR(p.state()(0), 0.1, 1e-3);
+  EXPECT_NEAR(p.zmp(), 0.1, 1e-4);
+  EXPECT_NEAR(p.state()(1), 0.0, 1e-3);
+}
+
+// A whole walk: the model's ZMP never leaves the support polygon of the
+// planned steps (with a margin), and the CoM ends over the final stance.
+void WalkAndCheck(const Pose2& goal) {
+  const GaitParams g;
+  WalkPattern w(g, 0.001, 5, 9.81);
+  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+  const std::vector<PlannedStep> plan = PlanFootsteps({}, goal, g);
+  std::vector<Footstep> steps;
+  std::vector<Pose2> centres;
+  for (const PlannedStep& p : plan) {
+    steps.push_back(p.step);
+    centres.push_back(p.centre);
+  }
+  w.Append(steps, centres);
+  int ticks = 0;
+  while (!w.standing() && ticks < 200000) {
+    w.Tick();
+    ++ticks;
+    ASSERT_TRUE(w.InSupport(w.zmp(), 0.01)) << "t=" << w.time() << " zmp " << w.zmp().transpose();
+  }
+  ASSERT_TRUE(w.standing());
+  for (int i = 0; i < 1500; ++i) w.Tick();
+  const Eigen::Vector2d want = goal.Apply(g.ankle_x + g.zmp_x, 0);
+  EXPECT_NEAR((w.com() - want).norm(), 0, 5e-3);
+  EXPECT_NEAR(Wrap(w.foot(Side::kLeft).theta - goal.theta), 0, 1e-9);
+}
+
+TEST(WalkPattern, TheZmpStaysInTheSupportPolygonOnWalksToFiveGoals) {
+  for (const Pose2& goal : {Pose2{1.0, 0, 0}, Pose2{0.5, 0.5, 1.0}, Pose2{-0.3, 0.2, -2.0}, Pose2{0, 0.15, 0},
+                            Pose2{0.1, -0.1, 3.0}}) {
+    WalkAndCheck(goal);
+  }
+}
+
+TEST(WalkPattern, StopSoonEndsWithinTwoStepsInDoubleSupport) {
+  const GaitParams g;
+  WalkPattern w(g, 0.001, 5, 9.81);
+  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+  const std::vector<PlannedStep> plan = PlanFootsteps({}, {2, 0, 0}, g);
+  std::vector<Footstep> steps;
+  std::vector<Pose2> centres;
+  for (const PlannedStep& p : plan) {
+    steps.push_back(p.step);
+    centres.push_back(p.centre);
+  }
+  w.Append(steps, centres);
+  for (int i = 0; i < 3300; ++i) w.Tick();  // in the air during the third step
+  ASSERT_FALSE(w.double_support());
+  const double before = w.time();
+  w.StopSoon();
+  EXPECT_LE(w.unstarted_steps(), 1);
+  while (!w.standing()) {
+    w.Tick();
+    ASSERT_TRUE(w.InSupport(w.zmp(), 0.0));
+  }
+  EXPECT_LE(w.time() - before, 2 * g.step_period() + g.end_shift);
+  EXPECT_TRUE(w.double_support());
+  const Pose2 l = w.foot(Side::kLeft), r = w.foot(Side::kRight);
+  EXPECT_NEAR(std::hypot(l.x - r.x, l.y - r.y), g.foot_separation, 1e-9) << "feet side by side";
+}
+
+TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {
+  const RobotModel m = LoadUrdfFile(testing::ProjectModel("simple_humanoid.urdf")).model;
+  const int lf = m.LinkIndex("left_foot"), rf = m.LinkIndex("right_foot");
+  LegIk ik(m, {lf, rf}, {Eigen::Vector3d(0, 0, -0.07), Eigen::Vector3d(0, 0, -0.07)});
+  int legs = 0;
+  for (std::uint8_t b : ik.leg_mask()) legs += b;
+  EXPECT_EQ(legs, 12);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(m.num_dofs());
+  q[m.dof_offset(m.JointIndex("left_knee"))] = 0.5;
+  q[m.dof_offset(m.JointIndex("right_knee"))] = 0.5;
+  Eigen::Isometry3d pelvis = Eigen::Isometry3d::Identity();
+  pelvis.translation() = Eigen::Vector3d(0.02, 0.01, 0.72);
+  pelvis.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::array<Eigen::Isometry3d, 2> soles{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  soles[0].translation() = Eigen::Vector3d(0.05, 0.10, 0.02);
+  soles[0].linear() = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  soles[1].translation() = Eigen::Vector3d(-0.03, -0.08, 0.0);
+  EXPECT_LT(ik.Solve(pelvis, soles, q), 1e-3);
+  for (int s = 0; s < 2; ++s) {
+    const Eigen::Isometry3d got = pelvis * ik.SoleInPelvis(s, q);
+    EXPECT_NEAR((got.translation() - soles[static_cast<size_t>(s)].translation()).norm(), 0, 1e-3);
+    EXPECT_NEAR(Eigen::AngleAxisd(got.linear().transpose() * soles[static_cast<size_t>(s)].linear()).angle(),
+                0, 1e-2);
+  }
+  EXPECT_GT(q[m.dof_offset(m.JointIndex("left_knee"))], 0.1) << "knees stay bent forward";
+  const Eigen::Vector3d com = ik.ComInPelvis(q);
+  EXPECT_LT(std::abs(com.x()), 0.05);
+  EXPECT_LT(std::abs(com.y()), 0.02);
+}
+
+}  // namespace
+}  // namespace robotalk::walking
