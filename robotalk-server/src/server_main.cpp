@@ -34,6 +34,7 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --driver-call-bound S           a driver call running longer than S seconds is a driver fault:
                                   its command answers ERROR, the robot is held in panic (default 2;
                                   0 = no bound)
+  --log-lines-per-second N        most log lines a second; the rest are counted (default 20)
   --simulate SEQ.txt              instead of serving: run the sequence file (docs/client.md
                                   format) on the one --robot as fast as possible on a
                                   simulated clock for --duration S (default 10) and print
@@ -84,6 +85,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         simulate = value();
       } else if (arg == "--sample-period") {
         sample_period = ParseNumber(arg, value(), 0.001, 3600);
+      } else if (arg == "--log-lines-per-second") {
+        options.log_lines_per_second = static_cast<int>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--driver-call-bound") {
         options.driver_call_bound = FromSeconds(ParseNumber(arg, value(), 0, 3600));
       } else if (arg == "--log-executions") {
