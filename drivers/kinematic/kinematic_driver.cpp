@@ -19,29 +19,12 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-double WrapAngle(double a) {
-  a = std::remainder(a, 2 * kPi);  // (-pi, pi]
-  return a;
-}
-
 using driver_support::Answer;
 using driver_support::Num;
 using driver_support::Quote;
 using driver_support::Unit;
 
-[[noreturn]] void BadOption(const std::string& key, const std::string& value, const char* expected) {
-  throw Error("kinematic driver: option " + key + "='" + value + "': expected " + expected);
-}
-
-double ParsePositive(const std::string& key, const std::string& value, const char* expected) {
-  const char* begin = value.c_str();
-  char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (value.empty() || end != begin + value.size() || !std::isfinite(v) || v <= 0) {
-    BadOption(key, value, expected);
-  }
-  return v;
-}
+using driver_support::WrapAngle;
 
 }  // namespace
 
@@ -49,28 +32,18 @@ double ParsePositive(const std::string& key, const std::string& value, const cha
 
 KinematicDriverOptions KinematicDriverOptions::FromMap(const std::map<std::string, std::string>& options) {
   KinematicDriverOptions o;
-  for (const auto& [key, value] : options) {
-    if (key == "merge_chains") {
-      const std::optional<bool> b = driver_support::ParseBool(value);
-      if (!b) BadOption(key, value, "true or false");
-      o.merge_chains = *b;
-    } else if (key == "period_ms") {
-      o.period = FromSeconds(ParsePositive(key, value, "a number of milliseconds > 0") / 1000.0);
-      if (o.period <= Duration::zero()) BadOption(key, value, "a number of milliseconds > 0");
-    } else if (key == "default_velocity") {
-      o.default_velocity = ParsePositive(key, value, "a speed > 0 (rad/s or m/s)");
-    } else if (key == "base_max_v") {
-      o.base_max_v = ParsePositive(key, value, "a speed > 0 (m/s)");
-    } else if (key == "base_max_omega") {
-      o.base_max_omega = ParsePositive(key, value, "a yaw rate > 0 (rad/s)");
-    } else if (key == "goto_tolerance") {
-      o.goto_tolerance = ParsePositive(key, value, "a distance > 0 (m)");
-    } else {
-      throw Error("kinematic driver: unknown option '" + key +
-                  "' (known: base_max_omega, base_max_v, default_velocity, goto_tolerance, merge_chains, "
-                  "period_ms)");
-    }
-  }
+  driver_support::OptionReader r("kinematic driver", options);
+  constexpr driver_support::OptionReader::Range kPositive{.min = 0, .min_inclusive = false};
+  r.Bool("merge_chains", &o.merge_chains);
+  double period_ms = ToSeconds(o.period) * 1000.0;
+  r.Number("period_ms", &period_ms, kPositive, "a number of milliseconds > 0");
+  o.period = FromSeconds(period_ms / 1000.0);
+  if (o.period <= Duration::zero()) r.Fail("period_ms", "a number of milliseconds > 0");
+  r.Number("default_velocity", &o.default_velocity, kPositive, "a speed > 0 (rad/s or m/s)");
+  r.Number("base_max_v", &o.base_max_v, kPositive, "a speed > 0 (m/s)");
+  r.Number("base_max_omega", &o.base_max_omega, kPositive, "a yaw rate > 0 (rad/s)");
+  r.Number("goto_tolerance", &o.goto_tolerance, kPositive, "a distance > 0 (m)");
+  r.Finish();
   return o;
 }
 
@@ -91,32 +64,14 @@ void KinematicDriverOptions::Validate() const {
 // ---------------------------------------------------------------- construction
 
 KinematicDriver::KinematicDriver(RobotModel model, const KinematicDriverOptions& options)
-    : model_(std::move(model)), options_(options), ik_(model_) {
+    : model_(std::move(model)), options_(options), dofs_(model_), ik_(model_) {
   options_.Validate();
   const int n = model_.num_dofs();
-  for (Eigen::VectorXd* v : {&q_, &qd_, &effort_, &target_, &speed_, &vmax_, &lower_, &upper_}) {
-    v->setZero(n);
-  }
+  for (Eigen::VectorXd* v : {&q_, &qd_, &effort_, &target_, &speed_, &vmax_}) v->setZero(n);
   mode_.assign(static_cast<size_t>(n), DofMode::kPosition);
-  mimic_leader_dof_.assign(static_cast<size_t>(n), -1);
-  mimic_multiplier_.assign(static_cast<size_t>(n), 0.0);
-
-  const auto joints = model_.joints();
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
-    const Joint& joint = joints[static_cast<size_t>(j)];
-    for (size_t k = 0; k < joint.dofs.size(); ++k) {
-      const int i = model_.dof_offset(j) + static_cast<int>(k);
-      const DofLimits& lim = joint.dofs[k].limits;
-      lower_[i] = lim.lower;
-      upper_[i] = lim.upper;
-      vmax_[i] = std::isfinite(lim.velocity) ? lim.velocity : options_.default_velocity;
-      q_[i] = std::clamp(0.0, lim.lower, lim.upper);
-    }
-    if (joint.mimic) {  // RobotModel guarantees 1-dof joint and leader
-      const auto i = static_cast<size_t>(model_.dof_offset(j));
-      mimic_leader_dof_[i] = model_.dof_offset(joint.mimic->leader_joint);
-      mimic_multiplier_[i] = joint.mimic->multiplier;
-    }
+  for (int i = 0; i < n; ++i) {
+    vmax_[i] = std::isfinite(dofs_.velocity[i]) ? dofs_.velocity[i] : options_.default_velocity;
+    q_[i] = std::clamp(0.0, dofs_.lower[i], dofs_.upper[i]);
   }
   ApplyMimics(model_, q_);
   target_ = q_;
@@ -164,7 +119,7 @@ void KinematicDriver::Advance(TimePoint now, std::vector<Completion>& completed)
 void KinematicDriver::StepDofs(double dt) {
   const Eigen::Index n = q_.size();
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (mimic_leader_dof_[static_cast<size_t>(i)] >= 0) continue;
+    if (dofs_.mimic_leader[static_cast<size_t>(i)] >= 0) continue;
     const double q0 = q_[i];
     if (mode_[static_cast<size_t>(i)] == DofMode::kPosition) {
       const double d = target_[i] - q0;
@@ -177,8 +132,8 @@ void KinematicDriver::StepDofs(double dt) {
     } else {
       double q1 = q0 + speed_[i] * dt;
       // A speed command stops at a position limit and holds there.
-      if (q1 >= upper_[i] || q1 <= lower_[i]) {
-        q1 = std::clamp(q1, lower_[i], upper_[i]);
+      if (q1 >= dofs_.upper[i] || q1 <= dofs_.lower[i]) {
+        q1 = std::clamp(q1, dofs_.lower[i], dofs_.upper[i]);
         mode_[static_cast<size_t>(i)] = DofMode::kPosition;
         target_[i] = q1;
         speed_[i] = 0;
@@ -189,8 +144,8 @@ void KinematicDriver::StepDofs(double dt) {
   }
   ApplyMimics(model_, q_);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const int leader = mimic_leader_dof_[static_cast<size_t>(i)];
-    if (leader >= 0) qd_[i] = mimic_multiplier_[static_cast<size_t>(i)] * qd_[leader];
+    const int leader = dofs_.mimic_leader[static_cast<size_t>(i)];
+    if (leader >= 0) qd_[i] = dofs_.mimic_multiplier[static_cast<size_t>(i)] * qd_[leader];
   }
 }
 
@@ -311,7 +266,7 @@ DriverResult KinematicDriver::JointSetPoint(const DriverCommand& c) {
   for (int k = 0; k < c.num_values; ++k) {
     const int i = model_.dof_offset(c.target) + k;
     const double want = c.values[static_cast<size_t>(k)];
-    const double got = std::clamp(want, lower_[i], upper_[i]);
+    const double got = std::clamp(want, dofs_.lower[i], dofs_.upper[i]);
     if (got != want) {
       const char* unit = Unit(joint.dofs[static_cast<size_t>(k)].type);
       note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " +
@@ -433,7 +388,7 @@ void KinematicDriver::ReadState(RobotState& state) const {
   state.base_omega = omega_;
   bool moving = base_mode_ != BaseMode::kIdle || v_ != 0 || vy_ != 0 || omega_ != 0;
   for (Eigen::Index i = 0; i < q_.size() && !moving; ++i) {
-    if (mimic_leader_dof_[static_cast<size_t>(i)] >= 0) continue;  // follows its leader
+    if (dofs_.mimic_leader[static_cast<size_t>(i)] >= 0) continue;  // follows its leader
     moving = qd_[i] != 0 ||
              (mode_[static_cast<size_t>(i)] == DofMode::kPosition ? q_[i] != target_[i] : speed_[i] != 0);
   }

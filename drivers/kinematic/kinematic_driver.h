@@ -17,6 +17,7 @@
 // Copy/move: neither (the InverseKinematics member refers to the owned model).
 #pragma once
 
+#include "robotalk/dof_table.h"
 #include "robotalk/driver.h"
 #include "robotalk/inverse_kinematics.h"
 
@@ -113,13 +114,12 @@ class KinematicDriver final : public Driver {
 
   RobotModel model_;
   KinematicDriverOptions options_;
+  DofTable dofs_;         // per-dof limits and mimic couplings
   InverseKinematics ik_;  // FRAME_SETPOINT; its default masks say which dofs move
 
   // Per dof (size num_dofs), allocated in the constructor.
-  Eigen::VectorXd q_, qd_, effort_, target_, speed_, vmax_, lower_, upper_;
+  Eigen::VectorXd q_, qd_, effort_, target_, speed_, vmax_;
   std::vector<DofMode> mode_;
-  std::vector<int> mimic_leader_dof_;  // -1 unless the dof follows a leader
-  std::vector<double> mimic_multiplier_;
 
   // Base (first root). x, y, theta: the root's planar pose in the world;
   // base_residual_ the rest of its model pose (height, roll, pitch).

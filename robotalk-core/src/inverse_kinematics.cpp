@@ -1,5 +1,7 @@
 #include "robotalk/inverse_kinematics.h"
 
+#include "robotalk/error.h"
+
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <limits>
@@ -15,26 +17,10 @@ std::string Where(const RobotModel& model) {
 
 }  // namespace
 
-InverseKinematics::InverseKinematics(const RobotModel& model) : model_(model), kin_(model) {
+InverseKinematics::InverseKinematics(const RobotModel& model) : model_(model), kin_(model), dofs_(model) {
   const int n = model_.num_dofs();
-  for (Eigen::VectorXd* v : {&lower_, &upper_, &q_, &best_, &dq_}) v->setZero(n);
+  for (Eigen::VectorXd* v : {&q_, &best_, &dq_}) v->setZero(n);
   jac_.setZero(6, n);
-  mimic_leader_.assign(static_cast<size_t>(n), -1);
-  mimic_multiplier_.assign(static_cast<size_t>(n), 0.0);
-  const auto joints = model_.joints();
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
-    const Joint& joint = joints[static_cast<size_t>(j)];
-    for (size_t k = 0; k < joint.dofs.size(); ++k) {
-      const int i = model_.dof_offset(j) + static_cast<int>(k);
-      lower_[i] = joint.dofs[k].limits.lower;
-      upper_[i] = joint.dofs[k].limits.upper;
-    }
-    if (joint.mimic) {  // RobotModel guarantees a 1-dof joint and leader
-      const auto i = static_cast<size_t>(model_.dof_offset(j));
-      mimic_leader_[i] = model_.dof_offset(joint.mimic->leader_joint);
-      mimic_multiplier_[i] = joint.mimic->multiplier;
-    }
-  }
   // Per control frame, the set-point joints on the path to its root. Mimic
   // joints are left out: they follow their leaders.
   for (const ControlFrame& frame : model_.frames()) {
@@ -69,21 +55,21 @@ InverseKinematics::Result InverseKinematics::Solve(int frame, const Eigen::Vecto
   model_.frame(frame);  // throws LookupError for a bad index
   const Eigen::Index n = q_.size();
   if (q_start.size() != n) {
-    throw std::invalid_argument(Where(model_) + "q_start has " + std::to_string(q_start.size()) +
-                                " entries, expected " + std::to_string(n));
+    throw Error(Where(model_) + "q_start has " + std::to_string(q_start.size()) + " entries, expected " +
+                std::to_string(n));
   }
   if (mask.empty()) mask = default_masks_[static_cast<size_t>(frame)];
   if (static_cast<Eigen::Index>(mask.size()) != n) {
-    throw std::invalid_argument(Where(model_) + "mask has " + std::to_string(mask.size()) +
-                                " entries, expected " + std::to_string(n));
+    throw Error(Where(model_) + "mask has " + std::to_string(mask.size()) + " entries, expected " +
+                std::to_string(n));
   }
   if (!position.allFinite()) {
-    throw std::invalid_argument(Where(model_) + "goal position is not finite");
+    throw Error(Where(model_) + "goal position is not finite");
   }
   const double norm = orientation.norm();
   if (!std::isfinite(norm) || norm < 1e-9) {
-    throw std::invalid_argument(Where(model_) + "goal quaternion has norm " + std::to_string(norm) +
-                                ", expected a unit quaternion");
+    throw Error(Where(model_) + "goal quaternion has norm " + std::to_string(norm) +
+                ", expected a unit quaternion");
   }
   const Eigen::Matrix3d goal_r = Eigen::Quaterniond(orientation.coeffs() / norm).toRotationMatrix();
 
@@ -91,7 +77,7 @@ InverseKinematics::Result InverseKinematics::Solve(int frame, const Eigen::Vecto
   // that picks the best pose weighs 1 rad of orientation as 0.1 m.
   // The start is clamped into the limits with its mimics applied, as every
   // later iterate is (a no-op for a state the drivers keep within limits).
-  q_ = q_start.cwiseMax(lower_).cwiseMin(upper_);
+  q_ = q_start.cwiseMax(dofs_.lower).cwiseMin(dofs_.upper);
   ApplyMimics(model_, q_);
   best_ = q_;
   Result best;
@@ -119,11 +105,12 @@ InverseKinematics::Result InverseKinematics::Solve(int frame, const Eigen::Vecto
 
     jac_ = kin_.FrameJacobian(frame);
     for (Eigen::Index i = 0; i < n; ++i) {  // a mimic dof moves with its leader
-      const int leader = mimic_leader_[static_cast<size_t>(i)];
-      if (leader >= 0) jac_.col(leader) += mimic_multiplier_[static_cast<size_t>(i)] * jac_.col(i);
+      const int leader = dofs_.mimic_leader[static_cast<size_t>(i)];
+      if (leader >= 0) jac_.col(leader) += dofs_.mimic_multiplier[static_cast<size_t>(i)] * jac_.col(i);
     }
     for (Eigen::Index i = 0; i < n; ++i) {
-      if (!mask[static_cast<size_t>(i)] || mimic_leader_[static_cast<size_t>(i)] >= 0) jac_.col(i).setZero();
+      if (!mask[static_cast<size_t>(i)] || dofs_.mimic_leader[static_cast<size_t>(i)] >= 0)
+        jac_.col(i).setZero();
     }
     Eigen::Matrix<double, 6, 6> a;
     a.noalias() = jac_ * jac_.transpose();
@@ -133,7 +120,7 @@ InverseKinematics::Result InverseKinematics::Solve(int frame, const Eigen::Vecto
     const double step = dq_.norm();
     if (step > kMaxStep) dq_ *= kMaxStep / step;
     q_ += dq_;
-    q_ = q_.cwiseMax(lower_).cwiseMin(upper_);
+    q_ = q_.cwiseMax(dofs_.lower).cwiseMin(dofs_.upper);
     ApplyMimics(model_, q_);
   }
   best.iterations = it;

@@ -18,7 +18,7 @@ Eigen::Isometry3d Translation(const Eigen::Vector3d& v) {
 
 // Only reached on the error path, so building strings here is fine.
 [[noreturn]] void BadArgument(const RobotModel& model, const std::string& what) {
-  throw std::invalid_argument("Kinematics::Update (robot '" + model.name() + "'): " + what);
+  throw Error("Kinematics::Update (robot '" + model.name() + "'): " + what);
 }
 
 }  // namespace
@@ -143,9 +143,8 @@ Eigen::Vector3d Kinematics::CenterOfMass() const {
 
 void ApplyMimics(const RobotModel& model, Eigen::Ref<Eigen::VectorXd> q) {
   if (q.size() != model.num_dofs()) {
-    throw std::invalid_argument("ApplyMimics (robot '" + model.name() + "'): q has " +
-                                std::to_string(q.size()) + " entries, expected " +
-                                std::to_string(model.num_dofs()));
+    throw Error("ApplyMimics (robot '" + model.name() + "'): q has " + std::to_string(q.size()) +
+                " entries, expected " + std::to_string(model.num_dofs()));
   }
   const auto joints = model.joints();
   for (int j = 0; j < static_cast<int>(joints.size()); ++j) {

@@ -1,7 +1,11 @@
 #include "robotalk/driver_support.h"
 
+#include "robotalk/error.h"
+
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <numbers>
 
 namespace robotalk::driver_support {
 
@@ -80,6 +84,58 @@ BaseTwist ShapeBaseSpeed(const DriverCommand& c, BaseType base, double max_v, do
     t.omega = std::copysign(max_omega, t.omega);
   }
   return t;
+}
+
+double WrapAngle(double radians) { return std::remainder(radians, 2 * std::numbers::pi); }
+
+OptionReader::OptionReader(std::string driver, const std::map<std::string, std::string>& options)
+    : driver_(std::move(driver)), options_(options) {}
+
+void OptionReader::Fail(const std::string& key, const char* expected) const {
+  auto it = options_.find(key);
+  throw Error(driver_ + ": option " + key + "='" + (it == options_.end() ? "" : it->second) + "': expected " +
+              expected);
+}
+
+void OptionReader::Number(const std::string& key, double* out, Range range, const char* expected) {
+  known_.insert(key);
+  auto it = options_.find(key);
+  if (it == options_.end()) return;
+  const std::string& text = it->second;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  const bool parsed = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v);
+  if (!parsed || v < range.min || (!range.min_inclusive && v == range.min) || v > range.max ||
+      (range.integer && v != std::floor(v))) {
+    Fail(key, expected);
+  }
+  *out = v;
+}
+
+void OptionReader::Bool(const std::string& key, bool* out) {
+  known_.insert(key);
+  auto it = options_.find(key);
+  if (it == options_.end()) return;
+  const std::optional<bool> b = ParseBool(it->second);
+  if (!b) Fail(key, "true or false");
+  *out = *b;
+}
+
+bool OptionReader::Text(const std::string& key, std::string* out) {
+  known_.insert(key);
+  auto it = options_.find(key);
+  if (it == options_.end()) return false;
+  *out = it->second;
+  return true;
+}
+
+void OptionReader::Finish() const {
+  for (const auto& [key, value] : options_) {
+    if (known_.count(key)) continue;
+    std::string known;
+    for (const std::string& k : known_) known += (known.empty() ? "" : ", ") + k;
+    throw Error(driver_ + ": unknown option '" + key + "' (known: " + known + ")");
+  }
 }
 
 }  // namespace robotalk::driver_support

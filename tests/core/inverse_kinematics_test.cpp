@@ -206,13 +206,13 @@ TEST(InverseKinematics, BadInputThrowsNamingTheArgument) {
   try {
     ik.Solve(0, Vector3d::Zero(), id, Eigen::VectorXd::Zero(3));
     FAIL() << "no error";
-  } catch (const std::invalid_argument& e) {
+  } catch (const robotalk::Error& e) {
     EXPECT_NE(std::string(e.what()).find("q_start has 3 entries, expected 2"), std::string::npos) << e.what();
   }
   const std::vector<std::uint8_t> mask = {1};
-  EXPECT_THROW(ik.Solve(0, Vector3d::Zero(), id, q, {}, mask), std::invalid_argument);
-  EXPECT_THROW(ik.Solve(0, Vector3d(NAN, 0, 0), id, q), std::invalid_argument);
-  EXPECT_THROW(ik.Solve(0, Vector3d::Zero(), Eigen::Quaterniond(0, 0, 0, 0), q), std::invalid_argument);
+  EXPECT_THROW(ik.Solve(0, Vector3d::Zero(), id, q, {}, mask), robotalk::Error);
+  EXPECT_THROW(ik.Solve(0, Vector3d(NAN, 0, 0), id, q), robotalk::Error);
+  EXPECT_THROW(ik.Solve(0, Vector3d::Zero(), Eigen::Quaterniond(0, 0, 0, 0), q), robotalk::Error);
   EXPECT_THROW(ik.Solve(7, Vector3d::Zero(), id, q), LookupError);
   EXPECT_THROW(ik.default_mask(-1), LookupError);
 }

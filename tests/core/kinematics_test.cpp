@@ -276,16 +276,16 @@ TEST(Kinematics, ApplyMimicsSetsFollowersFromLeaders) {
   ApplyMimics(model, q);
   EXPECT_EQ(q, Eigen::Vector4d(0.5, -0.5, 0.03, -2.0 * 0.03 + 0.1));
   Eigen::VectorXd short_q(3);
-  EXPECT_THROW(ApplyMimics(model, short_q), std::invalid_argument);
+  EXPECT_THROW(ApplyMimics(model, short_q), robotalk::Error);
 }
 
-// Expects `f` to throw std::invalid_argument whose message contains every fragment.
+// Expects `f` to throw robotalk::Error whose message contains every fragment.
 template <typename F>
 void ExpectInvalidArgument(F f, std::initializer_list<const char*> fragments) {
   try {
     f();
     ADD_FAILURE() << "no exception";
-  } catch (const std::invalid_argument& e) {
+  } catch (const robotalk::Error& e) {
     for (const char* fragment : fragments) EXPECT_THAT(e.what(), HasSubstr(fragment));
   }
 }

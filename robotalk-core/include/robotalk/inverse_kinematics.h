@@ -26,7 +26,7 @@
 // allocates only the 6×N matrix that Kinematics::FrameJacobian returns, once
 // per iteration (at most kMaxIterations), and the message of an exception.
 //
-// Errors: Solve() throws std::invalid_argument naming the argument and the
+// Errors: Solve() throws robotalk::Error naming the argument and the
 // bad value (q size or non-finite entry, mask size, root-pose count,
 // non-finite goal, zero quaternion), and LookupError (error.h) for a frame
 // index the model does not have.
@@ -34,6 +34,7 @@
 // Copy/move: neither (refers to the model and owns a Kinematics that does).
 #pragma once
 
+#include "robotalk/dof_table.h"
 #include "robotalk/kinematics.h"
 #include "robotalk/robot_model.h"
 
@@ -107,9 +108,7 @@ class InverseKinematics {
  private:
   const RobotModel& model_;
   Kinematics kin_;
-  Eigen::VectorXd lower_, upper_;  // per dof, position limits
-  std::vector<int> mimic_leader_;  // per dof: leader dof, -1 unless a mimic
-  std::vector<double> mimic_multiplier_;
+  DofTable dofs_;                                         // per dof: limits, mimic leader
   std::vector<std::vector<std::uint8_t>> default_masks_;  // per frame
   // Scratch.
   Eigen::VectorXd q_, best_, dq_;

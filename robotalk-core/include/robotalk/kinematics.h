@@ -6,7 +6,7 @@
 // so Update() and the pose accessors do not allocate (except to build the
 // message of an exception). The Jacobian functions return a new matrix.
 //
-// Errors: Update() throws std::invalid_argument for bad input; the accessors
+// Errors: Update() throws robotalk::Error for bad input; the accessors
 // throw LookupError (error.h) for an index the model does not have.
 #pragma once
 
@@ -37,7 +37,7 @@ class Kinematics {
   /// Computes every link pose for joint positions `q` (size num_dofs(), in
   /// dof_offset order). `root_poses`, if not empty, gives one world pose per
   /// RobotModel::roots() entry (same order); otherwise the model's are used.
-  /// Throws std::invalid_argument naming the bad size, the non-finite entry or
+  /// Throws robotalk::Error naming the bad size, the non-finite entry or
   /// the bad root-pose count. Pass a vector or a contiguous block: an Eigen
   /// expression would be evaluated into a temporary, which allocates.
   void Update(const Eigen::Ref<const Eigen::VectorXd>& q, std::span<const Eigen::Isometry3d> root_poses = {});
@@ -69,7 +69,7 @@ class Kinematics {
 };
 
 /// Fills the dofs of mimic joints from their leaders: q[m] = k * q[leader] + c.
-/// Throws std::invalid_argument if q.size() != model.num_dofs().
+/// Throws robotalk::Error if q.size() != model.num_dofs().
 void ApplyMimics(const RobotModel& model, Eigen::Ref<Eigen::VectorXd> q);
 
 }  // namespace robotalk

@@ -6,7 +6,10 @@
 #include "robotalk/driver.h"
 #include "robotalk/inverse_kinematics.h"
 
+#include <limits>
+#include <map>
 #include <optional>
+#include <set>
 #include <string>
 
 namespace robotalk::driver_support {
@@ -30,6 +33,43 @@ Eigen::Vector3d FrameGoalPosition(const DriverCommand& command);
 Eigen::Quaterniond FrameGoalOrientation(const DriverCommand& command);
 /// "true"/"1" or "false"/"0" of a driver option; nullopt for anything else.
 std::optional<bool> ParseBool(const std::string& value);
+
+/// An angle wrapped to (-π, π].
+double WrapAngle(double radians);
+
+/// Reads a driver's key=value options (DriverConfig::options) with errors
+/// that name the driver, the option, the value and what was expected:
+///
+///   OptionReader r("kinematic driver", config.options);
+///   r.Number("period_ms", &period_ms, {.min = 0, .min_inclusive = false}, "a number of milliseconds > 0");
+///   r.Bool("merge_chains", &merge);
+///   r.Finish();  // throws naming an unknown key and the known ones
+///
+/// Each call leaves its output untouched when the key is absent.
+class OptionReader {
+ public:
+  struct Range {
+    double min = -std::numeric_limits<double>::infinity();
+    bool min_inclusive = true;
+    double max = std::numeric_limits<double>::infinity();
+    bool integer = false;
+  };
+  OptionReader(std::string driver, const std::map<std::string, std::string>& options);
+
+  /// A finite number in `range`; throws Error "<driver>: option k='v': expected <expected>".
+  void Number(const std::string& key, double* out, Range range, const char* expected);
+  void Bool(const std::string& key, bool* out);
+  /// Any text (the caller checks it); returns whether the key was given.
+  bool Text(const std::string& key, std::string* out);
+  /// Throws Error "[driver]: unknown option 'k' (known: a, b, c)" for a key no call asked for.
+  void Finish() const;
+  [[noreturn]] void Fail(const std::string& key, const char* expected) const;
+
+ private:
+  std::string driver_;
+  const std::map<std::string, std::string>& options_;
+  std::set<std::string> known_;
+};
 
 /// After solving: SUCCESS within the solver's tolerance, else MODIFIED with the residual.
 DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinematics::Result& result);
