@@ -11,7 +11,7 @@ PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration
   const auto by_fraction =
       static_cast<std::size_t>(std::ceil(options_.fraction * static_cast<double>(total_)));
   needed_ = std::min(total_, std::max(options_.min_frames, by_fraction));
-  frames_.reserve(needed_);
+  frames_.reserve(std::min<std::size_t>(needed_, 1024));  // a declaration is a claim, not memory to reserve
 }
 
 void PlaybackEstimator::Add(Duration offset, TimePoint arrival) { frames_.push_back({offset, arrival}); }

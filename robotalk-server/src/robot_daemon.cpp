@@ -3,6 +3,7 @@
 #include "robotalk/signal.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -170,6 +171,16 @@ void RobotDaemon::QueueStop(bool only_if_moving) {
   stop.command.type = CommandType::kStop;
   stop.only_if_moving = only_if_moving;
   Submit(std::move(stop));
+}
+
+void RobotDaemon::QueueHold(std::vector<int> joints, bool base) {
+  QueuedItem hold;
+  hold.client_id = 0;
+  hold.command.type = CommandType::kStop;
+  hold.only_if_moving = true;
+  hold.hold_joints = std::move(joints);
+  hold.hold_base = base;
+  Submit(std::move(hold));
 }
 
 bool RobotDaemon::TakeOutput(DaemonOutput& out) {
@@ -359,13 +370,14 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     return outcome == CallOutcome::kOk;
   };
   if (item.command.type == CommandType::kStop) {
+    if (!item.hold_joints.empty() || item.hold_base) return Hold(item, now);
     if (item.only_if_moving) {
       // The watchdog's STOP: a robot already at rest needs none.
       if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
       if (!state_.moving) return;
     }
     if (!driver_call("Stop", [&] { driver_->Stop(now, completions_); })) return;
-    produced_.executed.push_back({item.client_id, CommandType::kStop});
+    produced_.executed.push_back({item.client_id, CommandType::kStop, -1});
     r.signal = Signal::kSuccess;
     Emit(item.client_id, std::move(r));
     return;
@@ -380,7 +392,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   command.id = next_driver_id_++;
   DriverResult result;
   if (!driver_call("Execute", [&] { result = driver_->Execute(command, now, completions_); })) return;
-  produced_.executed.push_back({item.client_id, item.command.type});
+  produced_.executed.push_back({item.client_id, item.command.type, item.command.target});
   if (options_.log_executions) {
     char line[256];
     std::snprintf(line, sizeof line,
@@ -397,6 +409,38 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   r.signal = result.signal;
   r.message = std::move(result.message);
   Emit(item.client_id, std::move(r));
+}
+
+void RobotDaemon::Hold(const QueuedItem& item, TimePoint now) {
+  if (panic_ || halted_) return;  // already at rest
+  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
+  if (!state_.moving) return;
+  const RobotModel& m = model();
+  const auto run = [&](DriverCommand c) {
+    c.id = next_driver_id_++;
+    DriverResult ignored;
+    Guarded("Execute", nullptr, now, [&] { ignored = driver_->Execute(c, now, completions_); });
+  };
+  if (item.hold_base && m.roots().front().base != BaseType::kFixed) {
+    run(DriverCommand{.type = CommandType::kSetSpeed, .target = -1, .num_values = 2, .values = {}});
+  }
+  for (int j : item.hold_joints) {
+    const Joint& joint = m.joint(j);
+    DriverCommand c{.target = j, .num_values = static_cast<int>(joint.dofs.size())};
+    if (joint.servo_types.Has(ServoType::kSpeed)) {
+      c.type = CommandType::kJointSpeed;  // values stay 0
+    } else if (joint.servo_types.Has(ServoType::kSetPoint)) {
+      c.type = CommandType::kJointSetPoint;
+      for (int k = 0; k < c.num_values; ++k)
+        c.values[static_cast<std::size_t>(k)] = state_.position[m.dof_offset(j) + k];
+      if (!std::all_of(c.values.begin(), c.values.begin() + c.num_values,
+                       [](double v) { return std::isfinite(v); }))
+        continue;
+    } else {
+      continue;
+    }
+    run(c);
+  }
 }
 
 void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {

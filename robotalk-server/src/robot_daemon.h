@@ -70,9 +70,10 @@ struct DaemonOutput {
     std::int64_t client_id = 0;
     Reply reply;
   };
-  struct Executed {  ///< a command the driver took (for the watchdog's bookkeeping)
+  struct Executed {  ///< a command the driver took (ownership of actuators)
     std::int64_t client_id = 0;
     CommandType type = CommandType::kStop;
+    int target = -1;  ///< joint (JOINT_*) or frame (FRAME_SETPOINT) index
   };
   std::vector<Answer> replies;
   std::vector<Executed> executed;
@@ -129,6 +130,11 @@ class RobotDaemon {
   /// A STOP from the server itself (watchdog, shutdown); with
   /// `only_if_moving` it is skipped when the robot is at rest.
   void QueueStop(bool only_if_moving);
+  /// The watchdog's hold for a vanished client: if the robot is moving, the
+  /// given joints are held where they are (a speed of 0 or a set-point at
+  /// their position) and, with `base`, the base is brought to rest. Nothing
+  /// else is touched, so another client's motion runs on.
+  void QueueHold(std::vector<int> joints, bool base);
   /// Swaps the outbox with `out` (cleared first). Returns false when empty.
   bool TakeOutput(DaemonOutput& out);
   /// Called from the RobotDaemon thread whenever the outbox has something.
@@ -162,6 +168,7 @@ class RobotDaemon {
   void DaemonLoop();
   void Execute(const QueuedItem& item, TimePoint now);
   void AnswerQuery(const QueuedItem& item, Reply& reply);
+  void Hold(const QueuedItem& item, TimePoint now);
   void Sample(TimePoint now, Duration period);
   enum class CallOutcome { kOk, kThrew, kOverran };
   // Runs one driver call with the fault guard (a throw latches a fault;

@@ -28,7 +28,11 @@ std::string Client(std::int64_t id) { return "client " + Hex64(static_cast<std::
 }  // namespace
 
 RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options)
-    : daemon_(daemon), robot_(daemon.robot_name()), config_hash_(config_hash), options_(options) {}
+    : daemon_(daemon),
+      robot_(daemon.robot_name()),
+      config_hash_(config_hash),
+      options_(options),
+      joint_owner_(daemon.model().joints().size(), 0) {}
 
 Session& RobotSessions::SessionFor(std::int64_t client_id, TimePoint now) {
   auto it = sessions_.find(client_id);
@@ -48,13 +52,30 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   answer.batch.server_receive = received;
   std::vector<Reply>& immediate = answer.batch.replies;
 
+  const auto refuse_all = [&](const std::string& why) {
+    ++refused_packages_;
+    for (CommandId id : r.item_ids()) immediate.push_back(MakeReply(id, Signal::kError, why, received));
+    return answer;
+  };
+  if (!sessions_.count(r.client_id) && sessions_.size() >= options_.max_sessions) {
+    return refuse_all("robot '" + robot_ + "' serves " + std::to_string(options_.max_sessions) +
+                      " clients already (the --max-sessions bound); try again later");
+  }
   Session& session = SessionFor(r.client_id, received);
-  session.last_heard = received;
+  if (session.seen.highest() > 0 && r.sequence > session.seen.highest() + SequenceWindow::kWindow) {
+    // A client numbers its packages 1, 2, 3...: a jump this far is not one of
+    // its packages (a forged INT64_MAX would make every later one a "duplicate").
+    return refuse_all("package sequence " + std::to_string(r.sequence) + " jumps more than " +
+                      std::to_string(SequenceWindow::kWindow) + " ahead of " +
+                      std::to_string(session.seen.highest()) + "; refused");
+  }
   if (!session.seen.Observe(r.sequence)) {
-    // A retransmission or a duplicate: never execute again; re-send what is known.
+    // A retransmission or a duplicate: never execute again; re-send what is
+    // known. It does not refresh the session (a replay must not keep it alive).
     immediate = session.replies.RepliesFor(r.sequence);
     return answer;
   }
+  session.last_heard = received;  // only a new, well-formed package refreshes the session
   std::vector<CommandId> ids = r.item_ids();
   // The playback delay reply (id = playback id) may come with any of its packages.
   const bool playback = r.mode == RequestMode::kPlayback;
@@ -78,8 +99,17 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
         daemon_.Submit(std::move(*item));
     }
   }
-  for (const Reply& reply : immediate) session.replies.RecordReply(reply);
+  for (Reply& reply : immediate) {
+    Bound(reply);
+    session.replies.RecordReply(reply);
+  }
   return answer;
+}
+
+void RobotSessions::Bound(Reply& reply) const {
+  if (reply.message.size() <= options_.max_message_bytes) return;
+  reply.message.resize(options_.max_message_bytes);
+  reply.message += "... (truncated)";
 }
 
 ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
@@ -89,12 +119,16 @@ ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
   answer.batch.ack_sequence = r.sequence > 0 ? r.sequence : 0;
   answer.batch.server_receive = received;
   const std::vector<CommandId> ids = r.item_ids();
-  for (CommandId id : ids)
+  ++refused_packages_;
+  for (CommandId id : ids) {
     answer.batch.replies.push_back(MakeReply(id, Signal::kError, r.header_error, received));
-  if (r.client_id != 0 && r.sequence > 0) {
-    // Remember it, so a retransmission of the same bad package gets the same answer.
-    Session& session = SessionFor(r.client_id, received);
-    session.last_heard = received;
+    Bound(answer.batch.replies.back());
+  }
+  // Remember it in an existing session, so a retransmission of the same bad
+  // package gets the same answer; a refused package neither opens nor
+  // refreshes a session.
+  if (auto it = sessions_.find(r.client_id); it != sessions_.end() && r.sequence > 0) {
+    Session& session = it->second;
     if (session.seen.Observe(r.sequence)) {
       session.replies.RecordPackage(r.sequence, ids);
       for (const Reply& reply : answer.batch.replies) session.replies.RecordReply(reply);
@@ -233,6 +267,16 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
 void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
                                   std::vector<Reply>& immediate) {
   const PlaybackDeclaration& d = r.playback;
+  if (d.frames > static_cast<std::int64_t>(options_.max_queue) && !s.playbacks.count(d.id)) {
+    for (const Command& c : r.commands) {
+      immediate.push_back(MakeReply(c.id, Signal::kError,
+                                    "PLAYBACK " + std::to_string(d.id) + ": declares " +
+                                        std::to_string(d.frames) + " frames; the queue limit is " +
+                                        std::to_string(options_.max_queue),
+                                    now));
+    }
+    return;
+  }
   auto [it, created] =
       s.playbacks.try_emplace(d.id, static_cast<std::size_t>(d.frames), d.duration, options_.playback);
   PlaybackSequence& seq = it->second;
@@ -314,13 +358,7 @@ void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {
 }
 
 void RobotSessions::File(DaemonOutput& output, std::vector<ReplyBatch>& to_send) {
-  for (const DaemonOutput::Executed& e : output.executed) {
-    if (e.type == CommandType::kStop) {
-      for (auto& [id, session] : sessions_) session.moved_robot = false;
-    } else if (auto s = sessions_.find(e.client_id); s != sessions_.end()) {
-      s->second.moved_robot = true;
-    }
-  }
+  for (const DaemonOutput::Executed& e : output.executed) Own(e);
   for (DaemonOutput::Answer& a : output.replies) Deliver(a.client_id, std::move(a.reply));
   for (auto& line : output.log) log_.push_back(std::move(line));
   for (auto& [client, replies] : pending_) {
@@ -333,25 +371,66 @@ void RobotSessions::File(DaemonOutput& output, std::vector<ReplyBatch>& to_send)
   pending_.clear();
 }
 
+void RobotSessions::Own(const DaemonOutput::Executed& e) {
+  const RobotModel& model = daemon_.model();
+  switch (e.type) {
+    case CommandType::kStop:  // the whole robot is at rest: nobody owns anything
+      std::fill(joint_owner_.begin(), joint_owner_.end(), 0);
+      base_owner_ = 0;
+      break;
+    case CommandType::kJointSetPoint:
+    case CommandType::kJointSpeed:
+    case CommandType::kJointForce:
+      joint_owner_[static_cast<std::size_t>(e.target)] = e.client_id;
+      break;
+    case CommandType::kFrameSetPoint:  // the joints on the frame's chain
+      for (int j = model.parent_joint(model.frame(e.target).parent_link); j >= 0;
+           j = model.parent_joint(model.joint(j).parent_link)) {
+        if (!model.joint(j).dofs.empty()) joint_owner_[static_cast<std::size_t>(j)] = e.client_id;
+      }
+      break;
+    case CommandType::kGoto:
+    case CommandType::kSetSpeed:
+      base_owner_ = e.client_id;
+      break;
+    case CommandType::kPanicReset:
+      break;
+  }
+}
+
 std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
   std::vector<ExpiredSession> expired;
-  bool stop = false;
   for (auto it = sessions_.begin(); it != sessions_.end();) {
     if (now - it->second.last_heard <= options_.session_timeout) {
       ++it;
       continue;
     }
+    const std::int64_t client = it->first;
     flushed_.clear();
-    daemon_.FlushClient(it->first, flushed_);
-    expired.push_back({it->first, flushed_.size() + it->second.buffered_frames(), it->second.moved_robot});
-    stop = stop || it->second.moved_robot;
-    daemon_.SetStream(it->first, Duration(0));
-    pending_.erase(it->first);
+    daemon_.FlushClient(client, flushed_);
+    // The watchdog holds only what the vanished client still owns; another
+    // client's motion (a GOTO it sent, a joint it moves) runs on.
+    std::vector<int> joints;
+    for (std::size_t j = 0; j < joint_owner_.size(); ++j) {
+      if (joint_owner_[j] != client) continue;
+      joints.push_back(static_cast<int>(j));
+      joint_owner_[j] = 0;
+    }
+    const bool base = base_owner_ == client;
+    if (base) base_owner_ = 0;
+    const bool owned = base || !joints.empty();
+    expired.push_back({client, flushed_.size() + it->second.buffered_frames(), owned});
+    if (owned) {
+      log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; holding what it moved (" +
+                     (base ? std::string("the base") : std::string()) +
+                     (base && !joints.empty() ? ", " : "") +
+                     (joints.empty() ? std::string() : std::to_string(joints.size()) + " joint(s)") +
+                     ") if the robot is still moving");
+      daemon_.QueueHold(std::move(joints), base);
+    }
+    daemon_.SetStream(client, Duration(0));
+    pending_.erase(client);
     it = sessions_.erase(it);
-  }
-  if (stop) {
-    log_.push_back("robot '" + robot_ + "': STOP if moving (a client that moved the robot vanished)");
-    daemon_.QueueStop(/*only_if_moving=*/true);
   }
   return expired;
 }

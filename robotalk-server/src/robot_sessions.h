@@ -30,6 +30,10 @@ struct SessionOptions {
   Duration max_future = std::chrono::hours(1);
   /// When playback mode has seen enough frames to estimate its delay.
   PlaybackEstimatorOptions playback;
+  /// Most client sessions of this robot at once; a new client beyond is refused.
+  std::size_t max_sessions = 256;
+  /// Longest reply message kept and sent (bad input is never echoed in full).
+  std::size_t max_message_bytes = 512;
 };
 
 /// What the ServerDaemon sends back at once for a received package.
@@ -43,7 +47,7 @@ struct ImmediateAnswer {
 struct ExpiredSession {
   std::int64_t client_id = 0;
   std::size_t dropped_commands = 0;  ///< queued commands that will never run
-  bool moved_robot = false;          ///< it had set the robot moving (a STOP follows if still moving)
+  bool moved_robot = false;          ///< it owned actuators (they are held if still moving)
 };
 
 class RobotSessions {
@@ -62,6 +66,11 @@ class RobotSessions {
   std::vector<std::string> TakeLog();
 
   std::size_t num_sessions() const { return sessions_.size(); }
+  /// Who last commanded each joint / the base (0 = nobody since the last STOP).
+  std::int64_t joint_owner(int joint) const { return joint_owner_[static_cast<std::size_t>(joint)]; }
+  std::int64_t base_owner() const { return base_owner_; }
+  /// Packages refused before admission, by reason (sequence jump, server full, ...).
+  std::uint64_t refused_packages() const { return refused_packages_; }
 
  private:
   Session& SessionFor(std::int64_t client_id, TimePoint now);
@@ -75,6 +84,8 @@ class RobotSessions {
   void Panic(std::int64_t client_id, TimePoint now);
   void Deliver(std::int64_t client_id, Reply reply);
   std::size_t Waiting(const Session& s) const;
+  void Own(const DaemonOutput::Executed& e);
+  void Bound(Reply& reply) const;
 
   RobotDaemon& daemon_;
   const std::string robot_;
@@ -84,6 +95,9 @@ class RobotSessions {
   std::map<std::int64_t, std::vector<Reply>> pending_;  // replies made outside Handle, by client
   std::vector<std::string> log_;
   std::vector<QueuedItem> flushed_;
+  std::vector<std::int64_t> joint_owner_;  // per joint: the client that last commanded it
+  std::int64_t base_owner_ = 0;
+  std::uint64_t refused_packages_ = 0;
 };
 
 }  // namespace robotalk

@@ -72,9 +72,6 @@ struct Session {
     for (const auto& [id, seq] : playbacks) n += seq.frames.size();
     return n;
   }
-  /// Set by a motion command of this client, cleared by any STOP: the
-  /// watchdog stops the robot when a session that moved it expires.
-  bool moved_robot = false;
 };
 
 }  // namespace robotalk

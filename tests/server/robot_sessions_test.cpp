@@ -9,6 +9,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace robotalk {
 namespace {
 
@@ -270,10 +272,11 @@ TEST_F(RobotSessionsTest, PanicFlushesEveryQueueHaltsTheDriverAndRefusesUntilRes
   EXPECT_DOUBLE_EQ(fake_->position, 0.3);
 }
 
-TEST_F(RobotSessionsTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
+TEST_F(RobotSessionsTest, HoldsWhatAVanishedClientMovedWhileTheRobotMoves) {
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
   Handle(Queries(kBob, 1, {Query{1, QueryType::kJointState, ""}}));
   Run();
+  EXPECT_EQ(sessions_->joint_owner(0), kAlice);
   clock_.Advance(seconds(1));
   Handle(Queries(kBob, 2, {}));  // Bob keeps his session alive with a heartbeat
   clock_.Advance(milliseconds(1500));
@@ -283,7 +286,95 @@ TEST_F(RobotSessionsTest, StopsTheRobotWhenAClientThatMovedItVanishes) {
   EXPECT_TRUE(expired[0].moved_robot);
   Run();
   ASSERT_FALSE(fake_->calls.empty());
-  EXPECT_EQ(fake_->calls.back().type, CommandType::kStop);
+  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "pan held where it is";
+  EXPECT_EQ(fake_->calls.back().values, std::vector<double>{0.5});
+  EXPECT_EQ(sessions_->joint_owner(0), 0);
+}
+
+// Issue 9: `robotalk send pioneer joint_setpoint pan 0.5; robotalk send pioneer
+// goto 3 0 0` -- the first CLI's session expired and its watchdog STOP
+// interrupted the second CLI's GOTO.
+TEST_F(RobotSessionsTest, TheWatchdogLeavesAnotherClientsGotoRunning) {
+  fake_->goto_updates = 1000;
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
+  Run();
+  Handle(Package(kBob, 1, {Cmd(1, CommandType::kGoto, {3, 0, 0})}));
+  Run();
+  fake_->moving = true;
+  EXPECT_EQ(sessions_->base_owner(), kBob);
+  for (int i = 1; i <= 25; ++i) {  // 2.5 s: Bob's client sends heartbeats, Alice's is gone
+    clock_.Advance(milliseconds(100));
+    Handle(Queries(kBob, 1 + i, {}));
+    sessions_->Expire(clock_.Now());
+    Run();
+  }
+  EXPECT_EQ(Replies(kBob).count(1), 0u) << "the GOTO is still running, not INTERRUPTED";
+  for (const auto& call : fake_->calls) EXPECT_NE(call.type, CommandType::kStop);
+  EXPECT_EQ(fake_->goto_id.has_value(), true);
+}
+
+TEST_F(RobotSessionsTest, NeitherDuplicatesNorRefusedPackagesRefreshASession) {
+  const Request p = Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")});
+  Handle(p);
+  Run();
+  for (int i = 0; i < 30; ++i) {  // 3 s of replayed copies, and a package with a bad header
+    clock_.Advance(milliseconds(100));
+    Handle(p);
+    Request bad = Package(kAlice, 100 + i, {Cmd(2, CommandType::kStop)});
+    bad.header_error = "package: header payload size 9 but 1 commands";
+    Handle(bad);
+  }
+  const auto expired = sessions_->Expire(clock_.Now());
+  ASSERT_EQ(expired.size(), 1u) << "the session expired despite the replays";
+  EXPECT_EQ(expired[0].client_id, kAlice);
+}
+
+// Issue 9: one spoofed heartbeat with sequence INT64_MAX made every later
+// call of the victim time out (the window follows the highest number seen).
+TEST_F(RobotSessionsTest, RefusesASequenceJumpSoItCannotPoisonTheWindow) {
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan")}));
+  auto forged = Handle(Package(kAlice, std::numeric_limits<std::int64_t>::max(),
+                               {Cmd(66, CommandType::kJointSetPoint, {-1}, "pan")}));
+  EXPECT_EQ(forged.at(66).signal, Signal::kError);
+  EXPECT_THAT(forged.at(66).message, HasSubstr("jumps more than"));
+  auto next = Handle(Package(kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan")}));
+  EXPECT_TRUE(next.empty()) << "the victim's next package is accepted";
+  Run();
+  EXPECT_EQ(Replies(kAlice).at(2).signal, Signal::kSuccess);
+  EXPECT_DOUBLE_EQ(fake_->position, 0.2);
+  EXPECT_EQ(sessions_->refused_packages(), 1u);
+}
+
+TEST_F(RobotSessionsTest, NeverEchoesALongBadTargetInFull) {
+  const std::string target(50000, 'x');
+  auto r = Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.1}, target)}));
+  EXPECT_EQ(r.at(1).signal, Signal::kError);
+  EXPECT_LT(r.at(1).message.size(), 600u);
+  EXPECT_THAT(r.at(1).message, HasSubstr("(truncated)"));
+}
+
+class FewSessionsTest : public RobotSessionsTest {
+ protected:
+  FewSessionsTest()
+      : RobotSessionsTest(BaseType::kDifferential, SessionOptions{.max_queue = 100, .max_sessions = 2}) {}
+};
+
+TEST_F(FewSessionsTest, RefusesANewClientBeyondTheSessionBoundAndServesKnownOnes) {
+  Handle(Queries(kAlice, 1, {Query{1, QueryType::kClock, ""}}));
+  Handle(Queries(kBob, 1, {Query{1, QueryType::kClock, ""}}));
+  auto third = Handle(Queries(0xC0FFEE, 1, {Query{1, QueryType::kClock, ""}}));
+  EXPECT_EQ(third.at(1).signal, Signal::kError);
+  EXPECT_THAT(third.at(1).message, HasSubstr("--max-sessions"));
+  EXPECT_EQ(sessions_->num_sessions(), 2u);
+  auto alice = Handle(Queries(kAlice, 2, {Query{2, QueryType::kClock, ""}}));
+  EXPECT_EQ(alice.at(2).signal, Signal::kSuccess);
+}
+
+TEST_F(FewSessionsTest, RefusesAPlaybackDeclaringMoreFramesThanTheQueueHolds) {
+  auto r = Handle(Playback(kAlice, 1, 5, std::numeric_limits<std::int32_t>::max(), seconds(10),
+                           {Cmd(1, CommandType::kStop, {}, "", TimePoint(Duration(0)))}));
+  EXPECT_EQ(r.at(1).signal, Signal::kError);
+  EXPECT_THAT(r.at(1).message, HasSubstr("the queue limit is 100"));
 }
 
 TEST_F(RobotSessionsTest, LeavesAStillRobotAloneWhenTheClientThatMovedItVanishes) {
@@ -403,7 +494,8 @@ TEST_F(RobotSessionsTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) 
   EXPECT_EQ(states.back().num_dofs, 1);
   EXPECT_EQ(states.back().robot, "bot");
 
-  Handle(Queries(kAlice, 9999, {Query{2, QueryType::kStateStreamCancel, ""}}));
+  Handle(Queries(kAlice, 1000 + static_cast<std::int64_t>(states.size()),
+                 {Query{2, QueryType::kStateStreamCancel, ""}}));
   states.clear();
   for (int i = 0; i < 50; ++i) {
     clock_.Advance(milliseconds(10));
