@@ -116,10 +116,11 @@ std::size_t RobotDaemon::queued(std::int64_t client_id) const {
   return scheduler_.queued(client_id);
 }
 
-void RobotDaemon::Panic(std::vector<QueuedItem>& flushed) {
+void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
   panic_ = true;
   {
     std::lock_guard lock(mutex_);
+    if (!reason.empty()) fault_ = reason;
     scheduler_.FlushAll(flushed);
     halt_requested_ = true;
     wake_flag_ = true;

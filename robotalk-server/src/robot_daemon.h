@@ -116,7 +116,7 @@ class RobotDaemon {
   std::size_t queued(std::int64_t client_id) const;
   /// Panic: removes every waiting item (appended to `flushed`), latches
   /// panic and asks the thread to halt the driver.
-  void Panic(std::vector<QueuedItem>& flushed);
+  void Panic(std::vector<QueuedItem>& flushed, const std::string& reason = {});
   /// Panic reset: returns false if the robot was not in panic.
   bool ResetPanic();
   bool in_panic() const { return panic_.load(); }

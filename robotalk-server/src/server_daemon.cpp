@@ -33,7 +33,9 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
       clock_(clock),
       options_(options),
       faults_(options.reply_drop_probability, options.reply_duplicate_probability, options.fault_seed),
+      latch_(options.panic_latch_path),
       congestion_rng_(options.fault_seed) {
+  latched_at_start_ = latch_.Load();  // throws naming the file
   event_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (event_fd_ < 0) throw Error("ServerDaemon: eventfd failed");
   server_id_ = options_.server_id;
@@ -59,7 +61,30 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options);
   daemon.Preallocate(robot.output);
   daemon.set_output_ready_callback([this] { Wake(); });
+  if (auto it = latched_at_start_.find(name); it != latched_at_start_.end()) {
+    // A panic outlives the server: the robot starts held, as it was left.
+    std::vector<QueuedItem> none;
+    daemon.Panic(none, "panic latched before this server started (" + it->second + ")");
+    Log("robot '" + name + "': starts in PANIC, latched in " + latch_.path() + " (" + it->second +
+        "); PANIC_RESET to resume");
+  }
   robots_.emplace(name, std::move(robot));
+}
+
+void ServerDaemon::SyncLatch(Robot& robot) {
+  const std::string& name = robot.daemon->robot_name();
+  const bool panic = robot.daemon->in_panic();
+  if (panic == latch_.latched(name)) return;
+  try {
+    if (panic) {
+      const std::string fault = robot.daemon->fault();
+      latch_.Set(name, fault.empty() ? "PANIC from a client" : fault);
+    } else {
+      latch_.Clear(name);
+    }
+  } catch (const Error& e) {
+    Log("robot '" + name + "': " + e.what() + " -- the panic will NOT survive a restart");
+  }
 }
 
 std::vector<std::string> ServerDaemon::robot_names() const {
@@ -135,6 +160,7 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
     return;
   }
   ImmediateAnswer answer = robot.sessions->Handle(request, received);
+  SyncLatch(robot);  // on disk before the panic (or its reset) is acknowledged
   if (!request.header_error.empty()) {
     Log("robot '" + *robot_name + "': refused package from client " +
         Hex64(static_cast<std::uint64_t>(request.client_id)) + ": " + request.header_error);
@@ -152,6 +178,7 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
 
 void ServerDaemon::Drain(Robot& robot) {
   robot.daemon->TakeOutput(robot.output);
+  SyncLatch(robot);  // a driver fault latched by the RobotDaemon
   const std::string& name = robot.daemon->robot_name();
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
     transport_.Publish(StateChannel(name), EncodeSample(name, robot.config_hash, robot.output.samples[i]));

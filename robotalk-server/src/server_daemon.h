@@ -12,6 +12,7 @@
 #pragma once
 
 #include "fault_injector.h"
+#include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robot_sessions.h"
 #include "robotalk/clock.h"
@@ -44,6 +45,8 @@ struct ServerDaemonOptions {
   int log_lines_per_second = 20;
   /// The server's instance id in ANNOUNCE (random when 0).
   std::int64_t server_id = 0;
+  /// The panic latch file (panic_latch.h); "" keeps no panic across restarts.
+  std::string panic_latch_path;
 };
 
 class ServerDaemon {
@@ -90,11 +93,14 @@ class ServerDaemon {
   void Announce(TimePoint now);
   void Watchdogs(TimePoint now);
   void Log(const std::string& line);
+  void SyncLatch(Robot& robot);
 
   Transport& transport_;
   const Clock& clock_;
   const ServerDaemonOptions options_;
   FaultInjector faults_;
+  PanicLatch latch_;
+  std::map<std::string, std::string> latched_at_start_;
   std::map<std::string, Robot> robots_;
   std::unique_ptr<Subscription> subscription_;
   std::vector<ReplyBatch> to_send_;

@@ -35,6 +35,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   its command answers ERROR, the robot is held in panic (default 2;
                                   0 = no bound)
   --log-lines-per-second N        most log lines a second; the rest are counted (default 20)
+  --panic-latch FILE              keep which robots are in panic in FILE, so a panic survives a
+                                  restart (written before a panic is acknowledged)
   --simulate SEQ.txt              instead of serving: run the sequence file (docs/client.md
                                   format) on the one --robot as fast as possible on a
                                   simulated clock for --duration S (default 10) and print
@@ -85,6 +87,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         simulate = value();
       } else if (arg == "--sample-period") {
         sample_period = ParseNumber(arg, value(), 0.001, 3600);
+      } else if (arg == "--panic-latch") {
+        options.panic_latch_path = value();
       } else if (arg == "--log-lines-per-second") {
         options.log_lines_per_second = static_cast<int>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--driver-call-bound") {

@@ -10,6 +10,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
 namespace robotalk {
 namespace {
 
@@ -116,6 +120,63 @@ TEST_F(ServerDaemonTest, PublishesTheConfigurationWhenAskedAndStateWhenStreamed)
   Step();
   EXPECT_THAT(channels_, ::testing::Contains(ConfigChannel("bot")));
   EXPECT_THAT(channels_, ::testing::Contains(StateChannel("bot")));
+}
+
+}  // namespace
+}  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// Issue 9: after kill -9 and a restart, a latched PANIC was gone.
+TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
+  const std::string latch = ::testing::TempDir() + "/panic_latch_test.txt";
+  std::remove(latch.c_str());
+  ManualClock clock;
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport client(bus);
+  std::map<CommandId, Reply> replies;
+  auto sub =
+      client.Subscribe("ROBOTALK/bot/REPLY/.*", [&](const std::string&, std::span<const std::uint8_t> b) {
+        for (Reply& r : DecodeReplyBatch(b).replies) replies[r.id] = r;
+      });
+  {
+    MemoryTransport transport(bus);
+    RobotDaemon robot("bot", "fake", std::make_unique<FakeDriver>(PanRobot()), clock);
+    ServerDaemon server(transport, clock, ServerDaemonOptions{.panic_latch_path = latch});
+    server.AddRobot(robot, SessionOptions{});
+    Request panic{.client_id = kAlice, .sequence = 1, .panic = true};
+    client.Publish(RequestChannel("bot"), EncodeRequest(panic));
+    server.RunOnce(Duration(0));
+    std::ifstream file(latch);
+    std::string text((std::istreambuf_iterator<char>(file)), {});
+    EXPECT_THAT(text, HasSubstr("bot\t")) << "written before the panic was acknowledged";
+  }  // the server goes away (a crash keeps the same file)
+  MemoryTransport transport(bus);
+  auto driver = std::make_unique<FakeDriver>(PanRobot());
+  FakeDriver* fake = driver.get();
+  RobotDaemon robot("bot", "fake", std::move(driver), clock);
+  ServerDaemon server(transport, clock, ServerDaemonOptions{.panic_latch_path = latch});
+  server.AddRobot(robot, SessionOptions{});
+  EXPECT_TRUE(robot.in_panic()) << "the restarted server starts in panic";
+  EXPECT_THAT(robot.fault(), HasSubstr("latched before this server started"));
+  Request move{.client_id = kAlice, .sequence = 1};
+  move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+  client.Publish(RequestChannel("bot"), EncodeRequest(move));
+  server.RunOnce(Duration(0));
+  robot.RunOnce(clock.Now());
+  client.HandleFor(Duration(0));
+  EXPECT_EQ(replies.at(1).signal, Signal::kPanic);
+  EXPECT_TRUE(fake->calls.empty());
+  Request reset{.client_id = kAlice, .sequence = 2};
+  reset.commands.push_back(Command{2, CommandType::kPanicReset, std::nullopt, "", {}});
+  client.Publish(RequestChannel("bot"), EncodeRequest(reset));
+  server.RunOnce(Duration(0));
+  EXPECT_FALSE(robot.in_panic());
+  std::ifstream file(latch);
+  std::string text((std::istreambuf_iterator<char>(file)), {});
+  EXPECT_THAT(text, ::testing::Not(HasSubstr("bot\t"))) << "the reset is on disk too";
+  std::remove(latch.c_str());
 }
 
 }  // namespace

@@ -46,6 +46,8 @@ struct ServerOptions {
   Duration driver_call_bound = std::chrono::seconds(2);
   /// Most server log lines per second; the rest are counted and summarised.
   int log_lines_per_second = 20;
+  /// A file that keeps which robots are in panic across restarts ("" = none).
+  std::string panic_latch_path;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
   /// The paper's congestion injector (§VI-B): after each received package the
