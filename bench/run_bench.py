@@ -328,7 +328,8 @@ def main():
     meta = {"date_utc": time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime()), "quick": args.quick,
             "runs": b.runs, "nproc": os.cpu_count(), "loadavg_start": os.getloadavg(),
             "commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                                     capture_output=True, text=True).stdout.strip()}
+                                     capture_output=True, text=True).stdout.strip()
+            or os.environ.get("ROBOTALK_COMMIT", "")}
     try:
         for name in only:
             t0 = time.monotonic()
