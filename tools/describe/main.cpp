@@ -13,6 +13,10 @@
 #include <optional>
 #include <string>
 
+#ifndef ROBOTALK_VERSION
+#define ROBOTALK_VERSION "unknown"
+#endif
+
 namespace {
 
 constexpr const char* kUsage =
@@ -24,6 +28,7 @@ constexpr const char* kUsage =
     "  --strict        treat every import warning as an error\n"
     "  --merge-chains  merge massless joint chains into multi-dof joints (pan-tilt -> 2 dofs)\n"
     "  --name NAME     robot name to use instead of <robot name=...>\n"
+    "  --version       the version\n"
     "  --max-bytes N   refuse files larger than N bytes (default 16 MiB)\n"
     "  --max-depth N   refuse XML nested deeper than N elements (default 100)\n"
     "Exit status: 0 on success, 1 if the file cannot be imported, 2 on a usage error.\n";
@@ -65,6 +70,9 @@ int main(int argc, char** argv) {
       } else {
         options.max_xml_depth = static_cast<int>(*v);
       }
+    } else if (arg == "--version") {
+      std::cout << "robotalk-describe " << ROBOTALK_VERSION << "\n";
+      return 0;
     } else if (arg == "-h" || arg == "--help") {
       std::cout << kUsage;
       return 0;
