@@ -230,7 +230,8 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
                                                        bool playback) {
   Command c;
   try {
-    c = FromWire(wire);
+    c = FromWire(wire, playback ? robotalk_msgs::package_header_t::MODE_PLAYBACK
+                                : robotalk_msgs::package_header_t::MODE_DIRECT);
   } catch (const ProtocolError& e) {
     immediate.push_back(MakeReply(wire.id, Signal::kError, e.what(), now));
     return std::nullopt;
@@ -262,9 +263,9 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
     return std::nullopt;
   }
   // A playback frame's start time is its offset from the sequence start.
-  const Duration ahead = !c.start_time ? Duration(0)
-                         : playback    ? c.start_time->time_since_epoch()
-                                       : *c.start_time - now;
+  const Duration ahead = c.start_time.is_after() ? *c.start_time.offset()
+                         : c.start_time.is_at()  ? *c.start_time.time() - now
+                                                 : Duration(0);
   if (ahead > options_.max_future) {
     immediate.push_back(
         MakeReply(c.id, Signal::kError,
@@ -287,8 +288,10 @@ std::optional<QueuedItem> RobotService::PrepareCommand(Session& s, const robotal
   QueuedItem item;
   item.arrival = ++arrivals_;
   item.client_id = s.client_id;
-  item.has_start_time = c.start_time.has_value();
-  if (c.start_time) item.start = *c.start_time;
+  item.has_start_time = !c.start_time.is_now();
+  if (c.start_time.is_at()) item.start = *c.start_time.time();
+  if (c.start_time.is_after())
+    item.start = TimePoint(*c.start_time.offset());  // read as an offset in _modes.cpp
   item.command.id = c.id;
   item.command.type = c.type;
   if (c.type == CommandType::kFrameSetPoint) {
