@@ -127,7 +127,8 @@ def rows_for(res):
         rows.append((f"scale: {lvl['clients']} clients × 100 Hz, delay mode (100 ms), {lvl['seconds']} s",
                      f"{100.0 * to / sent if sent else 0:.1f} % timed out; lateness p99 median {us(med(p99s))},"
                      f" worst {us(max(p99s) if p99s else None)}; client CPU {fmt(cpu, '%', 1)} each,"
-                     f" server {fmt(lvl['server_cpu_pct'], '%')}" + (f"; {fails} clients failed to connect" if fails else ""),
+                     f" server {fmt(lvl['server_cpu_pct'], '%')}" + machine_text(lvl.get("machine"))
+                     + (f"; {fails} clients failed to connect" if fails else ""),
                      "—", "—"))
     c = res.get("cli", {})
     a = med([med(x["robotalk_ms"]) for x in c.get("runs", [])])
@@ -146,8 +147,20 @@ def rows_for(res):
     for lv, (ch, hs, late, n) in playback_levels(res).items():
         rows.append((f"playback start latency, relay congestion U[0, {lv}] ms per message",
                      f"{fmt(ch, 's', 3)} (late frames: {late} of {n})",
-                     f"hindsight minimum: {fmt(hs, 's', 3)}", ratio(ch, hs, 1) + " (floor near 0: ratio not meaningful)" if hs is not None and hs < 0.005 else ratio(ch, hs, 1)))
+                     f"hindsight minimum: {fmt(hs, 's', 3)}", playback_ratio(ch, hs)))
     return rows
+
+
+def machine_text(m):
+    if not m:
+        return ""
+    return (f"; whole machine (shared): {100 - m['idle_pct']:.0f} % busy, "
+            f"{m['sys_pct'] + m['irq_softirq_pct']:.0f} % sys+softirq")
+
+
+def playback_ratio(chosen, hindsight):
+    r = ratio(chosen, hindsight, 1)
+    return r + " (floor near 0)" if hindsight is not None and hindsight < 0.005 else r
 
 
 def playback_levels(res):

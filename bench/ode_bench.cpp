@@ -56,22 +56,35 @@ std::unique_ptr<OdeDriver> Make(const Robot& r) {
 // world that differs (e.g. cylinder wheels: more contact points, a costlier
 // LCP) measured the difference of the worlds, not the driver: the Pioneer read
 // -25 %.
+RobotModel DriverModel(const Robot& r, const OdeDriverOptions& o) {
+  UrdfImportOptions import;
+  import.merge_massless_chains = o.merge_chains;
+  RobotModel model = LoadUrdfFile(r.path, import).model;
+  if (o.base.empty()) return model;
+  std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
+  roots.front().base = ParseBaseType(o.base);
+  return RobotModel(model.name(), {model.links().begin(), model.links().end()},
+                    {model.joints().begin(), model.joints().end()},
+                    {model.frames().begin(), model.frames().end()}, std::move(roots));
+}
+
+// Whether the driver runs its walking controller (whose robot's root is
+// dynamic); false for a driver without one.
+template <typename D>
+bool Walks(const D& driver) {
+  if constexpr (requires { driver.walk_status(); }) {
+    return driver.walk_status().has_value();
+  } else {
+    return false;
+  }
+}
+
 struct BareWorld {
   RobotModel model;
   std::unique_ptr<ode_detail::OdeWorld> world;
 
-  BareWorld(const Robot& r, bool walks) {
+  BareWorld(const Robot& r, bool walks) : model(DriverModel(r, OdeDriverOptions::FromMap(r.options))) {
     const OdeDriverOptions o = OdeDriverOptions::FromMap(r.options);
-    UrdfImportOptions import;
-    import.merge_massless_chains = o.merge_chains;
-    model = LoadUrdfFile(r.path, import).model;
-    if (!o.base.empty()) {
-      std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
-      roots.front().base = ParseBaseType(o.base);
-      model = RobotModel(model.name(), {model.links().begin(), model.links().end()},
-                         {model.joints().begin(), model.joints().end()},
-                         {model.frames().begin(), model.frames().end()}, std::move(roots));
-    }
     const BaseType base = model.roots().front().base;
     ode_detail::OdeWorldOptions wo;
     wo.step = 1.0 / o.step_hz;
@@ -142,7 +155,7 @@ void RealTimeFactor(const Robot& r) {
 
   // The bare loop: the ODE world the driver builds, built the same way
   // (BareWorld), stepped with constant motors and no controllers.
-  BareWorld bare(r, idle->walk_status().has_value());
+  BareWorld bare(r, Walks(*idle));
   ode_detail::OdeWorld& w = *bare.world;
   // Alternate the two, 5 rounds of 600 steps, and keep each one's fastest
   // round: the machine is shared, so the minimum is the cost.

@@ -105,6 +105,13 @@ class Bench:
             fields = f.read().rsplit(")", 1)[1].split()
         return int(fields[11]) + int(fields[12])  # utime + stime
 
+    @staticmethod
+    def machine_cpu():
+        """/proc/stat's aggregate line: (user+nice, system, irq+softirq, idle+iowait, total) jiffies."""
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:8]]
+        return (v[0] + v[1], v[2], v[5] + v[6], v[3] + v[4], sum(v))
+
     def rss_kb(self, pid):
         with open(f"/proc/{pid}/status") as f:
             for line in f:
@@ -181,7 +188,7 @@ class Bench:
                           "--req", req, "--rep", rep, "--cap", "60"])
             runs.append({"robotalk": a, "raw": b})
         big = []
-        cap = 20 if self.quick else 45
+        cap = 20 if self.quick else 30
         for _ in range(1 if self.quick else 3):
             self.start_server()  # a collapsed run must not leave its backlog to the next
             a = self.run([self.client, "pipe", "--url", URL, "--inflight", "1000", "--count", str(n),
@@ -202,11 +209,14 @@ class Bench:
             procs = [self.start([self.client, "stream", "--url", URL, "--seconds", str(seconds), "--rate", "100",
                                  "--delay-ms", "100", "--start-at", str(start_at)]) for _ in range(n)]
             time.sleep(max(0.0, (start_at - time.monotonic_ns()) / 1e9))
-            t0, c0 = time.monotonic(), self.cpu_ticks(srv.pid)
+            t0, c0, m0 = time.monotonic(), self.cpu_ticks(srv.pid), self.machine_cpu()
             time.sleep(seconds)
             server_pct = 100.0 * (self.cpu_ticks(srv.pid) - c0) / os.sysconf("SC_CLK_TCK") / (time.monotonic() - t0)
+            m = [b - a for a, b in zip(m0, self.machine_cpu())]
+            machine = {k: 100.0 * m[i] / m[4] for i, k in enumerate(("user_pct", "sys_pct", "irq_softirq_pct", "idle_pct"))}
             clients = [self.collect(p, seconds + allowance + 20, "stream") for p in procs]
-            levels.append({"clients": n, "seconds": seconds, "server_cpu_pct": server_pct, "per_client": clients})
+            levels.append({"clients": n, "seconds": seconds, "server_cpu_pct": server_pct, "machine": machine,
+                           "per_client": clients})
         return {"figure": "scale", "levels": levels}
 
     def cli(self):
@@ -318,7 +328,8 @@ def main():
     meta = {"date_utc": time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime()), "quick": args.quick,
             "runs": b.runs, "nproc": os.cpu_count(), "loadavg_start": os.getloadavg(),
             "commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                                     capture_output=True, text=True).stdout.strip()}
+                                     capture_output=True, text=True).stdout.strip()
+            or os.environ.get("ROBOTALK_COMMIT", "")}
     try:
         for name in only:
             t0 = time.monotonic()

@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-if unshare -n true 2>/dev/null; then
+if [ "${ROBOTALK_DEMO_NETNS:-1}" != 0 ] && unshare -n true 2>/dev/null; then  # ROBOTALK_DEMO_NETNS=0: on this host, for the browser view
   exec scripts/netns_run.sh scripts/demo_session.sh
 fi
 echo "(no network namespace available: running on this host with ttl=0)"

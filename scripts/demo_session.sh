@@ -15,7 +15,8 @@ show() { printf '$ robotalk %s\n' "$*"; robotalk "$@"; echo "(exit status $?)"; 
 log=$(mktemp)
 "$server_bin" --robot "pioneer=ode:$MODEL" --url "$URL" --duration 120 2>"$log" &
 server=$!
-trap 'kill $server 2>/dev/null; wait $server 2>/dev/null; rm -f "$log"' EXIT
+web_pid=; if [ -x "$BUILD_DIR/tools/web/robotalk-web" ]; then "$BUILD_DIR/tools/web/robotalk-web" --lcm-url "$URL" --port "${ROBOTALK_WEB_PORT:-8080}" >/dev/null 2>&1 & web_pid=$!; echo "Live 3D view (robotalk-web, docs/web.md): open http://127.0.0.1:${ROBOTALK_WEB_PORT:-8080}/ (from a browser on this machine: ROBOTALK_DEMO_NETNS=0 scripts/demo.sh)"; fi
+trap 'kill $server $web_pid 2>/dev/null; wait $server 2>/dev/null; rm -f "$log"' EXIT
 for _ in $(seq 50); do grep -q "serving robot" "$log" && break; sleep 0.1; done
 step "A server with one robot on ODE physics: robotalk-server --robot pioneer=ode:$MODEL"
 cat "$log"

@@ -11,7 +11,11 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless lua5.2
   iproute2 util-linux python3 python3-matplotlib
+  libboost-dev nlohmann-json3-dev chromium chromium-driver
 )
+# robotalk-web's page modules come from the npm registry: Node.js and npm from
+# Debian unless a node with npm is already installed (e.g. NodeSource's).
+command -v npm >/dev/null || PACKAGES+=(nodejs npm)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -23,6 +27,14 @@ if ((${#missing[@]})); then
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# three and urdf-loader for robotalk-web's page (tools/web/package.json,
+# versions pinned by its package-lock.json), served from tools/web/node_modules.
+if [ ! -f tools/web/node_modules/.package-lock.json ] ||
+   [ tools/web/package-lock.json -nt tools/web/node_modules/.package-lock.json ]; then
+  echo "robotalk: installing the web page's npm modules (tools/web)"
+  (cd tools/web && npm ci --no-audit --no-fund --loglevel=error)
 fi
 
 BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}

@@ -17,6 +17,14 @@ struct GlobalOptions {
   double timeout_s = 5.0;  ///< --timeout
 };
 
+/// Pulls `--name VALUE` (or the flag `--name` when value is null) out of
+/// args; returns whether it was there. Throws UsageError when the value is missing.
+bool TakeOption(std::vector<std::string>& args, const std::string& name, std::string* value);
+/// Throws UsageError "unknown option '--x'" for any option left in args.
+void RejectOptions(const std::vector<std::string>& args);
+/// 0 for SUCCESS / MODIFIED, 1 otherwise.
+int ExitStatus(const Reply& r);
+
 /// `<id> <SIGNAL> "<message>" [values]` on one line.
 void PrintReply(const Reply& r, std::ostream& out);
 

@@ -1,50 +1,69 @@
 // robotalk: command-line client of a RoboTalk server (docs/client.md).
 #include "cli_commands.h"
+#include "interrupt.h"
 #include "sequence_file.h"
+#include "sequence_runner.h"
 
 #include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <map>
 
+#ifndef ROBOTALK_VERSION
+#define ROBOTALK_VERSION "unknown"
+#endif
+
 namespace {
 
 constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] COMMAND ...
 
-  robots [--listen S]                 robots announced on ROBOTALK/ANNOUNCE (default 1.5 s)
+  robots [--listen S] [--json]        robots announced on ROBOTALK/ANNOUNCE (default 1.5 s)
   describe ROBOT [--json]             the robot's description (links, joints, frames)
-  query ROBOT TYPE [TARGET]           TYPE: joint_state | link_poses | frame_poses | base_pose
-  send ROBOT COMMAND ARGS... [--at S] one command, e.g.
+  query ROBOT TYPE [TARGET] [--json]  TYPE: joint_state | link_poses | frame_poses | base_pose
+  send ROBOT COMMAND ARGS... [--at S] [--hold] [--json]
+                                      one command, waited for to its end, e.g.
                                         send pioneer goto 1 0 0
                                         send pioneer joint_setpoint pan 0.5
-                                        send pioneer setspeed 0.2 0.1
+                                        send pioneer setspeed 0.2 0.1 --hold
                                         send pioneer stop --at 2
                                       --at S: start S seconds from now (server clock)
-  send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced]
+                                      --hold: keep a setspeed / joint_speed / joint_force
+                                      until Ctrl-C, then STOP (without it the server's
+                                      watchdog stops the robot ~2 s after robotalk exits)
+  send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced] [--json]
                                       a timed sequence (format: docs/client.md); M is
                                       direct (a handshake per frame), delay (start =
                                       server clock + S, default 0) or playback (the
                                       server picks the delay); --paced sends each frame
                                       at its time instead of all at once
-  watch ROBOT [--period S] [--duration S] [--count N]
+  watch ROBOT [--period S] [--duration S] [--count N] [--json]
                                       broadcast mode: print the state stream (default 0.1 s)
   panic ROBOT                         panic: stop everything, refuse commands
   reset ROBOT                         PANIC_RESET
 
 Global options:
   --url URL      LCM URL (default: $LCM_DEFAULT_URL or LCM's default)
-  --timeout S    seconds to wait for each reply (default 5)
+  --timeout S    seconds to wait for a robot that does not answer (default 5); a
+                 command that runs long (GOTO, a sequence) is waited for to its end
+  --version      the version
   --help         this text (also after a command)
 
-Each reply prints as: <id> <SIGNAL> "<message>" [values]
-Exit status: 0 SUCCESS/MODIFIED, 1 any other signal or a timeout, 2 usage error.
+Ctrl-C or SIGTERM during send stops what it started (STOP) and says so.
+Each reply prints as: <id> <SIGNAL> "<message>" [values]  (--json: one JSON object per reply)
+Exit status: 0 SUCCESS/MODIFIED, 1 any other signal or a timeout, 2 usage error,
+128+N after signal N.
 )";
 
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace robotalk::cli;
+  Interrupter::Install();  // first: every later thread inherits the blocked signals
   std::vector<std::string> args(argv + 1, argv + argc);
+  if (std::find(args.begin(), args.end(), "--version") != args.end()) {
+    std::cout << "robotalk " << ROBOTALK_VERSION << "\n";
+    return 0;
+  }
   if (args.empty() || std::find_if(args.begin(), args.end(), [](const std::string& a) {
                         return a == "--help" || a == "-h";
                       }) != args.end()) {
@@ -64,6 +83,8 @@ int main(int argc, char** argv) {
           g.timeout_s = ParseNumber(args[++i], "--timeout");
           if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");
         }
+      } else if (rest.empty() && args[i].size() > 1 && args[i][0] == '-') {
+        throw UsageError("unknown option '" + args[i] + "'");
       } else {
         rest.push_back(args[i]);
       }
@@ -81,7 +102,7 @@ int main(int argc, char** argv) {
     std::cerr << "robotalk: " << e.what() << "\n(robotalk --help for usage)\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "robotalk: " << e.what() << "\n";
+    std::cerr << "robotalk: " << TidyDurations(e.what()) << "\n";
     return 1;
   }
 }

@@ -100,8 +100,9 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
     for (std::size_t j = k; j < end; ++j) {
       Command c = std::move(frames[order[j]].command);
       // Playback carries the offset itself; delay mode an absolute server time.
-      c.start_time = options.mode == CommandMode::kPlayback ? TimePoint(frames[order[j]].offset)
-                                                            : server_start + frames[order[j]].offset;
+      c.start_time = options.mode == CommandMode::kPlayback
+                         ? StartTime::After(frames[order[j]].offset)
+                         : StartTime::At(server_start + frames[order[j]].offset);
       commands.push_back(std::move(c));
     }
     auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit, false, playback);

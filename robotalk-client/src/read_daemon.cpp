@@ -101,7 +101,8 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     p.header.playback_frames = playback.frames;
     p.header.playback_duration_us = ToWireMicros(playback.duration);
   }
-  for (const Command& c : commands) p.commands.push_back(ToWire(c));
+  // Checks each start time's kind against the mode (offsets only in PLAYBACK).
+  for (const Command& c : commands) p.commands.push_back(ToWire(c, p.header.mode));
   for (const robotalk::Query& q : queries) p.queries.push_back(ToWire(q));
   p.num_commands = static_cast<std::int32_t>(p.commands.size());
   p.num_queries = static_cast<std::int32_t>(p.queries.size());
@@ -135,8 +136,8 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
         // do not re-ask an acknowledged frame before the whole sequence could
         // have played: re-asks would only load a congested server.
         start = now + playback.duration + options_.timeout;
-      } else if (commands[i].start_time) {
-        start = clock_sync_.ClientTime(*commands[i].start_time);
+      } else if (auto at = commands[i].start_time.time()) {
+        start = clock_sync_.ClientTime(*at);
       }
       items.push_back({id, start});
     }

@@ -294,7 +294,7 @@ Reply RobotClient::Execute(Command command) {
   impl_->RethrowDaemonError();
   // The reply of a command scheduled ahead cannot come before its start.
   Duration wait = impl_->options_.timeout;
-  if (command.start_time) wait += std::max(Duration::zero(), *command.start_time - ServerNow());
+  if (auto at = command.start_time.time()) wait += std::max(Duration::zero(), *at - ServerNow());
   PendingReply p = Send(std::move(command));
   try {
     return p.Wait(wait);

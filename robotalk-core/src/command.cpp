@@ -115,6 +115,18 @@ std::optional<QueryType> ParseQueryType(const std::string& name) {
   return std::nullopt;
 }
 
+std::string ToString(const StartTime& s) {
+  switch (s.kind()) {
+    case StartTime::Kind::kNow:
+      return "now";
+    case StartTime::Kind::kAt:
+      return "at " + std::to_string(ToSeconds(s.time()->time_since_epoch())) + " s";
+    case StartTime::Kind::kAfter:
+      return "after " + std::to_string(ToSeconds(*s.offset())) + " s";
+  }
+  return "?";
+}
+
 bool IsMotionCommand(CommandType t) { return t != CommandType::kStop && t != CommandType::kPanicReset; }
 
 std::optional<std::string> CheckCommand(const RobotModel& model, const Command& c, Signal* signal) {

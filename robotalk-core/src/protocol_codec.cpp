@@ -3,7 +3,9 @@
 #include "robotalk/error.h"
 #include "wire_scanner.h"
 
+#include <algorithm>
 #include <climits>
+#include <cmath>
 
 namespace robotalk {
 namespace {
@@ -70,15 +72,90 @@ Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* function, voi
 
 }  // namespace
 
+namespace {
+
+using Header = robotalk_msgs::package_header_t;
+
+std::string CommandField(std::int64_t id, const char* field) {
+  return "command " + std::to_string(id) + ": " + field;
+}
+
+std::int64_t StartToWire(const Command& c) {
+  const StartTime& s = c.start_time;
+  if (s.is_now()) return 0;
+  if (s.is_at()) {
+    const std::int64_t us = ToWireMicros(*s.time());
+    if (us < 0) {
+      throw ProtocolError(CommandField(c.id, "start time ") + std::to_string(us) +
+                          " us is before the server clock's epoch");
+    }
+    return us;
+  }
+  const std::int64_t us = ToWireMicros(*s.offset());
+  if (us < 0)
+    throw ProtocolError(CommandField(c.id, "negative playback offset ") + std::to_string(us) + " us");
+  return us;
+}
+
+StartTime StartFromWire(const robotalk_msgs::command_t& w, std::int8_t mode) {
+  if (w.start_time_us < 0) {
+    throw ProtocolError(CommandField(w.id, "negative start time ") + std::to_string(w.start_time_us) + " us");
+  }
+  const std::string field = CommandField(w.id, "start_time_us");
+  if (mode == Header::MODE_PLAYBACK) return StartTime::After(DurationFromWireMicros(w.start_time_us, field));
+  if (w.start_time_us == 0) return StartTime::Now();
+  return StartTime::At(FromWireMicros(w.start_time_us, field));
+}
+
+std::string StateLabel(const robotalk_msgs::robot_state_t& w) {
+  return "robot_state '" + w.robot + "' sample " + std::to_string(w.sample) + ": ";
+}
+
+void CheckFiniteValues(const std::string& label, const char* field, const double* v, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) {
+      throw ProtocolError(label + field + "[" + std::to_string(i) + "] is " +
+                          (std::isnan(v[i]) ? "NaN" : "infinite"));
+    }
+  }
+}
+
+void CheckArraySize(const std::string& label, const char* field, std::size_t size, std::int32_t count,
+                    const char* count_field) {
+  if (count < 0 || size != static_cast<std::size_t>(count)) {
+    throw ProtocolError(label + field + " has " + std::to_string(size) + " values but " + count_field +
+                        " is " + std::to_string(count));
+  }
+}
+
+}  // namespace
+
 robotalk_msgs::command_t ToWire(const Command& c) {
   robotalk_msgs::command_t w{};
   w.id = c.id;
   w.type = static_cast<std::int8_t>(c.type);
-  w.start_time_us = c.start_time ? ToWireMicros(*c.start_time) : 0;
+  w.start_time_us = StartToWire(c);
   w.target = c.target;
+  if (c.values.size() > static_cast<std::size_t>(INT16_MAX)) {
+    throw ProtocolError(CommandField(c.id, "") + std::to_string(c.values.size()) + " values (at most " +
+                        std::to_string(INT16_MAX) + ")");
+  }
   w.num_values = static_cast<std::int16_t>(c.values.size());
   w.values = c.values;
   return w;
+}
+
+robotalk_msgs::command_t ToWire(const Command& c, std::int8_t package_mode) {
+  const bool playback = package_mode == Header::MODE_PLAYBACK;
+  if (playback && c.start_time.is_at()) {
+    throw ProtocolError(CommandField(c.id, "a PLAYBACK package carries offsets (StartTime::After), not ") +
+                        ToString(c.start_time));
+  }
+  if (!playback && c.start_time.is_after()) {
+    throw ProtocolError(CommandField(c.id, "only a PLAYBACK package carries offsets; got ") +
+                        ToString(c.start_time));
+  }
+  return ToWire(c);
 }
 
 robotalk_msgs::query_t ToWire(const Query& q) {
@@ -102,19 +179,17 @@ robotalk_msgs::reply_t ToWire(const Reply& r) {
   return w;
 }
 
-Command FromWire(const robotalk_msgs::command_t& w) {
+Command FromWire(const robotalk_msgs::command_t& w) { return FromWire(w, Header::MODE_DIRECT); }
+
+Command FromWire(const robotalk_msgs::command_t& w, std::int8_t package_mode) {
   if (w.type < 1 || w.type > static_cast<std::int8_t>(CommandType::kPanicReset)) {
     throw ProtocolError("command " + std::to_string(w.id) + ": unknown command type " +
                         std::to_string(w.type));
   }
-  if (w.start_time_us < 0) {
-    throw ProtocolError("command " + std::to_string(w.id) + ": negative start time " +
-                        std::to_string(w.start_time_us) + " us");
-  }
   Command c;
   c.id = w.id;
   c.type = static_cast<CommandType>(w.type);
-  if (w.start_time_us != 0) c.start_time = FromWireMicros(w.start_time_us);
+  c.start_time = StartFromWire(w, package_mode);
   c.target = w.target;
   c.values = w.values;
   return c;
@@ -128,21 +203,91 @@ Query FromWire(const robotalk_msgs::query_t& w) {
     throw ProtocolError("query " + std::to_string(w.id) + ": negative period " + std::to_string(w.period_us) +
                         " us");
   }
-  return Query{w.id, static_cast<QueryType>(w.type), w.target, std::chrono::microseconds(w.period_us)};
+  return Query{w.id, static_cast<QueryType>(w.type), w.target,
+               DurationFromWireMicros(w.period_us, "query " + std::to_string(w.id) + ": period_us")};
 }
 
 Reply FromWire(const robotalk_msgs::reply_t& w) {
   auto signal = SignalFromWire(w.signal);
   if (!signal)
     throw ProtocolError("reply " + std::to_string(w.id) + ": unknown signal " + std::to_string(w.signal));
+  const std::string label = "reply " + std::to_string(w.id) + ": ";
   Reply r;
   r.id = w.id;
   r.signal = *signal;
   r.message = w.message;
-  r.exec_time = FromWireMicros(w.exec_time_us);
-  r.lateness = std::chrono::microseconds(w.lateness_us);
+  r.exec_time = FromWireMicros(w.exec_time_us, label + "exec_time_us");
+  r.lateness = DurationFromWireMicros(w.lateness_us, label + "lateness_us");
   r.values = w.values;
   return r;
+}
+
+StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
+  const std::string label = StateLabel(w);
+  CheckArraySize(label, "position", w.position.size(), w.num_dofs, "num_dofs");
+  CheckArraySize(label, "velocity", w.velocity.size(), w.num_dofs, "num_dofs");
+  CheckArraySize(label, "effort", w.effort.size(), w.num_dofs, "num_dofs");
+  CheckArraySize(label, "frame_poses", w.frame_poses.size(), w.num_frames, "num_frames");
+  if (expected_dofs >= 0 && w.num_dofs != expected_dofs) {
+    throw ProtocolError(label + "num_dofs is " + std::to_string(w.num_dofs) + ", the model has " +
+                        std::to_string(expected_dofs));
+  }
+  if (w.period_us < 0) throw ProtocolError(label + "negative period_us " + std::to_string(w.period_us));
+  if (w.sample < 0) throw ProtocolError(label + "negative sample number");
+  CheckFiniteValues(label, "position", w.position.data(), w.position.size());
+  CheckFiniteValues(label, "velocity", w.velocity.data(), w.velocity.size());
+  CheckFiniteValues(label, "effort", w.effort.data(), w.effort.size());
+  CheckFiniteValues(label, "base", w.base, 5);
+  StateSample s;
+  s.frame_poses.reserve(w.frame_poses.size());
+  for (std::size_t i = 0; i < w.frame_poses.size(); ++i) {
+    if (w.frame_poses[i].size() != 7)
+      throw ProtocolError(label + "frame_poses[" + std::to_string(i) + "] is not 7 values");
+    CheckFiniteValues(label, ("frame_poses[" + std::to_string(i) + "]").c_str(), w.frame_poses[i].data(), 7);
+    PoseValues pose{};
+    std::copy(w.frame_poses[i].begin(), w.frame_poses[i].end(), pose.begin());
+    s.frame_poses.push_back(pose);
+  }
+  s.server_time = FromWireMicros(w.server_time_us, label + "server_time_us");
+  s.period = DurationFromWireMicros(w.period_us, label + "period_us");
+  s.sample = w.sample;
+  s.robot = w.robot;
+  s.config_hash = static_cast<std::uint64_t>(w.config_hash);
+  s.panic = w.panic;
+  s.moving = w.moving;
+  s.positions = w.position;
+  s.velocities = w.velocity;
+  s.efforts = w.effort;
+  s.base = BaseState{w.base[0], w.base[1], w.base[2], w.base[3], w.base[4]};
+  return s;
+}
+
+robotalk_msgs::robot_state_t ToWire(const StateSample& s) {
+  robotalk_msgs::robot_state_t w{};
+  w.server_time_us = ToWireMicros(s.server_time);
+  w.period_us = ToWireMicros(s.period);
+  w.sample = s.sample;
+  w.robot = s.robot;
+  w.config_hash = static_cast<std::int64_t>(s.config_hash);
+  w.panic = s.panic;
+  w.moving = s.moving;
+  if (s.velocities.size() != s.positions.size() || s.efforts.size() != s.positions.size()) {
+    throw ProtocolError("robot_state '" + s.robot + "': " + std::to_string(s.positions.size()) +
+                        " positions, " + std::to_string(s.velocities.size()) + " velocities, " +
+                        std::to_string(s.efforts.size()) + " efforts (must be equal)");
+  }
+  w.num_dofs = static_cast<std::int32_t>(s.positions.size());
+  w.position = s.positions;
+  w.velocity = s.velocities;
+  w.effort = s.efforts;
+  w.base[0] = s.base.x;
+  w.base[1] = s.base.y;
+  w.base[2] = s.base.theta;
+  w.base[3] = s.base.v;
+  w.base[4] = s.base.omega;
+  w.num_frames = static_cast<std::int32_t>(s.frame_poses.size());
+  for (const PoseValues& p : s.frame_poses) w.frame_poses.emplace_back(p.begin(), p.end());
+  return w;
 }
 
 robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes) {
@@ -155,6 +300,10 @@ robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> 
 
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes) {
   return DecodeChecked<robotalk_msgs::robot_state_t>(bytes, "DecodeRobotState", &ScanRobotState);
+}
+
+StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs) {
+  return FromWire(DecodeRobotState(bytes), expected_dofs);
 }
 
 std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
@@ -173,6 +322,10 @@ std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
     if (h.playback_frames < 1)
       return "package: PLAYBACK declares " + std::to_string(h.playback_frames) + " frames";
     if (h.playback_duration_us < 0) return "package: PLAYBACK declares a negative duration";
+    if (!TryDurationFromWireMicros(h.playback_duration_us)) {
+      return "package: playback_duration_us " + std::to_string(h.playback_duration_us) +
+             " us is out of range";
+    }
     if (h.playback_id == 0) return "package: PLAYBACK id 0 is reserved";
   }
   if (h.sequence <= 0) return "package: sequence " + std::to_string(h.sequence) + " is not positive";

@@ -34,12 +34,13 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes) {
   Request r;
   r.client_id = h.client_id;
   r.sequence = h.sequence;
-  r.send_time = FromWireMicros(h.send_time_us);
+  r.send_time = FromWireMicros(h.send_time_us, "package: send_time_us");
   r.panic = h.panic;
   r.header_error = CheckPackageHeader(p);
   r.mode = static_cast<RequestMode>(h.mode);
   if (r.mode == RequestMode::kPlayback && r.header_error.empty()) {
-    r.playback = {h.playback_id, h.playback_frames, std::chrono::microseconds(h.playback_duration_us)};
+    r.playback = {h.playback_id, h.playback_frames,
+                  DurationFromWireMicros(h.playback_duration_us, "package: playback_duration_us")};
   }
   for (const auto& q : p.queries) {
     try {
@@ -50,7 +51,7 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes) {
   }
   for (const auto& c : p.commands) {
     try {
-      r.commands.push_back(FromWire(c));
+      r.commands.push_back(FromWire(c, h.mode));
     } catch (const ProtocolError& e) {
       r.malformed.push_back({c.id, e.what()});
     }
@@ -73,7 +74,7 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
     h.playback_duration_us = ToWireMicros(r.playback.duration);
   }
   for (const Query& q : r.queries) p.queries.push_back(ToWire(q));
-  for (const Command& c : r.commands) p.commands.push_back(ToWire(c));
+  for (const Command& c : r.commands) p.commands.push_back(ToWire(c, h.mode));
   p.num_queries = static_cast<std::int32_t>(p.queries.size());
   p.num_commands = static_cast<std::int32_t>(p.commands.size());
   h.payload_type = p.num_queries > 0 ? robotalk_msgs::package_header_t::PAYLOAD_QUERIES
@@ -111,6 +112,7 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
   m.protocol_version = kProtocolVersion;
   m.server_id = a.server_id;
   m.server_time_us = ToWireMicros(a.server_time);
+  m.uptime_us = ToWireMicros(a.uptime);
   m.url_hint = a.url_hint;
   for (const RobotAnnouncement& r : a.robots) {
     robotalk_msgs::robot_info_t info{};
@@ -125,6 +127,34 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
   }
   m.num_robots = static_cast<std::int32_t>(m.robots.size());
   return Encode(m);
+}
+
+Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
+  // Bounded before LCM's decoder allocates: an ANNOUNCE is small.
+  constexpr std::size_t kMaxBytes = 64 * 1024;
+  if (bytes.size() > kMaxBytes) {
+    throw ProtocolError("DecodeAnnouncement: " + std::to_string(bytes.size()) + " bytes; at most " +
+                        std::to_string(kMaxBytes));
+  }
+  robotalk_msgs::announce_t m{};
+  if (bytes.size() < 8 ||
+      m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
+    throw ProtocolError("DecodeAnnouncement: " + std::to_string(bytes.size()) +
+                        " bytes do not decode as announce_t");
+  }
+  if (m.num_robots < 0 || m.num_robots > 1024) {
+    throw ProtocolError("DecodeAnnouncement: num_robots " + std::to_string(m.num_robots));
+  }
+  Announcement a;
+  a.server_id = m.server_id;
+  a.server_time = FromWireMicros(m.server_time_us, "announce: server_time_us");
+  a.uptime = DurationFromWireMicros(m.uptime_us, "announce: uptime_us");
+  a.url_hint = m.url_hint;
+  for (const auto& r : m.robots) {
+    a.robots.push_back({r.name, r.driver, static_cast<std::uint64_t>(r.config_hash), r.total_dofs,
+                        r.base_type, r.panic != 0, r.num_clients});
+  }
+  return a;
 }
 
 }  // namespace robotalk

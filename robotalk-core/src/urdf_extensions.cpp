@@ -5,6 +5,7 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
@@ -25,6 +26,71 @@ std::string Num(double v) {
   s.precision(10);
   s << v;
   return s.str();
+}
+
+namespace {
+
+// The end of the start tag that begins at xml[lt] ('<'): the index past its
+// '>', or npos when the text ends first. `self_closing` tells "<a/>".
+// TinyXML reads a quoted value only right after '=' (spaces allowed) and
+// refuses a quote anywhere else in a tag, so only such quotes open a value.
+std::size_t StartTagEnd(std::string_view xml, std::size_t lt, bool& self_closing) {
+  char last = 0;  // the last character outside spaces and values
+  for (std::size_t p = lt + 1; p < xml.size(); ++p) {
+    const char c = xml[p];
+    if ((c == '"' || c == '\'') && last == '=') {
+      p = xml.find(c, p + 1);
+      if (p == std::string_view::npos) return p;
+      last = c;
+    } else if (c == '>') {
+      self_closing = last == '/';
+      return p + 1;
+    } else if (c != ' ' && c != '\t' && c != '\n' && c != '\r') {
+      last = c;
+    }
+  }
+  return std::string_view::npos;
+}
+
+}  // namespace
+
+void CheckXmlDepth(std::string_view xml, int max_depth, const std::string& source) {
+  constexpr auto npos = std::string_view::npos;
+  auto past = [&](std::size_t from, std::string_view end) {
+    const std::size_t at = xml.find(end, from);
+    return at == npos ? npos : at + end.size();
+  };
+  int depth = 0;
+  int deepest = 0;
+  std::size_t first_too_deep = npos;
+  for (std::size_t i = 0; i < xml.size();) {
+    const std::size_t lt = xml.find('<', i);
+    if (lt == npos) break;
+    const std::string_view tag = xml.substr(lt);
+    bool self_closing = false;
+    if (tag.starts_with("<!--")) {
+      i = past(lt + 4, "-->");
+    } else if (tag.starts_with("<![CDATA[")) {
+      i = past(lt + 9, "]]>");
+    } else if (tag.starts_with("</")) {
+      depth = std::max(depth - 1, 0);
+      i = past(lt + 2, ">");
+    } else if (tag.starts_with("<!") || tag.starts_with("<?")) {
+      i = past(lt + 2, ">");  // TinyXML too ends these at the first '>'
+    } else {
+      i = StartTagEnd(xml, lt, self_closing);
+      if (i == npos || self_closing) continue;
+      deepest = std::max(deepest, ++depth);
+      if (depth > max_depth && first_too_deep == npos) first_too_deep = lt;
+    }
+  }
+  if (first_too_deep != npos) {
+    const auto line =
+        1 + std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(first_too_deep), '\n');
+    Refuse(source, "XML elements nested " + std::to_string(deepest) + " deep (deeper than " +
+                       std::to_string(max_depth) + " from line " + std::to_string(line) + "); the limit is " +
+                       std::to_string(max_depth) + " (UrdfImportOptions::max_xml_depth)");
+  }
 }
 
 namespace {

@@ -15,6 +15,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace robotalk::urdf_detail {
@@ -33,6 +34,15 @@ struct UrdfdomMessages {
 /// is process-wide. Messages other threads log meanwhile go to the handler
 /// installed before. Returns nullptr when urdfdom refuses or throws.
 urdf::ModelInterfaceSharedPtr ParseQuietly(const std::string& xml, UrdfdomMessages& messages);
+
+/// Refuses `xml` when its elements nest deeper than `max_depth`, naming the
+/// depth, the line where the limit is first passed and the limit. TinyXML
+/// (and urdfdom through it) parses and frees elements recursively, so this
+/// runs first: one pass over the text, no recursion, no allocation. It skips
+/// comments, CDATA, declarations and processing instructions, and quoted
+/// attribute values, where TinyXML does; where it cannot tell, it counts an
+/// element, so it never reports less depth than TinyXML would recurse.
+void CheckXmlDepth(std::string_view xml, int max_depth, const std::string& source);
 
 /// "'name'".
 std::string Quote(const std::string& s);

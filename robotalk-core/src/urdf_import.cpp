@@ -13,11 +13,13 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 namespace robotalk {
 namespace {
@@ -75,16 +77,16 @@ class Importer {
   std::vector<Dof> MakeDofs(const urdf::Joint& j, const urdf_detail::XmlJoint& xml);
   DofLimits OneDofLimits(const urdf::Joint& j, const urdf_detail::XmlJoint& xml);
   void ResolveMimics();
+  void FlattenMimicChains();
   void ApplyExtensions();
   void MergeMasslessChains();
   RobotModel Build(const std::string& robot_name);
 
   int LinkIndex(const std::string& name) const { return link_index_.at(name); }
+  // Valid from ImportJoints until MergeMasslessChains renames joints.
   int FindDraft(const std::string& name) const {
-    for (size_t i = 0; i < drafts_.size(); ++i) {
-      if (drafts_[i].joint.name == name) return static_cast<int>(i);
-    }
-    return -1;
+    auto it = draft_index_.find(name);
+    return it == draft_index_.end() ? -1 : it->second;
   }
 
   const UrdfImportOptions& options_;
@@ -95,10 +97,17 @@ class Importer {
   std::vector<Link> links_;
   std::map<std::string, int> link_index_;
   std::vector<Draft> drafts_;
+  std::map<std::string, int> draft_index_;
   std::string root_;
 };
 
 UrdfImportResult Importer::Run(const std::string& xml) {
+  // Both limits before any XML parser runs: TinyXML recurses per element.
+  if (xml.size() > options_.max_file_bytes) {
+    Fail(std::to_string(xml.size()) + " bytes is more than the limit of " +
+         std::to_string(options_.max_file_bytes) + " bytes (UrdfImportOptions::max_file_bytes)");
+  }
+  urdf_detail::CheckXmlDepth(xml, options_.max_xml_depth, source_);
   TiXmlDocument doc;
   doc.Parse(xml.c_str(), nullptr, TIXML_ENCODING_UTF8);
   if (doc.Error()) {
@@ -215,13 +224,16 @@ void Importer::CheckTree(const urdf::ModelInterface& model) {
     parent_joint[child] = name;
   }
   // Walk up from every link; a link met twice on one walk is on a cycle.
+  // Each link is walked over once: a walk stops at a link an earlier walk
+  // proved to reach the root, and on_path marks links with the walk's number.
   std::vector<char> reaches_root(n, 0);
+  std::vector<size_t> on_path(n, SIZE_MAX);
+  std::vector<int> path;
   for (size_t start = 0; start < n; ++start) {
-    std::vector<int> path;
-    std::vector<char> on_path(n, 0);
+    path.clear();
     int cur = static_cast<int>(start);
     while (!reaches_root[static_cast<size_t>(cur)]) {
-      if (on_path[static_cast<size_t>(cur)]) {
+      if (on_path[static_cast<size_t>(cur)] == start) {
         std::string cycle = Quote(links_[static_cast<size_t>(cur)].name);
         for (int l = parent[static_cast<size_t>(cur)]; l != cur; l = parent[static_cast<size_t>(l)]) {
           cycle += " <- " + Quote(links_[static_cast<size_t>(l)].name);
@@ -229,7 +241,7 @@ void Importer::CheckTree(const urdf::ModelInterface& model) {
         Fail("not a tree: the joints form a cycle through links " + cycle + " <- " +
              Quote(links_[static_cast<size_t>(cur)].name));
       }
-      on_path[static_cast<size_t>(cur)] = 1;
+      on_path[static_cast<size_t>(cur)] = start;
       path.push_back(cur);
       if (parent[static_cast<size_t>(cur)] < 0) break;
       cur = parent[static_cast<size_t>(cur)];
@@ -358,6 +370,7 @@ void Importer::ImportJoints(const urdf::ModelInterface& model) {
       d.multiplier = j.mimic->multiplier;
       d.offset = j.mimic->offset;
     }
+    draft_index_.emplace(name, static_cast<int>(drafts_.size()));
     drafts_.push_back(std::move(d));
   }
 }
@@ -387,16 +400,35 @@ void Importer::ResolveMimics() {
       d.leader.reset();
     }
   }
-  for (Draft& d : drafts_) {
-    size_t steps = 0;
-    while (d.leader) {
-      const Draft& lead = drafts_[static_cast<size_t>(FindDraft(*d.leader))];
-      if (!lead.leader) break;
-      if (++steps > drafts_.size()) {
+  FlattenMimicChains();
+}
+
+// A mimic of a mimic follows the first leader: each joint's chain is walked
+// once (state: 0 not seen, 1 on this walk, 2 resolved, 3 on or into a cycle),
+// then resolved from its leader's end, so the work is linear in joints.
+void Importer::FlattenMimicChains() {
+  enum : char { kNew, kOnWalk, kResolved, kCycle };
+  std::vector<char> state(drafts_.size(), kNew);
+  std::vector<size_t> walk;
+  for (size_t start = 0; start < drafts_.size(); ++start) {
+    walk.clear();
+    size_t cur = start;
+    while (state[cur] == kNew && drafts_[cur].leader) {
+      state[cur] = kOnWalk;
+      walk.push_back(cur);
+      cur = static_cast<size_t>(FindDraft(*drafts_[cur].leader));
+    }
+    const bool cycle = state[cur] == kOnWalk || state[cur] == kCycle;
+    for (auto it = walk.rbegin(); it != walk.rend(); ++it) {
+      Draft& d = drafts_[*it];
+      state[*it] = cycle ? kCycle : kResolved;
+      if (cycle) {
         Warn("joint " + Quote(d.joint.name) + ": mimic joints form a cycle; mimic dropped");
         d.leader.reset();
-        break;
+        continue;
       }
+      const Draft& lead = drafts_[static_cast<size_t>(FindDraft(*d.leader))];
+      if (!lead.leader) continue;  // already resolved: follows a joint that mimics nothing
       Warn("joint " + Quote(d.joint.name) + ": mimics " + Quote(lead.joint.name) + ", itself a mimic of " +
            Quote(*lead.leader) + "; now follows " + Quote(*lead.leader) + " directly");
       d.offset = d.multiplier * lead.offset + d.offset;
@@ -447,56 +479,74 @@ void Importer::ApplyExtensions() {
 // only carries C, has no control frame and J2 adds no translation:
 //   Tr(o1) R1 M1(q1) R2 M2(q2) = Tr(o1) (R1 R2) (R2^T M1(q1) R2) M2(q2),
 // so J1's dof axes are rotated by R2^T and J2's follow unchanged.
+// Joints are visited top-down (breadth-first from the root) and each one
+// absorbs the chain below it while it can, so every joint and link is looked
+// at a bounded number of times: linear in the size of the model.
 void Importer::MergeMasslessChains() {
-  std::set<std::string> framed;
-  for (const auto& f : ext_.frames) framed.insert(f.link);
-  bool merged = true;
-  while (merged) {
-    merged = false;
-    std::set<std::string> mimic_involved;
-    std::map<std::string, int> child_count;
-    for (const Draft& d : drafts_) {
-      if (d.leader) {
-        mimic_involved.insert(d.joint.name);
-        mimic_involved.insert(*d.leader);
-      }
-      ++child_count[d.parent];
-    }
-    for (size_t i2 = 0; i2 < drafts_.size() && !merged; ++i2) {
-      const Draft& j2 = drafts_[i2];
-      const std::string m = j2.parent;  // a copy: j2 is erased below
-      const int i1 = [&] {
-        for (size_t k = 0; k < drafts_.size(); ++k) {
-          if (drafts_[k].child == m) return static_cast<int>(k);
-        }
-        return -1;
-      }();
-      if (i1 < 0) continue;
-      const Draft& j1 = drafts_[static_cast<size_t>(i1)];
-      if (links_[static_cast<size_t>(LinkIndex(m))].mass != 0 || child_count[m] != 1 || framed.contains(m) ||
-          !j2.origin.isZero(0.0) || j1.joint.dofs.empty() || j2.joint.dofs.empty() ||
-          j1.joint.dofs.size() + j2.joint.dofs.size() > 6 || mimic_involved.contains(j1.joint.name) ||
-          mimic_involved.contains(j2.joint.name)) {
-        continue;
-      }
-      Draft out = j1;
-      const Eigen::Matrix3d r2t = j2.joint.rest.toRotationMatrix().transpose();
-      for (Dof& dof : out.joint.dofs) dof.axis = (r2t * dof.axis).normalized();
-      for (const Dof& dof : j2.joint.dofs) out.joint.dofs.push_back(dof);
-      out.joint.name = j1.joint.name + "+" + j2.joint.name;
-      out.joint.rest = (j1.joint.rest * j2.joint.rest).normalized();
-      out.joint.outboard = j2.joint.outboard;
-      out.joint.servo_types = ServoTypes::FromBits(j1.joint.servo_types.bits() & j2.joint.servo_types.bits());
-      out.child = j2.child;
-      drafts_[static_cast<size_t>(i1)] = std::move(out);
-      drafts_.erase(drafts_.begin() + static_cast<std::ptrdiff_t>(i2));
-      const int gone = LinkIndex(m);
-      links_.erase(links_.begin() + gone);
-      link_index_.clear();
-      for (size_t l = 0; l < links_.size(); ++l) link_index_.emplace(links_[l].name, static_cast<int>(l));
-      merged = true;
+  const size_t num_links = links_.size();
+  std::vector<char> framed(num_links, 0);
+  for (const auto& f : ext_.frames) framed[static_cast<size_t>(LinkIndex(f.link))] = 1;
+  std::set<std::string> mimic_involved;
+  for (const Draft& d : drafts_) {
+    if (d.leader) {
+      mimic_involved.insert(d.joint.name);
+      mimic_involved.insert(*d.leader);
     }
   }
+  std::vector<std::vector<int>> child_joints(num_links);
+  for (size_t i = 0; i < drafts_.size(); ++i)
+    child_joints[static_cast<size_t>(LinkIndex(drafts_[i].parent))].push_back(static_cast<int>(i));
+  std::vector<int> order;  // joints, parents before children
+  std::vector<int> links_to_visit{LinkIndex(root_)};
+  for (size_t k = 0; k < links_to_visit.size(); ++k) {
+    for (int j : child_joints[static_cast<size_t>(links_to_visit[k])]) {
+      order.push_back(j);
+      links_to_visit.push_back(LinkIndex(drafts_[static_cast<size_t>(j)].child));
+    }
+  }
+
+  std::vector<char> joint_gone(drafts_.size(), 0);
+  std::vector<char> link_gone(num_links, 0);
+  for (int h : order) {
+    if (joint_gone[static_cast<size_t>(h)]) continue;
+    Draft& head = drafts_[static_cast<size_t>(h)];
+    if (head.joint.dofs.empty() || mimic_involved.contains(head.joint.name)) continue;
+    for (;;) {
+      const size_t m = static_cast<size_t>(LinkIndex(head.child));
+      if (links_[m].mass != 0 || child_joints[m].size() != 1 || framed[m]) break;
+      const size_t i2 = static_cast<size_t>(child_joints[m].front());
+      const Draft& j2 = drafts_[i2];
+      if (!j2.origin.isZero(0.0) || j2.joint.dofs.empty() ||
+          head.joint.dofs.size() + j2.joint.dofs.size() > 6 || mimic_involved.contains(j2.joint.name)) {
+        break;
+      }
+      const Eigen::Matrix3d r2t = j2.joint.rest.toRotationMatrix().transpose();
+      for (Dof& dof : head.joint.dofs) dof.axis = (r2t * dof.axis).normalized();
+      for (const Dof& dof : j2.joint.dofs) head.joint.dofs.push_back(dof);
+      head.joint.name += "+" + j2.joint.name;
+      head.joint.rest = (head.joint.rest * j2.joint.rest).normalized();
+      head.joint.outboard = j2.joint.outboard;
+      head.joint.servo_types =
+          ServoTypes::FromBits(head.joint.servo_types.bits() & j2.joint.servo_types.bits());
+      head.child = j2.child;
+      joint_gone[i2] = 1;
+      link_gone[m] = 1;
+    }
+  }
+
+  std::vector<Draft> drafts;
+  for (size_t i = 0; i < drafts_.size(); ++i) {
+    if (!joint_gone[i]) drafts.push_back(std::move(drafts_[i]));
+  }
+  drafts_ = std::move(drafts);
+  draft_index_.clear();  // the merged joints have new names
+  std::vector<Link> links;
+  for (size_t l = 0; l < num_links; ++l) {
+    if (!link_gone[l]) links.push_back(std::move(links_[l]));
+  }
+  links_ = std::move(links);
+  link_index_.clear();
+  for (size_t l = 0; l < links_.size(); ++l) link_index_.emplace(links_[l].name, static_cast<int>(l));
 }
 
 RobotModel Importer::Build(const std::string& robot_name) {
@@ -527,10 +577,23 @@ RobotModel Importer::Build(const std::string& robot_name) {
 UrdfImportResult LoadUrdfFile(const std::string& path, const UrdfImportOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw UrdfError("LoadUrdfFile: cannot open '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Never more than max_file_bytes + 1 in memory, whatever the file is
+  // (a pipe has no size to ask for beforehand).
+  const std::string limit =
+      "the limit of " + std::to_string(options.max_file_bytes) + " bytes (UrdfImportOptions::max_file_bytes)";
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > options.max_file_bytes)
+    throw UrdfError(path + ": " + std::to_string(size) + " bytes is more than " + limit);
+  std::string text;
+  std::vector<char> chunk(64 * 1024);
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    text.append(chunk.data(), static_cast<size_t>(in.gcount()));
+    if (text.size() > options.max_file_bytes) throw UrdfError(path + ": the text is longer than " + limit);
+  }
   if (in.bad()) throw UrdfError("LoadUrdfFile: cannot read '" + path + "'");
-  return ParseUrdf(text.str(), options, path);
+  return ParseUrdf(text, options, path);
 }
 
 UrdfImportResult ParseUrdf(const std::string& xml, const UrdfImportOptions& options,

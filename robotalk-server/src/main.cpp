@@ -40,14 +40,14 @@ int Simulate(const robotalk::DriverRegistry& registry, const std::vector<robotal
     }
     std::cout << "t,x,y,theta,v,omega";
     if (!r.states.empty()) {
-      for (int i = 0; i < r.states.front().num_dofs; ++i) std::cout << ",q" << i;
+      for (std::size_t i = 0; i < r.states.front().positions.size(); ++i) std::cout << ",q" << i;
     }
     std::cout << "\n";
-    const std::int64_t t0 = r.states.empty() ? 0 : r.states.front().server_time_us;
+    const robotalk::TimePoint t0 = r.states.empty() ? robotalk::TimePoint{} : r.states.front().server_time;
     for (const auto& s : r.states) {
-      std::cout << (s.server_time_us - t0) * 1e-6;
-      for (double b : s.base) std::cout << ',' << b;
-      for (double q : s.position) std::cout << ',' << q;
+      std::cout << robotalk::ToSeconds(s.server_time - t0);
+      for (double b : {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega}) std::cout << ',' << b;
+      for (double q : s.positions) std::cout << ',' << q;
       std::cout << '\n';
     }
     std::cerr << "robotalk-server: simulated " << duration_s << " s in " << robotalk::ToSeconds(r.wall_time)

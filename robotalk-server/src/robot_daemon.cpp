@@ -190,7 +190,7 @@ bool RobotDaemon::TakeOutput(DaemonOutput& out) {
   std::lock_guard lock(mutex_);
   std::swap(out, outbox_);
   return !out.replies.empty() || !out.executed.empty() || out.num_samples > 0 || !out.log.empty() ||
-         out.dropped_samples > 0;
+         !out.audit.empty() || out.dropped_samples > 0;
 }
 
 bool RobotDaemon::CheckOverrun(TimePoint now) {
@@ -336,6 +336,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     for (auto& a : produced_.replies) outbox_.replies.push_back(std::move(a));
     for (const auto& e : produced_.executed) outbox_.executed.push_back(e);
     for (auto& line : produced_.log) outbox_.log.push_back(std::move(line));
+    for (auto& line : produced_.audit) outbox_.audit.push_back(std::move(line));
     if (sampled) {
       if (outbox_.num_samples < outbox_.samples.size()) {
         outbox_.samples[outbox_.num_samples++] = sample_;  // same sizes: no allocation
@@ -345,7 +346,8 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     }
     next = std::min(next, scheduler_.NextDeadline());
     if (halt_requested_ || resume_requested_) next = now;
-    ready = !produced_.replies.empty() || !produced_.executed.empty() || !produced_.log.empty() || sampled;
+    ready = !produced_.replies.empty() || !produced_.executed.empty() || !produced_.log.empty() ||
+            !produced_.audit.empty() || sampled;
   }
   if (ready && output_ready_) output_ready_();
   return next;
@@ -401,7 +403,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
                   robot_name_.c_str(), static_cast<std::uint64_t>(item.client_id), item.command.id,
                   ToString(item.command.type),
                   result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
-    produced_.log.emplace_back(line);
+    produced_.audit.emplace_back(line);
   }
   if (result.in_progress) {
     in_progress_[command.id] = Owner{item.client_id, item.command.id, now, r.lateness};

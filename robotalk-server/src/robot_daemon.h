@@ -80,7 +80,8 @@ struct DaemonOutput {
   std::vector<RobotSample> samples;  ///< the first `num_samples` are filled
   std::size_t num_samples = 0;
   std::uint64_t dropped_samples = 0;
-  std::vector<std::string> log;  ///< lines for the ServerDaemon to print
+  std::vector<std::string> log;    ///< lines for the ServerDaemon to print (rate-limited)
+  std::vector<std::string> audit;  ///< --log-executions lines, printed in full (asked for)
 
   void Clear() {
     replies.clear();
@@ -88,6 +89,7 @@ struct DaemonOutput {
     num_samples = 0;
     dropped_samples = 0;
     log.clear();
+    audit.clear();
   }
 };
 

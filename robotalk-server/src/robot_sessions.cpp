@@ -228,9 +228,12 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
     return std::nullopt;
   }
   // A playback frame's start time is its offset from the sequence start.
-  const Duration ahead = !c.start_time ? Duration(0)
-                         : playback    ? c.start_time->time_since_epoch()
-                                       : *c.start_time - now;
+  // A playback frame starts after an offset from the sequence start; a
+  // direct or delay command at a server-clock time (the codec checked the
+  // kind against the package mode).
+  const Duration ahead = c.start_time.is_after() ? *c.start_time.offset()
+                         : c.start_time.is_at()  ? *c.start_time.time() - now
+                                                 : Duration(0);
   if (ahead > options_.max_future) {
     immediate.push_back(MakeReply(c.id, Signal::kError,
                                   std::string(ToString(c.type)) + ": start time is " + Seconds(ahead) +
@@ -249,8 +252,8 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   }
   QueuedItem item;
   item.client_id = s.client_id;
-  item.has_start_time = c.start_time.has_value();
-  if (c.start_time && !playback) item.start = *c.start_time;
+  item.has_start_time = !c.start_time.is_now();
+  if (c.start_time.is_at()) item.start = *c.start_time.time();
   item.command.id = c.id;
   item.command.type = c.type;
   if (c.type == CommandType::kFrameSetPoint) {
@@ -295,7 +298,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   for (const Command& c : r.commands) {
     std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
     if (!item) continue;
-    const Duration offset = c.start_time ? c.start_time->time_since_epoch() : Duration(0);
+    const Duration offset = c.start_time.offset().value_or(Duration(0));
     if (offset > seq.duration || ++seq.received > seq.total) {
       immediate.push_back(MakeReply(c.id, Signal::kError,
                                     "PLAYBACK " + std::to_string(d.id) + ": frame at " + Seconds(offset) +

@@ -69,7 +69,8 @@ class Server::Impl {
                             .reply_duplicate_probability = options_.reply_duplicate_probability,
                             .fault_seed = options_.fault_seed,
                             .log_lines_per_second = options_.log_lines_per_second,
-                            .panic_latch_path = options_.panic_latch_path});
+                            .panic_latch_path = options_.panic_latch_path,
+                            .allow_duplicate_robots = options_.allow_duplicate_robots});
     const SessionOptions sessions{
         options_.session_timeout, options_.max_queue, options_.max_future,
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};

@@ -20,7 +20,7 @@ constexpr std::size_t kMaxBatchBytes = 30000;  // split reply packages well unde
 
 std::vector<std::uint8_t> EncodeSample(const std::string& robot, std::uint64_t config_hash,
                                        const RobotSample& s) {
-  const robotalk_msgs::robot_state_t msg = ToStateSample(robot, config_hash, s);
+  const robotalk_msgs::robot_state_t msg = ToWire(ToStateSample(robot, config_hash, s));
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
   msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   return bytes;
@@ -46,11 +46,15 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
   subscription_ = transport_.Subscribe(
       kAnyRequestChannelRegex,
       [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnRequest(channel, bytes); });
+  announce_subscription_ = transport_.Subscribe(
+      kAnnounceChannel,
+      [this](const std::string&, std::span<const std::uint8_t> bytes) { OnAnnounce(bytes); });
 }
 
 ServerDaemon::~ServerDaemon() {
   Stop();
   subscription_.reset();
+  announce_subscription_.reset();
   if (event_fd_ >= 0) close(event_fd_);
 }
 
@@ -93,6 +97,44 @@ std::vector<std::string> ServerDaemon::robot_names() const {
   return out;
 }
 
+std::string ServerDaemon::refused(const std::string& robot) const {
+  auto it = robots_.find(robot);
+  return it == robots_.end() ? std::string() : it->second.refused;
+}
+
+// One robot, one server: two servers serving one robot name would both
+// execute every command. The newcomer gives way: the server that has been
+// serving for less time refuses the robot (equal uptimes: the larger id
+// refuses), stops it if it moves, and leaves every package to the other.
+void ServerDaemon::OnAnnounce(std::span<const std::uint8_t> bytes) {
+  Announcement a;
+  try {
+    a = DecodeAnnouncement(bytes);
+  } catch (const ProtocolError&) {
+    return;  // not ours to judge; clients ignore it too
+  }
+  if (a.server_id == server_id_ || options_.allow_duplicate_robots) return;
+  const Duration mine = started_ == TimePoint::min() ? Duration(0) : clock_.Now() - started_;
+  const bool other_wins = a.uptime > mine + std::chrono::milliseconds(1) ||
+                          (a.uptime >= mine - std::chrono::milliseconds(1) && a.server_id < server_id_);
+  for (const RobotAnnouncement& r : a.robots) {
+    auto it = robots_.find(r.name);
+    if (it == robots_.end() || !it->second.refused.empty()) continue;
+    const std::string other = "server " + Hex64(static_cast<std::uint64_t>(a.server_id)) +
+                              (a.url_hint.empty() ? "" : " (" + a.url_hint + ")");
+    if (!other_wins) {
+      Log("robot '" + r.name + "': " + other +
+          " also announces it; it started after this server and gives way");
+      continue;
+    }
+    it->second.refused = "robot '" + r.name + "' is served by " + other + "; this server (" +
+                         Hex64(static_cast<std::uint64_t>(server_id_)) +
+                         ") refuses it: run one server per robot name (or --allow-duplicate-robots)";
+    Log("ERROR: " + it->second.refused);
+    it->second.daemon->QueueStop(/*only_if_moving=*/true);
+  }
+}
+
 void ServerDaemon::Start() {
   if (running_.exchange(true)) return;
   thread_ = std::thread([this] {
@@ -127,6 +169,7 @@ void ServerDaemon::RunOnce(Duration timeout) {
   }
   Flush();
   const TimePoint now = clock_.Now();
+  if (started_ == TimePoint::min()) started_ = now;
   if (now >= next_watchdog_) {
     Watchdogs(now);
     next_watchdog_ = now + options_.watchdog_period;
@@ -150,6 +193,7 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
   auto it = robots_.find(*robot_name);
   if (it == robots_.end()) return;  // another server's robot
   Robot& robot = it->second;
+  if (!robot.refused.empty()) return;  // the other server answers
   Request request;
   try {
     request = DecodeRequest(bytes);
@@ -183,6 +227,8 @@ void ServerDaemon::Drain(Robot& robot) {
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
     transport_.Publish(StateChannel(name), EncodeSample(name, robot.config_hash, robot.output.samples[i]));
   }
+  for (const std::string& line : robot.output.audit)
+    std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());
   to_send_.clear();
   robot.sessions->File(robot.output, to_send_);
   for (ReplyBatch& batch : to_send_) Send(name, batch);
@@ -227,8 +273,10 @@ void ServerDaemon::Announce(TimePoint now) {
   Announcement a;
   a.server_id = server_id_;
   a.server_time = now;
+  a.uptime = started_ == TimePoint::min() ? Duration(0) : now - started_;
   a.url_hint = transport_.url();
   for (const auto& [name, robot] : robots_) {
+    if (!robot.refused.empty()) continue;
     const RobotModel& m = robot.daemon->model();
     a.robots.push_back({name, robot.daemon->driver_name(), robot.config_hash, m.num_dofs(),
                         static_cast<std::int8_t>(m.roots().front().base), robot.daemon->in_panic(),

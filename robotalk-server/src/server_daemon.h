@@ -47,6 +47,10 @@ struct ServerDaemonOptions {
   std::int64_t server_id = 0;
   /// The panic latch file (panic_latch.h); "" keeps no panic across restarts.
   std::string panic_latch_path;
+  /// Serve a robot even when another server announces the same name (both
+  /// would execute every command). Off: one robot, one server (see
+  /// ServerDaemon::OnAnnounce).
+  bool allow_duplicate_robots = false;
 };
 
 class ServerDaemon {
@@ -74,6 +78,8 @@ class ServerDaemon {
   void Wake();
 
   std::vector<std::string> robot_names() const;
+  /// Why this server does not serve `robot` (another server does), or "".
+  std::string refused(const std::string& robot) const;
   std::int64_t server_id() const { return server_id_; }
   /// Packages dropped because their bytes could not be decoded at all.
   std::uint64_t malformed() const { return malformed_; }
@@ -85,9 +91,11 @@ class ServerDaemon {
     std::vector<std::uint8_t> encoded_config;
     std::uint64_t config_hash;
     DaemonOutput output;
+    std::string refused;  ///< non-empty: another server serves this robot; why we do not
   };
 
   void OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes);
+  void OnAnnounce(std::span<const std::uint8_t> bytes);
   void Send(const std::string& robot, ReplyBatch& batch);
   void Drain(Robot& robot);
   void Announce(TimePoint now);
@@ -103,6 +111,8 @@ class ServerDaemon {
   std::map<std::string, std::string> latched_at_start_;
   std::map<std::string, Robot> robots_;
   std::unique_ptr<Subscription> subscription_;
+  std::unique_ptr<Subscription> announce_subscription_;
+  TimePoint started_ = TimePoint::min();  // first RunOnce
   std::vector<ReplyBatch> to_send_;
   std::mt19937_64 congestion_rng_;
   int event_fd_ = -1;

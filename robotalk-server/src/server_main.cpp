@@ -37,6 +37,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --log-lines-per-second N        most log lines a second; the rest are counted (default 20)
   --panic-latch FILE              keep which robots are in panic in FILE, so a panic survives a
                                   restart (written before a panic is acknowledged)
+  --allow-duplicate-robots        serve a robot even when another server announces the same name
+                                  (by default the server that started later refuses it)
   --simulate SEQ.txt              instead of serving: run the sequence file (docs/client.md
                                   format) on the one --robot as fast as possible on a
                                   simulated clock for --duration S (default 10) and print
@@ -87,6 +89,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         simulate = value();
       } else if (arg == "--sample-period") {
         sample_period = ParseNumber(arg, value(), 0.001, 3600);
+      } else if (arg == "--allow-duplicate-robots") {
+        options.allow_duplicate_robots = true;
       } else if (arg == "--panic-latch") {
         options.panic_latch_path = value();
       } else if (arg == "--log-lines-per-second") {

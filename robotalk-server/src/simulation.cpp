@@ -29,7 +29,7 @@ SimulationResult RunSimulation(std::string robot_name, std::string driver_name,
   for (std::size_t i = 0; i < commands.size(); ++i) {
     Command c = commands[i].command;
     c.id = static_cast<CommandId>(i) + 2;
-    c.start_time = t0 + commands[i].offset;
+    c.start_time = StartTime::At(t0 + commands[i].offset);
     sequence.commands.push_back(std::move(c));
   }
   std::map<CommandId, Reply> replies;

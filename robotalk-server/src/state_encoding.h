@@ -1,37 +1,36 @@
-// A RobotDaemon state sample as the wire's robot_state_t.
-// TODO(state codec): moves into the codec with the C++ state sample type.
+// A RobotDaemon state sample as the protocol's StateSample (state_sample.h),
+// which the codec puts on the wire.
 #pragma once
 
 #include "robot_daemon.h"
-#include "robotalk_msgs/robot_state_t.hpp"
+#include "robotalk/state_sample.h"
 
 #include <string>
 
 namespace robotalk {
 
-inline robotalk_msgs::robot_state_t ToStateSample(const std::string& robot, std::uint64_t config_hash,
-                                                  const RobotSample& s) {
-  robotalk_msgs::robot_state_t msg{};
-  msg.server_time_us = ToWireMicros(s.time);
-  msg.period_us = ToWireMicros(s.period);
-  msg.sample = s.sample;
-  msg.robot = robot;
-  msg.config_hash = static_cast<std::int64_t>(config_hash);
-  msg.panic = s.panic;
-  msg.moving = s.moving;
-  msg.num_dofs = static_cast<std::int32_t>(s.position.size());
-  msg.position.assign(s.position.data(), s.position.data() + s.position.size());
-  msg.velocity.assign(s.velocity.data(), s.velocity.data() + s.velocity.size());
-  msg.effort.assign(s.effort.data(), s.effort.data() + s.effort.size());
-  for (int i = 0; i < 5; ++i) msg.base[i] = s.base[static_cast<std::size_t>(i)];
+inline StateSample ToStateSample(const std::string& robot, std::uint64_t config_hash, const RobotSample& s) {
+  StateSample out;
+  out.server_time = s.time;
+  out.period = s.period;
+  out.sample = s.sample;
+  out.robot = robot;
+  out.config_hash = config_hash;
+  out.panic = s.panic;
+  out.moving = s.moving;
+  out.positions.assign(s.position.data(), s.position.data() + s.position.size());
+  out.velocities.assign(s.velocity.data(), s.velocity.data() + s.velocity.size());
+  out.efforts.assign(s.effort.data(), s.effort.data() + s.effort.size());
+  out.base = {s.base[0], s.base[1], s.base[2], s.base[3], s.base[4]};
   if (s.frames_valid) {
-    msg.num_frames = static_cast<std::int32_t>(s.frame_poses.size() / 7);
-    for (std::size_t f = 0; f < s.frame_poses.size(); f += 7) {
-      msg.frame_poses.emplace_back(s.frame_poses.begin() + static_cast<std::ptrdiff_t>(f),
-                                   s.frame_poses.begin() + static_cast<std::ptrdiff_t>(f + 7));
+    for (std::size_t f = 0; f + 7 <= s.frame_poses.size(); f += 7) {
+      PoseValues pose;
+      std::copy(s.frame_poses.begin() + static_cast<std::ptrdiff_t>(f),
+                s.frame_poses.begin() + static_cast<std::ptrdiff_t>(f + 7), pose.begin());
+      out.frame_poses.push_back(pose);
     }
   }
-  return msg;
+  return out;
 }
 
 }  // namespace robotalk

@@ -35,7 +35,7 @@ check 0 "acknowledged" panic pioneer
 check 1 "PANIC" send pioneer goto 1 0 0
 check 0 "SUCCESS" reset pioneer
 check 0 "SUCCESS" send pioneer goto 1 0 0
-check 1 "Connect('nobody')" --timeout 0.5 query nobody joint_state
+check 1 "no robot 'nobody' on this network (heard: pioneer)" --timeout 0.5 query nobody joint_state
 kill $spid 2>/dev/null; wait $spid 2>/dev/null
 [ $fail = 0 ] && echo "cli end to end: all passed"
 exit $fail

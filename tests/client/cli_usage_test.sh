@@ -28,5 +28,18 @@ msg=$("$cli" send pioneer --file "$tmp" 2>&1)
 [ $? = 2 ] || { echo "FAIL: bad sequence file status"; fail=1; }
 case "$msg" in *"$tmp:2: GOTO takes 3 values"*) ;; *) echo "FAIL: message '$msg'"; fail=1 ;; esac
 rm -f "$tmp"
+# Unknown options are named as such, before or after the command.
+expect_msg() {  # expect_msg STATUS TEXT ARGS...
+  want=$1 text=$2; shift 2
+  out=$("$cli" "$@" 2>&1); got=$?
+  [ "$got" = "$want" ] || { echo "FAIL: robotalk $* -> $got, want $want"; fail=1; }
+  case "$out" in *"$text"*) ;; *) echo "FAIL: robotalk $*: no \"$text\" in: $out"; fail=1 ;; esac
+}
+expect_msg 2 "unknown option '--bogus'" --bogus robots
+expect_msg 2 "unknown option '--bogus'" send pioneer goto 1 0 0 --bogus
+expect_msg 2 "unknown option '-x'" query pioneer base_pose -x
+expect_msg 2 "--hold goes with setspeed" send pioneer goto 1 0 0 --hold
+expect_msg 0 "robotalk " --version
+"$cli" --version | grep -Eq '^robotalk [0-9]+\.[0-9]+\.[0-9]+$' || { echo "FAIL: --version format"; fail=1; }
 [ $fail = 0 ] && echo "cli usage: all passed"
 exit $fail

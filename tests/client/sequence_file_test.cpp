@@ -34,7 +34,7 @@ TEST(SequenceFile, ParsesCommandsCommentsAndBlankLines) {
   EXPECT_EQ(entries[1].command.values, (std::vector<double>{0.5, -0.2}));
   EXPECT_EQ(entries[2].command.type, CommandType::kSetSpeed);
   EXPECT_EQ(entries[3].command.type, CommandType::kStop);
-  EXPECT_FALSE(entries[3].command.start_time.has_value());
+  EXPECT_TRUE(entries[3].command.start_time.is_now());
 }
 
 TEST(SequenceFile, ErrorsNameTheLine) {

@@ -4,6 +4,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
 
 namespace robotalk {
@@ -44,7 +46,7 @@ TEST(ProtocolCodec, RoundTripsCommandsQueriesAndReplies) {
   EXPECT_EQ(back.start_time, c.start_time);
   EXPECT_EQ(back.target, c.target);
   EXPECT_EQ(back.values, c.values);
-  EXPECT_FALSE(FromWire(ToWire(Command{1, CommandType::kStop, std::nullopt, "", {}})).start_time.has_value());
+  EXPECT_TRUE(FromWire(ToWire(Command{1, CommandType::kStop, std::nullopt, "", {}})).start_time.is_now());
 
   const Query q{3, QueryType::kLinkPoses, "head"};
   EXPECT_EQ(FromWire(ToWire(q)).target, "head");
@@ -156,6 +158,130 @@ TEST(ProtocolCodec, ChecksTheHeaderAgainstThePayload) {
   p = SamplePackage();
   p.header.sequence = -1;
   EXPECT_THAT(CheckPackageHeader(p), HasSubstr("sequence"));
+}
+
+// --- Start times and wire times ----------------------------------------------
+
+using Header = robotalk_msgs::package_header_t;
+
+robotalk_msgs::command_t WireStop(std::int64_t start_us) {
+  robotalk_msgs::command_t w{};
+  w.id = 7;
+  w.type = static_cast<std::int8_t>(CommandType::kStop);
+  w.start_time_us = start_us;
+  return w;
+}
+
+TEST(StartTime, MapsToTheWireByThePackageMode) {
+  const TimePoint t(std::chrono::seconds(12));
+  EXPECT_EQ(ToWire(Command{.start_time = StartTime::Now()}).start_time_us, 0);
+  EXPECT_EQ(ToWire(Command{.start_time = StartTime::At(t)}, Header::MODE_DELAY).start_time_us, 12000000);
+  EXPECT_EQ(
+      ToWire(Command{.start_time = StartTime::After(std::chrono::milliseconds(300))}, Header::MODE_PLAYBACK)
+          .start_time_us,
+      300000);
+  EXPECT_EQ(FromWire(WireStop(0), Header::MODE_DIRECT).start_time, StartTime::Now());
+  EXPECT_EQ(FromWire(WireStop(12000000), Header::MODE_DELAY).start_time, StartTime::At(t));
+  EXPECT_EQ(FromWire(WireStop(12000000)).start_time, StartTime::At(t));  // no mode: absolute
+  EXPECT_EQ(FromWire(WireStop(300000), Header::MODE_PLAYBACK).start_time,
+            StartTime::After(std::chrono::milliseconds(300)));
+  // In a playback package 0 is the sequence start, not "now".
+  EXPECT_EQ(FromWire(WireStop(0), Header::MODE_PLAYBACK).start_time, StartTime::After(Duration(0)));
+}
+
+TEST(StartTime, RefusesAKindThatDoesNotBelongInThePackageMode) {
+  const Command offset{.id = 3, .start_time = StartTime::After(std::chrono::seconds(1))};
+  const Command absolute{.id = 4, .start_time = StartTime::At(TimePoint(std::chrono::seconds(5)))};
+  EXPECT_THROW(ToWire(offset, Header::MODE_DIRECT), ProtocolError);
+  EXPECT_THROW(ToWire(offset, Header::MODE_DELAY), ProtocolError);
+  EXPECT_THROW(ToWire(absolute, Header::MODE_PLAYBACK), ProtocolError);
+  EXPECT_NO_THROW(ToWire(Command{}, Header::MODE_PLAYBACK));
+  try {
+    ToWire(Command{.id = 5, .start_time = StartTime::At(TimePoint(-std::chrono::seconds(1)))});
+    ADD_FAILURE() << "a start before the epoch has no wire form";
+  } catch (const ProtocolError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("command 5"));
+  }
+  EXPECT_THROW(ToWire(Command{.start_time = StartTime::After(-std::chrono::seconds(1))}), ProtocolError);
+}
+
+TEST(StartTime, ConvertsFromTimePointsAndOptionals) {
+  const TimePoint t(std::chrono::seconds(3));
+  const StartTime from_time = t;
+  const StartTime from_nullopt = std::nullopt;
+  const StartTime from_optional = std::optional<TimePoint>(t);
+  EXPECT_EQ(from_time, StartTime::At(t));
+  EXPECT_TRUE(from_nullopt.is_now());
+  EXPECT_EQ(from_optional.time(), t);
+  EXPECT_FALSE(StartTime::After(Duration(5)).time());
+  EXPECT_EQ(StartTime::After(Duration(5)).offset(), Duration(5));
+  EXPECT_NE(StartTime::At(TimePoint(Duration(5))), StartTime::After(Duration(5)));
+  EXPECT_EQ(ToString(StartTime::After(std::chrono::milliseconds(250))), "after 0.250000 s");
+}
+
+TEST(WireTime, ConvertsTheExtremesWithoutOverflow) {
+  EXPECT_EQ(FromWireMicros(kMaxWireMicros).time_since_epoch().count(), kMaxWireMicros * 1000);
+  EXPECT_EQ(FromWireMicros(-kMaxWireMicros).time_since_epoch().count(), -kMaxWireMicros * 1000);
+  EXPECT_EQ(FromWireMicros(9'300'000'000'000LL).time_since_epoch(), std::chrono::seconds(9'300'000));
+  for (std::int64_t bad : {INT64_MAX, INT64_MIN, kMaxWireMicros + 1, -kMaxWireMicros - 1,
+                           std::int64_t{18446744073709552}, std::int64_t{9'300'000'000'000'000}}) {
+    EXPECT_FALSE(TryDurationFromWireMicros(bad)) << bad;
+    try {
+      FromWireMicros(bad, "reply 3: exec_time_us");
+      ADD_FAILURE() << bad;
+    } catch (const ProtocolError& e) {
+      EXPECT_THAT(e.what(),
+                  HasSubstr("reply 3: exec_time_us " + std::to_string(bad) + " us is out of range"));
+    }
+  }
+  // The other way cannot overflow: it divides.
+  EXPECT_EQ(ToWireMicros(TimePoint::max()), INT64_MAX / 1000);
+  EXPECT_EQ(ToWireMicros(TimePoint::min()), INT64_MIN / 1000);
+}
+
+TEST(WireTime, OutOfRangeStartTimesAreProtocolErrorsNamingTheField) {
+  for (std::int8_t mode : {Header::MODE_DIRECT, Header::MODE_DELAY, Header::MODE_PLAYBACK}) {
+    for (std::int64_t bad :
+         {INT64_MAX, std::int64_t{18446744073709552}, std::int64_t{9'300'000'000'000'000}}) {
+      try {
+        FromWire(WireStop(bad), mode);
+        ADD_FAILURE() << bad;
+      } catch (const ProtocolError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("command 7: start_time_us " + std::to_string(bad) + " us"));
+      }
+    }
+    EXPECT_THROW(FromWire(WireStop(INT64_MIN), mode), ProtocolError);
+  }
+}
+
+TEST(WireTime, RepliesAndQueriesCheckTheirTimes) {
+  robotalk_msgs::reply_t r = ToWire(Reply{.id = 9});
+  r.exec_time_us = INT64_MIN;
+  EXPECT_THROW(FromWire(r), ProtocolError);
+  r = ToWire(Reply{.id = 9});
+  r.lateness_us = INT64_MAX;
+  try {
+    FromWire(r);
+    ADD_FAILURE();
+  } catch (const ProtocolError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("reply 9: lateness_us"));
+  }
+  robotalk_msgs::query_t q = ToWire(Query{.id = 2, .type = QueryType::kStateStream});
+  q.period_us = INT64_MAX;
+  EXPECT_THROW(FromWire(q), ProtocolError);
+  auto p = SamplePackage();
+  p.header.mode = Header::MODE_PLAYBACK;
+  p.header.playback_id = 1;
+  p.header.playback_frames = 2;
+  p.header.playback_duration_us = INT64_MAX;
+  EXPECT_THAT(CheckPackageHeader(p), HasSubstr("playback_duration_us"));
+}
+
+TEST(WireTime, FromSecondsRefusesWhatNoDurationHolds) {
+  EXPECT_EQ(FromSeconds(1.5), std::chrono::milliseconds(1500));
+  EXPECT_THROW(FromSeconds(std::nan("")), Error);
+  EXPECT_THROW(FromSeconds(1e300), Error);
+  EXPECT_THROW(FromSeconds(-std::numeric_limits<double>::infinity()), Error);
 }
 
 RobotModel TestRobot(BaseType base) {

@@ -23,7 +23,7 @@ using testing::PanRobot;
 constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
 
 Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std::string target = "",
-            std::optional<TimePoint> start = std::nullopt) {
+            StartTime start = StartTime::Now()) {
   return Command{id, type, start, std::move(target), std::move(values)};
 }
 
@@ -40,7 +40,7 @@ Request Queries(std::int64_t client, std::int64_t seq, const std::vector<Query>&
   return r;
 }
 
-// A playback frame's start_time carries its offset from the sequence start.
+// A playback frame's start_time is After(its offset from the sequence start).
 Request Playback(std::int64_t client, std::int64_t seq, std::int64_t playback_id, int frames,
                  Duration duration, const std::vector<Command>& commands) {
   Request r = Package(client, seq, commands);
@@ -96,7 +96,7 @@ class RobotSessionsTest : public ::testing::Test {
   DaemonOutput output_;
   ImmediateAnswer last_;
   std::map<std::int64_t, std::map<CommandId, Reply>> collected_;
-  std::vector<robotalk_msgs::robot_state_t> states_;
+  std::vector<StateSample> states_;
 };
 
 TEST_F(RobotSessionsTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
@@ -434,7 +434,7 @@ TEST_F(RobotSessionsTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTim
     clock_.Set(t);
     if (sent < kFrames && t >= first_arrival + milliseconds(150) * sent) {
       const Command frame =
-          Cmd(sent + 1, CommandType::kJointSetPoint, {0.01 * sent}, "pan", TimePoint(period * sent));
+          Cmd(sent + 1, CommandType::kJointSetPoint, {0.01 * sent}, "pan", StartTime::After(period * sent));
       auto immediate = Handle(Playback(kAlice, sent + 1, kPlayback, kFrames, duration, {frame}));
       if (immediate.count(kPlayback)) delay_reply = immediate.at(kPlayback);
       ++sent;
@@ -465,8 +465,8 @@ TEST_F(RobotSessionsTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTim
 }
 
 TEST_F(RobotSessionsTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
-  auto r = Handle(
-      Playback(kAlice, 1, 77, 2, seconds(1), {Cmd(1, CommandType::kStop, {}, "", TimePoint(seconds(2)))}));
+  auto r = Handle(Playback(kAlice, 1, 77, 2, seconds(1),
+                           {Cmd(1, CommandType::kStop, {}, "", StartTime::After(seconds(2)))}));
   EXPECT_EQ(r.at(1).signal, Signal::kError);
   EXPECT_THAT(r.at(1).message, HasSubstr("beyond the declared"));
 }
@@ -475,7 +475,7 @@ TEST_F(RobotSessionsTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) 
   auto r = Handle(Queries(kAlice, 1, {Query{1, QueryType::kStateStream, "", milliseconds(100)}}));
   ASSERT_EQ(r.at(1).signal, Signal::kSuccess);
   const TimePoint t0 = clock_.Now();
-  std::vector<robotalk_msgs::robot_state_t>& states = states_;
+  std::vector<StateSample>& states = states_;
   // A minute of daemon iterations at an irregular 7 ms step.
   while (clock_.Now() < t0 + seconds(60)) {
     Run();
@@ -486,12 +486,12 @@ TEST_F(RobotSessionsTest, BroadcastsStateAtItsPeriodWithoutDriftUntilCancelled) 
   ASSERT_EQ(states.size(), 600u);
   for (size_t k = 0; k < states.size(); ++k) {
     const TimePoint due = t0 + milliseconds(100) * static_cast<int>(k);
-    const TimePoint sampled = FromWireMicros(states[k].server_time_us);
+    const TimePoint sampled = states[k].server_time;
     ASSERT_GE(sampled, due) << "sample " << k;
     ASSERT_LT(sampled, due + milliseconds(7)) << "sample " << k << " drifted";
   }
   EXPECT_EQ(states.back().sample, 600);
-  EXPECT_EQ(states.back().num_dofs, 1);
+  EXPECT_EQ(states.back().positions.size(), 1u);
   EXPECT_EQ(states.back().robot, "bot");
 
   Handle(Queries(kAlice, 1000 + static_cast<std::int64_t>(states.size()),

@@ -181,3 +181,55 @@ TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
 
 }  // namespace
 }  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// Issue 9: two servers serving the same robot name both executed every command.
+TEST(ServerDaemonOneRobotOneServer, TheServerThatStartedLaterRefusesTheRobotAndNamesTheOther) {
+  ManualClock clock;
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport first_transport(bus), second_transport(bus), client(bus);
+  auto first_driver = std::make_unique<FakeDriver>(PanRobot());
+  auto second_driver = std::make_unique<FakeDriver>(PanRobot());
+  FakeDriver* first_fake = first_driver.get();
+  FakeDriver* second_fake = second_driver.get();
+  RobotDaemon first_robot("bot", "fake", std::move(first_driver), clock);
+  RobotDaemon second_robot("bot", "fake", std::move(second_driver), clock);
+  ServerDaemon first(first_transport, clock, ServerDaemonOptions{.server_id = 7});
+  first.AddRobot(first_robot, SessionOptions{});
+  first.RunOnce(Duration(0));  // serving, announcing
+  clock.Advance(std::chrono::seconds(5));
+  ServerDaemon second(second_transport, clock, ServerDaemonOptions{.server_id = 3});  // smaller id, later
+  second.AddRobot(second_robot, SessionOptions{});
+  second.RunOnce(Duration(0));  // starts, announces
+  clock.Advance(std::chrono::seconds(1));
+  for (int i = 0; i < 3; ++i) {  // both hear each other's ANNOUNCE
+    first.RunOnce(Duration(0));
+    second.RunOnce(Duration(0));
+  }
+  EXPECT_EQ(first.refused("bot"), "") << "the first server keeps serving";
+  EXPECT_THAT(second.refused("bot"), HasSubstr("is served by server 0000000000000007"));
+
+  std::map<CommandId, Reply> replies;
+  auto sub =
+      client.Subscribe("ROBOTALK/bot/REPLY/.*", [&](const std::string&, std::span<const std::uint8_t> b) {
+        for (Reply& r : DecodeReplyBatch(b).replies) replies[r.id] = r;
+      });
+  Request move{.client_id = kAlice, .sequence = 1};
+  move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+  client.Publish(RequestChannel("bot"), EncodeRequest(move));
+  for (int i = 0; i < 2; ++i) {
+    first.RunOnce(Duration(0));
+    second.RunOnce(Duration(0));
+    first_robot.RunOnce(clock.Now());
+    second_robot.RunOnce(clock.Now());
+  }
+  client.HandleFor(Duration(0));
+  EXPECT_EQ(replies.at(1).signal, Signal::kSuccess);
+  EXPECT_EQ(first_fake->calls.size(), 1u);
+  EXPECT_TRUE(second_fake->calls.empty()) << "executed once, by one server";
+}
+
+}  // namespace
+}  // namespace robotalk

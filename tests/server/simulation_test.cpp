@@ -38,12 +38,12 @@ TEST(Simulation, RunsTheServerCoreOnSimulatedTimeWithTheKinematicDriver) {
   // Samples every 10 ms of simulated time, exactly on their grid.
   ASSERT_GE(r.states.size(), 400u);
   for (size_t k = 1; k < r.states.size(); ++k) {
-    ASSERT_EQ(r.states[k].server_time_us - r.states[k - 1].server_time_us, 10000) << "sample " << k;
+    ASSERT_EQ(r.states[k].server_time - r.states[k - 1].server_time, milliseconds(10)) << "sample " << k;
   }
   // An arc of radius v/omega = 0.6 m for 3 s: the robot ends on that circle.
   const auto& last = r.states.back();
-  EXPECT_NEAR(std::hypot(last.base[0], last.base[1] - 0.6), 0.6, 1e-3);
-  EXPECT_EQ(last.base[3], 0.0) << "stopped";
+  EXPECT_NEAR(std::hypot(last.base.x, last.base.y - 0.6), 0.6, 1e-3);
+  EXPECT_EQ(last.base.v, 0.0) << "stopped";
   EXPECT_LT(r.wall_time, seconds(2)) << "4 s of robot time, much faster than real time";
 }
 
@@ -52,12 +52,12 @@ TEST(Simulation, GivesTheSameTrajectoryForTheSameSeedAndCommandsOnPhysics) {
   const SimulationResult b = RunSimulation("pioneer", "ode", Ode("3"), Arc(), {.duration = seconds(4)});
   ASSERT_EQ(a.states.size(), b.states.size());
   for (size_t k = 0; k < a.states.size(); ++k) {
-    ASSERT_EQ(a.states[k].server_time_us - a.states[0].server_time_us,
-              b.states[k].server_time_us - b.states[0].server_time_us);
-    for (int i = 0; i < 5; ++i) ASSERT_EQ(a.states[k].base[i], b.states[k].base[i]) << "sample " << k;
-    ASSERT_EQ(a.states[k].position, b.states[k].position) << "sample " << k;
+    ASSERT_EQ(a.states[k].server_time - a.states[0].server_time,
+              b.states[k].server_time - b.states[0].server_time);
+    ASSERT_EQ(a.states[k].base, b.states[k].base) << "sample " << k;
+    ASSERT_EQ(a.states[k].positions, b.states[k].positions) << "sample " << k;
   }
-  EXPECT_GT(std::hypot(a.states.back().base[0], a.states.back().base[1]), 0.3) << "it drove";
+  EXPECT_GT(std::hypot(a.states.back().base.x, a.states.back().base.y), 0.3) << "it drove";
 }
 
 }  // namespace

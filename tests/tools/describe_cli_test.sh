@@ -55,6 +55,17 @@ cat >"$tmp/negative_mass.urdf" <<'XML'
 XML
 bad "negative mass" "heavy" "$tmp/negative_mass.urdf"
 
+# Limits (issue 9): a 100,000-deep file used to crash with SIGSEGV (rc 139).
+python3 -c "import sys; sys.stdout.write('<robot name=\"x\"><link name=\"a\"/>' + '<x>'*100000 + '</x>'*100000 + '</robot>')" >"$tmp/nested.urdf"
+bad "100,000-deep XML" "nested 100001 deep.*max_xml_depth" "$tmp/nested.urdf"
+"$describe" --max-bytes 1000 "$models/pioneer2dx_pantilt.urdf" >/dev/null 2>"$tmp/err"
+check "--max-bytes refuses a bigger file" test $? -eq 1
+check "--max-bytes names the limit" grep -q "limit of 1000 bytes (UrdfImportOptions::max_file_bytes)" "$tmp/err"
+"$describe" --max-depth 2 "$models/pioneer2dx_pantilt.urdf" >/dev/null 2>"$tmp/err"
+check "--max-depth 2 refuses the shipped model" grep -q "the limit is 2 (UrdfImportOptions::max_xml_depth)" "$tmp/err"
+"$describe" --max-depth 0 "$models/pioneer2dx_pantilt.urdf" >/dev/null 2>&1
+check "--max-depth 0 is a usage error" test $? -eq 2
+
 "$describe" >/dev/null 2>&1
 check "no argument is a usage error" test $? -eq 2
 "$describe" --bogus x.urdf >/dev/null 2>&1

@@ -1,24 +1,46 @@
 // robotalk-describe: prints a URDF robot as RoboTalk sees it.
-//   robotalk-describe [--json] [--strict] [--merge-chains] FILE.urdf
+//   robotalk-describe [--json] [--strict] [--merge-chains] [--max-bytes N] [--max-depth N] FILE.urdf
 #include "describe_format.h"
 #include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 
+#include <cerrno>
+#include <climits>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <string>
+
+#ifndef ROBOTALK_VERSION
+#define ROBOTALK_VERSION "unknown"
+#endif
 
 namespace {
 
 constexpr const char* kUsage =
-    "usage: robotalk-describe [--json] [--strict] [--merge-chains] [--name NAME] FILE.urdf\n"
+    "usage: robotalk-describe [--json] [--strict] [--merge-chains] [--name NAME] [--max-bytes N]\n"
+    "                         [--max-depth N] FILE.urdf\n"
     "Prints the RoboTalk motion specification of a URDF robot: links with masses,\n"
     "joints with dofs and limits, control frames, servo types, total mass.\n"
     "  --json          one JSON object on stdout instead of tables\n"
     "  --strict        treat every import warning as an error\n"
     "  --merge-chains  merge massless joint chains into multi-dof joints (pan-tilt -> 2 dofs)\n"
     "  --name NAME     robot name to use instead of <robot name=...>\n"
+    "  --version       the version\n"
+    "  --max-bytes N   refuse files larger than N bytes (default 16 MiB)\n"
+    "  --max-depth N   refuse XML nested deeper than N elements (default 100)\n"
     "Exit status: 0 on success, 1 if the file cannot be imported, 2 on a usage error.\n";
+
+// A positive decimal integer no larger than `max`, or nullopt.
+std::optional<unsigned long long> PositiveNumber(const char* text, unsigned long long max) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text, &end, 10);
+  if (end == text || *end != '\0' || errno != 0 || text[0] == '-' || v == 0 || v > max) return std::nullopt;
+  return v;
+}
 
 }  // namespace
 
@@ -36,6 +58,21 @@ int main(int argc, char** argv) {
       options.merge_massless_chains = true;
     } else if (arg == "--name" && i + 1 < argc) {
       options.robot_name = argv[++i];
+    } else if ((arg == "--max-bytes" || arg == "--max-depth") && i + 1 < argc) {
+      const bool bytes = arg == "--max-bytes";
+      const auto v = PositiveNumber(argv[++i], bytes ? SIZE_MAX : INT_MAX);
+      if (!v) {
+        std::cerr << "robotalk-describe: " << arg << " '" << argv[i] << "' is not a positive integer\n";
+        return 2;
+      }
+      if (bytes) {
+        options.max_file_bytes = static_cast<std::size_t>(*v);
+      } else {
+        options.max_xml_depth = static_cast<int>(*v);
+      }
+    } else if (arg == "--version") {
+      std::cout << "robotalk-describe " << ROBOTALK_VERSION << "\n";
+      return 0;
     } else if (arg == "-h" || arg == "--help") {
       std::cout << kUsage;
       return 0;

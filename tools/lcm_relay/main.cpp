@@ -8,6 +8,10 @@
 
 #include "lcm_relay.h"
 
+#ifndef ROBOTALK_VERSION
+#define ROBOTALK_VERSION "unknown"
+#endif
+
 namespace {
 robotalk::relay::LcmRelay* g_relay = nullptr;
 extern "C" void OnSignal(int) {
@@ -26,6 +30,10 @@ int main(int argc, char** argv) {
   }
   if (options.help) {
     std::fputs(RelayUsage().c_str(), stdout);
+    return 0;
+  }
+  if (options.version) {
+    std::printf("robotalk-lcm-relay %s\n", ROBOTALK_VERSION);
     return 0;
   }
   try {

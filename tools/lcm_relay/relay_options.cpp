@@ -75,6 +75,17 @@ bool ApplyDirection(const std::string& option, const std::string& name, const st
   return true;
 }
 
+// Whether `name` (without "--") is an option that takes a value.
+bool TakesValue(std::string name) {
+  if (name.rfind("a2b-", 0) == 0 || name.rfind("b2a-", 0) == 0) name = name.substr(4);
+  for (const char* known :
+       {"a", "b", "seed", "duration", "echo-window-ms", "latency-ms", "jitter-ms", "jitter-dist", "loss",
+        "dup", "reorder", "reorder-delay-ms", "congestion-max-ms", "channels"}) {
+    if (name == known) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 std::uint64_t DerivedSeed(std::uint64_t seed) {
@@ -111,12 +122,18 @@ RelayOptions ParseRelayOptions(const std::vector<std::string>& args) {
       o.help = true;
       return o;
     }
+    if (arg == "--version") {
+      o.version = true;
+      return o;
+    }
     if (arg == "--stats") {
       o.stats = true;
       continue;
     }
     if (arg.rfind("--", 0) != 0) Bad(arg, "", "unexpected argument (options start with --)");
     const auto eq = arg.find('=');
+    if (!TakesValue(arg.substr(2, eq == std::string::npos ? std::string::npos : eq - 2)))
+      throw std::invalid_argument("unknown option '" + arg.substr(0, eq) + "'");
     if (eq != std::string::npos) {
       items.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
     } else {
@@ -181,6 +198,7 @@ side), both ways, through a seeded impaired channel per direction.
   --duration S            stop after S seconds (default 0: until SIGINT/SIGTERM)
   --stats                 print per-direction counters at exit
   --echo-window-ms MS     how long to recognise our own publications (default 2000)
+  --version               the version
 
 Impairments (set both directions; --a2b-NAME / --b2a-NAME set one and win):
   --latency-ms MS         fixed delay

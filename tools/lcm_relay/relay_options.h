@@ -26,6 +26,7 @@ struct RelayOptions {
   bool stats = false;       ///< print counters at exit
   Duration echo_window = std::chrono::seconds(2);
   bool help = false;
+  bool version = false;  ///< --version: print it and exit
 };
 
 /// Parses argv[1..]. Unprefixed impairment options set both directions;

@@ -1,13 +1,18 @@
 // RoboTalk's one clock abstraction. Every time inside a process is a
 // TimePoint / Duration (std::chrono); only LCM messages carry int64
-// microseconds, converted at the edge by ToWireMicros / FromWireMicros.
+// microseconds, converted at the edge by ToWireMicros / FromWireMicros, which
+// check the range (a wire value is untrusted input; overflowing it is UB).
 //
 // Thread safety: Now() may be called from any thread on every implementation.
 #pragma once
 
+#include "robotalk/error.h"
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <optional>
+#include <string>
 
 namespace robotalk {
 
@@ -42,12 +47,36 @@ class ManualClock final : public Clock {
   std::atomic<Duration::rep> now_;
 };
 
-/// Microseconds on the wire (LCM int64 fields) <-> TimePoint.
+/// The largest |microseconds| a TimePoint / Duration (int64 nanoseconds) holds:
+/// about ±292 years. Wire values beyond it cannot be represented.
+inline constexpr std::int64_t kMaxWireMicros = INT64_MAX / 1000;
+
+/// Wire microseconds -> Duration; nullopt when |us| > kMaxWireMicros (the
+/// nanosecond count would overflow). Never undefined behaviour.
+inline std::optional<Duration> TryDurationFromWireMicros(std::int64_t us) {
+  if (us > kMaxWireMicros || us < -kMaxWireMicros) return std::nullopt;
+  return Duration(us * 1000);
+}
+
+/// Wire microseconds -> Duration. Throws ProtocolError naming `field` and the
+/// value when out of range ("command 7: start_time_us 18446744073709552 us is
+/// out of range (|t| <= 9223372036854775 us)").
+inline Duration DurationFromWireMicros(std::int64_t us, const std::string& field = "time") {
+  if (auto d = TryDurationFromWireMicros(us)) return *d;
+  throw ProtocolError(field + " " + std::to_string(us) +
+                      " us is out of range (|t| <= " + std::to_string(kMaxWireMicros) + " us)");
+}
+
+/// Wire microseconds (LCM int64 fields) -> TimePoint. Throws ProtocolError
+/// naming `field` and the value when out of range.
+inline TimePoint FromWireMicros(std::int64_t us, const std::string& field = "time") {
+  return TimePoint(DurationFromWireMicros(us, field));
+}
+
+/// TimePoint / Duration -> wire microseconds, truncated toward zero. Cannot
+/// overflow (it divides).
 inline std::int64_t ToWireMicros(TimePoint t) {
   return std::chrono::duration_cast<std::chrono::microseconds>(t.time_since_epoch()).count();
-}
-inline TimePoint FromWireMicros(std::int64_t us) {
-  return TimePoint(std::chrono::duration_cast<Duration>(std::chrono::microseconds(us)));
 }
 inline std::int64_t ToWireMicros(Duration d) {
   return std::chrono::duration_cast<std::chrono::microseconds>(d).count();
@@ -55,7 +84,11 @@ inline std::int64_t ToWireMicros(Duration d) {
 
 /// Seconds as a double, for printing and for maths on rates.
 inline double ToSeconds(Duration d) { return std::chrono::duration<double>(d).count(); }
+/// Seconds -> Duration, rounded to the nanosecond. Throws robotalk::Error for
+/// NaN, infinities and magnitudes beyond ±292 years (a cast would be UB).
 inline Duration FromSeconds(double s) {
+  if (!(s > -9.2e9 && s < 9.2e9))
+    throw Error("FromSeconds: " + std::to_string(s) + " s is not a finite time");
   return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s));
 }
 

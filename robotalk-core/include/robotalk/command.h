@@ -44,11 +44,66 @@ const char* ToString(QueryType t);
 std::optional<CommandType> ParseCommandType(const std::string& name);
 std::optional<QueryType> ParseQueryType(const std::string& name);
 
+/// When a command starts: now, at a time on the SERVER clock, or after an
+/// offset from the start of a playback sequence. On the wire (command_t
+/// start_time_us, see protocol_codec.h) these are 0, server-clock micros in a
+/// DIRECT/DELAY package, and offset micros in a PLAYBACK package.
+///
+///   Command c{.type = CommandType::kGoto, .start_time = StartTime::At(client.ServerNow() + 2s), ...};
+///
+/// A TimePoint converts implicitly to At(t), std::nullopt to Now(), and a
+/// std::optional<TimePoint> to either; an offset must be said: After(d).
+class StartTime {
+ public:
+  enum class Kind : std::int8_t { kNow, kAt, kAfter };
+
+  constexpr StartTime() = default;  ///< Now()
+  constexpr StartTime(std::nullopt_t) {}
+  constexpr StartTime(TimePoint t) : kind_(Kind::kAt), value_(t.time_since_epoch()) {}
+  constexpr StartTime(std::optional<TimePoint> t) {
+    if (t) *this = StartTime(*t);
+  }
+
+  static constexpr StartTime Now() { return StartTime(); }
+  /// At `t` on the server clock (DIRECT and DELAY packages).
+  static constexpr StartTime At(TimePoint t) { return StartTime(t); }
+  /// `offset` after the sequence start (PLAYBACK packages). REQUIRES offset >= 0.
+  static constexpr StartTime After(Duration offset) {
+    StartTime s;
+    s.kind_ = Kind::kAfter;
+    s.value_ = offset;
+    return s;
+  }
+
+  constexpr Kind kind() const { return kind_; }
+  constexpr bool is_now() const { return kind_ == Kind::kNow; }
+  constexpr bool is_at() const { return kind_ == Kind::kAt; }
+  constexpr bool is_after() const { return kind_ == Kind::kAfter; }
+  /// The server-clock time of At(); nullopt for the other kinds.
+  constexpr std::optional<TimePoint> time() const {
+    return is_at() ? std::optional<TimePoint>(TimePoint(value_)) : std::nullopt;
+  }
+  /// The offset of After(); nullopt for the other kinds.
+  constexpr std::optional<Duration> offset() const {
+    return is_after() ? std::optional<Duration>(value_) : std::nullopt;
+  }
+  /// Back to Now().
+  constexpr void reset() { *this = StartTime(); }
+
+  constexpr bool operator==(const StartTime&) const = default;
+
+ private:
+  Kind kind_ = Kind::kNow;
+  Duration value_{0};
+};
+
+/// "now", "at 12.5 s", "after 0.3 s" (server-clock seconds), for messages.
+std::string ToString(const StartTime& s);
+
 struct Command {
   CommandId id = 0;
   CommandType type = CommandType::kStop;
-  /// Server-clock start time; nullopt = execute at once (wire value 0).
-  std::optional<TimePoint> start_time;
+  StartTime start_time;
   std::string target;  ///< joint or control-frame name; empty for base / whole-robot commands
   std::vector<double> values;
 };

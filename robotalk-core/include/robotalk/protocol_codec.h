@@ -8,6 +8,7 @@
 #pragma once
 
 #include "robotalk/command.h"
+#include "robotalk/state_sample.h"
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
 #include "robotalk_msgs/robot_state_t.hpp"
@@ -20,14 +21,41 @@ namespace robotalk {
 
 inline constexpr std::int16_t kProtocolVersion = 1;
 
+// Start times on the wire (command_t.start_time_us, by the package's mode,
+// package_header_t::MODE_*):
+//   StartTime::Now()       <-> 0 in every mode
+//   StartTime::At(t)       <-> server-clock micros of t, DIRECT and DELAY packages
+//   StartTime::After(d)    <-> micros of the offset d, PLAYBACK packages (0 = the
+//                              sequence start: After(0), not Now())
+// Every wire time is range-checked (clock.h): an out-of-range value, or a kind
+// that does not belong in the package's mode, is a ProtocolError naming the
+// command id, the field and the value.
+
+/// Encodes by the start time's kind (Now -> 0, At -> time, After -> offset).
+/// Throws ProtocolError for a negative time or offset. (At(the epoch) encodes
+/// as 0, which a DIRECT/DELAY package reads as now: server clocks start far
+/// from their epoch, so only a test meets it.)
 robotalk_msgs::command_t ToWire(const Command& c);
+/// Same, and checks the kind against the package mode the command travels in.
+robotalk_msgs::command_t ToWire(const Command& c, std::int8_t package_mode);
 robotalk_msgs::query_t ToWire(const Query& q);
 robotalk_msgs::reply_t ToWire(const Reply& r);
 
-/// Throw ProtocolError naming the id and the bad field (unknown type, ...).
+/// Throw ProtocolError naming the id and the bad field (unknown type, time
+/// out of range, ...). The command's start time is read per `package_mode`;
+/// without one, as in a DIRECT package (absolute).
 Command FromWire(const robotalk_msgs::command_t& c);
+Command FromWire(const robotalk_msgs::command_t& c, std::int8_t package_mode);
 Query FromWire(const robotalk_msgs::query_t& q);
 Reply FromWire(const robotalk_msgs::reply_t& r);
+
+/// State samples. FromWire validates: num_dofs and num_frames non-negative and
+/// equal to the array sizes, every value finite, times in range, period and
+/// sample not negative; throws ProtocolError naming the field ("robot_state
+/// 'pioneer' sample 3: position[2] is NaN"). `expected_dofs` >= 0 also checks
+/// the dof count against a model's.
+StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs = -1);
+robotalk_msgs::robot_state_t ToWire(const StateSample& s);
 
 /// Decodes a client package; throws ProtocolError on truncated, hostile or
 /// foreign bytes (wrong fingerprint), naming what was wrong.
@@ -37,6 +65,8 @@ robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> 
 
 /// Decodes a broadcast state sample; same guarantees.
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes);
+/// DecodeRobotState + FromWire: bytes to a validated StateSample.
+StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs = -1);
 
 /// Checks a decoded package's header against its payload: version, client id,
 /// sequence, payload type and size, never both queries and commands. Returns

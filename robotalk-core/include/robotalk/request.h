@@ -87,9 +87,13 @@ struct RobotAnnouncement {
 struct Announcement {
   std::int64_t server_id = 0;
   TimePoint server_time{};
+  Duration uptime{0};  ///< how long the server has been serving
   std::string url_hint;
   std::vector<RobotAnnouncement> robots;
 };
 std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& announcement);
+/// Throws ProtocolError on truncated, hostile or foreign bytes, or more than
+/// 1024 robots.
+Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes);
 
 }  // namespace robotalk

@@ -48,6 +48,8 @@ struct ServerOptions {
   int log_lines_per_second = 20;
   /// A file that keeps which robots are in panic across restarts ("" = none).
   std::string panic_latch_path;
+  /// Serve a robot even when another server announces the same name.
+  bool allow_duplicate_robots = false;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
   /// The paper's congestion injector (§VI-B): after each received package the

@@ -10,7 +10,7 @@
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 #include "robotalk/driver.h"
-#include "robotalk_msgs/robot_state_t.hpp"
+#include "robotalk/state_sample.h"
 
 #include <memory>
 #include <string>
@@ -32,9 +32,9 @@ struct SimulationOptions {
 };
 
 struct SimulationResult {
-  std::vector<robotalk_msgs::robot_state_t> states;  ///< every sample, in time order
-  std::vector<Reply> replies;                        ///< one per command, in the order given
-  Duration wall_time{0};                             ///< how long the run took for real
+  std::vector<StateSample> states;  ///< every sample, in time order
+  std::vector<Reply> replies;       ///< one per command, in the order given
+  Duration wall_time{0};            ///< how long the run took for real
 };
 
 /// Runs `commands` on `driver` for `options.duration` of simulated time.

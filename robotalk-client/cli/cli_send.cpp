@@ -1,0 +1,190 @@
+// `robotalk send`: one command or a sequence file, waited for to its end,
+// stopped on Ctrl-C / SIGTERM (docs/client.md, "Ctrl-C and long commands").
+#include "cli_commands.h"
+#include "cli_support.h"
+#include "interrupt.h"
+#include "sequence_file.h"
+#include "sequence_runner.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace robotalk::cli {
+namespace {
+
+struct SequenceFlags {
+  SequenceOptions options;
+  bool any = false;  // a mode flag was given (only valid with --file)
+};
+
+// --mode direct|delay|playback, --delay S, --paced.
+SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
+  SequenceFlags f;
+  f.options.mode = CommandMode::kDelay;
+  f.options.delay = Duration(0);
+  f.options.paced = false;
+  std::string mode, delay;
+  if (TakeOption(args, "--mode", &mode)) {
+    auto m = ParseCommandMode(mode);
+    if (!m) throw UsageError("--mode " + mode + ": expected direct, delay or playback");
+    f.options.mode = *m;
+    f.any = true;
+  }
+  if (TakeOption(args, "--delay", &delay)) {
+    const double d = ParseNumber(delay, "--delay");
+    if (d < 0) throw UsageError("--delay " + delay + " is negative");
+    if (f.options.mode != CommandMode::kDelay) throw UsageError("--delay goes with --mode delay");
+    f.options.delay = FromSeconds(d);
+    f.any = true;
+  }
+  if (TakeOption(args, "--paced", nullptr)) {
+    f.options.paced = true;
+    f.any = true;
+  }
+  if (f.options.mode == CommandMode::kDirect) f.options.paced = true;  // a handshake per frame, at its time
+  return f;
+}
+
+bool ProgressOnTty() { return isatty(STDERR_FILENO) == 1; }
+
+void PrintOne(const Reply& r, bool json) {
+  if (json) {
+    std::cout << ReplyJson(r) << '\n' << std::flush;
+  } else {
+    PrintReply(r, std::cout);
+    std::cout << std::flush;
+  }
+}
+
+// After a signal: says what was stopped; returns 128 + signal.
+int Interrupted(int signal, const std::string& note) {
+  std::cerr << "robotalk: interrupted by " << Interrupter::Name(signal) << ": " << note << "\n";
+  return Interrupter::ExitStatus(signal);
+}
+
+int SendFile(const GlobalOptions& g, const std::string& robot, const std::string& path,
+             const SequenceOptions& options, bool json) {
+  std::ifstream file(path);
+  if (!file) throw UsageError("cannot read sequence file '" + path + "'");
+  std::stringstream text;
+  text << file.rdbuf();
+  const auto entries = ParseSequence(text.str(), path);  // all lines checked before connecting
+  std::vector<TimedCommand> frames;
+  for (const auto& e : entries) frames.push_back({FromSeconds(e.offset_s), e.command});
+
+  const auto client = ConnectClient(g, robot);
+  const bool bar = ProgressOnTty();
+  int status = 0;
+  const RunReport report = RunFrames(
+      *client, std::move(frames), options,
+      [&](std::size_t, const Reply& r) {
+        if (bar) std::cerr << "\r\033[K" << std::flush;
+        PrintOne(r, json);
+        status = std::max(status, ExitStatus(r));
+      },
+      [&](const RunProgress& p) {
+        if (bar) std::cerr << "\r" << ProgressBar(p) << std::flush;
+      });
+  if (bar) std::cerr << "\r\033[K" << std::flush;
+  if (report.playback_delay) {
+    std::cerr << "robotalk: playback: the server starts the sequence "
+              << FormatDuration(*report.playback_delay) << " after its first frame arrived\n";
+  }
+  if (report.signal) {
+    const int code = Interrupted(report.signal, report.interrupt_note);
+    if (report.worker_abandoned) {
+      std::fflush(stdout);
+      std::_Exit(code);
+    }
+    return code;
+  }
+  return status;
+}
+
+// Servo commands the server holds only while their client's session lives.
+bool HeldWhileAlive(CommandType t) {
+  return t == CommandType::kSetSpeed || t == CommandType::kJointSpeed || t == CommandType::kJointForce;
+}
+
+int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::optional<double> at, bool hold,
+            bool json) {
+  const auto client = ConnectClient(g, robot);
+  if (at) c.start_time = client->ServerNow() + FromSeconds(*at);
+  const CommandType type = c.type;
+  const bool motion = IsMotionCommand(type);
+  PendingReply pending = client->Send(std::move(c));
+  const bool bar = ProgressOnTty() && (type == CommandType::kGoto || at);
+  const std::optional<Reply> r = AwaitReply(pending, [&](Duration waited) {
+    if (bar && waited > std::chrono::milliseconds(300))
+      std::cerr << "\r" << ToString(type) << " " << pending.id() << ": waiting for its end, "
+                << FormatSeconds(std::round(ToSeconds(waited) * 10) / 10) << " \033[K" << std::flush;
+  });
+  if (bar) std::cerr << "\r\033[K" << std::flush;
+  if (!r) {
+    const int sig = Interrupter::Signal();
+    if (!motion) return Interrupted(sig, "nothing was moving");
+    const std::string note = StopNow(*client) + " for the " + ToString(type) + " this command started";
+    try {
+      PrintOne(pending.Wait(std::chrono::seconds(1)), json);  // usually INTERRUPTED by the STOP
+    } catch (const std::exception&) {
+    }
+    return Interrupted(sig, note);
+  }
+  PrintOne(*r, json);
+  if (!Succeeded(r->signal) || !HeldWhileAlive(type)) {
+    if (hold) std::cerr << "robotalk: --hold applies to setspeed, joint_speed and joint_force only\n";
+    return ExitStatus(*r);
+  }
+  if (!hold) {
+    std::cerr
+        << "robotalk: note: " << robot << " keeps this " << ToString(type)
+        << " only while this command runs: the server's watchdog stops the robot about its "
+           "--session-timeout (default 2 s) after robotalk exits. Use --hold to keep it until Ctrl-C.\n";
+    return ExitStatus(*r);
+  }
+  std::cerr << "robotalk: holding " << ToString(type) << " on " << robot << " until Ctrl-C (then STOP)\n";
+  while (!Interrupter::Signal()) Interrupter::WaitFor(std::chrono::seconds(1));
+  std::cerr << "robotalk: " << StopNow(*client) << " (hold ended by "
+            << Interrupter::Name(Interrupter::Signal()) << ")\n";
+  return 0;
+}
+
+}  // namespace
+
+int RunSend(const GlobalOptions& g, const std::vector<std::string>& in) {
+  std::vector<std::string> args = in;
+  std::string file, at;
+  const bool has_file = TakeOption(args, "--file", &file);
+  const bool has_at = TakeOption(args, "--at", &at);
+  const bool hold = TakeOption(args, "--hold", nullptr);
+  const bool json = TakeOption(args, "--json", nullptr);
+  const SequenceFlags sequence = TakeSequenceFlags(args);
+  RejectOptions(args);
+  if (args.empty()) {
+    throw UsageError(
+        "usage: robotalk send ROBOT COMMAND ARGS... [--at S] [--hold] | send ROBOT --file SEQ.txt [--mode M] "
+        "[--delay S] [--paced]");
+  }
+  if (has_file) {
+    if (args.size() != 1 || has_at || hold) throw UsageError("send ROBOT --file SEQ.txt takes nothing else");
+    return SendFile(g, args[0], file, sequence.options, json);
+  }
+  if (sequence.any) throw UsageError("--mode, --delay and --paced go with --file");
+  Command c = ParseCommandWords({args.begin() + 1, args.end()});
+  if (hold && !HeldWhileAlive(c.type))
+    throw UsageError("--hold goes with setspeed, joint_speed or joint_force");
+  std::optional<double> delay;
+  if (has_at) {
+    delay = ParseNumber(at, "--at");
+    if (*delay < 0) throw UsageError("--at " + at + " is negative");
+  }
+  return SendOne(g, args[0], std::move(c), delay, hold, json);
+}
+
+}  // namespace robotalk::cli

@@ -1,0 +1,172 @@
+#include "cli_support.h"
+
+#include "robotalk/channels.h"
+#include "robotalk_msgs/announce_t.hpp"
+#include "sequence_runner.h"
+
+#include <poll.h>
+#include <unistd.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+namespace robotalk::cli {
+
+constexpr Duration kAnnounceWait = std::chrono::milliseconds(1200);  // > one announce period
+
+struct AnnounceWatch::Impl {
+  lcm::LCM lcm;
+  int wake[2] = {-1, -1};
+  mutable std::mutex mu;
+  std::set<std::string> names;  // GUARDED_BY(mu)
+  std::thread thread;
+
+  explicit Impl(const std::string& url) : lcm(url) {}
+  void On(const lcm::ReceiveBuffer*, const std::string&, const robotalk_msgs::announce_t* a) {
+    std::lock_guard lock(mu);
+    for (const auto& r : a->robots) names.insert(r.name);
+  }
+  void Run() {
+    // poll() on LCM's socket and a pipe: the destructor wakes it at once.
+    for (;;) {
+      pollfd fds[2] = {{lcm.getFileno(), POLLIN, 0}, {wake[0], POLLIN, 0}};
+      if (poll(fds, 2, -1) < 0) continue;
+      if (fds[1].revents) return;
+      if (fds[0].revents & POLLIN) lcm.handle();
+    }
+  }
+};
+
+AnnounceWatch::AnnounceWatch(const std::string& url) : impl_(std::make_unique<Impl>(url)) {
+  if (!impl_->lcm.good() || pipe(impl_->wake) != 0) return;
+  impl_->lcm.subscribe(kAnnounceChannel, &Impl::On, impl_.get());
+  impl_->thread = std::thread([this] { impl_->Run(); });
+}
+
+AnnounceWatch::~AnnounceWatch() {
+  if (impl_->thread.joinable()) {
+    const char byte = 1;
+    if (write(impl_->wake[1], &byte, 1) != 1) impl_->thread.detach();
+    if (impl_->thread.joinable()) impl_->thread.join();
+  }
+  for (int fd : impl_->wake)
+    if (fd >= 0) close(fd);
+}
+
+std::set<std::string> AnnounceWatch::Heard() const {
+  std::lock_guard lock(impl_->mu);
+  return impl_->names;
+}
+
+ClientOptions MakeOptions(const GlobalOptions& g) {
+  ClientOptions o;
+  o.lcm_url = g.url;
+  o.timeout = FromSeconds(g.timeout_s);
+  o.connect_timeout = FromSeconds(g.timeout_s);
+  return o;
+}
+
+std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot) {
+  AnnounceWatch watch(g.url);
+  const Duration total = FromSeconds(g.timeout_s);
+  ClientOptions options = MakeOptions(g);
+  options.connect_timeout = std::min(total, kAnnounceWait);
+  auto client = std::make_unique<RobotClient>(options);
+  try {
+    client->Connect(robot);
+    return client;
+  } catch (const TimeoutError&) {
+    const std::set<std::string> heard = watch.Heard();
+    if (heard.count(robot) == 0) {
+      std::string list;
+      for (const auto& n : heard) list += (list.empty() ? "" : ", ") + n;
+      if (!list.empty()) throw ClientError("no robot '" + robot + "' on this network (heard: " + list + ")");
+      if (options.connect_timeout >= kAnnounceWait)
+        throw ClientError("no robot '" + robot + "' on this network (no server announced itself within " +
+                          FormatDuration(options.connect_timeout) +
+                          "; is robotalk-server running with this --url?)");
+    }
+    if (options.connect_timeout >= total) throw;
+  }
+  // Announced but slow to answer: use the rest of --timeout.
+  options.connect_timeout = total - options.connect_timeout;
+  client = std::make_unique<RobotClient>(options);
+  client->Connect(robot);
+  return client;
+}
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string JsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+namespace {
+template <typename It>
+std::string JsonArray(It begin, It end) {
+  std::string out = "[";
+  for (It it = begin; it != end; ++it) out += (it == begin ? "" : ",") + JsonNumber(*it);
+  return out + "]";
+}
+}  // namespace
+
+std::string ReplyJson(const Reply& r) {
+  std::ostringstream out;
+  out << "{\"id\":" << r.id << ",\"signal\":" << JsonString(std::string(ToString(r.signal)))
+      << ",\"message\":" << JsonString(r.message) << ",\"exec_time_us\":" << ToWireMicros(r.exec_time)
+      << ",\"lateness_s\":" << JsonNumber(ToSeconds(r.lateness))
+      << ",\"values\":" << JsonArray(r.values.begin(), r.values.end()) << "}";
+  return out.str();
+}
+
+std::string StateJson(const robotalk_msgs::robot_state_t& s) {
+  std::ostringstream out;
+  out << "{\"robot\":" << JsonString(s.robot) << ",\"sample\":" << s.sample
+      << ",\"server_time_us\":" << s.server_time_us
+      << ",\"period_s\":" << JsonNumber(static_cast<double>(s.period_us) * 1e-6)
+      << ",\"panic\":" << (s.panic ? "true" : "false") << ",\"moving\":" << (s.moving ? "true" : "false")
+      << ",\"base\":" << JsonArray(std::begin(s.base), std::end(s.base))
+      << ",\"position\":" << JsonArray(s.position.begin(), s.position.end())
+      << ",\"velocity\":" << JsonArray(s.velocity.begin(), s.velocity.end())
+      << ",\"effort\":" << JsonArray(s.effort.begin(), s.effort.end()) << "}";
+  return out.str();
+}
+
+std::string RobotsJson(const std::vector<AnnouncedRobot>& robots) {
+  std::ostringstream out;
+  out << "[";
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const AnnouncedRobot& r = robots[i];
+    out << (i ? "," : "") << "{\"name\":" << JsonString(r.name) << ",\"driver\":" << JsonString(r.driver)
+        << ",\"dofs\":" << r.total_dofs << ",\"config_hash\":" << JsonString(Hex64(r.config_hash))
+        << ",\"panic\":" << (r.panic ? "true" : "false") << ",\"clients\":" << r.num_clients
+        << ",\"server\":" << JsonString(Hex64(static_cast<std::uint64_t>(r.server_id))) << "}";
+  }
+  out << "]";
+  return out.str();
+}
+
+}  // namespace robotalk::cli

@@ -1,0 +1,49 @@
+// Helpers the `robotalk` subcommands share: connecting with a fast, clear
+// failure for a robot nobody offers, and JSON output.
+#pragma once
+
+#include "cli_commands.h"
+#include "robotalk/robot_client.h"
+
+#include <iosfwd>
+#include <memory>
+#include <set>
+#include <string>
+
+namespace robotalk::cli {
+
+/// Listens to ROBOTALK/ANNOUNCE on its own LCM instance and thread from
+/// construction to destruction (which wakes and joins it at once).
+/// Thread safety: Heard() may be called from any thread.
+class AnnounceWatch {
+ public:
+  explicit AnnounceWatch(const std::string& url);
+  ~AnnounceWatch();
+  AnnounceWatch(const AnnounceWatch&) = delete;
+  AnnounceWatch& operator=(const AnnounceWatch&) = delete;
+  /// Robot names heard so far, sorted.
+  std::set<std::string> Heard() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Connects a client to `robot`. While connecting it listens to ANNOUNCE:
+/// when the robot does not answer within ~1.2 s (servers announce once a
+/// second) and no server announced it, it fails at once with ClientError
+/// "no robot 'piooner' on this network (heard: pioneer)" instead of waiting
+/// the whole --timeout. Throws TimeoutError / ClientError otherwise.
+std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot);
+
+ClientOptions MakeOptions(const GlobalOptions& g);
+
+/// JSON text of a string (quoted, escaped) and of a number (null for NaN/inf).
+std::string JsonString(const std::string& s);
+std::string JsonNumber(double v);
+/// {"id":12,"signal":"SUCCESS","message":"","exec_time_us":..,"lateness_s":..,"values":[..]}
+std::string ReplyJson(const Reply& r);
+std::string StateJson(const robotalk_msgs::robot_state_t& s);
+std::string RobotsJson(const std::vector<AnnouncedRobot>& robots);
+
+}  // namespace robotalk::cli

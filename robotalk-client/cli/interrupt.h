@@ -1,0 +1,33 @@
+// Ctrl-C and SIGTERM for the command-line tools, as a flag that their wait
+// loops check: a tool that started a motion must send STOP for it before it
+// exits (docs/client.md, "Ctrl-C"), which a plain signal handler cannot do
+// (RobotClient is not async-signal-safe).
+//
+// Install() blocks SIGINT and SIGTERM in the calling thread and starts one
+// thread that sigwait()s for them; every thread started afterwards (LCM's,
+// RobotClient's ReadDaemon) inherits the mask, so only that thread receives
+// them. The first signal is recorded; a second one ends the process at once
+// with status 128 + signal (the user insists).
+//
+// Thread safety: every function may be called from any thread.
+#pragma once
+
+#include "robotalk/clock.h"
+
+namespace robotalk::cli {
+
+class Interrupter {
+ public:
+  /// Call first in main(), before any other thread exists. Idempotent.
+  static void Install();
+  /// The first SIGINT/SIGTERM received, or 0. Without Install(), always 0.
+  static int Signal();
+  /// Waits at most `d`, returning early when a signal arrives; returns Signal().
+  static int WaitFor(Duration d);
+  /// "SIGINT", "SIGTERM".
+  static const char* Name(int signal);
+  /// The conventional exit status after `signal`: 128 + signal.
+  static int ExitStatus(int signal) { return 128 + signal; }
+};
+
+}  // namespace robotalk::cli

@@ -1,0 +1,79 @@
+// Runs a timed sequence (or one command) through the public RobotClient API
+// and waits for its END, however long its tasks take, while reporting
+// progress and watching for Ctrl-C / SIGTERM (interrupt.h). Used by
+// `robotalk send` and `robotalk-logplay replay`.
+//
+// Unlike RobotClient::RunSequence, nothing here times out while the server
+// keeps answering (a 30 s GOTO is waited for); a dead server still ends the
+// wait with TimeoutError once the client gives up retransmitting.
+//
+// On a signal the runner stops what it started: it stops sending frames,
+// sends STOP at once, and (delay mode) a STOP at the start time of every
+// frame still queued on the server: the protocol cannot cancel a queued
+// command, so each one is ended as soon as it begins.
+//
+// Thread safety: one runner call per client at a time; callbacks run on the
+// calling thread.
+#pragma once
+
+#include "robotalk/robot_client.h"
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace robotalk::cli {
+
+struct RunProgress {
+  std::size_t answered = 0;
+  std::size_t total = 0;
+  Duration elapsed{0};   ///< since the sequence's offset 0 (negative before it)
+  Duration duration{0};  ///< the last frame's offset
+};
+
+struct RunReport {
+  /// One per frame, in the order given; nullopt when never answered (interrupted).
+  std::vector<std::optional<Reply>> replies;
+  int signal = 0;                          ///< the interrupting signal, 0 when none
+  std::string interrupt_note;              ///< what was done about it (STOP sent ...)
+  std::optional<Duration> playback_delay;  ///< playback: the server's choice
+  /// Playback only: RunSequence still runs on a thread of its own; the caller
+  /// must end the process (std::_Exit) instead of destroying the client.
+  bool worker_abandoned = false;
+};
+
+using ReplyCallback = std::function<void(std::size_t index, const Reply& reply)>;
+using ProgressCallback = std::function<void(const RunProgress& progress)>;
+
+/// Sends `frames` in `options.mode` (direct: one handshake per frame at its
+/// time; delay: start = server now + delay + offset, all at once or paced;
+/// playback: RobotClient::RunSequence on a worker thread) and waits for every
+/// reply. `on_reply` gets each reply (delay and playback: in the order given;
+/// direct: in time order); `on_progress` is called about every 50 ms.
+/// Throws TimeoutError / ClientError from the client.
+RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const SequenceOptions& options,
+                    const ReplyCallback& on_reply, const ProgressCallback& on_progress);
+
+/// Waits for one pending reply with no time limit, calling `on_progress`
+/// (time since the wait began) about every 50 ms. Returns nullopt when a
+/// signal arrived first. Throws TimeoutError when the client gave up.
+std::optional<Reply> AwaitReply(PendingReply& pending, const std::function<void(Duration)>& on_progress);
+
+/// Sends STOP now and waits for its reply (the client's timeout); returns a
+/// short account: "STOP sent to pioneer: SUCCESS". Never throws.
+std::string StopNow(RobotClient& client);
+
+/// "5 s", "0.25 s", "1.5 s": seconds without trailing zeros.
+std::string FormatSeconds(double seconds);
+inline std::string FormatDuration(Duration d) { return FormatSeconds(ToSeconds(d)); }
+
+/// Rewrites every "<number>.<digits> s" in a message to FormatSeconds form
+/// ("no reply within 5.000000 s" -> "no reply within 5 s").
+std::string TidyDurations(const std::string& message);
+
+/// A one-line progress bar "[#####.....]  12/40  3.2 s / 8 s" of `width` cells.
+std::string ProgressBar(const RunProgress& p, int width = 30);
+
+}  // namespace robotalk::cli

@@ -1,0 +1,109 @@
+#include "robotalk/state_sample.h"
+#include "robotalk/error.h"
+#include "robotalk/protocol_codec.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace robotalk {
+namespace {
+
+using ::testing::HasSubstr;
+
+StateSample Sample() {
+  StateSample s;
+  s.server_time = TimePoint(std::chrono::microseconds(5'000'123));
+  s.period = std::chrono::milliseconds(50);
+  s.sample = 3;
+  s.robot = "pioneer";
+  s.config_hash = 0xfedcba9876543210ULL;
+  s.panic = false;
+  s.moving = true;
+  s.positions = {0.1, -0.2};
+  s.velocities = {1, 2};
+  s.efforts = {0, 0.5};
+  s.base = {1, 2, 0.5, 0.3, -0.1};
+  s.frame_poses = {{1, 2, 3, 1, 0, 0, 0}};
+  return s;
+}
+
+std::vector<std::uint8_t> Encode(const robotalk_msgs::robot_state_t& w) {
+  std::vector<std::uint8_t> bytes(static_cast<size_t>(w.getEncodedSize()));
+  w.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+std::string FromWireError(const robotalk_msgs::robot_state_t& w, int expected_dofs = -1) {
+  try {
+    FromWire(w, expected_dofs);
+  } catch (const ProtocolError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(StateSample, RoundTripsThroughTheWireAndTheBytes) {
+  const StateSample s = Sample();
+  EXPECT_EQ(FromWire(ToWire(s)), s);
+  EXPECT_EQ(DecodeStateSample(Encode(ToWire(s)), 2), s);
+}
+
+TEST(StateSample, RefusesSizesThatDisagreeWithTheCounts) {
+  auto w = ToWire(Sample());
+  w.num_dofs = 3;
+  EXPECT_THAT(FromWireError(w),
+              HasSubstr("robot_state 'pioneer' sample 3: position has 2 values but num_dofs is 3"));
+  w = ToWire(Sample());
+  w.velocity.pop_back();
+  EXPECT_THAT(FromWireError(w), HasSubstr("velocity has 1 values"));
+  w = ToWire(Sample());
+  w.num_frames = -1;
+  EXPECT_THAT(FromWireError(w), HasSubstr("frame_poses has 1 values but num_frames is -1"));
+  w = ToWire(Sample());
+  w.frame_poses[0].pop_back();
+  EXPECT_THAT(FromWireError(w), HasSubstr("frame_poses[0] is not 7 values"));
+}
+
+TEST(StateSample, ChecksTheDofCountAgainstTheModel) {
+  EXPECT_THAT(FromWireError(ToWire(Sample()), 5), HasSubstr("num_dofs is 2, the model has 5"));
+  EXPECT_NO_THROW(FromWire(ToWire(Sample()), 2));
+}
+
+TEST(StateSample, RefusesNonFiniteValuesNamingTheField) {
+  auto w = ToWire(Sample());
+  w.position[1] = std::nan("");
+  EXPECT_THAT(FromWireError(w), HasSubstr("position[1] is NaN"));
+  w = ToWire(Sample());
+  w.base[4] = std::numeric_limits<double>::infinity();
+  EXPECT_THAT(FromWireError(w), HasSubstr("base[4] is infinite"));
+  w = ToWire(Sample());
+  w.frame_poses[0][3] = std::nan("");
+  EXPECT_THAT(FromWireError(w), HasSubstr("frame_poses[0][3] is NaN"));
+  w = ToWire(Sample());
+  w.effort[0] = -std::numeric_limits<double>::infinity();
+  EXPECT_THAT(FromWireError(w), HasSubstr("effort[0] is infinite"));
+}
+
+TEST(StateSample, RefusesTimesOutOfRange) {
+  auto w = ToWire(Sample());
+  w.server_time_us = INT64_MAX;
+  EXPECT_THAT(FromWireError(w), HasSubstr("server_time_us 9223372036854775807 us is out of range"));
+  w = ToWire(Sample());
+  w.period_us = -1;
+  EXPECT_THAT(FromWireError(w), HasSubstr("negative period_us"));
+  w = ToWire(Sample());
+  w.period_us = INT64_MAX;
+  EXPECT_THAT(FromWireError(w), HasSubstr("period_us"));
+}
+
+TEST(StateSample, ToWireRefusesUnequalDofArrays) {
+  StateSample s = Sample();
+  s.efforts.clear();
+  EXPECT_THROW(ToWire(s), ProtocolError);
+}
+
+}  // namespace
+}  // namespace robotalk

@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# robotalk-logplay end to end (docs/logplay.md): a session recorded with
+# lcm-logger on the ODE Pioneer, sent in the DEFAULT `robotalk send --file`
+# mode, replays onto a SECOND robot of another name and ends within 1 cm /
+# 0.01 rad of the recorded final pose. Also: info, extract (a file `robotalk
+# send --file` accepts), export (CSV, PNG).
+# Runs inside a private network namespace (CTest wraps it with netns_run.sh).
+#   logplay_replay_test.sh SERVER CLI LOGPLAY MODELS_DIR
+set -u
+server_bin=$1 cli=$2 logplay=$3 models=$4
+url="udpm://239.255.76.67:7811?ttl=0"
+command -v lcm-logger >/dev/null || { echo "SKIP: lcm-logger (liblcm-bin) not installed"; exit 77; }
+tmp=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+  wait 2>/dev/null
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+pass=0 failures=0
+check() {  # check NAME COMMAND...
+  local name=$1; shift
+  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
+}
+rt() { "$cli" --url "$url" "$@"; }
+
+"$server_bin" --robot "pioneer=ode:$models/pioneer2dx_pantilt.urdf" \
+  --robot "pioneer2=ode:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 100 2>"$tmp/server.log" &
+pids+=($!)
+for _ in $(seq 50); do [ "$(grep -c "serving robot" "$tmp/server.log")" -ge 2 ] && break; sleep 0.1; done
+
+# --- record: the state stream and a sequence in send's default mode ---------
+lcm-logger -q -f --lcm-url="$url" -c 'ROBOTALK/.*' "$tmp/session.lcmlog" &
+logger=$!
+rt watch pioneer --period 0.05 >"$tmp/watch.txt" 2>&1 &
+watcher=$!
+cat >"$tmp/seq.txt" <<'SEQ'
+0.0 setspeed 0.3 0
+0.0 joint_setpoint pan 0.4
+1.0 setspeed 0.3 0.6
+1.5 joint_setpoint tilt -0.3
+2.2 setspeed 0.25 -0.5
+3.0 joint_setpoint pan -0.2
+3.4 stop
+SEQ
+sleep 0.5
+rt send pioneer --file "$tmp/seq.txt" >"$tmp/send.out" 2>&1
+check "the recorded sequence succeeds" test "$(grep -c SUCCESS "$tmp/send.out")" -eq 7
+# The recording ends once the robot has settled (no longer moving).
+for _ in $(seq 40); do
+  tail -1 "$tmp/watch.txt" | grep -q "v=0.000 w=0.000" && break
+  sleep 0.1
+done
+sleep 0.3
+kill "$watcher"; wait "$watcher" 2>/dev/null
+sleep 0.2
+kill -INT "$logger"; wait "$logger" 2>/dev/null
+
+# --- info ---------------------------------------------------------------------
+"$logplay" info "$tmp/session.lcmlog" >"$tmp/info.txt" 2>&1
+check "info exits 0" test $? -eq 0
+check "info lists both robots" grep -q "pioneer2  driver ode" "$tmp/info.txt"
+check "info shows the command stream" grep -q "commands 7: JOINT_SETPOINT 3 SETSPEED 3 STOP 1" "$tmp/info.txt"
+check "info places it on the server clock" grep -q "7 frames over 3.4 s (server clock)" "$tmp/info.txt"
+final=$(grep "^state pioneer:" "$tmp/info.txt")
+read -r x0 y0 th0 < <(echo "$final" | sed 's/.*final base x \([^ ]*\) y \([^ ]*\) theta \([^;]*\);.*/\1 \2 \3/')
+read -r pan0 tilt0 < <(echo "$final" | awk '{print $(NF-1), $NF}')
+check "the recorded robot moved (x=$x0)" awk -v x="$x0" 'BEGIN { exit !(x > 0.5) }'
+
+# --- extract ------------------------------------------------------------------
+"$logplay" extract "$tmp/session.lcmlog" --robot pioneer -o "$tmp/extracted.txt" 2>"$tmp/extract.err"
+check "extract exits 0" test $? -eq 0
+check "extract writes 7 commands" test "$(grep -vc '^#' "$tmp/extracted.txt")" -eq 7
+check "extract recovers the offsets" grep -q "^3.400000 stop" "$tmp/extracted.txt"
+check "extract keeps targets and values" grep -q "^1.500000 joint_setpoint tilt -0.3$" "$tmp/extracted.txt"
+
+# --- replay onto pioneer2 -------------------------------------------------------
+"$logplay" replay "$tmp/session.lcmlog" --robot pioneer2 --from pioneer --url "$url" >"$tmp/replay.out" 2>&1
+check "replay exits 0" test $? -eq 0
+check "replay summarises the signals" grep -q "replayed 7/7 commands onto 'pioneer2'.*SUCCESS 7" "$tmp/replay.out"
+sleep 1.0
+read -r x1 y1 th1 < <(rt query pioneer2 base_pose | awk '{print $(NF-4), $(NF-3), $(NF-2)}')
+read -r pan1 tilt1 < <(rt query pioneer2 joint_state | awk '{print $6, $7}')
+echo "recorded final: x $x0 y $y0 theta $th0 pan $pan0 tilt $tilt0"
+echo "replayed final: x $x1 y $y1 theta $th1 pan $pan1 tilt $tilt1"
+within() { awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= tol) }'; }
+check "x within 1 cm" within "$x0" "$x1" 0.01
+check "y within 1 cm" within "$y0" "$y1" 0.01
+check "theta within 0.01 rad" within "$th0" "$th1" 0.01
+check "pan within 0.01 rad" within "$pan0" "$pan1" 0.01
+check "tilt within 0.01 rad" within "$tilt0" "$tilt1" 0.01
+
+# --- export -------------------------------------------------------------------
+if python3 -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"; fi
+"$logplay" export "$tmp/session.lcmlog" -o "$tmp/export" $plot >"$tmp/export.out" 2>&1
+check "export exits 0" test $? -eq 0
+check "commands.csv has 7 commands" test "$(grep -c ',pioneer,' "$tmp/export/commands.csv")" -eq 7
+check "state.csv has the samples" test "$(grep -c '^pioneer,' "$tmp/export/state.csv")" -gt 40
+[ -z "$plot" ] && check "the PNG was written" test -s "$tmp/export/session.png"
+
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,208 @@
+// SessionLog and the frame/sequence helpers of robotalk-logplay, fed with
+// encoded packages in memory (no LCM, no files).
+#include "logplay.h"
+#include "robotalk/channels.h"
+#include "robotalk/protocol_codec.h"
+#include "sequence_file.h"
+
+#include <gtest/gtest.h>
+
+namespace robotalk::logplay {
+namespace {
+
+using robotalk_msgs::package_header_t;
+constexpr std::int64_t kClient = 0x1234;
+
+template <typename Msg>
+std::vector<std::uint8_t> Encode(const Msg& m) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+struct Cmd {
+  std::int64_t id;
+  CommandType type;
+  std::int64_t start_us;
+  std::string target;
+  std::vector<double> values;
+};
+
+std::vector<std::uint8_t> Package(std::int64_t client, std::int64_t seq, std::int64_t send_us, int mode,
+                                  const std::vector<Cmd>& cmds, std::int64_t playback_id = 0) {
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = client;
+  p.header.sequence = seq;
+  p.header.send_time_us = send_us;
+  p.header.payload_type =
+      cmds.empty() ? package_header_t::PAYLOAD_QUERIES : package_header_t::PAYLOAD_COMMANDS;
+  p.header.payload_size = static_cast<std::int32_t>(cmds.size());
+  p.header.mode = static_cast<std::int8_t>(mode);
+  p.header.playback_id = playback_id;
+  p.header.playback_frames = static_cast<std::int32_t>(cmds.size());
+  for (const Cmd& c : cmds) {
+    Command command{c.id, c.type, std::nullopt, c.target, c.values};
+    auto w = ToWire(command);
+    w.start_time_us = c.start_us;
+    p.commands.push_back(w);
+  }
+  p.num_commands = static_cast<std::int32_t>(p.commands.size());
+  return Encode(p);
+}
+
+std::vector<std::uint8_t> ReplyPackage(std::int64_t client, std::int64_t ack, std::int64_t receive_us,
+                                       std::vector<Reply> replies) {
+  robotalk_msgs::reply_package_t p{};
+  p.protocol_version = kProtocolVersion;
+  p.client_id = client;
+  p.ack_sequence = ack;
+  p.server_receive_us = receive_us;
+  p.server_send_us = receive_us;
+  for (const Reply& r : replies) p.replies.push_back(ToWire(r));
+  p.num_replies = static_cast<std::int32_t>(p.replies.size());
+  return Encode(p);
+}
+
+const std::string kRequest = RequestChannel("pioneer");
+const std::string kReply = ReplyChannel("pioneer", kClient);
+
+TEST(SessionLog, KeepsOneCopyOfARetransmittedPackage) {
+  SessionLog log;
+  const auto p = Package(kClient, 1, 100, package_header_t::MODE_DELAY,
+                         {{1, CommandType::kGoto, 5'000'000, "", {1, 0, 0}}});
+  log.Add(kRequest, 10, p);
+  log.Add(kRequest, 20, p);
+  log.Add(kRequest, 30, p);
+  ASSERT_EQ(log.commands().size(), 1u);
+  EXPECT_EQ(log.clients().at(kClient).retransmissions, 2u);
+  EXPECT_EQ(log.clients().at(kClient).packages, 1u);
+  EXPECT_EQ(log.channels().at(kRequest).messages, 3u);
+}
+
+TEST(SessionLog, RecoversDelayModeOffsetsFromStartTimes) {
+  SessionLog log;
+  log.Add(kRequest, 10,
+          Package(kClient, 1, 100, package_header_t::MODE_DELAY,
+                  {{1, CommandType::kSetSpeed, 9'000'000, "", {0.3, 0}},
+                   {2, CommandType::kStop, 12'500'000, "", {}},
+                   {3, CommandType::kJointSetPoint, 10'000'000, "pan", {0.4}}}));
+  const Timeline t = log.MakeTimeline({.robot = "pioneer"});
+  EXPECT_EQ(t.clock, "server");  // absolute start times are server-clock times already
+  ASSERT_EQ(t.frames.size(), 3u);
+  EXPECT_DOUBLE_EQ(t.frames[0].offset_s, 0.0);
+  EXPECT_DOUBLE_EQ(t.frames[1].offset_s, 1.0);
+  EXPECT_EQ(t.frames[1].source->command.target, "pan");
+  EXPECT_DOUBLE_EQ(t.frames[2].offset_s, 3.5);
+}
+
+TEST(SessionLog, PlacesDirectCommandsBySendTimePlusTheAckedClockOffset) {
+  SessionLog log;
+  // Client clock 1 s behind the server: acks say receive = send + 1 s (+ latency).
+  log.Add(kRequest, 10, Package(kClient, 1, 1'000'000, 0, {{1, CommandType::kSetSpeed, 0, "", {0.1, 0}}}));
+  log.Add(kReply, 11, ReplyPackage(kClient, 1, 2'000'300, {}));
+  log.Add(kRequest, 12, Package(kClient, 2, 1'700'000, 0, {{2, CommandType::kStop, 0, "", {}}}));
+  log.Add(kReply, 13, ReplyPackage(kClient, 2, 2'700'100, {}));
+  EXPECT_EQ(log.clients().at(kClient).clock_offset_us, 1'000'100);
+  const Timeline t = log.MakeTimeline({.client_id = kClient});
+  EXPECT_EQ(t.clock, "server");
+  ASSERT_EQ(t.frames.size(), 2u);
+  EXPECT_NEAR(t.frames[1].offset_s, 0.7, 1e-9);
+}
+
+TEST(SessionLog, PlacesPlaybackFramesAtTheServersChosenStart) {
+  SessionLog log;
+  log.Add(kRequest, 10,
+          Package(kClient, 1, 0, package_header_t::MODE_PLAYBACK,
+                  {{2, CommandType::kSetSpeed, 0, "", {0.2, 0}}, {3, CommandType::kStop, 2'000'000, "", {}}},
+                  /*playback_id=*/1));
+  Reply delay{.id = 1, .values = {0.25, 50'000'000.0}};
+  log.Add(kReply, 11, ReplyPackage(kClient, 1, 49'750'000, {delay}));
+  EXPECT_EQ(log.clients().at(kClient).playback_start_us.at(1), 50'000'000);
+  const Timeline t = log.MakeTimeline({.client_id = kClient});
+  EXPECT_EQ(t.clock, "server");
+  EXPECT_EQ(t.frames[1].time_us, 52'000'000);
+  EXPECT_DOUBLE_EQ(t.frames[1].offset_s, 2.0);
+}
+
+TEST(SessionLog, RefusesToMixClientsWhoseClocksCannotBeJoined) {
+  SessionLog log;
+  log.Add(kRequest, 10, Package(kClient, 1, 5, 0, {{1, CommandType::kSetSpeed, 0, "", {0.1, 0}}}));
+  log.Add(kRequest, 11, Package(kClient + 1, 1, 7, 0, {{1, CommandType::kStop, 0, "", {}}}));
+  EXPECT_THROW(log.MakeTimeline({.robot = "pioneer"}), LogError);
+  EXPECT_EQ(log.MakeTimeline({.client_id = kClient}).clock, "client send times");
+}
+
+TEST(SessionLog, NeverReplaysAPanicOrAPanicReset) {
+  SessionLog log;
+  log.Add(kRequest, 10, Package(kClient, 1, 5, 1, {{1, CommandType::kGoto, 100, "", {1, 0, 0}}}));
+  log.Add(kRequest, 11, Package(kClient, 2, 6, 1, {{2, CommandType::kPanicReset, 200, "", {}}}));
+  const Timeline t = log.MakeTimeline({.client_id = kClient});
+  ASSERT_EQ(t.frames.size(), 1u);
+  ASSERT_EQ(t.skipped.size(), 1u);
+  EXPECT_NE(t.skipped[0].find("PANIC_RESET"), std::string::npos);
+}
+
+TEST(SessionLog, CountsUndecodableMessagesInsteadOfThrowing) {
+  SessionLog log;
+  const std::vector<std::uint8_t> junk = {1, 2, 3};
+  log.Add(kRequest, 10, junk);
+  log.Add("OTHER", 11, junk);
+  EXPECT_EQ(log.channels().at(kRequest).undecodable, 1u);
+  EXPECT_EQ(log.events(), 2u);
+  EXPECT_THROW(log.MakeTimeline({.robot = "pioneer"}), LogError);
+}
+
+TEST(Frames, RenameWindowAndSpeedApplyInThatOrder) {
+  SessionLog log;
+  log.Add(kRequest, 10,
+          Package(kClient, 1, 0, 1,
+                  {{1, CommandType::kJointSetPoint, 1'000'000, "pan", {0.1}},
+                   {2, CommandType::kJointSetPoint, 3'000'000, "pan", {0.2}},
+                   {3, CommandType::kJointSetPoint, 5'000'000, "tilt", {0.3}}}));
+  const Timeline t = log.MakeTimeline({.robot = "pioneer"});
+  const auto frames =
+      ToFrames(t, {.rename = {{"pan", "head_pan"}}, .from_s = 1.0, .to_s = 4.0, .speed = 2.0});
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].command.target, "head_pan");
+  EXPECT_DOUBLE_EQ(ToSeconds(frames[0].offset), 0.5);  // (2 s - 1 s) / 2
+  EXPECT_DOUBLE_EQ(ToSeconds(frames[1].offset), 1.5);
+  EXPECT_THROW(ToFrames(t, {.from_s = 4.5, .to_s = 4.9}), LogError);
+}
+
+TEST(Frames, AnExtractedSequenceParsesBackToTheSameCommands) {
+  std::vector<TimedCommand> frames = {
+      {FromSeconds(0), {0, CommandType::kSetSpeed, std::nullopt, "", {0.3, -0.123456789}}},
+      {FromSeconds(1.25), {0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.4}}},
+      {FromSeconds(3.4), {0, CommandType::kStop, std::nullopt, "", {}}}};
+  const std::string text = FormatSequence(frames, "a header\nof two lines");
+  const auto entries = cli::ParseSequence(text, "extracted.txt");
+  ASSERT_EQ(entries.size(), 3u);
+  EXPECT_DOUBLE_EQ(entries[1].offset_s, 1.25);
+  EXPECT_EQ(entries[1].command.target, "pan");
+  EXPECT_DOUBLE_EQ(entries[0].command.values[1], -0.123456789);
+  EXPECT_EQ(entries[2].command.type, CommandType::kStop);
+}
+
+TEST(Options, ParseMapsWindowsAndClientIds) {
+  EXPECT_EQ(ParseRename("pan=head_pan"), std::make_pair(std::string("pan"), std::string("head_pan")));
+  EXPECT_THROW(ParseRename("pan"), cli::UsageError);
+  EXPECT_EQ(ParseWindow("2:5"), std::make_pair(2.0, 5.0));
+  EXPECT_EQ(ParseWindow(":5").first, 0.0);
+  EXPECT_THROW(ParseWindow("5:2"), cli::UsageError);
+  EXPECT_EQ(ParseClientId("0000000000001234"), 0x1234);
+  EXPECT_EQ(ParseClientId("4660"), 0x1234);
+  EXPECT_THROW(ParseClientId("nope"), LogError);
+}
+
+TEST(Channels, AreSplitIntoRobotKindAndClient) {
+  const ChannelName n = ParseChannel("ROBOTALK/pioneer2/REPLY/00000000000004d2");
+  EXPECT_EQ(n.robot, "pioneer2");
+  EXPECT_EQ(n.kind, "REPLY");
+  EXPECT_EQ(n.rest, "00000000000004d2");
+  EXPECT_EQ(ParseChannel("ROBOTALK/ANNOUNCE").kind, "ANNOUNCE");
+  EXPECT_EQ(ParseChannel("OTHER/x/REQUEST").kind, "");
+}
+
+}  // namespace
+}  // namespace robotalk::logplay

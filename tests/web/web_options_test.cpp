@@ -1,0 +1,74 @@
+// Tests of robotalk-web's command line.
+#include "web_options.h"
+
+#include "robotalk/error.h"
+
+#include <gtest/gtest.h>
+
+namespace robotalk::web {
+namespace {
+
+WebOptions Parse(std::vector<std::string> args) { return ParseWebOptions(args, "/www", "/nm"); }
+
+std::string ErrorOf(std::vector<std::string> args) {
+  try {
+    Parse(std::move(args));
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(WebOptions, DefaultsToLoopbackPort8080At30Hz) {
+  const WebOptions o = Parse({});
+  EXPECT_EQ(o.bind, "127.0.0.1");
+  EXPECT_EQ(o.port, 8080);
+  EXPECT_DOUBLE_EQ(o.rate_hz, 30.0);
+  EXPECT_EQ(o.www_dir, "/www");
+  EXPECT_EQ(o.node_modules_dir, "/nm");
+  EXPECT_TRUE(o.urdf.empty());
+}
+
+TEST(WebOptions, ParsesEveryOption) {
+  const WebOptions o = Parse({"--bind",          "0.0.0.0",
+                              "--port",          "0",
+                              "--lcm-url",       "udpm://239.255.76.67:7901?ttl=0",
+                              "--rate",          "60",
+                              "--urdf",          "pioneer=models/p.urdf",
+                              "--urdf",          "arm=/x/iiwa.urdf",
+                              "--robot-timeout", "5",
+                              "--www",           "w",
+                              "--node-modules",  "n",
+                              "--version",       "-h"});
+  EXPECT_EQ(o.bind, "0.0.0.0");
+  EXPECT_EQ(o.port, 0);
+  EXPECT_EQ(o.lcm_url, "udpm://239.255.76.67:7901?ttl=0");
+  EXPECT_DOUBLE_EQ(o.rate_hz, 60.0);
+  EXPECT_EQ(o.urdf.at("pioneer"), "models/p.urdf");
+  EXPECT_EQ(o.urdf.at("arm"), "/x/iiwa.urdf");
+  EXPECT_DOUBLE_EQ(o.robot_timeout_s, 5.0);
+  EXPECT_EQ(o.www_dir, "w");
+  EXPECT_EQ(o.node_modules_dir, "n");
+  EXPECT_TRUE(o.version);
+  EXPECT_TRUE(o.help);
+}
+
+TEST(WebOptions, NamesTheBadArgument) {
+  EXPECT_EQ(ErrorOf({"--colour"}), "unknown option '--colour' (see --help)");
+  EXPECT_EQ(ErrorOf({"--port", "http"}), "--port: 'http' is not a number");
+  EXPECT_EQ(ErrorOf({"--port", "70000"}), "--port: 70000 is not a port (0-65535)");
+  EXPECT_EQ(ErrorOf({"--port"}), "--port: needs a value");
+  EXPECT_EQ(ErrorOf({"--urdf", "pioneer"}), "--urdf: 'pioneer' is not NAME=PATH");
+  EXPECT_EQ(ErrorOf({"--rate", "0"}), "--rate: 0 Hz is outside 1-240");
+  EXPECT_NE(ErrorOf({"--robot-timeout", "1"}).find("shorter than 1.5 s"), std::string::npos);
+}
+
+TEST(WebOptions, HelpMentionsEveryOption) {
+  const std::string usage = WebUsage();
+  for (const char* opt : {"--bind", "--port", "--lcm-url", "--rate", "--urdf", "--robot-timeout", "--www",
+                          "--node-modules", "--version", "--help"})
+    EXPECT_NE(usage.find(opt), std::string::npos) << opt;
+}
+
+}  // namespace
+}  // namespace robotalk::web

@@ -1,0 +1,64 @@
+// The pieces of robotalk-logplay (docs/logplay.md): reading an LCM log with
+// LCM's own log API, turning a recovered timeline into sequence-file lines or
+// client frames, and the four subcommands. Errors: LogError (bad log or
+// selection), robotalk::cli::UsageError (bad options), client errors on replay.
+#pragma once
+
+#include "robotalk/robot_client.h"
+#include "session_log.h"
+
+#include <iosfwd>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace robotalk::logplay {
+
+/// Reads every event of an LCM log (lcm::LogFile) into a SessionLog. Throws
+/// LogError when the file cannot be opened.
+SessionLog ReadLog(const std::string& path);
+
+/// How recorded commands become frames again.
+struct FrameOptions {
+  std::map<std::string, std::string> rename;  ///< --map old=new: joint / frame names
+  double from_s = 0;                          ///< --window A:B, on the recorded offsets
+  double to_s = std::numeric_limits<double>::infinity();
+  double speed = 1.0;  ///< --speed: offsets are divided by it
+};
+
+/// The selected frames, renamed, windowed (re-based to the window's start)
+/// and scaled. Throws LogError when the window holds nothing.
+std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions& options);
+
+/// A sequence file `robotalk send --file` plays: a comment header, then one
+/// "<offset> <command> [target] values..." line per frame.
+std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::string& header);
+
+/// `info`: channels, span, servers, robots, clients and their command streams.
+void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out);
+
+/// `export`: DIR/commands.csv and DIR/state.csv; returns the files written.
+std::vector<std::string> ExportCsv(const SessionLog& log, const std::string& dir);
+
+/// "old=new" -> {old, new}; throws UsageError.
+std::pair<std::string, std::string> ParseRename(const std::string& text);
+/// "A:B" (either side may be empty) -> {A, B}; throws UsageError.
+std::pair<double, double> ParseWindow(const std::string& text);
+
+struct ReplayOptions {
+  std::string robot;  ///< the live robot to drive
+  Selection selection;
+  FrameOptions frames;
+  SequenceOptions sequence;  ///< mode, delay
+  std::string url;
+  double timeout_s = 5;
+  bool progress = false;  ///< draw a progress bar on stderr
+};
+
+/// `replay`: sends the selected commands through RobotClient and waits for
+/// every reply; prints a summary of signals. Returns the exit status (0 all
+/// SUCCESS/MODIFIED, 1 otherwise, 128+signal when interrupted).
+int Replay(const SessionLog& log, const ReplayOptions& options, std::ostream& out);
+
+}  // namespace robotalk::logplay

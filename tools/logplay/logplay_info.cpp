@@ -1,0 +1,230 @@
+// robotalk-logplay: reading logs, frames and sequence files, info, CSV export.
+#include "logplay.h"
+#include "robotalk/channels.h"
+#include "robotalk_msgs/package_header_t.hpp"
+#include "sequence_file.h"
+#include "sequence_runner.h"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+
+namespace robotalk::logplay {
+namespace {
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string Num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string Utc(std::int64_t us) {
+  const std::time_t t = static_cast<std::time_t>(us / 1000000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[40];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  return buf;
+}
+
+const char* ModeName(int mode) {
+  switch (mode) {
+    case robotalk_msgs::package_header_t::MODE_DIRECT:
+      return "direct";
+    case robotalk_msgs::package_header_t::MODE_DELAY:
+      return "delay";
+    case robotalk_msgs::package_header_t::MODE_PLAYBACK:
+      return "playback";
+    default:
+      return "?";
+  }
+}
+
+void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out) {
+  std::map<std::string, int> types, signals;
+  int commands = 0;
+  for (const LoggedCommand& lc : log.commands()) {
+    if (lc.client_id != c.id || lc.mode < 0) continue;
+    ++commands;
+    ++types[ToString(lc.command.type)];
+    if (lc.reply) ++signals[std::string(ToString(lc.reply->signal))];
+  }
+  out << "  " << Hex64(static_cast<std::uint64_t>(c.id)) << "  robot " << c.robot << "  packages "
+      << c.packages << " (" << c.retransmissions << " retransmitted copies, " << c.heartbeats
+      << " heartbeats)  queries " << c.queries << (c.panics ? "  PANIC x" + std::to_string(c.panics) : "")
+      << "\n";
+  if (commands == 0) return;
+  out << "      commands " << commands << ":";
+  for (const auto& [t, n] : types) out << ' ' << t << ' ' << n;
+  int absolute = 0, now = 0, playback = 0;
+  for (const LoggedCommand& lc : log.commands()) {
+    if (lc.client_id != c.id || lc.mode < 0) continue;
+    if (lc.mode == robotalk_msgs::package_header_t::MODE_PLAYBACK) {
+      ++playback;
+    } else {
+      ++(lc.start_us != 0 ? absolute : now);
+    }
+  }
+  out << "; start times:";
+  if (absolute) out << " absolute " << absolute;
+  if (now) out << " now " << now;
+  if (playback) out << " playback offsets " << playback;
+  try {
+    const Timeline t = log.MakeTimeline({.client_id = c.id});
+    out << "; " << t.frames.size() << " frames over " << cli::FormatSeconds(t.frames.back().offset_s) << " ("
+        << t.clock << " clock)";
+  } catch (const LogError& e) {
+    out << "; timing unknown (" << e.what() << ")";
+  }
+  if (!signals.empty()) {
+    out << "; replies";
+    for (const auto& [s, n] : signals) out << ' ' << s << ' ' << n;
+  }
+  out << "\n";
+}
+
+}  // namespace
+
+SessionLog ReadLog(const std::string& path) {
+  lcm::LogFile file(path, "r");
+  if (!file.good()) throw LogError("cannot open LCM log '" + path + "'");
+  SessionLog log;
+  while (const lcm::LogEvent* e = file.readNextEvent()) {
+    log.Add(e->channel, e->timestamp,
+            {static_cast<const std::uint8_t*>(e->data), static_cast<std::size_t>(std::max(e->datalen, 0))});
+  }
+  return log;
+}
+
+std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions& options) {
+  if (!(options.speed > 0)) throw cli::UsageError("--speed must be positive");
+  std::vector<TimedCommand> frames;
+  for (const TimedFrame& f : timeline.frames) {
+    if (f.offset_s < options.from_s - 1e-9 || f.offset_s > options.to_s + 1e-9) continue;
+    Command c = f.source->command;
+    c.id = 0;
+    c.start_time.reset();
+    if (auto it = options.rename.find(c.target); it != options.rename.end()) c.target = it->second;
+    frames.push_back({FromSeconds((f.offset_s - options.from_s) / options.speed), std::move(c)});
+  }
+  if (frames.empty()) throw LogError("the window holds no command");
+  return frames;
+}
+
+std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::string& header) {
+  std::ostringstream out;
+  std::istringstream lines(header);
+  for (std::string line; std::getline(lines, line);) out << "# " << line << "\n";
+  for (const TimedCommand& f : frames) {
+    char offset[32];
+    std::snprintf(offset, sizeof offset, "%.6f", ToSeconds(f.offset));
+    out << offset << ' ' << Lower(ToString(f.command.type));
+    if (!f.command.target.empty()) out << ' ' << f.command.target;
+    for (double v : f.command.values) out << ' ' << Num(v);
+    out << "\n";
+  }
+  return out.str();
+}
+
+std::pair<std::string, std::string> ParseRename(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw cli::UsageError("--map " + text + ": expected old=new");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+std::pair<double, double> ParseWindow(const std::string& text) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) throw cli::UsageError("--window " + text + ": expected A:B (seconds)");
+  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+  const double from = a.empty() ? 0.0 : cli::ParseNumber(a, "--window start");
+  const double to = b.empty() ? std::numeric_limits<double>::infinity() : cli::ParseNumber(b, "--window end");
+  if (from < 0 || to <= from) throw cli::UsageError("--window " + text + ": need 0 <= A < B");
+  return {from, to};
+}
+
+void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out) {
+  out << "log " << path << ": " << log.events() << " events";
+  if (log.events() > 0) {
+    out << " over " << cli::FormatSeconds(static_cast<double>(log.last_us() - log.first_us()) * 1e-6) << ", "
+        << Utc(log.first_us()) << " .. " << Utc(log.last_us());
+  }
+  out << "\nchannels:\n";
+  for (const auto& [name, s] : log.channels()) {
+    char line[200];
+    std::snprintf(line, sizeof line, "  %-44s %7" PRIu64 " msgs %10" PRIu64 " bytes", name.c_str(),
+                  s.messages, s.bytes);
+    out << line << (s.undecodable ? "  (" + std::to_string(s.undecodable) + " undecodable)" : "") << "\n";
+  }
+  const auto servers = log.servers();
+  out << "servers: " << servers.size();
+  for (std::int64_t s : servers) out << ' ' << Hex64(static_cast<std::uint64_t>(s));
+  out << "\nrobots:\n";
+  for (const LoggedRobot& r : log.robots()) {
+    out << "  " << r.name << "  driver " << r.driver << "  dofs " << r.total_dofs << "  server "
+        << Hex64(static_cast<std::uint64_t>(r.server_id)) << "  config " << Hex64(r.config_hash)
+        << (r.panic_seen ? "  (panic seen)" : "") << "\n";
+  }
+  out << "clients: " << log.clients().size() << "\n";
+  for (const auto& [id, c] : log.clients()) PrintClient(log, c, out);
+  std::map<std::string, const StateSample*> last;
+  std::map<std::string, int> counts;
+  for (const StateSample& s : log.states()) {
+    last[s.robot] = &s;
+    ++counts[s.robot];
+  }
+  for (const auto& [robot, s] : last) {
+    char line[200];
+    std::snprintf(line, sizeof line, "state %s: %d samples; final base x %.4f y %.4f theta %.4f",
+                  robot.c_str(), counts[robot], s->base[0], s->base[1], s->base[2]);
+    out << line << "; q";
+    for (double q : s->position) out << ' ' << Num(q);
+    out << "\n";
+  }
+}
+
+std::vector<std::string> ExportCsv(const SessionLog& log, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const std::string commands_path = dir + "/commands.csv", state_path = dir + "/state.csv";
+  std::ofstream commands(commands_path), state(state_path);
+  if (!commands || !state) throw LogError("cannot write CSV files in '" + dir + "'");
+  commands
+      << "client,robot,sequence,mode,id,type,target,start_us,send_time_us,log_time_us,signal,exec_time_us,"
+         "values\n";
+  for (const LoggedCommand& c : log.commands()) {
+    commands << Hex64(static_cast<std::uint64_t>(c.client_id)) << ',' << c.robot << ',' << c.sequence << ','
+             << (c.mode < 0 ? "panic" : ModeName(c.mode)) << ',' << c.command.id << ','
+             << (c.mode < 0 ? "PANIC" : ToString(c.command.type)) << ',' << c.command.target << ','
+             << c.start_us << ',' << c.send_time_us << ',' << c.log_time_us << ','
+             << (c.reply ? std::string(ToString(c.reply->signal)) : "") << ','
+             << (c.reply ? std::to_string(ToWireMicros(c.reply->exec_time)) : "") << ',';
+    for (std::size_t i = 0; i < c.command.values.size(); ++i)
+      commands << (i ? " " : "") << Num(c.command.values[i]);
+    commands << "\n";
+  }
+  state << "robot,log_time_us,server_time_us,panic,moving,x,y,theta,v,omega,q\n";
+  for (const StateSample& s : log.states()) {
+    state << s.robot << ',' << s.log_time_us << ',' << s.server_time_us << ',' << s.panic << ',' << s.moving;
+    for (double b : s.base) state << ',' << Num(b);
+    state << ',';
+    for (std::size_t i = 0; i < s.position.size(); ++i) state << (i ? " " : "") << Num(s.position[i]);
+    state << "\n";
+  }
+  return {commands_path, state_path};
+}
+
+}  // namespace robotalk::logplay

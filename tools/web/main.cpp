@@ -1,0 +1,53 @@
+// robotalk-web: shows every robot on the LCM bus in a browser (docs/web.md).
+#include "robot_tracker.h"
+#include "robotalk/error.h"
+#include "web_options.h"
+#include "web_server.h"
+
+#include <filesystem>
+#include <iostream>
+
+int main(int argc, char** argv) {
+  using namespace robotalk::web;
+  WebOptions options;
+  try {
+    options = ParseWebOptions(std::vector<std::string>(argv + 1, argv + argc), ROBOTALK_WEB_SOURCE_DIR "/www",
+                              ROBOTALK_WEB_SOURCE_DIR "/node_modules");
+  } catch (const robotalk::Error& e) {
+    std::cerr << "robotalk-web: " << e.what() << "\n";
+    return 2;
+  }
+  if (options.help) {
+    std::cout << WebUsage();
+    return 0;
+  }
+  if (options.version) {
+    std::cout << "robotalk-web " << ROBOTALK_WEB_VERSION << "\n";
+    return 0;
+  }
+  namespace fs = std::filesystem;
+  for (const char* module : {"three", "urdf-loader"}) {
+    if (!fs::is_directory(fs::path(options.node_modules_dir) / module)) {
+      std::cerr << "robotalk-web: " << options.node_modules_dir << "/" << module
+                << " is missing: run scripts/setup.sh (npm ci in tools/web), or give --node-modules\n";
+      return 1;
+    }
+  }
+  for (const auto& [name, path] : options.urdf) {
+    if (!fs::is_regular_file(path)) {
+      std::cerr << "robotalk-web: --urdf " << name << "=" << path << ": no such file\n";
+      return 2;
+    }
+  }
+  try {
+    RobotTracker tracker(options);
+    WebServer server(options, tracker);
+    std::cout << "robotalk-web: open http://" << (options.bind == "0.0.0.0" ? "127.0.0.1" : options.bind)
+              << ":" << server.port() << "/" << std::endl;
+    server.Run();
+  } catch (const std::exception& e) {
+    std::cerr << "robotalk-web: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,372 @@
+#include "robot_tracker.h"
+
+#include "robotalk/channels.h"
+#include "robotalk/error.h"
+#include "robotalk/robot_client.h"
+#include "robotalk_msgs/announce_t.hpp"
+#include "scene_json.h"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace robotalk::web {
+namespace {
+
+using Steady = std::chrono::steady_clock;
+
+// The newest sample of one robot, written by its client's ReadDaemon.
+struct SampleSlot {
+  std::mutex mutex;
+  robotalk_msgs::robot_state_t sample;  // GUARDED_BY(mutex)
+  std::uint64_t received = 0;           // GUARDED_BY(mutex)
+};
+
+struct Robot {
+  std::string name;
+  std::int64_t server_id = 0;
+  std::uint64_t announced_hash = 0;
+  std::string driver;
+  bool panic = false;
+  int num_clients = 0;
+  Steady::time_point last_announce{};
+  std::string status = "connecting";
+  std::string message;
+  bool connecting = false;
+  Steady::time_point last_attempt{};
+  std::shared_ptr<RobotClient> client;
+  std::int64_t client_server_id = 0;
+  std::uint64_t client_hash = 0;
+  std::shared_ptr<SampleSlot> slot;
+  std::uint64_t slot_seen = 0;
+  // Touched by the Poll() thread only once `client` is set.
+  std::shared_ptr<const RobotModel> model;
+  std::unique_ptr<StatePoser> poser;
+  std::uint64_t generation = 0;
+  std::shared_ptr<const std::string> model_message;
+  // A floating base without a control frame: its height and tilt are not in
+  // the state stream, so a LINK_POSES query for the root runs alongside.
+  std::optional<PendingReply> root_query;
+  bool streaming = false;    // the current client asked for the state stream
+  bool stream_task = false;  // a start/stop of the stream is queued
+};
+
+enum class Task { kConnect, kStream };
+
+// The LCM typed decoder sizes robots[] from the count before checking the
+// bytes are there: check the count against the datagram first.
+bool AnnounceCountPlausible(const lcm::ReceiveBuffer* rbuf) {
+  const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
+  const std::size_t n = rbuf->data_size;
+  std::size_t at = 8 + 2 + 8 + 8;  // fingerprint, version, server id, time
+  if (n < at + 4) return false;
+  const std::uint32_t len = (std::uint32_t{b[at]} << 24) | (b[at + 1] << 16) | (b[at + 2] << 8) | b[at + 3];
+  at += 4 + std::size_t{len};
+  if (len > n || n < at + 4) return false;
+  const std::int32_t count = static_cast<std::int32_t>((std::uint32_t{b[at]} << 24) | (b[at + 1] << 16) |
+                                                       (b[at + 2] << 8) | b[at + 3]);
+  constexpr std::size_t kMinRobotBytes = 4 + 1 + 4 + 1 + 8 + 4 + 1 + 1 + 4;
+  return count >= 0 && static_cast<std::size_t>(count) <= (n - at) / kMinRobotBytes;
+}
+
+}  // namespace
+
+class RobotTracker::Impl {
+ public:
+  explicit Impl(const WebOptions& o) : options_(o), lcm_(o.lcm_url) {
+    if (!lcm_.good()) throw Error("robotalk-web: cannot open LCM '" + o.lcm_url + "'");
+    lcm_.subscribe(kAnnounceChannel, &Impl::OnAnnounce, this)->setQueueCapacity(100);
+    listener_ = std::thread([this] { Listen(); });
+    worker_ = std::thread([this] { Work(); });
+  }
+
+  ~Impl() {
+    stop_ = true;
+    wake_.notify_all();
+    listener_.join();
+    worker_.join();
+    for (std::thread& t : panics_) t.join();
+    std::lock_guard lock(mutex_);
+    robots_.clear();  // each RobotClient joins its ReadDaemon
+  }
+
+  TrackerFrame Poll();
+  void SetWatching(bool watching) { watching_ = watching; }
+  void Panic(const std::string& robot, std::function<void(const std::string&)> done);
+
+ private:
+  void Listen() {
+    while (!stop_) lcm_.handleTimeout(100);
+  }
+
+  void OnAnnounce(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    if (!AnnounceCountPlausible(rbuf)) return;
+    robotalk_msgs::announce_t msg;
+    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) return;
+    std::lock_guard lock(mutex_);
+    const auto now = Steady::now();
+    for (const auto& r : msg.robots) {
+      Robot& robot = robots_[r.name];
+      robot.name = r.name;
+      robot.server_id = msg.server_id;
+      robot.announced_hash = static_cast<std::uint64_t>(r.config_hash);
+      robot.driver = r.driver;
+      robot.panic = r.panic != 0;
+      robot.num_clients = r.num_clients;
+      robot.last_announce = now;
+    }
+  }
+
+  // Worker: connects one robot at a time and starts / stops state streams
+  // (blocking calls, up to the client's timeout).
+  void Work() {
+    std::unique_lock lock(mutex_);
+    while (!stop_) {
+      if (queue_.empty()) {
+        wake_.wait_for(lock, std::chrono::milliseconds(200));
+        continue;
+      }
+      const auto [name, task] = queue_.front();
+      queue_.pop_front();
+      lock.unlock();
+      if (task == Task::kConnect)
+        Connect(name);
+      else
+        SetStream(name);
+      lock.lock();
+    }
+  }
+
+  void Connect(const std::string& name) {
+    ClientOptions co;
+    co.lcm_url = options_.lcm_url;
+    co.timeout = std::chrono::seconds(2);
+    co.connect_timeout = std::chrono::seconds(4);
+    std::shared_ptr<RobotClient> client;
+    auto slot = std::make_shared<SampleSlot>();
+    std::string error;
+    try {
+      client = std::make_shared<RobotClient>(co);
+      client->Connect(name);
+    } catch (const std::exception& e) {
+      error = e.what();
+      client.reset();
+    }
+    std::lock_guard lock(mutex_);
+    auto it = robots_.find(name);
+    if (it == robots_.end()) return;
+    Robot& r = it->second;
+    r.connecting = false;
+    if (!client) {
+      r.status = "error";
+      r.message = "cannot connect: " + error;
+      return;
+    }
+    r.root_query.reset();
+    r.streaming = false;
+    r.client = std::move(client);
+    r.client_server_id = r.server_id;
+    r.client_hash = r.announced_hash;
+    r.slot = std::move(slot);
+    r.slot_seen = 0;
+    r.model = std::make_shared<const RobotModel>(r.client->model());
+    r.poser = std::make_unique<StatePoser>(*r.model);
+    r.status = "live";
+    r.message.clear();
+    ++r.generation;
+    nlohmann::json m = {
+        {"type", "model"}, {"robot", name}, {"generation", r.generation}, {"model", ModelToJson(*r.model)}};
+    r.model_message = std::make_shared<const std::string>(m.dump());
+  }
+
+  // Asks for the state stream while a page is open, cancels it when none is:
+  // a bridge nobody looks at adds no traffic to the bus.
+  void SetStream(const std::string& name) {
+    std::shared_ptr<RobotClient> client;
+    std::shared_ptr<SampleSlot> slot;
+    const bool want = watching_;
+    {
+      std::lock_guard lock(mutex_);
+      auto it = robots_.find(name);
+      if (it == robots_.end()) return;
+      it->second.stream_task = false;
+      client = it->second.client;
+      slot = it->second.slot;
+    }
+    if (!client || !slot) return;
+    std::string error;
+    try {
+      if (want) {
+        const auto period =
+            std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / options_.rate_hz));
+        client->StartStateStream(period, [slot](const robotalk_msgs::robot_state_t& s) {
+          std::lock_guard l(slot->mutex);
+          slot->sample = s;
+          ++slot->received;
+        });
+      } else {
+        client->StopStateStream();
+      }
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    std::lock_guard lock(mutex_);
+    auto it = robots_.find(name);
+    if (it == robots_.end() || it->second.client != client) return;
+    if (error.empty())
+      it->second.streaming = want;
+    else
+      it->second.message = std::string("state stream: ") + error;
+  }
+
+  void Housekeep(Robot& r, Steady::time_point now, std::vector<std::shared_ptr<RobotClient>>& drop);
+  static void MeasureRoot(Robot& r);
+  nlohmann::json RobotJson(const Robot& r) const;
+
+  const WebOptions options_;
+  lcm::LCM lcm_;
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::map<std::string, Robot> robots_;             // GUARDED_BY(mutex_)
+  std::deque<std::pair<std::string, Task>> queue_;  // GUARDED_BY(mutex_)
+  std::atomic<bool> watching_{false};
+  std::vector<std::thread> panics_;  // GUARDED_BY(mutex_)
+  std::thread listener_, worker_;
+};
+
+void RobotTracker::Impl::Housekeep(Robot& r, Steady::time_point now,
+                                   std::vector<std::shared_ptr<RobotClient>>& drop) {
+  const auto timeout = std::chrono::duration<double>(options_.robot_timeout_s);
+  if (now - r.last_announce > timeout) {
+    if (r.status != "gone") {
+      r.status = "gone";
+      r.message = "not announced for " + std::to_string(static_cast<int>(options_.robot_timeout_s)) + " s";
+    }
+    if (r.client) drop.push_back(std::move(r.client));
+    r.client.reset();
+    r.root_query.reset();
+    return;
+  }
+  const bool stale = r.client && (r.client_server_id != r.server_id || r.client_hash != r.announced_hash);
+  if (stale) {  // the server restarted or the robot changed: load it again
+    drop.push_back(std::move(r.client));
+    r.client.reset();
+    r.root_query.reset();
+  }
+  if (!r.client && !r.connecting && now - r.last_attempt > std::chrono::seconds(2)) {
+    r.connecting = true;
+    r.last_attempt = now;
+    r.status = "connecting";
+    r.message.clear();
+    queue_.push_back({r.name, Task::kConnect});
+    wake_.notify_all();
+  }
+  if (r.client && !r.stream_task && r.streaming != watching_) {
+    r.stream_task = true;
+    queue_.push_back({r.name, Task::kStream});
+    wake_.notify_all();
+  }
+}
+
+// One LINK_POSES query for the root in flight at a time; a new one goes out
+// when the previous is answered (so at most one per round trip and Poll()).
+void RobotTracker::Impl::MeasureRoot(Robot& r) {
+  try {
+    if (r.root_query) {
+      const std::optional<Reply> reply = r.root_query->Poll();
+      if (!reply) return;
+      r.root_query.reset();
+      if (reply->values.size() == 7) {
+        const auto& v = reply->values;
+        Eigen::Isometry3d root = Eigen::Isometry3d::Identity();
+        root.translation() << v[0], v[1], v[2];
+        root.linear() = Eigen::Quaterniond(v[3], v[4], v[5], v[6]).normalized().toRotationMatrix();
+        if (root.matrix().allFinite()) r.poser->SetMeasuredRoot(root);
+      }
+    }
+    const std::string root_link = r.model->link(r.model->roots().front().link).name;
+    r.root_query = r.client->SendQuery({.type = QueryType::kLinkPoses, .target = root_link});
+  } catch (const std::exception& e) {  // the client gave up (timeout): try again next time
+    r.root_query.reset();
+    r.message = std::string("root pose query: ") + e.what();
+  }
+}
+
+nlohmann::json RobotTracker::Impl::RobotJson(const Robot& r) const {
+  nlohmann::json urdf = nullptr;
+  if (auto it = options_.urdf.find(r.name); it != options_.urdf.end())
+    urdf = "/urdf/" + r.name + "/" + std::filesystem::path(it->second).filename().string();
+  return {{"name", r.name},
+          {"status", r.status},
+          {"message", r.message},
+          {"driver", r.driver},
+          {"panic", r.panic},
+          {"num_clients", r.num_clients},
+          {"server_id", Hex64(static_cast<std::uint64_t>(r.server_id))},
+          {"generation", r.generation},
+          {"urdf", urdf}};
+}
+
+TrackerFrame RobotTracker::Impl::Poll() {
+  TrackerFrame frame;
+  std::vector<std::shared_ptr<RobotClient>> drop;  // destroyed outside the lock (joins threads)
+  {
+    std::lock_guard lock(mutex_);
+    const auto now = Steady::now();
+    nlohmann::json list = nlohmann::json::array();
+    for (auto& [name, r] : robots_) {
+      Housekeep(r, now, drop);
+      list.push_back(RobotJson(r));
+      if (r.model_message) frame.models.push_back({name, r.generation, r.model_message});
+      if (!r.client || !r.slot || !r.poser) continue;
+      if (watching_ && r.poser->needs_measured_root()) MeasureRoot(r);
+      std::lock_guard slot_lock(r.slot->mutex);
+      if (r.slot->received == r.slot_seen) continue;
+      frame.samples_received += r.slot->received - r.slot_seen;
+      r.slot_seen = r.slot->received;
+      try {
+        nlohmann::json s = r.poser->Pose(r.slot->sample);
+        s["generation"] = r.generation;
+        frame.states.push_back(s.dump());
+      } catch (const Error& e) {
+        r.message = e.what();
+      }
+    }
+    frame.robots = {{"type", "robots"}, {"robots", list}};
+  }
+  drop.clear();
+  return frame;
+}
+
+void RobotTracker::Impl::Panic(const std::string& robot, std::function<void(const std::string&)> done) {
+  std::lock_guard lock(mutex_);
+  std::shared_ptr<RobotClient> client;
+  if (auto it = robots_.find(robot); it != robots_.end()) client = it->second.client;
+  panics_.emplace_back([client, robot, done = std::move(done)] {
+    if (!client) return done("robot '" + robot + "' is not connected");
+    try {
+      client->Panic();
+      done("");
+    } catch (const std::exception& e) {
+      done(e.what());
+    }
+  });
+}
+
+RobotTracker::RobotTracker(const WebOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+RobotTracker::~RobotTracker() = default;
+void RobotTracker::SetWatching(bool watching) { impl_->SetWatching(watching); }
+TrackerFrame RobotTracker::Poll() { return impl_->Poll(); }
+void RobotTracker::Panic(const std::string& robot, std::function<void(const std::string&)> done) {
+  impl_->Panic(robot, std::move(done));
+}
+
+}  // namespace robotalk::web

@@ -1,0 +1,90 @@
+#include "web_options.h"
+
+#include "robotalk/error.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace robotalk::web {
+namespace {
+
+double ParseNumber(const std::string& option, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+    throw Error(option + ": '" + text + "' is not a number");
+  return v;
+}
+
+}  // namespace
+
+std::string WebUsage() {
+  return "usage: robotalk-web [options]\n"
+         "Shows every robot announced on the LCM bus in a browser: a 3D view moving with\n"
+         "the state stream, the base path, joint plots, panic state and a PANIC button.\n"
+         "  --bind ADDR        listen address (default 127.0.0.1; 0.0.0.0 offers the page,\n"
+         "                     and its PANIC button, to the whole network)\n"
+         "  --port N           TCP port (default 8080; 0 = any free port)\n"
+         "  --lcm-url URL      LCM URL (default: LCM_DEFAULT_URL or LCM's default)\n"
+         "  --rate HZ          state frames per second sent to the page (default 30)\n"
+         "  --urdf NAME=PATH   draw robot NAME from this URDF with urdf-loader (repeatable)\n"
+         "  --robot-timeout S  a robot not announced for S seconds is shown as gone (default 3)\n"
+         "  --www DIR          the page's files (default: beside the sources)\n"
+         "  --node-modules DIR npm modules holding three and urdf-loader\n"
+         "  --version          print the version and exit\n"
+         "  -h, --help         print this help and exit\n"
+         "It sends queries (CONFIG, CLOCK, STATE_STREAM) and heartbeats, and a package\n"
+         "with the panic flag when the page's PANIC button is pressed; never a command.\n";
+}
+
+WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::string& default_www,
+                           const std::string& default_modules) {
+  WebOptions o;
+  o.www_dir = default_www;
+  o.node_modules_dir = default_modules;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw Error(a + ": needs a value");
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      o.help = true;
+    } else if (a == "--version") {
+      o.version = true;
+    } else if (a == "--bind") {
+      o.bind = value();
+      if (o.bind.empty()) throw Error("--bind: empty address");
+    } else if (a == "--port") {
+      const double p = ParseNumber(a, value());
+      if (p < 0 || p > 65535 || p != std::floor(p))
+        throw Error("--port: " + args[i] + " is not a port (0-65535)");
+      o.port = static_cast<int>(p);
+    } else if (a == "--lcm-url") {
+      o.lcm_url = value();
+    } else if (a == "--rate") {
+      o.rate_hz = ParseNumber(a, value());
+      if (o.rate_hz < 1 || o.rate_hz > 240) throw Error("--rate: " + args[i] + " Hz is outside 1-240");
+    } else if (a == "--robot-timeout") {
+      o.robot_timeout_s = ParseNumber(a, value());
+      if (o.robot_timeout_s < 1.5)
+        throw Error("--robot-timeout: " + args[i] +
+                    " s is shorter than 1.5 s (servers announce every second)");
+    } else if (a == "--urdf") {
+      const std::string& v = value();
+      const auto eq = v.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == v.size())
+        throw Error("--urdf: '" + v + "' is not NAME=PATH");
+      o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
+    } else if (a == "--www") {
+      o.www_dir = value();
+    } else if (a == "--node-modules") {
+      o.node_modules_dir = value();
+    } else {
+      throw Error("unknown option '" + a + "' (see --help)");
+    }
+  }
+  return o;
+}
+
+}  // namespace robotalk::web

@@ -1,0 +1,44 @@
+// Command-line options of robotalk-web (docs/web.md, "Running it").
+//
+// Thread safety: pure functions. Errors: ParseWebOptions throws robotalk::Error
+// naming the bad argument ("unknown option '--x'", "--port: 'abc' is not ...").
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace robotalk::web {
+
+struct WebOptions {
+  /// Address the HTTP/WebSocket server listens on. Loopback by default: the
+  /// page can PANIC a robot, so it is not offered to the network unless asked.
+  std::string bind = "127.0.0.1";
+  /// TCP port; 0 = any free port (printed on stdout).
+  int port = 8080;
+  /// LCM URL; "" = LCM's default (LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0).
+  std::string lcm_url;
+  /// Frames per second pushed to each browser (state samples are decimated to this).
+  double rate_hz = 30.0;
+  /// The page's files (index.html, app.js, ...).
+  std::string www_dir;
+  /// The npm modules folder holding three and urdf-loader.
+  std::string node_modules_dir;
+  /// Robot name -> URDF file: the page draws that robot with urdf-loader
+  /// from this file (and the meshes beside it) instead of from its configuration.
+  std::map<std::string, std::string> urdf;
+  /// A robot is shown as gone when no announce named it for this long (s).
+  double robot_timeout_s = 3.0;
+  bool help = false;
+  bool version = false;
+};
+
+/// Parses argv[1..]. `default_www` and `default_modules` fill www_dir and
+/// node_modules_dir when no option gives them.
+WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::string& default_www,
+                           const std::string& default_modules);
+
+/// The --help text.
+std::string WebUsage();
+
+}  // namespace robotalk::web

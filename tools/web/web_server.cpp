@@ -1,0 +1,280 @@
+#include "web_server.h"
+
+#include "robotalk/error.h"
+#include "web_files.h"
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/version.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <deque>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace robotalk::web {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using Message = std::shared_ptr<const std::string>;
+
+// A browser that cannot keep up loses state frames (never robots/models).
+constexpr std::size_t kMaxQueuedFrames = 8;
+
+class WsSession : public std::enable_shared_from_this<WsSession> {
+ public:
+  using PanicHandler = std::function<void(std::weak_ptr<WsSession>, const std::string& robot)>;
+
+  WsSession(tcp::socket socket, PanicHandler on_panic)
+      : ws_(std::move(socket)), on_panic_(std::move(on_panic)) {}
+
+  void Start(http::request<http::string_body> req, std::vector<Message> greeting) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.async_accept(req, [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
+      if (ec) return;
+      self->open_ = true;
+      for (const Message& m : greeting) self->Send(m, false);
+      self->Read();
+    });
+  }
+
+  bool open() const { return open_; }
+
+  // REQUIRES: the io thread.
+  void Send(const Message& m, bool droppable) {
+    if (!open_) return;
+    if (droppable && queue_.size() >= kMaxQueuedFrames) {
+      ++dropped_;
+      return;
+    }
+    queue_.push_back(m);
+    if (queue_.size() == 1) Write();
+  }
+
+ private:
+  void Write() {
+    ws_.text(true);
+    ws_.async_write(asio::buffer(*queue_.front()),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      if (ec) {
+                        self->open_ = false;
+                        return;
+                      }
+                      self->queue_.pop_front();
+                      if (!self->queue_.empty()) self->Write();
+                    });
+  }
+
+  void Read() {
+    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        self->open_ = false;
+        return;
+      }
+      const std::string text = beast::buffers_to_string(self->in_.data());
+      self->in_.consume(self->in_.size());
+      const nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
+      if (msg.is_object() && msg.value("type", "") == "panic" && msg.contains("robot") &&
+          msg["robot"].is_string())
+        self->on_panic_(self->weak_from_this(), msg["robot"].get<std::string>());
+      self->Read();
+    });
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  PanicHandler on_panic_;
+  beast::flat_buffer in_;
+  std::deque<Message> queue_;
+  bool open_ = false;
+  std::uint64_t dropped_ = 0;
+};
+
+}  // namespace
+
+class WebServer::Impl {
+ public:
+  Impl(const WebOptions& o, RobotTracker& tracker)
+      : options_(o), tracker_(tracker), acceptor_(*ioc_), tick_(*ioc_), signals_(*ioc_, SIGINT, SIGTERM) {
+    beast::error_code ec;
+    const auto address = asio::ip::make_address(o.bind, ec);
+    if (ec) throw Error("robotalk-web: --bind '" + o.bind + "': " + ec.message());
+    const tcp::endpoint ep(address, static_cast<unsigned short>(o.port));
+    acceptor_.open(ep.protocol(), ec);
+    if (!ec) acceptor_.set_option(asio::socket_base::reuse_address(true), ec);
+    if (!ec) acceptor_.bind(ep, ec);
+    if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+    if (ec)
+      throw Error("robotalk-web: cannot listen on " + o.bind + ":" + std::to_string(o.port) + ": " +
+                  ec.message());
+    period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(1.0 / o.rate_hz));
+  }
+
+  int port() const { return acceptor_.local_endpoint().port(); }
+
+  void Run() {
+    signals_.async_wait([this](beast::error_code, int) { Stop(); });
+    Accept();
+    next_tick_ = std::chrono::steady_clock::now();
+    Tick();
+    ioc_->run();
+  }
+
+  void Stop() {
+    asio::post(*ioc_, [ioc = ioc_] { ioc->stop(); });
+  }
+
+ private:
+  void Accept() {
+    acceptor_.async_accept([this](beast::error_code ec, tcp::socket socket) {
+      if (!ec) ReadRequest(std::make_shared<beast::tcp_stream>(std::move(socket)));
+      Accept();
+    });
+  }
+
+  void ReadRequest(std::shared_ptr<beast::tcp_stream> stream) {
+    auto buffer = std::make_shared<beast::flat_buffer>();
+    auto req = std::make_shared<http::request<http::string_body>>();
+    stream->expires_after(std::chrono::seconds(30));
+    http::async_read(*stream, *buffer, *req, [this, stream, buffer, req](beast::error_code ec, std::size_t) {
+      if (ec) return;
+      if (websocket::is_upgrade(*req) &&
+          std::string_view(req->target().data(), req->target().size()) == "/ws") {
+        stream->expires_never();
+        auto session = std::make_shared<WsSession>(
+            stream->release_socket(),
+            [this](std::weak_ptr<WsSession> s, const std::string& robot) { OnPanic(std::move(s), robot); });
+        sessions_.push_back(session);
+        session->Start(std::move(*req), Greeting());
+        return;
+      }
+      Respond(stream, std::move(*req));
+    });
+  }
+
+  void Respond(std::shared_ptr<beast::tcp_stream> stream, http::request<http::string_body> req) {
+    const bool keep_alive = req.keep_alive();
+    auto send = [this, stream, keep_alive](auto res) {
+      res.set(http::field::server, "robotalk-web");
+      res.set(http::field::cache_control, "no-store");
+      res.keep_alive(keep_alive);
+      res.prepare_payload();
+      auto sp = std::make_shared<decltype(res)>(std::move(res));
+      http::async_write(*stream, *sp, [this, stream, sp, keep_alive](beast::error_code ec, std::size_t) {
+        if (!ec && keep_alive) ReadRequest(stream);
+      });
+    };
+    auto error = [&](http::status status, const std::string& text) {
+      http::response<http::string_body> res{status, req.version()};
+      res.set(http::field::content_type, "text/plain; charset=utf-8");
+      res.body() = text + "\n";
+      send(std::move(res));
+    };
+    if (req.method() != http::verb::get && req.method() != http::verb::head)
+      return error(http::status::method_not_allowed, "only GET and HEAD");
+    const std::string target(req.target());
+    const auto path = ResolveWebPath(target, options_);
+    http::file_body::value_type body;
+    beast::error_code ec;
+    if (path && std::filesystem::is_regular_file(*path)) body.open(path->c_str(), beast::file_mode::scan, ec);
+    if (!path || !body.is_open() || ec) return error(http::status::not_found, "not found: " + target);
+    const auto size = body.size();
+    if (req.method() == http::verb::head) {
+      http::response<http::empty_body> res{http::status::ok, req.version()};
+      res.set(http::field::content_type, ContentTypeFor(*path));
+      res.content_length(size);
+      return send(std::move(res));
+    }
+    http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body)),
+                                        std::make_tuple(http::status::ok, req.version())};
+    res.set(http::field::content_type, ContentTypeFor(*path));
+    send(std::move(res));
+  }
+
+  std::vector<Message> Greeting() const {
+    std::vector<Message> g;
+    const nlohmann::json hello = {{"type", "hello"},
+                                  {"server", "robotalk-web"},
+                                  {"version", ROBOTALK_WEB_VERSION},
+                                  {"rate", options_.rate_hz}};
+    g.push_back(std::make_shared<const std::string>(hello.dump()));
+    if (robots_) g.push_back(robots_);
+    for (const auto& [name, m] : models_) g.push_back(m.second);
+    return g;
+  }
+
+  void Broadcast(const Message& m, bool droppable) {
+    for (auto& s : sessions_) s->Send(m, droppable);
+  }
+
+  void Tick() {
+    TrackerFrame f = tracker_.Poll();
+    std::erase_if(sessions_,
+                  [](const std::shared_ptr<WsSession>& s) { return s.use_count() == 1 && !s->open(); });
+    tracker_.SetWatching(
+        std::any_of(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->open(); }));
+    const std::string robots = f.robots.dump();
+    if (!robots_ || *robots_ != robots) {
+      robots_ = std::make_shared<const std::string>(robots);
+      Broadcast(robots_, false);
+    }
+    for (const TrackerFrame::Model& m : f.models) {
+      auto& known = models_[m.robot];
+      if (known.second != m.message) {
+        known = {m.generation, m.message};
+        Broadcast(m.message, false);
+      }
+    }
+    for (std::string& s : f.states) Broadcast(std::make_shared<const std::string>(std::move(s)), true);
+    // Absolute deadlines: the rate does not drift with the work done per tick.
+    next_tick_ += period_;
+    const auto now = std::chrono::steady_clock::now();
+    if (next_tick_ < now) next_tick_ = now;
+    tick_.expires_at(next_tick_);
+    tick_.async_wait([this](beast::error_code ec) {
+      if (!ec) Tick();
+    });
+  }
+
+  void OnPanic(std::weak_ptr<WsSession> session, const std::string& robot) {
+    // The callback runs on a tracker thread that may outlive this server: it
+    // keeps the io_context alive itself and reaches the session weakly.
+    tracker_.Panic(robot, [ioc = ioc_, session, robot](const std::string& error) {
+      const nlohmann::json r = {
+          {"type", "panic_result"}, {"robot", robot}, {"ok", error.empty()}, {"message", error}};
+      auto msg = std::make_shared<const std::string>(r.dump());
+      asio::post(*ioc, [session, msg] {
+        if (auto s = session.lock()) s->Send(msg, false);
+      });
+    });
+  }
+
+  const WebOptions options_;
+  RobotTracker& tracker_;
+  std::shared_ptr<asio::io_context> ioc_ = std::make_shared<asio::io_context>(1);
+  tcp::acceptor acceptor_;
+  asio::steady_timer tick_;
+  asio::signal_set signals_;
+  std::chrono::steady_clock::duration period_{};
+  std::chrono::steady_clock::time_point next_tick_{};
+  std::vector<std::shared_ptr<WsSession>> sessions_;
+  Message robots_;
+  std::map<std::string, std::pair<std::uint64_t, Message>> models_;
+};
+
+WebServer::WebServer(const WebOptions& options, RobotTracker& tracker)
+    : impl_(std::make_unique<Impl>(options, tracker)) {}
+WebServer::~WebServer() = default;
+int WebServer::port() const { return impl_->port(); }
+void WebServer::Run() { impl_->Run(); }
+void WebServer::Stop() { impl_->Stop(); }
+
+}  // namespace robotalk::web

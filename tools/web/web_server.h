@@ -1,0 +1,41 @@
+// WebServer: robotalk-web's HTTP and WebSocket side, on Boost.Beast
+// (docs/web.md). It serves the page's files, the three / urdf-loader modules
+// from node_modules, the URDF files given with --urdf (and files beside
+// them, for meshes), and one WebSocket at /ws that carries JSON: every
+// `1/rate` s it polls the RobotTracker and pushes the robots list when it
+// changed, each new model, and each robot's newest state. It reads one kind of
+// message from the page: {"type":"panic","robot":NAME}.
+//
+// Thread safety: everything runs on the thread that calls Run(); Stop() may
+// be called from any thread (or a signal handler's strand via asio).
+// Errors: the constructor throws robotalk::Error when it cannot listen
+// (address in use, bad address). Per-connection failures close that
+// connection only.
+#pragma once
+
+#include "robot_tracker.h"
+#include "web_options.h"
+
+#include <memory>
+
+namespace robotalk::web {
+
+class WebServer {
+ public:
+  WebServer(const WebOptions& options, RobotTracker& tracker);
+  ~WebServer();
+  WebServer(const WebServer&) = delete;
+  WebServer& operator=(const WebServer&) = delete;
+
+  /// The TCP port listened on (the chosen one when options.port was 0).
+  int port() const;
+  /// Serves until Stop() or SIGINT / SIGTERM.
+  void Run();
+  void Stop();
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace robotalk::web

@@ -1,0 +1,216 @@
+// RobotView: one robot drawn in 3D with three.js, in its own canvas.
+//
+// The robot is built either from its RoboTalk configuration (default: each
+// link's equivalent-inertia box at its centre of mass, bones to its joint
+// centres, axes at its control frames — the configuration carries no visual
+// geometry), or from a URDF file by urdf-loader when the bridge was given one
+// (--urdf NAME=PATH). Either way it is posed from the bridge's state frames:
+// world poses of every link (computed by the bridge with RoboTalk's own
+// kinematics) and the joint positions. The base's path is drawn on the floor.
+// Coordinates are RoboTalk's (z up, metres); one group turns them into
+// three.js's y-up world.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import URDFLoader from 'urdf-loader';
+
+const PATH_MAX_POINTS = 20000;
+const PATH_MIN_STEP = 0.005;  // m between recorded path points
+
+// A software WebGL (SwiftShader in headless Chromium, llvmpipe) draws several
+// times faster without multisampling.
+let software = null;
+function softwareGl() {
+  if (software === null) {
+    const gl = document.createElement('canvas').getContext('webgl2');
+    const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+    software = !!info && /swiftshader|llvmpipe|software/i.test(gl.getParameter(info.UNMASKED_RENDERER_WEBGL));
+  }
+  return software;
+}
+
+function quat(p) { return new THREE.Quaternion(p[4], p[5], p[6], p[3]); }
+
+export class RobotView {
+  constructor(container, model, urdfUrl) {
+    this.model = model;
+    this.renderer = new THREE.WebGLRenderer({ antialias: !softwareGl() });
+    this.renderer.setPixelRatio(1);
+    this.renderer.setSize(container.clientWidth, container.clientHeight);
+    container.prepend(this.renderer.domElement);
+    this.scene = new THREE.Scene();
+    this.scene.background = new THREE.Color(0x0d1117);
+    this.camera = new THREE.PerspectiveCamera(45, container.clientWidth / container.clientHeight, 0.01, 200);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.scene.add(new THREE.HemisphereLight(0xddeeff, 0x223344, 2.0));
+    const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+    sun.position.set(3, 6, 4);
+    this.scene.add(sun);
+    this.world = new THREE.Group();  // RoboTalk's z-up frame
+    this.world.rotation.x = -Math.PI / 2;
+    this.scene.add(this.world);
+    const grid = new THREE.GridHelper(20, 40, 0x6b7b90, 0x39485a);
+    this.scene.add(grid);
+    this.linkObjects = [];
+    this.urdfRobot = null;
+    this.loading = null;
+    this.buildFromSpec();
+    if (urdfUrl) this.loadUrdf(urdfUrl);
+    this.buildPath();
+    this.frameCamera();
+  }
+
+  buildFromSpec() {
+    const boxMat = new THREE.MeshStandardMaterial({ color: 0x4fa3ff, roughness: 0.6, transparent: true, opacity: 0.85 });
+    const jointMat = new THREE.MeshStandardMaterial({ color: 0xf5a623, roughness: 0.4 });
+    const boneMat = new THREE.MeshStandardMaterial({ color: 0xc7d0dc, roughness: 0.5 });
+    this.specGroup = new THREE.Group();
+    this.world.add(this.specGroup);
+    for (const link of this.model.links) {
+      const g = new THREE.Group();
+      g.name = link.name;
+      g.matrixAutoUpdate = true;
+      const com = new THREE.Vector3(...link.com);
+      if (link.mass > 0) {
+        const box = new THREE.Mesh(new THREE.BoxGeometry(...link.box), boxMat);
+        box.position.copy(com);
+        const r = link.box_rotation;
+        box.quaternion.set(r[1], r[2], r[3], r[0]);
+        g.add(box);
+      }
+      for (const p of link.points) {
+        const pt = new THREE.Vector3(...p);
+        const ball = new THREE.Mesh(new THREE.SphereGeometry(0.012, 12, 8), jointMat);
+        ball.position.copy(pt);
+        g.add(ball);
+        const len = pt.distanceTo(com);
+        if (len > 1e-4) {
+          const bone = new THREE.Mesh(new THREE.CylinderGeometry(0.006, 0.006, len, 8), boneMat);
+          bone.position.copy(com).add(pt).multiplyScalar(0.5);
+          bone.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), pt.clone().sub(com).normalize());
+          g.add(bone);
+        }
+      }
+      this.specGroup.add(g);
+      this.linkObjects.push(g);
+    }
+    for (const f of this.model.frames) {
+      const axes = new THREE.AxesHelper(0.08);
+      axes.position.set(f.pose[0], f.pose[1], f.pose[2]);
+      axes.quaternion.copy(quat(f.pose));
+      this.linkObjects[f.link].add(axes);
+    }
+  }
+
+  loadUrdf(url) {
+    const loader = new URDFLoader();
+    loader.parseVisual = true;
+    loader.parseCollision = false;
+    this.loading = new Promise((resolve) => {
+      loader.load(url, (robot) => {
+        this.urdfRobot = robot;
+        this.world.add(robot);
+        this.specGroup.visible = false;  // the URDF's own geometry replaces the spec's boxes
+        robot.traverse((o) => {  // URDF visuals without a colour of their own
+          if (o.isMesh && o.material && !o.material.name) o.material = new THREE.MeshStandardMaterial({ color: 0x6f93c8, roughness: 0.6 });
+        });
+        if (this.lastFrame) this.apply(this.lastFrame);
+        resolve(true);
+      }, undefined, (err) => { this.urdfError = String(err); resolve(false); });
+    });
+  }
+
+  buildPath() {
+    const geom = new THREE.BufferGeometry();
+    this.pathPositions = new Float32Array(PATH_MAX_POINTS * 3);
+    geom.setAttribute('position', new THREE.BufferAttribute(this.pathPositions, 3));
+    geom.setDrawRange(0, 0);
+    this.path = new THREE.Line(geom, new THREE.LineBasicMaterial({ color: 0x5dffb0 }));
+    this.path.frustumCulled = false;
+    this.world.add(this.path);
+    this.pathCount = 0;
+    this.pathLength = 0;
+  }
+
+  frameCamera() {
+    this.world.updateMatrixWorld(true);
+    const box = new THREE.Box3().setFromObject(this.specGroup);
+    const size = Math.max(0.5, box.getSize(new THREE.Vector3()).length());
+    const centre = box.getCenter(new THREE.Vector3());
+    this.controls.target.copy(centre);
+    this.camera.position.copy(centre).add(new THREE.Vector3(1.1 * size, 1.0 * size, 1.6 * size).multiplyScalar(1.3));
+    this.controls.update();
+    this.followBase = this.model.roots.length && this.model.roots[0].base !== 'fixed';
+  }
+
+  // Applies one state frame from the bridge to the scene.
+  apply(frame) {
+    this.lastFrame = frame;
+    const links = frame.links;
+    for (let i = 0; i < this.linkObjects.length && i < links.length; ++i) {
+      const p = links[i];
+      this.linkObjects[i].position.set(p[0], p[1], p[2]);
+      this.linkObjects[i].quaternion.copy(quat(p));
+    }
+    if (this.urdfRobot) this.applyUrdf(frame);
+    this.extendPath(frame.base[0], frame.base[1]);
+  }
+
+  applyUrdf(frame) {
+    const root = this.model.roots[0].link;
+    const p = frame.links[root];
+    this.urdfRobot.position.set(p[0], p[1], p[2]);
+    this.urdfRobot.quaternion.copy(quat(p));
+    for (const j of this.model.joints) {
+      const uj = this.urdfRobot.joints[j.name];
+      if (!uj || j.dofs.length === 0 || j.mimic) continue;
+      uj.setJointValue(...frame.q.slice(j.dof_offset, j.dof_offset + j.dofs.length));
+    }
+  }
+
+  extendPath(x, y) {
+    if (this.pathCount > 0) {
+      const k = 3 * (this.pathCount - 1);
+      const d = Math.hypot(x - this.pathPositions[k], y - this.pathPositions[k + 1]);
+      if (d < PATH_MIN_STEP) return;
+      this.pathLength += d;
+      if (this.followBase) {  // the camera follows the base
+        const delta = new THREE.Vector3(x - this.pathPositions[k], 0, -(y - this.pathPositions[k + 1]));
+        this.camera.position.add(delta);
+        this.controls.target.add(delta);
+      }
+    }
+    if (this.pathCount >= PATH_MAX_POINTS) {  // keep the newest half
+      this.pathPositions.copyWithin(0, 3 * (PATH_MAX_POINTS / 2));
+      this.pathCount = PATH_MAX_POINTS / 2;
+    }
+    this.pathPositions.set([x, y, 0.003], 3 * this.pathCount);
+    this.pathCount += 1;
+    this.path.geometry.setDrawRange(0, this.pathCount);
+    this.path.geometry.attributes.position.needsUpdate = true;
+  }
+
+  render() {
+    this.controls.update();
+    this.renderer.render(this.scene, this.camera);
+  }
+
+  // World pose of link `i` as the scene graph holds it (z-up), read back from
+  // the drawn objects: [x, y, z, qw, qx, qy, qz]. The URDF's own link object
+  // when the robot is drawn from a URDF.
+  drawnLinkPose(i) {
+    let obj = this.linkObjects[i];
+    if (this.urdfRobot && this.urdfRobot.links[this.model.links[i].name]) obj = this.urdfRobot.links[this.model.links[i].name];
+    this.scene.updateMatrixWorld(true);
+    const m = new THREE.Matrix4().copy(this.world.matrixWorld).invert().multiply(obj.matrixWorld);
+    const t = new THREE.Vector3(), q = new THREE.Quaternion(), s = new THREE.Vector3();
+    m.decompose(t, q, s);
+    return [t.x, t.y, t.z, q.w, q.x, q.y, q.z];
+  }
+
+  dispose() {
+    this.controls.dispose();
+    this.renderer.dispose();
+    this.renderer.forceContextLoss();
+    this.renderer.domElement.remove();
+  }
+}
