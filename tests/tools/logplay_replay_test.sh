@@ -92,7 +92,8 @@ check "pan within 0.01 rad" within "$pan0" "$pan1" 0.01
 check "tilt within 0.01 rad" within "$tilt0" "$tilt1" 0.01
 
 # --- export -------------------------------------------------------------------
-if python3 -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"; fi
+py=/usr/bin/python3; [ -x "$py" ] || py=python3
+if "$py" -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"; fi
 "$logplay" export "$tmp/session.lcmlog" -o "$tmp/export" $plot >"$tmp/export.out" 2>&1
 check "export exits 0" test $? -eq 0
 check "commands.csv has 7 commands" test "$(grep -c ',pioneer,' "$tmp/export/commands.csv")" -eq 7
