@@ -1,5 +1,7 @@
 #include "robot_tracker.h"
 
+#include "robotalk/protocol_codec.h"
+
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/robot_client.h"
@@ -206,9 +208,9 @@ class RobotTracker::Impl {
       if (want) {
         const auto period =
             std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / options_.rate_hz));
-        client->StartStateStream(period, [slot](const robotalk_msgs::robot_state_t& s) {
+        client->StartStateStream(period, [slot](const StateSample& s) {
           std::lock_guard l(slot->mutex);
-          slot->sample = s;
+          slot->sample = ToWire(s);
           ++slot->received;
         });
       } else {
