@@ -142,16 +142,17 @@ std::string ReplyJson(const Reply& r) {
   return out.str();
 }
 
-std::string StateJson(const robotalk_msgs::robot_state_t& s) {
+std::string StateJson(const StateSample& s) {
+  const double base[5] = {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega};
   std::ostringstream out;
   out << "{\"robot\":" << JsonString(s.robot) << ",\"sample\":" << s.sample
-      << ",\"server_time_us\":" << s.server_time_us
-      << ",\"period_s\":" << JsonNumber(static_cast<double>(s.period_us) * 1e-6)
-      << ",\"panic\":" << (s.panic ? "true" : "false") << ",\"moving\":" << (s.moving ? "true" : "false")
-      << ",\"base\":" << JsonArray(std::begin(s.base), std::end(s.base))
-      << ",\"position\":" << JsonArray(s.position.begin(), s.position.end())
-      << ",\"velocity\":" << JsonArray(s.velocity.begin(), s.velocity.end())
-      << ",\"effort\":" << JsonArray(s.effort.begin(), s.effort.end()) << "}";
+      << ",\"server_time_us\":" << ToWireMicros(s.server_time)
+      << ",\"period_s\":" << JsonNumber(ToSeconds(s.period)) << ",\"panic\":" << (s.panic ? "true" : "false")
+      << ",\"moving\":" << (s.moving ? "true" : "false")
+      << ",\"base\":" << JsonArray(std::begin(base), std::end(base))
+      << ",\"position\":" << JsonArray(s.positions.begin(), s.positions.end())
+      << ",\"velocity\":" << JsonArray(s.velocities.begin(), s.velocities.end())
+      << ",\"effort\":" << JsonArray(s.efforts.begin(), s.efforts.end()) << "}";
   return out.str();
 }
 

@@ -134,8 +134,7 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   return result;
 }
 
-Duration RobotClient::StartStateStream(Duration period,
-                                       std::function<void(const robotalk_msgs::robot_state_t&)> on_sample) {
+Duration RobotClient::StartStateStream(Duration period, std::function<void(const StateSample&)> on_sample) {
   if (!connected()) throw ClientError("RobotClient::StartStateStream: not connected (call Connect first)");
   impl_->SubscribeState(std::move(on_sample));
   const Reply r = Query(robotalk::Query{.type = QueryType::kStateStream, .period = period});
@@ -153,31 +152,36 @@ void RobotClient::StopStateStream() {
   impl_->on_state_ = nullptr;
 }
 
-void RobotClient::Impl::SubscribeState(std::function<void(const robotalk_msgs::robot_state_t&)> on_sample) {
+void RobotClient::Impl::SubscribeState(std::function<void(const StateSample&)> on_sample) {
   std::lock_guard lock(mu_);
   on_state_ = std::move(on_sample);
   if (state_subscription_) return;
-  state_subscription_ = lcm_->subscribe(StateChannel(robot_), &Impl::OnState, this);
-  if (!state_subscription_) throw ClientError("RobotClient: cannot subscribe to " + StateChannel(robot_));
-  state_subscription_->setQueueCapacity(options_.lcm_queue_capacity);
+  try {
+    state_subscription_ = transport_->Subscribe(
+        StateChannel(robot_), [this](const std::string&, std::span<const std::uint8_t> b) { OnState(b); });
+  } catch (const TransportError& e) {
+    throw ClientError("RobotClient: cannot subscribe to " + StateChannel(robot_) + ": " + e.what());
+  }
 }
 
-// LCM callback on the ReadDaemon: never throws.
-void RobotClient::Impl::OnState(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-  robotalk_msgs::robot_state_t state;
+// On the ReadDaemon: a bad sample is counted, a callback's exception stored.
+void RobotClient::Impl::OnState(std::span<const std::uint8_t> bytes) {
+  std::function<void(const StateSample&)> callback;
+  int dofs = -1;
+  {
+    std::lock_guard lock(mu_);
+    callback = on_state_;
+    if (model_) dofs = model_->num_dofs();
+  }
+  if (!callback) return;
+  StateSample state;
   try {
-    state = DecodeRobotState({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+    state = DecodeStateSample(bytes, dofs);
   } catch (const ProtocolError&) {
     std::lock_guard lock(mu_);
     ++stats_.malformed_packages;
     return;
   }
-  std::function<void(const robotalk_msgs::robot_state_t&)> callback;
-  {
-    std::lock_guard lock(mu_);
-    callback = on_state_;
-  }
-  if (!callback) return;
   try {
     callback(state);
   } catch (...) {

@@ -1,8 +1,9 @@
-// RobotClient against FakeServer on one in-process memq:// LCM: acks,
+// RobotClient against FakeServer on one in-process MemoryTransport: acks,
 // duplicates, dropped packages, reordering, scheduling, panic, timeouts.
 #include "robotalk/robot_client.h"
 #include "fake_server.h"
 #include "robotalk/config_codec.h"
+#include "robotalk/memory_transport.h"
 #include "robotalk/urdf_import.h"
 
 #include <gtest/gtest.h>
@@ -25,13 +26,13 @@ class RobotClientTest : public ::testing::Test {
  protected:
   ClientOptions Options() {
     ClientOptions o;
-    o.shared_lcm = &lcm_;
+    o.transport = &transport_;
     o.timeout = std::chrono::seconds(5);
     o.connect_timeout = std::chrono::seconds(5);
     return o;
   }
   void StartServer(FakeServerOptions options = {}) {
-    server_ = std::make_unique<FakeServer>(lcm_, model_, options);
+    server_ = std::make_unique<FakeServer>(transport_, model_, options);
   }
   std::unique_ptr<RobotClient> Connected(ClientOptions o) {
     auto c = std::make_unique<RobotClient>(o);
@@ -39,7 +40,9 @@ class RobotClientTest : public ::testing::Test {
     return c;
   }
 
-  lcm::LCM lcm_{"memq://"};
+  // Client and FakeServer share one endpoint of an in-process bus: the
+  // client's ReadDaemon dispatches both (no sockets).
+  MemoryTransport transport_{std::make_shared<MemoryBus>()};
   RobotModel model_ = Pioneer();
   std::unique_ptr<FakeServer> server_;
 };
