@@ -185,14 +185,30 @@ TEST_F(RobotClientTest, PanicTimesOutWithoutAck) {
   EXPECT_THROW(client->Panic(), TimeoutError);
 }
 
-TEST_F(RobotClientTest, IdleClientSendsHeartbeats) {
+// On a ManualClock: one heartbeat per idle interval the clock moves, none
+// while it stands still (no sleeping for the interval to pass).
+TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
   StartServer();
+  ManualClock clock;
   ClientOptions o = Options();
+  o.clock = &clock;
   o.heartbeat_interval = milliseconds(50);
+  o.max_idle_wait = milliseconds(1);  // re-read the manual clock often
   auto client = Connected(o);
-  std::this_thread::sleep_for(milliseconds(400));
-  EXPECT_GE(server_->heartbeats(), 4);
-  EXPECT_GE(client->stats().heartbeats, 4u);
+  const int before = server_->heartbeats();
+  for (int k = 1; k <= 4; ++k) {
+    clock.Advance(milliseconds(50));
+    // Bounded real-time wait for the ReadDaemon to notice the clock moved.
+    for (int i = 0; i < 2000 && server_->heartbeats() < before + k; ++i) {
+      std::this_thread::sleep_for(milliseconds(1));
+    }
+    ASSERT_EQ(server_->heartbeats(), before + k) << "after advancing " << k << " intervals";
+  }
+  clock.Advance(milliseconds(49));  // not yet an interval: nothing more is sent
+  // ~20 daemon wake-ups (max_idle_wait 1 ms) in which a wrong heartbeat would go.
+  std::this_thread::sleep_for(milliseconds(20));
+  EXPECT_EQ(client->stats().heartbeats, 4u);
+  EXPECT_EQ(server_->heartbeats(), before + 4);
 }
 
 TEST_F(RobotClientTest, ConnectTimesOutWithoutServer) {
