@@ -2,13 +2,17 @@
 // duplicates, dropped packages, reordering, scheduling, panic, timeouts.
 #include "robotalk/robot_client.h"
 #include "fake_server.h"
+#include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/memory_transport.h"
+#include "robotalk/protocol_codec.h"
 #include "robotalk/urdf_import.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
+#include <mutex>
 #include <thread>
 
 namespace robotalk {
@@ -209,6 +213,55 @@ TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
   std::this_thread::sleep_for(milliseconds(20));
   EXPECT_EQ(client->stats().heartbeats, 4u);
   EXPECT_EQ(server_->heartbeats(), before + 4);
+}
+
+TEST_F(RobotClientTest, StateStreamDeliversValidatedSamplesAndDropsBadOnes) {
+  StartServer();
+  auto client = Connected(Options());
+  std::mutex mu;
+  std::vector<StateSample> got;
+  EXPECT_EQ(client->StartStateStream(milliseconds(50),
+                                     [&](const StateSample& s) {
+                                       std::lock_guard lock(mu);
+                                       got.push_back(s);
+                                     }),
+            milliseconds(50));
+  const auto dofs = static_cast<std::size_t>(model_.num_dofs());
+  StateSample good;
+  good.robot = model_.name();
+  good.server_time = TimePoint(std::chrono::seconds(1000));
+  good.period = milliseconds(50);
+  good.sample = 1;
+  good.positions.assign(dofs, 0.25);
+  good.velocities.assign(dofs, 0.0);
+  good.efforts.assign(dofs, 0.0);
+  good.base = {1, 2, 0.5, 0.1, 0};
+  robotalk_msgs::robot_state_t nan = ToWire(good);
+  nan.sample = 2;
+  nan.position[0] = std::nan("");
+  StateSample extra_dof = good;
+  extra_dof.sample = 3;
+  for (auto* v : {&extra_dof.positions, &extra_dof.velocities, &extra_dof.efforts}) v->push_back(0);
+  StateSample last = good;
+  last.sample = 4;
+  // The server's side of the bus (published from this thread; the client's
+  // ReadDaemon dispatches).
+  Publish(transport_, StateChannel(model_.name()), ToWire(good));
+  Publish(transport_, StateChannel(model_.name()), nan);
+  Publish(transport_, StateChannel(model_.name()), ToWire(extra_dof));
+  Publish(transport_, StateChannel(model_.name()), ToWire(last));
+  for (int i = 0; i < 2000; ++i) {
+    {
+      std::lock_guard lock(mu);
+      if (got.size() >= 2 && client->stats().malformed_packages >= 2) break;
+    }
+    std::this_thread::sleep_for(milliseconds(1));
+  }
+  std::lock_guard lock(mu);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0], good);
+  EXPECT_EQ(got[1].sample, 4);
+  EXPECT_EQ(client->stats().malformed_packages, 2u);  // NaN, and a dof count the model does not have
 }
 
 TEST_F(RobotClientTest, ConnectTimesOutWithoutServer) {
