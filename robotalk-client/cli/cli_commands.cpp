@@ -175,6 +175,7 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
               << " (another client asked for faster)\n";
   }
   // Ends at --duration, --count or a signal (the usual end: exit 0).
+  Interrupter::Defer(true);
   const TimePoint end = SteadyClock().Now() + FromSeconds(std::min(duration_s, 1e9));
   while (SteadyClock().Now() < end && !Interrupter::Signal()) {
     {
