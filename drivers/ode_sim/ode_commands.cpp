@@ -60,6 +60,10 @@ DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
     return Answer(Signal::kError, name + ": no joint with index " + std::to_string(c.target));
   }
   const robotalk::Joint& joint = model_.joint(c.target);
+  if (walker_ && !joint.dofs.empty() && walker_->Owns(model_.dof_offset(c.target))) {  // walking hook
+    return Answer(Signal::kBusy,
+                  name + " " + Quote(joint.name) + ": the leg is driven by the walking controller");
+  }
   if (c.num_values != static_cast<int>(joint.dofs.size()) || joint.dofs.empty()) {
     return Answer(Signal::kError, name + " " + Quote(joint.name) + ": expected " +
                                       std::to_string(joint.dofs.size()) + " values (one per dof), got " +
@@ -140,6 +144,7 @@ DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
     return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
                                       std::to_string(c.num_values));
   }
+  if (walker_) return walker_->SetSpeed(c);  // walking hook
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }
@@ -179,6 +184,7 @@ DriverResult OdeDriver::Impl::Goto(const DriverCommand& c) {
   if (c.num_values != 3) {
     return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
   }
+  if (walker_) return walker_->Goto(c);  // walking hook
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "GOTO: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }

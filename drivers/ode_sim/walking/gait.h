@@ -49,7 +49,7 @@ struct GaitParams {
   double step_side = 0.05;     ///< m, only toward the swing foot's side
   double step_yaw = 0.25;      ///< rad
   // Timing.
-  double single_support = 0.7;  ///< s
+  double single_support = 0.8;  ///< s
   double double_support = 0.3;  ///< s
   double start_lead = 1.0;      ///< s: standing still after a start (the preview's look-ahead)
   double start_shift = 0.8;     ///< s: the first shift of weight onto the stance foot
