@@ -18,9 +18,11 @@ trap 'rm -f "$TRACE"' EXIT
 flock /tmp/rt-build.lock cmake --build "$BUILD_DIR" --target robotalk-walk-bench -j2 >/dev/null
 status=0
 "$BUILD_DIR/bench/robotalk-walk-bench" --goals 20 --seed 1 --trace "$TRACE" "$@" || status=$?
-if python3 -c 'import matplotlib' 2>/dev/null; then
+PY=python3
+[ -x /usr/bin/python3 ] && PY=/usr/bin/python3  # Debian's, where python3-matplotlib lives
+if "$PY" -c 'import matplotlib' 2>/dev/null; then
   mkdir -p "$(dirname "$PLOT")"
-  python3 scripts/plot_walk.py "$TRACE" "$PLOT" && echo "top view: $PLOT"
+  "$PY" scripts/plot_walk.py "$TRACE" "$PLOT" && echo "top view: $PLOT"
 else
   echo "python3-matplotlib not installed: no plot (scripts/setup.sh installs it)"
 fi

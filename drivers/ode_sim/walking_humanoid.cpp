@@ -205,7 +205,7 @@ void WalkingHumanoid::PlanGoto() {
     centres.push_back(p.centre);
   }
   pattern_.Append(steps, centres);
-  ++tries_;
+  replanned_at_ = pattern_.started_steps();
 }
 
 DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {
@@ -223,7 +223,7 @@ DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {
   }
   mode_ = Mode::kGoto;
   goto_id_ = c.id;
-  tries_ = 0;
+  tries_ = 1;
   PlanGoto();
   DriverResult r;
   r.in_progress = true;
@@ -299,6 +299,7 @@ void WalkingHumanoid::FinishGoto(std::vector<Completion>& completed) {
     return;
   }
   if (tries_ <= kRetries) {
+    ++tries_;
     PlanGoto();  // closed loop: walk again from the measured pose
     return;
   }
@@ -344,7 +345,12 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
     world_->SetMotor(static_cast<int>(i), v, fmax_[i]);
   }
   q_prev_ = q_ref_;
-  if (mode_ == Mode::kGoto && pattern_.standing()) FinishGoto(completed);
+  if (mode_ == Mode::kGoto && pattern_.standing()) {
+    FinishGoto(completed);
+  } else if (mode_ == Mode::kGoto && pattern_.started_steps() - replanned_at_ >= kReplanSteps &&
+             pattern_.unstarted_steps() > 2) {
+    PlanGoto();  // the feet slip (most when turning): re-plan from the measured pose
+  }
 }
 
 // The CoM measured on the physics against the planned one, each relative to

@@ -38,6 +38,8 @@ class WalkingHumanoid {
   /// GOTO: success within these (m, rad), as the issue asks; re-plans at most kRetries times.
   static constexpr double kTolerance = 0.05, kHeadingTolerance = 0.05;
   static constexpr int kRetries = 4;
+  /// During a GOTO, re-plan from the measured pose every this many steps.
+  static constexpr int kReplanSteps = 4;
   /// Pelvis shift per metre of divergent-component error (CoM + CoM rate / omega) and its bound, m.
   static constexpr double kBalanceGain = 1.0, kBalanceLimit = 0.04;
 
@@ -96,6 +98,7 @@ class WalkingHumanoid {
   CommandId goto_id_ = 0;
   walking::Pose2 goal_;  // world
   int tries_ = 0;
+  int replanned_at_ = 0;               // pattern_.started_steps() at the last plan
   double v_ = 0, vy_ = 0, omega_ = 0;  // SETSPEED per second
   bool fallen_ = false;
   double tilt_ = 0;
