@@ -247,7 +247,7 @@ int Watch(const Args& a) {
   std::vector<std::int64_t> arrivals;
   arrivals.reserve(static_cast<std::size_t>(count) + 16);
   c.StartStateStream(std::chrono::microseconds(static_cast<long>(period_us)),
-                     [&](const robotalk_msgs::robot_state_t&) {
+                     [&](const auto&) {  // robot_state_t or the C++ state type: either API
                        std::lock_guard<std::mutex> lock(mu);
                        if (static_cast<long>(arrivals.size()) < count + 16) arrivals.push_back(MonoNs());
                      });

@@ -115,7 +115,7 @@ def rows_for(res):
                      f"commands, cap {th.get('cap_s')} s)",
                      f"{per} cmd/s; {lost} gave up, {rtx} retransmissions",
                      f"raw LCM echo, 1,000 in flight: {per_s(b1k)}",
-                     f"{ratio(a1k, b1k)} (vs own 100-in-flight: {ratio(a1k, a100)})"))
+                     f"{ratio(a1k, b1k, 3)} (vs own 100-in-flight: {ratio(a1k, a100, 3)})"))
     for lvl in res.get("scale", {}).get("levels", []):
         cl = lvl["per_client"]
         ok = [c for c in cl if "sent" in c]

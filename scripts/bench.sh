@@ -20,7 +20,7 @@ while (($#)); do
     --only) run_args+=(--only "$2"); shift ;;
     --no-setup) setup=0 ;;
     --freeze-before) gen_args+=(--freeze-before) ;;
-    -h|--help) sed -n 2,13p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,11p "$0"; exit 0 ;;
     *) echo "bench.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift

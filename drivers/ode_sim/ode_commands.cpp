@@ -51,6 +51,10 @@ void OdeDriver::Impl::Stop(TimePoint now, std::vector<Completion>& interrupted) 
 DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
   const std::string name = ToString(c.type);
   const robotalk::Joint& joint = model_.joint(c.target);  // checked by the server (driver.h)
+  if (walker_ && !joint.dofs.empty() && walker_->Owns(model_.dof_offset(c.target))) {  // walking hook
+    return Answer(Signal::kBusy,
+                  name + " " + Quote(joint.name) + ": the leg is driven by the walking controller");
+  }
   if (IsWheel(c.target)) {
     if (base_mode_ == BaseMode::kGoto) {
       return Answer(Signal::kBusy, name + " " + Quote(joint.name) +
@@ -122,6 +126,7 @@ DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
     return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
                                       std::to_string(c.num_values));
   }
+  if (walker_) return walker_->SetSpeed(c);  // walking hook
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }
@@ -161,6 +166,7 @@ DriverResult OdeDriver::Impl::Goto(const DriverCommand& c) {
   if (c.num_values != 3) {
     return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
   }
+  if (walker_) return walker_->Goto(c);  // walking hook
   if (base_mode_ == BaseMode::kGoto) {
     return Answer(Signal::kBusy, "GOTO: GOTO in progress (command " + std::to_string(goto_id_) + ")");
   }

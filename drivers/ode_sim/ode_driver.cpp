@@ -91,7 +91,11 @@ OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::ve
   wo.virtual_mass = options_.virtual_mass;
   wo.caster_links = options_.casters;
   wo.seed = options_.seed;
-  wo.kinematic_first_root = base == BaseType::kHolonomic || base == BaseType::kFloating;
+  if (base == BaseType::kFloating && options_.walk) {  // walking hook
+    walker_ =
+        ode_detail::WalkingHumanoid::Create(model_, shapes, options_.gravity, ToSeconds(step_), &walk_why_);
+  }
+  wo.kinematic_first_root = (base == BaseType::kHolonomic || base == BaseType::kFloating) && !walker_;
   wo.place_on_ground = base != BaseType::kFixed;
   if (base == BaseType::kDifferential) {
     // A wheel touches the ground at one point: its collision cylinder becomes
@@ -113,7 +117,11 @@ OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::ve
     SetupWheels(shapes);
   } else if (base != BaseType::kFixed) {
     base_kind_ = BaseKind::kKinematic;
-    SetupGait();
+    if (walker_) {
+      walker_->Attach(world_.get(), vmax_, fmax_);  // walking hook
+    } else {
+      SetupGait();
+    }
   }
 }
 
@@ -245,6 +253,7 @@ void OdeDriver::Impl::SetWheels(double v, double omega) {
 void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
   const Eigen::VectorXd& q = world_->q();
   const Eigen::VectorXd& qd = world_->qd();
+  if (walker_) walker_->Control(completed);  // walking hook: drives the leg dofs
   if (base_mode_ != BaseMode::kIdle) {
     double x, y, th;
     BasePose(&x, &y, &th);
@@ -291,6 +300,7 @@ void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
   const Eigen::Index n = q.size();
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto u = static_cast<size_t>(i);
+    if (walker_ && walker_->Owns(i)) continue;  // walking hook
     switch (mode_[u]) {
       case Mode::kPosition:
         world_->SetMotor(static_cast<int>(i),
@@ -325,6 +335,7 @@ void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
 }
 
 void OdeDriver::Impl::StopAll(const char* why, std::vector<Completion>& completed) {
+  if (walker_) walker_->Stop(why, completed);  // walking hook: ends in double support within two steps
   if (base_mode_ == BaseMode::kGoto) {
     completed.push_back(
         Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
@@ -361,8 +372,8 @@ void OdeDriver::Impl::ReadState(RobotState& state) const {
   const Eigen::Vector3d v = world_->LinkLinearVelocity(root);
   state.base_v = base_kind_ == BaseKind::kFixed ? 0.0 : v.dot(p.linear().col(0));
   state.base_omega = base_kind_ == BaseKind::kFixed ? 0.0 : world_->LinkAngularVelocity(root).z();
-  bool moving = base_mode_ != BaseMode::kIdle || std::abs(state.base_v) > kMovingSpeed ||
-                std::abs(state.base_omega) > kMovingSpeed;
+  bool moving = (walker_ && walker_->status().stepping) || base_mode_ != BaseMode::kIdle ||
+                std::abs(state.base_v) > kMovingSpeed || std::abs(state.base_omega) > kMovingSpeed;
   const Eigen::VectorXd& q = world_->q();
   const Eigen::VectorXd& qd = world_->qd();
   for (Eigen::Index i = 0; i < q.size() && !moving; ++i) {
@@ -413,6 +424,10 @@ TimePoint OdeDriver::sim_time() const {
   return impl_->origin_.value_or(TimePoint{}) + impl_->dropped_ + impl_->steps_ * impl_->step_;
 }
 Duration OdeDriver::dropped_time() const { return impl_->dropped_; }
+std::optional<walking::WalkStatus> OdeDriver::walk_status() const {
+  if (!impl_->walker_) return std::nullopt;
+  return impl_->walker_->status();
+}
 Eigen::Isometry3d OdeDriver::LinkPose(int link) const { return impl_->world_->LinkPose(link); }
 OdeDriver::Stats OdeDriver::stats() const {
   const OdeWorld& w = *impl_->world_;

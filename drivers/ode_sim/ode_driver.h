@@ -23,6 +23,7 @@
 
 #include "collision_shapes.h"
 #include "robotalk/driver.h"
+#include "walking/walk_status.h"
 
 #include <chrono>
 #include <cstdint>
@@ -88,6 +89,10 @@ struct OdeDriverOptions {
   /// of each leg, '+'-separated "left_hip+left_knee+right_hip+right_knee";
   /// empty = guessed from common names. Key "gait_joints".
   std::string gait_joints;
+  /// Experimental: a floating base with feet walks on physics (docs/ode_sim.md,
+  /// "Walking"; it still falls on long walks); false (default) = the root
+  /// moves kinematically (the scripted gait). Key "walk".
+  bool walk = false;
 
   /// Parses DriverConfig::options. Throws Error naming an unknown key (and the
   /// known ones) or a bad value: "ode driver: option step_hz='0': expected a rate > 0 (Hz)".
@@ -132,6 +137,9 @@ class OdeDriver final : public Driver {
   TimePoint sim_time() const;
   /// Simulated time dropped because Update() fell behind by more than max_catchup_ms.
   Duration dropped_time() const;
+  /// The walking controller's status (docs/ode_sim.md, "Walking"); nullopt
+  /// when the robot does not walk (not a floating humanoid, or walk=false).
+  std::optional<walking::WalkStatus> walk_status() const;
   /// World pose of a link's frame, from the physics.
   Eigen::Isometry3d LinkPose(int link) const;
   /// Bodies, geoms and fused links of the simulation (for docs and tests).

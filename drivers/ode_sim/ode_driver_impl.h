@@ -9,6 +9,7 @@
 #include "ode_driver.h"
 #include "ode_world.h"
 #include "robotalk/inverse_kinematics.h"
+#include "walking_humanoid.h"
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -93,6 +94,12 @@ class OdeDriver::Impl {
   // the measured root poses it starts from, one per RobotModel::roots() entry.
   InverseKinematics ik_;
   std::vector<Eigen::Isometry3d> root_poses_;
+
+ public:
+  // --- walking hook: a floating humanoid with feet walks (walking_humanoid.h);
+  // it owns the leg dofs and answers GOTO/SETSPEED/STOP/Halt. Null otherwise.
+  std::unique_ptr<ode_detail::WalkingHumanoid> walker_;
+  std::string walk_why_;  // why the model does not walk (walker_ null)
 };
 
 }  // namespace robotalk

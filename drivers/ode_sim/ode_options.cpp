@@ -95,6 +95,10 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       const std::optional<bool> b = driver_support::ParseBool(value);
       if (!b) BadOption(key, value, "true or false");
       o.merge_chains = *b;
+    } else if (key == "walk") {
+      const std::optional<bool> b = driver_support::ParseBool(value);
+      if (!b) BadOption(key, value, "true or false");
+      o.walk = *b;
     } else if (key == "max_catchup_ms") {
       o.max_catchup_ms = ParseNumber(key, value, 0, false, "a number of milliseconds > 0");
     } else if (key == "virtual_mass") {
@@ -107,8 +111,8 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
           "ode driver: unknown option '" + key +
           "' (known: base, base_max_omega, base_max_v, casters, default_effort, default_velocity, friction, "
           "gait_joints, goto_heading_tolerance, goto_tolerance, gravity, kp, left_wheel, max_catchup_ms, "
-          "merge_chains, period_ms, right_wheel, seed, solver, step_hz, virtual_mass, wheel_radius, "
-          "wheel_separation)");
+          "merge_chains, period_ms, right_wheel, seed, solver, step_hz, virtual_mass, walk, "
+          "wheel_radius, wheel_separation)");
     }
   }
   return o;

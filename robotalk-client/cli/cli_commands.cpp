@@ -154,28 +154,28 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
             << "; Ctrl-C ends)\n";
   std::mutex mu;
   double samples = 0;
-  const Duration actual =
-      client->StartStateStream(FromSeconds(period_s), [&](const robotalk_msgs::robot_state_t& s) {
-        std::lock_guard lock(mu);
-        if (samples >= max_samples) return;
-        if (json) {
-          std::cout << StateJson(s) << '\n' << std::flush;
-        } else {
-          char line[160];
-          std::snprintf(line, sizeof line, "%" PRId64 " t=%.3f base %.4f %.4f %.4f v=%.3f w=%.3f%s q",
-                        s.sample, static_cast<double>(s.server_time_us) * 1e-6, s.base[0], s.base[1],
-                        s.base[2], s.base[3], s.base[4], s.panic ? " PANIC" : "");
-          std::cout << line;
-          for (double q : s.position) std::cout << ' ' << q;
-          std::cout << '\n' << std::flush;
-        }
-        ++samples;
-      });
+  const Duration actual = client->StartStateStream(FromSeconds(period_s), [&](const StateSample& s) {
+    std::lock_guard lock(mu);
+    if (samples >= max_samples) return;
+    if (json) {
+      std::cout << StateJson(s) << '\n' << std::flush;
+    } else {
+      char line[160];
+      std::snprintf(line, sizeof line, "%" PRId64 " t=%.3f base %.4f %.4f %.4f v=%.3f w=%.3f%s q", s.sample,
+                    ToSeconds(s.server_time.time_since_epoch()), s.base.x, s.base.y, s.base.theta, s.base.v,
+                    s.base.omega, s.panic ? " PANIC" : "");
+      std::cout << line;
+      for (double q : s.positions) std::cout << ' ' << q;
+      std::cout << '\n' << std::flush;
+    }
+    ++samples;
+  });
   if (actual != FromSeconds(period_s)) {
     std::cerr << "robotalk: the stream runs every " << FormatDuration(actual)
               << " (another client asked for faster)\n";
   }
   // Ends at --duration, --count or a signal (the usual end: exit 0).
+  Interrupter::Defer(true);
   const TimePoint end = SteadyClock().Now() + FromSeconds(std::min(duration_s, 1e9));
   while (SteadyClock().Now() < end && !Interrupter::Signal()) {
     {

@@ -79,6 +79,7 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
   for (const auto& e : entries) frames.push_back({FromSeconds(e.offset_s), e.command});
 
   const auto client = ConnectClient(g, robot);
+  Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
   const bool bar = ProgressOnTty();
   int status = 0;
   const RunReport report = RunFrames(
@@ -118,6 +119,7 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
   if (at) c.start_time = client->ServerNow() + FromSeconds(*at);
   const CommandType type = c.type;
   const bool motion = IsMotionCommand(type);
+  Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
   PendingReply pending = client->Send(std::move(c));
   const bool bar = ProgressOnTty() && (type == CommandType::kGoto || at);
   const std::optional<Reply> r = AwaitReply(pending, [&](Duration waited) {

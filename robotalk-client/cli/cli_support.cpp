@@ -20,19 +20,22 @@ namespace robotalk::cli {
 constexpr Duration kAnnounceWait = std::chrono::milliseconds(1200);  // > one announce period
 
 struct AnnounceWatch::Impl {
-  lcm::LCM lcm;
+  std::string url;
   int wake[2] = {-1, -1};
   mutable std::mutex mu;
   std::set<std::string> names;  // GUARDED_BY(mu)
   std::thread thread;
 
-  explicit Impl(const std::string& url) : lcm(url) {}
   void On(const lcm::ReceiveBuffer*, const std::string&, const robotalk_msgs::announce_t* a) {
     std::lock_guard lock(mu);
     for (const auto& r : a->robots) names.insert(r.name);
   }
+  // LCM is opened on this thread, so a Connect that succeeds at once does not
+  // wait for it; poll() on LCM's socket and a pipe lets the destructor wake it.
   void Run() {
-    // poll() on LCM's socket and a pipe: the destructor wakes it at once.
+    lcm::LCM lcm(url);
+    if (!lcm.good()) return;
+    lcm.subscribe(kAnnounceChannel, &Impl::On, this);
     for (;;) {
       pollfd fds[2] = {{lcm.getFileno(), POLLIN, 0}, {wake[0], POLLIN, 0}};
       if (poll(fds, 2, -1) < 0) continue;
@@ -42,9 +45,9 @@ struct AnnounceWatch::Impl {
   }
 };
 
-AnnounceWatch::AnnounceWatch(const std::string& url) : impl_(std::make_unique<Impl>(url)) {
-  if (!impl_->lcm.good() || pipe(impl_->wake) != 0) return;
-  impl_->lcm.subscribe(kAnnounceChannel, &Impl::On, impl_.get());
+AnnounceWatch::AnnounceWatch(const std::string& url) : impl_(std::make_unique<Impl>()) {
+  impl_->url = url;
+  if (pipe(impl_->wake) != 0) return;
   impl_->thread = std::thread([this] { impl_->Run(); });
 }
 
@@ -142,16 +145,17 @@ std::string ReplyJson(const Reply& r) {
   return out.str();
 }
 
-std::string StateJson(const robotalk_msgs::robot_state_t& s) {
+std::string StateJson(const StateSample& s) {
+  const double base[5] = {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega};
   std::ostringstream out;
   out << "{\"robot\":" << JsonString(s.robot) << ",\"sample\":" << s.sample
-      << ",\"server_time_us\":" << s.server_time_us
-      << ",\"period_s\":" << JsonNumber(static_cast<double>(s.period_us) * 1e-6)
-      << ",\"panic\":" << (s.panic ? "true" : "false") << ",\"moving\":" << (s.moving ? "true" : "false")
-      << ",\"base\":" << JsonArray(std::begin(s.base), std::end(s.base))
-      << ",\"position\":" << JsonArray(s.position.begin(), s.position.end())
-      << ",\"velocity\":" << JsonArray(s.velocity.begin(), s.velocity.end())
-      << ",\"effort\":" << JsonArray(s.effort.begin(), s.effort.end()) << "}";
+      << ",\"server_time_us\":" << ToWireMicros(s.server_time)
+      << ",\"period_s\":" << JsonNumber(ToSeconds(s.period)) << ",\"panic\":" << (s.panic ? "true" : "false")
+      << ",\"moving\":" << (s.moving ? "true" : "false")
+      << ",\"base\":" << JsonArray(std::begin(base), std::end(base))
+      << ",\"position\":" << JsonArray(s.positions.begin(), s.positions.end())
+      << ",\"velocity\":" << JsonArray(s.velocities.begin(), s.velocities.end())
+      << ",\"effort\":" << JsonArray(s.efforts.begin(), s.efforts.end()) << "}";
   return out.str();
 }
 

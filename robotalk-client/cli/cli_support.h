@@ -43,7 +43,7 @@ std::string JsonString(const std::string& s);
 std::string JsonNumber(double v);
 /// {"id":12,"signal":"SUCCESS","message":"","exec_time_us":..,"lateness_s":..,"values":[..]}
 std::string ReplyJson(const Reply& r);
-std::string StateJson(const robotalk_msgs::robot_state_t& s);
+std::string StateJson(const StateSample& s);
 std::string RobotsJson(const std::vector<AnnouncedRobot>& robots);
 
 }  // namespace robotalk::cli

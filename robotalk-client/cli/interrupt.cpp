@@ -14,6 +14,7 @@ namespace {
 
 std::atomic<int> g_signal{0};
 std::atomic<bool> g_installed{false};
+std::atomic<bool> g_defer{false};
 std::mutex g_mu;
 std::condition_variable g_cv;
 
@@ -30,8 +31,8 @@ void WaitForSignals() {
   for (;;) {
     int sig = 0;
     if (sigwait(&set, &sig) != 0) continue;
-    if (g_signal.load() != 0) {
-      // The second signal: the user does not want to wait for the STOP.
+    if (g_signal.load() != 0 || !g_defer.load()) {
+      // Nothing to stop yet, or the second signal: the user does not want to wait.
       std::fflush(stdout);
       std::_Exit(128 + sig);
     }
@@ -51,6 +52,8 @@ void Interrupter::Install() {
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   std::thread(WaitForSignals).detach();
 }
+
+void Interrupter::Defer(bool defer) { g_defer.store(defer); }
 
 int Interrupter::Signal() { return g_signal.load(); }
 

@@ -6,8 +6,10 @@
 // Install() blocks SIGINT and SIGTERM in the calling thread and starts one
 // thread that sigwait()s for them; every thread started afterwards (LCM's,
 // RobotClient's ReadDaemon) inherits the mask, so only that thread receives
-// them. The first signal is recorded; a second one ends the process at once
-// with status 128 + signal (the user insists).
+// them. Until a tool calls Defer(true) (it is about to start something it
+// must stop), a signal ends the process at once with status 128 + signal;
+// afterwards the first signal is recorded for the wait loops, and a second
+// one ends the process at once (the user insists).
 //
 // Thread safety: every function may be called from any thread.
 #pragma once
@@ -20,6 +22,8 @@ class Interrupter {
  public:
   /// Call first in main(), before any other thread exists. Idempotent.
   static void Install();
+  /// true: record signals for the wait loops instead of exiting at once.
+  static void Defer(bool defer);
   /// The first SIGINT/SIGTERM received, or 0. Without Install(), always 0.
   static int Signal();
   /// Waits at most `d`, returning early when a signal arrives; returns Signal().

@@ -12,7 +12,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/robot_client.h"
 
-#include <lcm/lcm-cpp.hpp>
+#include "robotalk/transport.h"
 
 #include <atomic>
 #include <condition_variable>
@@ -57,9 +57,11 @@ class RobotClient::Impl {
   CommandId NewId();
   /// Tells the retransmission bookkeeping when items will run (server clock).
   void SetStartTimes(const std::vector<std::pair<CommandId, TimePoint>>& server_starts);
-  void OnState(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnState(std::span<const std::uint8_t> bytes);
   /// Subscribes ROBOTALK/<robot>/STATE (once) and sets the sample callback.
-  void SubscribeState(std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);
+  void SubscribeState(std::function<void(const StateSample&)> on_sample);
+  /// Wakes the ReadDaemon (a new deadline, or closing). Thread-safe.
+  void WakeDaemon();
   PendingReply MakePending(CommandId id, std::string what);
 
   /// Subscribes the robot's channels (REPLY/<client>, CONFIG).
@@ -73,7 +75,8 @@ class RobotClient::Impl {
   std::string LastConfigError() const;
 
   const ClientOptions options_;
-  SteadyClock clock_;
+  SteadyClock steady_clock_;
+  const Clock& clock_;  // options_.clock or steady_clock_
   std::int64_t client_id_ = 0;
   std::shared_ptr<client::ReturnCache> cache_;
 
@@ -95,20 +98,22 @@ class RobotClient::Impl {
   std::unordered_set<std::int64_t> acked_;                                       // GUARDED_BY(mu_)
   std::exception_ptr daemon_error_;                                              // GUARDED_BY(mu_)
   ClientStats stats_;                                                            // GUARDED_BY(mu_)
-  lcm::Subscription* state_subscription_ = nullptr;                              // GUARDED_BY(mu_)
-  std::function<void(const robotalk_msgs::robot_state_t&)> on_state_;            // GUARDED_BY(mu_)
+  std::unique_ptr<Subscription> state_subscription_;                             // GUARDED_BY(mu_)
+  std::function<void(const StateSample&)> on_state_;                             // GUARDED_BY(mu_)
 
  private:
   void Run();  // the ReadDaemon
   void Tick(TimePoint now);
   void Publish(const std::string& channel, const std::vector<std::uint8_t>& bytes);
-  void OnReplyPackage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnConfig(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnReplyPackage(std::span<const std::uint8_t> bytes);
+  void OnConfig(std::span<const std::uint8_t> bytes);
+  Duration IdleWait(TimePoint now);
   std::vector<std::uint8_t> EncodeHeartbeat(TimePoint now);  // REQUIRES: mu_ held
 
-  std::unique_ptr<lcm::LCM> own_lcm_;
-  lcm::LCM* lcm_ = nullptr;
-  std::vector<lcm::Subscription*> subscriptions_;  // GUARDED_BY(mu_)
+  std::unique_ptr<Transport> own_transport_;
+  Transport* transport_ = nullptr;
+  std::vector<std::unique_ptr<Subscription>> subscriptions_;  // GUARDED_BY(mu_)
+  int wake_fd_ = -1;  // eventfd: SendPackage and Close wake the ReadDaemon
   std::mutex fault_mu_;
   std::mt19937_64 fault_rng_;  // GUARDED_BY(fault_mu_)
   std::atomic<bool> stop_{false};

@@ -3,6 +3,7 @@
 #include "client_impl.h"
 #include "robotalk/error.h"
 #include "robotalk/protocol_codec.h"
+#include "sequence_plan.h"
 
 #include <algorithm>
 #include <thread>
@@ -10,10 +11,12 @@
 namespace robotalk {
 namespace {
 
-// When frame i should leave the client: paced frames go at their offset.
+// Waits until the client's clock reaches `t`, re-reading it at least every
+// 10 ms of real time (a ManualClock moves when a test says so).
 void WaitUntil(const Clock& clock, TimePoint t) {
-  const Duration left = t - clock.Now();
-  if (left > Duration(0)) std::this_thread::sleep_for(left);
+  for (Duration left = t - clock.Now(); left > Duration(0); left = t - clock.Now()) {
+    std::this_thread::sleep_for(std::min<Duration>(left, std::chrono::milliseconds(10)));
+  }
 }
 
 }  // namespace
@@ -51,30 +54,26 @@ CommandId RobotClient::Impl::NewId() {
 
 SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options) {
   if (!connected()) throw ClientError("RobotClient::RunSequence: not connected (call Connect first)");
-  for (const TimedCommand& f : frames) {
-    if (f.offset < Duration(0)) throw ClientError("RobotClient::RunSequence: a frame has a negative offset");
-  }
+  const client::SequencePlan plan = client::PlanSequence(frames, options);
   SequenceResult result;
   result.replies.resize(frames.size());
   if (frames.empty()) return result;
-  // Frames leave in offset order; replies are returned in the order given.
-  std::vector<std::size_t> order(frames.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return frames[a].offset < frames[b].offset; });
-  const Duration duration = frames[order.back()].offset;
+  const Duration duration = plan.duration;
   const Clock& clock = impl_->clock_;
   const TimePoint t0 = clock.Now();
   result.first_sent = t0;
+  client::SequencePacer pacer(plan, t0);
 
   if (options.mode == CommandMode::kDirect) {
     // The handshake: the next frame cannot leave before the previous reply is
     // in, so a slow channel stretches the sequence (the paper's Fig. 11).
-    for (std::size_t i : order) {
-      if (options.paced) WaitUntil(clock, t0 + frames[i].offset);
-      Command c = std::move(frames[i].command);
-      c.start_time.reset();
-      result.replies[i] = Execute(std::move(c));
+    while (auto due = pacer.NextDeadline()) {
+      WaitUntil(clock, *due);
+      for (std::size_t i : pacer.NextDue(clock.Now())->frames) {
+        Command c = std::move(frames[i].command);
+        c.start_time = client::FrameStart(CommandMode::kDirect, frames[i].offset, {});
+        result.replies[i] = Execute(std::move(c));
+      }
     }
     return result;
   }
@@ -92,23 +91,20 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   }
 
   std::vector<std::optional<PendingReply>> pending(frames.size());
-  const std::size_t batch = options.paced ? 1 : std::max<std::size_t>(options.batch, 1);
-  for (std::size_t k = 0; k < order.size(); k += batch) {
-    const std::size_t end = std::min(order.size(), k + batch);
-    if (options.paced) WaitUntil(clock, t0 + frames[order[k]].offset);
+  while (auto due = pacer.NextDeadline()) {
+    WaitUntil(clock, *due);
+    const client::PlannedSend& send = *pacer.NextDue(clock.Now());
     std::vector<Command> commands;
-    for (std::size_t j = k; j < end; ++j) {
-      Command c = std::move(frames[order[j]].command);
-      // Playback carries the offset itself; delay mode an absolute server time.
-      c.start_time = options.mode == CommandMode::kPlayback
-                         ? StartTime::After(frames[order[j]].offset)
-                         : StartTime::At(server_start + frames[order[j]].offset);
+    for (std::size_t i : send.frames) {
+      Command c = std::move(frames[i].command);
+      c.start_time = client::FrameStart(options.mode, frames[i].offset, server_start);
       commands.push_back(std::move(c));
     }
     auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit, false, playback);
     playback.ask_for_delay = false;  // only the first package asks
-    for (std::size_t j = k; j < end; ++j) {
-      pending[order[j]] = impl_->MakePending(sent.ids[j - k], "sequence frame " + std::to_string(order[j]));
+    for (std::size_t j = 0; j < send.frames.size(); ++j) {
+      pending[send.frames[j]] =
+          impl_->MakePending(sent.ids[j], "sequence frame " + std::to_string(send.frames[j]));
     }
   }
 
@@ -134,8 +130,7 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   return result;
 }
 
-Duration RobotClient::StartStateStream(Duration period,
-                                       std::function<void(const robotalk_msgs::robot_state_t&)> on_sample) {
+Duration RobotClient::StartStateStream(Duration period, std::function<void(const StateSample&)> on_sample) {
   if (!connected()) throw ClientError("RobotClient::StartStateStream: not connected (call Connect first)");
   impl_->SubscribeState(std::move(on_sample));
   const Reply r = Query(robotalk::Query{.type = QueryType::kStateStream, .period = period});
@@ -153,31 +148,36 @@ void RobotClient::StopStateStream() {
   impl_->on_state_ = nullptr;
 }
 
-void RobotClient::Impl::SubscribeState(std::function<void(const robotalk_msgs::robot_state_t&)> on_sample) {
+void RobotClient::Impl::SubscribeState(std::function<void(const StateSample&)> on_sample) {
   std::lock_guard lock(mu_);
   on_state_ = std::move(on_sample);
   if (state_subscription_) return;
-  state_subscription_ = lcm_->subscribe(StateChannel(robot_), &Impl::OnState, this);
-  if (!state_subscription_) throw ClientError("RobotClient: cannot subscribe to " + StateChannel(robot_));
-  state_subscription_->setQueueCapacity(options_.lcm_queue_capacity);
+  try {
+    state_subscription_ = transport_->Subscribe(
+        StateChannel(robot_), [this](const std::string&, std::span<const std::uint8_t> b) { OnState(b); });
+  } catch (const TransportError& e) {
+    throw ClientError("RobotClient: cannot subscribe to " + StateChannel(robot_) + ": " + e.what());
+  }
 }
 
-// LCM callback on the ReadDaemon: never throws.
-void RobotClient::Impl::OnState(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-  robotalk_msgs::robot_state_t state;
+// On the ReadDaemon: a bad sample is counted, a callback's exception stored.
+void RobotClient::Impl::OnState(std::span<const std::uint8_t> bytes) {
+  std::function<void(const StateSample&)> callback;
+  int dofs = -1;
+  {
+    std::lock_guard lock(mu_);
+    callback = on_state_;
+    if (model_) dofs = model_->num_dofs();
+  }
+  if (!callback) return;
+  StateSample state;
   try {
-    state = DecodeRobotState({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+    state = DecodeStateSample(bytes, dofs);
   } catch (const ProtocolError&) {
     std::lock_guard lock(mu_);
     ++stats_.malformed_packages;
     return;
   }
-  std::function<void(const robotalk_msgs::robot_state_t&)> callback;
-  {
-    std::lock_guard lock(mu_);
-    callback = on_state_;
-  }
-  if (!callback) return;
   try {
     callback(state);
   } catch (...) {

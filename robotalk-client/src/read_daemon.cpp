@@ -5,7 +5,17 @@
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
 
+#include "robotalk/lcm_transport.h"
+
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <climits>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <utility>
 
@@ -13,7 +23,6 @@ namespace robotalk {
 namespace {
 
 constexpr std::size_t kMaxPackageBytes = 60000;  // docs/protocol.md "Limits"
-constexpr int kPollMillis = 10;                  // ReadDaemon tick
 
 std::int64_t RandomClientId() {
   std::random_device rd;
@@ -39,34 +48,46 @@ std::vector<std::uint8_t> Encode(const robotalk_msgs::package_t& p) {
 
 RobotClient::Impl::Impl(ClientOptions options)
     : options_(std::move(options)),
+      clock_(options_.clock ? *options_.clock : static_cast<const Clock&>(steady_clock_)),
       client_id_(options_.client_id != 0 ? options_.client_id : RandomClientId()),
       cache_(std::make_shared<client::ReturnCache>(options_.return_cache_capacity)),
       outstanding_(PolicyOf(options_)),
       fault_rng_(options_.fault_seed) {
-  if (options_.shared_lcm) {
-    lcm_ = options_.shared_lcm;
+  if (options_.transport) {
+    transport_ = options_.transport;
   } else {
-    own_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
-    lcm_ = own_lcm_.get();
+    try {
+      own_transport_ = std::make_unique<LcmTransport>(
+          LcmTransportOptions{.url = options_.lcm_url, .queue_capacity = options_.lcm_queue_capacity});
+    } catch (const TransportError& e) {
+      throw ClientError(std::string("RobotClient: ") + e.what());
+    }
+    transport_ = own_transport_.get();
   }
-  if (!lcm_->good()) {
-    throw ClientError("RobotClient: cannot initialise LCM with URL '" + options_.lcm_url + "'");
-  }
+  wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd_ < 0) throw ClientError(std::string("RobotClient: eventfd failed: ") + std::strerror(errno));
   last_send_ = clock_.Now();
   daemon_ = std::thread([this] { Run(); });
 }
 
 RobotClient::Impl::~Impl() {
   stop_ = true;
+  WakeDaemon();
   if (daemon_.joinable()) daemon_.join();
   {
     std::lock_guard lock(mu_);
-    // A shared LCM outlives us: its handlers must not call into a dead Impl.
-    for (lcm::Subscription* s : subscriptions_) lcm_->unsubscribe(s);
+    // A shared transport outlives us: its handlers must not call into a dead Impl.
     subscriptions_.clear();
+    state_subscription_.reset();
     outstanding_.Clear();
   }
+  ::close(wake_fd_);
   cache_->FailAll("RobotClient closed before the reply arrived", /*timed_out=*/false);
+}
+
+void RobotClient::Impl::WakeDaemon() {
+  const std::uint64_t one = 1;
+  [[maybe_unused]] auto n = ::write(wake_fd_, &one, sizeof one);
 }
 
 void RobotClient::Impl::Attach(const std::string& robot) {
@@ -74,13 +95,14 @@ void RobotClient::Impl::Attach(const std::string& robot) {
   robot_ = robot;
   request_channel_ = RequestChannel(robot);
   const std::string reply_channel = ReplyChannel(robot, client_id_);
-  const std::string config_channel = ConfigChannel(robot);
-  lcm::Subscription* reply = lcm_->subscribe(reply_channel, &Impl::OnReplyPackage, this);
-  lcm::Subscription* config = lcm_->subscribe(config_channel, &Impl::OnConfig, this);
-  if (!reply || !config) throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel);
-  reply->setQueueCapacity(options_.lcm_queue_capacity);
-  config->setQueueCapacity(8);
-  subscriptions_ = {reply, config};
+  try {
+    subscriptions_.push_back(transport_->Subscribe(
+        reply_channel, [this](const std::string&, std::span<const std::uint8_t> b) { OnReplyPackage(b); }));
+    subscriptions_.push_back(transport_->Subscribe(
+        ConfigChannel(robot), [this](const std::string&, std::span<const std::uint8_t> b) { OnConfig(b); }));
+  } catch (const TransportError& e) {
+    throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel + ": " + e.what());
+  }
 }
 
 RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands,
@@ -156,6 +178,7 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     ++stats_.packages_sent;
   }
   Publish(channel, bytes);
+  if (track == Track::kRetransmit) WakeDaemon();  // a new resend deadline
   return sent;
 }
 
@@ -174,7 +197,7 @@ void RobotClient::Impl::Publish(const std::string& channel, const std::vector<st
       copies = 2;
     }
   }
-  for (int i = 0; i < copies; ++i) lcm_->publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+  for (int i = 0; i < copies; ++i) transport_->Publish(channel, bytes);
 }
 
 bool RobotClient::Impl::WaitAck(std::int64_t sequence, std::chrono::steady_clock::time_point deadline) {
@@ -206,18 +229,39 @@ std::string RobotClient::Impl::LastConfigError() const {
 // ---------------------------------------------------------------------------
 // The ReadDaemon.
 
+// Sleeps until a message, a wake-up (new package, Close) or the next
+// deadline, at most max_idle_wait; then dispatches and ticks.
 void RobotClient::Impl::Run() {
   bool reported = false;
+  const int fd = transport_->fileno();
   while (!stop_) {
-    if (lcm_->handleTimeout(kPollMillis) < 0) {
-      // LCM failed (socket gone): report once and keep ticking so that waits
-      // still time out rather than hang.
+    const Duration wait = IdleWait(clock_.Now());
+    const auto ms = std::chrono::ceil<std::chrono::milliseconds>(wait).count();
+    try {
+      if (fd >= 0) {
+        pollfd fds[2] = {{wake_fd_, POLLIN, 0}, {fd, POLLIN, 0}};
+        ::poll(fds, 2, static_cast<int>(std::clamp<long long>(ms, 0, INT_MAX)));
+        if (fds[0].revents & POLLIN) {
+          std::uint64_t v = 0;
+          [[maybe_unused]] auto n = ::read(wake_fd_, &v, sizeof v);
+        }
+        if (stop_) break;
+        if (fds[1].revents & POLLIN) transport_->HandleFor(Duration(0));
+      } else {
+        transport_->HandleFor(std::min<Duration>(wait, std::chrono::milliseconds(10)));
+      }
+    } catch (const TransportError& e) {
+      // The transport failed (socket gone): report once and keep ticking so
+      // that waits still time out rather than hang.
       if (!reported) {
         std::lock_guard lock(mu_);
-        daemon_error_ = std::make_exception_ptr(ClientError("RobotClient: LCM handle() failed"));
+        daemon_error_ = std::make_exception_ptr(ClientError(std::string("RobotClient: ") + e.what()));
         reported = true;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(kPollMillis));
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    } catch (...) {
+      std::lock_guard lock(mu_);
+      daemon_error_ = std::current_exception();
     }
     try {
       Tick(clock_.Now());
@@ -226,6 +270,14 @@ void RobotClient::Impl::Run() {
       daemon_error_ = std::current_exception();
     }
   }
+}
+
+Duration RobotClient::Impl::IdleWait(TimePoint now) {
+  std::lock_guard lock(mu_);
+  Duration wait = options_.max_idle_wait;
+  if (!robot_.empty()) wait = std::min(wait, last_send_ + options_.heartbeat_interval - now);
+  if (outstanding_.size() > 0) wait = std::min(wait, outstanding_.retransmit_timeout() / 4);
+  return std::max(wait, Duration(0));
 }
 
 void RobotClient::Impl::Tick(TimePoint now) {
@@ -272,14 +324,13 @@ std::vector<std::uint8_t> RobotClient::Impl::EncodeHeartbeat(TimePoint now) {
   return Encode(p);
 }
 
-void RobotClient::Impl::OnReplyPackage(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-  // Never throw through LCM's C callback: protocol errors are counted, anything
-  // else is stored and rethrown to the next blocking call.
+void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
+  // Protocol errors are counted; anything else is stored and rethrown to the
+  // next blocking call (the ReadDaemon keeps running).
   try {
-    const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
     robotalk_msgs::reply_package_t pkg;
     try {
-      pkg = DecodeReplyPackage({data, rbuf->data_size});
+      pkg = DecodeReplyPackage(bytes);
     } catch (const ProtocolError&) {
       std::lock_guard lock(mu_);
       ++stats_.malformed_packages;
@@ -330,9 +381,8 @@ void RobotClient::Impl::OnReplyPackage(const lcm::ReceiveBuffer* rbuf, const std
   }
 }
 
-void RobotClient::Impl::OnConfig(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+void RobotClient::Impl::OnConfig(std::span<const std::uint8_t> bytes) {
   try {
-    const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
     std::uint64_t hash = 0;
     try {
       hash = static_cast<std::uint64_t>(DecodeConfigHeader(bytes).hash);

@@ -3,6 +3,7 @@
 #include "robotalk/robot_client.h"
 
 #include "client_impl.h"
+#include "robotalk/lcm_transport.h"
 #include "robotalk_msgs/announce_t.hpp"
 
 #include <algorithm>
@@ -95,20 +96,22 @@ Reply PendingReply::Wait(Duration timeout) {
 // --- ListRobots --------------------------------------------------------------
 
 std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen) {
-  std::unique_ptr<lcm::LCM> own;
-  lcm::LCM* lcm = options.shared_lcm;
-  if (!lcm) {
-    own = std::make_unique<lcm::LCM>(options.lcm_url);
-    lcm = own.get();
+  std::unique_ptr<Transport> own;
+  Transport* transport = options.transport;
+  if (!transport) {
+    try {
+      own = std::make_unique<LcmTransport>(LcmTransportOptions{.url = options.lcm_url});
+    } catch (const TransportError& e) {
+      throw ClientError(std::string("ListRobots: ") + e.what());
+    }
+    transport = own.get();
   }
-  if (!lcm->good()) throw ClientError("ListRobots: cannot initialise LCM with URL '" + options.lcm_url + "'");
   struct Collector {
     std::vector<AnnouncedRobot> robots;
-    std::uint64_t malformed = 0;
-    void On(const lcm::ReceiveBuffer* rbuf, const std::string&, const robotalk_msgs::announce_t* msg) {
-      for (const auto& r : msg->robots) {
+    void On(const robotalk_msgs::announce_t& msg) {
+      for (const auto& r : msg.robots) {
         const bool seen = std::any_of(robots.begin(), robots.end(), [&](const AnnouncedRobot& a) {
-          return a.server_id == msg->server_id && a.name == r.name;
+          return a.server_id == msg.server_id && a.name == r.name;
         });
         if (seen) continue;
         robots.push_back({.name = r.name,
@@ -118,23 +121,27 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
                           .base_type = r.base_type,
                           .panic = r.panic != 0,
                           .num_clients = r.num_clients,
-                          .server_id = msg->server_id,
-                          .url_hint = msg->url_hint});
+                          .server_id = msg.server_id,
+                          .url_hint = msg.url_hint});
       }
-      (void)rbuf;
     }
   } collector;
   // announce_t holds no unbounded arrays a hostile sender could abuse beyond
   // the datagram itself, so LCM's typed decoder is acceptable here.
-  lcm::Subscription* sub = lcm->subscribe(kAnnounceChannel, &Collector::On, &collector);
-  sub->setQueueCapacity(100);
+  auto sub = Subscribe<robotalk_msgs::announce_t>(
+      *transport, kAnnounceChannel,
+      [&](const std::string&, const robotalk_msgs::announce_t& msg) { collector.On(msg); });
   const SteadyPoint deadline = SteadyAfter(listen);
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyNow()).count();
-    if (left <= 0) break;
-    lcm->handleTimeout(static_cast<int>(std::min<long long>(left, 50)));
+  for (int round = 0; round < 1000000; ++round) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyNow());
+    if (left.count() <= 0) break;
+    try {
+      transport->HandleFor(std::min<Duration>(left, std::chrono::milliseconds(50)));
+    } catch (const ProtocolError&) {
+      // a malformed announcement: ignored
+    }
   }
-  lcm->unsubscribe(sub);
+  sub.reset();
   std::sort(collector.robots.begin(), collector.robots.end(),
             [](const AnnouncedRobot& a, const AnnouncedRobot& b) {
               return a.name != b.name ? a.name < b.name : a.server_id < b.server_id;

@@ -71,6 +71,15 @@ for _ in $(seq 12); do sleep 0.2; [ "$(speed)" = 0 ] || still=no; done
 check "the queued frames did not move the robot again" test "$still" = yes
 sleep 0.5
 
+# --- Ctrl-C while nothing was started ends at once -------------------------------
+start_bg robots --listen 5
+sleep 0.5
+t0=$(date +%s.%N)
+kill -INT "$bg"; wait "$bg"; status=$?
+t1=$(date +%s.%N)
+check "Ctrl-C during robots exits 130 (got $status)" test "$status" -eq 130
+check "at once" awk -v a="$t0" -v b="$t1" 'BEGIN { exit !(b - a < 0.5) }'
+
 # --- A GOTO longer than --timeout is waited for -----------------------------------
 rt send pioneer goto 0 0 0 >/dev/null 2>&1
 # A STOP clears every session's "moved the robot" mark: otherwise the expiry of

@@ -1,5 +1,6 @@
 #include "fake_server.h"
 
+#include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk_msgs/announce_t.hpp"
@@ -30,17 +31,17 @@ robotalk_msgs::reply_t MakeReply(std::int64_t id, std::int8_t signal, std::strin
 
 }  // namespace
 
-FakeServer::FakeServer(lcm::LCM& lcm, RobotModel model, FakeServerOptions options)
-    : lcm_(lcm), model_(std::move(model)), options_(options), rng_(options.seed) {
-  sub_ = lcm_.subscribe("ROBOTALK/" + model_.name() + "/REQUEST", &FakeServer::OnRequest, this);
-  sub_->setQueueCapacity(10000);
+FakeServer::FakeServer(Transport& transport, RobotModel model, FakeServerOptions options)
+    : transport_(transport), model_(std::move(model)), options_(options), rng_(options.seed) {
+  sub_ = transport_.Subscribe(RequestChannel(model_.name()),
+                              [this](const std::string&, std::span<const std::uint8_t> b) { OnRequest(b); });
   worker_ = std::thread([this] { Worker(); });
 }
 
 FakeServer::~FakeServer() {
   stop_ = true;
   worker_.join();
-  lcm_.unsubscribe(sub_);
+  sub_.reset();
 }
 
 std::int64_t FakeServer::ServerNowUs() const {
@@ -68,7 +69,7 @@ void FakeServer::Announce(std::int64_t server_id) {
   info.panic = panic();
   a.robots.push_back(info);
   a.num_robots = 1;
-  lcm_.publish("ROBOTALK/ANNOUNCE", &a);
+  Publish(transport_, kAnnounceChannel, a);
 }
 
 int FakeServer::executions(std::int64_t id) const {
@@ -106,15 +107,15 @@ void FakeServer::SendLocked(robotalk_msgs::reply_package_t p) {
   if (std::uniform_real_distribution<double>(0, 1)(rng_) < options_.reply_drop_probability) return;
   const std::string channel =
       "ROBOTALK/" + model_.name() + "/REPLY/" + Hex(static_cast<std::uint64_t>(p.client_id));
-  lcm_.publish(channel, &p);
-  if (options_.duplicate_replies) lcm_.publish(channel, &p);
+  Publish(transport_, channel, p);
+  if (options_.duplicate_replies) Publish(transport_, channel, p);
 }
 
-void FakeServer::OnRequest(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+void FakeServer::OnRequest(std::span<const std::uint8_t> bytes) {
   const std::int64_t receive_us = ServerNowUs();
   robotalk_msgs::package_t pkg;
   try {
-    pkg = DecodePackage({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+    pkg = DecodePackage(bytes);
   } catch (const std::exception&) {
     return;
   }
@@ -147,9 +148,8 @@ void FakeServer::OnRequest(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     robotalk_msgs::reply_t r;
     switch (q.type) {
       case robotalk_msgs::query_t::CONFIG: {
-        const auto bytes = EncodeConfig(model_);
-        lcm_.publish("ROBOTALK/" + model_.name() + "/CONFIG", bytes.data(),
-                     static_cast<unsigned>(bytes.size()));
+        const auto config = EncodeConfig(model_);
+        transport_.Publish(ConfigChannel(model_.name()), config);
         r = MakeReply(q.id, 0, Hex(ConfigHash(model_)), receive_us);
         break;
       }

@@ -1,12 +1,13 @@
 // FakeServer: a tiny in-process RoboTalk server for client tests, on a shared
-// LCM instance (memq://). It follows docs/protocol.md closely enough to
+// Transport (a MemoryTransport in the tests; an LcmTransport in
+// robotalk_fake_server). It follows docs/protocol.md closely enough to
 // exercise the client: acks every package, answers queries at once, executes a
 // command once per (client, sequence) and re-sends ack + final replies for a
 // repeated sequence, schedules commands with a future start time, handles panic.
 // Faults it can inject: silence, lost and duplicated reply packages, replies of
 // a batch in reverse order, the first delayed reply lost.
 //
-// Its LCM handler runs on whichever thread calls handle() (the client's
+// Its handler runs on whichever thread calls HandleFor() (the client's
 // ReadDaemon); delayed replies leave from its own worker thread.
 //
 // Thread safety: every method may be called from any thread.
@@ -16,7 +17,7 @@
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
 
-#include <lcm/lcm-cpp.hpp>
+#include "robotalk/transport.h"
 
 #include <atomic>
 #include <chrono>
@@ -41,7 +42,7 @@ struct FakeServerOptions {
 
 class FakeServer {
  public:
-  FakeServer(lcm::LCM& lcm, RobotModel model, FakeServerOptions options = {});
+  FakeServer(Transport& transport, RobotModel model, FakeServerOptions options = {});
   ~FakeServer();
   FakeServer(const FakeServer&) = delete;
   FakeServer& operator=(const FakeServer&) = delete;
@@ -59,7 +60,7 @@ class FakeServer {
   std::int64_t ServerNowUs() const;
 
  private:
-  void OnRequest(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnRequest(std::span<const std::uint8_t> bytes);
   void SendLocked(robotalk_msgs::reply_package_t p);  // REQUIRES: mu_
   void Worker();
 
@@ -69,10 +70,10 @@ class FakeServer {
     robotalk_msgs::reply_t reply;
   };
 
-  lcm::LCM& lcm_;
+  Transport& transport_;
   RobotModel model_;
   FakeServerOptions options_;
-  lcm::Subscription* sub_ = nullptr;
+  std::unique_ptr<Subscription> sub_;
   mutable std::mutex mu_;
   std::mt19937_64 rng_;
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::int64_t>> seen_;  // (client, seq) -> ids

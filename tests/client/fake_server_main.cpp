@@ -2,6 +2,7 @@
 // on a real LCM URL for SECONDS as robot "pioneer", announcing every 200 ms.
 // For the CLI test.
 #include "fake_server.h"
+#include "robotalk/lcm_transport.h"
 #include "robotalk/urdf_import.h"
 
 #include <chrono>
@@ -13,8 +14,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: robotalk_fake_server URL MODEL.urdf SECONDS\n");
     return 2;
   }
-  lcm::LCM lcm(argv[1]);
-  if (!lcm.good()) return 1;
+  robotalk::LcmTransport lcm(robotalk::LcmTransportOptions{.url = argv[1]});
   robotalk::testing::FakeServer server(lcm, robotalk::LoadUrdfFile(argv[2], {.robot_name = "pioneer"}).model);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[3]));
   auto next_announce = std::chrono::steady_clock::now();
@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
       server.Announce(42);
       next_announce += std::chrono::milliseconds(200);
     }
-    lcm.handleTimeout(20);
+    lcm.HandleFor(std::chrono::milliseconds(20));
   }
   return 0;
 }

@@ -1,13 +1,18 @@
-// RobotClient against FakeServer on one in-process memq:// LCM: acks,
+// RobotClient against FakeServer on one in-process MemoryTransport: acks,
 // duplicates, dropped packages, reordering, scheduling, panic, timeouts.
 #include "robotalk/robot_client.h"
 #include "fake_server.h"
+#include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
+#include "robotalk/memory_transport.h"
+#include "robotalk/protocol_codec.h"
 #include "robotalk/urdf_import.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
+#include <mutex>
 #include <thread>
 
 namespace robotalk {
@@ -25,13 +30,13 @@ class RobotClientTest : public ::testing::Test {
  protected:
   ClientOptions Options() {
     ClientOptions o;
-    o.shared_lcm = &lcm_;
+    o.transport = &transport_;
     o.timeout = std::chrono::seconds(5);
     o.connect_timeout = std::chrono::seconds(5);
     return o;
   }
   void StartServer(FakeServerOptions options = {}) {
-    server_ = std::make_unique<FakeServer>(lcm_, model_, options);
+    server_ = std::make_unique<FakeServer>(transport_, model_, options);
   }
   std::unique_ptr<RobotClient> Connected(ClientOptions o) {
     auto c = std::make_unique<RobotClient>(o);
@@ -39,7 +44,9 @@ class RobotClientTest : public ::testing::Test {
     return c;
   }
 
-  lcm::LCM lcm_{"memq://"};
+  // Client and FakeServer share one endpoint of an in-process bus: the
+  // client's ReadDaemon dispatches both (no sockets).
+  MemoryTransport transport_{std::make_shared<MemoryBus>()};
   RobotModel model_ = Pioneer();
   std::unique_ptr<FakeServer> server_;
 };
@@ -182,14 +189,79 @@ TEST_F(RobotClientTest, PanicTimesOutWithoutAck) {
   EXPECT_THROW(client->Panic(), TimeoutError);
 }
 
-TEST_F(RobotClientTest, IdleClientSendsHeartbeats) {
+// On a ManualClock: one heartbeat per idle interval the clock moves, none
+// while it stands still (no sleeping for the interval to pass).
+TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
   StartServer();
+  ManualClock clock;
   ClientOptions o = Options();
+  o.clock = &clock;
   o.heartbeat_interval = milliseconds(50);
+  o.max_idle_wait = milliseconds(1);  // re-read the manual clock often
   auto client = Connected(o);
-  std::this_thread::sleep_for(milliseconds(400));
-  EXPECT_GE(server_->heartbeats(), 4);
-  EXPECT_GE(client->stats().heartbeats, 4u);
+  const int before = server_->heartbeats();
+  for (int k = 1; k <= 4; ++k) {
+    clock.Advance(milliseconds(50));
+    // Bounded real-time wait for the ReadDaemon to notice the clock moved.
+    for (int i = 0; i < 2000 && server_->heartbeats() < before + k; ++i) {
+      std::this_thread::sleep_for(milliseconds(1));
+    }
+    ASSERT_EQ(server_->heartbeats(), before + k) << "after advancing " << k << " intervals";
+  }
+  clock.Advance(milliseconds(49));  // not yet an interval: nothing more is sent
+  // ~20 daemon wake-ups (max_idle_wait 1 ms) in which a wrong heartbeat would go.
+  std::this_thread::sleep_for(milliseconds(20));
+  EXPECT_EQ(client->stats().heartbeats, 4u);
+  EXPECT_EQ(server_->heartbeats(), before + 4);
+}
+
+TEST_F(RobotClientTest, StateStreamDeliversValidatedSamplesAndDropsBadOnes) {
+  StartServer();
+  auto client = Connected(Options());
+  std::mutex mu;
+  std::vector<StateSample> got;
+  EXPECT_EQ(client->StartStateStream(milliseconds(50),
+                                     [&](const StateSample& s) {
+                                       std::lock_guard lock(mu);
+                                       got.push_back(s);
+                                     }),
+            milliseconds(50));
+  const auto dofs = static_cast<std::size_t>(model_.num_dofs());
+  StateSample good;
+  good.robot = model_.name();
+  good.server_time = TimePoint(std::chrono::seconds(1000));
+  good.period = milliseconds(50);
+  good.sample = 1;
+  good.positions.assign(dofs, 0.25);
+  good.velocities.assign(dofs, 0.0);
+  good.efforts.assign(dofs, 0.0);
+  good.base = {1, 2, 0.5, 0.1, 0};
+  robotalk_msgs::robot_state_t nan = ToWire(good);
+  nan.sample = 2;
+  nan.position[0] = std::nan("");
+  StateSample extra_dof = good;
+  extra_dof.sample = 3;
+  for (auto* v : {&extra_dof.positions, &extra_dof.velocities, &extra_dof.efforts}) v->push_back(0);
+  StateSample last = good;
+  last.sample = 4;
+  // The server's side of the bus (published from this thread; the client's
+  // ReadDaemon dispatches).
+  Publish(transport_, StateChannel(model_.name()), ToWire(good));
+  Publish(transport_, StateChannel(model_.name()), nan);
+  Publish(transport_, StateChannel(model_.name()), ToWire(extra_dof));
+  Publish(transport_, StateChannel(model_.name()), ToWire(last));
+  for (int i = 0; i < 2000; ++i) {
+    {
+      std::lock_guard lock(mu);
+      if (got.size() >= 2 && client->stats().malformed_packages >= 2) break;
+    }
+    std::this_thread::sleep_for(milliseconds(1));
+  }
+  std::lock_guard lock(mu);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0], good);
+  EXPECT_EQ(got[1].sample, 4);
+  EXPECT_EQ(client->stats().malformed_packages, 2u);  // NaN, and a dof count the model does not have
 }
 
 TEST_F(RobotClientTest, ConnectTimesOutWithoutServer) {

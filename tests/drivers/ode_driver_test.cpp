@@ -328,8 +328,10 @@ TEST(OdeDriver, SimpleHumanoidStandsOnItsFeetAndTracksHeadSetPoints) {
   EXPECT_NEAR(s.Q("left_elbow"), -1.0, 2e-3);
 }
 
+// The default walk=false: the scripted gait on a kinematic root (the walking
+// humanoid, walk=true, is tests/drivers/ode_walk_test.cpp).
 TEST(OdeDriver, HumanoidGotoMovesTheRootKinematicallyAndAnswersModified) {
-  Sim s(MakeDriver(ProjectModel("simple_humanoid.urdf")));
+  Sim s(MakeDriver(ProjectModel("simple_humanoid.urdf"), {{"walk", "false"}}));
   EXPECT_TRUE(s.Exec(CommandType::kGoto, "", {0.6, 0.3, 0.5}).in_progress);
   s.Run(0.5);
   const double hip = s.Q("left_hip_pitch");

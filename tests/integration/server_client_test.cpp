@@ -267,16 +267,14 @@ TEST_F(ServerClientTest, BroadcastKeepsItsPeriodAndStopsOnCancel) {
   auto watcher = Connect();
   std::mutex mu;
   std::vector<std::int64_t> times;
-  const Duration period =
-      client->StartStateStream(milliseconds(50), [&](const robotalk_msgs::robot_state_t& s) {
-        std::lock_guard lock(mu);
-        times.push_back(s.server_time_us);
-      });
+  const Duration period = client->StartStateStream(milliseconds(50), [&](const StateSample& s) {
+    std::lock_guard lock(mu);
+    times.push_back(ToWireMicros(s.server_time));
+  });
   EXPECT_EQ(period, milliseconds(50));
   // Another subscriber sees the same stream without asking (as lcm-spy would).
   std::atomic<int> seen_by_watcher{0};
-  watcher->StartStateStream(milliseconds(500),
-                            [&](const robotalk_msgs::robot_state_t&) { ++seen_by_watcher; });
+  watcher->StartStateStream(milliseconds(500), [&](const StateSample&) { ++seen_by_watcher; });
   std::this_thread::sleep_for(seconds(2));
   client->StopStateStream();
   watcher->StopStateStream();

@@ -4,6 +4,9 @@
 # mode, replays onto a SECOND robot of another name and ends within 1 cm /
 # 0.01 rad of the recorded final pose. Also: info, extract (a file `robotalk
 # send --file` accepts), export (CSV, PNG).
+# The final pose depends on when the server executes each SETSPEED (a late
+# start by dt shifts the pose by about v*dt and the heading by omega*dt), so
+# speeds are modest; a machine starved for CPU can still exceed the bounds.
 # Runs inside a private network namespace (CTest wraps it with netns_run.sh).
 #   logplay_replay_test.sh SERVER CLI LOGPLAY MODELS_DIR
 set -u
@@ -36,11 +39,11 @@ logger=$!
 rt watch pioneer --period 0.05 >"$tmp/watch.txt" 2>&1 &
 watcher=$!
 cat >"$tmp/seq.txt" <<'SEQ'
-0.0 setspeed 0.3 0
+0.0 setspeed 0.2 0
 0.0 joint_setpoint pan 0.4
-1.0 setspeed 0.3 0.6
+1.0 setspeed 0.2 0.4
 1.5 joint_setpoint tilt -0.3
-2.2 setspeed 0.25 -0.5
+2.2 setspeed 0.2 -0.3
 3.0 joint_setpoint pan -0.2
 3.4 stop
 SEQ
@@ -66,7 +69,7 @@ check "info places it on the server clock" grep -q "7 frames over 3.4 s (server 
 final=$(grep "^state pioneer:" "$tmp/info.txt")
 read -r x0 y0 th0 < <(echo "$final" | sed 's/.*final base x \([^ ]*\) y \([^ ]*\) theta \([^;]*\);.*/\1 \2 \3/')
 read -r pan0 tilt0 < <(echo "$final" | awk '{print $(NF-1), $NF}')
-check "the recorded robot moved (x=$x0)" awk -v x="$x0" 'BEGIN { exit !(x > 0.5) }'
+check "the recorded robot moved (x=$x0)" awk -v x="$x0" 'BEGIN { exit !(x > 0.4) }'
 
 # --- extract ------------------------------------------------------------------
 "$logplay" extract "$tmp/session.lcmlog" --robot pioneer -o "$tmp/extracted.txt" 2>"$tmp/extract.err"
@@ -79,8 +82,11 @@ check "extract keeps targets and values" grep -q "^1.500000 joint_setpoint tilt 
 "$logplay" replay "$tmp/session.lcmlog" --robot pioneer2 --from pioneer --url "$url" >"$tmp/replay.out" 2>&1
 check "replay exits 0" test $? -eq 0
 check "replay summarises the signals" grep -q "replayed 7/7 commands onto 'pioneer2'.*SUCCESS 7" "$tmp/replay.out"
-sleep 1.0
-read -r x1 y1 th1 < <(rt query pioneer2 base_pose | awk '{print $(NF-4), $(NF-3), $(NF-2)}')
+for _ in $(seq 50); do  # until pioneer2 has settled (v = omega = 0)
+  read -r x1 y1 th1 v1 w1 < <(rt query pioneer2 base_pose | awk '{print $(NF-4), $(NF-3), $(NF-2), $(NF-1), $NF}')
+  awk -v v="${v1:-1}" -v w="${w1:-1}" 'BEGIN { exit !(v * v + w * w < 1e-8) }' && break
+  sleep 0.1
+done
 read -r pan1 tilt1 < <(rt query pioneer2 joint_state | awk '{print $6, $7}')
 echo "recorded final: x $x0 y $y0 theta $th0 pan $pan0 tilt $tilt0"
 echo "replayed final: x $x1 y $y1 theta $th1 pan $pan1 tilt $tilt1"
@@ -92,7 +98,8 @@ check "pan within 0.01 rad" within "$pan0" "$pan1" 0.01
 check "tilt within 0.01 rad" within "$tilt0" "$tilt1" 0.01
 
 # --- export -------------------------------------------------------------------
-if python3 -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"; fi
+py=/usr/bin/python3; [ -x "$py" ] || py=python3
+if "$py" -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"; fi
 "$logplay" export "$tmp/session.lcmlog" -o "$tmp/export" $plot >"$tmp/export.out" 2>&1
 check "export exits 0" test $? -eq 0
 check "commands.csv has 7 commands" test "$(grep -c ',pioneer,' "$tmp/export/commands.csv")" -eq 7

@@ -20,21 +20,23 @@ run() {  # run LABEL WATCH_PERIOD(or "")
   local web=$!
   local port=""
   for _ in $(seq 50); do port=$(grep -o '127.0.0.1:[0-9]*' "$out" | cut -d: -f2); [ -n "$port" ] && break; sleep 0.1; done
-  local watch=""
-  if [ -n "$2" ]; then "$build/robotalk-client/robotalk" watch pioneer --period "$2" >/dev/null 2>&1 & watch=$!; fi
+  local watch="" samples; samples=$(mktemp)
+  if [ -n "$2" ]; then "$build/robotalk-client/robotalk" watch pioneer --period "$2" >"$samples" 2>/dev/null & watch=$!; fi
   local frames; frames=$(mktemp)
   curl -s -N --max-time $((secs + 4)) -H "Connection: Upgrade" -H "Upgrade: websocket" -H "Sec-WebSocket-Version: 13" \
     -H "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==" "http://127.0.0.1:$port/ws" -o "$frames" &
   local reader=$!
   sleep 3  # connect, load the model, start the streams
-  local c0; c0=$(cpu $web); local n0; n0=$(grep -a -o '"type":"state"' "$frames" | wc -l)
+  local c0; c0=$(cpu $web); local n0; n0=$(grep -a -o '"type":"state"' "$frames" | wc -l); local s0; s0=$(wc -l <"$samples")
   sleep "$secs"
-  local c1; c1=$(cpu $web); local n1; n1=$(grep -a -o '"type":"state"' "$frames" | wc -l)
-  awk -v l="$1" -v c="$((c1 - c0))" -v n="$((n1 - n0))" -v t="$tick" -v s="$secs" \
-    'BEGIN { printf "%-36s bridge CPU %5.1f %% of one core, %5.1f state frames/s to the page\n", l, 100 * c / t / s, n / s }'
+  local c1; c1=$(cpu $web); local n1; n1=$(grep -a -o '"type":"state"' "$frames" | wc -l); local s1; s1=$(wc -l <"$samples")
+  awk -v l="$1" -v c="$((c1 - c0))" -v n="$((n1 - n0))" -v t="$tick" -v s="$secs" -v w="$((s1 - s0))" \
+    'BEGIN { printf "%-36s bridge CPU %5.1f %% of one core, %5.1f state frames/s to the page", l, 100 * c / t / s, n / s
+             if (w > 0) printf ", stream measured by the watch: %.0f samples/s", w / s
+             printf "\n" }'
   kill $reader $web $server $watch 2>/dev/null
   wait 2>/dev/null
-  rm -f "$out" "$frames"
+  rm -f "$out" "$frames" "$samples"
 }
 run "stream at 30 Hz (the bridge's own)" ""
 run "stream at 1 kHz (robotalk watch)" 0.001

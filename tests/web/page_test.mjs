@@ -253,7 +253,7 @@ async function arms() {
       for (const [r, j, v] of moves) await cli('--url', E.LCM_URL, 'send', r, 'joint_setpoint', j, String(v));
       return arc;
     }, 3000);
-    const seenH = await observe(wd, 'humanoid', () => sleep(1000));
+    const seenH = await observe(wd, 'humanoid', () => sleep(2000));
     checkFollows('iiwa', seen.seen, w, false);
     checkFollows('humanoid', seenH.seen, wh, true);
     const d = await drawn(wd, 'iiwa');

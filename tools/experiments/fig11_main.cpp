@@ -129,9 +129,9 @@ struct Sample {
 // The trajectory recorder: STATE samples arrive on the client's ReadDaemon.
 class Recorder {
  public:
-  void Add(const robotalk_msgs::robot_state_t& s) {
+  void Add(const StateSample& s) {
     std::lock_guard lock(mu_);
-    samples_.push_back({FromWireMicros(s.server_time_us), {s.base[0], s.base[1], s.base[2]}});
+    samples_.push_back({s.server_time, {s.base.x, s.base.y, s.base.theta}});
     cv_.notify_all();
   }
   // Waits (bounded) until a sample at or after server time `t` has arrived.
@@ -192,8 +192,7 @@ int Run(const Options& o) {
   client.Connect(o.robot);
 
   Recorder recorder;
-  client.StartStateStream(FromSeconds(o.state_period),
-                          [&](const robotalk_msgs::robot_state_t& s) { recorder.Add(s); });
+  client.StartStateStream(FromSeconds(o.state_period), [&](const StateSample& s) { recorder.Add(s); });
   if (!recorder.WaitCount(3, std::chrono::seconds(20)))
     throw std::runtime_error("no STATE samples within 20 s");
 

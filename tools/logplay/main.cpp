@@ -184,8 +184,10 @@ int RunExport(Args& a) {
   for (const auto& f : lp::ExportCsv(log, dir)) std::cout << f << "\n";
   if (!plot) return 0;
   const std::string png = dir + "/session.png";
+  // Debian's python3 (with python3-matplotlib), even when another python3 comes first in PATH.
+  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   const std::string command =
-      "python3 '" + PlotScript() + "' '" + dir + "/commands.csv' '" + dir + "/state.csv' '" + png + "'";
+      python + " '" + PlotScript() + "' '" + dir + "/commands.csv' '" + dir + "/state.csv' '" + png + "'";
   if (std::system(command.c_str()) != 0) {
     std::cerr << "robotalk-logplay: the plot failed (needs python3-matplotlib): " << command << "\n";
     return 1;

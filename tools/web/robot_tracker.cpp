@@ -1,5 +1,7 @@
 #include "robot_tracker.h"
 
+#include "robotalk/protocol_codec.h"
+
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/robot_client.h"
@@ -60,23 +62,29 @@ struct Robot {
 
 enum class Task { kConnect, kStream };
 
+}  // namespace
+
 // The LCM typed decoder sizes robots[] from the count before checking the
 // bytes are there: check the count against the datagram first.
-bool AnnounceCountPlausible(const lcm::ReceiveBuffer* rbuf) {
-  const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
-  const std::size_t n = rbuf->data_size;
+bool AnnounceCountPlausible(std::span<const std::uint8_t> bytes) {
+  const std::uint8_t* b = bytes.data();
+  const std::size_t n = bytes.size();
+  auto be32 = [&](std::size_t at) {
+    return (std::uint32_t{b[at]} << 24) | (std::uint32_t{b[at + 1]} << 16) | (std::uint32_t{b[at + 2]} << 8) |
+           std::uint32_t{b[at + 3]};
+  };
   std::size_t at = 8 + 2 + 8 + 8;  // fingerprint, version, server id, time
   if (n < at + 4) return false;
-  const std::uint32_t len = (std::uint32_t{b[at]} << 24) | (b[at + 1] << 16) | (b[at + 2] << 8) | b[at + 3];
+  const std::uint32_t len = be32(at);  // url_hint, with its NUL
+  if (len > n) return false;
   at += 4 + std::size_t{len};
-  if (len > n || n < at + 4) return false;
-  const std::int32_t count = static_cast<std::int32_t>((std::uint32_t{b[at]} << 24) | (b[at + 1] << 16) |
-                                                       (b[at + 2] << 8) | b[at + 3]);
-  constexpr std::size_t kMinRobotBytes = 4 + 1 + 4 + 1 + 8 + 4 + 1 + 1 + 4;
+  if (n < at + 4) return false;
+  const auto count = static_cast<std::int32_t>(be32(at));
+  at += 4;
+  constexpr std::size_t kMinRobotBytes =
+      4 + 1 + 4 + 1 + 8 + 4 + 1 + 1 + 4;  // two empty strings and the fields
   return count >= 0 && static_cast<std::size_t>(count) <= (n - at) / kMinRobotBytes;
 }
-
-}  // namespace
 
 class RobotTracker::Impl {
  public:
@@ -107,7 +115,7 @@ class RobotTracker::Impl {
   }
 
   void OnAnnounce(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    if (!AnnounceCountPlausible(rbuf)) return;
+    if (!AnnounceCountPlausible({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size})) return;
     robotalk_msgs::announce_t msg;
     if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) return;
     std::lock_guard lock(mutex_);
@@ -206,9 +214,9 @@ class RobotTracker::Impl {
       if (want) {
         const auto period =
             std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / options_.rate_hz));
-        client->StartStateStream(period, [slot](const robotalk_msgs::robot_state_t& s) {
+        client->StartStateStream(period, [slot](const StateSample& s) {
           std::lock_guard l(slot->mutex);
-          slot->sample = s;
+          slot->sample = ToWire(s);
           ++slot->received;
         });
       } else {

@@ -28,6 +28,8 @@ using Message = std::shared_ptr<const std::string>;
 
 // A browser that cannot keep up loses state frames (never robots/models).
 constexpr std::size_t kMaxQueuedFrames = 8;
+// The page sends only {"type":"panic","robot":NAME}: anything longer is refused.
+constexpr std::size_t kMaxPageMessage = 4096;
 
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
@@ -38,6 +40,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   void Start(http::request<http::string_body> req, std::vector<Message> greeting) {
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.read_message_max(kMaxPageMessage);
     ws_.async_accept(req, [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
       if (ec) return;
       self->open_ = true;

@@ -49,7 +49,7 @@ Side FirstSwing(const Pose2& start, const Pose2& goal) {
 }
 
 std::vector<PlannedStep> PlanFootsteps(const Pose2& start, const Pose2& goal, const GaitParams& g,
-                                       int max_steps, bool* reached) {
+                                       int max_steps, bool* reached, const Side* first) {
   std::vector<PlannedStep> plan;
   const auto at_goal = [&](const Pose2& p) {
     return std::hypot(p.x - goal.x, p.y - goal.y) < kReachedXY &&
@@ -58,7 +58,7 @@ std::vector<PlannedStep> PlanFootsteps(const Pose2& start, const Pose2& goal, co
   if (reached) *reached = true;
   if (at_goal(start)) return plan;
   Pose2 centre = start;
-  Side swing = FirstSwing(start, goal);
+  Side swing = first ? *first : FirstSwing(start, goal);
   while (static_cast<int>(plan.size()) < max_steps) {
     centre = StepToward(centre, goal, swing, g);
     if (at_goal(centre)) centre = goal;  // no sub-millimetre residue

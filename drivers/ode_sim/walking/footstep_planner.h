@@ -41,8 +41,10 @@ struct PlannedStep {
 /// stance around `goal`, the first swing foot chosen toward the goal's side
 /// (or its turn). Empty when already there (within 1 mm and 1 mrad). At most
 /// `max_steps` steps; *reached (if not null) says whether the plan ends at the goal.
+/// `first`: the first swing side, or FirstSwing() when not given.
 std::vector<PlannedStep> PlanFootsteps(const Pose2& start, const Pose2& goal, const GaitParams& g,
-                                       int max_steps = 400, bool* reached = nullptr);
+                                       int max_steps = 400, bool* reached = nullptr,
+                                       const Side* first = nullptr);
 
 /// The first swing side toward a goal: the side it lies on, else the side
 /// of the turn, else left.

@@ -47,9 +47,9 @@ struct GaitParams {
   double step_forward = 0.10;  ///< m
   double step_back = 0.05;     ///< m
   double step_side = 0.05;     ///< m, only toward the swing foot's side
-  double step_yaw = 0.25;      ///< rad
+  double step_yaw = 0.2;       ///< rad
   // Timing.
-  double single_support = 0.7;  ///< s
+  double single_support = 0.8;  ///< s
   double double_support = 0.3;  ///< s
   double start_lead = 1.0;      ///< s: standing still after a start (the preview's look-ahead)
   double start_shift = 0.8;     ///< s: the first shift of weight onto the stance foot

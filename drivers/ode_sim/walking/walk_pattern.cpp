@@ -180,6 +180,11 @@ double WalkPattern::time_to_end() const {
   return standing() ? 0.0 : static_cast<double>(EndTick() - tick_) * tick_s_;
 }
 
+Side WalkPattern::support_side() const {
+  if (double_support()) return Side::kLeft;
+  return Other(steps_[static_cast<size_t>(StepAt(tick_))].step.side);
+}
+
 bool WalkPattern::double_support() const {
   const int k = StepAt(tick_);
   return k < 0 || tick_ - steps_[static_cast<size_t>(k)].start >= ss_ticks_;
@@ -228,6 +233,8 @@ void WalkPattern::Tick() {
   const double t = static_cast<double>(phase == 0 ? every_ : phase) * tick_s_;
   cx_ = ZmpPreview::Propagate(sample_x_, ux_, t);
   cy_ = ZmpPreview::Propagate(sample_y_, uy_, t);
+  const int k = StepAt(tick_);
+  if (k >= 0 && steps_[static_cast<size_t>(k)].start == tick_) ++started_;
   UpdateFeet();
 }
 

@@ -60,6 +60,8 @@ class WalkPattern {
   /// Time until the end of the schedule's last step, s (0 when standing).
   double time_to_end() const;
   bool double_support() const;
+  /// The foot that carries the robot: the stance foot in single support, else the left.
+  Side support_side() const;
   /// The feet now: pose and height above the ground (m).
   const Pose2& foot(Side s) const { return foot_[static_cast<int>(s)]; }
   double foot_height(Side s) const { return height_[static_cast<int>(s)]; }
@@ -70,6 +72,10 @@ class WalkPattern {
   Eigen::Vector2d zmp_ref() const { return ZmpAt(tick_); }
   /// The stance centre of the last scheduled step (or the standing one).
   const Pose2& final_centre() const { return final_centre_; }
+  /// The side of the next step to append (left when none is scheduled).
+  Side next_side() const { return steps_.empty() ? Side::kLeft : Other(steps_.back().step.side); }
+  /// Steps whose swing has started since construction.
+  int started_steps() const { return started_; }
   /// The feet's support polygon now contains p (m)? For tests: a foot's
   /// sole rectangle, or in double support the convex hull of both.
   bool InSupport(const Eigen::Vector2d& p, double margin = 0) const;
@@ -107,6 +113,7 @@ class WalkPattern {
   Pose2 foot_[2];
   double height_[2] = {0, 0};
   Pose2 final_centre_;
+  int started_ = 0;
 };
 
 /// Point-in-convex-polygon test helper: the sole rectangle of a foot.

@@ -25,7 +25,8 @@
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 #include "robotalk/robot_model.h"
-#include "robotalk_msgs/robot_state_t.hpp"
+#include "robotalk/state_sample.h"
+#include "robotalk/transport.h"
 
 #include <cstdint>
 #include <functional>
@@ -33,10 +34,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-namespace lcm {
-class LCM;
-}
 
 namespace robotalk {
 
@@ -48,10 +45,20 @@ struct ClientOptions {
   /// LCM URL; "" = LCM's default (the LCM_DEFAULT_URL environment variable, or
   /// udpm://239.255.76.67:7667?ttl=0).
   std::string lcm_url;
-  /// Use this LCM instance instead of creating one from `lcm_url` (tests with
-  /// memq://, embedding). It must outlive the client, and nobody else may call
-  /// handle() on it: the client's ReadDaemon dispatches ALL its subscriptions.
-  lcm::LCM* shared_lcm = nullptr;
+  /// Use this transport instead of an LcmTransport on `lcm_url` (tests with a
+  /// MemoryTransport, embedding, several clients on one LCM). It must outlive
+  /// the client, and nobody else may call HandleFor() on it: the client's
+  /// ReadDaemon dispatches ALL its subscriptions.
+  Transport* transport = nullptr;
+  /// The client's clock: retransmission, heartbeats, clock-sync samples and
+  /// sequence pacing run on it. nullptr = the steady clock. It must outlive
+  /// the client. Blocking calls still time out in real time.
+  const Clock* clock = nullptr;
+  /// The ReadDaemon sleeps until its next deadline (a resend, a heartbeat) or
+  /// a message, but re-reads the clock at least this often in real time: how
+  /// soon it notices that a ManualClock moved. Close()/destruction wakes it at
+  /// once regardless.
+  Duration max_idle_wait = std::chrono::milliseconds(50);
   /// Each blocking call waits at most this long for its final reply, counted
   /// from the later of the call and the command's start time.
   Duration timeout = std::chrono::seconds(5);
@@ -69,8 +76,9 @@ struct ClientOptions {
   Duration heartbeat_interval = std::chrono::milliseconds(250);
   /// CLOCK round trips at Connect(); the one with the smallest round trip wins.
   int clock_sync_rounds = 8;
-  /// LCM receive-queue capacity of the client's subscriptions (messages).
-  int lcm_queue_capacity = 1000;
+  /// LCM receive-queue capacity of the client's subscriptions (messages),
+  /// when the client creates its own LcmTransport.
+  int lcm_queue_capacity = 10000;
   /// Answered but never collected replies kept at most (oldest evicted).
   std::size_t return_cache_capacity = 10000;
   /// The client id; 0 = random non-zero (std::random_device).
@@ -244,8 +252,9 @@ class RobotClient {
   /// calls `on_sample` with each sample, on the ReadDaemon thread (keep it
   /// short). Returns the period the stream runs at. Calling it again changes
   /// the period and the callback.
-  Duration StartStateStream(Duration period,
-                            std::function<void(const robotalk_msgs::robot_state_t&)> on_sample);
+  /// A sample that does not decode or validate (wrong dof count, NaN, ...) is
+  /// counted in ClientStats::malformed_packages and not passed on.
+  Duration StartStateStream(Duration period, std::function<void(const StateSample&)> on_sample);
   /// Cancels this client's stream request (the stream goes on while others want it).
   void StopStateStream();
 

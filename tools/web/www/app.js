@@ -32,6 +32,8 @@ function connect() {
   socket = ws;
   ws.onopen = () => {
     retryMs = 500;
+    // A restarted bridge numbers its models from 1 again: take its models as new.
+    for (const c of cards.values()) c.generation = -1;
     setConnection('bridge connected', 'ok');
     banner('');
   };

@@ -28,6 +28,33 @@ function softwareGl() {
   return software;
 }
 
+// The floor: a 40 m square with a 1 m grid (0.25 m minor lines) drawn into a
+// texture. Triangles, not GL lines: long lines passing behind the camera were
+// dropped by SwiftShader's line clipping.
+function floor() {
+  const canvas = document.createElement('canvas');
+  canvas.width = canvas.height = 256;
+  const g = canvas.getContext('2d');
+  g.fillStyle = '#141a22';
+  g.fillRect(0, 0, 256, 256);
+  g.strokeStyle = '#27313d';
+  g.lineWidth = 2;
+  for (let i = 1; i < 4; ++i) {
+    g.beginPath(); g.moveTo(i * 64, 0); g.lineTo(i * 64, 256); g.moveTo(0, i * 64); g.lineTo(256, i * 64); g.stroke();
+  }
+  g.strokeStyle = '#4a5a6e';
+  g.lineWidth = 4;
+  g.strokeRect(0, 0, 256, 256);
+  const texture = new THREE.CanvasTexture(canvas);
+  texture.wrapS = texture.wrapT = THREE.RepeatWrapping;
+  texture.repeat.set(40, 40);
+  texture.anisotropy = 4;
+  const plane = new THREE.Mesh(new THREE.PlaneGeometry(40, 40), new THREE.MeshBasicMaterial({ map: texture }));
+  plane.rotation.x = -Math.PI / 2;
+  plane.position.y = -0.001;
+  return plane;
+}
+
 function quat(p) { return new THREE.Quaternion(p[4], p[5], p[6], p[3]); }
 
 export class RobotView {
@@ -41,26 +68,27 @@ export class RobotView {
     this.scene.background = new THREE.Color(0x0d1117);
     this.camera = new THREE.PerspectiveCamera(45, container.clientWidth / container.clientHeight, 0.01, 200);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
-    this.scene.add(new THREE.HemisphereLight(0xddeeff, 0x223344, 2.0));
-    const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+    this.scene.add(new THREE.HemisphereLight(0xeef4ff, 0x445566, 3.0));
+    const sun = new THREE.DirectionalLight(0xffffff, 2.5);
     sun.position.set(3, 6, 4);
     this.scene.add(sun);
     this.world = new THREE.Group();  // RoboTalk's z-up frame
     this.world.rotation.x = -Math.PI / 2;
     this.scene.add(this.world);
-    const grid = new THREE.GridHelper(20, 40, 0x6b7b90, 0x39485a);
-    this.scene.add(grid);
+    this.scene.add(floor());
     this.linkObjects = [];
     this.urdfRobot = null;
     this.loading = null;
     this.buildFromSpec();
     if (urdfUrl) this.loadUrdf(urdfUrl);
     this.buildPath();
-    this.frameCamera();
+    this.framed = false;  // the camera is aimed once the first state has posed the links
+    this.followBase = this.model.roots.length > 0 && this.model.roots[0].base !== 'fixed';
+    this.camera.position.set(2, 1.5, 2.5);
   }
 
   buildFromSpec() {
-    const boxMat = new THREE.MeshStandardMaterial({ color: 0x4fa3ff, roughness: 0.6, transparent: true, opacity: 0.85 });
+    const boxMat = new THREE.MeshStandardMaterial({ color: 0x5fb0ff, roughness: 0.5, transparent: true, opacity: 0.9 });
     const jointMat = new THREE.MeshStandardMaterial({ color: 0xf5a623, roughness: 0.4 });
     const boneMat = new THREE.MeshStandardMaterial({ color: 0xc7d0dc, roughness: 0.5 });
     this.specGroup = new THREE.Group();
@@ -113,7 +141,10 @@ export class RobotView {
         robot.traverse((o) => {  // URDF visuals without a colour of their own
           if (o.isMesh && o.material && !o.material.name) o.material = new THREE.MeshStandardMaterial({ color: 0x6f93c8, roughness: 0.6 });
         });
-        if (this.lastFrame) this.apply(this.lastFrame);
+        if (this.lastFrame) {
+          this.apply(this.lastFrame);
+          this.frameCamera();
+        }
         resolve(true);
       }, undefined, (err) => { this.urdfError = String(err); resolve(false); });
     });
@@ -124,7 +155,7 @@ export class RobotView {
     this.pathPositions = new Float32Array(PATH_MAX_POINTS * 3);
     geom.setAttribute('position', new THREE.BufferAttribute(this.pathPositions, 3));
     geom.setDrawRange(0, 0);
-    this.path = new THREE.Line(geom, new THREE.LineBasicMaterial({ color: 0x5dffb0 }));
+    this.path = new THREE.Line(geom, new THREE.LineBasicMaterial({ color: 0x5dffb0, depthTest: false }));
     this.path.frustumCulled = false;
     this.world.add(this.path);
     this.pathCount = 0;
@@ -133,13 +164,14 @@ export class RobotView {
 
   frameCamera() {
     this.world.updateMatrixWorld(true);
-    const box = new THREE.Box3().setFromObject(this.specGroup);
-    const size = Math.max(0.5, box.getSize(new THREE.Vector3()).length());
+    const box = new THREE.Box3().setFromObject(this.urdfRobot || this.specGroup);
+    // A mobile base gets room around it for its path.
+    const size = Math.max(this.followBase ? 2.2 : 1.0, box.getSize(new THREE.Vector3()).length());
     const centre = box.getCenter(new THREE.Vector3());
     this.controls.target.copy(centre);
-    this.camera.position.copy(centre).add(new THREE.Vector3(1.1 * size, 1.0 * size, 1.6 * size).multiplyScalar(1.3));
+    this.camera.position.copy(centre).add(new THREE.Vector3(0.75 * size, 0.6 * size, 1.1 * size));
     this.controls.update();
-    this.followBase = this.model.roots.length && this.model.roots[0].base !== 'fixed';
+    this.framed = true;
   }
 
   // Applies one state frame from the bridge to the scene.
@@ -153,6 +185,7 @@ export class RobotView {
     }
     if (this.urdfRobot) this.applyUrdf(frame);
     this.extendPath(frame.base[0], frame.base[1]);
+    if (!this.framed) this.frameCamera();
   }
 
   applyUrdf(frame) {

@@ -1,0 +1,163 @@
+// Benchmark of the walking humanoid on ODE (not a test): N seeded GOTO goals
+// (up to 2 m away, any heading) walked one after another by
+// models/simple_humanoid.urdf on the ode driver at 1 kHz; prints per goal the
+// answer, end error, walking time and speed, falls, and the real-time factor;
+// optionally writes a trace of one walk (footsteps, ZMP, CoM) for plotting.
+// Figures go to docs/ode_sim.md ("Walking").
+//   robotalk-walk-bench [--model URDF] [--goals N] [--seed S] [--trace CSV] [--trace-goal K]
+//                       [--option key=value]...
+#include "ode_driver.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace robotalk;
+using WallClock = std::chrono::steady_clock;
+
+namespace {
+
+struct Args {
+  std::string model = std::string(ROBOTALK_BENCH_MODELS) + "/simple_humanoid.urdf";
+  int goals = 20;
+  unsigned seed = 1;
+  std::string trace;
+  int trace_goal = 0;
+  int stand = 0;  // seconds to stand and print before the goals
+  std::map<std::string, std::string> options = {{"walk", "true"}};
+};
+
+Args Parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i], v = argv[i + 1];
+    if (k == "--model") {
+      a.model = v;
+    } else if (k == "--goals") {
+      a.goals = std::atoi(v.c_str());
+    } else if (k == "--seed") {
+      a.seed = static_cast<unsigned>(std::atoi(v.c_str()));
+    } else if (k == "--trace") {
+      a.trace = v;
+    } else if (k == "--stand") {
+      a.stand = std::atoi(v.c_str());
+    } else if (k == "--trace-goal") {
+      a.trace_goal = std::atoi(v.c_str());
+    } else if (k == "--option") {
+      const size_t eq = v.find('=');
+      a.options[v.substr(0, eq)] = eq == std::string::npos ? "" : v.substr(eq + 1);
+    } else {
+      std::fprintf(stderr, "unknown argument %s\n", k.c_str());
+      std::exit(2);
+    }
+  }
+  return a;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = Parse(argc, argv);
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  std::unique_ptr<Driver> d = registry.Create(
+      "ode", DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+  auto* ode = static_cast<OdeDriver*>(d.get());
+  if (!ode->walk_status()) {
+    std::fprintf(stderr, "%s does not walk on the ode driver\n", args.model.c_str());
+    return 1;
+  }
+  std::vector<Completion> done;
+  for (int i = 0; i < 15 + args.stand * 10; ++i) {  // settle into the stance (--stand: and print it)
+    ode->Step(args.stand > 0 ? 20 : 100, done);
+    if (args.stand > 0) {
+      const walking::WalkStatus s = *ode->walk_status();
+      RobotState st;
+      ode->ReadState(st);
+      const RobotModel& m = ode->model();
+      std::printf(
+          "stand t=%.1f tilt %.4f com %.4f %.4f %.4f pelvis %.4f %.4f %.4f  hip %.3f knee %.3f ankle %.3f\n",
+          ToSeconds(ode->sim_time().time_since_epoch()), s.tilt, s.com.x(), s.com.y(), s.com.z(), s.pelvis.x,
+          s.pelvis.y, s.pelvis.theta, st.position[m.dof_offset(m.JointIndex("left_hip_pitch"))],
+          st.position[m.dof_offset(m.JointIndex("left_knee"))],
+          st.position[m.dof_offset(m.JointIndex("left_ankle_pitch"))]);
+    }
+  }
+  std::mt19937 rng(args.seed);
+  std::uniform_real_distribution<double> dist(0.2, 2.0), angle(-std::numbers::pi, std::numbers::pi);
+  std::ofstream trace;
+  if (!args.trace.empty()) {
+    trace.open(args.trace);
+    trace << "t,lx,ly,lth,lh,rx,ry,rth,rh,zmp_x,zmp_y,com_plan_x,com_plan_y,com_x,com_y,pelvis_x,pelvis_y\n";
+  }
+  int successes = 0, falls = 0;
+  double worst_d = 0, worst_th = 0, sum_d = 0, walked = 0, walk_time = 0, wall_total = 0, sim_total = 0;
+  std::printf(
+      "goal  x        y        theta    answer       time_s  dist_m  speed_m/s  end_err_m  end_err_rad  "
+      "rtf\n");
+  for (int g = 0; g < args.goals; ++g) {
+    const walking::Pose2 start = ode->walk_status()->pelvis;
+    const double r = dist(rng), bearing = angle(rng), heading = angle(rng);
+    const double gx = start.x + r * std::cos(bearing), gy = start.y + r * std::sin(bearing);
+    DriverCommand c;
+    c.id = g + 1;
+    c.type = CommandType::kGoto;
+    c.num_values = 3;
+    c.values[0] = gx;
+    c.values[1] = gy;
+    c.values[2] = heading;
+    done.clear();
+    const TimePoint t0 = ode->sim_time();
+    const auto w0 = WallClock::now();
+    const DriverResult res = d->Execute(c, t0, done);
+    Signal signal = res.signal;
+    std::string message = res.message;
+    for (int i = 0; res.in_progress && done.empty() && i < 12000; ++i) {  // at most 120 s per goal
+      ode->Step(10, done);
+      if (trace.is_open() && g == args.trace_goal && i % 2 == 0) {
+        const walking::WalkStatus s = *ode->walk_status();
+        trace << ToSeconds(ode->sim_time() - t0) << ',' << s.foot[0].x << ',' << s.foot[0].y << ','
+              << s.foot[0].theta << ',' << s.foot_height[0] << ',' << s.foot[1].x << ',' << s.foot[1].y << ','
+              << s.foot[1].theta << ',' << s.foot_height[1] << ',' << s.zmp_ref.x() << ',' << s.zmp_ref.y()
+              << ',' << s.com_plan.x() << ',' << s.com_plan.y() << ',' << s.com.x() << ',' << s.com.y() << ','
+              << s.pelvis.x << ',' << s.pelvis.y << '\n';
+      }
+    }
+    const double wall = std::chrono::duration<double>(WallClock::now() - w0).count();
+    const double sim = ToSeconds(ode->sim_time() - t0);
+    if (!done.empty()) {
+      signal = done[0].signal;
+      message = done[0].message;
+    }
+    const walking::WalkStatus s = *ode->walk_status();
+    const double ed = std::hypot(s.pelvis.x - gx, s.pelvis.y - gy);
+    const double eth = std::abs(walking::Wrap(s.pelvis.theta - heading));
+    if (s.fallen) ++falls;
+    if (signal == Signal::kSuccess) ++successes;
+    worst_d = std::max(worst_d, ed);
+    worst_th = std::max(worst_th, eth);
+    sum_d += ed;
+    walked += r;
+    walk_time += sim;
+    wall_total += wall;
+    sim_total += sim;
+    std::printf("%-4d  %7.3f  %7.3f  %7.3f  %-11s  %6.1f  %6.3f  %9.3f  %9.4f  %11.4f  %4.1f %s\n", g, gx, gy,
+                heading, std::string(ToString(signal)).c_str(), sim, r, r / sim, ed, eth, sim / wall,
+                message.c_str());
+    std::fflush(stdout);
+    if (s.fallen) break;
+  }
+  std::printf(
+      "\nsuccess %d/%d, falls %d, end error mean %.4f m, worst %.4f m and %.4f rad, "
+      "mean speed %.3f m/s (straight-line distance / walking time), real-time factor %.1f at 1 kHz\n",
+      successes, args.goals, falls, sum_d / args.goals, worst_d, worst_th, walked / walk_time,
+      sim_total / wall_total);
+  return successes == args.goals && falls == 0 ? 0 : 1;
+}

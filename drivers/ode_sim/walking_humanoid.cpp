@@ -1,0 +1,399 @@
+// The ode driver's walking controller: see walking_humanoid.h.
+#include "walking_humanoid.h"
+
+#include "robotalk/driver_support.h"
+#include "walking/footstep_planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+
+namespace robotalk::ode_detail {
+
+using driver_support::Answer;
+using driver_support::Num;
+using walking::Footstep;
+using walking::Pose2;
+using walking::Side;
+using walking::Wrap;
+
+namespace {
+
+constexpr double kSettle = 1.0;       // s: from straight legs to the walking stance after start-up
+constexpr double kKneeDrop = 0.07;    // of the pelvis-to-sole height: how far the pelvis sinks to walk
+constexpr int kPreviewEvery = 5;      // physics steps per preview sample (5 ms at 1 kHz)
+constexpr int kQueuedSpeedSteps = 2;  // SETSPEED keeps this many steps planned ahead
+
+// Bends the knees of a straight-legged q: at a straight knee the leg's
+// Jacobian loses its vertical row and damped least squares never bends it.
+void BendKnees(const RobotModel& m, std::span<const std::uint8_t> legs, Eigen::VectorXd& q) {
+  for (int j = 0; j < static_cast<int>(m.joints().size()); ++j) {
+    const Joint& joint = m.joint(j);
+    if (joint.dofs.size() != 1 || !legs[static_cast<size_t>(m.dof_offset(j))]) continue;
+    if (joint.name.find("knee") == std::string::npos && joint.name.find("kny") == std::string::npos) continue;
+    const int i = m.dof_offset(j);
+    const DofLimits& lim = joint.dofs[0].limits;
+    if (std::abs(q[i]) < 0.2) q[i] = std::clamp(lim.upper > 0 ? 0.3 : -0.3, lim.lower, lim.upper);
+  }
+}
+
+std::optional<int> FindAnyLink(const RobotModel& m, std::initializer_list<const char*> names) {
+  for (const char* n : names) {
+    if (auto l = m.FindLink(n)) return l;
+  }
+  return std::nullopt;
+}
+
+Eigen::Isometry3d Planar(const Pose2& p, double z) {
+  Eigen::Isometry3d x = Eigen::Isometry3d::Identity();
+  x.translation() = Eigen::Vector3d(p.x, p.y, z);
+  x.linear() = Eigen::AngleAxisd(p.theta, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return x;
+}
+
+// a ⊕ b: b given in a's frame, in a's parent frame.
+Pose2 Compose(const Pose2& a, const Pose2& b) {
+  const Eigen::Vector2d p = a.Apply(b.x, b.y);
+  return {p.x(), p.y(), Wrap(a.theta + b.theta)};
+}
+Pose2 Inverse(const Pose2& a) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  return {-(c * a.x + s * a.y), -(-s * a.x + c * a.y), -a.theta};
+}
+
+}  // namespace
+
+std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model,
+                                                         const std::vector<CollisionShape>& shapes,
+                                                         double gravity, double step, std::string* why) {
+  if (model.roots().empty() || model.roots().front().base != BaseType::kFloating) {
+    *why = "not a floating base";
+    return nullptr;
+  }
+  const std::optional<int> l = FindAnyLink(model, {"left_foot", "l_foot", "LFoot"});
+  const std::optional<int> r = FindAnyLink(model, {"right_foot", "r_foot", "RFoot"});
+  if (!l || !r) {
+    *why = "no feet named left_foot/right_foot or l_foot/r_foot";
+    return nullptr;
+  }
+  walking::GaitParams g;
+  const CollisionShape* box = nullptr;
+  for (const CollisionShape& s : shapes) {
+    if (s.link == model.link(*l).name && s.kind == CollisionShape::Kind::kBox) box = &s;
+  }
+  if (!box) {
+    *why = "foot '" + model.link(*l).name + "' has no box collision shape (the sole)";
+    return nullptr;
+  }
+  const Eigen::Vector3d t = box->origin.translation, size = box->size;
+  g.foot_front = t.x() + size.x() / 2;
+  g.foot_back = size.x() / 2 - t.x();
+  g.foot_half_width = size.y() / 2 - std::abs(t.y());
+  g.zmp_x = (g.foot_front - g.foot_back) / 2;
+  const double sole_z = t.z() - size.z() / 2;
+  // Feet apart as in the model at q = 0; the pelvis sinks so that the knees bend.
+  Kinematics kin(model);
+  std::vector<Eigen::Isometry3d> roots(model.roots().size(), Eigen::Isometry3d::Identity());
+  kin.Update(Eigen::VectorXd::Zero(model.num_dofs()), roots);
+  const Eigen::Vector3d lp = kin.link_pose(*l) * Eigen::Vector3d(0, 0, sole_z);
+  const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole_z);
+  g.foot_separation = lp.y() - rp.y();
+  auto w = std::unique_ptr<WalkingHumanoid>(new WalkingHumanoid(model, {*l, *r}, sole_z, g, gravity, step));
+  w->pelvis_z_ = -lp.z() * (1 - kKneeDrop);
+  // The stance: the CoM above the feet's ZMP points puts the pelvis at the stance centre.
+  for (int it = 0; it < 3; ++it) {
+    std::array<Eigen::Isometry3d, 2> soles{Planar(walking::FootAt({}, Side::kLeft, w->g_), 0),
+                                           Planar(walking::FootAt({}, Side::kRight, w->g_), 0)};
+    w->q_stance_.setZero();
+    BendKnees(model, w->ik_.leg_mask(), w->q_stance_);
+    w->ik_.Solve(Planar({}, w->pelvis_z_), soles, w->q_stance_);
+    w->com_in_pelvis_ = w->ik_.ComInPelvis(w->q_stance_);
+    w->g_.ankle_x = w->com_in_pelvis_.x() - w->g_.zmp_x;
+  }
+  w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
+  w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
+  w->omega_lipm_ = std::sqrt(gravity / w->g_.com_height);
+  return w;
+}
+
+WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
+                                 const walking::GaitParams& g, double gravity, double step)
+    : model_(model),
+      g_(g),
+      pattern_(g, step, kPreviewEvery, gravity),
+      ik_(model, feet, {Eigen::Vector3d(0, 0, sole_z), Eigen::Vector3d(0, 0, sole_z)}),
+      step_(step),
+      feet_(feet) {
+  const auto mask = ik_.leg_mask();
+  owned_.assign(mask.begin(), mask.end());
+  const int n = model.num_dofs();
+  for (Eigen::VectorXd* v : {&q_ref_, &q_prev_, &q_start_, &q_stance_}) v->setZero(n);
+}
+
+void WalkingHumanoid::Attach(OdeWorld* world, const Eigen::VectorXd& vmax, const Eigen::VectorXd& fmax) {
+  world_ = world;
+  vmax_ = vmax;
+  fmax_ = fmax;
+  q_start_ = world_->q();
+  q_ref_ = q_start_;
+  BendKnees(model_, ik_.leg_mask(), q_ref_);  // the first solve starts bent; the servos follow from q_start_
+  Eigen::Isometry3d pelvis;
+  std::array<Eigen::Isometry3d, 2> soles;
+  const Pose2 p = MeasuredPelvis();
+  plan_to_world_ = {};  // the plan frame starts as the world
+  pattern_.Reset(p, p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y()));
+  settle_ticks_ = std::llround(kSettle / step_);
+  DesiredPelvis(&pelvis, &soles);
+  ik_.Solve(pelvis, soles, q_ref_);
+  q_prev_ = q_ref_;
+}
+
+Pose2 WalkingHumanoid::MeasuredPelvis() const {
+  const Eigen::Isometry3d x = world_->LinkPose(model_.roots().front().link);
+  const Eigen::Vector3d fwd = x.linear().col(0);
+  return {x.translation().x(), x.translation().y(), std::atan2(fwd.y(), fwd.x())};
+}
+
+Pose2 WalkingHumanoid::ToPlan(const Pose2& world) const { return Compose(Inverse(plan_to_world_), world); }
+Pose2 WalkingHumanoid::ToWorld(const Pose2& plan) const { return Compose(plan_to_world_, plan); }
+
+// The plan frame is re-anchored so that the pelvis the pattern wants now is
+// where the physics measures it.
+void WalkingHumanoid::MapFrames() {
+  Eigen::Isometry3d pelvis;
+  std::array<Eigen::Isometry3d, 2> soles;
+  DesiredPelvis(&pelvis, &soles);
+  const Eigen::Vector3d fwd = pelvis.linear().col(0);
+  const Pose2 want{pelvis.translation().x(), pelvis.translation().y(), std::atan2(fwd.y(), fwd.x())};
+  plan_to_world_ = Compose(MeasuredPelvis(), Inverse(want));
+}
+
+void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
+                                    std::array<Eigen::Isometry3d, 2>* soles) const {
+  const Pose2& l = pattern_.foot(Side::kLeft);
+  const Pose2& r = pattern_.foot(Side::kRight);
+  const double yaw = Wrap(r.theta + 0.5 * Wrap(l.theta - r.theta));
+  const Eigen::Vector2d com = pattern_.com();
+  Pose2 p{0, 0, yaw};
+  const Eigen::Vector2d off = p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y());
+  p.x = com.x() - off.x() + balance_.x();
+  p.y = com.y() - off.y() + balance_.y();
+  double z = pelvis_z_;
+  if (tick_ < settle_ticks_) {  // sink smoothly from the straight-legged start
+    const double s = static_cast<double>(tick_) / static_cast<double>(settle_ticks_);
+    const double z0 = pelvis_z_ / (1 - kKneeDrop) - 0.002;
+    z = z0 + (pelvis_z_ - z0) * 0.5 * (1 - std::cos(std::numbers::pi * s));
+  }
+  *pelvis = Planar(p, z);
+  (*soles)[0] = Planar(l, pattern_.foot_height(Side::kLeft));
+  (*soles)[1] = Planar(r, pattern_.foot_height(Side::kRight));
+}
+
+void WalkingHumanoid::PlanGoto() {
+  MapFrames();
+  Side next = Side::kLeft;
+  const Pose2 from = pattern_.DropUnstarted(&next);
+  const Pose2 goal = ToPlan(goal_);
+  const bool standing = pattern_.standing();
+  const std::vector<walking::PlannedStep> plan =
+      walking::PlanFootsteps(from, goal, g_, 400, nullptr, standing ? nullptr : &next);
+  std::vector<Footstep> steps;
+  std::vector<Pose2> centres;
+  for (const walking::PlannedStep& p : plan) {
+    steps.push_back(p.step);
+    centres.push_back(p.centre);
+  }
+  pattern_.Append(steps, centres);
+  replanned_at_ = pattern_.started_steps();
+}
+
+DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {
+  if (fallen_)
+    return Answer(Signal::kError, "GOTO: the robot has fallen (torso tilt " + Num(tilt_) + " rad)");
+  if (mode_ == Mode::kGoto) {
+    return Answer(Signal::kBusy,
+                  "GOTO: a walk to a GOTO is in progress (command " + std::to_string(goto_id_) + ")");
+  }
+  goal_ = {c.values[0], c.values[1], Wrap(c.values[2])};
+  const Pose2 at = MeasuredPelvis();
+  if (pattern_.standing() && std::hypot(at.x - goal_.x, at.y - goal_.y) <= kTolerance &&
+      std::abs(Wrap(at.theta - goal_.theta)) <= kHeadingTolerance) {
+    return Answer(Signal::kSuccess);
+  }
+  mode_ = Mode::kGoto;
+  goto_id_ = c.id;
+  tries_ = 1;
+  PlanGoto();
+  DriverResult r;
+  r.in_progress = true;
+  return r;
+}
+
+DriverResult WalkingHumanoid::SetSpeed(const DriverCommand& c) {
+  if (fallen_)
+    return Answer(Signal::kError, "SETSPEED: the robot has fallen (torso tilt " + Num(tilt_) + " rad)");
+  if (mode_ == Mode::kGoto) {
+    return Answer(Signal::kBusy,
+                  "SETSPEED: a walk to a GOTO is in progress (command " + std::to_string(goto_id_) + ")");
+  }
+  const double period = g_.step_period();
+  const double want[3] = {c.values[0], c.num_values == 3 ? c.values[1] : 0.0, c.values[c.num_values - 1]};
+  const double lim_lo[3] = {-g_.step_back / period, -g_.step_side / (2 * period), -g_.step_yaw / period};
+  const double lim_hi[3] = {g_.step_forward / period, g_.step_side / (2 * period), g_.step_yaw / period};
+  const char* names[3] = {"v", "vy", "omega"};
+  const char* units[3] = {"m/s", "m/s", "rad/s"};
+  double got[3];
+  std::string note;
+  for (int i = 0; i < 3; ++i) {
+    got[i] = std::clamp(want[i], lim_lo[i], lim_hi[i]);
+    if (got[i] != want[i]) {
+      note += std::string(note.empty() ? "" : "; ") + names[i] + " " + Num(want[i]) + " " + units[i] +
+              " clamped to the gait's limit " + Num(got[i]) + " " + units[i];
+    }
+  }
+  v_ = got[0];
+  vy_ = got[1];
+  omega_ = got[2];
+  std::vector<Completion> none;
+  if (v_ == 0 && vy_ == 0 && omega_ == 0) {
+    Stop("", none);
+  } else {
+    mode_ = Mode::kSpeed;
+    Side next = Side::kLeft;
+    pattern_.DropUnstarted(&next);
+    KeepSpeedStepsQueued();
+  }
+  return note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + note);
+}
+
+void WalkingHumanoid::KeepSpeedStepsQueued() {
+  while (pattern_.unstarted_steps() < kQueuedSpeedSteps) {
+    const Pose2 centre = pattern_.final_centre();
+    Side next = pattern_.next_side();
+    if (pattern_.standing()) next = (vy_ < 0 || (vy_ == 0 && omega_ < 0)) ? Side::kRight : Side::kLeft;
+    const double period = g_.step_period();
+    const double dy = vy_ * 2 * period * (vy_ * walking::SideSign(next) > 0 ? 1.0 : 0.0);
+    const Pose2 c = walking::StepBy(centre, v_ * period, dy, omega_ * period, next, g_);
+    pattern_.Append({Footstep{next, walking::FootAt(c, next, g_)}}, {c});
+  }
+}
+
+void WalkingHumanoid::Stop(const std::string& why, std::vector<Completion>& completed) {
+  if (mode_ == Mode::kGoto) {
+    completed.push_back(
+        Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = "GOTO: " + why});
+  }
+  mode_ = Mode::kIdle;
+  v_ = vy_ = omega_ = 0;
+  if (!fallen_) pattern_.StopSoon();
+}
+
+void WalkingHumanoid::FinishGoto(std::vector<Completion>& completed) {
+  const Pose2 at = MeasuredPelvis();
+  const double d = std::hypot(at.x - goal_.x, at.y - goal_.y);
+  const double e = std::abs(Wrap(at.theta - goal_.theta));
+  if (d <= kTolerance && e <= kHeadingTolerance) {
+    completed.push_back(Completion{.id = goto_id_, .signal = Signal::kSuccess, .message = {}});
+    mode_ = Mode::kIdle;
+    return;
+  }
+  if (tries_ <= kRetries) {
+    ++tries_;
+    PlanGoto();  // closed loop: walk again from the measured pose
+    return;
+  }
+  completed.push_back(Completion{.id = goto_id_,
+                                 .signal = Signal::kInterrupted,
+                                 .message = "GOTO: stopped " + Num(d) + " m and " + Num(e) +
+                                            " rad from the goal after " + std::to_string(tries_) + " plans"});
+  mode_ = Mode::kIdle;
+}
+
+void WalkingHumanoid::Control(std::vector<Completion>& completed) {
+  ++tick_;
+  const Eigen::Isometry3d root = world_->LinkPose(model_.roots().front().link);
+  tilt_ = std::acos(std::clamp(root.linear()(2, 2), -1.0, 1.0));
+  const Eigen::VectorXd& q = world_->q();
+  if (!fallen_ && tilt_ > kFallTilt) {
+    fallen_ = true;
+    if (mode_ == Mode::kGoto) {
+      completed.push_back(Completion{.id = goto_id_,
+                                     .signal = Signal::kInterrupted,
+                                     .message = "GOTO: the robot fell (torso tilt " + Num(tilt_) + " rad)"});
+    }
+    mode_ = Mode::kIdle;
+  }
+  if (fallen_) {  // limp would be safer for hardware; here the joints hold where they are
+    for (Eigen::Index i = 0; i < q.size(); ++i) {
+      if (Owns(i)) world_->SetMotor(static_cast<int>(i), 0, fmax_[i]);
+    }
+    return;
+  }
+  if (mode_ == Mode::kSpeed) KeepSpeedStepsQueued();
+  pattern_.Tick();
+  if (tick_ > settle_ticks_) Balance();
+  Eigen::Isometry3d pelvis;
+  std::array<Eigen::Isometry3d, 2> soles;
+  DesiredPelvis(&pelvis, &soles);
+  ik_.Solve(pelvis, soles, q_ref_);
+  com_in_pelvis_ = ik_.ComInPelvis(q_ref_);
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    if (!Owns(i)) continue;
+    const double qd_ref = (q_ref_[i] - q_prev_[i]) / step_;
+    const double v = std::clamp(qd_ref + kKp * (q_ref_[i] - q[i]), -vmax_[i], vmax_[i]);
+    world_->SetMotor(static_cast<int>(i), v, fmax_[i]);
+  }
+  q_prev_ = q_ref_;
+  if (mode_ == Mode::kGoto && pattern_.standing()) {
+    FinishGoto(completed);
+  } else if (mode_ == Mode::kGoto && pattern_.started_steps() - replanned_at_ >= kReplanSteps &&
+             pattern_.unstarted_steps() > 2) {
+    PlanGoto();  // the feet slip (most when turning): re-plan from the measured pose
+  }
+}
+
+// The CoM measured on the physics against the planned one, each relative to
+// its support foot (the measured foot's yaw error rotated out), so that the
+// world drift of the plan does not count; the pelvis moves against the error
+// of the divergent component e + e'/omega, which shifts the ZMP the way that
+// brings the CoM back (ankle torque through the stiff joint servos).
+void WalkingHumanoid::Balance() {
+  const Side sup = pattern_.support_side();
+  const Eigen::Isometry3d fm = world_->LinkPose(feet_[static_cast<size_t>(sup)]);
+  const double yaw_m = std::atan2(fm.linear()(1, 0), fm.linear()(0, 0));
+  const Pose2& fp = pattern_.foot(sup);
+  const Eigen::Vector3d com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
+  const Eigen::Vector2d rel_m =
+      Eigen::Rotation2Dd(fp.theta - yaw_m) * (com.head<2>() - fm.translation().head<2>());
+  const Eigen::Vector2d rel_p = pattern_.com() - fp.xy();
+  const Eigen::Vector2d e = rel_m - rel_p;
+  if (sup != support_prev_) err_prev_ = e;  // the reference foot changed: no rate from the jump
+  support_prev_ = sup;
+  const double a = step_ / 0.02;  // 20 ms low-pass on the rate
+  err_rate_ += a * ((e - err_prev_) / step_ - err_rate_);
+  err_prev_ = e;
+  const Eigen::Vector2d dcm = e + err_rate_ / omega_lipm_;
+  balance_ = (-kBalanceGain * dcm).cwiseMax(-kBalanceLimit).cwiseMin(kBalanceLimit);
+}
+
+walking::WalkStatus WalkingHumanoid::status() const {
+  walking::WalkStatus s;
+  s.stepping = !pattern_.standing();
+  s.fallen = fallen_;
+  s.tilt = tilt_;
+  s.steps_taken = pattern_.started_steps();
+  const Pose2 com = ToWorld({pattern_.com().x(), pattern_.com().y(), 0});
+  s.com_plan = com.xy();
+  const Eigen::Vector2d z = pattern_.zmp_ref();
+  s.zmp_ref = ToWorld({z.x(), z.y(), 0}).xy();
+  for (int i = 0; i < 2; ++i) {
+    s.foot[i] = ToWorld(pattern_.foot(static_cast<Side>(i)));
+    s.foot_height[i] = pattern_.foot_height(static_cast<Side>(i));
+  }
+  s.pelvis = MeasuredPelvis();
+  s.com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
+  return s;
+}
+
+}  // namespace robotalk::ode_detail

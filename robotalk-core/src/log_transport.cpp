@@ -1,0 +1,171 @@
+#include "robotalk/log_transport.h"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <optional>
+#include <regex>
+#include <thread>
+#include <vector>
+
+namespace robotalk {
+namespace {
+
+struct Entry {
+  std::regex regex;
+  std::shared_ptr<const Transport::Handler> handler;
+  std::atomic<bool> active{true};
+};
+
+struct Event {
+  std::int64_t timestamp_us = 0;
+  std::string channel;
+  std::vector<std::uint8_t> bytes;
+};
+
+}  // namespace
+
+namespace internal {
+
+class LogCore {
+ public:
+  explicit LogCore(LogTransportOptions options)
+      : options_(std::move(options)),
+        log_(options_.path, "r"),
+        clock_(options_.clock ? *options_.clock : steady_) {
+    if (!log_.good()) throw TransportError("LogTransport: cannot read the LCM log '" + options_.path + "'");
+    if (!(options_.speed > 0)) {
+      throw TransportError("LogTransport '" + options_.path + "': speed " + std::to_string(options_.speed) +
+                           " is not positive");
+    }
+    ReadNext();
+  }
+
+  void ReadNext() {
+    const lcm::LogEvent* e = log_.readNextEvent();
+    if (e == nullptr) {
+      next_.reset();
+      return;
+    }
+    ++read_;
+    const auto* data = static_cast<const std::uint8_t*>(e->data);
+    next_ = Event{e->timestamp, e->channel, std::vector<std::uint8_t>(data, data + std::max(e->datalen, 0))};
+  }
+
+  // When the pending event is due on the clock (paced mode).
+  TimePoint DueTime() {
+    if (!start_) {
+      start_ = clock_.Now();
+      first_us_ = next_->timestamp_us;
+    }
+    const double offset_s = static_cast<double>(next_->timestamp_us - first_us_) * 1e-6 / options_.speed;
+    return *start_ + FromSeconds(std::max(offset_s, 0.0));
+  }
+
+  std::vector<std::shared_ptr<Entry>> Matching(const std::string& channel) {
+    std::lock_guard lock(mu_);
+    std::vector<std::shared_ptr<Entry>> out;
+    for (const auto& s : subs_) {
+      if (std::regex_match(channel, s->regex)) out.push_back(s);
+    }
+    return out;
+  }
+
+  const LogTransportOptions options_;
+  lcm::LogFile log_;
+  SteadyClock steady_;
+  const Clock& clock_;
+  std::optional<Event> next_;  // the first event not yet dispatched
+  std::optional<TimePoint> start_;
+  std::int64_t first_us_ = 0;
+  std::size_t read_ = 0;
+  std::mutex mu_;
+  std::vector<std::shared_ptr<Entry>> subs_;  // GUARDED_BY(mu_)
+};
+
+}  // namespace internal
+
+namespace {
+
+class LogSubscription final : public Subscription {
+ public:
+  LogSubscription(std::weak_ptr<internal::LogCore> owner, std::shared_ptr<Entry> entry)
+      : owner_(std::move(owner)), entry_(std::move(entry)) {}
+  ~LogSubscription() override {
+    entry_->active = false;
+    if (auto owner = owner_.lock()) {
+      std::lock_guard lock(owner->mu_);
+      std::erase(owner->subs_, entry_);
+    }
+  }
+
+ private:
+  std::weak_ptr<internal::LogCore> owner_;
+  std::shared_ptr<Entry> entry_;
+};
+
+}  // namespace
+
+LogTransport::LogTransport(LogTransportOptions options)
+    : impl_(std::make_shared<internal::LogCore>(std::move(options))) {}
+LogTransport::~LogTransport() = default;
+
+void LogTransport::Publish(const std::string& channel, std::span<const std::uint8_t>) {
+  throw TransportError("log transport is read-only: cannot publish on '" + channel + "' (" + url() + ")");
+}
+
+std::unique_ptr<Subscription> LogTransport::Subscribe(const std::string& channel_regex, Handler handler) {
+  auto entry = std::make_shared<Entry>();
+  try {
+    entry->regex = std::regex(channel_regex, std::regex::extended);
+  } catch (const std::regex_error& e) {
+    throw TransportError("LogTransport: bad channel regex '" + channel_regex + "': " + e.what());
+  }
+  entry->handler = std::make_shared<const Handler>(std::move(handler));
+  {
+    std::lock_guard lock(impl_->mu_);
+    impl_->subs_.push_back(entry);
+  }
+  return std::make_unique<LogSubscription>(impl_, std::move(entry));
+}
+
+int LogTransport::HandleFor(Duration timeout) {
+  internal::LogCore& d = *impl_;
+  if (d.options_.paced && d.next_) {
+    // Wait (bounded by `timeout`, in real time) for the next event to fall due.
+    const auto real_deadline = std::chrono::steady_clock::now() + timeout;
+    for (int i = 0; i < 100000; ++i) {
+      const Duration left = d.DueTime() - d.clock_.Now();
+      if (left <= Duration(0)) break;
+      const auto real_left = real_deadline - std::chrono::steady_clock::now();
+      if (real_left <= real_left.zero()) return 0;
+      std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(
+          real_left, std::min<Duration>(left, std::chrono::milliseconds(10))));
+    }
+  }
+  int dispatched = 0;
+  for (std::size_t n = 0; d.next_ && n < d.options_.max_per_call; ++n) {
+    if (d.options_.paced && d.DueTime() > d.clock_.Now()) break;
+    const Event event = std::move(*d.next_);
+    d.ReadNext();
+    const auto matching = d.Matching(event.channel);
+    if (matching.empty()) continue;
+    ++dispatched;
+    for (const auto& s : matching) {
+      if (!s->active) continue;
+      const std::shared_ptr<const Handler> handler = s->handler;
+      (*handler)(event.channel, event.bytes);  // an exception leaves the rest of the log to the next call
+    }
+  }
+  return dispatched;
+}
+
+std::string LogTransport::url() const { return "file://" + impl_->options_.path; }
+
+bool LogTransport::done() const { return !impl_->next_; }
+
+std::size_t LogTransport::events_read() const { return impl_->read_; }
+
+}  // namespace robotalk

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The walking humanoid's benchmark in one command (docs/ode_sim.md, "Walking"):
+# builds robotalk-walk-bench, walks 20 seeded GOTO goals (up to 2 m, any
+# heading) with models/simple_humanoid.urdf on the ode driver (walk=true) at
+# 1 kHz, prints per goal the answer, end error, speed and falls and the
+# real-time factor, and plots the top view of one walk (footsteps, ZMP, CoM)
+# with python3-matplotlib when it is installed (scripts/setup.sh installs it).
+#
+#   scripts/walk_bench.sh [--goals N] [--seed S] [--trace-goal K]
+# Environment: ROBOTALK_BUILD_DIR (default build), WALK_PLOT (default
+# docs/figures/walk_topview.png). Exit status 0 only for N/N successes, no fall.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
+PLOT=${WALK_PLOT:-docs/figures/walk_topview.png}
+TRACE=$(mktemp --suffix=.csv)
+trap 'rm -f "$TRACE"' EXIT
+flock /tmp/rt-build.lock cmake --build "$BUILD_DIR" --target robotalk-walk-bench -j2 >/dev/null
+status=0
+"$BUILD_DIR/bench/robotalk-walk-bench" --goals 20 --seed 1 --trace "$TRACE" "$@" || status=$?
+PY=python3
+[ -x /usr/bin/python3 ] && PY=/usr/bin/python3  # Debian's, where python3-matplotlib lives
+if "$PY" -c 'import matplotlib' 2>/dev/null; then
+  mkdir -p "$(dirname "$PLOT")"
+  "$PY" scripts/plot_walk.py "$TRACE" "$PLOT" && echo "top view: $PLOT"
+else
+  echo "python3-matplotlib not installed: no plot (scripts/setup.sh installs it)"
+fi
+exit $status
