@@ -1,7 +1,8 @@
 #include "cli_support.h"
 
 #include "robotalk/channels.h"
-#include "robotalk_msgs/announce_t.hpp"
+#include "robotalk/error.h"
+#include "robotalk/request.h"
 #include "sequence_runner.h"
 
 #include <poll.h>
@@ -26,9 +27,14 @@ struct AnnounceWatch::Impl {
   std::set<std::string> names;  // GUARDED_BY(mu)
   std::thread thread;
 
-  void On(const lcm::ReceiveBuffer*, const std::string&, const robotalk_msgs::announce_t* a) {
-    std::lock_guard lock(mu);
-    for (const auto& r : a->robots) names.insert(r.name);
+  void On(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    try {  // the checked decoder; a hostile ANNOUNCE is dropped, never thrown through LCM
+      const Announcement a =
+          DecodeAnnouncement({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+      std::lock_guard lock(mu);
+      for (const auto& r : a.robots) names.insert(r.name);
+    } catch (const ProtocolError&) {
+    }
   }
   // LCM is opened on this thread, so a Connect that succeeds at once does not
   // wait for it; poll() on LCM's socket and a pipe lets the destructor wake it.

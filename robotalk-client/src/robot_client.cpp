@@ -4,7 +4,7 @@
 
 #include "client_impl.h"
 #include "robotalk/lcm_transport.h"
-#include "robotalk_msgs/announce_t.hpp"
+#include "robotalk/request.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -108,7 +108,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
   }
   struct Collector {
     std::vector<AnnouncedRobot> robots;
-    void On(const robotalk_msgs::announce_t& msg) {
+    void On(const Announcement& msg) {
       for (const auto& r : msg.robots) {
         const bool seen = std::any_of(robots.begin(), robots.end(), [&](const AnnouncedRobot& a) {
           return a.server_id == msg.server_id && a.name == r.name;
@@ -116,21 +116,22 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
         if (seen) continue;
         robots.push_back({.name = r.name,
                           .driver = r.driver,
-                          .config_hash = static_cast<std::uint64_t>(r.config_hash),
+                          .config_hash = r.config_hash,
                           .total_dofs = r.total_dofs,
                           .base_type = r.base_type,
-                          .panic = r.panic != 0,
+                          .panic = r.panic,
                           .num_clients = r.num_clients,
                           .server_id = msg.server_id,
                           .url_hint = msg.url_hint});
       }
     }
   } collector;
-  // announce_t holds no unbounded arrays a hostile sender could abuse beyond
-  // the datagram itself, so LCM's typed decoder is acceptable here.
-  auto sub = Subscribe<robotalk_msgs::announce_t>(
-      *transport, kAnnounceChannel,
-      [&](const std::string&, const robotalk_msgs::announce_t& msg) { collector.On(msg); });
+  // The checked decoder: LCM's typed one throws through its C callback on a
+  // zero-length string (tests/fuzz/regressions/announce).
+  auto sub =
+      transport->Subscribe(kAnnounceChannel, [&](const std::string&, std::span<const std::uint8_t> bytes) {
+        collector.On(DecodeAnnouncement(bytes));
+      });
   const SteadyPoint deadline = SteadyAfter(listen);
   for (int round = 0; round < 1000000; ++round) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyNow());

@@ -4,6 +4,7 @@
 #include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "robotalk_msgs/announce_t.hpp"
+#include "wire_scanner.h"
 
 namespace robotalk {
 namespace {
@@ -130,20 +131,32 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
 }
 
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
-  // Bounded before LCM's decoder allocates: an ANNOUNCE is small.
+  // Walk the encoding with bounds checks before LCM's decoder runs: its
+  // generated code turns a string length of 0 or a negative count into
+  // std::length_error thrown through LCM's C callback (std::terminate; found
+  // by tests/fuzz). An ANNOUNCE is small.
   constexpr std::size_t kMaxBytes = 64 * 1024;
   if (bytes.size() > kMaxBytes) {
     throw ProtocolError("DecodeAnnouncement: " + std::to_string(bytes.size()) + " bytes; at most " +
                         std::to_string(kMaxBytes));
   }
-  robotalk_msgs::announce_t m{};
-  if (bytes.size() < 8 ||
-      m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
-    throw ProtocolError("DecodeAnnouncement: " + std::to_string(bytes.size()) +
-                        " bytes do not decode as announce_t");
+  WireScanner scan("DecodeAnnouncement", bytes);
+  if (scan.Int64("fingerprint") != robotalk_msgs::announce_t::getHash()) {
+    scan.Fail("fingerprint", "does not match (another message type?)");
   }
-  if (m.num_robots < 0 || m.num_robots > 1024) {
-    throw ProtocolError("DecodeAnnouncement: num_robots " + std::to_string(m.num_robots));
+  scan.Skip(2 + 8 + 8 + 8, "header");
+  scan.String("url_hint");
+  constexpr std::int64_t kMinRobotBytes = 2 * kLcmStringOverhead + 8 + 4 + 1 + 1 + 4;
+  const std::int32_t robots = scan.Count("num_robots", kMinRobotBytes);
+  for (std::int32_t i = 0; i < robots; ++i) {
+    scan.String("robot.name");
+    scan.String("robot.driver");
+    scan.Skip(8 + 4 + 1 + 1 + 4, "robot fields");
+  }
+  scan.ExpectEnd();
+  robotalk_msgs::announce_t m{};
+  if (m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
+    scan.Fail("message", "LCM decode failed");
   }
   Announcement a;
   a.server_id = m.server_id;

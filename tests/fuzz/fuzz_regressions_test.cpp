@@ -49,9 +49,8 @@ TEST(FuzzRegressions, ReplyPackageInputsDecodeOrAreRefused) { ReplayFolder("repl
 TEST(FuzzRegressions, RobotStateInputsDecodeOrAreRefused) { ReplayFolder("robot_state"); }
 TEST(FuzzRegressions, ConfigInputsDecodeOrAreRefused) { ReplayFolder("config"); }
 TEST(FuzzRegressions, UrdfInputsImportOrAreRefused) { ReplayFolder("urdf"); }
-// Disabled until the client decodes ANNOUNCE with a checked decoder:
-// regressions/announce/README.md.
-TEST(FuzzRegressions, DISABLED_AnnounceInputsDecodeOrAreDropped) { ReplayFolder("announce"); }
+// regressions/announce/README.md: fixed by the checked DecodeAnnouncement.
+TEST(FuzzRegressions, AnnounceInputsDecodeOrAreDropped) { ReplayFolder("announce"); }
 
 TEST(FuzzRegressions, EveryTargetSurvivesEmptyAndShortInputs) {
   for (const Target& t : Targets()) {

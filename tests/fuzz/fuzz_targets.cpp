@@ -3,6 +3,7 @@
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
 #include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "robotalk/urdf_import.h"
 #include "robotalk_msgs/announce_t.hpp"
 
@@ -60,10 +61,11 @@ void Config(Bytes bytes) {
 }
 
 void Announce(Bytes bytes) {
-  // lcm-cpp's trampoline: decode, drop the message when the status is < 0.
-  if (bytes.size() > static_cast<std::size_t>(INT_MAX)) return;
-  robotalk_msgs::announce_t msg;
-  (void)msg.decode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  // What the server, `robotalk robots` and the CLI's announce watch run.
+  try {
+    (void)DecodeAnnouncement(bytes);
+  } catch (const ProtocolError&) {
+  }
 }
 
 void Urdf(Bytes bytes) {

@@ -24,8 +24,9 @@ void ReplyPackage(Bytes bytes);
 void RobotState(Bytes bytes);
 /// Client, ROBOTALK/<robot>/CONFIG: DecodeConfigHeader, then DecodeConfig.
 void Config(Bytes bytes);
-/// Client (`robotalk robots`), ROBOTALK/ANNOUNCE: LCM's generated
-/// announce_t::decode, as lcm-cpp's subscription trampoline calls it.
+/// Server and client (`robotalk robots`), ROBOTALK/ANNOUNCE: DecodeAnnouncement
+/// (bounds-checked before LCM's generated decoder, which threw std::length_error
+/// through LCM's C callback on a zero-length string).
 void Announce(Bytes bytes);
 /// ParseUrdf on the bytes as text (robotalk-describe, the server's --robot).
 void Urdf(Bytes bytes);
