@@ -11,6 +11,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless lua5.2
   iproute2 util-linux python3 python3-matplotlib
+  libsodium-dev
 )
 
 missing=()
