@@ -2,6 +2,8 @@
 // security file must be an error naming the line, never a silent default.
 #include "robotalk/access_list.h"
 
+#include "robotalk/request.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>

@@ -1,6 +1,8 @@
 // The --clients access list (robotalk/access_list.h).
 #include "robotalk/access_list.h"
 
+#include "robotalk/request.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>

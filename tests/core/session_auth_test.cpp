@@ -1,6 +1,8 @@
 // Handshake, package MACs and the replay window (robotalk/session_auth.h).
 #include "robotalk/session_auth.h"
 
+#include "robotalk/request.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 

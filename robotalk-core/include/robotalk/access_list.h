@@ -25,7 +25,6 @@
 
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
-#include "robotalk/request.h"
 
 #include <cstdint>
 #include <filesystem>
@@ -35,6 +34,8 @@
 #include <vector>
 
 namespace robotalk {
+
+struct Request;  // robotalk/request.h
 
 /// The access list is malformed or its file unreadable / too open.
 /// The message starts with "FILE:LINE: " when a line is at fault.
