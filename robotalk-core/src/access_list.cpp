@@ -17,7 +17,7 @@ namespace robotalk {
 namespace {
 
 // A list of a few thousand clients is a few hundred KB; cap it well above.
-constexpr std::size_t kMaxFileBytes = 4 * 1024 * 1024;
+constexpr std::size_t kMaxFileBytes = std::size_t{4} * 1024 * 1024;
 
 bool IsRobotName(std::string_view s) {
   if (s.empty() || s.size() > 64) return false;

@@ -293,6 +293,23 @@ TEST_F(SessionAuth, PendingSessionsAndClientIdsPerKeyAreBounded) {
       AuthError);
 }
 
+TEST_F(SessionAuth, TheServerRefusesAHandshakeBeyondItsSessionBoundAndAcceptsOneAfterAClose) {
+  ServerAuthenticator server(Identity(100), access_, FixedNonce(1), {.max_sessions = 3});
+  std::vector<ClientSide> clients;
+  for (std::int64_t id = 1; id <= 3; ++id) clients.push_back(Connect(server, id % 2 ? alice_ : bob_, id));
+  EXPECT_THROW(
+      try { Connect(server, alice_, 4); } catch (const AuthError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("3 sessions open (limit max_sessions)"));
+        throw;
+      },
+      AuthError);
+  server.Close(clients[1].keys.session_id);
+  EXPECT_EQ(server.session_count(), 2U);
+  const ClientSide fourth = Connect(server, alice_, 4);
+  EXPECT_EQ(Send(server, fourth, 1), PackageVerdict::kAccepted);
+  EXPECT_EQ(Send(server, clients[1], 1), PackageVerdict::kUnknownSession);
+}
+
 TEST(ReplayWindow, AcceptsEachSequenceOnceInAnyOrderWithinTheWindow) {
   ReplayWindow w;
   using V = ReplayWindow::Verdict;
