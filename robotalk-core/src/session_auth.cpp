@@ -5,6 +5,7 @@
 #include <sodium.h>
 
 #include <algorithm>
+#include <iterator>
 #include <string_view>
 
 namespace robotalk {
@@ -215,7 +216,7 @@ void ServerAuthenticator::Refuse(const std::string& why) {
   throw AuthError(why);
 }
 
-ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello) {
+ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello, TimePoint now) {
   const std::string who =
       "hello of client " + std::to_string(hello.client_id) + " (key " + hello.client_key.Fingerprint() + ")";
   // The cheap map lookup first: a hello from an unlisted key costs no
@@ -258,7 +259,7 @@ ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello) {
   answer.signature = Sign(identity_, answer.SignedBytes(hello));
   // The server receives on the client's tx key: (tx_client, rx_client) = (rx, tx) here.
   Session session{
-      DeriveKeys(hello, answer, rx, tx), hello.client_id, client, false, ++counters_.handshakes, {}};
+      DeriveKeys(hello, answer, rx, tx), hello.client_id, client, false, ++counters_.handshakes, now, {}};
   sodium_memzero(rx.data(), rx.size());
   sodium_memzero(tx.data(), tx.size());
   const std::int64_t id = session.keys.session_id;
@@ -339,6 +340,19 @@ Mac ServerAuthenticator::SealReply(std::int64_t session_id, std::span<const std:
   const auto it = sessions_.find(session_id);
   if (it == sessions_.end()) throw AuthError("SealReply: unknown session " + std::to_string(session_id));
   return ComputeMac(it->second.keys.server_to_client, session_id, bytes);
+}
+
+std::size_t ServerAuthenticator::ExpirePending(TimePoint now, Duration max_age) {
+  std::size_t closed = 0;
+  for (auto it = sessions_.begin(); it != sessions_.end();) {
+    const auto next = std::next(it);
+    if (!it->second.live && now - it->second.opened_at > max_age) {
+      Erase(it);
+      ++closed;
+    }
+    it = next;
+  }
+  return closed;
 }
 
 void ServerAuthenticator::Close(std::int64_t session_id) {

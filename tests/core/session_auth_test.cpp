@@ -49,7 +49,7 @@ class SessionAuth : public ::testing::Test {
 
   ClientSide Connect(ServerAuthenticator& server, const KeyPair& who, std::int64_t client_id) {
     const ClientHandshake hs(who, client_id);
-    const ServerAnswer answer = server.Handshake(hs.hello());
+    const ServerAnswer answer = server.Handshake(hs.hello(), clock_.Now());
     return {hs.Finish(answer), client_id};
   }
   // Sends one package of `client` through `server`.
@@ -59,6 +59,7 @@ class SessionAuth : public ::testing::Test {
         .verdict;
   }
 
+  ManualClock clock_;
   KeyPair server_key_ = Identity(100);
   KeyPair alice_ = Identity(1);
   KeyPair bob_ = Identity(2);
@@ -133,7 +134,7 @@ TEST_F(SessionAuth, APackageRecordedBeforeAServerRestartIsRefusedByTheNewInstanc
     ServerAuthenticator old_server(Identity(100), access_, FixedNonce(1));
     const ClientHandshake hs(alice_, 42);
     recorded_hello = hs.hello();
-    const ClientSide alice{hs.Finish(old_server.Handshake(hs.hello())), 42};
+    const ClientSide alice{hs.Finish(old_server.Handshake(hs.hello(), clock_.Now())), 42};
     recorded_bytes = PackageBytes(1);
     recorded_mac = alice.Seal(recorded_bytes);
     recorded_sid = alice.keys.session_id;
@@ -146,7 +147,7 @@ TEST_F(SessionAuth, APackageRecordedBeforeAServerRestartIsRefusedByTheNewInstanc
             PackageVerdict::kUnknownSession);
   // Replaying the recorded hello too opens a session with another id, whose
   // key the recorder cannot know: re-labelled with that id, the package fails.
-  const ServerAnswer answer = new_server.Handshake(recorded_hello);
+  const ServerAnswer answer = new_server.Handshake(recorded_hello, clock_.Now());
   EXPECT_EQ(answer.instance_nonce, FixedNonce(2));
   EXPECT_EQ(new_server.session_count(), 1U);
   const std::int64_t replayed_sid = SessionId(recorded_hello, answer);  // public: anyone can compute it
@@ -162,8 +163,8 @@ TEST_F(SessionAuth, TheSameHelloAnsweredByTwoInstancesGivesUnrelatedSessions) {
   ServerAuthenticator a(Identity(100), access_, FixedNonce(1));
   ServerAuthenticator b(Identity(100), access_, FixedNonce(2));
   const ClientHandshake hs(alice_, 42);
-  const SessionKeys ka = hs.Finish(a.Handshake(hs.hello()));
-  const SessionKeys kb = hs.Finish(b.Handshake(hs.hello()));
+  const SessionKeys ka = hs.Finish(a.Handshake(hs.hello(), clock_.Now()));
+  const SessionKeys kb = hs.Finish(b.Handshake(hs.hello(), clock_.Now()));
   EXPECT_NE(ka.session_id, kb.session_id);
   EXPECT_NE(ka.client_to_server, kb.client_to_server);
   EXPECT_EQ(ka.instance_nonce, FixedNonce(1));
@@ -178,11 +179,11 @@ TEST_F(SessionAuth, TheSameHelloAnsweredByTwoInstancesGivesUnrelatedSessions) {
 TEST_F(SessionAuth, ANewSessionReplacesTheOldOneOnlyWithItsFirstAuthenticPackage) {
   ServerAuthenticator server(Identity(100), access_, FixedNonce(1));
   const ClientHandshake first(alice_, 42);
-  const ClientSide old_session{first.Finish(server.Handshake(first.hello())), 42};
+  const ClientSide old_session{first.Finish(server.Handshake(first.hello(), clock_.Now())), 42};
   ASSERT_EQ(Send(server, old_session, 1), PackageVerdict::kAccepted);
 
   // A replayed hello opens only a pending session: the live one runs on.
-  (void)server.Handshake(first.hello());
+  (void)server.Handshake(first.hello(), clock_.Now());
   EXPECT_EQ(server.LiveSession(42), old_session.keys.session_id);
   EXPECT_EQ(Send(server, old_session, 2), PackageVerdict::kAccepted);
 
@@ -200,7 +201,7 @@ TEST_F(SessionAuth, AClientIdBoundToAnotherKeyIsRefusedUntilItsSessionsClose) {
   ASSERT_EQ(Send(server, alice, 1), PackageVerdict::kAccepted);
   const ClientHandshake bob(bob_, 42);
   try {
-    server.Handshake(bob.hello());
+    server.Handshake(bob.hello(), clock_.Now());
     ADD_FAILURE() << "bob took alice's client id";
   } catch (const AuthError& e) {
     EXPECT_THAT(e.what(), HasSubstr("bound to another key (" + alice_.public_key.Fingerprint() + ")"));
@@ -212,7 +213,7 @@ TEST_F(SessionAuth, AClientIdBoundToAnotherKeyIsRefusedUntilItsSessionsClose) {
             PackageVerdict::kWrongClient);
 
   server.Close(alice.keys.session_id);
-  EXPECT_NO_THROW(server.Handshake(bob.hello()));
+  EXPECT_NO_THROW(server.Handshake(bob.hello(), clock_.Now()));
 }
 
 TEST_F(SessionAuth, AHelloWithAChangedFieldOrAnUnlistedKeyIsRefused) {
@@ -221,17 +222,17 @@ TEST_F(SessionAuth, AHelloWithAChangedFieldOrAnUnlistedKeyIsRefused) {
   ClientHello tampered = hs.hello();
   tampered.client_id = 43;  // alice's signature, another id
   EXPECT_THROW(
-      try { server.Handshake(tampered); } catch (const AuthError& e) {
+      try { server.Handshake(tampered, clock_.Now()); } catch (const AuthError& e) {
         EXPECT_THAT(e.what(), HasSubstr("bad signature"));
         throw;
       },
       AuthError);
   tampered = hs.hello();
   tampered.client_key = bob_.public_key;  // claims to be bob with alice's signature
-  EXPECT_THROW(server.Handshake(tampered), AuthError);
+  EXPECT_THROW(server.Handshake(tampered, clock_.Now()), AuthError);
   const ClientHandshake stranger(mallory_, 44);
   EXPECT_THROW(
-      try { server.Handshake(stranger.hello()); } catch (const AuthError& e) {
+      try { server.Handshake(stranger.hello(), clock_.Now()); } catch (const AuthError& e) {
         EXPECT_THAT(e.what(), HasSubstr("not in the access list"));
         throw;
       },
@@ -243,7 +244,7 @@ TEST_F(SessionAuth, AHelloWithAChangedFieldOrAnUnlistedKeyIsRefused) {
 TEST_F(SessionAuth, TheClientRefusesATamperedAnswerAndAnUnexpectedServer) {
   ServerAuthenticator server(Identity(100), access_, FixedNonce(1));
   const ClientHandshake hs(alice_, 42);
-  const ServerAnswer answer = server.Handshake(hs.hello());
+  const ServerAnswer answer = server.Handshake(hs.hello(), clock_.Now());
   ServerAnswer bad = answer;
   bad.instance_nonce[0] ^= 1;
   EXPECT_THROW(hs.Finish(bad), AuthError);
@@ -276,9 +277,10 @@ TEST_F(SessionAuth, PendingSessionsAndClientIdsPerKeyAreBounded) {
   ServerAuthenticator server(Identity(100), access_, FixedNonce(1),
                              {.max_sessions = 8, .max_pending_per_key = 2, .max_client_ids_per_key = 3});
   const ClientHandshake h1(alice_, 1), h2(alice_, 1), h3(alice_, 1);
-  const SessionKeys k1 = h1.Finish(server.Handshake(h1.hello()));
-  const SessionKeys k2 = h2.Finish(server.Handshake(h2.hello()));
-  const SessionKeys k3 = h3.Finish(server.Handshake(h3.hello()));  // drops k1, the oldest pending
+  const SessionKeys k1 = h1.Finish(server.Handshake(h1.hello(), clock_.Now()));
+  const SessionKeys k2 = h2.Finish(server.Handshake(h2.hello(), clock_.Now()));
+  const SessionKeys k3 =
+      h3.Finish(server.Handshake(h3.hello(), clock_.Now()));  // drops k1, the oldest pending
   EXPECT_EQ(server.session_count(), 2U);
   EXPECT_EQ(Send(server, {k1, 1}, 1), PackageVerdict::kUnknownSession);
   EXPECT_EQ(Send(server, {k3, 1}, 1), PackageVerdict::kAccepted);
@@ -308,6 +310,23 @@ TEST_F(SessionAuth, TheServerRefusesAHandshakeBeyondItsSessionBoundAndAcceptsOne
   const ClientSide fourth = Connect(server, alice_, 4);
   EXPECT_EQ(Send(server, fourth, 1), PackageVerdict::kAccepted);
   EXPECT_EQ(Send(server, clients[1], 1), PackageVerdict::kUnknownSession);
+}
+
+TEST_F(SessionAuth, APendingSessionNeverConfirmedExpiresAndReleasesItsClientId) {
+  ServerAuthenticator server(Identity(100), access_, FixedNonce(1));
+  const ClientSide live = Connect(server, alice_, 1);
+  ASSERT_EQ(Send(server, live, 1), PackageVerdict::kAccepted);
+  clock_.Advance(std::chrono::seconds(1));
+  const ClientHandshake unconfirmed(alice_, 2);
+  (void)server.Handshake(unconfirmed.hello(), clock_.Now());
+  clock_.Advance(std::chrono::seconds(2));
+  const ClientSide late = Connect(server, alice_, 3);  // pending, younger than the bound
+  EXPECT_EQ(server.ExpirePending(clock_.Now(), std::chrono::milliseconds(1500)), 1U);
+  EXPECT_EQ(server.session_count(), 2U);
+  EXPECT_EQ(Send(server, live, 2), PackageVerdict::kAccepted);  // live sessions never expire here
+  EXPECT_EQ(Send(server, late, 1), PackageVerdict::kAccepted);
+  // Client id 2 is free again: bob may take it.
+  EXPECT_NO_THROW(Connect(server, bob_, 2));
 }
 
 TEST(ReplayWindow, AcceptsEachSequenceOnceInAnyOrderWithinTheWindow) {

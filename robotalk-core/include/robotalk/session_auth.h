@@ -22,6 +22,7 @@
 #pragma once
 
 #include "robotalk/access_list.h"
+#include "robotalk/clock.h"
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
 
@@ -182,11 +183,21 @@ class ServerAuthenticator {
   ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce, Limits limits);
   ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce)
       : ServerAuthenticator(std::move(identity), access, instance_nonce, Limits{}) {}
+  /// The list is kept by reference: a temporary would dangle.
+  ServerAuthenticator(KeyPair, const AccessList&&, Nonce, Limits) = delete;
+  ServerAuthenticator(KeyPair, const AccessList&&, Nonce) = delete;
 
   /// Answers `hello` and opens a pending session.
   /// @throw AuthError (counted) when the signature is bad, the key is not in
   ///   the access list, the client id is bound to another key, or a bound is hit.
-  ServerAnswer Handshake(const ClientHello& hello);
+  /// `now`: when it arrived (any one clock; used only by ExpirePending).
+  ServerAnswer Handshake(const ClientHello& hello, TimePoint now);
+
+  /// Closes the pending sessions opened before `now - max_age` (hellos whose
+  /// client never sent an authentic package: lost answers, replayed hellos);
+  /// returns how many. Call it with the session timeout, e.g. from the
+  /// watchdog. Live sessions are the caller's to Close.
+  std::size_t ExpirePending(TimePoint now, Duration max_age);
 
   struct Verified {
     PackageVerdict verdict = PackageVerdict::kUnknownSession;
@@ -221,6 +232,7 @@ class ServerAuthenticator {
     const AccessEntry* client = nullptr;
     bool live = false;
     std::uint64_t opened = 0;  // handshake counter at opening: orders pending sessions
+    TimePoint opened_at{};
     ReplayWindow window;
   };
   struct Binding {
