@@ -1,7 +1,8 @@
 // Authenticated sessions as pure maths: the handshake that binds a client id
 // to a key and derives session keys, the per-package MAC, and the replay
-// window. No I/O, no clock, no LCM: the ServerDaemon / RobotClient carry the
-// values (wire proposal in docs/security.md). Every primitive is libsodium's.
+// window. No I/O, no clock of its own (times are passed in), no LCM: the
+// ServerDaemon / RobotClient carry the values (wire proposal in
+// docs/security.md). Every primitive is libsodium's.
 //
 //   client                                           server (instance nonce I, fresh per start)
 //   ClientHello{key C, client id, nonce Nc, X25519 eph. Ec, sig_C}  ->
@@ -31,6 +32,7 @@
 #include <map>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace robotalk {
@@ -162,7 +164,7 @@ struct AuthCounters {
   std::uint64_t wrong_client = 0;
   std::uint64_t forged = 0;
   std::uint64_t duplicate = 0;
-  std::uint64_t too_old = 0;
+  std::uint64_t too_old = 0;  ///< and sequences <= 0
 };
 
 /// The server's authentication state for one server instance: answers
