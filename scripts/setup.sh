@@ -13,6 +13,7 @@ PACKAGES=(
   iproute2 util-linux python3 python3-matplotlib
   libboost-dev nlohmann-json3-dev chromium chromium-driver
   libjchart2d-java xvfb x11-apps  # robotalk-spy (lcm-spy charts); its test: a virtual X server and xwd
+  libsodium-dev
 )
 # robotalk-web's page modules come from the npm registry: Node.js and npm from
 # Debian unless a node with npm is already installed (e.g. NodeSource's).

@@ -1,0 +1,116 @@
+// Google Benchmark of package authentication (robotalk/session_auth.h): what
+// keyed mode adds per package on the client (seal) and the server (verify:
+// session lookup, MAC, replay window), for a 200-byte package (a few
+// set-points) and a 30 kB one (a long playback batch); and the handshake,
+// paid once per session. Figures: docs/security.md, "Cost".
+//   robotalk-auth-bench [--benchmark_format=json ...]
+#include "robotalk/session_auth.h"
+
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+namespace {
+
+using namespace robotalk;
+
+KeyPair Identity(std::uint8_t v) {
+  std::array<std::uint8_t, 32> seed{};
+  seed.fill(v);
+  return KeyPair::FromSeed(seed);
+}
+
+struct Fixture {
+  KeyPair client = Identity(1);
+  AccessList access = AccessList::Parse(Identity(1).public_key.ToString() + " alice *=all\n", "bench");
+  ServerAuthenticator server{Identity(2), access, RandomNonce()};
+  SessionKeys keys;
+  Fixture() {
+    const ClientHandshake hs(client, 42);
+    keys = hs.Finish(server.Handshake(hs.hello(), TimePoint{}));
+  }
+};
+
+std::vector<std::uint8_t> Bytes(std::size_t n) {
+  std::vector<std::uint8_t> b(n);
+  for (std::size_t i = 0; i < n; ++i) b[i] = static_cast<std::uint8_t>(i * 13 + 1);
+  return b;
+}
+
+// Client: MAC of one package.
+void BM_SealPackage(benchmark::State& state) {
+  Fixture f;
+  const auto bytes = Bytes(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(ComputeMac(f.keys.client_to_server, f.keys.session_id, bytes));
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * state.range(0));
+}
+BENCHMARK(BM_SealPackage)->Arg(200)->Arg(30000);
+
+// Server: the whole per-package check. Each iteration verifies a package with
+// a new sequence number (MACs prepared outside the timed loop), so every one
+// takes the accept path.
+void BM_VerifyPackage(benchmark::State& state) {
+  Fixture f;
+  constexpr int kPrepared = 4096;
+  const auto size = static_cast<std::size_t>(state.range(0));
+  std::vector<std::vector<std::uint8_t>> packages(kPrepared, Bytes(size));
+  std::vector<Mac> macs(kPrepared);
+  std::int64_t sequence = 0;
+  auto prepare = [&] {
+    for (int i = 0; i < kPrepared; ++i) {
+      const std::int64_t s = sequence + 1 + i;
+      for (int b = 0; b < 8; ++b)
+        packages[static_cast<std::size_t>(i)][static_cast<std::size_t>(b)] =
+            static_cast<std::uint8_t>(s >> (8 * b));
+      macs[static_cast<std::size_t>(i)] =
+          ComputeMac(f.keys.client_to_server, f.keys.session_id, packages[static_cast<std::size_t>(i)]);
+    }
+  };
+  int next = kPrepared;
+  for (auto _ : state) {
+    if (next == kPrepared) {
+      state.PauseTiming();
+      prepare();
+      next = 0;
+      state.ResumeTiming();
+    }
+    ++sequence;
+    const auto v = f.server.Verify(f.keys.session_id, 42, sequence, packages[static_cast<std::size_t>(next)],
+                                   macs[static_cast<std::size_t>(next)]);
+    if (v.verdict != PackageVerdict::kAccepted) state.SkipWithError(ToString(v.verdict));
+    ++next;
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * state.range(0));
+}
+BENCHMARK(BM_VerifyPackage)->Arg(200)->Arg(30000);
+
+// Once per session: hello (sign), answer (verify, kx, sign), finish (verify, kx).
+void BM_Handshake(benchmark::State& state) {
+  Fixture f;
+  for (auto _ : state) {
+    const ClientHandshake hs(f.client, 42);
+    const SessionKeys keys = hs.Finish(f.server.Handshake(hs.hello(), TimePoint{}));
+    benchmark::DoNotOptimize(keys.session_id);
+    state.PauseTiming();
+    f.server.Close(keys.session_id);
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_Handshake);
+
+// What a hello from a listed key costs the server before it can refuse a bad
+// signature: one Ed25519 verification (a flood of forged hellos costs this each).
+void BM_VerifyHelloSignature(benchmark::State& state) {
+  Fixture f;
+  const ClientHandshake hs(f.client, 42);
+  const auto signed_bytes = hs.hello().SignedBytes();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(VerifySignature(hs.hello().client_key, signed_bytes, hs.hello().signature));
+  }
+}
+BENCHMARK(BM_VerifyHelloSignature);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,79 @@
+// robotalk-keygen: writes a RoboTalk identity key pair (Ed25519) for keyed
+// mode: FILE (the secret key, mode 0600) and FILE.pub (the public key and a
+// name: one line to paste into the server's --clients list). Never
+// overwrites. docs/security.md.
+#include "robotalk/keys.h"
+
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: robotalk-keygen --out FILE [--name NAME]\n"
+    "       robotalk-keygen --fingerprint FILE.pub\n"
+    "\n"
+    "Writes a RoboTalk identity key pair (Ed25519, libsodium):\n"
+    "  FILE      the secret key, mode 0600; give it to the client (--key FILE)\n"
+    "  FILE.pub  'ed25519:<hex> NAME'; add rights and put the line in the\n"
+    "            server's --clients file, e.g. '<FILE.pub line> pioneer=command,query,panic'\n"
+    "Refuses to overwrite either file.\n"
+    "\n"
+    "  --out FILE          where to write the pair\n"
+    "  --name NAME         the client's name in the access list and the server log\n"
+    "                      (1-64 of A-Z a-z 0-9 _ . @ -; default: FILE's base name)\n"
+    "  --fingerprint FILE  print the short fingerprint of a key file (.pub or secret)\n"
+    "  --help, --version\n";
+
+int Fail(const std::string& message) {
+  std::cerr << "robotalk-keygen: " << message << "\n";
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out;
+  std::string name;
+  std::string fingerprint;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](std::string& into) {
+      if (i + 1 >= argc) return false;
+      into = argv[++i];
+      return true;
+    };
+    if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+    if (arg == "--version") {
+      std::cout << "robotalk-keygen " << ROBOTALK_VERSION << "\n";
+      return 0;
+    }
+    const bool ok = (arg == "--out" && value(out)) || (arg == "--name" && value(name)) ||
+                    (arg == "--fingerprint" && value(fingerprint));
+    if (!ok) return Fail("unknown or incomplete option '" + arg + "' (see --help)");
+  }
+  try {
+    if (!fingerprint.empty()) {
+      const std::filesystem::path f(fingerprint);
+      const robotalk::PublicKey key = f.extension() == ".pub" ? robotalk::ReadPublicKeyFile(f).key
+                                                              : robotalk::ReadSecretKeyFile(f).public_key;
+      std::cout << key.Fingerprint() << " " << key.ToString() << "\n";
+      return 0;
+    }
+    if (out.empty()) return Fail("--out FILE is required (see --help)");
+    if (name.empty()) name = std::filesystem::path(out).filename().string();
+    const robotalk::KeyPair key = robotalk::KeyPair::Generate();
+    robotalk::WriteKeyFiles(out, key, name);
+    std::cout << "wrote " << out << " (secret, mode 0600) and " << out << ".pub\n"
+              << "name        " << name << "\n"
+              << "fingerprint " << key.public_key.Fingerprint() << "\n"
+              << "public key  " << key.public_key.ToString() << "\n";
+    return 0;
+  } catch (const robotalk::Error& e) {
+    return Fail(e.what());
+  }
+}
