@@ -27,8 +27,8 @@ std::vector<std::uint8_t> Encode(int robots, const std::string& url = "udpm://x"
   return bytes;
 }
 
-// Offset of num_robots: fingerprint, version, server id, time, url (length + text + NUL).
-size_t CountOffset(const std::string& url) { return 8 + 2 + 8 + 8 + 4 + url.size() + 1; }
+// Offset of num_robots: fingerprint, version, server id, time, uptime, url (length + text + NUL).
+size_t CountOffset(const std::string& url) { return 8 + 2 + 8 + 8 + 8 + 4 + url.size() + 1; }
 
 TEST(AnnounceCountPlausible, AcceptsRealAnnounces) {
   for (int n : {0, 1, 3}) EXPECT_TRUE(AnnounceCountPlausible(Encode(n))) << n;
@@ -45,10 +45,10 @@ TEST(AnnounceCountPlausible, RefusesACountTheDatagramCannotHold) {
 
 TEST(AnnounceCountPlausible, RefusesTruncatedBytesAndAnOverlongUrl) {
   const auto bytes = Encode(2);
-  for (size_t n : {size_t{0}, size_t{10}, size_t{29}, CountOffset("udpm://x") + 2})
+  for (size_t n : {size_t{0}, size_t{10}, size_t{37}, CountOffset("udpm://x") + 2})
     EXPECT_FALSE(AnnounceCountPlausible(std::span(bytes.data(), n))) << n;
   auto long_url = Encode(1);
-  long_url[26] = 0x7f;  // url length far beyond the datagram
+  long_url[34] = 0x7f;  // url length far beyond the datagram
   EXPECT_FALSE(AnnounceCountPlausible(long_url));
 }
 

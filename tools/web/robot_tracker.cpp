@@ -4,6 +4,7 @@
 
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
+#include "robotalk/request.h"
 #include "robotalk/robot_client.h"
 #include "robotalk_msgs/announce_t.hpp"
 #include "scene_json.h"
@@ -67,23 +68,14 @@ enum class Task { kConnect, kStream };
 // The LCM typed decoder sizes robots[] from the count before checking the
 // bytes are there: check the count against the datagram first.
 bool AnnounceCountPlausible(std::span<const std::uint8_t> bytes) {
-  const std::uint8_t* b = bytes.data();
-  const std::size_t n = bytes.size();
-  auto be32 = [&](std::size_t at) {
-    return (std::uint32_t{b[at]} << 24) | (std::uint32_t{b[at + 1]} << 16) | (std::uint32_t{b[at + 2]} << 8) |
-           std::uint32_t{b[at + 3]};
-  };
-  std::size_t at = 8 + 2 + 8 + 8;  // fingerprint, version, server id, time
-  if (n < at + 4) return false;
-  const std::uint32_t len = be32(at);  // url_hint, with its NUL
-  if (len > n) return false;
-  at += 4 + std::size_t{len};
-  if (n < at + 4) return false;
-  const auto count = static_cast<std::int32_t>(be32(at));
-  at += 4;
-  constexpr std::size_t kMinRobotBytes =
-      4 + 1 + 4 + 1 + 8 + 4 + 1 + 1 + 4;  // two empty strings and the fields
-  return count >= 0 && static_cast<std::size_t>(count) <= (n - at) / kMinRobotBytes;
+  // The project's checked decoder walks every count and string against the
+  // datagram before LCM's decoder allocates (request.h).
+  try {
+    (void)DecodeAnnouncement(bytes);
+    return true;
+  } catch (const ProtocolError&) {
+    return false;
+  }
 }
 
 class RobotTracker::Impl {
