@@ -1,4 +1,5 @@
 #include "ode_driver.h"
+#include "robotalk/dof_table.h"
 
 #include "ode_driver_impl.h"
 #include "robotalk/error.h"
@@ -52,31 +53,27 @@ OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::ve
   step_ = FromSeconds(1.0 / options_.step_hz);
   if (step_ <= Duration::zero()) throw Error("OdeDriver: step_hz " + Num(options_.step_hz) + " is too high");
   const int n = model_.num_dofs();
-  for (Eigen::VectorXd* v : {&target_, &speed_, &force_, &vmax_, &fmax_, &lower_, &upper_}) v->setZero(n);
-  mode_.assign(static_cast<size_t>(n), Mode::kPosition);
-  leader_.assign(static_cast<size_t>(n), -1);
-  mimic_k_.assign(static_cast<size_t>(n), 0);
-  mimic_c_.assign(static_cast<size_t>(n), 0);
+  for (Eigen::VectorXd* v : {&target_, &speed_, &force_}) v->setZero(n);
   root_poses_.assign(model_.roots().size(), Eigen::Isometry3d::Identity());
-  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(n);
-  for (int j = 0; j < static_cast<int>(model_.joints().size()); ++j) {
-    const Joint& joint = model_.joint(j);
-    for (size_t k = 0; k < joint.dofs.size(); ++k) {
-      const int i = model_.dof_offset(j) + static_cast<int>(k);
-      const DofLimits& lim = joint.dofs[k].limits;
-      lower_[i] = lim.lower;
-      upper_[i] = lim.upper;
-      vmax_[i] = std::isfinite(lim.velocity) ? lim.velocity : options_.default_velocity;
-      fmax_[i] = std::isfinite(lim.effort) ? lim.effort : options_.default_effort;
-      q0[i] = std::clamp(0.0, lim.lower, lim.upper);
-      if (joint.servo_types.empty() && !joint.mimic) mode_[static_cast<size_t>(i)] = Mode::kPassive;
-    }
-    if (joint.mimic) {
-      const auto i = static_cast<size_t>(model_.dof_offset(j));
-      mode_[i] = Mode::kMimic;
-      leader_[i] = model_.dof_offset(joint.mimic->leader_joint);
-      mimic_k_[i] = joint.mimic->multiplier;
-      mimic_c_[i] = joint.mimic->offset;
+  // The model's per-dof limits and mimic couplings (one table for the
+  // project: robotalk/dof_table.h), with this driver's defaults for limits
+  // the model leaves infinite.
+  const DofTable dofs(model_);
+  lower_ = dofs.lower;
+  upper_ = dofs.upper;
+  vmax_ = dofs.velocity.unaryExpr([&](double v) { return std::isfinite(v) ? v : options_.default_velocity; });
+  fmax_ = dofs.effort.unaryExpr([&](double f) { return std::isfinite(f) ? f : options_.default_effort; });
+  leader_ = dofs.mimic_leader;
+  mimic_k_ = dofs.mimic_multiplier;
+  mimic_c_ = dofs.mimic_offset;
+  mode_.assign(static_cast<size_t>(n), Mode::kPosition);
+  Eigen::VectorXd q0 = lower_.cwiseMax(0.0).cwiseMin(upper_);  // 0 clamped into the limits
+  for (int i = 0; i < n; ++i) {
+    const Joint& joint = model_.joint(dofs.joint_of[static_cast<size_t>(i)]);
+    if (dofs.is_mimic(i)) {
+      mode_[static_cast<size_t>(i)] = Mode::kMimic;
+    } else if (joint.servo_types.empty()) {
+      mode_[static_cast<size_t>(i)] = Mode::kPassive;
     }
   }
   ApplyMimics(model_, q0);
