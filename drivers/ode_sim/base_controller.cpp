@@ -6,8 +6,6 @@
 
 namespace robotalk::ode_detail {
 
-double WrapAngle(double a) { return std::remainder(a, 2 * std::numbers::pi); }
-
 void GotoController::Start(double x, double y, double theta, const Gains& gains) {
   g_ = gains;
   gx_ = x;

@@ -2,6 +2,8 @@
 // controller and the differential-drive wheel mapping. No ODE, no I/O.
 #pragma once
 
+#include "robotalk/driver_support.h"
+
 #include <cstdint>
 
 namespace robotalk::ode_detail {
@@ -42,7 +44,7 @@ class GotoController {
   bool done_ = false;
 };
 
-/// Angle wrapped into (-pi, pi].
-double WrapAngle(double a);
+/// Angle wrapped into (-pi, pi]: the project's one WrapAngle.
+using driver_support::WrapAngle;
 
 }  // namespace robotalk::ode_detail
