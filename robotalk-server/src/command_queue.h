@@ -1,6 +1,7 @@
 // A client's command queue: a min-heap ordered by start time, ties in arrival
 // order (paper §IV-A). Items due "now" (no start time) sort before any timed
-// item. Pure data structure, no locking: the owner (RobotService) locks.
+// item. Pure data structure, no locking: the owner (Scheduler, under the
+// RobotDaemon's lock) synchronises.
 #pragma once
 
 #include "robotalk/clock.h"

@@ -3,8 +3,9 @@
 // possible, for tests and experiments: no threads, no network. The same
 // driver seed and the same commands give the same trajectory.
 //
-// This is the server's RobotService itself (not a copy), stepped from one
-// deadline to the next: each driver period, each command's start time.
+// These are the server's own RobotSessions and RobotDaemon (not a copy),
+// without threads or a transport, stepped from one deadline to the next:
+// each driver period, each command's start time, each state sample.
 #pragma once
 
 #include "robotalk/clock.h"
