@@ -130,6 +130,8 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
   return Encode(m);
 }
 
+std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample) { return Encode(ToWire(sample)); }
+
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   // Walk the encoding with bounds checks before LCM's decoder runs: its
   // generated code turns a string length of 0 or a negative count into

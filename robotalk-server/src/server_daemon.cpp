@@ -3,7 +3,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "state_encoding.h"
 
 #include <poll.h>
@@ -17,14 +17,6 @@ namespace robotalk {
 namespace {
 
 constexpr std::size_t kMaxBatchBytes = 30000;  // split reply packages well under LCM's 64 KB
-
-std::vector<std::uint8_t> EncodeSample(const std::string& robot, std::uint64_t config_hash,
-                                       const RobotSample& s) {
-  const robotalk_msgs::robot_state_t msg = ToWire(ToStateSample(robot, config_hash, s));
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
 
 }  // namespace
 
@@ -225,7 +217,8 @@ void ServerDaemon::Drain(Robot& robot) {
   SyncLatch(robot);  // a driver fault latched by the RobotDaemon
   const std::string& name = robot.daemon->robot_name();
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
-    transport_.Publish(StateChannel(name), EncodeSample(name, robot.config_hash, robot.output.samples[i]));
+    transport_.Publish(StateChannel(name),
+                       EncodeStateSample(ToStateSample(name, robot.config_hash, robot.output.samples[i])));
   }
   for (const std::string& line : robot.output.audit)
     std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());

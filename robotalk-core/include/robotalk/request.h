@@ -6,6 +6,7 @@
 
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
+#include "robotalk/state_sample.h"
 
 #include <cstdint>
 #include <span>
@@ -92,6 +93,9 @@ struct Announcement {
   std::vector<RobotAnnouncement> robots;
 };
 std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& announcement);
+
+/// A broadcast state sample (ROBOTALK/<robot>/STATE) as bytes.
+std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample);
 /// Throws ProtocolError on truncated, hostile or foreign bytes, or more than
 /// 1024 robots.
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes);
