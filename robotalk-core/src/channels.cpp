@@ -37,6 +37,9 @@ std::optional<std::uint64_t> ParseHex64(std::string_view hex) {
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel) {
   return RobotBefore(channel, "/REQUEST");
 }
+std::optional<std::string> RobotOfHelloChannel(std::string_view channel) {
+  return RobotBefore(channel, "/HELLO");
+}
 std::optional<std::string> RobotOfConfigChannel(std::string_view channel) {
   return RobotBefore(channel, "/CONFIG");
 }
@@ -44,14 +47,23 @@ std::optional<std::string> RobotOfStateChannel(std::string_view channel) {
   return RobotBefore(channel, "/STATE");
 }
 
-std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel) {
-  constexpr std::string_view kReply = "/REPLY/";
+namespace {
+// "ROBOTALK/<robot><infix><16 hex>".
+std::optional<ReplyChannelParts> ParseClientChannel(std::string_view channel, std::string_view kReply) {
   if (channel.size() < 16) return std::nullopt;
   auto id = ParseHex64(channel.substr(channel.size() - 16));
   if (!id) return std::nullopt;
   auto robot = RobotBefore(channel.substr(0, channel.size() - 16), kReply);
   if (!robot) return std::nullopt;
   return ReplyChannelParts{*robot, static_cast<std::int64_t>(*id)};
+}
+}  // namespace
+
+std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel) {
+  return ParseClientChannel(channel, "/REPLY/");
+}
+std::optional<ReplyChannelParts> ParseHelloAnswerChannel(std::string_view channel) {
+  return ParseClientChannel(channel, "/HELLO/");
 }
 
 }  // namespace robotalk

@@ -2,6 +2,8 @@
 // built AND parsed here, in one place for the server, the client and tools.
 //
 //   ROBOTALK/ANNOUNCE                       every server's robots, once a second
+//   ROBOTALK/<robot>/HELLO                  client -> server: open a session
+//   ROBOTALK/<robot>/HELLO/<client id hex>  server -> one client: the answer
 //   ROBOTALK/<robot>/REQUEST                client -> server packages
 //   ROBOTALK/<robot>/REPLY/<client id hex>  server -> one client
 //   ROBOTALK/<robot>/CONFIG                 the robot's description
@@ -24,6 +26,8 @@ namespace robotalk {
 inline constexpr const char* kAnnounceChannel = "ROBOTALK/ANNOUNCE";
 /// Subscription regex (LCM: whole-name match) for the REQUEST channel of every robot.
 inline constexpr const char* kAnyRequestChannelRegex = "ROBOTALK/[^/]+/REQUEST";
+/// Subscription regex for the HELLO channel of every robot.
+inline constexpr const char* kAnyHelloChannelRegex = "ROBOTALK/[^/]+/HELLO";
 
 /// 16 lowercase hex digits: how client ids and configuration hashes are written.
 inline std::string Hex64(std::uint64_t v) {
@@ -36,11 +40,17 @@ inline std::string RequestChannel(const std::string& robot) { return "ROBOTALK/"
 inline std::string ReplyChannel(const std::string& robot, std::int64_t client_id) {
   return "ROBOTALK/" + robot + "/REPLY/" + Hex64(static_cast<std::uint64_t>(client_id));
 }
+inline std::string HelloChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/HELLO"; }
+inline std::string HelloAnswerChannel(const std::string& robot, std::int64_t client_id) {
+  return "ROBOTALK/" + robot + "/HELLO/" + Hex64(static_cast<std::uint64_t>(client_id));
+}
 inline std::string ConfigChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/CONFIG"; }
 inline std::string StateChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/STATE"; }
 
 /// The robot of "ROBOTALK/<robot>/REQUEST"; nullopt for any other channel.
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel);
+/// The robot of "ROBOTALK/<robot>/HELLO".
+std::optional<std::string> RobotOfHelloChannel(std::string_view channel);
 /// The robot of "ROBOTALK/<robot>/CONFIG".
 std::optional<std::string> RobotOfConfigChannel(std::string_view channel);
 /// The robot of "ROBOTALK/<robot>/STATE".
@@ -54,5 +64,7 @@ struct ReplyChannelParts {
 /// Robot and client id of "ROBOTALK/<robot>/REPLY/<16 lowercase hex digits>"
 /// (exactly what ReplyChannel() writes).
 std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel);
+/// Robot and client id of "ROBOTALK/<robot>/HELLO/<16 lowercase hex digits>".
+std::optional<ReplyChannelParts> ParseHelloAnswerChannel(std::string_view channel);
 
 }  // namespace robotalk
