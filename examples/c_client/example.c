@@ -1,0 +1,128 @@
+/* The C client example: connects to a robot, loads its configuration, sends
+ * a GOTO (direct mode), then a short timed sequence of pan/tilt set-points in
+ * delay mode, and prints every reply. Same steps and output as the Java
+ * example (examples/java_client); tests/examples/client_example_test.sh runs it.
+ *   robotalk_c_example [--url URL] [--robot NAME] [--delay S]
+ * Exit status 0 when every step succeeded. */
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "robotalk_c_client.h"
+
+#define SEQUENCE_FRAMES 4
+static const double kFrameSpacing = 0.25; /* s between the sequence's frames */
+
+static void print_reply(const char* what, const rtc_reply* r) {
+  printf("reply %" PRId64 " %s: %s%s%s exec_us=%" PRId64 " late_ms=%.1f\n", r->id, what,
+         rtc_signal_name(r->signal), r->message[0] ? " " : "", r->message, r->exec_time_us,
+         r->lateness_us / 1000.0);
+}
+
+static int query(rtc_client* c, int8_t type, const char* target, rtc_reply* out) {
+  robotalk_msgs_query_t q;
+  memset(&q, 0, sizeof q);
+  q.type = type;
+  q.target = (char*)target;
+  return rtc_send_queries(c, &q, 1) > 0 && rtc_wait(c, &q.id, 1, 5.0, out) == 0 ? 0 : -1;
+}
+
+static int run(rtc_client* c, double delay_s) {
+  int64_t offset_us = 0, rtt_us = 0;
+  if (rtc_sync_clock(c, 5, &offset_us, &rtt_us) != 0) return -1;
+  printf("clock: offset_us=%" PRId64 " round_trip_us=%" PRId64 "\n", offset_us, rtt_us);
+
+  robotalk_msgs_robot_config_t* config = rtc_load_config(c, 5.0);
+  if (!config) return -1;
+  int dofs = 0;
+  for (int j = 0; j < config->num_joints; ++j) dofs += config->joints[j].num_dofs;
+  printf("config: robot=%s links=%d joints=%d frames=%d dofs=%d hash=%016" PRIx64
+         " (reply and message agree)\n",
+         config->robot_name, config->num_links, config->num_joints, config->num_frames, dofs,
+         (uint64_t)config->header.hash);
+  robotalk_msgs_robot_config_t_destroy(config);
+
+  /* Direct mode: a GOTO is answered when the base has reached its goal. */
+  double goal[3] = {0.5, 0.0, 0.0};
+  robotalk_msgs_command_t go = {
+      .type = ROBOTALK_MSGS_COMMAND_T_GOTO, .target = "", .num_values = 3, .values = goal};
+  rtc_reply r;
+  if (rtc_send_commands(c, ROBOTALK_MSGS_PACKAGE_HEADER_T_MODE_DIRECT, &go, 1) < 0 ||
+      rtc_wait(c, &go.id, 1, 30.0, &r) != 0)
+    return -1;
+  print_reply("GOTO 0.5 0 0", &r);
+  int failures = r.signal != ROBOTALK_MSGS_REPLY_T_SUCCESS;
+
+  /* Delay mode: each frame stamped server now + delay + its offset, all sent at once. */
+  const char* joints[SEQUENCE_FRAMES] = {"pan", "pan", "pan", "tilt"};
+  double targets[SEQUENCE_FRAMES] = {0.1, 0.2, 0.3, -0.2};
+  robotalk_msgs_command_t frames[SEQUENCE_FRAMES];
+  int64_t ids[SEQUENCE_FRAMES];
+  const int64_t start_us = rtc_server_now_us(c) + (int64_t)(delay_s * 1e6);
+  for (int k = 0; k < SEQUENCE_FRAMES; ++k) {
+    frames[k] = (robotalk_msgs_command_t){.type = ROBOTALK_MSGS_COMMAND_T_JOINT_SETPOINT,
+                                          .start_time_us = start_us + (int64_t)(k * kFrameSpacing * 1e6),
+                                          .target = (char*)joints[k],
+                                          .num_values = 1,
+                                          .values = &targets[k]};
+    if (rtc_send_commands(c, ROBOTALK_MSGS_PACKAGE_HEADER_T_MODE_DELAY, &frames[k], 1) < 0) return -1;
+    ids[k] = frames[k].id;
+  }
+  rtc_reply replies[SEQUENCE_FRAMES];
+  if (rtc_wait(c, ids, SEQUENCE_FRAMES, 10.0 + delay_s, replies) != 0) return -1;
+  for (int k = 0; k < SEQUENCE_FRAMES; ++k) {
+    char what[64];
+    snprintf(what, sizeof what, "sequence +%.2f s %s %.2f", k * kFrameSpacing, joints[k], targets[k]);
+    print_reply(what, &replies[k]);
+    failures += replies[k].signal != ROBOTALK_MSGS_REPLY_T_SUCCESS;
+  }
+  printf("spacing_s:");
+  for (int k = 1; k < SEQUENCE_FRAMES; ++k)
+    printf(" %.3f", (replies[k].exec_time_us - replies[k - 1].exec_time_us) / 1e6);
+  printf("\n");
+
+  /* The last set-point was taken when answered; give the joint time to get there. */
+  if (rtc_pause(c, 0.5) != 0) return -1;
+  if (query(c, ROBOTALK_MSGS_QUERY_T_BASE_POSE, "", &r) != 0) return -1;
+  printf("pose: x=%.3f y=%.3f theta=%.3f\n", r.values[0], r.values[1], r.values[2]);
+  rtc_reply pan, tilt;
+  if (query(c, ROBOTALK_MSGS_QUERY_T_JOINT_STATE, "pan", &pan) != 0 ||
+      query(c, ROBOTALK_MSGS_QUERY_T_JOINT_STATE, "tilt", &tilt) != 0)
+    return -1;
+  printf("joints: pan=%.3f tilt=%.3f\n", pan.values[0], tilt.values[0]);
+  return failures ? -1 : 0;
+}
+
+int main(int argc, char** argv) {
+  const char* url = getenv("LCM_DEFAULT_URL");
+  const char* robot = "pioneer";
+  double delay_s = 0.5;
+  for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--url") == 0 && i + 1 < argc) {
+      url = argv[++i];
+    } else if (strcmp(argv[i], "--robot") == 0 && i + 1 < argc) {
+      robot = argv[++i];
+    } else if (strcmp(argv[i], "--delay") == 0 && i + 1 < argc) {
+      delay_s = atof(argv[++i]);
+    } else {
+      fprintf(stderr, "usage: %s [--url URL] [--robot NAME] [--delay S]\n", argv[0]);
+      return 2;
+    }
+  }
+  if (!url) url = "udpm://239.255.76.67:7667?ttl=0";
+  char err[512];
+  rtc_client* c = rtc_connect(url, robot, 5.0, err, sizeof err);
+  if (!c) {
+    fprintf(stderr, "error: %s\n", err);
+    return 1;
+  }
+  printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64 "\n",
+         robot, (uint64_t)rtc_server_id(c), rtc_split_layout(c) ? "split" : "single",
+         (uint64_t)rtc_session_id(c), (uint64_t)rtc_client_id(c));
+  int rc = run(c, delay_s);
+  if (rc != 0 && rtc_error(c)[0]) fprintf(stderr, "error: %s\n", rtc_error(c));
+  printf("%s\n", rc == 0 ? "done" : "failed");
+  rtc_close(c);
+  return rc == 0 ? 0 : 1;
+}

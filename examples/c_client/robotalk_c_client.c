@@ -1,0 +1,598 @@
+/* A small RoboTalk client in C: see robotalk_c_client.h. */
+#define _POSIX_C_SOURCE 200809L
+#include "robotalk_c_client.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <lcm/lcm.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/select.h>
+#include <time.h>
+
+#include "robotalk_msgs_announce_t.h"
+#include "robotalk_msgs_hello_answer_t.h"
+#include "robotalk_msgs_hello_t.h"
+#include "robotalk_msgs_package_t.h"
+#include "robotalk_msgs_reply_package_t.h"
+
+enum {
+  kProtocolVersion = 2,
+  kMaxPackages = 64,  /* outstanding packages */
+  kMaxReplies = 1024, /* the reply cache (oldest dropped first) */
+  kMaxIdsPerPackage = 64,
+  kRetransmitUs = 300000, /* unacknowledged: fixed timeout */
+  kRecheckUs = 1000000,   /* acknowledged, final replies missing: ask again */
+  kMaxTries = 10,
+  kHeartbeatUs = 250000,
+  kHelloRepeatUs = 200000,
+};
+
+typedef struct {
+  int used;
+  int64_t sequence;
+  uint8_t* bytes; /* the encoded package_t, re-sent as is */
+  int size;
+  int acked;
+  int tries;
+  int64_t first_send_us, last_send_us;
+  int n_ids;
+  int64_t ids[kMaxIdsPerPackage];
+  int64_t session_id;  /* the session it was sent in */
+  int session_unknown; /* SESSION_UNKNOWN: nothing ran; send again after a new hello */
+  /* Clock sample from its acknowledgement (only when sent once: Karn's rule). */
+  int have_clock;
+  int64_t t1, t4, server_receive_us, server_send_us;
+} pending_package;
+
+struct rtc_client {
+  char robot[128];
+  lcm_t* main_lcm;    /* ANNOUNCE, CONFIG, STATE */
+  lcm_t* request_lcm; /* HELLO, REQUEST (== main_lcm in the single layout) */
+  lcm_t* reply_lcm;   /* REPLY/<client>, HELLO/<client> (== main_lcm in the single layout) */
+  int split;
+  char hello_channel[192], request_channel[192], reply_channel[192], hello_answer_channel[192];
+  int64_t client_id, session_id, server_id;
+  uint8_t nonce[16];
+  int hello_answered;
+  char refusal[256];
+  int64_t next_sequence, next_id;
+  int64_t last_new_package_us;
+  int64_t clock_offset_us;
+  pending_package packages[kMaxPackages];
+  rtc_reply replies[kMaxReplies];
+  int reply_count, reply_next;
+  robotalk_msgs_robot_config_t* config; /* the last CONFIG message heard */
+  robotalk_msgs_hello_answer_t_subscription_t* hello_sub;
+  robotalk_msgs_reply_package_t_subscription_t* reply_sub;
+  char error[512];
+  /* rtc_connect: the ANNOUNCE search */
+  int found;
+  int announce_version, announce_keyed, announce_layout;
+  int64_t announce_server_id;
+  char heard[512];
+};
+
+static void set_error(rtc_client* c, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(c->error, sizeof c->error, fmt, ap);
+  va_end(ap);
+}
+
+const char* rtc_error(const rtc_client* c) { return c->error; }
+int64_t rtc_client_id(const rtc_client* c) { return c->client_id; }
+int64_t rtc_session_id(const rtc_client* c) { return c->session_id; }
+int64_t rtc_server_id(const rtc_client* c) { return c->server_id; }
+int rtc_split_layout(const rtc_client* c) { return c->split; }
+
+const char* rtc_signal_name(int signal) {
+  static const char* names[] = {"SUCCESS", "MODIFIED", "NA", "BUSY", "INTERRUPTED", "ERROR", "PANIC"};
+  if (signal >= 0 && signal <= 6) return names[signal];
+  return signal == RTC_UNKNOWN_OUTCOME ? "UNKNOWN_OUTCOME" : "?";
+}
+
+int64_t rtc_now_us(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+int64_t rtc_server_now_us(const rtc_client* c) { return rtc_now_us() + c->clock_offset_us; }
+
+static int random_bytes(void* out, size_t n) {
+  FILE* f = fopen("/dev/urandom", "rb");
+  if (!f) return -1;
+  size_t got = fread(out, 1, n, f);
+  fclose(f);
+  return got == n ? 0 : -1;
+}
+
+/* ---- receiving ---------------------------------------------------------- */
+
+static pending_package* find_package(rtc_client* c, int64_t sequence) {
+  for (int i = 0; i < kMaxPackages; ++i)
+    if (c->packages[i].used && c->packages[i].sequence == sequence) return &c->packages[i];
+  return NULL;
+}
+
+static const rtc_reply* find_reply(const rtc_client* c, int64_t id) {
+  for (int i = 0; i < c->reply_count; ++i)
+    if (c->replies[i].id == id) return &c->replies[i];
+  return NULL;
+}
+
+static void file_reply(rtc_client* c, const rtc_reply* r) {
+  if (find_reply(c, r->id)) return; /* a second copy: ignored */
+  c->replies[c->reply_next] = *r;
+  c->reply_next = (c->reply_next + 1) % kMaxReplies;
+  if (c->reply_count < kMaxReplies) ++c->reply_count;
+}
+
+/* A new server instance answered: what was acknowledged by the old one may or may not have run. */
+static void server_changed(rtc_client* c, int64_t new_server_id) {
+  for (int i = 0; i < kMaxPackages; ++i) {
+    pending_package* p = &c->packages[i];
+    if (!p->used || !p->acked) continue;
+    for (int k = 0; k < p->n_ids; ++k) {
+      rtc_reply r = {.id = p->ids[k], .signal = RTC_UNKNOWN_OUTCOME};
+      snprintf(r.message, sizeof r.message,
+               "may or may not have run on server instance %016" PRIx64 "; query or re-plan",
+               (uint64_t)c->server_id);
+      file_reply(c, &r);
+    }
+  }
+  c->server_id = new_server_id;
+}
+
+static void on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_reply_package_t* m,
+                     void* user) {
+  (void)rbuf;
+  (void)channel;
+  rtc_client* c = user;
+  int64_t t4 = rtc_now_us();
+  if (m->protocol_version != kProtocolVersion || m->client_id != c->client_id) return;
+  if (m->server_id != c->server_id && c->server_id != 0) server_changed(c, m->server_id);
+  pending_package* p = m->ack_sequence > 0 ? find_package(c, m->ack_sequence) : NULL;
+  if (m->session_status == ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN) {
+    if (p && p->session_id == m->session_id) p->session_unknown = 1; /* nothing in it ran */
+    if (m->session_id == c->session_id) c->hello_answered = 0;       /* say hello again */
+    return;
+  }
+  if (m->session_id != c->session_id) return; /* an older session's late answer */
+  if (p && !p->acked) {
+    p->acked = 1;
+    if (p->tries == 1) {
+      p->have_clock = 1;
+      p->t1 = p->first_send_us;
+      p->t4 = t4;
+      p->server_receive_us = m->server_receive_us;
+      p->server_send_us = m->server_send_us;
+    }
+  }
+  for (int i = 0; i < m->num_replies; ++i) {
+    const robotalk_msgs_reply_t* in = &m->replies[i];
+    rtc_reply r = {
+        .id = in->id, .signal = in->signal, .exec_time_us = in->exec_time_us, .lateness_us = in->lateness_us};
+    snprintf(r.message, sizeof r.message, "%s", in->message);
+    r.num_values = in->num_values < RTC_MAX_VALUES ? in->num_values : RTC_MAX_VALUES;
+    for (int k = 0; k < r.num_values; ++k) r.values[k] = in->values[k];
+    file_reply(c, &r);
+  }
+}
+
+static void on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
+                            const robotalk_msgs_hello_answer_t* m, void* user) {
+  (void)rbuf;
+  (void)channel;
+  rtc_client* c = user;
+  if (m->client_id != c->client_id || memcmp(m->client_nonce, c->nonce, 16) != 0) return; /* not our hello */
+  c->hello_answered = 1;
+  c->session_id = m->session_id;
+  c->server_id = m->server_id;
+  snprintf(c->refusal, sizeof c->refusal, "%s", m->session_id == 0 ? m->refusal : "");
+  if (m->keyed) snprintf(c->refusal, sizeof c->refusal, "the server answered in keyed mode");
+}
+
+static void on_config(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_robot_config_t* m,
+                      void* user) {
+  (void)rbuf;
+  (void)channel;
+  rtc_client* c = user;
+  if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
+  c->config = robotalk_msgs_robot_config_t_copy(m);
+}
+
+static void on_announce(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_announce_t* m,
+                        void* user) {
+  (void)rbuf;
+  (void)channel;
+  rtc_client* c = user;
+  for (int i = 0; i < m->num_robots; ++i) {
+    const char* name = m->robots[i].name;
+    if (strcmp(name, c->robot) == 0) {
+      c->found = 1;
+      c->announce_version = m->protocol_version;
+      c->announce_keyed = m->keyed;
+      c->announce_layout = m->traffic_layout;
+      c->announce_server_id = m->server_id;
+    } else if (!strstr(c->heard, name) && strlen(c->heard) + strlen(name) + 3 < sizeof c->heard) {
+      if (c->heard[0]) strcat(c->heard, ", ");
+      strcat(c->heard, name);
+    }
+  }
+}
+
+/* Handles what arrives on any of the client's LCM instances for at most wait_us. */
+static void handle_for(rtc_client* c, int64_t wait_us) {
+  lcm_t* all[2] = {c->main_lcm, c->reply_lcm}; /* request_lcm only publishes */
+  int n = c->split ? 2 : 1;
+  fd_set fds;
+  FD_ZERO(&fds);
+  int max_fd = -1;
+  for (int i = 0; i < n; ++i) {
+    int fd = lcm_get_fileno(all[i]);
+    FD_SET(fd, &fds);
+    if (fd > max_fd) max_fd = fd;
+  }
+  struct timeval tv = {.tv_sec = wait_us / 1000000, .tv_usec = wait_us % 1000000};
+  if (select(max_fd + 1, &fds, NULL, NULL, &tv) <= 0) return;
+  for (int i = 0; i < n; ++i)
+    if (FD_ISSET(lcm_get_fileno(all[i]), &fds)) lcm_handle(all[i]);
+}
+
+/* ---- sending ------------------------------------------------------------ */
+
+static int publish_package(rtc_client* c, robotalk_msgs_package_t* pkg, uint8_t** bytes_out, int* size_out) {
+  int size = robotalk_msgs_package_t_encoded_size(pkg);
+  uint8_t* bytes = malloc((size_t)size);
+  if (!bytes || robotalk_msgs_package_t_encode(bytes, 0, size, pkg) != size) {
+    free(bytes);
+    set_error(c, "cannot encode a package");
+    return -1;
+  }
+  lcm_publish(c->request_lcm, c->request_channel, bytes, (unsigned)size);
+  c->last_new_package_us = rtc_now_us();
+  if (bytes_out) {
+    *bytes_out = bytes;
+    *size_out = size;
+  } else {
+    free(bytes);
+  }
+  return 0;
+}
+
+static void fill_header(rtc_client* c, robotalk_msgs_package_header_t* h, int8_t payload_type, int32_t size,
+                        int8_t mode) {
+  memset(h, 0, sizeof *h);
+  h->protocol_version = kProtocolVersion;
+  h->client_id = c->client_id;
+  h->session_id = c->session_id;
+  h->sequence = c->next_sequence++;
+  h->send_time_us = rtc_now_us();
+  h->payload_type = payload_type;
+  h->payload_size = size;
+  h->mode = mode;
+}
+
+static void send_heartbeat(rtc_client* c) {
+  robotalk_msgs_package_t pkg;
+  memset(&pkg, 0, sizeof pkg); /* no payload; mac = 16 zero bytes (open mode) */
+  fill_header(c, &pkg.header, ROBOTALK_MSGS_PACKAGE_HEADER_T_PAYLOAD_QUERIES, 0,
+              ROBOTALK_MSGS_PACKAGE_HEADER_T_MODE_DIRECT);
+  publish_package(c, &pkg, NULL, NULL);
+}
+
+static int64_t track_and_send(rtc_client* c, robotalk_msgs_package_t* pkg, const int64_t* ids, int n_ids) {
+  pending_package* slot = NULL;
+  for (int i = 0; i < kMaxPackages && !slot; ++i)
+    if (!c->packages[i].used) slot = &c->packages[i];
+  if (!slot || n_ids > kMaxIdsPerPackage) {
+    set_error(c, "too many outstanding packages or items");
+    return -1;
+  }
+  memset(slot, 0, sizeof *slot);
+  if (publish_package(c, pkg, &slot->bytes, &slot->size) != 0) return -1;
+  slot->used = 1;
+  slot->sequence = pkg->header.sequence;
+  slot->session_id = c->session_id;
+  slot->tries = 1;
+  slot->first_send_us = slot->last_send_us = c->last_new_package_us;
+  slot->n_ids = n_ids;
+  memcpy(slot->ids, ids, sizeof(int64_t) * (size_t)n_ids);
+  return slot->sequence;
+}
+
+int64_t rtc_send_queries(rtc_client* c, robotalk_msgs_query_t* queries, int n) {
+  int64_t ids[kMaxIdsPerPackage];
+  if (n > kMaxIdsPerPackage) return set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
+  for (int i = 0; i < n; ++i) ids[i] = queries[i].id = c->next_id++;
+  robotalk_msgs_package_t pkg;
+  memset(&pkg, 0, sizeof pkg);
+  fill_header(c, &pkg.header, ROBOTALK_MSGS_PACKAGE_HEADER_T_PAYLOAD_QUERIES, n,
+              ROBOTALK_MSGS_PACKAGE_HEADER_T_MODE_DIRECT);
+  pkg.num_queries = n;
+  pkg.queries = queries;
+  return track_and_send(c, &pkg, ids, n);
+}
+
+int64_t rtc_send_commands(rtc_client* c, int8_t mode, robotalk_msgs_command_t* commands, int n) {
+  int64_t ids[kMaxIdsPerPackage];
+  if (n > kMaxIdsPerPackage) return set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
+  for (int i = 0; i < n; ++i) ids[i] = commands[i].id = c->next_id++;
+  robotalk_msgs_package_t pkg;
+  memset(&pkg, 0, sizeof pkg);
+  fill_header(c, &pkg.header, ROBOTALK_MSGS_PACKAGE_HEADER_T_PAYLOAD_COMMANDS, n, mode);
+  pkg.num_commands = n;
+  pkg.commands = commands;
+  return track_and_send(c, &pkg, ids, n);
+}
+
+/* ---- sessions ----------------------------------------------------------- */
+
+static int say_hello(rtc_client* c, double timeout_s) {
+  robotalk_msgs_hello_t hello;
+  memset(&hello, 0, sizeof hello); /* keyed = false, key fields zero: open mode */
+  hello.protocol_version = kProtocolVersion;
+  hello.client_id = c->client_id;
+  if (random_bytes(c->nonce, sizeof c->nonce) != 0) return set_error(c, "no /dev/urandom"), -1;
+  memcpy(hello.client_nonce, c->nonce, sizeof c->nonce);
+  c->hello_answered = 0;
+  const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
+  int64_t next_hello = 0;
+  while (!c->hello_answered) {
+    int64_t now = rtc_now_us();
+    if (now >= deadline)
+      return set_error(c, "no answer to hello from '%s' within %.1f s", c->robot, timeout_s), -1;
+    if (now >= next_hello) {
+      robotalk_msgs_hello_t_publish(c->request_lcm, c->hello_channel, &hello);
+      next_hello = now + kHelloRepeatUs;
+    }
+    handle_for(c, (next_hello < deadline ? next_hello : deadline) - now);
+  }
+  if (c->session_id == 0 || c->refusal[0])
+    return set_error(c, "hello refused by '%s': %s", c->robot, c->refusal), -1;
+  c->last_new_package_us = rtc_now_us();
+  return 0;
+}
+
+/* A package answered SESSION_UNKNOWN ran nothing: send it again, new sequence, new session. */
+static int resend_in_new_session(rtc_client* c, pending_package* p) {
+  robotalk_msgs_package_t pkg;
+  if (robotalk_msgs_package_t_decode(p->bytes, 0, p->size, &pkg) < 0)
+    return set_error(c, "cannot decode"), -1;
+  pkg.header.sequence = c->next_sequence++;
+  pkg.header.session_id = c->session_id;
+  pkg.header.send_time_us = rtc_now_us();
+  free(p->bytes);
+  p->bytes = NULL;
+  int rc = publish_package(c, &pkg, &p->bytes, &p->size);
+  robotalk_msgs_package_t_decode_cleanup(&pkg);
+  p->sequence = pkg.header.sequence;
+  p->session_id = c->session_id;
+  p->session_unknown = 0;
+  p->acked = 0;
+  p->tries = 1;
+  p->first_send_us = p->last_send_us = c->last_new_package_us;
+  return rc;
+}
+
+/* Timers: a new hello when the session is gone, retransmissions, heartbeats. */
+static int run_timers(rtc_client* c) {
+  if (!c->hello_answered) { /* SESSION_UNKNOWN for our session: the server forgot it */
+    fprintf(stderr, "robotalk-c: session unknown to the server; saying hello again\n");
+    if (say_hello(c, 3.0) != 0) return -1;
+  }
+  for (int i = 0; i < kMaxPackages; ++i)
+    if (c->packages[i].used && c->packages[i].session_unknown &&
+        resend_in_new_session(c, &c->packages[i]) != 0)
+      return -1;
+  const int64_t now = rtc_now_us();
+  for (int i = 0; i < kMaxPackages; ++i) {
+    pending_package* p = &c->packages[i];
+    if (!p->used) continue;
+    int complete = 1;
+    for (int k = 0; k < p->n_ids && complete; ++k) complete = find_reply(c, p->ids[k]) != NULL;
+    if (p->acked && complete) {
+      free(p->bytes);
+      p->bytes = NULL;
+      p->used = 0;
+      continue;
+    }
+    const int64_t timeout = p->acked ? kRecheckUs : kRetransmitUs;
+    if (now - p->last_send_us < timeout) continue;
+    if (!p->acked && p->tries >= kMaxTries) {
+      set_error(c, "package %" PRId64 " not acknowledged after %d tries", p->sequence, p->tries);
+      return -1;
+    }
+    lcm_publish(c->request_lcm, c->request_channel, p->bytes, (unsigned)p->size); /* same sequence */
+    p->last_send_us = now;
+    if (!p->acked) ++p->tries;
+  }
+  if (now - c->last_new_package_us >= kHeartbeatUs) send_heartbeat(c);
+  return 0;
+}
+
+int rtc_wait(rtc_client* c, const int64_t* ids, int n, double timeout_s, rtc_reply* out) {
+  const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
+  for (;;) {
+    int missing = 0;
+    for (int i = 0; i < n; ++i) missing += find_reply(c, ids[i]) == NULL;
+    if (!missing) break;
+    if (rtc_now_us() >= deadline)
+      return set_error(c, "%d of %d replies missing after %.1f s", missing, n, timeout_s), -1;
+    if (run_timers(c) != 0) return -1;
+    handle_for(c, 20000);
+  }
+  for (int i = 0; out && i < n; ++i) out[i] = *find_reply(c, ids[i]);
+  return 0;
+}
+
+int rtc_pause(rtc_client* c, double seconds) {
+  const int64_t deadline = rtc_now_us() + (int64_t)(seconds * 1e6);
+  for (int64_t now = rtc_now_us(); now < deadline; now = rtc_now_us()) {
+    if (run_timers(c) != 0) return -1;
+    handle_for(c, deadline - now < 20000 ? deadline - now : 20000);
+  }
+  return 0;
+}
+
+int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* round_trip_us) {
+  int64_t best_rtt = INT64_MAX, best_offset = 0;
+  for (int s = 0; s < samples; ++s) {
+    robotalk_msgs_query_t q;
+    memset(&q, 0, sizeof q);
+    q.type = ROBOTALK_MSGS_QUERY_T_CLOCK;
+    q.target = "";
+    int64_t seq = rtc_send_queries(c, &q, 1);
+    if (seq < 0 || rtc_wait(c, &q.id, 1, 3.0, NULL) != 0) return -1;
+    const pending_package* p = find_package(c, seq);
+    if (!p || !p->have_clock) continue; /* retransmitted: ambiguous sample */
+    int64_t rtt = (p->t4 - p->t1) - (p->server_send_us - p->server_receive_us);
+    int64_t offset = ((p->server_receive_us - p->t1) + (p->server_send_us - p->t4)) / 2;
+    if (rtt < best_rtt) best_rtt = rtt, best_offset = offset;
+  }
+  if (best_rtt == INT64_MAX) return set_error(c, "no usable CLOCK sample"), -1;
+  c->clock_offset_us = best_offset;
+  if (offset_us) *offset_us = best_offset;
+  if (round_trip_us) *round_trip_us = best_rtt;
+  return 0;
+}
+
+robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
+  char channel[192];
+  snprintf(channel, sizeof channel, "ROBOTALK/%s/CONFIG", c->robot);
+  robotalk_msgs_robot_config_t_subscription_t* sub =
+      robotalk_msgs_robot_config_t_subscribe(c->main_lcm, channel, on_config, c); /* before asking */
+  robotalk_msgs_query_t q;
+  memset(&q, 0, sizeof q);
+  q.type = ROBOTALK_MSGS_QUERY_T_CONFIG;
+  q.target = "";
+  robotalk_msgs_robot_config_t* result = NULL;
+  rtc_reply r;
+  if (rtc_send_queries(c, &q, 1) > 0 && rtc_wait(c, &q.id, 1, timeout_s, &r) == 0) {
+    if (r.signal != ROBOTALK_MSGS_REPLY_T_SUCCESS) {
+      set_error(c, "CONFIG answered %s: %s", rtc_signal_name(r.signal), r.message);
+    } else {
+      const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
+      char hash[17] = "";
+      while (rtc_now_us() < deadline) {
+        if (c->config) snprintf(hash, sizeof hash, "%016" PRIx64, (uint64_t)c->config->header.hash);
+        if (c->config && strcmp(hash, r.message) == 0) break;
+        if (run_timers(c) != 0) break;
+        handle_for(c, 20000);
+      }
+      if (c->config && strcmp(hash, r.message) == 0) {
+        result = c->config;
+        c->config = NULL;
+      } else {
+        set_error(c, "no robot_config_t with hash %s on %s within %.1f s", r.message, channel, timeout_s);
+      }
+    }
+  }
+  robotalk_msgs_robot_config_t_unsubscribe(c->main_lcm, sub);
+  return result;
+}
+
+/* ---- connecting --------------------------------------------------------- */
+
+/* "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts". 0, or -1 when url is not udpm. */
+static int shifted_url(const char* url, int delta, char* out, size_t len) {
+  const char* scheme = "udpm://";
+  if (strncmp(url, scheme, strlen(scheme)) != 0) return -1;
+  const char* colon = strchr(url + strlen(scheme), ':');
+  if (!colon) return -1;
+  char* end = NULL;
+  long port = strtol(colon + 1, &end, 10);
+  if (end == colon + 1 || port <= 0 || port + delta > 65535) return -1;
+  snprintf(out, len, "%.*s:%ld%s", (int)(colon - url), url, port + delta, end);
+  return 0;
+}
+
+static int open_layout(rtc_client* c, const char* url) {
+  c->split = c->announce_layout == ROBOTALK_MSGS_ANNOUNCE_T_TRAFFIC_SPLIT;
+  if (c->announce_layout != ROBOTALK_MSGS_ANNOUNCE_T_TRAFFIC_SINGLE && !c->split)
+    return set_error(c, "unknown traffic layout %d in ANNOUNCE", c->announce_layout), -1;
+  c->request_lcm = c->reply_lcm = c->main_lcm;
+  if (!c->split) return 0;
+  char request_url[512], reply_url[512];
+  int bucket = (int)((uint64_t)c->client_id % 64);
+  if (shifted_url(url, 1, request_url, sizeof request_url) != 0 ||
+      shifted_url(url, 2 + bucket, reply_url, sizeof reply_url) != 0)
+    return set_error(c, "the split layout needs a udpm://GROUP:PORT URL, not '%s'", url), -1;
+  c->request_lcm = lcm_create(request_url);
+  c->reply_lcm = lcm_create(reply_url);
+  if (!c->request_lcm || !c->reply_lcm)
+    return set_error(c, "cannot open %s or %s", request_url, reply_url), -1;
+  return 0;
+}
+
+static int find_robot(rtc_client* c, double timeout_s) {
+  robotalk_msgs_announce_t_subscription_t* sub =
+      robotalk_msgs_announce_t_subscribe(c->main_lcm, "ROBOTALK/ANNOUNCE", on_announce, c);
+  const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
+  while (!c->found && rtc_now_us() < deadline) handle_for(c, 50000);
+  robotalk_msgs_announce_t_unsubscribe(c->main_lcm, sub);
+  if (!c->found)
+    return set_error(c, "no robot '%s' announced within %.1f s (heard: %s)", c->robot, timeout_s,
+                     c->heard[0] ? c->heard : "nothing"),
+           -1;
+  if (c->announce_version != kProtocolVersion)
+    return set_error(c, "'%s' speaks protocol %d; this client speaks %d", c->robot, c->announce_version,
+                     kProtocolVersion),
+           -1;
+  if (c->announce_keyed)
+    return set_error(c,
+                     "the server of '%s' requires keys (keyed mode, docs/security.md); this example client "
+                     "supports open mode only",
+                     c->robot),
+           -1;
+  return 0;
+}
+
+rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, char* err, size_t err_len) {
+  rtc_client* c = calloc(1, sizeof *c);
+  if (!c) return NULL;
+  snprintf(c->robot, sizeof c->robot, "%s", robot);
+  c->next_sequence = 1;
+  c->next_id = 1;
+  while (c->client_id == 0)
+    if (random_bytes(&c->client_id, sizeof c->client_id) != 0) break;
+  c->main_lcm = lcm_create(url);
+  int ok = c->client_id != 0 && c->main_lcm != NULL;
+  if (!ok) set_error(c, "cannot open LCM on '%s'", url);
+  ok = ok && find_robot(c, timeout_s) == 0 && open_layout(c, url) == 0;
+  if (ok) {
+    uint64_t hex = (uint64_t)c->client_id;
+    snprintf(c->hello_channel, sizeof c->hello_channel, "ROBOTALK/%s/HELLO", robot);
+    snprintf(c->hello_answer_channel, sizeof c->hello_answer_channel, "ROBOTALK/%s/HELLO/%016" PRIx64, robot,
+             hex);
+    snprintf(c->request_channel, sizeof c->request_channel, "ROBOTALK/%s/REQUEST", robot);
+    snprintf(c->reply_channel, sizeof c->reply_channel, "ROBOTALK/%s/REPLY/%016" PRIx64, robot, hex);
+    c->hello_sub =
+        robotalk_msgs_hello_answer_t_subscribe(c->reply_lcm, c->hello_answer_channel, on_hello_answer, c);
+    c->reply_sub = robotalk_msgs_reply_package_t_subscribe(c->reply_lcm, c->reply_channel, on_reply, c);
+    robotalk_msgs_reply_package_t_subscription_set_queue_capacity(c->reply_sub, 1000);
+    ok = say_hello(c, timeout_s) == 0;
+  }
+  if (!ok) {
+    snprintf(err, err_len, "%s", c->error);
+    rtc_close(c);
+    return NULL;
+  }
+  return c;
+}
+
+void rtc_close(rtc_client* c) {
+  if (!c) return;
+  for (int i = 0; i < kMaxPackages; ++i) free(c->packages[i].bytes);
+  if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
+  if (c->hello_sub) robotalk_msgs_hello_answer_t_unsubscribe(c->reply_lcm, c->hello_sub);
+  if (c->reply_sub) robotalk_msgs_reply_package_t_unsubscribe(c->reply_lcm, c->reply_sub);
+  if (c->reply_lcm && c->reply_lcm != c->main_lcm) lcm_destroy(c->reply_lcm);
+  if (c->request_lcm && c->request_lcm != c->main_lcm) lcm_destroy(c->request_lcm);
+  if (c->main_lcm) lcm_destroy(c->main_lcm);
+  free(c);
+}

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Runs one client example (examples/c_client, java_client, lua_client) against a
+# real robotalk-server (kinematic Pioneer) and checks what it printed and what
+# the robot did. Run inside a private network namespace (CTest wraps it with
+# scripts/netns_run.sh, which exits 77 = skip where none can be made).
+#   client_example_test.sh SERVER CLI MODELS_DIR PORT CLIENT_COMMAND...
+# The client command gets "--url URL --robot NAME" appended.
+set -u
+server_bin=$1 cli=$2 models=$3 port=$4
+shift 4
+url="udpm://239.255.76.67:$port?ttl=0"
+tmp=$(mktemp -d)
+server_pid=""
+cleanup() {
+  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+pass=0 failures=0
+check() {  # check NAME COMMAND...
+  local name=$1; shift
+  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
+}
+# value KEY FILE: the number after "KEY=" on the first line that has it.
+value() { grep -o -m1 "$1=[-0-9.]*" "$2" | head -1 | cut -d= -f2; }
+within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v != "" && v >= lo && v <= hi) }'; }
+
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 90 \
+  2>"$tmp/server.log" &
+server_pid=$!
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+
+# --- the example: connect, configuration, GOTO, timed sequence, replies ------
+timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/out" 2>"$tmp/err"
+status=$?
+cat "$tmp/out"
+check "the example exits 0 (got $status)" test "$status" -eq 0
+check "it connected and opened a session" grep -q "^connected: robot=pioneer server=[0-9a-f]\{16\} layout=\(single\|split\) session=" "$tmp/out"
+check "the configuration message matches the CONFIG reply" \
+  grep -q "^config: robot=pioneer links=7 joints=6 frames=1 dofs=4 hash=[0-9a-f]\{16\} (reply and message agree)" "$tmp/out"
+check "the config hash is the one the server announced" \
+  grep -q "config $(grep -o -m1 'hash=[0-9a-f]*' "$tmp/out" | cut -d= -f2)" "$tmp/server.log"
+check "the GOTO succeeded" grep -q "^reply [0-9]* GOTO 0.5 0 0: SUCCESS" "$tmp/out"
+check "every frame of the sequence succeeded" test "$(grep -c '^reply [0-9]* sequence .*: SUCCESS' "$tmp/out")" -eq 4
+# The frames are 0.25 s apart: the server (delay mode) or the client (direct
+# mode) must never run one early. Each spacing is at least 0.24 s.
+spacings=$(grep -m1 "^spacing_s:" "$tmp/out" | cut -d: -f2)
+check "three spacings printed ($spacings)" test "$(echo $spacings | wc -w)" -eq 3
+for s in $spacings; do check "frame spacing $s s >= 0.24 s" within "$s" 0.24 10; done
+check "the example saw the base at the GOTO goal" within "$(value x "$tmp/out")" 0.48 0.52
+check "the example saw pan at 0.3" within "$(value pan "$tmp/out")" 0.29 0.31
+check "the example saw tilt at -0.2" within "$(value tilt "$tmp/out")" -0.21 -0.19
+# Another client (the C++ CLI) sees the same robot state.
+pose=$("$cli" --url "$url" --timeout 5 query pioneer base_pose 2>&1)
+check "the robot is at the goal for the CLI too ($pose)" within "$(echo "$pose" | awk '{print $(NF-4)}')" 0.48 0.52
+
+# --- a robot nobody announces: the error lists the robots heard --------------
+timeout 30 "$@" --url "$url" --robot piooner >"$tmp/out2" 2>"$tmp/err2"
+status=$?
+check "an unknown robot exits 1 (got $status)" test "$status" -eq 1
+check "the error names the robot and lists those heard" grep -q "no robot 'piooner'.*heard: pioneer" "$tmp/err2"
+
+if [ "$failures" -ne 0 ]; then
+  echo "--- client stderr"; cat "$tmp/err"; cat "$tmp/err2"
+  echo "--- server log"; cat "$tmp/server.log"
+fi
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
