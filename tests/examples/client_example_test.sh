@@ -3,15 +3,21 @@
 # real robotalk-server (kinematic Pioneer) and checks what it printed and what
 # the robot did. Run inside a private network namespace (CTest wraps it with
 # scripts/netns_run.sh, which exits 77 = skip where none can be made).
-#   client_example_test.sh SERVER CLI MODELS_DIR PORT CLIENT_COMMAND...
+#   client_example_test.sh SERVER CLI MODELS_DIR PORT LAYOUT CLIENT_COMMAND...
+# LAYOUT: "native" (the clients talk to the server's own URL, in whatever
+# layout it announces) or the path of split_layout_proxy: the server then runs
+# on port PORT-1 and the proxy presents it in the split layout on PORT.
 # The client command gets "--url URL --robot NAME" appended.
 set -u
-server_bin=$1 cli=$2 models=$3 port=$4
-shift 4
+server_bin=$1 cli=$2 models=$3 port=$4 layout=$5
+shift 5
 url="udpm://239.255.76.67:$port?ttl=0"
+server_url=$url
+[ "$layout" != native ] && server_url="udpm://239.255.76.67:$((port - 1))?ttl=0"
 tmp=$(mktemp -d)
-server_pid=""
+server_pid="" proxy_pid=""
 cleanup() {
+  [ -n "$proxy_pid" ] && kill "$proxy_pid" 2>/dev/null && wait "$proxy_pid" 2>/dev/null
   [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
   rm -rf "$tmp"
 }
@@ -25,10 +31,14 @@ check() {  # check NAME COMMAND...
 value() { grep -o -m1 "$1=[-0-9.]*" "$2" | head -1 | cut -d= -f2; }
 within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v != "" && v >= lo && v <= hi) }'; }
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 90 \
-  2>"$tmp/server.log" &
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$server_url" \
+  --duration 90 2>"$tmp/server.log" &
 server_pid=$!
 for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+if [ "$layout" != native ]; then
+  "$layout" "$server_url" "$url" 90 &
+  proxy_pid=$!
+fi
 
 # --- the example: connect, configuration, GOTO, timed sequence, replies ------
 timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/out" 2>"$tmp/err"
@@ -36,6 +46,7 @@ status=$?
 cat "$tmp/out"
 check "the example exits 0 (got $status)" test "$status" -eq 0
 check "it connected and opened a session" grep -q "^connected: robot=pioneer server=[0-9a-f]\{16\} layout=\(single\|split\) session=" "$tmp/out"
+[ "$layout" != native ] && check "it took the split layout from ANNOUNCE" grep -q "^connected: .* layout=split " "$tmp/out"
 check "the configuration message matches the CONFIG reply" \
   grep -q "^config: robot=pioneer links=7 joints=6 frames=1 dofs=4 hash=[0-9a-f]\{16\} (reply and message agree)" "$tmp/out"
 check "the config hash is the one the server announced" \
@@ -51,7 +62,7 @@ check "the example saw the base at the GOTO goal" within "$(value x "$tmp/out")"
 check "the example saw pan at 0.3" within "$(value pan "$tmp/out")" 0.29 0.31
 check "the example saw tilt at -0.2" within "$(value tilt "$tmp/out")" -0.21 -0.19
 # Another client (the C++ CLI) sees the same robot state.
-pose=$("$cli" --url "$url" --timeout 5 query pioneer base_pose 2>&1)
+pose=$("$cli" --url "$server_url" --timeout 5 query pioneer base_pose 2>&1)
 check "the robot is at the goal for the CLI too ($pose)" within "$(echo "$pose" | awk '{print $(NF-4)}')" 0.48 0.52
 
 # --- a robot nobody announces: the error lists the robots heard --------------
