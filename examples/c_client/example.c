@@ -2,7 +2,9 @@
  * a GOTO (direct mode), then a short timed sequence of pan/tilt set-points in
  * delay mode, and prints every reply. Same steps and output as the Java
  * example (examples/java_client); tests/examples/client_example_test.sh runs it.
- *   robotalk_c_example [--url URL] [--robot NAME] [--delay S]
+ *   robotalk_c_example [--url URL] [--robot NAME] [--delay S] [--pause S]
+ * --pause S: wait S seconds after the GOTO (keeping the session); the test
+ * restarts the server meanwhile, and the client must say hello again.
  * Exit status 0 when every step succeeded. */
 #include <inttypes.h>
 #include <stdio.h>
@@ -28,7 +30,7 @@ static int query(rtc_client* c, int8_t type, const char* target, rtc_reply* out)
   return rtc_send_queries(c, &q, 1) > 0 && rtc_wait(c, &q.id, 1, 5.0, out) == 0 ? 0 : -1;
 }
 
-static int run(rtc_client* c, double delay_s) {
+static int run(rtc_client* c, double delay_s, double pause_s) {
   int64_t offset_us = 0, rtt_us = 0;
   if (rtc_sync_clock(c, 5, &offset_us, &rtt_us) != 0) return -1;
   printf("clock: offset_us=%" PRId64 " round_trip_us=%" PRId64 "\n", offset_us, rtt_us);
@@ -53,6 +55,16 @@ static int run(rtc_client* c, double delay_s) {
     return -1;
   print_reply("GOTO 0.5 0 0", &r);
   int failures = r.signal != ROBOTALK_MSGS_REPLY_T_SUCCESS;
+  if (pause_s > 0) {
+    printf("pausing %.1f s\n", pause_s);
+    fflush(stdout);
+    if (rtc_pause(c, pause_s) != 0) return -1;
+  }
+  if (rtc_clock_stale(c)) { /* a new server instance: its clock may be another's */
+    if (rtc_sync_clock(c, 5, &offset_us, &rtt_us) != 0) return -1;
+    printf("new server instance %016" PRIx64 ", session %016" PRIx64 ": clock offset_us=%" PRId64 "\n",
+           (uint64_t)rtc_server_id(c), (uint64_t)rtc_session_id(c), offset_us);
+  }
 
   /* Delay mode: each frame stamped server now + delay + its offset, all sent at once. */
   const char* joints[SEQUENCE_FRAMES] = {"pan", "pan", "pan", "tilt"};
@@ -97,7 +109,7 @@ static int run(rtc_client* c, double delay_s) {
 int main(int argc, char** argv) {
   const char* url = getenv("LCM_DEFAULT_URL");
   const char* robot = "pioneer";
-  double delay_s = 0.5;
+  double delay_s = 0.5, pause_s = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--url") == 0 && i + 1 < argc) {
       url = argv[++i];
@@ -105,8 +117,10 @@ int main(int argc, char** argv) {
       robot = argv[++i];
     } else if (strcmp(argv[i], "--delay") == 0 && i + 1 < argc) {
       delay_s = atof(argv[++i]);
+    } else if (strcmp(argv[i], "--pause") == 0 && i + 1 < argc) {
+      pause_s = atof(argv[++i]);
     } else {
-      fprintf(stderr, "usage: %s [--url URL] [--robot NAME] [--delay S]\n", argv[0]);
+      fprintf(stderr, "usage: %s [--url URL] [--robot NAME] [--delay S] [--pause S]\n", argv[0]);
       return 2;
     }
   }
@@ -120,7 +134,7 @@ int main(int argc, char** argv) {
   printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64 "\n",
          robot, (uint64_t)rtc_server_id(c), rtc_split_layout(c) ? "split" : "single",
          (uint64_t)rtc_session_id(c), (uint64_t)rtc_client_id(c));
-  int rc = run(c, delay_s);
+  int rc = run(c, delay_s, pause_s);
   if (rc != 0 && rtc_error(c)[0]) fprintf(stderr, "error: %s\n", rtc_error(c));
   printf("%s\n", rc == 0 ? "done" : "failed");
   rtc_close(c);

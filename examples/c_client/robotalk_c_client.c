@@ -61,6 +61,7 @@ struct rtc_client {
   int64_t next_sequence, next_id;
   int64_t last_new_package_us;
   int64_t clock_offset_us;
+  int clock_stale;
   pending_package packages[kMaxPackages];
   rtc_reply replies[kMaxReplies];
   int reply_count, reply_next;
@@ -101,6 +102,7 @@ int64_t rtc_now_us(void) {
 }
 
 int64_t rtc_server_now_us(const rtc_client* c) { return rtc_now_us() + c->clock_offset_us; }
+int rtc_clock_stale(const rtc_client* c) { return c->clock_stale; }
 
 static int random_bytes(void* out, size_t n) {
   FILE* f = fopen("/dev/urandom", "rb");
@@ -145,6 +147,7 @@ static void server_changed(rtc_client* c, int64_t new_server_id) {
     }
   }
   c->server_id = new_server_id;
+  c->clock_stale = 1;
 }
 
 static void on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_reply_package_t* m,
@@ -191,6 +194,7 @@ static void on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
   if (m->client_id != c->client_id || memcmp(m->client_nonce, c->nonce, 16) != 0) return; /* not our hello */
   c->hello_answered = 1;
   c->session_id = m->session_id;
+  if (c->server_id != 0 && m->server_id != c->server_id) c->clock_stale = 1;
   c->server_id = m->server_id;
   snprintf(c->refusal, sizeof c->refusal, "%s", m->session_id == 0 ? m->refusal : "");
   if (m->keyed) snprintf(c->refusal, sizeof c->refusal, "the server answered in keyed mode");
@@ -456,6 +460,7 @@ int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* roun
   }
   if (best_rtt == INT64_MAX) return set_error(c, "no usable CLOCK sample"), -1;
   c->clock_offset_us = best_offset;
+  c->clock_stale = 0;
   if (offset_us) *offset_us = best_offset;
   if (round_trip_us) *round_trip_us = best_rtt;
   return 0;

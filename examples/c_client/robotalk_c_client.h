@@ -73,6 +73,9 @@ int rtc_split_layout(const rtc_client* c); /* 1: TRAFFIC_SPLIT, 0: TRAFFIC_SINGL
 int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* round_trip_us);
 /* The server clock now, from the client clock and the last rtc_sync_clock. */
 int64_t rtc_server_now_us(const rtc_client* c);
+/* 1 when a new server instance answered since the last rtc_sync_clock (its
+ * clock may be another's): sync again before stamping delay-mode commands. */
+int rtc_clock_stale(const rtc_client* c);
 
 /* Send one package, non-blocking. Each item's id is set by the library (read
  * it back from queries[i].id / commands[i].id). Returns the package's

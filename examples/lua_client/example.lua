@@ -4,19 +4,23 @@ mode (each frame sent at its time by the client's clock, start time "now",
 and its reply awaited before the next), and prints every reply. Same output
 as the C and Java examples; tests/examples/client_example_test.sh runs it.
   LUA_PATH="<lua modules dir>/?.lua;<lua modules dir>/?/init.lua;examples/lua_client/?.lua;;" \
-  lua5.2 examples/lua_client/example.lua [--url URL] [--robot NAME]
+  lua5.2 examples/lua_client/example.lua [--url URL] [--robot NAME] [--pause S]
+--pause S: wait S seconds after the GOTO (keeping the session); the test
+restarts the server meanwhile, and the client must say hello again.
 Exit status 0 when every step succeeded. ]]
 local rt = require('robotalk_client')
 local msgs = require('robotalk_msgs')
 
 local url = os.getenv('LCM_DEFAULT_URL') or 'udpm://239.255.76.67:7667?ttl=0'
 local robot = 'pioneer'
+local pause_s = 0
 local i = 1
 while i <= #arg do
   if arg[i] == '--url' and arg[i + 1] then url, i = arg[i + 1], i + 2
   elseif arg[i] == '--robot' and arg[i + 1] then robot, i = arg[i + 1], i + 2
+  elseif arg[i] == '--pause' and arg[i + 1] then pause_s, i = tonumber(arg[i + 1]), i + 2
   else
-    io.stderr:write('usage: lua5.2 example.lua [--url URL] [--robot NAME]\n')
+    io.stderr:write('usage: lua5.2 example.lua [--url URL] [--robot NAME] [--pause S]\n')
     os.exit(2)
   end
 end
@@ -51,6 +55,16 @@ local r, e = client:command(msgs.command_t.GOTO, '', { 0.5, 0.0, 0.0 }, 30)
 if not r then fail(e) end
 print_reply('GOTO 0.5 0 0', r)
 ok = ok and r.signal == msgs.reply_t.SUCCESS
+if pause_s > 0 then
+  print(string.format('pausing %.1f s', pause_s))
+  io.stdout:flush()
+  local server_before = client:server_hex()
+  local paused, perr = client:pause(pause_s)
+  if not paused then fail(perr) end
+  if client:server_hex() ~= server_before then
+    print(string.format('new server instance %s, session %s', client:server_hex(), client:session_hex()))
+  end
+end
 
 -- Direct mode: the client keeps the timing, sending each frame at t0 + offset.
 local spacing = 0.25

@@ -3,7 +3,9 @@
 // set-points in delay mode, and prints every reply. Same steps and output as
 // the C example (examples/c_client); tests/examples/client_example_test.sh runs it.
 //   java -cp lcm.jar:robotalk_lcmtypes.jar:robotalk_java_client.jar robotalk.client.Example
-//        [--url URL] [--robot NAME] [--delay S]
+//        [--url URL] [--robot NAME] [--delay S] [--pause S]
+// --pause S: wait S seconds after the GOTO (keeping the session); the test
+// restarts the server meanwhile, and the client must say hello again.
 // Exit status 0 when every step succeeded.
 package robotalk.client;
 
@@ -31,7 +33,7 @@ public final class Example {
     return c;
   }
 
-  static boolean run(RobotalkClient client, double delayS) throws Exception {
+  static boolean run(RobotalkClient client, double delayS, double pauseS) throws Exception {
     long[] clock = client.syncClock(5);
     System.out.printf("clock: offset_us=%d round_trip_us=%d%n", clock[0], clock[1]);
 
@@ -47,6 +49,16 @@ public final class Example {
     reply_t r = client.await(30.0, go.id)[0];
     printReply("GOTO 0.5 0 0", r);
     boolean ok = r.signal == reply_t.SUCCESS;
+    if (pauseS > 0) {
+      System.out.printf("pausing %.1f s%n", pauseS);
+      System.out.flush();
+      client.pause(pauseS);
+    }
+    if (client.clockStale()) {  // a new server instance: its clock may be another's
+      clock = client.syncClock(5);
+      System.out.printf("new server instance %016x, session %016x: clock offset_us=%d%n", client.serverId(),
+          client.sessionId(), clock[0]);
+    }
 
     // Delay mode: each frame stamped server now + delay + its offset, all sent at once.
     String[] joints = {"pan", "pan", "pan", "tilt"};
@@ -79,13 +91,14 @@ public final class Example {
   public static void main(String[] args) {
     String url = System.getenv().getOrDefault("LCM_DEFAULT_URL", "udpm://239.255.76.67:7667?ttl=0");
     String robot = "pioneer";
-    double delayS = 0.5;
+    double delayS = 0.5, pauseS = 0;
     for (int i = 0; i < args.length; i++) {
       if (args[i].equals("--url") && i + 1 < args.length) url = args[++i];
       else if (args[i].equals("--robot") && i + 1 < args.length) robot = args[++i];
       else if (args[i].equals("--delay") && i + 1 < args.length) delayS = Double.parseDouble(args[++i]);
+      else if (args[i].equals("--pause") && i + 1 < args.length) pauseS = Double.parseDouble(args[++i]);
       else {
-        System.err.println("usage: Example [--url URL] [--robot NAME] [--delay S]");
+        System.err.println("usage: Example [--url URL] [--robot NAME] [--delay S] [--pause S]");
         System.exit(2);
       }
     }
@@ -93,7 +106,7 @@ public final class Example {
     try (RobotalkClient client = new RobotalkClient(url, robot, 5.0)) {
       System.out.printf("connected: robot=%s server=%016x layout=%s session=%016x client=%016x%n", robot,
           client.serverId(), client.splitLayout() ? "split" : "single", client.sessionId(), client.clientId());
-      ok = run(client, delayS);
+      ok = run(client, delayS, pauseS);
     } catch (Exception e) {
       System.err.println("error: " + e.getMessage());
     }

@@ -82,7 +82,7 @@ public final class RobotalkClient implements AutoCloseable {
   private final String helloChannel, requestChannel, replyChannel, helloAnswerChannel;
   private long sessionId, serverId, nextSequence = 1, nextId = 1, lastNewPackageUs, clockOffsetUs;
   private byte[] nonce = new byte[16];
-  private boolean helloAnswered;
+  private boolean helloAnswered, clockStale;
   private String refusal = "";
   private robot_config_t config;
 
@@ -216,6 +216,7 @@ public final class RobotalkClient implements AutoCloseable {
     if (m.client_id != clientId || !Arrays.equals(m.client_nonce, nonce)) return;  // not our hello
     helloAnswered = true;
     sessionId = m.session_id;
+    if (serverId != 0 && m.server_id != serverId) clockStale = true;
     serverId = m.server_id;
     refusal = m.keyed ? "the server answered in keyed mode" : m.session_id == 0 ? m.refusal : "";
   }
@@ -239,6 +240,7 @@ public final class RobotalkClient implements AutoCloseable {
         }
       }
       serverId = m.server_id;
+      clockStale = true;
     }
     Pending p = pending.get(m.ack_sequence);
     if (m.session_status == reply_package_t.SESSION_UNKNOWN) {
@@ -438,8 +440,12 @@ public final class RobotalkClient implements AutoCloseable {
     }
     if (bestRtt == Long.MAX_VALUE) throw new RobotalkException("no usable CLOCK sample");
     clockOffsetUs = bestOffset;
+    clockStale = false;
     return new long[] {bestOffset, bestRtt};
   }
+
+  /** True when a new server instance answered since the last syncClock: sync again before delay mode. */
+  public boolean clockStale() { return clockStale; }
 
   /** The server clock now, from the client clock and the last syncClock. */
   public long serverNowUs() { return nowUs() + clockOffsetUs; }
