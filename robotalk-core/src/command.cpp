@@ -92,6 +92,10 @@ const char* ToString(QueryType t) {
       return "STATE_STREAM";
     case QueryType::kStateStreamCancel:
       return "STATE_STREAM_CANCEL";
+    case QueryType::kCommandStatus:
+      return "COMMAND_STATUS";
+    case QueryType::kServerCounters:
+      return "SERVER_COUNTERS";
   }
   return "UNKNOWN_QUERY";
 }

@@ -11,17 +11,17 @@ namespace robotalk {
 namespace {
 
 // Smallest encodings of the array elements (an empty string takes 5 bytes).
-constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead + 8;
+constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead + 8 + 8;
 constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2;
 constexpr std::int64_t kMinReplyBytes = 8 + 1 + kLcmStringOverhead + 8 + 8 + 4;
 
 void ScanPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8, "header");
   const std::int32_t nq = s.Count("num_queries", kMinQueryBytes);
   for (std::int32_t i = 0; i < nq; ++i) {
     s.Skip(8 + 1, "query");
     s.String("query.target");
-    s.Skip(8, "query.period_us");
+    s.Skip(8 + 8, "query.period_us, about_id");
   }
   const std::int32_t nc = s.Count("num_commands", kMinCommandBytes);
   for (std::int32_t i = 0; i < nc; ++i) {
@@ -29,10 +29,11 @@ void ScanPackage(WireScanner& s) {
     s.String("command.target");
     s.Skip(std::int64_t{8} * s.Count16("command.num_values", 8), "command.values");
   }
+  s.Skip(kMacBytesOnWire, "mac");
 }
 
 void ScanReplyPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 8, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 8 + 8 + 8, "header");
   const std::int32_t nr = s.Count("num_replies", kMinReplyBytes);
   for (std::int32_t i = 0; i < nr; ++i) {
     s.Skip(8 + 1, "reply");
@@ -40,6 +41,7 @@ void ScanReplyPackage(WireScanner& s) {
     s.Skip(8 + 8, "reply times");
     s.Skip(std::int64_t{8} * s.Count("reply.num_values", 8), "reply.values");
   }
+  s.Skip(kMacBytesOnWire, "mac");
 }
 
 void ScanRobotState(WireScanner& s) {
@@ -164,6 +166,7 @@ robotalk_msgs::query_t ToWire(const Query& q) {
   w.type = static_cast<std::int8_t>(q.type);
   w.target = q.target;
   w.period_us = ToWireMicros(q.period);
+  w.about_id = q.about;
   return w;
 }
 
@@ -196,7 +199,7 @@ Command FromWire(const robotalk_msgs::command_t& w, std::int8_t package_mode) {
 }
 
 Query FromWire(const robotalk_msgs::query_t& w) {
-  if (w.type < 1 || w.type > static_cast<std::int8_t>(QueryType::kStateStreamCancel)) {
+  if (w.type < 1 || w.type > static_cast<std::int8_t>(QueryType::kServerCounters)) {
     throw ProtocolError("query " + std::to_string(w.id) + ": unknown query type " + std::to_string(w.type));
   }
   if (w.period_us < 0) {
@@ -204,7 +207,8 @@ Query FromWire(const robotalk_msgs::query_t& w) {
                         " us");
   }
   return Query{w.id, static_cast<QueryType>(w.type), w.target,
-               DurationFromWireMicros(w.period_us, "query " + std::to_string(w.id) + ": period_us")};
+               DurationFromWireMicros(w.period_us, "query " + std::to_string(w.id) + ": period_us"),
+               w.about_id};
 }
 
 Reply FromWire(const robotalk_msgs::reply_t& w) {

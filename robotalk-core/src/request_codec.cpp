@@ -4,7 +4,12 @@
 #include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "robotalk_msgs/announce_t.hpp"
+#include "robotalk_msgs/hello_answer_t.hpp"
+#include "robotalk_msgs/hello_t.hpp"
 #include "wire_scanner.h"
+
+#include <cstring>
+#include <functional>
 
 namespace robotalk {
 namespace {
@@ -16,6 +21,42 @@ std::vector<std::uint8_t> Encode(const Msg& msg) {
     throw ProtocolError(std::string("encoding ") + Msg::getTypeName() + " failed");
   }
   return bytes;
+}
+
+template <std::size_t N>
+void CopyBytes(std::array<std::uint8_t, N>& to, const std::uint8_t (&from)[N]) {
+  std::memcpy(to.data(), from, N);
+}
+template <std::size_t N>
+void CopyBytes(std::uint8_t (&to)[N], const std::array<std::uint8_t, N>& from) {
+  std::memcpy(to, from.data(), N);
+}
+
+// The LCM decoders trust string lengths (length 0 -> std::length_error through
+// LCM's C callback): walk fixed-layout messages with the scanner first.
+template <typename Msg>
+Msg DecodeScanned(std::span<const std::uint8_t> bytes, const char* function,
+                  const std::function<void(WireScanner&)>& scan_body) {
+  constexpr std::size_t kMaxBytes = 64 * 1024;
+  if (bytes.size() > kMaxBytes) {
+    throw ProtocolError(std::string(function) + ": " + std::to_string(bytes.size()) + " bytes; at most " +
+                        std::to_string(kMaxBytes));
+  }
+  WireScanner scan(function, bytes);
+  if (scan.Int64("fingerprint") != Msg::getHash())
+    scan.Fail("fingerprint", "does not match (another message type?)");
+  scan_body(scan);
+  scan.ExpectEnd();
+  Msg m{};
+  if (m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
+    scan.Fail("message", "LCM decode failed");
+  }
+  if (m.protocol_version != kProtocolVersion) {
+    throw ProtocolError(std::string(function) + ": protocol version " + std::to_string(m.protocol_version) +
+                        " is not supported (this side speaks " + std::to_string(kProtocolVersion) + ")");
+  }
+  if (m.client_id == 0) throw ProtocolError(std::string(function) + ": client id 0 is reserved");
+  return m;
 }
 
 }  // namespace
@@ -34,6 +75,7 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes) {
   const auto& h = p.header;
   Request r;
   r.client_id = h.client_id;
+  r.session_id = h.session_id;
   r.sequence = h.sequence;
   r.send_time = FromWireMicros(h.send_time_us, "package: send_time_us");
   r.panic = h.panic;
@@ -57,6 +99,7 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes) {
       r.malformed.push_back({c.id, e.what()});
     }
   }
+  r.mac = ReadMacField(bytes);
   return r;
 }
 
@@ -65,6 +108,7 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
   auto& h = p.header;
   h.protocol_version = kProtocolVersion;
   h.client_id = r.client_id;
+  h.session_id = r.session_id;
   h.sequence = r.sequence;
   h.send_time_us = ToWireMicros(r.send_time);
   h.panic = r.panic;
@@ -81,6 +125,7 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
   h.payload_type = p.num_queries > 0 ? robotalk_msgs::package_header_t::PAYLOAD_QUERIES
                                      : robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
   h.payload_size = p.num_queries > 0 ? p.num_queries : p.num_commands;
+  CopyBytes(p.mac, r.mac);
   return Encode(p);
 }
 
@@ -88,12 +133,16 @@ std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
   robotalk_msgs::reply_package_t p{};
   p.protocol_version = kProtocolVersion;
   p.client_id = b.client_id;
+  p.server_id = b.server_id;
+  p.session_id = b.session_id;
+  p.session_status = static_cast<std::int8_t>(b.session_status);
   p.ack_sequence = b.ack_sequence;
   p.server_receive_us = ToWireMicros(b.server_receive);
   p.server_send_us = ToWireMicros(b.server_send);
   p.replies.reserve(b.replies.size());
   for (const Reply& r : b.replies) p.replies.push_back(ToWire(r));
   p.num_replies = static_cast<std::int32_t>(p.replies.size());
+  CopyBytes(p.mac, b.mac);
   return Encode(p);
 }
 
@@ -101,10 +150,18 @@ ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
   const robotalk_msgs::reply_package_t p = DecodeReplyPackage(bytes);
   ReplyBatch b;
   b.client_id = p.client_id;
+  b.server_id = p.server_id;
+  b.session_id = p.session_id;
+  if (p.session_status != robotalk_msgs::reply_package_t::SESSION_OK &&
+      p.session_status != robotalk_msgs::reply_package_t::SESSION_UNKNOWN) {
+    throw ProtocolError("DecodeReplyBatch: unknown session status " + std::to_string(p.session_status));
+  }
+  b.session_status = static_cast<SessionStatus>(p.session_status);
   b.ack_sequence = p.ack_sequence;
   b.server_receive = FromWireMicros(p.server_receive_us);
   b.server_send = FromWireMicros(p.server_send_us);
   for (const auto& r : p.replies) b.replies.push_back(FromWire(r));
+  CopyBytes(b.mac, p.mac);
   return b;
 }
 
@@ -115,6 +172,8 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
   m.server_time_us = ToWireMicros(a.server_time);
   m.uptime_us = ToWireMicros(a.uptime);
   m.url_hint = a.url_hint;
+  m.traffic_layout = static_cast<std::int8_t>(a.traffic_layout);
+  m.keyed = a.keyed;
   for (const RobotAnnouncement& r : a.robots) {
     robotalk_msgs::robot_info_t info{};
     info.name = r.name;
@@ -148,6 +207,7 @@ Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   }
   scan.Skip(2 + 8 + 8 + 8, "header");
   scan.String("url_hint");
+  scan.Skip(1 + 1, "traffic_layout, keyed");
   constexpr std::int64_t kMinRobotBytes = 2 * kLcmStringOverhead + 8 + 4 + 1 + 1 + 4;
   const std::int32_t robots = scan.Count("num_robots", kMinRobotBytes);
   for (std::int32_t i = 0; i < robots; ++i) {
@@ -165,11 +225,108 @@ Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   a.server_time = FromWireMicros(m.server_time_us, "announce: server_time_us");
   a.uptime = DurationFromWireMicros(m.uptime_us, "announce: uptime_us");
   a.url_hint = m.url_hint;
+  if (m.traffic_layout != robotalk_msgs::announce_t::TRAFFIC_SINGLE &&
+      m.traffic_layout != robotalk_msgs::announce_t::TRAFFIC_SPLIT) {
+    scan.Fail("traffic_layout", "unknown value " + std::to_string(m.traffic_layout));
+  }
+  a.traffic_layout = static_cast<TrafficLayout>(m.traffic_layout);
+  a.keyed = m.keyed != 0;
   for (const auto& r : m.robots) {
     a.robots.push_back({r.name, r.driver, static_cast<std::uint64_t>(r.config_hash), r.total_dofs,
                         r.base_type, r.panic != 0, r.num_clients});
   }
   return a;
+}
+
+std::vector<std::uint8_t> EncodeHello(const Hello& hello) {
+  robotalk_msgs::hello_t m{};
+  m.protocol_version = kProtocolVersion;
+  m.client_id = hello.body.client_id;
+  CopyBytes(m.client_nonce, hello.body.client_nonce);
+  m.keyed = hello.keyed;
+  CopyBytes(m.client_key, hello.body.client_key.bytes);
+  CopyBytes(m.client_kx, hello.body.client_kx);
+  CopyBytes(m.signature, hello.body.signature);
+  return Encode(m);
+}
+
+Hello DecodeHello(std::span<const std::uint8_t> bytes) {
+  const auto m = DecodeScanned<robotalk_msgs::hello_t>(
+      bytes, "DecodeHello", [](WireScanner& scan) { scan.Skip(2 + 8 + 16 + 1 + 32 + 32 + 64, "fields"); });
+  Hello h;
+  h.keyed = m.keyed != 0;
+  h.body.client_id = m.client_id;
+  CopyBytes(h.body.client_nonce, m.client_nonce);
+  CopyBytes(h.body.client_key.bytes, m.client_key);
+  CopyBytes(h.body.client_kx, m.client_kx);
+  CopyBytes(h.body.signature, m.signature);
+  return h;
+}
+
+std::vector<std::uint8_t> EncodeHelloAnswer(const HelloAnswer& a) {
+  robotalk_msgs::hello_answer_t m{};
+  m.protocol_version = kProtocolVersion;
+  m.client_id = a.body.client_id;
+  CopyBytes(m.client_nonce, a.body.client_nonce);
+  m.server_id = a.server_id;
+  m.session_id = a.session_id;
+  m.refusal = a.refusal;
+  m.keyed = a.keyed;
+  CopyBytes(m.instance_nonce, a.body.instance_nonce);
+  CopyBytes(m.server_nonce, a.body.server_nonce);
+  CopyBytes(m.server_kx, a.body.server_kx);
+  CopyBytes(m.server_key, a.body.server_key.bytes);
+  CopyBytes(m.signature, a.body.signature);
+  return Encode(m);
+}
+
+HelloAnswer DecodeHelloAnswer(std::span<const std::uint8_t> bytes) {
+  const auto m =
+      DecodeScanned<robotalk_msgs::hello_answer_t>(bytes, "DecodeHelloAnswer", [](WireScanner& scan) {
+        scan.Skip(2 + 8 + 16 + 8 + 8, "fields");
+        scan.String("refusal");
+        scan.Skip(1 + 16 + 16 + 32 + 32 + 64, "keyed fields");
+      });
+  if (m.session_id < 0) throw ProtocolError("DecodeHelloAnswer: negative session id");
+  HelloAnswer a;
+  a.server_id = m.server_id;
+  a.session_id = m.session_id;
+  a.refusal = m.refusal;
+  a.keyed = m.keyed != 0;
+  a.body.client_id = m.client_id;
+  CopyBytes(a.body.client_nonce, m.client_nonce);
+  CopyBytes(a.body.instance_nonce, m.instance_nonce);
+  CopyBytes(a.body.server_nonce, m.server_nonce);
+  CopyBytes(a.body.server_kx, m.server_kx);
+  CopyBytes(a.body.server_key.bytes, m.server_key);
+  CopyBytes(a.body.signature, m.signature);
+  return a;
+}
+
+namespace {
+void CheckMacRoom(std::size_t size) {
+  if (size < kMacBytes) {
+    throw ProtocolError("package of " + std::to_string(size) + " bytes is shorter than its " +
+                        std::to_string(kMacBytes) + "-byte MAC");
+  }
+}
+}  // namespace
+
+std::span<const std::uint8_t> MacCoveredBytes(std::span<const std::uint8_t> bytes) {
+  CheckMacRoom(bytes.size());
+  return bytes.first(bytes.size() - kMacBytes);
+}
+
+Mac ReadMacField(std::span<const std::uint8_t> bytes) {
+  CheckMacRoom(bytes.size());
+  Mac mac{};
+  std::memcpy(mac.data(), bytes.data() + bytes.size() - kMacBytes, kMacBytes);
+  return mac;
+}
+
+void WriteMacField(std::span<std::uint8_t> bytes, const Mac& mac) {
+  CheckMacRoom(bytes.size());
+  std::memcpy(bytes.data() + bytes.size() - kMacBytes, mac.data(), kMacBytes);
 }
 
 }  // namespace robotalk

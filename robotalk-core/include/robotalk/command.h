@@ -36,6 +36,8 @@ enum class QueryType : std::int8_t {
   kClock = 6,              ///< server time, for clock synchronisation
   kStateStream = 7,        ///< broadcast: robot_state_t on ROBOTALK/<robot>/STATE every `period`
   kStateStreamCancel = 8,  ///< ends this client's STATE_STREAM request
+  kCommandStatus = 9,      ///< what became of command `about` in this session
+  kServerCounters = 10,    ///< the server's refusal counters (values; message names them)
 };
 
 const char* ToString(CommandType t);
@@ -111,8 +113,9 @@ struct Command {
 struct Query {
   CommandId id = 0;
   QueryType type = QueryType::kJointState;
-  std::string target;  ///< one joint / link / frame name, or empty for all
-  Duration period{0};  ///< STATE_STREAM: the sampling period
+  std::string target;   ///< one joint / link / frame name, or empty for all
+  Duration period{0};   ///< STATE_STREAM: the sampling period
+  CommandId about = 0;  ///< COMMAND_STATUS: the command asked about
 };
 
 /// Shortest and longest broadcast periods a server accepts.

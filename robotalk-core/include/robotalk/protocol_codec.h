@@ -19,7 +19,9 @@
 
 namespace robotalk {
 
-inline constexpr std::int16_t kProtocolVersion = 1;
+inline constexpr std::int16_t kProtocolVersion = 2;
+/// The `mac` field that ends package_t and reply_package_t.
+inline constexpr std::int64_t kMacBytesOnWire = 16;
 
 // Start times on the wire (command_t.start_time_us, by the package's mode,
 // package_header_t::MODE_*):

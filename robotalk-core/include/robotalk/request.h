@@ -6,6 +6,7 @@
 
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
+#include "robotalk/session_auth.h"
 #include "robotalk/state_sample.h"
 
 #include <cstdint>
@@ -38,8 +39,9 @@ struct MalformedItem {
 /// One client package (ROBOTALK/<robot>/REQUEST).
 struct Request {
   std::int64_t client_id = 0;
-  std::int64_t sequence = 0;  ///< 1, 2, 3 ... per client; a retransmission repeats it
-  TimePoint send_time{};      ///< client clock (informational)
+  std::int64_t session_id = 0;  ///< from the client's HelloAnswer (docs/protocol.md, Sessions)
+  std::int64_t sequence = 0;    ///< 1, 2, 3 ... per client; a retransmission repeats it
+  TimePoint send_time{};        ///< client clock (informational)
   bool panic = false;
   RequestMode mode = RequestMode::kDirect;
   PlaybackDeclaration playback;  ///< kPlayback only
@@ -49,6 +51,8 @@ struct Request {
   /// Non-empty when the header is inconsistent with the payload (mixed
   /// payload, bad version, ...): every item is answered ERROR with it.
   std::string header_error;
+  /// Keyed mode: the package's MAC (the last kMacBytes of its encoding); zeros in open mode.
+  Mac mac{};
 
   /// The ids of every item, queries first, as the package carried them.
   std::vector<CommandId> item_ids() const;
@@ -62,17 +66,33 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes);
 /// Encodes a request (clients and tests).
 std::vector<std::uint8_t> EncodeRequest(const Request& request);
 
+/// Whether the package a ReplyBatch acknowledges belonged to a live session.
+enum class SessionStatus : std::int8_t {
+  kOk = 0,       ///< accepted in `session_id`
+  kUnknown = 1,  ///< this server instance has no such session: nothing ran; say hello again
+};
+
 /// Replies for one client (ROBOTALK/<robot>/REPLY/<client>).
 struct ReplyBatch {
   std::int64_t client_id = 0;
+  std::int64_t server_id = 0;   ///< the server instance (Announcement::server_id)
+  std::int64_t session_id = 0;  ///< the session the replies belong to (kUnknown: the one refused)
+  SessionStatus session_status = SessionStatus::kOk;
   std::int64_t ack_sequence = 0;  ///< the package this acknowledges; 0 = none
   TimePoint server_receive{};     ///< when that package arrived (clock sync)
   TimePoint server_send{};
   std::vector<Reply> replies;
+  Mac mac{};  ///< keyed mode: the last kMacBytes of the encoding
 };
 std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& batch);
 /// Throws ProtocolError on truncated, hostile or foreign bytes.
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes);
+
+/// Where requests and replies travel (docs/protocol.md, Channels).
+enum class TrafficLayout : std::int8_t {
+  kSingle = 0,  ///< every channel on one URL
+  kSplit = 1,   ///< requests, replies and the rest on separate ports
+};
 
 /// One served robot in an ANNOUNCE.
 struct RobotAnnouncement {
@@ -90,6 +110,8 @@ struct Announcement {
   TimePoint server_time{};
   Duration uptime{0};  ///< how long the server has been serving
   std::string url_hint;
+  TrafficLayout traffic_layout = TrafficLayout::kSingle;
+  bool keyed = false;  ///< clients must say hello with a key
   std::vector<RobotAnnouncement> robots;
 };
 std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& announcement);
@@ -99,5 +121,32 @@ std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample);
 /// Throws ProtocolError on truncated, hostile or foreign bytes, or more than
 /// 1024 robots.
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes);
+
+/// ROBOTALK/<robot>/HELLO: the first message of every session.
+struct Hello {
+  bool keyed = false;  ///< open mode: only body.client_id and body.client_nonce are meaningful
+  ClientHello body;
+};
+/// ROBOTALK/<robot>/HELLO/<client>: the server's answer.
+struct HelloAnswer {
+  std::int64_t server_id = 0;   ///< the server instance
+  std::int64_t session_id = 0;  ///< > 0: the session opened; 0: refused
+  std::string refusal;          ///< why not, when session_id is 0
+  bool keyed = false;           ///< open mode: only body.client_id and body.client_nonce are meaningful
+  ServerAnswer body;
+};
+std::vector<std::uint8_t> EncodeHello(const Hello& hello);
+/// Throws ProtocolError on truncated or foreign bytes, a bad version or client id 0.
+Hello DecodeHello(std::span<const std::uint8_t> bytes);
+std::vector<std::uint8_t> EncodeHelloAnswer(const HelloAnswer& answer);
+/// Throws ProtocolError on truncated, hostile or foreign bytes.
+HelloAnswer DecodeHelloAnswer(std::span<const std::uint8_t> bytes);
+
+/// A REQUEST or REPLY package's MAC is the last kMacBytes of its encoding and
+/// covers every byte before it. These read and write it in encoded bytes.
+/// Throw ProtocolError when `bytes` is shorter than a MAC.
+std::span<const std::uint8_t> MacCoveredBytes(std::span<const std::uint8_t> bytes);
+Mac ReadMacField(std::span<const std::uint8_t> bytes);
+void WriteMacField(std::span<std::uint8_t> bytes, const Mac& mac);
 
 }  // namespace robotalk
