@@ -112,6 +112,17 @@ void RobotSessions::Bound(Reply& reply) const {
   reply.message += "... (truncated)";
 }
 
+ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint received) const {
+  ImmediateAnswer answer;
+  answer.batch.client_id = r.client_id;
+  answer.batch.ack_sequence = r.sequence;
+  answer.batch.server_receive = received;
+  if (auto it = sessions_.find(r.client_id); it != sessions_.end()) {
+    answer.batch.replies = it->second.replies.RepliesFor(r.sequence);
+  }
+  return answer;
+}
+
 ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
   ImmediateAnswer answer;
   answer.send = r.client_id != 0;
@@ -161,6 +172,22 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
       immediate.push_back(std::move(r));
       return;
     }
+    case QueryType::kCommandStatus:
+      immediate.push_back(CommandStatus(s, q, now));
+      return;
+    case QueryType::kServerCounters: {
+      Reply r = MakeReply(q.id, Signal::kSuccess, "", now);
+      if (options_.counters) {
+        for (const auto& [name, value] : options_.counters()) {
+          r.message += (r.message.empty() ? "" : " ") + std::string(name);
+          r.values.push_back(value);
+        }
+      }
+      r.message += (r.message.empty() ? "" : " ") + std::string("refused_packages");
+      r.values.push_back(static_cast<double>(refused_packages_));
+      immediate.push_back(std::move(r));
+      return;
+    }
     case QueryType::kConfig:
       publish_config = true;
       immediate.push_back(MakeReply(q.id, Signal::kSuccess, Hex64(config_hash_), now));
@@ -196,6 +223,23 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
     }
   }
   daemon_.Submit(std::move(item));
+}
+
+// What became of a command of this session: its own final reply once it
+// ended, BUSY while it waits or runs, NA when this session never got it.
+Reply RobotSessions::CommandStatus(const Session& s, const Query& q, TimePoint now) const {
+  const std::optional<std::optional<Reply>> known = s.replies.Lookup(q.about);
+  if (!known) {
+    return MakeReply(q.id, Signal::kNa,
+                     "command " + std::to_string(q.about) +
+                         " was never received in this session (or is older than its reply cache)",
+                     now);
+  }
+  if (!*known)
+    return MakeReply(q.id, Signal::kBusy, "command " + std::to_string(q.about) + " has not ended", now);
+  Reply r = **known;
+  r.id = q.id;
+  return r;
 }
 
 std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, TimePoint now,

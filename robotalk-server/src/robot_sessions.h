@@ -15,6 +15,7 @@
 #include "session.h"
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -34,6 +35,8 @@ struct SessionOptions {
   std::size_t max_sessions = 256;
   /// Longest reply message kept and sent (bad input is never echoed in full).
   std::size_t max_message_bytes = 512;
+  /// The server's refusal counters for the SERVER_COUNTERS query (name, value).
+  std::function<std::vector<std::pair<const char*, double>>()> counters;
 };
 
 /// What the ServerDaemon sends back at once for a received package.
@@ -56,6 +59,13 @@ class RobotSessions {
 
   /// Handles one decoded request received at `received`.
   ImmediateAnswer Handle(const Request& request, TimePoint received);
+  /// An authenticated retransmission (keyed mode's replay window saw it):
+  /// acknowledges it with what is known of its items; runs nothing, opens
+  /// and refreshes no session.
+  ImmediateAnswer Resend(const Request& request, TimePoint received) const;
+  /// Raises a panic on behalf of `client_id` (outside any session: open
+  /// mode honours a panic from anyone).
+  void RaisePanic(std::int64_t client_id, TimePoint now) { Panic(client_id, now); }
   /// Files the RobotDaemon's output (replies into the sessions' caches, the
   /// watchdog's bookkeeping) and the replies this layer produced outside
   /// Handle (a panic's flushed items); appends what to send, one batch per client.
@@ -77,6 +87,7 @@ class RobotSessions {
   ImmediateAnswer Refuse(const Request& request, TimePoint received);
   void AdmitQuery(Session& s, const Query& q, TimePoint now, std::vector<Reply>& immediate,
                   bool& publish_config);
+  Reply CommandStatus(const Session& s, const Query& q, TimePoint now) const;
   // Checks a command; returns it ready to queue, or answers it in `immediate`.
   std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
                                   bool playback);

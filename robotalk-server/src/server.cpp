@@ -4,6 +4,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
+#include "robotalk/keys.h"
 #include "robotalk/lcm_transport.h"
 #include "server_daemon.h"
 
@@ -52,6 +53,31 @@ RobotSpec RobotSpec::Parse(const std::string& text) {
   return spec;
 }
 
+namespace {
+
+// Keyed mode from the key and access-list files (errors name the file).
+SessionGateOptions GateOptions(const ServerOptions& options) {
+  SessionGateOptions gate;
+  gate.max_sessions = options.max_sessions;
+  if (options.key_file.empty() != options.clients_file.empty()) {
+    throw Error("keyed mode needs both --key (the server's secret key) and --clients (the access list)");
+  }
+  if (options.key_file.empty()) {
+    std::fprintf(stderr,
+                 "robotalk-server: open mode: any process on the LAN may command these robots "
+                 "(--key and --clients turn on authentication; docs/security.md)\n");
+    return gate;
+  }
+  gate.identity = std::make_shared<const KeyPair>(ReadSecretKeyFile(options.key_file));
+  gate.access = std::make_shared<const AccessList>(AccessList::ReadFile(options.clients_file));
+  std::fprintf(stderr, "robotalk-server: keyed mode: %zu client keys from %s; server key %s\n",
+               gate.access->size(), options.clients_file.c_str(),
+               gate.identity->public_key.Fingerprint().c_str());
+  return gate;
+}
+
+}  // namespace
+
 class Server::Impl {
  public:
   Impl(Transport* transport, ServerOptions options, const std::vector<RobotSpec>& specs,
@@ -70,7 +96,8 @@ class Server::Impl {
                             .fault_seed = options_.fault_seed,
                             .log_lines_per_second = options_.log_lines_per_second,
                             .panic_latch_path = options_.panic_latch_path,
-                            .allow_duplicate_robots = options_.allow_duplicate_robots});
+                            .allow_duplicate_robots = options_.allow_duplicate_robots,
+                            .gate = GateOptions(options_)});
     const SessionOptions sessions{
         options_.session_timeout, options_.max_queue, options_.max_future,
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};

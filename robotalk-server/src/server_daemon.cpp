@@ -35,6 +35,10 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
     std::random_device rd;
     server_id_ = static_cast<std::int64_t>((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
   }
+  gate_ = std::make_unique<SessionGate>(server_id_, options_.gate);
+  hello_subscription_ = transport_.Subscribe(
+      kAnyHelloChannelRegex,
+      [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnHello(channel, bytes); });
   subscription_ = transport_.Subscribe(
       kAnyRequestChannelRegex,
       [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnRequest(channel, bytes); });
@@ -46,6 +50,7 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
 ServerDaemon::~ServerDaemon() {
   Stop();
   subscription_.reset();
+  hello_subscription_.reset();
   announce_subscription_.reset();
   if (event_fd_ >= 0) close(event_fd_);
 }
@@ -54,6 +59,11 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   const std::string& name = daemon.robot_name();
   if (robots_.count(name)) throw Error("ServerDaemon: robot name '" + name + "' is given twice");
   Robot robot{&daemon, nullptr, EncodeConfig(daemon.model()), ConfigHash(daemon.model()), {}};
+  options.counters = [this] {
+    auto table = gate_->counters().Table();
+    table.emplace_back("malformed", static_cast<double>(malformed_));
+    return table;
+  };
   robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options);
   daemon.Preallocate(robot.output);
   daemon.set_output_ready_callback([this] { Wake(); });
@@ -195,6 +205,7 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
     Log("robot '" + *robot_name + "': dropped a malformed package on " + channel + ": " + e.what());
     return;
   }
+  if (!Gate(robot, *robot_name, request, bytes, received)) return;
   ImmediateAnswer answer = robot.sessions->Handle(request, received);
   SyncLatch(robot);  // on disk before the panic (or its reset) is acknowledged
   if (!request.header_error.empty()) {
@@ -210,6 +221,67 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
     std::uniform_real_distribution<double> pause(0.0, ToSeconds(options_.congestion_max_pause));
     std::this_thread::sleep_for(FromSeconds(pause(congestion_rng_)));
   }
+}
+
+bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
+                        std::span<const std::uint8_t> bytes, TimePoint received) {
+  const SessionGate::Admission admission = gate_->Admit(name, request, bytes, received);
+  switch (admission.verdict) {
+    case SessionGate::Verdict::kAccepted:
+      return true;
+    case SessionGate::Verdict::kNoRights:
+      request.header_error = admission.why;  // every item is answered ERROR, nothing runs
+      Log("robot '" + name + "': refused " + admission.who + ": " + admission.why);
+      return true;
+    case SessionGate::Verdict::kDuplicate: {
+      ImmediateAnswer answer = robot.sessions->Resend(request, received);
+      Send(name, answer.batch);
+      return false;
+    }
+    case SessionGate::Verdict::kRefused:
+      Log("robot '" + name + "': dropped a package of " + admission.who + ": " + admission.why);
+      return false;
+    case SessionGate::Verdict::kUnknownSession:
+      break;
+  }
+  if (request.panic && !gate_->keyed()) {
+    // Open mode: a panic is honoured from anyone, in a session or not (a
+    // client whose server restarted must still be able to stop the robot).
+    robot.sessions->RaisePanic(request.client_id, received);
+    SyncLatch(robot);
+    Drain(robot);
+  }
+  if (request.client_id == 0) return false;
+  ReplyBatch unknown;
+  unknown.client_id = request.client_id;
+  unknown.session_id = request.session_id;
+  unknown.session_status = SessionStatus::kUnknown;
+  unknown.ack_sequence = request.sequence > 0 ? request.sequence : 0;
+  unknown.server_receive = received;
+  Send(name, unknown);
+  return false;
+}
+
+void ServerDaemon::OnHello(const std::string& channel, std::span<const std::uint8_t> bytes) {
+  const TimePoint received = clock_.Now();
+  const std::optional<std::string> robot_name = RobotOfHelloChannel(channel);
+  if (!robot_name) return;
+  auto it = robots_.find(*robot_name);
+  if (it == robots_.end() || !it->second.refused.empty()) return;
+  Hello hello;
+  try {
+    hello = DecodeHello(bytes);
+  } catch (const ProtocolError& e) {
+    ++malformed_;
+    Log("robot '" + *robot_name + "': dropped a malformed hello: " + e.what());
+    return;
+  }
+  const HelloAnswer answer = gate_->Answer(*robot_name, hello, received);
+  if (answer.session_id == 0) {
+    Log("robot '" + *robot_name + "': refused a hello of client " +
+        Hex64(static_cast<std::uint64_t>(hello.body.client_id)) + ": " + answer.refusal);
+  }
+  transport_.Publish(HelloAnswerChannel(*robot_name, hello.body.client_id), EncodeHelloAnswer(answer));
 }
 
 void ServerDaemon::Drain(Robot& robot) {
@@ -230,15 +302,23 @@ void ServerDaemon::Drain(Robot& robot) {
 
 void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
   const std::string channel = ReplyChannel(robot, batch.client_id);
+  batch.server_id = server_id_;
+  if (batch.session_id == 0) batch.session_id = gate_->LiveSession(robot, batch.client_id);
   const auto publish = [&](ReplyBatch& part) {
     part.server_send = clock_.Now();
-    const std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
+    std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
+    if (part.session_status == SessionStatus::kOk && !gate_->Seal(part.session_id, bytes)) {
+      ++unsealable_;  // its session closed: the client said hello again and failed these
+      return;
+    }
     for (int copies = faults_.Copies(); copies > 0; --copies) transport_.Publish(channel, bytes);
   };
   // Split long batches so each package stays well under LCM's 64 KB.
   std::size_t bytes = 0;
-  ReplyBatch part{batch.client_id, batch.ack_sequence, batch.server_receive, {}, {}};
-  for (Reply& r : batch.replies) {
+  std::vector<Reply> replies = std::move(batch.replies);
+  ReplyBatch part = batch;  // the header fields
+  part.replies.clear();
+  for (Reply& r : replies) {
     bytes += 64 + r.message.size() + 8 * r.values.size();
     part.replies.push_back(std::move(r));
     if (bytes > kMaxBatchBytes) {
@@ -247,13 +327,17 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
       bytes = 0;
     }
   }
-  if (!part.replies.empty() || part.ack_sequence != 0) publish(part);
+  if (!part.replies.empty() || part.ack_sequence != 0 || part.session_status != SessionStatus::kOk) {
+    publish(part);
+  }
 }
 
 void ServerDaemon::Watchdogs(TimePoint now) {
+  gate_->ExpirePending(now);
   for (auto& [name, robot] : robots_) {
     if (robot.daemon->CheckOverrun(now)) Drain(robot);
     for (const ExpiredSession& e : robot.sessions->Expire(now)) {
+      gate_->Close(name, e.client_id);  // a package of it is never executed again
       // Quiet for the ordinary case: a short-lived client (the CLI) that is done.
       if (e.dropped_commands == 0 && !e.moved_robot) continue;
       Log("robot '" + name + "': client " + Hex64(static_cast<std::uint64_t>(e.client_id)) +
@@ -268,6 +352,8 @@ void ServerDaemon::Announce(TimePoint now) {
   a.server_time = now;
   a.uptime = started_ == TimePoint::min() ? Duration(0) : now - started_;
   a.url_hint = transport_.url();
+  a.traffic_layout = options_.traffic_layout;
+  a.keyed = gate_->keyed();
   for (const auto& [name, robot] : robots_) {
     if (!robot.refused.empty()) continue;
     const RobotModel& m = robot.daemon->model();

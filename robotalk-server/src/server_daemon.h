@@ -17,6 +17,7 @@
 #include "robot_sessions.h"
 #include "robotalk/clock.h"
 #include "robotalk/transport.h"
+#include "session_gate.h"
 
 #include <atomic>
 #include <cstdint>
@@ -51,6 +52,10 @@ struct ServerDaemonOptions {
   /// would execute every command). Off: one robot, one server (see
   /// ServerDaemon::OnAnnounce).
   bool allow_duplicate_robots = false;
+  /// Open or keyed mode (session_gate.h).
+  SessionGateOptions gate;
+  /// Announced so that clients on another layout say so (docs/protocol.md).
+  TrafficLayout traffic_layout = TrafficLayout::kSingle;
 };
 
 class ServerDaemon {
@@ -83,6 +88,7 @@ class ServerDaemon {
   std::int64_t server_id() const { return server_id_; }
   /// Packages dropped because their bytes could not be decoded at all.
   std::uint64_t malformed() const { return malformed_; }
+  const SessionGate& gate() const { return *gate_; }
 
  private:
   struct Robot {
@@ -95,6 +101,10 @@ class ServerDaemon {
   };
 
   void OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes);
+  void OnHello(const std::string& channel, std::span<const std::uint8_t> bytes);
+  // The gate's verdict on a decoded request; false when Handle must not run.
+  bool Gate(Robot& robot, const std::string& name, Request& request, std::span<const std::uint8_t> bytes,
+            TimePoint received);
   void OnAnnounce(std::span<const std::uint8_t> bytes);
   void Send(const std::string& robot, ReplyBatch& batch);
   void Drain(Robot& robot);
@@ -110,7 +120,9 @@ class ServerDaemon {
   PanicLatch latch_;
   std::map<std::string, std::string> latched_at_start_;
   std::map<std::string, Robot> robots_;
+  std::unique_ptr<SessionGate> gate_;
   std::unique_ptr<Subscription> subscription_;
+  std::unique_ptr<Subscription> hello_subscription_;
   std::unique_ptr<Subscription> announce_subscription_;
   TimePoint started_ = TimePoint::min();  // first RunOnce
   std::vector<ReplyBatch> to_send_;
@@ -118,6 +130,7 @@ class ServerDaemon {
   int event_fd_ = -1;
   std::int64_t server_id_ = 0;
   std::uint64_t malformed_ = 0;
+  std::uint64_t unsealable_ = 0;  // replies of sessions closed before they were sent
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   // Rate limit of the log.

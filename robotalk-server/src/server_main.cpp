@@ -37,6 +37,10 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --log-lines-per-second N        most log lines a second; the rest are counted (default 20)
   --panic-latch FILE              keep which robots are in panic in FILE, so a panic survives a
                                   restart (written before a panic is acknowledged)
+  --key FILE                      keyed mode: the server's secret key (robotalk-keygen); with --clients
+  --clients FILE                  keyed mode: the access list of client keys and their rights per
+                                  robot (docs/security.md); without both the server runs open
+  --max-sessions N                most client sessions in the whole server (default 1024)
   --allow-duplicate-robots        serve a robot even when another server announces the same name
                                   (by default the server that started later refuses it)
   --simulate SEQ.txt              instead of serving: run the sequence file (docs/client.md
@@ -91,6 +95,12 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         sample_period = ParseNumber(arg, value(), 0.001, 3600);
       } else if (arg == "--allow-duplicate-robots") {
         options.allow_duplicate_robots = true;
+      } else if (arg == "--key") {
+        options.key_file = value();
+      } else if (arg == "--clients") {
+        options.clients_file = value();
+      } else if (arg == "--max-sessions") {
+        options.max_sessions = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--panic-latch") {
         options.panic_latch_path = value();
       } else if (arg == "--log-lines-per-second") {

@@ -30,6 +30,13 @@ class ReplyCache {
   void RecordReply(const Reply& reply);
   /// The final replies known for a package's items (for a retransmission).
   std::vector<Reply> RepliesFor(std::int64_t sequence) const;
+  /// nullopt: the id is not in the cache; a nullopt inside: received, no
+  /// final reply yet; else its final reply.
+  std::optional<std::optional<Reply>> Lookup(CommandId id) const {
+    const auto it = replies_.find(id);
+    if (it == replies_.end()) return std::nullopt;
+    return it->second;
+  }
 
  private:
   size_t max_packages_;

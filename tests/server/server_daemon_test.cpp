@@ -6,6 +6,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
+#include "session_test_util.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -21,6 +22,7 @@ using std::chrono::milliseconds;
 using testing::FakeDriver;
 using ::testing::HasSubstr;
 using testing::PanRobot;
+using testing::SayHello;
 
 constexpr std::int64_t kAlice = 0xA11CE;
 
@@ -43,7 +45,11 @@ class ServerDaemonTest : public ::testing::Test {
         });
   }
 
-  void Send(const std::string& robot, const Request& r) {
+  // Sends in the client's session on that robot (said hello to first).
+  void Send(const std::string& robot, Request r) {
+    std::int64_t& session = sessions_[{robot, r.client_id}];
+    if (session == 0) session = SayHello(client_, robot, r.client_id, [this] { Step(); }).session_id;
+    r.session_id = session;
     client_.Publish(RequestChannel(robot), EncodeRequest(r));
   }
   // One ServerDaemon iteration, every RobotDaemon once, another ServerDaemon
@@ -65,6 +71,7 @@ class ServerDaemonTest : public ::testing::Test {
   std::unique_ptr<Subscription> reply_sub_;
   std::vector<std::string> channels_;
   std::map<std::string, std::map<CommandId, Reply>> replies_;
+  std::map<std::pair<std::string, std::int64_t>, std::int64_t> sessions_;
 };
 
 TEST_F(ServerDaemonTest, RoutesAPackageToItsRobotAndAnswersOnTheClientsReplyChannel) {
@@ -160,7 +167,9 @@ TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
   server.AddRobot(robot, SessionOptions{});
   EXPECT_TRUE(robot.in_panic()) << "the restarted server starts in panic";
   EXPECT_THAT(robot.fault(), HasSubstr("latched before this server started"));
-  Request move{.client_id = kAlice, .sequence = 1};
+  const std::int64_t session =
+      SayHello(client, "bot", kAlice, [&] { server.RunOnce(Duration(0)); }).session_id;
+  Request move{.client_id = kAlice, .session_id = session, .sequence = 1};
   move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
   client.Publish(RequestChannel("bot"), EncodeRequest(move));
   server.RunOnce(Duration(0));
@@ -168,7 +177,7 @@ TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
   client.HandleFor(Duration(0));
   EXPECT_EQ(replies.at(1).signal, Signal::kPanic);
   EXPECT_TRUE(fake->calls.empty());
-  Request reset{.client_id = kAlice, .sequence = 2};
+  Request reset{.client_id = kAlice, .session_id = session, .sequence = 2};
   reset.commands.push_back(Command{2, CommandType::kPanicReset, std::nullopt, "", {}});
   client.Publish(RequestChannel("bot"), EncodeRequest(reset));
   server.RunOnce(Duration(0));
@@ -216,7 +225,11 @@ TEST(ServerDaemonOneRobotOneServer, TheServerThatStartedLaterRefusesTheRobotAndN
       client.Subscribe("ROBOTALK/bot/REPLY/.*", [&](const std::string&, std::span<const std::uint8_t> b) {
         for (Reply& r : DecodeReplyBatch(b).replies) replies[r.id] = r;
       });
-  Request move{.client_id = kAlice, .sequence = 1};
+  const std::int64_t session = SayHello(client, "bot", kAlice, [&] {
+                                 first.RunOnce(Duration(0));
+                                 second.RunOnce(Duration(0));
+                               }).session_id;
+  Request move{.client_id = kAlice, .session_id = session, .sequence = 1};
   move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
   client.Publish(RequestChannel("bot"), EncodeRequest(move));
   for (int i = 0; i < 2; ++i) {

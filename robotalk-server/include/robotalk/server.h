@@ -50,6 +50,13 @@ struct ServerOptions {
   std::string panic_latch_path;
   /// Serve a robot even when another server announces the same name.
   bool allow_duplicate_robots = false;
+  /// Keyed mode (docs/security.md): the server's secret key file and the
+  /// access list of client keys and rights. Both or neither; neither = open
+  /// mode (any process on the LAN may command the robots).
+  std::string key_file;
+  std::string clients_file;
+  /// Most sessions (open and not yet used) in the whole server.
+  std::size_t max_sessions = 1024;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
   /// The paper's congestion injector (§VI-B): after each received package the

@@ -1,0 +1,305 @@
+// Issue 9's reproducers against the ServerDaemon's session gate, bytes in and
+// out on the in-memory bus: replays across sessions and restarts (open and
+// keyed mode), spoofing, forged MACs, sequence poisoning, rights, and the
+// COMMAND_STATUS / SERVER_COUNTERS queries.
+#include "fake_driver.h"
+#include "robotalk/channels.h"
+#include "robotalk/memory_transport.h"
+#include "robotalk/request.h"
+#include "server_daemon.h"
+#include "session_test_util.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+namespace robotalk {
+namespace {
+
+using testing::FakeDriver;
+using ::testing::HasSubstr;
+using testing::PanRobot;
+using testing::SayHello;
+
+constexpr std::int64_t kAlice = 0xA11CE;
+constexpr std::int64_t kMallory = 0xBAD;
+
+// One server (replaceable: Restart) with robot "bot" on a bus, and a client's
+// view of the bus: replies by id and every reply package's status.
+class GateTest : public ::testing::Test {
+ protected:
+  explicit GateTest(SessionGateOptions gate = {}) : gate_(std::move(gate)) {
+    Restart();
+    sub_ = client_.Subscribe("ROBOTALK/bot/REPLY/.*",
+                             [this](const std::string&, std::span<const std::uint8_t> b) {
+                               ReplyBatch batch = DecodeReplyBatch(b);
+                               batches_.push_back(batch);
+                               for (Reply& r : batch.replies) replies_[r.id] = r;
+                             });
+  }
+
+  void Restart() {
+    server_.reset();
+    robot_.reset();
+    auto driver = std::make_unique<FakeDriver>(PanRobot());
+    fake_ = driver.get();
+    robot_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
+    server_ = std::make_unique<ServerDaemon>(transport_, clock_, ServerDaemonOptions{.gate = gate_});
+    server_->AddRobot(*robot_, SessionOptions{});
+  }
+
+  void Step() {
+    server_->RunOnce(Duration(0));
+    robot_->RunOnce(clock_.Now());
+    server_->RunOnce(Duration(0));
+    client_.HandleFor(Duration(0));
+  }
+
+  std::int64_t OpenSession(std::int64_t client_id) {
+    return SayHello(client_, "bot", client_id, [this] { Step(); }).session_id;
+  }
+
+  static Request Move(std::int64_t client, std::int64_t session, std::int64_t sequence, CommandId id) {
+    Request r{.client_id = client, .session_id = session, .sequence = sequence};
+    r.commands.push_back(Command{id, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+    return r;
+  }
+
+  std::vector<std::uint8_t> Publish(const std::vector<std::uint8_t>& bytes) {
+    client_.Publish(RequestChannel("bot"), bytes);
+    Step();
+    return bytes;
+  }
+
+  std::size_t Executed() const { return fake_->calls.size(); }
+
+  SessionGateOptions gate_;
+  ManualClock clock_;
+  std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
+  MemoryTransport transport_{bus_};
+  MemoryTransport client_{bus_};
+  FakeDriver* fake_ = nullptr;
+  std::unique_ptr<RobotDaemon> robot_;
+  std::unique_ptr<ServerDaemon> server_;
+  std::unique_ptr<Subscription> sub_;
+  std::vector<ReplyBatch> batches_;
+  std::map<CommandId, Reply> replies_;
+};
+
+TEST_F(GateTest, APackageOutsideAnySessionIsAnsweredSessionUnknownAndNotExecuted) {
+  Publish(EncodeRequest(Move(kAlice, 0, 1, 1)));
+  Publish(EncodeRequest(Move(kAlice, 123456789, 2, 2)));  // a made-up session
+  EXPECT_EQ(Executed(), 0u);
+  ASSERT_EQ(batches_.size(), 2u);
+  for (const ReplyBatch& b : batches_) {
+    EXPECT_EQ(b.session_status, SessionStatus::kUnknown);
+    EXPECT_TRUE(b.replies.empty());
+  }
+  EXPECT_EQ(server_->gate().counters().unknown_session, 2u);
+}
+
+TEST_F(GateTest, ARecordedSessionReplayedOnARestartedServerDoesNotRun) {
+  // Issue 9: after kill -9 and a restart, a recorded GOTO / set-points ran again.
+  const std::int64_t session = OpenSession(kAlice);
+  const auto recorded = Publish(EncodeRequest(Move(kAlice, session, 1, 1)));
+  ASSERT_EQ(Executed(), 1u);
+  Restart();          // the new instance has its own sessions
+  Publish(recorded);  // what lcm-logplayer would send
+  EXPECT_EQ(Executed(), 0u) << "a package of a session this instance did not open never runs";
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown);
+  EXPECT_NE(batches_.back().server_id, batches_.front().server_id) << "replies name the new instance";
+}
+
+TEST_F(GateTest, APackageOfAnExpiredSessionIsNotExecutedAgain) {
+  // Issue 9: after the session expired, all 7 commands of a recorded sequence ran again.
+  const std::int64_t session = OpenSession(kAlice);
+  const auto recorded = Publish(EncodeRequest(Move(kAlice, session, 1, 1)));
+  ASSERT_EQ(Executed(), 1u);
+  clock_.Advance(std::chrono::seconds(3));  // past the 2 s session timeout
+  Step();
+  const std::size_t after_expiry = Executed();
+  Publish(recorded);
+  EXPECT_EQ(Executed(), after_expiry);
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown);
+  // The client says hello again and goes on.
+  const std::int64_t fresh = OpenSession(kAlice);
+  Publish(EncodeRequest(Move(kAlice, fresh, 2, 2)));
+  EXPECT_EQ(replies_.at(2).signal, Signal::kSuccess);
+}
+
+TEST_F(GateTest, AnotherClientsSessionIdIsRefused) {
+  const std::int64_t session = OpenSession(kAlice);
+  Publish(EncodeRequest(Move(kMallory, session, 1, 1)));
+  EXPECT_EQ(Executed(), 0u);
+  EXPECT_EQ(server_->gate().counters().wrong_client, 1u);
+}
+
+TEST_F(GateTest, CommandStatusTellsWhatBecameOfACommand) {
+  const std::int64_t session = OpenSession(kAlice);
+  Publish(EncodeRequest(Move(kAlice, session, 1, 7)));
+  Request ask{.client_id = kAlice, .session_id = session, .sequence = 2};
+  ask.queries.push_back(Query{.id = 8, .type = QueryType::kCommandStatus, .about = 7});
+  ask.queries.push_back(Query{.id = 9, .type = QueryType::kCommandStatus, .about = 99});
+  Publish(EncodeRequest(ask));
+  EXPECT_EQ(replies_.at(8).signal, Signal::kSuccess) << replies_.at(8).message;
+  EXPECT_EQ(replies_.at(9).signal, Signal::kNa);
+  EXPECT_THAT(replies_.at(9).message, HasSubstr("never received in this session"));
+}
+
+TEST_F(GateTest, ServerCountersNameAndCountRefusals) {
+  Publish(EncodeRequest(Move(kAlice, 42, 1, 1)));
+  const std::int64_t session = OpenSession(kAlice);
+  Request ask{.client_id = kAlice, .session_id = session, .sequence = 2};
+  ask.queries.push_back(Query{.id = 5, .type = QueryType::kServerCounters});
+  Publish(EncodeRequest(ask));
+  const Reply& r = replies_.at(5);
+  ASSERT_EQ(r.signal, Signal::kSuccess);
+  EXPECT_THAT(r.message, HasSubstr("unknown_session"));
+  std::istringstream names(r.message);
+  std::string name;
+  for (std::size_t i = 0; names >> name; ++i) {
+    ASSERT_LT(i, r.values.size());
+    if (name == "unknown_session" || name == "hellos") {
+      EXPECT_EQ(r.values[i], 1.0) << name;
+    }
+  }
+}
+
+TEST_F(GateTest, InOpenModeAPanicOutsideAnySessionStillStopsTheRobot) {
+  Request panic{.client_id = kAlice, .sequence = 1, .panic = true};
+  Publish(EncodeRequest(panic));
+  EXPECT_TRUE(robot_->in_panic());
+}
+
+// --- keyed mode ------------------------------------------------------------
+
+KeyPair Key(std::uint8_t seed) {
+  std::array<std::uint8_t, SecretKey::kSeedBytes> bytes{};
+  bytes.fill(seed);
+  return KeyPair::FromSeed(bytes);
+}
+
+SessionGateOptions Keyed() {
+  SessionGateOptions gate;
+  gate.identity = std::make_shared<const KeyPair>(Key(1));
+  const std::string list = Key(2).public_key.ToString() + " alice *=all\n" + Key(3).public_key.ToString() +
+                           " monitor *=query,panic\n";
+  gate.access = std::make_shared<const AccessList>(AccessList::Parse(list, "test"));
+  return gate;
+}
+
+class KeyedGateTest : public GateTest {
+ protected:
+  KeyedGateTest() : GateTest(Keyed()) {}
+
+  struct Client {
+    std::int64_t id = 0;
+    SessionKeys keys;
+    std::int64_t sequence = 0;
+  };
+  // A handshake as the client library does it; nullopt when refused.
+  std::optional<Client> Handshake(const KeyPair& key, std::int64_t client_id,
+                                  std::string* refusal = nullptr) {
+    ClientHandshake handshake(key, client_id);
+    Hello hello{.keyed = true, .body = handshake.hello()};
+    const HelloAnswer answer = SayHello(
+        client_, "bot", client_id, [this] { Step(); }, hello);
+    if (answer.session_id == 0) {
+      if (refusal) *refusal = answer.refusal;
+      return std::nullopt;
+    }
+    return Client{client_id, handshake.Finish(answer.body), 0};
+  }
+  std::vector<std::uint8_t> Sealed(Client& c, Request r) {
+    r.client_id = c.id;
+    r.session_id = c.keys.session_id;
+    r.sequence = ++c.sequence;
+    std::vector<std::uint8_t> bytes = EncodeRequest(r);
+    WriteMacField(bytes, ComputeMac(c.keys.client_to_server, c.keys.session_id, MacCoveredBytes(bytes)));
+    return bytes;
+  }
+  static Request Commands(CommandType type, CommandId id, std::vector<double> values = {}) {
+    Request r;
+    r.commands.push_back(
+        Command{id, type, std::nullopt, type == CommandType::kJointSetPoint ? "pan" : "", values});
+    return r;
+  }
+};
+
+TEST_F(KeyedGateTest, RefusesAnOpenHelloAndAnUnlistedKey) {
+  const HelloAnswer open = SayHello(client_, "bot", kAlice, [this] { Step(); });
+  EXPECT_EQ(open.session_id, 0);
+  EXPECT_THAT(open.refusal, HasSubstr("keyed mode"));
+  std::string why;
+  EXPECT_FALSE(Handshake(Key(9), kMallory, &why));
+  EXPECT_THAT(why, HasSubstr("not in the access list"));
+}
+
+TEST_F(KeyedGateTest, ExecutesSealedPackagesOnceAndDropsForgedOnes) {
+  auto alice = Handshake(Key(2), kAlice);
+  ASSERT_TRUE(alice);
+  const auto bytes = Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
+  EXPECT_EQ(replies_.at(1).signal, Signal::kSuccess);
+  EXPECT_TRUE(batches_.back().mac != Mac{}) << "replies are sealed";
+  Publish(bytes);  // a replay inside the session: a duplicate
+  EXPECT_EQ(Executed(), 1u);
+  auto forged = Sealed(*alice, Commands(CommandType::kJointSetPoint, 2, {-2.0}));
+  forged[forged.size() - 1] ^= 1;
+  Publish(forged);
+  EXPECT_EQ(Executed(), 1u);
+  EXPECT_EQ(server_->gate().counters().forged, 1u);
+  EXPECT_EQ(replies_.count(2), 0u) << "a forged package gets no answer";
+}
+
+TEST_F(KeyedGateTest, ASpoofedClientIdCannotMoveTheRobotOrPoisonTheSequence) {
+  // Issue 9: 40 sequences under the victim's id, and one heartbeat with
+  // sequence INT64_MAX, took over the victim's session.
+  auto alice = Handshake(Key(2), kAlice);
+  ASSERT_TRUE(alice);
+  Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
+  std::string why;
+  EXPECT_FALSE(Handshake(Key(3), kAlice, &why)) << "another key may not take Alice's client id";
+  Request poison{.client_id = kAlice, .session_id = alice->keys.session_id, .sequence = INT64_MAX};
+  Publish(EncodeRequest(poison));  // no key, zero MAC
+  Request spoof = Move(kAlice, alice->keys.session_id, 2, 2);
+  spoof.commands[0].values = {-2.0};
+  Publish(EncodeRequest(spoof));
+  EXPECT_EQ(Executed(), 1u);
+  Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 3, {0.25})));
+  EXPECT_EQ(replies_.at(3).signal, Signal::kSuccess) << "Alice's own next package still runs";
+  EXPECT_EQ(Executed(), 2u);
+}
+
+TEST_F(KeyedGateTest, ASessionRecordedBeforeARestartNeverRunsAgain) {
+  auto alice = Handshake(Key(2), kAlice);
+  ASSERT_TRUE(alice);
+  const auto recorded = Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
+  Restart();
+  Publish(recorded);
+  EXPECT_EQ(Executed(), 0u);
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown);
+}
+
+TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
+  // Issue 9: a random client id reset another client's panic and stopped its GOTO.
+  auto alice = Handshake(Key(2), kAlice);
+  auto monitor = Handshake(Key(3), kMallory);
+  ASSERT_TRUE(alice && monitor);
+  Request panic;
+  panic.panic = true;
+  Publish(Sealed(*monitor, panic));
+  EXPECT_TRUE(robot_->in_panic()) << "monitor may raise a panic";
+  Publish(Sealed(*monitor, Commands(CommandType::kPanicReset, 10)));
+  EXPECT_TRUE(robot_->in_panic()) << "but not reset it";
+  EXPECT_EQ(replies_.at(10).signal, Signal::kError);
+  EXPECT_THAT(replies_.at(10).message, HasSubstr("monitor"));
+  Publish(Sealed(*monitor, Commands(CommandType::kStop, 11)));
+  EXPECT_EQ(replies_.at(11).signal, Signal::kError) << "nor stop the robot";
+  Publish(Sealed(*alice, Commands(CommandType::kPanicReset, 12)));
+  EXPECT_FALSE(robot_->in_panic());
+  EXPECT_EQ(server_->gate().counters().rights_refused, 2u);
+}
+
+}  // namespace
+}  // namespace robotalk
