@@ -12,6 +12,9 @@
 #include "robotalk/channels.h"
 #include "robotalk/robot_client.h"
 
+#include "robotalk/keys.h"
+#include "robotalk/protocol_codec.h"
+#include "robotalk/session_auth.h"
 #include "robotalk/transport.h"
 
 #include <atomic>
@@ -19,6 +22,7 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -101,6 +105,28 @@ class RobotClient::Impl {
   std::unique_ptr<Subscription> state_subscription_;                             // GUARDED_BY(mu_)
   std::function<void(const StateSample&)> on_state_;                             // GUARDED_BY(mu_)
 
+  // The session (docs/protocol.md, Sessions): opened by a hello, named in
+  // every package; lost when the server no longer knows it.
+  std::int64_t session_id_ = 0;                   // GUARDED_BY(mu_); 0 = none yet
+  std::int64_t server_id_ = 0;                    // GUARDED_BY(mu_); the instance that opened it
+  std::optional<SessionKeys> session_keys_;       // GUARDED_BY(mu_); keyed mode
+  std::unique_ptr<ClientHandshake> handshake_;    // GUARDED_BY(mu_); keyed: the hello in flight
+  Nonce hello_nonce_{};                           // GUARDED_BY(mu_)
+  bool hello_due_ = false;                        // GUARDED_BY(mu_)
+  TimePoint next_hello_{};                        // GUARDED_BY(mu_)
+  std::string hello_refusal_;                     // GUARDED_BY(mu_); non-empty: no session possible
+  bool resync_ = false;                           // GUARDED_BY(mu_); new instance: re-sync clock, config
+  std::optional<CommandId> resync_config_query_;  // GUARDED_BY(mu_)
+  std::optional<std::uint64_t> resync_hash_;      // GUARDED_BY(mu_): the new instance's config
+  std::optional<KeyPair> identity_;               // keyed mode; set at construction
+  std::optional<PublicKey> pinned_server_;        // keyed mode; set at construction
+
+  /// Waits for a session (REQUIRES: `lock` holds mu_). Throws ClientError
+  /// when the server refused the hello, TimeoutError when none answered.
+  void WaitSession(std::unique_lock<std::mutex>& lock);
+  /// Keyed mode: writes the package's MAC (REQUIRES: mu_ held).
+  void Seal(std::vector<std::uint8_t>& bytes);
+
  private:
   void Run();  // the ReadDaemon
   void Tick(TimePoint now);
@@ -109,7 +135,20 @@ class RobotClient::Impl {
   void OnConfig(std::span<const std::uint8_t> bytes);
   Duration IdleWait(TimePoint now);
   std::vector<std::uint8_t> EncodeHeartbeat(TimePoint now);  // REQUIRES: mu_ held
-
+  void OnHelloAnswer(std::span<const std::uint8_t> bytes);
+  /// The hello to publish now, or empty (REQUIRES: mu_ held).
+  std::vector<std::uint8_t> DueHello(TimePoint now);
+  /// The server no longer knows the session: fails every outstanding item as
+  /// an unknown outcome and says hello again (REQUIRES: mu_ held); returns
+  /// the ids to fail (outside the lock).
+  std::vector<CommandId> LoseSession(TimePoint now);
+  /// True when a reply package belongs to the live session (REQUIRES: mu_ held).
+  bool AcceptReplyPackage(const robotalk_msgs::reply_package_t& pkg, std::span<const std::uint8_t> bytes,
+                          TimePoint now, std::vector<CommandId>& lost);
+  void LoadKeys();
+  void Resync();  // after a new server instance: clock samples, configuration
+  void NoteResyncReplies(const std::vector<Reply>& replies);
+  void AttachLocked(const std::string& robot);  // REQUIRES: mu_ held
   std::unique_ptr<Transport> own_transport_;
   Transport* transport_ = nullptr;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;  // GUARDED_BY(mu_)

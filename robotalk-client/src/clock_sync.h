@@ -20,7 +20,14 @@ class ClockSync {
   bool AddSample(TimePoint t1, TimePoint t2, TimePoint t3, TimePoint t4);
 
   /// True once at least one sample was accepted.
-  bool synced() const { return best_round_trip_.has_value(); }
+  bool synced() const { return best_round_trip_.has_value() || restarted_; }
+  /// A new server instance: the next sample replaces the offset whatever its
+  /// round trip (until then the old offset stands).
+  void Restart() {
+    restarted_ = synced();
+    best_round_trip_.reset();
+    num_samples_ = 0;
+  }
   /// server clock − client clock, from the sample with the smallest round trip
   /// (zero before the first sample).
   Duration offset() const { return offset_; }
@@ -36,6 +43,7 @@ class ClockSync {
   Duration offset_{0};
   std::optional<Duration> best_round_trip_;
   int num_samples_ = 0;
+  bool restarted_ = false;
 };
 
 }  // namespace robotalk::client

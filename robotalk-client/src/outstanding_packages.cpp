@@ -11,7 +11,16 @@ Duration OutstandingPackages::BaseTimeout() const {
   return srtt_ ? std::max(policy_.interval, *srtt_ + 4 * rttvar_) : policy_.interval;
 }
 
-Duration OutstandingPackages::retransmit_timeout() const { return BaseTimeout() * (1 << timer_backoff_); }
+Duration OutstandingPackages::Ceiling() const {
+  // No gap between two sends of a package is longer than max_interval, nor a
+  // quarter of the give-up bound (a package is resent at least ~4 times
+  // before it is given up), unless the measured round trip itself is longer.
+  return std::max(BaseTimeout(), std::min(policy_.max_interval, policy_.give_up_after / 4));
+}
+
+Duration OutstandingPackages::retransmit_timeout() const {
+  return std::min(BaseTimeout() * (1 << timer_backoff_), Ceiling());
+}
 
 Duration OutstandingPackages::IntervalAt(int step) const {
   // A package backs off on its own resends (step) and with every package
@@ -21,8 +30,7 @@ Duration OutstandingPackages::IntervalAt(int step) const {
   const Duration base = BaseTimeout();
   const double factor = std::pow(std::max(1.0, policy_.backoff), std::max(step, timer_backoff_));
   const double ns = static_cast<double>(base.count()) * factor;
-  // The usual cap never undercuts the measured round trip or the timer back-off.
-  const Duration cap = std::max(policy_.max_interval, retransmit_timeout());
+  const Duration cap = Ceiling();
   if (ns >= static_cast<double>(cap.count())) return cap;
   return std::max(base, Duration(static_cast<Duration::rep>(ns)));
 }
@@ -125,8 +133,16 @@ std::optional<std::int64_t> OutstandingPackages::OnReply(CommandId id, TimePoint
 std::vector<OutstandingPackages::Resend> OutstandingPackages::TakeDue(TimePoint now) {
   std::vector<Resend> due;
   bool timed_out = false;
+  std::size_t deferred = 0;
   for (auto& [sequence, p] : packages_) {
     if (now < p.next_send) continue;
+    if (due.size() >= kMaxResendsPerCall) {
+      // Paced: a burst of due packages (a loss burst, 1000 in flight) leaves
+      // kMaxResendsPerCall at a time, one pacing step apart, instead of all
+      // at once into a receive buffer that just overflowed.
+      p.next_send = now + kPacingStep * static_cast<int>(1 + deferred++ / kMaxResendsPerCall);
+      continue;
+    }
     due.push_back({sequence, p.bytes});
     timed_out = timed_out || !p.acked;
     ++p.sends;

@@ -5,10 +5,13 @@
 //
 // Policy:
 //  - Unacknowledged: resend after the retransmission timeout (RTO), then
-//    RTO·backoff, RTO·backoff², ... capped at max(`max_interval`, RTO). The RTO
+//    RTO·backoff, RTO·backoff², ... capped at min(`max_interval`,
+//    `give_up_after`/4) (or the measured RTO when that is longer). The RTO
 //    adapts to the measured round trips as in TCP (RFC 6298: smoothed RTT +
 //    4 × its variation, Karn's rule), never below `interval`, and doubles
-//    after each timeout until a fresh round-trip sample (§5.5).
+//    after each timeout until a fresh round-trip sample (§5.5), within the
+//    same cap. At most kMaxResendsPerCall packages leave per TakeDue(); the
+//    rest are paced kPacingStep apart.
 //  - Acknowledged but items unanswered: ask again (resend the same sequence;
 //    the server re-sends the replies it has) only once the earliest unanswered
 //    item's start time has passed, starting again from `interval` and backing
@@ -104,6 +107,9 @@ class OutstandingPackages {
     TimePoint last_heard{};
   };
   Duration IntervalAt(int step) const;
+  Duration Ceiling() const;
+  static constexpr std::size_t kMaxResendsPerCall = 32;
+  static constexpr Duration kPacingStep = std::chrono::milliseconds(1);
   Duration BaseTimeout() const;
   void AddRoundTrip(Duration rtt);
   std::optional<Duration> srtt_;

@@ -64,6 +64,8 @@ RobotClient::Impl::Impl(ClientOptions options)
     }
     transport_ = own_transport_.get();
   }
+  LoadKeys();
+  for (std::random_device rd; auto& b : hello_nonce_) b = static_cast<std::uint8_t>(rd());
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw ClientError(std::string("RobotClient: eventfd failed: ") + std::strerror(errno));
   last_send_ = clock_.Now();
@@ -91,7 +93,16 @@ void RobotClient::Impl::WakeDaemon() {
 }
 
 void RobotClient::Impl::Attach(const std::string& robot) {
-  std::lock_guard lock(mu_);
+  {
+    std::lock_guard lock(mu_);
+    AttachLocked(robot);
+    hello_due_ = true;  // the ReadDaemon says hello
+    next_hello_ = clock_.Now();
+  }
+  WakeDaemon();
+}
+
+void RobotClient::Impl::AttachLocked(const std::string& robot) {
   robot_ = robot;
   request_channel_ = RequestChannel(robot);
   const std::string reply_channel = ReplyChannel(robot, client_id_);
@@ -100,6 +111,9 @@ void RobotClient::Impl::Attach(const std::string& robot) {
         reply_channel, [this](const std::string&, std::span<const std::uint8_t> b) { OnReplyPackage(b); }));
     subscriptions_.push_back(transport_->Subscribe(
         ConfigChannel(robot), [this](const std::string&, std::span<const std::uint8_t> b) { OnConfig(b); }));
+    subscriptions_.push_back(transport_->Subscribe(
+        HelloAnswerChannel(robot, client_id_),
+        [this](const std::string&, std::span<const std::uint8_t> b) { OnHelloAnswer(b); }));
   } catch (const TransportError& e) {
     throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel + ": " + e.what());
   }
@@ -138,9 +152,11 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
   std::vector<std::uint8_t> bytes;
   std::string channel;
   {
-    std::lock_guard lock(mu_);
+    std::unique_lock lock(mu_);
     if (daemon_error_) std::rethrow_exception(std::exchange(daemon_error_, nullptr));
     if (robot_.empty()) throw ClientError("RobotClient: not connected (call Connect first)");
+    WaitSession(lock);
+    p.header.session_id = session_id_;
     channel = request_channel_;
     const TimePoint now = clock_.Now();
     sent.sequence = next_sequence_++;
@@ -170,6 +186,7 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
       items.push_back({q.id, std::nullopt});
     }
     bytes = Encode(p);
+    Seal(bytes);
     for (CommandId id : sent.ids) cache_->Expect(id);
     if (track == Track::kRetransmit) outstanding_.Add(sent.sequence, bytes, std::move(items), now);
     if (clock_query) clock_packages_.insert(sent.sequence);
@@ -284,26 +301,37 @@ void RobotClient::Impl::Tick(TimePoint now) {
   std::vector<client::OutstandingPackages::Resend> resends;
   std::vector<client::OutstandingPackages::Expired> expired;
   std::vector<std::uint8_t> heartbeat;
+  std::vector<std::uint8_t> hello;
   std::string channel;
+  std::string hello_channel;
+  bool resync = false;
   {
     std::lock_guard lock(mu_);
     if (robot_.empty()) return;
     channel = request_channel_;
+    hello = DueHello(now);
+    if (!hello.empty()) hello_channel = HelloChannel(robot_);
+    if (resync_ && session_id_ != 0) {
+      resync = true;
+      resync_ = false;
+    }
     resends = outstanding_.TakeDue(now);
     expired = outstanding_.TakeExpired(now);
     stats_.retransmissions += resends.size();
     stats_.gave_up += expired.size();
     for (const auto& e : expired) clock_packages_.erase(e.sequence);
     if (!resends.empty()) last_send_ = now;
-    if (now - last_send_ >= options_.heartbeat_interval) {
+    if (session_id_ != 0 && now - last_send_ >= options_.heartbeat_interval) {
       heartbeat = EncodeHeartbeat(now);
       last_send_ = now;
       ++stats_.heartbeats;
       ++stats_.packages_sent;
     }
   }
+  if (!hello.empty()) Publish(hello_channel, hello);
   for (const auto& r : resends) Publish(channel, r.bytes);
   if (!heartbeat.empty()) Publish(channel, heartbeat);
+  if (resync) Resync();
   for (const auto& e : expired) {
     const std::string why = "no answer from robot about package " + std::to_string(e.sequence) + " (" +
                             (e.acked ? "acknowledged" : "never acknowledged") + ") for " +
@@ -316,12 +344,15 @@ std::vector<std::uint8_t> RobotClient::Impl::EncodeHeartbeat(TimePoint now) {
   robotalk_msgs::package_t p{};
   p.header.protocol_version = kProtocolVersion;
   p.header.client_id = client_id_;
+  p.header.session_id = session_id_;
   p.header.sequence = next_sequence_++;
   p.header.send_time_us = ToWireMicros(now);
   p.header.panic = false;
   p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
   p.header.payload_size = 0;
-  return Encode(p);
+  std::vector<std::uint8_t> bytes = Encode(p);
+  Seal(bytes);
+  return bytes;
 }
 
 void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
@@ -348,6 +379,16 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
       }
     }
     bool notify = false;
+    std::vector<CommandId> lost;
+    const auto fail_lost = [&] {
+      for (CommandId id : lost) {
+        cache_->Fail(id, "id " + std::to_string(id) +
+                             ": the server instance that had it restarted or forgot this client's session; "
+                             "it may or may not have run, and was not sent again");
+      }
+      if (!lost.empty()) WakeDaemon();  // say hello again at once
+    };
+    bool accepted = false;
     {
       std::lock_guard lock(mu_);
       stats_.malformed_packages += bad;
@@ -355,6 +396,14 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
         ++stats_.malformed_packages;
         return;
       }
+      accepted = AcceptReplyPackage(pkg, bytes, now, lost);
+    }
+    if (!accepted) {
+      fail_lost();
+      return;
+    }
+    {
+      std::lock_guard lock(mu_);
       if (pkg.ack_sequence > 0) {
         const auto info = outstanding_.OnAck(pkg.ack_sequence, now);
         if (info.known && info.first && clock_packages_.erase(pkg.ack_sequence) != 0 && !info.retransmitted) {
@@ -370,6 +419,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
       for (const Reply& r : replies) outstanding_.OnReply(r.id, now);
     }
     if (notify) cv_.notify_all();
+    NoteResyncReplies(replies);
     std::uint64_t filed = 0, ignored = 0;
     for (const Reply& r : replies) (cache_->Put(r) ? filed : ignored)++;
     std::lock_guard lock(mu_);
@@ -393,6 +443,10 @@ void RobotClient::Impl::OnConfig(std::span<const std::uint8_t> bytes) {
       auto model = std::make_shared<const RobotModel>(DecodeConfig(bytes));
       {
         std::lock_guard lock(mu_);
+        if (resync_hash_ == hash) {
+          model_ = model;  // the new server instance's description
+          resync_hash_.reset();
+        }
         models_.emplace(hash, std::move(model));
       }
       cv_.notify_all();

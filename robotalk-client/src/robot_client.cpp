@@ -63,7 +63,7 @@ std::optional<Reply> Resolve(client::ReturnCache::Outcome o, CommandId id, const
     case Kind::kReply:
       return std::move(o.reply);
     case Kind::kFailed:
-      if (o.timed_out) throw TimeoutError(what + " (id " + std::to_string(id) + "): " + o.failure);
+      if (o.timed_out) throw UnknownOutcomeError(what + " (id " + std::to_string(id) + "): " + o.failure);
       throw ClientError(what + " (id " + std::to_string(id) + "): " + o.failure);
     case Kind::kUnknown:
       throw ClientError(what + " (id " + std::to_string(id) +
@@ -195,7 +195,12 @@ void RobotClient::Connect(const std::string& robot) {
   }
   {
     std::lock_guard lock(impl_->mu_);
-    if (!impl_->clock_sync_.synced()) throw timeout("no CLOCK answer");
+    if (!impl_->clock_sync_.synced()) {
+      const ClientStats& st = impl_->stats_;
+      throw timeout("no CLOCK answer (" + std::to_string(st.packages_sent) + " packages sent, " +
+                    std::to_string(st.retransmissions) + " resent, " + std::to_string(st.replies_filed) +
+                    " replies)");
+    }
   }
 
   // 2. Configuration: ask, learn its hash from the reply, wait for the
@@ -315,6 +320,12 @@ Reply RobotClient::Execute(Command command) {
 Reply RobotClient::Query(QueryType type, const std::string& target) {
   return Query(robotalk::Query{.type = type, .target = target});
 }
+
+Reply RobotClient::CommandStatus(CommandId id) {
+  return Query(robotalk::Query{.type = QueryType::kCommandStatus, .about = id});
+}
+
+Reply RobotClient::ServerCounters() { return Query(robotalk::Query{.type = QueryType::kServerCounters}); }
 
 Reply RobotClient::Query(robotalk::Query query) {
   RequireConnected(*this, "Query");

@@ -3,6 +3,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "robotalk_msgs/announce_t.hpp"
 
 #include <cstdio>
@@ -35,7 +36,44 @@ FakeServer::FakeServer(Transport& transport, RobotModel model, FakeServerOptions
     : transport_(transport), model_(std::move(model)), options_(options), rng_(options.seed) {
   sub_ = transport_.Subscribe(RequestChannel(model_.name()),
                               [this](const std::string&, std::span<const std::uint8_t> b) { OnRequest(b); });
+  hello_sub_ =
+      transport_.Subscribe(HelloChannel(model_.name()),
+                           [this](const std::string&, std::span<const std::uint8_t> b) { OnHello(b); });
   worker_ = std::thread([this] { Worker(); });
+}
+
+void FakeServer::OnHello(std::span<const std::uint8_t> bytes) {
+  Hello hello;
+  try {
+    hello = DecodeHello(bytes);
+  } catch (const std::exception&) {
+    return;
+  }
+  HelloAnswer answer;
+  {
+    std::lock_guard lock(mu_);
+    ++hellos_;
+    if (options_.mute) return;
+    answer.server_id = server_id_;
+    answer.session_id = sessions_[hello.body.client_id] = ++next_session_;
+    answer.body.client_id = hello.body.client_id;
+    answer.body.client_nonce = hello.body.client_nonce;
+  }
+  transport_.Publish(HelloAnswerChannel(model_.name(), hello.body.client_id), EncodeHelloAnswer(answer));
+}
+
+void FakeServer::Restart() {
+  std::lock_guard lock(mu_);
+  ++server_id_;
+  sessions_.clear();
+  seen_.clear();
+  finals_.clear();
+  delayed_.clear();
+}
+
+int FakeServer::hellos() const {
+  std::lock_guard lock(mu_);
+  return hellos_;
 }
 
 FakeServer::~FakeServer() {
@@ -102,6 +140,8 @@ bool FakeServer::panic() const {
 
 void FakeServer::SendLocked(robotalk_msgs::reply_package_t p) {
   p.protocol_version = kProtocolVersion;
+  p.server_id = server_id_;
+  if (p.session_status == robotalk_msgs::reply_package_t::SESSION_OK) p.session_id = sessions_[p.client_id];
   p.server_send_us = ServerNowUs();
   p.num_replies = static_cast<std::int32_t>(p.replies.size());
   if (std::uniform_real_distribution<double>(0, 1)(rng_) < options_.reply_drop_probability) return;
@@ -127,6 +167,13 @@ void FakeServer::OnRequest(std::span<const std::uint8_t> bytes) {
   out.client_id = h.client_id;
   out.ack_sequence = h.sequence;
   out.server_receive_us = receive_us;
+  if (auto session = sessions_.find(h.client_id);
+      session == sessions_.end() || session->second != h.session_id) {
+    out.session_status = robotalk_msgs::reply_package_t::SESSION_UNKNOWN;
+    out.session_id = h.session_id;
+    SendLocked(out);
+    return;
+  }
 
   const auto key = std::make_pair(h.client_id, h.sequence);
   if (auto it = seen_.find(key); it != seen_.end()) {

@@ -48,6 +48,10 @@ class FakeServer {
   FakeServer& operator=(const FakeServer&) = delete;
 
   void SetMute(bool mute);
+  /// As if the server process restarted: a new instance id, no sessions, no
+  /// memory of packages; packages of old sessions are answered SESSION_UNKNOWN.
+  void Restart();
+  int hellos() const;
   /// Publishes one announce_t for this robot.
   void Announce(std::int64_t server_id);
 
@@ -61,6 +65,7 @@ class FakeServer {
 
  private:
   void OnRequest(std::span<const std::uint8_t> bytes);
+  void OnHello(std::span<const std::uint8_t> bytes);
   void SendLocked(robotalk_msgs::reply_package_t p);  // REQUIRES: mu_
   void Worker();
 
@@ -74,6 +79,11 @@ class FakeServer {
   RobotModel model_;
   FakeServerOptions options_;
   std::unique_ptr<Subscription> sub_;
+  std::unique_ptr<Subscription> hello_sub_;
+  std::int64_t server_id_ = 1;                     // GUARDED_BY(mu_)
+  std::map<std::int64_t, std::int64_t> sessions_;  // GUARDED_BY(mu_): client -> session
+  std::int64_t next_session_ = 1000;               // GUARDED_BY(mu_)
+  int hellos_ = 0;                                 // GUARDED_BY(mu_)
   mutable std::mutex mu_;
   std::mt19937_64 rng_;
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::int64_t>> seen_;  // (client, seq) -> ids

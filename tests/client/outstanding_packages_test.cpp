@@ -30,12 +30,44 @@ TEST(OutstandingPackages, ResendsAnUnackedPackageWithBackoff) {
   OutstandingPackages o(Policy());
   o.Add(1, Bytes(1), {{.id = 10}}, kT0);
   const auto times = ResendTimes(o, milliseconds(2000));
-  // 100 ms, then doubling, capped at max_interval (400 ms) -- until the timer
-  // back-off of unanswered timeouts (RFC 6298 §5.5) lifts the cap to 800 ms.
-  const std::vector<Duration> expected = {milliseconds(100), milliseconds(300), milliseconds(700),
-                                          milliseconds(1100), milliseconds(1900)};
+  // 100 ms, then doubling, capped at max_interval (400 ms); the timer
+  // back-off of unanswered timeouts (RFC 6298 §5.5) stays within that cap.
+  const std::vector<Duration> expected = {milliseconds(100),  milliseconds(300),  milliseconds(700),
+                                          milliseconds(1100), milliseconds(1500), milliseconds(1900)};
   EXPECT_EQ(times, expected);
-  EXPECT_EQ(o.retransmissions(), 5u);
+  EXPECT_EQ(o.retransmissions(), 6u);
+}
+
+// Issue 9 / 11: the shared back-off reached 6.4 s, past the 5 s give-up, so a
+// command that ran was given up without a single resend in its last seconds.
+TEST(OutstandingPackages, TheBackoffNeverOutlastsAQuarterOfTheGiveUpBound) {
+  RetransmitPolicy policy = Policy();
+  policy.max_interval = seconds(30);  // a careless setting
+  OutstandingPackages o(policy);
+  for (int i = 0; i < 50; ++i) o.Add(i + 1, Bytes(1), {{.id = i + 1}}, kT0);  // nothing ever answers
+  const auto times = ResendTimes(o, milliseconds(1900));
+  ASSERT_GE(times.size(), 4u);
+  for (std::size_t i = 1; i < times.size(); ++i) {
+    EXPECT_LE(times[i] - times[i - 1], policy.give_up_after / 4 + milliseconds(10)) << "gap " << i;
+  }
+  EXPECT_LE(o.retransmit_timeout(), policy.give_up_after / 4);
+}
+
+// Issue 11: 1,000 packages in flight were all resent in one burst into a
+// receive buffer that had just overflowed.
+TEST(OutstandingPackages, ABurstOfDuePackagesIsPaced) {
+  OutstandingPackages o(Policy());
+  for (int i = 0; i < 100; ++i) o.Add(i + 1, Bytes(1), {{.id = i + 1}}, kT0);
+  const TimePoint due = kT0 + milliseconds(100);
+  EXPECT_EQ(o.TakeDue(due).size(), 32u);
+  EXPECT_TRUE(o.TakeDue(due).empty()) << "the rest wait their pacing step";
+  std::size_t sent = 32;
+  for (int ms = 1; ms <= 4; ++ms) {
+    const std::size_t n = o.TakeDue(due + milliseconds(ms)).size();
+    EXPECT_LE(n, 32u);
+    sent += n;
+  }
+  EXPECT_EQ(sent, 100u) << "every package left within a few milliseconds";
 }
 
 TEST(OutstandingPackages, AFreshRoundTripResetsTheTimerBackoff) {

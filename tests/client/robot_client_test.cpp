@@ -75,6 +75,35 @@ TEST_F(RobotClientTest, ExecuteReturnsTheFinalReplyAndTheServerExecutesOnce) {
   EXPECT_EQ(js.values.size(), 3u * static_cast<size_t>(model_.num_dofs()));
 }
 
+// Issue 9: after a server restart three commands were never executed and the
+// CLI named only the first; the client ignored the new instance.
+TEST_F(RobotClientTest, AServerRestartAnswersOutstandingCommandsAsUnknownOutcomesAndTheClientGoesOn) {
+  StartServer();
+  auto client = Connected(Options());
+  std::vector<PendingReply> pending;
+  for (int i = 0; i < 3; ++i) {
+    pending.push_back(
+        client->Send(Command{.type = CommandType::kJointSetPoint,
+                             .start_time = StartTime::At(client->ServerNow() + std::chrono::seconds(30)),
+                             .target = "pan",
+                             .values = {0.1 * i}}));
+  }
+  server_->Restart();
+  for (auto& p : pending) {
+    try {
+      p.Wait(std::chrono::seconds(5));
+      ADD_FAILURE() << "id " << p.id() << " answered";
+    } catch (const UnknownOutcomeError& e) {
+      EXPECT_NE(std::string(e.what()).find("may or may not have run"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(client->stats().sessions_lost, 1u);
+  Reply r = client->Stop();  // a new session with the new instance
+  EXPECT_EQ(r.signal, Signal::kSuccess);
+  EXPECT_EQ(server_->hellos(), 2);
+  EXPECT_EQ(client->stats().sessions_opened, 2u);
+}
+
 TEST_F(RobotClientTest, CommandIdsIncrease) {
   StartServer();
   auto client = Connected(Options());

@@ -15,6 +15,15 @@ class TimeoutError : public Error {
   using Error::Error;
 };
 
+/// The client cannot tell whether a command ran: it gave up retransmitting a
+/// package the server may have received, or the server instance that had it
+/// is gone (restarted) or forgot the session. Ask with
+/// RobotClient::CommandStatus (same session) or re-plan from the robot's state.
+class UnknownOutcomeError : public TimeoutError {
+ public:
+  using TimeoutError::TimeoutError;
+};
+
 /// The client cannot do what was asked: not connected, already connected, LCM
 /// could not be initialised, a package too large, or the client is closing.
 class ClientError : public Error {

@@ -88,6 +88,12 @@ struct ClientOptions {
   double drop_probability = 0.0;       ///< package silently not sent
   double duplicate_probability = 0.0;  ///< package sent twice
   std::uint64_t fault_seed = 1;
+  /// Keyed mode (docs/security.md): this client's secret key file. Empty:
+  /// $ROBOTALK_KEY if set, else open mode.
+  std::string key_file;
+  /// Keyed mode: the server's public key file (.pub); when set, a server
+  /// answering with another key is refused (pinning).
+  std::string server_key_file;
 };
 
 /// The handle of a non-blocking call. Movable, not copyable. Destroying it
@@ -181,6 +187,9 @@ struct ClientStats {
   std::uint64_t replies_ignored = 0;     ///< duplicates, unknown ids
   std::uint64_t malformed_packages = 0;  ///< undecodable reply packages dropped
   std::uint64_t gave_up = 0;             ///< packages abandoned
+  std::uint64_t sessions_opened = 0;     ///< hellos answered with a session
+  std::uint64_t sessions_lost = 0;       ///< the server no longer knew the session (restart, expiry)
+  std::uint64_t replies_refused = 0;     ///< keyed: reply packages whose MAC did not verify
 };
 
 class RobotClient {
@@ -232,6 +241,13 @@ class RobotClient {
   Reply Execute(Command command);
   Reply Query(QueryType type, const std::string& target = "");
   Reply Query(robotalk::Query query);
+  /// What became of command `id` of this client's current session (after an
+  /// UnknownOutcomeError from giving up): its own final reply once it ended,
+  /// BUSY while it waits or runs, NA when the session never received it. A
+  /// session lost to a server restart cannot be asked (docs/protocol.md, Sessions).
+  Reply CommandStatus(CommandId id);
+  /// The server's refusal counters (values; the message names them).
+  Reply ServerCounters();
 
   // --- Non-blocking calls ----------------------------------------------------
   PendingReply Send(Command command);

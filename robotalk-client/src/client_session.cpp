@@ -1,0 +1,199 @@
+// RobotClient::Impl's session (docs/protocol.md, Sessions): the hello and its
+// answer, sealing packages and checking replies in keyed mode, and what
+// happens when the server no longer knows the session (a restart, an expiry).
+#include "client_impl.h"
+#include "robotalk/config_codec.h"
+#include "robotalk/request.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+
+namespace robotalk {
+namespace {
+
+constexpr Duration kHelloRepeat = std::chrono::milliseconds(250);
+
+std::string SecondsText(Duration d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g s", ToSeconds(d));
+  return buf;
+}
+
+}  // namespace
+
+void RobotClient::Impl::LoadKeys() {
+  std::string key_file = options_.key_file;
+  if (key_file.empty()) {
+    if (const char* env = std::getenv("ROBOTALK_KEY"); env != nullptr) key_file = env;
+  }
+  try {
+    if (!key_file.empty()) identity_ = ReadSecretKeyFile(key_file);
+    if (!options_.server_key_file.empty()) pinned_server_ = ReadPublicKeyFile(options_.server_key_file).key;
+  } catch (const Error& e) {
+    throw ClientError(std::string("RobotClient: ") + e.what());
+  }
+  if (pinned_server_ && !identity_) {
+    throw ClientError("RobotClient: a server key to pin (" + options_.server_key_file +
+                      ") needs a client key too (--key FILE or ROBOTALK_KEY)");
+  }
+}
+
+std::vector<std::uint8_t> RobotClient::Impl::DueHello(TimePoint now) {
+  if (!hello_due_ || robot_.empty() || now < next_hello_) return {};
+  next_hello_ = now + kHelloRepeat;
+  Hello hello;
+  if (identity_) {
+    if (!handshake_) handshake_ = std::make_unique<ClientHandshake>(*identity_, client_id_);
+    hello.keyed = true;
+    hello.body = handshake_->hello();
+  } else {
+    hello.body.client_id = client_id_;
+    hello.body.client_nonce = hello_nonce_;
+  }
+  hello_nonce_ = hello.body.client_nonce;
+  return EncodeHello(hello);
+}
+
+void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
+  HelloAnswer answer;
+  try {
+    answer = DecodeHelloAnswer(bytes);
+  } catch (const ProtocolError&) {
+    std::lock_guard lock(mu_);
+    ++stats_.malformed_packages;
+    return;
+  }
+  {
+    std::lock_guard lock(mu_);
+    if (!hello_due_ || answer.body.client_id != client_id_ || answer.body.client_nonce != hello_nonce_) {
+      return;  // another client's, or an answer to an earlier hello
+    }
+    if (answer.session_id == 0) {
+      hello_refusal_ = "robot '" + robot_ + "' refused this client's hello: " + answer.refusal;
+      hello_due_ = false;
+    } else if (identity_) {
+      try {
+        if (!answer.keyed) throw AuthError("the server answered in open mode, this client has a key");
+        SessionKeys keys = handshake_->Finish(answer.body, pinned_server_ ? &*pinned_server_ : nullptr);
+        if (keys.session_id != answer.session_id) throw AuthError("the answer's session id does not match");
+        session_keys_ = std::move(keys);
+      } catch (const AuthError& e) {
+        hello_refusal_ = "robot '" + robot_ + "': the server's answer failed authentication: " + e.what();
+        hello_due_ = false;
+      }
+    }
+    if (hello_refusal_.empty()) {
+      if (server_id_ != 0 && answer.server_id != server_id_) resync_ = true;
+      session_id_ = answer.session_id;
+      server_id_ = answer.server_id;
+      hello_due_ = false;
+      handshake_.reset();
+      ++stats_.sessions_opened;
+    }
+  }
+  cv_.notify_all();
+  WakeDaemon();  // the re-sync, if any
+}
+
+void RobotClient::Impl::WaitSession(std::unique_lock<std::mutex>& lock) {
+  if (session_id_ != 0) return;
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(options_.connect_timeout);
+  cv_.wait_until(lock, deadline, [&] { return session_id_ != 0 || !hello_refusal_.empty(); });
+  if (!hello_refusal_.empty()) throw ClientError("RobotClient: " + hello_refusal_);
+  if (session_id_ == 0) {
+    throw TimeoutError("RobotClient: no answer to HELLO from robot '" + robot_ + "' within " +
+                       SecondsText(options_.connect_timeout) + " (is a server offering it?)");
+  }
+}
+
+void RobotClient::Impl::Seal(std::vector<std::uint8_t>& bytes) {
+  if (!session_keys_) return;
+  WriteMacField(bytes, ComputeMac(session_keys_->client_to_server, session_id_, MacCoveredBytes(bytes)));
+}
+
+std::vector<CommandId> RobotClient::Impl::LoseSession(TimePoint now) {
+  std::vector<CommandId> lost = outstanding_.Clear();
+  clock_packages_.clear();
+  session_id_ = 0;
+  session_keys_.reset();
+  hello_due_ = true;
+  next_hello_ = now;
+  for (std::random_device rd; auto& b : hello_nonce_) b = static_cast<std::uint8_t>(rd());
+  ++stats_.sessions_lost;
+  return lost;
+}
+
+bool RobotClient::Impl::AcceptReplyPackage(const robotalk_msgs::reply_package_t& pkg,
+                                           std::span<const std::uint8_t> bytes, TimePoint now,
+                                           std::vector<CommandId>& lost) {
+  if (pkg.session_status == robotalk_msgs::reply_package_t::SESSION_UNKNOWN) {
+    // Unsealed by nature (the server has no key for it): believed only for
+    // the live session. A forger can make the client say hello again; it
+    // could as well drop every package (docs/security.md, availability).
+    if (session_id_ == 0 || pkg.session_id != session_id_) return false;
+    const std::string old = Hex64(static_cast<std::uint64_t>(server_id_));
+    lost = LoseSession(now);
+    if (!lost.empty()) {
+      std::fprintf(stderr,
+                   "robotalk: robot '%s': server %s no longer knows this client's session (restarted, or "
+                   "the session expired); %zu outstanding items may or may not have run\n",
+                   robot_.c_str(), old.c_str(), lost.size());
+    }
+    return false;
+  }
+  if (session_id_ == 0 || pkg.session_id != session_id_) return false;  // an old session's
+  if (session_keys_ &&
+      !VerifyMac(session_keys_->server_to_client, session_id_, MacCoveredBytes(bytes), ReadMacField(bytes))) {
+    ++stats_.replies_refused;
+    return false;
+  }
+  return true;
+}
+
+// A new server instance: its clock may differ (another host), and it may
+// serve another description under the robot's name. The ReadDaemon sends
+// CLOCK queries and a CONFIG query; their replies update the offset and the
+// model without any caller waiting.
+void RobotClient::Impl::Resync() {
+  {
+    std::lock_guard lock(mu_);
+    clock_sync_.Restart();
+  }
+  try {
+    for (int i = 0; i < 3; ++i) {
+      SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false, Track::kRetransmit, true);
+    }
+    const Sent sent =
+        SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false, Track::kRetransmit);
+    std::lock_guard lock(mu_);
+    resync_config_query_ = sent.ids.front();
+  } catch (const Error& e) {
+    std::fprintf(stderr, "robotalk: re-syncing with the new server instance failed: %s\n", e.what());
+  }
+}
+
+void RobotClient::Impl::NoteResyncReplies(const std::vector<Reply>& replies) {
+  std::lock_guard lock(mu_);
+  if (!resync_config_query_) return;
+  for (const Reply& r : replies) {
+    if (r.id != *resync_config_query_) continue;
+    resync_config_query_.reset();
+    std::uint64_t hash = 0;
+    try {
+      hash = std::stoull(r.message, nullptr, 16);
+    } catch (const std::exception&) {
+      return;
+    }
+    if (model_ && ConfigHash(*model_) == hash) return;
+    if (const auto it = models_.find(hash); it != models_.end()) {
+      model_ = it->second;
+    } else {
+      resync_hash_ = hash;  // OnConfig installs it when it arrives
+    }
+  }
+}
+
+}  // namespace robotalk
