@@ -143,6 +143,8 @@ std::string ResolveLcmUrl(const std::string& url) {
   return (env != nullptr && *env != '\0') ? std::string(env) : std::string(kLcmDefaultUrl);
 }
 
+std::string MainLcmUrl(const std::string& url) { return ParseTrafficUrl(ResolveLcmUrl(url)).lcm_url; }
+
 std::unique_ptr<Transport> OpenLcmTransport(const std::string& url, const OpenLcmOptions& options) {
   const TrafficUrl parsed = ParseTrafficUrl(ResolveLcmUrl(url));
   if (parsed.layout == TrafficLayout::kSplit) {

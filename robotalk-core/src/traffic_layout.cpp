@@ -10,6 +10,7 @@ namespace robotalk {
 namespace {
 
 constexpr std::string_view kUdpm = "udpm://";
+constexpr int kLcmDefaultPort = 7667;  // LCM's port for a udpm URL that gives none
 
 // The parts of "udpm://host:port?options" (options without the '?').
 struct UdpmParts {
@@ -24,6 +25,9 @@ UdpmParts SplitUdpm(const std::string& url) {
   const std::string address =
       url.substr(kUdpm.size(), query == std::string::npos ? query : query - kUdpm.size());
   const std::size_t colon = address.rfind(':');
+  if (colon == std::string::npos && !address.empty()) {
+    return {address, kLcmDefaultPort, query == std::string::npos ? "" : url.substr(query + 1)};
+  }
   int port = 0;
   const char* first = address.data() + (colon == std::string::npos ? 0 : colon + 1);
   const char* last = address.data() + address.size();
@@ -32,7 +36,7 @@ UdpmParts SplitUdpm(const std::string& url) {
       port <= 0 || port > 65535) {
     throw TransportError(
         "traffic layout: '" + url +
-        "' does not name a group and a port (udpm://GROUP:PORT); the split layout needs both");
+        "' does not name a group and a port (udpm://GROUP:PORT)");
   }
   return {address.substr(0, colon), port, query == std::string::npos ? "" : url.substr(query + 1)};
 }

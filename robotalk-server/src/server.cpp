@@ -4,7 +4,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
-#include "robotalk/lcm_transport.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "server_daemon.h"
 
 #include <atomic>
@@ -59,7 +59,7 @@ class Server::Impl {
       : options_(std::move(options)), clock_(clock) {
     if (specs.empty()) throw Error("Server: no robot to serve");
     if (!transport) {
-      owned_transport_ = std::make_unique<LcmTransport>(LcmTransportOptions{.url = options_.lcm_url});
+      owned_transport_ = OpenLcmTransport(options_.lcm_url);
       transport = owned_transport_.get();
     }
     server_daemon_ = std::make_unique<ServerDaemon>(

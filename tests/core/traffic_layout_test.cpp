@@ -86,7 +86,7 @@ TEST(TrafficLayout, RefusesBadTrafficOptionsNamingTheUrl) {
               ::testing::ThrowsMessage<TransportError>(HasSubstr("needs a udpm:// URL")));
   EXPECT_THAT([] { ParseTrafficUrl("udpm://239.255.76.67:65500"); },
               ::testing::ThrowsMessage<TransportError>(HasSubstr("65500..65565")));
-  EXPECT_THAT([] { ParseTrafficUrl("udpm://239.255.76.67"); },
+  EXPECT_THAT([] { ParseTrafficUrl("udpm://239.255.76.67:port"); },
               ::testing::ThrowsMessage<TransportError>(HasSubstr("udpm://GROUP:PORT")));
   EXPECT_THAT([] { ParseTrafficUrl(""); }, ::testing::ThrowsMessage<TransportError>(HasSubstr("empty URL")));
   // traffic=single needs no port: LCM decides what it accepts.
@@ -100,6 +100,7 @@ TEST(TrafficLayout, DerivesEachLaneUrlFromTheMainUrlByPort) {
   EXPECT_EQ(LaneUrl(main, ReplyLaneOf(0)), "udpm://239.255.76.67:7669?ttl=0&recv_buf_size=4096");
   EXPECT_EQ(LaneUrl(main, kLaneCount - 1), "udpm://239.255.76.67:7732?ttl=0&recv_buf_size=4096");
   EXPECT_EQ(LaneUrl("udpm://239.255.76.67:7667", 1), "udpm://239.255.76.67:7668");
+  EXPECT_EQ(LaneUrl("udpm://239.255.76.67?ttl=0", 1), "udpm://239.255.76.67:7668?ttl=0");  // LCM's port
   EXPECT_THROW(LaneUrl(main, kLaneCount), TransportError);
   EXPECT_THROW(LaneUrl(main, -1), TransportError);
   EXPECT_THROW(LaneUrl("memq://", 1), TransportError);

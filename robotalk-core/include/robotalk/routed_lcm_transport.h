@@ -82,4 +82,10 @@ std::unique_ptr<Transport> OpenLcmTransport(const std::string& url, const OpenLc
 /// udpm://239.255.76.67:7667?ttl=0); any other URL unchanged.
 std::string ResolveLcmUrl(const std::string& url);
 
+/// The LCM URL of RoboTalk URL `url`'s main lane (default resolved, traffic=
+/// removed): where ANNOUNCE, CONFIG and STATE travel in either layout, for
+/// tools that open LCM themselves to watch them. Throws TransportError as
+/// ParseTrafficUrl.
+std::string MainLcmUrl(const std::string& url);
+
 }  // namespace robotalk

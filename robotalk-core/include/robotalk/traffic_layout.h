@@ -69,7 +69,8 @@ struct TrafficUrl {
 /// default URL first). udpm:// defaults to split; other schemes are single.
 /// Throws TransportError for a traffic= value other than single|split, for
 /// traffic=split on a scheme other than udpm://, and, for split, for a udpm
-/// URL without a port or whose lanes would pass port 65535.
+/// URL without a valid group:port (no port = LCM's 7667) or whose lanes
+/// would pass port 65535.
 TrafficUrl ParseTrafficUrl(const std::string& url);
 
 /// The LCM URL of lane `lane` (0..kLaneCount-1) of split main URL `lcm_url`
