@@ -237,7 +237,7 @@ Impairments (set both directions; --a2b-NAME / --b2a-NAME set one and win):
                           message U[0, X] ms before the next may pass
   --channels REGEX        forward only channels fully matching REGEX (default .*)
 
-Example: --a udpm://239.255.76.67:7667?ttl=0 --b udpm://239.255.76.67:7668?ttl=0
+Example: --a udpm://239.255.76.67:7667?ttl=0 --b udpm://239.255.76.67:7767?ttl=0
          --a2b-congestion-max-ms 250 --latency-ms 5 --seed 7 --stats
 )";
 }
