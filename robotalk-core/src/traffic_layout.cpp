@@ -34,9 +34,8 @@ UdpmParts SplitUdpm(const std::string& url) {
   const auto [end, ec] = std::from_chars(first, last, port);
   if (colon == std::string::npos || colon == 0 || ec != std::errc() || end != last || first == last ||
       port <= 0 || port > 65535) {
-    throw TransportError(
-        "traffic layout: '" + url +
-        "' does not name a group and a port (udpm://GROUP:PORT)");
+    throw TransportError("traffic layout: '" + url +
+                         "' does not name a group and a port (udpm://GROUP:PORT)");
   }
   return {address.substr(0, colon), port, query == std::string::npos ? "" : url.substr(query + 1)};
 }
