@@ -26,6 +26,27 @@ class MultiLaneSubscription final : public Subscription {
   std::vector<std::unique_ptr<Subscription>> parts_;
 };
 
+// A udpm LcmTransport of the single layout that says so in its url(), so that
+// what a server prints and announces is a URL its clients can use as is.
+class SingleUdpmTransport final : public Transport {
+ public:
+  SingleUdpmTransport(LcmTransportOptions options, std::string url)
+      : inner_(std::move(options)), url_(std::move(url)) {}
+  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+    inner_.Publish(channel, bytes);
+  }
+  std::unique_ptr<Subscription> Subscribe(const std::string& channel_regex, Handler handler) override {
+    return inner_.Subscribe(channel_regex, std::move(handler));
+  }
+  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
+  int fileno() const override { return inner_.fileno(); }
+  std::string url() const override { return url_; }
+
+ private:
+  LcmTransport inner_;
+  const std::string url_;
+};
+
 }  // namespace
 
 RoutedLcmTransport::RoutedLcmTransport(std::string lcm_url, OpenLcmOptions options)
@@ -152,6 +173,11 @@ std::unique_ptr<Transport> OpenLcmTransport(const std::string& url, const OpenLc
   }
   LcmTransportOptions o = options.lane;
   o.url = parsed.lcm_url;
+  if (parsed.lcm_url.starts_with("udpm://")) {
+    const std::string lcm_url = LcmTransport::EffectiveUrl(o);
+    return std::make_unique<SingleUdpmTransport>(
+        o, lcm_url + (lcm_url.find('?') == std::string::npos ? "?" : "&") + "traffic=single");
+  }
   return std::make_unique<LcmTransport>(o);
 }
 

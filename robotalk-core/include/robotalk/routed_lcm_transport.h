@@ -73,9 +73,10 @@ class RoutedLcmTransport final : public Transport {
 
 /// Opens LCM on RoboTalk URL `url` ("" = $LCM_DEFAULT_URL, else LCM's
 /// default udpm://239.255.76.67:7667?ttl=0): a RoutedLcmTransport for the
-/// split layout, a plain LcmTransport for the single one (traffic=single,
-/// memq://, file://), with `options.lane` either way. Throws TransportError
-/// naming the URL (bad traffic= option, LCM cannot start).
+/// split layout, an LcmTransport for the single one (traffic=single,
+/// memq://, file://; for udpm its url() ends in traffic=single), with
+/// `options.lane` either way. Throws TransportError naming the URL (bad
+/// traffic= option, LCM cannot start).
 std::unique_ptr<Transport> OpenLcmTransport(const std::string& url, const OpenLcmOptions& options = {});
 
 /// `url` with LCM's default resolved ("" -> $LCM_DEFAULT_URL or
