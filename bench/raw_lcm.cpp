@@ -17,6 +17,8 @@
 // Each prints one JSON line on stdout. Every loop is bounded in count and time.
 #include "bench_util.h"
 #include "robotalk/channels.h"
+#include "robotalk/routed_lcm_transport.h"
+#include "robotalk/traffic_layout.h"
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
 #include "robotalk_msgs/robot_state_t.hpp"
@@ -247,13 +249,21 @@ int Watch(const Args& a) {
   return 0;
 }
 
+// The LCM URL that carries a RoboTalk server's `channel` for RoboTalk URL
+// `url`: its lane in the split traffic layout, or the one URL.
+std::string UrlOfChannel(const std::string& url, const std::string& channel) {
+  const robotalk::TrafficUrl t = robotalk::ParseTrafficUrl(robotalk::ResolveLcmUrl(url));
+  if (t.layout == robotalk::TrafficLayout::kSingle) return t.lcm_url;
+  return robotalk::LaneUrl(t.lcm_url, robotalk::LaneOfChannel(channel));
+}
+
 // K sessions that only send heartbeats (what an idle RobotClient sends).
 int Sessions(const Args& a) {
-  lcm::LCM lcm(a.Str("url", ""));
+  const std::string channel = robotalk::RequestChannel(a.Str("robot", "pioneer"));
+  lcm::LCM lcm(UrlOfChannel(a.Str("url", ""), channel));
   CheckGood(lcm, a);
   const long k = a.Int("count", 100);
   const std::int64_t end = MonoNs() + static_cast<std::int64_t>(a.Num("seconds", 5) * 1e9);
-  const std::string channel = robotalk::RequestChannel(a.Str("robot", "pioneer"));
   robotalk_msgs::package_t p{};
   p.header.protocol_version = 1;
   p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
@@ -296,11 +306,11 @@ class ArrivalLog {
 };
 
 int Arrivals(const Args& a) {
-  lcm::LCM lcm(a.Str("url", ""));
+  const std::string channel = robotalk::RequestChannel(a.Str("robot", "pioneer"));
+  lcm::LCM lcm(UrlOfChannel(a.Str("url", ""), channel));
   CheckGood(lcm, a);
   ArrivalLog log;
-  lcm.subscribe(robotalk::RequestChannel(a.Str("robot", "pioneer")), &ArrivalLog::On, &log)
-      ->setQueueCapacity(10000);
+  lcm.subscribe(channel, &ArrivalLog::On, &log)->setQueueCapacity(10000);
   const long frames = a.Int("frames", 40);
   const std::int64_t end = MonoNs() + static_cast<std::int64_t>(a.Num("timeout", 60) * 1e9);
   while (static_cast<long>(log.arrival_ns.size()) < frames && MonoNs() < end) lcm.handleTimeout(100);

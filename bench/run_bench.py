@@ -20,8 +20,9 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 URL = "udpm://239.255.76.67:7990?ttl=0"
-URL_A = "udpm://239.255.76.67:7992?ttl=0"  # playback: client side of the relay
-URL_B = "udpm://239.255.76.67:7993?ttl=0"  # playback: server side
+# Each URL's split traffic layout uses 66 ports from its own (docs/protocol.md): no overlaps.
+URL_A = "udpm://239.255.76.67:8100?ttl=0"  # playback: client side of the relay
+URL_B = "udpm://239.255.76.67:8200?ttl=0"  # playback: server side
 ROBOT = "pioneer"
 
 
@@ -200,13 +201,16 @@ class Bench:
         return {"figure": "throughput", "count": n, "cap_s": cap, "runs": runs, "inflight1000_runs": big}
 
     def scale(self):
-        seconds = 5 if self.quick else 30
+        seconds = self.args.scale_seconds or (5 if self.quick else 30)
+        # The traffic layout (docs/protocol.md, Channels): RoboTalk's default
+        # split, or everything on one URL with --traffic single.
+        url = URL + (f"&traffic={self.args.traffic}" if self.args.traffic else "")
         levels = []
         for n in (8, 16, 32, 64):
-            srv = self.start_server()
+            srv = self.start_server(url=url)
             allowance = 2.0 + 0.1 * n
             start_at = time.monotonic_ns() + int(allowance * 1e9)
-            procs = [self.start([self.client, "stream", "--url", URL, "--seconds", str(seconds), "--rate", "100",
+            procs = [self.start([self.client, "stream", "--url", url, "--seconds", str(seconds), "--rate", "100",
                                  "--delay-ms", "100", "--start-at", str(start_at)]) for _ in range(n)]
             time.sleep(max(0.0, (start_at - time.monotonic_ns()) / 1e9))
             t0, c0, m0 = time.monotonic(), self.cpu_ticks(srv.pid), self.machine_cpu()
@@ -217,7 +221,7 @@ class Bench:
             clients = [self.collect(p, seconds + allowance + 20, "stream") for p in procs]
             levels.append({"clients": n, "seconds": seconds, "server_cpu_pct": server_pct, "machine": machine,
                            "per_client": clients})
-        return {"figure": "scale", "levels": levels}
+        return {"figure": "scale", "traffic": self.args.traffic or "split", "levels": levels}
 
     def cli(self):
         k = 5 if self.quick else 10
@@ -321,6 +325,9 @@ def main():
     ap.add_argument("--quick", action="store_true", help="a ~2 minute smoke run (fewer, shorter runs)")
     ap.add_argument("--only", default="", help="comma-separated figures: " + ",".join(FIGURES))
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "latest"))
+    ap.add_argument("--traffic", choices=["split", "single"], default=None,
+                    help="scale: the traffic layout (default: RoboTalk's, split)")
+    ap.add_argument("--scale-seconds", type=float, default=None, help="scale: seconds per level (default 30)")
     args = ap.parse_args()
     only = [f for f in args.only.split(",") if f] or [f for f in FIGURES if not (args.quick and f == "ode")]
     os.makedirs(args.out, exist_ok=True)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # RoboTalk across several hosts, on one machine: a server host, two client
-# hosts and an lcm-logger host, each a network namespace joined by veth pairs
+# hosts and a recording host (robotalk-logplay record), each a network namespace joined by veth pairs
 # to one bridge, multicast routed to each host's veth, LCM URL with ttl=1
 # (DESIGN.md §4). Everything stays inside a private network namespace (needs
 # root); addresses are from a test subnet that exists only in there.
@@ -46,7 +46,9 @@ lan_demo() {
   on server "$build/robotalk-server/robotalk-server" --url "$LAN_URL" --duration 60 \
     --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" \
     --robot "pioneer2=kinematic:$models/pioneer2dx_pantilt.urdf" 2>"$tmp/server.log" &
-  on logger lcm-logger -q -f --lcm-url="$LAN_URL" -c 'ROBOTALK/.*' "$tmp/lan.lcmlog" &
+  # Every lane of the split traffic layout into one log (lcm-logger hears one URL).
+  on logger "$build/tools/logplay/robotalk-logplay" record -o "$tmp/lan.lcmlog" --lcm-url "$LAN_URL" \
+    -c 'ROBOTALK/.*' &
   sleep 1.5
   echo "== client1 ($LAN_SUBNET.2): robotalk robots"
   on client1 "$build/robotalk-client/robotalk" --url "$LAN_URL" robots --listen 1.2

@@ -3,6 +3,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "sequence_runner.h"
 
 #include <poll.h>
@@ -39,7 +40,13 @@ struct AnnounceWatch::Impl {
   // LCM is opened on this thread, so a Connect that succeeds at once does not
   // wait for it; poll() on LCM's socket and a pipe lets the destructor wake it.
   void Run() {
-    lcm::LCM lcm(url);
+    std::string main_url;  // ANNOUNCE travels on the main lane in either layout
+    try {
+      main_url = MainLcmUrl(url);
+    } catch (const TransportError&) {
+      return;  // the client's own Connect reports the bad URL
+    }
+    lcm::LCM lcm(main_url);
     if (!lcm.good()) return;
     lcm.subscribe(kAnnounceChannel, &Impl::On, this);
     for (;;) {

@@ -104,8 +104,11 @@ void RobotClient::Impl::WaitSession(std::unique_lock<std::mutex>& lock) {
   cv_.wait_until(lock, deadline, [&] { return session_id_ != 0 || !hello_refusal_.empty(); });
   if (!hello_refusal_.empty()) throw ClientError("RobotClient: " + hello_refusal_);
   if (session_id_ == 0) {
-    throw TimeoutError("RobotClient: no answer to HELLO from robot '" + robot_ + "' within " +
-                       SecondsText(options_.connect_timeout) + " (is a server offering it?)");
+    throw TimeoutError(
+        "RobotClient: no answer to HELLO from robot '" + robot_ + "' within " +
+        SecondsText(options_.connect_timeout) +
+        " (is a server offering it? every process on one bus must use the same traffic layout: "
+        "docs/protocol.md, Channels)");
   }
 }
 

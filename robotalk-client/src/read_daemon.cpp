@@ -5,7 +5,7 @@
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
 
-#include "robotalk/lcm_transport.h"
+#include "robotalk/routed_lcm_transport.h"
 
 #include <poll.h>
 #include <sys/eventfd.h>
@@ -57,8 +57,8 @@ RobotClient::Impl::Impl(ClientOptions options)
     transport_ = options_.transport;
   } else {
     try {
-      own_transport_ = std::make_unique<LcmTransport>(
-          LcmTransportOptions{.url = options_.lcm_url, .queue_capacity = options_.lcm_queue_capacity});
+      own_transport_ = OpenLcmTransport(
+          options_.lcm_url, OpenLcmOptions{.lane = {.queue_capacity = options_.lcm_queue_capacity}});
     } catch (const TransportError& e) {
       throw ClientError(std::string("RobotClient: ") + e.what());
     }

@@ -3,8 +3,8 @@
 #include "robotalk/robot_client.h"
 
 #include "client_impl.h"
-#include "robotalk/lcm_transport.h"
 #include "robotalk/request.h"
+#include "robotalk/routed_lcm_transport.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -100,7 +100,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
   Transport* transport = options.transport;
   if (!transport) {
     try {
-      own = std::make_unique<LcmTransport>(LcmTransportOptions{.url = options.lcm_url});
+      own = OpenLcmTransport(options.lcm_url);
     } catch (const TransportError& e) {
       throw ClientError(std::string("ListRobots: ") + e.what());
     }

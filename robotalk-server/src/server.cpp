@@ -5,7 +5,7 @@
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
-#include "robotalk/lcm_transport.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "server_daemon.h"
 
 #include <atomic>
@@ -85,7 +85,7 @@ class Server::Impl {
       : options_(std::move(options)), clock_(clock) {
     if (specs.empty()) throw Error("Server: no robot to serve");
     if (!transport) {
-      owned_transport_ = std::make_unique<LcmTransport>(LcmTransportOptions{.url = options_.lcm_url});
+      owned_transport_ = OpenLcmTransport(options_.lcm_url);
       transport = owned_transport_.get();
     }
     server_daemon_ = std::make_unique<ServerDaemon>(
@@ -97,7 +97,10 @@ class Server::Impl {
                             .log_lines_per_second = options_.log_lines_per_second,
                             .panic_latch_path = options_.panic_latch_path,
                             .allow_duplicate_robots = options_.allow_duplicate_robots,
-                            .gate = GateOptions(options_)});
+                            .gate = GateOptions(options_),
+                            .traffic_layout = dynamic_cast<RoutedLcmTransport*>(transport) != nullptr
+                                                  ? TrafficLayout::kSplit
+                                                  : TrafficLayout::kSingle});
     const SessionOptions sessions{
         options_.session_timeout, options_.max_queue, options_.max_future,
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};

@@ -2,7 +2,7 @@
 // on a real LCM URL for SECONDS as robot "pioneer", announcing every 200 ms.
 // For the CLI test.
 #include "fake_server.h"
-#include "robotalk/lcm_transport.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "robotalk/urdf_import.h"
 
 #include <chrono>
@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: robotalk_fake_server URL MODEL.urdf SECONDS\n");
     return 2;
   }
-  robotalk::LcmTransport lcm(robotalk::LcmTransportOptions{.url = argv[1]});
+  const std::unique_ptr<robotalk::Transport> transport = robotalk::OpenLcmTransport(argv[1]);
+  robotalk::Transport& lcm = *transport;
   robotalk::testing::FakeServer server(lcm, robotalk::LoadUrdfFile(argv[2], {.robot_name = "pioneer"}).model);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[3]));
   auto next_announce = std::chrono::steady_clock::now();

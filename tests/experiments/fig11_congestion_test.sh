@@ -27,7 +27,7 @@ port=7681
 pids=()
 for mode in "${modes[@]}"; do
   url="udpm://239.255.76.67:$port?ttl=0"
-  port=$((port + 1))
+  port=$((port + 100))  # the split traffic layout uses 66 ports from each URL's (docs/protocol.md)
   case $mode in
     direct) args=(--mode direct) ;;
     delay) args=(--mode delay --delay 8) ;;

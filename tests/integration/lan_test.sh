@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Many hosts on one machine (DESIGN.md §4): a server host, two client hosts and
-# an lcm-logger host, network namespaces joined by veth pairs to a bridge,
+# a recording host (robotalk-logplay record), network namespaces joined by veth pairs to a bridge,
 # multicast TTL 1 (examples/lan.sh sets them up). Everything works as on one
 # host, and the recorded log replays with robotalk-logplay.
 #   lan_test.sh SERVER CLI LOGPLAY MODELS_DIR
@@ -8,7 +8,6 @@ set -u
 server_bin=$1 cli=$2 logplay=$3 models=$4
 here=$(cd "$(dirname "$0")" && pwd)
 if [ -z "${LAN_INNER:-}" ]; then
-  command -v lcm-logger >/dev/null || { echo "SKIP: lcm-logger (liblcm-bin) not installed"; exit 77; }
   unshare -n -m true 2>/dev/null || { echo "SKIP: cannot create network namespaces here (needs root)"; exit 77; }
   LAN_INNER=1 exec unshare -n -m "$0" "$@"
 fi
@@ -27,7 +26,9 @@ rt() { local h=$1; shift; on "$h" "$cli" --url "$LAN_URL" "$@"; }
 on server "$server_bin" --url "$LAN_URL" --duration 90 \
   --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" \
   --robot "pioneer2=kinematic:$models/pioneer2dx_pantilt.urdf" 2>"$tmp/server.log" &
-on logger lcm-logger -q -f --lcm-url="$LAN_URL" -c 'ROBOTALK/.*' "$tmp/lan.lcmlog" &
+# Every lane of the split traffic layout into one log (lcm-logger hears one URL).
+on logger "$logplay" record -o "$tmp/lan.lcmlog" --lcm-url "$LAN_URL" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
+recorder=$!
 for _ in $(seq 50); do [ "$(grep -c "serving robot" "$tmp/server.log")" -ge 2 ] && break; sleep 0.1; done
 
 check "the hosts have their own addresses" bash -c "ip -n client1 -4 addr show eth0 | grep -q '$LAN_SUBNET.2/24'"
@@ -53,7 +54,8 @@ check "client2 watched client1's motion" awk '/base/ { if ($4 + 0 > 0.3) moved =
 read -r x0 y0 th0 < <(rt client2 query pioneer base_pose | awk '{print $(NF-4), $(NF-3), $(NF-2)}')
 sleep 0.3
 ip netns pids logger | xargs -r kill -INT
-sleep 0.5
+wait "$recorder"
+check "the recorder stops on SIGINT with status 0: $(cat "$tmp/record.log")" test $? -eq 0
 
 "$logplay" info "$tmp/lan.lcmlog" >"$tmp/info" 2>&1
 check "the logger host recorded client1's stream" grep -q "commands 5: JOINT_SETPOINT 1 SETSPEED 3 STOP 1" "$tmp/info"

@@ -6,8 +6,10 @@
 # usage: lcm_relay_cli_test.sh robotalk-lcm-relay lcm_probe
 set -u
 relay=$1; probe=$2
+# The split traffic layout (docs/protocol.md) uses 66 ports from each URL's:
+# A 7711..7776, B 7811..7876.
 A='udpm://239.255.76.67:7711?ttl=0'
-B='udpm://239.255.76.67:7712?ttl=0'
+B='udpm://239.255.76.67:7811?ttl=0'
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0
@@ -21,6 +23,8 @@ ge() { awk -v x="$1" -v y="$2" 'BEGIN { exit !(x + 0 >= y + 0) }'; }
 
 "$relay" --help | grep -q -- '--congestion-max-ms' || no "--help does not list --congestion-max-ms"
 "$relay" --a "$A" --b "$A" 2>/dev/null; [ $? = 2 ] || no "identical URLs were not refused with status 2"
+"$relay" --a "$A" --b 'udpm://239.255.76.67:7712?ttl=0' 2>/dev/null; [ $? = 2 ] ||
+  no "URLs whose lanes share ports were not refused with status 2"
 "$relay" --a "$A" --b "$B" --loss 2 2>/dev/null; [ $? = 2 ] || no "--loss 2 was not refused with status 2"
 
 # One run: A->B 40 ms and 25 % loss, B->A 15 ms and no loss. 200 messages
@@ -67,6 +71,25 @@ run second 7
 check second
 [ "$(pv "$tmp/first.b" seqs)" = "$(pv "$tmp/second.b" seqs)" ] ||
   no "seed 7 lost different messages: $(cat "$tmp/first.b") / $(cat "$tmp/second.b")"
+
+# Every lane: a request (lane 1, port +1) and client 5's replies (lane 2+5,
+# port +7) cross on their own lanes, and do not appear on B's main lane.
+REQ=ROBOTALK/r/REQUEST
+REP=ROBOTALK/r/REPLY/0000000000000005
+"$relay" --a "$A" --b "$B" --duration 2.5 --stats >"$tmp/lanes.stats" 2>"$tmp/lanes.log" &
+rpid=$!
+sleep 0.6
+"$probe" recv 'udpm://239.255.76.67:7812?ttl=0' "$REQ" 1.5 >"$tmp/lanes.req" &
+"$probe" recv 'udpm://239.255.76.67:7718?ttl=0' "$REP" 1.5 >"$tmp/lanes.rep" &
+"$probe" recv "$B" "$REQ" 1.5 >"$tmp/lanes.main" &
+sleep 0.3
+"$probe" send 'udpm://239.255.76.67:7712?ttl=0' "$REQ" 20 5 &
+"$probe" send 'udpm://239.255.76.67:7818?ttl=0' "$REP" 10 5 &
+wait $rpid || no "lanes: relay exited with $?"
+wait
+[ "$(pv "$tmp/lanes.req" count)" = 20 ] || no "lanes: B's request lane got $(pv "$tmp/lanes.req" count) of 20"
+[ "$(pv "$tmp/lanes.rep" count)" = 10 ] || no "lanes: reply lane 7 of A got $(pv "$tmp/lanes.rep" count) of 10"
+[ "$(pv "$tmp/lanes.main" count)" = 0 ] || no "lanes: B's main lane carried requests"
 
 [ $fail = 0 ] && echo "lcm relay end to end: all passed"
 exit $fail

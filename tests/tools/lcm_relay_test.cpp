@@ -302,7 +302,7 @@ TEST(EchoFilter, ForgetsExpectationsAfterTheWindowAndBeyondItsCapacity) {
 
 RelayOptions Parse(std::vector<std::string> extra) {
   std::vector<std::string> args = {"--a", "udpm://239.255.76.67:7701?ttl=0", "--b",
-                                   "udpm://239.255.76.67:7702?ttl=0"};
+                                   "udpm://239.255.76.67:7801?ttl=0"};
   args.insert(args.end(), extra.begin(), extra.end());
   return ParseRelayOptions(args);
 }
@@ -361,10 +361,35 @@ TEST(RelayOptions, RefusesUrlsThatWouldHearEachOther) {
       ParseRelayOptions({"--a", "udpm://239.255.76.67:7701?ttl=0", "--b", "udpm://239.255.76.68:7701"}),
       std::invalid_argument);
   EXPECT_THROW(ParseRelayOptions({"--a", "udpm://239.255.76.67"}), std::invalid_argument);
+  // The split layout's lanes: 7701..7766 and 7702..7767 share 65 ports.
+  EXPECT_THROW(
+      ParseRelayOptions({"--a", "udpm://239.255.76.67:7701?ttl=0", "--b", "udpm://239.255.76.67:7702?ttl=0"}),
+      std::invalid_argument);
+  EXPECT_THROW(
+      ParseRelayOptions({"--a", "udpm://239.255.76.67:7701?ttl=0", "--b", "udpm://239.255.76.67:7766?ttl=0"}),
+      std::invalid_argument);
+  EXPECT_NO_THROW(ParseRelayOptions(
+      {"--a", "udpm://239.255.76.67:7701?ttl=0", "--b", "udpm://239.255.76.67:7767?ttl=0"}));
+  // Single layouts use one port each.
+  EXPECT_NO_THROW(ParseRelayOptions({"--a", "udpm://239.255.76.67:7701?ttl=0&traffic=single", "--b",
+                                     "udpm://239.255.76.67:7702?ttl=0&traffic=single"}));
+  EXPECT_THROW(ParseRelayOptions({"--a", "udpm://239.255.76.67:7701?traffic=maybe", "--b", "memq://"}),
+               std::invalid_argument);
   EXPECT_EQ(UdpmPort("udpm://239.255.76.67?ttl=0"), 7667);
   EXPECT_EQ(UdpmPort("udpm://239.255.76.67:7702?ttl=0"), 7702);
   EXPECT_EQ(UdpmPort("memq://"), -1);
   EXPECT_TRUE(ParseRelayOptions({"--help"}).help);
+}
+
+TEST(RelayOptions, RelaysEveryLaneOfASplitUrlAndTheOneUrlOfASingleOne) {
+  const std::vector<std::string> split = RelayLaneUrls("udpm://239.255.76.67:7701?ttl=0");
+  ASSERT_EQ(split.size(), 66u);
+  EXPECT_EQ(split.front(), "udpm://239.255.76.67:7701?ttl=0");
+  EXPECT_EQ(split[1], "udpm://239.255.76.67:7702?ttl=0");
+  EXPECT_EQ(split.back(), "udpm://239.255.76.67:7766?ttl=0");
+  EXPECT_EQ(RelayLaneUrls("udpm://239.255.76.67:7701?traffic=single&ttl=0"),
+            std::vector<std::string>{"udpm://239.255.76.67:7701?ttl=0"});
+  EXPECT_EQ(RelayLaneUrls("memq://"), std::vector<std::string>{"memq://"});
 }
 
 }  // namespace

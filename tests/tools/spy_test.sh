@@ -49,8 +49,9 @@ n=$(echo "$found" | awk '{print $2}')
 check "lcm-spy found our $num_types types (${found:-no line})" test "${n:-0}" -ge "$num_types"
 check "no Java exception" bash -c "! grep -q 'Exception' '$tmp/spy.out'"
 
-# Traffic on every RoboTalk channel: ANNOUNCE, REQUEST, REPLY, CONFIG, STATE
-# (once the window is up and subscribed).
+# Traffic on every RoboTalk channel (once the window is up and subscribed);
+# with the split traffic layout the spy on the main URL sees ANNOUNCE, CONFIG
+# and STATE, while REQUEST and REPLY travel on their own ports.
 sleep 2
 "$cli" --url "$url" watch pioneer --period 0.1 --duration 8 >/dev/null 2>&1 &
 pids+=($!)

@@ -12,6 +12,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <robotalk/routed_lcm_transport.h>
+#include <robotalk/traffic_layout.h>
 #include <lcm/lcm-cpp.hpp>
 
 #include "echo_filter.h"
@@ -24,6 +26,7 @@ constexpr int kSideB = 1;
 
 struct Message {
   std::string channel;
+  int lane = 0;  // on the target side
   std::vector<unsigned char> data;
   std::uint64_t fingerprint = 0;
   TimePoint arrival{};
@@ -62,26 +65,47 @@ struct Direction {
 }  // namespace
 
 struct LcmRelay::Impl {
+  // The lane a message was heard on: LCM's callback context.
+  struct LaneTag {
+    Impl* impl;
+    int side;
+    int lane;
+  };
+
   explicit Impl(const RelayOptions& o)
       : options(o),
         directions{Direction(o.a2b, o.seed), Direction(o.b2a, DerivedSeed(o.seed))},
         echo{EchoFilter(o.echo_window), EchoFilter(o.echo_window)} {
     const std::string urls[2] = {o.url_a, o.url_b};
     for (int side : {kSideA, kSideB}) {
-      lcm[side] = std::make_unique<lcm::LCM>(urls[side]);
-      if (!lcm[side]->good()) {
-        throw std::runtime_error("LcmRelay: cannot open LCM URL '" + urls[side] + "'");
+      // Every lane of a split URL (traffic_layout.h), or the one URL.
+      for (const std::string& url : RelayLaneUrls(urls[side])) {
+        auto& lane = lcm[side].emplace_back(std::make_unique<lcm::LCM>(url));
+        if (!lane->good()) throw std::runtime_error("LcmRelay: cannot open LCM URL '" + url + "'");
       }
     }
-    lcm[kSideA]->subscribe(".*", &Impl::OnA, this);
-    lcm[kSideB]->subscribe(".*", &Impl::OnB, this);
+    for (int side : {kSideA, kSideB}) {
+      for (int lane = 0; lane < static_cast<int>(lcm[side].size()); ++lane) {
+        tags.push_back(std::make_unique<LaneTag>(LaneTag{this, side, lane}));
+        lcm[side][static_cast<std::size_t>(lane)]->subscribeFunction(".*", &Impl::OnLane, tags.back().get());
+      }
+    }
   }
 
-  void OnA(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { OnMessage(kSideA, rbuf, channel); }
-  void OnB(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { OnMessage(kSideB, rbuf, channel); }
+  static void OnLane(const lcm::ReceiveBuffer* rbuf, const std::string& channel, LaneTag* tag) {
+    tag->impl->OnMessage(tag->side, tag->lane, rbuf, channel);
+  }
+
+  // The lane of the target side: the same lane when both sides have the same
+  // layout; else the lane the split side's rules give (or the one URL).
+  int TargetLane(int source, int lane, const std::string& channel) const {
+    const std::size_t target_lanes = lcm[1 - source].size();
+    if (target_lanes == lcm[source].size()) return lane;
+    return target_lanes == 1 ? 0 : LaneOfChannel(channel);
+  }
 
   // Called from LCM's handle(): must not throw (see DESIGN/STYLE: store and rethrow).
-  void OnMessage(int source, const lcm::ReceiveBuffer* rbuf, const std::string& channel) noexcept {
+  void OnMessage(int source, int lane, const lcm::ReceiveBuffer* rbuf, const std::string& channel) noexcept {
     // LCM's udpm provider publishes one LCM_SELF_TEST message per instance at
     // start-up; it belongs to that instance, so it is never relayed (and does
     // not draw random numbers, which keeps the schedule reproducible).
@@ -104,7 +128,8 @@ struct LcmRelay::Impl {
       const Releases r = d.channel.Admit(now);
       if (r.count == 0) return;
       auto message = std::make_shared<Message>(
-          Message{channel, std::vector<unsigned char>(bytes, bytes + rbuf->data_size), fp, now});
+          Message{channel, TargetLane(source, lane, channel),
+                  std::vector<unsigned char>(bytes, bytes + rbuf->data_size), fp, now});
       for (int i = 0; i < r.count; ++i) queue.push(Release{r.at[i], next_order++, 1 - source, message});
       lock.unlock();
       wake.notify_one();
@@ -121,11 +146,18 @@ struct LcmRelay::Impl {
   }
 
   void ReceiveLoop() {
-    pollfd fds[2] = {{lcm[kSideA]->getFileno(), POLLIN, 0}, {lcm[kSideB]->getFileno(), POLLIN, 0}};
+    std::vector<pollfd> fds;
+    std::vector<lcm::LCM*> owners;
+    for (int side : {kSideA, kSideB}) {
+      for (auto& lane : lcm[side]) {
+        fds.push_back({lane->getFileno(), POLLIN, 0});
+        owners.push_back(lane.get());
+      }
+    }
     while (!stop.load()) {
-      if (::poll(fds, 2, 50) <= 0) continue;
-      for (int side : {kSideA, kSideB}) {
-        if (fds[side].revents & POLLIN) lcm[side]->handleTimeout(0);
+      if (::poll(fds.data(), fds.size(), 50) <= 0) continue;
+      for (std::size_t i = 0; i < fds.size(); ++i) {
+        if (fds[i].revents & POLLIN) owners[i]->handleTimeout(0);
       }
     }
   }
@@ -156,8 +188,8 @@ struct LcmRelay::Impl {
       results.reserve(due.size());
       for (const Release& r : due) {
         const Message& m = *r.message;
-        results.push_back(
-            lcm[r.target]->publish(m.channel, m.data.data(), static_cast<unsigned>(m.data.size())));
+        results.push_back(lcm[r.target][static_cast<std::size_t>(m.lane)]->publish(
+            m.channel, m.data.data(), static_cast<unsigned>(m.data.size())));
       }
       lock.lock();
       for (std::size_t i = 0; i < due.size(); ++i) {
@@ -177,7 +209,8 @@ struct LcmRelay::Impl {
 
   RelayOptions options;
   SteadyClock clock;
-  std::unique_ptr<lcm::LCM> lcm[2];
+  std::vector<std::unique_ptr<lcm::LCM>> lcm[2];  // per side, its lanes
+  std::vector<std::unique_ptr<LaneTag>> tags;
   std::atomic<bool> stop{false};
   mutable std::mutex mu;
   std::condition_variable wake;

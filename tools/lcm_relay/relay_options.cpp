@@ -1,7 +1,12 @@
 #include "relay_options.h"
 
+#include <robotalk/error.h>
+#include <robotalk/routed_lcm_transport.h>
+#include <robotalk/traffic_layout.h>
+
 #include <cmath>
 #include <regex>
+#include <set>
 #include <stdexcept>
 
 namespace robotalk::relay {
@@ -95,6 +100,18 @@ std::uint64_t DerivedSeed(std::uint64_t seed) {
   return z ^ (z >> 31);
 }
 
+std::vector<std::string> RelayLaneUrls(const std::string& url) {
+  try {
+    const TrafficUrl parsed = ParseTrafficUrl(ResolveLcmUrl(url));
+    if (parsed.layout == TrafficLayout::kSingle) return {parsed.lcm_url};
+    std::vector<std::string> lanes;
+    for (int lane = 0; lane < kLaneCount; ++lane) lanes.push_back(LaneUrl(parsed.lcm_url, lane));
+    return lanes;
+  } catch (const TransportError& e) {
+    throw std::invalid_argument(std::string("robotalk-lcm-relay: ") + e.what());
+  }
+}
+
 int UdpmPort(const std::string& url) {
   const std::string scheme = "udpm://";
   if (url.rfind(scheme, 0) != 0) return -1;
@@ -177,12 +194,20 @@ RelayOptions ParseRelayOptions(const std::vector<std::string>& args) {
   }
   if (o.url_a.empty() || o.url_b.empty()) Bad("--a/--b", o.url_a + "' '" + o.url_b, "both URLs are required");
   if (o.url_a == o.url_b) Bad("--b", o.url_b, "must differ from --a (the relay would hear its own output)");
-  const int port_a = UdpmPort(o.url_a);
-  if (port_a > 0 && port_a == UdpmPort(o.url_b)) {
-    // Linux delivers multicast to every socket bound to the port whose host
-    // joined the group (IP_MULTICAST_ALL), and LCM binds INADDR_ANY:port, so
-    // two groups on one port would hear each other.
-    Bad("--b", o.url_b, "must use a different udpm port from --a (same-port groups cross-talk on Linux)");
+  // Linux delivers multicast to every socket bound to the port whose host
+  // joined the group (IP_MULTICAST_ALL), and LCM binds INADDR_ANY:port, so
+  // two groups on one port would hear each other: no port of A's lanes may
+  // be one of B's.
+  std::set<int> ports_a;
+  for (const std::string& url : RelayLaneUrls(o.url_a)) ports_a.insert(UdpmPort(url));
+  ports_a.erase(-1);
+  for (const std::string& url : RelayLaneUrls(o.url_b)) {
+    if (ports_a.count(UdpmPort(url))) {
+      Bad("--b", o.url_b,
+          "uses udpm port " + std::to_string(UdpmPort(url)) +
+              ", a port of --a too (same-port groups cross-talk on Linux; the split traffic layout uses "
+              "66 ports from each URL's port)");
+    }
   }
   return o;
 }
@@ -212,7 +237,7 @@ Impairments (set both directions; --a2b-NAME / --b2a-NAME set one and win):
                           message U[0, X] ms before the next may pass
   --channels REGEX        forward only channels fully matching REGEX (default .*)
 
-Example: --a udpm://239.255.76.67:7667?ttl=0 --b udpm://239.255.76.67:7668?ttl=0
+Example: --a udpm://239.255.76.67:7667?ttl=0 --b udpm://239.255.76.67:7767?ttl=0
          --a2b-congestion-max-ms 250 --latency-ms 5 --seed 7 --stats
 )";
 }

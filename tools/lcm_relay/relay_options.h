@@ -45,4 +45,10 @@ std::uint64_t DerivedSeed(std::uint64_t seed);
 /// URL is not udpm.
 int UdpmPort(const std::string& url);
 
+/// The LCM URLs the relay listens and publishes on for RoboTalk URL `url`:
+/// the 66 lanes of the split traffic layout (robotalk/traffic_layout.h), or
+/// the one URL of the single layout (traffic=single, memq://). The traffic=
+/// option is removed. Throws std::invalid_argument for a bad traffic= option.
+std::vector<std::string> RelayLaneUrls(const std::string& url);
+
 }  // namespace robotalk::relay

@@ -61,4 +61,24 @@ struct ReplayOptions {
 /// SUCCESS/MODIFIED, 1 otherwise, 128+signal when interrupted).
 int Replay(const SessionLog& log, const ReplayOptions& options, std::ostream& out);
 
+struct RecordOptions {
+  std::string output;           ///< the LCM log to write (lcm-logger's format)
+  std::string url;              ///< RoboTalk URL; "" = $LCM_DEFAULT_URL or LCM's default
+  std::string channels = ".*";  ///< LCM channel regex (whole name) of what is kept
+  Duration duration{0};         ///< 0: until SIGINT/SIGTERM (cli::Interrupter, deferred)
+};
+
+struct RecordResult {
+  std::uint64_t events = 0;
+  std::uint64_t bytes = 0;
+  int signal = 0;  ///< the signal that stopped it, or 0
+};
+
+/// `record`: every channel of every lane of `options.url` (the split
+/// layout's 66 ports, or the one URL of the single layout) into one LCM log,
+/// stamped with the wall clock when dispatched, until the duration is over
+/// or a signal arrives; prints one line to `progress` when it starts.
+/// Throws LogError (cannot write) or TransportError (bad URL).
+RecordResult Record(const RecordOptions& options, std::ostream& progress);
+
 }  // namespace robotalk::logplay

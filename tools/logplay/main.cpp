@@ -22,7 +22,12 @@ namespace lp = robotalk::logplay;
 
 constexpr const char* kUsage = R"(usage: robotalk-logplay COMMAND LOG [options]
 
-Reads an LCM log (lcm-logger) of a RoboTalk session. See docs/logplay.md.
+Records and reads LCM logs of RoboTalk sessions. See docs/logplay.md.
+
+  record -o LOG [--lcm-url URL] [-c REGEX] [--duration S]
+                                 every channel of every lane of URL (the split
+                                 traffic layout's 66 ports) into one LCM log, until
+                                 S seconds have passed or Ctrl-C
 
   info LOG                       channels, time span, servers, robots, clients and
                                  each client's command stream; final state per robot
@@ -77,6 +82,10 @@ class Args {
     auto v = All(name);
     if (v.size() > 1) throw UsageError(name + " given twice");
     return v.empty() ? std::nullopt : std::optional<std::string>(v[0]);
+  }
+  // Nothing may remain (commands without a LOG argument).
+  void None() {
+    if (!args_.empty()) throw UsageError("unexpected '" + args_[0] + "'");
   }
   // The log path: the one remaining word; anything starting with '-' is unknown.
   std::string Log() {
@@ -176,6 +185,28 @@ int RunReplay(Args& a) {
   return lp::Replay(lp::ReadLog(path), o, std::cout);
 }
 
+int RunRecord(Args& a) {
+  lp::RecordOptions o;
+  o.output = a.One("-o").value_or("");
+  if (o.output.empty()) throw UsageError("record needs -o LOG");
+  if (auto u = a.One("--lcm-url")) o.url = *u;
+  if (auto u = a.One("--url")) o.url = *u;
+  if (auto c = a.One("-c")) o.channels = *c;
+  if (auto d = a.One("--duration")) {
+    const double s = robotalk::cli::ParseNumber(*d, "--duration");
+    if (s <= 0) throw UsageError("--duration must be positive");
+    o.duration = robotalk::FromSeconds(s);
+  }
+  a.None();
+  robotalk::cli::Interrupter::Defer(true);  // Ctrl-C ends the recording, the log is flushed
+  const lp::RecordResult r = lp::Record(o, std::cerr);
+  std::cerr << "robotalk-logplay: wrote " << r.events << " events (" << r.bytes << " bytes) to " << o.output
+            << (r.signal ? std::string(" (stopped by ") + robotalk::cli::Interrupter::Name(r.signal) + ")"
+                         : "")
+            << "\n";
+  return 0;
+}
+
 int RunExport(Args& a) {
   const std::string dir = a.One("-o").value_or("logplay_export");
   const bool plot = !a.Flag("--no-plot");
@@ -225,8 +256,9 @@ int main(int argc, char** argv) {
     if (command == "extract") return RunExtract(rest);
     if (command == "replay") return RunReplay(rest);
     if (command == "export") return RunExport(rest);
+    if (command == "record") return RunRecord(rest);
     if (command.size() > 1 && command[0] == '-') throw UsageError("unknown option '" + command + "'");
-    throw UsageError("unknown command '" + command + "' (info, extract, replay, export)");
+    throw UsageError("unknown command '" + command + "' (info, extract, replay, export, record)");
   } catch (const UsageError& e) {
     std::cerr << "robotalk-logplay: " << e.what() << "\n(robotalk-logplay --help for usage)\n";
     return 2;

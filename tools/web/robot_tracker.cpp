@@ -6,6 +6,7 @@
 #include "robotalk/error.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "robotalk_msgs/announce_t.hpp"
 #include "scene_json.h"
 
@@ -80,7 +81,7 @@ bool AnnounceCountPlausible(std::span<const std::uint8_t> bytes) {
 
 class RobotTracker::Impl {
  public:
-  explicit Impl(const WebOptions& o) : options_(o), lcm_(o.lcm_url) {
+  explicit Impl(const WebOptions& o) : options_(o), lcm_(MainLcmUrl(o.lcm_url)) {  // ANNOUNCE: main lane
     if (!lcm_.good()) throw Error("robotalk-web: cannot open LCM '" + o.lcm_url + "'");
     lcm_.subscribe(kAnnounceChannel, &Impl::OnAnnounce, this)->setQueueCapacity(100);
     listener_ = std::thread([this] { Listen(); });

@@ -8,6 +8,7 @@
 #include "robotalk/command.h"
 #include "robotalk/session_auth.h"
 #include "robotalk/state_sample.h"
+#include "robotalk/traffic_layout.h"
 
 #include <cstdint>
 #include <span>
@@ -87,12 +88,6 @@ struct ReplyBatch {
 std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& batch);
 /// Throws ProtocolError on truncated, hostile or foreign bytes.
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes);
-
-/// Where requests and replies travel (docs/protocol.md, Channels).
-enum class TrafficLayout : std::int8_t {
-  kSingle = 0,  ///< every channel on one URL
-  kSplit = 1,   ///< requests, replies and the rest on separate ports
-};
 
 /// One served robot in an ANNOUNCE.
 struct RobotAnnouncement {
