@@ -445,7 +445,8 @@ int rtc_pause(rtc_client* c, double seconds) {
 
 int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* round_trip_us) {
   int64_t best_rtt = INT64_MAX, best_offset = 0;
-  for (int s = 0; s < samples; ++s) {
+  int usable = 0;
+  for (int s = 0; s < 3 * samples && usable < samples; ++s) { /* retransmitted samples do not count */
     robotalk_msgs_query_t q;
     memset(&q, 0, sizeof q);
     q.type = ROBOTALK_MSGS_QUERY_T_CLOCK;
@@ -454,6 +455,7 @@ int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* roun
     if (seq < 0 || rtc_wait(c, &q.id, 1, 3.0, NULL) != 0) return -1;
     const pending_package* p = find_package(c, seq);
     if (!p || !p->have_clock) continue; /* retransmitted: ambiguous sample */
+    ++usable;
     int64_t rtt = (p->t4 - p->t1) - (p->server_send_us - p->server_receive_us);
     int64_t offset = ((p->server_receive_us - p->t1) + (p->server_send_us - p->t4)) / 2;
     if (rtt < best_rtt) best_rtt = rtt, best_offset = offset;
@@ -503,16 +505,48 @@ robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
 
 /* ---- connecting --------------------------------------------------------- */
 
-/* "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts". 0, or -1 when url is not udpm. */
+/* url without RoboTalk's own option traffic=single|split (LCM does not know
+ * it; the layout is taken from ANNOUNCE anyway). */
+static void lcm_url_of(const char* url, char* out, size_t len) {
+  const char* q = strchr(url, '?');
+  if (!q) {
+    snprintf(out, len, "%s", url);
+    return;
+  }
+  snprintf(out, len, "%.*s", (int)(q - url), url);
+  char sep = '?';
+  for (const char* opt = q + 1; *opt;) {
+    const char* end = strchr(opt, '&');
+    size_t n = end ? (size_t)(end - opt) : strlen(opt);
+    if (n > 0 && strncmp(opt, "traffic=", 8) != 0) {
+      size_t used = strlen(out);
+      snprintf(out + used, len - used, "%c%.*s", sep, (int)n, opt);
+      sep = '&';
+    }
+    opt += n + (end ? 1 : 0);
+  }
+}
+
+/* "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts" (no port: LCM's 7667). 0, or
+ * -1 when url is not udpm. */
 static int shifted_url(const char* url, int delta, char* out, size_t len) {
   const char* scheme = "udpm://";
   if (strncmp(url, scheme, strlen(scheme)) != 0) return -1;
-  const char* colon = strchr(url + strlen(scheme), ':');
-  if (!colon) return -1;
-  char* end = NULL;
-  long port = strtol(colon + 1, &end, 10);
-  if (end == colon + 1 || port <= 0 || port + delta > 65535) return -1;
-  snprintf(out, len, "%.*s:%ld%s", (int)(colon - url), url, port + delta, end);
+  const char* host = url + strlen(scheme);
+  const char* colon = strchr(host, ':');
+  const char* query = strchr(host, '?');
+  long port = 7667;
+  const char* rest = query ? query : host + strlen(host);
+  if (colon && (!query || colon < query)) {
+    char* end = NULL;
+    port = strtol(colon + 1, &end, 10);
+    if (end == colon + 1 || port <= 0) return -1;
+    rest = end;
+  } else {
+    colon = rest;
+  }
+  if (port + delta > 65535) return -1;
+  snprintf(out, len, "%.*s:%ld%s", (int)(colon - url), url, port + delta, rest);
   return 0;
 }
 
@@ -565,6 +599,9 @@ rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, ch
   c->next_id = 1;
   while (c->client_id == 0)
     if (random_bytes(&c->client_id, sizeof c->client_id) != 0) break;
+  char lcm_url[512];
+  lcm_url_of(url, lcm_url, sizeof lcm_url);
+  url = lcm_url;
   c->main_lcm = lcm_create(url);
   int ok = c->client_id != 0 && c->main_lcm != NULL;
   if (!ok) set_error(c, "cannot open LCM on '%s'", url);

@@ -68,7 +68,8 @@ int64_t rtc_session_id(const rtc_client* c);
 int64_t rtc_server_id(const rtc_client* c);
 int rtc_split_layout(const rtc_client* c); /* 1: TRAFFIC_SPLIT, 0: TRAFFIC_SINGLE */
 
-/* Estimates the server clock offset from `samples` CLOCK queries, keeping the
+/* Estimates the server clock offset from `samples` CLOCK queries answered
+ * without a retransmission (at most 3 x samples sent), keeping the
  * sample with the smallest round trip (docs/protocol.md, Clocks). 0 or -1. */
 int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* round_trip_us);
 /* The server clock now, from the client clock and the last rtc_sync_clock. */

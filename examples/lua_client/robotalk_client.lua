@@ -112,12 +112,30 @@ M.hex_of_raw = hex
 local Client = {}
 Client.__index = Client
 
--- "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts" (the split layout's ports).
+-- url without RoboTalk's own option traffic=single|split (LCM does not know
+-- it; the layout is taken from ANNOUNCE).
+local function lcm_url_of(url)
+  local base, query = url:match('^([^?]*)%?(.*)$')
+  if not base then return url end
+  local kept = {}
+  for opt in query:gmatch('[^&]+') do
+    if not opt:match('^traffic=') then kept[#kept + 1] = opt end
+  end
+  return base .. (#kept > 0 and '?' .. table.concat(kept, '&') or '')
+end
+M.lcm_url_of = lcm_url_of
+
+-- "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts" (the split layout's ports; no port: LCM's 7667).
 local function shifted_url(url, delta)
   local head, port, tail = url:match('^(udpm://[^:/?]+):(%d+)(.*)$')
-  if not head then return nil end
+  if not head then
+    head, tail = url:match('^(udpm://[^:/?]+)(.*)$')
+    port = 7667
+  end
+  if not head or (tail ~= '' and tail:sub(1, 1) ~= '?') then return nil end
   return head .. ':' .. (tonumber(port) + delta) .. tail
 end
+M.shifted_url = shifted_url
 
 -- Handles what arrives on the client's LCM instances for about `wait_s`.
 function Client:handle_for(wait_s)
@@ -363,6 +381,7 @@ function M.connect(url, robot, timeout_s)
     for i = 1, 7 do id = id * 256 + b:byte(i) end
     self.client_id = id % 2 ^ 52
   until self.client_id ~= 0
+  url = lcm_url_of(url)
   self.main = lcm.lcm.new(url)
   local found, problem, heard = nil, nil, {}
   local sub = self.main:subscribe('ROBOTALK/ANNOUNCE', function(_, data)

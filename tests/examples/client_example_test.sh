@@ -4,20 +4,26 @@
 # the robot did. Run inside a private network namespace (CTest wraps it with
 # scripts/netns_run.sh, which exits 77 = skip where none can be made).
 #   client_example_test.sh SERVER CLI MODELS_DIR PORT LAYOUT CLIENT_COMMAND...
-# LAYOUT: "native" (the clients talk to the server's own URL, in whatever
-# layout it announces) or the path of split_layout_proxy: the server then runs
-# on port PORT-1 and the proxy presents it in the split layout on PORT.
+# LAYOUT: "default" (the server's default traffic layout), "single" or
+# "split" (the URL option traffic=single|split, given to server, clients and
+# CLI alike; the clients strip it and follow ANNOUNCE), or "lossy" (default
+# layout, but the server drops and duplicates 30 % of its reply packages: each
+# command must still run exactly once).
 # The client command gets "--url URL --robot NAME" appended.
 set -u
 server_bin=$1 cli=$2 models=$3 port=$4 layout=$5
 shift 5
 url="udpm://239.255.76.67:$port?ttl=0"
-server_url=$url
-[ "$layout" != native ] && server_url="udpm://239.255.76.67:$((port - 1))?ttl=0"
+server_flags=()
+case $layout in
+  default) ;;
+  single | split) url="$url&traffic=$layout" ;;
+  lossy) server_flags=(--inject-reply-drop 0.3 --inject-reply-dup 0.3 --seed 5 --log-executions) ;;
+  *) echo "unknown layout $layout"; exit 2 ;;
+esac
 tmp=$(mktemp -d)
-server_pid="" proxy_pid=""
+server_pid=""
 cleanup() {
-  [ -n "$proxy_pid" ] && kill "$proxy_pid" 2>/dev/null && wait "$proxy_pid" 2>/dev/null
   [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
   rm -rf "$tmp"
 }
@@ -31,14 +37,10 @@ check() {  # check NAME COMMAND...
 value() { grep -o -m1 "$1=[-0-9.]*" "$2" | head -1 | cut -d= -f2; }
 within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v != "" && v >= lo && v <= hi) }'; }
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$server_url" \
-  --duration 90 2>"$tmp/server.log" &
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
+  --duration 90 "${server_flags[@]}" 2>"$tmp/server.log" &
 server_pid=$!
 for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
-if [ "$layout" != native ]; then
-  "$layout" "$server_url" "$url" 90 &
-  proxy_pid=$!
-fi
 
 # --- the example: connect, configuration, GOTO, timed sequence, replies ------
 timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/out" 2>"$tmp/err"
@@ -46,7 +48,9 @@ status=$?
 cat "$tmp/out"
 check "the example exits 0 (got $status)" test "$status" -eq 0
 check "it connected and opened a session" grep -q "^connected: robot=pioneer server=[0-9a-f]\{16\} layout=\(single\|split\) session=" "$tmp/out"
-[ "$layout" != native ] && check "it took the split layout from ANNOUNCE" grep -q "^connected: .* layout=split " "$tmp/out"
+case $layout in single | split)
+  check "it took the $layout layout from ANNOUNCE" grep -q "^connected: .* layout=$layout " "$tmp/out" ;;
+esac
 check "the configuration message matches the CONFIG reply" \
   grep -q "^config: robot=pioneer links=7 joints=6 frames=1 dofs=4 hash=[0-9a-f]\{16\} (reply and message agree)" "$tmp/out"
 check "the config hash is the one the server announced" \
@@ -61,8 +65,15 @@ for s in $spacings; do check "frame spacing $s s >= 0.24 s" within "$s" 0.24 10;
 check "the example saw the base at the GOTO goal" within "$(value x "$tmp/out")" 0.48 0.52
 check "the example saw pan at 0.3" within "$(value pan "$tmp/out")" 0.29 0.31
 check "the example saw tilt at -0.2" within "$(value tilt "$tmp/out")" -0.21 -0.19
+if [ "$layout" = lossy ]; then
+  client=$(grep -o -m1 " client=[0-9a-f]*" "$tmp/out" | cut -d= -f2)
+  executed=$(grep -c "executed client $client command" "$tmp/server.log")
+  distinct=$(grep -o "executed client $client command [0-9]*" "$tmp/server.log" | sort -u | wc -l)
+  check "5 commands executed, each once, despite lost and doubled replies (got $executed, $distinct distinct)" \
+    test "$executed" -eq 5 -a "$distinct" -eq 5
+fi
 # Another client (the C++ CLI) sees the same robot state.
-pose=$("$cli" --url "$server_url" --timeout 5 query pioneer base_pose 2>&1)
+pose=$("$cli" --url "$url" --timeout 5 query pioneer base_pose 2>&1)
 check "the robot is at the goal for the CLI too ($pose)" within "$(echo "$pose" | awk '{print $(NF-4)}')" 0.48 0.52
 
 # --- a robot nobody announces: the error lists the robots heard --------------

@@ -103,6 +103,7 @@ public final class RobotalkClient implements AutoCloseable {
     helloAnswerChannel = helloChannel + "/" + hex;
     requestChannel = "ROBOTALK/" + robot + "/REQUEST";
     replyChannel = "ROBOTALK/" + robot + "/REPLY/" + hex;
+    url = lcmUrl(url);
     mainLcm = new LCM(url);
     announce_t a = findRobot(timeoutS);
     split = a.traffic_layout == announce_t.TRAFFIC_SPLIT;
@@ -133,11 +134,22 @@ public final class RobotalkClient implements AutoCloseable {
     mainLcm.close();
   }
 
-  /** "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts" (the split layout's ports). */
+  /** url without RoboTalk's own option traffic=single|split (LCM does not know it; ANNOUNCE says the layout). */
+  static String lcmUrl(String url) {
+    int q = url.indexOf('?');
+    if (q < 0) return url;
+    List<String> kept = new ArrayList<>();
+    for (String opt : url.substring(q + 1).split("&"))
+      if (!opt.isEmpty() && !opt.startsWith("traffic=")) kept.add(opt);
+    return url.substring(0, q) + (kept.isEmpty() ? "" : "?" + String.join("&", kept));
+  }
+
+  /** "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts" (the split layout's ports; no port: LCM's 7667). */
   static String shiftedUrl(String url, int delta) throws RobotalkException {
-    java.util.regex.Matcher m = java.util.regex.Pattern.compile("^(udpm://[^:/?]+):(\\d+)(.*)$").matcher(url);
+    java.util.regex.Matcher m = java.util.regex.Pattern.compile("^(udpm://[^:/?]+)(?::(\\d+))?(\\?.*)?$").matcher(url);
     if (!m.matches()) throw new RobotalkException("the split layout needs a udpm://GROUP:PORT URL, not '" + url + "'");
-    return m.group(1) + ":" + (Integer.parseInt(m.group(2)) + delta) + m.group(3);
+    int port = m.group(2) == null ? 7667 : Integer.parseInt(m.group(2));
+    return m.group(1) + ":" + (port + delta) + (m.group(3) == null ? "" : m.group(3));
   }
 
   private void enqueue(LCM lcm, String channel, lcm.lcm.LCMDataInputStream ins) {
@@ -423,7 +435,8 @@ public final class RobotalkClient implements AutoCloseable {
    */
   public long[] syncClock(int samples) throws IOException, RobotalkException {
     long bestRtt = Long.MAX_VALUE, bestOffset = 0;
-    for (int s = 0; s < samples; s++) {
+    int usable = 0;
+    for (int s = 0; s < 3 * samples && usable < samples; s++) {  // retransmitted samples do not count
       query_t q = new query_t();
       q.type = query_t.CLOCK;
       q.target = "";
@@ -431,6 +444,7 @@ public final class RobotalkClient implements AutoCloseable {
       Pending p = pending.get(seq);
       await(3.0, q.id);
       if (!p.haveClock) continue;  // retransmitted: an ambiguous sample
+      usable++;
       long rtt = (p.t4 - p.t1) - (p.serverSendUs - p.serverReceiveUs);
       long offset = ((p.serverReceiveUs - p.t1) + (p.serverSendUs - p.t4)) / 2;
       if (rtt < bestRtt) {
