@@ -38,7 +38,7 @@ check "the Lua variable names the installed modules ($lua_dir)" test "$lua_dir" 
 check "LCM's jar is named ($lcm_jar)" test -f "$lcm_jar"
 check "LCM's Lua module folder is named ($lcm_cpath)" test -f "$lcm_cpath/lcm.so"
 check "the C bindings are an imported target" grep -q "TARGET robotalk::lcmtypes_c" "$tmp/vars.log"
-check "the installed jar holds the protocol 2 types" sh -c "unzip -l '$jar' | grep -q robotalk_msgs/hello_answer_t.class"
+check "the installed jar holds the protocol 2 types" sh -c "/usr/bin/python3 -m zipfile -l '$jar' | grep -q robotalk_msgs/hello_answer_t.class"
 # The installed Lua modules encode and decode with LCM's Lua module, from LUA_PATH alone.
 roundtrip=$(LUA_PATH="$lua_dir/?.lua;$lua_dir/?/init.lua;;" LUA_CPATH="$lcm_cpath/?.so;;" lua5.2 -e "
   local m = require('robotalk_msgs')
