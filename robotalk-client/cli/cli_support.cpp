@@ -84,6 +84,8 @@ ClientOptions MakeOptions(const GlobalOptions& g) {
   o.lcm_url = g.url;
   o.timeout = FromSeconds(g.timeout_s);
   o.connect_timeout = FromSeconds(g.timeout_s);
+  o.key_file = g.key_file;
+  o.server_key_file = g.server_key;
   return o;
 }
 

@@ -15,7 +15,7 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] COMMAND ...
+constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] [--key FILE] COMMAND ...
 
   robots [--listen S] [--json]        robots announced on ROBOTALK/ANNOUNCE (default 1.5 s)
   describe ROBOT [--json]             the robot's description (links, joints, frames)
@@ -45,6 +45,10 @@ Global options:
   --url URL      LCM URL (default: $LCM_DEFAULT_URL or LCM's default)
   --timeout S    seconds to wait for a robot that does not answer (default 5); a
                  command that runs long (GOTO, a sequence) is waited for to its end
+  --key FILE     keyed mode: this client's secret key (robotalk-keygen; default
+                 $ROBOTALK_KEY); without one the client talks in open mode
+  --server-key FILE.pub
+                 keyed mode: refuse a server that answers with another key
   --version      the version
   --help         this text (also after a command)
 
@@ -75,10 +79,14 @@ int main(int argc, char** argv) {
     if (const char* env = std::getenv("LCM_DEFAULT_URL")) g.url = env;
     std::vector<std::string> rest;
     for (std::size_t i = 0; i < args.size(); ++i) {
-      if (args[i] == "--url" || args[i] == "--timeout") {
+      if (args[i] == "--url" || args[i] == "--timeout" || args[i] == "--key" || args[i] == "--server-key") {
         if (i + 1 == args.size()) throw UsageError(args[i] + " needs a value");
         if (args[i] == "--url") {
           g.url = args[++i];
+        } else if (args[i] == "--key") {
+          g.key_file = args[++i];
+        } else if (args[i] == "--server-key") {
+          g.server_key = args[++i];
         } else {
           g.timeout_s = ParseNumber(args[++i], "--timeout");
           if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");

@@ -62,6 +62,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
                       " clients already (the --max-sessions bound); try again later");
   }
   Session& session = SessionFor(r.client_id, received);
+  session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
   if (session.seen.highest() > 0 && r.sequence > session.seen.highest() + SequenceWindow::kWindow) {
     // A client numbers its packages 1, 2, 3...: a jump this far is not one of
     // its packages (a forged INT64_MAX would make every later one a "duplicate").
@@ -85,7 +86,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   for (const MalformedItem& m : r.malformed)
     immediate.push_back(MakeReply(m.id, Signal::kError, m.reason, received));
   if (r.panic) {
-    Panic(r.client_id, received);
+    Panic(r.client_id, received, r.sender);
     for (CommandId id : r.item_ids()) {
       immediate.push_back(
           MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", received));
@@ -250,7 +251,7 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
     if (auto bad = CheckCommand(model, c, &signal)) {
       immediate.push_back(MakeReply(c.id, signal, *bad, now));
     } else if (daemon_.ResetPanic()) {
-      log_.push_back("robot '" + robot_ + "': panic reset by " + Client(s.client_id));
+      log_.push_back("robot '" + robot_ + "': panic reset by " + s.who);
       immediate.push_back(MakeReply(c.id, Signal::kSuccess, "panic reset", now));
     } else {
       immediate.push_back(MakeReply(c.id, Signal::kSuccess, "the robot was not in panic", now));
@@ -378,10 +379,10 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   immediate.push_back(std::move(reply));
 }
 
-void RobotSessions::Panic(std::int64_t client_id, TimePoint now) {
+void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::string& sender) {
   const bool first = !daemon_.in_panic();
-  log_.push_back("robot '" + robot_ + "': PANIC from " + Client(client_id) +
-                 (first ? "" : " (already in panic)"));
+  const std::string who = sender.empty() ? Client(client_id) : sender;
+  log_.push_back("robot '" + robot_ + "': PANIC from " + who + (first ? "" : " (already in panic)"));
   flushed_.clear();
   daemon_.Panic(flushed_);
   for (auto& [id, session] : sessions_) {
@@ -392,8 +393,8 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now) {
   }
   for (const QueuedItem& item : flushed_) {
     if (item.client_id == 0) continue;
-    Deliver(item.client_id, MakeReply(item.command.id, Signal::kInterrupted,
-                                      "flushed by panic from " + Client(client_id), now));
+    Deliver(item.client_id,
+            MakeReply(item.command.id, Signal::kInterrupted, "flushed by panic from " + who, now));
   }
 }
 

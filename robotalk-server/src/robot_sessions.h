@@ -92,7 +92,7 @@ class RobotSessions {
   std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
                                   bool playback);
   void AdmitPlayback(Session& s, const Request& request, TimePoint now, std::vector<Reply>& immediate);
-  void Panic(std::int64_t client_id, TimePoint now);
+  void Panic(std::int64_t client_id, TimePoint now, const std::string& sender = "");
   void Deliver(std::int64_t client_id, Reply reply);
   std::size_t Waiting(const Session& s) const;
   void Own(const DaemonOutput::Executed& e);

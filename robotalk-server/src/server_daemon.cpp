@@ -226,6 +226,7 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
 bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
                         std::span<const std::uint8_t> bytes, TimePoint received) {
   const SessionGate::Admission admission = gate_->Admit(name, request, bytes, received);
+  if (gate_->keyed()) request.sender = admission.who;
   switch (admission.verdict) {
     case SessionGate::Verdict::kAccepted:
       return true;

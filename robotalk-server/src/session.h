@@ -14,6 +14,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -68,6 +69,7 @@ struct Session {
   Session(std::int64_t id, TimePoint now) : client_id(id), created(now), last_heard(now) {}
 
   std::int64_t client_id;
+  std::string who;  ///< for logs: the sender as the session gate names it
   TimePoint created;
   TimePoint last_heard;
   SequenceWindow seen;

@@ -54,6 +54,9 @@ struct Request {
   std::string header_error;
   /// Keyed mode: the package's MAC (the last kMacBytes of its encoding); zeros in open mode.
   Mac mac{};
+  /// Not on the wire: who sent it as the server's session gate names it, for
+  /// logs ("'alice' (rt:..., client ...)"); empty = by client id.
+  std::string sender;
 
   /// The ids of every item, queries first, as the package carried them.
   std::vector<CommandId> item_ids() const;
