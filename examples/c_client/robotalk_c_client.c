@@ -1,6 +1,7 @@
 /* A small RoboTalk client in C: see robotalk_c_client.h. */
 #define _POSIX_C_SOURCE 200809L
 #include "robotalk_c_client.h"
+#include "robotalk_c_url.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -505,51 +506,6 @@ robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
 
 /* ---- connecting --------------------------------------------------------- */
 
-/* url without RoboTalk's own option traffic=single|split (LCM does not know
- * it; the layout is taken from ANNOUNCE anyway). */
-static void lcm_url_of(const char* url, char* out, size_t len) {
-  const char* q = strchr(url, '?');
-  if (!q) {
-    snprintf(out, len, "%s", url);
-    return;
-  }
-  snprintf(out, len, "%.*s", (int)(q - url), url);
-  char sep = '?';
-  for (const char* opt = q + 1; *opt;) {
-    const char* end = strchr(opt, '&');
-    size_t n = end ? (size_t)(end - opt) : strlen(opt);
-    if (n > 0 && strncmp(opt, "traffic=", 8) != 0) {
-      size_t used = strlen(out);
-      snprintf(out + used, len - used, "%c%.*s", sep, (int)n, opt);
-      sep = '&';
-    }
-    opt += n + (end ? 1 : 0);
-  }
-}
-
-/* "udpm://G:P?opts" -> "udpm://G:(P+delta)?opts" (no port: LCM's 7667). 0, or
- * -1 when url is not udpm. */
-static int shifted_url(const char* url, int delta, char* out, size_t len) {
-  const char* scheme = "udpm://";
-  if (strncmp(url, scheme, strlen(scheme)) != 0) return -1;
-  const char* host = url + strlen(scheme);
-  const char* colon = strchr(host, ':');
-  const char* query = strchr(host, '?');
-  long port = 7667;
-  const char* rest = query ? query : host + strlen(host);
-  if (colon && (!query || colon < query)) {
-    char* end = NULL;
-    port = strtol(colon + 1, &end, 10);
-    if (end == colon + 1 || port <= 0) return -1;
-    rest = end;
-  } else {
-    colon = rest;
-  }
-  if (port + delta > 65535) return -1;
-  snprintf(out, len, "%.*s:%ld%s", (int)(colon - url), url, port + delta, rest);
-  return 0;
-}
-
 static int open_layout(rtc_client* c, const char* url) {
   c->split = c->announce_layout == ROBOTALK_MSGS_ANNOUNCE_T_TRAFFIC_SPLIT;
   if (c->announce_layout != ROBOTALK_MSGS_ANNOUNCE_T_TRAFFIC_SINGLE && !c->split)
@@ -558,8 +514,8 @@ static int open_layout(rtc_client* c, const char* url) {
   if (!c->split) return 0;
   char request_url[512], reply_url[512];
   int bucket = (int)((uint64_t)c->client_id % 64);
-  if (shifted_url(url, 1, request_url, sizeof request_url) != 0 ||
-      shifted_url(url, 2 + bucket, reply_url, sizeof reply_url) != 0)
+  if (rtc_shifted_url(url, 1, request_url, sizeof request_url) != 0 ||
+      rtc_shifted_url(url, 2 + bucket, reply_url, sizeof reply_url) != 0)
     return set_error(c, "the split layout needs a udpm://GROUP:PORT URL, not '%s'", url), -1;
   c->request_lcm = lcm_create(request_url);
   c->reply_lcm = lcm_create(reply_url);
@@ -600,7 +556,7 @@ rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, ch
   while (c->client_id == 0)
     if (random_bytes(&c->client_id, sizeof c->client_id) != 0) break;
   char lcm_url[512];
-  lcm_url_of(url, lcm_url, sizeof lcm_url);
+  rtc_lcm_url_of(url, lcm_url, sizeof lcm_url);
   url = lcm_url;
   c->main_lcm = lcm_create(url);
   int ok = c->client_id != 0 && c->main_lcm != NULL;
