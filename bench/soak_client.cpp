@@ -1,0 +1,331 @@
+// robotalk-soak-client: one client of scripts/soak.sh (docs/soak.md), through
+// the public RobotClient API only. It drives a robot in one mode for a
+// bounded time and writes one JSON line per event to --out (flushed at once,
+// so a client killed with SIGKILL leaves everything it knew):
+//
+//   {"ev":"hello","client":"<16 hex>","mode":"delay","seed":3}
+//   {"ev":"sent","id":12,"type":"JOINT_SETPOINT","start_us":123}   start_us: server clock; -1 unknown
+//   {"ev":"final","id":12,"outcome":"SUCCESS","msg":"..."}         a signal, UNKNOWN_OUTCOME,
+//                                                                   TIMEOUT or CLIENT_ERROR
+//   {"ev":"seq","after":11,"frames":8}    a playback sequence whose frames got ids above 11
+//   {"ev":"seq_failed","after":11,"frames":8,"outcome":"UNKNOWN_OUTCOME","msg":"..."}
+//   {"ev":"notsent","what":"...","msg":"..."}   a call that threw before anything was sent
+//   {"ev":"panic"|"reset"|"samples"|"end", ...}
+//
+//   robotalk-soak-client --mode direct|delay|playback|watch|chaos --url U --robot R
+//                        --seconds S --seed N --out FILE
+//
+// Every loop is bounded by --seconds (and each wait by the client's timeouts).
+#include "bench_util.h"
+#include "robotalk/channels.h"
+#include "robotalk/robot_client.h"
+
+#include <atomic>
+#include <random>
+#include <thread>
+
+using namespace robotalk;
+using namespace robotalk::bench;
+
+namespace {
+
+// One JSON line per event, flushed (the process may be killed at any time).
+class Report {
+ public:
+  explicit Report(const std::string& path) : f_(std::fopen(path.c_str(), "w")) {
+    if (f_ == nullptr) throw std::runtime_error("cannot write " + path);
+  }
+  ~Report() { std::fclose(f_); }
+  Report(const Report&) = delete;
+  Report& operator=(const Report&) = delete;
+  void Line(const std::string& body) {
+    std::fprintf(f_, "{%s}\n", body.c_str());
+    std::fflush(f_);
+  }
+
+ private:
+  std::FILE* f_;
+};
+
+std::string Quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s.substr(0, 200)) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
+  }
+  return out + "\"";
+}
+
+std::string Kv(const std::string& k, const std::string& quoted_or_number) {
+  return "\"" + k + "\":" + quoted_or_number;
+}
+std::string Num(std::int64_t v) { return std::to_string(v); }
+
+struct Soak {
+  RobotClient& client;
+  Report& report;
+  std::mt19937_64 rng;
+  TimePoint deadline;
+  CommandId max_id = 0;  // the highest id this client has seen assigned
+
+  double Uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+  bool Running() const { return SteadyNow() < deadline; }
+  static TimePoint SteadyNow() { return TimePoint(std::chrono::steady_clock::now().time_since_epoch()); }
+  void Sleep(double s) { std::this_thread::sleep_for(FromSeconds(s)); }
+
+  // A random motion command: set-points of the head, base speeds, short GOTOs.
+  Command RandomCommand() {
+    const double p = Uniform(0, 1);
+    if (p < 0.45)
+      return Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {Uniform(-2, 2)}};
+    if (p < 0.7)
+      return Command{.type = CommandType::kJointSetPoint, .target = "tilt", .values = {Uniform(-0.5, 0.4)}};
+    if (p < 0.9)
+      return Command{.type = CommandType::kSetSpeed, .values = {Uniform(-0.2, 0.2), Uniform(-0.3, 0.3)}};
+    return Command{.type = CommandType::kGoto, .values = {Uniform(-0.3, 0.3), Uniform(-0.3, 0.3), 0.0}};
+  }
+
+  void Sent(CommandId id, CommandType type, std::int64_t start_us) {
+    max_id = std::max(max_id, id);
+    report.Line(Kv("ev", "\"sent\"") + "," + Kv("id", Num(id)) + "," + Kv("type", Quote(ToString(type))) +
+                "," + Kv("start_us", Num(start_us)));
+  }
+  void Final(CommandId id, const std::string& outcome, const std::string& msg) {
+    report.Line(Kv("ev", "\"final\"") + "," + Kv("id", Num(id)) + "," + Kv("outcome", Quote(outcome)) + "," +
+                Kv("msg", Quote(msg)));
+  }
+  void NotSent(const std::string& what, const std::string& msg) {
+    report.Line(Kv("ev", "\"notsent\"") + "," + Kv("what", Quote(what)) + "," + Kv("msg", Quote(msg)));
+  }
+
+  // Waits for one reply and reports its outcome, whatever it is.
+  void Collect(PendingReply& p, Duration wait) {
+    try {
+      const Reply r = p.Wait(wait);
+      Final(p.id(), std::string(ToString(r.signal)), r.message);
+    } catch (const UnknownOutcomeError& e) {
+      Final(p.id(), "UNKNOWN_OUTCOME", e.what());
+    } catch (const TimeoutError& e) {
+      Final(p.id(), "TIMEOUT", e.what());
+    } catch (const Error& e) {
+      Final(p.id(), "CLIENT_ERROR", e.what());
+    }
+  }
+
+  // A client-side wait long enough that the library's own answer (a reply,
+  // or UnknownOutcomeError after give_up_after) always comes first.
+  Duration WaitFor(Duration until_start) const {
+    return until_start + client.options().timeout + client.options().give_up_after + std::chrono::seconds(5);
+  }
+};
+
+// Direct mode: one command at a time, each waiting for its final reply.
+void RunDirect(Soak& s) {
+  while (s.Running()) {
+    const Command c = s.RandomCommand();
+    try {
+      const std::int64_t at = ToWireMicros(s.client.ServerNow());
+      PendingReply p = s.client.Send(c);
+      s.Sent(p.id(), c.type, at);
+      s.Collect(p, s.WaitFor(Duration(0)));
+    } catch (const Error& e) {
+      s.NotSent(ToString(c.type), e.what());
+      s.Sleep(0.2);
+    }
+    s.Sleep(s.Uniform(0, 0.05));
+  }
+}
+
+// Delay mode: batches of timed commands on the server clock, 50 ms apart,
+// starting 300 ms ahead; the next batch leaves when this one has ended.
+void RunDelay(Soak& s) {
+  while (s.Running()) {
+    const int n = static_cast<int>(s.Uniform(3, 11));
+    const TimePoint base = s.client.ServerNow() + std::chrono::milliseconds(300);
+    std::vector<Command> batch;
+    for (int i = 0; i < n; ++i) {
+      Command c = s.RandomCommand();
+      c.start_time = StartTime::At(base + i * std::chrono::milliseconds(50));
+      batch.push_back(std::move(c));
+    }
+    std::vector<PendingReply> pending;
+    try {
+      pending = s.client.SendBatch(batch);
+    } catch (const Error& e) {
+      s.NotSent("batch of " + std::to_string(n), e.what());
+      s.Sleep(0.2);
+      continue;
+    }
+    for (int i = 0; i < n; ++i) {
+      s.Sent(pending[static_cast<std::size_t>(i)].id(), batch[static_cast<std::size_t>(i)].type,
+             ToWireMicros(*batch[static_cast<std::size_t>(i)].start_time.time()));
+    }
+    for (int i = 0; i < n; ++i) {
+      const Duration until = *batch[static_cast<std::size_t>(i)].start_time.time() - s.client.ServerNow();
+      s.Collect(pending[static_cast<std::size_t>(i)], s.WaitFor(std::max(Duration(0), until)));
+    }
+  }
+}
+
+// A marker query: its id bounds the ids a sequence used (ids come from one
+// counter). Its reply is not awaited.
+void Mark(Soak& s) {
+  try {
+    PendingReply p = s.client.SendQuery(Query{.type = QueryType::kBasePose});
+    s.max_id = std::max(s.max_id, p.id());
+    s.report.Line(Kv("ev", "\"marker\"") + "," + Kv("id", Num(p.id())));
+  } catch (const Error& e) {
+    s.NotSent("marker", e.what());
+  }
+}
+
+// Playback mode: sequences of 4..10 frames 100 ms apart; the server chooses
+// the delay. A sequence that throws leaves its frames' ids unknown: the
+// report names the id range (above `after`, below the next marker).
+void RunPlayback(Soak& s) {
+  while (s.Running()) {
+    const int n = static_cast<int>(s.Uniform(4, 11));
+    std::vector<TimedCommand> frames;
+    for (int i = 0; i < n; ++i) frames.push_back({i * std::chrono::milliseconds(100), s.RandomCommand()});
+    const std::vector<TimedCommand> copy = frames;
+    Mark(s);
+    const CommandId after = s.max_id;
+    s.report.Line(Kv("ev", "\"seq\"") + "," + Kv("after", Num(after)) + "," + Kv("frames", Num(n)));
+    try {
+      const SequenceResult r = s.client.RunSequence(std::move(frames), {.mode = CommandMode::kPlayback});
+      for (int i = 0; i < n; ++i) {
+        const Reply& reply = r.replies[static_cast<std::size_t>(i)];
+        const std::int64_t start =
+            r.server_start ? ToWireMicros(*r.server_start + copy[static_cast<std::size_t>(i)].offset) : -1;
+        s.Sent(reply.id, copy[static_cast<std::size_t>(i)].command.type, start);
+        s.Final(reply.id, std::string(ToString(reply.signal)), reply.message);
+      }
+    } catch (const Error& e) {
+      const bool unknown = dynamic_cast<const UnknownOutcomeError*>(&e) != nullptr;
+      const bool timeout = dynamic_cast<const TimeoutError*>(&e) != nullptr;
+      s.report.Line(Kv("ev", "\"seq_failed\"") + "," + Kv("after", Num(after)) + "," + Kv("frames", Num(n)) +
+                    "," +
+                    Kv("outcome", Quote(unknown   ? "UNKNOWN_OUTCOME"
+                                        : timeout ? "TIMEOUT"
+                                                  : "CLIENT_ERROR")) +
+                    "," + Kv("msg", Quote(e.what())));
+      s.Sleep(0.2);
+    }
+    Mark(s);
+  }
+}
+
+// Broadcast/watch: a STATE stream every 50 ms, asked again when it stops
+// (a restarted server does not know the request), and a BASE_POSE each second.
+void RunWatch(Soak& s) {
+  std::atomic<long> samples{0};
+  long asked = 0, last = -1;
+  while (s.Running()) {
+    const long now = samples.load();
+    if (now == last) {
+      try {
+        s.client.StartStateStream(std::chrono::milliseconds(50), [&](const StateSample&) { ++samples; });
+        ++asked;
+      } catch (const Error& e) {
+        s.NotSent("STATE_STREAM", e.what());
+      }
+    }
+    last = samples.load();
+    try {
+      s.client.BasePose();
+    } catch (const Error& e) {
+      s.NotSent("BASE_POSE", e.what());
+    }
+    s.Sleep(1.0);
+  }
+  s.report.Line(Kv("ev", "\"samples\"") + "," + Kv("n", Num(samples.load())) + "," + Kv("asked", Num(asked)));
+  try {
+    s.client.StopStateStream();
+  } catch (const Error&) {
+  }
+}
+
+// Chaos: a panic every 2..6 s, reset 0.2..0.8 s later (seeded).
+void RunChaos(Soak& s) {
+  while (s.Running()) {
+    s.Sleep(s.Uniform(2, 6));
+    if (!s.Running()) break;
+    std::string outcome = "ACKNOWLEDGED";
+    try {
+      s.client.Panic();
+    } catch (const Error& e) {
+      outcome = std::string("FAILED: ") + e.what();
+    }
+    s.report.Line(Kv("ev", "\"panic\"") + "," + Kv("outcome", Quote(outcome)));
+    s.Sleep(s.Uniform(0.2, 0.8));
+    for (int attempt = 0; attempt < 5; ++attempt) {  // a reset must not be left undone
+      try {
+        const Reply r = s.client.ResetPanic();
+        s.report.Line(Kv("ev", "\"reset\"") + "," + Kv("outcome", Quote(std::string(ToString(r.signal)))));
+        break;
+      } catch (const Error& e) {
+        s.report.Line(Kv("ev", "\"reset\"") + "," + Kv("outcome", Quote("FAILED")) + "," +
+                      Kv("msg", Quote(e.what())));
+      }
+    }
+  }
+}
+
+int Main(int argc, char** argv) {
+  const Args a(argc, argv, 1);
+  const std::string mode = a.Str("mode", "direct");
+  const long seed = a.Int("seed", 1);
+  Report report(a.Str("out", "/dev/stdout"));
+  ClientOptions o;
+  o.lcm_url = a.Str("url", "");
+  RobotClient client(o);
+  const TimePoint deadline = Soak::SteadyNow() + FromSeconds(a.Num("seconds", 10));
+  // A client started while the server restarts retries until its deadline.
+  for (int attempt = 0;; ++attempt) {
+    try {
+      client.Connect(a.Str("robot", "pioneer"));
+      break;
+    } catch (const Error& e) {
+      if (Soak::SteadyNow() >= deadline || attempt >= 20) {
+        std::fprintf(stderr, "robotalk-soak-client: cannot connect: %s\n", e.what());
+        return 2;
+      }
+    }
+  }
+  report.Line(Kv("ev", "\"hello\"") + "," +
+              Kv("client", Quote(Hex64(static_cast<std::uint64_t>(client.client_id())))) + "," +
+              Kv("mode", Quote(mode)) + "," + Kv("seed", Num(seed)));
+  Soak s{client, report, std::mt19937_64(static_cast<std::uint64_t>(seed)), deadline};
+  if (mode == "direct") {
+    RunDirect(s);
+  } else if (mode == "delay") {
+    RunDelay(s);
+  } else if (mode == "playback") {
+    RunPlayback(s);
+  } else if (mode == "watch") {
+    RunWatch(s);
+  } else if (mode == "chaos") {
+    RunChaos(s);
+  } else {
+    std::fprintf(stderr, "robotalk-soak-client: unknown --mode '%s'\n", mode.c_str());
+    return 2;
+  }
+  const ClientStats st = client.stats();
+  report.Line(Kv("ev", "\"end\"") + "," +
+              Kv("retransmissions", Num(static_cast<std::int64_t>(st.retransmissions))) + "," +
+              Kv("gave_up", Num(static_cast<std::int64_t>(st.gave_up))) + "," +
+              Kv("sessions_opened", Num(static_cast<std::int64_t>(st.sessions_opened))) + "," +
+              Kv("sessions_lost", Num(static_cast<std::int64_t>(st.sessions_lost))));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "robotalk-soak-client: %s\n", e.what());
+    return 2;
+  }
+}
