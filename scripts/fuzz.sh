@@ -2,7 +2,7 @@
 # Fuzzes every decoder the server and the client run on received bytes, and
 # URDF import, with libFuzzer (docs/fuzzing.md).
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET ...]     default 60 s, every target
-# Targets: package reply_package robot_state config announce urdf.
+# Targets: package reply_package robot_state config announce urdf hello hello_answer.
 # Installs clang and libFuzzer's runtime when missing (Debian 12: clang +
 # libclang-rt-14-dev) and the project's own packages, builds with clang, ASan
 # and UBSan into build-fuzz/, writes seed corpora from valid messages, then
@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 
 SECONDS_PER_TARGET=${1:-60}
 shift || true
-ALL_TARGETS=(package reply_package robot_state config announce urdf)
+ALL_TARGETS=(package reply_package robot_state config announce urdf hello hello_answer)
 TARGETS=("$@")
 ((${#TARGETS[@]})) || TARGETS=("${ALL_TARGETS[@]}")
 BUILD_DIR=build-fuzz

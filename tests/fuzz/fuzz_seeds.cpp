@@ -4,6 +4,8 @@
 // URDF files, each also as its configuration message.
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
+#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "robotalk/urdf_import.h"
 #include "robotalk_msgs/announce_t.hpp"
 #include "robotalk_msgs/package_t.hpp"
@@ -37,7 +39,7 @@ std::vector<std::uint8_t> Encode(const Msg& m) {
 
 msgs::package_header_t Header(std::int64_t sequence, std::int8_t type, std::int32_t size, std::int8_t mode) {
   msgs::package_header_t h{};
-  h.protocol_version = 1;
+  h.protocol_version = robotalk::kProtocolVersion;
   h.client_id = 0x1234abcd;
   h.sequence = sequence;
   h.send_time_us = 1'000'000 * sequence;
@@ -94,7 +96,7 @@ void Packages(const fs::path& dir) {
 
 void Replies(const fs::path& dir) {
   msgs::reply_package_t p{};
-  p.protocol_version = 1;
+  p.protocol_version = robotalk::kProtocolVersion;
   p.client_id = 0x1234abcd;
   p.ack_sequence = 3;
   p.server_receive_us = 5'000'000;
@@ -135,7 +137,7 @@ void States(const fs::path& dir) {
 
 void Announces(const fs::path& dir) {
   msgs::announce_t a{};
-  a.protocol_version = 1;
+  a.protocol_version = robotalk::kProtocolVersion;
   a.server_id = 42;
   a.server_time_us = 1'000'000;
   a.url_hint = "udpm://239.255.76.67:7667?ttl=0";
@@ -153,6 +155,23 @@ void Announces(const fs::path& dir) {
 
 }  // namespace
 
+void Hellos(const fs::path& dir) {
+  robotalk::Hello open;
+  open.body.client_id = 0x1234abcd;
+  open.body.client_nonce = robotalk::RandomNonce();
+  Write(dir / "hello", "open", robotalk::EncodeHello(open));
+  robotalk::ClientHandshake handshake(robotalk::KeyPair::Generate(), 0x1234abcd);
+  Write(dir / "hello", "keyed", robotalk::EncodeHello({.keyed = true, .body = handshake.hello()}));
+  robotalk::HelloAnswer answer;
+  answer.server_id = 42;
+  answer.session_id = 77;
+  answer.body.client_id = 0x1234abcd;
+  Write(dir / "hello_answer", "open", robotalk::EncodeHelloAnswer(answer));
+  answer.session_id = 0;
+  answer.refusal = "this server runs in keyed mode";
+  Write(dir / "hello_answer", "refused", robotalk::EncodeHelloAnswer(answer));
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: robotalk-fuzz-seeds OUT_DIR [FILE.urdf ...]\n";
@@ -163,6 +182,7 @@ int main(int argc, char** argv) {
   Replies(out / "reply_package");
   States(out / "robot_state");
   Announces(out / "announce");
+  Hellos(out);
   for (int i = 2; i < argc; ++i) {
     std::ifstream in(argv[i], std::ios::binary);
     std::stringstream text;

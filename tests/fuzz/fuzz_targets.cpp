@@ -68,6 +68,22 @@ void Announce(Bytes bytes) {
   }
 }
 
+void Hello(Bytes bytes) {
+  // What the server runs on ROBOTALK/<robot>/HELLO.
+  try {
+    (void)DecodeHello(bytes);
+  } catch (const ProtocolError&) {
+  }
+}
+
+void HelloAnswer(Bytes bytes) {
+  // What the client runs on ROBOTALK/<robot>/HELLO/<client>.
+  try {
+    (void)DecodeHelloAnswer(bytes);
+  } catch (const ProtocolError&) {
+  }
+}
+
 void Urdf(Bytes bytes) {
   try {
     (void)ParseUrdf(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()), {}, "fuzz.urdf");
@@ -79,6 +95,7 @@ std::span<const Target> Targets() {
   static const Target targets[] = {
       {"package", &Package}, {"reply_package", &ReplyPackage}, {"robot_state", &RobotState},
       {"config", &Config},   {"announce", &Announce},          {"urdf", &Urdf},
+      {"hello", &Hello},     {"hello_answer", &HelloAnswer},
   };
   return targets;
 }

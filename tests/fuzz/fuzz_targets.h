@@ -30,6 +30,9 @@ void Config(Bytes bytes);
 void Announce(Bytes bytes);
 /// ParseUrdf on the bytes as text (robotalk-describe, the server's --robot).
 void Urdf(Bytes bytes);
+/// DecodeHello (server) and DecodeHelloAnswer (client), protocol 2 sessions.
+void Hello(Bytes bytes);
+void HelloAnswer(Bytes bytes);
 
 struct Target {
   const char* name;  ///< also the folder of its seeds and regressions
