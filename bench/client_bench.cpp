@@ -133,11 +133,22 @@ enum class Outcome { kReady, kPending, kLost };
 // Waits at most `wait` for `p`. A TimeoutError from Wait() is either the wait
 // itself or the client giving up on the package; Poll() tells them apart (a
 // given-up id has been consumed, so Poll throws).
+// Polls first, so the normal path (the reply is there, or a zero wait finds
+// it not yet there) throws nothing: a TimeoutError per not-yet-answered
+// command was 9 % of a loaded scale client's CPU in exception unwinding.
 Outcome WaitFor(PendingReply& p, Duration wait, Reply* out) {
-  try {
-    *out = p.Wait(wait);
-    return Outcome::kReady;
-  } catch (const TimeoutError&) {
+  if (wait.count() > 0) {
+    try {
+      if (auto r = p.Poll()) {
+        *out = *r;
+        return Outcome::kReady;
+      }
+      *out = p.Wait(wait);
+      return Outcome::kReady;
+    } catch (const TimeoutError&) {
+    } catch (const Error&) {
+      return Outcome::kLost;
+    }
   }
   try {
     if (auto r = p.Poll()) {

@@ -54,7 +54,44 @@ void OutstandingPackages::UpdateStart(CommandId id, TimePoint start, TimePoint n
   if (it == packages_.end()) return;
   Package& p = it->second;
   p.pending[id] = start;
-  if (p.acked) p.next_send = std::max(now, EarliestStart(p, now)) + IntervalAt(0);
+  if (p.acked) Reschedule(it->first, p, std::max(now, EarliestStart(p, now)) + IntervalAt(0));
+  RefreshSilence(it->first, p);
+}
+
+void OutstandingPackages::Reschedule(std::int64_t sequence, Package& p, TimePoint t) {
+  if (t == p.next_send) return;
+  by_next_send_.erase({p.next_send, sequence});
+  p.next_send = t;
+  by_next_send_.insert({t, sequence});
+}
+
+TimePoint OutstandingPackages::SilentSince(const Package& p) {
+  // Once acknowledged, silence counts only from when an answer is due.
+  return p.acked ? std::max(p.last_heard, EarliestStart(p, p.last_heard)) : p.last_heard;
+}
+
+void OutstandingPackages::RefreshSilence(std::int64_t sequence, Package& p) {
+  const TimePoint since = SilentSince(p);
+  if (since == p.silent_since) return;
+  by_silence_.erase({p.silent_since, sequence});
+  p.silent_since = since;
+  by_silence_.insert({since, sequence});
+}
+
+void OutstandingPackages::Erase(std::unordered_map<std::int64_t, Package>::iterator it) {
+  by_next_send_.erase({it->second.next_send, it->first});
+  by_silence_.erase({it->second.silent_since, it->first});
+  packages_.erase(it);
+}
+
+TimePoint OutstandingPackages::NextDeadline() const {
+  TimePoint next = TimePoint::max();
+  if (!by_next_send_.empty()) next = by_next_send_.begin()->first;
+  if (!by_silence_.empty()) {
+    // TakeExpired gives up once now - since > give_up_after.
+    next = std::min(next, by_silence_.begin()->first + policy_.give_up_after + Duration(1));
+  }
+  return next;
 }
 
 TimePoint OutstandingPackages::EarliestStart(const Package& p, TimePoint fallback) {
@@ -78,6 +115,9 @@ void OutstandingPackages::Add(std::int64_t sequence, std::vector<std::uint8_t> b
   p.first_send = now;
   p.last_heard = now;
   p.next_send = now + IntervalAt(0);
+  p.silent_since = SilentSince(p);
+  by_next_send_.insert({p.next_send, sequence});
+  by_silence_.insert({p.silent_since, sequence});
   packages_.emplace(sequence, std::move(p));
 }
 
@@ -97,12 +137,14 @@ OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, T
     if (p.sends == 1) AddRoundTrip(now - p.first_send);
     // Replies are not due before the items' start times: ask again only after.
     p.backoff_step = 0;
-    p.next_send = std::max(now, EarliestStart(p, now)) + IntervalAt(0);
+    Reschedule(sequence, p, std::max(now, EarliestStart(p, now)) + IntervalAt(0));
   }
   if (p.pending.empty()) {
-    packages_.erase(it);
+    Erase(it);
     info.completed = true;
+    return info;
   }
+  RefreshSilence(sequence, p);
   return info;
 }
 
@@ -123,24 +165,29 @@ std::optional<std::int64_t> OutstandingPackages::OnReply(CommandId id, TimePoint
     p.backoff_step = 0;
   }
   if (p.pending.empty()) {
-    packages_.erase(it);
+    Erase(it);
     return sequence;
   }
-  p.next_send = std::max(p.next_send, std::max(now, EarliestStart(p, now)) + IntervalAt(0));
+  Reschedule(sequence, p, std::max(p.next_send, std::max(now, EarliestStart(p, now)) + IntervalAt(0)));
+  RefreshSilence(sequence, p);
   return std::nullopt;
 }
 
 std::vector<OutstandingPackages::Resend> OutstandingPackages::TakeDue(TimePoint now) {
   std::vector<Resend> due;
   bool timed_out = false;
+  // The due packages, earliest first (taken out before rescheduling them).
+  std::vector<std::int64_t> sequences;
+  for (auto k = by_next_send_.begin(); k != by_next_send_.end() && k->first <= now; ++k)
+    sequences.push_back(k->second);
   std::size_t deferred = 0;
-  for (auto& [sequence, p] : packages_) {
-    if (now < p.next_send) continue;
+  for (const std::int64_t sequence : sequences) {
+    Package& p = packages_.at(sequence);
     if (due.size() >= kMaxResendsPerCall) {
       // Paced: a burst of due packages (a loss burst, 1000 in flight) leaves
       // kMaxResendsPerCall at a time, one pacing step apart, instead of all
       // at once into a receive buffer that just overflowed.
-      p.next_send = now + kPacingStep * static_cast<int>(1 + deferred++ / kMaxResendsPerCall);
+      Reschedule(sequence, p, now + kPacingStep * static_cast<int>(1 + deferred++ / kMaxResendsPerCall));
       continue;
     }
     due.push_back({sequence, p.bytes});
@@ -148,7 +195,7 @@ std::vector<OutstandingPackages::Resend> OutstandingPackages::TakeDue(TimePoint 
     ++p.sends;
     ++retransmissions_;
     ++p.backoff_step;
-    p.next_send = now + IntervalAt(p.backoff_step);
+    Reschedule(sequence, p, now + IntervalAt(p.backoff_step));
   }
   // RFC 6298 §5.5: an acknowledgement that did not come in time backs the
   // timer off for every package until a fresh round-trip sample arrives, so a
@@ -159,14 +206,9 @@ std::vector<OutstandingPackages::Resend> OutstandingPackages::TakeDue(TimePoint 
 
 std::vector<OutstandingPackages::Expired> OutstandingPackages::TakeExpired(TimePoint now) {
   std::vector<Expired> expired;
-  for (auto it = packages_.begin(); it != packages_.end();) {
+  while (!by_silence_.empty() && now - by_silence_.begin()->first > policy_.give_up_after) {
+    auto it = packages_.find(by_silence_.begin()->second);
     const Package& p = it->second;
-    // Once acknowledged, silence counts only from when an answer is due.
-    const TimePoint since = p.acked ? std::max(p.last_heard, EarliestStart(p, p.last_heard)) : p.last_heard;
-    if (now - since <= policy_.give_up_after) {
-      ++it;
-      continue;
-    }
     Expired e{.sequence = it->first, .acked = p.acked};
     for (const auto& [id, start] : p.pending) {
       e.unanswered.push_back(id);
@@ -174,7 +216,7 @@ std::vector<OutstandingPackages::Expired> OutstandingPackages::TakeExpired(TimeP
     }
     std::sort(e.unanswered.begin(), e.unanswered.end());
     expired.push_back(std::move(e));
-    it = packages_.erase(it);
+    Erase(it);
   }
   return expired;
 }
@@ -184,6 +226,8 @@ std::vector<CommandId> OutstandingPackages::Clear() {
   for (const auto& [id, sequence] : owner_) ids.push_back(id);
   owner_.clear();
   packages_.clear();
+  by_next_send_.clear();
+  by_silence_.clear();
   return ids;
 }
 

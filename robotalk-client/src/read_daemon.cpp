@@ -194,8 +194,10 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     last_send_ = now;
     ++stats_.packages_sent;
   }
+  // No wake-up of the ReadDaemon (a context switch per command): it never
+  // sleeps longer than retransmit_interval (IdleWait), and a new package's
+  // first resend is at least that far away.
   Publish(channel, bytes);
-  if (track == Track::kRetransmit) WakeDaemon();  // a new resend deadline
   return sent;
 }
 
@@ -292,8 +294,13 @@ void RobotClient::Impl::Run() {
 Duration RobotClient::Impl::IdleWait(TimePoint now) {
   std::lock_guard lock(mu_);
   Duration wait = options_.max_idle_wait;
-  if (!robot_.empty()) wait = std::min(wait, last_send_ + options_.heartbeat_interval - now);
-  if (outstanding_.size() > 0) wait = std::min(wait, outstanding_.retransmit_timeout() / 4);
+  if (!robot_.empty()) {
+    wait = std::min(wait, last_send_ + options_.heartbeat_interval - now);
+    // Bounded by the shortest resend interval, so a package added while the
+    // ReadDaemon sleeps (SendPackage does not wake it) is never resent late.
+    if (options_.retransmit_interval.count() > 0) wait = std::min(wait, options_.retransmit_interval);
+  }
+  if (outstanding_.size() > 0) wait = std::min(wait, outstanding_.NextDeadline() - now);
   return std::max(wait, Duration(0));
 }
 

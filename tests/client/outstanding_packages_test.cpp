@@ -70,6 +70,56 @@ TEST(OutstandingPackages, ABurstOfDuePackagesIsPaced) {
   EXPECT_EQ(sent, 100u) << "every package left within a few milliseconds";
 }
 
+// Issue 11: TakeDue scanned every outstanding package on every tick; the
+// index hands out the most overdue first.
+TEST(OutstandingPackages, ABurstIsResentEarliestDeadlineFirst) {
+  OutstandingPackages o(Policy());
+  for (int i = 40; i >= 1; --i) o.Add(i, Bytes(1), {{.id = i}}, kT0 + milliseconds(i));
+  const auto due = o.TakeDue(kT0 + milliseconds(200));
+  ASSERT_EQ(due.size(), 32u);
+  for (std::size_t k = 0; k < due.size(); ++k) EXPECT_EQ(due[k].sequence, static_cast<std::int64_t>(k + 1));
+  const auto rest = o.TakeDue(kT0 + milliseconds(201));
+  ASSERT_EQ(rest.size(), 8u);
+  EXPECT_EQ(rest.front().sequence, 33);
+}
+
+TEST(OutstandingPackages, NextDeadlineIsTheEarliestResendOrGiveUp) {
+  OutstandingPackages o(Policy());
+  EXPECT_EQ(o.NextDeadline(), TimePoint::max());
+  o.Add(1, Bytes(1), {{.id = 10, .start = kT0 + seconds(30)}}, kT0);
+  o.Add(2, Bytes(2), {{.id = 20}}, kT0 + milliseconds(50));
+  EXPECT_EQ(o.NextDeadline(), kT0 + milliseconds(100)) << "package 1's first resend";
+  o.OnAck(1, kT0 + milliseconds(60));  // now waits for its start time
+  EXPECT_EQ(o.NextDeadline(), kT0 + milliseconds(150)) << "package 2's first resend";
+  o.OnAck(2, kT0 + milliseconds(70));
+  o.OnReply(20, kT0 + milliseconds(80));
+  EXPECT_FALSE(o.Contains(2));
+  // Re-asked one RTO after its start; the 60 ms round trip made the RTO
+  // srtt + 4 rttvar = 60 + 4 × 30 ms.
+  EXPECT_EQ(o.NextDeadline(), kT0 + seconds(30) + milliseconds(180)) << "re-ask after the start";
+  EXPECT_TRUE(o.TakeDue(o.NextDeadline() - Duration(1)).empty());
+  EXPECT_EQ(o.TakeDue(o.NextDeadline()).size(), 1u);
+}
+
+TEST(OutstandingPackages, GivesUpAtTheDeadlineItAnnounces) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}}, kT0);
+  o.Add(2, Bytes(2), {{.id = 20}}, kT0 + milliseconds(500));
+  o.OnAck(1, kT0 + milliseconds(300));  // heard of at 300 ms: gives up 2 s later
+  TimePoint t = kT0;
+  std::vector<std::int64_t> order;
+  for (int step = 0; step < 1000 && o.size() > 0; ++step) {
+    t = o.NextDeadline();
+    o.TakeDue(t);
+    for (const auto& e : o.TakeExpired(t)) {
+      order.push_back(e.sequence);
+      EXPECT_EQ(t, (e.sequence == 1 ? kT0 + milliseconds(300) : kT0 + milliseconds(500)) + seconds(2) +
+                       Duration(1));
+    }
+  }
+  EXPECT_EQ(order, (std::vector<std::int64_t>{1, 2}));
+}
+
 TEST(OutstandingPackages, AFreshRoundTripResetsTheTimerBackoff) {
   OutstandingPackages o(Policy());
   o.Add(1, Bytes(1), {{.id = 10}}, kT0);
