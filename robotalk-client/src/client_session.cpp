@@ -136,6 +136,11 @@ bool RobotClient::Impl::AcceptReplyPackage(const robotalk_msgs::reply_package_t&
     // Unsealed by nature (the server has no key for it): believed only for
     // the live session. A forger can make the client say hello again; it
     // could as well drop every package (docs/security.md, availability).
+    if (!identity_ && ack_waited_.count(pkg.ack_sequence) != 0) {
+      // An open-mode server acts on a panic outside any session (it stopped
+      // the robot) before answering SESSION_UNKNOWN: that is its acknowledgement.
+      acked_.insert(pkg.ack_sequence);
+    }
     if (session_id_ == 0 || pkg.session_id != session_id_) return false;
     const std::string old = Hex64(static_cast<std::uint64_t>(server_id_));
     lost = LoseSession(now);

@@ -155,7 +155,10 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     std::unique_lock lock(mu_);
     if (daemon_error_) std::rethrow_exception(std::exchange(daemon_error_, nullptr));
     if (robot_.empty()) throw ClientError("RobotClient: not connected (call Connect first)");
-    WaitSession(lock);
+    // A panic never waits for a session: a client whose server restarted
+    // must still stop the robot (an open-mode server honours it outside any
+    // session; a keyed one refuses it unauthenticated).
+    if (!(panic && session_id_ == 0)) WaitSession(lock);
     p.header.session_id = session_id_;
     channel = request_channel_;
     const TimePoint now = clock_.Now();
@@ -406,6 +409,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
       accepted = AcceptReplyPackage(pkg, bytes, now, lost);
     }
     if (!accepted) {
+      cv_.notify_all();  // a panic acknowledged outside its session
       fail_lost();
       return;
     }

@@ -60,10 +60,13 @@ class CountingDriver final : public Driver {
 class ServerClientTest : public ::testing::Test {
  protected:
   void StartServer(ServerOptions options = {}) {
-    RegisterKinematicDriver(registry_);
-    registry_.Register("counting", [log = log_, this](const DriverConfig& config) {
-      return std::make_unique<CountingDriver>(registry_.Create("kinematic", config), log);
-    });
+    if (!registered_) {
+      RegisterKinematicDriver(registry_);
+      registry_.Register("counting", [log = log_, this](const DriverConfig& config) {
+        return std::make_unique<CountingDriver>(registry_.Create("kinematic", config), log);
+      });
+      registered_ = true;
+    }
     options.lcm_url = kUrl;
     RobotSpec spec{"pioneer", "counting", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
     server_ = std::make_unique<Server>(options, std::vector<RobotSpec>{spec}, registry_, clock_);
@@ -83,7 +86,29 @@ class ServerClientTest : public ::testing::Test {
   DriverRegistry registry_;
   std::shared_ptr<ExecutionLog> log_ = std::make_shared<ExecutionLog>();
   std::unique_ptr<Server> server_;
+  bool registered_ = false;
 };
+
+// Issue 9: after a restart the client ignored the new instance; a panic must
+// still stop the robot at once, before the client has a new session.
+TEST_F(ServerClientTest, AfterAServerRestartAPanicStopsTheRobotAtOnceAndTheClientGoesOn) {
+  StartServer();
+  auto client = Connect();
+  PendingReply later = client->Send(Command{.type = CommandType::kJointSetPoint,
+                                            .start_time = StartTime::At(client->ServerNow() + seconds(30)),
+                                            .target = "pan",
+                                            .values = {0.4}});
+  server_->Stop();
+  server_.reset();
+  StartServer();    // a new instance: none of the old sessions
+  client->Panic();  // sent in the old session; the new server acts on it and says so
+  EXPECT_THROW(later.Wait(seconds(5)), UnknownOutcomeError);
+  const Reply moved = client->SetJoint("pan", {0.2});  // a new session
+  EXPECT_EQ(moved.signal, Signal::kPanic) << "the panic reached the new instance: " << moved.message;
+  EXPECT_EQ(client->ResetPanic().signal, Signal::kSuccess);
+  EXPECT_EQ(client->SetJoint("pan", {0.2}).signal, Signal::kSuccess);
+  EXPECT_GE(client->stats().sessions_lost, 1u);
+}
 
 TEST_F(ServerClientTest, ConnectsLoadsTheConfigurationAndSynchronisesClocks) {
   StartServer();
