@@ -135,18 +135,22 @@ static void file_reply(rtc_client* c, const rtc_reply* r) {
 }
 
 /* A new server instance answered: what was acknowledged by the old one may or may not have run. */
-static void server_changed(rtc_client* c, int64_t new_server_id) {
-  for (int i = 0; i < kMaxPackages; ++i) {
-    pending_package* p = &c->packages[i];
-    if (!p->used || !p->acked) continue;
-    for (int k = 0; k < p->n_ids; ++k) {
-      rtc_reply r = {.id = p->ids[k], .signal = RTC_UNKNOWN_OUTCOME};
-      snprintf(r.message, sizeof r.message,
-               "may or may not have run on server instance %016" PRIx64 "; query or re-plan",
-               (uint64_t)c->server_id);
-      file_reply(c, &r);
-    }
+/* The items of an acknowledged package whose session is gone: they may or may
+ * not have run; never re-sent (the C++ client's UnknownOutcomeError). */
+static void unknown_outcome(rtc_client* c, const pending_package* p, const char* why) {
+  for (int k = 0; k < p->n_ids; ++k) {
+    rtc_reply r = {.id = p->ids[k], .signal = RTC_UNKNOWN_OUTCOME};
+    snprintf(r.message, sizeof r.message, "may or may not have run (%s); query or re-plan", why);
+    file_reply(c, &r); /* ignored for an item that has its final reply */
   }
+}
+
+/* A new server instance answered: what the old one acknowledged may or may not have run. */
+static void server_changed(rtc_client* c, int64_t new_server_id) {
+  char why[96];
+  snprintf(why, sizeof why, "server instance %016" PRIx64 " is gone", (uint64_t)c->server_id);
+  for (int i = 0; i < kMaxPackages; ++i)
+    if (c->packages[i].used && c->packages[i].acked) unknown_outcome(c, &c->packages[i], why);
   c->server_id = new_server_id;
   c->clock_stale = 1;
 }
@@ -161,8 +165,13 @@ static void on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robo
   if (m->server_id != c->server_id && c->server_id != 0) server_changed(c, m->server_id);
   pending_package* p = m->ack_sequence > 0 ? find_package(c, m->ack_sequence) : NULL;
   if (m->session_status == ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN) {
-    if (p && p->session_id == m->session_id) p->session_unknown = 1; /* nothing in it ran */
-    if (m->session_id == c->session_id) c->hello_answered = 0;       /* say hello again */
+    if (p && p->session_id == m->session_id) {
+      if (p->acked) /* its first copy was accepted in the session that has expired since */
+        unknown_outcome(c, p, "its session expired");
+      else
+        p->session_unknown = 1; /* nothing in it ran: send it again in a new session */
+    }
+    if (m->session_id == c->session_id) c->hello_answered = 0; /* say hello again */
     return;
   }
   if (m->session_id != c->session_id) return; /* an older session's late answer */

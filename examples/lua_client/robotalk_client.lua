@@ -36,7 +36,7 @@ local msgs = require('robotalk_msgs')
 local M = {}
 M.PROTOCOL_VERSION = 2
 local RETRANSMIT_S, RECHECK_S, HEARTBEAT_S, HELLO_REPEAT_S, MAX_TRIES = 0.3, 1.0, 0.25, 0.2, 10
-local SIGNALS = { [0] = 'SUCCESS', 'MODIFIED', 'NA', 'BUSY', 'INTERRUPTED', 'ERROR', 'PANIC' }
+local SIGNALS = { [-1] = 'UNKNOWN_OUTCOME', [0] = 'SUCCESS', 'MODIFIED', 'NA', 'BUSY', 'INTERRUPTED', 'ERROR', 'PANIC' }
 function M.signal_name(s) return SIGNALS[s] or '?' end
 
 -- The client's clock, seconds (sub-second: see above).
@@ -167,25 +167,36 @@ function Client:on_hello_answer(data)
   end
 end
 
+-- The items of an acknowledged package whose session is gone: they may or may
+-- not have run; never re-sent (signal -1, UNKNOWN_OUTCOME).
+function Client:unknown_outcome(p, why)
+  for _, id in ipairs(p.ids) do
+    self.replies[id] = self.replies[id] or { id = id, signal = -1, values = {}, lateness_us = 0, exec_time_us = 0,
+      message = 'may or may not have run (' .. why .. '); query or re-plan' }
+  end
+end
+
 function Client:on_reply(data)
   local m = msgs.reply_package_t.decode(zeroed(data, OFF.reply_session, OFF.reply_server))
   if m.protocol_version ~= M.PROTOCOL_VERSION or m.client_id ~= self.client_id then return end
   local session, server = raw8(data, OFF.reply_session), raw8(data, OFF.reply_server)
   if server ~= self.server_raw then
     -- A new server instance: what the old one acknowledged may or may not have run.
-    local p = self.pending
-    if p and p.acked then
-      for _, id in ipairs(p.ids) do
-        self.replies[id] = self.replies[id] or { id = id, signal = -1, values = {}, lateness_us = 0, exec_time_us = 0,
-          message = 'may or may not have run on server instance ' .. hex(self.server_raw) .. '; query or re-plan' }
-      end
+    if self.pending and self.pending.acked then
+      self:unknown_outcome(self.pending, 'server instance ' .. hex(self.server_raw) .. ' is gone')
     end
     self.server_raw = server
   end
   local p = self.pending
   if p and p.sequence ~= m.ack_sequence then p = nil end
   if m.session_status == msgs.reply_package_t.SESSION_UNKNOWN then
-    if p and p.session_raw == session then p.session_unknown = true end  -- nothing in it ran
+    if p and p.session_raw == session then
+      if p.acked then  -- its first copy was accepted in the session that has expired since
+        self:unknown_outcome(p, 'its session expired')
+      else
+        p.session_unknown = true  -- nothing in it ran: send it again in a new session
+      end
+    end
     if session == self.session_raw then self.hello_answered = false end  -- say hello again
     return
   end

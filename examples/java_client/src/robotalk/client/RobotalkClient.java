@@ -235,28 +235,34 @@ public final class RobotalkClient implements AutoCloseable {
 
   private void fileReply(reply_t r) { replies.putIfAbsent(r.id, r); }  // a second copy: ignored
 
+  /** The items of an acknowledged package whose session is gone: may or may not have run; never re-sent. */
+  private void unknownOutcome(Pending p, String why) {
+    for (long id : p.ids) {
+      reply_t r = new reply_t();
+      r.id = id;
+      r.signal = (byte) UNKNOWN_OUTCOME;
+      r.message = "may or may not have run (" + why + "); query or re-plan";
+      r.values = new double[0];
+      fileReply(r);
+    }
+  }
+
   private void onReply(reply_package_t m) {
     long t4 = nowUs();
     if (m.protocol_version != PROTOCOL_VERSION || m.client_id != clientId) return;
     if (serverId != 0 && m.server_id != serverId) {
       // A new server instance: what the old one acknowledged may or may not have run.
-      for (Pending p : pending.values()) {
-        if (!p.acked) continue;
-        for (long id : p.ids) {
-          reply_t r = new reply_t();
-          r.id = id;
-          r.signal = (byte) UNKNOWN_OUTCOME;
-          r.message = String.format("may or may not have run on server instance %016x; query or re-plan", serverId);
-          r.values = new double[0];
-          fileReply(r);
-        }
-      }
+      String why = String.format("server instance %016x is gone", serverId);
+      for (Pending p : pending.values()) if (p.acked) unknownOutcome(p, why);
       serverId = m.server_id;
       clockStale = true;
     }
     Pending p = pending.get(m.ack_sequence);
     if (m.session_status == reply_package_t.SESSION_UNKNOWN) {
-      if (p != null && p.sessionId == m.session_id) p.sessionUnknown = true;  // nothing in it ran
+      if (p != null && p.sessionId == m.session_id) {
+        if (p.acked) unknownOutcome(p, "its session expired");  // its first copy was accepted before
+        else p.sessionUnknown = true;  // nothing in it ran: send it again in a new session
+      }
       if (m.session_id == sessionId) helloAnswered = false;  // say hello again
       return;
     }
