@@ -23,6 +23,7 @@
 #include <atomic>
 #include <random>
 #include <thread>
+#include <utility>
 
 using namespace robotalk;
 using namespace robotalk::bench;
@@ -67,6 +68,7 @@ struct Soak {
   std::mt19937_64 rng;
   TimePoint deadline;
   CommandId max_id = 0;  // the highest id this client has seen assigned
+  bool panic_seen = false;
 
   double Uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
   bool Running() const { return SteadyNow() < deadline; }
@@ -90,9 +92,16 @@ struct Soak {
     report.Line(Kv("ev", "\"sent\"") + "," + Kv("id", Num(id)) + "," + Kv("type", Quote(ToString(type))) +
                 "," + Kv("start_us", Num(start_us)));
   }
-  void Final(CommandId id, const std::string& outcome, const std::string& msg) {
+  // exec_us: server clock when it ran (-1: no reply); late_us: how late after its start.
+  void Final(CommandId id, const std::string& outcome, const std::string& msg, const Reply* r = nullptr) {
+    if (r != nullptr && r->signal == Signal::kPanic) panic_seen = true;
     report.Line(Kv("ev", "\"final\"") + "," + Kv("id", Num(id)) + "," + Kv("outcome", Quote(outcome)) + "," +
-                Kv("msg", Quote(msg)));
+                Kv("exec_us", Num(r ? ToWireMicros(r->exec_time) : -1)) + "," +
+                Kv("late_us", Num(r ? ToWireMicros(r->lateness) : -1)) + "," + Kv("msg", Quote(msg)));
+  }
+  // A client answered PANIC waits a little before trying again, as a real one would.
+  void AfterPanic() {
+    if (std::exchange(panic_seen, false)) Sleep(0.3);
   }
   void NotSent(const std::string& what, const std::string& msg) {
     report.Line(Kv("ev", "\"notsent\"") + "," + Kv("what", Quote(what)) + "," + Kv("msg", Quote(msg)));
@@ -102,7 +111,7 @@ struct Soak {
   void Collect(PendingReply& p, Duration wait) {
     try {
       const Reply r = p.Wait(wait);
-      Final(p.id(), std::string(ToString(r.signal)), r.message);
+      Final(p.id(), std::string(ToString(r.signal)), r.message, &r);
     } catch (const UnknownOutcomeError& e) {
       Final(p.id(), "UNKNOWN_OUTCOME", e.what());
     } catch (const TimeoutError& e) {
@@ -132,38 +141,57 @@ void RunDirect(Soak& s) {
       s.NotSent(ToString(c.type), e.what());
       s.Sleep(0.2);
     }
+    s.AfterPanic();
     s.Sleep(s.Uniform(0, 0.05));
   }
 }
 
-// Delay mode: batches of timed commands on the server clock, 50 ms apart,
-// starting 300 ms ahead; the next batch leaves when this one has ended.
+// Delay mode: sequences of timed commands on the server clock, 50 ms apart,
+// starting 300 ms ahead, either in one package (a batch) or each frame in its
+// own package when its time comes minus the delay (a live stream, the mode's
+// purpose); the next sequence leaves when this one has ended.
 void RunDelay(Soak& s) {
+  constexpr Duration kDelay = std::chrono::milliseconds(300), kStep = std::chrono::milliseconds(50);
   while (s.Running()) {
     const int n = static_cast<int>(s.Uniform(3, 11));
-    const TimePoint base = s.client.ServerNow() + std::chrono::milliseconds(300);
+    const bool paced = s.Uniform(0, 1) < 0.5;
+    const TimePoint base = s.client.ServerNow() + kDelay;
     std::vector<Command> batch;
     for (int i = 0; i < n; ++i) {
       Command c = s.RandomCommand();
-      c.start_time = StartTime::At(base + i * std::chrono::milliseconds(50));
+      c.start_time = StartTime::At(base + i * kStep);
       batch.push_back(std::move(c));
     }
     std::vector<PendingReply> pending;
+    std::vector<std::size_t> index;  // pending[k] is batch[index[k]]
     try {
-      pending = s.client.SendBatch(batch);
+      if (paced) {
+        const TimePoint t0 = Soak::SteadyNow();
+        for (std::size_t i = 0; i < batch.size(); ++i) {
+          std::this_thread::sleep_until(std::chrono::steady_clock::time_point(
+              std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                  (t0 + static_cast<int>(i) * kStep).time_since_epoch())));
+          pending.push_back(s.client.Send(batch[i]));
+          index.push_back(i);
+          s.Sent(pending.back().id(), batch[i].type, ToWireMicros(*batch[i].start_time.time()));
+        }
+      } else {
+        pending = s.client.SendBatch(batch);
+        for (std::size_t i = 0; i < batch.size(); ++i) {
+          index.push_back(i);
+          s.Sent(pending[i].id(), batch[i].type, ToWireMicros(*batch[i].start_time.time()));
+        }
+      }
     } catch (const Error& e) {
-      s.NotSent("batch of " + std::to_string(n), e.what());
+      s.NotSent("delay sequence of " + std::to_string(n) + ", " + std::to_string(pending.size()) + " sent",
+                e.what());
       s.Sleep(0.2);
-      continue;
     }
-    for (int i = 0; i < n; ++i) {
-      s.Sent(pending[static_cast<std::size_t>(i)].id(), batch[static_cast<std::size_t>(i)].type,
-             ToWireMicros(*batch[static_cast<std::size_t>(i)].start_time.time()));
+    for (std::size_t k = 0; k < pending.size(); ++k) {
+      const Duration until = *batch[index[k]].start_time.time() - s.client.ServerNow();
+      s.Collect(pending[k], s.WaitFor(std::max(Duration(0), until)));
     }
-    for (int i = 0; i < n; ++i) {
-      const Duration until = *batch[static_cast<std::size_t>(i)].start_time.time() - s.client.ServerNow();
-      s.Collect(pending[static_cast<std::size_t>(i)], s.WaitFor(std::max(Duration(0), until)));
-    }
+    s.AfterPanic();
   }
 }
 
@@ -198,8 +226,9 @@ void RunPlayback(Soak& s) {
         const std::int64_t start =
             r.server_start ? ToWireMicros(*r.server_start + copy[static_cast<std::size_t>(i)].offset) : -1;
         s.Sent(reply.id, copy[static_cast<std::size_t>(i)].command.type, start);
-        s.Final(reply.id, std::string(ToString(reply.signal)), reply.message);
+        s.Final(reply.id, std::string(ToString(reply.signal)), reply.message, &reply);
       }
+      s.AfterPanic();
     } catch (const Error& e) {
       const bool unknown = dynamic_cast<const UnknownOutcomeError*>(&e) != nullptr;
       const bool timeout = dynamic_cast<const TimeoutError*>(&e) != nullptr;

@@ -2,6 +2,7 @@
 # The soak (issue 9, item 9; docs/soak.md). Not run by CI.
 #
 #   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep]
+#   scripts/soak.sh --check-only DIR     the checks again on a kept run's files
 #
 # One robotalk-server (kinematic driver, models/pioneer2dx_pantilt.urdf,
 # --log-executions, --panic-latch) behind robotalk-lcm-relay (10 % loss, 5 %
@@ -23,7 +24,7 @@
 # answers before they are killed; the relay stops by itself after N + 120 s.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
-seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0
+seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only=""
 while [ $# -gt 0 ]; do
   case $1 in
     --seconds) seconds=$2; shift 2 ;;
@@ -32,12 +33,196 @@ while [ $# -gt 0 ]; do
     --kills) kills=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
     --keep) keep=1; shift ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    --check-only) check_only=$2; shift 2 ;;
+    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     *) echo "soak.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 case $seconds in ''|*[!0-9]*) echo "soak.sh: --seconds wants whole seconds, got '$seconds'" >&2; exit 2 ;; esac
 [ "$seconds" -ge 10 ] || { echo "soak.sh: --seconds must be at least 10" >&2; exit 2; }
+
+check() {  # check DIR: the report (python below), exit status 1 on a violation
+/usr/bin/python3 - "$1" <<'EOF'
+import glob, json, os, re, sys
+tmp = sys.argv[1]
+audit_re = re.compile(r"executed client ([0-9a-f]{16}) command (-?\d+) (\S+) -> (.+)$")
+executed = {}   # (client, id) -> [(instance, signal)]
+order = {}      # client -> ids in execution order (instances in order)
+logs = sorted(glob.glob(os.path.join(tmp, "server*.log")), key=lambda p: int(re.findall(r"\d+", os.path.basename(p))[0]))
+per_instance = []
+for n, path in enumerate(logs, 1):
+    count = 0
+    for line in open(path, errors="replace"):
+        m = audit_re.search(line)
+        if not m:
+            continue
+        key = (m.group(1), int(m.group(2)))
+        executed.setdefault(key, []).append((n, m.group(4).strip()))
+        order.setdefault(m.group(1), []).append(key[1])
+        count += 1
+    per_instance.append(count)
+killed = set(os.path.basename(l.strip()) for l in open(os.path.join(tmp, "killed")) if l.strip())
+
+clients = {}    # hex -> dict
+panics = resets = 0
+notsent = 0
+samples = 0
+for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
+    c, mode = None, "?"
+    sent, final, seqs_failed, ids_seen = {}, {}, [], set()
+    for line in open(path, errors="replace"):
+        try:
+            e = json.loads(line)
+        except ValueError:
+            continue   # a line cut by kill -9
+        ev = e["ev"]
+        if ev == "hello":
+            c, mode = e["client"], e["mode"]
+        elif ev == "sent":
+            sent[e["id"]] = e; ids_seen.add(e["id"])
+        elif ev == "final":
+            final[e["id"]] = e
+        elif ev == "marker":
+            ids_seen.add(e["id"])
+        elif ev == "seq_failed":
+            seqs_failed.append(e)
+        elif ev == "notsent":
+            notsent += 1
+        elif ev == "panic":
+            panics += 1
+        elif ev == "reset":
+            resets += 1
+        elif ev == "samples":
+            samples += e["n"]
+    if c is not None:
+        clients[c] = dict(sent=sent, final=final, seqs_failed=seqs_failed, ids=sorted(ids_seen),
+                          killed=os.path.basename(path) in killed, path=path, mode=mode)
+
+violations = []
+count = dict(sent=0, executed=sum(per_instance), twice=0, lost=0, out_of_order=0, phantom=0)
+refused, answered_ran, unknown = {}, {}, {}
+def bump(d, k, n=1): d[k] = d.get(k, 0) + n
+
+for key, runs in executed.items():
+    if len(runs) > 1:
+        count["twice"] += 1
+        violations.append("EXECUTED TWICE: client %s command %d on instances %s" % (key[0], key[1], [r[0] for r in runs]))
+
+for c, info in clients.items():
+    for cid, s in info["sent"].items():
+        count["sent"] += 1
+        runs = executed.get((c, cid), [])
+        f = info["final"].get(cid)
+        if f is None:
+            if info["killed"]:
+                bump(unknown, "client killed before its answer (ran %d)" % min(len(runs), 1))
+            elif not runs:
+                count["lost"] += 1
+                violations.append("LOST: client %s command %d (%s) got no answer and never ran" % (c, cid, s["type"]))
+            else:
+                bump(unknown, "no answer recorded, ran")
+            continue
+        out = f["outcome"]
+        if out in ("UNKNOWN_OUTCOME", "TIMEOUT", "CLIENT_ERROR"):
+            label = {"UNKNOWN_OUTCOME": "UnknownOutcomeError", "TIMEOUT": "client wait timed out", "CLIENT_ERROR": "ClientError"}[out]
+            bump(unknown, "%s (ran %d)" % (label, min(len(runs), 1)))
+            continue
+        if runs:
+            sig = runs[0][1]
+            if out == "PANIC" or (sig != "in progress" and sig != out):
+                violations.append("ANSWER MISMATCH: client %s command %d ran (%s) but was answered %s: %s" % (c, cid, sig, out, f["msg"]))
+            bump(answered_ran, out)
+            continue
+        if out in ("SUCCESS", "MODIFIED"):
+            count["lost"] += 1
+            violations.append("LOST: client %s command %d (%s) answered %s but never ran" % (c, cid, s["type"], out))
+            continue
+        reason = out
+        if out == "INTERRUPTED":
+            reason += " (flushed by panic)" if "flushed by panic" in f["msg"] else \
+                      " (panic before it ran)" if "entered panic" in f["msg"] else " (" + f["msg"][:40] + ")"
+        elif out == "ERROR":
+            reason += " (" + re.sub(r"[0-9.e+-]+", "#", f["msg"])[:60] + ")"
+        bump(refused, reason)
+
+    # Executions nobody reported sending: frames of a failed playback
+    # sequence (ids between its marker and the next reported id), or a killed
+    # client's last commands (above every id it reported).
+    ids = info["ids"]
+    gaps = []
+    for sf in info["seqs_failed"]:
+        nxt = min([i for i in ids if i > sf["after"]], default=float("inf"))
+        gaps.append([sf["after"], nxt, sf["frames"], 0, sf["outcome"]])
+    top = max(ids, default=0)
+    for cid in order.get(c, []):
+        if cid in info["sent"]:
+            continue
+        g = next((g for g in gaps if g[0] < cid < g[1]), None)
+        if g is not None:
+            g[3] += 1
+        elif info["killed"] and cid > top:
+            bump(unknown, "client killed before its report (ran 1)")
+        else:
+            count["phantom"] += 1
+            violations.append("RAN UNSENT: client %s command %d ran but no report sent it" % (c, cid))
+    for g in gaps:
+        count["sent"] += g[2]
+        if g[3] > g[2]:
+            violations.append("EXECUTED TWICE?: a failed playback sequence of %d frames ran %d commands" % (g[2], g[3]))
+        bump(unknown, "playback frame, sequence %s (ran)" % g[4], g[3])
+        bump(unknown, "playback frame, sequence %s (not run)" % g[4], g[2] - g[3])
+
+    # Start-time order per client, over the commands whose start is known.
+    last = None
+    for cid in order.get(c, []):
+        s = info["sent"].get(cid)
+        if s is None or s["start_us"] < 0:
+            continue
+        if last is not None and s["start_us"] < last[1]:
+            count["out_of_order"] += 1
+            f = info["final"].get(cid, {})
+            late = f.get("late_us", -1)
+            why = "no reply" if late is None or late < 0 else \
+                  "it ran %.0f ms late: it reached the server after the newer one's start" % (late / 1e3) \
+                  if late > last[1] - s["start_us"] else "it ran %.0f ms late: the server had both" % (late / 1e3)
+            violations.append("OUT OF ORDER: client %s (%s) command %d (start %d us) ran after command %d (start %.0f ms later); %s" %
+                              (c, info["mode"], cid, s["start_us"], last[0], (last[1] - s["start_us"]) / 1e3, why))
+        if last is None or s["start_us"] >= last[1]:
+            last = (cid, s["start_us"])
+
+for c in set(k[0] for k in executed) - set(clients):
+    n = sum(1 for k in executed if k[0] == c)
+    count["phantom"] += n
+    violations.append("RAN UNSENT: %d commands of client %s, which no report names" % (n, c))
+
+relay = [l.strip() for l in open(os.path.join(tmp, "relay.out")) if l.startswith(("a2b", "b2a"))]
+kills = len(killed)
+print("soak: %d client reports (%d killed), %d server instances, %d panics (%d resets answered), %d watch samples" %
+      (len(clients), kills, len(logs), panics, resets, samples))
+for l in relay:
+    m = dict(kv.split("=") for kv in l.split()[1:])
+    print("  relay %s received %s lost %s duplicated %s reordered %s" % (l[:3], m.get("received"), m.get("lost"), m.get("duplicated"), m.get("reordered")))
+print("sent            %6d  (commands with an id; %d calls threw before sending: no session)" % (count["sent"], notsent))
+print("executed        %6d  (audit lines: %s per server instance)" % (count["executed"], " + ".join(map(str, per_instance))))
+print("  answered after running: " + ", ".join("%s %d" % kv for kv in sorted(answered_ran.items())))
+print("refused         %6d" % sum(refused.values()))
+for k, v in sorted(refused.items(), key=lambda kv: -kv[1]):
+    print("  %-60s %6d" % (k, v))
+print("unknown-outcome %6d" % sum(unknown.values()))
+for k, v in sorted(unknown.items(), key=lambda kv: -kv[1]):
+    print("  %-60s %6d" % (k, v))
+print("lost            %6d" % count["lost"])
+print("executed twice  %6d" % count["twice"])
+print("out of order    %6d" % count["out_of_order"])
+print("ran unsent      %6d" % count["phantom"])
+for v in violations[:40]:
+    print("  " + v)
+bad = count["lost"] or count["twice"] or count["out_of_order"] or count["phantom"] or violations
+print("soak: " + ("FAIL" if bad else "PASS"))
+sys.exit(1 if bad else 0)
+EOF
+}
+if [ -n "$check_only" ]; then check "$check_only"; exit; fi
 
 if [ -z "${ROBOTALK_SOAK_IN_NETNS:-}" ]; then
   export ROBOTALK_SOAK_IN_NETNS=1
@@ -150,178 +335,7 @@ kill "$server_pid" 2>/dev/null; wait "$server_pid" 2>/dev/null; server_pid=""
 kill "$relay_pid" 2>/dev/null; wait "$relay_pid" 2>/dev/null; relay_pid=""
 touch "$tmp/killed"
 
-/usr/bin/python3 - "$tmp" <<'EOF'
-import glob, json, os, re, sys
-tmp = sys.argv[1]
-audit_re = re.compile(r"executed client ([0-9a-f]{16}) command (-?\d+) (\S+) -> (.+)$")
-executed = {}   # (client, id) -> [(instance, signal)]
-order = {}      # client -> ids in execution order (instances in order)
-logs = sorted(glob.glob(os.path.join(tmp, "server*.log")), key=lambda p: int(re.findall(r"\d+", os.path.basename(p))[0]))
-per_instance = []
-for n, path in enumerate(logs, 1):
-    count = 0
-    for line in open(path, errors="replace"):
-        m = audit_re.search(line)
-        if not m:
-            continue
-        key = (m.group(1), int(m.group(2)))
-        executed.setdefault(key, []).append((n, m.group(4).strip()))
-        order.setdefault(m.group(1), []).append(key[1])
-        count += 1
-    per_instance.append(count)
-killed = set(l.strip() for l in open(os.path.join(tmp, "killed")) if l.strip())
-
-clients = {}    # hex -> dict
-panics = resets = 0
-notsent = 0
-samples = 0
-for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
-    c = None
-    sent, final, seqs_failed, ids_seen = {}, {}, [], set()
-    for line in open(path, errors="replace"):
-        try:
-            e = json.loads(line)
-        except ValueError:
-            continue   # a line cut by kill -9
-        ev = e["ev"]
-        if ev == "hello":
-            c = e["client"]
-        elif ev == "sent":
-            sent[e["id"]] = e; ids_seen.add(e["id"])
-        elif ev == "final":
-            final[e["id"]] = e
-        elif ev == "marker":
-            ids_seen.add(e["id"])
-        elif ev == "seq_failed":
-            seqs_failed.append(e)
-        elif ev == "notsent":
-            notsent += 1
-        elif ev == "panic":
-            panics += 1
-        elif ev == "reset":
-            resets += 1
-        elif ev == "samples":
-            samples += e["n"]
-    if c is not None:
-        clients[c] = dict(sent=sent, final=final, seqs_failed=seqs_failed, ids=sorted(ids_seen),
-                          killed=path in killed, path=path)
-
-violations = []
-count = dict(sent=0, executed=sum(per_instance), twice=0, lost=0, out_of_order=0, phantom=0)
-refused, answered_ran, unknown = {}, {}, {}
-def bump(d, k, n=1): d[k] = d.get(k, 0) + n
-
-for key, runs in executed.items():
-    if len(runs) > 1:
-        count["twice"] += 1
-        violations.append("EXECUTED TWICE: client %s command %d on instances %s" % (key[0], key[1], [r[0] for r in runs]))
-
-for c, info in clients.items():
-    for cid, s in info["sent"].items():
-        count["sent"] += 1
-        runs = executed.get((c, cid), [])
-        f = info["final"].get(cid)
-        if f is None:
-            if info["killed"]:
-                bump(unknown, "client killed before its answer (ran %d)" % min(len(runs), 1))
-            elif not runs:
-                count["lost"] += 1
-                violations.append("LOST: client %s command %d (%s) got no answer and never ran" % (c, cid, s["type"]))
-            else:
-                bump(unknown, "no answer recorded, ran")
-            continue
-        out = f["outcome"]
-        if out in ("UNKNOWN_OUTCOME", "TIMEOUT", "CLIENT_ERROR"):
-            label = {"UNKNOWN_OUTCOME": "UnknownOutcomeError", "TIMEOUT": "client wait timed out", "CLIENT_ERROR": "ClientError"}[out]
-            bump(unknown, "%s (ran %d)" % (label, min(len(runs), 1)))
-            continue
-        if runs:
-            sig = runs[0][1]
-            if out == "PANIC" or (sig != "in progress" and sig != out):
-                violations.append("ANSWER MISMATCH: client %s command %d ran (%s) but was answered %s: %s" % (c, cid, sig, out, f["msg"]))
-            bump(answered_ran, out)
-            continue
-        if out in ("SUCCESS", "MODIFIED"):
-            count["lost"] += 1
-            violations.append("LOST: client %s command %d (%s) answered %s but never ran" % (c, cid, s["type"], out))
-            continue
-        reason = out
-        if out == "INTERRUPTED":
-            reason += " (flushed by panic)" if "flushed by panic" in f["msg"] else \
-                      " (panic before it ran)" if "entered panic" in f["msg"] else " (" + f["msg"][:40] + ")"
-        elif out == "ERROR":
-            reason += " (" + re.sub(r"[0-9.e+-]+", "#", f["msg"])[:60] + ")"
-        bump(refused, reason)
-
-    # Executions nobody reported sending: frames of a failed playback
-    # sequence (ids between its marker and the next reported id), or a killed
-    # client's last commands (above every id it reported).
-    ids = info["ids"]
-    gaps = []
-    for sf in info["seqs_failed"]:
-        nxt = min([i for i in ids if i > sf["after"]], default=float("inf"))
-        gaps.append([sf["after"], nxt, sf["frames"], 0, sf["outcome"]])
-    top = max(ids, default=0)
-    for cid in order.get(c, []):
-        if cid in info["sent"]:
-            continue
-        g = next((g for g in gaps if g[0] < cid < g[1]), None)
-        if g is not None:
-            g[3] += 1
-        elif info["killed"] and cid > top:
-            bump(unknown, "client killed before its report (ran 1)")
-        else:
-            count["phantom"] += 1
-            violations.append("RAN UNSENT: client %s command %d ran but no report sent it" % (c, cid))
-    for g in gaps:
-        count["sent"] += g[2]
-        if g[3] > g[2]:
-            violations.append("EXECUTED TWICE?: a failed playback sequence of %d frames ran %d commands" % (g[2], g[3]))
-        bump(unknown, "playback frame, sequence %s (ran)" % g[4], g[3])
-        bump(unknown, "playback frame, sequence %s (not run)" % g[4], g[2] - g[3])
-
-    # Start-time order per client, over the commands whose start is known.
-    last = None
-    for cid in order.get(c, []):
-        s = info["sent"].get(cid)
-        if s is None or s["start_us"] < 0:
-            continue
-        if last is not None and s["start_us"] < last[1]:
-            count["out_of_order"] += 1
-            violations.append("OUT OF ORDER: client %s command %d (start %d us) ran after command %d (start %d us)" % (c, cid, s["start_us"], last[0], last[1]))
-        last = (cid, s["start_us"])
-
-for c in set(k[0] for k in executed) - set(clients):
-    n = sum(1 for k in executed if k[0] == c)
-    count["phantom"] += n
-    violations.append("RAN UNSENT: %d commands of client %s, which no report names" % (n, c))
-
-relay = [l.strip() for l in open(os.path.join(tmp, "relay.out")) if l.startswith(("a2b", "b2a"))]
-kills = len(killed)
-print("soak: %d client reports (%d killed), %d server instances, %d panics (%d resets answered), %d watch samples" %
-      (len(clients), kills, len(logs), panics, resets, samples))
-for l in relay:
-    m = dict(kv.split("=") for kv in l.split()[1:])
-    print("  relay %s received %s lost %s duplicated %s reordered %s" % (l[:3], m.get("received"), m.get("lost"), m.get("duplicated"), m.get("reordered")))
-print("sent            %6d  (commands with an id; %d calls threw before sending: no session)" % (count["sent"], notsent))
-print("executed        %6d  (audit lines: %s per server instance)" % (count["executed"], " + ".join(map(str, per_instance))))
-print("  answered after running: " + ", ".join("%s %d" % kv for kv in sorted(answered_ran.items())))
-print("refused         %6d" % sum(refused.values()))
-for k, v in sorted(refused.items(), key=lambda kv: -kv[1]):
-    print("  %-60s %6d" % (k, v))
-print("unknown-outcome %6d" % sum(unknown.values()))
-for k, v in sorted(unknown.items(), key=lambda kv: -kv[1]):
-    print("  %-60s %6d" % (k, v))
-print("lost            %6d" % count["lost"])
-print("executed twice  %6d" % count["twice"])
-print("out of order    %6d" % count["out_of_order"])
-print("ran unsent      %6d" % count["phantom"])
-for v in violations[:40]:
-    print("  " + v)
-bad = count["lost"] or count["twice"] or count["out_of_order"] or count["phantom"] or violations
-print("soak: " + ("FAIL" if bad else "PASS"))
-sys.exit(1 if bad else 0)
-EOF
+check "$tmp"
 rc=$?
 [ $rc -ne 0 ] && keep=1
 exit $rc
