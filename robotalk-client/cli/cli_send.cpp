@@ -93,6 +93,14 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
         if (bar) std::cerr << "\r" << ProgressBar(p) << std::flush;
       });
   if (bar) std::cerr << "\r\033[K" << std::flush;
+  for (const auto& [index, why] : report.unknown_outcomes) {
+    std::cerr << "robotalk: line " << entries[index].line << ": " << TidyDurations(why) << "\n";
+  }
+  if (!report.unknown_outcomes.empty()) {
+    std::cerr << "robotalk: " << report.unknown_outcomes.size() << " of " << entries.size()
+              << " commands may or may not have run; check the robot's state before sending them again\n";
+    status = std::max(status, 1);
+  }
   if (report.playback_delay) {
     std::cerr << "robotalk: playback: the server starts the sequence "
               << FormatDuration(*report.playback_delay) << " after its first frame arrived\n";

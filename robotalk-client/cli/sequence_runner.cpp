@@ -204,7 +204,14 @@ RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const
       next_send = end;
     }
     while (next_reply < frames.size() && pending[next_reply]) {
-      auto r = pending[next_reply]->Poll();
+      std::optional<Reply> r;
+      try {
+        r = pending[next_reply]->Poll();
+      } catch (const TimeoutError& e) {  // UnknownOutcomeError: name each frame, go on
+        report.unknown_outcomes.emplace_back(next_reply, e.what());
+        ++next_reply;
+        continue;
+      }
       if (!r) break;
       report.replies[next_reply] = *r;
       if (on_reply) on_reply(next_reply, *r);

@@ -42,6 +42,9 @@ struct RunReport {
   /// Playback only: RunSequence still runs on a thread of its own; the caller
   /// must end the process (std::_Exit) instead of destroying the client.
   bool worker_abandoned = false;
+  /// Delay mode: frames whose outcome is unknown (the client gave up, or the
+  /// server instance that had them restarted): index and why, every one of them.
+  std::vector<std::pair<std::size_t, std::string>> unknown_outcomes;
 };
 
 using ReplyCallback = std::function<void(std::size_t index, const Reply& reply)>;

@@ -330,7 +330,8 @@ void RobotClient::Impl::Tick(TimePoint now) {
     stats_.retransmissions += resends.size();
     stats_.gave_up += expired.size();
     for (const auto& e : expired) clock_packages_.erase(e.sequence);
-    if (!resends.empty()) last_send_ = now;
+    // Resends do not count: the server refreshes a session only on new
+    // packages, so heartbeats go on while a long GOTO is re-asked about.
     if (session_id_ != 0 && now - last_send_ >= options_.heartbeat_interval) {
       heartbeat = EncodeHeartbeat(now);
       last_send_ = now;

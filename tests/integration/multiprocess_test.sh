@@ -97,5 +97,22 @@ executed=$(grep -c "command [0-9]* JOINT_SETPOINT" "$tmp/server2.log")
 distinct=$(grep -o "client [0-9a-f]* command [0-9]* JOINT_SETPOINT" "$tmp/server2.log" | sort -u | wc -l)
 check "40 executions, each once (got $executed, $distinct distinct)" test "$executed" -eq 40 -a "$distinct" -eq 40
 
+# --- 5. a server restart (kill -9) during a timed sequence --------------------
+# Issue 9: three commands were never executed and the CLI named only the first.
+start_server "$tmp/server3.log" --log-executions
+printf '0 joint_setpoint pan 0.1\n1 joint_setpoint pan 0.2\n2.5 joint_setpoint pan 0.3\n3 joint_setpoint pan 0.4\n3.5 joint_setpoint pan 0.5\n' >"$tmp/restart.txt"
+rt send pioneer --file "$tmp/restart.txt" >"$tmp/restart.out" 2>&1 &
+sender=$!
+sleep 1.5
+kill -9 "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+start_server "$tmp/server4.log" --log-executions
+wait "$sender"; sender_rc=$?
+check "the CLI fails after a restart (rc $sender_rc)" test "$sender_rc" -ne 0
+check "it names each of the 3 commands that may or may not have run: $(cat "$tmp/restart.out")" \
+  test "$(grep -c "may or may not have run, and was not sent again" "$tmp/restart.out")" -eq 3
+check "and says how many" grep -q "3 of 5 commands may or may not have run" "$tmp/restart.out"
+check "the new instance ran none of the old session's commands" \
+  test "$(grep -c "JOINT_SETPOINT" "$tmp/server4.log")" -eq 0
+
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
