@@ -9,6 +9,7 @@
 //                                                                   TIMEOUT or CLIENT_ERROR
 //   {"ev":"seq","after":11,"frames":8}    a playback sequence whose frames got ids above 11
 //   {"ev":"seq_failed","after":11,"frames":8,"outcome":"UNKNOWN_OUTCOME","msg":"..."}
+//   {"ev":"status","id":13,"outcome":"BUSY","msg":"..."}  COMMAND_STATUS of a timed-out sequence's ids
 //   {"ev":"notsent","what":"...","msg":"..."}   a call that threw before anything was sent
 //   {"ev":"panic"|"reset"|"samples"|"end", ...}
 //
@@ -207,6 +208,24 @@ void Mark(Soak& s) {
   }
 }
 
+// COMMAND_STATUS of ids (first, last): BUSY means the server still holds
+// the command, unanswered; otherwise its final reply.
+void AskStatus(Soak& s, CommandId first, CommandId last) {
+  for (CommandId id = first; id < last; ++id) {
+    std::string outcome, msg;
+    try {
+      const Reply r = s.client.CommandStatus(id);
+      outcome = ToString(r.signal);
+      msg = r.message;
+    } catch (const Error& e) {
+      outcome = "STATUS_FAILED";
+      msg = e.what();
+    }
+    s.report.Line(Kv("ev", "\"status\"") + "," + Kv("id", Num(id)) + "," + Kv("outcome", Quote(outcome)) +
+                  "," + Kv("msg", Quote(msg)));
+  }
+}
+
 // Playback mode: sequences of 4..10 frames 100 ms apart; the server chooses
 // the delay. A sequence that throws leaves its frames' ids unknown: the
 // report names the id range (above `after`, below the next marker).
@@ -238,7 +257,12 @@ void RunPlayback(Soak& s) {
                                         : timeout ? "TIMEOUT"
                                                   : "CLIENT_ERROR")) +
                     "," + Kv("msg", Quote(e.what())));
-      s.Sleep(0.2);
+      s.Sleep(1.0);  // every frame's start has passed
+      Mark(s);
+      // A plain timeout leaves the session alive: ask what became of each
+      // id of the sequence (its frames, and the PLAYBACK id itself).
+      if (timeout && !unknown) AskStatus(s, after + 1, s.max_id);
+      continue;
     }
     Mark(s);
   }

@@ -69,7 +69,7 @@ notsent = 0
 samples = 0
 for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
     c, mode = None, "?"
-    sent, final, seqs_failed, ids_seen = {}, {}, [], set()
+    sent, final, seqs_failed, ids_seen, status = {}, {}, [], set(), {}
     for line in open(path, errors="replace"):
         try:
             e = json.loads(line)
@@ -82,6 +82,8 @@ for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
             sent[e["id"]] = e; ids_seen.add(e["id"])
         elif ev == "final":
             final[e["id"]] = e
+        elif ev == "status":
+            status[e["id"]] = e
         elif ev == "marker":
             ids_seen.add(e["id"])
         elif ev == "seq_failed":
@@ -95,7 +97,7 @@ for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
         elif ev == "samples":
             samples += e["n"]
     if c is not None:
-        clients[c] = dict(sent=sent, final=final, seqs_failed=seqs_failed, ids=sorted(ids_seen),
+        clients[c] = dict(sent=sent, final=final, seqs_failed=seqs_failed, status=status, ids=sorted(ids_seen),
                           killed=os.path.basename(path) in killed, path=path, mode=mode)
 
 violations = []
@@ -169,8 +171,25 @@ for c, info in clients.items():
         count["sent"] += g[2]
         if g[3] > g[2]:
             violations.append("EXECUTED TWICE?: a failed playback sequence of %d frames ran %d commands" % (g[2], g[3]))
-        bump(unknown, "playback frame, sequence %s (ran)" % g[4], g[3])
-        bump(unknown, "playback frame, sequence %s (not run)" % g[4], g[2] - g[3])
+        label = "playback frame, sequence " + ("UnknownOutcomeError" if g[4] == "UNKNOWN_OUTCOME" else "TimeoutError")
+        bump(unknown, label + " (ran)", g[3])
+        # COMMAND_STATUS of the frames that did not run (asked after a plain
+        # timeout; the first id after the marker is the PLAYBACK id itself).
+        known = 0
+        for cid, st in sorted(info["status"].items()):
+            if not (g[0] + 1 < cid < g[1]) or (c, cid) in executed:
+                continue
+            known += 1
+            out = st["outcome"]
+            if out == "BUSY":
+                count["lost"] += 1
+                violations.append("LOST: client %s playback frame %d was accepted, never ran and was never answered "
+                                  "(COMMAND_STATUS: %s)" % (c, cid, st["msg"]))
+            elif out in ("PANIC", "INTERRUPTED", "ERROR", "NA"):
+                bump(refused, "%s (playback frame, learnt by COMMAND_STATUS)" % out)
+            else:
+                bump(unknown, label + ", status %s (not run)" % out)
+        bump(unknown, label + " (not run)", g[2] - g[3] - known)
 
     # Start-time order per client, over the commands whose start is known.
     last = None
