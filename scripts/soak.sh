@@ -101,7 +101,7 @@ for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
                           killed=os.path.basename(path) in killed, path=path, mode=mode)
 
 violations = []
-count = dict(sent=0, executed=sum(per_instance), twice=0, lost=0, out_of_order=0, phantom=0)
+count = dict(sent=0, executed=sum(per_instance), twice=0, lost=0, out_of_order=0, phantom=0, playback_unanswered=0)
 refused, answered_ran, unknown = {}, {}, {}
 def bump(d, k, n=1): d[k] = d.get(k, 0) + n
 
@@ -177,11 +177,15 @@ for c, info in clients.items():
         # timeout; the first id after the marker is the PLAYBACK id itself).
         known = 0
         for cid, st in sorted(info["status"].items()):
-            if not (g[0] + 1 < cid < g[1]) or (c, cid) in executed:
+            # Frames are the ids after the marker and the PLAYBACK id (the
+            # ids above them are the client's own queries, e.g. a re-sync).
+            if not (g[0] + 1 < cid <= g[0] + 1 + g[2]) or cid >= g[1] or (c, cid) in executed:
                 continue
             known += 1
             out = st["outcome"]
-            if out == "BUSY":
+            if "never received in this session" in st["msg"]:
+                bump(unknown, label + ", status: not in this session (not run)")
+            elif out == "BUSY":
                 count["lost"] += 1
                 violations.append("LOST: client %s playback frame %d was accepted, never ran and was never answered "
                                   "(COMMAND_STATUS: %s)" % (c, cid, st["msg"]))
@@ -190,6 +194,9 @@ for c, info in clients.items():
             else:
                 bump(unknown, label + ", status %s (not run)" % out)
         bump(unknown, label + " (not run)", g[2] - g[3] - known)
+        pst = info["status"].get(g[0] + 1)
+        if pst is not None and pst["outcome"] == "BUSY":
+            count["playback_unanswered"] += 1
 
     # Start-time order per client, over the commands whose start is known.
     last = None
@@ -230,6 +237,7 @@ for k, v in sorted(refused.items(), key=lambda kv: -kv[1]):
 print("unknown-outcome %6d" % sum(unknown.values()))
 for k, v in sorted(unknown.items(), key=lambda kv: -kv[1]):
     print("  %-60s %6d" % (k, v))
+print("  (PLAYBACK requests the server never answered, COMMAND_STATUS BUSY: %d)" % count["playback_unanswered"])
 print("lost            %6d" % count["lost"])
 print("executed twice  %6d" % count["twice"])
 print("out of order    %6d" % count["out_of_order"])
