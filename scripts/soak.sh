@@ -233,11 +233,18 @@ print("executed        %6d  (audit lines: %s per server instance)" % (count["exe
 print("  answered after running: " + ", ".join("%s %d" % kv for kv in sorted(answered_ran.items())))
 print("refused         %6d" % sum(refused.values()))
 for k, v in sorted(refused.items(), key=lambda kv: -kv[1]):
-    print("  %-60s %6d" % (k, v))
+    if v:
+        print("  %-66s %6d" % (k, v))
 print("unknown-outcome %6d" % sum(unknown.values()))
 for k, v in sorted(unknown.items(), key=lambda kv: -kv[1]):
-    print("  %-60s %6d" % (k, v))
+    if v:
+        print("  %-66s %6d" % (k, v))
 print("  (PLAYBACK requests the server never answered, COMMAND_STATUS BUSY: %d)" % count["playback_unanswered"])
+not_run = sum(v for k, v in unknown.items() if "not run" in k or "ran 0" in k)
+unreported = unknown.get("client killed before its report (ran 1)", 0)
+print("  (balance: sent %d + unreported %d = executed %d + refused %d + unknown not run %d + lost %d%s)" %
+      (count["sent"], unreported, count["executed"], sum(refused.values()), not_run, count["lost"],
+       "" if count["sent"] + unreported == count["executed"] + sum(refused.values()) + not_run + count["lost"] else ": DOES NOT ADD UP"))
 print("lost            %6d" % count["lost"])
 print("executed twice  %6d" % count["twice"])
 print("out of order    %6d" % count["out_of_order"])
