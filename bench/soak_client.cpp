@@ -22,6 +22,7 @@
 #include "robotalk/robot_client.h"
 
 #include <atomic>
+#include <memory>
 #include <random>
 #include <thread>
 #include <utility>
@@ -271,13 +272,17 @@ void RunPlayback(Soak& s) {
 // Broadcast/watch: a STATE stream every 50 ms, asked again when it stops
 // (a restarted server does not know the request), and a BASE_POSE each second.
 void RunWatch(Soak& s) {
-  std::atomic<long> samples{0};
+  // Shared with the callback, which the ReadDaemon may still be running when
+  // this function returns.
+  const auto counter = std::make_shared<std::atomic<long>>(0);
+  std::atomic<long>& samples = *counter;
   long asked = 0, last = -1;
   while (s.Running()) {
     const long now = samples.load();
     if (now == last) {
       try {
-        s.client.StartStateStream(std::chrono::milliseconds(50), [&](const StateSample&) { ++samples; });
+        s.client.StartStateStream(std::chrono::milliseconds(50),
+                                  [counter](const StateSample&) { ++*counter; });
         ++asked;
       } catch (const Error& e) {
         s.NotSent("STATE_STREAM", e.what());

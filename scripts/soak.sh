@@ -10,8 +10,9 @@
 # (direct, delay, playback, watch; default 4 each = 16) plus one chaos client
 # (seeded panics and resets), for N seconds (default 60). On a seeded schedule
 # it kill -9s --kills command clients (default 3; each is replaced by a new
-# client with a new seed) and kill -9s the server once, starting it again at
-# once with the same --panic-latch file. Then it checks the clients' reports
+# client with a new seed) and kill -9s the server once, just after a panic,
+# starting it again at once with the same --panic-latch file (it must start in
+# panic when the file says so). Then it checks the clients' reports
 # (robotalk-soak-client, one JSON line per command outcome) against the
 # servers' execution logs and prints sent / executed / refused by reason /
 # unknown-outcome / lost; exits 1 if anything ran twice, out of start-time
@@ -34,7 +35,7 @@ while [ $# -gt 0 ]; do
     --build) build=$2; shift 2 ;;
     --keep) keep=1; shift ;;
     --check-only) check_only=$2; shift 2 ;;
-    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) echo "soak.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -252,6 +253,9 @@ print("ran unsent      %6d" % count["phantom"])
 for v in violations[:40]:
     print("  " + v)
 bad = count["lost"] or count["twice"] or count["out_of_order"] or count["phantom"] or violations
+if os.path.exists(os.path.join(tmp, "latch_lost")):
+    bad = True
+    print("  LATCH LOST: a panic latched at the kill was gone after the restart")
 print("soak: " + ("FAIL" if bad else "PASS"))
 sys.exit(1 if bad else 0)
 EOF
@@ -267,8 +271,9 @@ fi
 server_bin=$build/robotalk-server/robotalk-server
 relay_bin=$build/tools/lcm_relay/robotalk-lcm-relay
 client_bin=$build/bench/robotalk-soak-client
-for b in "$server_bin" "$relay_bin" "$client_bin"; do
-  [ -x "$b" ] || { echo "soak.sh: $b not built (cmake --build $build --target robotalk-server robotalk-lcm-relay robotalk-soak-client)" >&2; exit 2; }
+cli_bin=$build/robotalk-client/robotalk
+for b in "$server_bin" "$relay_bin" "$client_bin" "$cli_bin"; do
+  [ -x "$b" ] || { echo "soak.sh: $b not built (cmake --build $build --target robotalk-server robotalk-lcm-relay robotalk-soak-client robotalk)" >&2; exit 2; }
 done
 url_a="udpm://239.255.76.67:7100?ttl=0"   # clients
 url_b="udpm://239.255.76.67:7200?ttl=0"   # server
@@ -330,9 +335,22 @@ for ev in "${events[@]}"; do
   at=${ev%% *} what=${ev#* }
   sleep_until "$at"
   if [ "$what" = restart ]; then
+    # Kill it in panic (if the chaos client's reset does not come first): a
+    # server killed with the robot latched must start again in panic.
+    "$cli_bin" --url "$url_a" --timeout 5 panic pioneer >/dev/null 2>&1
     kill -9 "$server_pid"; wait "$server_pid" 2>/dev/null
-    echo "soak: t=$(elapsed) s: server killed (-9) and started again"
+    latched=no  # what the dead server left on disk
+    grep -q "^pioneer" "$tmp/panic.latch" 2>/dev/null && latched=yes
+    echo "soak: t=$(elapsed) s: server killed (-9) (panic latched: $latched) and started again"
     start_server
+    if [ "$latched" = yes ]; then
+      if grep -q "starts in PANIC" "$tmp/server$instance.log"; then
+        echo "soak: the new instance started in panic, as latched"
+      else
+        echo "LATCH LOST: the robot was latched in panic at the kill; the new instance did not start in panic" | tee "$tmp/latch_lost"
+      fi
+      "$cli_bin" --url "$url_a" --timeout 5 reset pioneer >/dev/null 2>&1 || echo "soak: the reset after the restart failed" >&2
+    fi
   else
     victims=()
     while read -r pid mode out; do
