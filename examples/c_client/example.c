@@ -81,6 +81,8 @@ static int run(rtc_client* c, double delay_s, double pause_s) {
     if (rtc_send_commands(c, ROBOTALK_MSGS_PACKAGE_HEADER_T_MODE_DELAY, &frames[k], 1) < 0) return -1;
     ids[k] = frames[k].id;
   }
+  printf("sequence sent: %d frames from server time %" PRId64 " us\n", SEQUENCE_FRAMES, start_us);
+  fflush(stdout);
   rtc_reply replies[SEQUENCE_FRAMES];
   if (rtc_wait(c, ids, SEQUENCE_FRAMES, 10.0 + delay_s, replies) != 0) return -1;
   for (int k = 0; k < SEQUENCE_FRAMES; ++k) {

@@ -267,8 +267,8 @@ static int publish_package(rtc_client* c, robotalk_msgs_package_t* pkg, uint8_t*
     set_error(c, "cannot encode a package");
     return -1;
   }
+  c->last_new_package_us = rtc_now_us(); /* before sending: a clock sample's t1 */
   lcm_publish(c->request_lcm, c->request_channel, bytes, (unsigned)size);
-  c->last_new_package_us = rtc_now_us();
   if (bytes_out) {
     *bytes_out = bytes;
     *size_out = size;

@@ -70,6 +70,8 @@ public final class Example {
       client.sendCommands(package_header_t.MODE_DELAY, frame);
       ids[k] = frame.id;
     }
+    System.out.printf("sequence sent: %d frames from server time %d us%n", joints.length, startUs);
+    System.out.flush();
     reply_t[] replies = client.await(10.0 + delayS, ids);
     StringBuilder spacing = new StringBuilder("spacing_s:");
     for (int k = 0; k < joints.length; k++) {

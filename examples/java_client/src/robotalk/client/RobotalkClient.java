@@ -303,8 +303,8 @@ public final class RobotalkClient implements AutoCloseable {
     ByteArrayOutputStream buffer = new ByteArrayOutputStream();
     pkg.encode(new DataOutputStream(buffer));
     byte[] bytes = buffer.toByteArray();
+    lastNewPackageUs = nowUs();  // before sending: a clock sample's t1
     requestLcm.publish(requestChannel, bytes, 0, bytes.length);
-    lastNewPackageUs = nowUs();
     return bytes;
   }
 
