@@ -1,4 +1,4 @@
-// Tests of InverseKinematics (robotalk-core/src/inverse_kinematics.cpp): a
+// Tests of InverseKinematics (robotalk-core/spec/src/inverse_kinematics.cpp): a
 // planar 2-link arm against its closed form, unreachable goals, limits, masks,
 // mimics, bad input, and random reachable poses of the iiwa14.
 #include "robotalk/inverse_kinematics.h"
