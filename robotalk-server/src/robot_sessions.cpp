@@ -153,7 +153,7 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
                                bool& publish_config) {
   const RobotModel& model = daemon_.model();
   if (auto bad = CheckQuery(model, q)) {
-    immediate.push_back(MakeReply(q.id, Signal::kError, *bad, now));
+    immediate.push_back(MakeReply(q.id, bad->signal, bad->message, now));
     return;
   }
   switch (q.type) {
@@ -247,9 +247,8 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                                std::vector<Reply>& immediate, bool playback) {
   const RobotModel& model = daemon_.model();
   if (c.type == CommandType::kPanicReset) {
-    Signal signal = Signal::kSuccess;
-    if (auto bad = CheckCommand(model, c, &signal)) {
-      immediate.push_back(MakeReply(c.id, signal, *bad, now));
+    if (auto bad = CheckCommand(model, c)) {
+      immediate.push_back(MakeReply(c.id, bad->signal, bad->message, now));
     } else if (daemon_.ResetPanic()) {
       log_.push_back("robot '" + robot_ + "': panic reset by " + s.who);
       immediate.push_back(MakeReply(c.id, Signal::kSuccess, "panic reset", now));
@@ -267,9 +266,8 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                   now));
     return std::nullopt;
   }
-  Signal signal = Signal::kError;
-  if (auto bad = CheckCommand(model, c, &signal)) {
-    immediate.push_back(MakeReply(c.id, signal, *bad, now));
+  if (auto bad = CheckCommand(model, c)) {
+    immediate.push_back(MakeReply(c.id, bad->signal, bad->message, now));
     return std::nullopt;
   }
   // A playback frame's start time is its offset from the sequence start.

@@ -297,9 +297,8 @@ RobotModel TestRobot(BaseType base) {
 }
 
 std::pair<Signal, std::string> Check(const RobotModel& m, const Command& c) {
-  Signal s = Signal::kSuccess;
-  auto msg = CheckCommand(m, c, &s);
-  return {msg ? s : Signal::kSuccess, msg.value_or("")};
+  auto bad = CheckCommand(m, c);
+  return {bad ? bad->signal : Signal::kSuccess, bad ? bad->message : ""};
 }
 
 TEST(CheckCommand, AcceptsWellFormedCommandsAndNamesWhatIsWrongOtherwise) {
@@ -337,8 +336,9 @@ TEST(CheckCommand, AcceptsWellFormedCommandsAndNamesWhatIsWrongOtherwise) {
 TEST(CheckCommand, ChecksQueryTargets) {
   const RobotModel m = TestRobot(BaseType::kDifferential);
   EXPECT_FALSE(CheckQuery(m, {1, QueryType::kJointState, "pan_tilt"}));
-  EXPECT_THAT(*CheckQuery(m, {1, QueryType::kLinkPoses, "nose"}), HasSubstr("no link named 'nose'"));
-  EXPECT_THAT(*CheckQuery(m, {1, QueryType::kClock, "x"}), HasSubstr("takes no target"));
+  EXPECT_THAT(CheckQuery(m, {1, QueryType::kLinkPoses, "nose"})->message, HasSubstr("no link named 'nose'"));
+  EXPECT_THAT(CheckQuery(m, {1, QueryType::kClock, "x"})->message, HasSubstr("takes no target"));
+  EXPECT_EQ(CheckQuery(m, {1, QueryType::kClock, "x"})->signal, Signal::kError);
 }
 
 TEST(CommandNames, ParseWhatTheyPrint) {

@@ -237,10 +237,11 @@ TEST(KinematicDriver, MimicJointFollowsItsLeader) {
   EXPECT_NEAR(s.position[1], -0.5, 1e-12);
   EXPECT_FALSE(s.moving);
   // A command to the follower never reaches a driver: the server refuses it (driver.h).
-  Signal signal = Signal::kSuccess;
   const Command to_follower{2, CommandType::kJointSetPoint, std::nullopt, "r", {0.1}};
-  EXPECT_THAT(CheckCommand(d.model(), to_follower, &signal).value_or(""), HasSubstr("mimic"));
-  EXPECT_EQ(signal, Signal::kNa);
+  const auto refusal = CheckCommand(d.model(), to_follower);
+  ASSERT_TRUE(refusal);
+  EXPECT_THAT(refusal->message, HasSubstr("mimic"));
+  EXPECT_EQ(refusal->signal, Signal::kNa);
 }
 
 // ---------------------------------------------------------------- base

@@ -133,7 +133,10 @@ std::string ToString(const StartTime& s) {
 
 bool IsMotionCommand(CommandType t) { return t != CommandType::kStop && t != CommandType::kPanicReset; }
 
-std::optional<std::string> CheckCommand(const RobotModel& model, const Command& c, Signal* signal) {
+namespace {
+
+// The text of what is wrong with `c`; `signal` gets the signal to answer with.
+std::optional<std::string> CommandProblem(const RobotModel& model, const Command& c, Signal* signal) {
   *signal = Signal::kError;
   if (auto bad = CheckFinite(c)) return bad;
   switch (c.type) {
@@ -198,7 +201,24 @@ std::optional<std::string> CheckCommand(const RobotModel& model, const Command& 
   return "unknown command type " + std::to_string(static_cast<int>(c.type));
 }
 
-std::optional<std::string> CheckQuery(const RobotModel& model, const Query& q) {
+std::optional<std::string> QueryProblem(const RobotModel& model, const Query& q);
+
+}  // namespace
+
+std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& c) {
+  Signal signal = Signal::kError;
+  if (auto problem = CommandProblem(model, c, &signal)) return Refusal{signal, std::move(*problem)};
+  return std::nullopt;
+}
+
+std::optional<Refusal> CheckQuery(const RobotModel& model, const Query& q) {
+  if (auto problem = QueryProblem(model, q)) return Refusal{Signal::kError, std::move(*problem)};
+  return std::nullopt;
+}
+
+namespace {
+
+std::optional<std::string> QueryProblem(const RobotModel& model, const Query& q) {
   if (q.type == QueryType::kStateStream && (q.period < kMinStreamPeriod || q.period > kMaxStreamPeriod)) {
     return "STATE_STREAM: period " + std::to_string(ToSeconds(q.period)) + " s is outside [" +
            std::to_string(ToSeconds(kMinStreamPeriod)) + ", " + std::to_string(ToSeconds(kMaxStreamPeriod)) +
@@ -225,5 +245,7 @@ std::optional<std::string> CheckQuery(const RobotModel& model, const Query& q) {
       return std::string(ToString(q.type)) + ": takes no target (got " + Quote(q.target) + ")";
   }
 }
+
+}  // namespace
 
 }  // namespace robotalk

@@ -134,15 +134,15 @@ struct Reply {
 /// True for the commands that move the robot (all but STOP and PANIC_RESET).
 bool IsMotionCommand(CommandType t);
 
-/// Checks a command against a model before it is queued. Returns the ERROR or
-/// NA reply text ("JOINT_SETPOINT: robot 'pioneer' has no joint named 'nek'",
+/// Checks a command against a model before it is queued: nullopt when
+/// well-formed, else the refusal — kError for a malformed request
+/// ("JOINT_SETPOINT: robot 'pioneer' has no joint named 'nek'",
 /// "JOINT_SETPOINT 'pan_tilt': expected 2 values (one per dof), got 3",
-/// "JOINT_SETPOINT 'pan_tilt': value 1 is NaN"), or nullopt when well-formed.
-/// `signal` receives kError for malformed requests and kNa for a servo type or
-/// base command the robot does not support.
-std::optional<std::string> CheckCommand(const RobotModel& model, const Command& command, Signal* signal);
+/// "JOINT_SETPOINT 'pan_tilt': value 1 is NaN"), kNa for a servo type or base
+/// command the robot does not support.
+std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& command);
 
-/// Same for queries (unknown target names, a STATE_STREAM period out of range).
-std::optional<std::string> CheckQuery(const RobotModel& model, const Query& query);
+/// Same for queries (unknown target names, a STATE_STREAM period out of range): kError.
+std::optional<Refusal> CheckQuery(const RobotModel& model, const Query& query);
 
 }  // namespace robotalk

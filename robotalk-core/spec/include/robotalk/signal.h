@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace robotalk {
@@ -23,5 +24,14 @@ std::string_view ToString(Signal s);
 std::optional<Signal> SignalFromWire(std::int8_t value);
 /// SUCCESS and MODIFIED mean the command was carried out.
 inline bool Succeeded(Signal s) { return s == Signal::kSuccess || s == Signal::kModified; }
+
+/// Why a request is not executed, as every check in RoboTalk reports it: the
+/// signal it is answered with (ERROR for a malformed request, NA for one this
+/// robot does not support) and a message naming what was wrong.
+struct Refusal {
+  Signal signal = Signal::kError;
+  std::string message;
+  bool operator==(const Refusal&) const = default;
+};
 
 }  // namespace robotalk
