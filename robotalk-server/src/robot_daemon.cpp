@@ -2,11 +2,16 @@
 
 #include "robotalk/signal.h"
 
+#include <pthread.h>
+#include <sched.h>
+#include <sys/prctl.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <utility>
 
 namespace robotalk {
@@ -57,6 +62,11 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
   produced_.executed.reserve(256);
   Preallocate(outbox_);
   in_progress_.reserve(64);
+  snapshot_.state = state_;
+  direct_state_ = snapshot_;
+  direct_kinematics_ = std::make_unique<Kinematics>(m);
+  direct_roots_ = roots_;
+  direct_.reserve(16);
 }
 
 RobotDaemon::~RobotDaemon() { Stop(); }
@@ -89,26 +99,108 @@ void RobotDaemon::Stop() {
 }
 
 void RobotDaemon::DaemonLoop() {
+  ApplyTiming();
   std::unique_lock lock(mutex_);
   while (running_) {
     lock.unlock();
     const TimePoint next = RunOnce(clock_.Now());
     lock.lock();
-    // Absolute deadline: the next start time, driver period or sample.
-    wake_.wait_until(lock, next, [this] { return wake_flag_ || !running_; });
+    WaitUntil(lock, next);
     wake_flag_ = false;
   }
+}
+
+// Absolute deadline: the next start time, driver period or sample. With
+// precise timing, the last `final_spin` before a start time or sample is a
+// busy wait with the lock released (a futex wake-up is tens of µs late on a
+// loaded machine); it ends at the deadline, so it is bounded by final_spin.
+void RobotDaemon::WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next) {
+  const auto woken = [this] { return wake_flag_ || !running_ || flush_deferred_.load(); };
+  if (!precise_ || !spin_ || options_.final_spin.count() <= 0 || next == TimePoint::max()) {
+    wake_.wait_until(lock, next, woken);
+    return;
+  }
+  if (wake_.wait_until(lock, next - options_.final_spin, woken)) return;
+  lock.unlock();
+  // Bounded in real time too (a test's ManualClock does not move by itself).
+  const auto bound = std::chrono::steady_clock::now() + 2 * options_.final_spin;
+  while (clock_.Now() < next && std::chrono::steady_clock::now() < bound) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+  lock.lock();
+}
+
+void RobotDaemon::ApplyTiming() {
+  std::string what = "default timer slack, no final spin, SCHED_OTHER (precise_timing off)";
+  const char* env = std::getenv("ROBOTALK_PRECISE_TIMING");
+  if (options_.precise_timing && !(env != nullptr && std::string(env) == "0")) {
+    precise_ = true;
+    const bool slack = prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0;
+    sched_param param{};
+    param.sched_priority = options_.fifo_priority;
+    const bool fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "%s, final spin %lld us, %s",
+                  slack ? "1 ns timer slack" : "default timer slack",
+                  static_cast<long long>(
+                      std::chrono::duration_cast<std::chrono::microseconds>(options_.final_spin).count()),
+                  fifo ? ("SCHED_FIFO priority " + std::to_string(param.sched_priority)).c_str()
+                       : "SCHED_OTHER (SCHED_FIFO not permitted)");
+    what = buf;
+  }
+  std::lock_guard lock(mutex_);
+  timing_ = what;
+  outbox_.log.push_back("robot '" + robot_name_ + "': RobotDaemon timing: " + what);
+}
+
+std::string RobotDaemon::timing() const {
+  std::lock_guard lock(mutex_);
+  return timing_;
 }
 
 // --- ServerDaemon side -------------------------------------------------------
 
 void RobotDaemon::Submit(QueuedItem item) {
+  const TimePoint now = clock_.Now();
+  const bool due = !item.has_start_time || item.start <= now;
+  if (item.is_query && due) {
+    // Answered here when the snapshot is what the driver would report now: it
+    // was read after every item due so far ran, no queued item became due
+    // since, the halt state is the one asked for, and it is at most one driver
+    // period old. Else queued (and snapshots taken for the next second).
+    snapshot_wanted_until_ = (now + std::chrono::seconds(1)).time_since_epoch().count();
+    bool current = false;
+    {
+      std::lock_guard lock(snapshot_mutex_);
+      current = snapshot_.valid && snapshot_.pushes_seen >= last_due_push_ && now < snapshot_.next_due &&
+                snapshot_.halted == panic_.load() && now - snapshot_.time <= snapshot_.max_age;
+      if (current) direct_state_ = snapshot_;  // same sizes: no allocation
+    }
+    if (current) {
+      Reply r;
+      r.id = item.command.id;
+      r.exec_time = now;
+      AnswerFrom(direct_state_.state, *direct_kinematics_, direct_roots_, item, r);
+      direct_.push_back({item.client_id, std::move(r)});
+      ++direct_queries_;
+      return;
+    }
+  }
   {
     std::lock_guard lock(mutex_);
     scheduler_.Push(std::move(item));
+    ++pushes_;
+    if (due) last_due_push_ = pushes_;
     wake_flag_ = true;
   }
   wake_.notify_one();
+}
+
+void RobotDaemon::TakeDirect(std::vector<DaemonOutput::Answer>& out) {
+  for (auto& a : direct_) out.push_back(std::move(a));
+  direct_.clear();
 }
 
 std::size_t RobotDaemon::queued(std::int64_t client_id) const {
@@ -117,18 +209,54 @@ std::size_t RobotDaemon::queued(std::int64_t client_id) const {
 }
 
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
-  panic_ = true;
+  panic_ = true;  // from here on only a STOP runs (Execute checks it)
+  std::unique_lock lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) {
+    if (reason.empty()) {
+      // The RobotDaemon holds the lock: do not wait for it before the
+      // acknowledgement; FinishPanic() or its next iteration flushes.
+      flush_deferred_ = true;
+      return;
+    }
+    lock.lock();
+  }
+  if (!reason.empty()) fault_ = reason;
+  scheduler_.FlushAll(flushed);
+  halt_requested_ = true;
+  wake_flag_ = true;
+  lock.unlock();
+  wake_.notify_one();
+}
+
+void RobotDaemon::FinishPanic() {
+  if (!flush_deferred_.load()) return;
   {
     std::lock_guard lock(mutex_);
-    if (!reason.empty()) fault_ = reason;
-    scheduler_.FlushAll(flushed);
-    halt_requested_ = true;
-    wake_flag_ = true;
+    if (flush_deferred_.load()) FlushForPanicLocked();
   }
   wake_.notify_one();
 }
 
+void RobotDaemon::FlushForPanicLocked() {
+  flush_deferred_ = false;
+  std::vector<QueuedItem> flushed;
+  scheduler_.FlushAll(flushed);
+  halt_requested_ = true;
+  wake_flag_ = true;
+  const TimePoint now = clock_.Now();
+  for (const QueuedItem& item : flushed) {
+    if (item.client_id == 0) continue;
+    Reply r;
+    r.id = item.command.id;
+    r.signal = Signal::kInterrupted;
+    r.message = "flushed by panic";
+    r.exec_time = now;
+    outbox_.replies.push_back({item.client_id, std::move(r)});
+  }
+}
+
 bool RobotDaemon::ResetPanic() {
+  FinishPanic();  // a deferred flush never outlives its panic
   if (!panic_.exchange(false)) return false;
   {
     std::lock_guard lock(mutex_);
@@ -184,10 +312,12 @@ void RobotDaemon::QueueHold(std::vector<int> joints, bool base) {
   Submit(std::move(hold));
 }
 
-bool RobotDaemon::TakeOutput(DaemonOutput& out) {
+bool RobotDaemon::TakeOutput(DaemonOutput& out, bool wait) {
   if (out.samples.size() != options_.max_buffered_samples) Preallocate(out);
   out.Clear();
-  std::lock_guard lock(mutex_);
+  std::unique_lock lock(mutex_, std::defer_lock);
+  if (!wait && !lock.try_lock()) return false;
+  if (wait) lock.lock();
   std::swap(out, outbox_);
   return !out.replies.empty() || !out.executed.empty() || out.num_samples > 0 || !out.log.empty() ||
          !out.audit.empty() || out.dropped_samples > 0;
@@ -293,9 +423,11 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   due_.clear();
   {
     std::lock_guard lock(mutex_);
-    halt = std::exchange(halt_requested_, false);
+    if (flush_deferred_.load()) FlushForPanicLocked();
+    halt = std::exchange(halt_requested_, false) || panic_.load();
     resume = std::exchange(resume_requested_, false);
     scheduler_.TakeDue(now, due_);
+    pushes_taken_ = pushes_;
     period = scheduler_.stream_period();
     sample_due = scheduler_.TakeSampleDue(now);
   }
@@ -329,7 +461,12 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     in_progress_.erase(owner);
   }
 
+  const bool snapshot = clock_.Now().time_since_epoch().count() < snapshot_wanted_until_.load();
+  const bool state_read = snapshot && (sampled || Guarded("ReadState", nullptr, now, [&] {
+                                                    driver_->ReadState(state_);
+                                                  }) == CallOutcome::kOk);
   TimePoint next = next_update_;
+  TimePoint next_due = TimePoint::max();
   bool ready = false;
   {
     std::lock_guard lock(mutex_);
@@ -344,10 +481,24 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
         ++outbox_.dropped_samples;  // the ServerDaemon is behind: drop the newest
       }
     }
-    next = std::min(next, scheduler_.NextDeadline());
+    next_due = scheduler_.NextDeadline();
+    spin_ = next_due < next;  // a start time or sample, not a driver period
+    next = std::min(next, next_due);
     if (halt_requested_ || resume_requested_) next = now;
     ready = !produced_.replies.empty() || !produced_.executed.empty() || !produced_.log.empty() ||
             !produced_.audit.empty() || sampled;
+  }
+  {
+    std::lock_guard lock(snapshot_mutex_);
+    snapshot_.valid = state_read;
+    if (state_read) {
+      snapshot_.state = state_;  // same sizes: no allocation
+      snapshot_.halted = halted_;
+      snapshot_.time = now;
+      snapshot_.pushes_seen = pushes_taken_;
+      snapshot_.next_due = next_due;
+      snapshot_.max_age = driver_->period();
+    }
   }
   if (ready && output_ready_) output_ready_();
   return next;
@@ -447,13 +598,19 @@ void RobotDaemon::Hold(const QueuedItem& item, TimePoint now) {
 }
 
 void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
-  const RobotModel& m = model();
   if (Guarded("ReadState", nullptr, reply.exec_time, [&] { driver_->ReadState(state_); }) !=
       CallOutcome::kOk) {
     reply.signal = Signal::kError;
     reply.message = std::string(ToString(item.query)) + ": " + last_fault_;
     return;
   }
+  AnswerFrom(state_, kinematics_, roots_, item, reply);
+}
+
+void RobotDaemon::AnswerFrom(const RobotState& state, Kinematics& kinematics,
+                             std::vector<Eigen::Isometry3d>& roots, const QueuedItem& item,
+                             Reply& reply) const {
+  const RobotModel& m = model();
   auto& v = reply.values;
   try {
     switch (item.query) {
@@ -464,27 +621,27 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
           count = static_cast<int>(m.joint(item.query_target).dofs.size());
         }
         v.reserve(3 * static_cast<std::size_t>(count));
-        for (const Eigen::VectorXd* vec : {&state_.position, &state_.velocity, &state_.effort}) {
+        for (const Eigen::VectorXd* vec : {&state.position, &state.velocity, &state.effort}) {
           v.insert(v.end(), vec->data() + first, vec->data() + first + count);
         }
         break;
       }
       case QueryType::kLinkPoses:
       case QueryType::kFramePoses: {
-        for (std::size_t i = 0; i < roots_.size(); ++i) roots_[i] = state_.root_poses[i].ToIsometry();
-        kinematics_.Update(state_.position, roots_);
+        for (std::size_t i = 0; i < roots.size(); ++i) roots[i] = state.root_poses[i].ToIsometry();
+        kinematics.Update(state.position, roots);
         const bool links = item.query == QueryType::kLinkPoses;
         const int n = static_cast<int>(links ? m.links().size() : m.frames().size());
         for (int i = 0; i < n; ++i) {
           if (item.query_target >= 0 && i != item.query_target) continue;
           v.resize(v.size() + 7);
-          WritePose(links ? kinematics_.link_pose(i) : kinematics_.frame_pose(i), v.data() + v.size() - 7);
+          WritePose(links ? kinematics.link_pose(i) : kinematics.frame_pose(i), v.data() + v.size() - 7);
         }
         break;
       }
       case QueryType::kBasePose: {
-        const Eigen::Isometry3d base = state_.root_poses.front().ToIsometry();
-        v = {base.translation().x(), base.translation().y(), Yaw(base), state_.base_v, state_.base_omega};
+        const Eigen::Isometry3d base = state.root_poses.front().ToIsometry();
+        v = {base.translation().x(), base.translation().y(), Yaw(base), state.base_v, state.base_omega};
         break;
       }
       default:

@@ -15,6 +15,16 @@
 //   query values (tests/server/robot_daemon_test.cpp counts).
 // Tests leave the thread unstarted and call RunOnce() with a ManualClock.
 //
+// Fewer hops (issue 11): a query that needs no waiting is answered by
+// Submit() itself, on the ServerDaemon's thread, from the state the
+// RobotDaemon snapshots after every iteration, when that snapshot is still
+// what the driver would report (no item became due since: see Submit()); the
+// reply is handed out by TakeDirect(), not through the outbox. Panic() does
+// not wait for mutex_: it latches panic at once (nothing runs after it) and,
+// if the RobotDaemon holds the lock, leaves the flush and the halt to
+// FinishPanic() (called after the acknowledgement is sent) or to the
+// RobotDaemon's next iteration, whichever comes first.
+//
 // Driver faults (driver.h): an exception from any driver call, or a call
 // still running past `driver_call_bound` (seen by CheckOverrun(), which the
 // ServerDaemon calls), halts the robot and latches panic with the reason;
@@ -48,6 +58,16 @@ struct RobotDaemonOptions {
   Duration driver_call_bound = std::chrono::seconds(2);
   /// State samples the outbox holds before the oldest are dropped (counted).
   std::size_t max_buffered_samples = 64;
+  /// Tighter deadlines for the RobotDaemon thread: 1 ns timer slack
+  /// (prctl PR_SET_TIMERSLACK), a busy wait of `final_spin` before a start
+  /// time or state sample, and SCHED_FIFO at `fifo_priority` when the process
+  /// may (else it stays SCHED_OTHER, silently; the outbox log says once which
+  /// was applied). The environment variable ROBOTALK_PRECISE_TIMING=0 turns
+  /// it off (the benchmark compares both). Cost: up to `final_spin` of CPU
+  /// per start time or sample (docs/performance.md).
+  bool precise_timing = true;
+  Duration final_spin = std::chrono::microseconds(50);
+  int fifo_priority = 10;
 };
 
 /// One broadcast state sample, preallocated for the model.
@@ -113,12 +133,23 @@ class RobotDaemon {
   void Stop();
 
   // --- ServerDaemon side (thread-safe) ------------------------------------
-  /// Queues a checked item. REQUIRES: admission checks passed.
+  /// Queues a checked item. REQUIRES: admission checks passed. A query due
+  /// now is answered at once from the state snapshot when that is current
+  /// (the reply waits in TakeDirect()); otherwise it is queued.
   void Submit(QueuedItem item);
+  /// Replies Submit() answered itself, moved into `out` (appended).
+  /// ServerDaemon thread only; takes no lock.
+  void TakeDirect(std::vector<DaemonOutput::Answer>& out);
+  /// Queries answered by Submit() so far (ServerDaemon thread only).
+  std::uint64_t direct_queries() const { return direct_queries_; }
   std::size_t queued(std::int64_t client_id) const;
   /// Panic: removes every waiting item (appended to `flushed`), latches
   /// panic and asks the thread to halt the driver.
   void Panic(std::vector<QueuedItem>& flushed, const std::string& reason = {});
+  /// Completes a panic whose flush Panic() left to later (the lock was held):
+  /// flushes every waiting item (answered INTERRUPTED through the outbox) and
+  /// wakes the thread to halt. No-op otherwise. May wait for mutex_.
+  void FinishPanic();
   /// Panic reset: returns false if the robot was not in panic.
   bool ResetPanic();
   bool in_panic() const { return panic_.load(); }
@@ -138,7 +169,11 @@ class RobotDaemon {
   /// else is touched, so another client's motion runs on.
   void QueueHold(std::vector<int> joints, bool base);
   /// Swaps the outbox with `out` (cleared first). Returns false when empty.
-  bool TakeOutput(DaemonOutput& out);
+  /// With `wait` false it does not wait for mutex_: when the RobotDaemon
+  /// holds it, `out` is left cleared and false returned (take it later).
+  bool TakeOutput(DaemonOutput& out, bool wait = true);
+  /// Which timing the thread runs with (precise_timing), once started; "" before.
+  std::string timing() const;
   /// Called from the RobotDaemon thread whenever the outbox has something.
   void set_output_ready_callback(std::function<void()> callback) { output_ready_ = std::move(callback); }
   /// Driver-call watchdog: if a call has run past the bound at `now`, latch
@@ -168,6 +203,12 @@ class RobotDaemon {
   };
 
   void DaemonLoop();
+  void ApplyTiming();
+  void WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next);
+  void FlushForPanicLocked();  // REQUIRES: mutex_ held
+  // A query answered from `state` (kinematics and roots are the caller's scratch).
+  void AnswerFrom(const RobotState& state, Kinematics& kinematics, std::vector<Eigen::Isometry3d>& roots,
+                  const QueuedItem& item, Reply& reply) const;
   void Execute(const QueuedItem& item, TimePoint now);
   void AnswerQuery(const QueuedItem& item, Reply& reply);
   void Hold(const QueuedItem& item, TimePoint now);
@@ -197,7 +238,33 @@ class RobotDaemon {
   bool resume_requested_ = false;  // GUARDED_BY(mutex_)
   bool wake_flag_ = false;         // GUARDED_BY(mutex_)
   bool running_ = false;           // GUARDED_BY(mutex_)
+  std::uint64_t pushes_ = 0;       // GUARDED_BY(mutex_): items submitted so far
+  std::string timing_;             // GUARDED_BY(mutex_)
   std::atomic<bool> panic_{false};
+  std::atomic<bool> flush_deferred_{false};              // Panic() could not take mutex_ to flush
+  std::atomic<Duration::rep> snapshot_wanted_until_{0};  // a query came: snapshot until then
+
+  // The state snapshot for queries answered on receipt.
+  struct StateSnapshot {
+    RobotState state;
+    bool valid = false;                     ///< ReadState succeeded
+    bool halted = false;                    ///< the driver was halted then
+    TimePoint time{};                       ///< when it was read
+    Duration max_age{0};                    ///< the driver period: older is stale
+    std::uint64_t pushes_seen = 0;          ///< every item pushed before this many was taken
+    TimePoint next_due = TimePoint::min();  ///< the scheduler's next deadline then
+  };
+  mutable std::mutex snapshot_mutex_;
+  StateSnapshot snapshot_;  // GUARDED_BY(snapshot_mutex_)
+  // ServerDaemon thread only.
+  std::uint64_t last_due_push_ = 0;  // pushes_ after the last item due on arrival
+  std::vector<DaemonOutput::Answer> direct_;
+  std::uint64_t direct_queries_ = 0;
+  StateSnapshot direct_state_;
+  std::unique_ptr<Kinematics> direct_kinematics_;
+  std::vector<Eigen::Isometry3d> direct_roots_;
+  bool precise_ = false;  // RobotDaemon thread: precise_timing applied
+  bool spin_ = false;     // RobotDaemon thread: the next deadline is a start time or sample
 
   mutable std::mutex call_mutex_;
   CurrentCall call_;  // GUARDED_BY(call_mutex_)
@@ -206,6 +273,7 @@ class RobotDaemon {
   std::thread thread_;
   std::vector<QueuedItem> due_;
   std::vector<Completion> completions_;
+  std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
   DaemonOutput produced_;
   std::unordered_map<CommandId, Owner> in_progress_;  // driver command id -> owner
   CommandId next_driver_id_ = 1;

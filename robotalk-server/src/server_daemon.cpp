@@ -49,6 +49,7 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
 
 ServerDaemon::~ServerDaemon() {
   Stop();
+  WriteLog();
   subscription_.reset();
   hello_subscription_.reset();
   announce_subscription_.reset();
@@ -180,10 +181,15 @@ void ServerDaemon::RunOnce(Duration timeout) {
     Announce(now);
     next_announce_ = now + options_.announce_period;
   }
+  WriteLog();
 }
 
 void ServerDaemon::Flush() {
-  for (auto& [name, robot] : robots_) Drain(robot);
+  for (auto& [name, robot] : robots_) {
+    robot.daemon->FinishPanic();
+    Drain(robot);
+  }
+  WriteLog();
 }
 
 // A transport handler: never throws for bad input (the transport would
@@ -213,8 +219,12 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
         Hex64(static_cast<std::uint64_t>(request.client_id)) + ": " + request.header_error);
   }
   if (answer.publish_config) transport_.Publish(ConfigChannel(*robot_name), robot.encoded_config);
-  if (answer.send) Send(*robot_name, answer.batch);
-  Drain(robot);  // a panic's flushed items, at once
+  if (answer.send) {
+    AnswerDirect(robot, answer.batch);
+    Send(*robot_name, answer.batch);
+  }
+  robot.daemon->FinishPanic();   // after the acknowledgement
+  Drain(robot, /*wait=*/false);  // a panic's flushed items, at once (RunOnce's Flush waits)
   if (options_.congestion_max_pause.count() > 0) {
     // The paper's congestion injector (§VI-B): a random pause after each
     // received package, during which nothing else is received.
@@ -250,6 +260,7 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
     // client whose server restarted must still be able to stop the robot).
     robot.sessions->RaisePanic(request.client_id, received);
     SyncLatch(robot);
+    robot.daemon->FinishPanic();
     Drain(robot);
   }
   if (request.client_id == 0) return false;
@@ -285,16 +296,30 @@ void ServerDaemon::OnHello(const std::string& channel, std::span<const std::uint
   transport_.Publish(HelloAnswerChannel(*robot_name, hello.body.client_id), EncodeHelloAnswer(answer));
 }
 
-void ServerDaemon::Drain(Robot& robot) {
-  robot.daemon->TakeOutput(robot.output);
+void ServerDaemon::AnswerDirect(Robot& robot, ReplyBatch& ack) {
+  direct_output_.Clear();
+  robot.daemon->TakeDirect(direct_output_.replies);
+  if (direct_output_.replies.empty()) return;
+  to_send_.clear();
+  robot.sessions->File(direct_output_, to_send_);
+  for (ReplyBatch& batch : to_send_) {
+    if (batch.client_id == ack.client_id) {
+      for (Reply& r : batch.replies) ack.replies.push_back(std::move(r));
+    } else {
+      Send(robot.daemon->robot_name(), batch);
+    }
+  }
+}
+
+void ServerDaemon::Drain(Robot& robot, bool wait) {
+  robot.daemon->TakeOutput(robot.output, wait);
   SyncLatch(robot);  // a driver fault latched by the RobotDaemon
   const std::string& name = robot.daemon->robot_name();
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
     transport_.Publish(StateChannel(name),
                        EncodeStateSample(ToStateSample(name, robot.config_hash, robot.output.samples[i])));
   }
-  for (const std::string& line : robot.output.audit)
-    std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());
+  for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
   to_send_.clear();
   robot.sessions->File(robot.output, to_send_);
   for (ReplyBatch& batch : to_send_) Send(name, batch);
@@ -369,8 +394,8 @@ void ServerDaemon::Log(const std::string& line) {
   const TimePoint now = clock_.Now();
   if (now - log_window_ >= std::chrono::seconds(1)) {
     if (log_suppressed_ > 0) {
-      std::fprintf(stderr, "robotalk-server: (%llu more log lines suppressed in the last second)\n",
-                   static_cast<unsigned long long>(log_suppressed_));
+      log_pending_.push_back("(" + std::to_string(log_suppressed_) +
+                             " more log lines suppressed in the last second)");
     }
     log_window_ = now;
     log_lines_ = 0;
@@ -380,7 +405,12 @@ void ServerDaemon::Log(const std::string& line) {
     ++log_suppressed_;
     return;
   }
-  std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());
+  log_pending_.push_back(line);
+}
+
+void ServerDaemon::WriteLog() {
+  for (const std::string& line : log_pending_) std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());
+  log_pending_.clear();
 }
 
 }  // namespace robotalk

@@ -6,6 +6,13 @@
 // configuration message, and ROBOTALK/ANNOUNCE once a period. It also runs the
 // session watchdog and the driver-call watchdog.
 //
+// Fewer hops (issue 11): a query the RobotDaemon can answer on receipt
+// (RobotDaemon::Submit) travels in the same reply package as the
+// acknowledgement; a panic is acknowledged before the RobotDaemon's lock is
+// waited for (RobotDaemon::FinishPanic comes after); log lines are written to
+// stderr at the end of an iteration, after every publish, never between a
+// package's receipt and its acknowledgement.
+//
 // Thread safety: RunOnce() and everything it calls run on one thread (the one
 // Start() launches, or a test's). Wake() may be called from any thread (the
 // RobotDaemons call it when their outbox has something).
@@ -107,7 +114,11 @@ class ServerDaemon {
             TimePoint received);
   void OnAnnounce(std::span<const std::uint8_t> bytes);
   void Send(const std::string& robot, ReplyBatch& batch);
-  void Drain(Robot& robot);
+  void Drain(Robot& robot, bool wait = true);
+  // Files the replies RobotDaemon::Submit answered itself; the ones for
+  // `ack`'s client join it, the rest are sent.
+  void AnswerDirect(Robot& robot, ReplyBatch& ack);
+  void WriteLog();
   void Announce(TimePoint now);
   void Watchdogs(TimePoint now);
   void Log(const std::string& line);
@@ -137,6 +148,8 @@ class ServerDaemon {
   TimePoint log_window_{};
   int log_lines_ = 0;
   std::uint64_t log_suppressed_ = 0;
+  std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes
+  DaemonOutput direct_output_;            // scratch for AnswerDirect
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -172,5 +172,92 @@ TEST_F(RobotDaemonTest, RunsTheWatchdogsStopOnlyWhenTheRobotIsMoving) {
   EXPECT_TRUE(out_.replies.empty()) << "the server's own STOP has nobody to answer";
 }
 
+QueuedItem JointStateQuery(CommandId id) {
+  QueuedItem item;
+  item.client_id = kAlice;
+  item.is_query = true;
+  item.query = QueryType::kJointState;
+  item.command.id = id;
+  return item;
+}
+
+// Issue 11: a query crossed the RobotDaemon's thread (its lock, a wake-up,
+// the outbox, an eventfd) even when the state it reads had not changed.
+TEST_F(RobotDaemonTest, AnswersAQueryOnReceiptFromTheStateOfItsLastIteration) {
+  daemon_->Submit(Motion(1, CommandType::kJointSetPoint, {0.5}, 0));
+  daemon_->Submit(JointStateQuery(2));
+  std::vector<DaemonOutput::Answer> direct;
+  daemon_->TakeDirect(direct);
+  EXPECT_TRUE(direct.empty()) << "no snapshot yet: queued behind the set-point";
+  auto replies = Run();
+  ASSERT_EQ(replies.size(), 2u);
+  EXPECT_EQ(replies[1].reply.values.at(0), 0.5) << "the query ran after the set-point";
+
+  clock_.Advance(milliseconds(1));
+  daemon_->Submit(JointStateQuery(3));
+  daemon_->TakeDirect(direct);
+  ASSERT_EQ(direct.size(), 1u) << "answered on receipt, without the RobotDaemon's thread";
+  EXPECT_EQ(direct[0].client_id, kAlice);
+  EXPECT_EQ(direct[0].reply.id, 3);
+  EXPECT_EQ(direct[0].reply.signal, Signal::kSuccess);
+  EXPECT_EQ(direct[0].reply.values.at(0), 0.5);
+  EXPECT_EQ(direct[0].reply.exec_time, clock_.Now());
+  EXPECT_EQ(daemon_->direct_queries(), 1u);
+}
+
+TEST_F(RobotDaemonTest, AQueryWaitsForACommandDueBeforeItAndForAStaleSnapshot) {
+  daemon_->Submit(JointStateQuery(1));
+  Run();  // snapshots from now on
+  daemon_->Submit(Motion(2, CommandType::kJointSetPoint, {0.25}, 0));
+  daemon_->Submit(JointStateQuery(3));
+  std::vector<DaemonOutput::Answer> direct;
+  daemon_->TakeDirect(direct);
+  EXPECT_TRUE(direct.empty()) << "the set-point has not run yet";
+  auto replies = Run();
+  ASSERT_EQ(replies.size(), 2u);
+  EXPECT_EQ(replies[1].reply.values.at(0), 0.25);
+
+  clock_.Advance(milliseconds(11));  // over the driver period (10 ms): Update is due
+  daemon_->Submit(JointStateQuery(4));
+  daemon_->TakeDirect(direct);
+  EXPECT_TRUE(direct.empty()) << "older than a driver period: queued";
+  EXPECT_EQ(Run().size(), 1u);
+
+  clock_.Advance(milliseconds(1));
+  std::vector<QueuedItem> flushed;
+  daemon_->Panic(flushed);
+  daemon_->Submit(JointStateQuery(5));
+  daemon_->TakeDirect(direct);
+  EXPECT_TRUE(direct.empty()) << "panic raised, the driver not halted yet: queued behind the halt";
+  Run();
+  clock_.Advance(milliseconds(1));
+  daemon_->Submit(JointStateQuery(6));
+  daemon_->TakeDirect(direct);
+  EXPECT_EQ(direct.size(), 1u) << "halted, as the snapshot says";
+}
+
+// Issue 11 item 4: the timing option, applied on the RobotDaemon's thread.
+TEST(RobotDaemonTiming, SaysWhichTimingItsThreadRunsWith) {
+  ManualClock clock;
+  for (const bool precise : {true, false}) {
+    RobotDaemon daemon("bot", "fake", std::make_unique<FakeDriver>(PanRobot()), clock,
+                       RobotDaemonOptions{.precise_timing = precise});
+    EXPECT_EQ(daemon.timing(), "");
+    daemon.Start();
+    for (int i = 0; i < 200 && daemon.timing().empty(); ++i) std::this_thread::sleep_for(milliseconds(5));
+    daemon.Stop();
+    if (precise && std::getenv("ROBOTALK_PRECISE_TIMING") == nullptr) {
+      EXPECT_THAT(daemon.timing(), HasSubstr("final spin 50 us"));
+      EXPECT_THAT(daemon.timing(), ::testing::AnyOf(HasSubstr("SCHED_FIFO priority 10"),
+                                                    HasSubstr("SCHED_FIFO not permitted")));
+    } else if (!precise) {
+      EXPECT_THAT(daemon.timing(), HasSubstr("precise_timing off"));
+    }
+    DaemonOutput out;
+    daemon.TakeOutput(out);
+    EXPECT_THAT(out.log, ::testing::Contains(HasSubstr("RobotDaemon timing: " + daemon.timing())));
+  }
+}
+
 }  // namespace
 }  // namespace robotalk

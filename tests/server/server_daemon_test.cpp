@@ -11,6 +11,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -85,6 +87,30 @@ TEST_F(ServerDaemonTest, RoutesAPackageToItsRobotAndAnswersOnTheClientsReplyChan
   EXPECT_TRUE(fakes_["bot"]->calls.empty()) << "the other robot saw nothing";
   EXPECT_THAT(channels_, ::testing::Contains(ReplyChannel("arm", kAlice)));
   EXPECT_THAT(channels_, ::testing::Contains(std::string(kAnnounceChannel)));
+}
+
+// Issue 11: a query whose answer the RobotDaemon's last iteration already
+// knows is answered without it, in the acknowledgement's own package.
+TEST_F(ServerDaemonTest, AnswersAStateQueryInTheAcknowledgementPackage) {
+  Request first{.client_id = kAlice, .sequence = 1};
+  first.queries.push_back(Query{1, QueryType::kJointState, ""});
+  Send("bot", first);
+  Step();
+  ASSERT_EQ(replies_["bot"].count(1), 1u);
+  clock_.Advance(milliseconds(1));
+  Request second{.client_id = kAlice, .sequence = 2};
+  second.queries.push_back(Query{2, QueryType::kJointState, ""});
+  Send("bot", second);
+  const auto reply_packages = [this] {
+    return std::count(channels_.begin(), channels_.end(), ReplyChannel("bot", kAlice));
+  };
+  const auto before = reply_packages();
+  server_->RunOnce(Duration(0));  // no RobotDaemon iteration
+  client_.HandleFor(Duration(0));
+  ASSERT_EQ(replies_["bot"].count(2), 1u);
+  EXPECT_EQ(replies_["bot"][2].signal, Signal::kSuccess);
+  EXPECT_EQ(replies_["bot"][2].values.size(), 3u);  // position, velocity, effort of the pan joint
+  EXPECT_EQ(reply_packages() - before, 1) << "the acknowledgement and the answer in one package";
 }
 
 TEST_F(ServerDaemonTest, CountsUndecodableBytesAndKeepsServing) {
