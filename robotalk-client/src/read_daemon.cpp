@@ -298,7 +298,12 @@ Duration RobotClient::Impl::IdleWait(TimePoint now) {
   std::lock_guard lock(mu_);
   Duration wait = options_.max_idle_wait;
   if (!robot_.empty()) {
-    wait = std::min(wait, last_send_ + options_.heartbeat_interval - now);
+    // Heartbeats only within a session; without one, the next hello is due.
+    if (session_id_ != 0) {
+      wait = std::min(wait, last_send_ + options_.heartbeat_interval - now);
+    } else if (hello_due_) {
+      wait = std::min(wait, next_hello_ - now);
+    }
     // Bounded by the shortest resend interval, so a package added while the
     // ReadDaemon sleeps (SendPackage does not wake it) is never resent late.
     if (options_.retransmit_interval.count() > 0) wait = std::min(wait, options_.retransmit_interval);

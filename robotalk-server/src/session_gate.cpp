@@ -38,7 +38,9 @@ SessionGate::~SessionGate() = default;
 
 std::int64_t SessionGate::NewOpenSessionId() {
   for (;;) {
-    const auto id = static_cast<std::int64_t>(rng_() >> 1);  // positive
+    // Positive and below 2^53, so that a client whose numbers are doubles
+    // (Lua 5.2, JavaScript) holds it exactly.
+    const auto id = static_cast<std::int64_t>(rng_() >> 11);
     if (id != 0 && !sessions_.count(id)) return id;
   }
 }
