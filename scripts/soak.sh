@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The soak (issue 9, item 9; docs/soak.md). Not run by CI.
 #
-#   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep]
+#   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep] [--keyed]
 #   scripts/soak.sh --check-only DIR     the checks again on a kept run's files
 #
 # One robotalk-server (kinematic driver, models/pioneer2dx_pantilt.urdf,
@@ -18,6 +18,9 @@
 # unknown-outcome / lost; exits 1 if anything ran twice, out of start-time
 # order, was lost, or ran without having been sent.
 #
+# --keyed: the server runs in keyed mode (robotalk-keygen: one key per client
+# process, all with every right), every package sealed (docs/security.md).
+#
 # Everything runs in one private network namespace (scripts/netns_run.sh; exits
 # 77 where none can be made). Clients talk on udpm://239.255.76.67:7100 (ports
 # 7100..7165, the split layout), the server on 7200 (7200..7265).
@@ -25,7 +28,7 @@
 # answers before they are killed; the relay stops by itself after N + 120 s.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
-seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only=""
+seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only="" keyed=0
 while [ $# -gt 0 ]; do
   case $1 in
     --seconds) seconds=$2; shift 2 ;;
@@ -34,6 +37,7 @@ while [ $# -gt 0 ]; do
     --kills) kills=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
     --keep) keep=1; shift ;;
+    --keyed) keyed=1; shift ;;
     --check-only) check_only=$2; shift 2 ;;
     -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     *) echo "soak.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
@@ -265,7 +269,7 @@ if [ -n "$check_only" ]; then check "$check_only"; exit; fi
 if [ -z "${ROBOTALK_SOAK_IN_NETNS:-}" ]; then
   export ROBOTALK_SOAK_IN_NETNS=1
   exec "$root/scripts/netns_run.sh" "$0" --seconds "$seconds" --seed "$seed" --per-mode "$per_mode" \
-    --kills "$kills" --build "$build" $([ "$keep" = 1 ] && echo --keep)
+    --kills "$kills" --build "$build" $([ "$keep" = 1 ] && echo --keep) $([ "$keyed" = 1 ] && echo --keyed)
 fi
 
 server_bin=$build/robotalk-server/robotalk-server
@@ -293,12 +297,30 @@ t0=$(date +%s.%N)
 elapsed() { awk -v t0="$t0" -v t="$(date +%s.%N)" 'BEGIN { printf "%.1f", t - t0 }'; }
 sleep_until() { local d; d=$(awk -v t0="$t0" -v at="$1" -v t="$(date +%s.%N)" 'BEGIN { d = t0 + at - t; print (d > 0 ? d : 0) }'); sleep "$d"; }
 
+# Keyed mode: a key pair for the server and one per client process (the
+# first clients, the replacements of killed ones, the CLI), all listed with
+# every right. Open mode: no keys (ROBOTALK_KEY empty = open).
+server_keys=()
+key_of() { [ "$keyed" = 1 ] && echo "$tmp/keys/client$1"; }
+if [ "$keyed" = 1 ]; then
+  keygen=$build/tools/keygen/robotalk-keygen
+  [ -x "$keygen" ] || { echo "soak.sh: $keygen not built" >&2; exit 2; }
+  mkdir -p "$tmp/keys"
+  "$keygen" --out "$tmp/keys/server" --name soak-server >/dev/null || exit 2
+  for k in cli $(seq $((per_mode * 4 + 1 + kills))); do
+    "$keygen" --out "$tmp/keys/client$k" --name "soak-$k" >/dev/null || exit 2
+    echo "$(cat "$tmp/keys/client$k.pub") *=all" >>"$tmp/keys/clients"
+  done
+  chmod 644 "$tmp/keys/clients"
+  server_keys=(--key "$tmp/keys/server" --clients "$tmp/keys/clients")
+fi
+
 instance=0
 start_server() {
   instance=$((instance + 1))
   local log=$tmp/server$instance.log
   "$server_bin" --robot "pioneer=kinematic:$root/models/pioneer2dx_pantilt.urdf" --url "$url_b" \
-    --log-executions --panic-latch "$tmp/panic.latch" 2>"$log" &
+    --log-executions --panic-latch "$tmp/panic.latch" "${server_keys[@]}" 2>"$log" &
   server_pid=$!
   for _ in $(seq 100); do grep -q "serving robot" "$log" 2>/dev/null && return 0; sleep 0.05; done
   echo "soak.sh: the server did not start:" >&2; cat "$log" >&2; exit 2
@@ -308,7 +330,7 @@ n_clients=0
 start_client() {  # start_client MODE SECONDS
   n_clients=$((n_clients + 1))
   local out=$tmp/client$n_clients.jsonl
-  "$client_bin" --mode "$1" --url "$url_a" --robot pioneer --seconds "$2" \
+  ROBOTALK_KEY=$(key_of "$n_clients") "$client_bin" --mode "$1" --url "$url_a" --robot pioneer --seconds "$2" \
     --seed $((seed * 1000 + n_clients)) --out "$out" 2>"$tmp/client$n_clients.err" &
   client_pids[$!]=$out
   echo "$!" "$1" "$out" >>"$tmp/clients"
@@ -330,14 +352,14 @@ restart_at=$((seconds / 3 + RANDOM % (seconds / 3)))
 events=("$restart_at restart")
 for _ in $(seq "$kills"); do events+=("$((1 + RANDOM % (seconds - 2))) kill"); done
 mapfile -t events < <(printf '%s\n' "${events[@]}" | sort -n)
-echo "soak: $seconds s, seed $seed, $((per_mode * 4 + 1)) clients ($per_mode per mode + chaos), files in $tmp"
+echo "soak: $seconds s, seed $seed, $([ "$keyed" = 1 ] && echo "keyed, ")$((per_mode * 4 + 1)) clients ($per_mode per mode + chaos), files in $tmp"
 for ev in "${events[@]}"; do
   at=${ev%% *} what=${ev#* }
   sleep_until "$at"
   if [ "$what" = restart ]; then
     # Kill it in panic (if the chaos client's reset does not come first): a
     # server killed with the robot latched must start again in panic.
-    "$cli_bin" --url "$url_a" --timeout 5 panic pioneer >/dev/null 2>&1
+    ROBOTALK_KEY=$(key_of cli) "$cli_bin" --url "$url_a" --timeout 5 panic pioneer >/dev/null 2>&1
     kill -9 "$server_pid"; wait "$server_pid" 2>/dev/null
     latched=no  # what the dead server left on disk
     grep -q "^pioneer" "$tmp/panic.latch" 2>/dev/null && latched=yes
@@ -349,7 +371,7 @@ for ev in "${events[@]}"; do
       else
         echo "LATCH LOST: the robot was latched in panic at the kill; the new instance did not start in panic" | tee "$tmp/latch_lost"
       fi
-      "$cli_bin" --url "$url_a" --timeout 5 reset pioneer >/dev/null 2>&1 || echo "soak: the reset after the restart failed" >&2
+      ROBOTALK_KEY=$(key_of cli) "$cli_bin" --url "$url_a" --timeout 5 reset pioneer >/dev/null 2>&1 || echo "soak: the reset after the restart failed" >&2
     fi
   else
     victims=()
