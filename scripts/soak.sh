@@ -277,7 +277,7 @@ relay_bin=$build/tools/lcm_relay/robotalk-lcm-relay
 client_bin=$build/bench/robotalk-soak-client
 cli_bin=$build/robotalk-client/robotalk
 for b in "$server_bin" "$relay_bin" "$client_bin" "$cli_bin"; do
-  [ -x "$b" ] || { echo "soak.sh: $b not built (cmake --build $build --target robotalk-server robotalk-lcm-relay robotalk-soak-client robotalk)" >&2; exit 2; }
+  [ -x "$b" ] || { echo "soak.sh: $b not built (cmake --build $build --target robotalk-server robotalk-lcm-relay robotalk-soak-client robotalk robotalk-keygen)" >&2; exit 2; }
 done
 url_a="udpm://239.255.76.67:7100?ttl=0"   # clients
 url_b="udpm://239.255.76.67:7200?ttl=0"   # server
