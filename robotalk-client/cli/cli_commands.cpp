@@ -3,7 +3,7 @@
 #include "cli_support.h"
 #include "describe_format.h"
 #include "interrupt.h"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
 #include <algorithm>

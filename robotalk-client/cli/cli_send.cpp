@@ -3,7 +3,7 @@
 #include "cli_commands.h"
 #include "cli_support.h"
 #include "interrupt.h"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
 #include <unistd.h>

@@ -1,7 +1,7 @@
 // robotalk: command-line client of a RoboTalk server (docs/client.md).
 #include "cli_commands.h"
 #include "interrupt.h"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
 #include <algorithm>

@@ -5,7 +5,7 @@
 #include "robotalk/error.h"
 #include "robotalk/server_main.h"
 #include "robotalk/simulation.h"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 
 #include <fstream>
 #include <iostream>

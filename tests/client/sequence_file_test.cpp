@@ -1,4 +1,4 @@
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 #include "logplay.h"
 #include "robotalk/channels.h"
 #include "robotalk/protocol_codec.h"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 #include "logplay.h"
 #include "robotalk/channels.h"
 #include "robotalk_msgs/package_header_t.hpp"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
 #include <lcm/lcm-cpp.hpp>

@@ -1,7 +1,7 @@
 // robotalk-logplay: reads LCM logs of RoboTalk sessions (docs/logplay.md).
 #include "interrupt.h"
 #include "logplay.h"
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
 #include <unistd.h>

@@ -1,9 +1,9 @@
-#include "sequence_file.h"
+#include "robotalk/sequence_file.h"
 
 #include <cmath>
 #include <sstream>
 
-namespace robotalk::cli {
+namespace robotalk {
 
 std::vector<std::string> SplitWords(const std::string& line) {
   std::istringstream in(line);
@@ -110,4 +110,4 @@ std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::str
   return entries;
 }
 
-}  // namespace robotalk::cli
+}  // namespace robotalk

@@ -1,10 +1,11 @@
-// Parsing of command arguments for the `robotalk` CLI and of sequence files
-// (docs/client.md "Sequence files"): one command per line,
+// The text forms of commands: command words as the `robotalk` CLI takes them,
+// and sequence files (docs/client.md "Sequence files"), one command per line,
 //
 //   <start seconds> <command> [target] values...
 //
 // with `#` comments and blank lines. <start seconds> is relative to the send
-// time of the sequence (>= 0). Pure; no I/O beyond the text given.
+// time of the sequence (>= 0). Pure; no I/O beyond the text given. Shared by
+// the CLI, robotalk-logplay and the server's --simulate.
 #pragma once
 
 #include "robotalk/command.h"
@@ -13,9 +14,9 @@
 #include <string>
 #include <vector>
 
-namespace robotalk::cli {
+namespace robotalk {
 
-/// A malformed command line or sequence file; the message names the line.
+/// A malformed command text or sequence file; the message names the line.
 class UsageError : public Error {
  public:
   using Error::Error;
@@ -44,4 +45,14 @@ std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::str
 /// Splits on blanks (no quoting).
 std::vector<std::string> SplitWords(const std::string& line);
 
+}  // namespace robotalk
+
+namespace robotalk::cli {
+// The CLI's names for them (its usage errors are UsageErrors too).
+using robotalk::ParseCommandWords;
+using robotalk::ParseNumber;
+using robotalk::ParseSequence;
+using robotalk::SequenceEntry;
+using robotalk::SplitWords;
+using robotalk::UsageError;
 }  // namespace robotalk::cli
