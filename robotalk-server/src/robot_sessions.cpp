@@ -313,6 +313,25 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
 void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
                                   std::vector<Reply>& immediate) {
   const PlaybackDeclaration& d = r.playback;
+  const std::string label = "PLAYBACK " + std::to_string(d.id);
+  if (s.PlaybackEnded(d.id)) {
+    // Late frames of a sequence a panic ended: answered, never a new sequence
+    // that would wait forever for the frames it had before.
+    for (const Command& c : r.commands) {
+      immediate.push_back(MakeReply(c.id, Signal::kInterrupted,
+                                    label + " was ended by a panic; its later frames do not run", now));
+    }
+    return;
+  }
+  if (daemon_.in_panic()) {
+    for (const Command& c : r.commands) Admit(s, c, now, immediate, /*playback=*/true);  // PANIC each
+    if (!s.playbacks.count(d.id) || !s.playbacks.at(d.id).start) {
+      immediate.push_back(
+          MakeReply(d.id, Signal::kPanic, label + ": the robot is in panic; it does not start", now));
+    }
+    s.EndPlayback(d.id);
+    return;
+  }
   if (d.frames > static_cast<std::int64_t>(options_.max_queue) && !s.playbacks.count(d.id)) {
     for (const Command& c : r.commands) {
       immediate.push_back(MakeReply(c.id, Signal::kError,
@@ -384,10 +403,18 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::stri
   flushed_.clear();
   daemon_.Panic(flushed_);
   for (auto& [id, session] : sessions_) {
+    std::vector<std::int64_t> ended;
     for (auto& [pid, seq] : session.playbacks) {
       for (PlaybackSequence::Frame& frame : seq.frames) flushed_.push_back(std::move(frame.item));
+      if (!seq.start) {  // its delay reply was never sent: it never will be
+        Deliver(session.client_id, MakeReply(pid, Signal::kInterrupted,
+                                             "PLAYBACK " + std::to_string(pid) + ": ended by panic from " +
+                                                 who + " before it started",
+                                             now));
+      }
+      ended.push_back(pid);
     }
-    session.playbacks.clear();
+    for (std::int64_t pid : ended) session.EndPlayback(pid);
   }
   for (const QueuedItem& item : flushed_) {
     if (item.client_id == 0) continue;

@@ -10,6 +10,7 @@
 #include "robotalk/command.h"
 #include "sequence_window.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -75,6 +76,18 @@ struct Session {
   SequenceWindow seen;
   ReplyCache replies;
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< by playback id
+  /// Playback sequences a panic ended (the most recent kMaxEnded): their
+  /// late frames are answered at once instead of starting a new sequence.
+  std::deque<std::int64_t> ended_playbacks;
+  static constexpr std::size_t kMaxEnded = 64;
+  void EndPlayback(std::int64_t id) {
+    playbacks.erase(id);
+    ended_playbacks.push_back(id);
+    if (ended_playbacks.size() > kMaxEnded) ended_playbacks.pop_front();
+  }
+  bool PlaybackEnded(std::int64_t id) const {
+    return std::find(ended_playbacks.begin(), ended_playbacks.end(), id) != ended_playbacks.end();
+  }
   /// Frames buffered over all playbacks (they count against the queue limit).
   std::size_t buffered_frames() const {
     std::size_t n = 0;

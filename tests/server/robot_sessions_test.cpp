@@ -464,6 +464,41 @@ TEST_F(RobotSessionsTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTim
   }
 }
 
+// Soak finding: a playback sequence that met a panic was never answered
+// (COMMAND_STATUS said "has not ended" forever).
+TEST_F(RobotSessionsTest, APlaybackSentDuringAPanicIsAnsweredNotHeld) {
+  Handle(Package(kBob, 1, {}, /*panic=*/true));
+  auto r =
+      Handle(Playback(kAlice, 1, 500, 20, seconds(2),
+                      {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))}));
+  EXPECT_EQ(r.at(1).signal, Signal::kPanic);
+  ASSERT_TRUE(r.count(500)) << "the sequence itself is answered";
+  EXPECT_EQ(r.at(500).signal, Signal::kPanic);
+}
+
+// Soak finding: frames arriving after a panic and its reset were held
+// forever by a new sequence waiting for frames it would never see.
+TEST_F(RobotSessionsTest, FramesOfASequenceAPanicEndedAreAnsweredEvenAfterTheReset) {
+  const auto frame = [](int i) {
+    return Cmd(i, CommandType::kJointSetPoint, {0.01 * i}, "pan", StartTime::After(milliseconds(100) * i));
+  };
+  for (int i = 1; i <= 3; ++i) Handle(Playback(kAlice, i, 600, 20, seconds(2), {frame(i)}));  // buffered
+  Handle(Package(kBob, 1, {}, /*panic=*/true));
+  const auto during = Replies(kAlice);
+  ASSERT_TRUE(during.count(600));
+  EXPECT_EQ(during.at(600).signal, Signal::kInterrupted) << "the sequence that never started is answered";
+  for (int i = 1; i <= 3; ++i) EXPECT_EQ(during.at(i).signal, Signal::kInterrupted) << "buffered frame " << i;
+  Handle(Package(kBob, 2, {Cmd(90, CommandType::kPanicReset)}));
+  for (int i = 4; i <= 6; ++i) {
+    auto r = Handle(Playback(kAlice, i, 600, 20, seconds(2), {frame(i)}));
+    ASSERT_TRUE(r.count(i)) << "frame " << i << " answered at once";
+    EXPECT_EQ(r.at(i).signal, Signal::kInterrupted);
+    EXPECT_THAT(r.at(i).message, HasSubstr("ended by a panic"));
+  }
+  Run();
+  EXPECT_TRUE(fake_->calls.empty()) << "nothing of the ended sequence ran";
+}
+
 TEST_F(RobotSessionsTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
   auto r = Handle(Playback(kAlice, 1, 77, 2, seconds(1),
                            {Cmd(1, CommandType::kStop, {}, "", StartTime::After(seconds(2)))}));
