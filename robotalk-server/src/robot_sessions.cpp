@@ -96,8 +96,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   } else {
     for (const Query& q : r.queries) AdmitQuery(session, q, received, immediate, answer.publish_config);
     for (const Command& c : r.commands) {
-      if (auto item = Admit(session, c, received, immediate, /*playback=*/false))
-        daemon_.Submit(std::move(*item));
+      auto item = Admit(session, c, received, immediate, /*playback=*/false);
+      if (item && !Superseded(session, *item, received, immediate)) daemon_.Submit(std::move(*item));
     }
   }
   for (Reply& reply : immediate) {
@@ -372,7 +372,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
     item->has_start_time = true;
     if (seq.start) {  // already playing: straight to the RobotDaemon
       item->start = *seq.start + offset;
-      daemon_.Submit(std::move(*item));
+      if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
     } else {
       seq.estimator.Add(offset, now);
       seq.frames.push_back({offset, std::move(*item)});
@@ -382,7 +382,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   seq.start = seq.estimator.StartTime();
   for (PlaybackSequence::Frame& frame : seq.frames) {
     frame.item.start = *seq.start + frame.offset;
-    daemon_.Submit(std::move(frame.item));
+    if (!Superseded(s, frame.item, now, immediate)) daemon_.Submit(std::move(frame.item));
   }
   seq.frames.clear();
   const Duration delay = *seq.start - *seq.first_arrival;
@@ -432,7 +432,10 @@ void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {
 
 void RobotSessions::File(DaemonOutput& output, std::vector<ReplyBatch>& to_send) {
   for (const DaemonOutput::Executed& e : output.executed) Own(e);
-  for (DaemonOutput::Answer& a : output.replies) Deliver(a.client_id, std::move(a.reply));
+  for (DaemonOutput::Answer& a : output.replies) {
+    NoteServoAnswer(a.client_id, a.reply);
+    Deliver(a.client_id, std::move(a.reply));
+  }
   for (auto& line : output.log) log_.push_back(std::move(line));
   for (auto& [client, replies] : pending_) {
     if (replies.empty()) continue;
@@ -442,6 +445,62 @@ void RobotSessions::File(DaemonOutput& output, std::vector<ReplyBatch>& to_send)
     to_send.push_back(std::move(batch));
   }
   pending_.clear();
+}
+
+namespace {
+// The actuator a servo command drives, as a key: a joint's index, a control
+// frame's (offset), the base (-1); nullopt for tasks and whole-robot commands.
+std::optional<int> ServoActuator(const DriverCommand& c) {
+  switch (c.type) {
+    case CommandType::kJointSetPoint:
+    case CommandType::kJointSpeed:
+    case CommandType::kJointForce:
+      return c.target;
+    case CommandType::kFrameSetPoint:
+      return 1'000'000 + c.target;
+    case CommandType::kSetSpeed:
+      return -1;
+    default:
+      return std::nullopt;
+  }
+}
+}  // namespace
+
+// Issue 9 ("stale set-points ran after newer ones") and the soak: a delay or
+// playback frame lost twice reached the server after later frames had run,
+// and ran at once, moving the robot back in time. Such a command is answered
+// INTERRUPTED instead. (A window remains between a later command running and
+// its reply being filed here; the RobotDaemon's scheduler orders whatever is
+// queued at the same time.)
+bool RobotSessions::Superseded(Session& s, const QueuedItem& item, TimePoint now,
+                               std::vector<Reply>& immediate) {
+  const std::optional<int> actuator = ServoActuator(item.command);
+  if (!actuator || !item.has_start_time) return false;
+  if (const auto it = s.latest_servo_start.find(*actuator);
+      it != s.latest_servo_start.end() && item.start < it->second) {
+    immediate.push_back(
+        MakeReply(item.command.id, Signal::kInterrupted,
+                  std::string(ToString(item.command.type)) +
+                      ": superseded: a command of this client on the same actuator starting " +
+                      Seconds(it->second - item.start) + " later has already run; not executed",
+                  now));
+    return true;
+  }
+  s.timed_servos[item.command.id] = {item.start, *actuator};
+  return false;
+}
+
+void RobotSessions::NoteServoAnswer(std::int64_t client_id, const Reply& reply) {
+  const auto session = sessions_.find(client_id);
+  if (session == sessions_.end()) return;
+  Session& s = session->second;
+  const auto it = s.timed_servos.find(reply.id);
+  if (it == s.timed_servos.end()) return;
+  if (reply.signal == Signal::kSuccess || reply.signal == Signal::kModified) {
+    TimePoint& latest = s.latest_servo_start.try_emplace(it->second.second, it->second.first).first->second;
+    latest = std::max(latest, it->second.first);
+  }
+  s.timed_servos.erase(it);
 }
 
 void RobotSessions::Own(const DaemonOutput::Executed& e) {

@@ -97,6 +97,10 @@ class RobotSessions {
   std::size_t Waiting(const Session& s) const;
   void Own(const DaemonOutput::Executed& e);
   void Bound(Reply& reply) const;
+  // True (and answered) when a timed servo command arrives after a
+  // later-starting one of the same client on the same actuator has run.
+  bool Superseded(Session& s, const QueuedItem& item, TimePoint now, std::vector<Reply>& immediate);
+  void NoteServoAnswer(std::int64_t client_id, const Reply& reply);
 
   RobotDaemon& daemon_;
   const std::string robot_;

@@ -76,6 +76,10 @@ struct Session {
   SequenceWindow seen;
   ReplyCache replies;
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< by playback id
+  /// Timed servo commands queued and not yet answered: id -> (start, actuator).
+  std::unordered_map<CommandId, std::pair<TimePoint, int>> timed_servos;
+  /// Per actuator, the latest start time of this client's servo commands that ran.
+  std::map<int, TimePoint> latest_servo_start;
   /// Playback sequences a panic ended (the most recent kMaxEnded): their
   /// late frames are answered at once instead of starting a new sequence.
   std::deque<std::int64_t> ended_playbacks;

@@ -499,6 +499,33 @@ TEST_F(RobotSessionsTest, FramesOfASequenceAPanicEndedAreAnsweredEvenAfterTheRes
   EXPECT_TRUE(fake_->calls.empty()) << "nothing of the ended sequence ran";
 }
 
+// Issue 9 / soak finding 1: a delay-mode set-point lost twice reached the
+// server after later ones had run, and ran at once (the head ended at an old
+// target).
+TEST_F(RobotSessionsTest, ASetPointArrivingAfterALaterOneRanIsAnsweredNotRun) {
+  const TimePoint t0 = clock_.Now();
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.2}, "pan", t0 + milliseconds(100))}));
+  clock_.Set(t0 + milliseconds(150));
+  Run();
+  ASSERT_EQ(Replies(kAlice).at(1).signal, Signal::kSuccess);
+  auto late =
+      Handle(Package(kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.1}, "pan", t0 + milliseconds(50))}));
+  ASSERT_TRUE(late.count(2));
+  EXPECT_EQ(late.at(2).signal, Signal::kInterrupted);
+  EXPECT_THAT(late.at(2).message, HasSubstr("superseded"));
+  // Another client's command, or the same client's on another actuator, is not superseded.
+  Handle(Package(kBob, 1, {Cmd(3, CommandType::kJointSetPoint, {0.3}, "pan", t0 + milliseconds(60))}));
+  Handle(Package(kAlice, 3, {Cmd(4, CommandType::kSetSpeed, {0.1, 0.0}, "", t0 + milliseconds(70))}));
+  Run();
+  EXPECT_EQ(Replies(kBob).at(3).signal, Signal::kSuccess);
+  EXPECT_EQ(Replies(kAlice).at(4).signal, Signal::kSuccess);
+  ASSERT_EQ(fake_->calls.size(), 3u);
+  for (const auto& call : fake_->calls) {
+    EXPECT_FALSE(call.type == CommandType::kJointSetPoint && call.values == std::vector<double>{0.1})
+        << "the stale pan 0.1 ran";
+  }
+}
+
 TEST_F(RobotSessionsTest, PlaybackRefusesFramesBeyondWhatWasDeclared) {
   auto r = Handle(Playback(kAlice, 1, 77, 2, seconds(1),
                            {Cmd(1, CommandType::kStop, {}, "", StartTime::After(seconds(2)))}));
