@@ -80,12 +80,14 @@ class Bench:
                 p.kill()
                 p.wait()
 
-    def start_server(self, url=URL, extra=()):
+    def start_server(self, url=URL, extra=(), env=None):
+        """env: extra environment, e.g. ROBOTALK_PRECISE_TIMING=0 (the RobotDaemon's timing option off)."""
         self.stop_server()
         log = open(f"{self.tmp}/server.log", "w+")
         self.server = subprocess.Popen(
             [self.server_bin, "--robot", f"{ROBOT}=kinematic:{self.model}", "--url", url,
-             "--duration", "3600", *extra], stdout=subprocess.DEVNULL, stderr=log, text=True)
+             "--duration", "3600", *extra], stdout=subprocess.DEVNULL, stderr=log, text=True,
+            env={**os.environ, **(env or {})})
         for _ in range(100):
             log.seek(0)
             if "serving robot" in log.read():
@@ -140,15 +142,24 @@ class Bench:
         return {"figure": "query", "count": n, "runs": runs}
 
     def timed_once(self, n):
-        return {
-            "robotalk": self.run([self.client, "timed", "--url", URL, "--count", str(n)]),
-            "bare_default": self.run([self.timer, "sleeploop", "--count", str(n)]),
-            "bare_1ns": self.run([self.timer, "sleeploop", "--count", str(n), "--slack-ns", "1"]),
-        }
+        # The server with its timing option (RobotDaemonOptions::precise_timing,
+        # the default) and without it, each with its CPU over the run.
+        r = {}
+        for key, env in (("robotalk", None), ("robotalk_plain", {"ROBOTALK_PRECISE_TIMING": "0"})):
+            srv = self.start_server(env=env)
+            c0, t0 = self.cpu_ticks(srv.pid), time.monotonic()
+            r[key] = self.run([self.client, "timed", "--url", URL, "--count", str(n)])
+            r[key]["server_cpu_pct"] = (100.0 * (self.cpu_ticks(srv.pid) - c0) / os.sysconf("SC_CLK_TCK")
+                                        / (time.monotonic() - t0))
+            log = open(f"{self.tmp}/server.log").read()
+            r[key]["server_timing"] = next((l.split("timing: ", 1)[1] for l in log.splitlines()
+                                            if "RobotDaemon timing: " in l), "")
+        r["bare_default"] = self.run([self.timer, "sleeploop", "--count", str(n)])
+        r["bare_1ns"] = self.run([self.timer, "sleeploop", "--count", str(n), "--slack-ns", "1"])
+        return r
 
     def timed(self):
         n = 1000 if self.quick else 2000
-        self.start_server()
         idle, loaded = [], []
         for _ in range(self.runs):
             idle.append(self.timed_once(n))
@@ -340,12 +351,14 @@ def main():
     try:
         for name in only:
             t0 = time.monotonic()
+            loadavg_start = os.getloadavg()
             print(f"bench: {name} ...", file=sys.stderr, flush=True)
             try:
                 result = getattr(b, name)()
             except Exception as e:  # one broken figure must not lose the others
                 result = {"figure": name, "error": repr(e)}
             result["wall_s"] = round(time.monotonic() - t0, 1)
+            result["loadavg_start"] = loadavg_start
             result["loadavg"] = os.getloadavg()
             result["meta"] = meta
             with open(os.path.join(args.out, f"{name}.json"), "w") as f:

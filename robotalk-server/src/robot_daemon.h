@@ -64,9 +64,11 @@ struct RobotDaemonOptions {
   /// may (else it stays SCHED_OTHER, silently; the outbox log says once which
   /// was applied). The environment variable ROBOTALK_PRECISE_TIMING=0 turns
   /// it off (the benchmark compares both). Cost: up to `final_spin` of CPU
-  /// per start time or sample (docs/performance.md).
+  /// per start time or sample, at most `spin_share` of a core over time
+  /// (past that budget, deadlines are dense and waited for without a spin).
   bool precise_timing = true;
   Duration final_spin = std::chrono::microseconds(50);
+  double spin_share = 0.05;
   int fifo_priority = 10;
 };
 
@@ -263,8 +265,10 @@ class RobotDaemon {
   StateSnapshot direct_state_;
   std::unique_ptr<Kinematics> direct_kinematics_;
   std::vector<Eigen::Isometry3d> direct_roots_;
-  bool precise_ = false;  // RobotDaemon thread: precise_timing applied
-  bool spin_ = false;     // RobotDaemon thread: the next deadline is a start time or sample
+  bool precise_ = false;     // RobotDaemon thread: precise_timing applied
+  bool spin_ = false;        // RobotDaemon thread: the next deadline is a start time or sample
+  Duration spin_budget_{0};  // RobotDaemon thread: spin time it may still use
+  std::chrono::steady_clock::time_point budget_time_{};
 
   mutable std::mutex call_mutex_;
   CurrentCall call_;  // GUARDED_BY(call_mutex_)

@@ -7,10 +7,13 @@
 #include "state_encoding.h"
 
 #include <poll.h>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 
 namespace robotalk {
@@ -141,8 +144,19 @@ void ServerDaemon::OnAnnounce(std::span<const std::uint8_t> bytes) {
 void ServerDaemon::Start() {
   if (running_.exchange(true)) return;
   thread_ = std::thread([this] {
+    ApplyPriority();
     while (running_) RunOnce(std::chrono::milliseconds(50));
   });
+}
+
+void ServerDaemon::ApplyPriority() {
+  const char* env = std::getenv("ROBOTALK_PRECISE_TIMING");
+  if (options_.fifo_priority <= 0 || (env != nullptr && std::string(env) == "0")) return;
+  sched_param param{};
+  param.sched_priority = options_.fifo_priority;
+  const bool fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  Log(fifo ? "ServerDaemon thread: SCHED_FIFO priority " + std::to_string(param.sched_priority)
+           : std::string("ServerDaemon thread: SCHED_OTHER (SCHED_FIFO not permitted)"));
 }
 
 void ServerDaemon::Stop() {

@@ -63,6 +63,13 @@ struct ServerDaemonOptions {
   SessionGateOptions gate;
   /// Announced so that clients on another layout say so (docs/protocol.md).
   TrafficLayout traffic_layout = TrafficLayout::kSingle;
+  /// The thread Start() launches runs SCHED_FIFO at this priority when the
+  /// process may (0 = never), below the RobotDaemons' (RobotDaemonOptions):
+  /// on a machine busy with other processes (64 clients on 2 cores) the
+  /// server keeps the CPU it needs instead of 1/65 of it. It only runs when a
+  /// package or output is there (it sleeps in poll()). Off with
+  /// ROBOTALK_PRECISE_TIMING=0, like the RobotDaemons' timing option.
+  int fifo_priority = 5;
 };
 
 class ServerDaemon {
@@ -119,6 +126,7 @@ class ServerDaemon {
   // `ack`'s client join it, the rest are sent.
   void AnswerDirect(Robot& robot, ReplyBatch& ack);
   void WriteLog();
+  void ApplyPriority();
   void Announce(TimePoint now);
   void Watchdogs(TimePoint now);
   void Log(const std::string& line);
