@@ -217,7 +217,7 @@ class Bench:
         # split, or everything on one URL with --traffic single.
         url = URL + (f"&traffic={self.args.traffic}" if self.args.traffic else "")
         levels = []
-        for n in (8, 16, 32, 64):
+        for n in self.args.scale_clients:
             srv = self.start_server(url=url)
             allowance = 2.0 + 0.1 * n
             start_at = time.monotonic_ns() + int(allowance * 1e9)
@@ -232,7 +232,8 @@ class Bench:
             clients = [self.collect(p, seconds + allowance + 20, "stream") for p in procs]
             levels.append({"clients": n, "seconds": seconds, "server_cpu_pct": server_pct, "machine": machine,
                            "per_client": clients})
-        return {"figure": "scale", "traffic": self.args.traffic or "split", "levels": levels}
+        return {"figure": "scale", "traffic": self.args.traffic or "split", "levels": levels,
+                "precise_timing": os.environ.get("ROBOTALK_PRECISE_TIMING", "") != "0"}
 
     def cli(self):
         k = 5 if self.quick else 10
@@ -339,6 +340,8 @@ def main():
     ap.add_argument("--traffic", choices=["split", "single"], default=None,
                     help="scale: the traffic layout (default: RoboTalk's, split)")
     ap.add_argument("--scale-seconds", type=float, default=None, help="scale: seconds per level (default 30)")
+    ap.add_argument("--scale-clients", type=lambda s: [int(x) for x in s.split(",")], default=[8, 16, 32, 64],
+                    help="scale: the numbers of clients, comma-separated (default 8,16,32,64)")
     args = ap.parse_args()
     only = [f for f in args.only.split(",") if f] or [f for f in FIGURES if not (args.quick and f == "ode")]
     os.makedirs(args.out, exist_ok=True)
