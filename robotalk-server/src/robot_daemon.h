@@ -215,6 +215,7 @@ class RobotDaemon {
   void AnswerQuery(const QueuedItem& item, Reply& reply);
   void Hold(const QueuedItem& item, TimePoint now);
   void Sample(TimePoint now, Duration period);
+  void FillSample(TimePoint now, Duration period);  // from state_, just read
   enum class CallOutcome { kOk, kThrew, kOverran };
   // Runs one driver call with the fault guard (a throw latches a fault;
   // an overrun was latched by CheckOverrun and its command answered there).
