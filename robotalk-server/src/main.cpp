@@ -3,9 +3,9 @@
 #include "kinematic_driver.h"
 #include "ode_driver.h"
 #include "robotalk/error.h"
+#include "robotalk/sequence_file.h"
 #include "robotalk/server_main.h"
 #include "robotalk/simulation.h"
-#include "robotalk/sequence_file.h"
 
 #include <fstream>
 #include <iostream>

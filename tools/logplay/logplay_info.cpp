@@ -1,8 +1,8 @@
 // robotalk-logplay: reading logs, frames and sequence files, info, CSV export.
 #include "logplay.h"
 #include "robotalk/channels.h"
-#include "robotalk_msgs/package_header_t.hpp"
 #include "robotalk/sequence_file.h"
+#include "robotalk_msgs/package_header_t.hpp"
 #include "sequence_runner.h"
 
 #include <lcm/lcm-cpp.hpp>
