@@ -4,7 +4,8 @@
 // so a client killed with SIGKILL leaves everything it knew):
 //
 //   {"ev":"hello","client":"<16 hex>","mode":"delay","seed":3}
-//   {"ev":"sent","id":12,"type":"JOINT_SETPOINT","start_us":123}   start_us: server clock; -1 unknown
+//   {"ev":"sent","id":12,"type":"JOINT_SETPOINT","target":"pan","start_us":123}   start_us: server clock; -1
+//   unknown
 //   {"ev":"final","id":12,"outcome":"SUCCESS","msg":"..."}         a signal, UNKNOWN_OUTCOME,
 //                                                                   TIMEOUT or CLIENT_ERROR
 //   {"ev":"seq","after":11,"frames":8}    a playback sequence whose frames got ids above 11
@@ -89,10 +90,10 @@ struct Soak {
     return Command{.type = CommandType::kGoto, .values = {Uniform(-0.3, 0.3), Uniform(-0.3, 0.3), 0.0}};
   }
 
-  void Sent(CommandId id, CommandType type, std::int64_t start_us) {
+  void Sent(CommandId id, const Command& c, std::int64_t start_us) {
     max_id = std::max(max_id, id);
-    report.Line(Kv("ev", "\"sent\"") + "," + Kv("id", Num(id)) + "," + Kv("type", Quote(ToString(type))) +
-                "," + Kv("start_us", Num(start_us)));
+    report.Line(Kv("ev", "\"sent\"") + "," + Kv("id", Num(id)) + "," + Kv("type", Quote(ToString(c.type))) +
+                "," + Kv("target", Quote(c.target)) + "," + Kv("start_us", Num(start_us)));
   }
   // exec_us: server clock when it ran (-1: no reply); late_us: how late after its start.
   void Final(CommandId id, const std::string& outcome, const std::string& msg, const Reply* r = nullptr) {
@@ -137,7 +138,7 @@ void RunDirect(Soak& s) {
     try {
       const std::int64_t at = ToWireMicros(s.client.ServerNow());
       PendingReply p = s.client.Send(c);
-      s.Sent(p.id(), c.type, at);
+      s.Sent(p.id(), c, at);
       s.Collect(p, s.WaitFor(Duration(0)));
     } catch (const Error& e) {
       s.NotSent(ToString(c.type), e.what());
@@ -175,13 +176,13 @@ void RunDelay(Soak& s) {
                   (t0 + static_cast<int>(i) * kStep).time_since_epoch())));
           pending.push_back(s.client.Send(batch[i]));
           index.push_back(i);
-          s.Sent(pending.back().id(), batch[i].type, ToWireMicros(*batch[i].start_time.time()));
+          s.Sent(pending.back().id(), batch[i], ToWireMicros(*batch[i].start_time.time()));
         }
       } else {
         pending = s.client.SendBatch(batch);
         for (std::size_t i = 0; i < batch.size(); ++i) {
           index.push_back(i);
-          s.Sent(pending[i].id(), batch[i].type, ToWireMicros(*batch[i].start_time.time()));
+          s.Sent(pending[i].id(), batch[i], ToWireMicros(*batch[i].start_time.time()));
         }
       }
     } catch (const Error& e) {
@@ -245,7 +246,7 @@ void RunPlayback(Soak& s) {
         const Reply& reply = r.replies[static_cast<std::size_t>(i)];
         const std::int64_t start =
             r.server_start ? ToWireMicros(*r.server_start + copy[static_cast<std::size_t>(i)].offset) : -1;
-        s.Sent(reply.id, copy[static_cast<std::size_t>(i)].command.type, start);
+        s.Sent(reply.id, copy[static_cast<std::size_t>(i)].command, start);
         s.Final(reply.id, std::string(ToString(reply.signal)), reply.message, &reply);
       }
       s.AfterPanic();

@@ -203,12 +203,22 @@ for c, info in clients.items():
         if pst is not None and pst["outcome"] == "BUSY":
             count["playback_unanswered"] += 1
 
-    # Start-time order per client, over the commands whose start is known.
-    last = None
+    # Start-time order per client and actuator, over the servo commands whose
+    # start is known (docs/protocol.md: a servo command that arrives after a
+    # later one of the same client on the same actuator ran is superseded;
+    # commands on other actuators, and tasks such as GOTO, may run late).
+    last_by = {}
     for cid in order.get(c, []):
         s = info["sent"].get(cid)
         if s is None or s["start_us"] < 0:
             continue
+        if s["type"] in ("JOINT_SETPOINT", "JOINT_SPEED", "JOINT_FORCE", "FRAME_SETPOINT"):
+            actuator = s["type"][:5] + ":" + s.get("target", "")
+        elif s["type"] == "SETSPEED":
+            actuator = "base"
+        else:
+            continue
+        last = last_by.get(actuator)
         if last is not None and s["start_us"] < last[1]:
             count["out_of_order"] += 1
             f = info["final"].get(cid, {})
@@ -219,7 +229,7 @@ for c, info in clients.items():
             violations.append("OUT OF ORDER: client %s (%s) command %d (start %d us) ran after command %d (start %.0f ms later); %s" %
                               (c, info["mode"], cid, s["start_us"], last[0], (last[1] - s["start_us"]) / 1e3, why))
         if last is None or s["start_us"] >= last[1]:
-            last = (cid, s["start_us"])
+            last_by[actuator] = (cid, s["start_us"])
 
 for c in set(k[0] for k in executed) - set(clients):
     n = sum(1 for k in executed if k[0] == c)
