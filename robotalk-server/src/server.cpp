@@ -100,12 +100,14 @@ class Server::Impl {
                             .gate = GateOptions(options_),
                             .traffic_layout = dynamic_cast<RoutedLcmTransport*>(transport) != nullptr
                                                   ? TrafficLayout::kSplit
-                                                  : TrafficLayout::kSingle});
+                                                  : TrafficLayout::kSingle,
+                            .fifo_priority = options_.precise_timing ? 5 : 0});
     const SessionOptions sessions{
         options_.session_timeout, options_.max_queue, options_.max_future,
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
-                                            .driver_call_bound = options_.driver_call_bound};
+                                            .driver_call_bound = options_.driver_call_bound,
+                                            .precise_timing = options_.precise_timing};
     for (const RobotSpec& spec : specs) {
       for (const auto& robot : robots_) {
         if (robot->robot_name() == spec.name)

@@ -41,6 +41,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --clients FILE                  keyed mode: the access list of client keys and their rights per
                                   robot (docs/security.md); without both the server runs open
   --max-sessions N                most client sessions in the whole server (default 1024)
+  --no-precise-timing             default timer slack, no final spin before deadlines, no SCHED_FIFO
+                                  (saves CPU; the same as ROBOTALK_PRECISE_TIMING=0)
   --allow-duplicate-robots        serve a robot even when another server announces the same name
                                   (by default the server that started later refuses it)
   --simulate SEQ.txt              instead of serving: run the sequence file (docs/client.md
@@ -99,6 +101,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.key_file = value();
       } else if (arg == "--clients") {
         options.clients_file = value();
+      } else if (arg == "--no-precise-timing") {
+        options.precise_timing = false;
       } else if (arg == "--max-sessions") {
         options.max_sessions = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--panic-latch") {

@@ -57,6 +57,10 @@ struct ServerOptions {
   std::string clients_file;
   /// Most sessions (open and not yet used) in the whole server.
   std::size_t max_sessions = 1024;
+  /// 1 ns timer slack, a short final spin before each deadline and SCHED_FIFO
+  /// for the server's threads where permitted (docs/server.md; costs CPU).
+  /// ROBOTALK_PRECISE_TIMING=0 in the environment turns it off too.
+  bool precise_timing = true;
   /// Period of the ROBOTALK/ANNOUNCE message.
   Duration announce_period = std::chrono::seconds(1);
   /// The paper's congestion injector (§VI-B): after each received package the
