@@ -9,18 +9,7 @@
 set -u
 server_bin=$1 cli=$2 models=$3
 url="udpm://239.255.76.67:7814?ttl=0"
-tmp=$(mktemp -d)
-server_pid=""
-cleanup() {
-  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
 rt() { "$cli" --url "$url" "$@"; }
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 100 \
   2>"$tmp/server.log" &

@@ -21,18 +21,7 @@ case $layout in
   lossy) server_flags=(--inject-reply-drop 0.3 --inject-reply-dup 0.3 --seed 5 --log-executions) ;;
   *) echo "unknown layout $layout"; exit 2 ;;
 esac
-tmp=$(mktemp -d)
-server_pid=""
-cleanup() {
-  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
 # value KEY FILE: the number after "KEY=" on the first line that has it.
 value() { grep -o -m1 "$1=[-0-9.]*" "$2" | head -1 | cut -d= -f2; }
 within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v != "" && v >= lo && v <= hi) }'; }

@@ -7,18 +7,7 @@ set -u
 server_bin=$1 keygen=$2 models=$3 port=$4
 shift 4
 url="udpm://239.255.76.67:$port?ttl=0"
-tmp=$(mktemp -d)
-server_pid=""
-cleanup() {
-  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
 "$keygen" --out "$tmp/server" >/dev/null && "$keygen" --out "$tmp/alice" >/dev/null || exit 1
 echo "$(cut -d' ' -f1 "$tmp/alice.pub") alice *=all" >"$tmp/clients"
 chmod 600 "$tmp/clients"

@@ -1,0 +1,17 @@
+# Shared by the shell tests (source it: . "$(dirname "$0")/../lib.sh"):
+#   $tmp          a temporary folder, removed at exit
+#   $server_pid   set it to a server's pid: it is stopped at exit
+#   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
+#   $pass, $failures        the counts
+tmp=$(mktemp -d)
+server_pid=""
+cleanup() {
+  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+pass=0 failures=0
+check() {  # check NAME COMMAND...
+  local name=$1; shift
+  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
+}
