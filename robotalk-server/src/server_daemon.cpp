@@ -373,7 +373,7 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
 }
 
 void ServerDaemon::Watchdogs(TimePoint now) {
-  gate_->ExpirePending(now);
+  gate_->Expire(now);
   for (auto& [name, robot] : robots_) {
     if (robot.daemon->CheckOverrun(now)) Drain(robot);
     for (const ExpiredSession& e : robot.sessions->Expire(now)) {

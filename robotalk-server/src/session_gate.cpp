@@ -64,12 +64,12 @@ HelloAnswer SessionGate::Answer(const std::string& robot, const Hello& hello, Ti
                                     "ROBOTALK_KEY; docs/security.md)"
                                   : "this server runs in open mode and takes no keys");
   }
-  if (sessions_.size() >= options_.max_sessions) ExpirePending(now);
+  if (sessions_.size() >= options_.max_sessions) Expire(now);
   if (sessions_.size() >= options_.max_sessions) {
     return Refuse(answer, "the server has " + std::to_string(options_.max_sessions) +
                               " sessions open already (the bound); try again later");
   }
-  Session session{robot, hello.body.client_id, false, now, Client(hello.body.client_id)};
+  Session session{robot, hello.body.client_id, false, now, now, Client(hello.body.client_id)};
   if (keyed()) {
     try {
       answer.body = auth_->Handshake(hello.body, now);
@@ -146,7 +146,7 @@ SessionGate::Admission SessionGate::Admit(const std::string& robot, const Reques
     }
     live_[key] = r.session_id;
   }
-  (void)now;
+  s.last_used = now;
   if (out.verdict != Verdict::kNoRights) out.verdict = Verdict::kAccepted;
   return out;
 }
@@ -184,10 +184,13 @@ void SessionGate::Close(const std::string& robot, std::int64_t client_id) {
   for (std::int64_t id : ids) Erase(id);
 }
 
-std::size_t SessionGate::ExpirePending(TimePoint now) {
+std::size_t SessionGate::Expire(TimePoint now) {
   std::vector<std::int64_t> ids;
   for (const auto& [id, s] : sessions_) {
-    if (!s.live && now - s.opened >= options_.pending_timeout) ids.push_back(id);
+    if ((!s.live && now - s.opened >= options_.pending_timeout) ||
+        (s.live && now - s.last_used >= options_.idle_timeout)) {
+      ids.push_back(id);
+    }
   }
   for (std::int64_t id : ids) Erase(id);
   if (auth_) auth_->ExpirePending(now, options_.pending_timeout);

@@ -35,6 +35,10 @@ struct SessionGateOptions {
   std::size_t max_sessions = 1024;
   /// A session opened by a hello but never used is closed after this long.
   Duration pending_timeout = std::chrono::seconds(10);
+  /// A used session that has sent nothing accepted for this long is closed
+  /// (sessions normally end sooner, with their RobotSessions state; this
+  /// catches those that never had one, e.g. every package refused for rights).
+  Duration idle_timeout = std::chrono::seconds(60);
 };
 
 /// Refusal counts, for the SERVER_COUNTERS query and the log.
@@ -91,8 +95,9 @@ class SessionGate {
   /// Ends `client_id`'s sessions on `robot` (its RobotSessions state expired):
   /// later packages of them are SESSION_UNKNOWN.
   void Close(const std::string& robot, std::int64_t client_id);
-  /// Closes sessions opened by a hello and never used. Returns how many.
-  std::size_t ExpirePending(TimePoint now);
+  /// Closes sessions opened by a hello and never used, and used ones idle
+  /// for `idle_timeout`. Returns how many.
+  std::size_t Expire(TimePoint now);
 
   /// "'alice' (rt:..., client ...)" in keyed mode, "client ..." in open mode.
   std::string Who(std::int64_t session_id, std::int64_t client_id) const;
@@ -105,6 +110,7 @@ class SessionGate {
     std::int64_t client_id = 0;
     bool live = false;  ///< used by at least one accepted package
     TimePoint opened{};
+    TimePoint last_used{};  ///< the last accepted (or rights-refused) package
     std::string who;
   };
   HelloAnswer Refuse(HelloAnswer answer, const std::string& why);

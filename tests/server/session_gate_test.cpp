@@ -301,5 +301,17 @@ TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
   EXPECT_EQ(server_->gate().counters().rights_refused, 2u);
 }
 
+TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdle) {
+  auto monitor = Handshake(Key(3), kMallory);
+  ASSERT_TRUE(monitor);
+  Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, 1, {0.5})));
+  EXPECT_EQ(replies_.at(1).signal, Signal::kError);
+  clock_.Advance(std::chrono::seconds(61));
+  Step();  // the watchdog
+  Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, 2, {0.5})));
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown) << "closed, not kept for ever";
+  EXPECT_EQ(server_->gate().session_count(), 0u);
+}
+
 }  // namespace
 }  // namespace robotalk
