@@ -1,11 +1,13 @@
 # Shared by the shell tests (source it: . "$(dirname "$0")/../lib.sh"):
 #   $tmp          a temporary folder, removed at exit
 #   $server_pid   set it to a server's pid: it is stopped at exit
+#   $client_pid   set it to a client's pid: it is stopped at exit (resumed first if stopped)
 #   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
 #   $pass, $failures        the counts
 tmp=$(mktemp -d)
-server_pid=""
+server_pid="" client_pid=""
 cleanup() {
+  [ -n "$client_pid" ] && kill -CONT "$client_pid" 2>/dev/null && kill "$client_pid" 2>/dev/null
   [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
   rm -rf "$tmp"
 }

@@ -207,7 +207,7 @@ RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const
       std::optional<Reply> r;
       try {
         r = pending[next_reply]->Poll();
-      } catch (const TimeoutError& e) {  // UnknownOutcomeError: name each frame, go on
+      } catch (const UnknownOutcomeError& e) {  // name each frame, go on
         report.unknown_outcomes.emplace_back(next_reply, e.what());
         ++next_reply;
         continue;

@@ -142,14 +142,7 @@ bool RobotClient::Impl::AcceptReplyPackage(const robotalk_msgs::reply_package_t&
       acked_.insert(pkg.ack_sequence);
     }
     if (session_id_ == 0 || pkg.session_id != session_id_) return false;
-    const std::string old = Hex64(static_cast<std::uint64_t>(server_id_));
-    lost = LoseSession(now);
-    if (!lost.empty()) {
-      std::fprintf(stderr,
-                   "robotalk: robot '%s': server %s no longer knows this client's session (restarted, or "
-                   "the session expired); %zu outstanding items may or may not have run\n",
-                   robot_.c_str(), old.c_str(), lost.size());
-    }
+    lost = LoseSession(now);  // each lost item's failure says why
     return false;
   }
   if (session_id_ == 0 || pkg.session_id != session_id_) return false;  // an old session's
@@ -179,7 +172,9 @@ void RobotClient::Impl::Resync() {
     std::lock_guard lock(mu_);
     resync_config_query_ = sent.ids.front();
   } catch (const Error& e) {
-    std::fprintf(stderr, "robotalk: re-syncing with the new server instance failed: %s\n", e.what());
+    // On the ReadDaemon: stored by Run() and thrown from the next call.
+    throw ClientError(std::string("RobotClient: re-syncing with the new server instance failed: ") +
+                      e.what());
   }
 }
 

@@ -197,9 +197,4 @@ std::size_t SessionGate::Expire(TimePoint now) {
   return ids.size();
 }
 
-std::string SessionGate::Who(std::int64_t session_id, std::int64_t client_id) const {
-  const auto it = sessions_.find(session_id);
-  return it == sessions_.end() ? Client(client_id) : it->second.who;
-}
-
 }  // namespace robotalk

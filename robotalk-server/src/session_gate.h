@@ -99,8 +99,6 @@ class SessionGate {
   /// for `idle_timeout`. Returns how many.
   std::size_t Expire(TimePoint now);
 
-  /// "'alice' (rt:..., client ...)" in keyed mode, "client ..." in open mode.
-  std::string Who(std::int64_t session_id, std::int64_t client_id) const;
   const GateCounters& counters() const { return counters_; }
   std::size_t session_count() const { return sessions_.size(); }
 

@@ -8,19 +8,7 @@ set -u
 server_bin=$1 models=$2 port=$3
 shift 3
 url="udpm://239.255.76.67:$port?ttl=0"
-tmp=$(mktemp -d)
-server_pid="" client_pid=""
-cleanup() {
-  [ -n "$client_pid" ] && kill "$client_pid" 2>/dev/null
-  [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, $client_pid, check
 start_server() {  # start_server LOG
   "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 2>"$1" &
   server_pid=$!
