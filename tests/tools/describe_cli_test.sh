@@ -5,15 +5,7 @@
 set -u
 describe=$1
 models=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-pass=0
-
-check() {  # check NAME CONDITION-COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"  # $tmp, check
 
 # A good file: a table naming the robot, its head joint and its total mass.
 "$describe" "$models/pioneer2dx_pantilt.urdf" >"$tmp/out" 2>"$tmp/err"

@@ -4,15 +4,7 @@
 #   keygen_cli_test.sh PATH/TO/robotalk-keygen
 set -u
 keygen=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-pass=0
-
-check() {  # check NAME CONDITION-COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"  # $tmp, check
 
 # A pair, whatever the umask.
 (umask 000; "$keygen" --out "$tmp/alice" >"$tmp/out" 2>"$tmp/err")
