@@ -62,8 +62,8 @@ struct RobotDaemonOptions {
   /// (prctl PR_SET_TIMERSLACK), a busy wait of `final_spin` before a start
   /// time or state sample, and SCHED_FIFO at `fifo_priority` when the process
   /// may (else it stays SCHED_OTHER, silently; the outbox log says once which
-  /// was applied). The environment variable ROBOTALK_PRECISE_TIMING=0 turns
-  /// it off (the benchmark compares both). Cost: up to `final_spin` of CPU
+  /// was applied). robotalk::Server turns it off for --no-precise-timing or
+  /// ROBOTALK_PRECISE_TIMING=0 (the benchmark compares both). Cost: up to `final_spin` of CPU
   /// per start time or sample, at most `spin_share` of a core over time
   /// (past that budget, deadlines are dense and waited for without a spin).
   bool precise_timing = true;

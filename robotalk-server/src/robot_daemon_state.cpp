@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
 namespace robotalk {
@@ -72,8 +71,7 @@ void RobotDaemon::WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next) 
 
 void RobotDaemon::ApplyTiming() {
   std::string what = "default timer slack, no final spin, SCHED_OTHER (precise_timing off)";
-  const char* env = std::getenv("ROBOTALK_PRECISE_TIMING");
-  if (options_.precise_timing && !(env != nullptr && std::string(env) == "0")) {
+  if (options_.precise_timing) {
     precise_ = true;
     const bool slack = prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0;
     sched_param param{};

@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <regex>
 
 namespace robotalk {
@@ -84,6 +85,9 @@ class Server::Impl {
        const DriverRegistry& registry, const Clock& clock)
       : options_(std::move(options)), clock_(clock) {
     if (specs.empty()) throw Error("Server: no robot to serve");
+    if (const char* env = std::getenv("ROBOTALK_PRECISE_TIMING"); env != nullptr && std::string(env) == "0") {
+      options_.precise_timing = false;  // the one place the environment is read
+    }
     if (!transport) {
       owned_transport_ = OpenLcmTransport(options_.lcm_url);
       transport = owned_transport_.get();

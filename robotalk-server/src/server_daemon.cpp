@@ -13,7 +13,6 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <random>
 
 namespace robotalk {
@@ -150,8 +149,7 @@ void ServerDaemon::Start() {
 }
 
 void ServerDaemon::ApplyPriority() {
-  const char* env = std::getenv("ROBOTALK_PRECISE_TIMING");
-  if (options_.fifo_priority <= 0 || (env != nullptr && std::string(env) == "0")) return;
+  if (options_.fifo_priority <= 0) return;
   sched_param param{};
   param.sched_priority = options_.fifo_priority;
   const bool fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
@@ -348,8 +346,7 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
     part.server_send = clock_.Now();
     std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
     if (part.session_status == SessionStatus::kOk && !gate_->Seal(part.session_id, bytes)) {
-      ++unsealable_;  // its session closed: the client said hello again and failed these
-      return;
+      return;  // its session closed: the client said hello again and failed these
     }
     for (int copies = faults_.Copies(); copies > 0; --copies) transport_.Publish(channel, bytes);
   };

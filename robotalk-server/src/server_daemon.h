@@ -67,8 +67,8 @@ struct ServerDaemonOptions {
   /// process may (0 = never), below the RobotDaemons' (RobotDaemonOptions):
   /// on a machine busy with other processes (64 clients on 2 cores) the
   /// server keeps the CPU it needs instead of 1/65 of it. It only runs when a
-  /// package or output is there (it sleeps in poll()). Off with
-  /// ROBOTALK_PRECISE_TIMING=0, like the RobotDaemons' timing option.
+  /// package or output is there (it sleeps in poll()). 0 = off
+  /// (robotalk::Server: with the RobotDaemons' timing option).
   int fifo_priority = 5;
 };
 
@@ -149,7 +149,6 @@ class ServerDaemon {
   int event_fd_ = -1;
   std::int64_t server_id_ = 0;
   std::uint64_t malformed_ = 0;
-  std::uint64_t unsealable_ = 0;  // replies of sessions closed before they were sent
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   // Rate limit of the log.
