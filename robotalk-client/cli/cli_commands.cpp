@@ -86,7 +86,7 @@ int RunDescribe(const GlobalOptions& g, const std::vector<std::string>& in) {
   const bool json = TakeOption(args, "--json", nullptr);
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("usage: robotalk describe ROBOT [--json]");
-  const auto client = ConnectClient(g, args[0]);
+  const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
   if (json) {
     PrintModelJson(client->model(), {}, std::cout);
   } else {
@@ -105,7 +105,7 @@ int RunQuery(const GlobalOptions& g, const std::vector<std::string>& in) {
   const auto type = ParseQueryType(args[1]);
   if (!type)
     throw UsageError("unknown query '" + args[1] + "' (joint_state, link_poses, frame_poses, base_pose)");
-  const auto client = ConnectClient(g, args[0]);
+  const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
   const Reply r = client->Query(*type, args.size() == 3 ? args[2] : "");
   if (json) {
     std::cout << ReplyJson(r) << "\n";
@@ -118,7 +118,7 @@ int RunQuery(const GlobalOptions& g, const std::vector<std::string>& in) {
 int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args) {
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("usage: robotalk panic ROBOT");
-  const auto client = ConnectClient(g, args[0]);
+  const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
   client->Panic();
   std::cout << "panic acknowledged by " << args[0] << "\n";
   return 0;
@@ -127,7 +127,7 @@ int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args) {
 int RunReset(const GlobalOptions& g, const std::vector<std::string>& args) {
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("usage: robotalk reset ROBOT");
-  const auto client = ConnectClient(g, args[0]);
+  const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
   const Reply r = client->ResetPanic();
   PrintReply(r, std::cout);
   return ExitStatus(r);

@@ -89,10 +89,11 @@ ClientOptions MakeOptions(const GlobalOptions& g) {
   return o;
 }
 
-std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot) {
+std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot, ClockUse clock) {
   AnnounceWatch watch(g.url);
   const Duration total = FromSeconds(g.timeout_s);
   ClientOptions options = MakeOptions(g);
+  if (clock == ClockUse::kUntimed) options.clock_sync_rounds = 1;
   options.connect_timeout = std::min(total, kAnnounceWait);
   auto client = std::make_unique<RobotClient>(options);
   try {

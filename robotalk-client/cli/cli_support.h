@@ -34,7 +34,14 @@ class AnnounceWatch {
 /// second) and no server announced it, it fails at once with ClientError
 /// "no robot 'piooner' on this network (heard: pioneer)" instead of waiting
 /// the whole --timeout. Throws TimeoutError / ClientError otherwise.
-std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot);
+///
+/// `clock`: kTimed syncs the clock in ClientOptions::clock_sync_rounds round
+/// trips (commands with start times, the state stream); kUntimed in one
+/// (describe, query, panic, reset never convert a time), so a one-shot
+/// process connects in fewer round trips.
+enum class ClockUse { kTimed, kUntimed };
+std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot,
+                                           ClockUse clock = ClockUse::kTimed);
 
 ClientOptions MakeOptions(const GlobalOptions& g);
 

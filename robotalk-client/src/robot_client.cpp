@@ -176,7 +176,14 @@ void RobotClient::Connect(const std::string& robot) {
                         std::to_string(ToSeconds(connect_timeout)) + " s (is a server offering it?)");
   };
 
-  // 1. Clock: `clock_sync_rounds` CLOCK round trips, more if none counted
+  // 1. The configuration query leaves first and travels while the clock
+  //    rounds run (a CLI process connects in fewer round trips).
+  std::optional<PendingReply> first_config = impl_->MakePending(
+      impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false, Impl::Track::kRetransmit)
+          .ids[0],
+      "CONFIG");
+
+  // 2. Clock: `clock_sync_rounds` CLOCK round trips, more if none counted
   //    (a resent package gives no sample).
   const int rounds = std::max(1, impl_->options_.clock_sync_rounds);
   for (int i = 0; SteadyNow() < deadline; ++i) {
@@ -203,13 +210,18 @@ void RobotClient::Connect(const std::string& robot) {
     }
   }
 
-  // 2. Configuration: ask, learn its hash from the reply, wait for the
+  // 3. Configuration: learn its hash from the reply, wait for the
   //    description on the CONFIG channel; ask again if that message was lost.
   std::shared_ptr<const RobotModel> model;
   while (!model && SteadyNow() < deadline) {
-    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false,
-                                   Impl::Track::kRetransmit);
-    PendingReply p = impl_->MakePending(sent.ids[0], "CONFIG");
+    PendingReply p =
+        first_config ? std::move(*first_config)
+                     : impl_->MakePending(impl_
+                                              ->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}},
+                                                            false, Impl::Track::kRetransmit)
+                                              .ids[0],
+                                          "CONFIG");
+    first_config.reset();
     Reply r;
     try {
       r = p.Wait(std::chrono::duration_cast<Duration>(deadline - SteadyNow()));
