@@ -1,42 +1,39 @@
-#!/bin/sh
-# The robotalk CLI end to end over UDP multicast against robotalk_fake_server,
-# inside a private network namespace (DESIGN.md §4).
-# usage: cli_fake_server_test.sh robotalk robotalk_fake_server models_dir
+#!/usr/bin/env bash
+# The robotalk CLI end to end over UDP multicast against a real robotalk-server
+# (kinematic Pioneer): robots, describe, query, send (now, --at, a sequence
+# file), panic and reset, an unknown robot. Runs inside a private network
+# namespace (CTest wraps it with netns_run.sh).
+#   cli_end_to_end_test.sh SERVER CLI MODELS_DIR
 set -u
-cli=$1; server=$2; models=$3
-if ! unshare -n true 2>/dev/null; then echo "SKIP: unshare -n not permitted"; exit 77; fi
-exec unshare -n sh -s "$cli" "$server" "$models" <<'INNER'
-set -u
-cli=$1; server=$2; models=$3
-ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
-url='udpm://239.255.76.67:7671?ttl=0'
-"$server" "$url" "$models/pioneer2dx_pantilt.urdf" 20 &
-spid=$!
-fail=0
-check() {  # check STATUS PATTERN ARGS...
-  want=$1; pattern=$2; shift 2
+server_bin=$1 cli=$2 models=$3
+url="udpm://239.255.76.67:7671?ttl=0"
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
+  2>"$tmp/server.log" &
+server_pid=$!
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+
+cli_says() {  # cli_says STATUS PATTERN ARGS...: robotalk ARGS exits STATUS and prints PATTERN
+  local want=$1 pattern=$2 out got
+  shift 2
   out=$("$cli" --url "$url" --timeout 2 "$@" 2>&1); got=$?
-  if [ "$got" != "$want" ]; then echo "FAIL: robotalk $* -> $got, want $want: $out"; fail=1; return; fi
-  case "$out" in *$pattern*) ;; *) echo "FAIL: robotalk $*: no '$pattern' in: $out"; fail=1 ;; esac
+  [ "$got" = "$want" ] || { echo "robotalk $* -> $got, want $want: $out"; return 1; }
+  case "$out" in *"$pattern"*) ;; *) echo "robotalk $*: no '$pattern' in: $out"; return 1 ;; esac
 }
-check 0 "pioneer" robots --listen 0.6
-check 0 "tilt" describe pioneer
-check 0 '"name"' describe pioneer --json
-check 0 "SUCCESS" query pioneer joint_state
-check 0 'SUCCESS "cmd' send pioneer goto 1 0 0
-check 0 "SUCCESS" send pioneer stop --at 0.3
-seq=$(mktemp)
-printf '# test\n0 setspeed 0.1 0\n0.2 joint_setpoint pan 0.3\n0.4 stop\n' > "$seq"
-check 0 "SUCCESS" send pioneer --file "$seq"
-n=$("$cli" --url "$url" send pioneer --file "$seq" | grep -c SUCCESS)
-[ "$n" = 3 ] || { echo "FAIL: sequence printed $n replies"; fail=1; }
-rm -f "$seq"
-check 0 "acknowledged" panic pioneer
-check 1 "PANIC" send pioneer goto 1 0 0
-check 0 "SUCCESS" reset pioneer
-check 0 "SUCCESS" send pioneer goto 1 0 0
-check 1 "no robot 'nobody' on this network (heard: pioneer)" --timeout 0.5 query nobody joint_state
-kill $spid 2>/dev/null; wait $spid 2>/dev/null
-[ $fail = 0 ] && echo "cli end to end: all passed"
-exit $fail
-INNER
+check "robots lists pioneer" cli_says 0 "pioneer" robots --listen 1.2
+check "describe names the tilt joint" cli_says 0 "tilt" describe pioneer
+check "describe --json" cli_says 0 '"name"' describe pioneer --json
+check "query joint_state" cli_says 0 "SUCCESS" query pioneer joint_state
+check "send goto" cli_says 0 "SUCCESS" send pioneer goto 0.3 0 0
+check "send stop --at" cli_says 0 "SUCCESS" send pioneer stop --at 0.3
+printf '# test\n0 setspeed 0.1 0\n0.2 joint_setpoint pan 0.3\n0.4 stop\n' >"$tmp/seq.txt"
+n=$("$cli" --url "$url" send pioneer --file "$tmp/seq.txt" | grep -c SUCCESS)
+check "a sequence file prints one SUCCESS per frame (got $n)" test "$n" = 3
+check "panic is acknowledged" cli_says 0 "acknowledged" panic pioneer
+check "a command in panic answers PANIC and exits 1" cli_says 1 "PANIC" send pioneer joint_setpoint pan 0.1
+check "reset lifts the panic" cli_says 0 "SUCCESS" reset pioneer
+check "a command after reset succeeds" cli_says 0 "SUCCESS" send pioneer joint_setpoint pan 0.1
+check "an unknown robot names the robots heard" \
+  cli_says 1 "no robot 'nobody' on this network (heard: pioneer)" query nobody joint_state
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]

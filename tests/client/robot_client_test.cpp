@@ -1,54 +1,226 @@
-// RobotClient against FakeServer on one in-process MemoryTransport: acks,
-// duplicates, dropped packages, reordering, scheduling, panic, timeouts.
+// RobotClient against the real server core (robotalk::Server with the
+// kinematic driver on models/pioneer2dx_pantilt.urdf) on one in-process
+// MemoryBus, the network's faults made by FaultyTransport: lost, repeated,
+// reordered and held packages, a server fallen silent, a server restarted,
+// panic, heartbeats on a ManualClock, the state stream, timeouts.
+//
+// Real time: the server runs on its own threads on the steady clock; the
+// client on a clock 1000 s behind it (or a ManualClock where a test says so).
+// Where a test waits for those threads it polls with a bound, never sleeps
+// for a result.
 #include "robotalk/robot_client.h"
-#include "fake_server.h"
+#include "client/faulty_transport.h"
+#include "kinematic_driver.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/protocol_codec.h"
+#include "robotalk/server.h"
 #include "robotalk/urdf_import.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 namespace robotalk {
 namespace {
 
 using std::chrono::milliseconds;
-using testing::FakeServer;
-using testing::FakeServerOptions;
+using std::chrono::seconds;
+using testing::Direction;
+using testing::FaultyTransport;
+using ::testing::HasSubstr;
 
-RobotModel Pioneer() {
-  return LoadUrdfFile(std::string(ROBOTALK_MODELS_DIR) + "/pioneer2dx_pantilt.urdf").model;
+const std::string kRobot = "pioneer";
+const std::string kRequests = RequestChannel(kRobot);
+const std::string kReplies = "ROBOTALK/" + kRobot + "/REPLY/.*";
+
+// The steady clock moved by a fixed offset: the client's clock, 1000 s behind
+// the server's, so that the measured clock offset cannot be right by accident.
+// (The server itself must run on the steady clock: its RobotDaemon sleeps
+// until deadlines on std::chrono::steady_clock.)
+class OffsetClock final : public Clock {
+ public:
+  explicit OffsetClock(Duration offset) : offset_(offset) {}
+  TimePoint Now() const override { return steady_.Now() + offset_; }
+
+ private:
+  SteadyClock steady_;
+  Duration offset_;
+};
+
+// What the server asked of the driver, by command type and first value (the
+// server gives the driver ids of its own, so tests tell their commands apart
+// by value); read by the test thread while the RobotDaemon's thread writes it.
+class DriverLog {
+ public:
+  void Executed(const DriverCommand& c) {
+    std::lock_guard lock(mu_);
+    ++executed_[{c.type, c.num_values > 0 ? c.values[0] : 0.0}];
+  }
+  void Halted(bool halted) {
+    std::lock_guard lock(mu_);
+    halted_ = halted;
+  }
+  int executions(CommandType type, double first_value) const {
+    std::lock_guard lock(mu_);
+    auto it = executed_.find({type, first_value});
+    return it == executed_.end() ? 0 : it->second;
+  }
+  int total() const {
+    std::lock_guard lock(mu_);
+    int n = 0;
+    for (const auto& [key, count] : executed_) n += count;
+    return n;
+  }
+  bool halted() const {
+    std::lock_guard lock(mu_);
+    return halted_;
+  }
+
+ private:
+  mutable std::mutex mu_;
+  std::map<std::pair<CommandType, double>, int> executed_;
+  bool halted_ = false;
+};
+
+// The kinematic driver, logging each Execute, Halt and Resume.
+class CountingDriver final : public Driver {
+ public:
+  CountingDriver(std::unique_ptr<Driver> inner, std::shared_ptr<DriverLog> log)
+      : inner_(std::move(inner)), log_(std::move(log)) {}
+  const RobotModel& model() const override { return inner_->model(); }
+  Duration period() const override { return inner_->period(); }
+  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
+    log_->Executed(c);
+    return inner_->Execute(c, now, done);
+  }
+  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
+  void ReadState(RobotState& s) const override { inner_->ReadState(s); }
+  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
+  void Halt(std::vector<Completion>& done) override {
+    log_->Halted(true);
+    inner_->Halt(done);
+  }
+  void Resume() override {
+    log_->Halted(false);
+    inner_->Resume();
+  }
+
+ private:
+  std::unique_ptr<Driver> inner_;
+  std::shared_ptr<DriverLog> log_;
+};
+
+// --- Filters on wire bytes, for FaultyTransport faults ------------------------
+
+bool IsHeartbeat(const std::string&, std::span<const std::uint8_t> bytes) {
+  try {
+    const auto p = DecodePackage(bytes);
+    return p.header.payload_size == 0 && !p.header.panic;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool HasPayload(const std::string&, std::span<const std::uint8_t> bytes) {
+  try {
+    return DecodePackage(bytes).header.payload_size > 0;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool HasReplies(const std::string&, std::span<const std::uint8_t> bytes) {
+  try {
+    return !DecodeReplyPackage(bytes).replies.empty();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// True for a package whose (client, sequence) was seen before: a retransmission or a duplicate.
+testing::MessageFilter Repeated() {
+  auto seen = std::make_shared<std::set<std::pair<std::int64_t, std::int64_t>>>();
+  return [seen](const std::string&, std::span<const std::uint8_t> bytes) {
+    try {
+      const auto p = DecodePackage(bytes);
+      return !seen->insert({p.header.client_id, p.header.sequence}).second;
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+}
+
+// Polls `done` every millisecond for at most `bound` of real time (the
+// server's and the client's threads run on their own); returns done().
+template <typename Done>
+bool WaitUntil(Done done, Duration bound = seconds(5)) {
+  const auto end = std::chrono::steady_clock::now() + bound;
+  while (!done() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(milliseconds(1));
+  return done();
 }
 
 class RobotClientTest : public ::testing::Test {
  protected:
-  ClientOptions Options() {
-    ClientOptions o;
-    o.transport = &transport_;
-    o.timeout = std::chrono::seconds(5);
-    o.connect_timeout = std::chrono::seconds(5);
+  RobotClientTest() {
+    RegisterKinematicDriver(registry_);
+    registry_.Register("counting", [this](const DriverConfig& config) {
+      return std::make_unique<CountingDriver>(registry_.Create("kinematic", config), log_);
+    });
+  }
+
+  static ServerOptions DefaultServerOptions() {
+    ServerOptions o;
+    o.precise_timing = false;  // no spinning or SCHED_FIFO on a shared test machine
     return o;
   }
-  void StartServer(FakeServerOptions options = {}) {
-    server_ = std::make_unique<FakeServer>(transport_, model_, options);
+  // Starts a new server instance on the same transport (a restart when one ran before).
+  void StartServer(ServerOptions options = DefaultServerOptions()) {
+    const RobotSpec spec{
+        kRobot, "counting", std::string(ROBOTALK_MODELS_DIR) + "/pioneer2dx_pantilt.urdf", {}};
+    server_ = std::make_unique<Server>(server_net_, options, std::vector<RobotSpec>{spec}, registry_,
+                                       server_clock_);
+    server_->Start();
+  }
+  ClientOptions Options() {
+    ClientOptions o;
+    o.transport = &client_net_;
+    o.clock = &client_clock_;
+    o.timeout = seconds(5);
+    o.connect_timeout = seconds(5);
+    return o;
   }
   std::unique_ptr<RobotClient> Connected(ClientOptions o) {
     auto c = std::make_unique<RobotClient>(o);
-    c->Connect(model_.name());
+    c->Connect(kRobot);
     return c;
   }
+  testing::FaultCounts Counts(FaultyTransport& net, FaultyTransport::FaultId id) { return net.counts(id); }
 
-  // Client and FakeServer share one endpoint of an in-process bus: the
-  // client's ReadDaemon dispatches both (no sockets).
-  MemoryTransport transport_{std::make_shared<MemoryBus>()};
-  RobotModel model_ = Pioneer();
-  std::unique_ptr<FakeServer> server_;
+  // The server's and the client's endpoints of one in-process bus, each
+  // behind a FaultyTransport: faults on what the server sends or receives,
+  // and on what the client sends.
+  std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
+  MemoryTransport server_end_{bus_};
+  MemoryTransport client_end_{bus_};
+  FaultyTransport server_net_{server_end_, {.seed = 5}};
+  FaultyTransport client_net_{client_end_, {.seed = 11}};
+  SteadyClock server_clock_;
+  OffsetClock client_clock_{-seconds(1000)};
+  std::shared_ptr<DriverLog> log_ = std::make_shared<DriverLog>();
+  DriverRegistry registry_;
+  RobotModel model_ =
+      LoadUrdfFile(std::string(ROBOTALK_MODELS_DIR) + "/pioneer2dx_pantilt.urdf", {.robot_name = kRobot})
+          .model;
+  std::unique_ptr<Server> server_;  // last: stopped before the transports go
 };
 
 TEST_F(RobotClientTest, ConnectSynchronisesTheClockAndLoadsTheModel) {
@@ -56,52 +228,62 @@ TEST_F(RobotClientTest, ConnectSynchronisesTheClockAndLoadsTheModel) {
   auto client = Connected(Options());
   EXPECT_TRUE(client->connected());
   EXPECT_EQ(client->model(), model_);
-  // The fake server's clock runs 1000 s ahead; in-process round trips are short.
+  EXPECT_EQ(ConfigHash(client->model()), ConfigHash(model_));
+  // The client's clock runs 1000 s behind the server's; in-process round trips are short.
   EXPECT_NEAR(ToSeconds(client->clock_offset()), 1000.0, 0.01);
   EXPECT_LT(client->clock_round_trip(), milliseconds(50));
-  const double skew =
-      ToSeconds(client->ServerNow().time_since_epoch()) * 1e6 - static_cast<double>(server_->ServerNowUs());
-  EXPECT_LT(std::abs(skew), 20000.0);
+  EXPECT_LT(std::chrono::abs(client->ServerNow() - server_clock_.Now()), milliseconds(20));
 }
 
 TEST_F(RobotClientTest, ExecuteReturnsTheFinalReplyAndTheServerExecutesOnce) {
   StartServer();
   auto client = Connected(Options());
-  Reply r = client->Goto(1.0, 0.0, 0.0);
-  EXPECT_EQ(r.signal, Signal::kSuccess);
-  EXPECT_EQ(r.message, "cmd " + std::to_string(r.id));
-  EXPECT_EQ(server_->executions(r.id), 1);
-  Reply js = client->JointState();
+  const Reply r = client->Goto(0.2, 0.0, 0.0);  // final when the robot arrived
+  EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+  EXPECT_EQ(log_->executions(CommandType::kGoto, 0.2), 1);
+  const Reply pose = client->BasePose();
+  ASSERT_EQ(pose.signal, Signal::kSuccess);
+  EXPECT_NEAR(pose.values[0], 0.2, 0.02);
+  const Reply js = client->JointState();
   EXPECT_EQ(js.values.size(), 3u * static_cast<size_t>(model_.num_dofs()));
 }
 
 // Issue 9: after a server restart three commands were never executed and the
-// CLI named only the first; the client ignored the new instance.
+// CLI named only the first; the client ignored the new instance. A restart
+// here: the server object is destroyed and a new one built on the same transport.
 TEST_F(RobotClientTest, AServerRestartAnswersOutstandingCommandsAsUnknownOutcomesAndTheClientGoesOn) {
   StartServer();
+  const auto hellos =
+      server_net_.Add({.channel_regex = HelloChannel(kRobot), .direction = Direction::kIncoming});
   auto client = Connected(Options());
   std::vector<PendingReply> pending;
   for (int i = 0; i < 3; ++i) {
-    pending.push_back(
-        client->Send(Command{.type = CommandType::kJointSetPoint,
-                             .start_time = StartTime::At(client->ServerNow() + std::chrono::seconds(30)),
-                             .target = "pan",
-                             .values = {0.1 * i}}));
+    pending.push_back(client->Send(Command{.type = CommandType::kJointSetPoint,
+                                           .start_time = StartTime::At(client->ServerNow() + seconds(30)),
+                                           .target = "pan",
+                                           .values = {0.1 * i}}));
   }
-  server_->Restart();
+  for (const auto& p : pending)
+    ASSERT_EQ(client->CommandStatus(p.id()).signal, Signal::kBusy);  // queued there
+  server_.reset();
+  StartServer();
   for (auto& p : pending) {
     try {
-      p.Wait(std::chrono::seconds(5));
+      p.Wait(seconds(5));
       ADD_FAILURE() << "id " << p.id() << " answered";
     } catch (const UnknownOutcomeError& e) {
-      EXPECT_NE(std::string(e.what()).find("may or may not have run"), std::string::npos) << e.what();
+      EXPECT_THAT(e.what(), HasSubstr("may or may not have run"));
     }
   }
   EXPECT_EQ(client->stats().sessions_lost, 1u);
-  Reply r = client->Stop();  // a new session with the new instance
-  EXPECT_EQ(r.signal, Signal::kSuccess);
-  EXPECT_EQ(server_->hellos(), 2);
+  const Reply r = client->Stop();  // a new session with the new instance
+  EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
   EXPECT_EQ(client->stats().sessions_opened, 2u);
+  EXPECT_GE(Counts(server_net_, hellos).matched, 2u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.1 * i), 0)
+        << "never re-sent to the new instance";
+  }
 }
 
 TEST_F(RobotClientTest, CommandIdsIncrease) {
@@ -113,59 +295,94 @@ TEST_F(RobotClientTest, CommandIdsIncrease) {
 }
 
 TEST_F(RobotClientTest, SurvivesDroppedAndDuplicatedPackagesEachCommandOnce) {
-  StartServer({.reply_drop_probability = 0.3, .duplicate_replies = true, .seed = 5});
+  StartServer();
+  client_net_.Add({.channel_regex = kRequests, .drop_probability = 0.3, .duplicate_probability = 0.3});
+  const auto replies =
+      server_net_.Add({.channel_regex = kReplies, .drop_probability = 0.3, .duplicate_probability = 0.3});
+  const auto repeats =
+      server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming, .when = Repeated()});
   ClientOptions o = Options();
-  o.drop_probability = 0.3;
-  o.duplicate_probability = 0.3;
-  o.fault_seed = 11;
   o.retransmit_interval = milliseconds(20);
   o.retransmit_max_interval = milliseconds(100);
   auto client = Connected(o);
   std::vector<PendingReply> pending;
+  const auto speed = [](int i) { return 0.01 * (i + 1); };  // tells the commands apart
   for (int i = 0; i < 40; ++i)
-    pending.push_back(client->Send(Command{.type = CommandType::kSetSpeed, .values = {0.1, 0.0}}));
-  for (auto& p : pending) {
-    Reply r = p.Wait(std::chrono::seconds(10));
-    EXPECT_EQ(r.signal, Signal::kSuccess);
-    EXPECT_EQ(r.id, p.id());
-    EXPECT_EQ(server_->executions(p.id()), 1) << "id " << p.id();
+    pending.push_back(client->Send(Command{.type = CommandType::kSetSpeed, .values = {speed(i), 0.0}}));
+  for (int i = 0; i < 40; ++i) {
+    const Reply r = pending[static_cast<std::size_t>(i)].Wait(seconds(10));
+    EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+    EXPECT_EQ(r.id, pending[static_cast<std::size_t>(i)].id());
+    EXPECT_EQ(log_->executions(CommandType::kSetSpeed, speed(i)), 1) << "command " << i;
   }
   const ClientStats s = client->stats();
   EXPECT_GT(s.retransmissions, 0u);
   EXPECT_GT(s.replies_ignored, 0u);  // duplicated reply packages
-  EXPECT_GT(server_->repeated_packages(), 0);
-  EXPECT_EQ(server_->total_executions(), 40);
+  EXPECT_GT(Counts(server_net_, replies).dropped, 0u);
+  EXPECT_GT(Counts(server_net_, repeats).matched, 0u);  // the server saw packages again
+  EXPECT_EQ(log_->total(), 40);
 }
 
+// Five commands of one batch run 80 ms apart, so each final reply leaves in a
+// package of its own; the network holds those packages and delivers them last
+// first. Each reply still reaches its own caller.
 TEST_F(RobotClientTest, BatchRepliesInReverseOrderReachTheirOwnCallers) {
-  StartServer({.reverse_batches = true});
-  auto client = Connected(Options());
+  StartServer();
+  ClientOptions o = Options();
+  o.retransmit_interval = seconds(2);  // no resend while the network holds the replies
+  auto client = Connected(o);
+  const auto sent =
+      server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming, .when = HasPayload});
+  const auto reversed = server_net_.Add({.channel_regex = kReplies, .when = HasReplies, .reverse_batch = 5});
+  const TimePoint first = client->ServerNow() + milliseconds(100);
   std::vector<Command> batch;
-  for (int i = 0; i < 5; ++i)
-    batch.push_back(Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.1 * i}});
+  for (int i = 0; i < 5; ++i) {  // beyond pan's upper limit 2.775 rad: each reply names its value
+    batch.push_back(Command{.type = CommandType::kJointSetPoint,
+                            .start_time = StartTime::At(first + i * milliseconds(80)),
+                            .target = "pan",
+                            .values = {3.0 + i}});
+  }
   auto pending = client->SendBatch(batch);
   ASSERT_EQ(pending.size(), 5u);
-  for (auto& p : pending) {
-    Reply r = p.Wait(std::chrono::seconds(2));
-    EXPECT_EQ(r.id, p.id());
-    EXPECT_EQ(r.message, "cmd " + std::to_string(p.id()));
+  // The batch is released when its fifth package is held; should a busy
+  // server thread have put two replies in one package, release the rest.
+  WaitUntil([&] { return Counts(server_net_, reversed).released >= 5; }, seconds(3));
+  server_net_.ReleaseAll();
+  std::vector<Reply> replies;
+  for (std::size_t i = 0; i < pending.size(); ++i) {
+    replies.push_back(pending[i].Wait(seconds(2)));
+    const Reply& r = replies.back();
+    EXPECT_EQ(r.id, pending[i].id());
+    EXPECT_EQ(r.signal, Signal::kModified) << r.message;
+    EXPECT_THAT(r.message, HasSubstr("dof 0: " + std::to_string(3 + i) + " rad clamped"));
+    if (i > 0) {
+      EXPECT_GT(r.exec_time, replies[i - 1].exec_time);  // it ran at its own start
+    }
   }
-  EXPECT_EQ(server_->packages_received() - server_->heartbeats(), 8 + 1 + 1);  // clock rounds, config, batch
+  EXPECT_GE(Counts(server_net_, reversed).held, 2u);
+  EXPECT_EQ(Counts(server_net_, reversed).released, Counts(server_net_, reversed).held);
+  EXPECT_EQ(Counts(server_net_, sent).matched, 1u);  // the batch travelled as one package
 }
 
 TEST_F(RobotClientTest, ScheduledCommandIsAnsweredAfterItsStartEvenIfTheReplyIsLost) {
-  StartServer({.drop_first_delayed_reply = true});
+  StartServer();
   ClientOptions o = Options();
   o.retransmit_interval = milliseconds(50);
   auto client = Connected(o);
+  // The first reply package that carries a reply (the acknowledgement does
+  // not: the command starts later) is lost.
+  const auto lost = server_net_.Add({.channel_regex = kReplies, .when = HasReplies, .drop_first = 1});
+  const auto repeats =
+      server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming, .when = Repeated()});
   const auto start = std::chrono::steady_clock::now();
-  Reply r = client->Goto(1.0, 2.0, 0.0, client->ServerNow() + milliseconds(300));
+  const Reply r = client->SetJoint("pan", {0.3}, client->ServerNow() + milliseconds(300));
   const auto waited = std::chrono::steady_clock::now() - start;
-  EXPECT_EQ(r.signal, Signal::kSuccess);
+  EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
   EXPECT_GE(waited, milliseconds(290));
-  EXPECT_LT(waited, std::chrono::seconds(2));
-  EXPECT_EQ(server_->executions(r.id), 1);
-  EXPECT_GE(server_->repeated_packages(), 1);  // the resend after the start recovered the reply
+  EXPECT_LT(waited, seconds(2));
+  EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.3), 1);
+  EXPECT_EQ(Counts(server_net_, lost).dropped, 1u);
+  EXPECT_GE(Counts(server_net_, repeats).matched, 1u);  // the resend after the start recovered the reply
 }
 
 TEST_F(RobotClientTest, BlockingCallTimesOutWhenTheServerFallsSilent) {
@@ -173,7 +390,7 @@ TEST_F(RobotClientTest, BlockingCallTimesOutWhenTheServerFallsSilent) {
   ClientOptions o = Options();
   o.timeout = milliseconds(300);
   auto client = Connected(o);
-  server_->SetMute(true);
+  server_net_.Add({.mute = true});  // everything the server sends
   const auto start = std::chrono::steady_clock::now();
   EXPECT_THROW(client->Stop(), TimeoutError);
   EXPECT_GE(std::chrono::steady_clock::now() - start, milliseconds(290));
@@ -185,16 +402,16 @@ TEST_F(RobotClientTest, GivingUpFailsPendingRepliesWithATimeout) {
   ClientOptions o = Options();
   o.give_up_after = milliseconds(200);
   auto client = Connected(o);
-  server_->SetMute(true);
+  server_net_.Add({.mute = true});
   PendingReply p = client->Send(Command{.type = CommandType::kStop});
   const auto start = std::chrono::steady_clock::now();
   try {
-    p.Wait(std::chrono::seconds(5));
+    p.Wait(seconds(5));
     FAIL() << "expected TimeoutError";
   } catch (const TimeoutError& e) {
-    EXPECT_NE(std::string(e.what()).find("gave up"), std::string::npos) << e.what();
+    EXPECT_THAT(e.what(), HasSubstr("gave up"));
   }
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, seconds(2));
   EXPECT_EQ(client->stats().gave_up, 1u);
 }
 
@@ -202,11 +419,17 @@ TEST_F(RobotClientTest, PanicIsAcknowledgedAndResetLiftsIt) {
   StartServer();
   auto client = Connected(Options());
   client->Panic();
-  EXPECT_TRUE(server_->panic());
-  EXPECT_EQ(client->Goto(1, 0, 0).signal, Signal::kPanic);
+  // The server halts the driver just after its acknowledgement (architecture.md).
+  EXPECT_TRUE(WaitUntil([&] { return log_->halted(); }));
+  const Reply refused = client->Goto(1, 0, 0);
+  EXPECT_EQ(refused.signal, Signal::kPanic) << refused.message;
+  EXPECT_EQ(log_->executions(CommandType::kGoto, 1), 0);
   EXPECT_EQ(client->JointState().signal, Signal::kSuccess);  // queries still answered
   EXPECT_EQ(client->ResetPanic().signal, Signal::kSuccess);
-  EXPECT_EQ(client->Goto(1, 0, 0).signal, Signal::kSuccess);
+  EXPECT_TRUE(WaitUntil([&] { return !log_->halted(); }));
+  const Reply moved = client->SetJoint("pan", {0.2});
+  EXPECT_EQ(moved.signal, Signal::kSuccess) << moved.message;
+  EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.2), 1);
 }
 
 TEST_F(RobotClientTest, PanicTimesOutWithoutAck) {
@@ -214,88 +437,122 @@ TEST_F(RobotClientTest, PanicTimesOutWithoutAck) {
   ClientOptions o = Options();
   o.timeout = milliseconds(200);
   auto client = Connected(o);
-  server_->SetMute(true);
+  server_net_.Add({.mute = true});
   EXPECT_THROW(client->Panic(), TimeoutError);
 }
 
 // On a ManualClock: one heartbeat per idle interval the clock moves, none
 // while it stands still (no sleeping for the interval to pass).
 TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
-  StartServer();
+  ServerOptions so = DefaultServerOptions();
+  so.session_timeout = seconds(60);  // the server's clock runs on while the client's stands still
+  StartServer(so);
+  const auto heartbeats =
+      server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming, .when = IsHeartbeat});
   ManualClock clock;
   ClientOptions o = Options();
   o.clock = &clock;
   o.heartbeat_interval = milliseconds(50);
   o.max_idle_wait = milliseconds(1);  // re-read the manual clock often
-  auto client = Connected(o);
-  const int before = server_->heartbeats();
-  for (int k = 1; k <= 4; ++k) {
+  std::unique_ptr<RobotClient> client;
+  {
+    // The real server takes time between a CLOCK query's receipt and its
+    // answer: a client clock standing still through Connect() would see a
+    // negative round trip in every sample and never synchronise. So the
+    // manual clock follows real time until Connect() returned; then only the
+    // test moves it.
+    const TimePoint manual_start = clock.Now();
+    const auto real_start = std::chrono::steady_clock::now();
+    std::jthread follow([&](std::stop_token stop) {
+      while (!stop.stop_requested()) {
+        clock.Set(manual_start + (std::chrono::steady_clock::now() - real_start));
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      }
+    });
+    client = Connected(o);
+  }
+  const auto received = [&] { return Counts(server_net_, heartbeats).matched; };
+  const std::uint64_t before = received();
+  for (std::uint64_t k = 1; k <= 4; ++k) {
     clock.Advance(milliseconds(50));
     // Bounded real-time wait for the ReadDaemon to notice the clock moved.
-    for (int i = 0; i < 2000 && server_->heartbeats() < before + k; ++i) {
-      std::this_thread::sleep_for(milliseconds(1));
-    }
-    ASSERT_EQ(server_->heartbeats(), before + k) << "after advancing " << k << " intervals";
+    WaitUntil([&] { return received() >= before + k; });
+    ASSERT_EQ(received(), before + k) << "after advancing " << k << " intervals";
   }
   clock.Advance(milliseconds(49));  // not yet an interval: nothing more is sent
   // ~20 daemon wake-ups (max_idle_wait 1 ms) in which a wrong heartbeat would go.
   std::this_thread::sleep_for(milliseconds(20));
   EXPECT_EQ(client->stats().heartbeats, 4u);
-  EXPECT_EQ(server_->heartbeats(), before + 4);
+  EXPECT_EQ(received(), before + 4);
 }
 
+// The server's own samples arrive validated; samples forged on the bus by
+// another endpoint are validated the same way: the bad ones are dropped and
+// counted, the good ones delivered as sent.
 TEST_F(RobotClientTest, StateStreamDeliversValidatedSamplesAndDropsBadOnes) {
   StartServer();
   auto client = Connected(Options());
   std::mutex mu;
   std::vector<StateSample> got;
+  const auto received = [&] {
+    std::lock_guard lock(mu);
+    return got.size();
+  };
   EXPECT_EQ(client->StartStateStream(milliseconds(50),
                                      [&](const StateSample& s) {
                                        std::lock_guard lock(mu);
                                        got.push_back(s);
                                      }),
             milliseconds(50));
+  ASSERT_TRUE(WaitUntil([&] { return received() >= 2; }));  // the server's, every 50 ms
   const auto dofs = static_cast<std::size_t>(model_.num_dofs());
   StateSample good;
-  good.robot = model_.name();
-  good.server_time = TimePoint(std::chrono::seconds(1000));
+  good.robot = kRobot;
+  good.server_time = TimePoint(seconds(1000));
   good.period = milliseconds(50);
-  good.sample = 1;
+  good.sample = 1000001;
   good.positions.assign(dofs, 0.25);
   good.velocities.assign(dofs, 0.0);
   good.efforts.assign(dofs, 0.0);
   good.base = {1, 2, 0.5, 0.1, 0};
   robotalk_msgs::robot_state_t nan = ToWire(good);
-  nan.sample = 2;
+  nan.sample = 1000002;
   nan.position[0] = std::nan("");
   StateSample extra_dof = good;
-  extra_dof.sample = 3;
+  extra_dof.sample = 1000003;
   for (auto* v : {&extra_dof.positions, &extra_dof.velocities, &extra_dof.efforts}) v->push_back(0);
   StateSample last = good;
-  last.sample = 4;
-  // The server's side of the bus (published from this thread; the client's
-  // ReadDaemon dispatches).
-  Publish(transport_, StateChannel(model_.name()), ToWire(good));
-  Publish(transport_, StateChannel(model_.name()), nan);
-  Publish(transport_, StateChannel(model_.name()), ToWire(extra_dof));
-  Publish(transport_, StateChannel(model_.name()), ToWire(last));
-  for (int i = 0; i < 2000; ++i) {
-    {
-      std::lock_guard lock(mu);
-      if (got.size() >= 2 && client->stats().malformed_packages >= 2) break;
-    }
-    std::this_thread::sleep_for(milliseconds(1));
-  }
-  std::lock_guard lock(mu);
-  ASSERT_EQ(got.size(), 2u);
-  EXPECT_EQ(got[0], good);
-  EXPECT_EQ(got[1].sample, 4);
+  last.sample = 1000004;
+  MemoryTransport forger(bus_);
+  for (const auto& wire : {ToWire(good), nan, ToWire(extra_dof), ToWire(last)})
+    Publish(forger, StateChannel(kRobot), wire);
+  const auto has = [&](std::int64_t sample) {
+    std::lock_guard lock(mu);
+    return std::any_of(got.begin(), got.end(), [&](const StateSample& s) { return s.sample == sample; });
+  };
+  ASSERT_TRUE(WaitUntil([&] { return has(1000004) && client->stats().malformed_packages >= 2; }));
   EXPECT_EQ(client->stats().malformed_packages, 2u);  // NaN, and a dof count the model does not have
+  EXPECT_FALSE(has(1000002));
+  EXPECT_FALSE(has(1000003));
+  std::lock_guard lock(mu);
+  int from_server = 0;
+  for (const StateSample& s : got) {
+    if (s.sample == good.sample) {
+      EXPECT_EQ(s, good);
+    }
+    if (s.sample >= 1000000) continue;
+    ++from_server;
+    EXPECT_EQ(s.robot, kRobot);
+    EXPECT_EQ(s.period, milliseconds(50));
+    EXPECT_EQ(s.config_hash, ConfigHash(model_));
+    EXPECT_EQ(s.positions.size(), dofs);
+  }
+  EXPECT_GE(from_server, 2);
 }
 
 TEST_F(RobotClientTest, ConnectTimesOutWithoutServer) {
   ClientOptions o = Options();
-  o.connect_timeout = milliseconds(300);
+  o.connect_timeout = milliseconds(300);  // real time: Connect() times out on the steady clock
   RobotClient client(o);
   EXPECT_THROW(client.Connect("nobody"), TimeoutError);
 }
@@ -321,33 +578,40 @@ TEST_F(RobotClientTest, ManyThreadsShareOneClient) {
   }
   for (auto& t : threads) t.join();
   EXPECT_EQ(ok.load(), 100);
+  EXPECT_EQ(log_->total(), 100);
 }
 
 TEST_F(RobotClientTest, PendingReplyOutlivingTheClientFailsCleanly) {
-  StartServer({.mute = false});
+  StartServer();
   auto client = Connected(Options());
-  server_->SetMute(true);
+  server_net_.Add({.mute = true});
   PendingReply p = client->Send(Command{.type = CommandType::kStop});
   client.reset();
   EXPECT_THROW(p.Wait(milliseconds(100)), ClientError);
 }
 
+// Two real servers announce the same robot (allowed), each once a second: the
+// list names each server once however often it was heard.
 TEST_F(RobotClientTest, ListRobotsDedupesAnnouncements) {
-  StartServer();
-  std::atomic<bool> stop{false};
-  std::thread announcer([&] {
-    while (!stop) {
-      server_->Announce(1);
-      server_->Announce(2);
-      std::this_thread::sleep_for(milliseconds(10));
-    }
-  });
-  auto robots = ListRobots(Options(), milliseconds(200));
-  stop = true;
-  announcer.join();
-  ASSERT_EQ(robots.size(), 2u);  // one robot, two servers
-  EXPECT_EQ(robots[0].name, model_.name());
-  EXPECT_EQ(robots[0].config_hash, ConfigHash(model_));
+  ServerOptions so = DefaultServerOptions();
+  so.allow_duplicate_robots = true;
+  StartServer(so);
+  MemoryTransport second_end(bus_);
+  const RobotSpec spec{
+      kRobot, "kinematic", std::string(ROBOTALK_MODELS_DIR) + "/pioneer2dx_pantilt.urdf", {}};
+  Server second(second_end, so, {spec}, registry_, server_clock_);
+  second.Start();
+  const auto heard = client_net_.Add({.channel_regex = kAnnounceChannel, .direction = Direction::kIncoming});
+  // Real time: the server announces once a second (ServerOptions::announce_period
+  // is not passed on to the ServerDaemon), so hearing each server twice takes 2 s.
+  const auto robots = ListRobots(Options(), milliseconds(2100));
+  second.Stop();
+  EXPECT_GE(Counts(client_net_, heard).matched, 3u);  // some server heard more than once
+  ASSERT_EQ(robots.size(), 2u);                       // one robot, two servers
+  for (const auto& robot : robots) {
+    EXPECT_EQ(robot.name, kRobot);
+    EXPECT_EQ(robot.config_hash, ConfigHash(model_));
+  }
   EXPECT_NE(robots[0].server_id, robots[1].server_id);
 }
 
