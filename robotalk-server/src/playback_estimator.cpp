@@ -14,7 +14,78 @@ PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration
   frames_.reserve(std::min<std::size_t>(needed_, 1024));  // a declaration is a claim, not memory to reserve
 }
 
-void PlaybackEstimator::Add(Duration offset, TimePoint arrival) { frames_.push_back({offset, arrival}); }
+namespace {
+std::optional<Duration> DelayOf(TimePoint sent, TimePoint arrival) {
+  Duration::rep d = 0;
+  if (__builtin_sub_overflow(arrival.time_since_epoch().count(), sent.time_since_epoch().count(), &d))
+    return std::nullopt;
+  return Duration(d);
+}
+}  // namespace
+
+void DelayHistory::Add(TimePoint sent, TimePoint received) {
+  const std::optional<Duration> d = DelayOf(sent, received);
+  if (!d) return;
+  ring_[next_] = {received, *d};
+  next_ = (next_ + 1) % kCapacity;
+  size_ = std::min(size_ + 1, kCapacity);
+}
+
+std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const {
+  std::vector<Duration> out;
+  out.reserve(size_);
+  for (std::size_t k = 0; k < size_; ++k) {
+    const Sample& s = ring_[(next_ + kCapacity - size_ + k) % kCapacity];
+    if (now - s.received <= window) out.push_back(s.delay);
+  }
+  return out;
+}
+
+void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent) {
+  frames_.push_back({offset, arrival, sent ? DelayOf(*sent, arrival) : std::nullopt});
+}
+
+std::optional<Duration> PlaybackEstimator::delay_spread() const {
+  std::vector<Duration> delays = history_;
+  for (const Frame& f : frames_) {
+    if (!f.delay) return std::nullopt;  // a client that sends no send times
+    delays.push_back(*f.delay);
+  }
+  if (frames_.empty() || delays.size() < options_.quick_min_delays) return std::nullopt;
+  const auto [lo, hi] = std::minmax_element(delays.begin(), delays.end());
+  return *hi - *lo;
+}
+
+bool PlaybackEstimator::quick() const {
+  if (!options_.quick_start) return false;
+  const std::optional<Duration> spread = delay_spread();
+  // A spread this small beside the frame interval is a channel that keeps up
+  // (a queue cannot build); a larger one gets the paper's estimate, which
+  // sees the drift.
+  const double interval = total_ > 1 ? ToSeconds(duration_) / static_cast<double>(total_ - 1) : 1.0;
+  return spread && ToSeconds(*spread) <= options_.quick_max_spread * interval;
+}
+
+TimePoint PlaybackEstimator::QuickStartTime() const {
+  // The worst delay a later frame may have is predicted as the least seen
+  // plus quick_jitter_factor times the spread (the history is a sample: its
+  // max underestimates the channel's). Offset 0 plays when the latest frame
+  // seen (arrival − offset) would plus that worst delay's excess over the
+  // frame's own; never before the decision (as StartTime).
+  const Frame* anchor = &frames_.front();  // quick(): every frame has a delay
+  Duration least = *anchor->delay, first_offset = Duration::max();
+  TimePoint decided = TimePoint::min();
+  for (const Frame& f : frames_) {
+    if (f.arrival - f.offset > anchor->arrival - anchor->offset) anchor = &f;
+    least = std::min(least, *f.delay);
+    first_offset = std::min(first_offset, f.offset);
+    decided = std::max(decided, f.arrival);
+  }
+  for (Duration d : history_) least = std::min(least, d);
+  const Duration worst = least + FromSeconds(ToSeconds(*delay_spread()) * options_.quick_jitter_factor);
+  const Duration excess = std::max(Duration(0), worst - *anchor->delay);
+  return std::max(anchor->arrival - anchor->offset + excess, decided - first_offset) + options_.quick_margin;
+}
 
 Duration PlaybackEstimator::mean_command_interval() const {
   if (frames_.size() < 2) return Duration(0);
@@ -67,6 +138,7 @@ Duration PlaybackEstimator::ExtraLagBound(Duration remaining) const {
 }
 
 TimePoint PlaybackEstimator::StartTime() const {
+  if (quick()) return QuickStartTime();
   // Frames seen must be there before they play: start >= a_i - o_i.
   TimePoint lag = TimePoint::min();
   Duration first_offset = Duration::max(), last_offset = Duration::min();

@@ -77,6 +77,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     return answer;
   }
   session.last_heard = received;  // only a new, well-formed package refreshes the session
+  if (r.send_time != TimePoint{}) session.delays.Add(r.send_time, received);  // playback's quick start
   std::vector<CommandId> ids = r.item_ids();
   // The playback delay reply (id = playback id) may come with any of its packages.
   const bool playback = r.mode == RequestMode::kPlayback;
@@ -356,7 +357,12 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
     }
     return;
   }
-  if (!seq.first_arrival) seq.first_arrival = now;
+  if (!seq.first_arrival) {
+    seq.first_arrival = now;
+    seq.estimator.SetDelayHistory(s.delays.Recent(now));
+  }
+  const std::optional<TimePoint> sent =
+      r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
   for (const Command& c : r.commands) {
     std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
     if (!item) continue;
@@ -374,7 +380,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
       item->start = *seq.start + offset;
       if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
     } else {
-      seq.estimator.Add(offset, now);
+      seq.estimator.Add(offset, now, sent);
       seq.frames.push_back({offset, std::move(*item)});
     }
   }
@@ -386,11 +392,15 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   }
   seq.frames.clear();
   const Duration delay = *seq.start - *seq.first_arrival;
+  const std::string why = seq.estimator.quick()
+                              ? "quick start: this client's packages' one-way delays vary by " +
+                                    Seconds(*seq.estimator.delay_spread())
+                              : "mean " + Seconds(seq.estimator.mean_command_interval()) +
+                                    " between commands, " + Seconds(seq.estimator.mean_arrival_interval()) +
+                                    " between arrivals";
   Reply reply = MakeReply(d.id, Signal::kSuccess,
                           "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +
-                              " after its first frame arrived (mean " +
-                              Seconds(seq.estimator.mean_command_interval()) + " between commands, " +
-                              Seconds(seq.estimator.mean_arrival_interval()) + " between arrivals)",
+                              " after its first frame arrived (" + why + ")",
                           now);
   reply.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
   immediate.push_back(std::move(reply));

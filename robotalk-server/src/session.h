@@ -75,6 +75,7 @@ struct Session {
   TimePoint last_heard;
   SequenceWindow seen;
   ReplyCache replies;
+  DelayHistory delays;  ///< one-way delays of its latest packages (playback's quick start)
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< by playback id
   /// Timed servo commands queued and not yet answered: id -> (start, actuator).
   std::unordered_map<CommandId, std::pair<TimePoint, int>> timed_servos;

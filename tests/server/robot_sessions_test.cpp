@@ -464,6 +464,47 @@ TEST_F(RobotSessionsTest, PlaybackHoldsFramesUntilItCanEstimateThenKeepsTheirTim
   }
 }
 
+TEST_F(RobotSessionsTest, PlaybackStartsAtTheFirstFrameFromTheSessionsSendTimesWhenTheChannelIsQuiet) {
+  // A client whose clock reads 7 days ahead of the server's; its packages
+  // take 300-500 us. Connect-time packages (clock rounds) give the history.
+  const Duration skew = std::chrono::hours(24 * 7);
+  std::int64_t seq = 0;
+  auto stamped = [&](Request r, Duration took) {
+    r.send_time = clock_.Now() - took + skew;
+    return r;
+  };
+  for (int i = 0; i < 6; ++i) {
+    Handle(stamped(Queries(kAlice, ++seq, {Query{.id = 100 + i, .type = QueryType::kClock}}),
+                   std::chrono::microseconds(300 + 40 * i)));
+    clock_.Advance(milliseconds(1));
+  }
+  constexpr std::int64_t kPlayback = 9100;
+  const Duration period = milliseconds(100);
+  const TimePoint first_arrival = clock_.Now();
+  const Command frame0 = Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)));
+  auto immediate = Handle(
+      stamped(Playback(kAlice, ++seq, kPlayback, 10, period * 9, {frame0}), std::chrono::microseconds(400)));
+  ASSERT_TRUE(immediate.count(kPlayback)) << "decided at the first frame";
+  const Reply& r = immediate.at(kPlayback);
+  EXPECT_EQ(r.signal, Signal::kSuccess);
+  EXPECT_THAT(r.message, HasSubstr("quick start"));
+  // 10 ms margin + 2.5 x the 200 us spread less this frame's 100 us excess over the least.
+  const Duration delay = FromSeconds(r.values.at(0));
+  EXPECT_GE(delay, milliseconds(10));
+  EXPECT_LE(delay, milliseconds(11));
+  EXPECT_EQ(FromWireMicros(static_cast<std::int64_t>(r.values.at(1))),
+            first_arrival + std::chrono::duration_cast<std::chrono::microseconds>(delay));
+}
+
+TEST_F(RobotSessionsTest, PlaybackWithoutSendTimesWaitsForFramesAsThePaperDoes) {
+  for (int i = 0; i < 6; ++i) {
+    Handle(Queries(kAlice, i + 1, {Query{.id = 100 + i, .type = QueryType::kClock}}));
+    clock_.Advance(milliseconds(1));
+  }
+  const Command frame0 = Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)));
+  EXPECT_FALSE(Handle(Playback(kAlice, 7, 9200, 10, milliseconds(900), {frame0})).count(9200));
+}
+
 // Soak finding: a playback sequence that met a panic was never answered
 // (COMMAND_STATUS said "has not ended" forever).
 TEST_F(RobotSessionsTest, APlaybackSentDuringAPanicIsAnsweredNotHeld) {
