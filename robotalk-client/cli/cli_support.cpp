@@ -20,6 +20,8 @@
 namespace robotalk::cli {
 
 constexpr Duration kAnnounceWait = std::chrono::milliseconds(1200);  // > one announce period
+// The watch listens from here to kAnnounceWait: still more than one period.
+constexpr std::chrono::milliseconds kWatchAfter(100);
 
 struct AnnounceWatch::Impl {
   std::string url;
@@ -37,9 +39,13 @@ struct AnnounceWatch::Impl {
     } catch (const ProtocolError&) {
     }
   }
-  // LCM is opened on this thread, so a Connect that succeeds at once does not
-  // wait for it; poll() on LCM's socket and a pipe lets the destructor wake it.
+  // LCM is opened on this thread, and only after kWatchAfter, so a Connect
+  // that succeeds at once neither waits for it nor shares the CPU with a
+  // third LCM instance (a one-shot CLI process); poll() on LCM's socket and a
+  // pipe lets the destructor wake it.
   void Run() {
+    pollfd early = {wake[0], POLLIN, 0};
+    if (poll(&early, 1, static_cast<int>(kWatchAfter.count())) != 0) return;  // woken: connected
     std::string main_url;  // ANNOUNCE travels on the main lane in either layout
     try {
       main_url = MainLcmUrl(url);
