@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages RoboTalk needs (only those missing) and
 # configures + builds the project in ./build. Used by demo.sh and test.sh.
+# Environment: ROBOTALK_BUILD_DIR (default build), ROBOTALK_BUILD_TARGETS.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -42,4 +43,8 @@ fi
 
 BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBOTALK_WERROR=ON >/dev/null
-cmake --build "$BUILD_DIR" -j"$(nproc)"
+# ROBOTALK_BUILD_TARGETS (space-separated): build only these (scripts/bench.sh);
+# default: everything.
+targets=()
+[ -n "${ROBOTALK_BUILD_TARGETS:-}" ] && read -r -a targets <<<"$ROBOTALK_BUILD_TARGETS"
+cmake --build "$BUILD_DIR" -j"$(nproc)" ${targets[@]+--target "${targets[@]}"}
