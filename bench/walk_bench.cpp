@@ -30,7 +30,13 @@ struct Args {
   unsigned seed = 1;
   std::string trace;
   int trace_goal = 0;
-  int stand = 0;  // seconds to stand and print before the goals
+  int stand = 0;
+  bool fixed_goal = false;
+  double goal[3] = {0, 0, 0};  // --goal x,y,theta: one goal instead of random ones
+  int verbose = 0;
+  double stop_after =
+      -1;  // --stop S: STOP each walk S s after its GOTO (then wait for standing)             // --verbose N:
+           // print the walk every N * 10 ms  // seconds to stand and print before the goals
   std::map<std::string, std::string> options = {{"walk", "true"}};
 };
 
@@ -48,6 +54,12 @@ Args Parse(int argc, char** argv) {
       a.trace = v;
     } else if (k == "--stand") {
       a.stand = std::atoi(v.c_str());
+    } else if (k == "--goal") {
+      a.fixed_goal = std::sscanf(v.c_str(), "%lf,%lf,%lf", &a.goal[0], &a.goal[1], &a.goal[2]) == 3;
+    } else if (k == "--stop") {
+      a.stop_after = std::atof(v.c_str());
+    } else if (k == "--verbose") {
+      a.verbose = std::atoi(v.c_str());
     } else if (k == "--trace-goal") {
       a.trace_goal = std::atoi(v.c_str());
     } else if (k == "--option") {
@@ -83,11 +95,14 @@ int main(int argc, char** argv) {
       ode->ReadState(st);
       const RobotModel& m = ode->model();
       std::printf(
-          "stand t=%.1f tilt %.4f com %.4f %.4f %.4f pelvis %.4f %.4f %.4f  hip %.3f knee %.3f ankle %.3f\n",
+          "stand t=%.2f tilt %.4f com %.4f %.4f %.4f pelvis %.4f %.4f %.4f  hip %.3f knee %.3f ankle %.3f "
+          "foot %.4f"
+          " zmp %.4f plan %.4f F %.0f/%d\n",
           ToSeconds(ode->sim_time().time_since_epoch()), s.tilt, s.com.x(), s.com.y(), s.com.z(), s.pelvis.x,
           s.pelvis.y, s.pelvis.theta, st.position[m.dof_offset(m.JointIndex("left_hip_pitch"))],
           st.position[m.dof_offset(m.JointIndex("left_knee"))],
-          st.position[m.dof_offset(m.JointIndex("left_ankle_pitch"))]);
+          st.position[m.dof_offset(m.JointIndex("left_ankle_pitch"))], s.foot_measured[0].x, s.zmp.x(),
+          s.zmp_ref.x(), s.foot_force[0], s.foot_contacts[0]);
     }
   }
   std::mt19937 rng(args.seed);
@@ -105,22 +120,49 @@ int main(int argc, char** argv) {
   for (int g = 0; g < args.goals; ++g) {
     const walking::Pose2 start = ode->walk_status()->pelvis;
     const double r = dist(rng), bearing = angle(rng), heading = angle(rng);
-    const double gx = start.x + r * std::cos(bearing), gy = start.y + r * std::sin(bearing);
+    double gx = start.x + r * std::cos(bearing), gy = start.y + r * std::sin(bearing);
+    if (args.fixed_goal) {
+      gx = start.x + args.goal[0];
+      gy = start.y + args.goal[1];
+    }
     DriverCommand c;
     c.id = g + 1;
     c.type = CommandType::kGoto;
     c.num_values = 3;
     c.values[0] = gx;
     c.values[1] = gy;
-    c.values[2] = heading;
+    c.values[2] = args.fixed_goal ? args.goal[2] : heading;
     done.clear();
     const TimePoint t0 = ode->sim_time();
     const auto w0 = WallClock::now();
     const DriverResult res = d->Execute(c, t0, done);
     Signal signal = res.signal;
     std::string message = res.message;
-    for (int i = 0; res.in_progress && done.empty() && i < 12000; ++i) {  // at most 120 s per goal
+    bool stopped = false;
+    for (int i = 0; res.in_progress && (done.empty() || stopped) && i < 12000;
+         ++i) {  // at most 120 s per goal
+      if (!stopped && args.stop_after >= 0 && ToSeconds(ode->sim_time() - t0) >= args.stop_after) {
+        d->Stop(ode->sim_time(), done);
+        stopped = true;
+      }
+      if (ode->walk_status()->fallen) break;
+      if (stopped && !ode->walk_status()->stepping && ToSeconds(ode->sim_time() - t0) > args.stop_after + 3)
+        break;
       ode->Step(10, done);
+      if (args.verbose > 0 && i % args.verbose == 0) {
+        const walking::WalkStatus s = *ode->walk_status();
+        std::printf(
+            "  t=%.2f pelvis %.3f %.3f %.3f tilt %.3f com-plan %.3f %.3f steps %d"
+            " L %.3f %.3f %.3f/%.3f h%.3f  R %.3f %.3f %.3f/%.3f h%.3f tilts %.3f %.3f"
+            " zmp %.3f %.3f plan %.3f %.3f F %.0f/%d %.0f/%d trk %.3f%s\n",
+            ToSeconds(ode->sim_time() - t0), s.pelvis.x, s.pelvis.y, s.pelvis.theta, s.tilt,
+            s.com.x() - s.com_plan.x(), s.com.y() - s.com_plan.y(), s.steps_taken, s.foot_measured[0].x,
+            s.foot_measured[0].y, s.foot_measured[0].theta, s.foot[0].theta, s.foot_height[0],
+            s.foot_measured[1].x, s.foot_measured[1].y, s.foot_measured[1].theta, s.foot[1].theta,
+            s.foot_height[1], s.foot_tilt[0], s.foot_tilt[1], s.zmp.x(), s.zmp.y(), s.zmp_ref.x(),
+            s.zmp_ref.y(), s.foot_force[0], s.foot_contacts[0], s.foot_force[1], s.foot_contacts[1],
+            s.tracking_error, s.fallen ? " FALLEN" : "");
+      }
       if (trace.is_open() && g == args.trace_goal && i % 2 == 0) {
         const walking::WalkStatus s = *ode->walk_status();
         trace << ToSeconds(ode->sim_time() - t0) << ',' << s.foot[0].x << ',' << s.foot[0].y << ','
@@ -138,7 +180,7 @@ int main(int argc, char** argv) {
     }
     const walking::WalkStatus s = *ode->walk_status();
     const double ed = std::hypot(s.pelvis.x - gx, s.pelvis.y - gy);
-    const double eth = std::abs(walking::Wrap(s.pelvis.theta - heading));
+    const double eth = std::abs(walking::Wrap(s.pelvis.theta - c.values[2]));
     if (s.fallen) ++falls;
     if (signal == Signal::kSuccess) ++successes;
     worst_d = std::max(worst_d, ed);
@@ -149,7 +191,7 @@ int main(int argc, char** argv) {
     wall_total += wall;
     sim_total += sim;
     std::printf("%-4d  %7.3f  %7.3f  %7.3f  %-11s  %6.1f  %6.3f  %9.3f  %9.4f  %11.4f  %4.1f %s\n", g, gx, gy,
-                heading, std::string(ToString(signal)).c_str(), sim, r, r / sim, ed, eth, sim / wall,
+                c.values[2], std::string(ToString(signal)).c_str(), sim, r, r / sim, ed, eth, sim / wall,
                 message.c_str());
     std::fflush(stdout);
     if (s.fallen) break;

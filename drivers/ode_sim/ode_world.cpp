@@ -129,6 +129,8 @@ OdeWorld::OdeWorld(const RobotModel& model, const std::vector<CollisionShape>& s
   BuildJoints(q0);
   if (options_.ground) ground_ = dCreatePlane(nullptr, 0, 0, 1, options_.ground_z);
   contact_scratch_.resize(kMaxContactsPerGeom);
+  contact_feedback_.resize(geoms_.size() * kMaxContactsPerGeom);
+  contacts_out_.reserve(contact_feedback_.size());
   ReadJoints();
 }
 
@@ -289,7 +291,7 @@ void OdeWorld::BuildGeoms(const std::vector<CollisionShape>& shapes) {
     dGeomSetOffsetQuaternion(g, dq);
     const bool caster = std::find(options_.caster_links.begin(), options_.caster_links.end(), s.link) !=
                         options_.caster_links.end();
-    geoms_.push_back(Geom{.geom = g, .frictionless = caster});
+    geoms_.push_back(Geom{.geom = g, .frictionless = caster, .link = *l});
   }
 }
 
@@ -398,6 +400,15 @@ void OdeWorld::SetRootVelocity(const Eigen::Vector3d& v, const Eigen::Vector3d& 
   dBodySetAngularVel(b, w.x(), w.y(), w.z());
 }
 
+void OdeWorld::SetContactSpring(int link, double stiffness, double damping) {
+  const double hk = options_.step * stiffness;
+  for (Geom& g : geoms_) {
+    if (g.link != link) continue;
+    g.erp = hk / (hk + damping);
+    g.cfm = 1.0 / (hk + damping);
+  }
+}
+
 void OdeWorld::Step() {
   EnsureOdeThread();
   for (DofJoint& d : dofs_) {
@@ -408,6 +419,7 @@ void OdeWorld::Step() {
       dJointAddSliderForce(d.joint, -d.effort_cmd);
     }
   }
+  contacts_out_.clear();
   if (ground_) {
     for (const Geom& g : geoms_) {
       dBodyID b = dGeomGetBody(g.geom);
@@ -419,10 +431,16 @@ void OdeWorld::Step() {
         contact.geom = contact_scratch_[static_cast<size_t>(c)];
         contact.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1;
         contact.surface.mu = g.frictionless ? 0.0 : options_.friction;
-        contact.surface.soft_erp = options_.contact_erp;
-        contact.surface.soft_cfm = options_.contact_cfm;
+        contact.surface.soft_erp = g.erp >= 0 ? g.erp : options_.contact_erp;
+        contact.surface.soft_cfm = g.cfm >= 0 ? g.cfm : options_.contact_cfm;
         dJointID cj = dJointCreateContact(world_, contacts_, &contact);
         dJointAttach(cj, b, nullptr);
+        const size_t k = contacts_out_.size();
+        dJointSetFeedback(cj, &contact_feedback_[k]);
+        const dReal* pos = contact.geom.pos;
+        ContactPoint& out = contacts_out_.emplace_back();
+        out.link = g.link;
+        out.position = Eigen::Vector3d(pos[0], pos[1], pos[2]);
       }
     }
   }
@@ -434,6 +452,10 @@ void OdeWorld::Step() {
     rand_state_ = dRandGetSeed();
   } else {
     dWorldStep(world_, options_.step);
+  }
+  for (size_t k = 0; k < contacts_out_.size(); ++k) {
+    const dReal* f = contact_feedback_[k].f1;
+    contacts_out_[k].force = {f[0], f[1], f[2]};
   }
   dJointGroupEmpty(contacts_);
   ++steps_;

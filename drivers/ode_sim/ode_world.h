@@ -45,6 +45,15 @@ struct OdeWorldOptions {
   std::uint32_t seed = 1;             ///< dRand state (used by quickstep)
 };
 
+/// One ground contact of the last Step(): the link whose shape touched the
+/// ground, the contact point and the force the ground exerted on the link
+/// (world frame, m and N).
+struct ContactPoint {
+  int link = -1;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+};
+
 class OdeWorld {
  public:
   /// Builds the world at joint positions q0 (size num_dofs). Throws Error for
@@ -61,6 +70,10 @@ class OdeWorld {
   void SetMotor(int dof, double velocity, double max_force);
   /// Applies `effort` (N·m | N) on the dof every step; turns the motor off.
   void SetEffort(int dof, double effort);
+  /// Ground contacts of `link`'s shapes become a spring-damper of `stiffness`
+  /// (N/m) and `damping` (N·s/m) per contact point (ODE's soft ERP/CFM at the
+  /// step), e.g. a humanoid's rubber soles; other links keep the world's.
+  void SetContactSpring(int link, double stiffness, double damping);
   /// Velocity of a kinematic first root, world frame (m/s, rad/s).
   void SetRootVelocity(const Eigen::Vector3d& v, const Eigen::Vector3d& w);
 
@@ -68,6 +81,8 @@ class OdeWorld {
   void Step();
 
   const Eigen::VectorXd& q() const { return q_; }
+  /// The ground contacts of the last Step() with their forces.
+  const std::vector<ContactPoint>& contacts() const { return contacts_out_; }
   const Eigen::VectorXd& qd() const { return qd_; }
   const Eigen::VectorXd& effort() const { return effort_; }
   /// World pose of a link's frame.
@@ -100,6 +115,8 @@ class OdeWorld {
   struct Geom {
     dGeomID geom = nullptr;
     bool frictionless = false;
+    int link = -1;
+    double erp = -1, cfm = -1;  // < 0: the world's contact_erp / contact_cfm
   };
 
   void BuildGroups();
@@ -132,6 +149,8 @@ class OdeWorld {
 
   Eigen::VectorXd q_, qd_, effort_;
   std::vector<dContactGeom> contact_scratch_;
+  std::vector<dJointFeedback> contact_feedback_;  // one per possible contact (sized when built)
+  std::vector<ContactPoint> contacts_out_;
   unsigned long rand_state_ = 1;
   std::int64_t steps_ = 0;
   int num_fused_ = 0, num_mesh_boxes_ = 0, num_skipped_meshes_ = 0;

@@ -21,6 +21,7 @@ using walking::Wrap;
 namespace {
 
 constexpr double kSettle = 1.0;       // s: from straight legs to the walking stance after start-up
+constexpr double kRamp = 0.3;         // s: the servo targets fade from the start-up joints to the IK's
 constexpr double kKneeDrop = 0.07;    // of the pelvis-to-sole height: how far the pelvis sinks to walk
 constexpr int kPreviewEvery = 5;      // physics steps per preview sample (5 ms at 1 kHz)
 constexpr int kQueuedSpeedSteps = 2;  // SETSPEED keeps this many steps planned ahead
@@ -113,7 +114,6 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
-  w->omega_lipm_ = std::sqrt(gravity / w->g_.com_height);
   return w;
 }
 
@@ -133,6 +133,7 @@ WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> fee
 
 void WalkingHumanoid::Attach(OdeWorld* world, const Eigen::VectorXd& vmax, const Eigen::VectorXd& fmax) {
   world_ = world;
+  for (int f : feet_) world_->SetContactSpring(f, kSoleStiffness, kSoleDamping);
   vmax_ = vmax;
   fmax_ = fmax;
   q_start_ = world_->q();
@@ -140,13 +141,22 @@ void WalkingHumanoid::Attach(OdeWorld* world, const Eigen::VectorXd& vmax, const
   BendKnees(model_, ik_.leg_mask(), q_ref_);  // the first solve starts bent; the servos follow from q_start_
   Eigen::Isometry3d pelvis;
   std::array<Eigen::Isometry3d, 2> soles;
-  const Pose2 p = MeasuredPelvis();
-  plan_to_world_ = {};  // the plan frame starts as the world
-  pattern_.Reset(p, p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y()));
+  // The plan frame starts as the world, the stance around the feet where
+  // they stand, the planned CoM at rest over them; DesiredPelvis() moves the
+  // pelvis there from where it stands during the first kSettle s.
+  plan_to_world_ = {};
+  const Pose2 l = MeasuredFoot(Side::kLeft), r = MeasuredFoot(Side::kRight);
+  Pose2 centre{0.5 * (l.x + r.x), 0.5 * (l.y + r.y), Wrap(r.theta + 0.5 * Wrap(l.theta - r.theta))};
+  const Eigen::Vector2d mid = centre.Apply(-g_.ankle_x, 0);
+  centre.x = mid.x();
+  centre.y = mid.y();
+  pattern_.Reset(centre, centre.Apply(g_.ankle_x + g_.zmp_x, 0));
+  pelvis_start_ = MeasuredPelvis().xy();
   settle_ticks_ = std::llround(kSettle / step_);
   DesiredPelvis(&pelvis, &soles);
   ik_.Solve(pelvis, soles, q_ref_);
-  q_prev_ = q_ref_;
+  q_prev_ = q_start_;
+  ramp_ticks_ = std::max<std::int64_t>(1, std::llround(kRamp / step_));
 }
 
 Pose2 WalkingHumanoid::MeasuredPelvis() const {
@@ -158,15 +168,18 @@ Pose2 WalkingHumanoid::MeasuredPelvis() const {
 Pose2 WalkingHumanoid::ToPlan(const Pose2& world) const { return Compose(Inverse(plan_to_world_), world); }
 Pose2 WalkingHumanoid::ToWorld(const Pose2& plan) const { return Compose(plan_to_world_, plan); }
 
-// The plan frame is re-anchored so that the pelvis the pattern wants now is
-// where the physics measures it.
+// The plan frame is re-anchored so that the planned support foot (on the
+// ground: the stance foot, or the left one in double support) is where the
+// physics measures it. The feet do not move while they carry the robot, so
+// this is the drift of the plan (slip) without the pelvis' tracking errors.
 void WalkingHumanoid::MapFrames() {
-  Eigen::Isometry3d pelvis;
-  std::array<Eigen::Isometry3d, 2> soles;
-  DesiredPelvis(&pelvis, &soles);
-  const Eigen::Vector3d fwd = pelvis.linear().col(0);
-  const Pose2 want{pelvis.translation().x(), pelvis.translation().y(), std::atan2(fwd.y(), fwd.x())};
-  plan_to_world_ = Compose(MeasuredPelvis(), Inverse(want));
+  const Side sup = pattern_.support_side();
+  plan_to_world_ = Compose(MeasuredFoot(sup), Inverse(pattern_.foot(sup)));
+}
+
+Pose2 WalkingHumanoid::MeasuredFoot(Side side) const {
+  const Eigen::Isometry3d f = world_->LinkPose(feet_[static_cast<size_t>(side)]);
+  return {f.translation().x(), f.translation().y(), std::atan2(f.linear()(1, 0), f.linear()(0, 0))};
 }
 
 void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
@@ -177,13 +190,16 @@ void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
   const Eigen::Vector2d com = pattern_.com();
   Pose2 p{0, 0, yaw};
   const Eigen::Vector2d off = p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y());
-  p.x = com.x() - off.x() + balance_.x();
-  p.y = com.y() - off.y() + balance_.y();
+  p.x = com.x() - off.x();
+  p.y = com.y() - off.y();
   double z = pelvis_z_;
-  if (tick_ < settle_ticks_) {  // sink smoothly from the straight-legged start
+  if (tick_ < settle_ticks_) {  // sink and move over the feet smoothly from the straight-legged start
     const double s = static_cast<double>(tick_) / static_cast<double>(settle_ticks_);
+    const double blend = 0.5 * (1 - std::cos(std::numbers::pi * s));
     const double z0 = pelvis_z_ / (1 - kKneeDrop) - 0.002;
-    z = z0 + (pelvis_z_ - z0) * 0.5 * (1 - std::cos(std::numbers::pi * s));
+    z = z0 + (pelvis_z_ - z0) * blend;
+    p.x = pelvis_start_.x() + (p.x - pelvis_start_.x()) * blend;
+    p.y = pelvis_start_.y() + (p.y - pelvis_start_.y()) * blend;
   }
   *pelvis = Planar(p, z);
   (*soles)[0] = Planar(l, pattern_.foot_height(Side::kLeft));
@@ -330,22 +346,29 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
     }
     return;
   }
+  MeasureContacts();
   if (mode_ == Mode::kSpeed) KeepSpeedStepsQueued();
   pattern_.Tick();
-  if (tick_ > settle_ticks_) Balance();
   Eigen::Isometry3d pelvis;
   std::array<Eigen::Isometry3d, 2> soles;
   DesiredPelvis(&pelvis, &soles);
   ik_.Solve(pelvis, soles, q_ref_);
   com_in_pelvis_ = ik_.ComInPelvis(q_ref_);
+  // The servos' targets: the IK's, faded in from the joints at start-up
+  // (the first bent-knee solution is not where the straight legs stand).
+  const double ramp = std::min(1.0, static_cast<double>(tick_) / static_cast<double>(ramp_ticks_));
+  const double fade = 0.5 * (1 - std::cos(std::numbers::pi * ramp));
+  tracking_error_ = 0;
   for (Eigen::Index i = 0; i < q.size(); ++i) {
     if (!Owns(i)) continue;
-    const double qd_ref = (q_ref_[i] - q_prev_[i]) / step_;
-    const double v = std::clamp(qd_ref + kKp * (q_ref_[i] - q[i]), -vmax_[i], vmax_[i]);
+    const double target = q_start_[i] + fade * (q_ref_[i] - q_start_[i]);
+    tracking_error_ = std::max(tracking_error_, std::abs(q_prev_[i] - q[i]));
+    const double qd_ref = (target - q_prev_[i]) / step_;
+    const double v = std::clamp(qd_ref + kKp * (target - q[i]), -vmax_[i], vmax_[i]);
     world_->SetMotor(static_cast<int>(i), v, fmax_[i]);
+    q_prev_[i] = target;
   }
-  q_prev_ = q_ref_;
-  if (mode_ == Mode::kGoto && pattern_.standing()) {
+  if (mode_ == Mode::kGoto && pattern_.settled(kSettled)) {
     FinishGoto(completed);
   } else if (mode_ == Mode::kGoto && pattern_.started_steps() - replanned_at_ >= kReplanSteps &&
              pattern_.unstarted_steps() > 2) {
@@ -353,28 +376,21 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   }
 }
 
-// The CoM measured on the physics against the planned one, each relative to
-// its support foot (the measured foot's yaw error rotated out), so that the
-// world drift of the plan does not count; the pelvis moves against the error
-// of the divergent component e + e'/omega, which shifts the ZMP the way that
-// brings the CoM back (ankle torque through the stiff joint servos).
-void WalkingHumanoid::Balance() {
-  const Side sup = pattern_.support_side();
-  const Eigen::Isometry3d fm = world_->LinkPose(feet_[static_cast<size_t>(sup)]);
-  const double yaw_m = std::atan2(fm.linear()(1, 0), fm.linear()(0, 0));
-  const Pose2& fp = pattern_.foot(sup);
-  const Eigen::Vector3d com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
-  const Eigen::Vector2d rel_m =
-      Eigen::Rotation2Dd(fp.theta - yaw_m) * (com.head<2>() - fm.translation().head<2>());
-  const Eigen::Vector2d rel_p = pattern_.com() - fp.xy();
-  const Eigen::Vector2d e = rel_m - rel_p;
-  if (sup != support_prev_) err_prev_ = e;  // the reference foot changed: no rate from the jump
-  support_prev_ = sup;
-  const double a = step_ / 0.02;  // 20 ms low-pass on the rate
-  err_rate_ += a * ((e - err_prev_) / step_ - err_rate_);
-  err_prev_ = e;
-  const Eigen::Vector2d dcm = e + err_rate_ / omega_lipm_;
-  balance_ = (-kBalanceGain * dcm).cwiseMax(-kBalanceLimit).cwiseMin(kBalanceLimit);
+void WalkingHumanoid::MeasureContacts() {
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  double fz = 0;
+  foot_force_[0] = foot_force_[1] = 0;
+  foot_contacts_[0] = foot_contacts_[1] = 0;
+  for (const ContactPoint& c : world_->contacts()) {
+    for (int s = 0; s < 2; ++s) {
+      if (c.link != feet_[static_cast<size_t>(s)]) continue;
+      foot_force_[s] += c.force.z();
+      ++foot_contacts_[s];
+    }
+    fz += c.force.z();
+    moment += c.force.z() * c.position;
+  }
+  if (fz > 1e-6) zmp_measured_ = moment.head<2>() / fz;
 }
 
 walking::WalkStatus WalkingHumanoid::status() const {
@@ -392,6 +408,17 @@ walking::WalkStatus WalkingHumanoid::status() const {
     s.foot_height[i] = pattern_.foot_height(static_cast<Side>(i));
   }
   s.pelvis = MeasuredPelvis();
+  s.zmp = zmp_measured_;
+  s.tracking_error = tracking_error_;
+  for (int i = 0; i < 2; ++i) {
+    s.foot_force[i] = foot_force_[i];
+    s.foot_contacts[i] = foot_contacts_[i];
+  }
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Isometry3d f = world_->LinkPose(feet_[static_cast<size_t>(i)]);
+    s.foot_measured[i] = MeasuredFoot(static_cast<Side>(i));
+    s.foot_tilt[i] = std::acos(std::clamp(f.linear()(2, 2), -1.0, 1.0));
+  }
   s.com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
   return s;
 }

@@ -33,15 +33,23 @@ class WalkingHumanoid {
  public:
   /// Motor gain of the leg servos: v = qd_ref + kKp (q_ref - q), 1/s.
   static constexpr double kKp = 100.0;
+  /// The soles' ground contacts: a spring-damper per contact point (N/m,
+  /// N·s/m), a rubber sole. With ODE's default stiff contacts a sole rests
+  /// on two corners (a 0.01 rad tilt lifts the others) and the robot rocks
+  /// heel to toe for seconds; its stance foot then turns on one corner.
+  /// Here the weight presses each corner ~0.6 mm in, so a sole lies flat on
+  /// four contacts, and the damping stops the rocking (docs/ode_sim.md).
+  static constexpr double kSoleStiffness = 2e5, kSoleDamping = 4e3;
   /// Torso tilt beyond which the robot counts as fallen, rad.
   static constexpr double kFallTilt = 0.6;
   /// GOTO: success within these (m, rad), as the issue asks; re-plans at most kRetries times.
   static constexpr double kTolerance = 0.05, kHeadingTolerance = 0.05;
   static constexpr int kRetries = 4;
+  /// A GOTO is judged when the planned CoM has come to rest over the feet:
+  /// within this (m) of the reference ZMP and slower than this per second.
+  static constexpr double kSettled = 2e-3;
   /// During a GOTO, re-plan from the measured pose every this many steps.
   static constexpr int kReplanSteps = 4;
-  /// Pelvis shift per metre of divergent-component error (CoM + CoM rate / omega) and its bound, m.
-  static constexpr double kBalanceGain = 1.0, kBalanceLimit = 0.04;
 
   /// The controller if `model` can walk: a floating first root and two feet
   /// found by name (left_foot/right_foot, l_foot/r_foot) with a box
@@ -71,6 +79,8 @@ class WalkingHumanoid {
   WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
                   const walking::GaitParams& g, double gravity, double step);
   walking::Pose2 MeasuredPelvis() const;
+  walking::Pose2 MeasuredFoot(
+      walking::Side side) const;  ///< the ankle point on the ground and the foot's yaw
   walking::Pose2 ToPlan(const walking::Pose2& world) const;
   walking::Pose2 ToWorld(const walking::Pose2& plan) const;
   void MapFrames();
@@ -88,10 +98,11 @@ class WalkingHumanoid {
   std::array<int, 2> feet_;
   std::vector<std::uint8_t> owned_;
   Eigen::VectorXd vmax_, fmax_;
-  Eigen::VectorXd q_ref_, q_prev_, q_start_, q_stance_;
+  Eigen::VectorXd q_ref_, q_prev_, q_start_, q_stance_;  // IK solution, last servo target, start-up, stance
   Eigen::Vector3d com_in_pelvis_ = Eigen::Vector3d::Zero();
   double pelvis_z_ = 0;
-  std::int64_t tick_ = 0, settle_ticks_ = 0;
+  Eigen::Vector2d pelvis_start_ = Eigen::Vector2d::Zero();  // the pelvis at Attach(), world = plan frame
+  std::int64_t tick_ = 0, settle_ticks_ = 0, ramp_ticks_ = 1;
   // Plan frame -> world (planar), set when a plan is made.
   walking::Pose2 plan_to_world_;
   Mode mode_ = Mode::kIdle;
@@ -102,13 +113,11 @@ class WalkingHumanoid {
   double v_ = 0, vy_ = 0, omega_ = 0;  // SETSPEED per second
   bool fallen_ = false;
   double tilt_ = 0;
-  // Balance: the measured CoM's (and divergent component's) error against the
-  // plan, both relative to the support foot, moves the pelvis (kBalanceGain).
-  Eigen::Vector2d balance_ = Eigen::Vector2d::Zero(), err_prev_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d err_rate_ = Eigen::Vector2d::Zero();
-  walking::Side support_prev_ = walking::Side::kLeft;
-  double omega_lipm_ = 3.7;  // sqrt(g / zc), 1/s
-  void Balance();
+  void MeasureContacts();
+  double foot_force_[2] = {0, 0};
+  int foot_contacts_[2] = {0, 0};
+  Eigen::Vector2d zmp_measured_ = Eigen::Vector2d::Zero();  // world
+  double tracking_error_ = 0;
 };
 
 }  // namespace robotalk::ode_detail

@@ -141,7 +141,43 @@ TEST(WalkPattern, TheZmpStaysInTheSupportPolygonOnWalksToFiveGoals) {
   }
 }
 
-TEST(WalkPattern, StopSoonEndsWithinTwoStepsInDoubleSupport) {
+TEST(WalkPattern, TheCoMSettlesOverTheFinalStanceSoonAfterTheLastShift) {
+  const GaitParams g;
+  WalkPattern w(g, 0.001, 5, 9.81);
+  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+  const Pose2 goal{0.3, 0.1, 0.4};
+  const std::vector<PlannedStep> plan = PlanFootsteps({}, goal, g);
+  std::vector<Footstep> steps;
+  std::vector<Pose2> centres;
+  for (const PlannedStep& p : plan) {
+    steps.push_back(p.step);
+    centres.push_back(p.centre);
+  }
+  w.Append(steps, centres);
+  EXPECT_FALSE(w.settled(2e-3)) << "a walk is scheduled";
+  int ticks = 0;
+  while (!w.standing() && ticks < 100000) {
+    EXPECT_FALSE(w.settled(2e-3));
+    w.Tick();
+    ++ticks;
+  }
+  const Eigen::Vector2d want = goal.Apply(g.ankle_x + g.zmp_x, 0);
+  const double at_standing = (w.com() - want).norm();
+  int more = 0;
+  while (!w.settled(2e-3) && more < 3000) {
+    w.Tick();
+    ++more;
+  }
+  EXPECT_TRUE(w.settled(2e-3));
+  EXPECT_LT(more * 0.001, 1.5) << "settles within 1.5 s of standing";
+  EXPECT_LT((w.com() - want).norm(), 2e-3);
+  EXPECT_GT(at_standing, (w.com() - want).norm()) << "the CoM was still on its way when the shift ended";
+}
+
+// STOP in single support (the step in the air and one more) and in double
+// support (one more step): the ZMP stays inside the feet with a margin, the
+// reference never jumps, and the walk ends within two steps, feet side by side.
+void StopAt(int tick) {
   const GaitParams g;
   WalkPattern w(g, 0.001, 5, 9.81);
   w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
@@ -153,19 +189,29 @@ TEST(WalkPattern, StopSoonEndsWithinTwoStepsInDoubleSupport) {
     centres.push_back(p.centre);
   }
   w.Append(steps, centres);
-  for (int i = 0; i < 3300; ++i) w.Tick();  // in the air during the third step
-  ASSERT_FALSE(w.double_support());
+  for (int i = 0; i < tick; ++i) w.Tick();
+  const bool in_air = !w.double_support();
   const double before = w.time();
+  const int started = w.started_steps();
   w.StopSoon();
   EXPECT_LE(w.unstarted_steps(), 1);
+  Eigen::Vector2d ref = w.zmp_ref();
   while (!w.standing()) {
     w.Tick();
-    ASSERT_TRUE(w.InSupport(w.zmp(), 0.0));
+    ASSERT_TRUE(w.InSupport(w.zmp(), 0.01)) << "stop at tick " << tick << ", t=" << w.time();
+    ASSERT_LT((w.zmp_ref() - ref).norm(), 1e-3) << "stop at tick " << tick << ", t=" << w.time();
+    ref = w.zmp_ref();
   }
+  EXPECT_LE(w.started_steps() - started, 1) << "in the air: " << in_air;
   EXPECT_LE(w.time() - before, 2 * g.step_period() + g.end_shift);
   EXPECT_TRUE(w.double_support());
   const Pose2 l = w.foot(Side::kLeft), r = w.foot(Side::kRight);
   EXPECT_NEAR(std::hypot(l.x - r.x, l.y - r.y), g.foot_separation, 1e-9) << "feet side by side";
+}
+
+TEST(WalkPattern, StopSoonEndsWithinTwoStepsInDoubleSupport) {
+  // Steps start every 1.1 s from 1.8 s: single support 0.8 s, double 0.3 s.
+  for (int tick : {3300, 3800, 3950, 5000}) StopAt(tick);
 }
 
 TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {

@@ -108,8 +108,11 @@ Eigen::Vector2d WalkPattern::ZmpAt(std::int64_t tick) const {
 
 void WalkPattern::Append(const std::vector<Footstep>& steps, const std::vector<Pose2>& centres) {
   if (steps.empty()) return;
-  const bool restart = steps_.empty() || tick_ >= steps_.back().start + ss_ticks_;
-  if (restart) {  // from standing (or from the end shift: start again from the feet as they are)
+  // In the last step's double support the schedule goes on (the next step
+  // starts where it would have); later, in the end shift or standing, the
+  // walk starts again from the feet as they are.
+  const bool restart = steps_.empty() || tick_ >= steps_.back().start + ss_ticks_ + ds_ticks_;
+  if (restart) {
     rest_[0] = foot_[0];
     rest_[1] = foot_[1];
     steps_.clear();
@@ -169,6 +172,10 @@ Pose2 WalkPattern::StopSoon() {
 }
 
 bool WalkPattern::standing() const { return steps_.empty() || tick_ >= EndTick(); }
+
+bool WalkPattern::settled(double tolerance) const {
+  return standing() && (com() - zmp_ref()).norm() <= tolerance && com_velocity().norm() <= tolerance;
+}
 
 int WalkPattern::unstarted_steps() const {
   int n = 0;

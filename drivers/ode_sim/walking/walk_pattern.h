@@ -40,7 +40,9 @@ class WalkPattern {
 
   /// Standing with both feet around `centre`, the CoM at `com` (xy), at rest.
   void Reset(const Pose2& centre, const Eigen::Vector2d& com);
-  /// Appends steps (with their centres) to the schedule; starts walking if standing.
+  /// Appends steps (with their centres) to the schedule; starts walking if
+  /// standing or in the final shift of weight (after `start_lead`), else the
+  /// first new step follows the last one's double support without a pause.
   void Append(const std::vector<Footstep>& steps, const std::vector<Pose2>& centres);
   /// Cuts the schedule: keeps the step in the air (or, in double support,
   /// none), then one step that brings the other foot alongside. Returns the
@@ -55,6 +57,11 @@ class WalkPattern {
 
   /// True when no step is scheduled or running and the end shift is over.
   bool standing() const;
+  /// Standing and the planned CoM at rest over the reference ZMP: within
+  /// `tolerance` (m) of it and slower than `tolerance` per second. The
+  /// preview's CoM settles a few tenths of a second after the last shift of
+  /// weight ends (standing() turns true).
+  bool settled(double tolerance = 1e-3) const;
   /// Steps scheduled but not yet started (the one in the air excluded).
   int unstarted_steps() const;
   /// Time until the end of the schedule's last step, s (0 when standing).

@@ -21,6 +21,13 @@ struct WalkStatus {
   // Measured.
   Eigen::Vector3d com = Eigen::Vector3d::Zero();  ///< whole-body CoM from the physics, m
   Pose2 pelvis;                                   ///< the root's planar pose
+  Pose2 foot_measured[2];                         ///< the feet's planar poses (ankle point, yaw)
+  double foot_tilt[2] = {0, 0};                   ///< the soles' tilt from level, rad
+  double foot_force[2] = {0, 0};                  ///< vertical ground force on each foot, N
+  int foot_contacts[2] = {0, 0};                  ///< contact points of each sole
+  Eigen::Vector2d zmp =
+      Eigen::Vector2d::Zero();  ///< centre of pressure of the ground forces (plan frame mapped to the world)
+  double tracking_error = 0;    ///< largest |q_ref - q| over the leg joints, rad
 };
 
 }  // namespace robotalk::walking
