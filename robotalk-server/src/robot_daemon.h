@@ -44,6 +44,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -240,9 +241,12 @@ class RobotDaemon {
   bool halt_requested_ = false;    // GUARDED_BY(mutex_)
   bool resume_requested_ = false;  // GUARDED_BY(mutex_)
   bool wake_flag_ = false;         // GUARDED_BY(mutex_)
-  bool running_ = false;           // GUARDED_BY(mutex_)
-  std::uint64_t pushes_ = 0;       // GUARDED_BY(mutex_): items submitted so far
-  std::string timing_;             // GUARDED_BY(mutex_)
+  /// The deadline the thread waits for; nullopt while it runs (Submit wakes it
+  /// only for an item due before this).
+  std::optional<TimePoint> sleeping_until_;  // GUARDED_BY(mutex_)
+  bool running_ = false;                     // GUARDED_BY(mutex_)
+  std::uint64_t pushes_ = 0;                 // GUARDED_BY(mutex_): items submitted so far
+  std::string timing_;                       // GUARDED_BY(mutex_)
   std::atomic<bool> panic_{false};
   std::atomic<bool> flush_deferred_{false};              // Panic() could not take mutex_ to flush
   std::atomic<Duration::rep> snapshot_wanted_until_{0};  // a query came: snapshot until then
