@@ -78,6 +78,9 @@ TEST(ReturnCache, FailWakesTheWaiterWithTheReason) {
   ReturnCache cache;
   cache.Expect(3);
   std::thread t([&] {
+    // Real time (WaitTake's deadline is on the steady clock by design: blocking
+    // calls time out in real time): 20 ms for the waiter to block first, so
+    // that the wake-up is what is tested; a Fail before the wait gives the same.
     std::this_thread::sleep_for(milliseconds(20));
     cache.Fail(3, "gave up");
   });

@@ -10,6 +10,7 @@
 // for a result.
 #include "robotalk/robot_client.h"
 #include "client/faulty_transport.h"
+#include "client/real_server_support.h"
 #include "kinematic_driver.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
@@ -34,139 +35,12 @@ namespace {
 
 using std::chrono::milliseconds;
 using std::chrono::seconds;
-using testing::Direction;
-using testing::FaultyTransport;
+using namespace robotalk::testing;  // NOLINT: the helpers of real_server_support.h
 using ::testing::HasSubstr;
 
 const std::string kRobot = "pioneer";
 const std::string kRequests = RequestChannel(kRobot);
 const std::string kReplies = "ROBOTALK/" + kRobot + "/REPLY/.*";
-
-// The steady clock moved by a fixed offset: the client's clock, 1000 s behind
-// the server's, so that the measured clock offset cannot be right by accident.
-// (The server itself must run on the steady clock: its RobotDaemon sleeps
-// until deadlines on std::chrono::steady_clock.)
-class OffsetClock final : public Clock {
- public:
-  explicit OffsetClock(Duration offset) : offset_(offset) {}
-  TimePoint Now() const override { return steady_.Now() + offset_; }
-
- private:
-  SteadyClock steady_;
-  Duration offset_;
-};
-
-// What the server asked of the driver, by command type and first value (the
-// server gives the driver ids of its own, so tests tell their commands apart
-// by value); read by the test thread while the RobotDaemon's thread writes it.
-class DriverLog {
- public:
-  void Executed(const DriverCommand& c) {
-    std::lock_guard lock(mu_);
-    ++executed_[{c.type, c.num_values > 0 ? c.values[0] : 0.0}];
-  }
-  void Halted(bool halted) {
-    std::lock_guard lock(mu_);
-    halted_ = halted;
-  }
-  int executions(CommandType type, double first_value) const {
-    std::lock_guard lock(mu_);
-    auto it = executed_.find({type, first_value});
-    return it == executed_.end() ? 0 : it->second;
-  }
-  int total() const {
-    std::lock_guard lock(mu_);
-    int n = 0;
-    for (const auto& [key, count] : executed_) n += count;
-    return n;
-  }
-  bool halted() const {
-    std::lock_guard lock(mu_);
-    return halted_;
-  }
-
- private:
-  mutable std::mutex mu_;
-  std::map<std::pair<CommandType, double>, int> executed_;
-  bool halted_ = false;
-};
-
-// The kinematic driver, logging each Execute, Halt and Resume.
-class CountingDriver final : public Driver {
- public:
-  CountingDriver(std::unique_ptr<Driver> inner, std::shared_ptr<DriverLog> log)
-      : inner_(std::move(inner)), log_(std::move(log)) {}
-  const RobotModel& model() const override { return inner_->model(); }
-  Duration period() const override { return inner_->period(); }
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
-    log_->Executed(c);
-    return inner_->Execute(c, now, done);
-  }
-  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
-  void ReadState(RobotState& s) const override { inner_->ReadState(s); }
-  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
-  void Halt(std::vector<Completion>& done) override {
-    log_->Halted(true);
-    inner_->Halt(done);
-  }
-  void Resume() override {
-    log_->Halted(false);
-    inner_->Resume();
-  }
-
- private:
-  std::unique_ptr<Driver> inner_;
-  std::shared_ptr<DriverLog> log_;
-};
-
-// --- Filters on wire bytes, for FaultyTransport faults ------------------------
-
-bool IsHeartbeat(const std::string&, std::span<const std::uint8_t> bytes) {
-  try {
-    const auto p = DecodePackage(bytes);
-    return p.header.payload_size == 0 && !p.header.panic;
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-bool HasPayload(const std::string&, std::span<const std::uint8_t> bytes) {
-  try {
-    return DecodePackage(bytes).header.payload_size > 0;
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-bool HasReplies(const std::string&, std::span<const std::uint8_t> bytes) {
-  try {
-    return !DecodeReplyPackage(bytes).replies.empty();
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-// True for a package whose (client, sequence) was seen before: a retransmission or a duplicate.
-testing::MessageFilter Repeated() {
-  auto seen = std::make_shared<std::set<std::pair<std::int64_t, std::int64_t>>>();
-  return [seen](const std::string&, std::span<const std::uint8_t> bytes) {
-    try {
-      const auto p = DecodePackage(bytes);
-      return !seen->insert({p.header.client_id, p.header.sequence}).second;
-    } catch (const std::exception&) {
-      return false;
-    }
-  };
-}
-
-// Polls `done` every millisecond for at most `bound` of real time (the
-// server's and the client's threads run on their own); returns done().
-template <typename Done>
-bool WaitUntil(Done done, Duration bound = seconds(5)) {
-  const auto end = std::chrono::steady_clock::now() + bound;
-  while (!done() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(milliseconds(1));
-  return done();
-}
 
 class RobotClientTest : public ::testing::Test {
  protected:
@@ -383,6 +257,29 @@ TEST_F(RobotClientTest, ScheduledCommandIsAnsweredAfterItsStartEvenIfTheReplyIsL
   EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.3), 1);
   EXPECT_EQ(Counts(server_net_, lost).dropped, 1u);
   EXPECT_GE(Counts(server_net_, repeats).matched, 1u);  // the resend after the start recovered the reply
+}
+
+// The network holds every reply until the test lets them go (a delay no clock
+// reaches): the client resends meanwhile, the server answers each resend from
+// its reply cache, the command runs once, and the late reply reaches its caller.
+TEST_F(RobotClientTest, RepliesHeldByTheNetworkArriveLateAndTheCommandRunsOnce) {
+  StartServer();
+  ClientOptions o = Options();
+  o.retransmit_interval = milliseconds(20);
+  auto client = Connected(o);
+  const auto held = server_net_.Add({.channel_regex = kReplies, .delay = std::chrono::hours(1)});
+  const auto repeats =
+      server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming, .when = Repeated()});
+  PendingReply p =
+      client->Send(Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.4}});
+  ASSERT_TRUE(WaitUntil([&] { return Counts(server_net_, repeats).matched >= 2; }));  // resent twice
+  EXPECT_FALSE(p.Poll().has_value());
+  EXPECT_GE(server_net_.held(), 3u);  // the first answer and one per resend
+  server_net_.Remove(held);           // lets them go
+  const Reply r = p.Wait(seconds(2));
+  EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+  EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.4), 1);
+  EXPECT_TRUE(WaitUntil([&] { return client->stats().replies_ignored > 0; }));  // the copies of the reply
 }
 
 TEST_F(RobotClientTest, BlockingCallTimesOutWhenTheServerFallsSilent) {
