@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <exception>
 #include <random>
 
 namespace robotalk {
@@ -38,15 +39,40 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
     server_id_ = static_cast<std::int64_t>((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
   }
   gate_ = std::make_unique<SessionGate>(server_id_, options_.gate);
-  hello_subscription_ = transport_.Subscribe(
-      kAnyHelloChannelRegex,
-      [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnHello(channel, bytes); });
-  subscription_ = transport_.Subscribe(
-      kAnyRequestChannelRegex,
-      [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnRequest(channel, bytes); });
-  announce_subscription_ = transport_.Subscribe(
-      kAnnounceChannel,
-      [this](const std::string&, std::span<const std::uint8_t> bytes) { OnAnnounce(bytes); });
+  const auto subscribe = [this] {
+    hello_subscription_ = transport_.Subscribe(
+        kAnyHelloChannelRegex,
+        [this](const std::string& channel, std::span<const std::uint8_t> bytes) { OnHello(channel, bytes); });
+    subscription_ = transport_.Subscribe(
+        kAnyRequestChannelRegex, [this](const std::string& channel, std::span<const std::uint8_t> bytes) {
+          OnRequest(channel, bytes);
+        });
+    announce_subscription_ = transport_.Subscribe(
+        kAnnounceChannel,
+        [this](const std::string&, std::span<const std::uint8_t> bytes) { OnAnnounce(bytes); });
+  };
+  if (options_.fifo_priority <= 0) {
+    subscribe();
+    return;
+  }
+  // LCM starts a subscription's receive thread on the subscribing thread, and
+  // a new thread inherits its creator's policy: subscribing from a thread at
+  // the ServerDaemon's SCHED_FIFO priority puts LCM's receive threads there
+  // too. Equal FIFO priorities do not preempt each other, so under load the
+  // receive thread reads every waiting datagram before the ServerDaemon runs
+  // and handles them in one wake-up, instead of a thread switch per package.
+  std::exception_ptr error;
+  std::thread([&] {
+    sched_param param{};
+    param.sched_priority = options_.fifo_priority;
+    pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);  // not permitted: as before
+    try {
+      subscribe();
+    } catch (...) {
+      error = std::current_exception();
+    }
+  }).join();
+  if (error) std::rethrow_exception(error);
 }
 
 ServerDaemon::~ServerDaemon() {

@@ -67,7 +67,10 @@ struct ServerDaemonOptions {
   /// process may (0 = never), below the RobotDaemons' (RobotDaemonOptions):
   /// on a machine busy with other processes (64 clients on 2 cores) the
   /// server keeps the CPU it needs instead of 1/65 of it. It only runs when a
-  /// package or output is there (it sleeps in poll()). 0 = off
+  /// package or output is there (it sleeps in poll()). LCM's receive threads
+  /// of its subscriptions are started at the same priority (see the
+  /// constructor): under load they read every waiting datagram before the
+  /// ServerDaemon runs, one wake-up for many packages. 0 = off
   /// (robotalk::Server: with the RobotDaemons' timing option).
   int fifo_priority = 5;
 };

@@ -76,6 +76,31 @@ class ServerDaemonTest : public ::testing::Test {
   std::map<std::pair<std::string, std::int64_t>, std::int64_t> sessions_;
 };
 
+// A transport whose subscriptions cannot be made (LCM could not start a lane).
+class RefusingTransport final : public Transport {
+ public:
+  void Publish(const std::string&, std::span<const std::uint8_t>) override {}
+  std::unique_ptr<Subscription> Subscribe(const std::string& regex, Handler) override {
+    throw TransportError("cannot listen on '" + regex + "'");
+  }
+  int HandleFor(Duration) override { return 0; }
+  int fileno() const override { return -1; }
+  std::string url() const override { return "refusing://"; }
+};
+
+TEST(ServerDaemon, ASubscriptionErrorReachesItsCreatorWithOrWithoutTheFifoSubscribingThread) {
+  // With fifo_priority the subscriptions are made on a short-lived thread (so
+  // LCM's receive threads inherit the priority); its error must still be the
+  // constructor's.
+  RefusingTransport transport;
+  ManualClock clock;
+  for (int priority : {0, 5}) {
+    EXPECT_THROW(ServerDaemon(transport, clock, ServerDaemonOptions{.fifo_priority = priority}),
+                 TransportError)
+        << "fifo_priority " << priority;
+  }
+}
+
 TEST_F(ServerDaemonTest, RoutesAPackageToItsRobotAndAnswersOnTheClientsReplyChannel) {
   Request r{.client_id = kAlice, .sequence = 1};
   r.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
