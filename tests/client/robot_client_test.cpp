@@ -25,9 +25,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <map>
 #include <mutex>
-#include <set>
 #include <thread>
 
 namespace robotalk {
@@ -77,8 +75,6 @@ class RobotClientTest : public ::testing::Test {
     c->Connect(kRobot);
     return c;
   }
-  testing::FaultCounts Counts(FaultyTransport& net, FaultyTransport::FaultId id) { return net.counts(id); }
-
   // The server's and the client's endpoints of one in-process bus, each
   // behind a FaultyTransport: faults on what the server sends or receives,
   // and on what the client sends.
@@ -153,7 +149,7 @@ TEST_F(RobotClientTest, AServerRestartAnswersOutstandingCommandsAsUnknownOutcome
   const Reply r = client->Stop();  // a new session with the new instance
   EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
   EXPECT_EQ(client->stats().sessions_opened, 2u);
-  EXPECT_GE(Counts(server_net_, hellos).matched, 2u);
+  EXPECT_GE(server_net_.counts(hellos).matched, 2u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.1 * i), 0)
         << "never re-sent to the new instance";
@@ -192,8 +188,8 @@ TEST_F(RobotClientTest, SurvivesDroppedAndDuplicatedPackagesEachCommandOnce) {
   const ClientStats s = client->stats();
   EXPECT_GT(s.retransmissions, 0u);
   EXPECT_GT(s.replies_ignored, 0u);  // duplicated reply packages
-  EXPECT_GT(Counts(server_net_, replies).dropped, 0u);
-  EXPECT_GT(Counts(server_net_, repeats).matched, 0u);  // the server saw packages again
+  EXPECT_GT(server_net_.counts(replies).dropped, 0u);
+  EXPECT_GT(server_net_.counts(repeats).matched, 0u);  // the server saw packages again
   EXPECT_EQ(log_->total(), 40);
 }
 
@@ -220,7 +216,7 @@ TEST_F(RobotClientTest, BatchRepliesInReverseOrderReachTheirOwnCallers) {
   ASSERT_EQ(pending.size(), 5u);
   // The batch is released when its fifth package is held; should a busy
   // server thread have put two replies in one package, release the rest.
-  WaitUntil([&] { return Counts(server_net_, reversed).released >= 5; }, seconds(3));
+  WaitUntil([&] { return server_net_.counts(reversed).released >= 5; }, seconds(3));
   server_net_.ReleaseAll();
   std::vector<Reply> replies;
   for (std::size_t i = 0; i < pending.size(); ++i) {
@@ -233,9 +229,9 @@ TEST_F(RobotClientTest, BatchRepliesInReverseOrderReachTheirOwnCallers) {
       EXPECT_GT(r.exec_time, replies[i - 1].exec_time);  // it ran at its own start
     }
   }
-  EXPECT_GE(Counts(server_net_, reversed).held, 2u);
-  EXPECT_EQ(Counts(server_net_, reversed).released, Counts(server_net_, reversed).held);
-  EXPECT_EQ(Counts(server_net_, sent).matched, 1u);  // the batch travelled as one package
+  EXPECT_GE(server_net_.counts(reversed).held, 2u);
+  EXPECT_EQ(server_net_.counts(reversed).released, server_net_.counts(reversed).held);
+  EXPECT_EQ(server_net_.counts(sent).matched, 1u);  // the batch travelled as one package
 }
 
 TEST_F(RobotClientTest, ScheduledCommandIsAnsweredAfterItsStartEvenIfTheReplyIsLost) {
@@ -255,8 +251,8 @@ TEST_F(RobotClientTest, ScheduledCommandIsAnsweredAfterItsStartEvenIfTheReplyIsL
   EXPECT_GE(waited, milliseconds(290));
   EXPECT_LT(waited, seconds(2));
   EXPECT_EQ(log_->executions(CommandType::kJointSetPoint, 0.3), 1);
-  EXPECT_EQ(Counts(server_net_, lost).dropped, 1u);
-  EXPECT_GE(Counts(server_net_, repeats).matched, 1u);  // the resend after the start recovered the reply
+  EXPECT_EQ(server_net_.counts(lost).dropped, 1u);
+  EXPECT_GE(server_net_.counts(repeats).matched, 1u);  // the resend after the start recovered the reply
 }
 
 // The network holds every reply until the test lets them go (a delay no clock
@@ -272,7 +268,7 @@ TEST_F(RobotClientTest, RepliesHeldByTheNetworkArriveLateAndTheCommandRunsOnce) 
       server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming, .when = Repeated()});
   PendingReply p =
       client->Send(Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.4}});
-  ASSERT_TRUE(WaitUntil([&] { return Counts(server_net_, repeats).matched >= 2; }));  // resent twice
+  ASSERT_TRUE(WaitUntil([&] { return server_net_.counts(repeats).matched >= 2; }));  // resent twice
   EXPECT_FALSE(p.Poll().has_value());
   EXPECT_GE(server_net_.held(), 3u);  // the first answer and one per resend
   server_net_.Remove(held);           // lets them go
@@ -368,7 +364,7 @@ TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
     });
     client = Connected(o);
   }
-  const auto received = [&] { return Counts(server_net_, heartbeats).matched; };
+  const auto received = [&] { return server_net_.counts(heartbeats).matched; };
   const std::uint64_t before = received();
   for (std::uint64_t k = 1; k <= 4; ++k) {
     clock.Advance(milliseconds(50));
@@ -503,8 +499,8 @@ TEST_F(RobotClientTest, ListRobotsDedupesAnnouncements) {
   // is not passed on to the ServerDaemon), so hearing each server twice takes 2 s.
   const auto robots = ListRobots(Options(), milliseconds(2100));
   second.Stop();
-  EXPECT_GE(Counts(client_net_, heard).matched, 3u);  // some server heard more than once
-  ASSERT_EQ(robots.size(), 2u);                       // one robot, two servers
+  EXPECT_GE(client_net_.counts(heard).matched, 3u);  // some server heard more than once
+  ASSERT_EQ(robots.size(), 2u);                      // one robot, two servers
   for (const auto& robot : robots) {
     EXPECT_EQ(robot.name, kRobot);
     EXPECT_EQ(robot.config_hash, ConfigHash(model_));
