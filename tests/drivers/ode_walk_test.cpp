@@ -12,7 +12,12 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace robotalk {
 namespace {
@@ -20,13 +25,12 @@ namespace {
 using testing::ProjectModel;
 
 struct Walker {
-  Walker() {
+  explicit Walker(const std::string& urdf = ProjectModel("simple_humanoid.urdf")) {
     DriverRegistry registry;
     RegisterOdeDriver(registry);
-    std::unique_ptr<Driver> d =
-        registry.Create("ode", DriverConfig{.robot_name = "",
-                                            .urdf_path = ProjectModel("simple_humanoid.urdf"),
-                                            .options = {{"walk", "true"}, {"seed", "7"}}});
+    std::unique_ptr<Driver> d = registry.Create(
+        "ode",
+        DriverConfig{.robot_name = "", .urdf_path = urdf, .options = {{"walk", "true"}, {"seed", "7"}}});
     driver.reset(static_cast<OdeDriver*>(d.release()));
     driver->Step(1, done);
   }
@@ -152,6 +156,40 @@ TEST(OdeWalk, SetSpeedWalksAtTheClampedRateAndPanicStopsStepping) {
   w.Run(1.0);
   EXPECT_FALSE(w.driver->walk_status()->fallen);
   EXPECT_LT(w.max_tilt, 0.2);
+}
+
+// The simple humanoid on soles 3 cm wide (a copy of the model in a temporary
+// file): it stands, but the first step tips it over the stance sole's edge.
+TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
+  std::ifstream in(ProjectModel("simple_humanoid.urdf"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string urdf = text.str();
+  const std::string sole = "box size=\"0.24 0.12 0.05\"";
+  int replaced = 0;
+  for (size_t at = urdf.find(sole); at != std::string::npos; at = urdf.find(sole, at)) {
+    urdf.replace(at, sole.size(), "box size=\"0.24 0.03 0.05\"");
+    ++replaced;
+  }
+  ASSERT_EQ(replaced, 4) << "visual and collision of both feet";
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("robotalk_narrow_feet_" + std::to_string(::getpid()) + ".urdf");
+  std::ofstream(path) << urdf;
+  Walker w(path.string());
+  std::filesystem::remove(path);
+  w.Run(1.0);
+  ASSERT_FALSE(w.driver->walk_status()->fallen) << "it stands";
+  ASSERT_TRUE(w.Exec(CommandType::kGoto, {1.0, 0, 0}).in_progress);
+  w.Run(20.0, [&] { return !w.done.empty(); });
+  ASSERT_EQ(w.done.size(), 1u);
+  EXPECT_EQ(w.done[0].signal, Signal::kInterrupted);
+  EXPECT_NE(w.done[0].message.find("fell"), std::string::npos) << w.done[0].message;
+  EXPECT_TRUE(w.driver->walk_status()->fallen);
+  EXPECT_GT(w.driver->walk_status()->tilt, 0.6);
+  const DriverResult again = w.Exec(CommandType::kGoto, {0, 0, 0});
+  EXPECT_EQ(again.signal, Signal::kError);
+  EXPECT_NE(again.message.find("fallen"), std::string::npos) << again.message;
+  EXPECT_EQ(w.Exec(CommandType::kSetSpeed, {0.05, 0}).signal, Signal::kError);
 }
 
 TEST(OdeWalk, TheSameCommandsGiveTheSameWalk) {
