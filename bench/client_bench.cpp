@@ -4,7 +4,8 @@
 //   robotalk-bench-client query    --url U --robot R --count N        BASE_POSE round trips (us)
 //   robotalk-bench-client timed    --url U --robot R --count N [--period-us 1000 --lead-ms 100]
 //                                  commands on a 1 kHz grid; the server's reported lateness (us)
-//   robotalk-bench-client panic    --url U --robot R --count N [--gap-ms 20]   Panic() ack (us), reset after
+//   robotalk-bench-client panic    --url U --robot R --count N [--gap-ms 20] [--state-period-us P]
+//       Panic() ack (us), reset after; with P: also Panic() to the first STATE sample saying panic
 //   each robotalk-bench-client pipe     --url U --robot R --inflight K --count M [--cap S]
 //                                  single-command packages, K in flight; cmd/s, gave-ups
 //   robotalk-bench-client stream   --url U --robot R --seconds T [--rate 100 --delay-ms 100 --start-at NS]
@@ -17,6 +18,7 @@
 
 #include <sys/resource.h>
 
+#include <condition_variable>
 #include <deque>
 #include <mutex>
 #include <thread>
@@ -105,25 +107,62 @@ int Timed(const Args& a) {
   return 0;
 }
 
+// With --state-period-us P > 0 it also watches the robot's STATE stream at
+// that period and measures, per panic, the time from Panic() to the first
+// sample that says panic (issue 11: "halt visible on a 1 kHz STATE stream").
 int PanicAck(const Args& a) {
   RobotClient c(Options(a));
   c.Connect(a.Str("robot", "pioneer"));
   const long count = a.Int("count", 100);
-  std::vector<double> ack;
-  long timeouts = 0;
+  const long state_period_us = a.Int("state-period-us", 0);
+  std::mutex mu;
+  std::condition_variable seen_cv;
+  std::int64_t panic_sent = 0, panic_seen = 0;  // GUARDED_BY(mu); 0 = none pending / none yet
+  if (state_period_us > 0) {
+    c.StartStateStream(std::chrono::microseconds(state_period_us), [&](const StateSample& s) {
+      const std::int64_t now = MonoNs();
+      std::lock_guard<std::mutex> lock(mu);
+      if (s.panic && panic_sent != 0 && panic_seen == 0) {
+        panic_seen = now;
+        seen_cv.notify_all();
+      }
+    });
+    SleepUntilNs(MonoNs() + 200000000);  // the stream is running
+  }
+  std::vector<double> ack, visible;
+  long timeouts = 0, never_visible = 0;
   for (long i = 0; i < count; ++i) {
     SleepUntilNs(MonoNs() + a.Int("gap-ms", 20) * 1000000);
     const std::int64_t t0 = MonoNs();
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      panic_sent = t0;
+      panic_seen = 0;
+    }
     try {
       c.Panic();
       ack.push_back(static_cast<double>(MonoNs() - t0) / 1e3);
     } catch (const TimeoutError&) {
       ++timeouts;
     }
+    if (state_period_us > 0) {
+      std::unique_lock<std::mutex> lock(mu);
+      if (seen_cv.wait_for(lock, std::chrono::seconds(1), [&] { return panic_seen != 0; })) {
+        visible.push_back(static_cast<double>(panic_seen - t0) / 1e3);
+      } else {
+        ++never_visible;
+      }
+      panic_sent = 0;
+    }
     c.ResetPanic();
   }
+  if (state_period_us > 0) c.StopStateStream();
   auto f = StatsFields(c);
   f.insert(f.begin(), {Summary("ack_us", ack), Field("timeouts", static_cast<double>(timeouts))});
+  if (state_period_us > 0) {
+    f.insert(f.begin() + 2, {Summary("halt_visible_us", visible),
+                             Field("halt_never_visible", static_cast<double>(never_visible))});
+  }
   PrintJson(f);
   return 0;
 }

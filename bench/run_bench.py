@@ -179,7 +179,8 @@ class Bench:
         time.sleep(2.0)
         runs = []
         for _ in range(self.runs):
-            a = self.run([self.client, "panic", "--url", URL, "--count", str(n), "--gap-ms", "20"])
+            a = self.run([self.client, "panic", "--url", URL, "--count", str(n), "--gap-ms", "20",
+                          "--state-period-us", "1000"])
             b = self.run([self.raw, "ping", "--url", URL, "--count", str(n), "--gap-us", "20000",
                           "--req", "64", "--rep", "64", "--warmup", "5"])
             runs.append({"robotalk": a, "raw": b})
