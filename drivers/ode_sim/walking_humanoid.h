@@ -6,9 +6,10 @@
 // free ODE body: the robot stands on its contacts and can fall.
 //
 // Frames: the pattern lives in its own planar frame; each plan maps a goal
-// from the world into it with the pelvis pose measured at planning time
-// (slip and tracking errors make the two drift apart, which the GOTO's
-// closed loop corrects by re-planning from the measured pose).
+// from the world into it with the support foot's pose measured at planning
+// time (if the feet slipped the two would drift apart; the GOTO's closed
+// loop re-plans from the measured pose). The soles' contacts are made
+// compliant (kSoleStiffness) so that they lie flat on the ground.
 //
 // Threading: the driver's one thread. Allocation: buffers in Create();
 // planning (Goto, SetSpeed) allocates the step list; Control() allocates
