@@ -5,7 +5,12 @@
 // optionally writes a trace of one walk (footsteps, ZMP, CoM) for plotting.
 // Figures go to docs/ode_sim.md ("Walking").
 //   robotalk-walk-bench [--model URDF] [--goals N] [--seed S] [--trace CSV] [--trace-goal K]
-//                       [--option key=value]...
+//                       [--option key=value]... [--goal x,y,theta] [--stop S] [--verbose N] [--stand S]
+// Diagnostics: --goal walks to one goal relative to the start instead;
+// --stop sends STOP S seconds into each walk; --verbose prints the measured
+// and planned state every N x 10 ms (pelvis, tilt, CoM error, feet, sole
+// tilts, centre of pressure, contact forces and counts, tracking error);
+// --stand prints S seconds of the start-up stance first.
 #include "ode_driver.h"
 
 #include <chrono>
@@ -74,6 +79,77 @@ Args Parse(int argc, char** argv) {
   return a;
 }
 
+void PrintStand(OdeDriver* ode) {
+  const walking::WalkStatus s = *ode->walk_status();
+  RobotState st;
+  ode->ReadState(st);
+  const RobotModel& m = ode->model();
+  const auto q = [&](const char* joint) { return st.position[m.dof_offset(m.JointIndex(joint))]; };
+  std::printf(
+      "stand t=%.2f tilt %.4f com %.4f %.4f %.4f pelvis %.4f %.4f %.4f  hip %.3f knee %.3f ankle %.3f "
+      "foot %.4f zmp %.4f plan %.4f F %.0f/%d\n",
+      ToSeconds(ode->sim_time().time_since_epoch()), s.tilt, s.com.x(), s.com.y(), s.com.z(), s.pelvis.x,
+      s.pelvis.y, s.pelvis.theta, q("left_hip_pitch"), q("left_knee"), q("left_ankle_pitch"),
+      s.foot_measured[0].x, s.zmp.x(), s.zmp_ref.x(), s.foot_force[0], s.foot_contacts[0]);
+}
+
+void PrintWalk(const walking::WalkStatus& s, double t) {
+  std::printf(
+      "  t=%.2f pelvis %.3f %.3f %.3f tilt %.3f com-plan %.3f %.3f steps %d"
+      " L %.3f %.3f %.3f/%.3f h%.3f  R %.3f %.3f %.3f/%.3f h%.3f tilts %.3f %.3f"
+      " zmp %.3f %.3f plan %.3f %.3f F %.0f/%d %.0f/%d trk %.3f%s\n",
+      t, s.pelvis.x, s.pelvis.y, s.pelvis.theta, s.tilt, s.com.x() - s.com_plan.x(),
+      s.com.y() - s.com_plan.y(), s.steps_taken, s.foot_measured[0].x, s.foot_measured[0].y,
+      s.foot_measured[0].theta, s.foot[0].theta, s.foot_height[0], s.foot_measured[1].x, s.foot_measured[1].y,
+      s.foot_measured[1].theta, s.foot[1].theta, s.foot_height[1], s.foot_tilt[0], s.foot_tilt[1], s.zmp.x(),
+      s.zmp.y(), s.zmp_ref.x(), s.zmp_ref.y(), s.foot_force[0], s.foot_contacts[0], s.foot_force[1],
+      s.foot_contacts[1], s.tracking_error, s.fallen ? " FALLEN" : "");
+}
+
+void WriteTrace(std::ofstream& trace, const walking::WalkStatus& s, double t) {
+  trace << t << ',' << s.foot[0].x << ',' << s.foot[0].y << ',' << s.foot[0].theta << ',' << s.foot_height[0]
+        << ',' << s.foot[1].x << ',' << s.foot[1].y << ',' << s.foot[1].theta << ',' << s.foot_height[1]
+        << ',' << s.zmp_ref.x() << ',' << s.zmp_ref.y() << ',' << s.com_plan.x() << ',' << s.com_plan.y()
+        << ',' << s.com.x() << ',' << s.com.y() << ',' << s.pelvis.x << ',' << s.pelvis.y << ',' << s.zmp.x()
+        << ',' << s.zmp.y() << '\n';
+}
+
+struct Outcome {
+  Signal signal = Signal::kError;
+  std::string message;
+  double sim = 0, wall = 0;  // s
+};
+
+// One GOTO to c (values x y theta): steps until it completes (at most 120 s),
+// a fall, or (--stop) the end of the stepping after a STOP.
+Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& args, std::ofstream* trace) {
+  std::vector<Completion> done;
+  const TimePoint t0 = ode->sim_time();
+  const auto w0 = WallClock::now();
+  const DriverResult res = d->Execute(c, t0, done);
+  Outcome out{.signal = res.signal, .message = res.message};
+  bool stopped = false;
+  for (int i = 0; res.in_progress && (done.empty() || stopped) && i < 12000; ++i) {
+    const double t = ToSeconds(ode->sim_time() - t0);
+    if (!stopped && args.stop_after >= 0 && t >= args.stop_after) {
+      d->Stop(ode->sim_time(), done);
+      stopped = true;
+    }
+    if (ode->walk_status()->fallen) break;
+    if (stopped && !ode->walk_status()->stepping && t > args.stop_after + 3) break;
+    ode->Step(10, done);
+    if (args.verbose > 0 && i % args.verbose == 0) PrintWalk(*ode->walk_status(), t + 0.01);
+    if (trace && i % 2 == 0) WriteTrace(*trace, *ode->walk_status(), t + 0.01);
+  }
+  out.wall = std::chrono::duration<double>(WallClock::now() - w0).count();
+  out.sim = ToSeconds(ode->sim_time() - t0);
+  if (!done.empty()) {
+    out.signal = done[0].signal;
+    out.message = done[0].message;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -87,24 +163,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s does not walk on the ode driver\n", args.model.c_str());
     return 1;
   }
-  std::vector<Completion> done;
+  std::vector<Completion> none;
   for (int i = 0; i < 15 + args.stand * 10; ++i) {  // settle into the stance (--stand: and print it)
-    ode->Step(args.stand > 0 ? 20 : 100, done);
-    if (args.stand > 0) {
-      const walking::WalkStatus s = *ode->walk_status();
-      RobotState st;
-      ode->ReadState(st);
-      const RobotModel& m = ode->model();
-      std::printf(
-          "stand t=%.2f tilt %.4f com %.4f %.4f %.4f pelvis %.4f %.4f %.4f  hip %.3f knee %.3f ankle %.3f "
-          "foot %.4f"
-          " zmp %.4f plan %.4f F %.0f/%d\n",
-          ToSeconds(ode->sim_time().time_since_epoch()), s.tilt, s.com.x(), s.com.y(), s.com.z(), s.pelvis.x,
-          s.pelvis.y, s.pelvis.theta, st.position[m.dof_offset(m.JointIndex("left_hip_pitch"))],
-          st.position[m.dof_offset(m.JointIndex("left_knee"))],
-          st.position[m.dof_offset(m.JointIndex("left_ankle_pitch"))], s.foot_measured[0].x, s.zmp.x(),
-          s.zmp_ref.x(), s.foot_force[0], s.foot_contacts[0]);
-    }
+    ode->Step(args.stand > 0 ? 20 : 100, none);
+    if (args.stand > 0) PrintStand(ode);
   }
   std::mt19937 rng(args.seed);
   std::uniform_real_distribution<double> dist(0.2, 2.0), angle(-std::numbers::pi, std::numbers::pi);
@@ -116,94 +178,46 @@ int main(int argc, char** argv) {
   }
   const std::clock_t cpu0 = std::clock();  // this process's CPU time: the RTF without the machine's load
   int successes = 0, falls = 0;
-  double worst_d = 0, worst_th = 0, sum_d = 0, walked = 0, walk_time = 0, wall_total = 0, sim_total = 0;
+  double worst_d = 0, worst_th = 0, sum_d = 0, walked = 0, walk_time = 0, wall_total = 0;
   std::printf(
       "goal  x        y        theta    answer       time_s  dist_m  speed_m/s  end_err_m  end_err_rad  "
       "rtf\n");
   for (int g = 0; g < args.goals; ++g) {
     const walking::Pose2 start = ode->walk_status()->pelvis;
-    const double r = dist(rng), bearing = angle(rng), heading = angle(rng);
-    double gx = start.x + r * std::cos(bearing), gy = start.y + r * std::sin(bearing);
-    if (args.fixed_goal) {
-      gx = start.x + args.goal[0];
-      gy = start.y + args.goal[1];
-    }
+    double r = dist(rng);
+    const double bearing = angle(rng), heading = angle(rng);
     DriverCommand c;
     c.id = g + 1;
     c.type = CommandType::kGoto;
     c.num_values = 3;
-    c.values[0] = gx;
-    c.values[1] = gy;
+    c.values[0] = start.x + (args.fixed_goal ? args.goal[0] : r * std::cos(bearing));
+    c.values[1] = start.y + (args.fixed_goal ? args.goal[1] : r * std::sin(bearing));
     c.values[2] = args.fixed_goal ? args.goal[2] : heading;
-    done.clear();
-    const TimePoint t0 = ode->sim_time();
-    const auto w0 = WallClock::now();
-    const DriverResult res = d->Execute(c, t0, done);
-    Signal signal = res.signal;
-    std::string message = res.message;
-    bool stopped = false;
-    for (int i = 0; res.in_progress && (done.empty() || stopped) && i < 12000;
-         ++i) {  // at most 120 s per goal
-      if (!stopped && args.stop_after >= 0 && ToSeconds(ode->sim_time() - t0) >= args.stop_after) {
-        d->Stop(ode->sim_time(), done);
-        stopped = true;
-      }
-      if (ode->walk_status()->fallen) break;
-      if (stopped && !ode->walk_status()->stepping && ToSeconds(ode->sim_time() - t0) > args.stop_after + 3)
-        break;
-      ode->Step(10, done);
-      if (args.verbose > 0 && i % args.verbose == 0) {
-        const walking::WalkStatus s = *ode->walk_status();
-        std::printf(
-            "  t=%.2f pelvis %.3f %.3f %.3f tilt %.3f com-plan %.3f %.3f steps %d"
-            " L %.3f %.3f %.3f/%.3f h%.3f  R %.3f %.3f %.3f/%.3f h%.3f tilts %.3f %.3f"
-            " zmp %.3f %.3f plan %.3f %.3f F %.0f/%d %.0f/%d trk %.3f%s\n",
-            ToSeconds(ode->sim_time() - t0), s.pelvis.x, s.pelvis.y, s.pelvis.theta, s.tilt,
-            s.com.x() - s.com_plan.x(), s.com.y() - s.com_plan.y(), s.steps_taken, s.foot_measured[0].x,
-            s.foot_measured[0].y, s.foot_measured[0].theta, s.foot[0].theta, s.foot_height[0],
-            s.foot_measured[1].x, s.foot_measured[1].y, s.foot_measured[1].theta, s.foot[1].theta,
-            s.foot_height[1], s.foot_tilt[0], s.foot_tilt[1], s.zmp.x(), s.zmp.y(), s.zmp_ref.x(),
-            s.zmp_ref.y(), s.foot_force[0], s.foot_contacts[0], s.foot_force[1], s.foot_contacts[1],
-            s.tracking_error, s.fallen ? " FALLEN" : "");
-      }
-      if (trace.is_open() && g == args.trace_goal && i % 2 == 0) {
-        const walking::WalkStatus s = *ode->walk_status();
-        trace << ToSeconds(ode->sim_time() - t0) << ',' << s.foot[0].x << ',' << s.foot[0].y << ','
-              << s.foot[0].theta << ',' << s.foot_height[0] << ',' << s.foot[1].x << ',' << s.foot[1].y << ','
-              << s.foot[1].theta << ',' << s.foot_height[1] << ',' << s.zmp_ref.x() << ',' << s.zmp_ref.y()
-              << ',' << s.com_plan.x() << ',' << s.com_plan.y() << ',' << s.com.x() << ',' << s.com.y() << ','
-              << s.pelvis.x << ',' << s.pelvis.y << ',' << s.zmp.x() << ',' << s.zmp.y() << '\n';
-      }
-    }
-    const double wall = std::chrono::duration<double>(WallClock::now() - w0).count();
-    const double sim = ToSeconds(ode->sim_time() - t0);
-    if (!done.empty()) {
-      signal = done[0].signal;
-      message = done[0].message;
-    }
+    if (args.fixed_goal) r = std::hypot(args.goal[0], args.goal[1]);
+    const Outcome o =
+        WalkTo(d.get(), ode, c, args, trace.is_open() && g == args.trace_goal ? &trace : nullptr);
     const walking::WalkStatus s = *ode->walk_status();
-    const double ed = std::hypot(s.pelvis.x - gx, s.pelvis.y - gy);
+    const double ed = std::hypot(s.pelvis.x - c.values[0], s.pelvis.y - c.values[1]);
     const double eth = std::abs(walking::Wrap(s.pelvis.theta - c.values[2]));
     if (s.fallen) ++falls;
-    if (signal == Signal::kSuccess) ++successes;
+    if (o.signal == Signal::kSuccess) ++successes;
     worst_d = std::max(worst_d, ed);
     worst_th = std::max(worst_th, eth);
     sum_d += ed;
     walked += r;
-    walk_time += sim;
-    wall_total += wall;
-    sim_total += sim;
-    std::printf("%-4d  %7.3f  %7.3f  %7.3f  %-11s  %6.1f  %6.3f  %9.3f  %9.4f  %11.4f  %4.1f %s\n", g, gx, gy,
-                c.values[2], std::string(ToString(signal)).c_str(), sim, r, r / sim, ed, eth, sim / wall,
-                message.c_str());
+    walk_time += o.sim;
+    wall_total += o.wall;
+    std::printf("%-4d  %7.3f  %7.3f  %7.3f  %-11s  %6.1f  %6.3f  %9.3f  %9.4f  %11.5f  %4.1f %s\n", g,
+                c.values[0], c.values[1], c.values[2], std::string(ToString(o.signal)).c_str(), o.sim, r,
+                r / o.sim, ed, eth, o.sim / o.wall, o.message.c_str());
     std::fflush(stdout);
     if (s.fallen) break;
   }
   std::printf(
-      "\nsuccess %d/%d, falls %d, end error mean %.4f m, worst %.4f m and %.4f rad, "
+      "\nsuccess %d/%d, falls %d, end error mean %.4f m, worst %.4f m and %.5f rad, "
       "mean speed %.3f m/s (straight-line distance / walking time), real-time factor %.1f at 1 kHz "
       "(%.1f per CPU second of this process)\n",
       successes, args.goals, falls, sum_d / args.goals, worst_d, worst_th, walked / walk_time,
-      sim_total / wall_total, sim_total / (static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC));
+      walk_time / wall_total, walk_time / (static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC));
   return successes == args.goals && falls == 0 ? 0 : 1;
 }
