@@ -186,16 +186,25 @@ void RobotClient::Connect(const std::string& robot) {
   // 2. Clock: `clock_sync_rounds` CLOCK round trips, more if none counted
   //    (a resent package gives no sample).
   const int rounds = std::max(1, impl_->options_.clock_sync_rounds);
+  int answered = 0;  // CLOCK answers received, usable or not
   for (int i = 0; SteadyNow() < deadline; ++i) {
     {
       std::lock_guard lock(impl_->mu_);
       if (i >= rounds && impl_->clock_sync_.synced()) break;
+      // Answers that never give a sample (a round trip <= 0 on the client's
+      // clock): asking on would flood the server, not help.
+      if (answered >= 4 * rounds + 4 && !impl_->clock_sync_.synced()) {
+        throw ClientError("RobotClient::Connect('" + robot + "'): " + std::to_string(answered) +
+                          " CLOCK answers gave no usable sample (each round trip came out negative on the "
+                          "client's clock: does ClientOptions::clock move with real time?)");
+      }
     }
     auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false,
                                    Impl::Track::kRetransmit, true);
     PendingReply p = impl_->MakePending(sent.ids[0], "CLOCK");
     try {
       p.Wait(std::chrono::duration_cast<Duration>(deadline - SteadyNow()));
+      ++answered;
     } catch (const TimeoutError&) {
       break;
     }

@@ -37,8 +37,14 @@ double Yaw(const Eigen::Isometry3d& x) { return std::atan2(x.linear()(1, 0), x.l
 // loaded machine); it ends at the deadline, so it is bounded by final_spin.
 void RobotDaemon::WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next) {
   const auto woken = [this] { return wake_flag_ || !running_ || flush_deferred_.load(); };
+  // The condition variable sleeps on the steady clock; `next` is on clock_
+  // (an offset or a test's clock): wait for the same distance from now.
+  const auto steady_deadline = [this](TimePoint t) {
+    if (t == TimePoint::max()) return std::chrono::steady_clock::time_point::max();
+    return std::chrono::steady_clock::now() + (t - clock_.Now());
+  };
   if (!precise_ || !spin_ || options_.final_spin.count() <= 0 || next == TimePoint::max()) {
-    wake_.wait_until(lock, next, woken);
+    wake_.wait_until(lock, steady_deadline(next), woken);
     return;
   }
   // The spin's budget: spin_share of a core, at most 20 spins saved up.
@@ -52,10 +58,10 @@ void RobotDaemon::WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next) 
   };
   refill();
   if (spin_budget_ < options_.final_spin) {  // dense deadlines: the spin would cost too much
-    wake_.wait_until(lock, next, woken);
+    wake_.wait_until(lock, steady_deadline(next), woken);
     return;
   }
-  if (wake_.wait_until(lock, next - options_.final_spin, woken)) return;
+  if (wake_.wait_until(lock, steady_deadline(next - options_.final_spin), woken)) return;
   lock.unlock();
   // Bounded in real time too (a test's ManualClock does not move by itself).
   const auto start = refill();

@@ -94,7 +94,8 @@ class Server::Impl {
     }
     server_daemon_ = std::make_unique<ServerDaemon>(
         *transport, clock_,
-        ServerDaemonOptions{.congestion_max_pause = options_.congestion_max_pause,
+        ServerDaemonOptions{.announce_period = options_.announce_period,
+                            .congestion_max_pause = options_.congestion_max_pause,
                             .reply_drop_probability = options_.reply_drop_probability,
                             .reply_duplicate_probability = options_.reply_duplicate_probability,
                             .fault_seed = options_.fault_seed,

@@ -460,6 +460,28 @@ TEST_F(RobotClientTest, ConnectTimesOutWithoutServer) {
   EXPECT_THROW(client.Connect("nobody"), TimeoutError);
 }
 
+// A client clock that stands still makes every CLOCK round trip negative:
+// Connect() says so after a bounded number of answers instead of asking the
+// server thousands of times a second until its timeout.
+TEST_F(RobotClientTest, ConnectOnAClockThatStandsStillFailsNamingTheClockAfterFewQueries) {
+  StartServer(DefaultServerOptions());
+  const auto clock_queries = server_net_.Add({.channel_regex = kRequests, .direction = Direction::kIncoming});
+  ManualClock frozen;
+  ClientOptions o = Options();
+  o.clock = &frozen;
+  RobotClient client(o);
+  try {
+    client.Connect("pioneer");
+    ADD_FAILURE() << "connected on a clock that stands still";
+  } catch (const TimeoutError& e) {
+    ADD_FAILURE() << "timed out instead: " << e.what();
+  } catch (const ClientError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("does ClientOptions::clock move with real time?"));
+  }
+  // 4 x 8 rounds + 4 answers, the CONFIG query, and a heartbeat or two.
+  EXPECT_LT(server_net_.counts(clock_queries).matched, 60u);
+}
+
 TEST_F(RobotClientTest, CallsBeforeConnectThrowClientError) {
   RobotClient client(Options());
   EXPECT_THROW(client.Stop(), ClientError);

@@ -236,6 +236,44 @@ TEST_F(RobotDaemonTest, AQueryWaitsForACommandDueBeforeItAndForAStaleSnapshot) {
   EXPECT_EQ(direct.size(), 1u) << "halted, as the snapshot says";
 }
 
+// A server clock need not be the steady clock (an offset, a simulated one):
+// the thread must sleep for the distance to a start time on *its* clock.
+TEST(RobotDaemonThread, RunsATimedCommandAtItsTimeOnAClockAheadOfTheSteadyClock) {
+  class AheadClock final : public Clock {
+   public:
+    TimePoint Now() const override { return steady_.Now() + seconds(1000); }
+
+   private:
+    SteadyClock steady_;
+  } clock;
+  for (const bool precise : {true, false}) {
+    auto driver = std::make_unique<FakeDriver>(PanRobot());
+    FakeDriver* fake = driver.get();
+    RobotDaemon daemon("bot", "fake", std::move(driver), clock,
+                       RobotDaemonOptions{.precise_timing = precise});
+    daemon.Start();
+    QueuedItem item = Motion(1, CommandType::kJointSetPoint, {0.2}, 0);
+    item.has_start_time = true;
+    item.start = clock.Now() + milliseconds(50);
+    const TimePoint start = item.start;
+    daemon.Submit(std::move(item));
+    // Bounded real-time wait (the thread sleeps on the steady clock); before
+    // the fix it slept until the steady clock read the start: 1000 s.
+    bool answered = false;
+    DaemonOutput out;
+    for (int i = 0; i < 400 && !answered; ++i) {
+      std::this_thread::sleep_for(milliseconds(5));
+      daemon.TakeOutput(out);
+      for (const auto& a : out.replies) answered = answered || a.reply.id == 1;
+    }
+    daemon.Stop();
+    EXPECT_TRUE(answered) << "precise " << precise;
+    ASSERT_EQ(fake->calls.size(), 1u) << "precise " << precise;
+    EXPECT_GE(fake->calls[0].at, start);
+    EXPECT_LT(fake->calls[0].at, start + milliseconds(500));
+  }
+}
+
 // Issue 11 item 4: the timing option, applied on the RobotDaemon's thread.
 TEST(RobotDaemonTiming, SaysWhichTimingItsThreadRunsWith) {
   ManualClock clock;
