@@ -333,6 +333,7 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   const Eigen::VectorXd& q = world_->q();
   if (!fallen_ && tilt_ > kFallTilt) {
     fallen_ = true;
+    fall_tilt_ = tilt_;
     if (mode_ == Mode::kGoto) {
       completed.push_back(Completion{.id = goto_id_,
                                      .signal = Signal::kInterrupted,

@@ -293,7 +293,8 @@ class RobotDaemon {
   TimePoint next_update_ = TimePoint::min();
   std::int64_t samples_ = 0;
   bool halted_ = false;
-  std::string last_fault_;  // the fault a throw latched, for the command's ERROR
+  std::string reported_condition_;  // the driver's last Driver::Fault() text
+  std::string last_fault_;          // the fault a throw latched, for the command's ERROR
 };
 
 }  // namespace robotalk

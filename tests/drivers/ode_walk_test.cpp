@@ -179,6 +179,7 @@ TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
   std::filesystem::remove(path);
   w.Run(1.0);
   ASSERT_FALSE(w.driver->walk_status()->fallen) << "it stands";
+  EXPECT_EQ(w.driver->Fault(), "");
   ASSERT_TRUE(w.Exec(CommandType::kGoto, {1.0, 0, 0}).in_progress);
   w.Run(20.0, [&] { return !w.done.empty(); });
   ASSERT_EQ(w.done.size(), 1u);
@@ -186,6 +187,10 @@ TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
   EXPECT_NE(w.done[0].message.find("fell"), std::string::npos) << w.done[0].message;
   EXPECT_TRUE(w.driver->walk_status()->fallen);
   EXPECT_GT(w.driver->walk_status()->tilt, 0.6);
+  // The server halts and holds in panic a robot whose driver reports a fault
+  // (Driver::Fault): the STATE stream says panic, commands name the fall.
+  EXPECT_NE(w.driver->Fault().find("the robot has fallen (torso tilt 0."), std::string::npos)
+      << w.driver->Fault();
   const DriverResult again = w.Exec(CommandType::kGoto, {0, 0, 0});
   EXPECT_EQ(again.signal, Signal::kError);
   EXPECT_NE(again.message.find("fallen"), std::string::npos) << again.message;

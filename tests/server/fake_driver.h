@@ -87,8 +87,10 @@ class FakeDriver : public Driver {
     goto_id.reset();
   }
   void Resume() override { halted = false; }
+  std::string Fault() const override { return fault; }
 
   RobotModel model_;
+  std::string fault;  // what Fault() reports ("" = none)
   std::vector<Call> calls;
   std::optional<CommandId> goto_id;
   int goto_updates = 3;

@@ -236,6 +236,35 @@ TEST_F(RobotDaemonTest, AQueryWaitsForACommandDueBeforeItAndForAStaleSnapshot) {
   EXPECT_EQ(direct.size(), 1u) << "halted, as the snapshot says";
 }
 
+// Issue 13: a driver that finds its robot in a state that must stop it (a
+// humanoid that fell) says so through Driver::Fault(); the server halts it and
+// holds it in panic like a throwing driver, and names the condition.
+TEST_F(RobotDaemonTest, HaltsAndHoldsInPanicARobotWhoseDriverReportsAFault) {
+  daemon_->Submit(Motion(1, CommandType::kGoto, {1.0, 0.0, 0.0}));
+  Run();
+  ASSERT_TRUE(fake_->goto_id.has_value());
+  fake_->fault = "the robot has fallen (torso tilt 0.71 rad)";
+  clock_.Advance(milliseconds(20));
+  const auto replies = Run();
+  EXPECT_TRUE(daemon_->in_panic());
+  EXPECT_TRUE(fake_->halted);
+  EXPECT_THAT(daemon_->fault(), HasSubstr("driver 'fake' reports: the robot has fallen"));
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].reply.signal, Signal::kInterrupted) << "the running GOTO";
+  // The same condition after PANIC_RESET does not halt again; a new one does.
+  EXPECT_TRUE(daemon_->ResetPanic());
+  clock_.Advance(milliseconds(20));
+  Run();
+  EXPECT_FALSE(daemon_->in_panic());
+  fake_->fault = "";
+  clock_.Advance(milliseconds(20));
+  Run();
+  fake_->fault = "the robot has fallen (torso tilt 0.80 rad)";
+  clock_.Advance(milliseconds(20));
+  Run();
+  EXPECT_TRUE(daemon_->in_panic());
+}
+
 // A server clock need not be the steady clock (an offset, a simulated one):
 // the thread must sleep for the distance to a start time on *its* clock.
 TEST(RobotDaemonThread, RunsATimedCommandAtItsTimeOnAClockAheadOfTheSteadyClock) {

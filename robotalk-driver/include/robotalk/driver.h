@@ -111,6 +111,13 @@ class Driver {
   virtual void Halt(std::vector<Completion>& interrupted) = 0;
   /// Panic reset: the robot stays where it is; Execute() may follow.
   virtual void Resume() = 0;
+  /// A condition the robot is in that must stop it, in words (e.g. "the robot
+  /// has fallen (torso tilt 0.71 rad)"); "" = none. Asked after every
+  /// Update(). The server treats a new one as a driver fault: the robot is
+  /// halted and held in panic until PANIC_RESET, the STATE stream says panic,
+  /// queries and refused commands name it. The same text again after a reset
+  /// does not halt again. Default: none.
+  virtual std::string Fault() const { return {}; }
 };
 
 /// What a driver factory receives.
