@@ -107,8 +107,10 @@ void RobotDaemon::Submit(QueuedItem item) {
     bool current = false;
     {
       std::lock_guard lock(snapshot_mutex_);
+      // After a driver fault a query is queued: its answer names the fault (AnswerQuery).
       current = snapshot_.valid && snapshot_.pushes_seen >= last_due_push_ && now < snapshot_.next_due &&
-                snapshot_.halted == panic_.load() && now - snapshot_.time <= snapshot_.max_age;
+                snapshot_.halted == panic_.load() && !faulted_.load() &&
+                now - snapshot_.time <= snapshot_.max_age;
       if (current) direct_state_ = snapshot_;  // same sizes: no allocation
     }
     if (current) {
@@ -199,6 +201,7 @@ bool RobotDaemon::ResetPanic() {
   {
     std::lock_guard lock(mutex_);
     fault_.clear();
+    faulted_ = false;
     resume_requested_ = true;
     wake_flag_ = true;
   }
@@ -331,6 +334,7 @@ RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem
 
 void RobotDaemon::Fault(const std::string& what, TimePoint /*now*/) {
   panic_ = true;
+  faulted_ = true;
   last_fault_ = what;
   {
     std::lock_guard lock(mutex_);
@@ -549,6 +553,10 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
     return;
   }
   AnswerFrom(state_, kinematics_, roots_, item, reply);
+  if (panic_.load()) {  // a fault names itself: "... the robot has fallen (...)"
+    const std::string why = fault();
+    if (!why.empty()) reply.message = "robot '" + robot_name_ + "' is in panic: " + why;
+  }
 }
 
 void RobotDaemon::Sample(TimePoint now, Duration period) {

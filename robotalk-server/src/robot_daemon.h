@@ -248,6 +248,7 @@ class RobotDaemon {
   std::uint64_t pushes_ = 0;                 // GUARDED_BY(mutex_): items submitted so far
   std::string timing_;                       // GUARDED_BY(mutex_)
   std::atomic<bool> panic_{false};
+  std::atomic<bool> faulted_{false};                     // a driver fault is the panic's reason (fault_)
   std::atomic<bool> flush_deferred_{false};              // Panic() could not take mutex_ to flush
   std::atomic<Duration::rep> snapshot_wanted_until_{0};  // a query came: snapshot until then
 

@@ -251,6 +251,16 @@ TEST_F(RobotDaemonTest, HaltsAndHoldsInPanicARobotWhoseDriverReportsAFault) {
   EXPECT_THAT(daemon_->fault(), HasSubstr("driver 'fake' reports: the robot has fallen"));
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].reply.signal, Signal::kInterrupted) << "the running GOTO";
+  // A query says why the robot is in panic (queued, not answered on receipt).
+  daemon_->Submit(JointStateQuery(2));
+  std::vector<DaemonOutput::Answer> direct;
+  daemon_->TakeDirect(direct);
+  EXPECT_TRUE(direct.empty());
+  const auto answers = Run();
+  ASSERT_EQ(answers.size(), 1u);
+  EXPECT_EQ(answers[0].reply.signal, Signal::kSuccess);
+  EXPECT_THAT(answers[0].reply.message,
+              HasSubstr("is in panic: driver 'fake' reports: the robot has fallen"));
   // The same condition after PANIC_RESET does not halt again; a new one does.
   EXPECT_TRUE(daemon_->ResetPanic());
   clock_.Advance(milliseconds(20));
