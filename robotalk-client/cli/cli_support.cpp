@@ -45,7 +45,7 @@ struct AnnounceWatch::Impl {
   // pipe lets the destructor wake it.
   void Run() {
     pollfd early = {wake[0], POLLIN, 0};
-    if (poll(&early, 1, static_cast<int>(kWatchAfter.count())) != 0) return;  // woken: connected
+    if (poll(&early, 1, static_cast<int>(kWatchAfter.count())) > 0) return;  // woken: connected
     std::string main_url;  // ANNOUNCE travels on the main lane in either layout
     try {
       main_url = MainLcmUrl(url);

@@ -15,10 +15,14 @@ PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration
 }
 
 namespace {
+// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
+// (73 years; two such delays still subtract without overflow).
 std::optional<Duration> DelayOf(TimePoint sent, TimePoint arrival) {
   Duration::rep d = 0;
   if (__builtin_sub_overflow(arrival.time_since_epoch().count(), sent.time_since_epoch().count(), &d))
     return std::nullopt;
+  constexpr Duration::rep kBound = Duration::rep{1} << 61;
+  if (d > kBound || d < -kBound) return std::nullopt;
   return Duration(d);
 }
 }  // namespace

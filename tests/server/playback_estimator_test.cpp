@@ -208,6 +208,7 @@ TEST(DelayHistory, KeepsTheLatestWithinTheWindowAndIgnoresOverflowingSendTimes) 
   EXPECT_EQ(recent.back(), milliseconds(39 % 5));                  // oldest first
   EXPECT_TRUE(h.Recent(kT0 + std::chrono::seconds(100)).empty());  // all older than 30 s
   h.Add(TimePoint::min(), TimePoint::max());                       // would overflow: ignored
+  h.Add(kT0 - std::chrono::hours(24 * 365 * 100), kT0);  // a century: ignored (two delays must subtract)
   EXPECT_EQ(h.Recent(kT0 + milliseconds(40)).back(), milliseconds(39 % 5));
 }
 
