@@ -39,10 +39,17 @@ void RobotDaemon::WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next) 
   const auto woken = [this] { return wake_flag_ || !running_ || flush_deferred_.load(); };
   // The condition variable sleeps on the steady clock; `next` is on clock_
   // (an offset or a test's clock): wait for the same distance from now.
+  // Saturating: `t` may be TimePoint::min() (an item due at once) or
+  // TimePoint::max() (idle), and neither may overflow (UBSan).
   const auto steady_deadline = [this](TimePoint t) {
-    if (t == TimePoint::max()) return std::chrono::steady_clock::time_point::max();
-    return std::chrono::steady_clock::now() + (t - clock_.Now());
+    using Steady = std::chrono::steady_clock;
+    const Steady::time_point steady_now = Steady::now();
+    const Duration distance = SaturatingSub(t, clock_.Now());
+    if (distance <= Duration(0)) return steady_now;
+    if (distance >= Steady::time_point::max() - steady_now) return Steady::time_point::max();
+    return steady_now + distance;
   };
+  if (next <= clock_.Now()) return;  // already due (an item "at once" has TimePoint::min())
   if (!precise_ || !spin_ || options_.final_spin.count() <= 0 || next == TimePoint::max()) {
     wake_.wait_until(lock, steady_deadline(next), woken);
     return;

@@ -276,8 +276,19 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   // direct or delay command at a server-clock time (the codec checked the
   // kind against the package mode).
   const Duration ahead = c.start_time.is_after() ? *c.start_time.offset()
-                         : c.start_time.is_at()  ? *c.start_time.time() - now
+                         : c.start_time.is_at()  ? SaturatingSub(*c.start_time.time(), now)
                                                  : Duration(0);
+  // As far behind as the limit ahead: a clock that wrong is a bug to report,
+  // not a command to run late (and its lateness must stay in range).
+  if (c.start_time.is_at() && ahead < -options_.max_future) {
+    immediate.push_back(MakeReply(c.id, Signal::kError,
+                                  std::string(ToString(c.type)) + ": start time is " +
+                                      Seconds(SaturatingSub(now, *c.start_time.time())) +
+                                      " in the past of the server clock; the limit is " +
+                                      Seconds(options_.max_future) + " (is the client's clock synchronised?)",
+                                  now));
+    return std::nullopt;
+  }
   if (ahead > options_.max_future) {
     immediate.push_back(MakeReply(c.id, Signal::kError,
                                   std::string(ToString(c.type)) + ": start time is " + Seconds(ahead) +

@@ -27,7 +27,7 @@ struct SessionOptions {
   Duration session_timeout = std::chrono::seconds(2);
   /// Most items one client may have waiting (queued and buffered playback frames).
   std::size_t max_queue = 10000;
-  /// Start times further ahead than this are refused.
+  /// Start times further ahead than this, or further in the past, are refused.
   Duration max_future = std::chrono::hours(1);
   /// When playback mode has seen enough frames to estimate its delay.
   PlaybackEstimatorOptions playback;

@@ -21,7 +21,7 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --url URL                       LCM URL (default: LCM's default or $LCM_DEFAULT_URL)
   --session-timeout S             expire a silent client after S seconds (default 2)
   --max-queue N                   most queued commands per client (default 10000)
-  --max-future S                  refuse start times more than S seconds ahead (default 3600)
+  --max-future S                  refuse start times more than S seconds ahead, or in the past (default 3600)
   --duration S                    exit after S seconds (default: run until SIGINT/SIGTERM)
   --congestion-max-pause S        the paper's congestion injector: pause a random time in
                                   [0, S] s in the ServerDaemon after each received package

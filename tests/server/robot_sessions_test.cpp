@@ -115,6 +115,40 @@ TEST_F(RobotSessionsTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
   EXPECT_EQ(r.lateness, milliseconds(3));
 }
 
+TEST_F(RobotSessionsTest, RunsARecentPastStartAtOnceAndRefusesOneBeyondTheLimitEvenAHostileOne) {
+  clock_.Set(TimePoint(std::chrono::hours(3)));
+  const TimePoint now = clock_.Now();
+  // The codec admits any start within +-292 years (kMaxWireMicros): the
+  // furthest past one must be refused without overflowing (UBSan).
+  const TimePoint hostile(-std::chrono::duration_cast<Duration>(std::chrono::microseconds(kMaxWireMicros)));
+  auto immediate =
+      Handle(Package(kAlice, 1,
+                     {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", now - seconds(10)),
+                      Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan", now - std::chrono::hours(2)),
+                      Cmd(3, CommandType::kJointSetPoint, {0.3}, "pan", hostile)}));
+  ASSERT_EQ(immediate.count(1), 0u) << "10 s late is run, late";
+  EXPECT_EQ(immediate.at(2).signal, Signal::kError);
+  EXPECT_THAT(immediate.at(2).message, HasSubstr("start time is 7200 s in the past of the server clock"));
+  EXPECT_THAT(immediate.at(2).message, HasSubstr("the limit is 3600 s"));
+  EXPECT_EQ(immediate.at(3).signal, Signal::kError);
+  EXPECT_THAT(immediate.at(3).message, HasSubstr("in the past of the server clock"));
+  Run();
+  ASSERT_EQ(fake_->calls.size(), 1u);
+  const Reply late = Replies(kAlice).at(1);
+  EXPECT_EQ(late.signal, Signal::kSuccess);
+  EXPECT_EQ(late.lateness, seconds(10));
+}
+
+TEST(SaturatingSub, SaturatesInsteadOfOverflowing) {
+  const TimePoint lo = TimePoint::min(), hi = TimePoint::max(), t(seconds(5));
+  EXPECT_EQ(SaturatingSub(t, TimePoint(seconds(2))), seconds(3));
+  EXPECT_EQ(SaturatingSub(lo, t), Duration::min());
+  EXPECT_EQ(SaturatingSub(hi, TimePoint(-seconds(1))), Duration::max());
+  EXPECT_EQ(SaturatingSub(hi, lo), Duration::max());
+  EXPECT_EQ(SaturatingSub(lo, hi), Duration::min());
+  EXPECT_EQ(SaturatingSub(lo, lo), Duration(0));
+}
+
 TEST_F(RobotSessionsTest, OrdersCommandsOfAllClientsByStartTimeThenArrival) {
   const TimePoint t = clock_.Now() + seconds(1);
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kStop, {}, "", t + seconds(40))}));

@@ -37,7 +37,8 @@ struct ServerOptions {
   Duration session_timeout = std::chrono::seconds(2);
   /// Most commands one client may have queued.
   size_t max_queue = 10000;
-  /// Start times further ahead than this are refused with ERROR.
+  /// Start times further ahead than this, or further in the past, are
+  /// refused with ERROR.
   Duration max_future = std::chrono::hours(1);
   /// Print one stderr line per executed command (diagnostics).
   bool log_executions = false;

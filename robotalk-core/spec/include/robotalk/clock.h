@@ -47,6 +47,19 @@ class ManualClock final : public Clock {
   std::atomic<Duration::rep> now_;
 };
 
+/// Another clock moved by a fixed offset: a client's clock that disagrees
+/// with the server's, or a server clock ahead of the steady clock. `base` must
+/// outlive it.
+class OffsetClock final : public Clock {
+ public:
+  OffsetClock(const Clock& base, Duration offset) : base_(base), offset_(offset) {}
+  TimePoint Now() const override { return base_.Now() + offset_; }
+
+ private:
+  const Clock& base_;
+  Duration offset_;
+};
+
 /// The largest |microseconds| a TimePoint / Duration (int64 nanoseconds) holds:
 /// about ±292 years. Wire values beyond it cannot be represented.
 inline constexpr std::int64_t kMaxWireMicros = INT64_MAX / 1000;
@@ -80,6 +93,16 @@ inline std::int64_t ToWireMicros(TimePoint t) {
 }
 inline std::int64_t ToWireMicros(Duration d) {
   return std::chrono::duration_cast<std::chrono::microseconds>(d).count();
+}
+
+/// a - b, saturated at Duration's range instead of overflowing: a start time
+/// from the wire may lie up to ±292 years away, and TimePoint::min() /
+/// max() stand for "at once" / "never".
+inline Duration SaturatingSub(TimePoint a, TimePoint b) {
+  Duration::rep d = 0;
+  if (__builtin_sub_overflow(a.time_since_epoch().count(), b.time_since_epoch().count(), &d))
+    return a > b ? Duration::max() : Duration::min();
+  return Duration(d);
 }
 
 /// Seconds as a double, for printing and for maths on rates.
