@@ -43,6 +43,9 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_strin
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$supp:print_suppressions=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
+# Sanitized programs run 2-3x (ASan) to 5-10x (TSan) slower: tests whose waits
+# are bounded in real time for a live simulation (the browser test) scale them.
+if [ "$kind" = asan ]; then export ROBOTALK_TEST_TIME_SCALE=3; else export ROBOTALK_TEST_TIME_SCALE=6; fi
 
 run=()
 if [ "$kind" = tsan ] && setarch "$(uname -m)" -R true 2>/dev/null; then

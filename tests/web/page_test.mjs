@@ -49,10 +49,14 @@ function cli(...args) {
   });
 }
 
-async function waitFor(what, fn, timeoutMs) {
+// Sanitizer builds run several times slower (scripts/sanitize.sh sets it).
+const timeScale = Math.max(1, Number(process.env.ROBOTALK_TEST_TIME_SCALE) || 1);
+
+async function waitFor(what, fn, unscaledMs) {
+  const timeoutMs = unscaledMs * timeScale;
   const end = Date.now() + timeoutMs;
   let last;
-  for (let i = 0; Date.now() < end && i < 1000; ++i) {
+  for (let i = 0; Date.now() < end && i < 1000 * timeScale; ++i) {
     last = await fn();
     if (last) return last;
     await sleep(100);
