@@ -2,13 +2,18 @@
 #   $tmp          a temporary folder, removed at exit
 #   $server_pid   set it to a server's pid: it is stopped at exit
 #   $client_pid   set it to a client's pid: it is stopped at exit (resumed first if stopped)
+#   pids+=($!)    any other background process: killed at exit
 #   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
 #   $pass, $failures        the counts
 tmp=$(mktemp -d)
 server_pid="" client_pid=""
+pids=()
 cleanup() {
+  local p
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
   [ -n "$client_pid" ] && kill -CONT "$client_pid" 2>/dev/null && kill "$client_pid" 2>/dev/null
   [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null; done
   rm -rf "$tmp"
 }
 trap cleanup EXIT

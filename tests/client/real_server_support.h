@@ -1,6 +1,5 @@
 // Helpers for tests that run the client against the real server core
-// (robot_client_test.cpp): a clock at an offset from the steady clock, a
-// driver wrapper that logs what the server asked of it, filters on wire bytes
+// (robot_client_test.cpp): a log of what the server asked of the driver, filters on wire bytes
 // for FaultyTransport faults, and a bounded real-time wait.
 #pragma once
 
@@ -8,6 +7,7 @@
 #include "robotalk/clock.h"
 #include "robotalk/driver.h"
 #include "robotalk/protocol_codec.h"
+#include "support/observed_driver.h"
 
 #include <chrono>
 #include <map>
@@ -19,30 +19,16 @@
 
 namespace robotalk::testing {
 
-// The steady clock moved by a fixed offset: the client's clock, 1000 s behind
-// the server's, so that the measured clock offset cannot be right by accident.
-// (The server itself must run on the steady clock: its RobotDaemon sleeps
-// until deadlines on std::chrono::steady_clock.)
-class OffsetClock final : public Clock {
- public:
-  explicit OffsetClock(Duration offset) : offset_(offset) {}
-  TimePoint Now() const override { return steady_.Now() + offset_; }
-
- private:
-  SteadyClock steady_;
-  Duration offset_;
-};
-
 // What the server asked of the driver, by command type and first value (the
 // server gives the driver ids of its own, so tests tell their commands apart
 // by value); read by the test thread while the RobotDaemon's thread writes it.
-class DriverLog {
+class DriverLog final : public DriverObserver {
  public:
-  void Executed(const DriverCommand& c) {
+  void Executed(const DriverCommand& c, TimePoint) override {
     std::lock_guard lock(mu_);
     ++executed_[{c.type, c.num_values > 0 ? c.values[0] : 0.0}];
   }
-  void Halted(bool halted) {
+  void Halted(bool halted) override {
     std::lock_guard lock(mu_);
     halted_ = halted;
   }
@@ -66,34 +52,6 @@ class DriverLog {
   mutable std::mutex mu_;
   std::map<std::pair<CommandType, double>, int> executed_;
   bool halted_ = false;
-};
-
-// The kinematic driver, logging each Execute, Halt and Resume.
-class CountingDriver final : public Driver {
- public:
-  CountingDriver(std::unique_ptr<Driver> inner, std::shared_ptr<DriverLog> log)
-      : inner_(std::move(inner)), log_(std::move(log)) {}
-  const RobotModel& model() const override { return inner_->model(); }
-  Duration period() const override { return inner_->period(); }
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
-    log_->Executed(c);
-    return inner_->Execute(c, now, done);
-  }
-  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
-  void ReadState(RobotState& s) const override { inner_->ReadState(s); }
-  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
-  void Halt(std::vector<Completion>& done) override {
-    log_->Halted(true);
-    inner_->Halt(done);
-  }
-  void Resume() override {
-    log_->Halted(false);
-    inner_->Resume();
-  }
-
- private:
-  std::unique_ptr<Driver> inner_;
-  std::shared_ptr<DriverLog> log_;
 };
 
 // --- Filters on wire bytes, for FaultyTransport faults ------------------------

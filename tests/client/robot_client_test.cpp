@@ -45,7 +45,7 @@ class RobotClientTest : public ::testing::Test {
   RobotClientTest() {
     RegisterKinematicDriver(registry_);
     registry_.Register("counting", [this](const DriverConfig& config) {
-      return std::make_unique<CountingDriver>(registry_.Create("kinematic", config), log_);
+      return std::make_unique<ObservedDriver>(registry_.Create("kinematic", config), log_);
     });
   }
 
@@ -84,7 +84,9 @@ class RobotClientTest : public ::testing::Test {
   FaultyTransport server_net_{server_end_, {.seed = 5}};
   FaultyTransport client_net_{client_end_, {.seed = 11}};
   SteadyClock server_clock_;
-  OffsetClock client_clock_{-seconds(1000)};
+  // 1000 s behind the server's, so that a measured clock offset cannot be
+  // right by accident. (The server runs on the steady clock itself.)
+  OffsetClock client_clock_{server_clock_, -seconds(1000)};
   std::shared_ptr<DriverLog> log_ = std::make_shared<DriverLog>();
   DriverRegistry registry_;
   RobotModel model_ =

@@ -5,6 +5,7 @@
 #include "robotalk/robot_client.h"
 #include "robotalk/server.h"
 #include "robotalk/urdf_import.h"
+#include "support/observed_driver.h"
 #include "test_paths.h"
 
 #include <gmock/gmock.h>
@@ -26,35 +27,16 @@ using ::testing::HasSubstr;
 constexpr const char* kUrl = "udpm://239.255.76.67:7711?ttl=0";
 
 // Records every set-point the driver executes, to prove exactly-once delivery.
-struct ExecutionLog {
+struct ExecutionLog final : testing::DriverObserver {
+  void Executed(const DriverCommand& c, TimePoint now) override {
+    if (c.type != CommandType::kJointSetPoint) return;
+    std::lock_guard lock(mutex);
+    ++setpoints[c.values[0]];
+    setpoint_times[c.values[0]] = now;
+  }
   std::mutex mutex;
   std::map<double, int> setpoints;             // pan value -> times executed
   std::map<double, TimePoint> setpoint_times;  // pan value -> when it executed
-};
-
-class CountingDriver final : public Driver {
- public:
-  CountingDriver(std::unique_ptr<Driver> inner, std::shared_ptr<ExecutionLog> log)
-      : inner_(std::move(inner)), log_(std::move(log)) {}
-  const RobotModel& model() const override { return inner_->model(); }
-  Duration period() const override { return inner_->period(); }
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
-    if (c.type == CommandType::kJointSetPoint) {
-      std::lock_guard lock(log_->mutex);
-      ++log_->setpoints[c.values[0]];
-      log_->setpoint_times[c.values[0]] = now;
-    }
-    return inner_->Execute(c, now, done);
-  }
-  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
-  void ReadState(RobotState& s) const override { inner_->ReadState(s); }
-  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
-  void Halt(std::vector<Completion>& done) override { inner_->Halt(done); }
-  void Resume() override { inner_->Resume(); }
-
- private:
-  std::unique_ptr<Driver> inner_;
-  std::shared_ptr<ExecutionLog> log_;
 };
 
 class ServerClientTest : public ::testing::Test {
@@ -63,7 +45,7 @@ class ServerClientTest : public ::testing::Test {
     if (!registered_) {
       RegisterKinematicDriver(registry_);
       registry_.Register("counting", [log = log_, this](const DriverConfig& config) {
-        return std::make_unique<CountingDriver>(registry_.Create("kinematic", config), log);
+        return std::make_unique<testing::ObservedDriver>(registry_.Create("kinematic", config), log);
       });
       registered_ = true;
     }

@@ -278,13 +278,8 @@ TEST_F(RobotDaemonTest, HaltsAndHoldsInPanicARobotWhoseDriverReportsAFault) {
 // A server clock need not be the steady clock (an offset, a simulated one):
 // the thread must sleep for the distance to a start time on *its* clock.
 TEST(RobotDaemonThread, RunsATimedCommandAtItsTimeOnAClockAheadOfTheSteadyClock) {
-  class AheadClock final : public Clock {
-   public:
-    TimePoint Now() const override { return steady_.Now() + seconds(1000); }
-
-   private:
-    SteadyClock steady_;
-  } clock;
+  SteadyClock steady;
+  OffsetClock clock(steady, seconds(1000));
   for (const bool precise : {true, false}) {
     auto driver = std::make_unique<FakeDriver>(PanRobot());
     FakeDriver* fake = driver.get();

@@ -13,19 +13,7 @@
 set -u
 server_bin=$1 cli=$2 logplay=$3 models=$4
 url="udpm://239.255.76.67:7811?ttl=0"
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
-  wait 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"
 rt() { "$cli" --url "$url" "$@"; }
 
 "$server_bin" --robot "pioneer=ode:$models/pioneer2dx_pantilt.urdf" \

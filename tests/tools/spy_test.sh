@@ -14,19 +14,7 @@ for tool in Xvfb xwd java "$py"; do
   command -v "$tool" >/dev/null || { echo "SKIP: $tool not installed (scripts/setup.sh installs it)"; exit 77; }
 done
 [ -x "$spy" ] || { echo "SKIP: robotalk-spy was not built (no robotalk_lcmtypes.jar)"; exit 77; }
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
-  wait 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/../lib.sh"
 
 display=":$((100 + $$ % 400))"
 Xvfb "$display" -screen 0 1100x560x24 -nolisten tcp >"$tmp/xvfb.log" 2>&1 &
