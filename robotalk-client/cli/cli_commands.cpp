@@ -92,7 +92,7 @@ int RunDescribe(const GlobalOptions& g, const std::vector<std::string>& in) {
   } else {
     PrintModelTable(client->model(), std::cout);
   }
-  return 0;
+  ExitAfterOutput(0);
 }
 
 int RunQuery(const GlobalOptions& g, const std::vector<std::string>& in) {
@@ -112,7 +112,7 @@ int RunQuery(const GlobalOptions& g, const std::vector<std::string>& in) {
   } else {
     PrintReply(r, std::cout);
   }
-  return ExitStatus(r);
+  ExitAfterOutput(ExitStatus(r));
 }
 
 int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args) {
@@ -121,7 +121,7 @@ int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args) {
   const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
   client->Panic();
   std::cout << "panic acknowledged by " << args[0] << "\n";
-  return 0;
+  ExitAfterOutput(0);
 }
 
 int RunReset(const GlobalOptions& g, const std::vector<std::string>& args) {
@@ -130,7 +130,7 @@ int RunReset(const GlobalOptions& g, const std::vector<std::string>& args) {
   const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
   const Reply r = client->ResetPanic();
   PrintReply(r, std::cout);
-  return ExitStatus(r);
+  ExitAfterOutput(ExitStatus(r));
 }
 
 int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <iostream>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -123,6 +125,13 @@ std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::st
   client = std::make_unique<RobotClient>(options);
   client->Connect(robot);
   return client;
+}
+
+void ExitAfterOutput(int status) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(status);
 }
 
 std::string JsonString(const std::string& s) {

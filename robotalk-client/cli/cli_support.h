@@ -45,6 +45,13 @@ std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::st
 
 ClientOptions MakeOptions(const GlobalOptions& g);
 
+/// Ends a one-shot command (describe, query, panic, reset) once its answer is
+/// written: flushes stdout and stderr and leaves the process without tearing
+/// the client down. The teardown (joining the client's thread and one LCM
+/// receive thread per lane) costs the caller time and does nothing the exit
+/// does not: the client sends nothing on close, the kernel closes the sockets.
+[[noreturn]] void ExitAfterOutput(int status);
+
 /// JSON text of a string (quoted, escaped) and of a number (null for NaN/inf).
 std::string JsonString(const std::string& s);
 std::string JsonNumber(double v);
