@@ -138,7 +138,7 @@ def rows_for(res):
     m = res.get("memory", {})
     if m.get("levels"):
         rows.append(("memory per idle session (server RSS)",
-                     "; ".join(f"{l['sessions']}: {l['per_session_kb']:.2f} KiB" for l in m["levels"]),
+                     "; ".join(session_level(l) for l in m["levels"]),
                      f"server RSS with none: {m['levels'][0]['base_rss_kb'] / 1024:.1f} MiB", "—"))
     j = res.get("jitter", {})
     a, b, r = pair(j, "robotalk", "raw", "deviation_us")
@@ -161,6 +161,15 @@ def machine_text(m):
 def playback_ratio(chosen, hindsight):
     r = ratio(chosen, hindsight, 1)
     return r + " (floor near 0)" if hindsight is not None and hindsight < 0.005 else r
+
+
+def session_level(level):
+    """'100: 1.68 KiB'; a run before sessions needed a hello has no 'opened'."""
+    opened = level.get("opened", level["sessions"])
+    if not opened or level.get("per_session_kb") is None:
+        return f"{level['sessions']}: none opened"
+    text = f"{opened}: {level['per_session_kb']:.2f} KiB"
+    return text if opened == level["sessions"] else text + f" ({level['sessions']} asked)"
 
 
 def playback_levels(res):
