@@ -152,7 +152,8 @@ class RobotClient::Impl {
   std::unique_ptr<Transport> own_transport_;
   Transport* transport_ = nullptr;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;  // GUARDED_BY(mu_)
-  int wake_fd_ = -1;  // eventfd: SendPackage and Close wake the ReadDaemon
+  int wake_fd_ = -1;       // eventfd: SendPackage and Close wake the ReadDaemon
+  int transport_fd_ = -1;  // transport_->fileno(), read before the ReadDaemon starts
   std::mutex fault_mu_;
   std::mt19937_64 fault_rng_;  // GUARDED_BY(fault_mu_)
   std::atomic<bool> stop_{false};

@@ -16,9 +16,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
-#include <exception>
 #include <random>
-#include <thread>
 #include <utility>
 
 namespace robotalk {
@@ -71,6 +69,10 @@ RobotClient::Impl::Impl(ClientOptions options)
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw ClientError(std::string("RobotClient: eventfd failed: ") + std::strerror(errno));
   last_send_ = clock_.Now();
+  // Asked here, not on the ReadDaemon: LCM 1.3.1 sets up its receive side
+  // (and lazily initialises glib mutexes) on the first fileno() or
+  // subscribe, which is not safe from two threads at once (TSan).
+  transport_fd_ = transport_->fileno();
   daemon_ = std::thread([this] { Run(); });
 }
 
@@ -108,41 +110,17 @@ void RobotClient::Impl::AttachLocked(const std::string& robot) {
   robot_ = robot;
   request_channel_ = RequestChannel(robot);
   const std::string reply_channel = ReplyChannel(robot, client_id_);
-  // CONFIG travels on the main lane, replies on the client's reply lane
-  // (docs/protocol.md "Traffic layout"): with LCM each lane's first
-  // subscription opens a receive socket and waits for LCM's self-test
-  // message, so the CONFIG subscription is made on a second thread while
-  // this one makes the others. (Subscribe may be called from any thread.)
-  std::unique_ptr<Subscription> config;
-  std::exception_ptr config_error;
-  std::thread config_subscriber([&] {
-    try {
-      config = transport_->Subscribe(
-          ConfigChannel(robot), [this](const std::string&, std::span<const std::uint8_t> b) { OnConfig(b); });
-    } catch (...) {
-      config_error = std::current_exception();
-    }
-  });
   try {
     subscriptions_.push_back(transport_->Subscribe(
         reply_channel, [this](const std::string&, std::span<const std::uint8_t> b) { OnReplyPackage(b); }));
     subscriptions_.push_back(transport_->Subscribe(
+        ConfigChannel(robot), [this](const std::string&, std::span<const std::uint8_t> b) { OnConfig(b); }));
+    subscriptions_.push_back(transport_->Subscribe(
         HelloAnswerChannel(robot, client_id_),
         [this](const std::string&, std::span<const std::uint8_t> b) { OnHelloAnswer(b); }));
   } catch (const TransportError& e) {
-    config_subscriber.join();
     throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel + ": " + e.what());
-  } catch (...) {
-    config_subscriber.join();
-    throw;
   }
-  config_subscriber.join();
-  try {
-    if (config_error) std::rethrow_exception(config_error);
-  } catch (const TransportError& e) {
-    throw ClientError("RobotClient::Connect: cannot subscribe to " + ConfigChannel(robot) + ": " + e.what());
-  }
-  subscriptions_.push_back(std::move(config));
 }
 
 RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands,
@@ -281,7 +259,7 @@ std::string RobotClient::Impl::LastConfigError() const {
 // deadline, at most max_idle_wait; then dispatches and ticks.
 void RobotClient::Impl::Run() {
   bool reported = false;
-  const int fd = transport_->fileno();
+  const int fd = transport_fd_;
   while (!stop_) {
     const Duration wait = IdleWait(clock_.Now());
     const auto ms = std::chrono::ceil<std::chrono::milliseconds>(wait).count();
