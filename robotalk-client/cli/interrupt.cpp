@@ -15,8 +15,17 @@ namespace {
 std::atomic<int> g_signal{0};
 std::atomic<bool> g_installed{false};
 std::atomic<bool> g_defer{false};
-std::mutex g_mu;
-std::condition_variable g_cv;
+// Never destroyed (as Drake's never_destroyed): the signal thread is
+// detached and may still be inside notify_all() when main() returns and
+// static destructors run (TSan saw exactly that race after a Ctrl-C).
+std::mutex& Mu() {
+  static auto* mu = new std::mutex;
+  return *mu;
+}
+std::condition_variable& Cv() {
+  static auto* cv = new std::condition_variable;
+  return *cv;
+}
 
 sigset_t Signals() {
   sigset_t set;
@@ -37,10 +46,10 @@ void WaitForSignals() {
       std::_Exit(128 + sig);
     }
     {
-      std::lock_guard lock(g_mu);
+      std::lock_guard lock(Mu());
       g_signal.store(sig);
     }
-    g_cv.notify_all();
+    Cv().notify_all();
   }
 }
 
@@ -48,6 +57,8 @@ void WaitForSignals() {
 
 void Interrupter::Install() {
   if (g_installed.exchange(true)) return;
+  Mu();  // constructed here, before the signal thread can need them
+  Cv();
   const sigset_t set = Signals();
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   std::thread(WaitForSignals).detach();
@@ -58,8 +69,8 @@ void Interrupter::Defer(bool defer) { g_defer.store(defer); }
 int Interrupter::Signal() { return g_signal.load(); }
 
 int Interrupter::WaitFor(Duration d) {
-  std::unique_lock lock(g_mu);
-  g_cv.wait_for(lock, d, [] { return g_signal.load() != 0; });
+  std::unique_lock lock(Mu());
+  Cv().wait_for(lock, d, [] { return g_signal.load() != 0; });
   return g_signal.load();
 }
 
