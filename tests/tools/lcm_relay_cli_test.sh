@@ -31,12 +31,15 @@ ge() { awk -v x="$1" -v y="$2" 'BEGIN { exit !(x + 0 >= y + 0) }'; }
 # A->B every 5 ms, 100 messages B->A every 10 ms.
 run() {  # run NAME SEED
   "$relay" --a "$A" --b "$B" --a2b-latency-ms 40 --a2b-loss 0.25 --b2a-latency-ms 15 --seed "$2" \
-    --duration 3 --stats >"$tmp/$1.stats" 2>"$tmp/$1.log" &
+    --duration 4 --stats >"$tmp/$1.stats" 2>"$tmp/$1.log" &
   rpid=$!
   sleep 0.4
-  "$probe" recv "$B" A2B 2 >"$tmp/$1.b" &
-  "$probe" recv "$A" B2A 2 >"$tmp/$1.a" &
-  "$probe" recv "$A" A2B 2 >"$tmp/$1.back" &
+  # Each probe listens 3 s for 1 s of sending: a loaded machine (a TSan run
+  # beside other tests) once started the sender late enough that the last 5
+  # of 200 messages came after a 2 s window.
+  "$probe" recv "$B" A2B 3 >"$tmp/$1.b" &
+  "$probe" recv "$A" B2A 3 >"$tmp/$1.a" &
+  "$probe" recv "$A" A2B 3 >"$tmp/$1.back" &
   sleep 0.3
   "$probe" send "$A" A2B 200 5 &
   "$probe" send "$B" B2A 100 10 &
