@@ -247,12 +247,21 @@ def plot(res, figdir):
 
 
 def describe(res):
-    meta = next((r["meta"] for r in res.values() if "meta" in r), {})
-    if not meta:
+    """The run most figures come from; figures re-run later (--only) are named."""
+    metas = [(name, r["meta"]) for name, r in res.items() if "meta" in r]
+    if not metas:
         return "no run"
-    return (f"{meta.get('date_utc')} UTC, commit {meta.get('commit')}, {'quick' if meta.get('quick') else 'full'} mode, "
+    runs = {}
+    for name, m in metas:
+        runs.setdefault((m.get("date_utc"), m.get("commit")), []).append(name)
+    main_key = max(runs, key=lambda k: len(runs[k]))
+    meta = next(m for name, m in metas if (m.get("date_utc"), m.get("commit")) == main_key)
+    text = (f"{meta.get('date_utc')} UTC, commit {meta.get('commit')}, {'quick' if meta.get('quick') else 'full'} mode, "
             f"{meta.get('runs')} runs, load average at start {meta.get('loadavg_start', [0])[0]:.1f} on "
             f"{meta.get('nproc')} CPUs")
+    later = [f"{', '.join(sorted(names))} re-run {date} UTC at {commit}"
+             for (date, commit), names in sorted(runs.items()) if (date, commit) != main_key]
+    return text + (f" ({'; '.join(later)})" if later else "")
 
 
 def main():
