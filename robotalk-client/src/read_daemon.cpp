@@ -70,8 +70,9 @@ RobotClient::Impl::Impl(ClientOptions options)
   if (wake_fd_ < 0) throw ClientError(std::string("RobotClient: eventfd failed: ") + std::strerror(errno));
   last_send_ = clock_.Now();
   // Asked here, not on the ReadDaemon: LCM 1.3.1 sets up its receive side
-  // (and lazily initialises glib mutexes) on the first fileno() or
-  // subscribe, which is not safe from two threads at once (TSan).
+  // (and lazily creates glib mutexes) on the first fileno() or subscribe, so
+  // that set-up stays on one thread rather than racing Connect's subscribe
+  // (TSan flagged it; glib's own atomics may make it safe, TSan cannot tell).
   transport_fd_ = transport_->fileno();
   daemon_ = std::thread([this] { Run(); });
 }
