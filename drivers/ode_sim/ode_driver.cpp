@@ -421,11 +421,8 @@ TimePoint OdeDriver::sim_time() const {
   return impl_->origin_.value_or(TimePoint{}) + impl_->dropped_ + impl_->steps_ * impl_->step_;
 }
 Duration OdeDriver::dropped_time() const { return impl_->dropped_; }
-std::string OdeDriver::Fault() const {
-  if (!impl_->walker_ || !impl_->walker_->fallen()) return {};
-  char tilt[32];
-  std::snprintf(tilt, sizeof tilt, "%.2f", impl_->walker_->fall_tilt());
-  return std::string("the robot has fallen (torso tilt ") + tilt + " rad)";
+std::string_view OdeDriver::Fault() const {
+  return impl_->walker_ ? std::string_view(impl_->walker_->fall()) : std::string_view();
 }
 
 std::optional<walking::WalkStatus> OdeDriver::walk_status() const {

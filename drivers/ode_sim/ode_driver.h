@@ -129,7 +129,7 @@ class OdeDriver final : public Driver {
   void Resume() override;
   /// A walking humanoid that fell: "the robot has fallen (torso tilt X rad)"
   /// (the server halts it and holds it in panic); "" otherwise.
-  std::string Fault() const override;
+  std::string_view Fault() const override;
 
   /// As fast as possible: `n` fixed steps now, whatever the clock says (the
   /// simulated time moves on by n steps). Completions go to `completed`.

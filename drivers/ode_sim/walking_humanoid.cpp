@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <span>
 
@@ -333,7 +334,9 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   const Eigen::VectorXd& q = world_->q();
   if (!fallen_ && tilt_ > kFallTilt) {
     fallen_ = true;
-    fall_tilt_ = tilt_;
+    char tilt[32];
+    std::snprintf(tilt, sizeof tilt, "%.2f", tilt_);
+    fall_ = std::string("the robot has fallen (torso tilt ") + tilt + " rad)";
     if (mode_ == Mode::kGoto) {
       completed.push_back(Completion{.id = goto_id_,
                                      .signal = Signal::kInterrupted,

@@ -65,8 +65,8 @@ class WalkingHumanoid {
   bool Owns(Eigen::Index dof) const { return owned_[static_cast<size_t>(dof)] != 0; }
   bool busy() const { return mode_ == Mode::kGoto; }
   bool fallen() const { return fallen_; }
-  /// The torso tilt when the fall was detected, rad.
-  double fall_tilt() const { return fall_tilt_; }
+  /// The fall in words, "" before one: "the robot has fallen (torso tilt 0.71 rad)".
+  const std::string& fall() const { return fall_; }
 
   DriverResult Goto(const DriverCommand& c);
   DriverResult SetSpeed(const DriverCommand& c);
@@ -115,7 +115,7 @@ class WalkingHumanoid {
   int replanned_at_ = 0;               // pattern_.started_steps() at the last plan
   double v_ = 0, vy_ = 0, omega_ = 0;  // SETSPEED per second
   bool fallen_ = false;
-  double fall_tilt_ = 0;
+  std::string fall_;  // written once, when the fall is detected
   double tilt_ = 0;
   void MeasureContacts();
   double foot_force_[2] = {0, 0};

@@ -385,11 +385,11 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   for (const QueuedItem& item : due_) Execute(item, now);
   if (now >= next_update_) {
     Guarded("Update", nullptr, now, [&] { driver_->Update(now, completions_); });
-    std::string condition;  // empty (no allocation) while the robot is fine
-    if (Guarded("Fault", nullptr, now, [&] { condition = driver_->Fault(); }) == CallOutcome::kOk) {
-      if (!condition.empty() && condition != reported_condition_)
-        Fault("driver '" + driver_name_ + "' reports: " + condition, now);
-      reported_condition_ = std::move(condition);
+    std::string_view condition;  // the driver's own text: nothing allocated unless it changed
+    if (Guarded("Fault", nullptr, now, [&] { condition = driver_->Fault(); }) == CallOutcome::kOk &&
+        condition != reported_condition_) {
+      if (!condition.empty()) Fault("driver '" + driver_name_ + "' reports: " + std::string(condition), now);
+      reported_condition_.assign(condition);
     }
     const Duration p = driver_->period();
     next_update_ = next_update_ == TimePoint::min() ? now + p : next_update_ + p;

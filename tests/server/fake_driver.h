@@ -87,7 +87,7 @@ class FakeDriver : public Driver {
     goto_id.reset();
   }
   void Resume() override { halted = false; }
-  std::string Fault() const override { return fault; }
+  std::string_view Fault() const override { return fault; }
 
   RobotModel model_;
   std::string fault;  // what Fault() reports ("" = none)

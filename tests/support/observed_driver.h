@@ -40,7 +40,7 @@ class ObservedDriver final : public Driver {
     observer_->Halted(false);
     inner_->Resume();
   }
-  std::string Fault() const override { return inner_->Fault(); }
+  std::string_view Fault() const override { return inner_->Fault(); }
 
  private:
   std::unique_ptr<Driver> inner_;

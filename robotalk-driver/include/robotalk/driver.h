@@ -41,6 +41,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace robotalk {
@@ -116,8 +117,10 @@ class Driver {
   /// Update(). The server treats a new one as a driver fault: the robot is
   /// halted and held in panic until PANIC_RESET, the STATE stream says panic,
   /// queries and refused commands name it. The same text again after a reset
-  /// does not halt again. Default: none.
-  virtual std::string Fault() const { return {}; }
+  /// does not halt again. Default: none. The text must stay valid until the
+  /// driver's next call: keep it in a member, so that asking every period
+  /// never allocates (the RobotDaemon's loop does not).
+  virtual std::string_view Fault() const { return {}; }
 };
 
 /// What a driver factory receives.
