@@ -274,7 +274,7 @@ std::int64_t RobotClient::client_id() const { return impl_->client_id_; }
 const RobotModel& RobotClient::model() const {
   std::lock_guard lock(impl_->mu_);
   if (!impl_->model_) throw ClientError("RobotClient::model: not connected");
-  return *impl_->model_;  // kept alive in models_ for the client's lifetime
+  return *impl_->model_;  // kept alive in configs_ for the client's lifetime (config_store.h)
 }
 
 const RobotModel& RobotClient::ReloadModel() {
@@ -428,9 +428,16 @@ ClientStats RobotClient::stats() const {
   std::lock_guard lock(impl_->mu_);
   ClientStats s = impl_->stats_;
   s.replies_ignored = std::max(s.replies_ignored, impl_->cache_->ignored());
+  s.configs_cached = impl_->configs_.size();
+  s.config_bytes_cached = impl_->configs_.bytes();
   return s;
 }
 
 const ClientOptions& RobotClient::options() const { return impl_->options_; }
+
+TrustedServer RobotClient::trusted_server() const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->trust_ ? impl_->trust_->Describe() : TrustedServer{};
+}
 
 }  // namespace robotalk
