@@ -192,10 +192,15 @@ struct AnnouncedRobot {
   int num_clients = 0;
   std::int64_t server_id = 0;
   std::string url_hint;
+  /// A keyed server's key ("ed25519:<64 hex>"), which signed this
+  /// announcement (verified); "" for an unsigned one (open mode). Compare it
+  /// with a pin (known_servers.h): anyone can sign with a key of their own.
+  std::string server_key;
 };
 
 /// Listens to ROBOTALK/ANNOUNCE for `listen` and returns every robot heard,
 /// once per (server id, name), sorted by name. Servers announce once a second.
+/// An announcement whose signature suffix does not verify is dropped.
 std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen);
 
 /// Client counters, for diagnostics and tests.
