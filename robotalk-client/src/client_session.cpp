@@ -73,8 +73,10 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
     return;
   }
   std::optional<PublicKey> first_use;  // keyed: a server key to pin before the session is used
+  std::string robot;
   {
     std::lock_guard lock(mu_);
+    robot = robot_;
     if (!hello_due_ || answer.body.client_id != client_id_ || answer.body.client_nonce != hello_nonce_) {
       return;  // another client's, or an answer to an earlier hello
     }
@@ -108,15 +110,17 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
     // outside the lock; only this thread handles answers).
     std::string error;
     try {
-      trust_->Pin(*first_use);
+      trust_->WritePin(*first_use);
     } catch (const KeyError& e) {
-      error = std::string("RobotClient: cannot pin the server key of robot '") + robot_ + "': " + e.what();
+      error = "cannot pin the server key of robot '" + robot + "': " + e.what();
     }
     std::lock_guard lock(mu_);
     if (!error.empty()) {
       hello_refusal_ = error;
       hello_due_ = false;
       session_keys_.reset();
+    } else {
+      trust_->Trust(*first_use);
     }
   }
   {

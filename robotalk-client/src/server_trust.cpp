@@ -53,9 +53,12 @@ std::string ServerTrust::Check(const PublicKey& offered) const {
          " (its first session), and a server answered with " + offered.Fingerprint() + "; refused";
 }
 
-void ServerTrust::Pin(const PublicKey& key) {
-  if (trusted_) return;
+void ServerTrust::WritePin(const PublicKey& key) const {
   KnownServers::Append(pin_file_, {robot_, network_, key});
+}
+
+void ServerTrust::Trust(const PublicKey& key) {
+  if (trusted_) return;
   trusted_ = key;
   source_ = TrustedServer::Source::kPinnedNow;
 }

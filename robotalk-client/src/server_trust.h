@@ -36,11 +36,15 @@ class ServerTrust {
   /// "" when `offered` (the key that signed a hello answer) may be trusted;
   /// otherwise why not, naming both fingerprints and how to fix it.
   std::string Check(const PublicKey& offered) const;
-  /// True when Check() passed for a key nobody pinned yet: Pin() must record it.
+  /// True when Check() passed for a key nobody pinned yet: WritePin() and
+  /// Trust() must record it.
   bool first_use() const { return !trusted_; }
-  /// Trusts `key` (after Check). On first use appends it to the pin file.
+  /// First use: appends `key` to the pin file. Reads only what Load() set,
+  /// so it may run outside the caller's lock.
   /// @throw KeyError when the pin cannot be written.
-  void Pin(const PublicKey& key);
+  void WritePin(const PublicKey& key) const;
+  /// Trusts `key` from now on (after Check, and WritePin on first use).
+  void Trust(const PublicKey& key);
 
   const std::optional<PublicKey>& trusted() const { return trusted_; }
   TrustedServer Describe() const;

@@ -7,14 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include "support/test_keys.h"
+
 namespace robotalk {
 namespace {
 
-KeyPair Key(std::uint8_t seed) {
-  std::array<std::uint8_t, SecretKey::kSeedBytes> bytes{};
-  bytes.fill(seed);
-  return KeyPair::FromSeed(bytes);
-}
+using testing::TestKey;
 
 Nonce NonceOf(std::uint8_t v) {
   Nonce n{};
@@ -32,7 +30,7 @@ std::vector<std::uint8_t> Sample(double x) {
 }
 
 TEST(BroadcastSignature, ASignedSampleVerifiesUnderItsKeyChannelAndInstance) {
-  const KeyPair server = Key(1);
+  const KeyPair server = TestKey(1);
   const BroadcastSigner signer(server, NonceOf(7));
   std::vector<std::uint8_t> bytes = Sample(1.0);
   const std::size_t plain = bytes.size();
@@ -47,7 +45,7 @@ TEST(BroadcastSignature, ASignedSampleVerifiesUnderItsKeyChannelAndInstance) {
 }
 
 TEST(BroadcastSignature, AForgedOrMovedOrForeignBroadcastIsRefusedWithItsReason) {
-  const KeyPair server = Key(1);
+  const KeyPair server = TestKey(1);
   const Nonce instance = NonceOf(7);
   const BroadcastSigner signer(server, instance);
   std::vector<std::uint8_t> bytes = Sample(1.0);
@@ -67,7 +65,7 @@ TEST(BroadcastSignature, AForgedOrMovedOrForeignBroadcastIsRefusedWithItsReason)
   EXPECT_EQ(VerifyBroadcast(StateChannel("pioneer"), bytes, server.public_key, &other_instance),
             BroadcastVerdict::kOtherInstance);
   std::vector<std::uint8_t> mallory = Sample(42.0);
-  BroadcastSigner(Key(2), instance).Sign(StateChannel("pioneer"), mallory);
+  BroadcastSigner(TestKey(2), instance).Sign(StateChannel("pioneer"), mallory);
   EXPECT_EQ(VerifyBroadcast(StateChannel("pioneer"), mallory, server.public_key, &instance),
             BroadcastVerdict::kOtherKey);
   // Mallory's message claiming the real server's key in its suffix.

@@ -3,8 +3,10 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
 #include <sys/stat.h>
 #include <unistd.h>
+#include "support/test_keys.h"
 
 #include <filesystem>
 #include <fstream>
@@ -16,11 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-PublicKey Key(std::uint8_t seed) {
-  std::array<std::uint8_t, SecretKey::kSeedBytes> bytes{};
-  bytes.fill(seed);
-  return KeyPair::FromSeed(bytes).public_key;
-}
+PublicKey Key(std::uint8_t seed) { return testing::TestKey(seed).public_key; }
 
 class KnownServersTest : public ::testing::Test {
  protected:
