@@ -214,6 +214,11 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     Interrupter::WaitFor(std::min<Duration>(std::chrono::milliseconds(20), end - SteadyClock().Now()));
   }
   client->StopStateStream();
+  if (const std::uint64_t refused = client->stats().broadcasts_refused; refused > 0) {
+    std::cerr << "robotalk: dropped " << refused
+              << " STATE/CONFIG messages not signed by the server's key (forged, replayed, or of another "
+                 "server)\n";
+  }
   return 0;
 }
 

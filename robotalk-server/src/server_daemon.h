@@ -3,8 +3,10 @@
 // the only place that knows the wire), hands it to that robot's
 // RobotSessions (sessions, admission), and sends what comes back: the
 // immediate acknowledgement, the RobotDaemons' replies and state samples, the
-// configuration message, and ROBOTALK/ANNOUNCE once a period. It also runs the
-// session watchdog and the driver-call watchdog.
+// configuration message, and ROBOTALK/ANNOUNCE once a period (keyed mode:
+// ANNOUNCE, CONFIG and STATE signed by the server's key, broadcast_signature.h).
+// It also runs the session watchdog and the driver-call watchdog, and applies
+// one robot, one server while it starts (OnAnnounce).
 //
 // Fewer hops (issue 11): a query the RobotDaemon can answer on receipt
 // (RobotDaemon::Submit) travels in the same reply package as the

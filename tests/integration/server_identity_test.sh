@@ -56,6 +56,7 @@ wait "$watch_pid"
 check "watch printed the real samples: $(wc -l <"$tmp/watch")" test "$(wc -l <"$tmp/watch")" -ge 10
 check "watch printed no forged sample: $(grep -c ' 42.0000 42.0000' "$tmp/watch")" \
   bash -c "! grep -q ' 42.0000 42.0000' '$tmp/watch'"
+check "watch says how many it dropped: $(cat "$tmp/watch.err")" grep -q "dropped [0-9]* STATE/CONFIG messages" "$tmp/watch.err"
 
 # Item 12: a second server for pioneer (its only robot) refuses it and exits 1.
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 20 \
