@@ -292,6 +292,7 @@ done
 url_a="udpm://239.255.76.67:7100?ttl=0"   # clients
 url_b="udpm://239.255.76.67:7200?ttl=0"   # server
 tmp=$(mktemp -d /tmp/robotalk-soak.XXXXXX)
+export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"  # keyed: a fresh server key per run, pinned here
 server_pid="" relay_pid=""
 declare -A client_pids=()   # pid -> report file
 cleanup() {

@@ -5,7 +5,9 @@
 #   pids+=($!)    any other background process: killed at exit
 #   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
 #   $pass, $failures        the counts
+#   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
 tmp=$(mktemp -d)
+export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
 server_pid="" client_pid=""
 pids=()
 cleanup() {

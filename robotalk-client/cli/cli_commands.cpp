@@ -3,6 +3,8 @@
 #include "cli_support.h"
 #include "describe_format.h"
 #include "interrupt.h"
+#include "robotalk/known_servers.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -55,6 +57,33 @@ void PrintReply(const Reply& r, std::ostream& out) {
   out << '\n';
 }
 
+namespace {
+// A keyed server's key as `robots` shows it: its fingerprint and what the
+// pin file says of it (a signature proves only that its signer holds that key).
+std::string KeyColumn(const GlobalOptions& g, const AnnouncedRobot& r) {
+  if (r.server_key.empty()) return "- (open mode)";
+  const PublicKey key = PublicKey::Parse(r.server_key);
+  if (!g.server_key.empty()) {
+    return key.Fingerprint() +
+           (ReadPublicKeyFile(g.server_key).key == key ? " (--server-key)" : " (NOT --server-key)");
+  }
+  const std::filesystem::path file =
+      g.known_servers.empty() ? DefaultKnownServersFile() : std::filesystem::path(g.known_servers);
+  const std::string network = PinNetwork(ResolveLcmUrl(g.url));
+  const ServerPin* pin = nullptr;
+  std::optional<KnownServers> pins;
+  try {
+    if (!file.empty()) pins = KnownServers::Read(file);
+    if (pins) pin = pins->Find(r.name, network);
+  } catch (const KeyError& e) {
+    return key.Fingerprint() + " (" + e.what() + ")";
+  }
+  if (!pin) return key.Fingerprint() + " (not pinned)";
+  return key.Fingerprint() +
+         (pin->key == key ? " (pinned)" : " (NOT the pinned " + pin->key.Fingerprint() + ")");
+}
+}  // namespace
+
 int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
   std::vector<std::string> args = in;
   std::string listen = "1.5";
@@ -71,12 +100,12 @@ int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
     return 0;
   }
   if (robots.empty()) return 0;
-  std::printf("%-20s %-10s %5s %-16s %-5s %7s %s\n", "ROBOT", "DRIVER", "DOFS", "CONFIG_HASH", "PANIC",
-              "CLIENTS", "SERVER");
+  std::printf("%-20s %-10s %5s %-16s %-5s %7s %-16s %s\n", "ROBOT", "DRIVER", "DOFS", "CONFIG_HASH", "PANIC",
+              "CLIENTS", "SERVER", "KEY");
   for (const auto& r : robots) {
-    std::printf("%-20s %-10s %5d %016llx %-5s %7d %016llx\n", r.name.c_str(), r.driver.c_str(), r.total_dofs,
-                static_cast<unsigned long long>(r.config_hash), r.panic ? "yes" : "no", r.num_clients,
-                static_cast<unsigned long long>(r.server_id));
+    std::printf("%-20s %-10s %5d %016llx %-5s %7d %016llx %s\n", r.name.c_str(), r.driver.c_str(),
+                r.total_dofs, static_cast<unsigned long long>(r.config_hash), r.panic ? "yes" : "no",
+                r.num_clients, static_cast<unsigned long long>(r.server_id), KeyColumn(g, r).c_str());
   }
   return 0;
 }
@@ -185,6 +214,11 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     Interrupter::WaitFor(std::min<Duration>(std::chrono::milliseconds(20), end - SteadyClock().Now()));
   }
   client->StopStateStream();
+  if (const std::uint64_t refused = client->stats().broadcasts_refused; refused > 0) {
+    std::cerr << "robotalk: dropped " << refused
+              << " STATE/CONFIG messages not signed by the server's key (forged, replayed, or of another "
+                 "server)\n";
+  }
   return 0;
 }
 

@@ -13,10 +13,11 @@
 namespace robotalk::cli {
 
 struct GlobalOptions {
-  std::string url;         ///< --url; "" = LCM default
-  double timeout_s = 5.0;  ///< --timeout
-  std::string key_file;    ///< --key; "" = $ROBOTALK_KEY or open mode
-  std::string server_key;  ///< --server-key: pin the server's public key
+  std::string url;            ///< --url; "" = LCM default
+  double timeout_s = 5.0;     ///< --timeout
+  std::string key_file;       ///< --key; "" = $ROBOTALK_KEY or open mode
+  std::string server_key;     ///< --server-key: pin the server's public key
+  std::string known_servers;  ///< --known-servers: the pin file ("" = the default)
 };
 
 /// Pulls `--name VALUE` (or the flag `--name` when value is null) out of

@@ -94,8 +94,21 @@ ClientOptions MakeOptions(const GlobalOptions& g) {
   o.connect_timeout = FromSeconds(g.timeout_s);
   o.key_file = g.key_file;
   o.server_key_file = g.server_key;
+  o.known_servers_file = g.known_servers;
   return o;
 }
+
+namespace {
+// Trust on first use says so, as SSH does (docs/security.md, "Which server?").
+std::unique_ptr<RobotClient> SayIfPinned(std::unique_ptr<RobotClient> client, const std::string& robot) {
+  const TrustedServer trust = client->trusted_server();
+  if (trust.source == TrustedServer::Source::kPinnedNow) {
+    std::cerr << "robotalk: first connection to robot '" << robot << "': trusting its server key "
+              << trust.fingerprint << " from now on (pinned in " << trust.file << ")\n";
+  }
+  return client;
+}
+}  // namespace
 
 std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::string& robot, ClockUse clock) {
   AnnounceWatch watch(g.url);
@@ -106,7 +119,7 @@ std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::st
   auto client = std::make_unique<RobotClient>(options);
   try {
     client->Connect(robot);
-    return client;
+    return SayIfPinned(std::move(client), robot);
   } catch (const TimeoutError&) {
     const std::set<std::string> heard = watch.Heard();
     if (heard.count(robot) == 0) {
@@ -124,7 +137,7 @@ std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::st
   options.connect_timeout = total - options.connect_timeout;
   client = std::make_unique<RobotClient>(options);
   client->Connect(robot);
-  return client;
+  return SayIfPinned(std::move(client), robot);
 }
 
 void ExitAfterOutput(int status) {
@@ -198,7 +211,9 @@ std::string RobotsJson(const std::vector<AnnouncedRobot>& robots) {
     out << (i ? "," : "") << "{\"name\":" << JsonString(r.name) << ",\"driver\":" << JsonString(r.driver)
         << ",\"dofs\":" << r.total_dofs << ",\"config_hash\":" << JsonString(Hex64(r.config_hash))
         << ",\"panic\":" << (r.panic ? "true" : "false") << ",\"clients\":" << r.num_clients
-        << ",\"server\":" << JsonString(Hex64(static_cast<std::uint64_t>(r.server_id))) << "}";
+        << ",\"server\":" << JsonString(Hex64(static_cast<std::uint64_t>(r.server_id)))
+        << ",\"server_key\":" << (r.server_key.empty() ? std::string("null") : JsonString(r.server_key))
+        << "}";
   }
   out << "]";
   return out.str();

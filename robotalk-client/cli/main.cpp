@@ -48,7 +48,11 @@ Global options:
   --key FILE     keyed mode: this client's secret key (robotalk-keygen; default
                  $ROBOTALK_KEY); without one the client talks in open mode
   --server-key FILE.pub
-                 keyed mode: refuse a server that answers with another key
+                 keyed mode: trust only the server with this key
+  --known-servers FILE
+                 keyed mode without --server-key: where each robot's server key
+                 is pinned on first use (default $ROBOTALK_KNOWN_SERVERS or
+                 ~/.robotalk/known_servers); a server with another key is refused
   --version      the version
   --help         this text (also after a command)
 
@@ -79,7 +83,8 @@ int main(int argc, char** argv) {
     if (const char* env = std::getenv("LCM_DEFAULT_URL")) g.url = env;
     std::vector<std::string> rest;
     for (std::size_t i = 0; i < args.size(); ++i) {
-      if (args[i] == "--url" || args[i] == "--timeout" || args[i] == "--key" || args[i] == "--server-key") {
+      if (args[i] == "--url" || args[i] == "--timeout" || args[i] == "--key" || args[i] == "--server-key" ||
+          args[i] == "--known-servers") {
         if (i + 1 == args.size()) throw UsageError(args[i] + " needs a value");
         if (args[i] == "--url") {
           g.url = args[++i];
@@ -87,6 +92,8 @@ int main(int argc, char** argv) {
           g.key_file = args[++i];
         } else if (args[i] == "--server-key") {
           g.server_key = args[++i];
+        } else if (args[i] == "--known-servers") {
+          g.known_servers = args[++i];
         } else {
           g.timeout_s = ParseNumber(args[++i], "--timeout");
           if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");

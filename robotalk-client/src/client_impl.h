@@ -7,10 +7,12 @@
 #pragma once
 
 #include "clock_sync.h"
+#include "config_store.h"
 #include "outstanding_packages.h"
 #include "return_cache.h"
 #include "robotalk/channels.h"
 #include "robotalk/robot_client.h"
+#include "server_trust.h"
 
 #include "robotalk/keys.h"
 #include "robotalk/protocol_codec.h"
@@ -85,25 +87,25 @@ class RobotClient::Impl {
   std::shared_ptr<client::ReturnCache> cache_;
 
   mutable std::mutex mu_;
-  std::condition_variable cv_;               // acks, configurations
-  client::OutstandingPackages outstanding_;  // GUARDED_BY(mu_)
-  client::ClockSync clock_sync_;             // GUARDED_BY(mu_)
-  std::int64_t next_sequence_ = 1;           // GUARDED_BY(mu_)
-  CommandId next_id_ = 1;                    // GUARDED_BY(mu_)
-  TimePoint last_send_{};                    // GUARDED_BY(mu_)
-  std::string robot_;                        // GUARDED_BY(mu_); set once by Attach
-  std::string request_channel_;              // GUARDED_BY(mu_)
-  bool connected_ = false;                   // GUARDED_BY(mu_)
-  std::shared_ptr<const RobotModel> model_;  // GUARDED_BY(mu_)
-  std::unordered_map<std::uint64_t, std::shared_ptr<const RobotModel>> models_;  // GUARDED_BY(mu_)
-  std::string last_config_error_;                                                // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> clock_packages_;                              // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> ack_waited_;                                  // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> acked_;                                       // GUARDED_BY(mu_)
-  std::exception_ptr daemon_error_;                                              // GUARDED_BY(mu_)
-  ClientStats stats_;                                                            // GUARDED_BY(mu_)
-  std::unique_ptr<Subscription> state_subscription_;                             // GUARDED_BY(mu_)
-  std::function<void(const StateSample&)> on_state_;                             // GUARDED_BY(mu_)
+  std::condition_variable cv_;                        // acks, configurations
+  client::OutstandingPackages outstanding_;           // GUARDED_BY(mu_)
+  client::ClockSync clock_sync_;                      // GUARDED_BY(mu_)
+  std::int64_t next_sequence_ = 1;                    // GUARDED_BY(mu_)
+  CommandId next_id_ = 1;                             // GUARDED_BY(mu_)
+  TimePoint last_send_{};                             // GUARDED_BY(mu_)
+  std::string robot_;                                 // GUARDED_BY(mu_); set once by Attach
+  std::string request_channel_;                       // GUARDED_BY(mu_)
+  bool connected_ = false;                            // GUARDED_BY(mu_)
+  std::shared_ptr<const RobotModel> model_;           // GUARDED_BY(mu_)
+  client::ConfigStore configs_;                       // GUARDED_BY(mu_)
+  std::string last_config_error_;                     // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> clock_packages_;   // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> ack_waited_;       // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> acked_;            // GUARDED_BY(mu_)
+  std::exception_ptr daemon_error_;                   // GUARDED_BY(mu_)
+  ClientStats stats_;                                 // GUARDED_BY(mu_)
+  std::unique_ptr<Subscription> state_subscription_;  // GUARDED_BY(mu_)
+  std::function<void(const StateSample&)> on_state_;  // GUARDED_BY(mu_)
 
   // The session (docs/protocol.md, Sessions): opened by a hello, named in
   // every package; lost when the server no longer knows it.
@@ -119,7 +121,12 @@ class RobotClient::Impl {
   std::optional<CommandId> resync_config_query_;  // GUARDED_BY(mu_)
   std::optional<std::uint64_t> resync_hash_;      // GUARDED_BY(mu_): the new instance's config
   std::optional<KeyPair> identity_;               // keyed mode; set at construction
-  std::optional<PublicKey> pinned_server_;        // keyed mode; set at construction
+  std::optional<client::ServerTrust> trust_;      // GUARDED_BY(mu_); keyed mode; loaded by Attach
+  std::string trust_error_;                       // GUARDED_BY(mu_); the last answer of an untrusted key
+  // Keyed: the newest authentic STATE sample's time, per server instance: an
+  // older one (a replay inside the instance) is refused.
+  std::optional<std::int64_t> last_state_us_;  // GUARDED_BY(mu_)
+  Nonce last_state_instance_{};                // GUARDED_BY(mu_)
 
   /// Waits for a session (REQUIRES: `lock` holds mu_). Throws ClientError
   /// when the server refused the hello, TimeoutError when none answered.
@@ -133,6 +140,12 @@ class RobotClient::Impl {
   void Publish(const std::string& channel, const std::vector<std::uint8_t>& bytes);
   void OnReplyPackage(std::span<const std::uint8_t> bytes);
   void OnConfig(std::span<const std::uint8_t> bytes);
+  /// Keyed mode: the bytes of a STATE or CONFIG message received on
+  /// `channel` without their signature suffix when signed by the trusted
+  /// server key for the live session's instance; else nullopt (counted).
+  /// Open mode: the bytes without any suffix, unchecked.
+  std::optional<std::span<const std::uint8_t>> Authentic(const std::string& channel,
+                                                         std::span<const std::uint8_t> bytes);
   Duration IdleWait(TimePoint now);
   std::vector<std::uint8_t> EncodeHeartbeat(TimePoint now);  // REQUIRES: mu_ held
   void OnHelloAnswer(std::span<const std::uint8_t> bytes);

@@ -3,6 +3,7 @@
 // happens when the server no longer knows the session (a restart, an expiry).
 #include "client_impl.h"
 #include "robotalk/config_codec.h"
+#include "robotalk/known_servers.h"
 #include "robotalk/request.h"
 
 #include <cstdio>
@@ -29,11 +30,18 @@ void RobotClient::Impl::LoadKeys() {
   }
   try {
     if (!key_file.empty()) identity_ = ReadSecretKeyFile(key_file);
-    if (!options_.server_key_file.empty()) pinned_server_ = ReadPublicKeyFile(options_.server_key_file).key;
+    std::optional<PublicKey> server_key;
+    if (!options_.server_key_file.empty()) server_key = ReadPublicKeyFile(options_.server_key_file).key;
+    if (identity_) {
+      trust_.emplace(server_key, options_.server_key_file,
+                     options_.known_servers_file.empty()
+                         ? DefaultKnownServersFile()
+                         : std::filesystem::path(options_.known_servers_file));
+    }
   } catch (const Error& e) {
     throw ClientError(std::string("RobotClient: ") + e.what());
   }
-  if (pinned_server_ && !identity_) {
+  if (!options_.server_key_file.empty() && !identity_) {
     throw ClientError("RobotClient: a server key to pin (" + options_.server_key_file +
                       ") needs a client key too (--key FILE or ROBOTALK_KEY)");
   }
@@ -64,8 +72,11 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
     ++stats_.malformed_packages;
     return;
   }
+  std::optional<PublicKey> first_use;  // keyed: a server key to pin before the session is used
+  std::string robot;
   {
     std::lock_guard lock(mu_);
+    robot = robot_;
     if (!hello_due_ || answer.body.client_id != client_id_ || answer.body.client_nonce != hello_nonce_) {
       return;  // another client's, or an answer to an earlier hello
     }
@@ -75,20 +86,52 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
     } else if (identity_) {
       try {
         if (!answer.keyed) throw AuthError("the server answered in open mode, this client has a key");
-        SessionKeys keys = handshake_->Finish(answer.body, pinned_server_ ? &*pinned_server_ : nullptr);
+        // Signed by the key it names, for this hello (the whole transcript).
+        SessionKeys keys = handshake_->Finish(answer.body);
         if (keys.session_id != answer.session_id) throw AuthError("the answer's session id does not match");
+        if (std::string why = trust_->Check(answer.body.server_key); !why.empty()) {
+          // Not the server this client trusts (an impersonator, or another
+          // server of that name): wait on for the trusted one; WaitSession
+          // says why if none answers.
+          trust_error_ = std::move(why);
+          ++stats_.servers_refused;
+          return;
+        }
+        if (trust_->first_use()) first_use = answer.body.server_key;
         session_keys_ = std::move(keys);
       } catch (const AuthError& e) {
         hello_refusal_ = "robot '" + robot_ + "': the server's answer failed authentication: " + e.what();
         hello_due_ = false;
       }
     }
-    if (hello_refusal_.empty()) {
+  }
+  if (first_use) {
+    // Trust on first use: pinned before the session is used (file I/O, so
+    // outside the lock; only this thread handles answers).
+    std::string error;
+    try {
+      trust_->WritePin(*first_use);
+    } catch (const KeyError& e) {
+      error = "cannot pin the server key of robot '" + robot + "': " + e.what();
+    }
+    std::lock_guard lock(mu_);
+    if (!error.empty()) {
+      hello_refusal_ = error;
+      hello_due_ = false;
+      session_keys_.reset();
+    } else {
+      trust_->Trust(*first_use);
+    }
+  }
+  {
+    std::lock_guard lock(mu_);
+    if (hello_refusal_.empty() && hello_due_) {
       if (server_id_ != 0 && answer.server_id != server_id_) resync_ = true;
       session_id_ = answer.session_id;
       server_id_ = answer.server_id;
       hello_due_ = false;
       handshake_.reset();
+      trust_error_.clear();
       ++stats_.sessions_opened;
     }
   }
@@ -103,6 +146,7 @@ void RobotClient::Impl::WaitSession(std::unique_lock<std::mutex>& lock) {
       std::chrono::duration_cast<std::chrono::steady_clock::duration>(options_.connect_timeout);
   cv_.wait_until(lock, deadline, [&] { return session_id_ != 0 || !hello_refusal_.empty(); });
   if (!hello_refusal_.empty()) throw ClientError("RobotClient: " + hello_refusal_);
+  if (session_id_ == 0 && !trust_error_.empty()) throw ClientError("RobotClient: " + trust_error_);
   if (session_id_ == 0) {
     throw TimeoutError(
         "RobotClient: no answer to HELLO from robot '" + robot_ + "' within " +
@@ -191,8 +235,8 @@ void RobotClient::Impl::NoteResyncReplies(const std::vector<Reply>& replies) {
       return;
     }
     if (model_ && ConfigHash(*model_) == hash) return;
-    if (const auto it = models_.find(hash); it != models_.end()) {
-      model_ = it->second;
+    if (auto model = configs_.Want(hash)) {
+      model_ = std::move(model);
     } else {
       resync_hash_ = hash;  // OnConfig installs it when it arrives
     }

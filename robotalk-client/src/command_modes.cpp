@@ -160,30 +160,4 @@ void RobotClient::Impl::SubscribeState(std::function<void(const StateSample&)> o
   }
 }
 
-// On the ReadDaemon: a bad sample is counted, a callback's exception stored.
-void RobotClient::Impl::OnState(std::span<const std::uint8_t> bytes) {
-  std::function<void(const StateSample&)> callback;
-  int dofs = -1;
-  {
-    std::lock_guard lock(mu_);
-    callback = on_state_;
-    if (model_) dofs = model_->num_dofs();
-  }
-  if (!callback) return;
-  StateSample state;
-  try {
-    state = DecodeStateSample(bytes, dofs);
-  } catch (const ProtocolError&) {
-    std::lock_guard lock(mu_);
-    ++stats_.malformed_packages;
-    return;
-  }
-  try {
-    callback(state);
-  } catch (...) {
-    std::lock_guard lock(mu_);
-    if (!daemon_error_) daemon_error_ = std::current_exception();
-  }
-}
-
 }  // namespace robotalk

@@ -3,6 +3,7 @@
 #include "client_impl.h"
 
 #include "robotalk/config_codec.h"
+#include "robotalk/known_servers.h"
 #include "robotalk/protocol_codec.h"
 
 #include "robotalk/routed_lcm_transport.h"
@@ -100,6 +101,11 @@ void RobotClient::Impl::WakeDaemon() {
 void RobotClient::Impl::Attach(const std::string& robot) {
   {
     std::lock_guard lock(mu_);
+    try {
+      if (trust_) trust_->Load(robot, PinNetwork(transport_->url()));  // keyed: the pinned server key
+    } catch (const KeyError& e) {
+      throw ClientError(std::string("RobotClient::Connect('") + robot + "'): " + e.what());
+    }
     AttachLocked(robot);
     hello_due_ = true;  // the ReadDaemon says hello
     next_hello_ = clock_.Now();
@@ -238,9 +244,9 @@ bool RobotClient::Impl::WaitAck(std::int64_t sequence, std::chrono::steady_clock
 std::shared_ptr<const RobotModel> RobotClient::Impl::WaitModel(
     std::uint64_t hash, std::chrono::steady_clock::time_point deadline) {
   std::unique_lock lock(mu_);
-  cv_.wait_until(lock, deadline, [&] { return models_.count(hash) != 0; });
-  auto it = models_.find(hash);
-  return it == models_.end() ? nullptr : it->second;
+  std::shared_ptr<const RobotModel> model;
+  cv_.wait_until(lock, deadline, [&] { return (model = configs_.Want(hash)) != nullptr; });
+  return model;
 }
 
 void RobotClient::Impl::RethrowDaemonError() {
@@ -447,36 +453,6 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     std::lock_guard lock(mu_);
     stats_.replies_filed += filed;
     stats_.replies_ignored += ignored;
-  } catch (...) {
-    std::lock_guard lock(mu_);
-    daemon_error_ = std::current_exception();
-  }
-}
-
-void RobotClient::Impl::OnConfig(std::span<const std::uint8_t> bytes) {
-  try {
-    std::uint64_t hash = 0;
-    try {
-      hash = static_cast<std::uint64_t>(DecodeConfigHeader(bytes).hash);
-      {
-        std::lock_guard lock(mu_);
-        if (models_.count(hash) != 0) return;  // cached: skip decoding the blocks
-      }
-      auto model = std::make_shared<const RobotModel>(DecodeConfig(bytes));
-      {
-        std::lock_guard lock(mu_);
-        if (resync_hash_ == hash) {
-          model_ = model;  // the new server instance's description
-          resync_hash_.reset();
-        }
-        models_.emplace(hash, std::move(model));
-      }
-      cv_.notify_all();
-    } catch (const Error& e) {
-      std::lock_guard lock(mu_);
-      ++stats_.malformed_packages;
-      last_config_error_ = e.what();
-    }
   } catch (...) {
     std::lock_guard lock(mu_);
     daemon_error_ = std::current_exception();

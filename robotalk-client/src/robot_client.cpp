@@ -3,6 +3,7 @@
 #include "robotalk/robot_client.h"
 
 #include "client_impl.h"
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/request.h"
 #include "robotalk/routed_lcm_transport.h"
 
@@ -108,7 +109,14 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
   }
   struct Collector {
     std::vector<AnnouncedRobot> robots;
-    void On(const Announcement& msg) {
+    void On(std::span<const std::uint8_t> bytes) {
+      std::string key;
+      if (SignatureSuffix(bytes)) {
+        const std::optional<SignedBy> by = VerifySelfSigned(kAnnounceChannel, bytes);
+        if (!by) return;  // a suffix that does not verify: forged
+        key = by->server_key.ToString();
+      }
+      const Announcement msg = DecodeAnnouncement(bytes);
       for (const auto& r : msg.robots) {
         const bool seen = std::any_of(robots.begin(), robots.end(), [&](const AnnouncedRobot& a) {
           return a.server_id == msg.server_id && a.name == r.name;
@@ -122,16 +130,16 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
                           .panic = r.panic,
                           .num_clients = r.num_clients,
                           .server_id = msg.server_id,
-                          .url_hint = msg.url_hint});
+                          .url_hint = msg.url_hint,
+                          .server_key = key});
       }
     }
   } collector;
   // The checked decoder: LCM's typed one throws through its C callback on a
   // zero-length string (tests/fuzz/regressions/announce).
-  auto sub =
-      transport->Subscribe(kAnnounceChannel, [&](const std::string&, std::span<const std::uint8_t> bytes) {
-        collector.On(DecodeAnnouncement(bytes));
-      });
+  auto sub = transport->Subscribe(
+      kAnnounceChannel,
+      [&](const std::string&, std::span<const std::uint8_t> bytes) { collector.On(bytes); });
   const SteadyPoint deadline = SteadyAfter(listen);
   for (int round = 0; round < 1000000; ++round) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyNow());
@@ -274,7 +282,7 @@ std::int64_t RobotClient::client_id() const { return impl_->client_id_; }
 const RobotModel& RobotClient::model() const {
   std::lock_guard lock(impl_->mu_);
   if (!impl_->model_) throw ClientError("RobotClient::model: not connected");
-  return *impl_->model_;  // kept alive in models_ for the client's lifetime
+  return *impl_->model_;  // kept alive in configs_ for the client's lifetime (config_store.h)
 }
 
 const RobotModel& RobotClient::ReloadModel() {
@@ -428,9 +436,16 @@ ClientStats RobotClient::stats() const {
   std::lock_guard lock(impl_->mu_);
   ClientStats s = impl_->stats_;
   s.replies_ignored = std::max(s.replies_ignored, impl_->cache_->ignored());
+  s.configs_cached = impl_->configs_.size();
+  s.config_bytes_cached = impl_->configs_.bytes();
   return s;
 }
 
 const ClientOptions& RobotClient::options() const { return impl_->options_; }
+
+TrustedServer RobotClient::trusted_server() const {
+  std::lock_guard lock(impl_->mu_);
+  return impl_->trust_ ? impl_->trust_->Describe() : TrustedServer{};
+}
 
 }  // namespace robotalk

@@ -149,6 +149,7 @@ class Server::Impl {
   }
 
   std::vector<std::string> names() const { return server_daemon_->robot_names(); }
+  const ServerDaemon& daemon() const { return *server_daemon_; }
 
  private:
   ServerOptions options_;
@@ -170,5 +171,7 @@ Server::~Server() = default;
 void Server::Start() { impl_->Start(); }
 void Server::Stop() { impl_->Stop(); }
 std::vector<std::string> Server::robot_names() const { return impl_->names(); }
+std::size_t Server::serving() const { return impl_->daemon().serving(); }
+std::vector<std::string> Server::refusals() const { return impl_->daemon().refusals(); }
 
 }  // namespace robotalk

@@ -1,5 +1,6 @@
 #include "server_daemon.h"
 
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/error.h"
@@ -39,6 +40,7 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
     server_id_ = static_cast<std::int64_t>((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
   }
   gate_ = std::make_unique<SessionGate>(server_id_, options_.gate);
+  if (gate_->keyed()) signer_.emplace(*options_.gate.identity, *gate_->instance_nonce());
   const auto subscribe = [this] {
     hello_subscription_ = transport_.Subscribe(
         kAnyHelloChannelRegex,
@@ -94,6 +96,7 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
     return table;
   };
   robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options);
+  if (signer_) signer_->Sign(ConfigChannel(name), robot.encoded_config);  // once: it never changes
   daemon.Preallocate(robot.output);
   daemon.set_output_ready_callback([this] { Wake(); });
   if (auto it = latched_at_start_.find(name); it != latched_at_start_.end()) {
@@ -104,6 +107,7 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
         "); PANIC_RESET to resume");
   }
   robots_.emplace(name, std::move(robot));
+  ++serving_;
 }
 
 void ServerDaemon::SyncLatch(Robot& robot) {
@@ -133,10 +137,19 @@ std::string ServerDaemon::refused(const std::string& robot) const {
   return it == robots_.end() ? std::string() : it->second.refused;
 }
 
+std::vector<std::string> ServerDaemon::refusals() const {
+  std::lock_guard lock(refusals_mu_);
+  return refusals_;
+}
+
 // One robot, one server: two servers serving one robot name would both
-// execute every command. The newcomer gives way: the server that has been
-// serving for less time refuses the robot (equal uptimes: the larger id
-// refuses), stops it if it moves, and leaves every package to the other.
+// execute every command. The server that starts later decides, during its
+// start-up window: it refuses a robot that a server serving for longer
+// announces (equal uptimes: the larger id refuses), stops it if it moved,
+// and leaves every package to the other. After the window an ANNOUNCE never
+// changes what this server serves: anyone on the LAN can send one (issue 19:
+// a single forged datagram disabled a robot until the server restarted), and
+// the rule has already been applied by whichever server came later.
 void ServerDaemon::OnAnnounce(std::span<const std::uint8_t> bytes) {
   Announcement a;
   try {
@@ -146,6 +159,7 @@ void ServerDaemon::OnAnnounce(std::span<const std::uint8_t> bytes) {
   }
   if (a.server_id == server_id_ || options_.allow_duplicate_robots) return;
   const Duration mine = started_ == TimePoint::min() ? Duration(0) : clock_.Now() - started_;
+  const bool starting = mine < options_.startup_window;
   const bool other_wins = a.uptime > mine + std::chrono::milliseconds(1) ||
                           (a.uptime >= mine - std::chrono::milliseconds(1) && a.server_id < server_id_);
   for (const RobotAnnouncement& r : a.robots) {
@@ -153,17 +167,54 @@ void ServerDaemon::OnAnnounce(std::span<const std::uint8_t> bytes) {
     if (it == robots_.end() || !it->second.refused.empty()) continue;
     const std::string other = "server " + Hex64(static_cast<std::uint64_t>(a.server_id)) +
                               (a.url_hint.empty() ? "" : " (" + a.url_hint + ")");
-    if (!other_wins) {
+    if (!starting) {
+      LogConflict(it->second, other, mine);
+    } else if (!other_wins) {
       Log("robot '" + r.name + "': " + other +
           " also announces it; it started after this server and gives way");
-      continue;
+    } else {
+      Refuse(it->second, "robot '" + r.name + "' is served by " + other + "; this server (" +
+                             Hex64(static_cast<std::uint64_t>(server_id_)) +
+                             ") refuses it: run one server per robot name (or --allow-duplicate-robots)");
     }
-    it->second.refused = "robot '" + r.name + "' is served by " + other + "; this server (" +
-                         Hex64(static_cast<std::uint64_t>(server_id_)) +
-                         ") refuses it: run one server per robot name (or --allow-duplicate-robots)";
-    Log("ERROR: " + it->second.refused);
-    it->second.daemon->QueueStop(/*only_if_moving=*/true);
   }
+}
+
+void ServerDaemon::Refuse(Robot& robot, const std::string& why) {
+  robot.refused = why;
+  robot.daemon->QueueStop(/*only_if_moving=*/true);
+  --serving_;
+  {
+    std::lock_guard lock(refusals_mu_);
+    refusals_.push_back(why);
+  }
+  std::string still;
+  for (const auto& [name, r] : robots_) {
+    if (r.refused.empty()) still += (still.empty() ? "'" : ", '") + name + "'";
+  }
+  Log("ERROR: " + why + "; " +
+      (still.empty() ? std::string("this server serves no robot now") : "still serving " + still));
+}
+
+// A conflict after the start-up window: said, at most once per robot per
+// 10 s (a flood of forged ANNOUNCEs must not flood the log), nothing else.
+void ServerDaemon::LogConflict(Robot& robot, const std::string& other, Duration served) {
+  const TimePoint now = clock_.Now();
+  if (now < robot.next_conflict_log) {
+    ++robot.conflicts_unlogged;
+    return;
+  }
+  robot.next_conflict_log = now + std::chrono::seconds(10);
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%.0f s", ToSeconds(served));
+  Log("robot '" + robot.daemon->robot_name() + "': " + other + " also announces it; this server (" +
+      Hex64(static_cast<std::uint64_t>(server_id_)) + ") has served it for " + seconds +
+      " and keeps serving it (one robot, one server is decided when a server starts: a server started "
+      "with --allow-duplicate-robots, or a forged ANNOUNCE)" +
+      (robot.conflicts_unlogged > 0
+           ? "; " + std::to_string(robot.conflicts_unlogged) + " more such ANNOUNCEs since the last line"
+           : std::string()));
+  robot.conflicts_unlogged = 0;
 }
 
 void ServerDaemon::Start() {
@@ -354,8 +405,11 @@ void ServerDaemon::Drain(Robot& robot, bool wait) {
   SyncLatch(robot);  // a driver fault latched by the RobotDaemon
   const std::string& name = robot.daemon->robot_name();
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
-    transport_.Publish(StateChannel(name),
-                       EncodeStateSample(ToStateSample(name, robot.config_hash, robot.output.samples[i])));
+    std::vector<std::uint8_t> bytes =
+        EncodeStateSample(ToStateSample(name, robot.config_hash, robot.output.samples[i]));
+    const std::string channel = StateChannel(name);
+    if (signer_) signer_->Sign(channel, bytes);  // keyed: readers verify the server key (issue 19)
+    transport_.Publish(channel, bytes);
   }
   for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
   to_send_.clear();
@@ -424,7 +478,9 @@ void ServerDaemon::Announce(TimePoint now) {
                         static_cast<std::int8_t>(m.roots().front().base), robot.daemon->in_panic(),
                         static_cast<int>(robot.sessions->num_sessions())});
   }
-  transport_.Publish(kAnnounceChannel, EncodeAnnouncement(a));
+  std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+  if (signer_) signer_->Sign(kAnnounceChannel, bytes);
+  transport_.Publish(kAnnounceChannel, bytes);
 }
 
 void ServerDaemon::Log(const std::string& line) {

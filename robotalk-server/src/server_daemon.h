@@ -3,8 +3,10 @@
 // the only place that knows the wire), hands it to that robot's
 // RobotSessions (sessions, admission), and sends what comes back: the
 // immediate acknowledgement, the RobotDaemons' replies and state samples, the
-// configuration message, and ROBOTALK/ANNOUNCE once a period. It also runs the
-// session watchdog and the driver-call watchdog.
+// configuration message, and ROBOTALK/ANNOUNCE once a period (keyed mode:
+// ANNOUNCE, CONFIG and STATE signed by the server's key, broadcast_signature.h).
+// It also runs the session watchdog and the driver-call watchdog, and applies
+// one robot, one server while it starts (OnAnnounce).
 //
 // Fewer hops (issue 11): a query the RobotDaemon can answer on receipt
 // (RobotDaemon::Submit) travels in the same reply package as the
@@ -22,6 +24,7 @@
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robot_sessions.h"
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/clock.h"
 #include "robotalk/transport.h"
 #include "session_gate.h"
@@ -30,6 +33,8 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -59,6 +64,13 @@ struct ServerDaemonOptions {
   /// would execute every command). Off: one robot, one server (see
   /// ServerDaemon::OnAnnounce).
   bool allow_duplicate_robots = false;
+  /// One robot, one server is decided by the server that starts later, during
+  /// this long after its first RunOnce: an ANNOUNCE of the same robot by a
+  /// server that has served longer makes it refuse that robot. After the
+  /// window an ANNOUNCE changes nothing (a forged one could otherwise disable
+  /// a serving robot); a conflict is only logged. Must exceed the announce
+  /// period of the other servers (1 s by default).
+  Duration startup_window = std::chrono::seconds(2);
   /// Open or keyed mode (session_gate.h).
   SessionGateOptions gate;
   /// Announced so that clients on another layout say so (docs/protocol.md).
@@ -101,7 +113,13 @@ class ServerDaemon {
 
   std::vector<std::string> robot_names() const;
   /// Why this server does not serve `robot` (another server does), or "".
+  /// REQUIRES: the ServerDaemon's thread (or it is not running).
   std::string refused(const std::string& robot) const;
+  /// How many of its robots this server serves (the others are refused).
+  /// Thread-safe: robotalk-server exits when it reaches 0.
+  std::size_t serving() const { return serving_.load(); }
+  /// Why each refused robot is refused. Thread-safe.
+  std::vector<std::string> refusals() const;
   std::int64_t server_id() const { return server_id_; }
   /// Packages dropped because their bytes could not be decoded at all.
   std::uint64_t malformed() const { return malformed_; }
@@ -114,7 +132,9 @@ class ServerDaemon {
     std::vector<std::uint8_t> encoded_config;
     std::uint64_t config_hash;
     DaemonOutput output;
-    std::string refused;  ///< non-empty: another server serves this robot; why we do not
+    std::string refused;            ///< non-empty: another server serves this robot; why we do not
+    TimePoint next_conflict_log{};  ///< a conflicting ANNOUNCE after the start-up window: logged then
+    std::uint64_t conflicts_unlogged = 0;
   };
 
   void OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes);
@@ -123,6 +143,8 @@ class ServerDaemon {
   bool Gate(Robot& robot, const std::string& name, Request& request, std::span<const std::uint8_t> bytes,
             TimePoint received);
   void OnAnnounce(std::span<const std::uint8_t> bytes);
+  void Refuse(Robot& robot, const std::string& why);
+  void LogConflict(Robot& robot, const std::string& other, Duration served);
   void Send(const std::string& robot, ReplyBatch& batch);
   void Drain(Robot& robot, bool wait = true);
   // Files the replies RobotDaemon::Submit answered itself; the ones for
@@ -143,6 +165,7 @@ class ServerDaemon {
   std::map<std::string, std::string> latched_at_start_;
   std::map<std::string, Robot> robots_;
   std::unique_ptr<SessionGate> gate_;
+  std::optional<BroadcastSigner> signer_;  // keyed mode: signs ANNOUNCE, CONFIG and STATE
   std::unique_ptr<Subscription> subscription_;
   std::unique_ptr<Subscription> hello_subscription_;
   std::unique_ptr<Subscription> announce_subscription_;
@@ -152,6 +175,9 @@ class ServerDaemon {
   int event_fd_ = -1;
   std::int64_t server_id_ = 0;
   std::uint64_t malformed_ = 0;
+  std::atomic<std::size_t> serving_{0};
+  mutable std::mutex refusals_mu_;
+  std::vector<std::string> refusals_;  // GUARDED_BY(refusals_mu_)
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   // Rate limit of the log.

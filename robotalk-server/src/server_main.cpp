@@ -3,6 +3,8 @@
 
 #include "robotalk/error.h"
 
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -168,13 +170,27 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
     SteadyClock clock;
     Server server(options, robots, registry, clock);
     server.Start();
+    // Waits for a signal or --duration, and looks every 100 ms whether the
+    // server still serves a robot: one that another server already served
+    // when this one started is refused, and a server with none left exits.
     int received = 0;
-    if (duration >= 0) {
-      const timespec timeout{static_cast<time_t>(duration),
-                             static_cast<long>((duration - static_cast<time_t>(duration)) * 1e9)};
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration);
+    while (received <= 0) {
+      if (server.serving() == 0) {
+        server.Stop();
+        std::cerr << "robotalk-server: error: no robot left to serve:";
+        for (const std::string& why : server.refusals()) std::cerr << "\n  " << why;
+        std::cerr << "\n";
+        return 1;
+      }
+      auto wait = std::chrono::nanoseconds(std::chrono::milliseconds(100));
+      if (duration >= 0) {
+        const auto left = end - std::chrono::steady_clock::now();
+        if (left <= decltype(left)::zero()) break;
+        wait = std::min(wait, std::chrono::duration_cast<std::chrono::nanoseconds>(left));
+      }
+      const timespec timeout{0, static_cast<long>(wait.count())};
       received = sigtimedwait(&signals, nullptr, &timeout);
-    } else {
-      sigwait(&signals, &received);
     }
     if (received > 0) std::cerr << "robotalk-server: " << strsignal(received) << ", stopping every robot\n";
     server.Stop();

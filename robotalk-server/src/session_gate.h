@@ -63,6 +63,8 @@ class SessionGate {
   SessionGate& operator=(const SessionGate&) = delete;
 
   bool keyed() const { return auth_ != nullptr; }
+  /// Keyed mode: this server instance's nonce (it signs broadcasts too); nullptr in open mode.
+  const Nonce* instance_nonce() const { return auth_ ? &auth_->instance_nonce() : nullptr; }
 
   /// Answers a hello for `robot`. Never throws for bad input: a refused
   /// hello gets an answer with session_id 0 and the reason (counted).

@@ -92,8 +92,28 @@ struct ClientOptions {
   /// $ROBOTALK_KEY if set, else open mode.
   std::string key_file;
   /// Keyed mode: the server's public key file (.pub); when set, a server
-  /// answering with another key is refused (pinning).
+  /// answering with another key is refused, and the known-servers file is
+  /// not used.
   std::string server_key_file;
+  /// Keyed mode without `server_key_file`: the known-servers file that pins
+  /// each robot's server key on first use (docs/security.md, "Which server?").
+  /// Empty: $ROBOTALK_KNOWN_SERVERS, else ~/.robotalk/known_servers.
+  std::string known_servers_file;
+};
+
+/// Keyed mode: which server key a client trusts, and why (docs/security.md,
+/// "Which server?"). Hello answers, STATE and CONFIG of any other key are refused.
+struct TrustedServer {
+  enum class Source {
+    kNone,       ///< open mode, or no server trusted yet
+    kExplicit,   ///< ClientOptions::server_key_file (--server-key)
+    kPinned,     ///< pinned in the known-servers file before this client started
+    kPinnedNow,  ///< first use: this client pinned it (say so to the user)
+  };
+  Source source = Source::kNone;
+  std::string key;          ///< "ed25519:<64 hex>"
+  std::string fingerprint;  ///< "rt:1a2b:3c4d:5e6f:7a8b"
+  std::string file;         ///< the .pub file or the known-servers file
 };
 
 /// The handle of a non-blocking call. Movable, not copyable. Destroying it
@@ -172,10 +192,15 @@ struct AnnouncedRobot {
   int num_clients = 0;
   std::int64_t server_id = 0;
   std::string url_hint;
+  /// A keyed server's key ("ed25519:<64 hex>"), which signed this
+  /// announcement (verified); "" for an unsigned one (open mode). Compare it
+  /// with a pin (known_servers.h): anyone can sign with a key of their own.
+  std::string server_key;
 };
 
 /// Listens to ROBOTALK/ANNOUNCE for `listen` and returns every robot heard,
 /// once per (server id, name), sorted by name. Servers announce once a second.
+/// An announcement whose signature suffix does not verify is dropped.
 std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen);
 
 /// Client counters, for diagnostics and tests.
@@ -190,6 +215,12 @@ struct ClientStats {
   std::uint64_t sessions_opened = 0;     ///< hellos answered with a session
   std::uint64_t sessions_lost = 0;       ///< the server no longer knew the session (restart, expiry)
   std::uint64_t replies_refused = 0;     ///< keyed: reply packages whose MAC did not verify
+  /// Keyed: STATE and CONFIG messages dropped: unsigned, signed by another
+  /// key or server instance, forged, or (STATE) not newer than the last one.
+  std::uint64_t broadcasts_refused = 0;
+  std::uint64_t servers_refused = 0;    ///< keyed: hello answers of a server key this client does not trust
+  std::size_t configs_cached = 0;       ///< robot descriptions held (bounded: docs/client.md)
+  std::size_t config_bytes_cached = 0;  ///< their encoded size
 };
 
 class RobotClient {
@@ -297,6 +328,8 @@ class RobotClient {
 
   ClientStats stats() const;
   const ClientOptions& options() const;
+  /// Keyed mode: the server key this client trusts and why (after Connect).
+  TrustedServer trusted_server() const;
 
  private:
   class Impl;

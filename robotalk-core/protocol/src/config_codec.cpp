@@ -1,5 +1,7 @@
 #include "robotalk/config_codec.h"
 
+#include "robotalk/broadcast_signature.h"
+
 #include "robotalk/error.h"
 #include "wire_scanner.h"
 
@@ -502,6 +504,7 @@ RobotModel FromMessage(const robotalk_msgs::robot_config_t& msg) {
 std::vector<std::uint8_t> EncodeConfig(const RobotModel& model) { return EncodeMessage(ToMessage(model)); }
 
 RobotModel DecodeConfig(std::span<const std::uint8_t> bytes) {
+  bytes = WithoutSignature(bytes);  // a keyed server's; verified (or not) by the caller
   if (bytes.size() > static_cast<std::size_t>(INT_MAX)) {
     Protocol("DecodeConfig", std::to_string(bytes.size()) + " bytes is more than an LCM message can hold");
   }

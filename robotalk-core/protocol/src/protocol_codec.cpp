@@ -1,5 +1,6 @@
 #include "robotalk/protocol_codec.h"
 
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/error.h"
 #include "wire_scanner.h"
 
@@ -303,7 +304,9 @@ robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> 
 }
 
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes) {
-  return DecodeChecked<robotalk_msgs::robot_state_t>(bytes, "DecodeRobotState", &ScanRobotState);
+  // A keyed server's signature suffix: verified (or not) by the caller.
+  return DecodeChecked<robotalk_msgs::robot_state_t>(WithoutSignature(bytes), "DecodeRobotState",
+                                                     &ScanRobotState);
 }
 
 StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs) {

@@ -1,5 +1,6 @@
 // The codec of whole packages (request.h): the only place besides
 // protocol_codec.cpp that knows the LCM wire structs.
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/error.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
@@ -192,6 +193,7 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
 std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample) { return Encode(ToWire(sample)); }
 
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
+  bytes = WithoutSignature(bytes);  // a keyed server's; verified (or not) by the caller
   // Walk the encoding with bounds checks before LCM's decoder runs: its
   // generated code turns a string length of 0 or a negative count into
   // std::length_error thrown through LCM's C callback (std::terminate; found

@@ -97,6 +97,14 @@ class Server {
   void Stop();
 
   std::vector<std::string> robot_names() const;
+  /// How many robots this server serves: fewer than robot_names() when
+  /// another server already served some at start (one robot, one server;
+  /// docs/server.md). 0: it serves nothing, and robotalk-server exits.
+  /// Thread-safe.
+  std::size_t serving() const;
+  /// Why each refused robot is refused ("robot 'pioneer' is served by
+  /// server ..."). Thread-safe.
+  std::vector<std::string> refusals() const;
 
  private:
   class Impl;

@@ -28,7 +28,8 @@ RobotModel FromMessage(const robotalk_msgs::robot_config_t& msg);
 /// Encodes ToMessage(model) as LCM bytes (with LCM's fingerprint).
 std::vector<std::uint8_t> EncodeConfig(const RobotModel& model);
 /// Decodes bytes of EncodeConfig(). Throws ProtocolError on truncated or
-/// hostile input.
+/// hostile input. A keyed server's signature suffix is skipped, not verified
+/// (broadcast_signature.h).
 RobotModel DecodeConfig(std::span<const std::uint8_t> bytes);
 /// Decodes only the fixed-length header at the start of encoded config bytes.
 robotalk_msgs::config_header_t DecodeConfigHeader(std::span<const std::uint8_t> bytes);

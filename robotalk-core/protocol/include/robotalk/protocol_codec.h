@@ -65,7 +65,8 @@ robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes);
 /// Decodes a server reply package; same guarantees.
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes);
 
-/// Decodes a broadcast state sample; same guarantees.
+/// Decodes a broadcast state sample; same guarantees. A keyed server's
+/// signature suffix is skipped, not verified (broadcast_signature.h).
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes);
 /// DecodeRobotState + FromWire: bytes to a validated StateSample.
 StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs = -1);

@@ -117,7 +117,8 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& announcement);
 /// A broadcast state sample (ROBOTALK/<robot>/STATE) as bytes.
 std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample);
 /// Throws ProtocolError on truncated, hostile or foreign bytes, or more than
-/// 1024 robots.
+/// 1024 robots. A keyed server's signature suffix is skipped, not verified
+/// (broadcast_signature.h).
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes);
 
 /// ROBOTALK/<robot>/HELLO: the first message of every session.

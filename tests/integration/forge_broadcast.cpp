@@ -1,0 +1,62 @@
+// forge_broadcast: anyone on the LAN, for server_identity_test.sh (issue 19).
+//   forge_broadcast URL state ROBOT DOFS N
+//       N forged STATE samples of ROBOT (base 42 42, q 1.234), each sent twice:
+//       unsigned, and signed by a key of the forger's own; 10 ms apart.
+//   forge_broadcast URL announce ROBOT N
+//       N ANNOUNCEs naming ROBOT, by server 0000000000000001 "serving it for a year".
+#include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
+#include "robotalk/request.h"
+#include "robotalk/routed_lcm_transport.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+int main(int argc, char** argv) {
+  using namespace robotalk;
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: forge_broadcast URL state ROBOT DOFS N | URL announce ROBOT N\n");
+    return 2;
+  }
+  const std::string url = argv[1], what = argv[2], robot = argv[3];
+  auto lan = OpenLcmTransport(url);
+  if (what == "state" && argc == 6) {
+    const int dofs = std::atoi(argv[4]), n = std::atoi(argv[5]);
+    const KeyPair mallory = KeyPair::Generate();
+    for (int i = 0; i < n; ++i) {
+      StateSample s;
+      s.robot = robot;
+      s.server_time = TimePoint(std::chrono::hours(10000) + std::chrono::milliseconds(i));
+      s.sample = 1000 + i;
+      s.base.x = s.base.y = 42;
+      s.positions.assign(static_cast<std::size_t>(dofs), 1.234);
+      s.velocities.assign(static_cast<std::size_t>(dofs), 0.0);
+      s.efforts.assign(static_cast<std::size_t>(dofs), 0.0);
+      std::vector<std::uint8_t> bytes = EncodeStateSample(s);
+      lan->Publish(StateChannel(robot), bytes);
+      BroadcastSigner(mallory, Nonce{}).Sign(StateChannel(robot), bytes);
+      lan->Publish(StateChannel(robot), bytes);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return 0;
+  }
+  if (what == "announce") {
+    const int n = std::atoi(argv[4]);
+    for (int i = 0; i < n; ++i) {
+      Announcement a;
+      a.server_id = 1;
+      a.server_time = TimePoint(std::chrono::hours(1000));
+      a.uptime = std::chrono::hours(24 * 365);
+      a.url_hint = "forged";
+      a.robots.push_back({robot, "kinematic", 1, 1, 0, false, 0});
+      lan->Publish(kAnnounceChannel, EncodeAnnouncement(a));
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return 0;
+  }
+  std::fprintf(stderr, "forge_broadcast: unknown '%s'\n", what.c_str());
+  return 2;
+}

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Which server (issue 19 items 3, 4, 7, and item 12's refused robot) across
+# processes, inside a private network namespace (scripts/netns_run.sh):
+#   - a forged ANNOUNCE leaves the serving server serving;
+#   - a keyed CLI pins the server key on first use and says so; `watch`
+#     prints no forged STATE; a server with another key is refused
+#     (`send ... goto` never reaches it) unless --server-key names it;
+#   - a server started while another serves its only robot exits 1.
+#   server_identity_test.sh SERVER CLI KEYGEN FORGE MODELS_DIR
+set -u
+server_bin=$1 cli=$2 keygen=$3 forge=$4 models=$5
+url="udpm://239.255.76.67:7610?ttl=0"
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check; ROBOTALK_KNOWN_SERVERS in $tmp
+pins=$ROBOTALK_KNOWN_SERVERS
+rt() { "$cli" --url "$url" --timeout 3 --key "$tmp/alice" "$@"; }
+serve() {  # serve KEY LOG: a keyed server of pioneer
+  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --log-executions \
+    --key "$tmp/$1" --clients "$tmp/clients" --duration 60 2>"$tmp/$2" &
+  server_pid=$!
+  for _ in $(seq 50); do grep -q "serving robot" "$tmp/$2" 2>/dev/null && break; sleep 0.1; done
+}
+
+for who in server mallory alice; do "$keygen" --out "$tmp/$who" --name "$who" >/dev/null; done
+echo "$(cat "$tmp/alice.pub") *=all" >"$tmp/clients"  # public: an impersonator may copy it
+chmod 644 "$tmp/clients"
+fp() { "$keygen" --fingerprint "$tmp/$1.pub" | cut -d' ' -f1; }
+
+serve server real.log
+rt query pioneer base_pose >"$tmp/first" 2>&1
+check "first use pins the server key and says so: $(cat "$tmp/first")" \
+  grep -q "first connection to robot 'pioneer': trusting its server key $(fp server)" "$tmp/first"
+check "the pin file names the robot, the network and the key" \
+  grep -qx "pioneer udpm://239.255.76.67:7610 $(cut -d' ' -f1 "$tmp/server.pub")" "$pins"
+rt query pioneer base_pose >"$tmp/second" 2>&1
+check "the second time says nothing: $(cat "$tmp/second")" bash -c "! grep -q 'first connection' '$tmp/second'"
+
+# Item 3: a forged ANNOUNCE (another server, a year of uptime) is logged; nothing
+# else, once the server's 2 s start-up window (when the duplicate rule applies) is over.
+sleep 2
+"$forge" "$url" announce pioneer 20
+sleep 1.2
+rt query pioneer base_pose >"$tmp/after_announce" 2>&1
+check "after a forged ANNOUNCE the robot still answers: $(cat "$tmp/after_announce")" \
+  grep -q SUCCESS "$tmp/after_announce"
+check "the server logged the conflict and kept the robot" grep -q "keeps serving it" "$tmp/real.log"
+check "the server refused nothing" bash -c "! grep -q 'refuses it' '$tmp/real.log'"
+rt robots --listen 1.2 >"$tmp/robots" 2>&1
+check "robots shows the pinned key: $(cat "$tmp/robots")" grep -q "$(fp server) (pinned)" "$tmp/robots"
+
+# Item 7: forged STATE (unsigned, and signed by another key) is not printed by a keyed watch.
+rt watch pioneer --period 0.05 --duration 3 >"$tmp/watch" 2>"$tmp/watch.err" &
+watch_pid=$!
+sleep 1
+"$forge" "$url" state pioneer 4 40
+wait "$watch_pid"
+check "watch printed the real samples: $(wc -l <"$tmp/watch")" test "$(wc -l <"$tmp/watch")" -ge 10
+check "watch printed no forged sample: $(grep -c ' 42.0000 42.0000' "$tmp/watch")" \
+  bash -c "! grep -q ' 42.0000 42.0000' '$tmp/watch'"
+check "watch says how many it dropped: $(cat "$tmp/watch.err")" grep -q "dropped [0-9]* STATE/CONFIG messages" "$tmp/watch.err"
+
+# Item 12: a second server for pioneer (its only robot) refuses it and exits 1.
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 20 \
+  >"$tmp/second_server.log" 2>&1
+status=$?
+check "a server that serves no robot exits 1 ($status): $(tail -2 "$tmp/second_server.log")" test "$status" -eq 1
+check "and names the server that serves it" grep -q "robot 'pioneer' is served by server" "$tmp/second_server.log"
+
+# Item 4: the real server is gone; an impersonator with another key answers.
+kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+serve mallory fake.log
+rt send pioneer goto 1 0 0 >"$tmp/fake" 2>&1
+status=$?
+check "a server with another key is refused ($status): $(cat "$tmp/fake")" test "$status" -ne 0
+check "the refusal names both keys" grep -q "pinned.*$(fp server)" "$tmp/fake"
+check "... and the key offered" grep -q "this server's key: $(fp mallory)" "$tmp/fake"
+check "the impersonator ran nothing" bash -c "! grep -q 'GOTO' '$tmp/fake.log'"
+rt --server-key "$tmp/mallory.pub" query pioneer base_pose >"$tmp/explicit" 2>&1
+check "--server-key overrides the pin: $(cat "$tmp/explicit")" grep -q SUCCESS "$tmp/explicit"
+
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
