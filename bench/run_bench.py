@@ -304,7 +304,7 @@ class Bench:
             time.sleep(1.0)
             idle = self.rss_kb(srv.pid)
             r = self.run([self.raw, "sessions", "--url", URL, "--robot", ROBOT, "--count", str(k),
-                          "--seconds", "4", "--load", load, "--packages", str(n),
+                          "--seconds", "120", "--load", load, "--packages", str(n),
                           "--server-pid", str(srv.pid)], timeout=180)
             opened = int(r.get("opened", 0))
             rss = r.get("server_rss_kb", -1)

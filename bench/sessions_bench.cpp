@@ -12,9 +12,9 @@
 //   playbacks  N playback sequences of 5 frames, each finished at once
 //   queue      N packages of 250 STOPs due in 30 minutes (10,000 a session at
 //              N = 40: the --max-queue default)
-// then heartbeats until S seconds have passed. With --server-pid it reads the
-// server's VmRSS and VmHWM once the load is in, and (queue) whether a new
-// client's command is still admitted. Prints one JSON line; every loop is
+// (within S seconds), then heartbeats for 1.5 s (idle: until S seconds have
+// passed). With --server-pid it then reads the server's VmRSS and VmHWM, and
+// (queue) whether a new client's command is still admitted. Prints one JSON line; every loop is
 // bounded in count and time.
 #include "sessions_bench.h"
 
@@ -129,28 +129,29 @@ int Sessions(const Args& a) {
       if (!r) break;
       send(client, std::move(*r));
       ++sent_packages;
-      transport->HandleFor(std::chrono::microseconds(load == "playbacks" ? 100 : 500));  // paced
+      // Paced (the server's receive buffer): the small playback packages ten at a time.
+      if (load != "playbacks" || sent_packages % 10 == 0)
+        transport->HandleFor(std::chrono::microseconds(500));
     }
   }
   const double load_s = static_cast<double>(MonoNs() - load_start) / 1e9;
-  // Heartbeats (an empty query package, as an idle RobotClient sends) keep
-  // every session open; the server's memory is read once the load is in.
+  // Heartbeats (an empty package, as an idle RobotClient sends) keep every
+  // session open: until --seconds have passed when idle, else 1.5 s after
+  // the load; then the server's memory is read.
   std::int64_t heartbeats = 0;
-  double rss = -1, hwm = -1;
-  const std::int64_t measure_at = MonoNs() + 1500000000;
-  while (MonoNs() < end || (server_pid > 0 && rss < 0)) {
+  const std::int64_t hold_until = load == "none" ? end : MonoNs() + 1500000000;
+  while (MonoNs() < hold_until) {
     const std::int64_t round = MonoNs();
     for (const auto& [client, session] : session_of) {
       send(client, Request{});
       if (++heartbeats % 50 == 0) transport->HandleFor(std::chrono::milliseconds(2));
     }
-    if (server_pid > 0 && rss < 0 && MonoNs() >= measure_at) {
-      rss = StatusKb(server_pid, "VmRSS");
-      hwm = StatusKb(server_pid, "VmHWM");
-    }
-    while (MonoNs() < std::min(end, round + 400000000)) transport->HandleFor(std::chrono::milliseconds(50));
-    if (MonoNs() > end + 10'000'000'000) break;  // bounded whatever happens
+    while (MonoNs() < std::min(hold_until, round + 400000000))
+      transport->HandleFor(std::chrono::milliseconds(50));
   }
+  const double rss = server_pid > 0 ? StatusKb(server_pid, "VmRSS") : -1;
+  const double hwm = server_pid > 0 ? StatusKb(server_pid, "VmHWM") : -1;
+  const std::size_t opened = session_of.size();
   // A new client after the flood: is its command still admitted?
   double admitted = -1;
   if (load == "queue") {
@@ -177,8 +178,7 @@ int Sessions(const Args& a) {
       }
     }
   }
-  PrintJson({Field("sessions", static_cast<double>(k)),
-             Field("opened", static_cast<double>(session_of.size())),
+  PrintJson({Field("sessions", static_cast<double>(k)), Field("opened", static_cast<double>(opened)),
              Field("load_packages", static_cast<double>(sent_packages)), Field("load_s", load_s),
              Field("heartbeats", static_cast<double>(heartbeats)), Field("server_rss_kb", rss),
              Field("server_hwm_kb", hwm), Field("new_client_admitted", admitted)});

@@ -71,7 +71,10 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
       r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
   for (const Command& c : r.commands) {
     std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
-    if (!item) continue;
+    if (!item) {  // answered: one frame fewer to wait for
+      ++seq.received;
+      continue;
+    }
     const Duration offset = c.start_time.offset().value_or(Duration(0));
     if (offset > seq.duration || ++seq.received > seq.total) {
       immediate.push_back(MakeReply(c.id, Signal::kError,

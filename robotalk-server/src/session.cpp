@@ -57,10 +57,13 @@ void ReplyCache::Evict() {
   while (!order_.empty() && (order_.size() > limits_.max_packages || bytes_ > limits_.max_bytes)) {
     EvictOldestPackage();
   }
-  while (detached_.size() > limits_.max_packages) {
+  // Waiting items of forgotten packages: at most max_packages, and within
+  // the byte budget even when no package is left.
+  while (!detached_.empty() && (detached_.size() > limits_.max_packages || bytes_ > limits_.max_bytes)) {
     auto it = replies_.find(detached_.front());
     if (it != replies_.end() && it->second.detached) Erase(it);
     detached_.pop_front();
+    bytes_ -= sizeof(CommandId);
   }
 }
 
@@ -75,6 +78,7 @@ void ReplyCache::EvictOldestPackage() {
     } else {  // still waiting: remember it was received
       it->second.detached = true;
       detached_.push_back(id);
+      bytes_ += sizeof(CommandId);
     }
   }
   bytes_ -= PackageBytes(package->second);

@@ -25,13 +25,15 @@ namespace robotalk {
 /// Final replies of a client's recent packages, by package sequence, so a
 /// retransmission is answered without running anything again.
 ///
-/// Bounds: at most `max_packages` packages and `max_bytes` of memory as
-/// Bytes() counts it (each reply's struct, message and values, each id, the
-/// index entries). Past either, the oldest packages are forgotten. Items of a
+/// Bounds: at most `max_packages` packages, and bytes() (each reply's
+/// struct, message and values, each id, the index entries) never above
+/// `max_bytes`: past either, the oldest packages are forgotten. Items of a
 /// forgotten package that still wait for their final reply keep a small
 /// entry (counted) until it comes, so a retransmission is not told they were
 /// forgotten while they wait; that reply is sent, not kept. At most
-/// `max_packages` such entries are kept.
+/// `max_packages` such entries are kept, the oldest dropped first. A
+/// package's items named in another package (a playback's id comes with
+/// each of its packages) stay until the last of them is forgotten.
 class ReplyCache {
  public:
   struct Limits {

@@ -182,6 +182,20 @@ TEST_F(SessionMemoryTest, FinishedPlaybacksAreFreedAndLateFramesAnswered) {
   EXPECT_EQ(sessions_->memory(kAlice).unfinished_playbacks, 0u);
 }
 
+TEST_F(SessionMemoryTest, APlaybackWithARefusedFrameStillFinishesAndIsFreed) {
+  constexpr int kFrames = 10;
+  for (int f = 0; f < kFrames; ++f) {
+    const std::string joint = f == 3 ? "no_such_joint" : "pan";
+    auto r = Handle(Playback(
+        kAlice, f + 1, 77, kFrames, milliseconds(10) * (kFrames - 1),
+        {Cmd(f + 1, CommandType::kJointSetPoint, {0.01}, joint, StartTime::After(milliseconds(10) * f))}));
+    if (f == 3) {
+      EXPECT_EQ(r.at(4).signal, Signal::kError);
+    }
+  }
+  EXPECT_EQ(sessions_->memory(kAlice).unfinished_playbacks, 0u) << "the refused frame was answered";
+}
+
 TEST_F(SessionMemoryTest, UnfinishedPlaybacksAreBoundedPerSessionAndTheRefusalAnswersTheDelayToo) {
   const SessionOptions defaults;
   CommandId id = 1;
