@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 namespace robotalk {
@@ -290,6 +291,9 @@ TEST(ServerMemoryBound, TheDefaultBoundsKeepTheWholeServerUnder512MiB) {
                                   Session::kMaxEnded * 16 + sizeof(Session) + 256;
   const std::size_t queued = server.max_queued_total * QueuedItemBytes();
   const std::size_t total = server.max_sessions * per_session + queued;
+  std::printf("a session at most %zu KiB; %zu sessions %zu MiB; queued %zu MiB; total %zu MiB\n",
+              per_session / 1024, server.max_sessions, server.max_sessions * per_session >> 20, queued >> 20,
+              total >> 20);
   EXPECT_LT(per_session, 1u << 20);
   EXPECT_LT(total, 512u << 20) << "sessions " << server.max_sessions * per_session << " + queued " << queued;
 }
