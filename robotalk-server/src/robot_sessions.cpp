@@ -88,13 +88,14 @@ std::vector<Reply> RobotSessions::Retransmitted(const Session& s, const Request&
     if (known && *known) out.push_back(**known);
     if (known) continue;
     const ReplyCache::Limits& limits = s.replies.limits();
-    out.push_back(MakeReply(id, Signal::kError,
-                            "package " + std::to_string(r.sequence) +
-                                " was received before and never runs twice, but its replies are older than "
-                                "what this session keeps (its latest " +
-                                std::to_string(limits.max_packages) + " packages, " + KiB(limits.max_bytes) +
-                                "): its outcome is unknown here (read the robot's state)",
-                            now));
+    out.push_back(
+        MakeReply(id, Signal::kError,
+                  "package " + std::to_string(r.sequence) +
+                      " was seen before (or is too old to tell) and does not run again; its replies "
+                      "are older than what this session keeps (its latest " +
+                      std::to_string(limits.max_packages) + " packages, " + KiB(limits.max_bytes) +
+                      "): its outcome is unknown here (read the robot's state)",
+                  now));
   }
   return out;
 }
