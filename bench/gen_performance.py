@@ -140,6 +140,8 @@ def rows_for(res):
         rows.append(("memory per idle session (server RSS)",
                      "; ".join(session_level(l) for l in m["levels"]),
                      f"server RSS with none: {m['levels'][0]['base_rss_kb'] / 1024:.1f} MiB", "—"))
+    for load in m.get("loads", []):
+        rows.append(memory_load_row(load))
     j = res.get("jitter", {})
     a, b, r = pair(j, "robotalk", "raw", "deviation_us")
     rows.append(("STATE stream at 1 kHz: \\|inter-arrival − 1 ms\\| p50 / p99", a,
@@ -161,6 +163,26 @@ def machine_text(m):
 def playback_ratio(chosen, hindsight):
     r = ratio(chosen, hindsight, 1)
     return r + " (floor near 0)" if hindsight is not None and hindsight < 0.005 else r
+
+
+MEMORY_LOADS = {
+    "unknown": "{n} packages of 300 long-named unknown joints",
+    "playbacks": "{n} finished 5-frame playbacks",
+    "queue": "10,000 queued STOPs",
+}
+
+
+def memory_load_row(load):
+    """One exhaustion case of issue 19 item 8: server RSS under the load beside its idle RSS."""
+    what = MEMORY_LOADS.get(load["load"], load["load"]).format(n=f"{load['packages']:,}")
+    if load.get("rss_kb", -1) in (None, -1) or load.get("per_session_kb") is None:
+        return (f"memory: {load['sessions']} sessions × {what}", "not measured: " + str(load.get("error")), "—", "—")
+    text = (f"{(load['rss_kb'] - load['idle_rss_kb']) / 1024:.1f} MiB over idle "
+            f"({load['per_session_kb']:.0f} KiB a session; peak {load['hwm_kb'] / 1024:.1f} MiB)")
+    if load.get("new_client_admitted") is not None and load["new_client_admitted"] >= 0:
+        text += "; a new client's command " + ("admitted" if load["new_client_admitted"] else "REFUSED")
+    return (f"memory: {load['opened']} sessions × {what} (server RSS)", text,
+            f"the same server idle: {load['idle_rss_kb'] / 1024:.1f} MiB", "—")
 
 
 def session_level(level):

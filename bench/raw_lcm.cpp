@@ -9,7 +9,8 @@
 //   robotalk-bench-raw once     --url U                           open LCM, one round trip, exit
 //   robotalk-bench-raw stream   --url U --count N [--period-us P --bytes B --slack-ns S]
 //   robotalk-bench-raw watch    --url U --channel C --count N [--period-us P --timeout S]
-//   robotalk-bench-raw sessions --url U --robot R --count K --seconds S   K idle sessions (hello, heartbeats)
+//   robotalk-bench-raw sessions --url U --robot R --count K --seconds S [--load L ...]
+//       K sessions, idle or under an exhaustion load (sessions_bench.cpp)
 //   robotalk-bench-raw arrivals --url U --robot R --frames N [--timeout S]
 //       the arrival log of a playback sequence at the server's side: each frame's
 //       lag (arrival - first arrival - offset) and the hindsight minimum delay
@@ -23,6 +24,7 @@
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
 #include "robotalk_msgs/robot_state_t.hpp"
+#include "sessions_bench.h"
 
 #include <sys/prctl.h>
 #include <lcm/lcm-cpp.hpp>
@@ -257,70 +259,6 @@ std::string UrlOfChannel(const std::string& url, const std::string& channel) {
   const robotalk::TrafficUrl t = robotalk::ParseTrafficUrl(robotalk::ResolveLcmUrl(url));
   if (t.layout == robotalk::TrafficLayout::kSingle) return t.lcm_url;
   return robotalk::LaneUrl(t.lcm_url, robotalk::LaneOfChannel(channel));
-}
-
-// K idle client sessions: each says hello (open mode) and then only sends
-// heartbeats in its session, as an idle RobotClient does. A package without
-// a session from a hello opens nothing (the server answers SESSION_UNKNOWN),
-// so the hellos come first; "opened" says how many the server granted.
-int Sessions(const Args& a) {
-  const std::string robot = a.Str("robot", "pioneer");
-  const auto transport =
-      robotalk::OpenLcmTransport(a.Str("url", ""), robotalk::OpenLcmOptions{.all_lanes = true});
-  const long k = a.Int("count", 100);
-  const std::int64_t end = MonoNs() + static_cast<std::int64_t>(a.Num("seconds", 5) * 1e9);
-  const std::int64_t first_id = 0x5e55000000000000;
-  std::map<std::int64_t, std::int64_t> session_of;  // client id -> session id
-  std::string refusal;
-  const auto sub =
-      transport->Subscribe(robotalk::HelloChannel(robot) + "/.*",  // every client's HELLO/<client> answer
-                           [&](const std::string&, std::span<const std::uint8_t> bytes) {
-                             const robotalk::HelloAnswer answer = robotalk::DecodeHelloAnswer(bytes);
-                             if (answer.session_id > 0) {
-                               session_of[answer.body.client_id] = answer.session_id;
-                             } else if (refusal.empty()) {
-                               refusal = answer.refusal;
-                             }
-                           });
-  std::mt19937_64 rng(7);
-  for (long i = 0; i < k; ++i) {
-    robotalk::Hello hello;
-    hello.body.client_id = first_id + i + 1;
-    for (auto& b : hello.body.client_nonce) b = static_cast<std::uint8_t>(rng());
-    transport->Publish(robotalk::HelloChannel(robot), robotalk::EncodeHello(hello));
-    if (i % 50 == 49) transport->HandleFor(std::chrono::milliseconds(2));  // ~40 ms per 1000
-  }
-  for (int i = 0; i < 100 && static_cast<long>(session_of.size()) < k; ++i)
-    transport->HandleFor(std::chrono::milliseconds(20));
-  if (!refusal.empty()) std::fprintf(stderr, "sessions: a hello was refused: %s\n", refusal.c_str());
-
-  const std::string channel = robotalk::RequestChannel(robot);
-  robotalk_msgs::package_t p{};
-  p.header.protocol_version = 1;
-  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
-  std::vector<std::uint8_t> buf;
-  std::int64_t seq = 0, sent = 0;
-  while (MonoNs() < end) {
-    const std::int64_t round = MonoNs();
-    ++seq;
-    long n = 0;
-    for (const auto& [client, session] : session_of) {
-      p.header.client_id = client;
-      p.header.session_id = session;
-      p.header.sequence = seq;
-      p.header.send_time_us = round / 1000;
-      buf.resize(static_cast<std::size_t>(p.getEncodedSize()));
-      p.encode(buf.data(), 0, static_cast<int>(buf.size()));
-      transport->Publish(channel, buf);
-      ++sent;
-      if (++n % 50 == 0) transport->HandleFor(std::chrono::milliseconds(2));
-    }
-    while (MonoNs() < std::min(end, round + 400000000)) transport->HandleFor(std::chrono::milliseconds(50));
-  }
-  PrintJson({Field("sessions", static_cast<double>(k)),
-             Field("opened", static_cast<double>(session_of.size())),
-             Field("heartbeats", static_cast<double>(sent))});
-  return 0;
 }
 
 // Logs the first arrival of every playback frame on the robot's REQUEST

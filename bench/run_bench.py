@@ -287,7 +287,33 @@ class Bench:
             levels.append({"sessions": k, "opened": opened, "rss_kb": rss, "base_rss_kb": base,
                            "per_session_kb": (rss - base) / opened if opened else None})
             time.sleep(3.0)  # the sessions expire (2 s watchdog)
-        return {"figure": "memory", "levels": levels}
+        return {"figure": "memory", "levels": levels, "loads": self.memory_loads()}
+
+    def memory_loads(self):
+        """Issue 19 item 8: the server's RSS under each well-formed exhaustion
+        load, each on a fresh server beside its own idle RSS (same run)."""
+        q = self.quick
+        cases = [  # (load, sessions, packages per session)
+            ("unknown", 5, 64 if q else 256),  # 300 long-named unknown joints a package
+            ("playbacks", 4, 1000 if q else 5000),  # finished 5-frame sequences
+            ("queue", 250, 40),  # 250 STOPs due in 30 min a package: 10,000 a session
+        ]
+        out = []
+        for load, k, n in cases:
+            srv = self.start_server()
+            time.sleep(1.0)
+            idle = self.rss_kb(srv.pid)
+            r = self.run([self.raw, "sessions", "--url", URL, "--robot", ROBOT, "--count", str(k),
+                          "--seconds", "120", "--load", load, "--packages", str(n),
+                          "--server-pid", str(srv.pid)], timeout=180)
+            opened = int(r.get("opened", 0))
+            rss = r.get("server_rss_kb", -1)
+            out.append({"load": load, "sessions": k, "packages": n, "opened": opened, "idle_rss_kb": idle,
+                        "rss_kb": rss, "hwm_kb": r.get("server_hwm_kb"), "load_s": r.get("load_s"),
+                        "per_session_kb": (rss - idle) / opened if opened and rss > 0 else None,
+                        "new_client_admitted": r.get("new_client_admitted"), "error": r.get("error")})
+        self.stop_server()
+        return out
 
     def jitter(self):
         n = 1000 if self.quick else 3000

@@ -93,6 +93,10 @@ class PlaybackEstimator {
   void Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent = std::nullopt);
   std::size_t frames_seen() const { return frames_.size(); }
   std::size_t frames_needed() const { return needed_; }
+  /// Heap memory it holds (its frames and delay history), for the session's accounting.
+  std::size_t heap_bytes() const {
+    return frames_.capacity() * sizeof(Frame) + history_.capacity() * sizeof(Duration);
+  }
   bool ready() const { return quick() || frames_.size() >= needed_; }
   /// Whether the start is decided by the quick start (see above).
   bool quick() const;

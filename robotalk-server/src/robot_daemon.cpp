@@ -148,6 +148,11 @@ std::size_t RobotDaemon::queued(std::int64_t client_id) const {
   return scheduler_.queued(client_id);
 }
 
+std::size_t RobotDaemon::queued_total() const {
+  std::lock_guard lock(mutex_);
+  return scheduler_.size();
+}
+
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
   panic_ = true;  // from here on only a STOP runs (Execute checks it)
   std::unique_lock lock(mutex_, std::try_to_lock);

@@ -146,6 +146,8 @@ class RobotDaemon {
   /// Queries answered by Submit() so far (ServerDaemon thread only).
   std::uint64_t direct_queries() const { return direct_queries_; }
   std::size_t queued(std::int64_t client_id) const;
+  /// Items of every client (and the server's) waiting.
+  std::size_t queued_total() const;
   /// Panic: removes every waiting item (appended to `flushed`), latches
   /// panic and asks the thread to halt the driver.
   void Panic(std::vector<QueuedItem>& flushed, const std::string& reason = {});

@@ -1,31 +1,22 @@
 #include "robot_sessions.h"
 
+#include "robot_sessions_text.h"
 #include "robotalk/channels.h"
 #include "robotalk/protocol_codec.h"
 
-#include <cstdio>
-
 namespace robotalk {
-namespace {
 
-Reply MakeReply(CommandId id, Signal signal, std::string message, TimePoint now) {
-  Reply r;
-  r.id = id;
-  r.signal = signal;
-  r.message = std::move(message);
-  r.exec_time = now;
-  return r;
+using namespace sessions_text;
+
+std::size_t QueuedItemBytes() {
+  // The item in its client's heap or in a playback buffer (a vector: up to
+  // twice its size in capacity), a buffered frame's estimator entry (offset,
+  // arrival, delay), and its timed-servo entry (a hash-map node).
+  constexpr std::size_t kEstimatorFrame = 4 * sizeof(Duration);
+  constexpr std::size_t kTimedServo =
+      sizeof(std::pair<const CommandId, std::pair<TimePoint, int>>) + 3 * sizeof(void*);
+  return 2 * sizeof(PlaybackSequence::Frame) + kEstimatorFrame + kTimedServo;
 }
-
-std::string Seconds(Duration d) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g s", ToSeconds(d));
-  return buf;
-}
-
-std::string Client(std::int64_t id) { return "client " + Hex64(static_cast<std::uint64_t>(id)); }
-
-}  // namespace
 
 RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options)
     : daemon_(daemon),
@@ -36,12 +27,77 @@ RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, Ses
 
 Session& RobotSessions::SessionFor(std::int64_t client_id, TimePoint now) {
   auto it = sessions_.find(client_id);
-  if (it == sessions_.end()) it = sessions_.emplace(client_id, Session(client_id, now)).first;
+  if (it == sessions_.end())
+    it = sessions_.emplace(client_id, Session(client_id, now, options_.replies)).first;
   return it->second;
 }
 
 std::size_t RobotSessions::Waiting(const Session& s) const {
   return daemon_.queued(s.client_id) + s.buffered_frames();
+}
+
+std::string RobotSessions::QueueRefusal(const Session& s) {
+  if (!count_.known) {
+    count_.known = true;
+    count_.own = Waiting(s);
+    count_.total = daemon_.queued_total();
+    for (const auto& [id, session] : sessions_) count_.total += session.buffered_frames();
+  }
+  const std::string has = Client(s.client_id) + " has " + std::to_string(count_.own) +
+                          " commands queued on robot '" + robot_ + "'; the limit is ";
+  if (count_.own >= options_.max_queue) {
+    return has + std::to_string(options_.max_queue) + " (--max-queue)";
+  }
+  // Half the robot's bound is the clients' guaranteed shares; past its own, a
+  // client draws on the other half only while it has room (header).
+  const std::size_t share = options_.max_robot_queue / (2 * std::max<std::size_t>(options_.max_sessions, 1));
+  if (count_.own >= share && count_.total >= options_.max_robot_queue / 2) {
+    return has + std::to_string(share) + " while the robot's queues are full (" +
+           std::to_string(count_.total) + " commands of all clients; each client may always queue " +
+           std::to_string(share) + ", the robot holds at most " + std::to_string(options_.max_robot_queue) +
+           ")";
+  }
+  ++count_.own;
+  ++count_.total;
+  return "";
+}
+
+RobotSessions::SessionMemory RobotSessions::memory(std::int64_t client_id) const {
+  SessionMemory m;
+  const auto it = sessions_.find(client_id);
+  if (it == sessions_.end()) return m;
+  const Session& s = it->second;
+  m.reply_cache = s.replies.bytes();
+  m.playbacks = s.playback_bytes();
+  m.waiting = Waiting(s);
+  m.waiting_bytes = m.waiting * QueuedItemBytes();
+  m.unfinished_playbacks = s.playbacks.size();
+  m.timed_servos = s.timed_servos.size();
+  return m;
+}
+
+std::vector<Reply> RobotSessions::Retransmitted(const Session& s, const Request& r, TimePoint now) const {
+  if (s.replies.HasPackage(r.sequence)) return s.replies.RepliesFor(r.sequence);
+  // Older than the reply cache: its items still waiting are answered when
+  // they end; the others get an answer that says what is known.
+  std::vector<CommandId> ids = r.item_ids();
+  if (r.mode == RequestMode::kPlayback) ids.push_back(r.playback.id);
+  std::vector<Reply> out;
+  for (CommandId id : ids) {
+    const std::optional<std::optional<Reply>> known = s.replies.Lookup(id);
+    if (known && *known) out.push_back(**known);
+    if (known) continue;
+    const ReplyCache::Limits& limits = s.replies.limits();
+    out.push_back(
+        MakeReply(id, Signal::kError,
+                  "package " + std::to_string(r.sequence) +
+                      " was seen before (or is too old to tell) and does not run again; its replies "
+                      "are older than what this session keeps (its latest " +
+                      std::to_string(limits.max_packages) + " packages, " + KiB(limits.max_bytes) +
+                      "): its outcome is unknown here (read the robot's state)",
+                  now));
+  }
+  return out;
 }
 
 ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
@@ -51,6 +107,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   answer.batch.ack_sequence = r.sequence;
   answer.batch.server_receive = received;
   std::vector<Reply>& immediate = answer.batch.replies;
+  count_.known = false;
 
   const auto refuse_all = [&](const std::string& why) {
     ++refused_packages_;
@@ -73,7 +130,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   if (!session.seen.Observe(r.sequence)) {
     // A retransmission or a duplicate: never execute again; re-send what is
     // known. It does not refresh the session (a replay must not keep it alive).
-    immediate = session.replies.RepliesFor(r.sequence);
+    immediate = Retransmitted(session, r, received);
     return answer;
   }
   session.last_heard = received;  // only a new, well-formed package refreshes the session
@@ -120,7 +177,7 @@ ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint received) cons
   answer.batch.ack_sequence = r.sequence;
   answer.batch.server_receive = received;
   if (auto it = sessions_.find(r.client_id); it != sessions_.end()) {
-    answer.batch.replies = it->second.replies.RepliesFor(r.sequence);
+    answer.batch.replies = Retransmitted(it->second, r, received);
   }
   return answer;
 }
@@ -197,11 +254,8 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
     default:
       break;
   }
-  if (Waiting(s) >= options_.max_queue) {
-    immediate.push_back(MakeReply(q.id, Signal::kError,
-                                  "queue of " + Client(s.client_id) + " is full (" +
-                                      std::to_string(options_.max_queue) + " items); query not queued",
-                                  now));
+  if (std::string full = QueueRefusal(s); !full.empty()) {
+    immediate.push_back(MakeReply(q.id, Signal::kError, std::move(full) + "; query not queued", now));
     return;
   }
   QueuedItem item;
@@ -298,11 +352,8 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                   now));
     return std::nullopt;
   }
-  if (Waiting(s) >= options_.max_queue) {
-    immediate.push_back(MakeReply(c.id, Signal::kError,
-                                  "queue of " + Client(s.client_id) + " is full (" +
-                                      std::to_string(options_.max_queue) + " items); command not queued",
-                                  now));
+  if (std::string full = QueueRefusal(s); !full.empty()) {
+    immediate.push_back(MakeReply(c.id, Signal::kError, std::move(full) + "; command not queued", now));
     return std::nullopt;
   }
   QueuedItem item;
@@ -320,101 +371,6 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   item.command.num_values = static_cast<int>(c.values.size());
   std::copy(c.values.begin(), c.values.end(), item.command.values.begin());
   return item;
-}
-
-void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
-                                  std::vector<Reply>& immediate) {
-  const PlaybackDeclaration& d = r.playback;
-  const std::string label = "PLAYBACK " + std::to_string(d.id);
-  if (s.PlaybackEnded(d.id)) {
-    // Late frames of a sequence a panic ended: answered, never a new sequence
-    // that would wait forever for the frames it had before.
-    for (const Command& c : r.commands) {
-      immediate.push_back(MakeReply(c.id, Signal::kInterrupted,
-                                    label + " was ended by a panic; its later frames do not run", now));
-    }
-    return;
-  }
-  if (daemon_.in_panic()) {
-    for (const Command& c : r.commands) Admit(s, c, now, immediate, /*playback=*/true);  // PANIC each
-    if (!s.playbacks.count(d.id) || !s.playbacks.at(d.id).start) {
-      immediate.push_back(
-          MakeReply(d.id, Signal::kPanic, label + ": the robot is in panic; it does not start", now));
-    }
-    s.EndPlayback(d.id);
-    return;
-  }
-  if (d.frames > static_cast<std::int64_t>(options_.max_queue) && !s.playbacks.count(d.id)) {
-    for (const Command& c : r.commands) {
-      immediate.push_back(MakeReply(c.id, Signal::kError,
-                                    "PLAYBACK " + std::to_string(d.id) + ": declares " +
-                                        std::to_string(d.frames) + " frames; the queue limit is " +
-                                        std::to_string(options_.max_queue),
-                                    now));
-    }
-    return;
-  }
-  auto [it, created] =
-      s.playbacks.try_emplace(d.id, static_cast<std::size_t>(d.frames), d.duration, options_.playback);
-  PlaybackSequence& seq = it->second;
-  if (!created && (seq.total != static_cast<std::size_t>(d.frames) || seq.duration != d.duration)) {
-    for (const Command& c : r.commands) {
-      immediate.push_back(MakeReply(c.id, Signal::kError,
-                                    "PLAYBACK " + std::to_string(d.id) + ": declared " +
-                                        std::to_string(seq.total) + " frames over " + Seconds(seq.duration) +
-                                        " before, now " + std::to_string(d.frames) + " over " +
-                                        Seconds(d.duration),
-                                    now));
-    }
-    return;
-  }
-  if (!seq.first_arrival) {
-    seq.first_arrival = now;
-    seq.estimator.SetDelayHistory(s.delays.Recent(now));
-  }
-  const std::optional<TimePoint> sent =
-      r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
-  for (const Command& c : r.commands) {
-    std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
-    if (!item) continue;
-    const Duration offset = c.start_time.offset().value_or(Duration(0));
-    if (offset > seq.duration || ++seq.received > seq.total) {
-      immediate.push_back(MakeReply(c.id, Signal::kError,
-                                    "PLAYBACK " + std::to_string(d.id) + ": frame at " + Seconds(offset) +
-                                        " is beyond the declared " + std::to_string(seq.total) +
-                                        " frames over " + Seconds(seq.duration),
-                                    now));
-      continue;
-    }
-    item->has_start_time = true;
-    if (seq.start) {  // already playing: straight to the RobotDaemon
-      item->start = *seq.start + offset;
-      if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
-    } else {
-      seq.estimator.Add(offset, now, sent);
-      seq.frames.push_back({offset, std::move(*item)});
-    }
-  }
-  if (seq.start || !seq.estimator.ready()) return;
-  seq.start = seq.estimator.StartTime();
-  for (PlaybackSequence::Frame& frame : seq.frames) {
-    frame.item.start = *seq.start + frame.offset;
-    if (!Superseded(s, frame.item, now, immediate)) daemon_.Submit(std::move(frame.item));
-  }
-  seq.frames.clear();
-  const Duration delay = *seq.start - *seq.first_arrival;
-  const std::string why = seq.estimator.quick()
-                              ? "quick start: this client's packages' one-way delays vary by " +
-                                    Seconds(*seq.estimator.delay_spread())
-                              : "mean " + Seconds(seq.estimator.mean_command_interval()) +
-                                    " between commands, " + Seconds(seq.estimator.mean_arrival_interval()) +
-                                    " between arrivals";
-  Reply reply = MakeReply(d.id, Signal::kSuccess,
-                          "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +
-                              " after its first frame arrived (" + why + ")",
-                          now);
-  reply.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
-  immediate.push_back(std::move(reply));
 }
 
 void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::string& sender) {
@@ -435,7 +391,7 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::stri
       }
       ended.push_back(pid);
     }
-    for (std::int64_t pid : ended) session.EndPlayback(pid);
+    for (std::int64_t pid : ended) session.EndPlayback(pid, Session::Ended::kPanic);
   }
   for (const QueuedItem& item : flushed_) {
     if (item.client_id == 0) continue;
@@ -447,16 +403,14 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::stri
 void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {
   auto it = sessions_.find(client_id);
   if (it == sessions_.end()) return;  // an expired client
+  NoteServoAnswer(client_id, reply);  // also a flushed one's: its entry is freed
   it->second.replies.RecordReply(reply);
   pending_[client_id].push_back(std::move(reply));
 }
 
 void RobotSessions::File(DaemonOutput& output, std::vector<ReplyBatch>& to_send) {
   for (const DaemonOutput::Executed& e : output.executed) Own(e);
-  for (DaemonOutput::Answer& a : output.replies) {
-    NoteServoAnswer(a.client_id, a.reply);
-    Deliver(a.client_id, std::move(a.reply));
-  }
+  for (DaemonOutput::Answer& a : output.replies) Deliver(a.client_id, std::move(a.reply));
   for (auto& line : output.log) log_.push_back(std::move(line));
   for (auto& [client, replies] : pending_) {
     if (replies.empty()) continue;

@@ -37,7 +37,24 @@ struct SessionOptions {
   std::size_t max_message_bytes = 512;
   /// The server's refusal counters for the SERVER_COUNTERS query (name, value).
   std::function<std::vector<std::pair<const char*, double>>()> counters;
+  /// Most items all clients of this robot may have waiting (queued and
+  /// buffered playback frames; each costs QueuedItemBytes()). Half of it is
+  /// every client's guaranteed share, max_robot_queue / (2 · max_sessions)
+  /// each, always admitted (within max_queue); the other half is shared:
+  /// items past a client's share are admitted only while all clients' items
+  /// are fewer than max_robot_queue / 2. So the robot never holds more than
+  /// max_robot_queue, and clients flooding it cannot lock a new one out.
+  std::size_t max_robot_queue = 65536;
+  /// Most playback sequences one client may have unfinished at once.
+  std::size_t max_playbacks = 16;
+  /// Each session's reply cache.
+  ReplyCache::Limits replies;
 };
+
+/// What one waiting item (a queued command or query, a buffered playback
+/// frame with its estimator entry and its timed-servo entry) costs at most,
+/// the queue's spare capacity included: the byte bound behind the item bounds.
+std::size_t QueuedItemBytes();
 
 /// What the ServerDaemon sends back at once for a received package.
 struct ImmediateAnswer {
@@ -81,6 +98,17 @@ class RobotSessions {
   std::int64_t base_owner() const { return base_owner_; }
   /// Packages refused before admission, by reason (sequence jump, server full, ...).
   std::uint64_t refused_packages() const { return refused_packages_; }
+  /// Memory a client's session holds, as its bounds count it (0 when there
+  /// is no such session).
+  struct SessionMemory {
+    std::size_t reply_cache = 0;           ///< ReplyCache::bytes(), at most replies.max_bytes
+    std::size_t playbacks = 0;             ///< unfinished sequences and the ended list
+    std::size_t waiting = 0;               ///< items queued or buffered, at most max_queue
+    std::size_t waiting_bytes = 0;         ///< waiting × QueuedItemBytes()
+    std::size_t unfinished_playbacks = 0;  ///< at most max_playbacks
+    std::size_t timed_servos = 0;          ///< entries, one per waiting timed servo command
+  };
+  SessionMemory memory(std::int64_t client_id) const;
 
  private:
   Session& SessionFor(std::int64_t client_id, TimePoint now);
@@ -95,6 +123,12 @@ class RobotSessions {
   void Panic(std::int64_t client_id, TimePoint now, const std::string& sender = "");
   void Deliver(std::int64_t client_id, Reply reply);
   std::size_t Waiting(const Session& s) const;
+  // Why `s` may not have one more item waiting, or "" (and it is counted).
+  std::string QueueRefusal(const Session& s);
+  // The answer to a retransmission of a package already seen.
+  std::vector<Reply> Retransmitted(const Session& s, const Request& request, TimePoint now) const;
+  void Start(Session& s, std::int64_t id, PlaybackSequence& seq, TimePoint now,
+             std::vector<Reply>& immediate);
   void Own(const DaemonOutput::Executed& e);
   void Bound(Reply& reply) const;
   // True (and answered) when a timed servo command arrives after a
@@ -113,6 +147,13 @@ class RobotSessions {
   std::vector<std::int64_t> joint_owner_;  // per joint: the client that last commanded it
   std::int64_t base_owner_ = 0;
   std::uint64_t refused_packages_ = 0;
+  // Items waiting, the client's own and all clients': counted when a
+  // package's first item asks (the RobotDaemon only takes items meanwhile),
+  // then kept up to date as its items are admitted.
+  struct QueueCount {
+    bool known = false;
+    std::size_t own = 0, total = 0;
+  } count_;
 };
 
 }  // namespace robotalk

@@ -8,6 +8,7 @@
 #include "robotalk/routed_lcm_transport.h"
 #include "server_daemon.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -107,9 +108,11 @@ class Server::Impl {
                                                   ? TrafficLayout::kSplit
                                                   : TrafficLayout::kSingle,
                             .fifo_priority = options_.precise_timing ? 5 : 0});
-    const SessionOptions sessions{
+    SessionOptions sessions{
         options_.session_timeout, options_.max_queue, options_.max_future,
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};
+    // The server-wide bound of queued items, an equal part per robot.
+    sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
                                             .precise_timing = options_.precise_timing};

@@ -23,6 +23,9 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --url URL                       LCM URL (default: LCM's default or $LCM_DEFAULT_URL)
   --session-timeout S             expire a silent client after S seconds (default 2)
   --max-queue N                   most queued commands per client (default 10000)
+  --max-queued-total N            most queued commands of all clients in the server, shared
+                                  equally by its robots; half is each client's guaranteed
+                                  share (default 65536)
   --max-future S                  refuse start times more than S seconds ahead, or in the past (default 3600)
   --duration S                    exit after S seconds (default: run until SIGINT/SIGTERM)
   --congestion-max-pause S        the paper's congestion injector: pause a random time in
@@ -123,6 +126,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.session_timeout = FromSeconds(ParseNumber(arg, value(), 0.05, 3600));
       } else if (arg == "--max-queue") {
         options.max_queue = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e7));
+      } else if (arg == "--max-queued-total") {
+        options.max_queued_total = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e8));
       } else if (arg == "--max-future") {
         options.max_future = FromSeconds(ParseNumber(arg, value(), 0, 86400 * 7));
       } else if (arg == "--congestion-max-pause") {

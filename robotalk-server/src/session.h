@@ -22,38 +22,77 @@
 
 namespace robotalk {
 
-/// Final replies of a client's recent packages, by package sequence.
+/// Final replies of a client's recent packages, by package sequence, so a
+/// retransmission is answered without running anything again.
+///
+/// Bounds: at most `max_packages` packages, and bytes() (each reply's
+/// struct, message and values, each id, the index entries) never above
+/// `max_bytes`: past either, the oldest packages are forgotten. Items of a
+/// forgotten package that still wait for their final reply keep a small
+/// entry (counted) until it comes, so a retransmission is not told they were
+/// forgotten while they wait; that reply is sent, not kept. At most
+/// `max_packages` such entries are kept, the oldest dropped first. A
+/// package's items named in another package (a playback's id comes with
+/// each of its packages) stay until the last of them is forgotten.
 class ReplyCache {
  public:
-  explicit ReplyCache(size_t max_packages = 1024) : max_packages_(max_packages) {}
-  /// Remembers which item ids a package carried (evicts the oldest package).
+  struct Limits {
+    std::size_t max_packages = 1024;
+    std::size_t max_bytes = 256 * 1024;
+  };
+  ReplyCache() : ReplyCache(Limits{}) {}
+  explicit ReplyCache(Limits limits) : limits_(limits) {}
+
+  /// Remembers which item ids a package carried (evicts the oldest packages).
   void RecordPackage(std::int64_t sequence, std::vector<CommandId> ids);
   /// Remembers a final reply (ignored unless its id belongs to a recorded package).
   void RecordReply(const Reply& reply);
   /// The final replies known for a package's items (for a retransmission).
   std::vector<Reply> RepliesFor(std::int64_t sequence) const;
+  /// True while the cache still holds `sequence`'s package.
+  bool HasPackage(std::int64_t sequence) const { return packages_.count(sequence) != 0; }
   /// nullopt: the id is not in the cache; a nullopt inside: received, no
   /// final reply yet; else its final reply.
   std::optional<std::optional<Reply>> Lookup(CommandId id) const {
     const auto it = replies_.find(id);
     if (it == replies_.end()) return std::nullopt;
-    return it->second;
+    return it->second.reply;
   }
 
+  /// Memory held, as counted against `max_bytes`.
+  std::size_t bytes() const { return bytes_; }
+  std::size_t packages() const { return packages_.size(); }
+  const Limits& limits() const { return limits_; }
+  /// What one cached reply costs (its index entry, struct, message, values).
+  static std::size_t Bytes(const std::optional<Reply>& reply);
+
  private:
-  size_t max_packages_;
+  struct Entry {
+    std::optional<Reply> reply;
+    int packages = 0;       // recorded packages that carry it
+    bool detached = false;  // its packages were forgotten while it waited
+  };
+  void Evict();
+  void EvictOldestPackage();
+  void Erase(std::unordered_map<CommandId, Entry>::iterator it);
+
+  Limits limits_;
+  std::size_t bytes_ = 0;
   std::deque<std::int64_t> order_;                                     // oldest first
   std::unordered_map<std::int64_t, std::vector<CommandId>> packages_;  // sequence -> item ids
-  std::unordered_map<CommandId, std::optional<Reply>> replies_;        // id -> final reply once known
+  std::unordered_map<CommandId, Entry> replies_;                       // id -> final reply once known
+  std::deque<CommandId> detached_;                                     // oldest first
 };
 
 /// One playback sequence of a client (paper §V-C): its frames wait in the
-/// playback queue until the delay is estimated, then move to the command queue.
+/// playback queue until the delay is estimated, then move to the command
+/// queue. Once it started, the estimator and the buffer are freed; once every
+/// declared frame was received, the sequence itself (Session::EndPlayback).
 struct PlaybackSequence {
   PlaybackSequence(std::size_t total_frames, Duration duration, PlaybackEstimatorOptions options)
-      : estimator(total_frames, duration, options), total(total_frames), duration(duration) {}
+      : estimator(std::in_place, total_frames, duration, options), total(total_frames), duration(duration) {}
 
-  PlaybackEstimator estimator;
+  std::optional<PlaybackEstimator> estimator;  ///< until the start is known
   struct Frame {
     Duration offset;  ///< from the sequence start
     QueuedItem item;  ///< its start is set once the sequence's start is known
@@ -64,10 +103,16 @@ struct PlaybackSequence {
   std::size_t total;
   Duration duration;
   std::size_t received = 0;
+
+  /// Memory it holds beyond its map entry (buffer and estimator).
+  std::size_t bytes() const {
+    return frames.capacity() * sizeof(Frame) + (estimator ? estimator->heap_bytes() : 0);
+  }
 };
 
 struct Session {
-  Session(std::int64_t id, TimePoint now) : client_id(id), created(now), last_heard(now) {}
+  Session(std::int64_t id, TimePoint now, ReplyCache::Limits reply_limits = {})
+      : client_id(id), created(now), last_heard(now), replies(reply_limits) {}
 
   std::int64_t client_id;
   std::string who;  ///< for logs: the sender as the session gate names it
@@ -76,27 +121,40 @@ struct Session {
   SequenceWindow seen;
   ReplyCache replies;
   DelayHistory delays;  ///< one-way delays of its latest packages (playback's quick start)
-  std::map<std::int64_t, PlaybackSequence> playbacks;  ///< by playback id
+  std::map<std::int64_t, PlaybackSequence> playbacks;  ///< unfinished ones, by playback id
   /// Timed servo commands queued and not yet answered: id -> (start, actuator).
   std::unordered_map<CommandId, std::pair<TimePoint, int>> timed_servos;
   /// Per actuator, the latest start time of this client's servo commands that ran.
   std::map<int, TimePoint> latest_servo_start;
-  /// Playback sequences a panic ended (the most recent kMaxEnded): their
-  /// late frames are answered at once instead of starting a new sequence.
-  std::deque<std::int64_t> ended_playbacks;
+  /// Why a playback sequence is no longer in `playbacks`.
+  enum class Ended { kPanic, kComplete };
+  /// Playback sequences that ended (the most recent kMaxEnded): their late
+  /// frames are answered at once instead of starting a new sequence.
+  std::deque<std::pair<std::int64_t, Ended>> ended_playbacks;
   static constexpr std::size_t kMaxEnded = 64;
-  void EndPlayback(std::int64_t id) {
+  void EndPlayback(std::int64_t id, Ended why) {
     playbacks.erase(id);
-    ended_playbacks.push_back(id);
+    ended_playbacks.emplace_back(id, why);
     if (ended_playbacks.size() > kMaxEnded) ended_playbacks.pop_front();
   }
-  bool PlaybackEnded(std::int64_t id) const {
-    return std::find(ended_playbacks.begin(), ended_playbacks.end(), id) != ended_playbacks.end();
+  std::optional<Ended> PlaybackEnded(std::int64_t id) const {
+    for (const auto& [ended, why] : ended_playbacks) {
+      if (ended == id) return why;
+    }
+    return std::nullopt;
   }
   /// Frames buffered over all playbacks (they count against the queue limit).
   std::size_t buffered_frames() const {
     std::size_t n = 0;
     for (const auto& [id, seq] : playbacks) n += seq.frames.size();
+    return n;
+  }
+  /// Memory of its playback sequences: map nodes, buffers, estimators and
+  /// the ended list.
+  std::size_t playback_bytes() const {
+    constexpr std::size_t kNode = sizeof(std::pair<const std::int64_t, PlaybackSequence>) + 4 * sizeof(void*);
+    std::size_t n = ended_playbacks.size() * sizeof(std::pair<std::int64_t, Ended>);
+    for (const auto& [id, seq] : playbacks) n += kNode + seq.bytes();
     return n;
   }
 };

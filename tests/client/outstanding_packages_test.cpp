@@ -163,6 +163,27 @@ TEST(OutstandingPackages, AckedAndAnsweredPackageIsForgotten) {
   EXPECT_TRUE(o.TakeDue(kT0 + seconds(10)).empty());
 }
 
+// Issue 19 item 8: why a server that forgot a package's replies must still
+// answer its items. Acknowledgements alone keep an acked package alive (a
+// long GOTO is re-asked about this way), so the client would ask forever;
+// the server's answer for a forgotten item (ERROR, outcome unknown) ends it.
+TEST(OutstandingPackages, AcksWithoutTheReplyKeepAskingAndTheServersAnswerForAForgottenItemEndsIt) {
+  OutstandingPackages o(Policy());
+  o.Add(1, Bytes(1), {{.id = 10}}, kT0);
+  o.OnAck(1, kT0 + milliseconds(5));
+  int resends = 0;
+  for (Duration t = milliseconds(10); t < seconds(60); t += milliseconds(10)) {
+    if (!o.TakeDue(kT0 + t).empty()) {
+      ++resends;
+      o.OnAck(1, kT0 + t + milliseconds(1));  // the server re-acks, with no reply
+    }
+    ASSERT_TRUE(o.TakeExpired(kT0 + t).empty()) << "never given up while acked";
+  }
+  EXPECT_GT(resends, 100);
+  EXPECT_EQ(o.OnReply(10, kT0 + seconds(60)), 1) << "the answer completes the package";
+  EXPECT_EQ(o.size(), 0u);
+}
+
 TEST(OutstandingPackages, PackageWithoutItemsCompletesOnItsAck) {
   OutstandingPackages o(Policy());
   o.Add(3, Bytes(3), {}, kT0);  // a panic package

@@ -77,7 +77,7 @@ TEST(SequenceWindow, TreatsSequencesFarBelowTheHighestAsDuplicates) {
 }
 
 TEST(ReplyCache, ReturnsTheFinalRepliesOfAPackageAndForgetsOldPackages) {
-  ReplyCache cache(2);
+  ReplyCache cache(ReplyCache::Limits{.max_packages = 2});
   cache.RecordPackage(1, {10, 11});
   cache.RecordReply(Reply{.id = 10, .signal = Signal::kSuccess});
   cache.RecordReply(Reply{.id = 99});  // not of a recorded package: ignored

@@ -1,6 +1,6 @@
 #include "robot_sessions.h"
 
-#include "fake_driver.h"
+#include "robot_sessions_fixture.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
@@ -16,88 +16,8 @@ namespace {
 
 using std::chrono::milliseconds;
 using std::chrono::seconds;
-using testing::FakeDriver;
+using namespace robotalk::testing;  // the fixture
 using ::testing::HasSubstr;
-using testing::PanRobot;
-
-constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
-
-Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std::string target = "",
-            StartTime start = StartTime::Now()) {
-  return Command{id, type, start, std::move(target), std::move(values)};
-}
-
-Request Package(std::int64_t client, std::int64_t seq, const std::vector<Command>& commands,
-                bool panic = false) {
-  Request r{.client_id = client, .sequence = seq, .panic = panic};
-  r.commands = commands;
-  return r;
-}
-
-Request Queries(std::int64_t client, std::int64_t seq, const std::vector<Query>& queries) {
-  Request r{.client_id = client, .sequence = seq};
-  r.queries = queries;
-  return r;
-}
-
-// A playback frame's start_time is After(its offset from the sequence start).
-Request Playback(std::int64_t client, std::int64_t seq, std::int64_t playback_id, int frames,
-                 Duration duration, const std::vector<Command>& commands) {
-  Request r = Package(client, seq, commands);
-  r.mode = RequestMode::kPlayback;
-  r.playback = {playback_id, frames, duration};
-  return r;
-}
-
-// The ServerDaemon's session layer of one robot and its RobotDaemon, on a
-// manual clock, without threads or a transport.
-class RobotSessionsTest : public ::testing::Test {
- protected:
-  explicit RobotSessionsTest(BaseType base = BaseType::kDifferential, SessionOptions options = {}) {
-    auto driver = std::make_unique<FakeDriver>(PanRobot(base));
-    fake_ = driver.get();
-    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
-    sessions_ = std::make_unique<RobotSessions>(*daemon_, ConfigHash(daemon_->model()), options);
-    daemon_->Preallocate(output_);
-  }
-
-  // Immediate replies of a package, by id.
-  std::map<CommandId, Reply> Handle(const Request& p) {
-    std::map<CommandId, Reply> out;
-    last_ = sessions_->Handle(p, clock_.Now());
-    for (const auto& r : last_.batch.replies) out[r.id] = r;
-    return out;
-  }
-  // Runs the RobotDaemon once at the current time and files what it produced.
-  void Run() {
-    daemon_->RunOnce(clock_.Now());
-    Collect();
-  }
-  void Collect() {
-    daemon_->TakeOutput(output_);
-    for (std::size_t i = 0; i < output_.num_samples; ++i) {
-      states_.push_back(ToStateSample("bot", ConfigHash(daemon_->model()), output_.samples[i]));
-    }
-    std::vector<ReplyBatch> batches;
-    sessions_->File(output_, batches);
-    for (auto& b : batches) {
-      for (auto& r : b.replies) collected_[b.client_id][r.id] = r;
-    }
-  }
-  std::map<CommandId, Reply> Replies(std::int64_t client) {
-    Collect();
-    return collected_[client];
-  }
-
-  ManualClock clock_;
-  FakeDriver* fake_ = nullptr;
-  std::unique_ptr<RobotDaemon> daemon_;
-  std::unique_ptr<RobotSessions> sessions_;
-  DaemonOutput output_;
-  ImmediateAnswer last_;
-  std::map<std::int64_t, std::map<CommandId, Reply>> collected_;
-  std::vector<StateSample> states_;
-};
 
 TEST_F(RobotSessionsTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
   const TimePoint start = clock_.Now() + seconds(2);
@@ -267,7 +187,8 @@ TEST_F(SmallQueueSessionsTest, RefusesCommandsBeyondTheQueueLimit) {
                      {Cmd(1, CommandType::kStop, {}, "", later), Cmd(2, CommandType::kStop, {}, "", later),
                       Cmd(3, CommandType::kStop, {}, "", later)}));
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_THAT(r.at(3).message, HasSubstr("is full (2 items)"));
+  EXPECT_THAT(r.at(3).message, HasSubstr("client 00000000000a11ce has 2 commands queued on robot 'bot'; "
+                                         "the limit is 2 (--max-queue)"));
   EXPECT_EQ(daemon_->queued(kAlice), 2u);
 }
 
@@ -383,8 +304,8 @@ TEST_F(RobotSessionsTest, NeverEchoesALongBadTargetInFull) {
   const std::string target(50000, 'x');
   auto r = Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.1}, target)}));
   EXPECT_EQ(r.at(1).signal, Signal::kError);
-  EXPECT_LT(r.at(1).message.size(), 600u);
-  EXPECT_THAT(r.at(1).message, HasSubstr("(truncated)"));
+  EXPECT_LT(r.at(1).message.size(), 160u);
+  EXPECT_THAT(r.at(1).message, HasSubstr("xxx...' (50000 bytes)"));
 }
 
 class FewSessionsTest : public RobotSessionsTest {

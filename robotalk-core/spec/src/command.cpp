@@ -16,7 +16,16 @@ std::string Upper(std::string s) {
   return s;
 }
 
-std::string Quote(const std::string& s) { return "'" + s + "'"; }
+// A name from the wire, quoted; a long one is shown by its first bytes and
+// its length, so every refusal stays short whatever a client sends (the
+// server keeps refusals in its reply cache).
+std::string Quote(const std::string& s) {
+  constexpr std::size_t kShown = 48;
+  if (s.size() <= kShown + 16) return "'" + s + "'";
+  std::size_t cut = kShown;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // whole UTF-8 characters
+  return "'" + s.substr(0, cut) + "...' (" + std::to_string(s.size()) + " bytes)";
+}
 
 // "JOINT_SETPOINT 'neck'" or "GOTO".
 std::string Label(const Command& c) {

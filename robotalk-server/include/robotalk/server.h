@@ -37,6 +37,10 @@ struct ServerOptions {
   Duration session_timeout = std::chrono::seconds(2);
   /// Most commands one client may have queued.
   size_t max_queue = 10000;
+  /// Most commands all clients may have queued in the whole server; each
+  /// robot gets an equal part, half of it as every client's guaranteed
+  /// share (docs/protocol.md, Bounds).
+  size_t max_queued_total = 65536;
   /// Start times further ahead than this, or further in the past, are
   /// refused with ERROR.
   Duration max_future = std::chrono::hours(1);

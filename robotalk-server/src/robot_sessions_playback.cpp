@@ -1,0 +1,127 @@
+// RobotSessions' playback mode (paper §V-C): a sequence's frames wait in the
+// session's playback queue until its delay is estimated, then move to the
+// RobotDaemon's command queue; a finished sequence is freed.
+#include "robot_sessions.h"
+#include "robot_sessions_text.h"
+
+namespace robotalk {
+
+using namespace sessions_text;
+
+void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
+                                  std::vector<Reply>& immediate) {
+  const PlaybackDeclaration& d = r.playback;
+  const std::string label = "PLAYBACK " + std::to_string(d.id);
+  const auto refuse = [&](const std::string& why, bool delay_reply) {
+    for (const Command& c : r.commands) immediate.push_back(MakeReply(c.id, Signal::kError, why, now));
+    // A sequence that never starts: its delay reply is this refusal too.
+    if (delay_reply) immediate.push_back(MakeReply(d.id, Signal::kError, why, now));
+  };
+  if (const std::optional<Session::Ended> ended = s.PlaybackEnded(d.id)) {
+    // Late frames of a sequence that ended: answered, never a new sequence
+    // that would wait forever for the frames it had before.
+    if (*ended == Session::Ended::kComplete) {
+      refuse(label + ": all its declared frames were received already; this frame is beyond them", false);
+      return;
+    }
+    for (const Command& c : r.commands) {
+      immediate.push_back(MakeReply(c.id, Signal::kInterrupted,
+                                    label + " was ended by a panic; its later frames do not run", now));
+    }
+    return;
+  }
+  if (daemon_.in_panic()) {
+    for (const Command& c : r.commands) Admit(s, c, now, immediate, /*playback=*/true);  // PANIC each
+    if (!s.playbacks.count(d.id) || !s.playbacks.at(d.id).start) {
+      immediate.push_back(
+          MakeReply(d.id, Signal::kPanic, label + ": the robot is in panic; it does not start", now));
+    }
+    s.EndPlayback(d.id, Session::Ended::kPanic);
+    return;
+  }
+  if (!s.playbacks.count(d.id)) {
+    if (d.frames > static_cast<std::int64_t>(options_.max_queue)) {
+      refuse(label + ": declares " + std::to_string(d.frames) + " frames; the queue limit is " +
+                 std::to_string(options_.max_queue),
+             true);
+      return;
+    }
+    if (s.playbacks.size() >= options_.max_playbacks) {
+      refuse(Client(s.client_id) + " has " + std::to_string(s.playbacks.size()) +
+                 " playback sequences unfinished on robot '" + robot_ + "'; the limit is " +
+                 std::to_string(options_.max_playbacks) + "; " + label + " does not start",
+             true);
+      return;
+    }
+  }
+  auto [it, created] =
+      s.playbacks.try_emplace(d.id, static_cast<std::size_t>(d.frames), d.duration, options_.playback);
+  PlaybackSequence& seq = it->second;
+  if (!created && (seq.total != static_cast<std::size_t>(d.frames) || seq.duration != d.duration)) {
+    refuse(label + ": declared " + std::to_string(seq.total) + " frames over " + Seconds(seq.duration) +
+               " before, now " + std::to_string(d.frames) + " over " + Seconds(d.duration),
+           false);
+    return;
+  }
+  if (!seq.first_arrival) {
+    seq.first_arrival = now;
+    seq.estimator->SetDelayHistory(s.delays.Recent(now));
+  }
+  const std::optional<TimePoint> sent =
+      r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
+  for (const Command& c : r.commands) {
+    std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
+    if (!item) {  // answered: one frame fewer to wait for
+      ++seq.received;
+      continue;
+    }
+    const Duration offset = c.start_time.offset().value_or(Duration(0));
+    if (offset > seq.duration || ++seq.received > seq.total) {
+      immediate.push_back(MakeReply(c.id, Signal::kError,
+                                    label + ": frame at " + Seconds(offset) + " is beyond the declared " +
+                                        std::to_string(seq.total) + " frames over " + Seconds(seq.duration),
+                                    now));
+      continue;
+    }
+    item->has_start_time = true;
+    if (seq.start) {  // already playing: straight to the RobotDaemon
+      item->start = *seq.start + offset;
+      if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
+    } else {
+      seq.estimator->Add(offset, now, sent);
+      seq.frames.push_back({offset, std::move(*item)});
+    }
+  }
+  if (!seq.start && seq.estimator->ready()) Start(s, d.id, seq, now, immediate);
+  // Every declared frame is in the command queue: nothing of it is left here.
+  if (seq.start && seq.received >= seq.total) s.EndPlayback(d.id, Session::Ended::kComplete);
+}
+
+// The delay is estimated: every buffered frame moves to the command queue,
+// the client learns when the sequence plays, and the estimator and the
+// buffer are freed.
+void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, TimePoint now,
+                          std::vector<Reply>& immediate) {
+  const PlaybackEstimator& estimator = *seq.estimator;
+  seq.start = estimator.StartTime();
+  for (PlaybackSequence::Frame& frame : seq.frames) {
+    frame.item.start = *seq.start + frame.offset;
+    if (!Superseded(s, frame.item, now, immediate)) daemon_.Submit(std::move(frame.item));
+  }
+  std::vector<PlaybackSequence::Frame>().swap(seq.frames);
+  const Duration delay = *seq.start - *seq.first_arrival;
+  const std::string why = estimator.quick()
+                              ? "quick start: this client's packages' one-way delays vary by " +
+                                    Seconds(*estimator.delay_spread())
+                              : "mean " + Seconds(estimator.mean_command_interval()) + " between commands, " +
+                                    Seconds(estimator.mean_arrival_interval()) + " between arrivals";
+  Reply reply = MakeReply(id, Signal::kSuccess,
+                          "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +
+                              " after its first frame arrived (" + why + ")",
+                          now);
+  reply.values = {ToSeconds(delay), static_cast<double>(ToWireMicros(*seq.start))};
+  immediate.push_back(std::move(reply));
+  seq.estimator.reset();
+}
+
+}  // namespace robotalk
