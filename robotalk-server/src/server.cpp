@@ -107,9 +107,10 @@ class Server::Impl {
                                                   ? TrafficLayout::kSplit
                                                   : TrafficLayout::kSingle,
                             .fifo_priority = options_.precise_timing ? 5 : 0});
-    const SessionOptions sessions{
+    SessionOptions sessions{
         options_.session_timeout, options_.max_queue, options_.max_future,
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};
+    sessions.max_sessions = options_.max_sessions_per_robot;
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
                                             .precise_timing = options_.precise_timing};
