@@ -285,9 +285,9 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
     case SessionGate::Verdict::kDuplicate: {
       ImmediateAnswer answer = robot.sessions->Resend(request, received);
       if (request.panic) {
-        // As the first copy was answered: the rights are the key's, unchanged.
-        answer.batch.panic = admission.why.empty() ? PanicStatus::kTaken : PanicStatus::kRefused;
-        answer.batch.panic_refusal = admission.why;
+        // As the first copy was answered: its header and the key's rights are unchanged.
+        answer.batch.panic_refusal = request.header_error.empty() ? admission.why : request.header_error;
+        answer.batch.panic = answer.batch.panic_refusal.empty() ? PanicStatus::kTaken : PanicStatus::kRefused;
       }
       Send(name, answer.batch);
       return false;

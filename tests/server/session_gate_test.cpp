@@ -377,6 +377,21 @@ TEST_F(KeyedGateTest, APanicWithTheRightIsAnsweredTaken) {
   EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken) << "a retransmission: taken when first seen";
 }
 
+TEST_F(KeyedGateTest, ARetransmittedPanicWithABadHeaderIsAnsweredRefusedAgain) {
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
+  ASSERT_TRUE(monitor);
+  Request panic;
+  panic.panic = true;
+  panic.queries.push_back(Query{.id = 1, .type = QueryType::kBasePose});
+  panic.commands.push_back(Command{2, CommandType::kStop, std::nullopt, "", {}});  // mixed: refused
+  const auto bytes = Publish(Sealed(*monitor, panic));
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  Publish(bytes);  // the replay window's duplicate path
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_FALSE(batches_.back().panic_refusal.empty());
+  EXPECT_FALSE(robot_->in_panic());
+}
+
 TEST_F(KeyedGateTest, APanicOutsideAnySessionIsAnsweredRefusedNotTaken) {
   Request panic{.client_id = kAlice, .session_id = 77, .sequence = 1, .panic = true};
   Publish(EncodeRequest(panic));
