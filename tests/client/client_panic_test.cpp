@@ -2,7 +2,8 @@
 // RobotClient::Panic() against the real server core (robotalk::Server,
 // kinematic driver) on an in-process bus, open and keyed mode, and against a
 // hand-made answer for what no correct server sends: the client believes only
-// the reply package's explicit panic answer, in every mode.
+// the reply package's explicit panic answer, in every mode. And item 6: a
+// keyed client keeps its id across a server restart, whoever says hello first.
 #include "kinematic_driver.h"
 #include "robotalk/channels.h"
 #include "robotalk/client_errors.h"
@@ -21,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <optional>
 #include <thread>
 
 namespace robotalk {
@@ -130,6 +132,42 @@ TEST_F(ClientPanicTest, AnOpenModePanicOutsideAnySessionIsTakenByTheServersExpli
   StartServer(/*keyed=*/false);  // a new instance: the client's session is unknown there
   EXPECT_NO_THROW(client->Panic());
   EXPECT_EQ(Client()->SetJoint("pan", {0.2}).signal, Signal::kPanic);
+}
+
+TEST_F(ClientPanicTest, AfterARestartAnotherKeyCannotTakeAKeyedClientsIdAndTheClientGoesOn) {
+  MakeKeys();
+  StartServer(/*keyed=*/true);
+  auto alice = Client("alice");
+  ASSERT_EQ(alice->Stop().signal, Signal::kSuccess);
+  server_.reset();
+  StartServer(/*keyed=*/true);
+  // Another listed key says hello first under alice's id (a process that
+  // does not use the library: the library refuses such an id itself).
+  MemoryTransport attacker(bus_);
+  std::optional<HelloAnswer> answer;
+  auto sub = attacker.Subscribe(
+      HelloAnswerChannel(kRobot, alice->client_id()),
+      [&](const std::string&, std::span<const std::uint8_t> b) { answer = DecodeHelloAnswer(b); });
+  const ClientHandshake hello(ReadSecretKeyFile(dir_ / "monitor"), alice->client_id());
+  attacker.Publish(HelloChannel(kRobot), EncodeHello(Hello{.keyed = true, .body = hello.hello()}));
+  for (int i = 0; i < 400 && !answer; ++i) attacker.HandleFor(std::chrono::milliseconds(5));
+  ASSERT_TRUE(answer);
+  EXPECT_EQ(answer->session_id, 0) << "another key took alice's client id";
+  EXPECT_THAT(answer->refusal, HasSubstr("is not one of this key's"));
+  try {
+    alice->Stop();  // its session died with the old instance: an unknown outcome, once
+  } catch (const UnknownOutcomeError&) {
+  }
+  EXPECT_EQ(alice->Stop().signal, Signal::kSuccess) << "the same client object goes on";
+  EXPECT_THROW(
+      {
+        ClientOptions o;
+        o.transport = &client_end_;
+        o.key_file = (dir_ / "monitor").string();
+        o.client_id = alice->client_id();
+        RobotClient impostor(o);
+      },
+      ClientError);
 }
 
 // What no correct server sends, answered by hand once the real server is
