@@ -252,6 +252,11 @@ class KeyedGateTest : public GateTest {
     WriteMacField(bytes, ComputeMac(c.keys.client_to_server, c.keys.session_id, MacCoveredBytes(bytes)));
     return bytes;
   }
+  // Publishes `c`'s sealed package `r` with the panic flag; returns its bytes.
+  std::vector<std::uint8_t> PublishPanic(Client& c, Request r = {}) {
+    r.panic = true;
+    return Publish(Sealed(c, std::move(r)));
+  }
   static Request Commands(CommandType type, CommandId id, std::vector<double> values = {}) {
     Request r;
     r.commands.push_back(
@@ -319,9 +324,7 @@ TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
   auto alice = Handshake(Key(2), Id(Key(2), kAlice));
   auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
   ASSERT_TRUE(alice && monitor);
-  Request panic;
-  panic.panic = true;
-  Publish(Sealed(*monitor, panic));
+  PublishPanic(*monitor);
   EXPECT_TRUE(robot_->in_panic()) << "monitor may raise a panic";
   Publish(Sealed(*monitor, Commands(CommandType::kPanicReset, 10)));
   EXPECT_TRUE(robot_->in_panic()) << "but not reset it";
@@ -351,9 +354,7 @@ TEST_F(KeyedGateTest, APanicRefusedForRightsIsAnsweredRefusedWithTheReasonAndDoe
   // while the robot went on; another client's motion completed.
   auto viewer = Handshake(Key(4), Id(Key(4), kMallory));
   ASSERT_TRUE(viewer);
-  Request panic;
-  panic.panic = true;
-  const auto bytes = Publish(Sealed(*viewer, panic));
+  const auto bytes = PublishPanic(*viewer);
   EXPECT_FALSE(robot_->in_panic());
   ASSERT_FALSE(batches_.empty());
   EXPECT_EQ(batches_.back().session_status, SessionStatus::kOk);
@@ -368,9 +369,7 @@ TEST_F(KeyedGateTest, APanicRefusedForRightsIsAnsweredRefusedWithTheReasonAndDoe
 TEST_F(KeyedGateTest, APanicWithTheRightIsAnsweredTaken) {
   auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
   ASSERT_TRUE(monitor);
-  Request panic;
-  panic.panic = true;
-  const auto bytes = Publish(Sealed(*monitor, panic));
+  const auto bytes = PublishPanic(*monitor);
   EXPECT_TRUE(robot_->in_panic());
   EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken);
   Publish(bytes);
@@ -380,11 +379,10 @@ TEST_F(KeyedGateTest, APanicWithTheRightIsAnsweredTaken) {
 TEST_F(KeyedGateTest, ARetransmittedPanicWithABadHeaderIsAnsweredRefusedAgain) {
   auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
   ASSERT_TRUE(monitor);
-  Request panic;
-  panic.panic = true;
-  panic.queries.push_back(Query{.id = 1, .type = QueryType::kBasePose});
-  panic.commands.push_back(Command{2, CommandType::kStop, std::nullopt, "", {}});  // mixed: refused
-  const auto bytes = Publish(Sealed(*monitor, panic));
+  Request mixed;  // queries and commands: refused
+  mixed.queries.push_back(Query{.id = 1, .type = QueryType::kBasePose});
+  mixed.commands.push_back(Command{2, CommandType::kStop, std::nullopt, "", {}});
+  const auto bytes = PublishPanic(*monitor, mixed);
   EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
   Publish(bytes);  // the replay window's duplicate path
   EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
