@@ -17,7 +17,8 @@ std::vector<std::pair<const char*, double>> GateCounters::Table() const {
           {"wrong_client", static_cast<double>(wrong_client)},
           {"forged", static_cast<double>(forged)},
           {"replayed", static_cast<double>(replayed)},
-          {"rights_refused", static_cast<double>(rights_refused)}};
+          {"rights_refused", static_cast<double>(rights_refused)},
+          {"hello_repeats", static_cast<double>(hello_repeats)}};
 }
 
 SessionGate::SessionGate(std::int64_t server_id, SessionGateOptions options)
@@ -69,6 +70,7 @@ HelloAnswer SessionGate::Answer(const std::string& robot, const Hello& hello, Ti
     // answer; nothing new is opened. (Keyed: the authenticator recognises it.)
     for (const auto& [id, s] : sessions_) {
       if (s.client_id == hello.body.client_id && s.nonce == hello.body.client_nonce && s.robot == robot) {
+        ++counters_.hello_repeats;
         answer.session_id = id;
         return answer;
       }
@@ -94,7 +96,10 @@ HelloAnswer SessionGate::Answer(const std::string& robot, const Hello& hello, Ti
     }
     EraseClosedByAuthenticator();
     answer.session_id = SessionId(hello.body, answer.body);
-    if (sessions_.count(answer.session_id)) return answer;  // a hello answered before: nothing new
+    if (sessions_.count(answer.session_id)) {  // a hello answered before: nothing new
+      ++counters_.hello_repeats;
+      return answer;
+    }
     const AccessEntry* entry = options_.access->Find(hello.body.client_key);
     session.who = "'" + (entry ? entry->name : std::string("?")) + "' (" +
                   hello.body.client_key.Fingerprint() + ", " + Client(hello.body.client_id) + ")";

@@ -50,6 +50,7 @@ struct GateCounters {
   std::uint64_t forged = 0;           ///< keyed: the MAC did not verify
   std::uint64_t replayed = 0;         ///< keyed: duplicate or too old in the replay window
   std::uint64_t rights_refused = 0;   ///< keyed: the key may not do that on that robot
+  std::uint64_t hello_repeats = 0;    ///< a hello answered before (lost answer, or replayed): answered again
 
   /// Names and values, in a fixed order (the reply's values and message).
   std::vector<std::pair<const char*, double>> Table() const;

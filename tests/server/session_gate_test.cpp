@@ -441,6 +441,7 @@ TEST_F(KeyedGateTest, OneHelloReplayedThousandsOfTimesLeavesRoomForEveryOtherKey
   Step();
   EXPECT_EQ(server_->gate().session_count(), 1u) << "one hello, one pending session";
   EXPECT_EQ(server_->gate().counters().hellos_refused, 0u) << "its copies are answered again, not refused";
+  EXPECT_EQ(server_->gate().counters().hello_repeats, 2999u) << "and counted (SERVER_COUNTERS)";
   for (std::uint8_t key : {3, 4}) {
     auto other = Handshake(Key(key), Id(Key(key), kMallory));
     ASSERT_TRUE(other) << "key " << int{key};
