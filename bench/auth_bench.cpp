@@ -26,7 +26,7 @@ struct Fixture {
   ServerAuthenticator server{Identity(2), access, RandomNonce()};
   SessionKeys keys;
   Fixture() {
-    const ClientHandshake hs(client, 42);
+    const ClientHandshake hs(client, KeyedClientId(client.public_key, 42));
     keys = hs.Finish(server.Handshake(hs.hello(), TimePoint{}));
   }
 };
@@ -89,7 +89,7 @@ BENCHMARK(BM_VerifyPackage)->Arg(200)->Arg(30000);
 void BM_Handshake(benchmark::State& state) {
   Fixture f;
   for (auto _ : state) {
-    const ClientHandshake hs(f.client, 42);
+    const ClientHandshake hs(f.client, KeyedClientId(f.client.public_key, 42));
     const SessionKeys keys = hs.Finish(f.server.Handshake(hs.hello(), TimePoint{}));
     benchmark::DoNotOptimize(keys.session_id);
     state.PauseTiming();

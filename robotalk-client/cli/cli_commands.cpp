@@ -148,8 +148,13 @@ int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args) {
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("usage: robotalk panic ROBOT");
   const auto client = ConnectClient(g, args[0], ClockUse::kUntimed);
-  client->Panic();
-  std::cout << "panic acknowledged by " << args[0] << "\n";
+  try {
+    client->Panic();
+  } catch (const PanicRefusedError& e) {
+    std::cerr << "panic REFUSED by " << args[0] << ": " << e.what() << "\n";
+    ExitAfterOutput(1);
+  }
+  std::cout << "panic taken by " << args[0] << " (the robot is in panic)\n";
   ExitAfterOutput(0);
 }
 

@@ -72,8 +72,16 @@ class RobotClient::Impl {
 
   /// Subscribes the robot's channels (REPLY/<client>, CONFIG).
   void Attach(const std::string& robot);
-  /// Blocks until the panic package `sequence` is acknowledged; false on timeout.
-  bool WaitAck(std::int64_t sequence, std::chrono::steady_clock::time_point deadline);
+  /// The server's explicit answer to a panic package (reply_package_t.panic_status).
+  struct PanicAnswer {
+    bool taken = false;
+    std::string refusal;           ///< not taken: the server's reason
+    bool session_unknown = false;  ///< not taken because the server had no such session
+  };
+  /// Blocks until the server has answered the panic package `sequence`;
+  /// nullopt on timeout.
+  std::optional<PanicAnswer> WaitPanicAnswer(std::int64_t sequence,
+                                             std::chrono::steady_clock::time_point deadline);
   /// Waits until a configuration with `hash` has been received.
   std::shared_ptr<const RobotModel> WaitModel(std::uint64_t hash,
                                               std::chrono::steady_clock::time_point deadline);
@@ -100,8 +108,8 @@ class RobotClient::Impl {
   client::ConfigStore configs_;                       // GUARDED_BY(mu_)
   std::string last_config_error_;                     // GUARDED_BY(mu_)
   std::unordered_set<std::int64_t> clock_packages_;   // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> ack_waited_;       // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> acked_;            // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> ack_waited_;       // GUARDED_BY(mu_): panics
+  std::unordered_map<std::int64_t, PanicAnswer> panic_answers_;  // GUARDED_BY(mu_)
   std::exception_ptr daemon_error_;                   // GUARDED_BY(mu_)
   ClientStats stats_;                                 // GUARDED_BY(mu_)
   std::unique_ptr<Subscription> state_subscription_;  // GUARDED_BY(mu_)
@@ -155,6 +163,9 @@ class RobotClient::Impl {
   /// an unknown outcome and says hello again (REQUIRES: mu_ held); returns
   /// the ids to fail (outside the lock).
   std::vector<CommandId> LoseSession(TimePoint now);
+  /// Files the answer to a waited-for panic package (REQUIRES: mu_ held);
+  /// true when one was filed.
+  bool NotePanicAnswer(const robotalk_msgs::reply_package_t& pkg);
   /// True when a reply package belongs to the live session (REQUIRES: mu_ held).
   bool AcceptReplyPackage(const robotalk_msgs::reply_package_t& pkg, std::span<const std::uint8_t> bytes,
                           TimePoint now, std::vector<CommandId>& lost);

@@ -83,6 +83,7 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
     if (answer.session_id == 0) {
       hello_refusal_ = "robot '" + robot_ + "' refused this client's hello: " + answer.refusal;
       hello_due_ = false;
+      handshake_.reset();  // the next hello is a new one
     } else if (identity_) {
       try {
         if (!answer.keyed) throw AuthError("the server answered in open mode, this client has a key");
@@ -145,7 +146,14 @@ void RobotClient::Impl::WaitSession(std::unique_lock<std::mutex>& lock) {
       std::chrono::steady_clock::now() +
       std::chrono::duration_cast<std::chrono::steady_clock::duration>(options_.connect_timeout);
   cv_.wait_until(lock, deadline, [&] { return session_id_ != 0 || !hello_refusal_.empty(); });
-  if (!hello_refusal_.empty()) throw ClientError("RobotClient: " + hello_refusal_);
+  if (!hello_refusal_.empty()) {
+    // Reported to this call; the next one says hello again (a refusal may
+    // not last: a bound, an access list the operator fixes).
+    const std::string why = std::exchange(hello_refusal_, {});
+    hello_due_ = true;
+    next_hello_ = clock_.Now();
+    throw ClientError("RobotClient: " + why);
+  }
   if (session_id_ == 0 && !trust_error_.empty()) throw ClientError("RobotClient: " + trust_error_);
   if (session_id_ == 0) {
     throw TimeoutError(
@@ -180,11 +188,10 @@ bool RobotClient::Impl::AcceptReplyPackage(const robotalk_msgs::reply_package_t&
     // Unsealed by nature (the server has no key for it): believed only for
     // the live session. A forger can make the client say hello again; it
     // could as well drop every package (docs/security.md, availability).
-    if (!identity_ && ack_waited_.count(pkg.ack_sequence) != 0) {
-      // An open-mode server acts on a panic outside any session (it stopped
-      // the robot) before answering SESSION_UNKNOWN: that is its acknowledgement.
-      acked_.insert(pkg.ack_sequence);
-    }
+    // Its panic answer counts in open mode, where nothing is sealed; in keyed
+    // mode only as a refusal for want of a session (RobotClient::Panic then
+    // says hello and sends the panic again), never as a panic taken.
+    if (!identity_ || pkg.panic_status == robotalk_msgs::reply_package_t::PANIC_REFUSED) NotePanicAnswer(pkg);
     if (session_id_ == 0 || pkg.session_id != session_id_) return false;
     lost = LoseSession(now);  // each lost item's failure says why
     return false;
@@ -195,6 +202,25 @@ bool RobotClient::Impl::AcceptReplyPackage(const robotalk_msgs::reply_package_t&
     ++stats_.replies_refused;
     return false;
   }
+  return true;
+}
+
+bool RobotClient::Impl::NotePanicAnswer(const robotalk_msgs::reply_package_t& pkg) {
+  if (pkg.ack_sequence <= 0 || ack_waited_.count(pkg.ack_sequence) == 0) return false;
+  PanicAnswer answer;
+  answer.session_unknown = pkg.session_status == robotalk_msgs::reply_package_t::SESSION_UNKNOWN;
+  switch (pkg.panic_status) {
+    case robotalk_msgs::reply_package_t::PANIC_TAKEN:
+      answer.taken = true;
+      break;
+    case robotalk_msgs::reply_package_t::PANIC_REFUSED:
+      answer.refusal = pkg.panic_refusal.empty() ? "no reason given" : pkg.panic_refusal;
+      break;
+    default:  // an answer to a panic package that does not say: never counted as taken
+      answer.refusal = "the server's answer to the panic package does not say that it was taken";
+      break;
+  }
+  panic_answers_[pkg.ack_sequence] = std::move(answer);
   return true;
 }
 

@@ -66,6 +66,17 @@ RobotClient::Impl::Impl(ClientOptions options)
     transport_ = own_transport_.get();
   }
   LoadKeys();
+  if (identity_) {
+    // Keyed mode: the client id is one of the key's (docs/security.md,
+    // Binding), so no other key can take it, before or after a restart.
+    if (options_.client_id == 0) {
+      client_id_ = KeyedClientId(identity_->public_key, static_cast<std::uint32_t>(RandomClientId()));
+    } else if (!ClientIdBelongsTo(options_.client_id, identity_->public_key)) {
+      throw ClientError("RobotClient: client id " + std::to_string(options_.client_id) +
+                        " is not one of key " + identity_->public_key.Fingerprint() +
+                        "'s (keyed mode: use robotalk::KeyedClientId, or leave client_id 0)");
+    }
+  }
   for (std::random_device rd; auto& b : hello_nonce_) b = static_cast<std::uint8_t>(rd());
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw ClientError(std::string("RobotClient: eventfd failed: ") + std::strerror(errno));
@@ -166,10 +177,11 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     std::unique_lock lock(mu_);
     if (daemon_error_) std::rethrow_exception(std::exchange(daemon_error_, nullptr));
     if (robot_.empty()) throw ClientError("RobotClient: not connected (call Connect first)");
-    // A panic never waits for a session: a client whose server restarted
-    // must still stop the robot (an open-mode server honours it outside any
-    // session; a keyed one refuses it unauthenticated).
-    if (!(panic && session_id_ == 0)) WaitSession(lock);
+    // An open-mode panic never waits for a session: a client whose server
+    // restarted must still stop the robot, and an open-mode server takes a
+    // panic outside any session. A keyed server takes one only in an
+    // authenticated session, so a keyed client waits for its hello's answer.
+    if (!(panic && session_id_ == 0 && !identity_)) WaitSession(lock);
     p.header.session_id = session_id_;
     channel = request_channel_;
     const TimePoint now = clock_.Now();
@@ -233,12 +245,16 @@ void RobotClient::Impl::Publish(const std::string& channel, const std::vector<st
   for (int i = 0; i < copies; ++i) transport_->Publish(channel, bytes);
 }
 
-bool RobotClient::Impl::WaitAck(std::int64_t sequence, std::chrono::steady_clock::time_point deadline) {
+std::optional<RobotClient::Impl::PanicAnswer> RobotClient::Impl::WaitPanicAnswer(
+    std::int64_t sequence, std::chrono::steady_clock::time_point deadline) {
   std::unique_lock lock(mu_);
-  const bool acked = cv_.wait_until(lock, deadline, [&] { return acked_.count(sequence) != 0; });
-  acked_.erase(sequence);
+  cv_.wait_until(lock, deadline, [&] { return panic_answers_.count(sequence) != 0; });
+  std::optional<PanicAnswer> answer;
+  if (const auto it = panic_answers_.find(sequence); it != panic_answers_.end())
+    answer = std::move(it->second);
+  panic_answers_.erase(sequence);
   ack_waited_.erase(sequence);
-  return acked;
+  return answer;
 }
 
 std::shared_ptr<const RobotModel> RobotClient::Impl::WaitModel(
@@ -426,7 +442,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
       accepted = AcceptReplyPackage(pkg, bytes, now, lost);
     }
     if (!accepted) {
-      cv_.notify_all();  // a panic acknowledged outside its session
+      cv_.notify_all();  // a panic answered outside its session
       fail_lost();
       return;
     }
@@ -439,10 +455,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
           clock_sync_.AddSample(info.first_send, FromWireMicros(pkg.server_receive_us),
                                 FromWireMicros(pkg.server_send_us), now);
         }
-        if (ack_waited_.count(pkg.ack_sequence) != 0) {
-          acked_.insert(pkg.ack_sequence);
-          notify = true;
-        }
+        notify = NotePanicAnswer(pkg);
       }
       for (const Reply& r : replies) outstanding_.OnReply(r.id, now);
     }

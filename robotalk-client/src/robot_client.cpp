@@ -396,11 +396,22 @@ std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands) 
 
 void RobotClient::Panic() {
   RequireConnected(*this, "Panic");
-  auto sent = impl_->SendPackage({}, {}, /*panic=*/true, Impl::Track::kRetransmit);
-  if (!impl_->WaitAck(sent.sequence, SteadyAfter(impl_->options_.timeout))) {
-    throw TimeoutError("RobotClient::Panic: panic package " + std::to_string(sent.sequence) +
-                       " not acknowledged by robot '" + robot() + "' within " +
-                       std::to_string(ToSeconds(impl_->options_.timeout)) + " s");
+  const auto deadline = SteadyAfter(impl_->options_.timeout);
+  for (int attempt = 1;; ++attempt) {
+    auto sent = impl_->SendPackage({}, {}, /*panic=*/true, Impl::Track::kRetransmit);
+    const auto answer = impl_->WaitPanicAnswer(sent.sequence, deadline);
+    if (!answer) {
+      throw TimeoutError("RobotClient::Panic: panic package " + std::to_string(sent.sequence) +
+                         " not answered by robot '" + robot() + "' within " +
+                         std::to_string(ToSeconds(impl_->options_.timeout)) + " s");
+    }
+    if (answer->taken) return;
+    // Keyed mode: the session was gone (a restarted server); the client says
+    // hello again and the panic goes out once more, in the new session.
+    if (answer->session_unknown && impl_->identity_ && attempt == 1) continue;
+    throw PanicRefusedError(
+        "RobotClient::Panic: robot '" + robot() +
+        "' refused the panic (the robot is NOT in panic because of it): " + answer->refusal);
   }
 }
 

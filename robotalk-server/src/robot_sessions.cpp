@@ -108,26 +108,33 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   answer.batch.server_receive = received;
   std::vector<Reply>& immediate = answer.batch.replies;
   count_.known = false;
+  // The panic flag is acted on for every admitted package with a sound
+  // header, whatever the session bookkeeping below decides about its items
+  // (a duplicate was acted on when first seen): the answer says so.
+  if (r.panic) answer.batch.panic = PanicStatus::kTaken;
 
   const auto refuse_all = [&](const std::string& why) {
     ++refused_packages_;
+    if (r.panic) Panic(r.client_id, received, r.sender);
     for (CommandId id : r.item_ids()) immediate.push_back(MakeReply(id, Signal::kError, why, received));
     return answer;
   };
   if (!sessions_.count(r.client_id) && sessions_.size() >= options_.max_sessions) {
     return refuse_all("robot '" + robot_ + "' serves " + std::to_string(options_.max_sessions) +
-                      " clients already (the --max-sessions bound); try again later");
+                      " clients already (the --max-sessions-per-robot bound); try again later");
   }
   Session& session = SessionFor(r.client_id, received);
   session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
-  if (session.seen.highest() > 0 && r.sequence > session.seen.highest() + SequenceWindow::kWindow) {
-    // A client numbers its packages 1, 2, 3...: a jump this far is not one of
-    // its packages (a forged INT64_MAX would make every later one a "duplicate").
-    return refuse_all("package sequence " + std::to_string(r.sequence) + " jumps more than " +
-                      std::to_string(SequenceWindow::kWindow) + " ahead of " +
-                      std::to_string(session.seen.highest()) + "; refused");
+  const SequenceWindow::Verdict seen = session.seen.Observe(r.sequence);
+  if (seen == SequenceWindow::Verdict::kTooManyGaps) {
+    // A client numbers its packages 1, 2, 3...: a jump that leaves this many
+    // numbers unreceived is not one of its packages (sequence_window.h).
+    return refuse_all("package sequence " + std::to_string(r.sequence) + " jumps ahead of " +
+                      std::to_string(session.seen.highest()) + " and would leave more than " +
+                      std::to_string(SequenceWindow::kMaxUnseen) +
+                      " sequence numbers of this client never received; refused");
   }
-  if (!session.seen.Observe(r.sequence)) {
+  if (seen == SequenceWindow::Verdict::kDuplicate) {
     // A retransmission or a duplicate: never execute again; re-send what is
     // known. It does not refresh the session (a replay must not keep it alive).
     immediate = Retransmitted(session, r, received);
@@ -190,6 +197,10 @@ ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
   answer.batch.server_receive = received;
   const std::vector<CommandId> ids = r.item_ids();
   ++refused_packages_;
+  if (r.panic) {
+    answer.batch.panic = PanicStatus::kRefused;
+    answer.batch.panic_refusal = r.header_error;
+  }
   for (CommandId id : ids) {
     answer.batch.replies.push_back(MakeReply(id, Signal::kError, r.header_error, received));
     Bound(answer.batch.replies.back());
@@ -199,7 +210,7 @@ ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
   // refreshes a session.
   if (auto it = sessions_.find(r.client_id); it != sessions_.end() && r.sequence > 0) {
     Session& session = it->second;
-    if (session.seen.Observe(r.sequence)) {
+    if (session.seen.Observe(r.sequence) == SequenceWindow::Verdict::kNew) {
       session.replies.RecordPackage(r.sequence, ids);
       for (const Reply& reply : answer.batch.replies) session.replies.RecordReply(reply);
     }

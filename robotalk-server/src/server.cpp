@@ -113,6 +113,7 @@ class Server::Impl {
         PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
+    sessions.max_sessions = options_.max_sessions_per_robot;
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
                                             .precise_timing = options_.precise_timing};

@@ -335,6 +335,11 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
       return true;
     case SessionGate::Verdict::kDuplicate: {
       ImmediateAnswer answer = robot.sessions->Resend(request, received);
+      if (request.panic) {
+        // As the first copy was answered: its header and the key's rights are unchanged.
+        answer.batch.panic_refusal = request.header_error.empty() ? admission.why : request.header_error;
+        answer.batch.panic = answer.batch.panic_refusal.empty() ? PanicStatus::kTaken : PanicStatus::kRefused;
+      }
       Send(name, answer.batch);
       return false;
     }
@@ -344,6 +349,7 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
     case SessionGate::Verdict::kUnknownSession:
       break;
   }
+  ReplyBatch unknown;
   if (request.panic && !gate_->keyed()) {
     // Open mode: a panic is honoured from anyone, in a session or not (a
     // client whose server restarted must still be able to stop the robot).
@@ -351,9 +357,16 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
     SyncLatch(robot);
     robot.daemon->FinishPanic();
     Drain(robot);
+    unknown.panic = PanicStatus::kTaken;
+  } else if (request.panic) {
+    unknown.panic = PanicStatus::kRefused;
+    unknown.panic_refusal =
+        "keyed mode: a panic is taken only in an authenticated session, and this server instance has no "
+        "session " +
+        std::to_string(request.session_id) + "; say hello and send it again";
+    Log("robot '" + name + "': refused a panic of " + admission.who + " outside any session");
   }
   if (request.client_id == 0) return false;
-  ReplyBatch unknown;
   unknown.client_id = request.client_id;
   unknown.session_id = request.session_id;
   unknown.session_status = SessionStatus::kUnknown;

@@ -46,6 +46,7 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --clients FILE                  keyed mode: the access list of client keys and their rights per
                                   robot (docs/security.md); without both the server runs open
   --max-sessions N                most client sessions in the whole server (default 1024)
+  --max-sessions-per-robot N      most clients one robot serves at once (default 256)
   --no-precise-timing             default timer slack, no final spin before deadlines, no SCHED_FIFO
                                   (saves CPU; the same as ROBOTALK_PRECISE_TIMING=0)
   --allow-duplicate-robots        serve a robot even when another server announces the same name
@@ -110,6 +111,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.precise_timing = false;
       } else if (arg == "--max-sessions") {
         options.max_sessions = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
+      } else if (arg == "--max-sessions-per-robot") {
+        options.max_sessions_per_robot = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--panic-latch") {
         options.panic_latch_path = value();
       } else if (arg == "--log-lines-per-second") {

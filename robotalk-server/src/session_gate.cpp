@@ -17,7 +17,8 @@ std::vector<std::pair<const char*, double>> GateCounters::Table() const {
           {"wrong_client", static_cast<double>(wrong_client)},
           {"forged", static_cast<double>(forged)},
           {"replayed", static_cast<double>(replayed)},
-          {"rights_refused", static_cast<double>(rights_refused)}};
+          {"rights_refused", static_cast<double>(rights_refused)},
+          {"hello_repeats", static_cast<double>(hello_repeats)}};
 }
 
 SessionGate::SessionGate(std::int64_t server_id, SessionGateOptions options)
@@ -64,19 +65,41 @@ HelloAnswer SessionGate::Answer(const std::string& robot, const Hello& hello, Ti
                                     "ROBOTALK_KEY; docs/security.md)"
                                   : "this server runs in open mode and takes no keys");
   }
-  if (sessions_.size() >= options_.max_sessions) Expire(now);
-  if (sessions_.size() >= options_.max_sessions) {
-    return Refuse(answer, "the server has " + std::to_string(options_.max_sessions) +
-                              " sessions open already (the bound); try again later");
+  if (!keyed()) {
+    // The same hello again (its answer was lost, or a replay): the same
+    // answer; nothing new is opened. (Keyed: the authenticator recognises it.)
+    for (const auto& [id, s] : sessions_) {
+      if (s.client_id == hello.body.client_id && s.nonce == hello.body.client_nonce && s.robot == robot) {
+        ++counters_.hello_repeats;
+        answer.session_id = id;
+        return answer;
+      }
+    }
   }
-  Session session{robot, hello.body.client_id, false, now, now, Client(hello.body.client_id)};
+  // A keyed hello seen before is answered (or refused) by the authenticator
+  // without opening anything: it never makes room at another's expense.
+  if (!keyed() || !auth_->KnowsNonce(hello.body.client_nonce)) {
+    MakeRoom(hello.body.client_id, now);
+    if (sessions_.size() >= options_.max_sessions) {
+      return Refuse(answer, "the server has " + std::to_string(options_.max_sessions) +
+                                " sessions in use already (the --max-sessions bound); try again later");
+    }
+  }
+  Session session{
+      robot, hello.body.client_id, false, now, now, Client(hello.body.client_id), hello.body.client_nonce};
   if (keyed()) {
     try {
       answer.body = auth_->Handshake(hello.body, now);
     } catch (const AuthError& e) {
+      EraseClosedByAuthenticator();
       return Refuse(answer, e.what());
     }
+    EraseClosedByAuthenticator();
     answer.session_id = SessionId(hello.body, answer.body);
+    if (sessions_.count(answer.session_id)) {  // a hello answered before: nothing new
+      ++counters_.hello_repeats;
+      return answer;
+    }
     const AccessEntry* entry = options_.access->Find(hello.body.client_key);
     session.who = "'" + (entry ? entry->name : std::string("?")) + "' (" +
                   hello.body.client_key.Fingerprint() + ", " + Client(hello.body.client_id) + ")";
@@ -85,6 +108,36 @@ HelloAnswer SessionGate::Answer(const std::string& robot, const Hello& hello, Ti
   }
   sessions_[answer.session_id] = std::move(session);
   return answer;
+}
+
+// Pending sessions (opened by a hello, never used) are bounded per source
+// (client id: kMaxPendingPerClient, the oldest dropped) and may use the
+// whole table only while nothing else needs it: when the table is full, the
+// oldest pending session makes room. Live sessions are never dropped here.
+// Keyed mode adds the authenticator's bound per key.
+void SessionGate::MakeRoom(std::int64_t client_id, TimePoint now) {
+  if (sessions_.size() >= options_.max_sessions) Expire(now);
+  std::vector<std::int64_t> mine;  // this client id's pending sessions, by id
+  std::int64_t oldest = 0;
+  for (const auto& [id, s] : sessions_) {
+    if (s.live) continue;
+    if (s.client_id == client_id) mine.push_back(id);
+    if (oldest == 0 || s.opened < sessions_.at(oldest).opened) oldest = id;
+  }
+  if (mine.size() >= kMaxPendingPerClient) {
+    std::int64_t first = mine.front();
+    for (std::int64_t id : mine) {
+      if (sessions_.at(id).opened < sessions_.at(first).opened) first = id;
+    }
+    Erase(first);
+  } else if (sessions_.size() >= options_.max_sessions && oldest != 0) {
+    Erase(oldest);
+  }
+}
+
+void SessionGate::EraseClosedByAuthenticator() {
+  if (!auth_) return;
+  for (std::int64_t id : auth_->TakeClosed()) Erase(id);
 }
 
 SessionGate::Admission SessionGate::Admit(const std::string& robot, const Request& r,
@@ -107,11 +160,13 @@ SessionGate::Admission SessionGate::Admit(const std::string& robot, const Reques
   out.who = s.who;
   if (keyed()) {
     const auto verified = auth_->Verify(r.session_id, r.client_id, r.sequence, MacCoveredBytes(bytes), r.mac);
+    EraseClosedByAuthenticator();  // the client id's previous session, replaced by this one
     switch (verified.verdict) {
       case PackageVerdict::kAccepted:
         break;
       case PackageVerdict::kDuplicate:
         out.verdict = Verdict::kDuplicate;
+        out.why = CheckRights(*options_.access, *verified.client, robot, r);  // "" = had the rights
         return out;
       case PackageVerdict::kUnknownSession:  // the authenticator closed it (a newer live session)
         ++counters_.unknown_session;
@@ -194,6 +249,7 @@ std::size_t SessionGate::Expire(TimePoint now) {
   }
   for (std::int64_t id : ids) Erase(id);
   if (auth_) auth_->ExpirePending(now, options_.pending_timeout);
+  EraseClosedByAuthenticator();
   return ids.size();
 }
 

@@ -50,6 +50,7 @@ struct GateCounters {
   std::uint64_t forged = 0;           ///< keyed: the MAC did not verify
   std::uint64_t replayed = 0;         ///< keyed: duplicate or too old in the replay window
   std::uint64_t rights_refused = 0;   ///< keyed: the key may not do that on that robot
+  std::uint64_t hello_repeats = 0;    ///< a hello answered before (lost answer, or replayed): answered again
 
   /// Names and values, in a fixed order (the reply's values and message).
   std::vector<std::pair<const char*, double>> Table() const;
@@ -80,7 +81,7 @@ class SessionGate {
   struct Admission {
     Verdict verdict = Verdict::kUnknownSession;
     std::string who;  ///< for logs: "client 503d..." or "'alice' (rt:1a2b:..., client 503d...)"
-    std::string why;  ///< kRefused / kNoRights: what was wrong
+    std::string why;  ///< kRefused / kNoRights: what was wrong; kDuplicate: the rights it lacks, or ""
   };
   /// Checks one decoded package of `robot` against its session. `bytes` are
   /// the package as received (the MAC is their last 16 bytes).
@@ -112,7 +113,13 @@ class SessionGate {
     TimePoint opened{};
     TimePoint last_used{};  ///< the last accepted (or rights-refused) package
     std::string who;
+    Nonce nonce{};  ///< of the hello that opened it
   };
+  /// Most pending sessions of one client id (the "source": LCM does not tell
+  /// the server a datagram's address); a new hello drops the oldest.
+  static constexpr std::size_t kMaxPendingPerClient = 2;
+  void MakeRoom(std::int64_t client_id, TimePoint now);
+  void EraseClosedByAuthenticator();
   HelloAnswer Refuse(HelloAnswer answer, const std::string& why);
   std::int64_t NewOpenSessionId();
   void Erase(std::int64_t session_id);

@@ -29,7 +29,7 @@ check "send stop --at" cli_says 0 "SUCCESS" send pioneer stop --at 0.3
 printf '# test\n0 setspeed 0.1 0\n0.2 joint_setpoint pan 0.3\n0.4 stop\n' >"$tmp/seq.txt"
 n=$("$cli" --url "$url" send pioneer --file "$tmp/seq.txt" | grep -c SUCCESS)
 check "a sequence file prints one SUCCESS per frame (got $n)" test "$n" = 3
-check "panic is acknowledged" cli_says 0 "acknowledged" panic pioneer
+check "panic is taken" cli_says 0 "panic taken by pioneer" panic pioneer
 check "a command in panic answers PANIC and exits 1" cli_says 1 "PANIC" send pioneer joint_setpoint pan 0.1
 check "reset lifts the panic" cli_says 0 "SUCCESS" reset pioneer
 check "a command after reset succeeds" cli_says 0 "SUCCESS" send pioneer joint_setpoint pan 0.1

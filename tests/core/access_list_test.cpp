@@ -159,5 +159,56 @@ TEST_F(AccessListFile, ALineErrorNamesThePathAndLine) {
   EXPECT_THROW(AccessList::ReadFile(file_.string() + ".missing"), AccessListError);
 }
 
+// Issue 19 item 12: an access list owned by another user, in a
+// world-writable directory or through a symlink was accepted.
+class AccessListTrust : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/robotalk_acl_trust_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern), nullptr);
+    dir_ = pattern;
+    file_ = dir_ / "clients";
+    { std::ofstream(file_) << Line(1, "alice *=all"); }
+    ASSERT_EQ(::chmod(file_.c_str(), 0644), 0);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  // The refusal's text, or "" when the list was accepted.
+  std::string Refusal(const std::filesystem::path& file) const {
+    try {
+      AccessList::ReadFile(file);
+      return "";
+    } catch (const AccessListError& e) {
+      return e.what();
+    }
+  }
+  std::filesystem::path dir_, file_;
+};
+
+TEST_F(AccessListTrust, AListOwnedByAnotherUserIsRefusedNamingTheOwner) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to give a file away (chown)";
+  ASSERT_EQ(::chown(file_.c_str(), 4242, -1), 0);
+  EXPECT_THAT(Refusal(file_), HasSubstr(file_.string() + ": owned by uid 4242"));
+  ASSERT_EQ(::chown(file_.c_str(), 0, -1), 0);  // root:root 0644, as documented
+  EXPECT_EQ(Refusal(file_), "");
+}
+
+TEST_F(AccessListTrust, AListInAWorldWritableDirectoryIsRefused) {
+  ASSERT_EQ(::chmod(dir_.c_str(), 0777), 0);
+  EXPECT_THAT(Refusal(file_), HasSubstr("directory " + dir_.string() + " (mode 0777) is world-writable"));
+  ASSERT_EQ(::chmod(dir_.c_str(), 0755), 0);
+  EXPECT_EQ(Refusal(file_), "");
+}
+
+TEST_F(AccessListTrust, AListInADirectoryOwnedByAnotherUserIsRefused) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to give a directory away (chown)";
+  ASSERT_EQ(::chown(dir_.c_str(), 4242, -1), 0);
+  EXPECT_THAT(Refusal(file_), HasSubstr("directory " + dir_.string() + " is owned by uid 4242"));
+}
+
+TEST_F(AccessListTrust, AListThroughASymlinkIsRefused) {
+  std::filesystem::create_symlink(file_, dir_ / "link");
+  EXPECT_THAT(Refusal(dir_ / "link"), HasSubstr((dir_ / "link").string() + ": is a symbolic link"));
+}
+
 }  // namespace
 }  // namespace robotalk

@@ -9,10 +9,11 @@ url="udpm://239.255.76.67:7600?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
 rt() { "$cli" --url "$url" --timeout 3 "$@"; }
 
-for who in server alice monitor stranger; do "$keygen" --out "$tmp/$who" --name "$who" >/dev/null; done
+for who in server alice monitor viewer stranger; do "$keygen" --out "$tmp/$who" --name "$who" >/dev/null; done
 {
   echo "$(cat "$tmp/alice.pub") *=all"
   echo "$(cat "$tmp/monitor.pub") *=query,panic"
+  echo "$(cat "$tmp/viewer.pub") *=query"
 } >"$tmp/clients"
 chmod 644 "$tmp/clients"
 
@@ -20,7 +21,7 @@ chmod 644 "$tmp/clients"
   --key "$tmp/server" --clients "$tmp/clients" --duration 60 2>"$tmp/server.log" &
 server_pid=$!
 for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
-check "the server says it runs keyed" grep -q "keyed mode: 2 client keys" "$tmp/server.log"
+check "the server says it runs keyed" grep -q "keyed mode: 3 client keys" "$tmp/server.log"
 
 rt --key "$tmp/alice" query pioneer base_pose >"$tmp/alice_query" 2>&1
 check "alice may query: $(cat "$tmp/alice_query")" grep -q "SUCCESS" "$tmp/alice_query"
@@ -32,8 +33,18 @@ ROBOTALK_KEY="$tmp/alice" rt send pioneer joint_setpoint pan 0.3 >"$tmp/env" 2>&
 check "ROBOTALK_KEY works like --key: $(cat "$tmp/env")" grep -q "SUCCESS" "$tmp/env"
 rt --key "$tmp/monitor" send pioneer joint_setpoint pan -1 >"$tmp/monitor_cmd" 2>&1
 check "monitor may not command: $(cat "$tmp/monitor_cmd")" grep -q "monitor" "$tmp/monitor_cmd"
+# Issue 19 item 2: a query-only key's panic printed "panic acknowledged" and
+# exited 0 while the robot went on moving.
+rt --key "$tmp/viewer" panic pioneer >"$tmp/viewer_panic" 2>&1
+status=$?
+check "a panic refused for rights exits non-zero (status $status)" test "$status" -ne 0
+check "and says REFUSED with the server's reason: $(cat "$tmp/viewer_panic")" \
+  grep -q "panic REFUSED by pioneer: .*may not panic robot 'pioneer'" "$tmp/viewer_panic"
+rt --key "$tmp/alice" send pioneer joint_setpoint pan 0.1 >"$tmp/after_refused" 2>&1
+check "the robot is not in panic after the refused one: $(cat "$tmp/after_refused")" \
+  grep -q "SUCCESS" "$tmp/after_refused"
 rt --key "$tmp/monitor" panic pioneer >"$tmp/monitor_panic" 2>&1
-check "monitor may raise a panic: $(cat "$tmp/monitor_panic")" grep -qi "panic" "$tmp/monitor_panic"
+check "monitor may raise a panic: $(cat "$tmp/monitor_panic")" grep -q "panic taken by pioneer" "$tmp/monitor_panic"
 rt --key "$tmp/monitor" reset pioneer >"$tmp/monitor_reset" 2>&1
 check "monitor may not reset it: $(cat "$tmp/monitor_reset")" grep -q "ERROR" "$tmp/monitor_reset"
 rt --key "$tmp/alice" reset pioneer >"$tmp/alice_reset" 2>&1

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace robotalk {
 namespace {
 
@@ -58,22 +60,49 @@ TEST(CommandQueue, FlushesEverythingInRunOrder) {
 }
 
 TEST(SequenceWindow, AcceptsEachSequenceOnceInAnyOrder) {
+  using V = SequenceWindow::Verdict;
   SequenceWindow w;
-  EXPECT_TRUE(w.Observe(1));
-  EXPECT_TRUE(w.Observe(3));
-  EXPECT_FALSE(w.Observe(3));
-  EXPECT_TRUE(w.Observe(2));
-  EXPECT_FALSE(w.Observe(1));
-  EXPECT_FALSE(w.Observe(2));
-  EXPECT_TRUE(w.Observe(4));
+  EXPECT_EQ(w.Observe(1), V::kNew);
+  EXPECT_EQ(w.Observe(3), V::kNew);
+  EXPECT_EQ(w.Observe(3), V::kDuplicate);
+  EXPECT_EQ(w.Observe(2), V::kNew);
+  EXPECT_EQ(w.Observe(1), V::kDuplicate);
+  EXPECT_EQ(w.Observe(2), V::kDuplicate);
+  EXPECT_EQ(w.Observe(4), V::kNew);
+  EXPECT_EQ(w.Observe(0), V::kDuplicate);
+  EXPECT_EQ(w.unseen(), 0);
 }
 
-TEST(SequenceWindow, TreatsSequencesFarBelowTheHighestAsDuplicates) {
+// Issue 19 item 12: strides of +4000, each under the old 4096-jump guard,
+// pushed the victim's next number out of the window; its package was then
+// dropped as a duplicate and never ran.
+TEST(SequenceWindow, ANumberNeverSeenStaysNewHoweverFarBelowTheHighest) {
+  using V = SequenceWindow::Verdict;
   SequenceWindow w;
-  EXPECT_TRUE(w.Observe(1));
-  EXPECT_TRUE(w.Observe(10 + SequenceWindow::kWindow));
-  EXPECT_FALSE(w.Observe(5));  // a gap that fell out of the window
-  EXPECT_TRUE(w.Observe(20 + SequenceWindow::kWindow - 1));
+  ASSERT_EQ(w.Observe(1), V::kNew);
+  EXPECT_EQ(w.Observe(4001), V::kNew);
+  EXPECT_EQ(w.Observe(8001), V::kTooManyGaps) << "7999 numbers would be unseen";
+  for (std::int64_t s = 4002; s < 20000; ++s) ASSERT_EQ(w.Observe(s), V::kNew) << s;
+  EXPECT_EQ(w.Observe(2), V::kNew) << "the victim's next number, 18000 below the highest";
+  EXPECT_EQ(w.Observe(2), V::kDuplicate);
+  EXPECT_EQ(w.unseen(), 3998);
+}
+
+TEST(SequenceWindow, BoundsTheUnseenNumbersNotTheJump) {
+  using V = SequenceWindow::Verdict;
+  SequenceWindow w;
+  ASSERT_EQ(w.Observe(100000), V::kNew) << "a client may keep counting across sessions";
+  EXPECT_EQ(w.unseen(), SequenceWindow::kLead);
+  EXPECT_EQ(w.Observe(99990), V::kNew) << "reordered at the session's start";
+  EXPECT_EQ(w.Observe(99000), V::kDuplicate) << "before the session";
+  const std::int64_t room = SequenceWindow::kMaxUnseen - w.unseen();
+  EXPECT_EQ(w.Check(100000 + room + 2), V::kTooManyGaps);
+  EXPECT_EQ(w.Observe(100000 + room + 1), V::kNew);
+  EXPECT_EQ(w.Observe(100000 + room + 3), V::kTooManyGaps) << "no room left";
+  EXPECT_EQ(w.Observe(100000 + room + 2), V::kNew) << "the next number is always fine";
+  EXPECT_EQ(w.Observe(100001), V::kNew) << "filling a gap makes room";
+  EXPECT_EQ(w.Observe(100000 + room + 4), V::kNew);
+  EXPECT_EQ(w.Observe(std::numeric_limits<std::int64_t>::max()), V::kTooManyGaps);
 }
 
 TEST(ReplyCache, ReturnsTheFinalRepliesOfAPackageAndForgetsOldPackages) {

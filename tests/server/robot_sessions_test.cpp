@@ -291,13 +291,27 @@ TEST_F(RobotSessionsTest, RefusesASequenceJumpSoItCannotPoisonTheWindow) {
   auto forged = Handle(Package(kAlice, std::numeric_limits<std::int64_t>::max(),
                                {Cmd(66, CommandType::kJointSetPoint, {-1}, "pan")}));
   EXPECT_EQ(forged.at(66).signal, Signal::kError);
-  EXPECT_THAT(forged.at(66).message, HasSubstr("jumps more than"));
+  EXPECT_THAT(forged.at(66).message, HasSubstr("never received; refused"));
   auto next = Handle(Package(kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan")}));
   EXPECT_TRUE(next.empty()) << "the victim's next package is accepted";
   Run();
   EXPECT_EQ(Replies(kAlice).at(2).signal, Signal::kSuccess);
   EXPECT_DOUBLE_EQ(fake_->position, 0.2);
   EXPECT_EQ(sessions_->refused_packages(), 1u);
+}
+
+// Issue 19 item 12 (open mode): strides of +4000 under the victim's id, each
+// within the old 4096-jump guard, made the victim's next package a
+// "duplicate": it never ran and the client saw UnknownOutcome after 4.3 s.
+TEST_F(RobotSessionsTest, StridesUnderTheGuardCannotMakeTheVictimsNextPackageADuplicate) {
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan")}));
+  for (std::int64_t i = 1; i <= 40; ++i) Handle(Package(kAlice, 1 + 4000 * i, {}));
+  auto next = Handle(Package(kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan")}));
+  EXPECT_TRUE(next.empty()) << "the victim's next package is accepted";
+  Run();
+  ASSERT_EQ(Replies(kAlice).count(2), 1u) << "and answered";
+  EXPECT_EQ(Replies(kAlice).at(2).signal, Signal::kSuccess);
+  EXPECT_DOUBLE_EQ(fake_->position, 0.2);
 }
 
 TEST_F(RobotSessionsTest, NeverEchoesALongBadTargetInFull) {
@@ -319,10 +333,19 @@ TEST_F(FewSessionsTest, RefusesANewClientBeyondTheSessionBoundAndServesKnownOnes
   Handle(Queries(kBob, 1, {Query{1, QueryType::kClock, ""}}));
   auto third = Handle(Queries(0xC0FFEE, 1, {Query{1, QueryType::kClock, ""}}));
   EXPECT_EQ(third.at(1).signal, Signal::kError);
-  EXPECT_THAT(third.at(1).message, HasSubstr("--max-sessions"));
+  // Issue 19 item 12: it named --max-sessions, the server-wide bound.
+  EXPECT_THAT(third.at(1).message, HasSubstr("(the --max-sessions-per-robot bound)"));
   EXPECT_EQ(sessions_->num_sessions(), 2u);
   auto alice = Handle(Queries(kAlice, 2, {Query{2, QueryType::kClock, ""}}));
   EXPECT_EQ(alice.at(2).signal, Signal::kSuccess);
+}
+
+TEST_F(FewSessionsTest, APanicFromAClientBeyondTheSessionBoundIsStillTakenAndSaysSo) {
+  Handle(Queries(kAlice, 1, {Query{1, QueryType::kClock, ""}}));
+  Handle(Queries(kBob, 1, {Query{1, QueryType::kClock, ""}}));
+  const ImmediateAnswer answer = sessions_->Handle(Package(0xC0FFEE, 1, {}, /*panic=*/true), clock_.Now());
+  EXPECT_TRUE(daemon_->in_panic());
+  EXPECT_EQ(answer.batch.panic, PanicStatus::kTaken);
 }
 
 TEST_F(FewSessionsTest, RefusesAPlaybackDeclaringMoreFramesThanTheQueueHolds) {

@@ -170,6 +170,34 @@ TEST_F(GateTest, InOpenModeAPanicOutsideAnySessionStillStopsTheRobot) {
   Request panic{.client_id = kAlice, .sequence = 1, .panic = true};
   Publish(EncodeRequest(panic));
   EXPECT_TRUE(robot_->in_panic());
+  // Issue 19 item 2: the answer says the panic was taken, explicitly; the
+  // SESSION_UNKNOWN status alone no longer counts as its acknowledgement.
+  ASSERT_FALSE(batches_.empty());
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown);
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken);
+}
+
+TEST_F(GateTest, APanicInASessionIsAnsweredTakenAndAPlainPackageNone) {
+  const std::int64_t session = OpenSession(kAlice);
+  Publish(EncodeRequest(Move(kAlice, session, 1, 1)));
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kNone);
+  const auto bytes = Publish(
+      EncodeRequest(Request{.client_id = kAlice, .session_id = session, .sequence = 2, .panic = true}));
+  EXPECT_TRUE(robot_->in_panic());
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken);
+  Publish(bytes);  // a retransmission is answered as the first copy was
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken);
+}
+
+TEST_F(GateTest, APanicInAPackageWithABadHeaderIsAnsweredRefusedWithTheReason) {
+  const std::int64_t session = OpenSession(kAlice);
+  Request panic{.client_id = kAlice, .session_id = session, .sequence = 1, .panic = true};
+  panic.queries.push_back(Query{.id = 1, .type = QueryType::kBasePose});
+  panic.commands.push_back(Command{2, CommandType::kStop, std::nullopt, "", {}});  // mixed: refused
+  Publish(EncodeRequest(panic));
+  EXPECT_FALSE(robot_->in_panic());
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_FALSE(batches_.back().panic_refusal.empty());
 }
 
 // --- keyed mode ------------------------------------------------------------
@@ -180,11 +208,16 @@ KeyPair Key(std::uint8_t seed) {
   return KeyPair::FromSeed(bytes);
 }
 
+// Keyed mode: a client id of `key` (issue 19 item 6).
+std::int64_t Id(const KeyPair& key, std::int64_t low) {
+  return KeyedClientId(key.public_key, static_cast<std::uint32_t>(low));
+}
+
 SessionGateOptions Keyed() {
   SessionGateOptions gate;
   gate.identity = std::make_shared<const KeyPair>(Key(1));
   const std::string list = Key(2).public_key.ToString() + " alice *=all\n" + Key(3).public_key.ToString() +
-                           " monitor *=query,panic\n";
+                           " monitor *=query,panic\n" + Key(4).public_key.ToString() + " viewer *=query\n";
   gate.access = std::make_shared<const AccessList>(AccessList::Parse(list, "test"));
   return gate;
 }
@@ -219,6 +252,11 @@ class KeyedGateTest : public GateTest {
     WriteMacField(bytes, ComputeMac(c.keys.client_to_server, c.keys.session_id, MacCoveredBytes(bytes)));
     return bytes;
   }
+  // Publishes `c`'s sealed package `r` with the panic flag; returns its bytes.
+  std::vector<std::uint8_t> PublishPanic(Client& c, Request r = {}) {
+    r.panic = true;
+    return Publish(Sealed(c, std::move(r)));
+  }
   static Request Commands(CommandType type, CommandId id, std::vector<double> values = {}) {
     Request r;
     r.commands.push_back(
@@ -232,12 +270,12 @@ TEST_F(KeyedGateTest, RefusesAnOpenHelloAndAnUnlistedKey) {
   EXPECT_EQ(open.session_id, 0);
   EXPECT_THAT(open.refusal, HasSubstr("keyed mode"));
   std::string why;
-  EXPECT_FALSE(Handshake(Key(9), kMallory, &why));
+  EXPECT_FALSE(Handshake(Key(9), Id(Key(9), kMallory), &why));
   EXPECT_THAT(why, HasSubstr("not in the access list"));
 }
 
 TEST_F(KeyedGateTest, ExecutesSealedPackagesOnceAndDropsForgedOnes) {
-  auto alice = Handshake(Key(2), kAlice);
+  auto alice = Handshake(Key(2), Id(Key(2), kAlice));
   ASSERT_TRUE(alice);
   const auto bytes = Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
   EXPECT_EQ(replies_.at(1).signal, Signal::kSuccess);
@@ -255,14 +293,14 @@ TEST_F(KeyedGateTest, ExecutesSealedPackagesOnceAndDropsForgedOnes) {
 TEST_F(KeyedGateTest, ASpoofedClientIdCannotMoveTheRobotOrPoisonTheSequence) {
   // Issue 9: 40 sequences under the victim's id, and one heartbeat with
   // sequence INT64_MAX, took over the victim's session.
-  auto alice = Handshake(Key(2), kAlice);
+  auto alice = Handshake(Key(2), Id(Key(2), kAlice));
   ASSERT_TRUE(alice);
   Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
   std::string why;
-  EXPECT_FALSE(Handshake(Key(3), kAlice, &why)) << "another key may not take Alice's client id";
-  Request poison{.client_id = kAlice, .session_id = alice->keys.session_id, .sequence = INT64_MAX};
+  EXPECT_FALSE(Handshake(Key(3), alice->id, &why)) << "another key may not take Alice's client id";
+  Request poison{.client_id = alice->id, .session_id = alice->keys.session_id, .sequence = INT64_MAX};
   Publish(EncodeRequest(poison));  // no key, zero MAC
-  Request spoof = Move(kAlice, alice->keys.session_id, 2, 2);
+  Request spoof = Move(alice->id, alice->keys.session_id, 2, 2);
   spoof.commands[0].values = {-2.0};
   Publish(EncodeRequest(spoof));
   EXPECT_EQ(Executed(), 1u);
@@ -272,7 +310,7 @@ TEST_F(KeyedGateTest, ASpoofedClientIdCannotMoveTheRobotOrPoisonTheSequence) {
 }
 
 TEST_F(KeyedGateTest, ASessionRecordedBeforeARestartNeverRunsAgain) {
-  auto alice = Handshake(Key(2), kAlice);
+  auto alice = Handshake(Key(2), Id(Key(2), kAlice));
   ASSERT_TRUE(alice);
   const auto recorded = Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
   Restart();
@@ -283,12 +321,10 @@ TEST_F(KeyedGateTest, ASessionRecordedBeforeARestartNeverRunsAgain) {
 
 TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
   // Issue 9: a random client id reset another client's panic and stopped its GOTO.
-  auto alice = Handshake(Key(2), kAlice);
-  auto monitor = Handshake(Key(3), kMallory);
+  auto alice = Handshake(Key(2), Id(Key(2), kAlice));
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
   ASSERT_TRUE(alice && monitor);
-  Request panic;
-  panic.panic = true;
-  Publish(Sealed(*monitor, panic));
+  PublishPanic(*monitor);
   EXPECT_TRUE(robot_->in_panic()) << "monitor may raise a panic";
   Publish(Sealed(*monitor, Commands(CommandType::kPanicReset, 10)));
   EXPECT_TRUE(robot_->in_panic()) << "but not reset it";
@@ -302,7 +338,7 @@ TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
 }
 
 TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdle) {
-  auto monitor = Handshake(Key(3), kMallory);
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
   ASSERT_TRUE(monitor);
   Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, 1, {0.5})));
   EXPECT_EQ(replies_.at(1).signal, Signal::kError);
@@ -311,6 +347,116 @@ TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdl
   Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, 2, {0.5})));
   EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown) << "closed, not kept for ever";
   EXPECT_EQ(server_->gate().session_count(), 0u);
+}
+
+TEST_F(KeyedGateTest, APanicRefusedForRightsIsAnsweredRefusedWithTheReasonAndDoesNothing) {
+  // Issue 19 item 2: a query-only key's panic was reported as acknowledged
+  // while the robot went on; another client's motion completed.
+  auto viewer = Handshake(Key(4), Id(Key(4), kMallory));
+  ASSERT_TRUE(viewer);
+  const auto bytes = PublishPanic(*viewer);
+  EXPECT_FALSE(robot_->in_panic());
+  ASSERT_FALSE(batches_.empty());
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kOk);
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_THAT(batches_.back().panic_refusal, HasSubstr("may not panic robot 'bot'"));
+  EXPECT_TRUE(batches_.back().mac != Mac{}) << "the refusal is sealed: the client can believe it";
+  Publish(bytes);  // its retransmission: refused the same way
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_FALSE(robot_->in_panic());
+}
+
+TEST_F(KeyedGateTest, APanicWithTheRightIsAnsweredTaken) {
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
+  ASSERT_TRUE(monitor);
+  const auto bytes = PublishPanic(*monitor);
+  EXPECT_TRUE(robot_->in_panic());
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken);
+  Publish(bytes);
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kTaken) << "a retransmission: taken when first seen";
+}
+
+TEST_F(KeyedGateTest, ARetransmittedPanicWithABadHeaderIsAnsweredRefusedAgain) {
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
+  ASSERT_TRUE(monitor);
+  Request mixed;  // queries and commands: refused
+  mixed.queries.push_back(Query{.id = 1, .type = QueryType::kBasePose});
+  mixed.commands.push_back(Command{2, CommandType::kStop, std::nullopt, "", {}});
+  const auto bytes = PublishPanic(*monitor, mixed);
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  Publish(bytes);  // the replay window's duplicate path
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_FALSE(batches_.back().panic_refusal.empty());
+  EXPECT_FALSE(robot_->in_panic());
+}
+
+TEST_F(KeyedGateTest, APanicOutsideAnySessionIsAnsweredRefusedNotTaken) {
+  Request panic{.client_id = kAlice, .session_id = 77, .sequence = 1, .panic = true};
+  Publish(EncodeRequest(panic));
+  EXPECT_FALSE(robot_->in_panic());
+  ASSERT_FALSE(batches_.empty());
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown);
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_THAT(batches_.back().panic_refusal, HasSubstr("say hello"));
+}
+
+TEST_F(GateTest, ARepeatedHelloGetsTheSameSessionAndPendingSessionsAreBoundedPerClientId) {
+  Hello hello;
+  hello.body.client_id = kAlice;
+  hello.body.client_nonce = RandomNonce();
+  const auto step = [this] { Step(); };
+  const std::int64_t first = SayHello(client_, "bot", kAlice, step, hello).session_id;
+  EXPECT_EQ(SayHello(client_, "bot", kAlice, step, hello).session_id, first) << "its answer was lost: again";
+  EXPECT_EQ(server_->gate().session_count(), 1u);
+  std::int64_t last = 0;
+  for (int i = 0; i < 5; ++i) last = OpenSession(kAlice);  // new hellos of one source, never used
+  EXPECT_EQ(server_->gate().session_count(), 2u) << "pending sessions per client id are bounded";
+  Publish(EncodeRequest(Move(kAlice, last, 1, 1)));
+  EXPECT_EQ(replies_.at(1).signal, Signal::kSuccess);
+}
+
+class SmallGateTest : public GateTest {
+ protected:
+  SmallGateTest() : GateTest(SessionGateOptions{.max_sessions = 4}) {}
+};
+
+TEST_F(SmallGateTest, AFloodOfHellosNeverLocksANewClientOutOrDropsALiveSession) {
+  const std::int64_t live = OpenSession(kAlice);
+  Publish(EncodeRequest(Move(kAlice, live, 1, 1)));
+  for (std::int64_t id = 1; id <= 20; ++id) OpenSession(1000 + id);  // never used
+  const std::int64_t late = OpenSession(kMallory);
+  ASSERT_NE(late, 0) << "the oldest pending session made room";
+  Publish(EncodeRequest(Move(kMallory, late, 1, 2)));
+  EXPECT_EQ(replies_.at(2).signal, Signal::kSuccess);
+  Publish(EncodeRequest(Move(kAlice, live, 2, 3)));
+  EXPECT_EQ(replies_.at(3).signal, Signal::kSuccess) << "a live session is never dropped for a hello";
+  EXPECT_LE(server_->gate().session_count(), 4u);
+}
+
+TEST_F(KeyedGateTest, OneHelloReplayedThousandsOfTimesLeavesRoomForEveryOtherKey) {
+  // Issue 19 item 5: "the server has 1024 sessions open already" for everyone.
+  const ClientHandshake recorded(Key(2), Id(Key(2), kAlice));
+  const auto bytes = EncodeHello(Hello{.keyed = true, .body = recorded.hello()});
+  for (int i = 0; i < 3000; ++i) client_.Publish(HelloChannel("bot"), bytes);
+  Step();
+  EXPECT_EQ(server_->gate().session_count(), 1u) << "one hello, one pending session";
+  EXPECT_EQ(server_->gate().counters().hellos_refused, 0u) << "its copies are answered again, not refused";
+  EXPECT_EQ(server_->gate().counters().hello_repeats, 2999u) << "and counted (SERVER_COUNTERS)";
+  for (std::uint8_t key : {3, 4}) {
+    auto other = Handshake(Key(key), Id(Key(key), kMallory));
+    ASSERT_TRUE(other) << "key " << int{key};
+    Publish(Sealed(*other, Commands(CommandType::kStop, 10 + key)));
+    EXPECT_EQ(batches_.back().session_status, SessionStatus::kOk);
+  }
+}
+
+TEST_F(KeyedGateTest, PendingSessionsPerKeyAreBoundedAndTheGateForgetsTheDroppedOnes) {
+  for (std::int64_t id = 1; id <= 6; ++id) ASSERT_TRUE(Handshake(Key(2), Id(Key(2), id)));  // never used
+  EXPECT_EQ(server_->gate().session_count(), 4u) << "4 pending per key, as the authenticator keeps them";
+  auto monitor = Handshake(Key(3), Id(Key(3), 1));
+  ASSERT_TRUE(monitor);
+  Publish(Sealed(*monitor, Commands(CommandType::kStop, 1)));
+  EXPECT_EQ(replies_.at(1).signal, Signal::kError) << "monitor may not STOP; but it has a session";
 }
 
 }  // namespace

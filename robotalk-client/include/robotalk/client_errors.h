@@ -24,6 +24,15 @@ class UnknownOutcomeError : public TimeoutError {
   using TimeoutError::TimeoutError;
 };
 
+/// The server answered a panic package and did NOT act on it: the robot is
+/// not in panic because of this call. what() names the robot and the
+/// server's reason (a key without the `panic` right on that robot, a package
+/// the server could not accept, ...). Never thrown for a panic the server took.
+class PanicRefusedError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// The client cannot do what was asked: not connected, already connected, LCM
 /// could not be initialised, a package too large, or the client is closing.
 class ClientError : public Error {

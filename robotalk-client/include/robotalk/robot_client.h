@@ -81,7 +81,9 @@ struct ClientOptions {
   int lcm_queue_capacity = 10000;
   /// Answered but never collected replies kept at most (oldest evicted).
   std::size_t return_cache_capacity = 10000;
-  /// The client id; 0 = random non-zero (std::random_device).
+  /// The client id; 0 = random non-zero (std::random_device). With a key,
+  /// one of the key's (robotalk::KeyedClientId; 0 = random low bits); another
+  /// is refused with ClientError at construction.
   std::int64_t client_id = 0;
 
   // --- Fault injection, for tests: applied to every request package sent.

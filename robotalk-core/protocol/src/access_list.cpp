@@ -2,6 +2,8 @@
 // security file must be an error naming the line, never a silent default.
 #include "robotalk/access_list.h"
 
+#include "file_trust.h"
+
 #include "robotalk/request.h"
 
 #include <fcntl.h>
@@ -153,20 +155,13 @@ AccessList AccessList::Parse(std::string_view text, std::string_view source) {
 }
 
 AccessList AccessList::ReadFile(const std::filesystem::path& file) {
-  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0)
-    throw AccessListError("access list " + file.string() + ": cannot open: " + std::strerror(errno));
   struct stat st {};
   std::string text;
   std::string problem;
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    problem = "not a readable regular file";
-  } else if ((st.st_mode & 022) != 0) {
-    char mode[8];
-    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
-    problem = std::string("mode ") + mode +
-              ": group or others may write it and so grant themselves rights; run chmod go-w " +
-              file.string();
+  const int fd = OpenTrustedFile(file, st, problem);
+  if (fd < 0) throw AccessListError("access list " + file.string() + ": " + problem);
+  if (problem = FileTrustProblem(file, st, TrustedFile::kShared); !problem.empty()) {
+    // owner, mode (who may write it grants themselves rights), directories
   } else if (static_cast<std::size_t>(st.st_size) > kMaxFileBytes) {
     problem = "larger than " + std::to_string(kMaxFileBytes) + " bytes";
   } else {

@@ -2,6 +2,8 @@
 // libsodium's; this file only formats, parses and guards files.
 #include "robotalk/keys.h"
 
+#include "file_trust.h"
+
 #include <fcntl.h>
 #include <sodium.h>
 #include <sys/stat.h>
@@ -38,12 +40,6 @@ bool FromHex(std::string_view hex, std::span<std::uint8_t> out) {
     return false;
   }
   return written == out.size() && end == hex.data() + hex.size();
-}
-
-std::string ModeString(mode_t mode) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "%04o", static_cast<unsigned>(mode & 07777));
-  return buf;
 }
 
 std::string ErrnoText() { return std::strerror(errno); }
@@ -87,6 +83,7 @@ class Fd {
   ~Fd() {
     if (fd_ >= 0) ::close(fd_);
   }
+  Fd(Fd&& other) noexcept : fd_(other.release()) {}
   Fd(const Fd&) = delete;
   Fd& operator=(const Fd&) = delete;
   int get() const { return fd_; }
@@ -222,19 +219,24 @@ void WriteKeyFiles(const std::filesystem::path& secret_file, const KeyPair& key,
   }
 }
 
-KeyPair ReadSecretKeyFile(const std::filesystem::path& file) {
-  Fd fd(::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW));
-  if (fd.get() < 0) throw KeyError("secret key file " + file.string() + ": cannot open: " + ErrnoText());
+namespace {
+// Opens a key file after the checks of file_trust.h; throws KeyError naming
+// the file and the problem.
+Fd OpenKeyFile(const std::filesystem::path& file, TrustedFile kind) {
+  const std::string what =
+      (kind == TrustedFile::kSecret ? "secret key file " : "public key file ") + file.string();
   struct stat st {};
-  if (::fstat(fd.get(), &st) != 0) {
-    throw KeyError("secret key file " + file.string() + ": cannot stat: " + ErrnoText());
-  }
-  if (!S_ISREG(st.st_mode)) throw KeyError("secret key file " + file.string() + ": not a regular file");
-  if ((st.st_mode & 077) != 0) {
-    throw KeyError("secret key file " + file.string() + ": mode " + ModeString(st.st_mode) +
-                   ": the secret key must not be readable or writable by group or others; run chmod 600 " +
-                   file.string());
-  }
+  std::string problem;
+  Fd fd(OpenTrustedFile(file, st, problem));
+  if (fd.get() < 0) throw KeyError(what + ": " + problem);
+  problem = FileTrustProblem(file, st, kind);
+  if (!problem.empty()) throw KeyError(what + ": " + problem);
+  return fd;
+}
+}  // namespace
+
+KeyPair ReadSecretKeyFile(const std::filesystem::path& file) {
+  const Fd fd = OpenKeyFile(file, TrustedFile::kSecret);
   std::string text = ReadFd(fd.get(), file);
   const std::string line = FirstContentLine(text);
   sodium_memzero(text.data(), text.size());
@@ -252,8 +254,7 @@ KeyPair ReadSecretKeyFile(const std::filesystem::path& file) {
 }
 
 PublicKeyFile ReadPublicKeyFile(const std::filesystem::path& file) {
-  Fd fd(::open(file.c_str(), O_RDONLY | O_CLOEXEC));
-  if (fd.get() < 0) throw KeyError("public key file " + file.string() + ": cannot open: " + ErrnoText());
+  const Fd fd = OpenKeyFile(file, TrustedFile::kShared);
   const std::string line = FirstContentLine(ReadFd(fd.get(), file));
   const auto space = line.find(' ');
   try {

@@ -34,7 +34,9 @@ void ScanPackage(WireScanner& s) {
 }
 
 void ScanReplyPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 1 + 8 + 8 + 8, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1, "header");
+  s.String("panic_refusal");
+  s.Skip(8 + 8 + 8, "header times");
   const std::int32_t nr = s.Count("num_replies", kMinReplyBytes);
   for (std::int32_t i = 0; i < nr; ++i) {
     s.Skip(8 + 1, "reply");
@@ -301,6 +303,15 @@ robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes) {
 
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes) {
   return DecodeChecked<robotalk_msgs::reply_package_t>(bytes, "DecodeReplyPackage", &ScanReplyPackage);
+}
+
+std::int8_t CheckedPanicStatus(const robotalk_msgs::reply_package_t& p) {
+  using R = robotalk_msgs::reply_package_t;
+  if (p.panic_status != R::PANIC_NONE && p.panic_status != R::PANIC_TAKEN &&
+      p.panic_status != R::PANIC_REFUSED) {
+    throw ProtocolError("reply package: unknown panic_status " + std::to_string(p.panic_status));
+  }
+  return p.panic_status;
 }
 
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes) {

@@ -137,6 +137,8 @@ std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
   p.server_id = b.server_id;
   p.session_id = b.session_id;
   p.session_status = static_cast<std::int8_t>(b.session_status);
+  p.panic_status = static_cast<std::int8_t>(b.panic);
+  p.panic_refusal = b.panic_refusal;
   p.ack_sequence = b.ack_sequence;
   p.server_receive_us = ToWireMicros(b.server_receive);
   p.server_send_us = ToWireMicros(b.server_send);
@@ -158,6 +160,8 @@ ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
     throw ProtocolError("DecodeReplyBatch: unknown session status " + std::to_string(p.session_status));
   }
   b.session_status = static_cast<SessionStatus>(p.session_status);
+  b.panic = static_cast<PanicStatus>(CheckedPanicStatus(p));
+  b.panic_refusal = p.panic_refusal;
   b.ack_sequence = p.ack_sequence;
   b.server_receive = FromWireMicros(p.server_receive_us);
   b.server_send = FromWireMicros(p.server_send_us);

@@ -62,6 +62,28 @@ SessionKeys DeriveKeys(const ClientHello& hello, const ServerAnswer& answer,
 
 }  // namespace
 
+namespace {
+std::uint32_t KeyPrefix(const PublicKey& key) {
+  const auto h = Hash({}, "robotalk-client-id-v1", key.bytes);
+  return (static_cast<std::uint32_t>(h[0]) << 24 | static_cast<std::uint32_t>(h[1]) << 16 |
+          static_cast<std::uint32_t>(h[2]) << 8 | h[3]) &
+         0x7fffffffU;
+}
+bool SameHello(const ClientHello& a, const ClientHello& b) {
+  return a.client_key == b.client_key && a.client_id == b.client_id && a.client_nonce == b.client_nonce &&
+         a.client_kx == b.client_kx && a.signature == b.signature;
+}
+}  // namespace
+
+std::int64_t KeyedClientId(const PublicKey& key, std::uint32_t low) {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(KeyPrefix(key)) << 32 | (low == 0 ? 1U : low));
+}
+
+bool ClientIdBelongsTo(std::int64_t client_id, const PublicKey& key) {
+  const auto id = static_cast<std::uint64_t>(client_id);
+  return client_id > 0 && (id & 0xffffffffULL) != 0 && (id >> 32) == KeyPrefix(key);
+}
+
 std::int64_t SessionId(const ClientHello& hello, const ServerAnswer& answer) {
   return SessionIdOf(TranscriptHash(hello, answer));
 }
@@ -223,10 +245,26 @@ ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello, TimePoint 
   // signature verification (~50 us), so a flood of them costs little.
   const AccessEntry* client = access_.Find(hello.client_key);
   if (client == nullptr) Refuse(who + ": key not in the access list");
+  if (const auto seen = by_nonce_.find(hello.client_nonce); seen != by_nonce_.end()) {
+    // The same hello again: its client repeats it until an answer arrives,
+    // or someone replays a recording. Either way: the same answer, nothing
+    // new opened, no signature to check (the bytes are the ones verified).
+    const Session& s = sessions_.at(seen->second);
+    if (!SameHello(s.hello, hello)) Refuse(who + ": hello nonce already used by another hello");
+    ++counters_.hello_repeats;
+    return s.answer;
+  }
+  if (used_nonces_.contains(hello.client_nonce)) {
+    Refuse(who + ": replayed hello (its nonce opened a session of this server instance already)");
+  }
   if (!VerifySignature(hello.client_key, hello.SignedBytes(), hello.signature)) {
     Refuse(who + ": bad signature");
   }
-  if (hello.client_id == 0) Refuse(who + ": client id 0 is reserved");
+  if (!ClientIdBelongsTo(hello.client_id, hello.client_key)) {
+    Refuse(who + ": client id " + std::to_string(hello.client_id) +
+           " is not one of this key's (keyed mode: " +
+           "a client id's high bits come from its key; robotalk::KeyedClientId, docs/security.md)");
+  }
   const auto bound = bindings_.find(hello.client_id);
   if (bound != bindings_.end() && !(bound->second.key == hello.client_key)) {
     Refuse(who + ": client id is bound to another key (" + bound->second.key.Fingerprint() + ")");
@@ -258,13 +296,21 @@ ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello, TimePoint 
   if (kx != 0) Refuse(who + ": unusable key-exchange key");
   answer.signature = Sign(identity_, answer.SignedBytes(hello));
   // The server receives on the client's tx key: (tx_client, rx_client) = (rx, tx) here.
-  Session session{
-      DeriveKeys(hello, answer, rx, tx), hello.client_id, client, false, ++counters_.handshakes, now, {}};
+  Session session{DeriveKeys(hello, answer, rx, tx),
+                  hello.client_id,
+                  client,
+                  false,
+                  ++counters_.handshakes,
+                  now,
+                  {},
+                  hello,
+                  answer};
   sodium_memzero(rx.data(), rx.size());
   sodium_memzero(tx.data(), tx.size());
   const std::int64_t id = session.keys.session_id;
   if (sessions_.contains(id)) Refuse(who + ": session id collision; retry");  // 2^-63: never in practice
   sessions_.emplace(id, std::move(session));
+  by_nonce_[hello.client_nonce] = id;
   auto& binding = bindings_[hello.client_id];
   binding.key = hello.client_key;
   ++binding.sessions;
@@ -289,6 +335,15 @@ void ServerAuthenticator::Erase(std::map<std::int64_t, Session>::iterator it) {
   if (const auto b = bindings_.find(client_id); b != bindings_.end() && --b->second.sessions == 0) {
     bindings_.erase(b);
   }
+  // Its hello must not open a session again: remember its nonce (bounded).
+  const Nonce& nonce = it->second.hello.client_nonce;
+  by_nonce_.erase(nonce);
+  if (used_nonces_.insert(nonce).second) used_order_.push_back(nonce);
+  while (used_order_.size() > kRememberedNonces) {
+    used_nonces_.erase(used_order_.front());
+    used_order_.pop_front();
+  }
+  closed_.push_back(it->first);
   sessions_.erase(it);
 }
 
@@ -356,7 +411,10 @@ std::size_t ServerAuthenticator::ExpirePending(TimePoint now, Duration max_age) 
 }
 
 void ServerAuthenticator::Close(std::int64_t session_id) {
-  if (const auto it = sessions_.find(session_id); it != sessions_.end()) Erase(it);
+  if (const auto it = sessions_.find(session_id); it != sessions_.end()) {
+    Erase(it);
+    closed_.pop_back();  // the caller knows
+  }
 }
 
 std::int64_t ServerAuthenticator::LiveSession(std::int64_t client_id) const {

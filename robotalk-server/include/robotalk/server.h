@@ -62,6 +62,8 @@ struct ServerOptions {
   std::string clients_file;
   /// Most sessions (open and not yet used) in the whole server.
   std::size_t max_sessions = 1024;
+  /// Most clients one robot serves at once (`--max-sessions-per-robot`).
+  std::size_t max_sessions_per_robot = 256;
   /// 1 ns timer slack, a short final spin before each deadline and SCHED_FIFO
   /// for the server's threads where permitted (docs/server.md; costs CPU).
   /// ROBOTALK_PRECISE_TIMING=0 in the environment turns it off too.

@@ -65,6 +65,11 @@ robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes);
 /// Decodes a server reply package; same guarantees.
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes);
 
+/// The reply package's answer to the acknowledged package's panic flag, as
+/// the PANIC_* value (0 none, 1 taken, 2 refused; request.h PanicStatus).
+/// Throws ProtocolError for any other value.
+std::int8_t CheckedPanicStatus(const robotalk_msgs::reply_package_t& p);
+
 /// Decodes a broadcast state sample; same guarantees. A keyed server's
 /// signature suffix is skipped, not verified (broadcast_signature.h).
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes);

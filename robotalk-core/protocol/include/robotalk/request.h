@@ -76,14 +76,24 @@ enum class SessionStatus : std::int8_t {
   kUnknown = 1,  ///< this server instance has no such session: nothing ran; say hello again
 };
 
+/// What the server did with the panic flag of the package a ReplyBatch
+/// acknowledges: a dedicated answer, never inferred from another status.
+enum class PanicStatus : std::int8_t {
+  kNone = 0,     ///< the package carried no panic flag (or nothing is acknowledged)
+  kTaken = 1,    ///< the server acted on it: the robot is in panic
+  kRefused = 2,  ///< the server did not act on it; ReplyBatch::panic_refusal says why
+};
+
 /// Replies for one client (ROBOTALK/<robot>/REPLY/<client>).
 struct ReplyBatch {
   std::int64_t client_id = 0;
   std::int64_t server_id = 0;   ///< the server instance (Announcement::server_id)
   std::int64_t session_id = 0;  ///< the session the replies belong to (kUnknown: the one refused)
   SessionStatus session_status = SessionStatus::kOk;
-  std::int64_t ack_sequence = 0;  ///< the package this acknowledges; 0 = none
-  TimePoint server_receive{};     ///< when that package arrived (clock sync)
+  std::int64_t ack_sequence = 0;           ///< the package this acknowledges; 0 = none
+  PanicStatus panic = PanicStatus::kNone;  ///< what became of that package's panic flag
+  std::string panic_refusal;               ///< kRefused: why (names the rule or the missing right)
+  TimePoint server_receive{};              ///< when that package arrived (clock sync)
   TimePoint server_send{};
   std::vector<Reply> replies;
   Mac mac{};  ///< keyed mode: the last kMacBytes of the encoding

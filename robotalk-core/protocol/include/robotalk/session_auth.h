@@ -29,7 +29,9 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <map>
+#include <set>
 #include <span>
 #include <string>
 #include <utility>
@@ -114,6 +116,16 @@ class ClientHandshake {
   std::array<std::uint8_t, 32> kx_secret_{};
 };
 
+/// Keyed mode: the client ids a key may use. A client id belongs to a key
+/// when its bits 62..32 are the first 31 bits of BLAKE2b-256("robotalk-client-id-v1"
+/// || key); bits 31..0 are the client's own choice (random, non-zero), so one
+/// key may run several clients at once and no other key can claim one of its
+/// ids, on this server instance or the next (docs/security.md, Binding).
+/// `low` = 0 is made 1. The result is positive and non-zero.
+std::int64_t KeyedClientId(const PublicKey& key, std::uint32_t low);
+/// True when `client_id` is one of `key`'s (KeyedClientId with any `low`).
+bool ClientIdBelongsTo(std::int64_t client_id, const PublicKey& key);
+
 /// The session id both sides derive from a hello and its answer. Not a
 /// secret (it is a hash of public values); the session keys are.
 std::int64_t SessionId(const ClientHello& hello, const ServerAnswer& answer);
@@ -164,7 +176,8 @@ struct AuthCounters {
   std::uint64_t wrong_client = 0;
   std::uint64_t forged = 0;
   std::uint64_t duplicate = 0;
-  std::uint64_t too_old = 0;  ///< and sequences <= 0
+  std::uint64_t too_old = 0;        ///< and sequences <= 0
+  std::uint64_t hello_repeats = 0;  ///< a hello answered before (lost answer or replay): answered again
 };
 
 /// The server's authentication state for one server instance: answers
@@ -173,6 +186,11 @@ struct AuthCounters {
 /// its client holds the ephemeral secret: a replayed hello opens nothing and
 /// never displaces a live session); only then does it replace the client
 /// id's previous session. Pending sessions are bounded per key and in all.
+/// A hello is recognised by its client nonce: the same hello again (its
+/// client repeats it until answered, or a recording is replayed) gets the
+/// same answer and opens nothing new, without a signature check; a hello
+/// whose nonce belonged to a session of this instance that has since closed
+/// is refused as a replay (the last kRememberedNonces closed sessions).
 class ServerAuthenticator {
  public:
   struct Limits {
@@ -189,9 +207,13 @@ class ServerAuthenticator {
   ServerAuthenticator(KeyPair, const AccessList&&, Nonce, Limits) = delete;
   ServerAuthenticator(KeyPair, const AccessList&&, Nonce) = delete;
 
-  /// Answers `hello` and opens a pending session.
+  static constexpr std::size_t kRememberedNonces = 4096;
+  /// Answers `hello` and opens a pending session, or answers a hello seen
+  /// before (same nonce and bytes, its session still open) with its answer.
   /// @throw AuthError (counted) when the signature is bad, the key is not in
-  ///   the access list, the client id is bound to another key, or a bound is hit.
+  ///   the access list, the client id is not one of the key's
+  ///   (ClientIdBelongsTo) or is bound to another key, the nonce was used
+  ///   (a replay), or a bound is hit.
   /// `now`: when it arrived (any one clock; used only by ExpirePending).
   ServerAnswer Handshake(const ClientHello& hello, TimePoint now);
 
@@ -222,6 +244,16 @@ class ServerAuthenticator {
 
   /// The live session of `client_id`, or 0.
   std::int64_t LiveSession(std::int64_t client_id) const;
+  /// True when a hello with `client_nonce` was answered by this instance
+  /// (its session open, or among the remembered closed ones): Handshake
+  /// would answer it again or refuse it as a replay, opening nothing.
+  bool KnowsNonce(const Nonce& client_nonce) const {
+    return by_nonce_.contains(client_nonce) || used_nonces_.contains(client_nonce);
+  }
+  /// The sessions this object closed on its own since the last call (a
+  /// pending one dropped for a bound, replaced by a newer live one, expired):
+  /// a caller that keeps its own table of sessions erases them too.
+  std::vector<std::int64_t> TakeClosed() { return std::exchange(closed_, {}); }
   std::size_t session_count() const { return sessions_.size(); }
   const AuthCounters& counters() const { return counters_; }
   const Nonce& instance_nonce() const { return instance_nonce_; }
@@ -236,6 +268,8 @@ class ServerAuthenticator {
     std::uint64_t opened = 0;  // handshake counter at opening: orders pending sessions
     TimePoint opened_at{};
     ReplayWindow window;
+    ClientHello hello;    // as received: a repeat must equal it
+    ServerAnswer answer;  // sent again to a repeat
   };
   struct Binding {
     PublicKey key;
@@ -252,6 +286,10 @@ class ServerAuthenticator {
   std::map<std::int64_t, Session> sessions_;   // by session id
   std::map<std::int64_t, Binding> bindings_;   // client id -> key
   std::map<std::int64_t, std::int64_t> live_;  // client id -> live session id
+  std::map<Nonce, std::int64_t> by_nonce_;     // client nonce -> session id, open sessions
+  std::set<Nonce> used_nonces_;                // nonces of closed sessions (the last kRememberedNonces)
+  std::deque<Nonce> used_order_;               // the same, oldest first
+  std::vector<std::int64_t> closed_;           // TakeClosed()
   AuthCounters counters_;
 };
 
