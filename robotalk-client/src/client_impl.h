@@ -95,25 +95,25 @@ class RobotClient::Impl {
   std::shared_ptr<client::ReturnCache> cache_;
 
   mutable std::mutex mu_;
-  std::condition_variable cv_;                        // acks, configurations
-  client::OutstandingPackages outstanding_;           // GUARDED_BY(mu_)
-  client::ClockSync clock_sync_;                      // GUARDED_BY(mu_)
-  std::int64_t next_sequence_ = 1;                    // GUARDED_BY(mu_)
-  CommandId next_id_ = 1;                             // GUARDED_BY(mu_)
-  TimePoint last_send_{};                             // GUARDED_BY(mu_)
-  std::string robot_;                                 // GUARDED_BY(mu_); set once by Attach
-  std::string request_channel_;                       // GUARDED_BY(mu_)
-  bool connected_ = false;                            // GUARDED_BY(mu_)
-  std::shared_ptr<const RobotModel> model_;           // GUARDED_BY(mu_)
-  client::ConfigStore configs_;                       // GUARDED_BY(mu_)
-  std::string last_config_error_;                     // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> clock_packages_;   // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> ack_waited_;       // GUARDED_BY(mu_): panics
+  std::condition_variable cv_;                                   // acks, configurations
+  client::OutstandingPackages outstanding_;                      // GUARDED_BY(mu_)
+  client::ClockSync clock_sync_;                                 // GUARDED_BY(mu_)
+  std::int64_t next_sequence_ = 1;                               // GUARDED_BY(mu_)
+  CommandId next_id_ = 1;                                        // GUARDED_BY(mu_)
+  TimePoint last_send_{};                                        // GUARDED_BY(mu_)
+  std::string robot_;                                            // GUARDED_BY(mu_); set once by Attach
+  std::string request_channel_;                                  // GUARDED_BY(mu_)
+  bool connected_ = false;                                       // GUARDED_BY(mu_)
+  std::shared_ptr<const RobotModel> model_;                      // GUARDED_BY(mu_)
+  client::ConfigStore configs_;                                  // GUARDED_BY(mu_)
+  std::string last_config_error_;                                // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> clock_packages_;              // GUARDED_BY(mu_)
+  std::unordered_set<std::int64_t> ack_waited_;                  // GUARDED_BY(mu_): panics
   std::unordered_map<std::int64_t, PanicAnswer> panic_answers_;  // GUARDED_BY(mu_)
-  std::exception_ptr daemon_error_;                   // GUARDED_BY(mu_)
-  ClientStats stats_;                                 // GUARDED_BY(mu_)
-  std::unique_ptr<Subscription> state_subscription_;  // GUARDED_BY(mu_)
-  std::function<void(const StateSample&)> on_state_;  // GUARDED_BY(mu_)
+  std::exception_ptr daemon_error_;                              // GUARDED_BY(mu_)
+  ClientStats stats_;                                            // GUARDED_BY(mu_)
+  std::unique_ptr<Subscription> state_subscription_;             // GUARDED_BY(mu_)
+  std::function<void(const StateSample&)> on_state_;             // GUARDED_BY(mu_)
 
   // The session (docs/protocol.md, Sessions): opened by a hello, named in
   // every package; lost when the server no longer knows it.
