@@ -526,6 +526,9 @@ void RobotSessions::NoteServoAnswer(std::int64_t client_id, const Reply& reply) 
 
 void RobotSessions::Own(const DaemonOutput::Executed& e) {
   const RobotModel& model = daemon_.model();
+  // A command of a client the watchdog expired meanwhile (taken before its
+  // flush) ran before the watchdog's StopOnly, which stops it: it owns nothing.
+  if (e.type != CommandType::kStop && sessions_.count(e.client_id) == 0) return;
   switch (e.type) {
     case CommandType::kStop:  // the whole robot is at rest: nobody owns anything
       std::fill(joint_owner_.begin(), joint_owner_.end(), 0);
@@ -561,8 +564,10 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
     const std::int64_t client = it->first;
     flushed_.clear();
     daemon_.FlushClient(client, flushed_);
-    // The watchdog holds only what the vanished client still owns; another
-    // client's motion (a GOTO it sent, a joint it moves) runs on.
+    // The watchdog stops only what the vanished client still owns, through
+    // the STOP path (Driver::StopOnly, which cannot refuse: its GOTO is
+    // interrupted); another client's motion (a GOTO it sent, a joint it
+    // moves) runs on.
     std::vector<int> joints;
     for (std::size_t j = 0; j < joint_owner_.size(); ++j) {
       if (joint_owner_[j] != client) continue;
@@ -574,12 +579,11 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
     const bool owned = base || !joints.empty();
     expired.push_back({client, flushed_.size() + it->second.buffered_frames(), owned});
     if (owned) {
-      log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; holding what it moved (" +
+      log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; stopping what it moved (" +
                      (base ? std::string("the base") : std::string()) +
                      (base && !joints.empty() ? ", " : "") +
-                     (joints.empty() ? std::string() : std::to_string(joints.size()) + " joint(s)") +
-                     ") if the robot is still moving");
-      daemon_.QueueHold(std::move(joints), base);
+                     (joints.empty() ? std::string() : std::to_string(joints.size()) + " joint(s)") + ")");
+      daemon_.QueueStopOnly(std::move(joints), base);
     }
     daemon_.SetStream(client, Duration(0));
     pending_.erase(client);

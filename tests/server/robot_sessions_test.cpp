@@ -1,9 +1,9 @@
 #include "robot_sessions.h"
 
-#include "fake_driver.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
+#include "sessions_fixture.h"
 #include "state_encoding.h"
 
 #include <gmock/gmock.h>
@@ -16,88 +16,12 @@ namespace {
 
 using std::chrono::milliseconds;
 using std::chrono::seconds;
+using testing::Cmd, testing::Package, testing::Queries, testing::Playback;
 using testing::FakeDriver;
 using ::testing::HasSubstr;
+using testing::kAlice, testing::kBob;
 using testing::PanRobot;
-
-constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
-
-Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std::string target = "",
-            StartTime start = StartTime::Now()) {
-  return Command{id, type, start, std::move(target), std::move(values)};
-}
-
-Request Package(std::int64_t client, std::int64_t seq, const std::vector<Command>& commands,
-                bool panic = false) {
-  Request r{.client_id = client, .sequence = seq, .panic = panic};
-  r.commands = commands;
-  return r;
-}
-
-Request Queries(std::int64_t client, std::int64_t seq, const std::vector<Query>& queries) {
-  Request r{.client_id = client, .sequence = seq};
-  r.queries = queries;
-  return r;
-}
-
-// A playback frame's start_time is After(its offset from the sequence start).
-Request Playback(std::int64_t client, std::int64_t seq, std::int64_t playback_id, int frames,
-                 Duration duration, const std::vector<Command>& commands) {
-  Request r = Package(client, seq, commands);
-  r.mode = RequestMode::kPlayback;
-  r.playback = {playback_id, frames, duration};
-  return r;
-}
-
-// The ServerDaemon's session layer of one robot and its RobotDaemon, on a
-// manual clock, without threads or a transport.
-class RobotSessionsTest : public ::testing::Test {
- protected:
-  explicit RobotSessionsTest(BaseType base = BaseType::kDifferential, SessionOptions options = {}) {
-    auto driver = std::make_unique<FakeDriver>(PanRobot(base));
-    fake_ = driver.get();
-    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
-    sessions_ = std::make_unique<RobotSessions>(*daemon_, ConfigHash(daemon_->model()), options);
-    daemon_->Preallocate(output_);
-  }
-
-  // Immediate replies of a package, by id.
-  std::map<CommandId, Reply> Handle(const Request& p) {
-    std::map<CommandId, Reply> out;
-    last_ = sessions_->Handle(p, clock_.Now());
-    for (const auto& r : last_.batch.replies) out[r.id] = r;
-    return out;
-  }
-  // Runs the RobotDaemon once at the current time and files what it produced.
-  void Run() {
-    daemon_->RunOnce(clock_.Now());
-    Collect();
-  }
-  void Collect() {
-    daemon_->TakeOutput(output_);
-    for (std::size_t i = 0; i < output_.num_samples; ++i) {
-      states_.push_back(ToStateSample("bot", ConfigHash(daemon_->model()), output_.samples[i]));
-    }
-    std::vector<ReplyBatch> batches;
-    sessions_->File(output_, batches);
-    for (auto& b : batches) {
-      for (auto& r : b.replies) collected_[b.client_id][r.id] = r;
-    }
-  }
-  std::map<CommandId, Reply> Replies(std::int64_t client) {
-    Collect();
-    return collected_[client];
-  }
-
-  ManualClock clock_;
-  FakeDriver* fake_ = nullptr;
-  std::unique_ptr<RobotDaemon> daemon_;
-  std::unique_ptr<RobotSessions> sessions_;
-  DaemonOutput output_;
-  ImmediateAnswer last_;
-  std::map<std::int64_t, std::map<CommandId, Reply>> collected_;
-  std::vector<StateSample> states_;
-};
+using testing::RobotSessionsTest;
 
 TEST_F(RobotSessionsTest, ExecutesACommandAtItsStartTimeAndReportsLateness) {
   const TimePoint start = clock_.Now() + seconds(2);
@@ -319,9 +243,9 @@ TEST_F(RobotSessionsTest, HoldsWhatAVanishedClientMovedWhileTheRobotMoves) {
   EXPECT_EQ(expired[0].client_id, kAlice);
   EXPECT_TRUE(expired[0].moved_robot);
   Run();
-  ASSERT_FALSE(fake_->calls.empty());
-  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "pan held where it is";
-  EXPECT_EQ(fake_->calls.back().values, std::vector<double>{0.5});
+  ASSERT_EQ(fake_->partial_stops.size(), 1u) << "pan stopped where it is (StopOnly)";
+  EXPECT_EQ(fake_->partial_stops[0].joints, std::vector<int>{0});
+  EXPECT_FALSE(fake_->partial_stops[0].base);
   EXPECT_EQ(sessions_->joint_owner(0), 0);
 }
 
@@ -411,14 +335,19 @@ TEST_F(FewSessionsTest, RefusesAPlaybackDeclaringMoreFramesThanTheQueueHolds) {
   EXPECT_THAT(r.at(1).message, HasSubstr("the queue limit is 100"));
 }
 
-TEST_F(RobotSessionsTest, LeavesAStillRobotAloneWhenTheClientThatMovedItVanishes) {
+// The watchdog does not trust a driver's `moving` (a driver may never set
+// it): what the vanished client owned is stopped, which leaves a still
+// robot still, and nothing else is touched.
+TEST_F(RobotSessionsTest, StopsOnlyWhatAVanishedClientOwnedEvenOnAStillRobot) {
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
   Run();
   fake_->moving = false;  // the set-point has been reached
   clock_.Advance(seconds(3));
   ASSERT_EQ(sessions_->Expire(clock_.Now()).size(), 1u);
   Run();
-  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "no STOP was needed";
+  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "no STOP of everything";
+  ASSERT_EQ(fake_->partial_stops.size(), 1u);
+  EXPECT_EQ(fake_->partial_stops[0].joints, std::vector<int>{0});
 }
 
 TEST_F(RobotSessionsTest, DoesNotStopTheRobotWhenAQueryOnlyClientVanishes) {
