@@ -168,7 +168,7 @@ for c, info in clients.items():
         reason = out
         if out == "INTERRUPTED":
             reason += " (flushed by panic)" if "flushed by panic" in f["msg"] else \
-                      " (panic before it ran)" if "entered panic" in f["msg"] else " (" + f["msg"][:40] + ")"
+                      " (panic before it ran)" if "entered panic" in f["msg"] else " (" + re.sub(r"\d+", "#", f["msg"])[:40] + ")"
         elif out == "ERROR":
             reason += " (" + re.sub(r"[0-9.e+-]+", "#", f["msg"])[:60] + ")"
         bump(refused, reason)
