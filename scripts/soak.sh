@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The soak (issue 9, item 9; docs/soak.md). Not run by CI.
+# The soak (issue 9, item 9; docs/soak.md). Its 60 s form runs in ctest (soak_60s, label soak).
 #
 #   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep] [--keyed]
 #   scripts/soak.sh --check-only DIR     the checks again on a kept run's files
@@ -14,7 +14,7 @@
 # starting it again at once with the same --panic-latch file (it must start in
 # panic when the file says so). Then it checks the clients' reports
 # (robotalk-soak-client, one JSON line per command outcome) against the
-# servers' execution logs and prints sent / executed / refused by reason /
+# servers' audit logs ("executed" / "refused" lines) and prints sent / executed / refused by reason /
 # unknown-outcome / lost; exits 1 if anything ran twice, out of start-time
 # order, was lost, or ran without having been sent.
 #
