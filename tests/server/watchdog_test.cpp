@@ -116,6 +116,23 @@ TEST_F(WatchdogTest, ACommandTheDriverRefusedOwnsNothing) {
   EXPECT_THAT(log_, Contains(AllOf(HasSubstr("client 00000000000a11ce vanished"), HasSubstr("the base"))));
 }
 
+// A delay-mode command that became due just as its client's session
+// expired: the RobotDaemon took it before the watchdog flushed the queue, so
+// the watchdog's stop did not cover it. It is stopped as soon as it is filed.
+TEST_F(WatchdogTest, StopsACommandThatRanJustAsItsClientExpired) {
+  const TimePoint start = clock_.Now() + milliseconds(2500);
+  Send(kAlice, Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan", start));
+  clock_.Advance(milliseconds(2500));
+  daemon_->RunOnce(clock_.Now());  // runs the JOINT_SETPOINT; its record waits in the outbox
+  ASSERT_EQ(sessions_->Expire(clock_.Now()).size(), 1u);
+  EXPECT_THAT(fake_->partial_stops, IsEmpty()) << "Alice owned nothing yet";
+  Collect();
+  Run();
+  ASSERT_EQ(fake_->partial_stops.size(), 1u) << "the set-point of a client that is gone runs on";
+  EXPECT_EQ(fake_->partial_stops[0].joints, std::vector<int>{0});
+  EXPECT_EQ(sessions_->joint_owner(0), 0);
+}
+
 TEST_F(WatchdogTest, AClientsStopStillStopsEverythingAndInterruptsTheGoto) {
   Send(kAlice, Cmd(1, CommandType::kGoto, {6, 0, 0}));
   Run();
