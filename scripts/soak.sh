@@ -116,6 +116,10 @@ for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
                           killed=os.path.basename(path) in killed, path=path, mode=mode)
 
 violations = []
+for key, runs in executed.items():
+    for n, sig in runs:
+        if sig not in ("SUCCESS", "MODIFIED", "in progress"):
+            violations.append("AUDIT: client %s command %d is logged as executed with %s (a refusal)" % (key[0], key[1], sig))
 count = dict(sent=0, executed=sum(per_instance), twice=0, lost=0, out_of_order=0, phantom=0, playback_unanswered=0)
 refused, answered_ran, unknown = {}, {}, {}
 def bump(d, k, n=1): d[k] = d.get(k, 0) + n
