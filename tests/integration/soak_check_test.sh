@@ -28,33 +28,29 @@ make_run() {
 EOF
 }
 
-make_run "$tmp/refused" "refused client 00000000000000a1 command 4 SETSPEED -> BUSY (SETSPEED: GOTO in progress (command 3))" BUSY
-"$soak" --check-only "$tmp/refused" >"$tmp/refused.out" 2>&1
-check "a late SETSPEED refused with BUSY passes" test $? -eq 0
-check "it is refused, not run" grep -q "BUSY (refused by the driver) *1" "$tmp/refused.out"
-check "nothing out of order" grep -q "^out of order *0" "$tmp/refused.out"
-check "one executed" grep -q "^executed *1 " "$tmp/refused.out"
+# scenario NAME AUDIT_LINE_OF_4 ANSWER_OF_4 EXIT_STATUS WHAT [PATTERN...]: the
+# checker's exit status, then each PATTERN found in its report.
+scenario() {
+  local name=$1 line=$2 answer=$3 rc=$4 what=$5 p; shift 5
+  make_run "$tmp/$name" "$line" "$answer"
+  "$soak" --check-only "$tmp/$name" >"$tmp/$name.out" 2>&1
+  check "$what (exit $rc)" test $? -eq "$rc"
+  for p in "$@"; do check "$what: '$p'" grep -q "$p" "$tmp/$name.out"; done
+}
 
-make_run "$tmp/ran" "executed client 00000000000000a1 command 4 SETSPEED -> SUCCESS" SUCCESS
-"$soak" --check-only "$tmp/ran" >"$tmp/ran.out" 2>&1
-check "a late SETSPEED that ran after a newer one fails" test $? -eq 1
-check "it is out of order" grep -q "^out of order *1" "$tmp/ran.out"
-
+scenario refused "refused client 00000000000000a1 command 4 SETSPEED -> BUSY (SETSPEED: GOTO in progress (command 3))" \
+  BUSY 0 "a late SETSPEED refused with BUSY passes" \
+  "BUSY (refused by the driver) *1" "^out of order *0" "^executed *1 "
+scenario ran "executed client 00000000000000a1 command 4 SETSPEED -> SUCCESS" SUCCESS 1 \
+  "a late SETSPEED that ran after a newer one fails" "^out of order *1"
 # What the server printed before issue 19: a refusal logged as executed.
-make_run "$tmp/old" "executed client 00000000000000a1 command 4 SETSPEED -> BUSY" BUSY
-"$soak" --check-only "$tmp/old" >"$tmp/old.out" 2>&1
-check "a refusal logged as executed fails" test $? -eq 1
-check "and is named" grep -q "AUDIT: client 00000000000000a1 command 4 is logged as executed with BUSY" "$tmp/old.out"
-
-make_run "$tmp/mismatch" "refused client 00000000000000a1 command 4 SETSPEED -> BUSY (GOTO in progress)" SUCCESS
-"$soak" --check-only "$tmp/mismatch" >"$tmp/mismatch.out" 2>&1
-check "a refused command answered SUCCESS fails" test $? -eq 1
-check "as a mismatch" grep -q "ANSWER MISMATCH" "$tmp/mismatch.out"
-
-make_run "$tmp/twice" "refused client 00000000000000a1 command 5 SETSPEED -> BUSY (again)" BUSY
-"$soak" --check-only "$tmp/twice" >"$tmp/twice.out" 2>&1
-check "a command that reached the driver twice fails" test $? -eq 1
-check "as executed twice" grep -q "^executed twice *1" "$tmp/twice.out"
+scenario old "executed client 00000000000000a1 command 4 SETSPEED -> BUSY" BUSY 1 \
+  "a refusal logged as executed fails" "AUDIT: client 00000000000000a1 command 4 is logged as executed with BUSY"
+scenario mismatch "refused client 00000000000000a1 command 4 SETSPEED -> BUSY (GOTO in progress)" SUCCESS 1 \
+  "a refused command answered SUCCESS fails" "ANSWER MISMATCH"
+# Command 5 ran; a second audit line for it (refused) means it reached the driver twice.
+scenario twice "refused client 00000000000000a1 command 5 SETSPEED -> BUSY (again)" BUSY 1 \
+  "a command that reached the driver twice fails" "^executed twice *1"
 
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
