@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The soak (issue 9, item 9; docs/soak.md). Not run by CI.
+# The soak (issue 9, item 9; docs/soak.md). Its 60 s form runs in ctest (soak_60s, label soak).
 #
 #   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep] [--keyed]
 #   scripts/soak.sh --check-only DIR     the checks again on a kept run's files
@@ -14,7 +14,7 @@
 # starting it again at once with the same --panic-latch file (it must start in
 # panic when the file says so). Then it checks the clients' reports
 # (robotalk-soak-client, one JSON line per command outcome) against the
-# servers' execution logs and prints sent / executed / refused by reason /
+# servers' audit logs ("executed" / "refused" lines) and prints sent / executed / refused by reason /
 # unknown-outcome / lost; exits 1 if anything ran twice, out of start-time
 # order, was lost, or ran without having been sent.
 #
@@ -50,9 +50,15 @@ check() {  # check DIR: the report (python below), exit status 1 on a violation
 /usr/bin/python3 - "$1" <<'EOF'
 import glob, json, os, re, sys
 tmp = sys.argv[1]
-audit_re = re.compile(r"executed client ([0-9a-f]{16}) command (-?\d+) (\S+) -> (.+)$")
-executed = {}   # (client, id) -> [(instance, signal)]
-order = {}      # client -> ids in execution order (instances in order)
+# The server's audit (--log-executions): "executed" = the driver accepted
+# the command (SUCCESS, MODIFIED, in progress): it ran; "refused" = the
+# driver refused it (BUSY, NA, ERROR, INTERRUPTED): it reached the driver
+# and moved nothing.
+audit_re = re.compile(r"(executed|refused) client ([0-9a-f]{16}) command (-?\d+) (\S+) -> (in progress|[A-Z_]+)")
+executed = {}   # (client, id) -> [(instance, signal)]: the commands that ran
+driver_refused = {}  # (client, id) -> [(instance, signal)]: refused by the driver
+order = {}      # client -> ids that ran, in execution order (instances in order)
+audited = {}    # client -> every audited id (ran or refused), in order
 logs = sorted(glob.glob(os.path.join(tmp, "server*.log")), key=lambda p: int(re.findall(r"\d+", os.path.basename(p))[0]))
 per_instance = []
 for n, path in enumerate(logs, 1):
@@ -61,9 +67,13 @@ for n, path in enumerate(logs, 1):
         m = audit_re.search(line)
         if not m:
             continue
-        key = (m.group(1), int(m.group(2)))
-        executed.setdefault(key, []).append((n, m.group(4).strip()))
-        order.setdefault(m.group(1), []).append(key[1])
+        key = (m.group(2), int(m.group(3)))
+        audited.setdefault(key[0], []).append(key[1])
+        if m.group(1) == "refused":
+            driver_refused.setdefault(key, []).append((n, m.group(5)))
+            continue
+        executed.setdefault(key, []).append((n, m.group(5)))
+        order.setdefault(key[0], []).append(key[1])
         count += 1
     per_instance.append(count)
 killed = set(os.path.basename(l.strip()) for l in open(os.path.join(tmp, "killed")) if l.strip())
@@ -106,23 +116,32 @@ for path in sorted(glob.glob(os.path.join(tmp, "client*.jsonl"))):
                           killed=os.path.basename(path) in killed, path=path, mode=mode)
 
 violations = []
+for key, runs in executed.items():
+    for n, sig in runs:
+        if sig not in ("SUCCESS", "MODIFIED", "in progress"):
+            violations.append("AUDIT: client %s command %d is logged as executed with %s (a refusal)" % (key[0], key[1], sig))
 count = dict(sent=0, executed=sum(per_instance), twice=0, lost=0, out_of_order=0, phantom=0, playback_unanswered=0)
 refused, answered_ran, unknown = {}, {}, {}
 def bump(d, k, n=1): d[k] = d.get(k, 0) + n
 
-for key, runs in executed.items():
+for key in set(executed) | set(driver_refused):
+    runs = executed.get(key, []) + driver_refused.get(key, [])
     if len(runs) > 1:
         count["twice"] += 1
-        violations.append("EXECUTED TWICE: client %s command %d on instances %s" % (key[0], key[1], [r[0] for r in runs]))
+        violations.append("EXECUTED TWICE: client %s command %d reached the driver %d times (%s)" %
+                          (key[0], key[1], len(runs), ", ".join("instance %d: %s" % r for r in runs)))
 
 for c, info in clients.items():
     for cid, s in info["sent"].items():
         count["sent"] += 1
         runs = executed.get((c, cid), [])
+        no = driver_refused.get((c, cid), [])
         f = info["final"].get(cid)
         if f is None:
             if info["killed"]:
                 bump(unknown, "client killed before its answer (ran %d)" % min(len(runs), 1))
+            elif no and not runs:
+                bump(unknown, "no answer recorded, refused by the driver (not run)")
             elif not runs:
                 count["lost"] += 1
                 violations.append("LOST: client %s command %d (%s) got no answer and never ran" % (c, cid, s["type"]))
@@ -140,6 +159,12 @@ for c, info in clients.items():
                 violations.append("ANSWER MISMATCH: client %s command %d ran (%s) but was answered %s: %s" % (c, cid, sig, out, f["msg"]))
             bump(answered_ran, out)
             continue
+        if no:
+            # Refused by the driver: moved nothing, and its answer must say so.
+            if out != no[0][1]:
+                violations.append("ANSWER MISMATCH: client %s command %d was refused by the driver (%s) but was answered %s: %s" % (c, cid, no[0][1], out, f["msg"]))
+            bump(refused, "%s (refused by the driver)" % no[0][1])
+            continue
         if out in ("SUCCESS", "MODIFIED"):
             count["lost"] += 1
             violations.append("LOST: client %s command %d (%s) answered %s but never ran" % (c, cid, s["type"], out))
@@ -147,7 +172,7 @@ for c, info in clients.items():
         reason = out
         if out == "INTERRUPTED":
             reason += " (flushed by panic)" if "flushed by panic" in f["msg"] else \
-                      " (panic before it ran)" if "entered panic" in f["msg"] else " (" + f["msg"][:40] + ")"
+                      " (panic before it ran)" if "entered panic" in f["msg"] else " (" + re.sub(r"\d+", "#", f["msg"])[:40] + ")"
         elif out == "ERROR":
             reason += " (" + re.sub(r"[0-9.e+-]+", "#", f["msg"])[:60] + ")"
         bump(refused, reason)
@@ -161,14 +186,16 @@ for c, info in clients.items():
         nxt = min([i for i in ids if i > sf["after"]], default=float("inf"))
         gaps.append([sf["after"], nxt, sf["frames"], 0, sf["outcome"]])
     top = max(ids, default=0)
-    for cid in order.get(c, []):
+    for cid in audited.get(c, []):
         if cid in info["sent"]:
             continue
+        ran = (c, cid) in executed
         g = next((g for g in gaps if g[0] < cid < g[1]), None)
         if g is not None:
-            g[3] += 1
+            g[3] += ran
         elif info["killed"] and cid > top:
-            bump(unknown, "client killed before its report (ran 1)")
+            bump(unknown, "client killed before its report (ran 1)" if ran else
+                 "client killed before its report (refused by the driver; outside the balance)")
         else:
             count["phantom"] += 1
             violations.append("RAN UNSENT: client %s command %d ran but no report sent it" % (c, cid))
@@ -231,8 +258,8 @@ for c, info in clients.items():
         if last is None or s["start_us"] >= last[1]:
             last_by[actuator] = (cid, s["start_us"])
 
-for c in set(k[0] for k in executed) - set(clients):
-    n = sum(1 for k in executed if k[0] == c)
+for c in set(audited) - set(clients):
+    n = len(audited[c])
     count["phantom"] += n
     violations.append("RAN UNSENT: %d commands of client %s, which no report names" % (n, c))
 
@@ -244,8 +271,13 @@ for l in relay:
     m = dict(kv.split("=") for kv in l.split()[1:])
     print("  relay %s received %s lost %s duplicated %s reordered %s" % (l[:3], m.get("received"), m.get("lost"), m.get("duplicated"), m.get("reordered")))
 print("sent            %6d  (commands with an id; %d calls threw before sending: no session)" % (count["sent"], notsent))
-print("executed        %6d  (audit lines: %s per server instance)" % (count["executed"], " + ".join(map(str, per_instance))))
+print("executed        %6d  (audit 'executed' lines: %s per server instance)" % (count["executed"], " + ".join(map(str, per_instance))))
 print("  answered after running: " + ", ".join("%s %d" % kv for kv in sorted(answered_ran.items())))
+by_signal = {}
+for runs in driver_refused.values():
+    bump(by_signal, runs[0][1])
+print("refused by the driver %d  (audit 'refused' lines: %s; none counts as run)" %
+      (len(driver_refused), ", ".join("%s %d" % kv for kv in sorted(by_signal.items())) or "none"))
 print("refused         %6d" % sum(refused.values()))
 for k, v in sorted(refused.items(), key=lambda kv: -kv[1]):
     if v:

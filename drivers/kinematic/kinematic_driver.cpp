@@ -355,7 +355,17 @@ void KinematicDriver::Stop(TimePoint now, std::vector<Completion>& interrupted) 
   StopAll("interrupted by STOP", interrupted);
 }
 
-void KinematicDriver::StopAll(const char* why, std::vector<Completion>& completed) {
+void KinematicDriver::StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) {
+  Advance(now, interrupted);
+  if (scope.base) StopBase("interrupted by STOP", interrupted);
+  for (const int j : scope.joints) {
+    const int first = model_.dof_offset(j);
+    const int n = static_cast<int>(model_.joint(j).dofs.size());
+    for (int i = first; i < first + n; ++i) HoldDof(i);
+  }
+}
+
+void KinematicDriver::StopBase(const char* why, std::vector<Completion>& completed) {
   if (base_mode_ == BaseMode::kGoto) {
     completed.push_back(
         Completion{.id = goto_id_, .signal = Signal::kInterrupted, .message = std::string("GOTO: ") + why});
@@ -363,10 +373,18 @@ void KinematicDriver::StopAll(const char* why, std::vector<Completion>& complete
   base_mode_ = BaseMode::kIdle;
   cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
   v_ = vy_ = omega_ = 0;
-  std::fill(mode_.begin(), mode_.end(), DofMode::kPosition);
-  target_ = q_;
-  speed_.setZero();
-  qd_.setZero();
+}
+
+void KinematicDriver::HoldDof(int i) {
+  mode_[static_cast<size_t>(i)] = DofMode::kPosition;
+  target_[i] = q_[i];
+  speed_[i] = 0;
+  qd_[i] = 0;
+}
+
+void KinematicDriver::StopAll(const char* why, std::vector<Completion>& completed) {
+  StopBase(why, completed);
+  for (int i = 0; i < static_cast<int>(q_.size()); ++i) HoldDof(i);
 }
 
 void KinematicDriver::Halt(std::vector<Completion>& interrupted) {

@@ -78,6 +78,9 @@ class KinematicDriver final : public Driver {
   void Update(TimePoint now, std::vector<Completion>& completed) override;
   void ReadState(RobotState& state) const override;
   void Stop(TimePoint now, std::vector<Completion>& interrupted) override;
+  /// The scope's joints hold where they are; with the base, the base stops
+  /// and a GOTO in progress completes INTERRUPTED. Nothing else changes.
+  void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) override;
   void Halt(std::vector<Completion>& interrupted) override;
   void Resume() override;
 
@@ -102,6 +105,9 @@ class KinematicDriver final : public Driver {
   void IntegrateBase(double vx, double vy, double omega, double dt);
   // Stops every motion; an in-progress GOTO completes INTERRUPTED with `why`.
   void StopAll(const char* why, std::vector<Completion>& completed);
+  // The base part of StopAll; HoldDof holds one dof where it is.
+  void StopBase(const char* why, std::vector<Completion>& completed);
+  void HoldDof(int i);
 
   DriverResult JointSetPoint(const DriverCommand& c);
   DriverResult JointSpeed(const DriverCommand& c);

@@ -48,6 +48,33 @@ void OdeDriver::Impl::Stop(TimePoint now, std::vector<Completion>& interrupted) 
   StopAll("interrupted by STOP", interrupted);
 }
 
+// The watchdog's stop of what one client moved. The base (with a walking
+// humanoid, its walk) stops when asked, or when a leg the walk drives is in
+// the scope (stopping more than asked is safe). A wheel stays with the base's
+// controller while another client's GOTO or SETSPEED drives it.
+void OdeDriver::Impl::StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) {
+  Advance(now, true, interrupted);
+  bool base = scope.base;
+  for (const int j : scope.joints) {
+    const int first = model_.dof_offset(j);
+    for (int k = 0; k < static_cast<int>(model_.joint(j).dofs.size()); ++k)
+      base = base || (walker_ && walker_->Owns(first + k));
+  }
+  if (base) {
+    StopBase("interrupted by STOP", interrupted);
+    if (base_kind_ == BaseKind::kWheels)
+      for (const int w : wheel_dof_) HoldDof(w);
+  }
+  for (const int j : scope.joints) {
+    if (IsWheel(j) && base_mode_ != BaseMode::kIdle) continue;
+    const int first = model_.dof_offset(j);
+    for (int k = 0; k < static_cast<int>(model_.joint(j).dofs.size()); ++k) {
+      if (walker_ && walker_->Owns(first + k)) continue;
+      HoldDof(first + k);
+    }
+  }
+}
+
 DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
   const std::string name = ToString(c.type);
   const robotalk::Joint& joint = model_.joint(c.target);  // checked by the server (driver.h)

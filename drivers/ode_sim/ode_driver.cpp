@@ -332,6 +332,11 @@ void OdeDriver::Impl::ControlStep(std::vector<Completion>& completed) {
 }
 
 void OdeDriver::Impl::StopAll(const char* why, std::vector<Completion>& completed) {
+  StopBase(why, completed);
+  for (size_t i = 0; i < mode_.size(); ++i) HoldDof(static_cast<Eigen::Index>(i));
+}
+
+void OdeDriver::Impl::StopBase(const char* why, std::vector<Completion>& completed) {
   if (walker_) walker_->Stop(why, completed);  // walking hook: ends in double support within two steps
   if (base_mode_ == BaseMode::kGoto) {
     completed.push_back(
@@ -340,18 +345,19 @@ void OdeDriver::Impl::StopAll(const char* why, std::vector<Completion>& complete
   base_mode_ = BaseMode::kIdle;
   cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
   world_->SetRootVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-  // Every actuator stops at once: motors at zero velocity with their full
-  // force (a position hold would drive back over the braking distance).
-  const Eigen::VectorXd& q = world_->q();
-  for (size_t i = 0; i < mode_.size(); ++i) {
-    const auto e = static_cast<Eigen::Index>(i);
-    if (mode_[i] == Mode::kMimic || mode_[i] == Mode::kPassive) continue;
-    mode_[i] = Mode::kVelocity;
-    target_[e] = std::clamp(q[e], lower_[e], upper_[e]);
-    speed_[e] = 0;
-    force_[e] = 0;
-    world_->SetMotor(static_cast<int>(i), 0, fmax_[e]);
-  }
+}
+
+// The dof stops at once: its motor at zero velocity with its full force (a
+// position hold would drive back over the braking distance). Mimic followers
+// follow their leader; passive dofs have no motor.
+void OdeDriver::Impl::HoldDof(Eigen::Index i) {
+  const auto u = static_cast<size_t>(i);
+  if (mode_[u] == Mode::kMimic || mode_[u] == Mode::kPassive) return;
+  mode_[u] = Mode::kVelocity;
+  target_[i] = std::clamp(world_->q()[i], lower_[i], upper_[i]);
+  speed_[i] = 0;
+  force_[i] = 0;
+  world_->SetMotor(static_cast<int>(i), 0, fmax_[i]);
 }
 
 // ---------------------------------------------------------------- state
@@ -408,6 +414,9 @@ void OdeDriver::Update(TimePoint now, std::vector<Completion>& completed) {
 }
 void OdeDriver::ReadState(RobotState& state) const { impl_->ReadState(state); }
 void OdeDriver::Stop(TimePoint now, std::vector<Completion>& interrupted) { impl_->Stop(now, interrupted); }
+void OdeDriver::StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) {
+  impl_->StopOnly(scope, now, interrupted);
+}
 void OdeDriver::Halt(std::vector<Completion>& interrupted) { impl_->Halt(interrupted); }
 void OdeDriver::Resume() { impl_->Resume(); }
 void OdeDriver::Step(int n, std::vector<Completion>& completed) {

@@ -125,6 +125,9 @@ class OdeDriver final : public Driver {
   void Update(TimePoint now, std::vector<Completion>& completed) override;
   void ReadState(RobotState& state) const override;
   void Stop(TimePoint now, std::vector<Completion>& interrupted) override;
+  /// The scope's joints stop and hold; with the base, the base (a walking
+  /// humanoid's walk) stops and a GOTO in progress completes INTERRUPTED.
+  void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) override;
   void Halt(std::vector<Completion>& interrupted) override;
   void Resume() override;
   /// A walking humanoid that fell: "the robot has fallen (torso tilt X rad)"

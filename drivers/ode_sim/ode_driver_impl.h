@@ -38,6 +38,7 @@ class OdeDriver::Impl {
 
   DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed);
   void Stop(TimePoint now, std::vector<Completion>& interrupted);
+  void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted);
   void Advance(TimePoint now, bool limit, std::vector<Completion>& completed);
   void Step(int n, std::vector<Completion>& completed);
   void ReadState(RobotState& state) const;
@@ -59,6 +60,10 @@ class OdeDriver::Impl {
 
   void ControlStep(std::vector<Completion>& completed);
   void StopAll(const char* why, std::vector<Completion>& completed);
+  // The base part of StopAll (the walk, a GOTO, the root's speed); HoldDof
+  // stops one dof's motor and holds it.
+  void StopBase(const char* why, std::vector<Completion>& completed);
+  void HoldDof(Eigen::Index i);
   void SetWheels(double v, double omega);
   void BasePose(double* x, double* y, double* theta) const;
   void SetupWheels(const std::vector<CollisionShape>& shapes);

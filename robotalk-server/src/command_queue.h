@@ -23,12 +23,13 @@ struct QueuedItem {
   DriverCommand command;  ///< when !is_query; command.id is the client's id
   QueryType query = QueryType::kJointState;
   int query_target = -1;        ///< joint / link / frame index, -1 = all
-  bool only_if_moving = false;  ///< the watchdog's STOP: skipped if the robot is still
-  /// The watchdog's hold of a vanished client's actuators (client_id 0,
-  /// only_if_moving): these joints are held where they are and, with
-  /// `hold_base`, the base is brought to rest; other clients' motion runs on.
-  std::vector<int> hold_joints;
-  bool hold_base = false;
+  bool only_if_moving = false;  ///< the server's STOP: skipped if the robot is still
+  /// A STOP of only part of the robot (Driver::StopOnly): the watchdog's for
+  /// a vanished client (client_id 0): these joints and, with `stop_base`,
+  /// the base and its task. Other clients' motion runs on.
+  bool scoped_stop = false;
+  std::vector<int> stop_joints;
+  bool stop_base = false;
 
   /// Earlier start first; equal starts in arrival order.
   bool RunsBefore(const QueuedItem& o) const {

@@ -248,14 +248,14 @@ void RobotDaemon::QueueStop(bool only_if_moving) {
   Submit(std::move(stop));
 }
 
-void RobotDaemon::QueueHold(std::vector<int> joints, bool base) {
-  QueuedItem hold;
-  hold.client_id = 0;
-  hold.command.type = CommandType::kStop;
-  hold.only_if_moving = true;
-  hold.hold_joints = std::move(joints);
-  hold.hold_base = base;
-  Submit(std::move(hold));
+void RobotDaemon::QueueStopOnly(std::vector<int> joints, bool base) {
+  QueuedItem stop;
+  stop.client_id = 0;
+  stop.command.type = CommandType::kStop;
+  stop.scoped_stop = true;
+  stop.stop_joints = std::move(joints);
+  stop.stop_base = base;
+  Submit(std::move(stop));
 }
 
 bool RobotDaemon::TakeOutput(DaemonOutput& out, bool wait) {
@@ -477,14 +477,26 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     return outcome == CallOutcome::kOk;
   };
   if (item.command.type == CommandType::kStop) {
-    if (!item.hold_joints.empty() || item.hold_base) return Hold(item, now);
     if (item.only_if_moving) {
-      // The watchdog's STOP: a robot already at rest needs none.
+      // The server's STOP when it gives a robot up: a robot at rest needs none.
       if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
       if (!state_.moving) return;
     }
-    if (!driver_call("Stop", [&] { driver_->Stop(now, completions_); })) return;
-    produced_.executed.push_back({item.client_id, CommandType::kStop, -1});
+    // A client's STOP stops everything; the watchdog's stops what the
+    // vanished client owned (its GOTO included). Neither can be refused:
+    // Stop() and StopOnly() answer nothing.
+    const StopScope scope{.joints = item.stop_joints, .base = item.stop_base};
+    if (!driver_call(item.scoped_stop ? "StopOnly" : "Stop", [&] {
+          if (item.scoped_stop) {
+            driver_->StopOnly(scope, now, completions_);
+          } else {
+            driver_->Stop(now, completions_);
+          }
+        }))
+      return;
+    // A STOP of everything ends every ownership; a scoped one ends only the
+    // vanished client's, which RobotSessions::Expire already cleared.
+    if (!item.scoped_stop) produced_.executed.push_back({item.client_id, CommandType::kStop, -1});
     r.signal = Signal::kSuccess;
     Emit(item.client_id, std::move(r));
     return;
@@ -499,16 +511,13 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   command.id = next_driver_id_++;
   DriverResult result;
   if (!driver_call("Execute", [&] { result = driver_->Execute(command, now, completions_); })) return;
-  produced_.executed.push_back({item.client_id, item.command.type, item.command.target});
-  if (options_.log_executions) {
-    char line[256];
-    std::snprintf(line, sizeof line,
-                  "robot '%s': executed client %016" PRIx64 " command %" PRId64 " %s -> %s",
-                  robot_name_.c_str(), static_cast<std::uint64_t>(item.client_id), item.command.id,
-                  ToString(item.command.type),
-                  result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
-    produced_.audit.emplace_back(line);
-  }
+  // Only what the driver accepted is ownership and ran; a refusal (BUSY, NA,
+  // INTERRUPTED, ERROR) moved nothing (issue 19: a refused SETSPEED named the
+  // wrong client to the watchdog, and the soak counted it as run).
+  const bool accepted =
+      result.in_progress || result.signal == Signal::kSuccess || result.signal == Signal::kModified;
+  if (accepted) produced_.executed.push_back({item.client_id, item.command.type, item.command.target});
+  if (options_.log_executions) Audit(item, result, accepted);
   if (result.in_progress) {
     in_progress_[command.id] = Owner{item.client_id, item.command.id, now, r.lateness};
     return;
@@ -518,36 +527,14 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   Emit(item.client_id, std::move(r));
 }
 
-void RobotDaemon::Hold(const QueuedItem& item, TimePoint now) {
-  if (panic_ || halted_) return;  // already at rest
-  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
-  if (!state_.moving) return;
-  const RobotModel& m = model();
-  const auto run = [&](DriverCommand c) {
-    c.id = next_driver_id_++;
-    DriverResult ignored;
-    Guarded("Execute", nullptr, now, [&] { ignored = driver_->Execute(c, now, completions_); });
-  };
-  if (item.hold_base && m.roots().front().base != BaseType::kFixed) {
-    run(DriverCommand{.type = CommandType::kSetSpeed, .target = -1, .num_values = 2, .values = {}});
-  }
-  for (int j : item.hold_joints) {
-    const Joint& joint = m.joint(j);
-    DriverCommand c{.target = j, .num_values = static_cast<int>(joint.dofs.size())};
-    if (joint.servo_types.Has(ServoType::kSpeed)) {
-      c.type = CommandType::kJointSpeed;  // values stay 0
-    } else if (joint.servo_types.Has(ServoType::kSetPoint)) {
-      c.type = CommandType::kJointSetPoint;
-      for (int k = 0; k < c.num_values; ++k)
-        c.values[static_cast<std::size_t>(k)] = state_.position[m.dof_offset(j) + k];
-      if (!std::all_of(c.values.begin(), c.values.begin() + c.num_values,
-                       [](double v) { return std::isfinite(v); }))
-        continue;
-    } else {
-      continue;
-    }
-    run(c);
-  }
+void RobotDaemon::Audit(const QueuedItem& item, const DriverResult& result, bool accepted) {
+  char line[256];
+  std::snprintf(line, sizeof line, "robot '%s': %s client %016" PRIx64 " command %" PRId64 " %s -> %s",
+                robot_name_.c_str(), accepted ? "executed" : "refused",
+                static_cast<std::uint64_t>(item.client_id), item.command.id, ToString(item.command.type),
+                result.in_progress ? "in progress" : std::string(ToString(result.signal)).c_str());
+  produced_.audit.emplace_back(line);
+  if (!accepted && !result.message.empty()) produced_.audit.back() += " (" + result.message + ")";
 }
 
 void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {

@@ -93,7 +93,7 @@ struct DaemonOutput {
     std::int64_t client_id = 0;
     Reply reply;
   };
-  struct Executed {  ///< a command the driver took (ownership of actuators)
+  struct Executed {  ///< a command the driver accepted (SUCCESS, MODIFIED, in progress): ownership
     std::int64_t client_id = 0;
     CommandType type = CommandType::kStop;
     int target = -1;  ///< joint (JOINT_*) or frame (FRAME_SETPOINT) index
@@ -168,11 +168,12 @@ class RobotDaemon {
   /// A STOP from the server itself (watchdog, shutdown); with
   /// `only_if_moving` it is skipped when the robot is at rest.
   void QueueStop(bool only_if_moving);
-  /// The watchdog's hold for a vanished client: if the robot is moving, the
-  /// given joints are held where they are (a speed of 0 or a set-point at
-  /// their position) and, with `base`, the base is brought to rest. Nothing
-  /// else is touched, so another client's motion runs on.
-  void QueueHold(std::vector<int> joints, bool base);
+  /// The watchdog's STOP for a vanished client: the same path as a STOP,
+  /// restricted to what it owned (Driver::StopOnly): the given joints stop
+  /// and hold and, with `base`, the base stops and a task on it (a GOTO)
+  /// completes INTERRUPTED. A driver cannot refuse it. Another client's
+  /// motion runs on.
+  void QueueStopOnly(std::vector<int> joints, bool base);
   /// Swaps the outbox with `out` (cleared first). Returns false when empty.
   /// With `wait` false it does not wait for mutex_: when the RobotDaemon
   /// holds it, `out` is left cleared and false returned (take it later).
@@ -216,7 +217,9 @@ class RobotDaemon {
                   const QueuedItem& item, Reply& reply) const;
   void Execute(const QueuedItem& item, TimePoint now);
   void AnswerQuery(const QueuedItem& item, Reply& reply);
-  void Hold(const QueuedItem& item, TimePoint now);
+  // The --log-executions line of a motion command: "executed" (the driver
+  // accepted it) or "refused" (with the driver's reason).
+  void Audit(const QueuedItem& item, const DriverResult& result, bool accepted);
   void Sample(TimePoint now, Duration period);
   void FillSample(TimePoint now, Duration period);  // from state_, just read
   enum class CallOutcome { kOk, kThrew, kOverran };

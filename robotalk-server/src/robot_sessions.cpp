@@ -491,29 +491,40 @@ void RobotSessions::NoteServoAnswer(std::int64_t client_id, const Reply& reply) 
 
 void RobotSessions::Own(const DaemonOutput::Executed& e) {
   const RobotModel& model = daemon_.model();
+  if (e.type == CommandType::kStop) {  // the whole robot is at rest: nobody owns anything
+    std::fill(joint_owner_.begin(), joint_owner_.end(), 0);
+    base_owner_ = 0;
+    return;
+  }
+  std::vector<int> joints;  // what the command moves
+  bool base = false;
   switch (e.type) {
-    case CommandType::kStop:  // the whole robot is at rest: nobody owns anything
-      std::fill(joint_owner_.begin(), joint_owner_.end(), 0);
-      base_owner_ = 0;
-      break;
     case CommandType::kJointSetPoint:
     case CommandType::kJointSpeed:
     case CommandType::kJointForce:
-      joint_owner_[static_cast<std::size_t>(e.target)] = e.client_id;
+      joints.push_back(e.target);
       break;
     case CommandType::kFrameSetPoint:  // the joints on the frame's chain
       for (int j = model.parent_joint(model.frame(e.target).parent_link); j >= 0;
            j = model.parent_joint(model.joint(j).parent_link)) {
-        if (!model.joint(j).dofs.empty()) joint_owner_[static_cast<std::size_t>(j)] = e.client_id;
+        if (!model.joint(j).dofs.empty()) joints.push_back(j);
       }
       break;
     case CommandType::kGoto:
     case CommandType::kSetSpeed:
-      base_owner_ = e.client_id;
+      base = true;
       break;
-    case CommandType::kPanicReset:
-      break;
+    default:
+      return;
   }
+  if (sessions_.count(e.client_id) == 0) {
+    // Taken by the RobotDaemon just before the watchdog expired its client:
+    // the watchdog's stop did not cover it. Stopped now; nobody owns it.
+    daemon_.QueueStopOnly(std::move(joints), base);
+    return;
+  }
+  for (const int j : joints) joint_owner_[static_cast<std::size_t>(j)] = e.client_id;
+  if (base) base_owner_ = e.client_id;
 }
 
 std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
@@ -526,8 +537,8 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
     const std::int64_t client = it->first;
     flushed_.clear();
     daemon_.FlushClient(client, flushed_);
-    // The watchdog holds only what the vanished client still owns; another
-    // client's motion (a GOTO it sent, a joint it moves) runs on.
+    // A STOP of only what it owns (Driver::StopOnly cannot refuse: its GOTO
+    // is interrupted); another client's motion runs on.
     std::vector<int> joints;
     for (std::size_t j = 0; j < joint_owner_.size(); ++j) {
       if (joint_owner_[j] != client) continue;
@@ -539,12 +550,11 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
     const bool owned = base || !joints.empty();
     expired.push_back({client, flushed_.size() + it->second.buffered_frames(), owned});
     if (owned) {
-      log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; holding what it moved (" +
+      log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; stopping what it moved (" +
                      (base ? std::string("the base") : std::string()) +
                      (base && !joints.empty() ? ", " : "") +
-                     (joints.empty() ? std::string() : std::to_string(joints.size()) + " joint(s)") +
-                     ") if the robot is still moving");
-      daemon_.QueueHold(std::move(joints), base);
+                     (joints.empty() ? std::string() : std::to_string(joints.size()) + " joint(s)") + ")");
+      daemon_.QueueStopOnly(std::move(joints), base);
     }
     daemon_.SetStream(client, Duration(0));
     pending_.erase(client);

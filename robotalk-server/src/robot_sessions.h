@@ -67,7 +67,7 @@ struct ImmediateAnswer {
 struct ExpiredSession {
   std::int64_t client_id = 0;
   std::size_t dropped_commands = 0;  ///< queued commands that will never run
-  bool moved_robot = false;          ///< it owned actuators (they are held if still moving)
+  bool moved_robot = false;          ///< it owned actuators (they are stopped: Driver::StopOnly)
 };
 
 class RobotSessions {

@@ -75,7 +75,7 @@ for _ in $(seq 30); do
   sleep 0.1
 done
 check "watchdog stopped the robot (last speed $speed)" test "$stopped" = yes
-check "server logged the watchdog hold" grep -q "vanished; holding what it moved (the base" "$tmp/server1.log"
+check "server logged the watchdog stop" grep -q "vanished; stopping what it moved (the base" "$tmp/server1.log"
 
 # --- 4. lost and duplicated replies still give exactly-once execution -------
 start_server "$tmp/server2.log" --inject-reply-drop 0.3 --inject-reply-dup 0.3 --seed 3 --log-executions

@@ -1,5 +1,6 @@
 // A scripted Driver for server tests: records what it was asked, answers
-// GOTO as a task that completes after `goto_updates` Update() calls.
+// GOTO as a task that completes after `goto_updates` Update() calls and,
+// as the shipped drivers do, SETSPEED with BUSY while a GOTO runs.
 #pragma once
 
 #include "robotalk/driver.h"
@@ -52,6 +53,9 @@ class FakeDriver : public Driver {
         goto_id = c.id;
         updates_left = goto_updates;
         return {Signal::kSuccess, true, ""};
+      case CommandType::kSetSpeed:
+        if (goto_id) return {Signal::kBusy, false, "SETSPEED: GOTO in progress"};
+        return {};
       case CommandType::kJointSetPoint:
         if (std::abs(c.values[0]) > 1) return {Signal::kModified, false, "clamped"};
         position = c.values[0];
@@ -66,6 +70,11 @@ class FakeDriver : public Driver {
     if (goto_id) interrupted.push_back({*goto_id, Signal::kInterrupted, "stopped"});
     goto_id.reset();
     moving = false;
+  }
+  void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) override {
+    partial_stops.push_back({now, {scope.joints.begin(), scope.joints.end()}, scope.base});
+    if (scope.base && goto_id) interrupted.push_back({*goto_id, Signal::kInterrupted, "stopped"});
+    if (scope.base) goto_id.reset();
   }
   void Update(TimePoint, std::vector<Completion>& completed) override {
     ++updates;
@@ -89,8 +98,15 @@ class FakeDriver : public Driver {
   void Resume() override { halted = false; }
   std::string_view Fault() const override { return fault; }
 
+  struct PartialStop {
+    TimePoint at;
+    std::vector<int> joints;
+    bool base = false;
+  };
+
   RobotModel model_;
-  std::string fault;  // what Fault() reports ("" = none)
+  std::vector<PartialStop> partial_stops;  // StopOnly() calls (not in `calls`)
+  std::string fault;                       // what Fault() reports ("" = none)
   std::vector<Call> calls;
   std::optional<CommandId> goto_id;
   int goto_updates = 3;

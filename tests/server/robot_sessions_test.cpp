@@ -1,9 +1,9 @@
 #include "robot_sessions.h"
 
-#include "robot_sessions_fixture.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
+#include "sessions_fixture.h"
 #include "state_encoding.h"
 
 #include <gmock/gmock.h>
@@ -240,9 +240,9 @@ TEST_F(RobotSessionsTest, HoldsWhatAVanishedClientMovedWhileTheRobotMoves) {
   EXPECT_EQ(expired[0].client_id, kAlice);
   EXPECT_TRUE(expired[0].moved_robot);
   Run();
-  ASSERT_FALSE(fake_->calls.empty());
-  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "pan held where it is";
-  EXPECT_EQ(fake_->calls.back().values, std::vector<double>{0.5});
+  ASSERT_EQ(fake_->partial_stops.size(), 1u) << "pan stopped where it is (StopOnly)";
+  EXPECT_EQ(fake_->partial_stops[0].joints, std::vector<int>{0});
+  EXPECT_FALSE(fake_->partial_stops[0].base);
   EXPECT_EQ(sessions_->joint_owner(0), 0);
 }
 
@@ -355,14 +355,19 @@ TEST_F(FewSessionsTest, RefusesAPlaybackDeclaringMoreFramesThanTheQueueHolds) {
   EXPECT_THAT(r.at(1).message, HasSubstr("the queue limit is 100"));
 }
 
-TEST_F(RobotSessionsTest, LeavesAStillRobotAloneWhenTheClientThatMovedItVanishes) {
+// The watchdog does not trust a driver's `moving` (a driver may never set
+// it): what the vanished client owned is stopped, which leaves a still
+// robot still, and nothing else is touched.
+TEST_F(RobotSessionsTest, StopsOnlyWhatAVanishedClientOwnedEvenOnAStillRobot) {
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan")}));
   Run();
   fake_->moving = false;  // the set-point has been reached
   clock_.Advance(seconds(3));
   ASSERT_EQ(sessions_->Expire(clock_.Now()).size(), 1u);
   Run();
-  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "no STOP was needed";
+  EXPECT_EQ(fake_->calls.back().type, CommandType::kJointSetPoint) << "no STOP of everything";
+  ASSERT_EQ(fake_->partial_stops.size(), 1u);
+  EXPECT_EQ(fake_->partial_stops[0].joints, std::vector<int>{0});
 }
 
 TEST_F(RobotSessionsTest, DoesNotStopTheRobotWhenAQueryOnlyClientVanishes) {

@@ -4,7 +4,7 @@
 // and entries the stores account, never RSS or time.
 #include "robot_sessions.h"
 
-#include "robot_sessions_fixture.h"
+#include "sessions_fixture.h"
 #include "robotalk/server.h"
 
 #include <gmock/gmock.h>

@@ -32,6 +32,9 @@ class ObservedDriver final : public Driver {
   void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
   void ReadState(RobotState& s) const override { inner_->ReadState(s); }
   void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
+  void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& done) override {
+    inner_->StopOnly(scope, now, done);
+  }
   void Halt(std::vector<Completion>& done) override {
     observer_->Halted(true);
     inner_->Halt(done);

@@ -7,6 +7,7 @@
 //   concurrently: a driver needs no locking of its own.
 // - Execute() receives only motion commands (JOINT_SETPOINT / JOINT_SPEED /
 //   JOINT_FORCE / FRAME_SETPOINT / GOTO / SETSPEED): STOP arrives as Stop(),
+//   the watchdog's stop of a vanished client's actuators as StopOnly(),
 //   panic as Halt(), PANIC_RESET as Resume(). The command was checked against
 //   model() (robotalk::CheckCommand): `target` is a valid joint (JOINT_*) or
 //   control-frame (FRAME_SETPOINT) index, never a mimic follower, and the
@@ -24,7 +25,7 @@
 // treated the same way as soon as the bound passes (the call's late result is
 // discarded).
 //
-// Real-time: the RobotDaemon is the real-time path. Execute(), Stop(),
+// Real-time: the RobotDaemon is the real-time path. Execute(), Stop(), StopOnly(),
 // Update() and ReadState() must not block on I/O for longer than a control
 // period and should not allocate (the output vectors come preallocated;
 // push_back within their capacity; messages of non-SUCCESS answers may
@@ -40,6 +41,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -69,6 +71,19 @@ struct Completion {
   CommandId id = 0;
   Signal signal = Signal::kSuccess;
   std::string message;
+};
+
+/// Part of the robot for StopOnly(): what one client moved (the server's
+/// watchdog stops it when that client vanishes). Views the server's own
+/// storage, valid for the call only.
+struct StopScope {
+  /// Joint indices (RobotModel::joint), each at most once; only joints with
+  /// dofs. A mimic follower may appear (it follows its leader whatever is
+  /// done to it).
+  std::span<const int> joints;
+  /// The base (the first root), its speed and a task on it (a GOTO: it
+  /// completes INTERRUPTED).
+  bool base = false;
 };
 
 /// The robot's measured state. Sized by the server from the model once.
@@ -101,6 +116,18 @@ class Driver {
   /// every command in progress completes INTERRUPTED (appended). Also called
   /// by the server's watchdog and at shutdown.
   virtual void Stop(TimePoint now, std::vector<Completion>& interrupted) = 0;
+  /// A STOP of part of the robot at `now`, which cannot be refused: the
+  /// joints of `scope` come to rest and hold; with `scope.base` the base
+  /// comes to rest and a task on it (a GOTO in progress) completes
+  /// INTERRUPTED (appended). Everything else -- another client's joint, its
+  /// GOTO -- runs on. Called by the server's watchdog for a vanished client.
+  /// Default: Stop(now, interrupted), i.e. everything stops: stopping more
+  /// than asked is safe, stopping less is not. A driver that overrides it
+  /// must stop at least the scope, also while a task runs (a GOTO that
+  /// refuses SETSPEED with BUSY must still be interrupted here).
+  virtual void StopOnly(const StopScope& /*scope*/, TimePoint now, std::vector<Completion>& interrupted) {
+    Stop(now, interrupted);
+  }
   /// Advances the robot to `now` (one period after the previous call);
   /// appends the completions of commands that finished.
   virtual void Update(TimePoint now, std::vector<Completion>& completed) = 0;

@@ -1,6 +1,6 @@
-// The RobotSessions test fixture: the ServerDaemon's session layer of one
-// robot and its RobotDaemon on a manual clock with a fake driver, and
-// helpers that build request packages.
+// The session layer of one robot and its RobotDaemon on a fake driver and a
+// manual clock, without threads or a transport, for RobotSessions tests
+// (robot_sessions_test.cpp, watchdog_test.cpp, session_memory_test.cpp).
 #pragma once
 
 #include "fake_driver.h"
@@ -13,11 +13,12 @@
 
 #include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace robotalk::testing {
 
-constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
+inline constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
 
 inline Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std::string target = "",
                    StartTime start = StartTime::Now()) {
