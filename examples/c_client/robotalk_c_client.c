@@ -20,7 +20,7 @@
 #include "robotalk_msgs_reply_package_t.h"
 
 enum {
-  kProtocolVersion = 2,
+  kProtocolVersion = 3,
   kMaxPackages = 64,  /* outstanding packages */
   kMaxReplies = 1024, /* the reply cache (oldest dropped first) */
   kMaxIdsPerPackage = 64,

@@ -1,4 +1,4 @@
---[[ A small RoboTalk client in Lua 5.2 (protocol 2, open mode, direct mode),
+--[[ A small RoboTalk client in Lua 5.2 (protocol 3, open mode, direct mode),
 written from docs/protocol.md and docs/writing_a_client.md with LCM's Lua
 module (Debian's liblcm-lua: /usr/lib/lua/5.2/lcm.so) and the Lua modules
 lcm-gen makes of lcmtypes/robotalk_msgs.
@@ -34,7 +34,7 @@ local lcm = require('lcm')
 local msgs = require('robotalk_msgs')
 
 local M = {}
-M.PROTOCOL_VERSION = 2
+M.PROTOCOL_VERSION = 3
 local RETRANSMIT_S, RECHECK_S, HEARTBEAT_S, HELLO_REPEAT_S, MAX_TRIES = 0.3, 1.0, 0.25, 0.2, 10
 local SIGNALS = { [-1] = 'UNKNOWN_OUTCOME', [0] = 'SUCCESS', 'MODIFIED', 'NA', 'BUSY', 'INTERRUPTED', 'ERROR', 'PANIC' }
 function M.signal_name(s) return SIGNALS[s] or '?' end
