@@ -6,6 +6,7 @@
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
 #include "robotalk/routed_lcm_transport.h"
+#include "panic_latch.h"
 #include "server_daemon.h"
 
 #include <atomic>
@@ -92,6 +93,10 @@ class Server::Impl {
       owned_transport_ = OpenLcmTransport(options_.lcm_url);
       transport = owned_transport_.get();
     }
+    if (options_.panic_latch_path.empty() && !options_.state_dir.empty()) {
+      PanicLatch::MakeStateDir(options_.state_dir);
+      options_.panic_latch_path = PanicLatch::LatchFileFor(options_.state_dir, transport->url());
+    }
     server_daemon_ = std::make_unique<ServerDaemon>(
         *transport, clock_,
         ServerDaemonOptions{.announce_period = options_.announce_period,
@@ -107,9 +112,9 @@ class Server::Impl {
                                                   ? TrafficLayout::kSplit
                                                   : TrafficLayout::kSingle,
                             .fifo_priority = options_.precise_timing ? 5 : 0});
-    const SessionOptions sessions{
-        options_.session_timeout, options_.max_queue, options_.max_future,
-        PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};
+    SessionOptions sessions{options_.session_timeout, options_.max_queue, options_.max_future};
+    sessions.limits.max_goto_distance = options_.max_goto_distance;
+    sessions.playback = PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction};
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
                                             .precise_timing = options_.precise_timing};
@@ -132,6 +137,10 @@ class Server::Impl {
     for (auto& robot : robots_) robot->Start();
     server_daemon_->Start();
     running_ = true;
+    if (!options_.panic_latch_path.empty()) {
+      std::fprintf(stderr, "robotalk-server: panic latch %s (a panic survives a restart)\n",
+                   options_.panic_latch_path.c_str());
+    }
     for (auto& robot : robots_) {
       std::fprintf(stderr, "robotalk-server: serving robot '%s' (%zu links, %d dofs, config %s) on '%s'\n",
                    robot->robot_name().c_str(), robot->model().links().size(), robot->model().num_dofs(),
