@@ -45,8 +45,8 @@ class LogLimiter {
 
  private:
   struct Seen {
-    TimePoint first{};      // when the current window started
-    TimePoint last{};       // the latest repeat
+    TimePoint first{};        // when the current window started
+    TimePoint last{};         // the latest repeat
     std::uint64_t count = 0;  // repeats in this window
   };
   void Summarise(TimePoint now, bool all, std::vector<std::string>& out);

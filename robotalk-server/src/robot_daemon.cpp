@@ -413,8 +413,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   }
 
   const bool snapshot = clock_.Now().time_since_epoch().count() < snapshot_wanted_until_.load();
-  const bool state_read =
-      snapshot && (state_fresh || sampled || ReadState(now)) && state_problem_.empty();
+  const bool state_read = snapshot && (state_fresh || sampled || ReadState(now)) && state_problem_.empty();
   TimePoint next = next_update_;
   TimePoint next_due = TimePoint::max();
   bool ready = false;
@@ -568,7 +567,8 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
 }
 
 bool RobotDaemon::ReadState(TimePoint now) {
-  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return false;
+  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk)
+    return false;
   std::optional<std::string> problem = NonFiniteState(model(), state_);
   if (!problem) {
     if (!state_problem_.empty()) state_problem_.clear();

@@ -65,7 +65,8 @@ std::optional<std::string> NonFiniteState(const RobotModel& model, const RobotSt
         r < model.roots().size() ? "root '" + model.link(model.roots()[r].link).name + "'" : "root";
     static constexpr const char* kAxis[3] = {"x", "y", "z"};
     for (int a = 0; a < 3; ++a) {
-      if (!std::isfinite(p.translation[a])) return root + " " + kAxis[a] + " is " + NotFinite(p.translation[a]);
+      if (!std::isfinite(p.translation[a]))
+        return root + " " + kAxis[a] + " is " + NotFinite(p.translation[a]);
     }
     if (!p.rotation.coeffs().allFinite()) return root + " orientation is not finite";
   }

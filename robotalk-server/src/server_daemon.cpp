@@ -102,7 +102,8 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   if (auto it = latched_at_start_.find(name); it != latched_at_start_.end()) {
     // A panic outlives the server: the robot starts held, as it was left.
     std::vector<QueuedItem> none;
-    daemon.Panic(none, "panic latched before this server started (in " + latch_.path() + ": " + it->second + ")");
+    daemon.Panic(none,
+                 "panic latched before this server started (in " + latch_.path() + ": " + it->second + ")");
     Log("robot '" + name + "': starts in PANIC, latched in " + latch_.path() + " (" + it->second +
         "); PANIC_RESET to resume");
   }

@@ -294,8 +294,10 @@ TEST(WireTime, FromSecondsNamesTheLimitForAFiniteTimeOutOfRangeAndNonFiniteOnlyF
     }
     return std::string("no error");
   };
-  EXPECT_EQ(message(1e12), "FromSeconds: 1e+12 s is out of range: a time holds at most +-9.2e+09 s (292 years)");
-  EXPECT_EQ(message(-1e12), "FromSeconds: -1e+12 s is out of range: a time holds at most +-9.2e+09 s (292 years)");
+  EXPECT_EQ(message(1e12),
+            "FromSeconds: 1e+12 s is out of range: a time holds at most +-9.2e+09 s (292 years)");
+  EXPECT_EQ(message(-1e12),
+            "FromSeconds: -1e+12 s is out of range: a time holds at most +-9.2e+09 s (292 years)");
   EXPECT_THAT(message(std::nan("")), HasSubstr("nan s is not a finite time"));
   EXPECT_THAT(message(std::numeric_limits<double>::infinity()), HasSubstr("inf s is not a finite time"));
   EXPECT_NO_THROW(FromSeconds(9.1e9));

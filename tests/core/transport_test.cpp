@@ -63,9 +63,12 @@ TEST_P(TransportTest, DeliversPublishedBytesToItsOwnSubscriber) {
 // at dispatch wrote replies before their requests).
 TEST_P(TransportTest, SaysWhenTheDispatchedMessageWasReceivedNotWhenItIsDispatched) {
   std::vector<WallTime> received;
-  auto sub = transport_->Subscribe(
-      "A", [&](const std::string&, std::span<const std::uint8_t>) { received.push_back(transport_->ReceiveTime()); });
-  const auto now = [] { return std::chrono::time_point_cast<std::chrono::microseconds>(std::chrono::system_clock::now()); };
+  auto sub = transport_->Subscribe("A", [&](const std::string&, std::span<const std::uint8_t>) {
+    received.push_back(transport_->ReceiveTime());
+  });
+  const auto now = [] {
+    return std::chrono::time_point_cast<std::chrono::microseconds>(std::chrono::system_clock::now());
+  };
   const WallTime before = now();
   transport_->Publish("A", Bytes{1});
   std::this_thread::sleep_for(std::chrono::milliseconds(50));  // received, not yet dispatched

@@ -52,7 +52,8 @@ TEST(LogLimiter, CapsDistinctLinesPerSecondAndSaysHowManyWereSuppressed) {
   const TimePoint t{seconds(100)};
   for (int i = 0; i < 10; ++i) limiter.Add("line " + std::to_string(i), t, out);
   limiter.Tick(t + seconds(1), out);
-  EXPECT_THAT(out, ElementsAre("line 0", "line 1", "line 2", "(7 more log lines suppressed in the last second)"));
+  EXPECT_THAT(out,
+              ElementsAre("line 0", "line 1", "line 2", "(7 more log lines suppressed in the last second)"));
 }
 
 TEST(LogLimiter, RemembersAtMostItsBoundOfDistinctLines) {

@@ -93,7 +93,8 @@ TEST_F(NonFiniteStateTest, HaltsTheRobotInPanicNamingTheValueEvenWhenNobodyReads
   Run();
   EXPECT_TRUE(daemon_->in_panic());
   EXPECT_TRUE(driver_->halted);
-  EXPECT_THAT(daemon_->fault(), HasSubstr("driver 'fake' reports a non-finite state: joint 'pan' dof 0 position is NaN"));
+  EXPECT_THAT(daemon_->fault(),
+              HasSubstr("driver 'fake' reports a non-finite state: joint 'pan' dof 0 position is NaN"));
   ASSERT_FALSE(out_.log.empty());
   EXPECT_THAT(out_.log.front(), HasSubstr("DRIVER FAULT"));
 }
@@ -106,7 +107,8 @@ TEST_F(NonFiniteStateTest, AQueryAnswersErrorNamingTheNonFiniteValue) {
   const auto replies = Run();
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].reply.signal, Signal::kError);
-  EXPECT_THAT(replies[0].reply.message, HasSubstr("BASE_POSE: driver 'fake' reports a non-finite state: root 'base' x is +inf"));
+  EXPECT_THAT(replies[0].reply.message,
+              HasSubstr("BASE_POSE: driver 'fake' reports a non-finite state: root 'base' x is +inf"));
   EXPECT_TRUE(replies[0].reply.values.empty());
   // A reset with the sensor still broken: halted again at the next read.
   EXPECT_TRUE(daemon_->ResetPanic());

@@ -205,8 +205,9 @@ int RunRecord(Args& a) {
                          : "")
             << "\n";
   if (r.late > 0) {
-    std::cerr << "robotalk-logplay: warning: " << r.late
-              << " events were dispatched more than 0.25 s after their receipt and are written after later ones\n";
+    std::cerr
+        << "robotalk-logplay: warning: " << r.late
+        << " events were dispatched more than 0.25 s after their receipt and are written after later ones\n";
   }
   return 0;
 }

@@ -12,10 +12,10 @@
 // Thread safety: none.
 #pragma once
 
-#include <cstddef>
-#include <cstdint>
 #include <algorithm>
 #include <climits>
+#include <cstddef>
+#include <cstdint>
 #include <map>
 #include <span>
 #include <string>

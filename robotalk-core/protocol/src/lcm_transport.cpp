@@ -65,7 +65,7 @@ class LcmCore {
   lcm_t* lcm_ = nullptr;
   const LcmTransportOptions options_;
   const std::string url_;
-  std::exception_ptr error_;    // only touched by the HandleFor() thread
+  std::exception_ptr error_;      // only touched by the HandleFor() thread
   std::int64_t received_us_ = 0;  // the dispatched message's recv_utime (HandleFor() thread)
 };
 
@@ -149,7 +149,9 @@ int LcmTransport::HandleFor(Duration timeout) {
 
 int LcmTransport::fileno() const { return lcm_get_fileno(impl_->lcm_); }
 
-WallTime LcmTransport::ReceiveTime() const { return WallTime(std::chrono::microseconds(impl_->received_us_)); }
+WallTime LcmTransport::ReceiveTime() const {
+  return WallTime(std::chrono::microseconds(impl_->received_us_));
+}
 
 std::string LcmTransport::url() const { return impl_->url_.empty() ? "(LCM default)" : impl_->url_; }
 

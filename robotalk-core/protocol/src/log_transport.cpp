@@ -166,7 +166,9 @@ int LogTransport::HandleFor(Duration timeout) {
 
 std::string LogTransport::url() const { return "file://" + impl_->options_.path; }
 
-WallTime LogTransport::ReceiveTime() const { return WallTime(std::chrono::microseconds(impl_->received_us_)); }
+WallTime LogTransport::ReceiveTime() const {
+  return WallTime(std::chrono::microseconds(impl_->received_us_));
+}
 
 bool LogTransport::done() const { return !impl_->next_; }
 

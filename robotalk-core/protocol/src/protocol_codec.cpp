@@ -253,7 +253,8 @@ StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
     if (w.frame_poses[i].size() != 7)
       throw ProtocolError(label + "frame_poses[" + std::to_string(i) + "] is not 7 values");
     if (finite) {
-      CheckFiniteValues(label, ("frame_poses[" + std::to_string(i) + "]").c_str(), w.frame_poses[i].data(), 7);
+      CheckFiniteValues(label, ("frame_poses[" + std::to_string(i) + "]").c_str(), w.frame_poses[i].data(),
+                        7);
     }
     PoseValues pose{};
     std::copy(w.frame_poses[i].begin(), w.frame_poses[i].end(), pose.begin());

@@ -137,8 +137,8 @@ bool IsMotionCommand(CommandType t) { return t != CommandType::kStop && t != Com
 namespace {
 
 // The text of what is wrong with `c`; `signal` gets the signal to answer with.
-std::optional<std::string> CommandProblem(const RobotModel& model, const Command& c, const CommandLimits& limits,
-                                          Signal* signal) {
+std::optional<std::string> CommandProblem(const RobotModel& model, const Command& c,
+                                          const CommandLimits& limits, Signal* signal) {
   *signal = Signal::kError;
   if (auto bad = CheckFinite(c)) return bad;
   switch (c.type) {

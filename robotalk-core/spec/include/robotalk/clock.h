@@ -122,8 +122,9 @@ inline Duration FromSeconds(double s) {
   if (!(s > -kMaxSeconds && s < kMaxSeconds)) {
     char text[160];
     if (std::isfinite(s)) {  // finite: name the limit
-      std::snprintf(text, sizeof text, "FromSeconds: %g s is out of range: a time holds at most +-%g s (292 years)",
-                    s, kMaxSeconds);
+      std::snprintf(text, sizeof text,
+                    "FromSeconds: %g s is out of range: a time holds at most +-%g s (292 years)", s,
+                    kMaxSeconds);
     } else {
       std::snprintf(text, sizeof text, "FromSeconds: %g s is not a finite time", s);
     }
