@@ -216,7 +216,7 @@ TEST(ReceiptOrder, WritesEventsByReceiveTimeNotByDispatchOrder) {
   order.Add(2050, "ROBOTALK/pioneer/STATE", none);  // same time: dispatch order kept
   std::vector<std::string> written;
   const auto write = [&](const ReceiptOrder::Event& e) { written.push_back(e.channel); };
-  order.Release(2999, write);
+  order.Release(3000, write);
   EXPECT_EQ(written, std::vector<std::string>{"ROBOTALK/pioneer/REQUEST"}) << "held until `hold` has passed";
   order.Release(3050, write);
   EXPECT_EQ(written, (std::vector<std::string>{"ROBOTALK/pioneer/REQUEST", "ROBOTALK/pioneer/REPLY/00",
