@@ -388,6 +388,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     if (Guarded("Resume", nullptr, now, [&] { driver_->Resume(); }) == CallOutcome::kOk) halted_ = false;
   }
   for (const QueuedItem& item : due_) Execute(item, now);
+  bool state_fresh = false;  // state_ read after this iteration's Update
   if (now >= next_update_) {
     Guarded("Update", nullptr, now, [&] { driver_->Update(now, completions_); });
     std::string_view condition;  // the driver's own text: nothing allocated unless it changed
@@ -399,8 +400,10 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     const Duration p = driver_->period();
     next_update_ = next_update_ == TimePoint::min() ? now + p : next_update_ + p;
     if (next_update_ <= now) next_update_ = now + p;  // overran: skip, don't burst
+    // Every period, watched or not: a non-finite state is a fault at once.
+    state_fresh = ReadState(now);
   }
-  const bool sampled = sample_due && (Sample(now, period), true);
+  const bool sampled = sample_due && (Sample(now, period, state_fresh), true);
   for (const Completion& c : completions_) {
     auto owner = in_progress_.find(c.id);
     if (owner == in_progress_.end()) continue;
@@ -415,9 +418,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   }
 
   const bool snapshot = clock_.Now().time_since_epoch().count() < snapshot_wanted_until_.load();
-  const bool state_read = snapshot && (sampled || Guarded("ReadState", nullptr, now, [&] {
-                                                    driver_->ReadState(state_);
-                                                  }) == CallOutcome::kOk);
+  const bool state_read = snapshot && (state_fresh || sampled || ReadState(now)) && state_problem_.empty();
   TimePoint next = next_update_;
   TimePoint next_due = TimePoint::max();
   bool ready = false;
@@ -538,10 +539,16 @@ void RobotDaemon::Audit(const QueuedItem& item, const DriverResult& result, bool
 }
 
 void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
-  if (Guarded("ReadState", nullptr, reply.exec_time, [&] { driver_->ReadState(state_); }) !=
-      CallOutcome::kOk) {
+  if (!ReadState(reply.exec_time)) {
     reply.signal = Signal::kError;
     reply.message = std::string(ToString(item.query)) + ": " + last_fault_;
+    return;
+  }
+  if (!state_problem_.empty()) {  // a broken sensor: no value is trusted
+    reply.signal = Signal::kError;
+    reply.message = std::string(ToString(item.query)) + ": driver '" + driver_name_ +
+                    "' reports a non-finite state: " + state_problem_ + "; robot '" + robot_name_ +
+                    "' halted (panic) until PANIC_RESET";
     return;
   }
   AnswerFrom(state_, kinematics_, roots_, item, reply);
@@ -551,9 +558,24 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
   }
 }
 
-void RobotDaemon::Sample(TimePoint now, Duration period) {
-  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
-  FillSample(now, period);
+bool RobotDaemon::ReadState(TimePoint now) {
+  if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk)
+    return false;
+  std::optional<std::string> problem = NonFiniteState(model(), state_);
+  if (!problem) {
+    if (!state_problem_.empty()) state_problem_.clear();
+    return true;
+  }
+  state_problem_ = std::move(*problem);
+  // A broken sensor: the robot cannot be driven safely on it. The fault's
+  // text is the same while the value stays bad (the log prints it once).
+  Fault("driver '" + driver_name_ + "' reports a non-finite state: " + state_problem_, now);
+  return true;
+}
+
+void RobotDaemon::Sample(TimePoint now, Duration period, bool state_fresh) {
+  if (!state_fresh && !ReadState(now)) return;
+  FillSample(now, period);  // in panic; non-finite values are sent as they are (docs/protocol.md)
 }
 
 }  // namespace robotalk

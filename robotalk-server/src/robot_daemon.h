@@ -116,6 +116,11 @@ struct DaemonOutput {
   }
 };
 
+/// What in `state` is not finite, naming the joint and dof or the base
+/// field ("joint 'pan' dof 0 position is NaN", "root 'base' x is +inf",
+/// "base v is NaN"); nullopt when every value is finite. Allocates only then.
+std::optional<std::string> NonFiniteState(const RobotModel& model, const RobotState& state);
+
 class RobotDaemon {
  public:
   RobotDaemon(std::string robot_name, std::string driver_name, std::unique_ptr<Driver> driver,
@@ -220,7 +225,11 @@ class RobotDaemon {
   // The --log-executions line of a motion command: "executed" (the driver
   // accepted it) or "refused" (with the driver's reason).
   void Audit(const QueuedItem& item, const DriverResult& result, bool accepted);
-  void Sample(TimePoint now, Duration period);
+  // Reads the driver's state into state_ with the fault guard; a non-finite
+  // value is a driver fault (halt, panic; issue 19) and state_problem_ names
+  // it. False when the call threw.
+  bool ReadState(TimePoint now);
+  void Sample(TimePoint now, Duration period, bool state_fresh);
   void FillSample(TimePoint now, Duration period);  // from state_, just read
   enum class CallOutcome { kOk, kThrew, kOverran };
   // Runs one driver call with the fault guard (a throw latches a fault;
@@ -301,6 +310,7 @@ class RobotDaemon {
   bool halted_ = false;
   std::string reported_condition_;  // the driver's last Driver::Fault() text
   std::string last_fault_;          // the fault a throw latched, for the command's ERROR
+  std::string state_problem_;       // what the last state read had that was not finite, or ""
 };
 
 }  // namespace robotalk

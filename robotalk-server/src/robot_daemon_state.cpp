@@ -29,7 +29,49 @@ void WritePose(const Eigen::Isometry3d& x, double* out) {
 
 double Yaw(const Eigen::Isometry3d& x) { return std::atan2(x.linear()(1, 0), x.linear()(0, 0)); }
 
+std::string NotFinite(double v) { return std::isnan(v) ? "NaN" : (v > 0 ? "+inf" : "-inf"); }
+
 }  // namespace
+
+std::optional<std::string> NonFiniteState(const RobotModel& model, const RobotState& state) {
+  // The usual case, allocation-free: everything finite.
+  const auto finite = [](const Eigen::VectorXd& v) { return v.allFinite(); };
+  bool roots_finite = std::isfinite(state.base_v) && std::isfinite(state.base_omega);
+  for (const Pose& p : state.root_poses) {
+    roots_finite = roots_finite && p.translation.allFinite() && p.rotation.coeffs().allFinite();
+  }
+  if (finite(state.position) && finite(state.velocity) && finite(state.effort) && roots_finite) {
+    return std::nullopt;
+  }
+  static constexpr const char* kWhat[3] = {"position", "velocity", "effort"};
+  const Eigen::VectorXd* vectors[3] = {&state.position, &state.velocity, &state.effort};
+  for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
+    const Joint& joint = model.joint(j);
+    for (int k = 0; k < static_cast<int>(joint.dofs.size()); ++k) {
+      const int i = model.dof_offset(j) + k;
+      for (int w = 0; w < 3; ++w) {
+        if (i < vectors[w]->size() && !std::isfinite((*vectors[w])[i])) {
+          return "joint '" + joint.name + "' dof " + std::to_string(k) + " " + kWhat[w] + " is " +
+                 NotFinite((*vectors[w])[i]);
+        }
+      }
+    }
+  }
+  if (!std::isfinite(state.base_v)) return "base v is " + NotFinite(state.base_v);
+  if (!std::isfinite(state.base_omega)) return "base omega is " + NotFinite(state.base_omega);
+  for (std::size_t r = 0; r < state.root_poses.size(); ++r) {
+    const Pose& p = state.root_poses[r];
+    const std::string root =
+        r < model.roots().size() ? "root '" + model.link(model.roots()[r].link).name + "'" : "root";
+    static constexpr const char* kAxis[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      if (!std::isfinite(p.translation[a]))
+        return root + " " + kAxis[a] + " is " + NotFinite(p.translation[a]);
+    }
+    if (!p.rotation.coeffs().allFinite()) return root + " orientation is not finite";
+  }
+  return "a value is not finite";  // sizes that do not match the model
+}
 
 // Absolute deadline: the next start time, driver period or sample. With
 // precise timing, the last `final_spin` before a start time or sample is a

@@ -313,7 +313,7 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                                std::vector<Reply>& immediate, bool playback) {
   const RobotModel& model = daemon_.model();
   if (c.type == CommandType::kPanicReset) {
-    if (auto bad = CheckCommand(model, c)) {
+    if (auto bad = CheckCommand(model, c, options_.limits)) {
       immediate.push_back(MakeReply(c.id, bad->signal, bad->message, now));
     } else if (daemon_.ResetPanic()) {
       log_.push_back("robot '" + robot_ + "': panic reset by " + s.who);
@@ -332,7 +332,7 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                   now));
     return std::nullopt;
   }
-  if (auto bad = CheckCommand(model, c)) {
+  if (auto bad = CheckCommand(model, c, options_.limits)) {
     immediate.push_back(MakeReply(c.id, bad->signal, bad->message, now));
     return std::nullopt;
   }

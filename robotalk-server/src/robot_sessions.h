@@ -29,6 +29,8 @@ struct SessionOptions {
   std::size_t max_queue = 10000;
   /// Start times further ahead than this, or further in the past, are refused.
   Duration max_future = std::chrono::hours(1);
+  /// What CheckCommand allows beyond the model (the GOTO bound).
+  CommandLimits limits;
   /// When playback mode has seen enough frames to estimate its delay.
   PlaybackEstimatorOptions playback;
   /// Most client sessions of this robot at once; a new client beyond is refused.

@@ -1,5 +1,6 @@
 #include "robotalk/server.h"
 
+#include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
@@ -93,6 +94,10 @@ class Server::Impl {
       owned_transport_ = OpenLcmTransport(options_.lcm_url);
       transport = owned_transport_.get();
     }
+    if (options_.panic_latch_path.empty() && !options_.state_dir.empty()) {
+      PanicLatch::MakeStateDir(options_.state_dir);
+      options_.panic_latch_path = PanicLatch::LatchFileFor(options_.state_dir, transport->url());
+    }
     server_daemon_ = std::make_unique<ServerDaemon>(
         *transport, clock_,
         ServerDaemonOptions{.announce_period = options_.announce_period,
@@ -108,9 +113,9 @@ class Server::Impl {
                                                   ? TrafficLayout::kSplit
                                                   : TrafficLayout::kSingle,
                             .fifo_priority = options_.precise_timing ? 5 : 0});
-    SessionOptions sessions{
-        options_.session_timeout, options_.max_queue, options_.max_future,
-        PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction}};
+    SessionOptions sessions{options_.session_timeout, options_.max_queue, options_.max_future};
+    sessions.limits.max_goto_distance = options_.max_goto_distance;
+    sessions.playback = PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction};
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     sessions.max_sessions = options_.max_sessions_per_robot;
@@ -136,6 +141,10 @@ class Server::Impl {
     for (auto& robot : robots_) robot->Start();
     server_daemon_->Start();
     running_ = true;
+    if (!options_.panic_latch_path.empty()) {
+      std::fprintf(stderr, "robotalk-server: panic latch %s (a panic survives a restart)\n",
+                   options_.panic_latch_path.c_str());
+    }
     for (auto& robot : robots_) {
       std::fprintf(stderr, "robotalk-server: serving robot '%s' (%zu links, %d dofs, config %s) on '%s'\n",
                    robot->robot_name().c_str(), robot->model().links().size(), robot->model().num_dofs(),

@@ -30,6 +30,8 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
       options_(options),
       faults_(options.reply_drop_probability, options.reply_duplicate_probability, options.fault_seed),
       latch_(options.panic_latch_path),
+      log_limiter_(LogLimiterOptions{.lines_per_second = options.log_lines_per_second,
+                                     .repeat_window = options.log_repeat_window}),
       congestion_rng_(options.fault_seed) {
   latched_at_start_ = latch_.Load();  // throws naming the file
   event_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -79,6 +81,7 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
 
 ServerDaemon::~ServerDaemon() {
   Stop();
+  log_limiter_.Flush(clock_.Now(), log_pending_);  // what repeated since its last summary
   WriteLog();
   subscription_.reset();
   hello_subscription_.reset();
@@ -102,7 +105,8 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   if (auto it = latched_at_start_.find(name); it != latched_at_start_.end()) {
     // A panic outlives the server: the robot starts held, as it was left.
     std::vector<QueuedItem> none;
-    daemon.Panic(none, "panic latched before this server started (" + it->second + ")");
+    daemon.Panic(none,
+                 "panic latched before this server started (in " + latch_.path() + ": " + it->second + ")");
     Log("robot '" + name + "': starts in PANIC, latched in " + latch_.path() + " (" + it->second +
         "); PANIC_RESET to resume");
   }
@@ -270,6 +274,7 @@ void ServerDaemon::RunOnce(Duration timeout) {
     Announce(now);
     next_announce_ = now + options_.announce_period;
   }
+  log_limiter_.Tick(now, log_pending_);
   WriteLog();
 }
 
@@ -496,23 +501,7 @@ void ServerDaemon::Announce(TimePoint now) {
   transport_.Publish(kAnnounceChannel, bytes);
 }
 
-void ServerDaemon::Log(const std::string& line) {
-  const TimePoint now = clock_.Now();
-  if (now - log_window_ >= std::chrono::seconds(1)) {
-    if (log_suppressed_ > 0) {
-      log_pending_.push_back("(" + std::to_string(log_suppressed_) +
-                             " more log lines suppressed in the last second)");
-    }
-    log_window_ = now;
-    log_lines_ = 0;
-    log_suppressed_ = 0;
-  }
-  if (++log_lines_ > options_.log_lines_per_second) {
-    ++log_suppressed_;
-    return;
-  }
-  log_pending_.push_back(line);
-}
+void ServerDaemon::Log(const std::string& line) { log_limiter_.Add(line, clock_.Now(), log_pending_); }
 
 void ServerDaemon::WriteLog() {
   for (const std::string& line : log_pending_) std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());

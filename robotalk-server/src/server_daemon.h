@@ -21,6 +21,7 @@
 #pragma once
 
 #include "fault_injector.h"
+#include "log_limiter.h"
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robot_sessions.h"
@@ -54,8 +55,11 @@ struct ServerDaemonOptions {
   double reply_drop_probability = 0.0;
   double reply_duplicate_probability = 0.0;
   std::uint64_t fault_seed = 1;
-  /// Most log lines per second; the rest are counted and summarised.
+  /// Most log lines per second; the rest are counted and summarised. A line
+  /// repeated within `log_repeat_window` prints once, then one summary per
+  /// window ("... (repeated 230 times in 10 s)"; log_limiter.h).
   int log_lines_per_second = 20;
+  Duration log_repeat_window = std::chrono::seconds(10);
   /// The server's instance id in ANNOUNCE (random when 0).
   std::int64_t server_id = 0;
   /// The panic latch file (panic_latch.h); "" keeps no panic across restarts.
@@ -162,6 +166,7 @@ class ServerDaemon {
   const ServerDaemonOptions options_;
   FaultInjector faults_;
   PanicLatch latch_;
+  LogLimiter log_limiter_;  // per line and per second (log_limiter.h)
   std::map<std::string, std::string> latched_at_start_;
   std::map<std::string, Robot> robots_;
   std::unique_ptr<SessionGate> gate_;
@@ -180,10 +185,6 @@ class ServerDaemon {
   std::vector<std::string> refusals_;  // GUARDED_BY(refusals_mu_)
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
-  // Rate limit of the log.
-  TimePoint log_window_{};
-  int log_lines_ = 0;
-  std::uint64_t log_suppressed_ = 0;
   std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes
   DaemonOutput direct_output_;            // scratch for AnswerDirect
   std::atomic<bool> running_{false};

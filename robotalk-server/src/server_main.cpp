@@ -1,6 +1,7 @@
 // robotalk-server's command line (server_main.h).
 #include "robotalk/server_main.h"
 
+#include "panic_latch.h"
 #include "robotalk/error.h"
 
 #include <algorithm>
@@ -27,6 +28,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   equally by its robots; half is each client's guaranteed
                                   share (default 65536)
   --max-future S                  refuse start times more than S seconds ahead, or in the past (default 3600)
+  --max-goto-distance M           refuse a GOTO whose target is more than M metres from the world
+                                  origin (default 100)
   --duration S                    exit after S seconds (default: run until SIGINT/SIGTERM)
   --congestion-max-pause S        the paper's congestion injector: pause a random time in
                                   [0, S] s in the ServerDaemon after each received package
@@ -40,8 +43,14 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   its command answers ERROR, the robot is held in panic (default 2;
                                   0 = no bound)
   --log-lines-per-second N        most log lines a second; the rest are counted (default 20)
-  --panic-latch FILE              keep which robots are in panic in FILE, so a panic survives a
-                                  restart (written before a panic is acknowledged)
+  --state-dir DIR                 where the server keeps state across restarts (default
+                                  $ROBOTALK_STATE_DIR, else /var/lib/robotalk for root, else
+                                  $XDG_STATE_HOME/robotalk or ~/.local/state/robotalk)
+  --panic-latch FILE              the panic latch: which robots are in panic, so a panic survives a
+                                  restart (written before a panic is acknowledged; default: a file
+                                  per LCM network in the state directory, panic-latch.<network>)
+  --no-panic-latch                keep no panic across restarts (warns: a restarted server forgets
+                                  a panic)
   --key FILE                      keyed mode: the server's secret key (robotalk-keygen); with --clients
   --clients FILE                  keyed mode: the access list of client keys and their rights per
                                   robot (docs/security.md); without both the server runs open
@@ -81,6 +90,7 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
   double duration = -1;
   std::string simulate;
   double sample_period = 0.01;
+  bool no_panic_latch = false;
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -115,6 +125,12 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.max_sessions_per_robot = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--panic-latch") {
         options.panic_latch_path = value();
+        if (options.panic_latch_path.empty()) throw Error("--panic-latch needs a file name");
+      } else if (arg == "--state-dir") {
+        options.state_dir = value();
+        if (options.state_dir.empty()) throw Error("--state-dir needs a directory name");
+      } else if (arg == "--no-panic-latch") {
+        no_panic_latch = true;
       } else if (arg == "--log-lines-per-second") {
         options.log_lines_per_second = static_cast<int>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--driver-call-bound") {
@@ -131,6 +147,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.max_queue = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e7));
       } else if (arg == "--max-queued-total") {
         options.max_queued_total = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e8));
+      } else if (arg == "--max-goto-distance") {
+        options.max_goto_distance = ParseNumber(arg, value(), 0, 1e7);
       } else if (arg == "--max-future") {
         options.max_future = FromSeconds(ParseNumber(arg, value(), 0, 86400 * 7));
       } else if (arg == "--congestion-max-pause") {
@@ -154,6 +172,9 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
       std::cerr << "robotalk-server: no --robot given\n" << kUsage;
       return 2;
     }
+    if (no_panic_latch && (!options.panic_latch_path.empty() || !options.state_dir.empty())) {
+      throw Error("--no-panic-latch contradicts --panic-latch / --state-dir");
+    }
   } catch (const std::exception& e) {
     std::cerr << "robotalk-server: " << e.what() << "\n";
     return 2;
@@ -165,6 +186,18 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
       return 2;
     }
     return simulate_command(registry, robots, simulate, duration < 0 ? 10.0 : duration, sample_period);
+  }
+
+  if (no_panic_latch) {
+    std::cerr << "robotalk-server: WARNING: --no-panic-latch: a panic does not survive a restart of this "
+                 "server (a restarted server runs the next command)\n";
+  } else if (options.panic_latch_path.empty() && options.state_dir.empty()) {
+    try {
+      options.state_dir = PanicLatch::DefaultStateDir();
+    } catch (const std::exception& e) {
+      std::cerr << "robotalk-server: error: " << e.what() << "\n";
+      return 1;
+    }
   }
 
   // Signals are taken synchronously by this thread; the daemons never see them.

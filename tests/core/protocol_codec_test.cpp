@@ -284,6 +284,25 @@ TEST(WireTime, FromSecondsRefusesWhatNoDurationHolds) {
   EXPECT_THROW(FromSeconds(-std::numeric_limits<double>::infinity()), Error);
 }
 
+// Issue 19: "FromSeconds: 1e12 s is not a finite time" (it is finite).
+TEST(WireTime, FromSecondsNamesTheLimitForAFiniteTimeOutOfRangeAndNonFiniteOnlyForNaNAndInfinity) {
+  const auto message = [](double s) {
+    try {
+      FromSeconds(s);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(1e12),
+            "FromSeconds: 1e+12 s is out of range: a time holds at most +-9.2e+09 s (292 years)");
+  EXPECT_EQ(message(-1e12),
+            "FromSeconds: -1e+12 s is out of range: a time holds at most +-9.2e+09 s (292 years)");
+  EXPECT_THAT(message(std::nan("")), HasSubstr("nan s is not a finite time"));
+  EXPECT_THAT(message(std::numeric_limits<double>::infinity()), HasSubstr("inf s is not a finite time"));
+  EXPECT_NO_THROW(FromSeconds(9.1e9));
+}
+
 RobotModel TestRobot(BaseType base) {
   RobotModelBuilder b("bot");
   b.AddLink(Link{.name = "base"}).AddLink(Link{.name = "head"});
@@ -331,6 +350,23 @@ TEST(CheckCommand, AcceptsWellFormedCommandsAndNamesWhatIsWrongOtherwise) {
   auto [s6, m6] = Check(arm, {1, CommandType::kSetSpeed, {}, "", {0.1, 0.1}});
   EXPECT_EQ(s6, Signal::kNa);
   EXPECT_THAT(m6, HasSubstr("fixed base"));
+}
+
+// Issue 19: `GOTO 1e308 0 0` was accepted (ODE drove at full speed).
+TEST(CheckCommand, RefusesAGotoBeyondTheBoundNamingTheTargetAndTheBound) {
+  const RobotModel m = TestRobot(BaseType::kDifferential);
+  auto [s1, m1] = Check(m, {1, CommandType::kGoto, {}, "", {1e308, 0, 0}});
+  EXPECT_EQ(s1, Signal::kError);
+  EXPECT_EQ(m1, "GOTO: target (1e+308, 0) m is 1e+308 m from the world origin; the bound is 100 m");
+  auto [s2, m2] = Check(m, {1, CommandType::kGoto, {}, "", {-80, 70, 0}});
+  EXPECT_EQ(s2, Signal::kError);
+  EXPECT_THAT(m2, HasSubstr("106.3 m from the world origin"));
+  EXPECT_EQ(Check(m, {1, CommandType::kGoto, {}, "", {-60, 79, 3}}).first, Signal::kSuccess);
+  // Configurable: the server's --max-goto-distance.
+  const CommandLimits wide{.max_goto_distance = 1000};
+  EXPECT_FALSE(CheckCommand(m, {1, CommandType::kGoto, {}, "", {-80, 70, 0}}, wide));
+  EXPECT_THAT(CheckCommand(m, {1, CommandType::kGoto, {}, "", {0, 2000, 0}}, wide)->message,
+              HasSubstr("the bound is 1000 m"));
 }
 
 TEST(CheckCommand, ChecksQueryTargets) {

@@ -87,6 +87,19 @@ TEST(StateSample, RefusesNonFiniteValuesNamingTheField) {
   EXPECT_THAT(FromWireError(w), HasSubstr("effort[0] is infinite"));
 }
 
+// Issue 19: a driver reporting NaN left `watch` printing nothing (the sample
+// was refused). In panic the server sends what the driver reported.
+TEST(StateSample, AcceptsNonFiniteValuesOnlyInASampleThatSaysPanic) {
+  auto w = ToWire(Sample());
+  w.base[0] = std::nan("");
+  w.position[1] = std::numeric_limits<double>::infinity();
+  EXPECT_THAT(FromWireError(w), HasSubstr("position[1] is infinite"));
+  w.panic = true;
+  const StateSample s = FromWire(w);
+  EXPECT_TRUE(std::isnan(s.base.x));
+  EXPECT_TRUE(std::isinf(s.positions[1]));
+}
+
 TEST(StateSample, RefusesTimesOutOfRange) {
   auto w = ToWire(Sample());
   w.server_time_us = INT64_MAX;

@@ -59,6 +59,31 @@ TEST_P(TransportTest, DeliversPublishedBytesToItsOwnSubscriber) {
   EXPECT_EQ(got[0].second, payload);
 }
 
+// Issue 19: the receive time travels through the seam (a recorder stamping
+// at dispatch wrote replies before their requests).
+TEST_P(TransportTest, SaysWhenTheDispatchedMessageWasReceivedNotWhenItIsDispatched) {
+  std::vector<WallTime> received;
+  auto sub = transport_->Subscribe("A", [&](const std::string&, std::span<const std::uint8_t>) {
+    received.push_back(transport_->ReceiveTime());
+  });
+  const auto now = [] {
+    return std::chrono::time_point_cast<std::chrono::microseconds>(std::chrono::system_clock::now());
+  };
+  const WallTime before = now();
+  transport_->Publish("A", Bytes{1});
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // received, not yet dispatched
+  const WallTime published = now();
+  transport_->Publish("A", Bytes{2});
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const WallTime dispatch = now();
+  EXPECT_EQ(HandleUpTo(2), 2);
+  ASSERT_EQ(received.size(), 2u);
+  EXPECT_GE(received[0], before);
+  EXPECT_LT(received[0], published) << "the first message's receipt, before the second was published";
+  EXPECT_GE(received[1], published);
+  EXPECT_LT(received[1], dispatch) << "stamped at receipt, 50 ms before this dispatch";
+}
+
 TEST_P(TransportTest, MatchesTheChannelRegexAgainstTheWholeName) {
   std::vector<std::string> got;
   auto record = [&](const std::string& ch, std::span<const std::uint8_t>) { got.push_back(ch); };

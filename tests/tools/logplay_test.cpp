@@ -1,6 +1,7 @@
 // SessionLog and the frame/sequence helpers of robotalk-logplay, fed with
 // encoded packages in memory (no LCM, no files).
 #include "logplay.h"
+#include "receipt_order.h"
 #include "robotalk/channels.h"
 #include "robotalk/protocol_codec.h"
 #include "robotalk/sequence_file.h"
@@ -202,6 +203,40 @@ TEST(Channels, AreSplitIntoRobotKindAndClient) {
   EXPECT_EQ(n.rest, "00000000000004d2");
   EXPECT_EQ(ParseChannel("ROBOTALK/ANNOUNCE").kind, "ANNOUNCE");
   EXPECT_EQ(ParseChannel("OTHER/x/REQUEST").kind, "");
+}
+
+// Issue 19: the recorder dispatches the 66 lanes one after the other, so a
+// reply (received later) could be written before its request.
+TEST(ReceiptOrder, WritesEventsByReceiveTimeNotByDispatchOrder) {
+  ReceiptOrder order(/*hold_us=*/1000);
+  const std::vector<std::uint8_t> none;
+  // Dispatched: the reply lane first, then the request lane.
+  order.Add(2050, "ROBOTALK/pioneer/REPLY/00", none);
+  order.Add(2000, "ROBOTALK/pioneer/REQUEST", none);
+  order.Add(2050, "ROBOTALK/pioneer/STATE", none);  // same time: dispatch order kept
+  std::vector<std::string> written;
+  const auto write = [&](const ReceiptOrder::Event& e) { written.push_back(e.channel); };
+  order.Release(3000, write);
+  EXPECT_EQ(written, std::vector<std::string>{"ROBOTALK/pioneer/REQUEST"}) << "held until `hold` has passed";
+  order.Release(3050, write);
+  EXPECT_EQ(written, (std::vector<std::string>{"ROBOTALK/pioneer/REQUEST", "ROBOTALK/pioneer/REPLY/00",
+                                               "ROBOTALK/pioneer/STATE"}));
+  EXPECT_EQ(order.late(), 0u);
+  // Dispatched later than `hold`: written at once, and counted.
+  order.Add(1500, "LATE", none);
+  order.ReleaseAll(write);
+  EXPECT_EQ(written.back(), "LATE");
+  EXPECT_EQ(order.late(), 1u);
+}
+
+TEST(ReceiptOrder, HoldsAtMostItsBoundWritingTheOldestFirst) {
+  ReceiptOrder order(/*hold_us=*/1000000, /*max_held=*/2);
+  std::vector<std::int64_t> written;
+  const auto write = [&](const ReceiptOrder::Event& e) { written.push_back(e.received_us); };
+  for (std::int64_t t : {30, 10, 20}) order.Add(t, "C", std::vector<std::uint8_t>{});
+  order.Release(0, write);
+  EXPECT_EQ(written, std::vector<std::int64_t>{10});
+  EXPECT_EQ(order.held(), 2u);
 }
 
 }  // namespace

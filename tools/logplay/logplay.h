@@ -72,12 +72,15 @@ struct RecordResult {
   std::uint64_t events = 0;
   std::uint64_t bytes = 0;
   int signal = 0;  ///< the signal that stopped it, or 0
+  /// Events dispatched too late to be written in receipt order (ReceiptOrder::late).
+  std::uint64_t late = 0;
 };
 
 /// `record`: every channel of every lane of `options.url` (the split
 /// layout's 66 ports, or the one URL of the single layout) into one LCM log,
-/// stamped with the wall clock when dispatched, until the duration is over
-/// or a signal arrives; prints one line to `progress` when it starts.
+/// each event stamped with LCM's receive time and written in receipt order
+/// (held up to 0.25 s to sort the lanes), until the duration is over or a
+/// signal arrives; prints one line to `progress` when it starts.
 /// Throws LogError (cannot write) or TransportError (bad URL).
 RecordResult Record(const RecordOptions& options, std::ostream& progress);
 

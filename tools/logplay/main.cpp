@@ -204,6 +204,11 @@ int RunRecord(Args& a) {
             << (r.signal ? std::string(" (stopped by ") + robotalk::cli::Interrupter::Name(r.signal) + ")"
                          : "")
             << "\n";
+  if (r.late > 0) {
+    std::cerr
+        << "robotalk-logplay: warning: " << r.late
+        << " events were dispatched more than 0.25 s after their receipt and are written after later ones\n";
+  }
   return 0;
 }
 

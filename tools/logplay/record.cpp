@@ -2,10 +2,13 @@
 // lcm-logger hears one LCM URL; with the split traffic layout
 // (robotalk/traffic_layout.h) requests and replies travel on other ports, so
 // the recorder opens the URL with every lane and writes what it hears through
-// LCM's own log API, in the file format lcm-logger writes.
+// LCM's own log API, in the file format lcm-logger writes: each event stamped
+// with LCM's receive time (Transport::ReceiveTime) and written in receipt
+// order (ReceiptOrder), not in the order the lanes were dispatched.
 #include "logplay.h"
 
 #include "interrupt.h"
+#include "receipt_order.h"
 #include "robotalk/routed_lcm_transport.h"
 
 #include <lcm/lcm-cpp.hpp>
@@ -24,24 +27,26 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
       OpenLcmTransport(options.url, OpenLcmOptions{.all_lanes = true});
   RecordResult result;
   std::string write_error;
+  // Written in receipt order, stamped with the receive time (ReceiptOrder).
+  ReceiptOrder order;
+  const auto write = [&](const ReceiptOrder::Event& e) {
+    if (!write_error.empty()) return;
+    lcm::LogEvent event{};
+    event.timestamp = e.received_us;  // as lcm-logger: LCM's receive time
+    event.channel = e.channel;
+    event.datalen = static_cast<std::int32_t>(e.bytes.size());
+    event.data = const_cast<std::uint8_t*>(e.bytes.data());  // LCM's API is not const; it only reads
+    if (file.writeEvent(&event) != 0) {
+      write_error = "record: writing '" + options.output + "' failed";
+      return;
+    }
+    ++result.events;
+    result.bytes += e.bytes.size();
+  };
   auto sub = transport->Subscribe(
       options.channels, [&](const std::string& channel, std::span<const std::uint8_t> bytes) {
         if (channel == "LCM_SELF_TEST") return;  // each LCM instance's own start-up probe
-        lcm::LogEvent event{};
-        // Wall-clock microseconds at dispatch (lcm-logger stamps LCM's receive
-        // time; the difference is this thread's dispatch delay, microseconds).
-        event.timestamp = std::chrono::duration_cast<std::chrono::microseconds>(
-                              std::chrono::system_clock::now().time_since_epoch())
-                              .count();
-        event.channel = channel;
-        event.datalen = static_cast<std::int32_t>(bytes.size());
-        event.data = const_cast<std::uint8_t*>(bytes.data());  // LCM's API is not const; it only reads
-        if (file.writeEvent(&event) != 0) {
-          if (write_error.empty()) write_error = "record: writing '" + options.output + "' failed";
-          return;
-        }
-        ++result.events;
-        result.bytes += bytes.size();
+        order.Add(transport->ReceiveTime().time_since_epoch().count(), channel, bytes);
       });
   progress << "robotalk-logplay: recording " << transport->url()
            << (dynamic_cast<RoutedLcmTransport*>(transport.get()) ? " (every lane of the split layout)" : "")
@@ -55,12 +60,18 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
     Duration wait = std::chrono::milliseconds(100);
     if (options.duration > Duration(0)) wait = std::min<Duration>(wait, options.duration - (now - start));
     transport->HandleFor(wait);
-    if (clock.Now() - last_flush >= std::chrono::seconds(1)) {  // a killed recorder loses at most 1 s
+    order.Release(std::chrono::duration_cast<std::chrono::microseconds>(
+                      std::chrono::system_clock::now().time_since_epoch())
+                      .count(),
+                  write);
+    if (clock.Now() - last_flush >= std::chrono::seconds(1)) {  // a killed recorder loses at most 1.25 s
       std::fflush(file.getFilePtr());
       last_flush = clock.Now();
     }
   }
   sub.reset();
+  order.ReleaseAll(write);
+  result.late = order.late();
   std::fflush(file.getFilePtr());
   if (!write_error.empty()) throw LogError(write_error);
   result.signal = cli::Interrupter::Signal();

@@ -13,6 +13,10 @@ namespace robotalk {
 Subscription::~Subscription() = default;
 Transport::~Transport() = default;
 
+WallTime Transport::ReceiveTime() const {
+  return std::chrono::time_point_cast<std::chrono::microseconds>(std::chrono::system_clock::now());
+}
+
 namespace {
 
 // What LCM's C callback needs: the handler and where to store its exception.
@@ -22,6 +26,7 @@ namespace {
 struct Entry {
   std::shared_ptr<const Transport::Handler> handler;
   std::exception_ptr* error = nullptr;  // owned by the transport's Impl
+  std::int64_t* received_us = nullptr;  // owned by the transport's Impl
 };
 
 // Never lets an exception cross LCM's C stack: it is stored and rethrown by
@@ -30,6 +35,7 @@ extern "C" void OnLcmMessage(const lcm_recv_buf_t* rbuf, const char* channel, vo
   auto* entry = static_cast<Entry*>(user);
   std::exception_ptr* error = entry->error;
   if (*error) return;  // an earlier handler of this message failed
+  *entry->received_us = rbuf->recv_utime;
   const std::shared_ptr<const Transport::Handler> handler = entry->handler;
   try {
     (*handler)(channel,
@@ -59,7 +65,8 @@ class LcmCore {
   lcm_t* lcm_ = nullptr;
   const LcmTransportOptions options_;
   const std::string url_;
-  std::exception_ptr error_;  // only touched by the HandleFor() thread
+  std::exception_ptr error_;      // only touched by the HandleFor() thread
+  std::int64_t received_us_ = 0;  // the dispatched message's recv_utime (HandleFor() thread)
 };
 
 }  // namespace internal
@@ -109,6 +116,7 @@ std::unique_ptr<Subscription> LcmTransport::Subscribe(const std::string& channel
   auto entry = std::make_unique<Entry>();
   entry->handler = std::make_shared<const Handler>(std::move(handler));
   entry->error = &impl_->error_;
+  entry->received_us = &impl_->received_us_;
   lcm_subscription_t* sub = lcm_subscribe(impl_->lcm_, channel_regex.c_str(), &OnLcmMessage, entry.get());
   if (sub == nullptr) {
     throw TransportError("LcmTransport: cannot subscribe '" + channel_regex + "' on " + url());
@@ -140,6 +148,10 @@ int LcmTransport::HandleFor(Duration timeout) {
 }
 
 int LcmTransport::fileno() const { return lcm_get_fileno(impl_->lcm_); }
+
+WallTime LcmTransport::ReceiveTime() const {
+  return WallTime(std::chrono::microseconds(impl_->received_us_));
+}
 
 std::string LcmTransport::url() const { return impl_->url_.empty() ? "(LCM default)" : impl_->url_; }
 

@@ -81,6 +81,7 @@ class LogCore {
   std::optional<TimePoint> start_;
   std::int64_t first_us_ = 0;
   std::size_t read_ = 0;
+  std::int64_t received_us_ = 0;  // the dispatched event's timestamp (HandleFor() thread)
   std::mutex mu_;
   std::vector<std::shared_ptr<Entry>> subs_;  // GUARDED_BY(mu_)
 };
@@ -156,6 +157,7 @@ int LogTransport::HandleFor(Duration timeout) {
     for (const auto& s : matching) {
       if (!s->active) continue;
       const std::shared_ptr<const Handler> handler = s->handler;
+      d.received_us_ = event.timestamp_us;
       (*handler)(event.channel, event.bytes);  // an exception leaves the rest of the log to the next call
     }
   }
@@ -163,6 +165,10 @@ int LogTransport::HandleFor(Duration timeout) {
 }
 
 std::string LogTransport::url() const { return "file://" + impl_->options_.path; }
+
+WallTime LogTransport::ReceiveTime() const {
+  return WallTime(std::chrono::microseconds(impl_->received_us_));
+}
 
 bool LogTransport::done() const { return !impl_->next_; }
 

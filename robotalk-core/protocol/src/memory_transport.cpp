@@ -20,6 +20,7 @@ namespace {
 struct Message {
   std::string channel;
   std::shared_ptr<const std::vector<std::uint8_t>> bytes;  // shared by every endpoint
+  WallTime published{};
 };
 
 struct SubscriptionEntry {
@@ -113,7 +114,8 @@ void MemoryBus::Leave(const MemoryEndpoint* endpoint) {
 }
 
 void MemoryBus::Deliver(const std::string& channel, std::span<const std::uint8_t> bytes) {
-  Message m{channel, std::make_shared<const std::vector<std::uint8_t>>(bytes.begin(), bytes.end())};
+  Message m{channel, std::make_shared<const std::vector<std::uint8_t>>(bytes.begin(), bytes.end()),
+            std::chrono::time_point_cast<std::chrono::microseconds>(std::chrono::system_clock::now())};
   std::vector<std::shared_ptr<MemoryEndpoint>> targets;
   {
     std::lock_guard lock(mu_);
@@ -185,6 +187,7 @@ int MemoryTransport::HandleFor(Duration timeout) {
     for (const auto& s : matching) {
       if (!s->active) continue;  // unsubscribed by an earlier handler
       const std::shared_ptr<const Handler> handler = s->handler;
+      received_ = m.published;
       (*handler)(m.channel, *m.bytes);  // an exception leaves the rest queued
     }
   }

@@ -241,16 +241,24 @@ StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
   }
   if (w.period_us < 0) throw ProtocolError(label + "negative period_us " + std::to_string(w.period_us));
   if (w.sample < 0) throw ProtocolError(label + "negative sample number");
-  CheckFiniteValues(label, "position", w.position.data(), w.position.size());
-  CheckFiniteValues(label, "velocity", w.velocity.data(), w.velocity.size());
-  CheckFiniteValues(label, "effort", w.effort.data(), w.effort.size());
-  CheckFiniteValues(label, "base", w.base, 5);
+  // A sample in panic may carry what a broken driver reported (NaN, inf):
+  // the server halted the robot for it (issue 19; docs/protocol.md).
+  const bool finite = !w.panic;
+  if (finite) {
+    CheckFiniteValues(label, "position", w.position.data(), w.position.size());
+    CheckFiniteValues(label, "velocity", w.velocity.data(), w.velocity.size());
+    CheckFiniteValues(label, "effort", w.effort.data(), w.effort.size());
+    CheckFiniteValues(label, "base", w.base, 5);
+  }
   StateSample s;
   s.frame_poses.reserve(w.frame_poses.size());
   for (std::size_t i = 0; i < w.frame_poses.size(); ++i) {
     if (w.frame_poses[i].size() != 7)
       throw ProtocolError(label + "frame_poses[" + std::to_string(i) + "] is not 7 values");
-    CheckFiniteValues(label, ("frame_poses[" + std::to_string(i) + "]").c_str(), w.frame_poses[i].data(), 7);
+    if (finite) {
+      CheckFiniteValues(label, ("frame_poses[" + std::to_string(i) + "]").c_str(), w.frame_poses[i].data(),
+                        7);
+    }
     PoseValues pose{};
     std::copy(w.frame_poses[i].begin(), w.frame_poses[i].end(), pose.begin());
     s.frame_poses.push_back(pose);

@@ -41,6 +41,7 @@ class SingleUdpmTransport final : public Transport {
   int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
   int fileno() const override { return inner_.fileno(); }
   std::string url() const override { return url_; }
+  WallTime ReceiveTime() const override { return inner_.ReceiveTime(); }
 
  private:
   LcmTransport inner_;
@@ -126,7 +127,15 @@ std::unique_ptr<Subscription> RoutedLcmTransport::Subscribe(const std::string& c
 
 int RoutedLcmTransport::DispatchLane(int lane) {
   LcmTransport* t = lanes_[static_cast<std::size_t>(lane)].load(std::memory_order_acquire);
-  return t ? t->HandleFor(Duration(0)) : 0;
+  if (!t) return 0;
+  dispatching_ = t;
+  const int n = t->HandleFor(Duration(0));
+  dispatching_ = nullptr;
+  return n;
+}
+
+WallTime RoutedLcmTransport::ReceiveTime() const {
+  return dispatching_ ? dispatching_->ReceiveTime() : Transport::ReceiveTime();
 }
 
 int RoutedLcmTransport::HandleFor(Duration timeout) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 
 namespace robotalk {
 namespace {
@@ -145,7 +146,8 @@ bool IsMotionCommand(CommandType t) { return t != CommandType::kStop && t != Com
 namespace {
 
 // The text of what is wrong with `c`; `signal` gets the signal to answer with.
-std::optional<std::string> CommandProblem(const RobotModel& model, const Command& c, Signal* signal) {
+std::optional<std::string> CommandProblem(const RobotModel& model, const Command& c,
+                                          const CommandLimits& limits, Signal* signal) {
   *signal = Signal::kError;
   if (auto bad = CheckFinite(c)) return bad;
   switch (c.type) {
@@ -200,6 +202,16 @@ std::optional<std::string> CommandProblem(const RobotModel& model, const Command
         *signal = Signal::kNa;
         return Label(c) + ": robot " + Quote(model.name()) + " has a fixed base";
       }
+      if (c.type == CommandType::kGoto) {
+        const double distance = std::hypot(c.values[0], c.values[1]);
+        if (!(distance <= limits.max_goto_distance)) {
+          char text[200];
+          std::snprintf(text, sizeof text,
+                        "GOTO: target (%.4g, %.4g) m is %.4g m from the world origin; the bound is %.4g m",
+                        c.values[0], c.values[1], distance, limits.max_goto_distance);
+          return std::string(text);
+        }
+      }
       return std::nullopt;
     }
     case CommandType::kStop:
@@ -214,9 +226,9 @@ std::optional<std::string> QueryProblem(const RobotModel& model, const Query& q)
 
 }  // namespace
 
-std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& c) {
+std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& c, const CommandLimits& limits) {
   Signal signal = Signal::kError;
-  if (auto problem = CommandProblem(model, c, &signal)) return Refusal{signal, std::move(*problem)};
+  if (auto problem = CommandProblem(model, c, limits, &signal)) return Refusal{signal, std::move(*problem)};
   return std::nullopt;
 }
 

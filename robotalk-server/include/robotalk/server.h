@@ -9,6 +9,7 @@
 #pragma once
 
 #include "robotalk/clock.h"
+#include "robotalk/command.h"
 #include "robotalk/driver.h"
 #include "robotalk/transport.h"
 
@@ -44,6 +45,9 @@ struct ServerOptions {
   /// Start times further ahead than this, or further in the past, are
   /// refused with ERROR.
   Duration max_future = std::chrono::hours(1);
+  /// A GOTO target farther than this from the world origin (m) is refused
+  /// with ERROR naming both (robotalk::CommandLimits).
+  double max_goto_distance = kDefaultMaxGotoDistance;
   /// Print one stderr line per executed command (diagnostics).
   bool log_executions = false;
   /// A driver call running longer than this is a driver fault: its command
@@ -51,8 +55,16 @@ struct ServerOptions {
   Duration driver_call_bound = std::chrono::seconds(2);
   /// Most server log lines per second; the rest are counted and summarised.
   int log_lines_per_second = 20;
-  /// A file that keeps which robots are in panic across restarts ("" = none).
+  /// The panic latch (docs/server.md): a file that keeps which robots are in
+  /// panic, so a panic survives a restart. `panic_latch_path` names it; when
+  /// that is "" and `state_dir` is not, it is the file for this server's LCM
+  /// network in `state_dir` (created, mode 0700): "<state_dir>/panic-latch.
+  /// udpm-239.255.76.67-7667". Both "" = no latch (robotalk-server's command
+  /// line defaults `state_dir` to PanicLatch::DefaultStateDir(); only
+  /// --no-panic-latch leaves both empty). The Server constructor throws
+  /// Error naming the file or directory when it cannot be created or written.
   std::string panic_latch_path;
+  std::string state_dir;
   /// Serve a robot even when another server announces the same name.
   bool allow_duplicate_robots = false;
   /// Keyed mode (docs/security.md): the server's secret key file and the

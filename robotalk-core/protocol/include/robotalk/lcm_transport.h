@@ -45,6 +45,8 @@ class LcmTransport final : public Transport {
   int fileno() const override;
   /// The URL LCM was started with (recv_buf_size included), or "(LCM default)".
   std::string url() const override;
+  /// LCM's recv_utime of the message being dispatched.
+  WallTime ReceiveTime() const override;
 
   /// The URL LcmTransport would hand LCM for `options` (exposed for tests).
   static std::string EffectiveUrl(const LcmTransportOptions& options);

@@ -52,6 +52,8 @@ class LogTransport final : public Transport {
   /// -1: there is no descriptor to poll; call HandleFor().
   int fileno() const override { return -1; }
   std::string url() const override;
+  /// The logged timestamp of the event being dispatched.
+  WallTime ReceiveTime() const override;
 
   /// True once every event has been read.
   bool done() const;

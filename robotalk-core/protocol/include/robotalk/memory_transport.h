@@ -63,6 +63,8 @@ class MemoryTransport final : public Transport {
   int HandleFor(Duration timeout) override;
   int fileno() const override;
   std::string url() const override { return "memory://"; }
+  /// When the message being dispatched was published.
+  WallTime ReceiveTime() const override { return received_; }
 
   /// Messages waiting in this endpoint's queue.
   std::size_t queued() const;
@@ -72,6 +74,7 @@ class MemoryTransport final : public Transport {
  private:
   std::shared_ptr<MemoryBus> bus_;
   std::shared_ptr<MemoryEndpoint> endpoint_;
+  WallTime received_{};  // the dispatched message's (HandleFor() thread)
 };
 
 }  // namespace robotalk

@@ -52,10 +52,11 @@ Query FromWire(const robotalk_msgs::query_t& q);
 Reply FromWire(const robotalk_msgs::reply_t& r);
 
 /// State samples. FromWire validates: num_dofs and num_frames non-negative and
-/// equal to the array sizes, every value finite, times in range, period and
-/// sample not negative; throws ProtocolError naming the field ("robot_state
-/// 'pioneer' sample 3: position[2] is NaN"). `expected_dofs` >= 0 also checks
-/// the dof count against a model's.
+/// equal to the array sizes, every value finite unless the sample says panic
+/// (then NaN or inf is what a broken driver reported; the server halted the
+/// robot for it), times in range, period and sample not negative; throws ProtocolError naming the field
+/// ("robot_state 'pioneer' sample 3: position[2] is NaN"). `expected_dofs` >= 0 also checks the dof count
+/// against a model's.
 StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs = -1);
 robotalk_msgs::robot_state_t ToWire(const StateSample& s);
 

@@ -53,6 +53,8 @@ class RoutedLcmTransport final : public Transport {
   int fileno() const override;
   /// The main URL, as given to the constructor.
   std::string url() const override;
+  /// LCM's recv_utime of the message being dispatched, from its lane.
+  WallTime ReceiveTime() const override;
 
   /// Whether lane `lane` has a receive socket (exposed for tests).
   bool Receives(int lane) const;
@@ -69,6 +71,7 @@ class RoutedLcmTransport final : public Transport {
   std::array<std::unique_ptr<LcmTransport>, kLaneCount> owned_;  // GUARDED_BY(mu_)
   std::array<std::atomic<LcmTransport*>, kLaneCount> lanes_{};   // published after creation
   std::array<std::atomic<bool>, kLaneCount> receiving_{};        // a socket in epoll_fd_
+  LcmTransport* dispatching_ = nullptr;  // the lane HandleFor() is dispatching (its thread only)
 };
 
 /// Opens LCM on RoboTalk URL `url` ("" = $LCM_DEFAULT_URL, else LCM's

@@ -23,6 +23,7 @@
 #include "robotalk/clock.h"
 #include "robotalk/error.h"
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -44,6 +45,10 @@ class Subscription {
   Subscription(const Subscription&) = delete;
   Subscription& operator=(const Subscription&) = delete;
 };
+
+/// Wall-clock time (the UNIX epoch, microseconds): when a message was
+/// received, as LCM stamps it (lcm_recv_buf_t::recv_utime).
+using WallTime = std::chrono::time_point<std::chrono::system_clock, std::chrono::microseconds>;
 
 class Transport {
  public:
@@ -75,6 +80,16 @@ class Transport {
   /// Where this transport talks ("udpm://239.255.76.67:7667?ttl=0",
   /// "memory://", "log:///path/file.lcmlog").
   virtual std::string url() const = 0;
+
+  /// When the message whose handler is running was received: LCM's receive
+  /// stamp (the kernel's, where the socket gives one), the publish time on a
+  /// MemoryTransport, the logged time on a LogTransport. Dispatch comes
+  /// later, and across the lanes of the split layout not in receipt order
+  /// (issue 19: a recorder stamping at dispatch wrote replies before their
+  /// requests). Call it only from inside a handler, on the dispatching
+  /// thread; this default (for transports that cannot know) is the time of
+  /// the call.
+  virtual WallTime ReceiveTime() const;
 
  protected:
   Transport() = default;

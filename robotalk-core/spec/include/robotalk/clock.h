@@ -10,7 +10,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -107,11 +109,27 @@ inline Duration SaturatingSub(TimePoint a, TimePoint b) {
 
 /// Seconds as a double, for printing and for maths on rates.
 inline double ToSeconds(Duration d) { return std::chrono::duration<double>(d).count(); }
+/// The largest |seconds| FromSeconds() accepts: a Duration (int64
+/// nanoseconds) holds about ±292 years.
+inline constexpr double kMaxSeconds = 9.2e9;
+
 /// Seconds -> Duration, rounded to the nanosecond. Throws robotalk::Error for
-/// NaN, infinities and magnitudes beyond ±292 years (a cast would be UB).
+/// NaN and infinities ("FromSeconds: nan s is not a finite time") and for
+/// magnitudes beyond kMaxSeconds, naming the limit ("FromSeconds: 1e+12 s is
+/// out of range: a time holds at most +-9.2e+09 s (292 years)"); a cast
+/// would be UB.
 inline Duration FromSeconds(double s) {
-  if (!(s > -9.2e9 && s < 9.2e9))
-    throw Error("FromSeconds: " + std::to_string(s) + " s is not a finite time");
+  if (!(s > -kMaxSeconds && s < kMaxSeconds)) {
+    char text[160];
+    if (std::isfinite(s)) {  // finite: name the limit
+      std::snprintf(text, sizeof text,
+                    "FromSeconds: %g s is out of range: a time holds at most +-%g s (292 years)", s,
+                    kMaxSeconds);
+    } else {
+      std::snprintf(text, sizeof text, "FromSeconds: %g s is not a finite time", s);
+    }
+    throw Error(text);
+  }
   return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s));
 }
 

@@ -134,13 +134,26 @@ struct Reply {
 /// True for the commands that move the robot (all but STOP and PANIC_RESET).
 bool IsMotionCommand(CommandType t);
 
-/// Checks a command against a model before it is queued: nullopt when
-/// well-formed, else the refusal — kError for a malformed request
-/// ("JOINT_SETPOINT: robot 'pioneer' has no joint named 'nek'",
-/// "JOINT_SETPOINT 'pan_tilt': expected 2 values (one per dof), got 3",
-/// "JOINT_SETPOINT 'pan_tilt': value 1 is NaN"), kNa for a servo type or base
-/// command the robot does not support.
-std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& command);
+/// The default of CommandLimits::max_goto_distance (m).
+inline constexpr double kDefaultMaxGotoDistance = 100.0;
+
+/// What a server allows beyond the model (robotalk-server's options).
+struct CommandLimits {
+  /// A GOTO target (x, y) farther than this from the world origin is refused
+  /// with ERROR: the workspace of a base, in m (--max-goto-distance).
+  double max_goto_distance = kDefaultMaxGotoDistance;
+};
+
+/// Checks a command against a model and the server's limits before it is
+/// queued: nullopt when well-formed, else the refusal — kError for a
+/// malformed request ("JOINT_SETPOINT: robot 'pioneer' has no joint named
+/// 'nek'", "JOINT_SETPOINT 'pan_tilt': expected 2 values (one per dof), got
+/// 3", "JOINT_SETPOINT 'pan_tilt': value 1 is NaN", "GOTO: target (1e+308,
+/// 0) m is 1e+308 m from the world origin; the bound is 100 m"), kNa for a
+/// servo type or base command the robot does not support. The one check for
+/// every driver.
+std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& command,
+                                    const CommandLimits& limits = {});
 
 /// Same for queries (unknown target names, a STATE_STREAM period out of range): kError.
 std::optional<Refusal> CheckQuery(const RobotModel& model, const Query& query);

@@ -1,0 +1,136 @@
+// A driver reporting a non-finite state (issue 19: `query` answered
+// "SUCCESS nan 0 0" while `watch` printed nothing). It is a driver fault: the
+// robot is halted and held in panic, queries answer ERROR naming the value,
+// and the state stream keeps coming, in panic, with what the driver said.
+#include "robot_daemon.h"
+
+#include "fake_driver.h"
+#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
+#include "state_encoding.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace robotalk {
+namespace {
+
+using std::chrono::milliseconds;
+using ::testing::HasSubstr;
+
+constexpr std::int64_t kAlice = 0xA11CE;
+
+// A broken encoder: the pan joint's position (or the base's x) is NaN.
+class BrokenSensorDriver final : public testing::FakeDriver {
+ public:
+  using FakeDriver::FakeDriver;
+  void ReadState(RobotState& s) const override {
+    FakeDriver::ReadState(s);
+    if (nan_position) s.position[0] = std::nan("");
+    if (inf_base_x) s.root_poses[0].translation.x() = std::numeric_limits<double>::infinity();
+  }
+  bool nan_position = false;
+  bool inf_base_x = false;
+};
+
+QueuedItem Query(CommandId id, QueryType type) {
+  QueuedItem item;
+  item.client_id = kAlice;
+  item.is_query = true;
+  item.query = type;
+  item.command.id = id;
+  return item;
+}
+
+class NonFiniteStateTest : public ::testing::Test {
+ protected:
+  NonFiniteStateTest() {
+    auto driver = std::make_unique<BrokenSensorDriver>(testing::PanRobot());
+    driver_ = driver.get();
+    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
+    daemon_->Preallocate(out_);
+  }
+  std::vector<DaemonOutput::Answer> Run() {
+    daemon_->RunOnce(clock_.Now());
+    daemon_->TakeOutput(out_);
+    std::vector<DaemonOutput::Answer> all = out_.replies;
+    std::vector<DaemonOutput::Answer> direct;
+    daemon_->TakeDirect(direct);
+    all.insert(all.end(), direct.begin(), direct.end());
+    return all;
+  }
+
+  ManualClock clock_;
+  BrokenSensorDriver* driver_ = nullptr;
+  std::unique_ptr<RobotDaemon> daemon_;
+  DaemonOutput out_;
+};
+
+TEST(NonFiniteState, NamesTheJointAndDofOrTheBaseField) {
+  const RobotModel model = testing::PanRobot();
+  RobotState s;
+  s.position = s.velocity = s.effort = Eigen::VectorXd::Zero(1);
+  s.root_poses.resize(1);
+  EXPECT_EQ(NonFiniteState(model, s), std::nullopt);
+  s.velocity[0] = -std::numeric_limits<double>::infinity();
+  EXPECT_EQ(NonFiniteState(model, s), "joint 'pan' dof 0 velocity is -inf");
+  s.velocity[0] = 0;
+  s.root_poses[0].translation.y() = std::nan("");
+  EXPECT_EQ(NonFiniteState(model, s), "root 'base' y is NaN");
+  s.root_poses[0].translation.y() = 0;
+  s.base_v = std::nan("");
+  EXPECT_EQ(NonFiniteState(model, s), "base v is NaN");
+}
+
+TEST_F(NonFiniteStateTest, HaltsTheRobotInPanicNamingTheValueEvenWhenNobodyReadsTheState) {
+  Run();
+  EXPECT_FALSE(daemon_->in_panic());
+  driver_->nan_position = true;
+  clock_.Advance(milliseconds(10));  // the driver's next period
+  Run();
+  EXPECT_TRUE(daemon_->in_panic());
+  EXPECT_TRUE(driver_->halted);
+  EXPECT_THAT(daemon_->fault(),
+              HasSubstr("driver 'fake' reports a non-finite state: joint 'pan' dof 0 position is NaN"));
+  ASSERT_FALSE(out_.log.empty());
+  EXPECT_THAT(out_.log.front(), HasSubstr("DRIVER FAULT"));
+}
+
+TEST_F(NonFiniteStateTest, AQueryAnswersErrorNamingTheNonFiniteValue) {
+  driver_->inf_base_x = true;
+  Run();
+  clock_.Advance(milliseconds(1));
+  daemon_->Submit(Query(7, QueryType::kBasePose));
+  const auto replies = Run();
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].reply.signal, Signal::kError);
+  EXPECT_THAT(replies[0].reply.message,
+              HasSubstr("BASE_POSE: driver 'fake' reports a non-finite state: root 'base' x is +inf"));
+  EXPECT_TRUE(replies[0].reply.values.empty());
+  // A reset with the sensor still broken: halted again at the next read.
+  EXPECT_TRUE(daemon_->ResetPanic());
+  clock_.Advance(milliseconds(10));
+  Run();
+  EXPECT_TRUE(daemon_->in_panic());
+}
+
+TEST_F(NonFiniteStateTest, TheStateStreamSaysPanicAndCarriesTheValueAClientDecodes) {
+  daemon_->SetStream(kAlice, milliseconds(10));
+  driver_->nan_position = true;
+  Run();
+  clock_.Advance(milliseconds(10));
+  Run();
+  ASSERT_GE(out_.num_samples, 1u);
+  const RobotSample& sample = out_.samples[out_.num_samples - 1];
+  EXPECT_TRUE(sample.panic);
+  const StateSample decoded = DecodeStateSample(EncodeStateSample(ToStateSample("bot", 1, sample)));
+  EXPECT_TRUE(decoded.panic);
+  ASSERT_EQ(decoded.positions.size(), 1u);
+  EXPECT_TRUE(std::isnan(decoded.positions[0])) << "watch prints it: nan, PANIC";
+}
+
+}  // namespace
+}  // namespace robotalk

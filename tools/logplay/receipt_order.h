@@ -1,0 +1,84 @@
+// ReceiptOrder: puts the recorder's events back in the order they were
+// received. `robotalk-logplay record` hears the split layout's 66 lanes; each
+// lane's LCM receive thread stamps a message when it arrives (recv_utime),
+// but the recorder's thread dispatches the lanes one after the other, so a
+// reply can be dispatched before the request that caused it (issue 19: 6 of
+// 19 in a direct-mode session). Events wait here for `hold` (longer than any
+// dispatch delay) and are written sorted by their receive time; equal times
+// keep their dispatch order.
+//
+// Pure (no clock, no I/O): times are given by the caller, in µs since the
+// UNIX epoch. Bounded: past `max_held` events the oldest is written at once.
+// Thread safety: none.
+#pragma once
+
+#include <algorithm>
+#include <climits>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace robotalk::logplay {
+
+class ReceiptOrder {
+ public:
+  struct Event {
+    std::int64_t received_us = 0;
+    std::string channel;
+    std::vector<std::uint8_t> bytes;
+  };
+
+  explicit ReceiptOrder(std::int64_t hold_us = 250000, std::size_t max_held = 100000)
+      : hold_us_(hold_us), max_held_(max_held) {}
+
+  /// Holds a copy of one dispatched message.
+  void Add(std::int64_t received_us, const std::string& channel, std::span<const std::uint8_t> bytes) {
+    held_.emplace(Key{received_us, next_++}, Event{received_us, channel, {bytes.begin(), bytes.end()}});
+  }
+
+  /// Calls `write(const Event&)` in receipt order for every event received
+  /// at or before `now_us - hold`, and for the oldest ones beyond
+  /// `max_held`. An event received before one already written (it waited
+  /// longer than `hold` to be dispatched) is written at once and counted in
+  /// late().
+  template <typename Write>
+  void Release(std::int64_t now_us, Write&& write) {
+    while (!held_.empty() && (held_.begin()->first.first <= now_us - hold_us_ || held_.size() > max_held_)) {
+      WriteFirst(write);
+    }
+  }
+  /// Writes every held event (at the end of a recording).
+  template <typename Write>
+  void ReleaseAll(Write&& write) {
+    while (!held_.empty()) WriteFirst(write);
+  }
+
+  std::size_t held() const { return held_.size(); }
+  /// Events written after a later-received one (dispatched more than `hold` late).
+  std::uint64_t late() const { return late_; }
+
+ private:
+  using Key = std::pair<std::int64_t, std::uint64_t>;  // (receive time, dispatch order)
+
+  template <typename Write>
+  void WriteFirst(Write& write) {
+    auto first = held_.begin();
+    if (first->first.first < last_written_us_) ++late_;
+    last_written_us_ = std::max(last_written_us_, first->first.first);
+    write(first->second);
+    held_.erase(first);
+  }
+
+  const std::int64_t hold_us_;
+  const std::size_t max_held_;
+  std::map<Key, Event> held_;
+  std::uint64_t next_ = 0;
+  std::int64_t last_written_us_ = INT64_MIN;
+  std::uint64_t late_ = 0;
+};
+
+}  // namespace robotalk::logplay
