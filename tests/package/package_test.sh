@@ -8,6 +8,9 @@
 set -euo pipefail
 build=$1 source=$2 cli=$3
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
+# The outside server latches panics by default: in this run's folder, so a
+# second run by hand does not start with robot 'bad' in panic.
+export ROBOTALK_STATE_DIR="$tmp/state"
 cmake --install "$build" --prefix "$tmp/prefix" >"$tmp/install.log"
 cmake -S "$source/tests/package/consumer" -B "$tmp/consumer" -DCMAKE_PREFIX_PATH="$tmp/prefix" >"$tmp/configure.log"
 cmake --build "$tmp/consumer" -j2 >"$tmp/build.log" || { cat "$tmp/build.log"; exit 1; }
