@@ -12,6 +12,7 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
 
 namespace robotalk {
 namespace {
@@ -284,9 +285,10 @@ TEST(ServerMemoryBound, TheDefaultBoundsKeepTheWholeServerUnder512MiB) {
   const ServerOptions server;
   const SessionOptions session;
   // Per session: its reply cache, its unfinished playbacks (their buffered
-  // frames are queued items), the sequence window (at most 4097 set nodes).
+  // frames are queued items), the sequence window (at most kMaxUnseen gaps,
+  // a vector of pairs: twice that while it grows).
   const std::size_t playback = sizeof(PlaybackSequence) + 64 + 32 * sizeof(Duration);
-  const std::size_t window = (SequenceWindow::kWindow + 1) * 48;
+  const std::size_t window = 2 * SequenceWindow::kMaxUnseen * sizeof(std::pair<std::int64_t, std::int64_t>);
   const std::size_t per_session = session.replies.max_bytes + session.max_playbacks * playback + window +
                                   Session::kMaxEnded * 16 + sizeof(Session) + 256;
   const std::size_t queued = server.max_queued_total * QueuedItemBytes();
