@@ -4,8 +4,8 @@
 // and entries the stores account, never RSS or time.
 #include "robot_sessions.h"
 
-#include "sessions_fixture.h"
 #include "robotalk/server.h"
+#include "sessions_fixture.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
