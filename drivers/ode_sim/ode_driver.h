@@ -22,8 +22,8 @@
 #pragma once
 
 #include "collision_shapes.h"
+#include "ode_walk_status.h"
 #include "robotalk/driver.h"
-#include "walking/walk_status.h"
 
 #include <chrono>
 #include <cstdint>
