@@ -163,11 +163,7 @@ void WalkingHumanoid::Attach(OdeWorld& world, JointServos& servos, const std::ve
   ramp_ticks_ = std::max<std::int64_t>(1, std::llround(kRamp / step_));
 }
 
-Pose2 WalkingHumanoid::MeasuredPelvis() const {
-  const Eigen::Isometry3d x = world_->LinkPose(model_.roots().front().link);
-  const Eigen::Vector3d fwd = x.linear().col(0);
-  return {x.translation().x(), x.translation().y(), std::atan2(fwd.y(), fwd.x())};
-}
+Pose2 WalkingHumanoid::MeasuredPelvis() const { return RootPose2(*world_, model_); }
 
 Pose2 WalkingHumanoid::ToPlan(const Pose2& world) const { return Compose(Inverse(plan_to_world_), world); }
 Pose2 WalkingHumanoid::ToWorld(const Pose2& plan) const { return Compose(plan_to_world_, plan); }
