@@ -1,6 +1,7 @@
-// OdeDriver's command handlers: Execute() and the joint, frame and base
-// commands. The controllers that carry them out each step are in
-// ode_driver.cpp; docs/ode_sim.md describes the behaviour.
+// OdeDriver's command handlers: Execute(), STOP, and the joint and frame
+// commands; GOTO and SETSPEED go to the base (base_controller.h). The joint
+// servos that carry them out each step are joint_servos.cpp;
+// docs/ode_sim.md describes the behaviour.
 #include "ode_driver_impl.h"
 
 #include <algorithm>
@@ -10,11 +11,10 @@
 
 namespace robotalk {
 
-using ode_detail::Answer;
-using ode_detail::GotoController;
-using ode_detail::Num;
-using ode_detail::Quote;
-using ode_detail::Unit;
+using driver_support::Answer;
+using driver_support::Num;
+using driver_support::Quote;
+using driver_support::Unit;
 
 DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {
@@ -30,12 +30,9 @@ DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
     case CommandType::kFrameSetPoint:
       return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks reachability
     case CommandType::kGoto:
+      return base_->Goto(c);
     case CommandType::kSetSpeed:
-      if (base_kind_ == BaseKind::kFixed) {
-        return Answer(Signal::kNa,
-                      std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
-      }
-      return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
+      return base_->SetSpeed(c);
     case CommandType::kStop:
     case CommandType::kPanicReset:
       break;  // never sent to a driver (driver.h)
@@ -48,49 +45,24 @@ void OdeDriver::Impl::Stop(TimePoint now, std::vector<Completion>& interrupted) 
   StopAll("interrupted by STOP", interrupted);
 }
 
-// The watchdog's stop of what one client moved. The base (with a walking
-// humanoid, its walk) stops when asked, or when a leg the walk drives is in
-// the scope (stopping more than asked is safe). A wheel stays with the base's
-// controller while another client's GOTO or SETSPEED drives it.
+// The watchdog's stop of what one client moved. The base decides whether the
+// scope concerns it (the base; for a walking humanoid, also a leg its walk
+// drives); a joint the base still drives afterwards (a wheel under another
+// client's GOTO, a leg) stays with it.
 void OdeDriver::Impl::StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted) {
   Advance(now, true, interrupted);
-  bool base = scope.base;
+  base_->StopOnly(scope, interrupted);
   for (const int j : scope.joints) {
+    if (base_->Drives(j)) continue;
     const int first = model_.dof_offset(j);
-    for (int k = 0; k < static_cast<int>(model_.joint(j).dofs.size()); ++k)
-      base = base || (walker_ && walker_->Owns(first + k));
-  }
-  if (base) {
-    StopBase("interrupted by STOP", interrupted);
-    if (base_kind_ == BaseKind::kWheels)
-      for (const int w : wheel_dof_) HoldDof(w);
-  }
-  for (const int j : scope.joints) {
-    if (IsWheel(j) && base_mode_ != BaseMode::kIdle) continue;
-    const int first = model_.dof_offset(j);
-    for (int k = 0; k < static_cast<int>(model_.joint(j).dofs.size()); ++k) {
-      if (walker_ && walker_->Owns(first + k)) continue;
-      HoldDof(first + k);
-    }
+    for (int k = 0; k < static_cast<int>(model_.joint(j).dofs.size()); ++k) servos_.Hold(first + k, *world_);
   }
 }
 
 DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
   const std::string name = ToString(c.type);
-  const robotalk::Joint& joint = model_.joint(c.target);  // checked by the server (driver.h)
-  if (walker_ && !joint.dofs.empty() && walker_->Owns(model_.dof_offset(c.target))) {  // walking hook
-    return Answer(Signal::kBusy,
-                  name + " " + Quote(joint.name) + ": the leg is driven by the walking controller");
-  }
-  if (IsWheel(c.target)) {
-    if (base_mode_ == BaseMode::kGoto) {
-      return Answer(Signal::kBusy, name + " " + Quote(joint.name) +
-                                       ": the wheel is driven by a GOTO in progress (command " +
-                                       std::to_string(goto_id_) + ")");
-    }
-    base_mode_ = BaseMode::kIdle;  // a wheel command takes the wheels over from SETSPEED
-    cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
-  }
+  const robotalk::Joint& joint = model_.joint(c.target);         // checked by the server (driver.h)
+  if (auto busy = base_->Release(c.target, name)) return *busy;  // a wheel under a GOTO, a leg of a walk
   std::string note;
   for (int k = 0; k < c.num_values; ++k) {
     const auto i = static_cast<Eigen::Index>(model_.dof_offset(c.target) + k);
@@ -100,22 +72,19 @@ DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
     std::string unit = Unit(dof.type);
     const char* what = "";
     if (c.type == CommandType::kJointSetPoint) {
-      got = std::clamp(want, lower_[i], upper_[i]);
+      got = std::clamp(want, servos_.lower(i), servos_.upper(i));
       what = want > got ? "the upper limit" : "the lower limit";
-      mode_[static_cast<size_t>(i)] = Mode::kPosition;
-      target_[i] = got;
+      servos_.SetPoint(i, got);
     } else if (c.type == CommandType::kJointSpeed) {
       got = std::clamp(want, -dof.limits.velocity, dof.limits.velocity);
       unit += "/s";
       what = "the velocity limit";
-      mode_[static_cast<size_t>(i)] = Mode::kVelocity;
-      speed_[i] = got;
+      servos_.Speed(i, got);
     } else {
-      got = std::clamp(want, -fmax_[i], fmax_[i]);
+      got = std::clamp(want, -servos_.fmax()[i], servos_.fmax()[i]);
       unit = dof.type == DofType::kRevolute ? "N m" : "N";
       what = "the effort limit";
-      mode_[static_cast<size_t>(i)] = Mode::kForce;
-      force_[i] = got;
+      servos_.Force(i, got);
     }
     if (got != want) {
       note += std::string(note.empty() ? "" : "; ") + "dof " + std::to_string(k) + ": " + Num(want) + " " +
@@ -139,85 +108,9 @@ DriverResult OdeDriver::Impl::FrameSetPoint(const DriverCommand& c) {
   const std::span<const std::uint8_t> mask = ik_.default_mask(c.target);
   const Eigen::VectorXd& best = ik_.solution();
   for (Eigen::Index i = 0; i < best.size(); ++i) {
-    if (!mask[static_cast<size_t>(i)]) continue;
-    mode_[static_cast<size_t>(i)] = Mode::kPosition;
-    target_[i] = best[i];
-    speed_[i] = 0;
-    force_[i] = 0;
+    if (mask[static_cast<size_t>(i)] && !servos_.base_driven(i)) servos_.SetPoint(i, best[i]);
   }
   return driver_support::AnswerFrameSetPoint(model_.frame(c.target).name, r);
-}
-
-DriverResult OdeDriver::Impl::SetSpeed(const DriverCommand& c) {
-  if (c.num_values != 2 && c.num_values != 3) {
-    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
-                                      std::to_string(c.num_values));
-  }
-  if (walker_) return walker_->SetSpeed(c);  // walking hook
-  if (base_mode_ == BaseMode::kGoto) {
-    return Answer(Signal::kBusy, "SETSPEED: GOTO in progress (command " + std::to_string(goto_id_) + ")");
-  }
-  driver_support::BaseTwist t = driver_support::ShapeBaseSpeed(c, model_.roots().front().base,
-                                                               options_.base_max_v, options_.base_max_omega);
-  double& vx = t.vx;
-  double& vy = t.vy;
-  double& w = t.omega;
-  const auto add = [&t](const std::string& what) { t.Note(what); };
-  if (base_kind_ == BaseKind::kWheels) {  // the wheels' own speed limit
-    const double b = 0.5 * wheel_separation_;
-    double k = 1;
-    for (int s = 0; s < 2; ++s) {
-      const double rate = std::abs((vx + (s == 0 ? -b : b) * w) / wheel_radius_);
-      const double lim = vmax_[static_cast<Eigen::Index>(wheel_dof_[s])];
-      if (rate > lim) k = std::min(k, lim / rate);
-    }
-    if (k < 1) {
-      add("scaled by " + Num(k) + " to the wheels' velocity limit");
-      vx *= k;
-      w *= k;
-    }
-  } else {
-    add("the root moves kinematically (" + std::string(ToString(model_.roots().front().base)) + " base)");
-  }
-  cmd_vx_ = vx;
-  cmd_vy_ = vy;
-  cmd_omega_ = w;
-  base_mode_ = (vx == 0 && vy == 0 && w == 0) ? BaseMode::kIdle : BaseMode::kSpeed;
-  if (base_kind_ == BaseKind::kWheels) SetWheels(vx, w);
-  if (base_mode_ == BaseMode::kIdle)
-    world_->SetRootVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-  return t.note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + t.note);
-}
-
-DriverResult OdeDriver::Impl::Goto(const DriverCommand& c) {
-  if (c.num_values != 3) {
-    return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
-  }
-  if (walker_) return walker_->Goto(c);  // walking hook
-  if (base_mode_ == BaseMode::kGoto) {
-    return Answer(Signal::kBusy, "GOTO: GOTO in progress (command " + std::to_string(goto_id_) + ")");
-  }
-  GotoController::Gains g;
-  g.max_v = options_.base_max_v;
-  g.max_omega = options_.base_max_omega;
-  g.tolerance = options_.goto_tolerance;
-  g.heading_tolerance = options_.goto_heading_tolerance;
-  goto_.Start(c.values[0], c.values[1], c.values[2], g);
-  cmd_vx_ = cmd_vy_ = cmd_omega_ = 0;
-  double x, y, th;
-  BasePose(&x, &y, &th);
-  goto_.Update(x, y, th);
-  if (goto_.done()) {  // already there
-    base_mode_ = BaseMode::kIdle;
-    if (base_kind_ == BaseKind::kWheels) SetWheels(0, 0);
-    return Answer(Signal::kSuccess);
-  }
-  goto_.Start(c.values[0], c.values[1], c.values[2], g);
-  base_mode_ = BaseMode::kGoto;
-  goto_id_ = c.id;
-  DriverResult r;
-  r.in_progress = true;
-  return r;
 }
 
 }  // namespace robotalk

@@ -5,7 +5,8 @@
 // plane, gravity. Joints are servoed by ODE velocity motors bounded by the
 // effort limits (control-frame set-points through inverse kinematics); a
 // differential base is driven through its wheel joints; a floating or
-// holonomic first root is moved kinematically. The physics steps
+// holonomic first root is moved kinematically, or with walk=true a humanoid
+// walks (the base is one strategy chosen at construction). The physics steps
 // at a fixed rate on its own simulated time. docs/ode_sim.md describes the
 // physics mapping, controllers, gains and tolerances.
 //
@@ -22,8 +23,8 @@
 #pragma once
 
 #include "collision_shapes.h"
+#include "ode_walk_status.h"
 #include "robotalk/driver.h"
-#include "walking/walk_status.h"
 
 #include <chrono>
 #include <cstdint>

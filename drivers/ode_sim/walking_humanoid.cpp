@@ -132,11 +132,14 @@ WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> fee
   for (Eigen::VectorXd* v : {&q_ref_, &q_prev_, &q_start_, &q_stance_}) v->setZero(n);
 }
 
-void WalkingHumanoid::Attach(OdeWorld* world, const Eigen::VectorXd& vmax, const Eigen::VectorXd& fmax) {
-  world_ = world;
+void WalkingHumanoid::Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>&) {
+  world_ = &world;
   for (int f : feet_) world_->SetContactSpring(f, kSoleStiffness, kSoleDamping);
-  vmax_ = vmax;
-  fmax_ = fmax;
+  vmax_ = servos.vmax();
+  fmax_ = servos.fmax();
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(owned_.size()); ++i) {
+    if (Owns(i)) servos.GiveToBase(i);
+  }
   q_start_ = world_->q();
   q_ref_ = q_start_;
   BendKnees(model_, ik_.leg_mask(), q_ref_);  // the first solve starts bent; the servos follow from q_start_
@@ -160,11 +163,7 @@ void WalkingHumanoid::Attach(OdeWorld* world, const Eigen::VectorXd& vmax, const
   ramp_ticks_ = std::max<std::int64_t>(1, std::llround(kRamp / step_));
 }
 
-Pose2 WalkingHumanoid::MeasuredPelvis() const {
-  const Eigen::Isometry3d x = world_->LinkPose(model_.roots().front().link);
-  const Eigen::Vector3d fwd = x.linear().col(0);
-  return {x.translation().x(), x.translation().y(), std::atan2(fwd.y(), fwd.x())};
-}
+Pose2 WalkingHumanoid::MeasuredPelvis() const { return RootPose2(*world_, model_); }
 
 Pose2 WalkingHumanoid::ToPlan(const Pose2& world) const { return Compose(Inverse(plan_to_world_), world); }
 Pose2 WalkingHumanoid::ToWorld(const Pose2& plan) const { return Compose(plan_to_world_, plan); }
@@ -225,7 +224,36 @@ void WalkingHumanoid::PlanGoto() {
   replanned_at_ = pattern_.started_steps();
 }
 
+bool WalkingHumanoid::Drives(int joint) const {
+  const int first = model_.dof_offset(joint);
+  for (int k = 0; k < static_cast<int>(model_.joint(joint).dofs.size()); ++k) {
+    if (Owns(first + k)) return true;
+  }
+  return false;
+}
+
+std::optional<DriverResult> WalkingHumanoid::Release(int joint, std::string_view command) {
+  if (!Drives(joint)) return std::nullopt;
+  return Answer(Signal::kBusy, std::string(command) + " " + driver_support::Quote(model_.joint(joint).name) +
+                                   ": the leg is driven by the walking controller");
+}
+
+void WalkingHumanoid::StopOnly(const StopScope& scope, std::vector<Completion>& completed) {
+  if (scope.base || std::any_of(scope.joints.begin(), scope.joints.end(), [&](int j) { return Drives(j); }))
+    Stop("interrupted by STOP", completed);
+}
+
+bool WalkingHumanoid::moving() const {
+  if (!pattern_.standing()) return true;
+  const Eigen::VectorXd& qd = world_->qd();
+  for (Eigen::Index i = 0; i < qd.size(); ++i) {
+    if (Owns(i) && std::abs(qd[i]) > kMovingSpeed) return true;
+  }
+  return false;
+}
+
 DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {
+  if (auto bad = CheckBaseValues(c)) return *bad;
   if (fallen_)
     return Answer(Signal::kError, "GOTO: the robot has fallen (torso tilt " + Num(tilt_) + " rad)");
   if (mode_ == Mode::kGoto) {
@@ -248,6 +276,7 @@ DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {
 }
 
 DriverResult WalkingHumanoid::SetSpeed(const DriverCommand& c) {
+  if (auto bad = CheckBaseValues(c)) return *bad;
   if (fallen_)
     return Answer(Signal::kError, "SETSPEED: the robot has fallen (torso tilt " + Num(tilt_) + " rad)");
   if (mode_ == Mode::kGoto) {

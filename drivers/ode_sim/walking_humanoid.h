@@ -11,16 +11,21 @@
 // loop re-plans from the measured pose). The soles' contacts are made
 // compliant (kSoleStiffness) so that they lie flat on the ground.
 //
+// It is the walking one of the driver's bases (base_controller.h): it owns
+// the leg dofs (the joint servos leave them to it) and answers GOTO,
+// SETSPEED, STOP and panic.
+//
 // Threading: the driver's one thread. Allocation: buffers in Create();
 // planning (Goto, SetSpeed) allocates the step list; Control() allocates
 // only what InverseKinematics::Solve does and completion messages.
 #pragma once
 
+#include "base_controller.h"
+#include "ode_walk_status.h"
 #include "ode_world.h"
 #include "robotalk/driver.h"
 #include "walking/leg_ik.h"
 #include "walking/walk_pattern.h"
-#include "walking/walk_status.h"
 
 #include <cstdint>
 #include <memory>
@@ -30,7 +35,7 @@
 
 namespace robotalk::ode_detail {
 
-class WalkingHumanoid {
+class WalkingHumanoid final : public BaseController {
  public:
   /// Motor gain of the leg servos: v = qd_ref + kKp (q_ref - q), 1/s.
   static constexpr double kKp = 100.0;
@@ -58,23 +63,38 @@ class WalkingHumanoid {
   static std::unique_ptr<WalkingHumanoid> Create(const RobotModel& model,
                                                  const std::vector<CollisionShape>& shapes, double gravity,
                                                  double step, std::string* why);
-  /// Binds the world (after the driver built it) and plans the stance.
-  void Attach(OdeWorld* world, const Eigen::VectorXd& vmax, const Eigen::VectorXd& fmax);
+  /// A free root standing on the ground.
+  void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>&) override {
+    world.place_on_ground = true;
+  }
+  /// Binds the world (after the driver built it), takes the leg dofs from
+  /// the joint servos and plans the stance.
+  void Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>& shapes) override;
 
   /// Per dof: true if the walking controller drives it (the leg dofs).
   bool Owns(Eigen::Index dof) const { return owned_[static_cast<size_t>(dof)] != 0; }
-  bool busy() const { return mode_ == Mode::kGoto; }
-  bool fallen() const { return fallen_; }
-  /// The fall in words, "" before one: "the robot has fallen (torso tilt 0.71 rad)".
-  const std::string& fall() const { return fall_; }
+  /// The legs, always.
+  bool Drives(int joint) const override;
+  /// BUSY for a leg: "the leg is driven by the walking controller".
+  std::optional<DriverResult> Release(int joint, std::string_view command) override;
 
-  DriverResult Goto(const DriverCommand& c);
-  DriverResult SetSpeed(const DriverCommand& c);
+  DriverResult Goto(const DriverCommand& c) override;
+  DriverResult SetSpeed(const DriverCommand& c) override;
   /// STOP (and panic): no new steps; the step in the air and one more end
   /// in double support. A running GOTO completes INTERRUPTED with `why`.
-  void Stop(const std::string& why, std::vector<Completion>& completed);
+  void Stop(const std::string& why, std::vector<Completion>& completed) override;
+  /// The walk stops with the base, or when a leg it drives is in the scope
+  /// (stopping more than asked is safe).
+  void StopOnly(const StopScope& scope, std::vector<Completion>& completed) override;
   /// One physics step's control: the pattern, IK, motors, fall check, GOTO completion.
-  void Control(std::vector<Completion>& completed);
+  void Control(std::vector<Completion>& completed) override;
+
+  Twist2 twist() const override { return RootTwist(*world_, model_); }
+  /// Stepping, or a leg still moving (settling at start-up, after a stop).
+  bool moving() const override;
+  /// The fall in words, "" before one: "the robot has fallen (torso tilt 0.71 rad)".
+  std::string_view fault() const override { return fall_; }
+  std::optional<walking::WalkStatus> walk_status() const override { return status(); }
   walking::WalkStatus status() const;
 
  private:

@@ -158,6 +158,38 @@ TEST(OdeWalk, SetSpeedWalksAtTheClampedRateAndPanicStopsStepping) {
   EXPECT_LT(w.max_tilt, 0.2);
 }
 
+// RobotState::moving tells a walk from standing: the server sends its STOP
+// on giving a robot up only when it moves, and a standing walker's legs
+// (servoed by the walk, not to a set-point) are at rest. (The arms' servos
+// at their elbow stops twitch now and then: "at rest" is asked of a second.)
+TEST(OdeWalk, AStandingWalkerIsNotMovingAndAWalkingOneIs) {
+  Walker w;
+  RobotState state;
+  // Samples every 10 ms for `seconds`: how many found the robot moving, of how many.
+  const auto moving_samples = [&](double seconds) {
+    int moving = 0, samples = 0;
+    w.Run(seconds, [&] {
+      w.driver->ReadState(state);
+      moving += state.moving ? 1 : 0;
+      return ++samples > seconds * 100;
+    });
+    return std::pair{moving, samples};
+  };
+  w.Run(2.0);
+  const auto [standing, of_standing] = moving_samples(1.0);
+  EXPECT_LT(standing, of_standing / 2) << "standing on both soles";
+  ASSERT_EQ(w.Exec(CommandType::kSetSpeed, {0.05, 0.0}).signal, Signal::kSuccess);
+  w.Run(1.0);
+  const auto [walking, of_walking] = moving_samples(2.0);
+  EXPECT_EQ(walking, of_walking) << "walking";
+  w.Stop();
+  w.Run(5.0, [&] { return !w.driver->walk_status()->stepping; });
+  w.Run(1.0);
+  const auto [stopped, of_stopped] = moving_samples(1.0);
+  EXPECT_LT(stopped, of_stopped / 2) << "standing again after the STOP";
+  EXPECT_FALSE(w.driver->walk_status()->fallen);
+}
+
 // The simple humanoid on soles 3 cm wide (a copy of the model in a temporary
 // file): it stands, but the first step tips it over the stance sole's edge.
 TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {

@@ -16,6 +16,8 @@ cmake -S "$source/tests/package/consumer" -B "$tmp/consumer" -DCMAKE_PREFIX_PATH
 cmake --build "$tmp/consumer" -j2 >"$tmp/build.log" || { cat "$tmp/build.log"; exit 1; }
 urdf="$source/models/pioneer2dx_pantilt.urdf"
 check "client program runs" sh -c "'$tmp/consumer/consumer' '$urdf' | grep -q 'pioneer2dx_pantilt 4 dofs'"
+check "the ode driver's installed header builds a driver that steps" \
+  sh -c "'$tmp/consumer/ode-consumer' '$urdf' | grep -q 'ode p 100 steps on wheels'"
 server="$tmp/consumer/outside-server"
 check "ServerMain gives the full --help" sh -c "'$server' --help | grep -q -- '--session-timeout'"
 check "its drivers and the shipped one are registered" \

@@ -8,28 +8,14 @@
 // foot's yaw.
 #pragma once
 
+#include "ode_walk_status.h"  // Wrap, Pose2: part of the driver's public status
+
 #include <Eigen/Core>
 
 #include <cmath>
 #include <numbers>
 
 namespace robotalk::walking {
-
-/// Angle wrapped into (-pi, pi].
-inline double Wrap(double a) {
-  a = std::remainder(a, 2 * std::numbers::pi);
-  return a <= -std::numbers::pi ? a + 2 * std::numbers::pi : a;
-}
-
-struct Pose2 {
-  double x = 0, y = 0, theta = 0;  ///< m, m, rad
-  Eigen::Vector2d xy() const { return {x, y}; }
-  /// A point given in this pose's frame, in the world.
-  Eigen::Vector2d Apply(double px, double py) const {
-    const double c = std::cos(theta), s = std::sin(theta);
-    return {x + c * px - s * py, y + s * px + c * py};
-  }
-};
 
 enum class Side : int { kLeft = 0, kRight = 1 };
 inline Side Other(Side s) { return s == Side::kLeft ? Side::kRight : Side::kLeft; }

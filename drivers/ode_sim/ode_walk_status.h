@@ -1,12 +1,33 @@
 // What the ode driver's walking controller reports (OdeDriver::walk_status()):
-// for tests, the benchmark and the plots. Plain data.
+// for tests, the benchmark and the plots. Plain data, installed beside
+// ode_driver.h; the walking controller's own types (walking/) are private.
+//
+// Conventions: world frame, z up, metres, radians.
 #pragma once
-
-#include "walking/gait.h"
 
 #include <Eigen/Core>
 
+#include <cmath>
+#include <numbers>
+
 namespace robotalk::walking {
+
+/// Angle wrapped into (-pi, pi].
+inline double Wrap(double a) {
+  a = std::remainder(a, 2 * std::numbers::pi);
+  return a <= -std::numbers::pi ? a + 2 * std::numbers::pi : a;
+}
+
+/// A planar pose.
+struct Pose2 {
+  double x = 0, y = 0, theta = 0;  ///< m, m, rad
+  Eigen::Vector2d xy() const { return {x, y}; }
+  /// A point given in this pose's frame, in the world.
+  Eigen::Vector2d Apply(double px, double py) const {
+    const double c = std::cos(theta), s = std::sin(theta);
+    return {x + c * px - s * py, y + s * px + c * py};
+  }
+};
 
 struct WalkStatus {
   bool stepping = false;  ///< a step schedule is running (GOTO, SETSPEED or the steps of a STOP)

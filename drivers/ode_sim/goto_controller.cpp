@@ -1,4 +1,4 @@
-#include "base_controller.h"
+#include "goto_controller.h"
 
 #include <algorithm>
 #include <cmath>

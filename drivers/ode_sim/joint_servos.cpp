@@ -1,0 +1,116 @@
+// The ode driver's joint servos: see joint_servos.h.
+#include "joint_servos.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace robotalk::ode_detail {
+
+JointServos::JointServos(const RobotModel& model, const OdeDriverOptions& options)
+    : table_(model), kp_(options.kp) {
+  const int n = model.num_dofs();
+  vmax_ =
+      table_.velocity.unaryExpr([&](double v) { return std::isfinite(v) ? v : options.default_velocity; });
+  fmax_ = table_.effort.unaryExpr([&](double f) { return std::isfinite(f) ? f : options.default_effort; });
+  mode_.assign(static_cast<std::size_t>(n), Mode::kPosition);
+  for (int i = 0; i < n; ++i) {
+    if (table_.is_mimic(i)) {
+      mode_[static_cast<std::size_t>(i)] = Mode::kMimic;
+    } else if (model.joint(table_.joint_of[static_cast<std::size_t>(i)]).servo_types.empty()) {
+      mode_[static_cast<std::size_t>(i)] = Mode::kPassive;
+    }
+  }
+  q0_ = table_.lower.cwiseMax(0.0).cwiseMin(table_.upper);
+  ApplyMimics(model, q0_);
+  target_ = q0_;
+  speed_.setZero(n);
+  force_.setZero(n);
+}
+
+void JointServos::SetPoint(Eigen::Index i, double q) {
+  mode_[static_cast<std::size_t>(i)] = Mode::kPosition;
+  target_[i] = q;
+  speed_[i] = 0;
+  force_[i] = 0;
+}
+
+void JointServos::Speed(Eigen::Index i, double v) {
+  mode_[static_cast<std::size_t>(i)] = Mode::kVelocity;
+  speed_[i] = v;
+}
+
+void JointServos::Force(Eigen::Index i, double f) {
+  mode_[static_cast<std::size_t>(i)] = Mode::kForce;
+  force_[i] = f;
+}
+
+void JointServos::Hold(Eigen::Index i, OdeWorld& world) {
+  const Mode m = mode_[static_cast<std::size_t>(i)];
+  if (m == Mode::kMimic || m == Mode::kPassive || m == Mode::kBase) return;
+  mode_[static_cast<std::size_t>(i)] = Mode::kVelocity;
+  target_[i] = std::clamp(world.q()[i], table_.lower[i], table_.upper[i]);
+  speed_[i] = 0;
+  force_[i] = 0;
+  world.SetMotor(static_cast<int>(i), 0, fmax_[i]);
+}
+
+void JointServos::Apply(OdeWorld& world) {
+  const Eigen::VectorXd& q = world.q();
+  const Eigen::VectorXd& qd = world.qd();
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    if (mode_[u] == Mode::kVelocity &&
+        ((q[i] >= table_.upper[i] && speed_[i] > 0) || (q[i] <= table_.lower[i] && speed_[i] < 0))) {
+      SetPoint(i, std::clamp(q[i], table_.lower[i],
+                             table_.upper[i]));  // a speed command stops and holds at a limit
+    }
+    switch (mode_[u]) {
+      case Mode::kPosition:
+        world.SetMotor(static_cast<int>(i), std::clamp(kp_ * (target_[i] - q[i]), -vmax_[i], vmax_[i]),
+                       fmax_[i]);
+        break;
+      case Mode::kVelocity:
+        world.SetMotor(static_cast<int>(i), speed_[i], fmax_[i]);
+        break;
+      case Mode::kForce:
+        world.SetEffort(static_cast<int>(i), force_[i]);
+        break;
+      case Mode::kPassive:
+        world.SetMotor(static_cast<int>(i), 0, 0);
+        break;
+      case Mode::kMimic: {
+        const auto l = static_cast<Eigen::Index>(table_.mimic_leader[u]);
+        const double k = table_.mimic_multiplier[u];
+        const double want = k * q[l] + table_.mimic_offset[u];
+        world.SetMotor(static_cast<int>(i), std::clamp(k * qd[l] + kp_ * (want - q[i]), -vmax_[i], vmax_[i]),
+                       fmax_[i]);
+        break;
+      }
+      case Mode::kBase:
+        break;
+    }
+  }
+}
+
+bool JointServos::Moving(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    switch (mode_[static_cast<std::size_t>(i)]) {
+      case Mode::kPosition:
+        if (std::abs(target_[i] - q[i]) > kTargetReached || std::abs(qd[i]) > kMovingSpeed) return true;
+        break;
+      case Mode::kVelocity:
+        if (speed_[i] != 0 || std::abs(qd[i]) > kMovingSpeed) return true;
+        break;
+      case Mode::kForce:
+        if (force_[i] != 0) return true;
+        break;
+      case Mode::kPassive:
+      case Mode::kMimic:
+      case Mode::kBase:
+        break;
+    }
+  }
+  return false;
+}
+
+}  // namespace robotalk::ode_detail

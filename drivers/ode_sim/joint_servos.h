@@ -1,0 +1,71 @@
+// The ode driver's joint servos (private): per dof a mode — set-point, speed,
+// force, passive, mimic follower, or driven by the base controller (a
+// walking humanoid's legs) — with its target and the dof's limits. Apply()
+// sets the ODE motors every physics step; docs/ode_sim.md, "Controllers and
+// gains", gives the control laws.
+//
+// Threading and allocation as in ode_driver.h: one thread; the tables are
+// sized in the constructor and nothing allocates afterwards.
+#pragma once
+
+#include "ode_driver.h"
+#include "ode_world.h"
+#include "robotalk/dof_table.h"
+#include "robotalk/kinematics.h"
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace robotalk::ode_detail {
+
+inline constexpr double kMovingSpeed =
+    1e-3;  ///< rad/s or m/s: below this a dof (or the base) counts as still
+inline constexpr double kTargetReached = 2e-3;  ///< rad or m: a set-point counts as reached
+
+class JointServos {
+ public:
+  /// The model's limits (robotalk/dof_table.h) with the options' defaults for
+  /// infinite speed and effort limits; every dof holds q0() (below), mimic
+  /// followers follow, joints without servo types are passive.
+  JointServos(const RobotModel& model, const OdeDriverOptions& options);
+
+  /// The start pose: q = 0 clamped into the limits, mimic couplings applied.
+  const Eigen::VectorXd& q0() const { return q0_; }
+  double lower(Eigen::Index i) const { return table_.lower[i]; }
+  double upper(Eigen::Index i) const { return table_.upper[i]; }
+  /// Speed and force limits with the options' defaults for infinite ones.
+  const Eigen::VectorXd& vmax() const { return vmax_; }
+  const Eigen::VectorXd& fmax() const { return fmax_; }
+
+  /// Servo dof `i` to position `q` (REQUIRES: within the limits; not base_driven(i)).
+  void SetPoint(Eigen::Index i, double q);
+  /// Run dof `i` at `v`; it stops and holds at a position limit.
+  void Speed(Eigen::Index i, double v);
+  /// Apply `f` to dof `i` (N·m or N), motor off.
+  void Force(Eigen::Index i, double f);
+  /// Stop dof `i` at once: its motor at zero velocity with its full force (a
+  /// position hold would drive back over the braking distance). Mimic
+  /// followers follow their leader; passive and base-driven dofs are left alone.
+  void Hold(Eigen::Index i, OdeWorld& world);
+  /// From now on the base controller sets dof `i`'s motor itself; Apply(),
+  /// Hold() and Moving() leave it alone.
+  void GiveToBase(Eigen::Index i) { mode_[static_cast<std::size_t>(i)] = Mode::kBase; }
+  bool base_driven(Eigen::Index i) const { return mode_[static_cast<std::size_t>(i)] == Mode::kBase; }
+
+  /// One physics step: every dof's motor or effort from its mode.
+  void Apply(OdeWorld& world);
+  /// Whether a servoed dof moves or has not reached its set-point.
+  bool Moving(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
+
+ private:
+  enum class Mode : std::uint8_t { kPosition, kVelocity, kForce, kPassive, kMimic, kBase };
+
+  DofTable table_;
+  double kp_;
+  Eigen::VectorXd q0_, vmax_, fmax_;
+  std::vector<Mode> mode_;
+  Eigen::VectorXd target_, speed_, force_;
+};
+
+}  // namespace robotalk::ode_detail
