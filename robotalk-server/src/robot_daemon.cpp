@@ -385,7 +385,10 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); });
   }
   if (resume && halted_ && !panic_) {
-    if (Guarded("Resume", nullptr, now, [&] { driver_->Resume(); }) == CallOutcome::kOk) halted_ = false;
+    // Not halted from the call on: a Resume that throws or overruns part-way
+    // (the robot may already be let go) is a fault that halts it again.
+    halted_ = false;
+    Guarded("Resume", nullptr, now, [&] { driver_->Resume(); });
   }
   for (const QueuedItem& item : due_) Execute(item, now);
   if (now >= next_update_) {
