@@ -79,6 +79,30 @@ void RobotDaemon::Stop() {
   RunOnce(clock_.Now());
 }
 
+void RobotDaemon::EndSoon() {
+  {
+    std::lock_guard lock(mutex_);
+    running_ = false;
+  }
+  wake_.notify_all();
+}
+
+void RobotDaemon::Shutdown() {
+  EndSoon();
+  if (thread_.joinable()) thread_.join();
+  // The thread is gone: this one acts as it, once. What waits never runs
+  // (issue 19: a command due during the shutdown ran after its STOP).
+  {
+    std::lock_guard lock(mutex_);
+    std::vector<QueuedItem> waiting;
+    scheduler_.FlushAll(waiting);
+    InterruptLocked(waiting, "the server is shutting down");
+  }
+  QueueStop(/*only_if_moving=*/false);
+  last_iteration_ = true;
+  RunOnce(clock_.Now());
+}
+
 void RobotDaemon::DaemonLoop() {
   ApplyTiming();
   std::unique_lock lock(mutex_);
@@ -188,13 +212,17 @@ void RobotDaemon::FlushForPanicLocked() {
   scheduler_.FlushAll(flushed);
   halt_requested_ = true;
   wake_flag_ = true;
+  InterruptLocked(flushed, "flushed by panic");
+}
+
+void RobotDaemon::InterruptLocked(const std::vector<QueuedItem>& items, const char* why) {
   const TimePoint now = clock_.Now();
-  for (const QueuedItem& item : flushed) {
+  for (const QueuedItem& item : items) {
     if (item.client_id == 0) continue;
     Reply r;
     r.id = item.command.id;
     r.signal = Signal::kInterrupted;
-    r.message = "flushed by panic";
+    r.message = why;
     r.exec_time = now;
     outbox_.replies.push_back({item.client_id, std::move(r)});
   }
@@ -376,7 +404,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     scheduler_.TakeDue(now, due_);
     pushes_taken_ = pushes_;
     period = scheduler_.stream_period();
-    sample_due = scheduler_.TakeSampleDue(now);
+    sample_due = scheduler_.TakeSampleDue(now) || (last_iteration_ && period.count() > 0);
   }
   completions_.clear();
   produced_.Clear();
@@ -500,6 +528,10 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     // A STOP of everything ends every ownership; a scoped one ends only the
     // vanished client's, which RobotSessions::Expire already cleared.
     if (!item.scoped_stop) produced_.executed.push_back({item.client_id, CommandType::kStop, -1});
+    if (last_iteration_ && item.client_id == 0) {
+      produced_.log.push_back("robot '" + robot_name_ +
+                              "': stopped (STOP executed; the server is shutting down)");
+    }
     r.signal = Signal::kSuccess;
     Emit(item.client_id, std::move(r));
     return;

@@ -134,6 +134,14 @@ class RobotDaemon {
   /// so a STOP queued just before (QueueStop) still executes.
   void Start();
   void Stop();
+  /// The server's shutdown, in two halves so that every robot's thread ends
+  /// at once: EndSoon() asks the thread to end after its current iteration
+  /// (returns at once); Shutdown() ends and joins it, answers every waiting
+  /// item INTERRUPTED ("the server is shutting down") without running it, and
+  /// STOPs the robot: that STOP is the last command the driver gets, and the
+  /// broadcast stream gets a last sample after it.
+  void EndSoon();
+  void Shutdown();
 
   // --- ServerDaemon side (thread-safe) ------------------------------------
   /// Queues a checked item. REQUIRES: admission checks passed. A query due
@@ -212,6 +220,8 @@ class RobotDaemon {
   void ApplyTiming();
   void WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next);
   void FlushForPanicLocked();  // REQUIRES: mutex_ held
+  // Answers the client items of `items` INTERRUPTED with `why` through the outbox.
+  void InterruptLocked(const std::vector<QueuedItem>& items, const char* why);  // REQUIRES: mutex_ held
   // A query answered from `state` (kinematics and roots are the caller's scratch).
   void AnswerFrom(const RobotState& state, Kinematics& kinematics, std::vector<Eigen::Isometry3d>& roots,
                   const QueuedItem& item, Reply& reply) const;
@@ -299,6 +309,7 @@ class RobotDaemon {
   TimePoint next_update_ = TimePoint::min();
   std::int64_t samples_ = 0;
   bool halted_ = false;
+  bool last_iteration_ = false;     // Shutdown()'s: STOP, then a last sample
   std::string reported_condition_;  // the driver's last Driver::Fault() text
   std::string last_fault_;          // the fault a throw latched, for the command's ERROR
 };
