@@ -4,6 +4,7 @@
 // until the reset. And an Execute that overruns the driver-call bound: its
 // command answers ERROR as soon as the bound passes; its late result is dropped.
 #include "fake_driver.h"
+#include "queued_items.h"
 #include "robot_daemon.h"
 
 #include <gmock/gmock.h>
@@ -21,9 +22,11 @@ namespace {
 using std::chrono::milliseconds;
 using testing::FakeDriver;
 using ::testing::HasSubstr;
+using testing::JointStateQuery;
+using testing::Motion;
 using testing::PanRobot;
 
-constexpr std::int64_t kAlice = 0xA11CE;
+constexpr std::int64_t kAlice = testing::kItemClient;
 
 // A FakeDriver that throws from the one call named `throw_in` while armed.
 class ThrowingDriver : public FakeDriver {
@@ -62,26 +65,6 @@ class ThrowingDriver : public FakeDriver {
   }
 };
 
-QueuedItem Item(CommandId id, CommandType type, std::vector<double> values, int target = -1) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.command.id = id;
-  item.command.type = type;
-  item.command.target = target;
-  item.command.num_values = static_cast<int>(values.size());
-  std::copy(values.begin(), values.end(), item.command.values.begin());
-  return item;
-}
-
-QueuedItem JointQuery(CommandId id) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.is_query = true;
-  item.query = QueryType::kJointState;
-  item.command.id = id;
-  return item;
-}
-
 class DriverFaultTest : public ::testing::TestWithParam<const char*> {
  protected:
   DriverFaultTest() {
@@ -105,11 +88,11 @@ class DriverFaultTest : public ::testing::TestWithParam<const char*> {
     fake_->armed = true;
     if (call == "Update") return Run();
     if (call == "ReadState") {
-      daemon_->Submit(JointQuery(5));
+      daemon_->Submit(JointStateQuery(5));
       return Run();
     }
     if (call == "Stop") {
-      daemon_->Submit(Item(5, CommandType::kStop, {}));
+      daemon_->Submit(Motion(5, CommandType::kStop, {}));
       return Run();
     }
     if (call == "Halt") {  // a client's panic halts the robot
@@ -138,7 +121,7 @@ class DriverFaultTest : public ::testing::TestWithParam<const char*> {
 TEST_P(DriverFaultTest, AThrowIsContainedTheRobotHeldInPanicUntilResetAndTheFaultNamesTheCall) {
   const std::string call = GetParam();
   // The robot runs a GOTO when the driver fails.
-  daemon_->Submit(Item(1, CommandType::kGoto, {1.0, 0.0, 0.0}));
+  daemon_->Submit(Motion(1, CommandType::kGoto, {1.0, 0.0, 0.0}));
   fake_->goto_updates = 1000;
   Run();
   ASSERT_TRUE(fake_->goto_id.has_value());
@@ -167,7 +150,7 @@ TEST_P(DriverFaultTest, AThrowIsContainedTheRobotHeldInPanicUntilResetAndTheFaul
 
   // No Execute until PANIC_RESET, however long it waits.
   for (int i = 0; i < 3; ++i) {
-    daemon_->Submit(Item(10 + i, CommandType::kJointSetPoint, {0.2}, 0));
+    daemon_->Submit(Motion(10 + i, CommandType::kJointSetPoint, {0.2}, 0));
     const auto refused = Run();
     ASSERT_FALSE(refused.empty());
     EXPECT_EQ(refused.back().reply.signal, Signal::kInterrupted);
@@ -176,7 +159,7 @@ TEST_P(DriverFaultTest, AThrowIsContainedTheRobotHeldInPanicUntilResetAndTheFaul
   EXPECT_TRUE(daemon_->in_panic());
 
   // A query says why.
-  daemon_->Submit(JointQuery(20));
+  daemon_->Submit(JointStateQuery(20));
   const auto answer = Run();
   ASSERT_EQ(answer.size(), 1u);
   EXPECT_THAT(answer[0].reply.message, HasSubstr(fault));
@@ -188,7 +171,7 @@ TEST_P(DriverFaultTest, AThrowIsContainedTheRobotHeldInPanicUntilResetAndTheFaul
   Run();
   EXPECT_EQ(fake_->resumes, resumes_before + 1) << "the server still saw the robot halted, and resumed it";
   EXPECT_FALSE(fake_->halted);
-  daemon_->Submit(Item(30, CommandType::kJointSetPoint, {0.2}, 0));
+  daemon_->Submit(Motion(30, CommandType::kJointSetPoint, {0.2}, 0));
   const auto after = Run();
   ASSERT_EQ(after.size(), 1u);
   EXPECT_EQ(after[0].reply.signal, Signal::kSuccess) << after[0].reply.message;
@@ -219,7 +202,7 @@ TEST(DriverCallBound, AnExecutePastTheBoundAnswersErrorAtOnceAndItsLateResultIsD
                      RobotDaemonOptions{.driver_call_bound = milliseconds(200)});
   DaemonOutput out;
   daemon.Preallocate(out);
-  daemon.Submit(Item(7, CommandType::kGoto, {1.0, 0.0, 0.0}));
+  daemon.Submit(Motion(7, CommandType::kGoto, {1.0, 0.0, 0.0}));
   std::thread robot_daemon([&] { daemon.RunOnce(clock.Now()); });
   while (!slow->entered) std::this_thread::sleep_for(milliseconds(1));
 
