@@ -55,7 +55,7 @@ struct CallLog {
 };
 
 // Forwards to a real driver and records the motion calls. When `slow_stop`
-// is set, Stop() first waits (at most 1.5 s) for another robot to get a call:
+// is set, Stop() first waits (at most 2.5 s) for another robot to get a call:
 // a driver whose STOP takes time, during which the server must not let any
 // other robot start something.
 class RecordingDriver final : public Driver {
@@ -80,7 +80,7 @@ class RecordingDriver final : public Driver {
   void ReadState(RobotState& s) const override { inner_->ReadState(s); }
   void Stop(TimePoint now, std::vector<Completion>& done) override {
     if (slow_stop_ && slow_stop_->armed.exchange(false)) {
-      log_->WaitForMoreThan(slow_stop_->other, log_->Count(slow_stop_->other), milliseconds(1500));
+      log_->WaitForMoreThan(slow_stop_->other, log_->Count(slow_stop_->other), milliseconds(2500));
     }
     log_->Add(robot_, "Stop");
     inner_->Stop(now, done);
@@ -173,16 +173,15 @@ TEST_F(ServerShutdownTest, NothingThatWaitedRunsOnAnyRobotOnceTheShutdownHasBegu
   auto pioneer = Connect("pioneer");
   auto rover = Connect("rover");
   ASSERT_EQ(pioneer->SetSpeed(0.3, 0.0).signal, Signal::kSuccess);
-  // Due 0.3 s from now on the rover, queued on the server.
-  PendingReply later =
-      rover->Send(Command{.type = CommandType::kSetSpeed,
-                          .start_time = StartTime::At(rover->ServerNow() + milliseconds(300)),
-                          .values = {0.4, 0.0}});
+  // Due 1 s from now on the rover, queued on the server.
+  PendingReply later = rover->Send(Command{.type = CommandType::kSetSpeed,
+                                           .start_time = StartTime::At(rover->ServerNow() + seconds(1)),
+                                           .values = {0.4, 0.0}});
   // Until the server has it: a query behind it in the same session is answered after it was queued.
   EXPECT_EQ(rover->Query(QueryType::kBasePose).signal, Signal::kSuccess);
   const std::size_t rover_before = log_->Count("rover");
   slow_stop_->other = "rover";
-  slow_stop_->armed = true;  // the pioneer's STOP waits for a rover call (1.5 s at most)
+  slow_stop_->armed = true;  // the pioneer's STOP waits for a rover call (2.5 s at most)
 
   server_->Stop();
   EXPECT_EQ(CallsFrom("rover", rover_before), std::vector<std::string>{"Stop"})
