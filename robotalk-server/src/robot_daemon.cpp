@@ -365,7 +365,7 @@ RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem
   return CallOutcome::kThrew;
 }
 
-void RobotDaemon::Fault(const std::string& what, TimePoint /*now*/) {
+void RobotDaemon::Fault(const std::string& what, TimePoint now) {
   panic_ = true;
   faulted_ = true;
   last_fault_ = what;
@@ -382,8 +382,19 @@ void RobotDaemon::Fault(const std::string& what, TimePoint /*now*/) {
   } catch (const std::exception& e) {
     produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ +
                             "' threw in Halt too: " + e.what());
+    StopInstead(now);
   } catch (...) {
     produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ + "' threw in Halt too");
+    StopInstead(now);
+  }
+}
+
+void RobotDaemon::StopInstead(TimePoint now) {
+  try {
+    driver_->Stop(now, completions_);
+  } catch (...) {
+    produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ +
+                            "' threw in Stop too, after Halt: the robot may still move");
   }
 }
 
@@ -409,8 +420,10 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   completions_.clear();
   produced_.Clear();
   if (halt && !halted_) {
-    halted_ = true;
-    Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); });
+    halted_ = true;  // a Halt that throws still counts: no Execute until the reset
+    if (Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); }) == CallOutcome::kThrew) {
+      StopInstead(now);
+    }
   }
   if (resume && halted_ && !panic_) {
     // Not halted from the call on: a Resume that throws or overruns part-way

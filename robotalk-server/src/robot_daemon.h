@@ -238,6 +238,8 @@ class RobotDaemon {
   template <typename F>
   CallOutcome Guarded(const char* name, const QueuedItem* item, TimePoint now, F&& call);
   void Fault(const std::string& what, TimePoint now);
+  // After a Halt that threw: a STOP, so the robot does not move on (a throw is logged).
+  void StopInstead(TimePoint now);
   void Emit(std::int64_t client_id, Reply reply);
 
   const std::string robot_name_;
