@@ -91,12 +91,14 @@ void RobotDaemon::Shutdown() {
   EndSoon();
   if (thread_.joinable()) thread_.join();
   // The thread is gone: this one acts as it, once. What waits never runs
-  // (issue 19: a command due during the shutdown ran after its STOP).
+  // (issue 19: a command due during the shutdown ran after its STOP); it is
+  // not answered either: to its client it is an outcome the server took
+  // away, as after a crash (an UnknownOutcomeError once it meets the next
+  // server instance).
+  std::vector<QueuedItem> waiting;
   {
     std::lock_guard lock(mutex_);
-    std::vector<QueuedItem> waiting;
     scheduler_.FlushAll(waiting);
-    InterruptLocked(waiting, "the server is shutting down");
   }
   QueueStop(/*only_if_moving=*/false);
   last_iteration_ = true;
@@ -212,17 +214,13 @@ void RobotDaemon::FlushForPanicLocked() {
   scheduler_.FlushAll(flushed);
   halt_requested_ = true;
   wake_flag_ = true;
-  InterruptLocked(flushed, "flushed by panic");
-}
-
-void RobotDaemon::InterruptLocked(const std::vector<QueuedItem>& items, const char* why) {
   const TimePoint now = clock_.Now();
-  for (const QueuedItem& item : items) {
+  for (const QueuedItem& item : flushed) {
     if (item.client_id == 0) continue;
     Reply r;
     r.id = item.command.id;
     r.signal = Signal::kInterrupted;
-    r.message = why;
+    r.message = "flushed by panic";
     r.exec_time = now;
     outbox_.replies.push_back({item.client_id, std::move(r)});
   }

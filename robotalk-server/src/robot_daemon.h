@@ -136,10 +136,10 @@ class RobotDaemon {
   void Stop();
   /// The server's shutdown, in two halves so that every robot's thread ends
   /// at once: EndSoon() asks the thread to end after its current iteration
-  /// (returns at once); Shutdown() ends and joins it, answers every waiting
-  /// item INTERRUPTED ("the server is shutting down") without running it, and
-  /// STOPs the robot: that STOP is the last command the driver gets, and the
-  /// broadcast stream gets a last sample after it.
+  /// (returns at once); Shutdown() ends and joins it, drops every waiting
+  /// item without running it (unanswered, as after a crash), and STOPs the
+  /// robot: that STOP is the last command the driver gets, and the broadcast
+  /// stream gets a last sample after it.
   void EndSoon();
   void Shutdown();
 
@@ -220,8 +220,6 @@ class RobotDaemon {
   void ApplyTiming();
   void WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next);
   void FlushForPanicLocked();  // REQUIRES: mutex_ held
-  // Answers the client items of `items` INTERRUPTED with `why` through the outbox.
-  void InterruptLocked(const std::vector<QueuedItem>& items, const char* why);  // REQUIRES: mutex_ held
   // A query answered from `state` (kinematics and roots are the caller's scratch).
   void AnswerFrom(const RobotState& state, Kinematics& kinematics, std::vector<Eigen::Isometry3d>& roots,
                   const QueuedItem& item, Reply& reply) const;

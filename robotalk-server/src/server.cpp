@@ -147,8 +147,8 @@ class Server::Impl {
     if (!running_.exchange(false)) return;
     // Never leave a robot moving: take no command any more, end every
     // robot's thread at once, then STOP each robot as the last command its
-    // driver gets; what still waited is answered INTERRUPTED, never run
-    // (issue 19: a command due while another robot stopped ran after its STOP).
+    // driver gets; what still waited never runs (issue 19: a command due
+    // while another robot stopped ran after its STOP).
     server_daemon_->Stop();
     for (auto& robot : robots_) robot->EndSoon();
     for (auto& robot : robots_) robot->Shutdown();

