@@ -79,6 +79,32 @@ void RobotDaemon::Stop() {
   RunOnce(clock_.Now());
 }
 
+void RobotDaemon::EndSoon() {
+  {
+    std::lock_guard lock(mutex_);
+    running_ = false;
+  }
+  wake_.notify_all();
+}
+
+void RobotDaemon::Shutdown() {
+  EndSoon();
+  if (thread_.joinable()) thread_.join();
+  // The thread is gone: this one acts as it, once. What waits never runs
+  // (issue 19: a command due during the shutdown ran after its STOP); it is
+  // not answered either: to its client it is an outcome the server took
+  // away, as after a crash (an UnknownOutcomeError once it meets the next
+  // server instance).
+  std::vector<QueuedItem> waiting;
+  {
+    std::lock_guard lock(mutex_);
+    scheduler_.FlushAll(waiting);
+  }
+  QueueStop(/*only_if_moving=*/false);
+  last_iteration_ = true;
+  RunOnce(clock_.Now());
+}
+
 void RobotDaemon::DaemonLoop() {
   ApplyTiming();
   std::unique_lock lock(mutex_);
@@ -337,7 +363,7 @@ RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem
   return CallOutcome::kThrew;
 }
 
-void RobotDaemon::Fault(const std::string& what, TimePoint /*now*/) {
+void RobotDaemon::Fault(const std::string& what, TimePoint now) {
   panic_ = true;
   faulted_ = true;
   last_fault_ = what;
@@ -354,8 +380,19 @@ void RobotDaemon::Fault(const std::string& what, TimePoint /*now*/) {
   } catch (const std::exception& e) {
     produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ +
                             "' threw in Halt too: " + e.what());
+    StopInstead(now);
   } catch (...) {
     produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ + "' threw in Halt too");
+    StopInstead(now);
+  }
+}
+
+void RobotDaemon::StopInstead(TimePoint now) {
+  try {
+    driver_->Stop(now, completions_);
+  } catch (...) {
+    produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ +
+                            "' threw in Stop too, after Halt: the robot may still move");
   }
 }
 
@@ -376,16 +413,21 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     scheduler_.TakeDue(now, due_);
     pushes_taken_ = pushes_;
     period = scheduler_.stream_period();
-    sample_due = scheduler_.TakeSampleDue(now);
+    sample_due = scheduler_.TakeSampleDue(now) || (last_iteration_ && period.count() > 0);
   }
   completions_.clear();
   produced_.Clear();
   if (halt && !halted_) {
-    halted_ = true;
-    Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); });
+    halted_ = true;  // a Halt that throws still counts: no Execute until the reset
+    if (Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); }) == CallOutcome::kThrew) {
+      StopInstead(now);
+    }
   }
   if (resume && halted_ && !panic_) {
-    if (Guarded("Resume", nullptr, now, [&] { driver_->Resume(); }) == CallOutcome::kOk) halted_ = false;
+    // Not halted from the call on: a Resume that throws or overruns part-way
+    // (the robot may already be let go) is a fault that halts it again.
+    halted_ = false;
+    Guarded("Resume", nullptr, now, [&] { driver_->Resume(); });
   }
   for (const QueuedItem& item : due_) Execute(item, now);
   bool state_fresh = false;  // state_ read after this iteration's Update
@@ -498,6 +540,10 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     // A STOP of everything ends every ownership; a scoped one ends only the
     // vanished client's, which RobotSessions::Expire already cleared.
     if (!item.scoped_stop) produced_.executed.push_back({item.client_id, CommandType::kStop, -1});
+    if (last_iteration_ && item.client_id == 0) {
+      produced_.log.push_back("robot '" + robot_name_ +
+                              "': stopped (STOP executed; the server is shutting down)");
+    }
     r.signal = Signal::kSuccess;
     Emit(item.client_id, std::move(r));
     return;

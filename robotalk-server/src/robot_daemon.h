@@ -139,6 +139,14 @@ class RobotDaemon {
   /// so a STOP queued just before (QueueStop) still executes.
   void Start();
   void Stop();
+  /// The server's shutdown, in two halves so that every robot's thread ends
+  /// at once: EndSoon() asks the thread to end after its current iteration
+  /// (returns at once); Shutdown() ends and joins it, drops every waiting
+  /// item without running it (unanswered, as after a crash), and STOPs the
+  /// robot: that STOP is the last command the driver gets, and the broadcast
+  /// stream gets a last sample after it.
+  void EndSoon();
+  void Shutdown();
 
   // --- ServerDaemon side (thread-safe) ------------------------------------
   /// Queues a checked item. REQUIRES: admission checks passed. A query due
@@ -237,6 +245,8 @@ class RobotDaemon {
   template <typename F>
   CallOutcome Guarded(const char* name, const QueuedItem* item, TimePoint now, F&& call);
   void Fault(const std::string& what, TimePoint now);
+  // After a Halt that threw: a STOP, so the robot does not move on (a throw is logged).
+  void StopInstead(TimePoint now);
   void Emit(std::int64_t client_id, Reply reply);
 
   const std::string robot_name_;
@@ -308,6 +318,7 @@ class RobotDaemon {
   TimePoint next_update_ = TimePoint::min();
   std::int64_t samples_ = 0;
   bool halted_ = false;
+  bool last_iteration_ = false;     // Shutdown()'s: STOP, then a last sample
   std::string reported_condition_;  // the driver's last Driver::Fault() text
   std::string last_fault_;          // the fault a throw latched, for the command's ERROR
   std::string state_problem_;       // what the last state read had that was not finite, or ""

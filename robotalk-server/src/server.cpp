@@ -154,11 +154,14 @@ class Server::Impl {
 
   void Stop() {
     if (!running_.exchange(false)) return;
-    // Never leave a robot moving: stop each, let its daemon run the STOP, then join.
-    for (auto& robot : robots_) robot->QueueStop(/*only_if_moving=*/false);
-    for (auto& robot : robots_) robot->Stop();  // runs the queued STOP before returning
+    // Never leave a robot moving: take no command any more, end every
+    // robot's thread at once, then STOP each robot as the last command its
+    // driver gets; what still waited never runs (issue 19: a command due
+    // while another robot stopped ran after its STOP).
     server_daemon_->Stop();
-    server_daemon_->Flush();  // the STOPs' and the last replies
+    for (auto& robot : robots_) robot->EndSoon();
+    for (auto& robot : robots_) robot->Shutdown();
+    server_daemon_->Flush();  // the STOPs' log lines, the last replies and samples
   }
 
   std::vector<std::string> names() const { return server_daemon_->robot_names(); }

@@ -45,10 +45,19 @@ check "the robot is not in panic after the refused one: $(cat "$tmp/after_refuse
   grep -q "SUCCESS" "$tmp/after_refused"
 rt --key "$tmp/monitor" panic pioneer >"$tmp/monitor_panic" 2>&1
 check "monitor may raise a panic: $(cat "$tmp/monitor_panic")" grep -q "panic taken by pioneer" "$tmp/monitor_panic"
+# Issue 19: the line alone proved nothing; the robot must really be in panic.
+rt --key "$tmp/viewer" watch pioneer --count 1 --json >"$tmp/panic_state" 2>&1
+check "after monitor's panic the STATE stream says panic: $(cat "$tmp/panic_state")" \
+  grep -q '"panic":true' "$tmp/panic_state"
+rt --key "$tmp/alice" send pioneer joint_setpoint pan 0.2 >"$tmp/in_panic" 2>&1
+check "and alice's command is answered PANIC, not run: $(cat "$tmp/in_panic")" grep -q " PANIC " "$tmp/in_panic"
 rt --key "$tmp/monitor" reset pioneer >"$tmp/monitor_reset" 2>&1
 check "monitor may not reset it: $(cat "$tmp/monitor_reset")" grep -q "ERROR" "$tmp/monitor_reset"
 rt --key "$tmp/alice" reset pioneer >"$tmp/alice_reset" 2>&1
 check "alice may reset: $(cat "$tmp/alice_reset")" grep -q "SUCCESS" "$tmp/alice_reset"
+rt --key "$tmp/alice" send pioneer joint_setpoint pan 0.2 >"$tmp/after_reset" 2>&1
+check "after alice's reset the robot runs commands again: $(cat "$tmp/after_reset")" \
+  grep -q "SUCCESS" "$tmp/after_reset"
 check "the reset is logged with the key's name" grep -q "panic reset by 'alice' (rt:" "$tmp/server.log"
 rt --key "$tmp/alice" --server-key "$tmp/alice.pub" query pioneer base_pose >"$tmp/pinned" 2>&1
 check "a pinned server key that does not match is refused: $(cat "$tmp/pinned")" grep -q "given with --server-key; refused" "$tmp/pinned"

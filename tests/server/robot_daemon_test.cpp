@@ -1,6 +1,7 @@
 #include "robot_daemon.h"
 
 #include "fake_driver.h"
+#include "queued_items.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -35,20 +36,11 @@ using std::chrono::milliseconds;
 using std::chrono::seconds;
 using testing::FakeDriver;
 using ::testing::HasSubstr;
+using testing::JointStateQuery;
+using testing::Motion;
 using testing::PanRobot;
 
-constexpr std::int64_t kAlice = 0xA11CE;
-
-QueuedItem Motion(CommandId id, CommandType type, std::vector<double> values, int target = -1) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.command.id = id;
-  item.command.type = type;
-  item.command.target = target;
-  item.command.num_values = static_cast<int>(values.size());
-  std::copy(values.begin(), values.end(), item.command.values.begin());
-  return item;
-}
+constexpr std::int64_t kAlice = testing::kItemClient;
 
 class RobotDaemonTest : public ::testing::Test {
  protected:
@@ -170,15 +162,6 @@ TEST_F(RobotDaemonTest, RunsTheWatchdogsStopOnlyWhenTheRobotIsMoving) {
   ASSERT_EQ(fake_->calls.size(), 1u);
   EXPECT_EQ(fake_->calls[0].type, CommandType::kStop);
   EXPECT_TRUE(out_.replies.empty()) << "the server's own STOP has nobody to answer";
-}
-
-QueuedItem JointStateQuery(CommandId id) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.is_query = true;
-  item.query = QueryType::kJointState;
-  item.command.id = id;
-  return item;
 }
 
 // Issue 11: a query crossed the RobotDaemon's thread (its lock, a wake-up,

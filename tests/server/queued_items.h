@@ -1,0 +1,35 @@
+// Items as the ServerDaemon hands them to a RobotDaemon, for RobotDaemon
+// tests: a motion command and a joint-state query of one client.
+#pragma once
+
+#include "scheduler.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace robotalk::testing {
+
+inline constexpr std::int64_t kItemClient = 0xA11CE;  ///< the client of Motion() and JointStateQuery()
+
+inline QueuedItem Motion(CommandId id, CommandType type, std::vector<double> values, int target = -1) {
+  QueuedItem item;
+  item.client_id = kItemClient;
+  item.command.id = id;
+  item.command.type = type;
+  item.command.target = target;
+  item.command.num_values = static_cast<int>(values.size());
+  std::copy(values.begin(), values.end(), item.command.values.begin());
+  return item;
+}
+
+inline QueuedItem JointStateQuery(CommandId id) {
+  QueuedItem item;
+  item.client_id = kItemClient;
+  item.is_query = true;
+  item.query = QueryType::kJointState;
+  item.command.id = id;
+  return item;
+}
+
+}  // namespace robotalk::testing
