@@ -376,12 +376,17 @@ PendingReply RobotClient::SendQuery(robotalk::Query query) {
   return impl_->MakePending(sent.ids[0], what);
 }
 
-std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands) {
+std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands, CommandMode mode) {
   RequireConnected(*this, "SendBatch");
+  if (mode == CommandMode::kPlayback) {
+    throw ClientError("RobotClient::SendBatch: a playback sequence is declared whole; use RunSequence");
+  }
   if (commands.empty()) return {};
   std::vector<std::string> what;
   for (const Command& c : commands) what.push_back(Describe(c));
-  auto sent = impl_->SendPackage(std::move(commands), {});
+  auto sent =
+      impl_->SendPackage(std::move(commands), {},
+                         {.mode = mode == CommandMode::kDelay ? RequestMode::kDelay : RequestMode::kDirect});
   std::vector<PendingReply> pending;
   for (std::size_t i = 0; i < sent.ids.size(); ++i)
     pending.push_back(impl_->MakePending(sent.ids[i], what[i]));

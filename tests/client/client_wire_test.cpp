@@ -2,10 +2,10 @@
 // decoder (DecodeRequest, request.h): every package the client sends --
 // single calls, sequences in each mode, heartbeats, panics -- is one the
 // server's codec reads without a header error, labelled with the package
-// mode docs/protocol.md documents (issue 20 item 1: delay sequences went out
-// as MODE_DIRECT, so `robotalk-logplay export` called every delay session
-// "direct"). And what the client reads: a reply package with one reply it
-// cannot decode still delivers the others.
+// mode docs/protocol.md documents (issue 20 item 1: delay sequences, and
+// `robotalk send --file`'s delay batches, went out as MODE_DIRECT, so
+// `robotalk-logplay export` called every delay session "direct"). And what the client reads: a reply package
+// with one reply it cannot decode still delivers the others.
 //
 // Against the real server core (robotalk::Server, kinematic driver) on an
 // in-process MemoryBus; the server's end is a FaultyTransport whose incoming
@@ -14,6 +14,7 @@
 #include "client/real_server_support.h"
 #include "kinematic_driver.h"
 #include "robotalk/channels.h"
+#include "robotalk/client_errors.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
@@ -113,6 +114,19 @@ TEST_F(RobotClientWireTest, ADelaySequenceTravelsInMODE_DELAYPackagesWithAbsolut
   for (const Request& r : sent) {
     for (const Command& c : r.commands) EXPECT_TRUE(c.start_time.is_at()) << ToString(c.start_time);
   }
+}
+
+// `robotalk send --file` sends its delay sequence piece by piece through SendBatch.
+TEST_F(RobotClientWireTest, ABatchSentInDelayModeTravelsAsMODE_DELAYAndAPlaybackBatchIsRefused) {
+  TakeSent();
+  const TimePoint start = client_->ServerNow() + milliseconds(100);
+  auto pending =
+      client_->SendBatch({Command{.type = CommandType::kStop, .start_time = start}}, CommandMode::kDelay);
+  ASSERT_EQ(pending.size(), 1u);
+  EXPECT_EQ(pending[0].Wait(seconds(5)).signal, Signal::kSuccess);
+  ExpectCommandPackagesIn(TakeSent(), RequestMode::kDelay, 1);
+  EXPECT_THROW(client_->SendBatch({Command{.type = CommandType::kStop}}, CommandMode::kPlayback),
+               ClientError);
 }
 
 TEST_F(RobotClientWireTest, SingleCallsAndDirectSequencesTravelInMODE_DIRECT) {
