@@ -27,7 +27,8 @@ std::size_t SendShadowStops(RobotClient& client, const std::vector<TimePoint>& s
     for (std::size_t j = k; j < std::min(starts.size(), k + batch); ++j)
       stops.push_back({.type = CommandType::kStop, .start_time = starts[j]});
     try {
-      sent += client.SendBatch(std::move(stops)).size();  // nobody waits: the handles may go
+      // Part of the delay session; nobody waits: the handles may go.
+      sent += client.SendBatch(std::move(stops), CommandMode::kDelay).size();
     } catch (const std::exception&) {
       break;
     }
@@ -199,7 +200,7 @@ RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const
         commands.push_back(std::move(frames[order[j]].command));
         commands.back().start_time = starts[order[j]];
       }
-      auto sent = client.SendBatch(std::move(commands));
+      auto sent = client.SendBatch(std::move(commands), CommandMode::kDelay);
       for (std::size_t j = next_send; j < end; ++j) pending[order[j]] = std::move(sent[j - next_send]);
       next_send = end;
     }

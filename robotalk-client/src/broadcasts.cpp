@@ -8,7 +8,7 @@
 
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/config_codec.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 
 namespace robotalk {
 

@@ -15,7 +15,7 @@
 #include "server_trust.h"
 
 #include "robotalk/keys.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "robotalk/session_auth.h"
 #include "robotalk/transport.h"
 
@@ -34,14 +34,18 @@
 
 namespace robotalk {
 
-/// Header fields of a PLAYBACK package (id 0: an ordinary package).
-struct PlaybackHeader {
-  std::int64_t id = 0;
-  std::int32_t frames = 0;
-  Duration duration{0};
-  /// This package also waits for the server's delay reply (id = `id`): the
-  /// client re-asks through it until that reply is in.
+/// What a package says besides its items (docs/protocol.md, Modes).
+struct PackageOptions {
+  bool panic = false;
+  /// MODE_DIRECT for single calls and direct sequences, MODE_DELAY for delay
+  /// sequences, MODE_PLAYBACK (with `playback`) for playback sequences.
+  RequestMode mode = RequestMode::kDirect;
+  PlaybackDeclaration playback;  ///< kPlayback: the sequence (id from NewId)
+  /// kPlayback: this package also waits for the server's delay reply (id =
+  /// playback.id): the client re-asks through it until that reply is in.
   bool ask_for_delay = false;
+  /// A CLOCK query: the ack of a package sent once is a clock sample.
+  bool clock_query = false;
 };
 
 class RobotClient::Impl {
@@ -53,12 +57,13 @@ class RobotClient::Impl {
     std::int64_t sequence = 0;
     std::vector<CommandId> ids;
   };
-  enum class Track { kNone, kRetransmit };
-  using Playback = PlaybackHeader;
-  /// Builds, registers and publishes one package. Assigns the ids of
-  /// `commands` / `queries` (returned in order). Throws ClientError.
-  Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries, bool panic,
-                   Track track, bool clock_query = false, const Playback& playback = {});
+  /// Builds one Request, encodes it with EncodeRequest (request.h), seals it
+  /// (keyed mode), registers it for retransmission and publishes it. Assigns
+  /// the ids of `commands` / `queries` (returned in order). Throws
+  /// ClientError (not connected, too large, no session), ProtocolError (a
+  /// start time EncodeRequest refuses); nothing is consumed when it throws.
+  Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries,
+                   const PackageOptions& options = {});
   /// A fresh id from the client's command-id space (for a playback sequence).
   CommandId NewId();
   /// Tells the retransmission bookkeeping when items will run (server clock).
@@ -72,7 +77,7 @@ class RobotClient::Impl {
 
   /// Subscribes the robot's channels (REPLY/<client>, CONFIG).
   void Attach(const std::string& robot);
-  /// The server's explicit answer to a panic package (reply_package_t.panic_status).
+  /// The server's explicit answer to a panic package (ReplyBatch::panic).
   struct PanicAnswer {
     bool taken = false;
     std::string refusal;           ///< not taken: the server's reason
@@ -139,8 +144,6 @@ class RobotClient::Impl {
   /// Waits for a session (REQUIRES: `lock` holds mu_). Throws ClientError
   /// when the server refused the hello, TimeoutError when none answered.
   void WaitSession(std::unique_lock<std::mutex>& lock);
-  /// Keyed mode: writes the package's MAC (REQUIRES: mu_ held).
-  void Seal(std::vector<std::uint8_t>& bytes);
 
  private:
   void Run();  // the ReadDaemon
@@ -155,7 +158,13 @@ class RobotClient::Impl {
   std::optional<std::span<const std::uint8_t>> Authentic(const std::string& channel,
                                                          std::span<const std::uint8_t> bytes);
   Duration IdleWait(TimePoint now);
-  std::vector<std::uint8_t> EncodeHeartbeat(TimePoint now);  // REQUIRES: mu_ held
+  /// A package of this client's session with the next sequence number,
+  /// sent at `now` (REQUIRES: mu_ held). The caller takes the number
+  /// (++next_sequence_) once the package is encoded.
+  Request NextRequest(TimePoint now) const;
+  /// EncodeRequest, the size limit, and in keyed mode the MAC over the
+  /// encoded bytes (MacCoveredBytes / WriteMacField) (REQUIRES: mu_ held).
+  std::vector<std::uint8_t> EncodeSealed(const Request& request) const;
   void OnHelloAnswer(std::span<const std::uint8_t> bytes);
   /// The hello to publish now, or empty (REQUIRES: mu_ held).
   std::vector<std::uint8_t> DueHello(TimePoint now);
@@ -165,10 +174,10 @@ class RobotClient::Impl {
   std::vector<CommandId> LoseSession(TimePoint now);
   /// Files the answer to a waited-for panic package (REQUIRES: mu_ held);
   /// true when one was filed.
-  bool NotePanicAnswer(const robotalk_msgs::reply_package_t& pkg);
+  bool NotePanicAnswer(const ReplyBatch& batch);
   /// True when a reply package belongs to the live session (REQUIRES: mu_ held).
-  bool AcceptReplyPackage(const robotalk_msgs::reply_package_t& pkg, std::span<const std::uint8_t> bytes,
-                          TimePoint now, std::vector<CommandId>& lost);
+  bool AcceptReplyPackage(const ReplyBatch& batch, std::span<const std::uint8_t> bytes, TimePoint now,
+                          std::vector<CommandId>& lost);
   void LoadKeys();
   void Resync();  // after a new server instance: clock samples, configuration
   void NoteResyncReplies(const std::vector<Reply>& replies);

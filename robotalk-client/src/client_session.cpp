@@ -14,6 +14,7 @@ namespace robotalk {
 namespace {
 
 constexpr Duration kHelloRepeat = std::chrono::milliseconds(250);
+constexpr std::size_t kMaxPackageBytes = 60000;  // docs/protocol.md "Limits"
 
 std::string SecondsText(Duration d) {
   char buf[32];
@@ -164,9 +165,19 @@ void RobotClient::Impl::WaitSession(std::unique_lock<std::mutex>& lock) {
   }
 }
 
-void RobotClient::Impl::Seal(std::vector<std::uint8_t>& bytes) {
-  if (!session_keys_) return;
-  WriteMacField(bytes, ComputeMac(session_keys_->client_to_server, session_id_, MacCoveredBytes(bytes)));
+std::vector<std::uint8_t> RobotClient::Impl::EncodeSealed(const Request& request) const {
+  std::vector<std::uint8_t> bytes = EncodeRequest(request);
+  if (bytes.size() > kMaxPackageBytes) {
+    throw ClientError("RobotClient: a package of " +
+                      std::to_string(request.commands.size() + request.queries.size()) + " items would be " +
+                      std::to_string(bytes.size()) + " bytes, over the " + std::to_string(kMaxPackageBytes) +
+                      "-byte limit; send fewer per batch");
+  }
+  // Keyed mode: the MAC covers every encoded byte before it (docs/security.md).
+  if (session_keys_) {
+    WriteMacField(bytes, ComputeMac(session_keys_->client_to_server, session_id_, MacCoveredBytes(bytes)));
+  }
+  return bytes;
 }
 
 std::vector<CommandId> RobotClient::Impl::LoseSession(TimePoint now) {
@@ -181,46 +192,45 @@ std::vector<CommandId> RobotClient::Impl::LoseSession(TimePoint now) {
   return lost;
 }
 
-bool RobotClient::Impl::AcceptReplyPackage(const robotalk_msgs::reply_package_t& pkg,
-                                           std::span<const std::uint8_t> bytes, TimePoint now,
-                                           std::vector<CommandId>& lost) {
-  if (pkg.session_status == robotalk_msgs::reply_package_t::SESSION_UNKNOWN) {
+bool RobotClient::Impl::AcceptReplyPackage(const ReplyBatch& batch, std::span<const std::uint8_t> bytes,
+                                           TimePoint now, std::vector<CommandId>& lost) {
+  if (batch.session_status == SessionStatus::kUnknown) {
     // Unsealed by nature (the server has no key for it): believed only for
     // the live session. A forger can make the client say hello again; it
     // could as well drop every package (docs/security.md, availability).
     // Its panic answer counts in open mode, where nothing is sealed; in keyed
     // mode only as a refusal for want of a session (RobotClient::Panic then
     // says hello and sends the panic again), never as a panic taken.
-    if (!identity_ || pkg.panic_status == robotalk_msgs::reply_package_t::PANIC_REFUSED) NotePanicAnswer(pkg);
-    if (session_id_ == 0 || pkg.session_id != session_id_) return false;
+    if (!identity_ || batch.panic == PanicStatus::kRefused) NotePanicAnswer(batch);
+    if (session_id_ == 0 || batch.session_id != session_id_) return false;
     lost = LoseSession(now);  // each lost item's failure says why
     return false;
   }
-  if (session_id_ == 0 || pkg.session_id != session_id_) return false;  // an old session's
+  if (session_id_ == 0 || batch.session_id != session_id_) return false;  // an old session's
   if (session_keys_ &&
-      !VerifyMac(session_keys_->server_to_client, session_id_, MacCoveredBytes(bytes), ReadMacField(bytes))) {
+      !VerifyMac(session_keys_->server_to_client, session_id_, MacCoveredBytes(bytes), batch.mac)) {
     ++stats_.replies_refused;
     return false;
   }
   return true;
 }
 
-bool RobotClient::Impl::NotePanicAnswer(const robotalk_msgs::reply_package_t& pkg) {
-  if (pkg.ack_sequence <= 0 || ack_waited_.count(pkg.ack_sequence) == 0) return false;
+bool RobotClient::Impl::NotePanicAnswer(const ReplyBatch& batch) {
+  if (batch.ack_sequence <= 0 || ack_waited_.count(batch.ack_sequence) == 0) return false;
   PanicAnswer answer;
-  answer.session_unknown = pkg.session_status == robotalk_msgs::reply_package_t::SESSION_UNKNOWN;
-  switch (pkg.panic_status) {
-    case robotalk_msgs::reply_package_t::PANIC_TAKEN:
+  answer.session_unknown = batch.session_status == SessionStatus::kUnknown;
+  switch (batch.panic) {
+    case PanicStatus::kTaken:
       answer.taken = true;
       break;
-    case robotalk_msgs::reply_package_t::PANIC_REFUSED:
-      answer.refusal = pkg.panic_refusal.empty() ? "no reason given" : pkg.panic_refusal;
+    case PanicStatus::kRefused:
+      answer.refusal = batch.panic_refusal.empty() ? "no reason given" : batch.panic_refusal;
       break;
-    default:  // an answer to a panic package that does not say: never counted as taken
+    case PanicStatus::kNone:  // an answer to a panic package that does not say: never counted as taken
       answer.refusal = "the server's answer to the panic package does not say that it was taken";
       break;
   }
-  panic_answers_[pkg.ack_sequence] = std::move(answer);
+  panic_answers_[batch.ack_sequence] = std::move(answer);
   return true;
 }
 
@@ -235,10 +245,9 @@ void RobotClient::Impl::Resync() {
   }
   try {
     for (int i = 0; i < 3; ++i) {
-      SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false, Track::kRetransmit, true);
+      SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, {.clock_query = true});
     }
-    const Sent sent =
-        SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false, Track::kRetransmit);
+    const Sent sent = SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}});
     std::lock_guard lock(mu_);
     resync_config_query_ = sent.ids.front();
   } catch (const Error& e) {

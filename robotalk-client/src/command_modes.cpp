@@ -2,7 +2,6 @@
 // sequences, and broadcast state streams.
 #include "client_impl.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
 #include "sequence_plan.h"
 
 #include <algorithm>
@@ -79,12 +78,14 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   }
 
   std::optional<PendingReply> delay_reply;
-  Impl::Playback playback;
+  PackageOptions package{.mode = RequestMode::kDelay};
   TimePoint server_start{};
   if (options.mode == CommandMode::kPlayback) {
-    playback = {impl_->NewId(), static_cast<std::int32_t>(frames.size()), duration, /*ask_for_delay=*/true};
-    impl_->cache_->Expect(playback.id);
-    delay_reply = impl_->MakePending(playback.id, "PLAYBACK " + std::to_string(playback.id));
+    package = {.mode = RequestMode::kPlayback,
+               .playback = {impl_->NewId(), static_cast<std::int64_t>(frames.size()), duration},
+               .ask_for_delay = true};
+    impl_->cache_->Expect(package.playback.id);
+    delay_reply = impl_->MakePending(package.playback.id, "PLAYBACK " + std::to_string(package.playback.id));
   } else {
     server_start = ServerTime(t0) + options.delay;
     result.server_start = server_start;
@@ -100,8 +101,8 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       c.start_time = client::FrameStart(options.mode, frames[i].offset, server_start);
       commands.push_back(std::move(c));
     }
-    auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit, false, playback);
-    playback.ask_for_delay = false;  // only the first package asks
+    auto sent = impl_->SendPackage(std::move(commands), {}, package);
+    package.ask_for_delay = false;  // only the first package asks
     for (std::size_t j = 0; j < send.frames.size(); ++j) {
       pending[send.frames[j]] =
           impl_->MakePending(sent.ids[j], "sequence frame " + std::to_string(send.frames[j]));

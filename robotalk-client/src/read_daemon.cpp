@@ -4,7 +4,6 @@
 
 #include "robotalk/config_codec.h"
 #include "robotalk/known_servers.h"
-#include "robotalk/protocol_codec.h"
 
 #include "robotalk/routed_lcm_transport.h"
 
@@ -23,8 +22,6 @@
 namespace robotalk {
 namespace {
 
-constexpr std::size_t kMaxPackageBytes = 60000;  // docs/protocol.md "Limits"
-
 std::int64_t RandomClientId() {
   std::random_device rd;
   std::uint64_t id = 0;
@@ -37,12 +34,6 @@ client::RetransmitPolicy PolicyOf(const ClientOptions& o) {
           .backoff = o.retransmit_backoff,
           .max_interval = o.retransmit_max_interval,
           .give_up_after = o.give_up_after};
-}
-
-std::vector<std::uint8_t> Encode(const robotalk_msgs::package_t& p) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(p.getEncodedSize()));
-  p.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
 }
 
 }  // namespace
@@ -142,34 +133,8 @@ void RobotClient::Impl::AttachLocked(const std::string& robot) {
 }
 
 RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> commands,
-                                                       std::vector<robotalk::Query> queries, bool panic,
-                                                       Track track, bool clock_query,
-                                                       const Playback& playback) {
-  robotalk_msgs::package_t p{};
-  p.header.protocol_version = kProtocolVersion;
-  p.header.client_id = client_id_;
-  p.header.panic = panic;
-  const bool is_commands = !commands.empty();
-  p.header.payload_type = is_commands ? robotalk_msgs::package_header_t::PAYLOAD_COMMANDS
-                                      : robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
-  p.header.payload_size = static_cast<std::int32_t>(is_commands ? commands.size() : queries.size());
-  if (playback.id != 0) {
-    p.header.mode = robotalk_msgs::package_header_t::MODE_PLAYBACK;
-    p.header.playback_id = playback.id;
-    p.header.playback_frames = playback.frames;
-    p.header.playback_duration_us = ToWireMicros(playback.duration);
-  }
-  // Checks each start time's kind against the mode (offsets only in PLAYBACK).
-  for (const Command& c : commands) p.commands.push_back(ToWire(c, p.header.mode));
-  for (const robotalk::Query& q : queries) p.queries.push_back(ToWire(q));
-  p.num_commands = static_cast<std::int32_t>(p.commands.size());
-  p.num_queries = static_cast<std::int32_t>(p.queries.size());
-  if (const int size = p.getEncodedSize(); static_cast<std::size_t>(size) > kMaxPackageBytes) {
-    throw ClientError("RobotClient: a package of " + std::to_string(p.header.payload_size) +
-                      " items would be " + std::to_string(size) + " bytes, over the " +
-                      std::to_string(kMaxPackageBytes) + "-byte limit; send fewer per batch");
-  }
-
+                                                       std::vector<robotalk::Query> queries,
+                                                       const PackageOptions& options) {
   Sent sent;
   std::vector<std::uint8_t> bytes;
   std::string channel;
@@ -181,42 +146,47 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     // restarted must still stop the robot, and an open-mode server takes a
     // panic outside any session. A keyed server takes one only in an
     // authenticated session, so a keyed client waits for its hello's answer.
-    if (!(panic && session_id_ == 0 && !identity_)) WaitSession(lock);
-    p.header.session_id = session_id_;
+    if (!(options.panic && session_id_ == 0 && !identity_)) WaitSession(lock);
     channel = request_channel_;
     const TimePoint now = clock_.Now();
-    sent.sequence = next_sequence_++;
-    p.header.sequence = sent.sequence;
-    p.header.send_time_us = ToWireMicros(now);
+    Request request = NextRequest(now);
+    request.panic = options.panic;
+    request.mode = options.mode;
+    request.playback = options.playback;
+    // Ids are taken from next_id_ only once the package is encoded: a
+    // package EncodeRequest refuses consumes nothing.
+    CommandId id = next_id_;
     std::vector<client::OutstandingPackages::Item> items;
-    for (std::size_t i = 0; i < commands.size(); ++i) {
-      const CommandId id = next_id_++;
-      p.commands[i].id = id;
-      sent.ids.push_back(id);
+    for (Command& c : commands) {
+      c.id = id++;
       std::optional<TimePoint> start;
-      if (playback.id != 0) {
+      if (options.mode == RequestMode::kPlayback) {
         // A playback frame's start is an offset; when it runs is known only
         // once the server has chosen the delay (SetStartTimes). Until then,
         // do not re-ask an acknowledged frame before the whole sequence could
         // have played: re-asks would only load a congested server.
-        start = now + playback.duration + options_.timeout;
-      } else if (auto at = commands[i].start_time.time()) {
+        start = now + options.playback.duration + options_.timeout;
+      } else if (auto at = c.start_time.time()) {
         start = clock_sync_.ClientTime(*at);
       }
-      items.push_back({id, start});
+      items.push_back({c.id, start});
+      sent.ids.push_back(c.id);
     }
-    if (playback.ask_for_delay) items.push_back({playback.id, std::nullopt});
-    for (auto& q : p.queries) {
-      q.id = next_id_++;
-      sent.ids.push_back(q.id);
+    if (options.ask_for_delay) items.push_back({options.playback.id, std::nullopt});
+    for (robotalk::Query& q : queries) {
+      q.id = id++;
       items.push_back({q.id, std::nullopt});
+      sent.ids.push_back(q.id);
     }
-    bytes = Encode(p);
-    Seal(bytes);
-    for (CommandId id : sent.ids) cache_->Expect(id);
-    if (track == Track::kRetransmit) outstanding_.Add(sent.sequence, bytes, std::move(items), now);
-    if (clock_query) clock_packages_.insert(sent.sequence);
-    if (panic) ack_waited_.insert(sent.sequence);
+    request.commands = std::move(commands);
+    request.queries = std::move(queries);
+    bytes = EncodeSealed(request);
+    next_id_ = id;
+    sent.sequence = next_sequence_++;
+    for (CommandId i : sent.ids) cache_->Expect(i);
+    outstanding_.Add(sent.sequence, bytes, std::move(items), now);
+    if (options.clock_query) clock_packages_.insert(sent.sequence);
+    if (options.panic) ack_waited_.insert(sent.sequence);
     last_send_ = now;
     ++stats_.packages_sent;
   }
@@ -365,7 +335,8 @@ void RobotClient::Impl::Tick(TimePoint now) {
     // Resends do not count: the server refreshes a session only on new
     // packages, so heartbeats go on while a long GOTO is re-asked about.
     if (session_id_ != 0 && now - last_send_ >= options_.heartbeat_interval) {
-      heartbeat = EncodeHeartbeat(now);
+      heartbeat = EncodeSealed(NextRequest(now));  // no items: PAYLOAD_QUERIES, size 0
+      ++next_sequence_;
       last_send_ = now;
       ++stats_.heartbeats;
       ++stats_.packages_sent;
@@ -383,44 +354,24 @@ void RobotClient::Impl::Tick(TimePoint now) {
   }
 }
 
-std::vector<std::uint8_t> RobotClient::Impl::EncodeHeartbeat(TimePoint now) {
-  robotalk_msgs::package_t p{};
-  p.header.protocol_version = kProtocolVersion;
-  p.header.client_id = client_id_;
-  p.header.session_id = session_id_;
-  p.header.sequence = next_sequence_++;
-  p.header.send_time_us = ToWireMicros(now);
-  p.header.panic = false;
-  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
-  p.header.payload_size = 0;
-  std::vector<std::uint8_t> bytes = Encode(p);
-  Seal(bytes);
-  return bytes;
+Request RobotClient::Impl::NextRequest(TimePoint now) const {
+  return Request{
+      .client_id = client_id_, .session_id = session_id_, .sequence = next_sequence_, .send_time = now};
 }
 
 void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
   // Protocol errors are counted; anything else is stored and rethrown to the
   // next blocking call (the ReadDaemon keeps running).
   try {
-    robotalk_msgs::reply_package_t pkg;
+    ReplyBatch batch;
     try {
-      pkg = DecodeReplyPackage(bytes);
+      batch = DecodeReplyBatch(bytes);
     } catch (const ProtocolError&) {
       std::lock_guard lock(mu_);
       ++stats_.malformed_packages;
       return;
     }
     const TimePoint now = clock_.Now();
-    std::vector<Reply> replies;
-    replies.reserve(pkg.replies.size());
-    std::uint64_t bad = 0;
-    for (const auto& w : pkg.replies) {
-      try {
-        replies.push_back(FromWire(w));
-      } catch (const ProtocolError&) {
-        ++bad;  // unknown signal: the id's waiter will time out rather than see garbage
-      }
-    }
     bool notify = false;
     std::vector<CommandId> lost;
     const auto fail_lost = [&] {
@@ -434,12 +385,14 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     bool accepted = false;
     {
       std::lock_guard lock(mu_);
-      stats_.malformed_packages += bad;
-      if (pkg.client_id != client_id_ || pkg.protocol_version != kProtocolVersion) {
+      // A reply that did not decode (unknown signal): its waiter times out
+      // rather than see garbage; the rest of the batch stands.
+      stats_.malformed_packages += batch.malformed.size();
+      if (batch.client_id != client_id_) {
         ++stats_.malformed_packages;
         return;
       }
-      accepted = AcceptReplyPackage(pkg, bytes, now, lost);
+      accepted = AcceptReplyPackage(batch, bytes, now, lost);
     }
     if (!accepted) {
       cv_.notify_all();  // a panic answered outside its session
@@ -448,21 +401,21 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     }
     {
       std::lock_guard lock(mu_);
-      if (pkg.ack_sequence > 0) {
-        const auto info = outstanding_.OnAck(pkg.ack_sequence, now);
-        if (info.known && info.first && clock_packages_.erase(pkg.ack_sequence) != 0 && !info.retransmitted) {
+      if (batch.ack_sequence > 0) {
+        const auto info = outstanding_.OnAck(batch.ack_sequence, now);
+        if (info.known && info.first && clock_packages_.erase(batch.ack_sequence) != 0 &&
+            !info.retransmitted) {
           // Only a never-resent package gives an unambiguous t1.
-          clock_sync_.AddSample(info.first_send, FromWireMicros(pkg.server_receive_us),
-                                FromWireMicros(pkg.server_send_us), now);
+          clock_sync_.AddSample(info.first_send, batch.server_receive, batch.server_send, now);
         }
-        notify = NotePanicAnswer(pkg);
+        notify = NotePanicAnswer(batch);
       }
-      for (const Reply& r : replies) outstanding_.OnReply(r.id, now);
+      for (const Reply& r : batch.replies) outstanding_.OnReply(r.id, now);
     }
     if (notify) cv_.notify_all();
-    NoteResyncReplies(replies);
+    NoteResyncReplies(batch.replies);
     std::uint64_t filed = 0, ignored = 0;
-    for (const Reply& r : replies) (cache_->Put(r) ? filed : ignored)++;
+    for (const Reply& r : batch.replies) (cache_->Put(r) ? filed : ignored)++;
     std::lock_guard lock(mu_);
     stats_.replies_filed += filed;
     stats_.replies_ignored += ignored;

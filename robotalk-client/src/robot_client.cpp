@@ -187,9 +187,7 @@ void RobotClient::Connect(const std::string& robot) {
   // 1. The configuration query leaves first and travels while the clock
   //    rounds run (a CLI process connects in fewer round trips).
   std::optional<PendingReply> first_config = impl_->MakePending(
-      impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}, false, Impl::Track::kRetransmit)
-          .ids[0],
-      "CONFIG");
+      impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}).ids[0], "CONFIG");
 
   // 2. Clock: `clock_sync_rounds` CLOCK round trips, more if none counted
   //    (a resent package gives no sample).
@@ -207,8 +205,7 @@ void RobotClient::Connect(const std::string& robot) {
                           "client's clock: does ClientOptions::clock move with real time?)");
       }
     }
-    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false,
-                                   Impl::Track::kRetransmit, true);
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, {.clock_query = true});
     PendingReply p = impl_->MakePending(sent.ids[0], "CLOCK");
     try {
       p.Wait(std::chrono::duration_cast<Duration>(deadline - SteadyNow()));
@@ -232,12 +229,10 @@ void RobotClient::Connect(const std::string& robot) {
   std::shared_ptr<const RobotModel> model;
   while (!model && SteadyNow() < deadline) {
     PendingReply p =
-        first_config ? std::move(*first_config)
-                     : impl_->MakePending(impl_
-                                              ->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}},
-                                                            false, Impl::Track::kRetransmit)
-                                              .ids[0],
-                                          "CONFIG");
+        first_config
+            ? std::move(*first_config)
+            : impl_->MakePending(impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}}).ids[0],
+                                 "CONFIG");
     first_config.reset();
     Reply r;
     try {
@@ -318,8 +313,7 @@ Duration RobotClient::clock_round_trip() const {
 
 void RobotClient::SyncClock(int rounds) {
   for (int i = 0; i < rounds; ++i) {
-    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, false,
-                                   Impl::Track::kRetransmit, true);
+    auto sent = impl_->SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, {.clock_query = true});
     impl_->MakePending(sent.ids[0], "CLOCK").Wait(impl_->options_.timeout);
   }
 }
@@ -371,23 +365,28 @@ Reply RobotClient::Query(robotalk::Query query) {
 PendingReply RobotClient::Send(Command command) {
   RequireConnected(*this, "Send");
   const std::string what = Describe(command);
-  auto sent = impl_->SendPackage({std::move(command)}, {}, false, Impl::Track::kRetransmit);
+  auto sent = impl_->SendPackage({std::move(command)}, {});
   return impl_->MakePending(sent.ids[0], what);
 }
 
 PendingReply RobotClient::SendQuery(robotalk::Query query) {
   RequireConnected(*this, "SendQuery");
   const std::string what = Describe(query);
-  auto sent = impl_->SendPackage({}, {std::move(query)}, false, Impl::Track::kRetransmit);
+  auto sent = impl_->SendPackage({}, {std::move(query)});
   return impl_->MakePending(sent.ids[0], what);
 }
 
-std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands) {
+std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands, CommandMode mode) {
   RequireConnected(*this, "SendBatch");
+  if (mode == CommandMode::kPlayback) {
+    throw ClientError("RobotClient::SendBatch: a playback sequence is declared whole; use RunSequence");
+  }
   if (commands.empty()) return {};
   std::vector<std::string> what;
   for (const Command& c : commands) what.push_back(Describe(c));
-  auto sent = impl_->SendPackage(std::move(commands), {}, false, Impl::Track::kRetransmit);
+  auto sent =
+      impl_->SendPackage(std::move(commands), {},
+                         {.mode = mode == CommandMode::kDelay ? RequestMode::kDelay : RequestMode::kDirect});
   std::vector<PendingReply> pending;
   for (std::size_t i = 0; i < sent.ids.size(); ++i)
     pending.push_back(impl_->MakePending(sent.ids[i], what[i]));
@@ -398,7 +397,7 @@ void RobotClient::Panic() {
   RequireConnected(*this, "Panic");
   const auto deadline = SteadyAfter(impl_->options_.timeout);
   for (int attempt = 1;; ++attempt) {
-    auto sent = impl_->SendPackage({}, {}, /*panic=*/true, Impl::Track::kRetransmit);
+    auto sent = impl_->SendPackage({}, {}, {.panic = true});
     const auto answer = impl_->WaitPanicAnswer(sent.sequence, deadline);
     if (!answer) {
       throw TimeoutError("RobotClient::Panic: panic package " + std::to_string(sent.sequence) +

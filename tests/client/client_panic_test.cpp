@@ -75,7 +75,9 @@ class ClientPanicTest : public ::testing::Test {
     o.timeout = seconds(5);
     o.connect_timeout = seconds(5);
     if (!key.empty()) o.key_file = (dir_ / key).string();
-    o.known_servers_file = (dir_ / "known_servers").string();  // never the user's own pins
+    // Its own pins: the default file is the user's, shared with every other
+    // test run on the machine (a key pinned there by another run is "CHANGED").
+    o.known_servers_file = (dir_ / "known_servers").string();
     auto c = std::make_unique<RobotClient>(o);
     c->Connect(kRobot);
     return c;

@@ -6,7 +6,7 @@
 #include "client/faulty_transport.h"
 #include "robotalk/clock.h"
 #include "robotalk/driver.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "support/observed_driver.h"
 
 #include <chrono>
@@ -54,12 +54,12 @@ class DriverLog final : public DriverObserver {
   bool halted_ = false;
 };
 
-// --- Filters on wire bytes, for FaultyTransport faults ------------------------
+// --- Filters on wire bytes, for FaultyTransport faults (the server's decoders) --
 
 inline bool IsHeartbeat(const std::string&, std::span<const std::uint8_t> bytes) {
   try {
-    const auto p = DecodePackage(bytes);
-    return p.header.payload_size == 0 && !p.header.panic;
+    const Request r = DecodeRequest(bytes);
+    return r.item_ids().empty() && !r.panic;
   } catch (const std::exception&) {
     return false;
   }
@@ -67,7 +67,7 @@ inline bool IsHeartbeat(const std::string&, std::span<const std::uint8_t> bytes)
 
 inline bool HasPayload(const std::string&, std::span<const std::uint8_t> bytes) {
   try {
-    return DecodePackage(bytes).header.payload_size > 0;
+    return !DecodeRequest(bytes).item_ids().empty();
   } catch (const std::exception&) {
     return false;
   }
@@ -75,7 +75,7 @@ inline bool HasPayload(const std::string&, std::span<const std::uint8_t> bytes) 
 
 inline bool HasReplies(const std::string&, std::span<const std::uint8_t> bytes) {
   try {
-    return !DecodeReplyPackage(bytes).replies.empty();
+    return !DecodeReplyBatch(bytes).replies.empty();
   } catch (const std::exception&) {
     return false;
   }
@@ -86,8 +86,8 @@ inline MessageFilter Repeated() {
   auto seen = std::make_shared<std::set<std::pair<std::int64_t, std::int64_t>>>();
   return [seen](const std::string&, std::span<const std::uint8_t> bytes) {
     try {
-      const auto p = DecodePackage(bytes);
-      return !seen->insert({p.header.client_id, p.header.sequence}).second;
+      const Request r = DecodeRequest(bytes);
+      return !seen->insert({r.client_id, r.sequence}).second;
     } catch (const std::exception&) {
       return false;
     }

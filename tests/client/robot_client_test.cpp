@@ -15,7 +15,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
 #include "robotalk/memory_transport.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 #include "robotalk/server.h"
 #include "robotalk/urdf_import.h"
 
@@ -420,17 +420,17 @@ TEST_F(RobotClientTest, StateStreamDeliversValidatedSamplesAndDropsBadOnes) {
   good.velocities.assign(dofs, 0.0);
   good.efforts.assign(dofs, 0.0);
   good.base = {1, 2, 0.5, 0.1, 0};
-  robotalk_msgs::robot_state_t nan = ToWire(good);
+  StateSample nan = good;
   nan.sample = 1000002;
-  nan.position[0] = std::nan("");
+  nan.positions[0] = std::nan("");
   StateSample extra_dof = good;
   extra_dof.sample = 1000003;
   for (auto* v : {&extra_dof.positions, &extra_dof.velocities, &extra_dof.efforts}) v->push_back(0);
   StateSample last = good;
   last.sample = 1000004;
   MemoryTransport forger(bus_);
-  for (const auto& wire : {ToWire(good), nan, ToWire(extra_dof), ToWire(last)})
-    Publish(forger, StateChannel(kRobot), wire);
+  for (const StateSample& s : {good, nan, extra_dof, last})
+    forger.Publish(StateChannel(kRobot), EncodeStateSample(s));
   const auto has = [&](std::int64_t sample) {
     std::lock_guard lock(mu);
     return std::any_of(got.begin(), got.end(), [&](const StateSample& s) { return s.sample == sample; });

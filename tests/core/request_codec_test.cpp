@@ -1,4 +1,5 @@
 #include "robotalk/error.h"
+#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "robotalk_msgs/announce_t.hpp"
 
@@ -11,6 +12,10 @@ namespace robotalk {
 namespace {
 
 using ::testing::HasSubstr;
+using Header = robotalk_msgs::package_header_t;
+// Copies of LCM's in-class constants (binding those to a reference needs a definition).
+constexpr std::int8_t kQueries = Header::PAYLOAD_QUERIES, kCommands = Header::PAYLOAD_COMMANDS;
+constexpr std::int8_t kDirect = Header::MODE_DIRECT, kDelay = Header::MODE_DELAY;
 
 TEST(RequestCodec, RoundTripsARequestWithEveryStartKind) {
   Request r{.client_id = 42, .sequence = 7, .send_time = TimePoint(std::chrono::seconds(5))};
@@ -72,6 +77,114 @@ TEST(RequestCodec, RefusesAnAnnouncementWithAZeroLengthStringOrAHostileCount) {
   }
   bytes.pop_back();
   EXPECT_THROW(DecodeAnnouncement(bytes), ProtocolError) << "truncated";
+}
+
+// The C++ client sends every package through EncodeRequest: a heartbeat and
+// a panic are empty packages, which docs/protocol.md documents as
+// PAYLOAD_QUERIES of size 0, and the server's own header check accepts.
+TEST(RequestCodec, AnEmptyRequestIsTheDocumentedHeartbeatAQueriesPackageOfSizeZero) {
+  for (const bool panic : {false, true}) {
+    const Request empty{.client_id = 42, .session_id = 3, .sequence = 9, .panic = panic};
+    const auto p = DecodePackage(EncodeRequest(empty));
+    EXPECT_EQ(p.header.payload_type, kQueries);
+    EXPECT_EQ(p.header.payload_size, 0);
+    EXPECT_EQ(p.header.panic, panic);
+    EXPECT_EQ(CheckPackageHeader(p), "");
+  }
+  Request commands{.client_id = 42, .sequence = 10};
+  commands.commands.push_back(Command{1, CommandType::kStop, StartTime::Now(), "", {}});
+  const auto p = DecodePackage(EncodeRequest(commands));
+  EXPECT_EQ(p.header.payload_type, kCommands);
+  EXPECT_EQ(p.header.payload_size, 1);
+}
+
+TEST(RequestCodec, EachModeTravelsAsTheProtocolPageNamesIt) {
+  const TimePoint at(std::chrono::seconds(9));
+  for (const auto& [mode, wire] :
+       {std::pair{RequestMode::kDirect, kDirect}, std::pair{RequestMode::kDelay, kDelay}}) {
+    Request r{.client_id = 42, .sequence = 1, .mode = mode};
+    r.commands.push_back(Command{1, CommandType::kGoto, StartTime::At(at), "", {1, 2, 3}});
+    const auto bytes = EncodeRequest(r);
+    EXPECT_EQ(DecodePackage(bytes).header.mode, wire);
+    const Request back = DecodeRequest(bytes);
+    EXPECT_EQ(back.mode, mode);
+    EXPECT_EQ(back.commands.at(0).start_time, StartTime::At(at));
+  }
+  // Offsets belong in PLAYBACK only: refused before anything is sent.
+  Request delay{.client_id = 42, .sequence = 2, .mode = RequestMode::kDelay};
+  delay.commands.push_back(Command{1, CommandType::kStop, StartTime::After(std::chrono::seconds(1)), "", {}});
+  EXPECT_THROW(EncodeRequest(delay), ProtocolError);
+}
+
+TEST(RequestCodec, TheMacIsTheLastBytesOfTheEncodingAndCoversEveryByteBeforeIt) {
+  Request r{.client_id = 42, .session_id = 5, .sequence = 1};
+  r.queries.push_back(Query{.id = 1, .type = QueryType::kClock});
+  std::vector<std::uint8_t> bytes = EncodeRequest(r);
+  EXPECT_EQ(MacCoveredBytes(bytes).size(), bytes.size() - kMacBytes);
+  Mac mac{};
+  mac.fill(0xab);
+  WriteMacField(bytes, mac);
+  EXPECT_EQ(DecodeRequest(bytes).mac, mac);
+  r.mac = mac;
+  EXPECT_EQ(EncodeRequest(r), bytes) << "sealing the bytes and encoding the MAC agree";
+}
+
+// Everything the client reads from a reply package comes through DecodeReplyBatch.
+TEST(RequestCodec, AReplyBatchRoundTripsEveryFieldTheClientReads) {
+  ReplyBatch b{.client_id = 42,
+               .server_id = 7,
+               .session_id = 5,
+               .session_status = SessionStatus::kUnknown,
+               .ack_sequence = 11,
+               .panic = PanicStatus::kRefused,
+               .panic_refusal = "key 'viewer' has no panic right",
+               .server_receive = TimePoint(std::chrono::seconds(20)),
+               .server_send = TimePoint(std::chrono::seconds(21))};
+  b.replies.push_back(Reply{.id = 3, .signal = Signal::kModified, .message = "clamped", .values = {0.5}});
+  b.mac.fill(0x5a);
+  const ReplyBatch back = DecodeReplyBatch(EncodeReplyBatch(b));
+  EXPECT_EQ(back.client_id, 42);
+  EXPECT_EQ(back.server_id, 7);
+  EXPECT_EQ(back.session_id, 5);
+  EXPECT_EQ(back.session_status, SessionStatus::kUnknown);
+  EXPECT_EQ(back.ack_sequence, 11);
+  EXPECT_EQ(back.panic, PanicStatus::kRefused);
+  EXPECT_EQ(back.panic_refusal, b.panic_refusal);
+  EXPECT_EQ(back.server_receive, b.server_receive);
+  EXPECT_EQ(back.server_send, b.server_send);
+  ASSERT_EQ(back.replies.size(), 1u);
+  EXPECT_EQ(back.replies[0].signal, Signal::kModified);
+  EXPECT_EQ(back.replies[0].values, std::vector<double>{0.5});
+  EXPECT_TRUE(back.malformed.empty());
+  EXPECT_EQ(back.mac, b.mac);
+}
+
+// A reply the client cannot read (a newer signal) must not cost the batch's
+// ack and its other replies: it is reported, the rest stands.
+TEST(RequestCodec, AnUndecodableReplyIsReportedAndTheRestOfTheBatchStands) {
+  ReplyBatch b{.client_id = 42, .session_id = 5, .ack_sequence = 11};
+  b.replies.push_back(Reply{.id = 3, .signal = Signal::kSuccess});
+  b.replies.push_back(Reply{.id = 4, .signal = static_cast<Signal>(99)});
+  const ReplyBatch back = DecodeReplyBatch(EncodeReplyBatch(b));
+  EXPECT_EQ(back.ack_sequence, 11);
+  ASSERT_EQ(back.replies.size(), 1u);
+  EXPECT_EQ(back.replies[0].id, 3);
+  ASSERT_EQ(back.malformed.size(), 1u);
+  EXPECT_EQ(back.malformed[0].id, 4);
+  EXPECT_THAT(back.malformed[0].reason, HasSubstr("signal"));
+}
+
+TEST(RequestCodec, AReplyBatchOfAnotherProtocolVersionIsRefusedNamingBothVersions) {
+  std::vector<std::uint8_t> bytes = EncodeReplyBatch(ReplyBatch{.client_id = 42});
+  bytes[8] = 0;  // protocol_version (int16, big-endian) follows the 8-byte fingerprint
+  bytes[9] = 1;
+  try {
+    DecodeReplyBatch(bytes);
+    FAIL() << "a version-1 reply package was accepted";
+  } catch (const ProtocolError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("protocol version 1"));
+    EXPECT_THAT(e.what(), HasSubstr(std::to_string(kProtocolVersion)));
+  }
 }
 
 }  // namespace

@@ -15,10 +15,11 @@ namespace robotalk::fuzz {
 
 using Bytes = std::span<const std::uint8_t>;
 
-/// Server, ROBOTALK/<robot>/REQUEST: DecodePackage, CheckPackageHeader, and
-/// FromWire of every query and command.
+/// Server, ROBOTALK/<robot>/REQUEST: DecodeRequest (DecodePackage,
+/// CheckPackageHeader, FromWire of every query and command).
 void Package(Bytes bytes);
-/// Client, ROBOTALK/<robot>/REPLY/<id>: DecodeReplyPackage, FromWire of every reply.
+/// Client, ROBOTALK/<robot>/REPLY/<id>: DecodeReplyBatch (DecodeReplyPackage,
+/// FromWire of every reply).
 void ReplyPackage(Bytes bytes);
 /// Client, ROBOTALK/<robot>/STATE: DecodeRobotState.
 void RobotState(Bytes bytes);

@@ -55,7 +55,8 @@ check "record says what it wrote" grep -q "wrote [0-9]* events" "$tmp/record.log
 "$logplay" info "$tmp/session.lcmlog" >"$tmp/info.txt" 2>&1
 check "info exits 0" test $? -eq 0
 check "info lists both robots" grep -q "pioneer2  driver ode" "$tmp/info.txt"
-check "info shows the command stream" grep -q "commands 7: JOINT_SETPOINT 3 SETSPEED 3 STOP 1" "$tmp/info.txt"
+check "info shows the command stream, sent in send's default mode (delay)" \
+  grep -q "commands 7 in mode delay: JOINT_SETPOINT 3 SETSPEED 3 STOP 1" "$tmp/info.txt"
 check "info places it on the server clock" grep -q "7 frames over 3.4 s (server clock)" "$tmp/info.txt"
 final=$(grep "^state pioneer:" "$tmp/info.txt")
 read -r x0 y0 th0 < <(echo "$final" | sed 's/.*final base x \([^ ]*\) y \([^ ]*\) theta \([^;]*\);.*/\1 \2 \3/')
@@ -94,6 +95,8 @@ if "$py" -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"
 "$logplay" export "$tmp/session.lcmlog" -o "$tmp/export" $plot >"$tmp/export.out" 2>&1
 check "export exits 0" test $? -eq 0
 check "commands.csv has 7 commands" test "$(grep -c ',pioneer,' "$tmp/export/commands.csv")" -eq 7
+check "commands.csv labels the delay session delay (issue 20)" \
+  test "$(grep -c ',pioneer,[0-9]*,delay,' "$tmp/export/commands.csv")" -eq 7
 check "state.csv has the samples" test "$(grep -c '^pioneer,' "$tmp/export/state.csv")" -gt 40
 [ -z "$plot" ] && check "the PNG was written" test -s "$tmp/export/session.png"
 

@@ -68,7 +68,9 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
       << " heartbeats)  queries " << c.queries << (c.panics ? "  PANIC x" + std::to_string(c.panics) : "")
       << "\n";
   if (commands == 0) return;
-  out << "      commands " << commands << ":";
+  out << "      commands " << commands << " in " << (c.modes.size() == 1 ? "mode" : "modes");
+  for (int mode : c.modes) out << ' ' << ModeName(mode);
+  out << ":";
   for (const auto& [t, n] : types) out << ' ' << t << ' ' << n;
   int absolute = 0, now = 0, playback = 0;
   for (const LoggedCommand& lc : log.commands()) {

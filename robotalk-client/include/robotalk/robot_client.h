@@ -286,8 +286,14 @@ class RobotClient {
   PendingReply Send(Command command);
   PendingReply SendQuery(robotalk::Query query);
   /// Several commands in ONE package (executed in start-time order by the
-  /// server). Throws ClientError when the package would exceed ~60 KB.
-  std::vector<PendingReply> SendBatch(std::vector<Command> commands);
+  /// server). `mode` is the package mode the server and a recording see
+  /// (docs/protocol.md, Modes): kDelay for commands stamped ahead on the
+  /// synchronised server clock, as a delay sequence sent piece by piece
+  /// (`robotalk send --file`); kPlayback is RunSequence's only (it declares
+  /// the sequence) and throws ClientError. Throws ClientError when the
+  /// package would exceed ~60 KB, ProtocolError for an offset start time
+  /// (StartTime::After).
+  std::vector<PendingReply> SendBatch(std::vector<Command> commands, CommandMode mode = CommandMode::kDirect);
 
   // --- Command modes (docs/client.md, "Modes") ---------------------------------
   /// Sends `frames` in `options.mode` and waits for every reply (each at most

@@ -328,10 +328,6 @@ robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> byte
                                                      &ScanRobotState);
 }
 
-StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs) {
-  return FromWire(DecodeRobotState(bytes), expected_dofs);
-}
-
 std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
   const auto& h = p.header;
   if (h.protocol_version != kProtocolVersion) {

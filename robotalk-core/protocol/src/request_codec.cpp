@@ -123,9 +123,10 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
   for (const Command& c : r.commands) p.commands.push_back(ToWire(c, h.mode));
   p.num_queries = static_cast<std::int32_t>(p.queries.size());
   p.num_commands = static_cast<std::int32_t>(p.commands.size());
-  h.payload_type = p.num_queries > 0 ? robotalk_msgs::package_header_t::PAYLOAD_QUERIES
-                                     : robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
-  h.payload_size = p.num_queries > 0 ? p.num_queries : p.num_commands;
+  const bool commands = p.num_commands > 0;  // a package mixing both is refused by the server
+  h.payload_type = commands ? robotalk_msgs::package_header_t::PAYLOAD_COMMANDS
+                            : robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
+  h.payload_size = commands ? p.num_commands : p.num_queries;
   CopyBytes(p.mac, r.mac);
   return Encode(p);
 }
@@ -151,6 +152,10 @@ std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
 
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
   const robotalk_msgs::reply_package_t p = DecodeReplyPackage(bytes);
+  if (p.protocol_version != kProtocolVersion) {
+    throw ProtocolError("DecodeReplyBatch: protocol version " + std::to_string(p.protocol_version) +
+                        " is not supported (this side speaks " + std::to_string(kProtocolVersion) + ")");
+  }
   ReplyBatch b;
   b.client_id = p.client_id;
   b.server_id = p.server_id;
@@ -163,9 +168,15 @@ ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
   b.panic = static_cast<PanicStatus>(CheckedPanicStatus(p));
   b.panic_refusal = p.panic_refusal;
   b.ack_sequence = p.ack_sequence;
-  b.server_receive = FromWireMicros(p.server_receive_us);
-  b.server_send = FromWireMicros(p.server_send_us);
-  for (const auto& r : p.replies) b.replies.push_back(FromWire(r));
+  b.server_receive = FromWireMicros(p.server_receive_us, "reply package: server_receive_us");
+  b.server_send = FromWireMicros(p.server_send_us, "reply package: server_send_us");
+  for (const auto& r : p.replies) {
+    try {
+      b.replies.push_back(FromWire(r));
+    } catch (const ProtocolError& e) {
+      b.malformed.push_back({r.id, e.what()});
+    }
+  }
   CopyBytes(b.mac, p.mac);
   return b;
 }
@@ -195,6 +206,10 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
 }
 
 std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample) { return Encode(ToWire(sample)); }
+
+StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs) {
+  return FromWire(DecodeRobotState(bytes), expected_dofs);
+}
 
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   bytes = WithoutSignature(bytes);  // a keyed server's; verified (or not) by the caller

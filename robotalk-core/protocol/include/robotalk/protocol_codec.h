@@ -8,6 +8,7 @@
 #pragma once
 
 #include "robotalk/command.h"
+#include "robotalk/request.h"
 #include "robotalk/state_sample.h"
 #include "robotalk_msgs/package_t.hpp"
 #include "robotalk_msgs/reply_package_t.hpp"
@@ -74,8 +75,7 @@ std::int8_t CheckedPanicStatus(const robotalk_msgs::reply_package_t& p);
 /// Decodes a broadcast state sample; same guarantees. A keyed server's
 /// signature suffix is skipped, not verified (broadcast_signature.h).
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes);
-/// DecodeRobotState + FromWire: bytes to a validated StateSample.
-StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs = -1);
+// DecodeStateSample (DecodeRobotState + FromWire) is declared in request.h.
 
 /// Checks a decoded package's header against its payload: version, client id,
 /// sequence, payload type and size, never both queries and commands. Returns

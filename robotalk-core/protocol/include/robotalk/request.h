@@ -1,6 +1,10 @@
 // Whole protocol messages as C++ values: a client's REQUEST package, a
-// server's batch of replies, and a server's ANNOUNCE. The server core and the
-// client speak these; only their codec (request_codec.cpp, beside
+// server's batch of replies, the hello and its answer, and a server's
+// ANNOUNCE. The server core and the C++ client (robotalk-client/src) both
+// speak these and nothing else: every package the client sends, hello,
+// heartbeat and panic included, goes out through EncodeRequest, and every
+// reply package it reads comes in through DecodeReplyBatch -- the functions
+// the server's tests use. Only their codec (request_codec.cpp, beside
 // protocol_codec.cpp) knows the LCM wire structs (docs/protocol.md).
 #pragma once
 
@@ -67,7 +71,13 @@ struct Request {
 /// ProtocolError only for bytes that carry no trustworthy client id
 /// (truncated, hostile counts, another message type).
 Request DecodeRequest(std::span<const std::uint8_t> bytes);
-/// Encodes a request (clients and tests).
+/// Encodes a request (the C++ client, tests). The payload type is COMMANDS
+/// when it carries commands, else QUERIES (an empty package -- a heartbeat,
+/// a panic -- is `PAYLOAD_QUERIES`, size 0, as docs/protocol.md says); the
+/// playback fields are written in kPlayback only; `mac` goes in as given
+/// (keyed mode: seal the bytes afterwards, see WriteMacField). Throws
+/// ProtocolError for a start time whose kind does not belong in `mode`
+/// (protocol_codec.h) or a negative time.
 std::vector<std::uint8_t> EncodeRequest(const Request& request);
 
 /// Whether the package a ReplyBatch acknowledges belonged to a live session.
@@ -96,10 +106,14 @@ struct ReplyBatch {
   TimePoint server_receive{};              ///< when that package arrived (clock sync)
   TimePoint server_send{};
   std::vector<Reply> replies;
+  /// Replies that did not decode (an unknown signal, a time out of range):
+  /// the rest of the batch stands; their waiters see no reply.
+  std::vector<MalformedItem> malformed;
   Mac mac{};  ///< keyed mode: the last kMacBytes of the encoding
 };
 std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& batch);
-/// Throws ProtocolError on truncated, hostile or foreign bytes.
+/// Throws ProtocolError on truncated, hostile or foreign bytes, another
+/// protocol version, or an unknown session or panic status.
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes);
 
 /// One served robot in an ANNOUNCE.
@@ -126,6 +140,12 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& announcement);
 
 /// A broadcast state sample (ROBOTALK/<robot>/STATE) as bytes.
 std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample);
+/// Bytes to a validated StateSample (protocol_codec.h FromWire: counts,
+/// finite values, times; `expected_dofs` >= 0 also checks the dof count).
+/// Throws ProtocolError on truncated, hostile, foreign or invalid bytes. A
+/// keyed server's signature suffix is skipped, not verified
+/// (broadcast_signature.h).
+StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs = -1);
 /// Throws ProtocolError on truncated, hostile or foreign bytes, or more than
 /// 1024 robots. A keyed server's signature suffix is skipped, not verified
 /// (broadcast_signature.h).
