@@ -1,5 +1,6 @@
 #include "cli_support.h"
 
+#include "describe_format.h"
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
@@ -147,76 +148,43 @@ void ExitAfterOutput(int status) {
   std::_Exit(status);
 }
 
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
-}
-
-std::string JsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-namespace {
-template <typename It>
-std::string JsonArray(It begin, It end) {
-  std::string out = "[";
-  for (It it = begin; it != end; ++it) out += (it == begin ? "" : ",") + JsonNumber(*it);
-  return out + "]";
-}
-}  // namespace
-
 std::string ReplyJson(const Reply& r) {
-  std::ostringstream out;
-  out << "{\"id\":" << r.id << ",\"signal\":" << JsonString(std::string(ToString(r.signal)))
-      << ",\"message\":" << JsonString(r.message) << ",\"exec_time_us\":" << ToWireMicros(r.exec_time)
-      << ",\"lateness_s\":" << JsonNumber(ToSeconds(r.lateness))
-      << ",\"values\":" << JsonArray(r.values.begin(), r.values.end()) << "}";
-  return out.str();
+  return JsonText(nlohmann::ordered_json{{"id", r.id},
+                                         {"signal", ToString(r.signal)},
+                                         {"message", r.message},
+                                         {"exec_time_us", ToWireMicros(r.exec_time)},
+                                         {"lateness_s", ToSeconds(r.lateness)},
+                                         {"values", r.values}});
 }
 
 std::string StateJson(const StateSample& s) {
-  const double base[5] = {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega};
-  std::ostringstream out;
-  out << "{\"robot\":" << JsonString(s.robot) << ",\"sample\":" << s.sample
-      << ",\"server_time_us\":" << ToWireMicros(s.server_time)
-      << ",\"period_s\":" << JsonNumber(ToSeconds(s.period)) << ",\"panic\":" << (s.panic ? "true" : "false")
-      << ",\"moving\":" << (s.moving ? "true" : "false")
-      << ",\"base\":" << JsonArray(std::begin(base), std::end(base))
-      << ",\"position\":" << JsonArray(s.positions.begin(), s.positions.end())
-      << ",\"velocity\":" << JsonArray(s.velocities.begin(), s.velocities.end())
-      << ",\"effort\":" << JsonArray(s.efforts.begin(), s.efforts.end()) << "}";
-  return out.str();
+  return JsonText(nlohmann::ordered_json{{"robot", s.robot},
+                                         {"sample", s.sample},
+                                         {"server_time_us", ToWireMicros(s.server_time)},
+                                         {"period_s", ToSeconds(s.period)},
+                                         {"panic", s.panic},
+                                         {"moving", s.moving},
+                                         {"base", {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega}},
+                                         {"position", s.positions},
+                                         {"velocity", s.velocities},
+                                         {"effort", s.efforts}});
 }
 
 std::string RobotsJson(const std::vector<AnnouncedRobot>& robots) {
-  std::ostringstream out;
-  out << "[";
-  for (std::size_t i = 0; i < robots.size(); ++i) {
-    const AnnouncedRobot& r = robots[i];
-    out << (i ? "," : "") << "{\"name\":" << JsonString(r.name) << ",\"driver\":" << JsonString(r.driver)
-        << ",\"dofs\":" << r.total_dofs << ",\"config_hash\":" << JsonString(Hex64(r.config_hash))
-        << ",\"panic\":" << (r.panic ? "true" : "false") << ",\"clients\":" << r.num_clients
-        << ",\"server\":" << JsonString(Hex64(static_cast<std::uint64_t>(r.server_id)))
-        << ",\"server_key\":" << (r.server_key.empty() ? std::string("null") : JsonString(r.server_key))
-        << "}";
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const AnnouncedRobot& r : robots) {
+    list.push_back({{"name", r.name},
+                    {"driver", r.driver},
+                    {"dofs", r.total_dofs},
+                    {"base", ToString(r.base_type)},
+                    {"config_hash", Hex64(r.config_hash)},
+                    {"panic", r.panic},
+                    {"clients", r.num_clients},
+                    {"server", Hex64(static_cast<std::uint64_t>(r.server_id))},
+                    {"server_key", r.server_key.empty() ? nlohmann::ordered_json(nullptr)
+                                                        : nlohmann::ordered_json(r.server_key)}});
   }
-  out << "]";
-  return out.str();
+  return JsonText(list);
 }
 
 }  // namespace robotalk::cli

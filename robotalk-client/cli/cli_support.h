@@ -52,12 +52,14 @@ ClientOptions MakeOptions(const GlobalOptions& g);
 /// does not: the client sends nothing on close, the kernel closes the sockets.
 [[noreturn]] void ExitAfterOutput(int status);
 
-/// JSON text of a string (quoted, escaped) and of a number (null for NaN/inf).
-std::string JsonString(const std::string& s);
-std::string JsonNumber(double v);
+/// The --json outputs, each one line of JSON (JsonText: non-finite numbers
+/// are null, strings that are not UTF-8 are repaired).
 /// {"id":12,"signal":"SUCCESS","message":"","exec_time_us":..,"lateness_s":..,"values":[..]}
 std::string ReplyJson(const Reply& r);
+/// {"robot","sample","server_time_us","period_s","panic","moving","base":[x,y,θ,v,ω],
+///  "position":[..],"velocity":[..],"effort":[..]}
 std::string StateJson(const StateSample& s);
+/// [{"name","driver","dofs","base","config_hash","panic","clients","server","server_key"}, ...]
 std::string RobotsJson(const std::vector<AnnouncedRobot>& robots);
 
 }  // namespace robotalk::cli

@@ -493,7 +493,7 @@ void ServerDaemon::Announce(TimePoint now) {
     if (!robot.refused.empty()) continue;
     const RobotModel& m = robot.daemon->model();
     a.robots.push_back({name, robot.daemon->driver_name(), robot.config_hash, m.num_dofs(),
-                        static_cast<std::int8_t>(m.roots().front().base), robot.daemon->in_panic(),
+                        m.roots().front().base, robot.daemon->in_panic(),
                         static_cast<int>(robot.sessions->num_sessions())});
   }
   std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);

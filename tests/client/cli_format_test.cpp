@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace robotalk::cli {
 namespace {
 
@@ -34,15 +36,33 @@ TEST(ProgressBar, FillsWithTheLaterOfTimeAndAnsweredFrames) {
       "[....] 0/1  0.0 s / 2 s");
 }
 
-TEST(Json, EscapesStringsAndWritesNullForNonFiniteNumbers) {
-  EXPECT_EQ(JsonString("a\"b\\c\n"), "\"a\\\"b\\\\c\\u000a\"");
-  EXPECT_EQ(JsonNumber(0.5), "0.5");
-  EXPECT_EQ(JsonNumber(std::numeric_limits<double>::quiet_NaN()), "null");
-  Reply r{.id = 7, .signal = Signal::kModified, .message = "clamped", .values = {1, 2}};
-  const std::string j = ReplyJson(r);
-  EXPECT_NE(j.find("\"id\":7"), std::string::npos);
-  EXPECT_NE(j.find("\"signal\":\"MODIFIED\""), std::string::npos);
-  EXPECT_NE(j.find("\"values\":[1,2]"), std::string::npos);
+TEST(Json, AReplyIsOneLineWithItsKeysInOrderEscapedStringsAndNullForNonFiniteNumbers) {
+  Reply r{.id = 7,
+          .signal = Signal::kModified,
+          .message = "a\"b\\c\n",
+          .values = {1, 0.1, std::numeric_limits<double>::quiet_NaN()}};
+  EXPECT_EQ(ReplyJson(r),
+            R"({"id":7,"signal":"MODIFIED","message":"a\"b\\c\n","exec_time_us":0,"lateness_s":0.0,)"
+            R"("values":[1.0,0.1,null]})");
+}
+
+TEST(Json, BytesThatAreNotUtf8AreReplacedInsteadOfThrowing) {
+  Reply r{.id = 1, .signal = Signal::kError, .message = std::string("bad \xff name")};
+  EXPECT_NE(ReplyJson(r).find("\"message\":\"bad \xef\xbf\xbd name\""), std::string::npos);  // U+FFFD
+}
+
+TEST(Json, ARobotListNamesTheBaseTypeAndNullForAnUnsignedAnnouncement) {
+  AnnouncedRobot a{.name = "pioneer",
+                   .driver = "ode",
+                   .config_hash = 0xab,
+                   .total_dofs = 4,
+                   .base_type = BaseType::kDifferential,
+                   .num_clients = 2,
+                   .server_id = 1};
+  EXPECT_EQ(
+      RobotsJson({a}),
+      R"([{"name":"pioneer","driver":"ode","dofs":4,"base":"differential","config_hash":"00000000000000ab",)"
+      R"("panic":false,"clients":2,"server":"0000000000000001","server_key":null}])");
 }
 
 }  // namespace

@@ -46,7 +46,7 @@ TEST(RequestCodec, RoundTripsAnAnnouncement) {
                  .server_time = TimePoint(std::chrono::seconds(3)),
                  .uptime = std::chrono::seconds(2),
                  .url_hint = "memory://"};
-  a.robots.push_back({"pioneer", "ode", 0xabcdef, 4, 1, true, 3});
+  a.robots.push_back({"pioneer", "ode", 0xabcdef, 4, BaseType::kDifferential, true, 3});
   const Announcement back = DecodeAnnouncement(EncodeAnnouncement(a));
   EXPECT_EQ(back.server_id, 9);
   EXPECT_EQ(back.uptime, std::chrono::seconds(2));
@@ -54,13 +54,29 @@ TEST(RequestCodec, RoundTripsAnAnnouncement) {
   EXPECT_EQ(back.robots[0].name, "pioneer");
   EXPECT_EQ(back.robots[0].config_hash, 0xabcdefu);
   EXPECT_TRUE(back.robots[0].panic);
+  EXPECT_EQ(back.robots[0].base_type, BaseType::kDifferential);
+}
+
+TEST(RequestCodec, RefusesAnAnnouncedRobotWhoseBaseTypeIsNoBaseType) {
+  Announcement a{.server_id = 9, .url_hint = "u"};
+  a.robots.push_back({"r", "d", 1, 1, BaseType::kFloating, false, 0});
+  std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+  // The robot's base_type byte: after config_hash (8) and total_dofs (4), 1 + 4 bytes before the end.
+  ASSERT_EQ(bytes[bytes.size() - 6], 3);
+  bytes[bytes.size() - 6] = 4;
+  try {
+    DecodeAnnouncement(bytes);
+    FAIL() << "base_type 4 was accepted";
+  } catch (const ProtocolError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("base_type"));
+  }
 }
 
 // tests/fuzz: a zero-length string made LCM's generated decoder throw
 // std::length_error through its C callback (std::terminate in the client).
 TEST(RequestCodec, RefusesAnAnnouncementWithAZeroLengthStringOrAHostileCount) {
   Announcement a{.server_id = 9, .url_hint = "u"};
-  a.robots.push_back({"r", "d", 1, 1, 0, false, 0});
+  a.robots.push_back({"r", "d", 1, 1, BaseType::kFixed, false, 0});
   std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
   // The url_hint's length field sits after the fingerprint and 2+8+8+8 header bytes.
   std::vector<std::uint8_t> zero = bytes;

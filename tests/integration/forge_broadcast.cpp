@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
       a.server_time = TimePoint(std::chrono::hours(1000));
       a.uptime = std::chrono::hours(24 * 365);
       a.url_hint = "forged";
-      a.robots.push_back({robot, "kinematic", 1, 1, 0, false, 0});
+      a.robots.push_back({robot, "kinematic", 1, 1, BaseType::kFixed, false, 0});
       lan->Publish(kAnnounceChannel, EncodeAnnouncement(a));
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }

@@ -28,7 +28,7 @@ std::vector<std::uint8_t> ForgedAnnounce(std::int64_t server_id, const std::stri
   a.server_time = TimePoint(std::chrono::hours(1000));
   a.uptime = std::chrono::hours(24 * 365);  // "I have served it for a year"
   a.url_hint = "udpm://10.6.6.6:7667";
-  a.robots.push_back({robot, "fake", 1, 1, 0, false, 0});
+  a.robots.push_back({robot, "fake", 1, 1, BaseType::kFixed, false, 0});
   return EncodeAnnouncement(a);
 }
 

@@ -1,7 +1,6 @@
 #include "describe_format.h"
 
 #include <cmath>
-#include <cstdio>
 #include <iomanip>
 #include <sstream>
 
@@ -33,64 +32,18 @@ std::string LimitText(const Dof& dof) {
   return pos + " v<=" + Num(l.velocity) + " f<=" + Num(l.effort);
 }
 
-// Escapes a string for JSON (names come from user files).
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
-  }
-  return out + "\"";
-}
+using Json = nlohmann::ordered_json;
 
-std::string JsonNum(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(17) << v;
-  return s.str();
-}
+Json JsonVec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+Json JsonQuat(const Eigen::Quaterniond& q) { return {q.w(), q.x(), q.y(), q.z()}; }
 
-std::string JsonVec(const Eigen::Vector3d& v) {
-  return "[" + JsonNum(v.x()) + ", " + JsonNum(v.y()) + ", " + JsonNum(v.z()) + "]";
-}
-
-std::string JsonQuat(const Eigen::Quaterniond& q) {
-  return "[" + JsonNum(q.w()) + ", " + JsonNum(q.x()) + ", " + JsonNum(q.y()) + ", " + JsonNum(q.z()) + "]";
-}
-
-std::string JsonServo(ServoTypes t) {
-  std::string s = "[";
-  bool first = true;
+Json JsonServo(ServoTypes t) {
+  Json words = Json::array();
   for (auto [type, word] : {std::pair{ServoType::kSetPoint, "setpoint"},
                             std::pair{ServoType::kSpeed, "speed"}, std::pair{ServoType::kForce, "force"}}) {
-    if (!t.Has(type)) continue;
-    s += (first ? "\"" : ", \"") + std::string(word) + "\"";
-    first = false;
+    if (t.Has(type)) words.push_back(word);
   }
-  return s + "]";
+  return words;
 }
 
 }  // namespace
@@ -141,59 +94,63 @@ void PrintModelTable(const RobotModel& m, std::ostream& out) {
   }
 }
 
-void PrintModelJson(const RobotModel& m, const std::vector<std::string>& warnings, std::ostream& out) {
-  out << "{\n  \"name\": " << JsonString(m.name()) << ",\n  \"total_mass\": " << JsonNum(m.total_mass())
-      << ",\n  \"num_dofs\": " << m.num_dofs() << ",\n  \"links\": [";
-  for (size_t i = 0; i < m.links().size(); ++i) {
-    const Link& l = m.links()[i];
+Json ModelJson(const RobotModel& m, const std::vector<std::string>& warnings) {
+  Json links = Json::array();
+  for (const Link& l : m.links()) {
     const Eigen::Matrix3d& I = l.inertia;
-    out << (i ? ",\n    " : "\n    ") << "{\"name\": " << JsonString(l.name)
-        << ", \"mass\": " << JsonNum(l.mass) << ", \"com\": " << JsonVec(l.com) << ", \"inertia\": ["
-        << JsonNum(I(0, 0)) << ", " << JsonNum(I(0, 1)) << ", " << JsonNum(I(0, 2)) << ", "
-        << JsonNum(I(1, 1)) << ", " << JsonNum(I(1, 2)) << ", " << JsonNum(I(2, 2)) << "]}";
+    links.push_back({{"name", l.name},
+                     {"mass", l.mass},
+                     {"com", JsonVec(l.com)},
+                     {"inertia", {I(0, 0), I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2)}}});
   }
-  out << "\n  ],\n  \"joints\": [";
-  for (size_t i = 0; i < m.joints().size(); ++i) {
-    const Joint& j = m.joints()[i];
-    out << (i ? ",\n    " : "\n    ") << "{\"name\": " << JsonString(j.name)
-        << ", \"parent\": " << JsonString(m.link(j.parent_link).name)
-        << ", \"child\": " << JsonString(m.link(j.child_link).name) << ", \"inboard\": " << JsonVec(j.inboard)
-        << ", \"outboard\": " << JsonVec(j.outboard) << ", \"rest\": " << JsonQuat(j.rest)
-        << ", \"servo\": " << JsonServo(j.servo_types) << ", \"dofs\": [";
-    for (size_t k = 0; k < j.dofs.size(); ++k) {
-      const Dof& d = j.dofs[k];
-      out << (k ? ", " : "") << "{\"type\": \"" << ToString(d.type) << "\", \"axis\": " << JsonVec(d.axis)
-          << ", \"lower\": " << JsonNum(d.limits.lower) << ", \"upper\": " << JsonNum(d.limits.upper)
-          << ", \"velocity\": " << JsonNum(d.limits.velocity) << ", \"effort\": " << JsonNum(d.limits.effort)
-          << "}";
+  Json joints = Json::array();
+  for (const Joint& j : m.joints()) {
+    Json dofs = Json::array();
+    for (const Dof& d : j.dofs) {
+      dofs.push_back({{"type", ToString(d.type)},
+                      {"axis", JsonVec(d.axis)},
+                      {"lower", d.limits.lower},
+                      {"upper", d.limits.upper},
+                      {"velocity", d.limits.velocity},
+                      {"effort", d.limits.effort}});
     }
-    out << "]";
+    Json joint = {{"name", j.name},
+                  {"parent", m.link(j.parent_link).name},
+                  {"child", m.link(j.child_link).name},
+                  {"inboard", JsonVec(j.inboard)},
+                  {"outboard", JsonVec(j.outboard)},
+                  {"rest", JsonQuat(j.rest)},
+                  {"servo", JsonServo(j.servo_types)},
+                  {"dofs", dofs}};
     if (j.mimic) {
-      out << ", \"mimic\": {\"joint\": " << JsonString(m.joint(j.mimic->leader_joint).name)
-          << ", \"multiplier\": " << JsonNum(j.mimic->multiplier)
-          << ", \"offset\": " << JsonNum(j.mimic->offset) << "}";
+      joint["mimic"] = {{"joint", m.joint(j.mimic->leader_joint).name},
+                        {"multiplier", j.mimic->multiplier},
+                        {"offset", j.mimic->offset}};
     }
-    out << "}";
+    joints.push_back(joint);
   }
-  out << "\n  ],\n  \"control_frames\": [";
-  for (size_t i = 0; i < m.frames().size(); ++i) {
-    const ControlFrame& f = m.frames()[i];
-    out << (i ? ",\n    " : "\n    ") << "{\"name\": " << JsonString(f.name)
-        << ", \"link\": " << JsonString(m.link(f.parent_link).name)
-        << ", \"position\": " << JsonVec(f.pose_in_link.translation)
-        << ", \"orientation\": " << JsonQuat(f.pose_in_link.rotation)
-        << ", \"servo\": " << JsonServo(f.servo_types) << "}";
+  Json frames = Json::array();
+  for (const ControlFrame& f : m.frames()) {
+    frames.push_back({{"name", f.name},
+                      {"link", m.link(f.parent_link).name},
+                      {"position", JsonVec(f.pose_in_link.translation)},
+                      {"orientation", JsonQuat(f.pose_in_link.rotation)},
+                      {"servo", JsonServo(f.servo_types)}});
   }
-  out << "\n  ],\n  \"roots\": [";
-  for (size_t i = 0; i < m.roots().size(); ++i) {
-    const RootLink& r = m.roots()[i];
-    out << (i ? ", " : "") << "{\"link\": " << JsonString(m.link(r.link).name) << ", \"base\": \""
-        << ToString(r.base) << "\", \"position\": " << JsonVec(r.pose_in_world.translation)
-        << ", \"orientation\": " << JsonQuat(r.pose_in_world.rotation) << "}";
+  Json roots = Json::array();
+  for (const RootLink& r : m.roots()) {
+    roots.push_back({{"link", m.link(r.link).name},
+                     {"base", ToString(r.base)},
+                     {"position", JsonVec(r.pose_in_world.translation)},
+                     {"orientation", JsonQuat(r.pose_in_world.rotation)}});
   }
-  out << "],\n  \"warnings\": [";
-  for (size_t i = 0; i < warnings.size(); ++i) out << (i ? ", " : "") << JsonString(warnings[i]);
-  out << "]\n}\n";
+  return {
+      {"name", m.name()}, {"total_mass", m.total_mass()}, {"num_dofs", m.num_dofs()}, {"links", links},
+      {"joints", joints}, {"control_frames", frames},     {"roots", roots},           {"warnings", warnings}};
+}
+
+void PrintModelJson(const RobotModel& model, const std::vector<std::string>& warnings, std::ostream& out) {
+  out << JsonText(ModelJson(model, warnings)) << "\n";
 }
 
 }  // namespace robotalk

@@ -4,6 +4,8 @@
 
 #include "robotalk/robot_model.h"
 
+#include "json_text.h"
+
 #include <ostream>
 #include <string>
 #include <vector>
@@ -13,8 +15,12 @@ namespace robotalk {
 /// Tables of links, joints (dofs, limits, servo types), control frames and roots.
 void PrintModelTable(const RobotModel& model, std::ostream& out);
 
-/// One JSON object. Infinite limits are written as null ("no limit").
-/// `warnings` (import warnings) go into a "warnings" array.
+/// The model as one JSON object, keys in a fixed order: name, total_mass,
+/// num_dofs, links, joints, control_frames, roots, warnings (import warnings).
+/// Infinite limits are null ("no limit").
+nlohmann::ordered_json ModelJson(const RobotModel& model, const std::vector<std::string>& warnings);
+
+/// ModelJson as one line of text and a newline.
 void PrintModelJson(const RobotModel& model, const std::vector<std::string>& warnings, std::ostream& out);
 
 }  // namespace robotalk

@@ -24,7 +24,7 @@ constexpr const char* kUsage =
     "                         [--max-depth N] FILE.urdf\n"
     "Prints the RoboTalk motion specification of a URDF robot: links with masses,\n"
     "joints with dofs and limits, control frames, servo types, total mass.\n"
-    "  --json          one JSON object on stdout instead of tables\n"
+    "  --json          one JSON object (one line) on stdout instead of tables\n"
     "  --strict        treat every import warning as an error\n"
     "  --merge-chains  merge massless joint chains into multi-dof joints (pan-tilt -> 2 dofs)\n"
     "  --name NAME     robot name to use instead of <robot name=...>\n"

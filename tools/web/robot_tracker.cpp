@@ -1,5 +1,6 @@
 #include "robot_tracker.h"
 
+#include "json_text.h"
 #include "robotalk/protocol_codec.h"
 
 #include "robotalk/channels.h"
@@ -184,7 +185,7 @@ class RobotTracker::Impl {
     ++r.generation;
     nlohmann::json m = {
         {"type", "model"}, {"robot", name}, {"generation", r.generation}, {"model", ModelToJson(*r.model)}};
-    r.model_message = std::make_shared<const std::string>(m.dump());
+    r.model_message = std::make_shared<const std::string>(JsonText(m));
   }
 
   // Asks for the state stream while a page is open, cancels it when none is:
@@ -336,7 +337,7 @@ TrackerFrame RobotTracker::Impl::Poll() {
       try {
         nlohmann::json s = r.poser->Pose(r.slot->sample);
         s["generation"] = r.generation;
-        frame.states.push_back(s.dump());
+        frame.states.push_back(JsonText(s));
       } catch (const Error& e) {
         r.message = e.what();
       }

@@ -21,9 +21,6 @@ nlohmann::json PoseJson(const Eigen::Isometry3d& x) {
           Round6(r.x()), Round6(r.y()), Round6(r.z())};
 }
 
-// JSON has no infinity: an absent limit is written as null.
-nlohmann::json Limit(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 }  // namespace
 
 InertiaBox EquivalentInertiaBox(const Link& link, double min_side) {
@@ -79,8 +76,8 @@ nlohmann::json ModelToJson(const RobotModel& model) {
     for (const Dof& d : j.dofs) {
       dofs.push_back({{"type", ToString(d.type)},
                       {"axis", Vec(d.axis)},
-                      {"lower", Limit(d.limits.lower)},
-                      {"upper", Limit(d.limits.upper)}});
+                      {"lower", d.limits.lower},    // JsonText writes an absent (infinite)
+                      {"upper", d.limits.upper}});  // limit as null
     }
     nlohmann::json joint = {{"name", j.name},
                             {"parent", j.parent_link},

@@ -1,5 +1,6 @@
 #include "web_server.h"
 
+#include "json_text.h"
 #include "robotalk/error.h"
 #include "web_files.h"
 
@@ -208,7 +209,7 @@ class WebServer::Impl {
                                   {"server", "robotalk-web"},
                                   {"version", ROBOTALK_WEB_VERSION},
                                   {"rate", options_.rate_hz}};
-    g.push_back(std::make_shared<const std::string>(hello.dump()));
+    g.push_back(std::make_shared<const std::string>(JsonText(hello)));
     if (robots_) g.push_back(robots_);
     for (const auto& [name, m] : models_) g.push_back(m.second);
     return g;
@@ -224,7 +225,7 @@ class WebServer::Impl {
                   [](const std::shared_ptr<WsSession>& s) { return s.use_count() == 1 && !s->open(); });
     tracker_.SetWatching(
         std::any_of(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->open(); }));
-    const std::string robots = f.robots.dump();
+    const std::string robots = JsonText(f.robots);
     if (!robots_ || *robots_ != robots) {
       robots_ = std::make_shared<const std::string>(robots);
       Broadcast(robots_, false);
@@ -253,7 +254,7 @@ class WebServer::Impl {
     tracker_.Panic(robot, [ioc = ioc_, session, robot](const std::string& error) {
       const nlohmann::json r = {
           {"type", "panic_result"}, {"robot", robot}, {"ok", error.empty()}, {"message", error}};
-      auto msg = std::make_shared<const std::string>(r.dump());
+      auto msg = std::make_shared<const std::string>(JsonText(r));
       asio::post(*ioc, [session, msg] {
         if (auto s = session.lock()) s->Send(msg, false);
       });

@@ -189,7 +189,7 @@ struct AnnouncedRobot {
   std::string driver;
   std::uint64_t config_hash = 0;
   int total_dofs = 0;
-  int base_type = 0;  ///< robotalk_msgs::root_link_t BASE_*
+  BaseType base_type = BaseType::kFixed;  ///< of its first root
   bool panic = false;
   int num_clients = 0;
   std::int64_t server_id = 0;

@@ -7,6 +7,7 @@
 #include "robotalk_msgs/announce_t.hpp"
 #include "robotalk_msgs/hello_answer_t.hpp"
 #include "robotalk_msgs/hello_t.hpp"
+#include "robotalk_msgs/root_link_t.hpp"
 #include "wire_scanner.h"
 
 #include <cstring>
@@ -196,7 +197,7 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
     info.driver = r.driver;
     info.config_hash = static_cast<std::int64_t>(r.config_hash);
     info.total_dofs = r.total_dofs;
-    info.base_type = r.base_type;
+    info.base_type = static_cast<std::int8_t>(r.base_type);
     info.panic = r.panic;
     info.num_clients = r.num_clients;
     m.robots.push_back(info);
@@ -253,8 +254,12 @@ Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   a.traffic_layout = static_cast<TrafficLayout>(m.traffic_layout);
   a.keyed = m.keyed != 0;
   for (const auto& r : m.robots) {
+    if (r.base_type < robotalk_msgs::root_link_t::BASE_FIXED ||
+        r.base_type > robotalk_msgs::root_link_t::BASE_FLOATING) {
+      scan.Fail("robot.base_type", "unknown value " + std::to_string(r.base_type));
+    }
     a.robots.push_back({r.name, r.driver, static_cast<std::uint64_t>(r.config_hash), r.total_dofs,
-                        r.base_type, r.panic != 0, r.num_clients});
+                        static_cast<BaseType>(r.base_type), r.panic != 0, r.num_clients});
   }
   return a;
 }

@@ -122,7 +122,7 @@ struct RobotAnnouncement {
   std::string driver;
   std::uint64_t config_hash = 0;
   int total_dofs = 0;
-  std::int8_t base_type = 0;
+  BaseType base_type = BaseType::kFixed;  ///< of its first root
   bool panic = false;
   int num_clients = 0;
 };
