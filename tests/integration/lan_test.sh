@@ -58,7 +58,7 @@ wait "$recorder"
 check "the recorder stops on SIGINT with status 0: $(cat "$tmp/record.log")" test $? -eq 0
 
 "$logplay" info "$tmp/lan.lcmlog" >"$tmp/info" 2>&1
-check "the logger host recorded client1's stream" grep -q "commands 5: JOINT_SETPOINT 1 SETSPEED 3 STOP 1" "$tmp/info"
+check "the logger host recorded client1's stream" grep -q "commands 5 in mode delay: JOINT_SETPOINT 1 SETSPEED 3 STOP 1" "$tmp/info"
 check "the logger host recorded client2's watch" grep -q "^state pioneer:" "$tmp/info"
 rt client2 stop >/dev/null 2>&1
 on client2 "$logplay" replay "$tmp/lan.lcmlog" --robot pioneer2 --from pioneer --url "$LAN_URL" --no-progress \
