@@ -33,7 +33,7 @@ kill -INT "$logger"; wait "$logger"
 check "record stops on SIGINT with status 0: $(cat "$tmp/record.log")" test $? -eq 0
 
 "$logplay" info "$tmp/session.lcmlog" >"$tmp/info.txt" 2>&1
-check "info counts $n commands" grep -q "commands $n: JOINT_SETPOINT $n" "$tmp/info.txt"
+check "info counts $n commands" grep -q "commands $n in mode direct: JOINT_SETPOINT $n" "$tmp/info.txt"
 check "info counts a reply for every command: $(grep replies "$tmp/info.txt")" grep -q "replies SUCCESS $n\$" "$tmp/info.txt"
 
 "$logplay" export "$tmp/session.lcmlog" -o "$tmp/csv" --no-plot >/dev/null 2>&1
