@@ -100,7 +100,7 @@ class RobotClient::Impl {
   std::shared_ptr<client::ReturnCache> cache_;
 
   mutable std::mutex mu_;
-  std::condition_variable cv_;                                   // acks, configurations
+  std::condition_variable cv_;                                   // panic answers, sessions, configurations
   client::OutstandingPackages outstanding_;                      // GUARDED_BY(mu_)
   client::ClockSync clock_sync_;                                 // GUARDED_BY(mu_)
   std::int64_t next_sequence_ = 1;                               // GUARDED_BY(mu_)

@@ -9,7 +9,7 @@
 // the key for its lifetime: a restarted server must answer with the same key.
 //
 // Thread safety: none; RobotClient::Impl uses it under its mutex, and calls
-// Pin() (file I/O) outside it.
+// WritePin() (file I/O) outside it.
 #pragma once
 
 #include "robotalk/keys.h"

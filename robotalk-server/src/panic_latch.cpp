@@ -1,6 +1,7 @@
 #include "panic_latch.h"
 
 #include "robotalk/error.h"
+#include "robotalk/known_servers.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -130,7 +131,7 @@ std::string PanicLatch::DefaultStateDir() {
 }
 
 std::string PanicLatch::LatchFileFor(const std::string& state_dir, const std::string& url) {
-  std::string where = url.substr(0, url.find('?'));
+  std::string where = PinNetwork(url);  // the network, without its options
   if (const auto scheme = where.find("://"); scheme != std::string::npos) where.replace(scheme, 3, "-");
   while (!where.empty() && (where.back() == '/' || where.back() == '-')) where.pop_back();
   for (char& c : where) {

@@ -522,8 +522,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   if (item.command.type == CommandType::kStop) {
     if (item.only_if_moving) {
       // The server's STOP when it gives a robot up: a robot at rest needs none.
-      if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk) return;
-      if (!state_.moving) return;
+      if (!ReadState(now) || !state_.moving) return;
     }
     // A client's STOP stops everything; the watchdog's stops what the
     // vanished client owned (its GOTO included). Neither can be refused:

@@ -43,16 +43,19 @@ std::string RobotSessions::QueueRefusal(const Session& s) {
     count_.total = daemon_.queued_total();
     for (const auto& [id, session] : sessions_) count_.total += session.buffered_frames();
   }
-  const std::string has = Client(s.client_id) + " has " + std::to_string(count_.own) +
-                          " commands queued on robot '" + robot_ + "'; the limit is ";
+  // Built only for a refusal: admission is the receive path.
+  const auto has = [&] {
+    return Client(s.client_id) + " has " + std::to_string(count_.own) + " commands queued on robot '" +
+           robot_ + "'; the limit is ";
+  };
   if (count_.own >= options_.max_queue) {
-    return has + std::to_string(options_.max_queue) + " (--max-queue)";
+    return has() + std::to_string(options_.max_queue) + " (--max-queue)";
   }
   // Half the robot's bound is the clients' guaranteed shares; past its own, a
   // client draws on the other half only while it has room (header).
   const std::size_t share = options_.max_robot_queue / (2 * std::max<std::size_t>(options_.max_sessions, 1));
   if (count_.own >= share && count_.total >= options_.max_robot_queue / 2) {
-    return has + std::to_string(share) + " while the robot's queues are full (" +
+    return has() + std::to_string(share) + " while the robot's queues are full (" +
            std::to_string(count_.total) + " commands of all clients; each client may always queue " +
            std::to_string(share) + ", the robot holds at most " + std::to_string(options_.max_robot_queue) +
            ")";
@@ -496,18 +499,30 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
     base_owner_ = 0;
     return;
   }
-  std::vector<int> joints;  // what the command moves
+  // What the command moves becomes its client's. A command the RobotDaemon
+  // took just before the watchdog expired its client was not covered by the
+  // watchdog's stop: it is stopped now and nobody owns it. (The vector is
+  // only filled in that rare case: this is every executed command's path.)
+  const bool vanished = sessions_.count(e.client_id) == 0;
+  std::vector<int> to_stop;
+  const auto take = [&](int j) {
+    if (vanished) {
+      to_stop.push_back(j);
+    } else {
+      joint_owner_[static_cast<std::size_t>(j)] = e.client_id;
+    }
+  };
   bool base = false;
   switch (e.type) {
     case CommandType::kJointSetPoint:
     case CommandType::kJointSpeed:
     case CommandType::kJointForce:
-      joints.push_back(e.target);
+      take(e.target);
       break;
     case CommandType::kFrameSetPoint:  // the joints on the frame's chain
       for (int j = model.parent_joint(model.frame(e.target).parent_link); j >= 0;
            j = model.parent_joint(model.joint(j).parent_link)) {
-        if (!model.joint(j).dofs.empty()) joints.push_back(j);
+        if (!model.joint(j).dofs.empty()) take(j);
       }
       break;
     case CommandType::kGoto:
@@ -517,14 +532,11 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
     default:
       return;
   }
-  if (sessions_.count(e.client_id) == 0) {
-    // Taken by the RobotDaemon just before the watchdog expired its client:
-    // the watchdog's stop did not cover it. Stopped now; nobody owns it.
-    daemon_.QueueStopOnly(std::move(joints), base);
-    return;
+  if (!vanished) {
+    if (base) base_owner_ = e.client_id;
+  } else if (base || !to_stop.empty()) {
+    daemon_.QueueStopOnly(std::move(to_stop), base);
   }
-  for (const int j : joints) joint_owner_[static_cast<std::size_t>(j)] = e.client_id;
-  if (base) base_owner_ = e.client_id;
 }
 
 std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {

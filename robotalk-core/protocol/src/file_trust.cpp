@@ -48,13 +48,20 @@ int OpenTrustedFile(const std::filesystem::path& file, struct stat& st, std::str
 
 std::string FileTrustProblem(const std::filesystem::path& file, const struct stat& st, TrustedFile kind) {
   const bool secret = kind == TrustedFile::kSecret;
-  if (secret ? st.st_uid != ::geteuid() : !OwnerTrusted(st.st_uid)) return OwnerProblem(st.st_uid, !secret);
+  const bool callers_own = kind != TrustedFile::kShared;
+  if (callers_own ? st.st_uid != ::geteuid() : !OwnerTrusted(st.st_uid))
+    return OwnerProblem(st.st_uid, !callers_own);
   if (secret && (st.st_mode & 077) != 0) {
     return "mode " + Mode(st.st_mode) +
            ": the secret key must not be readable or writable by group or others; run chmod 600 " +
            file.string();
   }
-  if (!secret && (st.st_mode & 022) != 0) {
+  if (kind == TrustedFile::kPinned && (st.st_mode & 022) != 0) {
+    return "mode " + Mode(st.st_mode) +
+           " lets group or others write it, and so choose which server this client trusts; run chmod 600 " +
+           file.string();
+  }
+  if (kind == TrustedFile::kShared && (st.st_mode & 022) != 0) {
     return "mode " + Mode(st.st_mode) +
            ": group or others may write it (and so grant themselves rights or change the key); run chmod "
            "go-w " +

@@ -1,6 +1,7 @@
 // Whether a file that grants trust (a secret key, a pinned public key, the
-// access list) may be believed: who could have written it, or put another in
-// its place. Private to robotalk-core (keys.cpp, access_list.cpp).
+// access list, the known-servers pin file) may be believed: who could have
+// written it, or put another in its place. Private to robotalk-core
+// (keys.cpp, access_list.cpp, known_servers.cpp).
 #pragma once
 
 #include <sys/stat.h>
@@ -13,6 +14,7 @@ namespace robotalk {
 enum class TrustedFile {
   kSecret,  ///< a secret key: owned by the caller; no group or other access at all
   kShared,  ///< an access list or a public key: owned by root or the caller; nobody else may write it
+  kPinned,  ///< the known-servers pin file: owned by the caller; nobody else may write it
 };
 
 /// Opens `file` for reading, refusing a symbolic link (lstat, and O_NOFOLLOW)

@@ -1,12 +1,13 @@
 // The known-servers pin file (known_servers.h; docs/security.md).
 #include "robotalk/known_servers.h"
 
+#include "file_trust.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -19,22 +20,14 @@ constexpr off_t kMaxFileBytes = 1 << 20;  // a million bytes of pins is not a pi
 std::string Where(const std::filesystem::path& file) { return "known-servers file " + file.string(); }
 
 // The file descriptor's file must be a regular file of this user that group
-// and others cannot write: whoever writes it chooses the server the client obeys.
+// and others cannot write, in directories nobody else may change: whoever
+// writes it chooses the server the client obeys (file_trust.h, kPinned).
 void CheckOwnership(int fd, const std::filesystem::path& file) {
   struct stat st {};
   if (::fstat(fd, &st) != 0) throw KeyError(Where(file) + ": cannot stat: " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw KeyError(Where(file) + ": not a regular file");
-  if (st.st_uid != ::geteuid()) {
-    throw KeyError(Where(file) + ": owned by uid " + std::to_string(st.st_uid) + ", not by this user (uid " +
-                   std::to_string(::geteuid()) + "); whoever writes it chooses which server to trust");
-  }
-  if ((st.st_mode & 022) != 0) {
-    char mode[8];
-    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
-    throw KeyError(Where(file) + ": mode " + mode +
-                   " lets group or others write it, and so choose which server this client trusts; run "
-                   "chmod 600 " +
-                   file.string());
+  if (std::string problem = FileTrustProblem(file, st, TrustedFile::kPinned); !problem.empty()) {
+    throw KeyError(Where(file) + ": " + problem);
   }
 }
 

@@ -328,7 +328,7 @@ void ServerAuthenticator::DropOldestPending(const PublicKey& key) {
   if (pending >= limits_.max_pending_per_key && oldest != sessions_.end()) Erase(oldest);
 }
 
-void ServerAuthenticator::Erase(std::map<std::int64_t, Session>::iterator it) {
+void ServerAuthenticator::Erase(std::map<std::int64_t, Session>::iterator it, bool report) {
   const std::int64_t client_id = it->second.client_id;
   if (const auto live = live_.find(client_id); live != live_.end() && live->second == it->first)
     live_.erase(live);
@@ -343,7 +343,7 @@ void ServerAuthenticator::Erase(std::map<std::int64_t, Session>::iterator it) {
     used_nonces_.erase(used_order_.front());
     used_order_.pop_front();
   }
-  closed_.push_back(it->first);
+  if (report) closed_.push_back(it->first);  // closed by the authenticator itself: TakeClosed() says so
   sessions_.erase(it);
 }
 
@@ -412,8 +412,7 @@ std::size_t ServerAuthenticator::ExpirePending(TimePoint now, Duration max_age) 
 
 void ServerAuthenticator::Close(std::int64_t session_id) {
   if (const auto it = sessions_.find(session_id); it != sessions_.end()) {
-    Erase(it);
-    closed_.pop_back();  // the caller knows
+    Erase(it, /*report=*/false);  // the caller closed it: it knows
   }
 }
 

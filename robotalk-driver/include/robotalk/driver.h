@@ -114,7 +114,9 @@ class Driver {
                                std::vector<Completion>& completed) = 0;
   /// STOP at `now`: every actuator and the base come to rest (and hold);
   /// every command in progress completes INTERRUPTED (appended). Also called
-  /// by the server's watchdog and at shutdown.
+  /// by the server at shutdown (the last call a driver gets), when it gives
+  /// up a robot another server serves, and after a Halt() that threw. (The
+  /// watchdog calls StopOnly().)
   virtual void Stop(TimePoint now, std::vector<Completion>& interrupted) = 0;
   /// A STOP of part of the robot at `now`, which cannot be refused: the
   /// joints of `scope` come to rest and hold; with `scope.base` the base

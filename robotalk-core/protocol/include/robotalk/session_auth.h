@@ -277,7 +277,8 @@ class ServerAuthenticator {
   };
   [[noreturn]] void Refuse(const std::string& why);
   void DropOldestPending(const PublicKey& key);
-  void Erase(std::map<std::int64_t, Session>::iterator it);
+  // Forgets a session; with `report`, TakeClosed() lists it (the gate did not close it).
+  void Erase(std::map<std::int64_t, Session>::iterator it, bool report = true);
 
   KeyPair identity_;
   const AccessList& access_;
