@@ -86,6 +86,16 @@ TEST_F(KnownServersTest, AFileOthersMayWriteOrASymlinkIsRefused) {
   EXPECT_THAT(ReadError(), HasSubstr("is a symlink"));
 }
 
+// Whoever may replace the file chooses the server too: its directories are
+// checked like the key files' (file_trust.h).
+TEST_F(KnownServersTest, AFileInAWorldWritableDirectoryIsRefusedUnlessTheDirectoryIsSticky) {
+  Write("pioneer net " + Key(1).ToString() + "\n");
+  ::chmod(file_.parent_path().c_str(), 0777);
+  EXPECT_THAT(ReadError(), HasSubstr("world-writable without the sticky bit"));
+  ::chmod(file_.parent_path().c_str(), 01777);
+  EXPECT_EQ(ReadError(), "");
+}
+
 TEST(PinNetwork, IsTheUrlWithoutItsOptions) {
   EXPECT_EQ(PinNetwork("udpm://239.255.76.67:7667?ttl=0&traffic=split"), "udpm://239.255.76.67:7667");
   EXPECT_EQ(PinNetwork("memory://"), "memory://");
