@@ -152,7 +152,12 @@ export class RobotView {
   }
 
   async loadUrdfAsync(url, meshesUrl) {
-    const catalog = await fetch(meshesUrl).then((r) => (r.ok ? r.json() : { meshes: [] }), () => ({ meshes: [] }));
+    // Without the catalog no mesh can be placed on its link: the whole URDF
+    // is then given up and the configuration drawn (with the note).
+    const catalog = await fetch(meshesUrl).then((r) => {
+      if (!r.ok) throw new Error(`${meshesUrl}: HTTP ${r.status}`);
+      return r.json();
+    });
     const byUri = new Map();
     for (const m of catalog.meshes) byUri.set(m.uri, [...(byUri.get(m.uri) || []), m]);
     const text = await fetch(url).then((r) => {
@@ -194,8 +199,7 @@ export class RobotView {
         // Many STL files leave their facet normals zero: they would draw black.
         if (!geometry.attributes.normal || geometry.attributes.normal.array.every((v) => v === 0)) geometry.computeVertexNormals();
         obj = new THREE.Mesh(geometry, material);
-      }
-      else if (ext === 'dae') obj = (await new ColladaLoader().loadAsync(served.url)).scene;
+      } else if (ext === 'dae') obj = (await new ColladaLoader().loadAsync(served.url)).scene;
       else if (ext === 'gltf' || ext === 'glb') obj = (await new GLTFLoader().loadAsync(served.url)).scene;
       else if (ext === 'obj') {
         obj = await new OBJLoader().loadAsync(served.url);
