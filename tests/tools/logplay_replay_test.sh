@@ -99,6 +99,16 @@ check "commands.csv labels the delay session delay (issue 20)" \
   test "$(grep -c ',pioneer,[0-9]*,delay,' "$tmp/export/commands.csv")" -eq 7
 check "state.csv has the samples" test "$(grep -c '^pioneer,' "$tmp/export/state.csv")" -gt 40
 [ -z "$plot" ] && check "the PNG was written" test -s "$tmp/export/session.png"
+check "state.csv names the joints from the logged configuration (issue 21)" \
+  grep -q '^robot,.*,omega,left_wheel_joint,right_wheel_joint,pan,tilt$' "$tmp/export/state.csv"
+check "joints.csv gives their units" grep -q '^pioneer,2,pan,rad,config$' "$tmp/export/joints.csv"
+check "export warns of no unnamed robot" test "$(grep -c 'q0' "$tmp/export.out")" -eq 0
+if [ -z "$plot" ]; then
+  "$py" "$models/../tools/logplay/plot_log.py" --summary "$tmp/export/commands.csv" "$tmp/export/state.csv" \
+    "$tmp/export/again.png" "$tmp/export/joints.csv" >"$tmp/plot.txt"
+  check "the plot has one axis per joint" test "$(grep -c '^joint axis' "$tmp/plot.txt")" -eq 4
+  check "the pan axis is pan's alone" grep -q '^joint axis 2: pioneer: pan (rad)$' "$tmp/plot.txt"
+fi
 
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -3,12 +3,13 @@
 // robot is driven with the robotalk CLI and the page is read through its
 // window.robotalkTest hook. Screenshots are saved for a person to look at.
 //
-//   node page_test.mjs pioneer|arms   (env: see the run_page_test.sh header)
+//   node page_test.mjs pioneer|arms|meshes   (env: see the run_page_test.sh header)
 //
 // Run it inside a private network namespace (scripts/netns_run.sh): it uses
 // LCM multicast on the loopback and listens on 127.0.0.1 only.
 import { spawn, execFile } from 'node:child_process';
 import { writeFileSync, mkdirSync } from 'node:fs';
+import http from 'node:http';
 import { WebDriver } from './webdriver.mjs';
 
 const E = process.env;
@@ -207,29 +208,73 @@ async function pioneer() {
     await checkFrameLag(wd, 'pioneer', w);
     await shot(wd, 'web_pioneer.png');
 
-    await wd.click('article[data-robot="pioneer"] button.panic');
-    await waitFor('the panic to show', async () => (await robots(wd))[0].panic, 5000);
+    const card = async () => (await robots(wd)).find((r) => r.name === 'pioneer');
+    const panicNow = async (what) => {
+      await wd.click('article[data-robot="pioneer"] button.panic');
+      const c = await waitFor('the panic to show', async () => {
+        const r = await card();
+        return r && r.panic && r.panicPill && /PANIC sent and acknowledged/.test(r.message) ? r : null;
+      }, 5000);
+      check(true, `PANIC on the page shows "PANIC sent and acknowledged." and the PANIC pill (${what})`, c.message);
+    };
+    check(!(await card()).overflow.length, 'nothing on the card runs past its edge (readout, message, head)',
+      JSON.stringify((await card()).overflow));
+    await panicNow('before a reset');
     const refused = await cli('--url', E.LCM_URL, 'send', 'pioneer', 'goto', '0', '0', '0');
     check(/PANIC/.test(refused.out), 'after PANIC on the page, a CLI command is refused PANIC', refused.out.trim());
     await shot(wd, 'web_pioneer_panic.png');
     await cli('--url', E.LCM_URL, 'reset', 'pioneer');
-    await waitFor('the panic to clear', async () => !(await robots(wd))[0].panic, 5000);
-    check(true, 'PANIC_RESET from the CLI clears the page\'s panic state');
+    const reset = await waitFor('the panic to clear', async () => {
+      const r = await card();
+      return !r.panic && !r.panicPill ? r : null;
+    }, 5000);
+    check(!/PANIC/.test(reset.message), 'after PANIC_RESET the card no longer says PANIC sent', JSON.stringify(reset.message));
 
-    await stop(w);
-    await stop(server);
-    const gone = await waitFor('the page to say the robot is gone', async () => {
-      const r = (await robots(wd))[0];
-      return r.status === 'gone' && /Robot gone/.test(r.overlay) ? r : null;
-    }, 8000);
-    check(true, 'the page says when the robot goes away', gone.overlay);
+    // A bridge restart: the server is still in panic (the pill says so), the
+    // message of the old connection is gone.
+    await panicNow('before a bridge restart');
     await stop(bridge.proc);
     const banner = await waitFor('the page to say the bridge is gone', () =>
       wd.run('const b = document.querySelector("#banner"); return b.hidden ? "" : b.textContent;'), 5000);
     check(/Lost the connection/.test(banner), 'the page says when the bridge goes away', banner);
-    server = startServer([`pioneer=ode:${urdf}`]);
+    const lostCard = await card();
+    check(lostCard.statusText === 'bridge lost' && !/client/.test(lostCard.driverText) && !lostCard.panicPill &&
+      !/PANIC sent/.test(lostCard.message), 'without the bridge the card claims no status, clients or panic',
+      JSON.stringify(lostCard));
     bridge = await startBridge(bridge.port, ['--urdf', `pioneer=${urdf}`]);
     await waitLive(wd, ['pioneer'], 20000);
+    const back = await waitFor('the panic pill from the new bridge', async () => {
+      const r = await card();
+      return r.panicPill ? r : null;
+    }, 5000);
+    check(!/PANIC sent/.test(back.message), 'after a bridge restart the old "PANIC sent" is gone; the pill shows the server\'s panic',
+      JSON.stringify(back.message));
+    await cli('--url', E.LCM_URL, 'reset', 'pioneer');
+
+    // A server restart: the robot goes away (no clients, no panic shown), then
+    // comes back from a new server that is not in panic.
+    await waitFor('the panic to clear', async () => !(await card()).panicPill, 5000);
+    await panicNow('before a server restart');
+    await stop(w);
+    await stop(server);
+    const gone = await waitFor('the page to say the robot is gone', async () => {
+      const r = await card();
+      return r.status === 'gone' && /Robot gone/.test(r.overlay) ? r : null;
+    }, 8000);
+    check(true, 'the page says when the robot goes away', gone.overlay);
+    check(!/client/.test(gone.driverText) && !gone.panicPill && !/PANIC sent/.test(gone.message),
+      'a gone robot shows no clients, no panic and no "PANIC sent"', JSON.stringify(gone));
+    // The new server starts in the panic it latched (docs/server.md): the
+    // pill says so, the old acknowledgement does not come back.
+    server = startServer([`pioneer=ode:${urdf}`]);
+    await waitLive(wd, ['pioneer'], 20000);
+    const fresh = await waitFor('the restarted robot\'s latched panic', async () => {
+      const r = await card();
+      return r.panicPill ? r : null;
+    }, 5000);
+    check(!/PANIC sent/.test(fresh.message) && /client/.test(fresh.driverText),
+      'the restarted robot shows its own state: clients, its latched panic, not the old acknowledgement', JSON.stringify(fresh));
+    await cli('--url', E.LCM_URL, 'reset', 'pioneer');
     check(await wd.run('return window.robotalkTest.connected();'), 'the page reconnects by itself to the restarted bridge and robot');
   } finally {
     await wd.quit();
@@ -240,7 +285,8 @@ async function arms() {
   const iiwa = `${E.SHARED_ROBOTS}/iiwa14.urdf`, atlas = `${E.SHARED_ROBOTS}/atlas.urdf`;
   startServer([`pioneer=ode:${E.MODELS_DIR}/pioneer2dx_pantilt.urdf`, `iiwa=ode:${iiwa}`,
                `humanoid=ode:${atlas},base=floating,solver=quickstep`]);
-  const bridge = await startBridge(0, []);
+  // The iiwa from its URDF: none of its package://drake_models meshes is here.
+  const bridge = await startBridge(0, ['--urdf', `iiwa=${iiwa}`]);
   const wd = await openBrowser(bridge.url, '1700,1000');
   try {
     await waitLive(wd, ['pioneer', 'iiwa', 'humanoid'], 30000);
@@ -266,18 +312,93 @@ async function arms() {
     await checkFrameLag(wd, 'iiwa', w);
     const p = await drawn(wd, 'pioneer');
     check(p.pathLength > 0.8, 'the Pioneer\'s arc is drawn on the floor', `${p.pathLength.toFixed(2)} m`);
+    // Issue 21: the iiwa card was an empty floor.
+    const m = await wd.run('return window.robotalkTest.meshes(arguments[0]);', 'iiwa');
+    const unresolved = m.problems.filter((x) => /package 'drake_models' not found/.test(x.error));
+    check(m.problems.length > 0 && unresolved.length === m.problems.length,
+      'every iiwa mesh is reported unresolved, naming its package', `${unresolved.length} of ${m.problems.length}`);
+    const meshLinks = [...new Set(m.problems.flatMap((x) => x.link.split(', ')))];
+    check(meshLinks.length >= 7 && meshLinks.every((l) => m.fallbackLinks.includes(l)),
+      'each link whose mesh did not resolve is drawn from the configuration', `${m.fallbackLinks.length} links: ${m.fallbackLinks.join(' ')}`);
+    const iiwaCard = (await robots(wd)).find((r) => r.name === 'iiwa');
+    check(/not drawn/.test(iiwaCard.meshNote) && /package:\/\/drake_models\//.test(iiwaCard.meshNote),
+      'the iiwa card says which meshes are not drawn', iiwaCard.meshNote);
     await shot(wd, 'web_robots.png');
   } finally {
     await wd.quit();
   }
 }
 
-const scenarios = { pioneer, arms };
+// Issue 21: a URDF of our own (tests/web/data/mesh_bot) naming its meshes
+// with package://, a relative ../ path, a package that is not there and a
+// path that climbs out of every folder; the bridge gets --package-path.
+async function meshes() {
+  const data = new URL('./data', import.meta.url).pathname;
+  const urdf = `${data}/mesh_bot/urdf/mesh_bot.urdf`;
+  startServer([`meshbot=kinematic:${urdf}`]);
+  const bridge = await startBridge(0, ['--urdf', `meshbot=${urdf}`, '--package-path', data]);
+  const said = await waitFor('the bridge to name the unresolved meshes', () =>
+    /meshbot: 2 of 4 meshes not resolved/.test(bridge.proc.err || '') && bridge.proc.err, 5000);
+  check(/meshbot: link 'tool': mesh package:\/\/missing_pkg\/meshes\/tool.stl: package 'missing_pkg' not found/.test(said),
+    'the bridge names an unresolved mesh on stderr', said.split('\n')[0]);
+  const wd = await openBrowser(bridge.url);
+  try {
+    await waitLive(wd, ['meshbot']);
+    const m = await wd.run('return window.robotalkTest.meshes(arguments[0]);', 'meshbot');
+    check(m.loaded === 2 && m.geometry.arm > 0 && m.geometry.base_link > 0,
+      'the package:// and the relative ../ meshes are loaded and drawn', JSON.stringify({ loaded: m.loaded, geometry: m.geometry, error: m.error }));
+    check(m.geometry.tool === 0 && m.geometry.probe === 0, 'the unresolved meshes draw nothing of the URDF', JSON.stringify(m.geometry));
+    check(JSON.stringify(m.fallbackLinks.sort()) === '["probe","tool"]',
+      'exactly the links whose meshes did not resolve show the configuration\'s shapes', JSON.stringify(m.fallbackLinks));
+    const byUri = Object.fromEntries(m.problems.map((x) => [x.uri, x.error]));
+    check(/package 'missing_pkg' not found in the package paths/.test(byUri['package://missing_pkg/meshes/tool.stl'] || ''),
+      'a missing package is named', byUri['package://missing_pkg/meshes/tool.stl']);
+    const climb = Object.keys(byUri).find((u) => /etc\/passwd/.test(u));
+    check(/^refused: .* is outside the package paths and the URDF's folder/.test(byUri[climb] || ''),
+      'a mesh name that climbs out of the package is refused, not served', byUri[climb]);
+    const r = (await robots(wd))[0];
+    check(/2 meshes not drawn/.test(r.meshNote) && /missing_pkg/.test(r.meshNote), 'the card notes the meshes not drawn', r.meshNote);
+    const w = watch('meshbot');
+    await waitFor('the CLI watch', () => w.samples.size > 0, 10000);
+    const seen = await observe(wd, 'meshbot', async () => {
+      await cli('--url', E.LCM_URL, 'send', 'meshbot', 'joint_setpoint', 'shoulder', '0.8');
+      return cli('--url', E.LCM_URL, 'send', 'meshbot', 'joint_setpoint', 'wrist', '1.2');
+    }, 1500);
+    checkFollows('meshbot', seen.seen, w, false);
+    await shot(wd, 'web_meshes.png');
+
+    // What the bridge serves, asked without a browser (which would normalise "../" away).
+    const get = (path) => new Promise((resolve) => {
+      http.get({ host: '127.0.0.1', port: bridge.port, path }, (res) => {
+        let body = '';
+        res.on('data', (d) => { body += d; });
+        res.on('end', () => resolve({ status: res.statusCode, body }));
+      }).on('error', (e) => resolve({ status: 0, body: String(e) }));
+    });
+    const catalog = JSON.parse((await get('/meshes/meshbot')).body);
+    const arm = catalog.meshes.find((x) => x.link === 'arm');
+    const stl = await get(arm.url);
+    check(stl.status === 200 && stl.body.startsWith('solid arm'), `the resolved mesh is served at ${arm.url}`, stl.status);
+    for (const path of ['/mesh/meshbot/../../../../etc/passwd', '/urdf/meshbot/../../../../../../etc/passwd',
+                        '/mesh/meshbot/1/%2e%2e/%2e%2e/etc/passwd', '/..%2f..%2fetc/passwd']) {
+      const res = await get(path);
+      check(res.status === 403 && /path traversal/.test(res.body) && !/root:/.test(res.body),
+        `path traversal is refused with a clear error: ${path}`, `${res.status} ${res.body.trim()}`);
+    }
+    const other = await get(`/mesh/meshbot/${catalog.meshes.findIndex((x) => x.link === 'probe')}/passwd`);
+    check(other.status === 404 && !/root:/.test(other.body), 'a refused mesh is not served under its index', other.status);
+    await stop(w);
+  } finally {
+    await wd.quit();
+  }
+}
+
+const scenarios = { pioneer, arms, meshes };
 if (!scenarios[scenario]) {
-  console.error('usage: node page_test.mjs pioneer|arms');
+  console.error('usage: node page_test.mjs pioneer|arms|meshes');
   process.exit(2);
 }
-const limit = setTimeout(() => { console.error('FAIL: the test took longer than 100 s'); process.exit(1); }, 100000);
+const limit = setTimeout(() => { console.error('FAIL: the test took longer than 140 s'); process.exit(1); }, 140000);
 try {
   await scenarios[scenario]();
 } catch (e) {

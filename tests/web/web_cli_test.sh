@@ -18,5 +18,7 @@ expect "--version prints the version" 0 "^robotalk-web [0-9]" -- --version
 expect "an unknown option is named" 2 "unknown option '--colour'" -- --colour
 expect "a bad port is named" 2 "--port: 'x' is not a number" -- --port x
 expect "a missing URDF file is named" 2 "--urdf arm=/nonexistent.urdf: no such file" -- --urdf arm=/nonexistent.urdf
+expect "--help offers --package-path and ROS_PACKAGE_PATH" 0 "package-path DIRS.*" -- --help
+expect "an empty --package-path is named" 2 "--package-path: ':' names no folder" -- --package-path :
 expect "missing npm modules say how to install them" 1 "run scripts/setup.sh" -- --node-modules /nonexistent
 exit $fail

@@ -72,3 +72,18 @@ TEST(WebOptions, HelpMentionsEveryOption) {
 
 }  // namespace
 }  // namespace robotalk::web
+
+namespace robotalk::web {
+namespace {
+
+TEST(WebOptions, TakesPackagePathsFromTheOptionThenRosPackagePath) {
+  const WebOptions o = ParseWebOptions({"--package-path", "/a:/b", "--package-path", "/c"}, "/www", "/nm",
+                                       "/ros/one::/ros/two");
+  EXPECT_EQ(o.package_paths, (std::vector<std::string>{"/a", "/b", "/c", "/ros/one", "/ros/two"}));
+  EXPECT_TRUE(ParseWebOptions({}, "/www", "/nm").package_paths.empty());
+  EXPECT_EQ(ErrorOf({"--package-path", ":"}), "--package-path: ':' names no folder");
+  EXPECT_EQ(ErrorOf({"--package-path"}), "--package-path: needs a value");
+}
+
+}  // namespace
+}  // namespace robotalk::web

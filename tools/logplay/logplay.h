@@ -38,8 +38,10 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
 /// `info`: channels, span, servers, robots, clients and their command streams.
 void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out);
 
-/// `export`: DIR/commands.csv and DIR/state.csv; returns the files written.
-std::vector<std::string> ExportCsv(const SessionLog& log, const std::string& dir);
+/// A number as info, extract and export write it (%.10g).
+std::string Num(double v);
+/// "direct", "delay", "playback" (package_header_t::MODE_*), "?" otherwise.
+const char* ModeName(int mode);
 
 /// "old=new" -> {old, new}; throws UsageError.
 std::pair<std::string, std::string> ParseRename(const std::string& text);

@@ -26,12 +26,6 @@ std::string Lower(std::string s) {
   return s;
 }
 
-std::string Num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
 std::string Utc(std::int64_t us) {
   const std::time_t t = static_cast<std::time_t>(us / 1000000);
   std::tm tm{};
@@ -39,19 +33,6 @@ std::string Utc(std::int64_t us) {
   char buf[40];
   std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
   return buf;
-}
-
-const char* ModeName(int mode) {
-  switch (mode) {
-    case robotalk_msgs::package_header_t::MODE_DIRECT:
-      return "direct";
-    case robotalk_msgs::package_header_t::MODE_DELAY:
-      return "delay";
-    case robotalk_msgs::package_header_t::MODE_PLAYBACK:
-      return "playback";
-    default:
-      return "?";
-  }
 }
 
 void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out) {
@@ -100,6 +81,25 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
 }
 
 }  // namespace
+
+std::string Num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+const char* ModeName(int mode) {
+  switch (mode) {
+    case robotalk_msgs::package_header_t::MODE_DIRECT:
+      return "direct";
+    case robotalk_msgs::package_header_t::MODE_DELAY:
+      return "delay";
+    case robotalk_msgs::package_header_t::MODE_PLAYBACK:
+      return "playback";
+    default:
+      return "?";
+  }
+}
 
 SessionLog ReadLog(const std::string& path) {
   lcm::LogFile file(path, "r");
@@ -197,36 +197,6 @@ void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out
     for (double q : s->position) out << ' ' << Num(q);
     out << "\n";
   }
-}
-
-std::vector<std::string> ExportCsv(const SessionLog& log, const std::string& dir) {
-  std::filesystem::create_directories(dir);
-  const std::string commands_path = dir + "/commands.csv", state_path = dir + "/state.csv";
-  std::ofstream commands(commands_path), state(state_path);
-  if (!commands || !state) throw LogError("cannot write CSV files in '" + dir + "'");
-  commands
-      << "client,robot,sequence,mode,id,type,target,start_us,send_time_us,log_time_us,signal,exec_time_us,"
-         "values\n";
-  for (const LoggedCommand& c : log.commands()) {
-    commands << Hex64(static_cast<std::uint64_t>(c.client_id)) << ',' << c.robot << ',' << c.sequence << ','
-             << (c.mode < 0 ? "panic" : ModeName(c.mode)) << ',' << c.command.id << ','
-             << (c.mode < 0 ? "PANIC" : ToString(c.command.type)) << ',' << c.command.target << ','
-             << c.start_us << ',' << c.send_time_us << ',' << c.log_time_us << ','
-             << (c.reply ? std::string(ToString(c.reply->signal)) : "") << ','
-             << (c.reply ? std::to_string(ToWireMicros(c.reply->exec_time)) : "") << ',';
-    for (std::size_t i = 0; i < c.command.values.size(); ++i)
-      commands << (i ? " " : "") << Num(c.command.values[i]);
-    commands << "\n";
-  }
-  state << "robot,log_time_us,server_time_us,panic,moving,x,y,theta,v,omega,q\n";
-  for (const StateSample& s : log.states()) {
-    state << s.robot << ',' << s.log_time_us << ',' << s.server_time_us << ',' << s.panic << ',' << s.moving;
-    for (double b : s.base) state << ',' << Num(b);
-    state << ',';
-    for (std::size_t i = 0; i < s.position.size(); ++i) state << (i ? " " : "") << Num(s.position[i]);
-    state << "\n";
-  }
-  return {commands_path, state_path};
 }
 
 }  // namespace robotalk::logplay

@@ -1,4 +1,5 @@
 // robotalk-logplay: reads LCM logs of RoboTalk sessions (docs/logplay.md).
+#include "export.h"
 #include "interrupt.h"
 #include "logplay.h"
 #include "robotalk/sequence_file.h"
@@ -41,8 +42,10 @@ Records and reads LCM logs of RoboTalk sessions. See docs/logplay.md.
                                  --from defaults to --robot; delay mode starts
                                  --delay S (default 0.5) ahead on the server clock
   export LOG [-o DIR] [--no-plot]
-                                 DIR/commands.csv, DIR/state.csv and DIR/session.png
-                                 (base path and joint traces; python3-matplotlib)
+                                 DIR/commands.csv, DIR/state.csv (a column per joint,
+                                 named from the logged configuration), DIR/joints.csv
+                                 and DIR/session.png (base path; each joint's trace on
+                                 its own axis, python3-matplotlib)
 
   --map old=new   rename a joint or control frame (repeatable)
   --window A:B    only the commands between A and B seconds into the recording
@@ -217,13 +220,13 @@ int RunExport(Args& a) {
   const bool plot = !a.Flag("--no-plot");
   const std::string path = a.Log();
   const lp::SessionLog log = lp::ReadLog(path);
-  for (const auto& f : lp::ExportCsv(log, dir)) std::cout << f << "\n";
+  for (const auto& f : lp::ExportCsv(log, lp::ReadConfigs(path), dir, std::cerr)) std::cout << f << "\n";
   if (!plot) return 0;
   const std::string png = dir + "/session.png";
   // Debian's python3 (with python3-matplotlib), even when another python3 comes first in PATH.
   const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command =
-      python + " '" + PlotScript() + "' '" + dir + "/commands.csv' '" + dir + "/state.csv' '" + png + "'";
+  const std::string command = python + " '" + PlotScript() + "' '" + dir + "/commands.csv' '" + dir +
+                              "/state.csv' '" + png + "' '" + dir + "/joints.csv'";
   if (std::system(command.c_str()) != 0) {
     std::cerr << "robotalk-logplay: the plot failed (needs python3-matplotlib): " << command << "\n";
     return 1;

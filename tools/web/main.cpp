@@ -4,6 +4,7 @@
 #include "web_options.h"
 #include "web_server.h"
 
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -11,8 +12,10 @@ int main(int argc, char** argv) {
   using namespace robotalk::web;
   WebOptions options;
   try {
-    options = ParseWebOptions(std::vector<std::string>(argv + 1, argv + argc), ROBOTALK_WEB_SOURCE_DIR "/www",
-                              ROBOTALK_WEB_SOURCE_DIR "/node_modules");
+    const char* ros_package_path = std::getenv("ROS_PACKAGE_PATH");
+    options =
+        ParseWebOptions(std::vector<std::string>(argv + 1, argv + argc), ROBOTALK_WEB_SOURCE_DIR "/www",
+                        ROBOTALK_WEB_SOURCE_DIR "/node_modules", ros_package_path ? ros_package_path : "");
   } catch (const robotalk::Error& e) {
     std::cerr << "robotalk-web: " << e.what() << "\n";
     return 2;
@@ -39,9 +42,26 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  for (const std::string& dir : options.package_paths) {
+    if (!fs::is_directory(dir))
+      std::cerr << "robotalk-web: package path " << dir << ": no such folder (skipped)\n";
+  }
   try {
     RobotTracker tracker(options);
     WebServer server(options, tracker);
+    for (const auto& [name, catalog] : server.meshes()) {  // the page notes the same under the robot's view
+      if (!catalog.error.empty())
+        std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.error << "\n";
+      std::size_t told = 0;
+      for (const MeshEntry& m : catalog.meshes) {
+        if (!m.error.empty() && ++told <= 5)
+          std::cerr << "robotalk-web: " << name << ": link '" << m.link << "': mesh " << m.uri << ": "
+                    << m.error << "\n";
+      }
+      if (told > 0)
+        std::cerr << "robotalk-web: " << name << ": " << told << " of " << catalog.meshes.size()
+                  << " meshes not resolved; the page draws their links from the configuration\n";
+    }
     std::cout << "robotalk-web: open http://" << (options.bind == "0.0.0.0" ? "127.0.0.1" : options.bind)
               << ":" << server.port() << "/" << std::endl;
     server.Run();

@@ -2,6 +2,7 @@
 
 #include "robotalk/error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -16,6 +17,15 @@ double ParseNumber(const std::string& option, const std::string& text) {
   return v;
 }
 
+void AppendPaths(const std::string& list, std::vector<std::string>& paths) {
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t end = std::min(list.find(':', start), list.size());
+    if (end > start) paths.push_back(list.substr(start, end - start));
+    start = end + 1;
+  }
+}
+
 }  // namespace
 
 std::string WebUsage() {
@@ -28,6 +38,8 @@ std::string WebUsage() {
          "  --lcm-url URL      LCM URL (default: LCM_DEFAULT_URL or LCM's default)\n"
          "  --rate HZ          state frames per second sent to the page (default 30)\n"
          "  --urdf NAME=PATH   draw robot NAME from this URDF with urdf-loader (repeatable)\n"
+         "  --package-path DIRS folders holding the packages of package:// meshes\n"
+         "                     (colon-separated, repeatable; then $ROS_PACKAGE_PATH)\n"
          "  --robot-timeout S  a robot not announced for S seconds is shown as gone (default 3)\n"
          "  --www DIR          the page's files (default: beside the sources)\n"
          "  --node-modules DIR npm modules holding three and urdf-loader\n"
@@ -38,7 +50,7 @@ std::string WebUsage() {
 }
 
 WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::string& default_www,
-                           const std::string& default_modules) {
+                           const std::string& default_modules, const std::string& ros_package_path) {
   WebOptions o;
   o.www_dir = default_www;
   o.node_modules_dir = default_modules;
@@ -76,6 +88,11 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       if (eq == std::string::npos || eq == 0 || eq + 1 == v.size())
         throw Error("--urdf: '" + v + "' is not NAME=PATH");
       o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
+    } else if (a == "--package-path") {
+      const std::string& v = value();
+      const std::size_t before = o.package_paths.size();
+      AppendPaths(v, o.package_paths);
+      if (o.package_paths.size() == before) throw Error("--package-path: '" + v + "' names no folder");
     } else if (a == "--www") {
       o.www_dir = value();
     } else if (a == "--node-modules") {
@@ -84,6 +101,7 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       throw Error("unknown option '" + a + "' (see --help)");
     }
   }
+  AppendPaths(ros_package_path, o.package_paths);
   return o;
 }
 

@@ -27,6 +27,10 @@ struct WebOptions {
   /// Robot name -> URDF file: the page draws that robot with urdf-loader
   /// from this file (and the meshes beside it) instead of from its configuration.
   std::map<std::string, std::string> urdf;
+  /// Folders searched for the packages of package:// mesh names (--package-path,
+  /// colon-separated and repeatable, then $ROS_PACKAGE_PATH); meshes are served
+  /// only from below these and the URDF's own folder (mesh_catalog.h).
+  std::vector<std::string> package_paths;
   /// A robot is shown as gone when no announce named it for this long (s).
   double robot_timeout_s = 3.0;
   bool help = false;
@@ -34,9 +38,11 @@ struct WebOptions {
 };
 
 /// Parses argv[1..]. `default_www` and `default_modules` fill www_dir and
-/// node_modules_dir when no option gives them.
+/// node_modules_dir when no option gives them; `ros_package_path` (the
+/// environment's ROS_PACKAGE_PATH, colon-separated) is appended to the
+/// --package-path folders.
 WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::string& default_www,
-                           const std::string& default_modules);
+                           const std::string& default_modules, const std::string& ros_package_path = "");
 
 /// The --help text.
 std::string WebUsage();

@@ -1,6 +1,7 @@
 #include "web_server.h"
 
 #include "json_text.h"
+#include "mesh_catalog.h"
 #include "robotalk/error.h"
 #include "web_files.h"
 
@@ -31,6 +32,23 @@ using Message = std::shared_ptr<const std::string>;
 constexpr std::size_t kMaxQueuedFrames = 8;
 // The page sends only {"type":"panic","robot":NAME}: anything longer is refused.
 constexpr std::size_t kMaxPageMessage = 4096;
+
+bool StartsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+
+// A request path that tries to leave the served folders: a "." or ".."
+// segment, a backslash, or a percent escape (which could hide either).
+// Browsers normalise "../" away before sending; what arrives is deliberate.
+bool Traverses(std::string_view path) {
+  if (path.find_first_of("\\%") != std::string_view::npos) return true;
+  std::size_t start = 0;
+  while (start < path.size()) {
+    const std::size_t end = std::min(path.find('/', start), path.size());
+    const std::string_view seg = path.substr(start, end - start);
+    if (seg == "." || seg == "..") return true;
+    start = end + 1;
+  }
+  return false;
+}
 
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
@@ -120,7 +138,10 @@ class WebServer::Impl {
                   ec.message());
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(1.0 / o.rate_hz));
+    for (const auto& [robot, urdf] : o.urdf) meshes_[robot] = ResolveMeshes(robot, urdf, o.package_paths);
   }
+
+  const std::map<std::string, MeshCatalog>& meshes() const { return meshes_; }
 
   int port() const { return acceptor_.local_endpoint().port(); }
 
@@ -185,7 +206,31 @@ class WebServer::Impl {
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return error(http::status::method_not_allowed, "only GET and HEAD");
     const std::string target(req.target());
-    const auto path = ResolveWebPath(target, options_);
+    const std::string_view path_part = std::string_view(target).substr(0, target.find('?'));
+    if (Traverses(path_part)) {
+      return error(http::status::forbidden,
+                   "refused: '" + std::string(path_part) +
+                       "' has a '.' or '..' segment, a backslash or a percent escape (path traversal); "
+                       "robotalk-web serves only its page, its modules, the --urdf files and the meshes "
+                       "they name");
+    }
+    if (StartsWith(path_part, "/meshes/")) {  // a robot's mesh catalog (mesh_catalog.h)
+      const auto it = meshes_.find(std::string(path_part.substr(8)));
+      if (it == meshes_.end()) return error(http::status::not_found, "no --urdf for robot: " + target);
+      http::response<http::string_body> res{http::status::ok, req.version()};
+      res.set(http::field::content_type, "application/json");
+      res.body() = JsonText(it->second.Json());
+      return send(std::move(res));
+    }
+    std::optional<std::filesystem::path> path;
+    if (StartsWith(path_part, "/mesh/")) {  // only the files the catalog resolved
+      const std::string_view rest = path_part.substr(6);
+      const auto it = meshes_.find(std::string(rest.substr(0, rest.find('/'))));
+      if (it != meshes_.end() && rest.find('/') != std::string_view::npos)
+        path = it->second.File(rest.substr(rest.find('/') + 1));
+    } else {
+      path = ResolveWebPath(target, options_);
+    }
     http::file_body::value_type body;
     beast::error_code ec;
     if (path && std::filesystem::is_regular_file(*path)) body.open(path->c_str(), beast::file_mode::scan, ec);
@@ -272,12 +317,14 @@ class WebServer::Impl {
   std::vector<std::shared_ptr<WsSession>> sessions_;
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
+  std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start
 };
 
 WebServer::WebServer(const WebOptions& options, RobotTracker& tracker)
     : impl_(std::make_unique<Impl>(options, tracker)) {}
 WebServer::~WebServer() = default;
 int WebServer::port() const { return impl_->port(); }
+const std::map<std::string, MeshCatalog>& WebServer::meshes() const { return impl_->meshes(); }
 void WebServer::Run() { impl_->Run(); }
 void WebServer::Stop() { impl_->Stop(); }
 

@@ -1,7 +1,10 @@
 // WebServer: robotalk-web's HTTP and WebSocket side, on Boost.Beast
 // (docs/web.md). It serves the page's files, the three / urdf-loader modules
 // from node_modules, the URDF files given with --urdf (and files beside
-// them, for meshes), and one WebSocket at /ws that carries JSON: every
+// them), each such robot's mesh catalog at /meshes/NAME and the mesh files
+// it resolved at /mesh/NAME/... (mesh_catalog.h; a request path with a "."
+// or ".." segment, a backslash or a percent escape is refused 403, naming
+// it), and one WebSocket at /ws that carries JSON: every
 // `1/rate` s it polls the RobotTracker and pushes the robots list when it
 // changed, each new model, and each robot's newest state. It reads one kind of
 // message from the page: {"type":"panic","robot":NAME}.
@@ -13,10 +16,13 @@
 // connection only.
 #pragma once
 
+#include "mesh_catalog.h"
 #include "robot_tracker.h"
 #include "web_options.h"
 
+#include <map>
 #include <memory>
+#include <string>
 
 namespace robotalk::web {
 
@@ -29,6 +35,8 @@ class WebServer {
 
   /// The TCP port listened on (the chosen one when options.port was 0).
   int port() const;
+  /// The mesh catalog of every --urdf robot, by name (resolved in the constructor).
+  const std::map<std::string, MeshCatalog>& meshes() const;
   /// Serves until Stop() or SIGINT / SIGTERM.
   void Run();
   void Stop();

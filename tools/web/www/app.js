@@ -32,8 +32,14 @@ function connect() {
   socket = ws;
   ws.onopen = () => {
     retryMs = 500;
-    // A restarted bridge numbers its models from 1 again: take its models as new.
-    for (const c of cards.values()) c.generation = -1;
+    // A restarted bridge numbers its models from 1 again: take its models as
+    // new. What the page knew through the old connection (a panic it sent)
+    // is not current any more; the bridge's robots list says what is.
+    for (const c of cards.values()) {
+      c.generation = -1;
+      c.panicResult = null;
+      showMessage(c);
+    }
     setConnection('bridge connected', 'ok');
     banner('');
   };
@@ -43,7 +49,17 @@ function connect() {
     setConnection('bridge lost', 'bad');
     banner(`Lost the connection to robotalk-web — reconnecting in ${(retryMs / 1000).toFixed(1)} s…` +
            ' (the robots shown are the last known state)');
-    for (const c of cards.values()) c.el.classList.add('gone');
+    for (const c of cards.values()) {  // nothing on the card is known now
+      c.el.classList.add('gone');
+      c.el.classList.remove('in-panic');
+      setStatus(c, 'bridge lost', 'bad');
+      $('.driver', c.el).textContent = c.info ? c.info.driver : '';
+      $('.panic-state', c.el).hidden = true;
+      $('button.panic', c.el).disabled = true;
+      c.panicResult = null;
+      c.info = c.info && { ...c.info, status: 'unknown', panic: false, message: '' };
+      showMessage(c);
+    }
     setTimeout(connect, retryMs);
     retryMs = Math.min(5000, retryMs * 2);
   };
@@ -55,8 +71,43 @@ function onMessage(m) {
   else if (m.type === 'state') onState(m);
   else if (m.type === 'panic_result') {
     const c = cards.get(m.robot);
-    if (c) $('.message', c.el).textContent = m.ok ? 'PANIC sent and acknowledged.' : 'PANIC failed: ' + m.message;
+    if (!c) return;
+    c.panicResult = { text: m.ok ? 'PANIC sent and acknowledged.' : 'PANIC failed: ' + m.message,
+                      ok: m.ok, at: performance.now(), server: c.info && c.info.server_id, seenPanic: false };
+    c.panicRequested = false;
+    showMessage(c);
   }
+}
+
+// A panic result stays while it describes the robot: until the panic is
+// reset, the robot's server changes or it goes away (a failure: 10 s, or
+// until then).
+const PANIC_RESULT_UNSEEN_MS = 5000, PANIC_FAILURE_MS = 10000;
+function panicResultCurrent(c, r) {
+  const p = c.panicResult;
+  if (!p || !r) return false;
+  if (r.status !== 'live' || (p.server && r.server_id !== p.server)) return false;
+  const age = performance.now() - p.at;
+  if (!p.ok) return age < PANIC_FAILURE_MS;
+  if (r.panic) p.seenPanic = true;
+  return r.panic || (!p.seenPanic && age < PANIC_RESULT_UNSEEN_MS);  // the list may not say panic yet
+}
+
+// The card's message line, from the current state only.
+function showMessage(c) {
+  const r = c.info;
+  if (c.panicResult && !panicResultCurrent(c, r)) c.panicResult = null;
+  const parts = [];
+  if (c.panicRequested && !c.panicResult) parts.push('PANIC requested…');
+  if (c.panicResult) parts.push(c.panicResult.text);
+  if (r && r.status === 'live' && r.message) parts.push(r.message);
+  $('.message', c.el).textContent = parts.join(' ');
+}
+
+function setStatus(c, text, cls) {
+  const status = $('.status', c.el);
+  status.textContent = text;
+  status.className = 'pill status ' + cls;
 }
 
 function card(name) {
@@ -68,11 +119,14 @@ function card(name) {
   $('button.panic', el).addEventListener('click', () => {
     if (socket && socket.readyState === WebSocket.OPEN) {
       socket.send(JSON.stringify({ type: 'panic', robot: name }));
-      $('.message', el).textContent = 'PANIC requested…';
+      c.panicResult = null;
+      c.panicRequested = true;
+      showMessage(c);
     }
   });
   $('#robots').append(el);
-  c = { name, el, info: null, view: null, plot: null, generation: -1, pending: null, arrivalFrame: 0, drawn: null };
+  c = { name, el, info: null, view: null, plot: null, generation: -1, pending: null, arrivalFrame: 0, drawn: null,
+        panicResult: null, panicRequested: false };
   cards.set(name, c);
   return c;
 }
@@ -82,21 +136,23 @@ function updateRobots(list) {
   for (const r of list) {
     const c = card(r.name);
     c.info = r;
-    const status = $('.status', c.el);
-    status.textContent = r.status;
-    status.className = 'pill status ' + ({ live: 'ok', connecting: 'wait' }[r.status] || 'bad');
-    $('.driver', c.el).textContent = `${r.driver} · ${r.num_clients} client${r.num_clients === 1 ? '' : 's'}`;
-    $('.panic-state', c.el).hidden = !r.panic;
-    c.el.classList.toggle('in-panic', r.panic);
-    c.el.classList.toggle('gone', r.status === 'gone');
-    $('button.panic', c.el).disabled = r.status !== 'live';
+    const live = r.status === 'live';
+    setStatus(c, r.status, { live: 'ok', connecting: 'wait' }[r.status] || 'bad');
+    // Clients and panic are what the robot's announces say: only while it is heard.
+    $('.driver', c.el).textContent = live || r.status === 'connecting'
+      ? `${r.driver} · ${r.num_clients} client${r.num_clients === 1 ? '' : 's'}` : `${r.driver} · not announced`;
+    $('.panic-state', c.el).hidden = !(live && r.panic);
+    c.el.classList.toggle('in-panic', live && r.panic);
+    c.el.classList.toggle('gone', r.status === 'gone' || r.status === 'error');
+    $('button.panic', c.el).disabled = !live;
+    if (c.panicResult || !live) c.panicRequested = false;
     const overlay = $('.overlay', c.el);
     const lost = { gone: `Robot gone: ${r.message}. Waiting for it to be announced again…`,
                    error: `Cannot reach the robot: ${r.message}. Retrying…`,
                    connecting: c.view ? '' : 'Loading the configuration…' }[r.status];
     overlay.hidden = !lost;
     overlay.textContent = lost || '';
-    if (r.status === 'live' && r.message) $('.message', c.el).textContent = r.message;
+    showMessage(c);
   }
 }
 
@@ -106,7 +162,11 @@ function setModel(m) {
   c.generation = m.generation;
   if (c.view) c.view.dispose();
   c.model = m.model;
-  c.view = new RobotView($('.view', c.el), m.model, c.info && c.info.urdf);
+  const urdf = c.info && c.info.urdf;
+  c.view = new RobotView($('.view', c.el), m.model, urdf, urdf ? `/meshes/${encodeURIComponent(m.robot)}` : null);
+  const note = $('.mesh-note', c.el);
+  note.hidden = true;
+  c.view.onNote = (text) => { note.textContent = text; note.hidden = !text; };
   c.plot = new JointPlot($('.plot', c.el), $('.plot-joints', c.el), m.model.dof_names, m.model.joints);
   c.pending = null;
   c.drawn = null;
@@ -141,7 +201,8 @@ function animate(now) {
       ++statesDrawn;
       c.drawn = { sample: c.pending.sample, frame, state: c.pending };
       $('.readout', c.el).textContent = readout(c, c.pending);
-      $('.panic-state', c.el).hidden = !(c.pending.panic || (c.info && c.info.panic));
+      const live = c.info && c.info.status === 'live';
+      $('.panic-state', c.el).hidden = !(live && (c.pending.panic || c.info.panic));
       c.pending = null;
       c.plot.draw();
     }
@@ -162,7 +223,33 @@ window.robotalkTest = {
   connected: () => !!socket && socket.readyState === WebSocket.OPEN,
   robots: () => [...cards.values()].map((c) => ({ name: c.name, status: c.info && c.info.status,
     panic: !!(c.info && c.info.panic), hasView: !!c.view, urdf: !!(c.view && c.view.urdfRobot),
-    overlay: $('.overlay', c.el).hidden ? '' : $('.overlay', c.el).textContent })),
+    overlay: $('.overlay', c.el).hidden ? '' : $('.overlay', c.el).textContent,
+    // What a person reads on the card, and whether it fits inside it.
+    statusText: $('.status', c.el).textContent, driverText: $('.driver', c.el).textContent,
+    message: $('.message', c.el).textContent, panicPill: !$('.panic-state', c.el).hidden,
+    meshNote: $('.mesh-note', c.el).hidden ? '' : $('.mesh-note', c.el).textContent,
+    overflow: [...c.el.querySelectorAll('.card-head, .readout, .message, .mesh-note, .plot-joints')].filter((e) => {
+      const box = e.getBoundingClientRect(), card = c.el.getBoundingClientRect();
+      return e.scrollWidth > e.clientWidth + 1 || box.right > card.right + 0.5;
+    }).map((e) => e.className) })),
+  // The URDF view of a robot: meshes drawn, the problems noted, which links
+  // show the configuration's shapes, and mesh geometry per URDF link.
+  meshes: (name) => {
+    const c = cards.get(name);
+    const v = c && c.view;
+    if (!v) return null;
+    if (!v.urdfRobot) return { loaded: 0, problems: v.meshProblems, geometry: {}, fallbackLinks: [], error: v.urdfError || 'not loaded' };
+    const geometry = {};
+    for (const [link, obj] of Object.entries(v.urdfRobot.links)) {
+      let vertices = 0;
+      for (const visual of obj.children.filter((ch) => ch.isURDFVisual)) {
+        visual.traverse((o) => { if (o.isMesh && o.geometry) vertices += o.geometry.attributes.position.count; });
+      }
+      geometry[link] = vertices;
+    }
+    return { loaded: v.meshesLoaded, problems: v.meshProblems, geometry,
+             fallbackLinks: c.model.links.filter((l, i) => v.linkObjects[i].visible).map((l) => l.name) };
+  },
   // The newest drawn state of a robot and the poses the scene graph holds for it.
   drawn: (name) => {
     const c = cards.get(name);

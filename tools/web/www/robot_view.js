@@ -4,13 +4,18 @@
 // link's equivalent-inertia box at its centre of mass, bones to its joint
 // centres, axes at its control frames — the configuration carries no visual
 // geometry), or from a URDF file by urdf-loader when the bridge was given one
-// (--urdf NAME=PATH). Either way it is posed from the bridge's state frames:
+// (--urdf NAME=PATH); a link whose mesh the bridge could not resolve, or the
+// page could not load, keeps the configuration's shapes, with a note. Either way it is posed from the bridge's state frames:
 // world poses of every link (computed by the bridge with RoboTalk's own
 // kinematics) and the joint positions. The base's path is drawn on the floor.
 // Coordinates are RoboTalk's (z up, metres); one group turns them into
 // three.js's y-up world.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { STLLoader } from 'three/examples/jsm/loaders/STLLoader.js';
+import { ColladaLoader } from 'three/examples/jsm/loaders/ColladaLoader.js';
+import { OBJLoader } from 'three/examples/jsm/loaders/OBJLoader.js';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import URDFLoader from 'urdf-loader';
 
 const PATH_MAX_POINTS = 20000;
@@ -58,7 +63,7 @@ function floor() {
 function quat(p) { return new THREE.Quaternion(p[4], p[5], p[6], p[3]); }
 
 export class RobotView {
-  constructor(container, model, urdfUrl) {
+  constructor(container, model, urdfUrl, meshesUrl) {
     this.model = model;
     this.renderer = new THREE.WebGLRenderer({ antialias: !softwareGl() });
     this.renderer.setPixelRatio(1);
@@ -80,7 +85,8 @@ export class RobotView {
     this.urdfRobot = null;
     this.loading = null;
     this.buildFromSpec();
-    if (urdfUrl) this.loadUrdf(urdfUrl);
+    this.meshProblems = [];
+    if (urdfUrl) this.loadUrdf(urdfUrl, meshesUrl);
     this.buildPath();
     this.framed = false;  // the camera is aimed once the first state has posed the links
     this.followBase = this.model.roots.length > 0 && this.model.roots[0].base !== 'fixed';
@@ -129,25 +135,105 @@ export class RobotView {
     }
   }
 
-  loadUrdf(url) {
+  // The URDF's own geometry, mesh by mesh: the bridge's catalog (/meshes/NAME,
+  // docs/web.md "Meshes") says where each mesh filename is served, or why it
+  // is not; a link whose mesh did not resolve or load keeps the
+  // configuration's shapes, and `meshProblems` (shown under the view) names
+  // the mesh and the reason.
+  loadUrdf(url, meshesUrl) {
+    this.meshProblems = [];
+    this.meshesLoaded = 0;
+    this.failedLinks = new Set();
+    this.loading = this.loadUrdfAsync(url, meshesUrl).catch((err) => {
+      this.urdfError = String(err.message || err);
+      this.problem({ link: '', uri: url, error: 'the URDF did not load: ' + this.urdfError });
+      return false;
+    });
+  }
+
+  async loadUrdfAsync(url, meshesUrl) {
+    // Without the catalog no mesh can be placed on its link: the whole URDF
+    // is then given up and the configuration drawn (with the note).
+    const catalog = await fetch(meshesUrl).then((r) => {
+      if (!r.ok) throw new Error(`${meshesUrl}: HTTP ${r.status}`);
+      return r.json();
+    });
+    const byUri = new Map();
+    for (const m of catalog.meshes) byUri.set(m.uri, [...(byUri.get(m.uri) || []), m]);
+    const text = await fetch(url).then((r) => {
+      if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
+      return r.text();
+    });
+    const pending = [];
     const loader = new URDFLoader();
     loader.parseVisual = true;
     loader.parseCollision = false;
-    this.loading = new Promise((resolve) => {
-      loader.load(url, (robot) => {
-        this.urdfRobot = robot;
-        this.world.add(robot);
-        this.specGroup.visible = false;  // the URDF's own geometry replaces the spec's boxes
-        robot.traverse((o) => {  // URDF visuals without a colour of their own
-          if (o.isMesh && o.material && !o.material.name) o.material = new THREE.MeshStandardMaterial({ color: 0x6f93c8, roughness: 0.6 });
-        });
-        if (this.lastFrame) {
-          this.apply(this.lastFrame);
-          this.frameCamera();
-        }
-        resolve(true);
-      }, undefined, (err) => { this.urdfError = String(err); resolve(false); });
+    loader.packages = (pkg) => 'package://' + pkg;  // filenames reach loadMeshCb as the URDF writes them
+    loader.loadMeshCb = (path, manager, material, done) => {
+      pending.push(this.loadMesh(path, byUri.get(path) || [], material).then((obj) => done(obj), (err) => done(null, err)));
+    };
+    const robot = loader.parse(text, '');
+    this.urdfRobot = robot;
+    this.world.add(robot);
+    this.showFallback();
+    if (this.lastFrame) this.apply(this.lastFrame);
+    await Promise.all(pending);
+    if (this.lastFrame) this.frameCamera();
+    return true;
+  }
+
+  async loadMesh(uri, entries, material) {
+    const links = entries.map((e) => e.link);
+    const served = entries.find((e) => e.url);
+    const fail = (error) => {
+      this.problem({ link: links.join(', '), uri, error }, links);
+      throw new Error(`${uri}: ${error}`);
+    };
+    if (!served) return fail(entries.length ? entries[0].error : 'not in the bridge\'s mesh catalog');
+    if (!material || !material.name) material = new THREE.MeshStandardMaterial({ color: 0x6f93c8, roughness: 0.6 });
+    const ext = (served.url.match(/\.([a-z0-9]+)$/i) || [])[1]?.toLowerCase();
+    try {
+      let obj;
+      if (ext === 'stl') {
+        const geometry = await new STLLoader().loadAsync(served.url);
+        // Many STL files leave their facet normals zero: they would draw black.
+        if (!geometry.attributes.normal || geometry.attributes.normal.array.every((v) => v === 0)) geometry.computeVertexNormals();
+        obj = new THREE.Mesh(geometry, material);
+      } else if (ext === 'dae') obj = (await new ColladaLoader().loadAsync(served.url)).scene;
+      else if (ext === 'gltf' || ext === 'glb') obj = (await new GLTFLoader().loadAsync(served.url)).scene;
+      else if (ext === 'obj') {
+        obj = await new OBJLoader().loadAsync(served.url);
+        obj.traverse((o) => { if (o.isMesh) o.material = material; });
+      } else return fail(`the page draws .stl, .dae, .obj, .gltf and .glb meshes, not .${ext}`);
+      ++this.meshesLoaded;
+      return obj;
+    } catch (err) {
+      if (String(err.message || '').startsWith(uri + ':')) throw err;
+      return fail(`${served.url}: ${err.message || err}`);
+    }
+  }
+
+  problem(p, links = []) {
+    this.meshProblems.push(p);
+    for (const l of links) this.failedLinks.add(l);
+    this.showFallback();
+    if (this.onNote) this.onNote(this.meshNote());
+  }
+
+  // The configuration's shapes of exactly the links the URDF cannot draw.
+  showFallback() {
+    if (!this.urdfRobot) return;
+    this.model.links.forEach((l, i) => {
+      this.linkObjects[i].visible = this.failedLinks.has(l.name) || !this.urdfRobot.links[l.name];
     });
+  }
+
+  meshNote() {
+    const n = this.meshProblems.length;
+    if (n === 0) return '';
+    const shown = this.meshProblems.slice(0, 2).map((p) => `${p.uri}${p.link ? ` (link ${p.link})` : ''}: ${p.error}`);
+    return `${n} mesh${n === 1 ? '' : 'es'} not drawn; ${n === 1 ? 'its link is' : 'their links are'} shown ` +
+           `as the configuration's shapes. ${shown.join('; ')}${n > 2 ? `; and ${n - 2} more` : ''}`;
   }
 
   buildPath() {
@@ -164,7 +250,9 @@ export class RobotView {
 
   frameCamera() {
     this.world.updateMatrixWorld(true);
-    const box = new THREE.Box3().setFromObject(this.urdfRobot || this.specGroup);
+    // The configuration's shapes always (meshes may be missing), with the URDF's.
+    const box = new THREE.Box3().setFromObject(this.specGroup);
+    if (this.urdfRobot) box.union(new THREE.Box3().setFromObject(this.urdfRobot));
     // A mobile base gets room around it for its path.
     const size = Math.max(this.followBase ? 2.2 : 1.0, box.getSize(new THREE.Vector3()).length());
     const centre = box.getCenter(new THREE.Vector3());

@@ -1,0 +1,114 @@
+// robotalk-logplay export (tools/logplay/export.h): state.csv's joint
+// columns are named from the configuration the log holds (issue 21: they
+// were one "q" column of unnamed values), joints.csv gives their units, and
+// a robot whose configuration the log lacks is named q0.. and said so.
+#include "export.h"
+#include "robotalk/channels.h"
+#include "robotalk/config_codec.h"
+#include "robotalk/urdf_import.h"
+#include "robotalk_msgs/robot_state_t.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace robotalk::logplay {
+namespace {
+
+const char* kUrdf = R"(<robot name="rover">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="wheel"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="mast"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="wheel_joint" type="continuous"><parent link="base"/><child link="wheel"/><axis xyz="0 1 0"/></joint>
+  <joint name="lift" type="prismatic"><parent link="base"/><child link="mast"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0.5" effort="10" velocity="1"/></joint>
+</robot>)";
+
+std::vector<std::uint8_t> State(const std::string& robot, std::vector<double> q) {
+  robotalk_msgs::robot_state_t s{};
+  s.server_time_us = 1'000'000;
+  s.sample = 1;
+  s.robot = robot;
+  s.num_dofs = static_cast<std::int32_t>(q.size());
+  s.position = q;
+  s.velocity = std::vector<double>(q.size(), 0.0);
+  s.effort = std::vector<double>(q.size(), 0.0);
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(s.getEncodedSize()));
+  s.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+class Export : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("logplay_export_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+TEST_F(Export, NamesTheStateColumnsFromTheLoggedConfiguration) {
+  SessionLog log;
+  LoggedConfigs configs;
+  configs.Add(ConfigChannel("rover"), EncodeConfig(ParseUrdf(kUrdf, {}, "rover.urdf").model));
+  log.Add(StateChannel("rover"), 10, State("rover", {45.5, 0.25}));
+  std::ostringstream warnings;
+  const auto files = ExportCsv(log, configs, dir_.string(), warnings);
+  ASSERT_EQ(files.size(), 3u);
+  const auto state = Lines(dir_ / "state.csv");
+  ASSERT_EQ(state.size(), 2u);
+  EXPECT_EQ(state[0], "robot,log_time_us,server_time_us,panic,moving,x,y,theta,v,omega,wheel_joint,lift");
+  EXPECT_EQ(state[1], "rover,10,1000000,0,0,0,0,0,0,0,45.5,0.25");
+  EXPECT_EQ(Lines(dir_ / "joints.csv"),
+            (std::vector<std::string>{"robot,dof,column,unit,named_from", "rover,0,wheel_joint,rad,config",
+                                      "rover,1,lift,m,config"}));
+  EXPECT_EQ(warnings.str(), "");
+}
+
+TEST_F(Export, FallsBackToQNumbersAndSaysSoWithoutAConfiguration) {
+  SessionLog log;
+  LoggedConfigs configs;
+  // A configuration of another size (the robot was restarted with another
+  // model) does not name these dofs.
+  configs.Add(ConfigChannel("rover"), EncodeConfig(ParseUrdf(kUrdf, {}, "rover.urdf").model));
+  log.Add(StateChannel("rover"), 10, State("rover", {1, 2, 3}));
+  std::ostringstream warnings;
+  ExportCsv(log, configs, dir_.string(), warnings);
+  EXPECT_EQ(Lines(dir_ / "state.csv")[0],
+            "robot,log_time_us,server_time_us,panic,moving,x,y,theta,v,omega,q0,q1,q2");
+  EXPECT_NE(warnings.str().find("no configuration (ROBOTALK/rover/CONFIG) of robot 'rover' with 3 dofs: its "
+                                "joints are named q0..q2"),
+            std::string::npos)
+      << warnings.str();
+  EXPECT_EQ(Lines(dir_ / "joints.csv")[1], "rover,0,q0,,none");
+}
+
+TEST_F(Export, GivesEachRobotItsOwnColumnsAndIgnoresABrokenConfiguration) {
+  SessionLog log;
+  LoggedConfigs configs;
+  configs.Add(ConfigChannel("rover"), EncodeConfig(ParseUrdf(kUrdf, {}, "rover.urdf").model));
+  configs.Add(ConfigChannel("other"), std::vector<std::uint8_t>{1, 2, 3});
+  EXPECT_EQ(configs.undecodable(), 1u);
+  log.Add(StateChannel("rover"), 10, State("rover", {1, 2}));
+  log.Add(StateChannel("other"), 11, State("other", {7}));
+  std::ostringstream warnings;
+  ExportCsv(log, configs, dir_.string(), warnings);
+  const auto state = Lines(dir_ / "state.csv");
+  EXPECT_EQ(state[0], "robot,log_time_us,server_time_us,panic,moving,x,y,theta,v,omega,wheel_joint,lift,q0");
+  EXPECT_EQ(state[1], "rover,10,1000000,0,0,0,0,0,0,0,1,2,");
+  EXPECT_EQ(state[2], "other,11,1000000,0,0,0,0,0,0,0,,,7");
+}
+
+}  // namespace
+}  // namespace robotalk::logplay
