@@ -1,6 +1,7 @@
 /* A small RoboTalk client in C: see robotalk_c_client.h. */
 #define _POSIX_C_SOURCE 200809L
 #include "robotalk_c_client.h"
+#include "robotalk_c_keyed.h"
 #include "robotalk_c_url.h"
 
 #include <errno.h>
@@ -75,6 +76,13 @@ struct rtc_client {
   int announce_version, announce_keyed, announce_layout;
   int64_t announce_server_id;
   char heard[512];
+  /* Keyed mode (docs/security.md, "Keyed mode byte by byte"). */
+  int keyed, have_server_key;
+  rtc_identity identity;
+  uint8_t server_key[32];     /* --server-key, else the key that signed the ANNOUNCE */
+  uint8_t kx_public[32], kx_secret[32]; /* this hello's ephemeral pair */
+  uint8_t instance_nonce[16]; /* of the server instance of the session */
+  rtc_session_keys keys;
 };
 
 static void set_error(rtc_client* c, const char* fmt, ...) {
@@ -157,11 +165,15 @@ static void server_changed(rtc_client* c, int64_t new_server_id) {
 
 static void on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_reply_package_t* m,
                      void* user) {
-  (void)rbuf;
   (void)channel;
   rtc_client* c = user;
   int64_t t4 = rtc_now_us();
   if (m->protocol_version != kProtocolVersion || m->client_id != c->client_id) return;
+  /* Keyed: a reply of our session must carry its MAC (SESSION_UNKNOWN has none). */
+  if (c->keyed && m->session_status != ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN &&
+      (m->session_id != c->keys.session_id ||
+       !rtc_mac_verifies(c->keys.s2c, c->keys.session_id, rbuf->data, rbuf->data_size)))
+    return;
   if (m->server_id != c->server_id && c->server_id != 0) server_changed(c, m->server_id);
   pending_package* p = m->ack_sequence > 0 ? find_package(c, m->ack_sequence) : NULL;
   if (m->session_status == ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN) {
@@ -202,28 +214,45 @@ static void on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
   (void)channel;
   rtc_client* c = user;
   if (m->client_id != c->client_id || memcmp(m->client_nonce, c->nonce, 16) != 0) return; /* not our hello */
+  /* A forged answer (bad signature) is ignored: the real one may follow. */
+  if (c->keyed && m->session_id != 0 &&
+      rtc_check_answer(m, c->identity.public_key, c->kx_public, c->kx_secret, c->server_key, &c->keys, c->refusal,
+                       sizeof c->refusal) != 0) {
+    fprintf(stderr, "robotalk-c: answer ignored: %s\n", c->refusal);
+    c->refusal[0] = 0;
+    return;
+  }
   c->hello_answered = 1;
   c->session_id = m->session_id;
+  memcpy(c->instance_nonce, m->instance_nonce, 16);
   if (c->server_id != 0 && m->server_id != c->server_id) c->clock_stale = 1;
   c->server_id = m->server_id;
   snprintf(c->refusal, sizeof c->refusal, "%s", m->session_id == 0 ? m->refusal : "");
-  if (m->keyed) snprintf(c->refusal, sizeof c->refusal, "the server answered in keyed mode");
+  if (m->keyed && !c->keyed) snprintf(c->refusal, sizeof c->refusal, "the server answered in keyed mode");
 }
 
 static void on_config(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_robot_config_t* m,
                       void* user) {
-  (void)rbuf;
-  (void)channel;
   rtc_client* c = user;
+  if (c->keyed && !rtc_broadcast_verifies(channel, rbuf->data, rbuf->data_size, c->server_key, c->instance_nonce))
+    return; /* not signed by our server's instance */
   if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
   c->config = robotalk_msgs_robot_config_t_copy(m);
 }
 
 static void on_announce(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_announce_t* m,
                         void* user) {
-  (void)rbuf;
-  (void)channel;
   rtc_client* c = user;
+  /* Keyed: only an ANNOUNCE signed by the server key we trust (--server-key),
+   * else by the key its own suffix names (trust on first use, unpinned). */
+  if (c->keyed && m->keyed) {
+    const uint8_t* data = rbuf->data;
+    const size_t n = rbuf->data_size;
+    const uint8_t* signer = n >= RTC_SIGNATURE_SUFFIX_BYTES ? data + n - RTC_SIGNATURE_SUFFIX_BYTES + 8 : NULL;
+    if (!signer || !rtc_broadcast_verifies(channel, data, n, c->have_server_key ? c->server_key : signer, NULL))
+      return;
+    if (!c->have_server_key) memcpy(c->server_key, signer, 32);
+  }
   for (int i = 0; i < m->num_robots; ++i) {
     const char* name = m->robots[i].name;
     if (strcmp(name, c->robot) == 0) {
@@ -267,6 +296,8 @@ static int publish_package(rtc_client* c, robotalk_msgs_package_t* pkg, uint8_t*
     set_error(c, "cannot encode a package");
     return -1;
   }
+  if (c->keyed) /* the MAC is the encoding's last 16 bytes and covers every byte before */
+    rtc_mac(c->keys.c2s, pkg->header.session_id, bytes, (size_t)size - 16, bytes + size - 16);
   c->last_new_package_us = rtc_now_us(); /* before sending: a clock sample's t1 */
   lcm_publish(c->request_lcm, c->request_channel, bytes, (unsigned)size);
   if (bytes_out) {
@@ -353,6 +384,7 @@ static int say_hello(rtc_client* c, double timeout_s) {
   hello.client_id = c->client_id;
   if (random_bytes(c->nonce, sizeof c->nonce) != 0) return set_error(c, "no /dev/urandom"), -1;
   memcpy(hello.client_nonce, c->nonce, sizeof c->nonce);
+  if (c->keyed) rtc_keyed_hello(&hello, &c->identity, c->kx_public, c->kx_secret);
   c->hello_answered = 0;
   const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
   int64_t next_hello = 0;
@@ -547,21 +579,50 @@ static int find_robot(rtc_client* c, double timeout_s) {
     return set_error(c, "'%s' speaks protocol %d; this client speaks %d", c->robot, c->announce_version,
                      kProtocolVersion),
            -1;
-  if (c->announce_keyed)
+  if (c->announce_keyed && !c->keyed)
     return set_error(c,
-                     "the server of '%s' requires keys (keyed mode, docs/security.md); this example client "
-                     "supports open mode only",
+                     "the server of '%s' requires keys (keyed mode, docs/security.md); give this client one "
+                     "(--key FILE or ROBOTALK_KEY)",
+                     c->robot),
+           -1;
+  if (!c->announce_keyed && c->keyed)
+    return set_error(c, "the server of '%s' is in open mode; this client was given a key and talks keyed only",
                      c->robot),
            -1;
   return 0;
 }
 
 rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, char* err, size_t err_len) {
+  return rtc_connect_keyed(url, robot, NULL, NULL, timeout_s, err, err_len);
+}
+
+/* Keyed: reads the keys; the client id is one of the key's. */
+static int load_keys(rtc_client* c, const char* key_file, const char* server_key_file) {
+  if (rtc_keyed_init() != 0) return set_error(c, "libsodium cannot start"), -1;
+  if (rtc_read_secret_key(key_file, &c->identity, c->error, sizeof c->error) != 0) return -1;
+  if (server_key_file) {
+    if (rtc_read_public_key(server_key_file, c->server_key, c->error, sizeof c->error) != 0) return -1;
+    c->have_server_key = 1;
+  }
+  c->keyed = 1;
+  uint32_t low = 0;
+  if (random_bytes(&low, sizeof low) != 0) return set_error(c, "no /dev/urandom"), -1;
+  c->client_id = rtc_keyed_client_id(c->identity.public_key, low);
+  return 0;
+}
+
+rtc_client* rtc_connect_keyed(const char* url, const char* robot, const char* key_file,
+                              const char* server_key_file, double timeout_s, char* err, size_t err_len) {
   rtc_client* c = calloc(1, sizeof *c);
   if (!c) return NULL;
   snprintf(c->robot, sizeof c->robot, "%s", robot);
   c->next_sequence = 1;
   c->next_id = 1;
+  if (key_file && load_keys(c, key_file, server_key_file) != 0) {
+    snprintf(err, err_len, "%s", c->error);
+    free(c);
+    return NULL;
+  }
   while (c->client_id == 0)
     if (random_bytes(&c->client_id, sizeof c->client_id) != 0) break;
   char lcm_url[512];

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The C example in keyed mode against a keyed robotalk-server: with a listed
+# key it runs its whole session (hello signed, packages sealed, replies and
+# CONFIG verified); an unlisted key is refused, a wrong server key finds no
+# robot, no key is told to give one; none of those moves the robot. Run inside
+# a private network namespace (CTest: scripts/netns_run.sh).
+#   c_keyed_session_test.sh SERVER KEYGEN MODELS_DIR PORT C_EXAMPLE
+set -u
+server_bin=$1 keygen=$2 models=$3 port=$4 example=$5
+url="udpm://239.255.76.67:$port?ttl=0"
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
+for k in server alice mallory; do "$keygen" --out "$tmp/$k" >/dev/null || exit 1; done
+echo "$(cut -d' ' -f1 "$tmp/alice.pub") alice *=all" >"$tmp/clients"
+chmod 600 "$tmp/clients"
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 90 \
+  --key "$tmp/server" --clients "$tmp/clients" 2>"$tmp/server.log" &
+server_pid=$!
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+run() {  # run NAME ARGS...: the example's exit status in $tmp/NAME.status
+  local name=$1
+  shift
+  timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/$name.out" 2>"$tmp/$name.err"
+  echo $? >"$tmp/$name.status"
+}
+
+run pinned env -u ROBOTALK_KEY "$example" --key "$tmp/alice" --server-key "$tmp/server.pub"
+check "with a listed key and the server's key it exits 0" grep -qx 0 "$tmp/pinned.status"
+check "it connected keyed" grep -q "^connected: robot=pioneer .* keyed$" "$tmp/pinned.out"
+check "its GOTO succeeded" grep -q "GOTO 0.5 0 0: SUCCESS" "$tmp/pinned.out"
+check "its sequence ran (4 set-points, SUCCESS)" test "$(grep -c "sequence +.*SUCCESS" "$tmp/pinned.out")" -eq 4
+check "the CONFIG it verified is the robot's" grep -q "^config: robot=pioneer links=7 joints=6" "$tmp/pinned.out"
+check "the robot reached x = 0.5" grep -q "^pose: x=0.50" "$tmp/pinned.out"
+
+run tofu env ROBOTALK_KEY="$tmp/alice" "$example"
+check "ROBOTALK_KEY, the server key taken from the signed ANNOUNCE: exits 0" grep -qx 0 "$tmp/tofu.status"
+check "... and says done" grep -q "^done$" "$tmp/tofu.out"
+
+run unlisted env -u ROBOTALK_KEY "$example" --key "$tmp/mallory"
+check "an unlisted key exits 1" grep -qx 1 "$tmp/unlisted.status"
+check "... saying the hello was refused" grep -q "error: hello refused by 'pioneer'" "$tmp/unlisted.err"
+
+run impostor env -u ROBOTALK_KEY "$example" --key "$tmp/alice" --server-key "$tmp/mallory.pub"
+check "another server key: exits 1" grep -qx 1 "$tmp/impostor.status"
+check "... having found no robot signed by that key" grep -q "error: no robot 'pioneer' announced" "$tmp/impostor.err"
+
+run nokey env -u ROBOTALK_KEY "$example"
+check "no key: exits 1" grep -qx 1 "$tmp/nokey.status"
+check "... saying the server requires keys and how to give one" \
+  grep -q "requires keys (keyed mode, docs/security.md); give this client one (--key FILE or ROBOTALK_KEY)" \
+  "$tmp/nokey.err"
+for n in pinned tofu unlisted impostor nokey; do
+  [ "$failures" -eq 0 ] || { echo "--- $n (exit $(cat "$tmp/$n.status"))"; cat "$tmp/$n.out" "$tmp/$n.err"; }
+done
+[ "$failures" -eq 0 ] || { echo "--- server log"; cat "$tmp/server.log"; }
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
