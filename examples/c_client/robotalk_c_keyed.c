@@ -79,10 +79,10 @@ int rtc_read_public_key(const char* path, uint8_t key[32], char* err, size_t err
   return 0;
 }
 
-void rtc_fingerprint(const uint8_t key[32], char out[21]) {
+void rtc_fingerprint(const uint8_t key[32], char out[23]) {
   uint8_t h[32];
   crypto_generichash(h, sizeof h, key, 32, NULL, 0);
-  snprintf(out, 21, "rt:%02x%02x:%02x%02x:%02x%02x:%02x%02x", h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7]);
+  snprintf(out, 23, "rt:%02x%02x:%02x%02x:%02x%02x:%02x%02x", h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7]);
 }
 
 void rtc_kx_keypair(uint8_t public_key[32], uint8_t secret_key[32]) { crypto_kx_keypair(public_key, secret_key); }
@@ -196,7 +196,7 @@ int rtc_check_answer(const robotalk_msgs_hello_answer_t* m, const uint8_t client
                      const uint8_t kx_public[32], const uint8_t kx_secret[32], const uint8_t trusted_server_key[32],
                      rtc_session_keys* keys, char* why, size_t why_len) {
   uint8_t hello[RTC_HELLO_SIGNED_BYTES], answer[RTC_ANSWER_SIGNED_BYTES];
-  char want[21], got[21];
+  char want[23], got[23];
   if (!m->keyed) return snprintf(why, why_len, "the server answered in open mode"), -1;
   if (memcmp(m->server_key, trusted_server_key, 32) != 0) {
     rtc_fingerprint(trusted_server_key, want);

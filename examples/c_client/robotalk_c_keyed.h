@@ -46,8 +46,8 @@ void rtc_identity_from_seed(const uint8_t seed[32], rtc_identity* id);
 int rtc_read_secret_key(const char* path, rtc_identity* id, char* err, size_t err_len);
 /* Reads a .pub file ("ed25519:<64 hex> NAME"). */
 int rtc_read_public_key(const char* path, uint8_t key[32], char* err, size_t err_len);
-/* "rt:1a2b:3c4d:5e6f:7a8b" (20 characters and a NUL). */
-void rtc_fingerprint(const uint8_t key[32], char out[21]);
+/* "rt:1a2b:3c4d:5e6f:7a8b" (22 characters and a NUL). */
+void rtc_fingerprint(const uint8_t key[32], char out[23]);
 
 /* A fresh X25519 pair for one session (crypto_kx_keypair). */
 void rtc_kx_keypair(uint8_t public_key[32], uint8_t secret_key[32]);

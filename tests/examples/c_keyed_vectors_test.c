@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
   rtc_identity_from_seed(seed, &server);
   expect_hex("client_key", client.public_key, 32);
   expect_hex("server_key", server.public_key, 32);
-  char fingerprint[21];
+  char fingerprint[23];
   rtc_fingerprint(client.public_key, fingerprint);
   expect_text("client_fingerprint", fingerprint);
 
