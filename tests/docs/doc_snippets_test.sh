@@ -31,7 +31,7 @@ untagged_ok=" docs/architecture.md "
 cmake --install "$build" --prefix "$tmp/prefix" >"$tmp/install.log"
 mkdir -p "$tmp/blocks" "$tmp/cpp" "$tmp/java"
 n=0
-for doc in README.md docs/*.md; do
+for doc in README.md $(cd "$source" && ls docs/*.md); do
   awk -v doc="$doc" -v out="$tmp/blocks" -v first="$n" -f "$here/extract_snippets.awk" "$source/$doc"
   n=$(find "$tmp/blocks" -name '*.meta' | wc -l)
 done
@@ -103,7 +103,8 @@ for meta in "$tmp/blocks"/*.meta; do
         (cd "$tmp/run_$id" && PATH="$tmp/prefix/bin:$PATH" HOME="$tmp/run_$id/home" \
           LCM_DEFAULT_URL="udpm://239.255.76.67:7743?ttl=0" ROBOTALK_KNOWN_SERVERS="" \
           timeout 120 "$source/scripts/netns_run.sh" bash -c \
-          'trap "kill \$(jobs -p) 2>/dev/null; wait" EXIT; set -e; . "$1"' run "$src" \
+          'trap "rc=\$?; j=\$(jobs -p); [ -z \"\$j\" ] || kill \$j 2>/dev/null; wait; exit \$rc" EXIT; set -e; . "$1"' \
+          run "$src" \
           >"$tmp/run_$id.log" 2>&1) || rc=$?
         case $rc in
           0) pass=$((pass + 1)) ;;
