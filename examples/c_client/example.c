@@ -5,7 +5,7 @@
  *   robotalk_c_example [--url URL] [--robot NAME] [--delay S] [--pause S]
  *                      [--key FILE] [--server-key FILE.pub]
  * --key FILE: keyed mode with this secret key (or $ROBOTALK_KEY);
- * --server-key FILE.pub: the server key to trust (default: the ANNOUNCE's signer).
+ * --server-key FILE.pub: the server key to trust (default: the first answer's, not pinned).
  * --pause S: wait S seconds after the GOTO (keeping the session); the test
  * restarts the server meanwhile, and the client must say hello again.
  * Exit status 0 when every step succeeded. */

@@ -79,7 +79,8 @@ struct rtc_client {
   /* Keyed mode (docs/security.md, "Keyed mode byte by byte"). */
   int keyed, have_server_key;
   rtc_identity identity;
-  uint8_t server_key[32];     /* --server-key, else the key that signed the ANNOUNCE */
+  uint8_t server_key[32];     /* --server-key, else the first answer's that verified */
+  char ignored[256];          /* why the last answer was ignored */
   uint8_t kx_public[32], kx_secret[32]; /* this hello's ephemeral pair */
   uint8_t instance_nonce[16]; /* of the server instance of the session */
   rtc_session_keys keys;
@@ -214,13 +215,24 @@ static void on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
   (void)channel;
   rtc_client* c = user;
   if (m->client_id != c->client_id || memcmp(m->client_nonce, c->nonce, 16) != 0) return; /* not our hello */
-  /* A forged answer (bad signature) is ignored: the real one may follow. */
-  if (c->keyed && m->session_id != 0 &&
-      rtc_check_answer(m, c->identity.public_key, c->kx_public, c->kx_secret, c->server_key, &c->keys, c->refusal,
-                       sizeof c->refusal) != 0) {
-    fprintf(stderr, "robotalk-c: answer ignored: %s\n", c->refusal);
-    c->refusal[0] = 0;
-    return;
+  /* Keyed: an answer that does not verify (forged, another server's key) is
+   * ignored: the real one may follow. With no --server-key, the first answer
+   * that verifies names the server (trusted on first use, not pinned). */
+  if (c->keyed && m->session_id != 0) {
+    const uint8_t* trusted = c->have_server_key ? c->server_key : m->server_key;
+    if (rtc_check_answer(m, c->identity.public_key, c->kx_public, c->kx_secret, trusted, &c->keys, c->ignored,
+                         sizeof c->ignored) != 0) {
+      fprintf(stderr, "robotalk-c: answer ignored: %s\n", c->ignored);
+      return;
+    }
+    if (!c->have_server_key) {
+      char fingerprint[23];
+      rtc_fingerprint(m->server_key, fingerprint);
+      fprintf(stderr, "robotalk-c: trusting server key %s (not pinned; --server-key FILE.pub checks it)\n",
+              fingerprint);
+      memcpy(c->server_key, m->server_key, 32);
+      c->have_server_key = 1;
+    }
   }
   c->hello_answered = 1;
   c->session_id = m->session_id;
@@ -242,17 +254,9 @@ static void on_config(const lcm_recv_buf_t* rbuf, const char* channel, const rob
 
 static void on_announce(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_announce_t* m,
                         void* user) {
+  (void)rbuf; /* keyed: its signature proves only who signed it; the answer is what we check */
+  (void)channel;
   rtc_client* c = user;
-  /* Keyed: only an ANNOUNCE signed by the server key we trust (--server-key),
-   * else by the key its own suffix names (trust on first use, unpinned). */
-  if (c->keyed && m->keyed) {
-    const uint8_t* data = rbuf->data;
-    const size_t n = rbuf->data_size;
-    const uint8_t* signer = n >= RTC_SIGNATURE_SUFFIX_BYTES ? data + n - RTC_SIGNATURE_SUFFIX_BYTES + 8 : NULL;
-    if (!signer || !rtc_broadcast_verifies(channel, data, n, c->have_server_key ? c->server_key : signer, NULL))
-      return;
-    if (!c->have_server_key) memcpy(c->server_key, signer, 32);
-  }
   for (int i = 0; i < m->num_robots; ++i) {
     const char* name = m->robots[i].name;
     if (strcmp(name, c->robot) == 0) {
@@ -391,7 +395,9 @@ static int say_hello(rtc_client* c, double timeout_s) {
   while (!c->hello_answered) {
     int64_t now = rtc_now_us();
     if (now >= deadline)
-      return set_error(c, "no answer to hello from '%s' within %.1f s", c->robot, timeout_s), -1;
+      return set_error(c, "no answer to hello from '%s' within %.1f s%s%s%s", c->robot, timeout_s,
+                       c->ignored[0] ? " (an answer was ignored: " : "", c->ignored, c->ignored[0] ? ")" : ""),
+             -1;
     if (now >= next_hello) {
       robotalk_msgs_hello_t_publish(c->request_lcm, c->hello_channel, &hello);
       next_hello = now + kHelloRepeatUs;

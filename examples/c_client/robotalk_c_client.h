@@ -64,7 +64,8 @@ int64_t rtc_now_us(void);
 rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, char* err, size_t err_len);
 /* The same in keyed mode (docs/security.md) when key_file is not NULL: the
  * client's secret key file, and the server's .pub file to trust (NULL: the key
- * that signed the robot's ANNOUNCE, trusted on first use and not pinned).
+ * of the first hello answer whose signature verifies, trusted on first use and
+ * not pinned; its fingerprint is printed on stderr).
  * The client id is one of the key's; every package is sealed with the
  * session's MAC; replies, answers and CONFIG messages that do not verify are
  * dropped. */

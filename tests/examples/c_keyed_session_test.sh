@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The C example in keyed mode against a keyed robotalk-server: with a listed
 # key it runs its whole session (hello signed, packages sealed, replies and
-# CONFIG verified); an unlisted key is refused, a wrong server key finds no
-# robot, no key is told to give one; none of those moves the robot. Run inside
-# a private network namespace (CTest: scripts/netns_run.sh).
+# CONFIG verified), with or without the server key given; an unlisted key is
+# refused, a wrong server key ignores the real server's answers and says whose
+# they were, no key is told to give one; none of those opens a session. Run
+# inside a private network namespace (CTest: scripts/netns_run.sh).
 #   c_keyed_session_test.sh SERVER KEYGEN MODELS_DIR PORT C_EXAMPLE
 set -u
 server_bin=$1 keygen=$2 models=$3 port=$4 example=$5
@@ -34,8 +35,11 @@ check "the robot reached the GOTO goal (x = ${x:-?})" awk -v x="$x" 'BEGIN { exi
 
 
 run tofu env ROBOTALK_KEY="$tmp/alice" "$example"
-check "ROBOTALK_KEY, the server key taken from the signed ANNOUNCE: exits 0" grep -qx 0 "$tmp/tofu.status"
+check "ROBOTALK_KEY, no server key (the first answer's trusted): exits 0" grep -qx 0 "$tmp/tofu.status"
 check "... and says done" grep -q "^done$" "$tmp/tofu.out"
+fingerprint=$("$keygen" --fingerprint "$tmp/server.pub" | grep -o 'rt:[0-9a-f:]*' | head -1)
+check "... naming the server key it trusted ($fingerprint)" \
+  grep -q "trusting server key $fingerprint (not pinned" "$tmp/tofu.err"
 
 run unlisted env -u ROBOTALK_KEY "$example" --key "$tmp/mallory"
 check "an unlisted key exits 1" grep -qx 1 "$tmp/unlisted.status"
@@ -44,7 +48,9 @@ check "... saying the hello was refused for its key" \
 
 run impostor env -u ROBOTALK_KEY "$example" --key "$tmp/alice" --server-key "$tmp/mallory.pub"
 check "another server key: exits 1" grep -qx 1 "$tmp/impostor.status"
-check "... having found no robot signed by that key" grep -q "error: no robot 'pioneer' announced" "$tmp/impostor.err"
+check "... naming the key that answered and the one expected" \
+  grep -q "error: no answer to hello from 'pioneer' .*answer signed by $fingerprint, expected server key rt:" \
+  "$tmp/impostor.err"
 
 run nokey env -u ROBOTALK_KEY "$example"
 check "no key: exits 1" grep -qx 1 "$tmp/nokey.status"
