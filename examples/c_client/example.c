@@ -146,7 +146,8 @@ int main(int argc, char** argv) {
     fprintf(stderr, "error: %s\n", err);
     return 1;
   }
-  printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64 "%s\n",
+  printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64
+         "%s\n",
          robot, (uint64_t)rtc_server_id(c), rtc_split_layout(c) ? "split" : "single",
          (uint64_t)rtc_session_id(c), (uint64_t)rtc_client_id(c), key_file ? " keyed" : "");
   int rc = run(c, delay_s, pause_s);

@@ -79,10 +79,10 @@ struct rtc_client {
   /* Keyed mode (docs/security.md, "Keyed mode byte by byte"). */
   int keyed, have_server_key;
   rtc_identity identity;
-  uint8_t server_key[32];     /* --server-key, else the first answer's that verified */
-  char ignored[256];          /* why the last answer was ignored */
+  uint8_t server_key[32];               /* --server-key, else the first answer's that verified */
+  char ignored[256];                    /* why the last answer was ignored */
   uint8_t kx_public[32], kx_secret[32]; /* this hello's ephemeral pair */
-  uint8_t instance_nonce[16]; /* of the server instance of the session */
+  uint8_t instance_nonce[16];           /* of the server instance of the session */
   rtc_session_keys keys;
 };
 
@@ -246,7 +246,8 @@ static void on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
 static void on_config(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_robot_config_t* m,
                       void* user) {
   rtc_client* c = user;
-  if (c->keyed && !rtc_broadcast_verifies(channel, rbuf->data, rbuf->data_size, c->server_key, c->instance_nonce))
+  if (c->keyed &&
+      !rtc_broadcast_verifies(channel, rbuf->data, rbuf->data_size, c->server_key, c->instance_nonce))
     return; /* not signed by our server's instance */
   if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
   c->config = robotalk_msgs_robot_config_t_copy(m);
@@ -396,7 +397,8 @@ static int say_hello(rtc_client* c, double timeout_s) {
     int64_t now = rtc_now_us();
     if (now >= deadline)
       return set_error(c, "no answer to hello from '%s' within %.1f s%s%s%s", c->robot, timeout_s,
-                       c->ignored[0] ? " (an answer was ignored: " : "", c->ignored, c->ignored[0] ? ")" : ""),
+                       c->ignored[0] ? " (an answer was ignored: " : "", c->ignored,
+                       c->ignored[0] ? ")" : ""),
              -1;
     if (now >= next_hello) {
       robotalk_msgs_hello_t_publish(c->request_lcm, c->hello_channel, &hello);
@@ -592,7 +594,8 @@ static int find_robot(rtc_client* c, double timeout_s) {
                      c->robot),
            -1;
   if (!c->announce_keyed && c->keyed)
-    return set_error(c, "the server of '%s' is in open mode; this client was given a key and talks keyed only",
+    return set_error(c,
+                     "the server of '%s' is in open mode; this client was given a key and talks keyed only",
                      c->robot),
            -1;
   return 0;

@@ -17,8 +17,8 @@ static size_t put_le64(uint8_t* out, int64_t v) {
   return 8;
 }
 /* BLAKE2b-256(key, tag || data) */
-static void hash_tagged(uint8_t out[32], const uint8_t* key, size_t key_len, const char* tag, const uint8_t* data,
-                        size_t n) {
+static void hash_tagged(uint8_t out[32], const uint8_t* key, size_t key_len, const char* tag,
+                        const uint8_t* data, size_t n) {
   crypto_generichash_state st;
   crypto_generichash_init(&st, key, key_len, 32);
   crypto_generichash_update(&st, (const unsigned char*)tag, strlen(tag));
@@ -48,8 +48,9 @@ static int first_line(const char* path, char* line, size_t len, int secret, char
   struct stat st;
   if (secret && (fstat(fileno(f), &st) != 0 || (st.st_mode & 077) != 0)) {
     fclose(f);
-    return snprintf(err, err_len, "%s: the secret key must not be readable by group or others; run chmod 600 %s",
-                    path, path),
+    return snprintf(err, err_len,
+                    "%s: the secret key must not be readable by group or others; run chmod 600 %s", path,
+                    path),
            -1;
   }
   int found = 0;
@@ -85,13 +86,16 @@ void rtc_fingerprint(const uint8_t key[32], char out[23]) {
   snprintf(out, 23, "rt:%02x%02x:%02x%02x:%02x%02x:%02x%02x", h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7]);
 }
 
-void rtc_kx_keypair(uint8_t public_key[32], uint8_t secret_key[32]) { crypto_kx_keypair(public_key, secret_key); }
+void rtc_kx_keypair(uint8_t public_key[32], uint8_t secret_key[32]) {
+  crypto_kx_keypair(public_key, secret_key);
+}
 
 void rtc_sign(const rtc_identity* id, const uint8_t* bytes, size_t n, uint8_t signature[64]) {
   crypto_sign_detached(signature, NULL, bytes, n, id->secret_key);
 }
 
-int rtc_signature_verifies(const uint8_t key[32], const uint8_t* bytes, size_t n, const uint8_t signature[64]) {
+int rtc_signature_verifies(const uint8_t key[32], const uint8_t* bytes, size_t n,
+                           const uint8_t signature[64]) {
   return crypto_sign_verify_detached(signature, bytes, n, key) == 0;
 }
 
@@ -114,8 +118,8 @@ void rtc_hello_signed(const uint8_t client_key[32], int64_t client_id, const uin
 
 void rtc_answer_signed(const uint8_t hello_signed[RTC_HELLO_SIGNED_BYTES], int64_t client_id,
                        const uint8_t client_nonce[16], const uint8_t instance_nonce[16],
-                       const uint8_t server_nonce[16], const uint8_t server_kx[32], const uint8_t server_key[32],
-                       uint8_t out[RTC_ANSWER_SIGNED_BYTES]) {
+                       const uint8_t server_nonce[16], const uint8_t server_kx[32],
+                       const uint8_t server_key[32], uint8_t out[RTC_ANSWER_SIGNED_BYTES]) {
   size_t at = put_tag(out, "robotalk-answer-v1");
   at += put(out + at, hello_signed, RTC_HELLO_SIGNED_BYTES);
   at += put_le64(out + at, client_id);
@@ -193,8 +197,9 @@ void rtc_keyed_hello(robotalk_msgs_hello_t* hello, const rtc_identity* id, uint8
 }
 
 int rtc_check_answer(const robotalk_msgs_hello_answer_t* m, const uint8_t client_key[32],
-                     const uint8_t kx_public[32], const uint8_t kx_secret[32], const uint8_t trusted_server_key[32],
-                     rtc_session_keys* keys, char* why, size_t why_len) {
+                     const uint8_t kx_public[32], const uint8_t kx_secret[32],
+                     const uint8_t trusted_server_key[32], rtc_session_keys* keys, char* why,
+                     size_t why_len) {
   uint8_t hello[RTC_HELLO_SIGNED_BYTES], answer[RTC_ANSWER_SIGNED_BYTES];
   char want[23], got[23];
   if (!m->keyed) return snprintf(why, why_len, "the server answered in open mode"), -1;

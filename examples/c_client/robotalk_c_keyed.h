@@ -54,7 +54,8 @@ void rtc_kx_keypair(uint8_t public_key[32], uint8_t secret_key[32]);
 /* Ed25519 detached signature of bytes[0..n). */
 void rtc_sign(const rtc_identity* id, const uint8_t* bytes, size_t n, uint8_t signature[64]);
 /* 1 when `signature` is `key`'s over bytes[0..n). */
-int rtc_signature_verifies(const uint8_t key[32], const uint8_t* bytes, size_t n, const uint8_t signature[64]);
+int rtc_signature_verifies(const uint8_t key[32], const uint8_t* bytes, size_t n,
+                           const uint8_t signature[64]);
 
 /* A client id of `key`: its top half names the key; `low` 0 is made 1. */
 int64_t rtc_keyed_client_id(const uint8_t key[32], uint32_t low);
@@ -65,8 +66,8 @@ void rtc_hello_signed(const uint8_t client_key[32], int64_t client_id, const uin
 /* The answer's signed bytes (the hello's inside). */
 void rtc_answer_signed(const uint8_t hello_signed[RTC_HELLO_SIGNED_BYTES], int64_t client_id,
                        const uint8_t client_nonce[16], const uint8_t instance_nonce[16],
-                       const uint8_t server_nonce[16], const uint8_t server_kx[32], const uint8_t server_key[32],
-                       uint8_t out[RTC_ANSWER_SIGNED_BYTES]);
+                       const uint8_t server_nonce[16], const uint8_t server_kx[32],
+                       const uint8_t server_key[32], uint8_t out[RTC_ANSWER_SIGNED_BYTES]);
 /* Session keys from the client's ephemeral pair, the server's kx key and the
  * answer's signed bytes. -1 for an unusable server kx key. */
 int rtc_session_keys_derive(const uint8_t client_kx[32], const uint8_t client_kx_secret[32],
@@ -89,8 +90,8 @@ void rtc_keyed_hello(robotalk_msgs_hello_t* hello, const rtc_identity* id, uint8
  * kx pair: keyed, signed by trusted_server_key, and its session id the derived
  * one; fills keys. 0, or -1 with the reason in why. */
 int rtc_check_answer(const robotalk_msgs_hello_answer_t* m, const uint8_t client_key[32],
-                     const uint8_t kx_public[32], const uint8_t kx_secret[32], const uint8_t trusted_server_key[32],
-                     rtc_session_keys* keys, char* why, size_t why_len);
+                     const uint8_t kx_public[32], const uint8_t kx_secret[32],
+                     const uint8_t trusted_server_key[32], rtc_session_keys* keys, char* why, size_t why_len);
 
 #ifdef __cplusplus
 }

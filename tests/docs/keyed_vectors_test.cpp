@@ -40,7 +40,8 @@ std::string Hex(std::span<const std::uint8_t> b) {
 
 Bytes Unhex(const std::string& s) {
   Bytes out;
-  for (std::size_t i = 0; i + 1 < s.size(); i += 2) out.push_back(static_cast<std::uint8_t>(std::stoi(s.substr(i, 2), nullptr, 16)));
+  for (std::size_t i = 0; i + 1 < s.size(); i += 2)
+    out.push_back(static_cast<std::uint8_t>(std::stoi(s.substr(i, 2), nullptr, 16)));
   return out;
 }
 
@@ -54,12 +55,14 @@ std::span<const std::uint8_t> Text(std::string_view s) {
 }
 Bytes Le64(std::int64_t v) {
   Bytes out;
-  for (int i = 0; i < 8; ++i) out.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(v) >> (8 * i)));
+  for (int i = 0; i < 8; ++i)
+    out.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(v) >> (8 * i)));
   return out;
 }
 Bytes Blake2b(std::size_t size, std::span<const std::uint8_t> key, std::span<const std::uint8_t> data) {
   Bytes out(size);
-  crypto_generichash(out.data(), size, data.data(), data.size(), key.empty() ? nullptr : key.data(), key.size());
+  crypto_generichash(out.data(), size, data.data(), data.size(), key.empty() ? nullptr : key.data(),
+                     key.size());
   return out;
 }
 template <std::size_t N>
@@ -149,9 +152,9 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
   const std::int64_t client_id = KeyedClientId(client.public_key, low);
   Expect("client_id", std::to_string(client_id));
   const Bytes prefix = Blake2b(32, {}, Cat({Text("robotalk-client-id-v1"), client.public_key.bytes}));
-  const std::uint64_t by_page =
-      (std::uint64_t{prefix[0]} << 24 | std::uint64_t{prefix[1]} << 16 | std::uint64_t{prefix[2]} << 8 | prefix[3]) &
-      0x7fffffffU;
+  const std::uint64_t by_page = (std::uint64_t{prefix[0]} << 24 | std::uint64_t{prefix[1]} << 16 |
+                                 std::uint64_t{prefix[2]} << 8 | prefix[3]) &
+                                0x7fffffffU;
   EXPECT_EQ(static_cast<std::uint64_t>(client_id), by_page << 32 | low);
   EXPECT_TRUE(ClientIdBelongsTo(client_id, client.public_key));
   EXPECT_FALSE(ClientIdBelongsTo(client_id, server.public_key));
@@ -168,7 +171,7 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
   const Bytes hello_signed = hello.SignedBytes();
   Expect("hello_signed", hello_signed);
   EXPECT_EQ(Hex(hello_signed), Hex(Cat({Text("robotalk-hello-v1"), client.public_key.bytes, Le64(client_id),
-                                       In("client_nonce"), ec})));
+                                        In("client_nonce"), ec})));
   Expect("hello_signature", hello.signature);
 
   // The server's answer, from its fixed draws.
@@ -182,9 +185,9 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
   Expect("server_kx", answer.server_kx);
   const Bytes answer_signed = answer.SignedBytes(hello);
   Expect("answer_signed", answer_signed);
-  EXPECT_EQ(Hex(answer_signed), Hex(Cat({Text("robotalk-answer-v1"), hello_signed, Le64(client_id),
-                                        In("client_nonce"), In("instance_nonce"), In("server_nonce"),
-                                        answer.server_kx, server.public_key.bytes})));
+  EXPECT_EQ(Hex(answer_signed),
+            Hex(Cat({Text("robotalk-answer-v1"), hello_signed, Le64(client_id), In("client_nonce"),
+                     In("instance_nonce"), In("server_nonce"), answer.server_kx, server.public_key.bytes})));
   Expect("answer_signature", answer.signature);
   EXPECT_TRUE(VerifySignature(server.public_key, answer_signed, answer.signature));
 
@@ -218,10 +221,9 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
   const Bytes package = In("package_before_mac");
   const Mac package_mac = ComputeMac(keys.client_to_server, keys.session_id, package);
   Expect("package_mac", package_mac);
-  EXPECT_EQ(Hex(package_mac),
-            Hex(Blake2b(16, keys.client_to_server, Cat({Le64(keys.session_id), package}))));
-  const auto verified = authenticator.Verify(keys.session_id, client_id,
-                                             std::stoll(v.at("package_sequence")), package, package_mac);
+  EXPECT_EQ(Hex(package_mac), Hex(Blake2b(16, keys.client_to_server, Cat({Le64(keys.session_id), package}))));
+  const auto verified = authenticator.Verify(keys.session_id, client_id, std::stoll(v.at("package_sequence")),
+                                             package, package_mac);
   EXPECT_EQ(verified.verdict, PackageVerdict::kAccepted);
   const Bytes reply = In("reply_before_mac");
   const Mac reply_mac = authenticator.SealReply(keys.session_id, reply);
@@ -237,7 +239,8 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
   const Bytes covered =
       Cat({Text("robotalk-broadcast-v1"), Text(channel), Bytes{0}, In("broadcast_message"), suffix_head});
   Bytes signature(64);
-  crypto_sign_detached(signature.data(), nullptr, covered.data(), covered.size(), server.secret_key.bytes().data());
+  crypto_sign_detached(signature.data(), nullptr, covered.data(), covered.size(),
+                       server.secret_key.bytes().data());
   EXPECT_EQ(Hex(broadcast), Hex(Cat({In("broadcast_message"), suffix_head, signature})));
   const Nonce instance = Array<16>(In("instance_nonce"));
   EXPECT_EQ(VerifyBroadcast(channel, broadcast, server.public_key, &instance), BroadcastVerdict::kAuthentic);

@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
   rtc_fingerprint(client.public_key, fingerprint);
   expect_text("client_fingerprint", fingerprint);
 
-  const int64_t client_id = rtc_keyed_client_id(client.public_key, (uint32_t)strtoul(value("client_id_low"), 0, 10));
+  const int64_t client_id =
+      rtc_keyed_client_id(client.public_key, (uint32_t)strtoul(value("client_id_low"), 0, 10));
   char id_text[32];
   snprintf(id_text, sizeof id_text, "%lld", (long long)client_id);
   expect_text("client_id", id_text);
@@ -120,7 +121,8 @@ int main(int argc, char** argv) {
               rtc_signature_verifies(server.public_key, answer, sizeof answer, answer_signature));
 
   rtc_session_keys keys;
-  expect_true("session keys derive", rtc_session_keys_derive(kx_public, kx_secret, server_kx, answer, &keys) == 0);
+  expect_true("session keys derive",
+              rtc_session_keys_derive(kx_public, kx_secret, server_kx, answer, &keys) == 0);
   expect_hex("key_c2s", keys.c2s, 32);
   expect_hex("key_s2c", keys.s2c, 32);
   snprintf(id_text, sizeof id_text, "%lld", (long long)keys.session_id);
@@ -139,10 +141,12 @@ int main(int argc, char** argv) {
   uint8_t broadcast[MAX_VALUE / 2];
   n = bytes("broadcast_signed", broadcast, sizeof broadcast);
   const char* channel = value("broadcast_channel");
-  expect_true("the broadcast verifies", rtc_broadcast_verifies(channel, broadcast, n, server.public_key, instance));
-  expect_true("not on another channel", !rtc_broadcast_verifies("ROBOTALK/other/STATE", broadcast, n,
-                                                                server.public_key, instance));
-  expect_true("not by another key", !rtc_broadcast_verifies(channel, broadcast, n, client.public_key, instance));
+  expect_true("the broadcast verifies",
+              rtc_broadcast_verifies(channel, broadcast, n, server.public_key, instance));
+  expect_true("not on another channel",
+              !rtc_broadcast_verifies("ROBOTALK/other/STATE", broadcast, n, server.public_key, instance));
+  expect_true("not by another key",
+              !rtc_broadcast_verifies(channel, broadcast, n, client.public_key, instance));
   printf("%d checks passed, %d failed\n", passes, failures);
   return failures ? 1 : 0;
 }
