@@ -10,13 +10,8 @@ server_bin=$1 keygen=$2 models=$3 port=$4
 shift 4
 url="udpm://239.255.76.67:$port?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
-"$keygen" --out "$tmp/server" >/dev/null && "$keygen" --out "$tmp/alice" >/dev/null || exit 1
-echo "$(cut -d' ' -f1 "$tmp/alice.pub") alice *=all" >"$tmp/clients"
-chmod 600 "$tmp/clients"
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-  --key "$tmp/server" --clients "$tmp/clients" 2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+. "$(dirname "$0")/keyed_server.sh"  # start_keyed_server
+start_keyed_server "$server_bin" "$keygen" "$models" "$url" 60
 
 ROBOTALK_KEY= timeout 30 "$@" --url "$url" --robot pioneer >"$tmp/out" 2>"$tmp/err"
 status=$?
