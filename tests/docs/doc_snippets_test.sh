@@ -22,7 +22,7 @@
 #   <!-- snippet: fragment -->  (xml, java) a piece of a whole
 #   doc_snippets_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
-build=$1 source=$2
+build=$(cd "$1" && pwd) source=$(cd "$2" && pwd)
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/../lib.sh"  # $tmp, check
 # The lead's pages, not yet tagged: their untagged fences are taken as text.
