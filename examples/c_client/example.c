@@ -3,6 +3,9 @@
  * delay mode, and prints every reply. Same steps and output as the Java
  * example (examples/java_client); tests/examples/client_example_test.sh runs it.
  *   robotalk_c_example [--url URL] [--robot NAME] [--delay S] [--pause S]
+ *                      [--key FILE] [--server-key FILE.pub]
+ * --key FILE: keyed mode with this secret key (or $ROBOTALK_KEY);
+ * --server-key FILE.pub: the server key to trust (default: the first answer's, not pinned).
  * --pause S: wait S seconds after the GOTO (keeping the session); the test
  * restarts the server meanwhile, and the client must say hello again.
  * Exit status 0 when every step succeeded. */
@@ -111,6 +114,8 @@ static int run(rtc_client* c, double delay_s, double pause_s) {
 int main(int argc, char** argv) {
   const char* url = getenv("LCM_DEFAULT_URL");
   const char* robot = "pioneer";
+  const char* key_file = getenv("ROBOTALK_KEY");
+  const char* server_key_file = NULL;
   double delay_s = 0.5, pause_s = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--url") == 0 && i + 1 < argc) {
@@ -121,21 +126,30 @@ int main(int argc, char** argv) {
       delay_s = atof(argv[++i]);
     } else if (strcmp(argv[i], "--pause") == 0 && i + 1 < argc) {
       pause_s = atof(argv[++i]);
+    } else if (strcmp(argv[i], "--key") == 0 && i + 1 < argc) {
+      key_file = argv[++i];
+    } else if (strcmp(argv[i], "--server-key") == 0 && i + 1 < argc) {
+      server_key_file = argv[++i];
     } else {
-      fprintf(stderr, "usage: %s [--url URL] [--robot NAME] [--delay S] [--pause S]\n", argv[0]);
+      fprintf(stderr,
+              "usage: %s [--url URL] [--robot NAME] [--delay S] [--pause S] [--key FILE] "
+              "[--server-key FILE.pub]\n",
+              argv[0]);
       return 2;
     }
   }
   if (!url) url = "udpm://239.255.76.67:7667?ttl=0";
   char err[512];
-  rtc_client* c = rtc_connect(url, robot, 5.0, err, sizeof err);
+  if (key_file && !key_file[0]) key_file = NULL;
+  rtc_client* c = rtc_connect_keyed(url, robot, key_file, server_key_file, 5.0, err, sizeof err);
   if (!c) {
     fprintf(stderr, "error: %s\n", err);
     return 1;
   }
-  printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64 "\n",
+  printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64
+         "%s\n",
          robot, (uint64_t)rtc_server_id(c), rtc_split_layout(c) ? "split" : "single",
-         (uint64_t)rtc_session_id(c), (uint64_t)rtc_client_id(c));
+         (uint64_t)rtc_session_id(c), (uint64_t)rtc_client_id(c), key_file ? " keyed" : "");
   int rc = run(c, delay_s, pause_s);
   if (rc != 0 && rtc_error(c)[0]) fprintf(stderr, "error: %s\n", rtc_error(c));
   printf("%s\n", rc == 0 ? "done" : "failed");

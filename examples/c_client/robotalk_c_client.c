@@ -1,8 +1,6 @@
-/* A small RoboTalk client in C: see robotalk_c_client.h. */
+/* A small RoboTalk client in C: see robotalk_c_client.h. Sessions, packages,
+ * replies; connecting is in robotalk_c_connect.c. */
 #define _POSIX_C_SOURCE 200809L
-#include "robotalk_c_client.h"
-#include "robotalk_c_url.h"
-
 #include <errno.h>
 #include <inttypes.h>
 #include <lcm/lcm.h>
@@ -13,71 +11,11 @@
 #include <sys/select.h>
 #include <time.h>
 
-#include "robotalk_msgs_announce_t.h"
-#include "robotalk_msgs_hello_answer_t.h"
+#include "robotalk_c_internal.h"
 #include "robotalk_msgs_hello_t.h"
 #include "robotalk_msgs_package_t.h"
-#include "robotalk_msgs_reply_package_t.h"
 
-enum {
-  kProtocolVersion = 3,
-  kMaxPackages = 64,  /* outstanding packages */
-  kMaxReplies = 1024, /* the reply cache (oldest dropped first) */
-  kMaxIdsPerPackage = 64,
-  kRetransmitUs = 300000, /* unacknowledged: fixed timeout */
-  kRecheckUs = 1000000,   /* acknowledged, final replies missing: ask again */
-  kMaxTries = 10,
-  kHeartbeatUs = 250000,
-  kHelloRepeatUs = 200000,
-};
-
-typedef struct {
-  int used;
-  int64_t sequence;
-  uint8_t* bytes; /* the encoded package_t, re-sent as is */
-  int size;
-  int acked;
-  int tries;
-  int64_t first_send_us, last_send_us;
-  int n_ids;
-  int64_t ids[kMaxIdsPerPackage];
-  int64_t session_id;  /* the session it was sent in */
-  int session_unknown; /* SESSION_UNKNOWN: nothing ran; send again after a new hello */
-  /* Clock sample from its acknowledgement (only when sent once: Karn's rule). */
-  int have_clock;
-  int64_t t1, t4, server_receive_us, server_send_us;
-} pending_package;
-
-struct rtc_client {
-  char robot[128];
-  lcm_t* main_lcm;    /* ANNOUNCE, CONFIG, STATE */
-  lcm_t* request_lcm; /* HELLO, REQUEST (== main_lcm in the single layout) */
-  lcm_t* reply_lcm;   /* REPLY/<client>, HELLO/<client> (== main_lcm in the single layout) */
-  int split;
-  char hello_channel[192], request_channel[192], reply_channel[192], hello_answer_channel[192];
-  int64_t client_id, session_id, server_id;
-  uint8_t nonce[16];
-  int hello_answered;
-  char refusal[256];
-  int64_t next_sequence, next_id;
-  int64_t last_new_package_us;
-  int64_t clock_offset_us;
-  int clock_stale;
-  pending_package packages[kMaxPackages];
-  rtc_reply replies[kMaxReplies];
-  int reply_count, reply_next;
-  robotalk_msgs_robot_config_t* config; /* the last CONFIG message heard */
-  robotalk_msgs_hello_answer_t_subscription_t* hello_sub;
-  robotalk_msgs_reply_package_t_subscription_t* reply_sub;
-  char error[512];
-  /* rtc_connect: the ANNOUNCE search */
-  int found;
-  int announce_version, announce_keyed, announce_layout;
-  int64_t announce_server_id;
-  char heard[512];
-};
-
-static void set_error(rtc_client* c, const char* fmt, ...) {
+void rtci_set_error(rtc_client* c, const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(c->error, sizeof c->error, fmt, ap);
@@ -105,7 +43,7 @@ int64_t rtc_now_us(void) {
 int64_t rtc_server_now_us(const rtc_client* c) { return rtc_now_us() + c->clock_offset_us; }
 int rtc_clock_stale(const rtc_client* c) { return c->clock_stale; }
 
-static int random_bytes(void* out, size_t n) {
+int rtci_random_bytes(void* out, size_t n) {
   FILE* f = fopen("/dev/urandom", "rb");
   if (!f) return -1;
   size_t got = fread(out, 1, n, f);
@@ -155,13 +93,17 @@ static void server_changed(rtc_client* c, int64_t new_server_id) {
   c->clock_stale = 1;
 }
 
-static void on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_reply_package_t* m,
-                     void* user) {
-  (void)rbuf;
+void rtci_on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_reply_package_t* m,
+                   void* user) {
   (void)channel;
   rtc_client* c = user;
   int64_t t4 = rtc_now_us();
   if (m->protocol_version != kProtocolVersion || m->client_id != c->client_id) return;
+  /* Keyed: a reply of our session must carry its MAC (SESSION_UNKNOWN has none). */
+  if (c->keyed && m->session_status != ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN &&
+      (m->session_id != c->keys.session_id ||
+       !rtc_mac_verifies(c->keys.s2c, c->keys.session_id, rbuf->data, rbuf->data_size)))
+    return;
   if (m->server_id != c->server_id && c->server_id != 0) server_changed(c, m->server_id);
   pending_package* p = m->ack_sequence > 0 ? find_package(c, m->ack_sequence) : NULL;
   if (m->session_status == ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN) {
@@ -196,51 +138,52 @@ static void on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robo
   }
 }
 
-static void on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
-                            const robotalk_msgs_hello_answer_t* m, void* user) {
+void rtci_on_hello_answer(const lcm_recv_buf_t* rbuf, const char* channel,
+                          const robotalk_msgs_hello_answer_t* m, void* user) {
   (void)rbuf;
   (void)channel;
   rtc_client* c = user;
   if (m->client_id != c->client_id || memcmp(m->client_nonce, c->nonce, 16) != 0) return; /* not our hello */
+  /* Keyed: an answer that does not verify (forged, another server's key) is
+   * ignored: the real one may follow. With no --server-key, the first answer
+   * that verifies names the server (trusted on first use, not pinned). */
+  if (c->keyed && m->session_id != 0) {
+    const uint8_t* trusted = c->have_server_key ? c->server_key : m->server_key;
+    if (rtc_check_answer(m, c->identity.public_key, c->kx_public, c->kx_secret, trusted, &c->keys, c->ignored,
+                         sizeof c->ignored) != 0) {
+      fprintf(stderr, "robotalk-c: answer ignored: %s\n", c->ignored);
+      return;
+    }
+    if (!c->have_server_key) {
+      char fingerprint[23];
+      rtc_fingerprint(m->server_key, fingerprint);
+      fprintf(stderr, "robotalk-c: trusting server key %s (not pinned; --server-key FILE.pub checks it)\n",
+              fingerprint);
+      memcpy(c->server_key, m->server_key, 32);
+      c->have_server_key = 1;
+    }
+  }
   c->hello_answered = 1;
   c->session_id = m->session_id;
+  memcpy(c->instance_nonce, m->instance_nonce, 16);
   if (c->server_id != 0 && m->server_id != c->server_id) c->clock_stale = 1;
   c->server_id = m->server_id;
   snprintf(c->refusal, sizeof c->refusal, "%s", m->session_id == 0 ? m->refusal : "");
-  if (m->keyed) snprintf(c->refusal, sizeof c->refusal, "the server answered in keyed mode");
+  if (m->keyed && !c->keyed) snprintf(c->refusal, sizeof c->refusal, "the server answered in keyed mode");
 }
 
 static void on_config(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_robot_config_t* m,
                       void* user) {
-  (void)rbuf;
-  (void)channel;
   rtc_client* c = user;
+  if (c->keyed &&
+      !rtc_broadcast_verifies(channel, rbuf->data, rbuf->data_size, c->server_key, c->instance_nonce))
+    return; /* not signed by our server's instance */
   if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
   c->config = robotalk_msgs_robot_config_t_copy(m);
 }
 
-static void on_announce(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_announce_t* m,
-                        void* user) {
-  (void)rbuf;
-  (void)channel;
-  rtc_client* c = user;
-  for (int i = 0; i < m->num_robots; ++i) {
-    const char* name = m->robots[i].name;
-    if (strcmp(name, c->robot) == 0) {
-      c->found = 1;
-      c->announce_version = m->protocol_version;
-      c->announce_keyed = m->keyed;
-      c->announce_layout = m->traffic_layout;
-      c->announce_server_id = m->server_id;
-    } else if (!strstr(c->heard, name) && strlen(c->heard) + strlen(name) + 3 < sizeof c->heard) {
-      if (c->heard[0]) strcat(c->heard, ", ");
-      strcat(c->heard, name);
-    }
-  }
-}
-
 /* Handles what arrives on any of the client's LCM instances for at most wait_us. */
-static void handle_for(rtc_client* c, int64_t wait_us) {
+void rtci_handle_for(rtc_client* c, int64_t wait_us) {
   lcm_t* all[2] = {c->main_lcm, c->reply_lcm}; /* request_lcm only publishes */
   int n = c->split ? 2 : 1;
   fd_set fds;
@@ -264,9 +207,11 @@ static int publish_package(rtc_client* c, robotalk_msgs_package_t* pkg, uint8_t*
   uint8_t* bytes = malloc((size_t)size);
   if (!bytes || robotalk_msgs_package_t_encode(bytes, 0, size, pkg) != size) {
     free(bytes);
-    set_error(c, "cannot encode a package");
+    rtci_set_error(c, "cannot encode a package");
     return -1;
   }
+  if (c->keyed) /* the MAC is the encoding's last 16 bytes and covers every byte before */
+    rtc_mac(c->keys.c2s, pkg->header.session_id, bytes, (size_t)size - 16, bytes + size - 16);
   c->last_new_package_us = rtc_now_us(); /* before sending: a clock sample's t1 */
   lcm_publish(c->request_lcm, c->request_channel, bytes, (unsigned)size);
   if (bytes_out) {
@@ -304,7 +249,7 @@ static int64_t track_and_send(rtc_client* c, robotalk_msgs_package_t* pkg, const
   for (int i = 0; i < kMaxPackages && !slot; ++i)
     if (!c->packages[i].used) slot = &c->packages[i];
   if (!slot || n_ids > kMaxIdsPerPackage) {
-    set_error(c, "too many outstanding packages or items");
+    rtci_set_error(c, "too many outstanding packages or items");
     return -1;
   }
   memset(slot, 0, sizeof *slot);
@@ -321,7 +266,7 @@ static int64_t track_and_send(rtc_client* c, robotalk_msgs_package_t* pkg, const
 
 int64_t rtc_send_queries(rtc_client* c, robotalk_msgs_query_t* queries, int n) {
   int64_t ids[kMaxIdsPerPackage];
-  if (n > kMaxIdsPerPackage) return set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
+  if (n > kMaxIdsPerPackage) return rtci_set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
   for (int i = 0; i < n; ++i) ids[i] = queries[i].id = c->next_id++;
   robotalk_msgs_package_t pkg;
   memset(&pkg, 0, sizeof pkg);
@@ -334,7 +279,7 @@ int64_t rtc_send_queries(rtc_client* c, robotalk_msgs_query_t* queries, int n) {
 
 int64_t rtc_send_commands(rtc_client* c, int8_t mode, robotalk_msgs_command_t* commands, int n) {
   int64_t ids[kMaxIdsPerPackage];
-  if (n > kMaxIdsPerPackage) return set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
+  if (n > kMaxIdsPerPackage) return rtci_set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
   for (int i = 0; i < n; ++i) ids[i] = commands[i].id = c->next_id++;
   robotalk_msgs_package_t pkg;
   memset(&pkg, 0, sizeof pkg);
@@ -346,28 +291,32 @@ int64_t rtc_send_commands(rtc_client* c, int8_t mode, robotalk_msgs_command_t* c
 
 /* ---- sessions ----------------------------------------------------------- */
 
-static int say_hello(rtc_client* c, double timeout_s) {
+int rtci_say_hello(rtc_client* c, double timeout_s) {
   robotalk_msgs_hello_t hello;
   memset(&hello, 0, sizeof hello); /* keyed = false, key fields zero: open mode */
   hello.protocol_version = kProtocolVersion;
   hello.client_id = c->client_id;
-  if (random_bytes(c->nonce, sizeof c->nonce) != 0) return set_error(c, "no /dev/urandom"), -1;
+  if (rtci_random_bytes(c->nonce, sizeof c->nonce) != 0) return rtci_set_error(c, "no /dev/urandom"), -1;
   memcpy(hello.client_nonce, c->nonce, sizeof c->nonce);
+  if (c->keyed) rtc_keyed_hello(&hello, &c->identity, c->kx_public, c->kx_secret);
   c->hello_answered = 0;
   const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
   int64_t next_hello = 0;
   while (!c->hello_answered) {
     int64_t now = rtc_now_us();
     if (now >= deadline)
-      return set_error(c, "no answer to hello from '%s' within %.1f s", c->robot, timeout_s), -1;
+      return rtci_set_error(c, "no answer to hello from '%s' within %.1f s%s%s%s", c->robot, timeout_s,
+                            c->ignored[0] ? " (an answer was ignored: " : "", c->ignored,
+                            c->ignored[0] ? ")" : ""),
+             -1;
     if (now >= next_hello) {
       robotalk_msgs_hello_t_publish(c->request_lcm, c->hello_channel, &hello);
       next_hello = now + kHelloRepeatUs;
     }
-    handle_for(c, (next_hello < deadline ? next_hello : deadline) - now);
+    rtci_handle_for(c, (next_hello < deadline ? next_hello : deadline) - now);
   }
   if (c->session_id == 0 || c->refusal[0])
-    return set_error(c, "hello refused by '%s': %s", c->robot, c->refusal), -1;
+    return rtci_set_error(c, "hello refused by '%s': %s", c->robot, c->refusal), -1;
   c->last_new_package_us = rtc_now_us();
   return 0;
 }
@@ -376,7 +325,7 @@ static int say_hello(rtc_client* c, double timeout_s) {
 static int resend_in_new_session(rtc_client* c, pending_package* p) {
   robotalk_msgs_package_t pkg;
   if (robotalk_msgs_package_t_decode(p->bytes, 0, p->size, &pkg) < 0)
-    return set_error(c, "cannot decode"), -1;
+    return rtci_set_error(c, "cannot decode"), -1;
   pkg.header.sequence = c->next_sequence++;
   pkg.header.session_id = c->session_id;
   pkg.header.send_time_us = rtc_now_us();
@@ -397,7 +346,7 @@ static int resend_in_new_session(rtc_client* c, pending_package* p) {
 static int run_timers(rtc_client* c) {
   if (!c->hello_answered) { /* SESSION_UNKNOWN for our session: the server forgot it */
     fprintf(stderr, "robotalk-c: session unknown to the server; saying hello again\n");
-    if (say_hello(c, 3.0) != 0) return -1;
+    if (rtci_say_hello(c, 3.0) != 0) return -1;
   }
   for (int i = 0; i < kMaxPackages; ++i)
     if (c->packages[i].used && c->packages[i].session_unknown &&
@@ -418,7 +367,7 @@ static int run_timers(rtc_client* c) {
     const int64_t timeout = p->acked ? kRecheckUs : kRetransmitUs;
     if (now - p->last_send_us < timeout) continue;
     if (!p->acked && p->tries >= kMaxTries) {
-      set_error(c, "package %" PRId64 " not acknowledged after %d tries", p->sequence, p->tries);
+      rtci_set_error(c, "package %" PRId64 " not acknowledged after %d tries", p->sequence, p->tries);
       return -1;
     }
     lcm_publish(c->request_lcm, c->request_channel, p->bytes, (unsigned)p->size); /* same sequence */
@@ -436,9 +385,9 @@ int rtc_wait(rtc_client* c, const int64_t* ids, int n, double timeout_s, rtc_rep
     for (int i = 0; i < n; ++i) missing += find_reply(c, ids[i]) == NULL;
     if (!missing) break;
     if (rtc_now_us() >= deadline)
-      return set_error(c, "%d of %d replies missing after %.1f s", missing, n, timeout_s), -1;
+      return rtci_set_error(c, "%d of %d replies missing after %.1f s", missing, n, timeout_s), -1;
     if (run_timers(c) != 0) return -1;
-    handle_for(c, 20000);
+    rtci_handle_for(c, 20000);
   }
   for (int i = 0; out && i < n; ++i) out[i] = *find_reply(c, ids[i]);
   return 0;
@@ -448,7 +397,7 @@ int rtc_pause(rtc_client* c, double seconds) {
   const int64_t deadline = rtc_now_us() + (int64_t)(seconds * 1e6);
   for (int64_t now = rtc_now_us(); now < deadline; now = rtc_now_us()) {
     if (run_timers(c) != 0) return -1;
-    handle_for(c, deadline - now < 20000 ? deadline - now : 20000);
+    rtci_handle_for(c, deadline - now < 20000 ? deadline - now : 20000);
   }
   return 0;
 }
@@ -470,7 +419,7 @@ int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* roun
     int64_t offset = ((p->server_receive_us - p->t1) + (p->server_send_us - p->t4)) / 2;
     if (rtt < best_rtt) best_rtt = rtt, best_offset = offset;
   }
-  if (best_rtt == INT64_MAX) return set_error(c, "no usable CLOCK sample"), -1;
+  if (best_rtt == INT64_MAX) return rtci_set_error(c, "no usable CLOCK sample"), -1;
   c->clock_offset_us = best_offset;
   c->clock_stale = 0;
   if (offset_us) *offset_us = best_offset;
@@ -491,7 +440,7 @@ robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
   rtc_reply r;
   if (rtc_send_queries(c, &q, 1) > 0 && rtc_wait(c, &q.id, 1, timeout_s, &r) == 0) {
     if (r.signal != ROBOTALK_MSGS_REPLY_T_SUCCESS) {
-      set_error(c, "CONFIG answered %s: %s", rtc_signal_name(r.signal), r.message);
+      rtci_set_error(c, "CONFIG answered %s: %s", rtc_signal_name(r.signal), r.message);
     } else {
       const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
       char hash[17] = "";
@@ -499,107 +448,17 @@ robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
         if (c->config) snprintf(hash, sizeof hash, "%016" PRIx64, (uint64_t)c->config->header.hash);
         if (c->config && strcmp(hash, r.message) == 0) break;
         if (run_timers(c) != 0) break;
-        handle_for(c, 20000);
+        rtci_handle_for(c, 20000);
       }
       if (c->config && strcmp(hash, r.message) == 0) {
         result = c->config;
         c->config = NULL;
       } else {
-        set_error(c, "no robot_config_t with hash %s on %s within %.1f s", r.message, channel, timeout_s);
+        rtci_set_error(c, "no robot_config_t with hash %s on %s within %.1f s", r.message, channel,
+                       timeout_s);
       }
     }
   }
   robotalk_msgs_robot_config_t_unsubscribe(c->main_lcm, sub);
   return result;
-}
-
-/* ---- connecting --------------------------------------------------------- */
-
-static int open_layout(rtc_client* c, const char* url) {
-  c->split = c->announce_layout == ROBOTALK_MSGS_ANNOUNCE_T_TRAFFIC_SPLIT;
-  if (c->announce_layout != ROBOTALK_MSGS_ANNOUNCE_T_TRAFFIC_SINGLE && !c->split)
-    return set_error(c, "unknown traffic layout %d in ANNOUNCE", c->announce_layout), -1;
-  c->request_lcm = c->reply_lcm = c->main_lcm;
-  if (!c->split) return 0;
-  char request_url[512], reply_url[512];
-  int bucket = (int)((uint64_t)c->client_id % 64);
-  if (rtc_shifted_url(url, 1, request_url, sizeof request_url) != 0 ||
-      rtc_shifted_url(url, 2 + bucket, reply_url, sizeof reply_url) != 0)
-    return set_error(c, "the split layout needs a udpm://GROUP:PORT URL, not '%s'", url), -1;
-  c->request_lcm = lcm_create(request_url);
-  c->reply_lcm = lcm_create(reply_url);
-  if (!c->request_lcm || !c->reply_lcm)
-    return set_error(c, "cannot open %s or %s", request_url, reply_url), -1;
-  return 0;
-}
-
-static int find_robot(rtc_client* c, double timeout_s) {
-  robotalk_msgs_announce_t_subscription_t* sub =
-      robotalk_msgs_announce_t_subscribe(c->main_lcm, "ROBOTALK/ANNOUNCE", on_announce, c);
-  const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
-  while (!c->found && rtc_now_us() < deadline) handle_for(c, 50000);
-  robotalk_msgs_announce_t_unsubscribe(c->main_lcm, sub);
-  if (!c->found)
-    return set_error(c, "no robot '%s' announced within %.1f s (heard: %s)", c->robot, timeout_s,
-                     c->heard[0] ? c->heard : "nothing"),
-           -1;
-  if (c->announce_version != kProtocolVersion)
-    return set_error(c, "'%s' speaks protocol %d; this client speaks %d", c->robot, c->announce_version,
-                     kProtocolVersion),
-           -1;
-  if (c->announce_keyed)
-    return set_error(c,
-                     "the server of '%s' requires keys (keyed mode, docs/security.md); this example client "
-                     "supports open mode only",
-                     c->robot),
-           -1;
-  return 0;
-}
-
-rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, char* err, size_t err_len) {
-  rtc_client* c = calloc(1, sizeof *c);
-  if (!c) return NULL;
-  snprintf(c->robot, sizeof c->robot, "%s", robot);
-  c->next_sequence = 1;
-  c->next_id = 1;
-  while (c->client_id == 0)
-    if (random_bytes(&c->client_id, sizeof c->client_id) != 0) break;
-  char lcm_url[512];
-  rtc_lcm_url_of(url, lcm_url, sizeof lcm_url);
-  url = lcm_url;
-  c->main_lcm = lcm_create(url);
-  int ok = c->client_id != 0 && c->main_lcm != NULL;
-  if (!ok) set_error(c, "cannot open LCM on '%s'", url);
-  ok = ok && find_robot(c, timeout_s) == 0 && open_layout(c, url) == 0;
-  if (ok) {
-    uint64_t hex = (uint64_t)c->client_id;
-    snprintf(c->hello_channel, sizeof c->hello_channel, "ROBOTALK/%s/HELLO", robot);
-    snprintf(c->hello_answer_channel, sizeof c->hello_answer_channel, "ROBOTALK/%s/HELLO/%016" PRIx64, robot,
-             hex);
-    snprintf(c->request_channel, sizeof c->request_channel, "ROBOTALK/%s/REQUEST", robot);
-    snprintf(c->reply_channel, sizeof c->reply_channel, "ROBOTALK/%s/REPLY/%016" PRIx64, robot, hex);
-    c->hello_sub =
-        robotalk_msgs_hello_answer_t_subscribe(c->reply_lcm, c->hello_answer_channel, on_hello_answer, c);
-    c->reply_sub = robotalk_msgs_reply_package_t_subscribe(c->reply_lcm, c->reply_channel, on_reply, c);
-    robotalk_msgs_reply_package_t_subscription_set_queue_capacity(c->reply_sub, 1000);
-    ok = say_hello(c, timeout_s) == 0;
-  }
-  if (!ok) {
-    snprintf(err, err_len, "%s", c->error);
-    rtc_close(c);
-    return NULL;
-  }
-  return c;
-}
-
-void rtc_close(rtc_client* c) {
-  if (!c) return;
-  for (int i = 0; i < kMaxPackages; ++i) free(c->packages[i].bytes);
-  if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
-  if (c->hello_sub) robotalk_msgs_hello_answer_t_unsubscribe(c->reply_lcm, c->hello_sub);
-  if (c->reply_sub) robotalk_msgs_reply_package_t_unsubscribe(c->reply_lcm, c->reply_sub);
-  if (c->reply_lcm && c->reply_lcm != c->main_lcm) lcm_destroy(c->reply_lcm);
-  if (c->request_lcm && c->request_lcm != c->main_lcm) lcm_destroy(c->request_lcm);
-  if (c->main_lcm) lcm_destroy(c->main_lcm);
-  free(c);
 }

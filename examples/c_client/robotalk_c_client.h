@@ -1,6 +1,7 @@
-/* A small RoboTalk client in C (protocol 2, open mode), written from
- * docs/protocol.md and docs/writing_a_client.md with LCM's C API and the C
- * bindings lcm-gen makes of lcmtypes/robotalk_msgs (robotalk::lcmtypes_c).
+/* A small RoboTalk client in C (protocol 3, open and keyed mode), written from
+ * docs/protocol.md, docs/writing_a_client.md and docs/security.md with LCM's C
+ * API, the C bindings lcm-gen makes of lcmtypes/robotalk_msgs
+ * (robotalk::lcmtypes_c) and libsodium (keyed mode: robotalk_c_keyed.h).
  *
  * What it does: finds the robot on ROBOTALK/ANNOUNCE (and from it the traffic
  * layout, single or split), opens a session with a hello, numbers packages
@@ -11,8 +12,9 @@
  * keeps the session; says hello again after SESSION_UNKNOWN (nothing in that
  * package ran) and sends the package again in the new session.
  *
- * Not done here: keyed mode (a keyed server is refused with an error),
- * RFC 6298 adaptive timeouts (the C++ client does that).
+ * Not done here: pinning the server key in a file (give it, or the ANNOUNCE's
+ * signer is trusted), checking STATE signatures (no STATE is read), RFC 6298
+ * adaptive timeouts (the C++ client does those).
  *
  * Threads: one rtc_client is used by one thread; nothing runs in the
  * background. Every blocking call takes a timeout in seconds. Errors: calls
@@ -60,6 +62,15 @@ int64_t rtc_now_us(void);
  * hello. NULL on failure, with the reason in err (a robot not heard, a keyed
  * server, a refused hello, a layout this client cannot derive ports for). */
 rtc_client* rtc_connect(const char* url, const char* robot, double timeout_s, char* err, size_t err_len);
+/* The same in keyed mode (docs/security.md) when key_file is not NULL: the
+ * client's secret key file, and the server's .pub file to trust (NULL: the key
+ * of the first hello answer whose signature verifies, trusted on first use and
+ * not pinned; its fingerprint is printed on stderr).
+ * The client id is one of the key's; every package is sealed with the
+ * session's MAC; replies, answers and CONFIG messages that do not verify are
+ * dropped. */
+rtc_client* rtc_connect_keyed(const char* url, const char* robot, const char* key_file,
+                              const char* server_key_file, double timeout_s, char* err, size_t err_len);
 void rtc_close(rtc_client* c);
 const char* rtc_error(const rtc_client* c);
 
