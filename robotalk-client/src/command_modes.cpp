@@ -130,14 +130,16 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   // until its own deadline), waking for the reply, a stop, and progress.
   // Returns whether frame i is settled (answered, or of unknown outcome).
   std::optional<std::chrono::steady_clock::time_point> deadline;  // of the frame waited for
+  Duration allowed{0};                                            // what `deadline` allows
   const auto wait_frame = [&](std::size_t i, std::optional<TimePoint> until) {
-    if (!deadline && !hooks.wait_until_given_up) {
+    // Playback: no frame's start is known before the delay reply.
+    if (!deadline && !hooks.wait_until_given_up && !delay_reply) {
       // Each reply can come no earlier than its start time.
       Duration until_start{0};
       if (start_known) until_start = std::max(Duration(0), server_start + frames[i].offset - ServerNow());
-      deadline =
-          std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                 until_start + impl_->options_.timeout);
+      allowed = until_start + impl_->options_.timeout;
+      deadline = std::chrono::steady_clock::now() +
+                 std::chrono::duration_cast<std::chrono::steady_clock::duration>(allowed);
     }
     for (;;) {
       progress();
@@ -163,8 +165,8 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       if (deadline && std::chrono::steady_clock::now() >= *deadline) {
         impl_->RethrowDaemonError();
         throw TimeoutError("sequence frame " + std::to_string(i) + " (id " +
-                           std::to_string(pending[i]->id()) +
-                           "): no reply in time (ClientOptions::timeout after its start)");
+                           std::to_string(pending[i]->id()) + "): no reply within " +
+                           std::to_string(ToSeconds(allowed)) + " s");
       }
     }
   };
