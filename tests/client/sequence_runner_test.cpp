@@ -124,5 +124,55 @@ TEST_F(SequenceRunnerTest, AStopRequestEndsADelaySequenceAndStopsTheFramesQueued
       << report.interrupt_note;
 }
 
+// Before, a playback run was left on an abandoned thread and the process had
+// to _Exit; now RunSequence itself ends on the stop request.
+TEST_F(SequenceRunnerTest, AStopRequestEndsAPlaybackSequenceWithoutLeavingAThreadBehind) {
+  std::stop_source stop;
+  std::size_t answered = 0;
+  const TimePoint t0 = SteadyClock().Now();
+  const RunReport report = RunFrames(
+      *client_, PanFrames(20, milliseconds(100)), {.mode = CommandMode::kPlayback, .paced = false},
+      [&](std::size_t, const Reply&) {
+        if (++answered == 1) stop.request_stop();
+      },
+      nullptr, stop.get_token());
+  EXPECT_EQ(answered, 1u);
+  EXPECT_LT(SteadyClock().Now() - t0, seconds(1)) << "the 1.9 s sequence was waited for";
+  EXPECT_FALSE(report.worker_abandoned);
+  EXPECT_NE(report.interrupt_note.find("playback frames already queued on the server stay queued"),
+            std::string::npos)
+      << report.interrupt_note;
+}
+
+TEST_F(SequenceRunnerTest, AStopRequestEndsADirectSequenceBeforeItsNextFrame) {
+  std::stop_source stop;
+  std::size_t answered = 0;
+  const RunReport report = RunFrames(
+      *client_, PanFrames(10, milliseconds(200)), {.mode = CommandMode::kDirect},
+      [&](std::size_t, const Reply&) {
+        if (++answered == 2) stop.request_stop();
+      },
+      nullptr, stop.get_token());
+  EXPECT_EQ(answered, 2u);
+  ASSERT_EQ(report.replies.size(), 10u);
+  EXPECT_TRUE(report.replies[1].has_value());
+  EXPECT_FALSE(report.replies[2].has_value());
+  EXPECT_NE(report.interrupt_note.find("the frames not yet sent were not sent"), std::string::npos)
+      << report.interrupt_note;
+}
+
+// The library's default (no hooks) is unchanged: every reply, in the order given.
+TEST_F(SequenceRunnerTest, RunSequenceWithoutHooksReturnsEveryReplyInTheOrderGiven) {
+  std::vector<TimedCommand> frames = PanFrames(4, milliseconds(30));
+  std::swap(frames[0], frames[3]);  // out of time order
+  const SequenceResult r =
+      client_->RunSequence(frames, {.mode = CommandMode::kDelay, .delay = milliseconds(50)});
+  ASSERT_EQ(r.replies.size(), 4u);
+  for (const Reply& reply : r.replies) EXPECT_NE(reply.id, 0);
+  EXPECT_LT(r.replies[3].exec_time, r.replies[0].exec_time);  // frame 3 has offset 0
+  EXPECT_FALSE(r.stopped);
+  EXPECT_EQ(r.frames_sent, 4u);
+}
+
 }  // namespace
 }  // namespace robotalk::cli
