@@ -53,6 +53,19 @@ class SequenceRunnerTest : public ::testing::Test {
     return frames;
   }
 
+  // Runs `frames` and requests a stop when the `stop_after`-th reply arrives;
+  // counts the replies in `answered`.
+  RunReport RunThenStop(std::vector<TimedCommand> frames, const SequenceOptions& options,
+                        std::size_t stop_after, std::size_t& answered) {
+    std::stop_source stop;
+    return RunFrames(
+        *client_, std::move(frames), options,
+        [&](std::size_t, const Reply&) {
+          if (++answered == stop_after) stop.request_stop();
+        },
+        nullptr, stop.get_token());
+  }
+
   std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
   MemoryTransport server_end_{bus_};
   MemoryTransport client_end_{bus_};
@@ -106,17 +119,12 @@ TEST_F(SequenceRunnerTest, DelayModeReportsEveryReplyInTheOrderGivenWithProgress
 }
 
 TEST_F(SequenceRunnerTest, AStopRequestEndsADelaySequenceAndStopsTheFramesQueuedOnTheServer) {
-  std::stop_source stop;
   std::size_t answered = 0;
   // 20 frames 100 ms apart, all sent at once, 0.2 s ahead: the stop comes
   // after the first reply, while most frames wait on the server.
-  const RunReport report = RunFrames(
-      *client_, PanFrames(20, milliseconds(100)),
-      {.mode = CommandMode::kDelay, .delay = milliseconds(200), .paced = false},
-      [&](std::size_t, const Reply&) {
-        if (++answered == 1) stop.request_stop();
-      },
-      nullptr, stop.get_token());
+  const RunReport report =
+      RunThenStop(PanFrames(20, milliseconds(100)),
+                  {.mode = CommandMode::kDelay, .delay = milliseconds(200), .paced = false}, 1, answered);
   EXPECT_EQ(answered, 1u);
   EXPECT_NE(report.interrupt_note.find("STOP sent to pioneer"), std::string::npos) << report.interrupt_note;
   EXPECT_NE(report.interrupt_note.find("frames already queued on the server each get a STOP"),
@@ -127,15 +135,10 @@ TEST_F(SequenceRunnerTest, AStopRequestEndsADelaySequenceAndStopsTheFramesQueued
 // Before, a playback run was left on an abandoned thread and the process had
 // to _Exit; now RunSequence itself ends on the stop request.
 TEST_F(SequenceRunnerTest, AStopRequestEndsAPlaybackSequenceWithoutLeavingAThreadBehind) {
-  std::stop_source stop;
   std::size_t answered = 0;
   const TimePoint t0 = SteadyClock().Now();
-  const RunReport report = RunFrames(
-      *client_, PanFrames(20, milliseconds(100)), {.mode = CommandMode::kPlayback, .paced = false},
-      [&](std::size_t, const Reply&) {
-        if (++answered == 1) stop.request_stop();
-      },
-      nullptr, stop.get_token());
+  const RunReport report = RunThenStop(PanFrames(20, milliseconds(100)),
+                                       {.mode = CommandMode::kPlayback, .paced = false}, 1, answered);
   EXPECT_EQ(answered, 1u);
   EXPECT_LT(SteadyClock().Now() - t0, seconds(1)) << "the 1.9 s sequence was waited for";
   EXPECT_FALSE(report.worker_abandoned);
@@ -145,14 +148,9 @@ TEST_F(SequenceRunnerTest, AStopRequestEndsAPlaybackSequenceWithoutLeavingAThrea
 }
 
 TEST_F(SequenceRunnerTest, AStopRequestEndsADirectSequenceBeforeItsNextFrame) {
-  std::stop_source stop;
   std::size_t answered = 0;
-  const RunReport report = RunFrames(
-      *client_, PanFrames(10, milliseconds(200)), {.mode = CommandMode::kDirect},
-      [&](std::size_t, const Reply&) {
-        if (++answered == 2) stop.request_stop();
-      },
-      nullptr, stop.get_token());
+  const RunReport report =
+      RunThenStop(PanFrames(10, milliseconds(200)), {.mode = CommandMode::kDirect}, 2, answered);
   EXPECT_EQ(answered, 2u);
   ASSERT_EQ(report.replies.size(), 10u);
   EXPECT_TRUE(report.replies[1].has_value());
