@@ -171,7 +171,7 @@ namespace {
 // Servers announce once a second: three periods without an announcement or a
 // STATE sample mean the server is gone.
 constexpr Duration kServerSilence = std::chrono::seconds(3);
-constexpr Duration kStreamCancelWait = std::chrono::milliseconds(300);
+constexpr Duration kStreamCancelWait = std::chrono::milliseconds(200);
 }  // namespace
 
 int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
@@ -237,13 +237,18 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     }
     Interrupter::WaitFor(std::min<Duration>(std::chrono::milliseconds(20), end - SteadyClock().Now()));
   }
+  const auto streaming = [&] {  // samples still arrive (not under `mu` while the cancel waits)
+    std::lock_guard lock(mu);
+    return SteadyClock().Now() - last_sample < std::max<Duration>(3 * actual, kStreamCancelWait);
+  };
   if (gone) {
     std::cerr << "robotalk: " << args[0] << ": no STATE sample and no announcement for "
               << FormatDuration(kServerSilence)
               << ": its server is gone (stopped, crashed or unreachable); watch ends\n";
-  } else {
-    // The server drops the stream with this client's session anyway: ask it
-    // to stop now, but never wait long for the answer (Ctrl-C ends promptly).
+  } else if (streaming()) {
+    // The stream runs: ask the server to end it now (it ends with this
+    // client's session anyway), never waiting long for the answer, and not
+    // at all when the samples stopped (a server gone: Ctrl-C ends at once).
     try {
       client->SendQuery({.type = QueryType::kStateStreamCancel}).Wait(kStreamCancelWait);
     } catch (const std::exception&) {
