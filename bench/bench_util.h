@@ -1,7 +1,10 @@
 // Small helpers shared by the multi-process bench programs (not a library):
-// argument parsing, sample summaries as one JSON line, the monotonic clock.
+// argument parsing, sample summaries as one JSON line (JsonText), the
+// monotonic clock.
 // Everything here is single-threaded unless a function says otherwise.
 #pragma once
+
+#include "json_text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +15,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace robotalk::bench {
@@ -62,31 +66,29 @@ inline double Percentile(std::vector<double>& v, double q) {
   return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
 }
 
-/// `"name": {"n": .., "p50": .., "p99": .., "mean": .., "max": ..}` (no braces
-/// around it), in the samples' own unit.
-inline std::string Summary(const std::string& name, std::vector<double> v) {
+/// A bench's output is one JSON object per line, written by JsonText
+/// (tools/describe/json_text.h), as every JSON the project writes.
+using Json = nlohmann::ordered_json;
+/// One named figure of that object.
+using Field = std::pair<std::string, Json>;
+
+/// `name: {"n", "p50", "p99", "mean", "max"}` of `v`, in the samples' own unit.
+inline Field Summary(const std::string& name, std::vector<double> v) {
   double sum = 0;
   for (double x : v) sum += x;
-  char buf[320];
   const double p50 = Percentile(v, 0.5), p99 = Percentile(v, 0.99);
-  std::snprintf(buf, sizeof buf,
-                "\"%s\": {\"n\": %zu, \"p50\": %.3f, \"p99\": %.3f, \"mean\": %.3f, \"max\": %.3f}",
-                name.c_str(), v.size(), p50, p99, v.empty() ? 0.0 : sum / static_cast<double>(v.size()),
-                v.empty() ? 0.0 : v.back());
-  return buf;
+  return {name, Json{{"n", v.size()},
+                     {"p50", p50},
+                     {"p99", p99},
+                     {"mean", v.empty() ? 0.0 : sum / static_cast<double>(v.size())},
+                     {"max", v.empty() ? 0.0 : v.back()}}};
 }
 
-inline std::string Field(const std::string& name, double value) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "\"%s\": %.6g", name.c_str(), value);
-  return buf;
-}
-
-/// Prints `{a, b, ...}` as one line on stdout and flushes.
-inline void PrintJson(const std::vector<std::string>& fields) {
-  std::string s = "{";
-  for (std::size_t i = 0; i < fields.size(); ++i) s += (i ? ", " : "") + fields[i];
-  std::printf("%s}\n", s.c_str());
+/// Prints `{fields...}` as one line on stdout and flushes.
+inline void PrintJson(const std::vector<Field>& fields) {
+  Json object = Json::object();
+  for (const auto& [name, value] : fields) object[name] = value;
+  std::printf("%s\n", JsonText(object).c_str());
   std::fflush(stdout);
 }
 

@@ -41,7 +41,7 @@ Command Pan(int k, std::optional<TimePoint> start) {
       .type = CommandType::kJointSetPoint, .start_time = start, .target = "pan", .values = {0.05 * (k % 4)}};
 }
 
-std::vector<std::string> StatsFields(const RobotClient& c) {
+std::vector<Field> StatsFields(const RobotClient& c) {
   const ClientStats s = c.stats();
   return {Field("retransmissions", static_cast<double>(s.retransmissions)),
           Field("gave_up", static_cast<double>(s.gave_up))};

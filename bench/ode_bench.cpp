@@ -4,7 +4,9 @@
 // Pioneer. Figures go to docs/ode_sim.md.
 //   robotalk-ode-bench [MODELS_DIR] [SHARED_ROBOTS_DIR]
 #include "collision_shapes.h"
+#include "joint_servos.h"
 #include "ode_driver.h"
+#include "ode_driver_impl.h"
 #include "ode_world.h"
 #include "robotalk/urdf_import.h"
 
@@ -46,78 +48,35 @@ std::unique_ptr<OdeDriver> Make(const Robot& r) {
   return std::unique_ptr<OdeDriver>(static_cast<OdeDriver*>(d.release()));
 }
 
-// The ODE world the ode driver builds for `r` (OdeDriver::Impl's
-// constructor, drivers/ode_sim/ode_driver.cpp), rebuilt here rule by rule so
-// "bare ODE" is the same physics: the same import options, base type, world
-// options (step, gravity, friction, solver, virtual mass, casters, seed), a
-// differential base's wheel cylinders as spheres, a walking humanoid's root
-// left dynamic, and the servo law of a holding driver (Step()). "Bare ODE"
-// is then this world and a 5-line servo; the overhead is everything else the
-// driver does per step (its command state, limits, base, state read-out). Comparing against a
-// world that differs (e.g. cylinder wheels: more contact points, a costlier
-// LCP) measured the difference of the worlds, not the driver: the Pioneer read
-// -25 %.
+// "Bare ODE" is the world the ode driver builds for `r`, built by the
+// driver's own code (ode_detail::BuildDriverWorld: the same import options,
+// base type, world options, shapes as the base controller prepares them, a
+// walking humanoid's root left dynamic) and stepped with a 5-line servo (the
+// servo law of a holding driver, Step()). The overhead is everything else the
+// driver does per step (its command state, limits, base, state read-out).
+// Comparing against a world that differs (e.g. cylinder wheels: more contact
+// points, a costlier LCP) measured the difference of the worlds, not the
+// driver: the Pioneer read -25 %.
 RobotModel DriverModel(const Robot& r, const OdeDriverOptions& o) {
   UrdfImportOptions import;
   import.merge_massless_chains = o.merge_chains;
-  RobotModel model = LoadUrdfFile(r.path, import).model;
-  if (o.base.empty()) return model;
-  std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
-  roots.front().base = ParseBaseType(o.base);
-  return RobotModel(model.name(), {model.links().begin(), model.links().end()},
-                    {model.joints().begin(), model.joints().end()},
-                    {model.frames().begin(), model.frames().end()}, std::move(roots));
+  return ode_detail::DriverModel(LoadUrdfFile(r.path, import).model, o);
 }
 
-// Whether the driver runs its walking controller (whose robot's root is
-// dynamic); false for a driver without one.
-template <typename D>
-bool Walks(const D& driver) {
-  if constexpr (requires { driver.walk_status(); }) {
-    return driver.walk_status().has_value();
-  } else {
-    return false;
-  }
+OdeDriverOptions ValidOptions(const Robot& r) {
+  OdeDriverOptions o = OdeDriverOptions::FromMap(r.options);
+  o.Validate();
+  return o;
 }
 
 struct BareWorld {
   RobotModel model;
   std::unique_ptr<ode_detail::OdeWorld> world;
 
-  BareWorld(const Robot& r, bool walks) : model(DriverModel(r, OdeDriverOptions::FromMap(r.options))) {
-    const OdeDriverOptions o = OdeDriverOptions::FromMap(r.options);
-    const BaseType base = model.roots().front().base;
-    ode_detail::OdeWorldOptions wo;
-    wo.step = 1.0 / o.step_hz;
-    wo.gravity = o.gravity;
-    wo.friction = o.friction;
-    wo.quickstep = o.solver == "quickstep";
-    wo.virtual_mass = o.virtual_mass;
-    wo.caster_links = o.casters;
-    wo.seed = o.seed;
-    wo.kinematic_first_root = (base == BaseType::kHolonomic || base == BaseType::kFloating) && !walks;
-    wo.place_on_ground = base != BaseType::kFixed;
-    std::vector<CollisionShape> shapes = LoadCollisionShapes(r.path);
-    if (base == BaseType::kDifferential) {
-      for (const std::string& wheel : {o.left_wheel, o.right_wheel}) {
-        const std::optional<int> j = model.FindJoint(wheel);
-        if (!j) continue;
-        const std::string& link = model.link(model.joint(*j).child_link).name;
-        for (CollisionShape& sh : shapes) {
-          if (sh.link != link || sh.kind != CollisionShape::Kind::kCylinder) continue;
-          sh.kind = CollisionShape::Kind::kSphere;
-          sh.size = {sh.size.x(), 0, 0};
-        }
-      }
-    }
-    Eigen::VectorXd q0 = Eigen::VectorXd::Zero(model.num_dofs());
-    for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
-      for (size_t k = 0; k < model.joint(j).dofs.size(); ++k) {
-        const DofLimits& l = model.joint(j).dofs[k].limits;
-        q0[model.dof_offset(j) + static_cast<int>(k)] = std::clamp(0.0, l.lower, l.upper);
-      }
-    }
-    world = std::make_unique<ode_detail::OdeWorld>(model, shapes, wo, q0);
+  explicit BareWorld(const Robot& r) : model(DriverModel(r, ValidOptions(r))) {
+    const OdeDriverOptions o = ValidOptions(r);
+    const Eigen::VectorXd q0 = ode_detail::JointServos(model, o).q0();
+    world = ode_detail::BuildDriverWorld(model, o, q0, LoadCollisionShapes(r.path)).world;
     target = q0;
     kp = o.kp;
     for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
@@ -174,7 +133,7 @@ void RealTimeFactor(const Robot& r) {
 
   // The bare loop: the ODE world the driver builds, built the same way
   // (BareWorld), stepped with the minimal servo and nothing else.
-  BareWorld bare(r, Walks(*idle));
+  BareWorld bare(r);
   // Alternate the two in 30 rounds of 100 steps and keep each one's fastest
   // round: the machine is shared, so the minimum is the cost. Both have
   // stepped once before (the driver's first Step), and both step 3001 times.

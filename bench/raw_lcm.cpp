@@ -292,18 +292,16 @@ int Arrivals(const Args& a) {
   while (static_cast<long>(log.arrival_ns.size()) < frames && MonoNs() < end) lcm.handleTimeout(100);
   std::int64_t first = log.arrival_ns.empty() ? 0 : log.arrival_ns.front();
   for (std::int64_t t : log.arrival_ns) first = std::min(first, t);
-  std::string lags = "\"lag_ms\": [";
+  std::vector<double> lags;
   double worst = 0;
   for (std::size_t i = 0; i < log.arrival_ns.size(); ++i) {
     const double lag =
         static_cast<double>(log.arrival_ns[i] - first) / 1e6 - static_cast<double>(log.offset_us[i]) / 1e3;
     worst = std::max(worst, lag);
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%s%.3f", i ? ", " : "", lag);
-    lags += buf;
+    lags.push_back(std::round(lag * 1e3) / 1e3);
   }
   PrintJson({Field("frames", static_cast<double>(log.arrival_ns.size())),
-             Field("hindsight_min_s", worst / 1e3), lags + "]"});
+             Field("hindsight_min_s", worst / 1e3), Field("lag_ms", lags)});
   return 0;
 }
 

@@ -42,8 +42,8 @@ class Report {
   ~Report() { std::fclose(f_); }
   Report(const Report&) = delete;
   Report& operator=(const Report&) = delete;
-  void Line(const std::string& body) {
-    std::fprintf(f_, "{%s}\n", body.c_str());
+  void Line(const Json& event) {
+    std::fprintf(f_, "%s\n", robotalk::JsonText(event).c_str());
     std::fflush(f_);
   }
 
@@ -51,19 +51,8 @@ class Report {
   std::FILE* f_;
 };
 
-std::string Quote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s.substr(0, 200)) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
-  }
-  return out + "\"";
-}
-
-std::string Kv(const std::string& k, const std::string& quoted_or_number) {
-  return "\"" + k + "\":" + quoted_or_number;
-}
-std::string Num(std::int64_t v) { return std::to_string(v); }
+// Messages are cut to 200 bytes: a line per event stays short.
+std::string Short(const std::string& s) { return s.substr(0, 200); }
 
 struct Soak {
   RobotClient& client;
@@ -92,22 +81,28 @@ struct Soak {
 
   void Sent(CommandId id, const Command& c, std::int64_t start_us) {
     max_id = std::max(max_id, id);
-    report.Line(Kv("ev", "\"sent\"") + "," + Kv("id", Num(id)) + "," + Kv("type", Quote(ToString(c.type))) +
-                "," + Kv("target", Quote(c.target)) + "," + Kv("start_us", Num(start_us)));
+    report.Line({{"ev", "sent"},
+                 {"id", id},
+                 {"type", ToString(c.type)},
+                 {"target", c.target},
+                 {"start_us", start_us}});
   }
   // exec_us: server clock when it ran (-1: no reply); late_us: how late after its start.
   void Final(CommandId id, const std::string& outcome, const std::string& msg, const Reply* r = nullptr) {
     if (r != nullptr && r->signal == Signal::kPanic) panic_seen = true;
-    report.Line(Kv("ev", "\"final\"") + "," + Kv("id", Num(id)) + "," + Kv("outcome", Quote(outcome)) + "," +
-                Kv("exec_us", Num(r ? ToWireMicros(r->exec_time) : -1)) + "," +
-                Kv("late_us", Num(r ? ToWireMicros(r->lateness) : -1)) + "," + Kv("msg", Quote(msg)));
+    report.Line({{"ev", "final"},
+                 {"id", id},
+                 {"outcome", outcome},
+                 {"exec_us", r ? ToWireMicros(r->exec_time) : -1},
+                 {"late_us", r ? ToWireMicros(r->lateness) : -1},
+                 {"msg", Short(msg)}});
   }
   // A client answered PANIC waits a little before trying again, as a real one would.
   void AfterPanic() {
     if (std::exchange(panic_seen, false)) Sleep(0.3);
   }
   void NotSent(const std::string& what, const std::string& msg) {
-    report.Line(Kv("ev", "\"notsent\"") + "," + Kv("what", Quote(what)) + "," + Kv("msg", Quote(msg)));
+    report.Line({{"ev", "notsent"}, {"what", Short(what)}, {"msg", Short(msg)}});
   }
 
   // Waits for one reply and reports its outcome, whatever it is.
@@ -204,7 +199,7 @@ void Mark(Soak& s) {
   try {
     PendingReply p = s.client.SendQuery(Query{.type = QueryType::kBasePose});
     s.max_id = std::max(s.max_id, p.id());
-    s.report.Line(Kv("ev", "\"marker\"") + "," + Kv("id", Num(p.id())));
+    s.report.Line({{"ev", "marker"}, {"id", p.id()}});
   } catch (const Error& e) {
     s.NotSent("marker", e.what());
   }
@@ -223,8 +218,7 @@ void AskStatus(Soak& s, CommandId first, CommandId last) {
       outcome = "STATUS_FAILED";
       msg = e.what();
     }
-    s.report.Line(Kv("ev", "\"status\"") + "," + Kv("id", Num(id)) + "," + Kv("outcome", Quote(outcome)) +
-                  "," + Kv("msg", Quote(msg)));
+    s.report.Line({{"ev", "status"}, {"id", id}, {"outcome", outcome}, {"msg", Short(msg)}});
   }
 }
 
@@ -239,7 +233,7 @@ void RunPlayback(Soak& s) {
     const std::vector<TimedCommand> copy = frames;
     Mark(s);
     const CommandId after = s.max_id;
-    s.report.Line(Kv("ev", "\"seq\"") + "," + Kv("after", Num(after)) + "," + Kv("frames", Num(n)));
+    s.report.Line({{"ev", "seq"}, {"after", after}, {"frames", n}});
     try {
       const SequenceResult r = s.client.RunSequence(std::move(frames), {.mode = CommandMode::kPlayback});
       for (int i = 0; i < n; ++i) {
@@ -253,12 +247,13 @@ void RunPlayback(Soak& s) {
     } catch (const Error& e) {
       const bool unknown = dynamic_cast<const UnknownOutcomeError*>(&e) != nullptr;
       const bool timeout = dynamic_cast<const TimeoutError*>(&e) != nullptr;
-      s.report.Line(Kv("ev", "\"seq_failed\"") + "," + Kv("after", Num(after)) + "," + Kv("frames", Num(n)) +
-                    "," +
-                    Kv("outcome", Quote(unknown   ? "UNKNOWN_OUTCOME"
-                                        : timeout ? "TIMEOUT"
-                                                  : "CLIENT_ERROR")) +
-                    "," + Kv("msg", Quote(e.what())));
+      s.report.Line({{"ev", "seq_failed"},
+                     {"after", after},
+                     {"frames", n},
+                     {"outcome", unknown   ? "UNKNOWN_OUTCOME"
+                                 : timeout ? "TIMEOUT"
+                                           : "CLIENT_ERROR"},
+                     {"msg", Short(e.what())}});
       s.Sleep(1.0);  // every frame's start has passed
       Mark(s);
       // A plain timeout leaves the session alive: ask what became of each
@@ -297,7 +292,7 @@ void RunWatch(Soak& s) {
     }
     s.Sleep(1.0);
   }
-  s.report.Line(Kv("ev", "\"samples\"") + "," + Kv("n", Num(samples.load())) + "," + Kv("asked", Num(asked)));
+  s.report.Line({{"ev", "samples"}, {"n", samples.load()}, {"asked", asked}});
   try {
     s.client.StopStateStream();
   } catch (const Error&) {
@@ -315,16 +310,15 @@ void RunChaos(Soak& s) {
     } catch (const Error& e) {
       outcome = std::string("FAILED: ") + e.what();
     }
-    s.report.Line(Kv("ev", "\"panic\"") + "," + Kv("outcome", Quote(outcome)));
+    s.report.Line({{"ev", "panic"}, {"outcome", outcome}});
     s.Sleep(s.Uniform(0.2, 0.8));
     for (int attempt = 0; attempt < 5; ++attempt) {  // a reset must not be left undone
       try {
         const Reply r = s.client.ResetPanic();
-        s.report.Line(Kv("ev", "\"reset\"") + "," + Kv("outcome", Quote(std::string(ToString(r.signal)))));
+        s.report.Line({{"ev", "reset"}, {"outcome", ToString(r.signal)}});
         break;
       } catch (const Error& e) {
-        s.report.Line(Kv("ev", "\"reset\"") + "," + Kv("outcome", Quote("FAILED")) + "," +
-                      Kv("msg", Quote(e.what())));
+        s.report.Line({{"ev", "reset"}, {"outcome", "FAILED"}, {"msg", Short(e.what())}});
       }
     }
   }
@@ -351,9 +345,10 @@ int Main(int argc, char** argv) {
       }
     }
   }
-  report.Line(Kv("ev", "\"hello\"") + "," +
-              Kv("client", Quote(Hex64(static_cast<std::uint64_t>(client.client_id())))) + "," +
-              Kv("mode", Quote(mode)) + "," + Kv("seed", Num(seed)));
+  report.Line({{"ev", "hello"},
+               {"client", Hex64(static_cast<std::uint64_t>(client.client_id()))},
+               {"mode", mode},
+               {"seed", seed}});
   Soak s{client, report, std::mt19937_64(static_cast<std::uint64_t>(seed)), deadline};
   if (mode == "direct") {
     RunDirect(s);
@@ -370,11 +365,11 @@ int Main(int argc, char** argv) {
     return 2;
   }
   const ClientStats st = client.stats();
-  report.Line(Kv("ev", "\"end\"") + "," +
-              Kv("retransmissions", Num(static_cast<std::int64_t>(st.retransmissions))) + "," +
-              Kv("gave_up", Num(static_cast<std::int64_t>(st.gave_up))) + "," +
-              Kv("sessions_opened", Num(static_cast<std::int64_t>(st.sessions_opened))) + "," +
-              Kv("sessions_lost", Num(static_cast<std::int64_t>(st.sessions_lost))));
+  report.Line({{"ev", "end"},
+               {"retransmissions", st.retransmissions},
+               {"gave_up", st.gave_up},
+               {"sessions_opened", st.sessions_opened},
+               {"sessions_lost", st.sessions_lost}});
   return 0;
 }
 

@@ -17,16 +17,6 @@ using ode_detail::OdeWorld;
 
 namespace {
 
-// The model with its first root's base type replaced (option "base").
-RobotModel WithBase(RobotModel model, const std::string& base) {
-  if (base.empty()) return model;
-  std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
-  roots.front().base = ParseBaseType(base);
-  return RobotModel(model.name(), {model.links().begin(), model.links().end()},
-                    {model.joints().begin(), model.joints().end()},
-                    {model.frames().begin(), model.frames().end()}, std::move(roots));
-}
-
 // Validated first: the servos' defaults come from the options.
 const OdeDriverOptions& Validated(const OdeDriverOptions& options) {
   options.Validate();
@@ -35,26 +25,51 @@ const OdeDriverOptions& Validated(const OdeDriverOptions& options) {
 
 }  // namespace
 
+namespace ode_detail {
+
+RobotModel DriverModel(RobotModel model, const OdeDriverOptions& options) {
+  if (options.base.empty()) return model;
+  std::vector<RootLink> roots(model.roots().begin(), model.roots().end());
+  roots.front().base = ParseBaseType(options.base);
+  return RobotModel(model.name(), {model.links().begin(), model.links().end()},
+                    {model.joints().begin(), model.joints().end()},
+                    {model.frames().begin(), model.frames().end()}, std::move(roots));
+}
+
+DriverWorld BuildDriverWorld(const RobotModel& model, const OdeDriverOptions& options,
+                             const Eigen::VectorXd& q0, std::vector<CollisionShape> shapes) {
+  const double step = ToSeconds(FromSeconds(1.0 / options.step_hz));
+  DriverWorld built;
+  built.base = MakeBaseController(model, options, shapes, step);
+  OdeWorldOptions wo;
+  wo.step = step;
+  wo.gravity = options.gravity;
+  wo.friction = options.friction;
+  wo.quickstep = options.solver == "quickstep";
+  wo.virtual_mass = options.virtual_mass;
+  wo.caster_links = options.casters;
+  wo.seed = options.seed;
+  built.base->Prepare(wo, shapes);
+  built.world = std::make_unique<OdeWorld>(model, shapes, wo, q0);
+  built.shapes = std::move(shapes);
+  return built;
+}
+
+}  // namespace ode_detail
+
 OdeDriver::Impl::Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes)
-    : model_(WithBase(std::move(model), options.base)),
+    : model_(ode_detail::DriverModel(std::move(model), options)),
       options_(Validated(options)),
       servos_(model_, options_),
       ik_(model_) {
   step_ = FromSeconds(1.0 / options_.step_hz);
   if (step_ <= Duration::zero()) throw Error("OdeDriver: step_hz " + Num(options_.step_hz) + " is too high");
   root_poses_.assign(model_.roots().size(), Eigen::Isometry3d::Identity());
-  base_ = ode_detail::MakeBaseController(model_, options_, shapes, ToSeconds(step_));
-  ode_detail::OdeWorldOptions wo;
-  wo.step = ToSeconds(step_);
-  wo.gravity = options_.gravity;
-  wo.friction = options_.friction;
-  wo.quickstep = options_.solver == "quickstep";
-  wo.virtual_mass = options_.virtual_mass;
-  wo.caster_links = options_.casters;
-  wo.seed = options_.seed;
-  base_->Prepare(wo, shapes);
-  world_ = std::make_unique<OdeWorld>(model_, shapes, wo, servos_.q0());
-  base_->Attach(*world_, servos_, shapes);
+  ode_detail::DriverWorld built =
+      ode_detail::BuildDriverWorld(model_, options_, servos_.q0(), std::move(shapes));
+  base_ = std::move(built.base);
+  world_ = std::move(built.world);
+  base_->Attach(*world_, servos_, built.shapes);
 }
 
 // ---------------------------------------------------------------- time

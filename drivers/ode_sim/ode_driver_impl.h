@@ -23,6 +23,23 @@
 
 namespace robotalk {
 
+namespace ode_detail {
+/// The model as an ode driver sees it: the option "base" applied to its first root.
+RobotModel DriverModel(RobotModel model, const OdeDriverOptions& options);
+
+/// The ODE world an ode driver builds, and the base controller that prepared
+/// it (not attached yet; OdeDriver's constructor attaches it).
+struct DriverWorld {
+  std::unique_ptr<BaseController> base;
+  std::unique_ptr<OdeWorld> world;
+  std::vector<CollisionShape> shapes;  ///< as the base prepared them
+};
+/// REQUIRES: `model` from DriverModel, `options` validated, `q0` the servos'
+/// start pose. robotalk-ode-bench steps this world bare, against the driver.
+DriverWorld BuildDriverWorld(const RobotModel& model, const OdeDriverOptions& options,
+                             const Eigen::VectorXd& q0, std::vector<CollisionShape> shapes);
+}  // namespace ode_detail
+
 class OdeDriver::Impl {
  public:
   Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes);

@@ -167,6 +167,13 @@ int RunReset(const GlobalOptions& g, const std::vector<std::string>& args) {
   ExitAfterOutput(ExitStatus(r));
 }
 
+namespace {
+// Servers announce once a second: three periods without an announcement or a
+// STATE sample mean the server is gone.
+constexpr Duration kServerSilence = std::chrono::seconds(3);
+constexpr Duration kStreamCancelWait = std::chrono::milliseconds(200);
+}  // namespace
+
 int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   std::vector<std::string> args = in;
   std::string period = "0.1", duration, count;
@@ -184,12 +191,15 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     throw UsageError("watch: --period must be >= 0.001 s, --duration and --count positive");
   }
   const auto client = ConnectClient(g, args[0]);
+  AnnounceWatch announces(g.url);  // with the STATE samples: is the server still there?
   std::cerr << "robotalk: watching ROBOTALK/" << args[0] << "/STATE (asked every " << FormatSeconds(period_s)
             << "; Ctrl-C ends)\n";
   std::mutex mu;
-  double samples = 0;
+  double samples = 0;                           // GUARDED_BY(mu)
+  TimePoint last_sample = SteadyClock().Now();  // GUARDED_BY(mu)
   const Duration actual = client->StartStateStream(FromSeconds(period_s), [&](const StateSample& s) {
     std::lock_guard lock(mu);
+    last_sample = SteadyClock().Now();
     if (samples >= max_samples) return;
     if (json) {
       std::cout << StateJson(s) << '\n' << std::flush;
@@ -208,23 +218,49 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     std::cerr << "robotalk: the stream runs every " << FormatDuration(actual)
               << " (another client asked for faster)\n";
   }
-  // Ends at --duration, --count or a signal (the usual end: exit 0).
+  // Ends at --duration, --count or a signal (exit 0), or when the server has
+  // gone quiet: no STATE sample and no announcement for kServerSilence (exit 1).
   Interrupter::Defer(true);
-  const TimePoint end = SteadyClock().Now() + FromSeconds(std::min(duration_s, 1e9));
+  const TimePoint start = SteadyClock().Now();
+  const TimePoint end = start + FromSeconds(std::min(duration_s, 1e9));
+  bool gone = false;
   while (SteadyClock().Now() < end && !Interrupter::Signal()) {
+    TimePoint heard = announces.LastHeard(args[0]).value_or(start);
     {
       std::lock_guard lock(mu);
       if (samples >= max_samples) break;
+      heard = std::max(heard, last_sample);
+    }
+    if (SteadyClock().Now() - heard > kServerSilence) {
+      gone = true;
+      break;
     }
     Interrupter::WaitFor(std::min<Duration>(std::chrono::milliseconds(20), end - SteadyClock().Now()));
   }
-  client->StopStateStream();
+  const auto streaming = [&] {  // samples still arrive (not under `mu` while the cancel waits)
+    std::lock_guard lock(mu);
+    return SteadyClock().Now() - last_sample < std::max<Duration>(3 * actual, kStreamCancelWait);
+  };
+  if (gone) {
+    std::cerr << "robotalk: " << args[0] << ": no STATE sample and no announcement for "
+              << FormatDuration(kServerSilence)
+              << ": its server is gone (stopped, crashed or unreachable); watch ends\n";
+  } else if (streaming()) {
+    // The stream runs: ask the server to end it now (it ends with this
+    // client's session anyway), never waiting long for the answer, and not
+    // at all when the samples stopped (a server gone: Ctrl-C ends at once).
+    try {
+      client->SendQuery({.type = QueryType::kStateStreamCancel}).Wait(kStreamCancelWait);
+    } catch (const std::exception&) {
+    }
+  }
   if (const std::uint64_t refused = client->stats().broadcasts_refused; refused > 0) {
     std::cerr << "robotalk: dropped " << refused
               << " STATE/CONFIG messages not signed by the server's key (forged, replayed, or of another "
                  "server)\n";
   }
-  return 0;
+  // No teardown: the sample callback must not outlive `mu` and `samples`.
+  ExitAfterOutput(gone ? 1 : 0);
 }
 
 }  // namespace robotalk::cli

@@ -105,14 +105,7 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
     std::cerr << "robotalk: playback: the server starts the sequence "
               << FormatDuration(*report.playback_delay) << " after its first frame arrived\n";
   }
-  if (report.signal) {
-    const int code = Interrupted(report.signal, report.interrupt_note);
-    if (report.worker_abandoned) {
-      std::fflush(stdout);
-      std::_Exit(code);
-    }
-    return code;
-  }
+  if (report.signal) return Interrupted(report.signal, report.interrupt_note);
   return status;
 }
 

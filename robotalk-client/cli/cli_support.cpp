@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -30,15 +31,16 @@ struct AnnounceWatch::Impl {
   std::string url;
   int wake[2] = {-1, -1};
   mutable std::mutex mu;
-  std::set<std::string> names;  // GUARDED_BY(mu)
+  std::map<std::string, TimePoint> heard;  // GUARDED_BY(mu): robot -> last announce (steady clock)
   std::thread thread;
 
   void On(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     try {  // the checked decoder; a hostile ANNOUNCE is dropped, never thrown through LCM
       const Announcement a =
           DecodeAnnouncement({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+      const TimePoint now = SteadyClock().Now();
       std::lock_guard lock(mu);
-      for (const auto& r : a.robots) names.insert(r.name);
+      for (const auto& r : a.robots) heard[r.name] = now;
     } catch (const ProtocolError&) {
     }
   }
@@ -85,7 +87,16 @@ AnnounceWatch::~AnnounceWatch() {
 
 std::set<std::string> AnnounceWatch::Heard() const {
   std::lock_guard lock(impl_->mu);
-  return impl_->names;
+  std::set<std::string> names;
+  for (const auto& entry : impl_->heard) names.insert(entry.first);
+  return names;
+}
+
+std::optional<TimePoint> AnnounceWatch::LastHeard(const std::string& robot) const {
+  std::lock_guard lock(impl_->mu);
+  auto it = impl_->heard.find(robot);
+  if (it == impl_->heard.end()) return std::nullopt;
+  return it->second;
 }
 
 ClientOptions MakeOptions(const GlobalOptions& g) {
@@ -131,6 +142,12 @@ std::unique_ptr<RobotClient> ConnectClient(const GlobalOptions& g, const std::st
         throw ClientError("no robot '" + robot + "' on this network (no server announced itself within " +
                           FormatDuration(options.connect_timeout) +
                           "; is robotalk-server running with this --url?)");
+      // A --timeout shorter than an announce period cannot rule a server
+      // out, but the likely cause is still the same: say that, not HELLO.
+      throw ClientError("no robot '" + robot + "' answered within " + FormatDuration(total) +
+                        " and no server announced itself meanwhile; is robotalk-server running with this "
+                        "--url? (servers announce once a second: a --timeout under " +
+                        FormatDuration(kAnnounceWait) + " may miss one)");
     }
     if (options.connect_timeout >= total) throw;
   }

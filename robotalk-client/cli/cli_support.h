@@ -7,6 +7,7 @@
 
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -23,6 +24,8 @@ class AnnounceWatch {
   AnnounceWatch& operator=(const AnnounceWatch&) = delete;
   /// Robot names heard so far, sorted.
   std::set<std::string> Heard() const;
+  /// When `robot` was last announced (steady clock), or nullopt.
+  std::optional<TimePoint> LastHeard(const std::string& robot) const;
 
  private:
   struct Impl;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <stop_token>
 #include <thread>
 
 namespace robotalk::cli {
@@ -25,6 +26,10 @@ std::mutex& Mu() {
 std::condition_variable& Cv() {
   static auto* cv = new std::condition_variable;
   return *cv;
+}
+std::stop_source& Stop() {
+  static auto* source = new std::stop_source;
+  return *source;
 }
 
 sigset_t Signals() {
@@ -50,6 +55,7 @@ void WaitForSignals() {
       g_signal.store(sig);
     }
     Cv().notify_all();
+    Stop().request_stop();
   }
 }
 
@@ -59,6 +65,7 @@ void Interrupter::Install() {
   if (g_installed.exchange(true)) return;
   Mu();  // constructed here, before the signal thread can need them
   Cv();
+  Stop();
   const sigset_t set = Signals();
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   std::thread(WaitForSignals).detach();
@@ -67,6 +74,8 @@ void Interrupter::Install() {
 void Interrupter::Defer(bool defer) { g_defer.store(defer); }
 
 int Interrupter::Signal() { return g_signal.load(); }
+
+std::stop_token Interrupter::StopToken() { return Stop().get_token(); }
 
 int Interrupter::WaitFor(Duration d) {
   std::unique_lock lock(Mu());

@@ -16,6 +16,8 @@
 
 #include "robotalk/clock.h"
 
+#include <stop_token>
+
 namespace robotalk::cli {
 
 class Interrupter {
@@ -28,6 +30,9 @@ class Interrupter {
   static int Signal();
   /// Waits at most `d`, returning early when a signal arrives; returns Signal().
   static int WaitFor(Duration d);
+  /// Requested when the first signal is recorded: waits that take a
+  /// std::stop_token (PendingReply::WaitFor, SequenceHooks::stop) end at once.
+  static std::stop_token StopToken();
   /// "SIGINT", "SIGTERM".
   static const char* Name(int signal);
   /// The conventional exit status after `signal`: 128 + signal.

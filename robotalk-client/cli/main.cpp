@@ -37,7 +37,9 @@ constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] [--k
                                       server picks the delay); --paced sends each frame
                                       at its time instead of all at once
   watch ROBOT [--period S] [--duration S] [--count N] [--json]
-                                      broadcast mode: print the state stream (default 0.1 s)
+                                      broadcast mode: print the state stream (default 0.1 s);
+                                      exits 1 when the server is gone (3 s without STATE
+                                      or announce), 0 at the end or on Ctrl-C
   panic ROBOT                         panic: stop everything, refuse commands
   reset ROBOT                         PANIC_RESET
 

@@ -3,9 +3,11 @@
 // progress and watching for Ctrl-C / SIGTERM (interrupt.h). Used by
 // `robotalk send` and `robotalk-logplay replay`.
 //
-// Unlike RobotClient::RunSequence, nothing here times out while the server
-// keeps answering (a 30 s GOTO is waited for); a dead server still ends the
-// wait with TimeoutError once the client gives up retransmitting.
+// Sequences run through RobotClient::RunSequence (SequenceHooks): unlike its
+// default, nothing here times out while the server keeps answering (a 30 s
+// GOTO is waited for); a dead server still ends the wait with TimeoutError
+// once the client gives up retransmitting. Every wait wakes at once for its
+// reply (no polling slices).
 //
 // On a signal the runner stops what it started: it stops sending frames,
 // sends STOP at once, and (delay mode) a STOP at the start time of every
@@ -16,22 +18,19 @@
 // calling thread.
 #pragma once
 
+#include "interrupt.h"
 #include "robotalk/robot_client.h"
 
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <vector>
 
 namespace robotalk::cli {
 
-struct RunProgress {
-  std::size_t answered = 0;
-  std::size_t total = 0;
-  Duration elapsed{0};   ///< since the sequence's offset 0 (negative before it)
-  Duration duration{0};  ///< the last frame's offset
-};
+using RunProgress = SequenceProgress;
 
 struct RunReport {
   /// One per frame, in the order given; nullopt when never answered (interrupted).
@@ -39,8 +38,8 @@ struct RunReport {
   int signal = 0;                          ///< the interrupting signal, 0 when none
   std::string interrupt_note;              ///< what was done about it (STOP sent ...)
   std::optional<Duration> playback_delay;  ///< playback: the server's choice
-  /// Playback only: RunSequence still runs on a thread of its own; the caller
-  /// must end the process (std::_Exit) instead of destroying the client.
+  /// Always false: RunSequence now ends on a stop request in every mode (it
+  /// ran on an abandoned thread in playback before). Kept for callers.
   bool worker_abandoned = false;
   /// Delay mode: frames whose outcome is unknown (the client gave up, or the
   /// server instance that had them restarted): index and why, every one of them.
@@ -50,14 +49,15 @@ struct RunReport {
 using ReplyCallback = std::function<void(std::size_t index, const Reply& reply)>;
 using ProgressCallback = std::function<void(const RunProgress& progress)>;
 
-/// Sends `frames` in `options.mode` (direct: one handshake per frame at its
-/// time; delay: start = server now + delay + offset, all at once or paced;
-/// playback: RobotClient::RunSequence on a worker thread) and waits for every
-/// reply. `on_reply` gets each reply (delay and playback: in the order given;
-/// direct: in time order); `on_progress` is called about every 50 ms.
-/// Throws TimeoutError / ClientError from the client.
+/// Sends `frames` in `options.mode` through RobotClient::RunSequence and waits
+/// for every reply. `on_reply` gets each reply (delay and playback: in the
+/// order given; direct: in time order); `on_progress` is called about every
+/// 50 ms. `stop` (default: Ctrl-C / SIGTERM) ends the run at once; the runner
+/// then sends STOP (and, delay mode, a STOP for each frame still queued) and
+/// says so in RunReport::interrupt_note. Throws TimeoutError / ClientError.
 RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const SequenceOptions& options,
-                    const ReplyCallback& on_reply, const ProgressCallback& on_progress);
+                    const ReplyCallback& on_reply, const ProgressCallback& on_progress,
+                    std::stop_token stop = Interrupter::StopToken());
 
 /// Waits for one pending reply with no time limit, calling `on_progress`
 /// (time since the wait began) about every 50 ms. Returns nullopt when a

@@ -5,17 +5,33 @@
 #include "sequence_plan.h"
 
 #include <algorithm>
-#include <thread>
+#include <condition_variable>
+#include <mutex>
+#include <stop_token>
 
 namespace robotalk {
 namespace {
 
-// Waits until the client's clock reaches `t`, re-reading it at least every
-// 10 ms of real time (a ManualClock moves when a test says so).
-void WaitUntil(const Clock& clock, TimePoint t) {
-  for (Duration left = t - clock.Now(); left > Duration(0); left = t - clock.Now()) {
-    std::this_thread::sleep_for(std::min<Duration>(left, std::chrono::milliseconds(10)));
+using std::chrono::milliseconds;
+
+// How long to block now, for a deadline on the client's clock: a clock other
+// than the steady one (a ManualClock moves when a test says so) is re-read
+// at least every 10 ms of real time.
+Duration RealWait(const Clock& clock, bool steady, TimePoint t) {
+  const Duration left = std::max(Duration(0), t - clock.Now());
+  return steady ? left : std::min<Duration>(left, milliseconds(10));
+}
+
+// Sleeps until the client's clock reaches `t`; false when `stop` came first.
+bool SleepUntil(const Clock& clock, bool steady, TimePoint t, const std::stop_token& stop) {
+  std::mutex mu;
+  std::condition_variable_any cv;
+  std::unique_lock lock(mu);
+  while (clock.Now() < t) {
+    cv.wait_for(lock, stop, RealWait(clock, steady, t), [] { return false; });
+    if (stop.stop_requested()) return false;
   }
+  return !stop.stop_requested();
 }
 
 }  // namespace
@@ -51,49 +67,50 @@ CommandId RobotClient::Impl::NewId() {
   return next_id_++;
 }
 
-SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options) {
+SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options,
+                                        const SequenceHooks& hooks) {
   if (!connected()) throw ClientError("RobotClient::RunSequence: not connected (call Connect first)");
   const client::SequencePlan plan = client::PlanSequence(frames, options);
   SequenceResult result;
   result.replies.resize(frames.size());
   if (frames.empty()) return result;
-  const Duration duration = plan.duration;
   const Clock& clock = impl_->clock_;
+  const bool steady = &clock == &impl_->steady_clock_;
+  const std::stop_token& stop = hooks.stop;
   const TimePoint t0 = clock.Now();
   result.first_sent = t0;
   client::SequencePacer pacer(plan, t0);
 
-  if (options.mode == CommandMode::kDirect) {
-    // The handshake: the next frame cannot leave before the previous reply is
-    // in, so a slow channel stretches the sequence (the paper's Fig. 11).
-    while (auto due = pacer.NextDeadline()) {
-      WaitUntil(clock, *due);
-      for (std::size_t i : pacer.NextDue(clock.Now())->frames) {
-        Command c = std::move(frames[i].command);
-        c.start_time = client::FrameStart(CommandMode::kDirect, frames[i].offset, {});
-        result.replies[i] = Execute(std::move(c));
-      }
-    }
-    return result;
-  }
-
   std::optional<PendingReply> delay_reply;
-  PackageOptions package{.mode = RequestMode::kDelay};
-  TimePoint server_start{};
+  PackageOptions package{.mode = RequestMode::kDirect};
+  TimePoint server_start{};  // known from the start in delay mode, after the delay reply in playback
+  bool start_known = false;
   if (options.mode == CommandMode::kPlayback) {
     package = {.mode = RequestMode::kPlayback,
-               .playback = {impl_->NewId(), static_cast<std::int64_t>(frames.size()), duration},
+               .playback = {impl_->NewId(), static_cast<std::int64_t>(frames.size()), plan.duration},
                .ask_for_delay = true};
     impl_->cache_->Expect(package.playback.id);
     delay_reply = impl_->MakePending(package.playback.id, "PLAYBACK " + std::to_string(package.playback.id));
-  } else {
+  } else if (options.mode == CommandMode::kDelay) {
+    package.mode = RequestMode::kDelay;
     server_start = ServerTime(t0) + options.delay;
     result.server_start = server_start;
+    start_known = true;
   }
 
   std::vector<std::optional<PendingReply>> pending(frames.size());
-  while (auto due = pacer.NextDeadline()) {
-    WaitUntil(clock, *due);
+  std::size_t answered = 0;
+  std::chrono::steady_clock::time_point next_progress = std::chrono::steady_clock::now();
+  const auto progress = [&] {
+    const auto now = std::chrono::steady_clock::now();
+    if (!hooks.on_progress || now < next_progress) return;
+    hooks.on_progress({answered, frames.size(), start_known ? ServerNow() - server_start : clock.Now() - t0,
+                       plan.duration});
+    next_progress =
+        now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(hooks.progress_every);
+  };
+  // Sends the next package of the plan (due now).
+  const auto send_next = [&] {
     const client::PlannedSend& send = *pacer.NextDue(clock.Now());
     std::vector<Command> commands;
     for (std::size_t i : send.frames) {
@@ -107,26 +124,134 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       pending[send.frames[j]] =
           impl_->MakePending(sent.ids[j], "sequence frame " + std::to_string(send.frames[j]));
     }
-  }
-
-  if (delay_reply) {
-    // The server answers once it has seen enough frames to estimate.
-    const Reply r = delay_reply->Wait(duration + impl_->options_.timeout);
-    if (r.values.size() >= 2) {
-      result.playback_delay = FromSeconds(r.values[0]);
-      result.server_start = FromWireMicros(static_cast<std::int64_t>(r.values[1]));
-      server_start = *result.server_start;
-      std::vector<std::pair<CommandId, TimePoint>> starts;
-      for (std::size_t i = 0; i < frames.size(); ++i) {
-        if (pending[i]) starts.emplace_back(pending[i]->id(), server_start + frames[i].offset);
-      }
-      impl_->SetStartTimes(starts);
+    result.frames_sent += send.frames.size();
+  };
+  // Waits for frame i's reply until `until` on the client's clock (nullopt:
+  // until its own deadline), waking for the reply, a stop, and progress.
+  // Returns whether frame i is settled (answered, or of unknown outcome).
+  std::optional<std::chrono::steady_clock::time_point> deadline;  // of the frame waited for
+  Duration allowed{0};                                            // what `deadline` allows
+  const auto wait_frame = [&](std::size_t i, std::optional<TimePoint> until) {
+    // Playback: no frame's start is known before the delay reply.
+    if (!deadline && !hooks.wait_until_given_up && !delay_reply) {
+      // Each reply can come no earlier than its start time.
+      Duration until_start{0};
+      if (start_known) until_start = std::max(Duration(0), server_start + frames[i].offset - ServerNow());
+      allowed = until_start + impl_->options_.timeout;
+      deadline = std::chrono::steady_clock::now() +
+                 std::chrono::duration_cast<std::chrono::steady_clock::duration>(allowed);
     }
+    for (;;) {
+      progress();
+      auto wake = std::min(next_progress, deadline.value_or(std::chrono::steady_clock::time_point::max()));
+      if (until) wake = std::min(wake, std::chrono::steady_clock::now() + RealWait(clock, steady, *until));
+      std::optional<Reply> r;
+      try {
+        r = pending[i]->WaitFor(std::max(Duration(0), wake - std::chrono::steady_clock::now()), stop);
+      } catch (const UnknownOutcomeError& e) {
+        if (!hooks.collect_unknown_outcomes) throw;
+        result.unknown_outcomes.emplace_back(i, e.what());
+        deadline.reset();
+        return true;
+      }
+      if (r) {
+        result.replies[i] = *r;
+        ++answered;
+        deadline.reset();
+        if (hooks.on_reply) hooks.on_reply(i, result.replies[i]);
+        return true;
+      }
+      if (stop.stop_requested() || (until && clock.Now() >= *until)) return false;
+      if (deadline && std::chrono::steady_clock::now() >= *deadline) {
+        impl_->RethrowDaemonError();
+        throw TimeoutError("sequence frame " + std::to_string(i) + " (id " +
+                           std::to_string(pending[i]->id()) + "): no reply within " +
+                           std::to_string(ToSeconds(allowed)) + " s");
+      }
+    }
+  };
+
+  std::size_t next_reply = 0;  // frames are reported in the order given (direct: in plan order)
+  std::vector<std::size_t> report_order(frames.size());
+  if (options.mode == CommandMode::kDirect) {
+    report_order.clear();
+    for (const auto& send : plan.sends)
+      report_order.insert(report_order.end(), send.frames.begin(), send.frames.end());
+  } else {
+    for (std::size_t i = 0; i < frames.size(); ++i) report_order[i] = i;
   }
+  while (next_reply < frames.size() && !stop.stop_requested()) {
+    const std::optional<TimePoint> due = pacer.NextDeadline();
+    const std::size_t i = report_order[next_reply];
+    if (options.mode == CommandMode::kDirect) {
+      // The handshake: a frame leaves at its time, never before the previous
+      // reply, so a slow channel stretches the sequence (the paper's Fig. 11).
+      if (!SleepUntil(clock, steady, *due, stop)) break;
+      send_next();
+      if (!wait_frame(i, std::nullopt)) break;
+      ++next_reply;
+      continue;
+    }
+    if (due && clock.Now() >= *due) {
+      send_next();
+      continue;
+    }
+    if (!due && delay_reply && !start_known) {
+      // Playback: the server answers once it has seen enough frames to estimate.
+      const Duration most = plan.duration + impl_->options_.timeout;
+      const auto give_up = std::chrono::steady_clock::now() +
+                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(most);
+      std::optional<Reply> r;
+      while (!r && !stop.stop_requested()) {
+        progress();
+        const auto now = std::chrono::steady_clock::now();
+        if (!hooks.wait_until_given_up && now >= give_up) {
+          throw TimeoutError("PLAYBACK " + std::to_string(delay_reply->id()) + ": no delay reply within " +
+                             std::to_string(ToSeconds(most)) + " s");
+        }
+        r = delay_reply->WaitFor(
+            std::min(next_progress, hooks.wait_until_given_up ? next_progress : give_up) - now, stop);
+      }
+      if (!r) break;
+      start_known = true;
+      if (r->values.size() >= 2) {
+        result.playback_delay = FromSeconds(r->values[0]);
+        result.server_start = FromWireMicros(static_cast<std::int64_t>(r->values[1]));
+        server_start = *result.server_start;
+        std::vector<std::pair<CommandId, TimePoint>> starts;
+        for (std::size_t k = 0; k < frames.size(); ++k) {
+          if (pending[k]) starts.emplace_back(pending[k]->id(), server_start + frames[k].offset);
+        }
+        impl_->SetStartTimes(starts);
+      } else {
+        start_known = false;
+      }
+      delay_reply.reset();
+      continue;
+    }
+    if (!pending[i]) {  // not sent yet (paced, a later offset than frames sent after it)
+      if (!SleepUntil(clock, steady, *due, stop)) break;
+      continue;
+    }
+    if (wait_frame(i, due)) ++next_reply;
+  }
+  if (!stop.stop_requested() || next_reply == frames.size()) return result;
+
+  result.stopped = true;
+  if (options.mode != CommandMode::kDelay) return result;
+  // Frames already queued on the server would still run: say which.
+  const TimePoint now = ServerNow();
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    // Each reply can come no earlier than its start time.
-    const Duration until_start = std::max(Duration(0), server_start + frames[i].offset - ServerNow());
-    result.replies[i] = pending[i]->Wait(until_start + impl_->options_.timeout);
+    if (!pending[i] || result.replies[i].id != 0) continue;
+    try {
+      if (auto r = pending[i]->Poll()) {
+        result.replies[i] = *r;
+        continue;
+      }
+    } catch (const Error&) {
+      continue;  // given up on: nothing to stop
+    }
+    if (server_start + frames[i].offset > now) result.queued.push_back(server_start + frames[i].offset);
   }
   return result;
 }

@@ -72,13 +72,15 @@ ReturnCache::Outcome ReturnCache::Take(CommandId id) {
   return TakeLocked(id);
 }
 
-ReturnCache::Outcome ReturnCache::WaitTake(CommandId id, std::chrono::steady_clock::time_point deadline) {
+ReturnCache::Outcome ReturnCache::WaitTake(CommandId id, std::chrono::steady_clock::time_point deadline,
+                                           std::stop_token stop) {
   std::unique_lock lock(mu_);
-  for (;;) {
-    Outcome o = TakeLocked(id);
-    if (o.kind != Kind::kPending) return o;
-    if (cv_.wait_until(lock, deadline) == std::cv_status::timeout) return TakeLocked(id);
-  }
+  Outcome o;
+  cv_.wait_until(lock, stop, deadline, [&] {
+    o = TakeLocked(id);
+    return o.kind != Kind::kPending;
+  });
+  return o;
 }
 
 ReturnCache::Outcome ReturnCache::TakeLocked(CommandId id) {

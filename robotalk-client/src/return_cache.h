@@ -20,6 +20,7 @@
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <unordered_map>
 
@@ -52,9 +53,10 @@ class ReturnCache {
 
   /// The outcome now; kReply/kFailed remove the entry (collected).
   Outcome Take(CommandId id);
-  /// Waits until the id has an outcome or `deadline` passes (then kPending).
-  /// A reply or failure is removed from the cache when returned.
-  Outcome WaitTake(CommandId id, std::chrono::steady_clock::time_point deadline);
+  /// Waits until the id has an outcome, `deadline` passes or `stop` is
+  /// requested (then kPending); wakes at once for each. A reply or failure
+  /// is removed from the cache when returned.
+  Outcome WaitTake(CommandId id, std::chrono::steady_clock::time_point deadline, std::stop_token stop = {});
 
   /// Ids registered and not yet collected (pending or answered).
   std::size_t size() const;
@@ -70,7 +72,7 @@ class ReturnCache {
 
   const std::size_t capacity_;
   mutable std::mutex mu_;
-  std::condition_variable cv_;
+  std::condition_variable_any cv_;                // _any: waits that a std::stop_token can end
   std::unordered_map<CommandId, Entry> entries_;  // GUARDED_BY(mu_)
   std::deque<CommandId> answered_order_;          // GUARDED_BY(mu_), may hold stale ids
   std::size_t num_answered_ = 0;                  // GUARDED_BY(mu_)

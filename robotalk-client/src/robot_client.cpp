@@ -94,6 +94,13 @@ Reply PendingReply::Wait(Duration timeout) {
   return *reply_;
 }
 
+std::optional<Reply> PendingReply::WaitFor(Duration most, std::stop_token stop) {
+  if (reply_) return reply_;
+  if (!cache_) throw ClientError("PendingReply::WaitFor: moved-from handle");
+  reply_ = Resolve(cache_->WaitTake(id_, SteadyAfter(most), std::move(stop)), id_, what_);
+  return reply_;
+}
+
 // --- ListRobots --------------------------------------------------------------
 
 std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen) {

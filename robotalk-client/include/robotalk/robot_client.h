@@ -32,7 +32,9 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stop_token>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace robotalk {
@@ -135,6 +137,10 @@ class PendingReply {
   std::optional<Reply> Poll();
   /// Waits at most `timeout` for the reply; throws TimeoutError.
   Reply Wait(Duration timeout);
+  /// Waits at most `most` for the reply, waking at once when it arrives or
+  /// when `stop` is requested; nullopt when `most` passed or `stop` came
+  /// first. Throws as Poll() does when the client gave up on it.
+  std::optional<Reply> WaitFor(Duration most, std::stop_token stop = {});
 
  private:
   friend class RobotClient;
@@ -176,11 +182,54 @@ struct SequenceOptions {
   std::size_t batch = 200;
 };
 
+/// How far a running sequence is (SequenceHooks::on_progress).
+struct SequenceProgress {
+  std::size_t answered = 0;  ///< frames whose reply is in
+  std::size_t total = 0;
+  Duration elapsed{0};   ///< since the sequence's offset 0 (delay mode: negative before it)
+  Duration duration{0};  ///< the last frame's offset
+};
+
+/// What a caller watching a running sequence gets, and how it ends one early
+/// (the robotalk CLI: replies printed as they come, a progress bar, Ctrl-C).
+/// The callbacks run on the thread that called RunSequence.
+struct SequenceHooks {
+  /// Each frame's reply as it is collected: delay and playback in the order
+  /// given, direct in offset order (the order they are sent).
+  std::function<void(std::size_t index, const Reply& reply)> on_reply;
+  /// Called about every `progress_every` while the sequence runs.
+  std::function<void(const SequenceProgress& progress)> on_progress;
+  Duration progress_every = std::chrono::milliseconds(50);
+  /// A stop request ends RunSequence at once (no further frame sent or
+  /// waited for; SequenceResult::stopped). It stops nothing on the robot:
+  /// send STOP yourself; SequenceResult::queued lists what a delay sequence
+  /// still has queued on the server.
+  std::stop_token stop;
+  /// Waits for each reply however long its command runs, as long as the
+  /// server acknowledges the package (a dead server still ends the wait once
+  /// the client gives up retransmitting), instead of at most
+  /// ClientOptions::timeout after the frame's start.
+  bool wait_until_given_up = false;
+  /// A frame whose outcome is unknown (UnknownOutcomeError) is listed in
+  /// SequenceResult::unknown_outcomes and the others are still waited for,
+  /// instead of RunSequence throwing.
+  bool collect_unknown_outcomes = false;
+};
+
 struct SequenceResult {
-  std::vector<Reply> replies;              ///< one per frame, in the order given
+  /// One per frame, in the order given. A frame without a reply (stopped
+  /// early, or of unknown outcome) keeps a default Reply with id 0.
+  std::vector<Reply> replies;
   TimePoint first_sent{};                  ///< client clock, when the first frame left
   std::optional<TimePoint> server_start;   ///< server time of offset 0 (delay, playback)
   std::optional<Duration> playback_delay;  ///< playback: the delay the server chose after its first frame
+  bool stopped = false;                    ///< SequenceHooks::stop ended it
+  std::size_t frames_sent = 0;
+  /// Stopped, delay mode: the server start time of every frame sent and not
+  /// answered whose start had not come (it is still queued on the server).
+  std::vector<TimePoint> queued;
+  /// SequenceHooks::collect_unknown_outcomes: each frame of unknown outcome and why.
+  std::vector<std::pair<std::size_t, std::string>> unknown_outcomes;
 };
 
 /// A robot offered by a server, from its announce message.
@@ -297,9 +346,11 @@ class RobotClient {
 
   // --- Command modes (docs/client.md, "Modes") ---------------------------------
   /// Sends `frames` in `options.mode` and waits for every reply (each at most
-  /// ClientOptions::timeout after its start). Returns the replies in the order
-  /// given. Throws TimeoutError, ClientError.
-  SequenceResult RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options);
+  /// ClientOptions::timeout after its start, unless `hooks` say otherwise);
+  /// each wait wakes at once when its reply arrives. Returns the replies in
+  /// the order given. Throws TimeoutError, UnknownOutcomeError, ClientError.
+  SequenceResult RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options,
+                             const SequenceHooks& hooks = {});
 
   /// Broadcast mode: asks the server to publish the robot's state every
   /// `period` on ROBOTALK/<robot>/STATE (one stream per robot, shared with
