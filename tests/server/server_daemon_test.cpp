@@ -239,6 +239,64 @@ TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
   std::remove(latch.c_str());
 }
 
+// Reads the latch file whenever the server publishes a reply that answers
+// ERROR: what was on disk at the moment it left.
+class LatchAtErrorTransport final : public Transport {
+ public:
+  LatchAtErrorTransport(std::shared_ptr<MemoryBus> bus, std::string latch)
+      : inner_(std::move(bus)), latch_(std::move(latch)) {}
+  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+    if (ParseReplyChannel(channel)) {
+      for (const Reply& r : DecodeReplyBatch(bytes).replies) {
+        if (r.signal != Signal::kError) continue;
+        std::ifstream file(latch_);
+        on_disk_at_error.assign(std::istreambuf_iterator<char>(file), {});
+      }
+    }
+    inner_.Publish(channel, bytes);
+  }
+  std::unique_ptr<Subscription> Subscribe(const std::string& regex, Handler handler) override {
+    return inner_.Subscribe(regex, std::move(handler));
+  }
+  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
+  int fileno() const override { return inner_.fileno(); }
+  std::string url() const override { return inner_.url(); }
+
+  std::string on_disk_at_error;
+
+ private:
+  MemoryTransport inner_;
+  std::string latch_;
+};
+
+// Issue 20: the latch is written in one place (ServerDaemon::Drain), for a
+// panic the RobotDaemon latched itself (a driver fault) as for a client's,
+// before the fault's ERROR leaves.
+TEST(ServerDaemonPanicLatch, ADriverFaultIsOnDiskBeforeItsErrorIsSent) {
+  const std::string latch = ::testing::TempDir() + "/panic_latch_fault_test.txt";
+  std::remove(latch.c_str());
+  ManualClock clock;
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport client(bus);
+  LatchAtErrorTransport transport(bus, latch);
+  auto driver = std::make_unique<FakeDriver>(PanRobot());
+  driver->throw_on_execute = "serial port write failed";
+  RobotDaemon robot("bot", "fake", std::move(driver), clock);
+  ServerDaemon server(transport, clock, ServerDaemonOptions{.panic_latch_path = latch});
+  server.AddRobot(robot, SessionOptions{});
+  const std::int64_t session =
+      SayHello(client, "bot", kAlice, [&] { server.RunOnce(Duration(0)); }).session_id;
+  Request move{.client_id = kAlice, .session_id = session, .sequence = 1};
+  move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+  client.Publish(RequestChannel("bot"), EncodeRequest(move));
+  server.RunOnce(Duration(0));
+  robot.RunOnce(clock.Now());  // the driver throws: a fault, panic
+  server.RunOnce(Duration(0));
+  EXPECT_THAT(transport.on_disk_at_error,
+              HasSubstr("bot\tdriver 'fake' threw in Execute: serial port write failed"));
+  std::remove(latch.c_str());
+}
+
 }  // namespace
 }  // namespace robotalk
 
