@@ -9,9 +9,10 @@
 // RobotSessions directly).
 //
 // Threads:
-// - the ServerDaemon calls Submit(), FlushAll(), SetStream(), QueueStop(),
-//   RequestHalt()/RequestResume(), TakeOutput() and the accessors; each takes
-//   the short inbox/outbox lock (mutex_) and never waits on the driver;
+// - the ServerDaemon calls Submit(), Panic(), ResetPanic(), SetStream(),
+//   QueueStop(), TakeOutput() and the accessors; each takes the short
+//   inbox/outbox lock (mutex_) or the PanicState's and never waits on the
+//   driver;
 // - the RobotDaemon thread (Start()) runs RunOnce() at each deadline (a start
 //   time, a driver period, a state sample), with absolute deadlines. It holds
 //   mutex_ only to take due items and to append to the outbox, never while
