@@ -17,6 +17,15 @@ std::string Seconds(Duration d) {
   return buf;
 }
 
+// Zero joints, the roots where the model puts them: sized for the model, so
+// later reads and copies do not allocate.
+RobotState InitialState(const RobotModel& m) {
+  RobotState s;
+  for (Eigen::VectorXd* v : {&s.position, &s.velocity, &s.effort}) *v = Eigen::VectorXd::Zero(m.num_dofs());
+  for (const RootLink& r : m.roots()) s.root_poses.push_back(r.pose_in_world);
+  return s;
+}
+
 }  // namespace
 
 RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::unique_ptr<Driver> driver,
@@ -26,14 +35,16 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
       driver_(std::move(driver)),
       clock_(clock),
       options_(options),
-      kinematics_(driver_->model()) {
+      waiter_(clock, DeadlineOptions{.precise = options.precise_timing,
+                                     .final_spin = options.final_spin,
+                                     .spin_share = options.spin_share,
+                                     .fifo_priority = options.fifo_priority}),
+      woken_([this] { return wake_flag_ || !running_ || flush_deferred_.load(); }),
+      kinematics_(driver_->model()),
+      snapshot_(driver_->model(), InitialState(driver_->model()), clock, panic_) {
   const RobotModel& m = model();
-  for (Eigen::VectorXd* v : {&state_.position, &state_.velocity, &state_.effort})
-    *v = Eigen::VectorXd::Zero(m.num_dofs());
-  for (const RootLink& r : m.roots()) {
-    state_.root_poses.push_back(r.pose_in_world);
-    roots_.push_back(r.pose_in_world.ToIsometry());
-  }
+  state_ = InitialState(m);
+  for (const RootLink& r : m.roots()) roots_.push_back(r.pose_in_world.ToIsometry());
   for (Eigen::VectorXd* v : {&sample_.position, &sample_.velocity, &sample_.effort})
     *v = Eigen::VectorXd::Zero(m.num_dofs());
   sample_.frame_poses.assign(7 * m.frames().size(), 0.0);
@@ -43,11 +54,6 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
   produced_.executed.reserve(256);
   Preallocate(outbox_);
   in_progress_.reserve(64);
-  snapshot_.state = state_;
-  direct_state_ = snapshot_;
-  direct_kinematics_ = std::make_unique<Kinematics>(m);
-  direct_roots_ = roots_;
-  direct_.reserve(16);
 }
 
 RobotDaemon::~RobotDaemon() { Stop(); }
@@ -106,15 +112,17 @@ void RobotDaemon::Shutdown() {
 }
 
 void RobotDaemon::DaemonLoop() {
-  ApplyTiming();
+  const std::string timing = waiter_.Apply();
   std::unique_lock lock(mutex_);
+  timing_ = timing;
+  outbox_.log.push_back("robot '" + robot_name_ + "': RobotDaemon timing: " + timing);
   while (running_) {
     sleeping_until_.reset();
     lock.unlock();
     const TimePoint next = RunOnce(clock_.Now());
     lock.lock();
     sleeping_until_ = next;
-    WaitUntil(lock, next);
+    waiter_.WaitUntil(lock, wake_, next, spin_, woken_);
     wake_flag_ = false;
   }
 }
@@ -124,31 +132,6 @@ void RobotDaemon::DaemonLoop() {
 void RobotDaemon::Submit(QueuedItem item) {
   const TimePoint now = clock_.Now();
   const bool due = !item.has_start_time || item.start <= now;
-  if (item.is_query && due) {
-    // Answered here when the snapshot is what the driver would report now: it
-    // was read after every item due so far ran, no queued item became due
-    // since, the halt state is the one asked for, and it is at most one driver
-    // period old. Else queued (and snapshots taken for the next second).
-    snapshot_wanted_until_ = (now + std::chrono::seconds(1)).time_since_epoch().count();
-    bool current = false;
-    {
-      std::lock_guard lock(snapshot_mutex_);
-      // After a driver fault a query is queued: its answer names the fault (AnswerQuery).
-      current = snapshot_.valid && snapshot_.pushes_seen >= last_due_push_ && now < snapshot_.next_due &&
-                snapshot_.halted == panic_.load() && !faulted_.load() &&
-                now - snapshot_.time <= snapshot_.max_age;
-      if (current) direct_state_ = snapshot_;  // same sizes: no allocation
-    }
-    if (current) {
-      Reply r;
-      r.id = item.command.id;
-      r.exec_time = now;
-      AnswerFrom(direct_state_.state, *direct_kinematics_, direct_roots_, item, r);
-      direct_.push_back({item.client_id, std::move(r)});
-      ++direct_queries_;
-      return;
-    }
-  }
   bool wake = true;
   {
     std::lock_guard lock(mutex_);
@@ -158,15 +141,10 @@ void RobotDaemon::Submit(QueuedItem item) {
     wake = due || !sleeping_until_ || item.start < *sleeping_until_;
     scheduler_.Push(std::move(item));
     ++pushes_;
-    if (due) last_due_push_ = pushes_;
+    if (due) snapshot_.NoteDue(pushes_);  // a snapshot older than this item is no answer
     if (wake) wake_flag_ = true;
   }
   if (wake) wake_.notify_one();
-}
-
-void RobotDaemon::TakeDirect(std::vector<DaemonOutput::Answer>& out) {
-  for (auto& a : direct_) out.push_back(std::move(a));
-  direct_.clear();
 }
 
 std::size_t RobotDaemon::queued(std::int64_t client_id) const {
@@ -180,7 +158,7 @@ std::size_t RobotDaemon::queued_total() const {
 }
 
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
-  panic_ = true;  // from here on only a STOP runs (Execute checks it)
+  panic_.Raise(reason);  // from here on only a STOP runs (Execute checks it)
   std::unique_lock lock(mutex_, std::try_to_lock);
   if (!lock.owns_lock()) {
     if (reason.empty()) {
@@ -191,28 +169,26 @@ void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& rea
     }
     lock.lock();
   }
-  if (!reason.empty()) fault_ = reason;
   scheduler_.FlushAll(flushed);
-  halt_requested_ = true;
   wake_flag_ = true;
   lock.unlock();
   wake_.notify_one();
 }
 
-void RobotDaemon::FinishPanic() {
-  if (!flush_deferred_.load()) return;
+bool RobotDaemon::FinishPanic() {
+  if (!flush_deferred_.load()) return false;
   {
     std::lock_guard lock(mutex_);
     if (flush_deferred_.load()) FlushForPanicLocked();
   }
   wake_.notify_one();
+  return true;
 }
 
 void RobotDaemon::FlushForPanicLocked() {
   flush_deferred_ = false;
   std::vector<QueuedItem> flushed;
   scheduler_.FlushAll(flushed);
-  halt_requested_ = true;
   wake_flag_ = true;
   const TimePoint now = clock_.Now();
   for (const QueuedItem& item : flushed) {
@@ -228,21 +204,13 @@ void RobotDaemon::FlushForPanicLocked() {
 
 bool RobotDaemon::ResetPanic() {
   FinishPanic();  // a deferred flush never outlives its panic
-  if (!panic_.exchange(false)) return false;
+  if (!panic_.Reset()) return false;
   {
     std::lock_guard lock(mutex_);
-    fault_.clear();
-    faulted_ = false;
-    resume_requested_ = true;
     wake_flag_ = true;
   }
   wake_.notify_one();
   return true;
-}
-
-std::string RobotDaemon::fault() const {
-  std::lock_guard lock(mutex_);
-  return fault_;
 }
 
 void RobotDaemon::FlushClient(std::int64_t client_id, std::vector<QueuedItem>& out) {
@@ -305,11 +273,9 @@ bool RobotDaemon::CheckOverrun(TimePoint now) {
   const std::string what = "driver '" + driver_name_ + "' " + call_.name + " has run for " +
                            Seconds(now - call_.started) + " (the bound is " +
                            Seconds(options_.driver_call_bound) + ")";
-  panic_ = true;
+  panic_.Raise(what);
   {
     std::lock_guard lock(mutex_);
-    fault_ = what;
-    halt_requested_ = true;
     wake_flag_ = true;
     outbox_.log.push_back("robot '" + robot_name_ + "': DRIVER FAULT: " + what +
                           "; robot held in panic until PANIC_RESET");
@@ -364,17 +330,10 @@ RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem
 }
 
 void RobotDaemon::Fault(const std::string& what, TimePoint now) {
-  panic_ = true;
-  faulted_ = true;
-  last_fault_ = what;
-  {
-    std::lock_guard lock(mutex_);
-    fault_ = what;
-  }
+  const bool halt = panic_.Fault(what);
   produced_.log.push_back("robot '" + robot_name_ + "': DRIVER FAULT: " + what +
                           "; robot halted, in panic until PANIC_RESET");
-  if (halted_) return;
-  halted_ = true;
+  if (!halt) return;
   try {
     driver_->Halt(completions_);
   } catch (const std::exception& e) {
@@ -402,14 +361,12 @@ void RobotDaemon::Emit(std::int64_t client_id, Reply reply) {
 }
 
 TimePoint RobotDaemon::RunOnce(TimePoint now) {
-  bool halt = false, resume = false, sample_due = false;
+  bool sample_due = false;
   Duration period{0};
   due_.clear();
   {
     std::lock_guard lock(mutex_);
     if (flush_deferred_.load()) FlushForPanicLocked();
-    halt = std::exchange(halt_requested_, false) || panic_.load();
-    resume = std::exchange(resume_requested_, false);
     scheduler_.TakeDue(now, due_);
     pushes_taken_ = pushes_;
     period = scheduler_.stream_period();
@@ -417,18 +374,14 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   }
   completions_.clear();
   produced_.Clear();
-  if (halt && !halted_) {
-    halted_ = true;  // a Halt that throws still counts: no Execute until the reset
-    if (Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); }) == CallOutcome::kThrew) {
-      StopInstead(now);
-    }
+  // A Halt that throws still counts as halted: no Execute until the reset.
+  if (panic_.BeginHalt() &&
+      Guarded("Halt", nullptr, now, [&] { driver_->Halt(completions_); }) == CallOutcome::kThrew) {
+    StopInstead(now);
   }
-  if (resume && halted_ && !panic_) {
-    // Not halted from the call on: a Resume that throws or overruns part-way
-    // (the robot may already be let go) is a fault that halts it again.
-    halted_ = false;
-    Guarded("Resume", nullptr, now, [&] { driver_->Resume(); });
-  }
+  // Not halted from the call on: a Resume that throws or overruns part-way
+  // (the robot may already be let go) is a fault that halts it again.
+  if (panic_.BeginResume()) Guarded("Resume", nullptr, now, [&] { driver_->Resume(); });
   for (const QueuedItem& item : due_) Execute(item, now);
   bool state_fresh = false;  // state_ read after this iteration's Update
   if (now >= next_update_) {
@@ -459,8 +412,8 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     in_progress_.erase(owner);
   }
 
-  const bool snapshot = clock_.Now().time_since_epoch().count() < snapshot_wanted_until_.load();
-  const bool state_read = snapshot && (state_fresh || sampled || ReadState(now)) && state_problem_.empty();
+  const bool state_read =
+      snapshot_.wanted(clock_.Now()) && (state_fresh || sampled || ReadState(now)) && state_problem_.empty();
   TimePoint next = next_update_;
   TimePoint next_due = TimePoint::max();
   bool ready = false;
@@ -480,22 +433,12 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     next_due = scheduler_.NextDeadline();
     spin_ = next_due < next;  // a start time or sample, not a driver period
     next = std::min(next, next_due);
-    if (halt_requested_ || resume_requested_) next = now;
+    if (panic_.requests_pending()) next = now;
     ready = !produced_.replies.empty() || !produced_.executed.empty() || !produced_.log.empty() ||
             !produced_.audit.empty() || sampled;
   }
-  {
-    std::lock_guard lock(snapshot_mutex_);
-    snapshot_.valid = state_read;
-    if (state_read) {
-      snapshot_.state = state_;  // same sizes: no allocation
-      snapshot_.halted = halted_;
-      snapshot_.time = now;
-      snapshot_.pushes_seen = pushes_taken_;
-      snapshot_.next_due = next_due;
-      snapshot_.max_age = driver_->period();
-    }
-  }
+  snapshot_.Publish(state_read ? &state_ : nullptr, now, driver_->period(), pushes_taken_, next_due,
+                    panic_.driver_halted());
   if (ready && output_ready_) output_ready_();
   return next;
 }
@@ -514,7 +457,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     const CallOutcome outcome = Guarded(name, &item, now, call);
     if (outcome == CallOutcome::kThrew) {
       r.signal = Signal::kError;
-      r.message = last_fault_ + "; robot '" + robot_name_ + "' halted (panic) until PANIC_RESET";
+      r.message = panic_.last_fault() + "; robot '" + robot_name_ + "' halted (panic) until PANIC_RESET";
       Emit(item.client_id, std::move(r));
     }
     return outcome == CallOutcome::kOk;
@@ -547,7 +490,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     Emit(item.client_id, std::move(r));
     return;
   }
-  if (panic_ || halted_) {
+  if (panic_.in_panic() || panic_.driver_halted()) {
     r.signal = Signal::kInterrupted;
     r.message = "the robot entered panic before the command ran";
     Emit(item.client_id, std::move(r));
@@ -586,7 +529,7 @@ void RobotDaemon::Audit(const QueuedItem& item, const DriverResult& result, bool
 void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
   if (!ReadState(reply.exec_time)) {
     reply.signal = Signal::kError;
-    reply.message = std::string(ToString(item.query)) + ": " + last_fault_;
+    reply.message = std::string(ToString(item.query)) + ": " + panic_.last_fault();
     return;
   }
   if (!state_problem_.empty()) {  // a broken sensor: no value is trusted
@@ -596,9 +539,9 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
                     "' halted (panic) until PANIC_RESET";
     return;
   }
-  AnswerFrom(state_, kinematics_, roots_, item, reply);
-  if (panic_.load()) {  // a fault names itself: "... the robot has fallen (...)"
-    const std::string why = fault();
+  AnswerQueryFrom(model(), state_, kinematics_, roots_, item, reply);
+  if (panic_.in_panic()) {  // a fault names itself: "... the robot has fallen (...)"
+    const std::string why = panic_.reason();
     if (!why.empty()) reply.message = "robot '" + robot_name_ + "' is in panic: " + why;
   }
 }

@@ -1,12 +1,18 @@
-// The paper's RobotDaemon for one robot: owns the driver and its thread,
-// takes the due items of every client from the Scheduler at their start
-// times, executes them on the driver, and hands replies and state samples to
-// the ServerDaemon through an outbox.
+// The paper's RobotDaemon for one robot: runs the driver on time, and nothing
+// else. It owns the driver and its thread, takes the due items of every
+// client from the Scheduler at their start times, executes them on the driver
+// with a fault guard, and hands replies and state samples to the ServerDaemon
+// through an outbox (PumpOutput, daemon_pump.h). Three parts live beside it,
+// each a type of its own (issue 20): how it waits for a deadline
+// (DeadlineWaiter), the panic/halt/fault state (PanicState) and the state
+// snapshot queries are answered from on receipt (QuerySnapshot, read by
+// RobotSessions directly).
 //
 // Threads:
-// - the ServerDaemon calls Submit(), FlushAll(), SetStream(), QueueStop(),
-//   RequestHalt()/RequestResume(), TakeOutput() and the accessors; each takes
-//   the short inbox/outbox lock (mutex_) and never waits on the driver;
+// - the ServerDaemon calls Submit(), Panic(), ResetPanic(), SetStream(),
+//   QueueStop(), TakeOutput() and the accessors; each takes the short
+//   inbox/outbox lock (mutex_) or the PanicState's and never waits on the
+//   driver;
 // - the RobotDaemon thread (Start()) runs RunOnce() at each deadline (a start
 //   time, a driver period, a state sample), with absolute deadlines. It holds
 //   mutex_ only to take due items and to append to the outbox, never while
@@ -15,15 +21,14 @@
 //   query values (tests/server/robot_daemon_test.cpp counts).
 // Tests leave the thread unstarted and call RunOnce() with a ManualClock.
 //
-// Fewer hops (issue 11): a query that needs no waiting is answered by
-// Submit() itself, on the ServerDaemon's thread, from the state the
-// RobotDaemon snapshots after every iteration, when that snapshot is still
-// what the driver would report (no item became due since: see Submit()); the
-// reply is handed out by TakeDirect(), not through the outbox. Panic() does
-// not wait for mutex_: it latches panic at once (nothing runs after it) and,
-// if the RobotDaemon holds the lock, leaves the flush and the halt to
-// FinishPanic() (called after the acknowledgement is sent) or to the
-// RobotDaemon's next iteration, whichever comes first.
+// Fewer hops (issue 11, 20): after every iteration it publishes the state it
+// read to its QuerySnapshot, which RobotSessions answers a state query from
+// on receipt when that is still what the driver would report (query_snapshot.h);
+// such a query never reaches this class. Panic() does not wait for mutex_: it
+// latches panic at once in the PanicState (nothing runs after it) and, if
+// the RobotDaemon holds the lock, leaves the flush to FinishPanic() (called
+// after the acknowledgement is sent) or to the RobotDaemon's next
+// iteration, whichever comes first.
 //
 // Driver faults (driver.h): an exception from any driver call, or a call
 // still running past `driver_call_bound` (seen by CheckOverrun(), which the
@@ -31,6 +36,9 @@
 // the command answers ERROR naming the driver, the call and the message.
 #pragma once
 
+#include "deadline_waiter.h"
+#include "panic_state.h"
+#include "query_snapshot.h"
 #include "robotalk/clock.h"
 #include "robotalk/driver.h"
 #include "robotalk/kinematics.h"
@@ -149,15 +157,13 @@ class RobotDaemon {
   void Shutdown();
 
   // --- ServerDaemon side (thread-safe) ------------------------------------
-  /// Queues a checked item. REQUIRES: admission checks passed. A query due
-  /// now is answered at once from the state snapshot when that is current
-  /// (the reply waits in TakeDirect()); otherwise it is queued.
+  /// Queues a checked item. REQUIRES: admission checks passed. A state query
+  /// due now is answered from snapshot() first when it can be (RobotSessions).
   void Submit(QueuedItem item);
-  /// Replies Submit() answered itself, moved into `out` (appended).
-  /// ServerDaemon thread only; takes no lock.
-  void TakeDirect(std::vector<DaemonOutput::Answer>& out);
-  /// Queries answered by Submit() so far (ServerDaemon thread only).
-  std::uint64_t direct_queries() const { return direct_queries_; }
+  /// The state queries are answered from on receipt (the session side's).
+  QuerySnapshot& snapshot() { return snapshot_; }
+  /// The robot's panic, halt and driver-fault state.
+  const PanicState& panic_state() const { return panic_; }
   std::size_t queued(std::int64_t client_id) const;
   /// Items of every client (and the server's) waiting.
   std::size_t queued_total() const;
@@ -166,13 +172,14 @@ class RobotDaemon {
   void Panic(std::vector<QueuedItem>& flushed, const std::string& reason = {});
   /// Completes a panic whose flush Panic() left to later (the lock was held):
   /// flushes every waiting item (answered INTERRUPTED through the outbox) and
-  /// wakes the thread to halt. No-op otherwise. May wait for mutex_.
-  void FinishPanic();
+  /// wakes the thread to halt. Returns false (a no-op) when there was none.
+  /// May wait for mutex_.
+  bool FinishPanic();
   /// Panic reset: returns false if the robot was not in panic.
   bool ResetPanic();
-  bool in_panic() const { return panic_.load(); }
+  bool in_panic() const { return panic_.in_panic(); }
   /// Why the robot is in panic: "" for a client's panic, else the driver fault.
-  std::string fault() const;
+  std::string fault() const { return panic_.reason(); }
   /// Removes one client's waiting items (appended to `out`).
   void FlushClient(std::int64_t client_id, std::vector<QueuedItem>& out);
   /// Broadcast request of a client (0 cancels); returns the stream period now.
@@ -201,8 +208,8 @@ class RobotDaemon {
 
   // --- RobotDaemon side ----------------------------------------------------
   /// One iteration at `now`: halt/resume, every due item in run order, the
-  /// driver's Update when its period is due, a state sample when due.
-  /// Returns when it next has work.
+  /// driver's Update when its period is due, a state sample when due, the
+  /// query snapshot. Returns when it next has work.
   TimePoint RunOnce(TimePoint now);
 
  private:
@@ -222,12 +229,7 @@ class RobotDaemon {
   };
 
   void DaemonLoop();
-  void ApplyTiming();
-  void WaitUntil(std::unique_lock<std::mutex>& lock, TimePoint next);
   void FlushForPanicLocked();  // REQUIRES: mutex_ held
-  // A query answered from `state` (kinematics and roots are the caller's scratch).
-  void AnswerFrom(const RobotState& state, Kinematics& kinematics, std::vector<Eigen::Isometry3d>& roots,
-                  const QueuedItem& item, Reply& reply) const;
   void Execute(const QueuedItem& item, TimePoint now);
   void AnswerQuery(const QueuedItem& item, Reply& reply);
   // The --log-executions line of a motion command: "executed" (the driver
@@ -255,56 +257,30 @@ class RobotDaemon {
   const Clock& clock_;
   const RobotDaemonOptions options_;
   std::function<void()> output_ready_;
+  PanicState panic_;
 
   // The inbox and outbox, shared with the ServerDaemon.
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  Scheduler scheduler_;            // GUARDED_BY(mutex_)
-  DaemonOutput outbox_;            // GUARDED_BY(mutex_)
-  std::string fault_;              // GUARDED_BY(mutex_)
-  bool halt_requested_ = false;    // GUARDED_BY(mutex_)
-  bool resume_requested_ = false;  // GUARDED_BY(mutex_)
-  bool wake_flag_ = false;         // GUARDED_BY(mutex_)
+  Scheduler scheduler_;     // GUARDED_BY(mutex_)
+  DaemonOutput outbox_;     // GUARDED_BY(mutex_)
+  bool wake_flag_ = false;  // GUARDED_BY(mutex_)
   /// The deadline the thread waits for; nullopt while it runs (Submit wakes it
   /// only for an item due before this).
   std::optional<TimePoint> sleeping_until_;  // GUARDED_BY(mutex_)
   bool running_ = false;                     // GUARDED_BY(mutex_)
   std::uint64_t pushes_ = 0;                 // GUARDED_BY(mutex_): items submitted so far
   std::string timing_;                       // GUARDED_BY(mutex_)
-  std::atomic<bool> panic_{false};
-  std::atomic<bool> faulted_{false};                     // a driver fault is the panic's reason (fault_)
-  std::atomic<bool> flush_deferred_{false};              // Panic() could not take mutex_ to flush
-  std::atomic<Duration::rep> snapshot_wanted_until_{0};  // a query came: snapshot until then
-
-  // The state snapshot for queries answered on receipt.
-  struct StateSnapshot {
-    RobotState state;
-    bool valid = false;                     ///< ReadState succeeded
-    bool halted = false;                    ///< the driver was halted then
-    TimePoint time{};                       ///< when it was read
-    Duration max_age{0};                    ///< the driver period: older is stale
-    std::uint64_t pushes_seen = 0;          ///< every item pushed before this many was taken
-    TimePoint next_due = TimePoint::min();  ///< the scheduler's next deadline then
-  };
-  mutable std::mutex snapshot_mutex_;
-  StateSnapshot snapshot_;  // GUARDED_BY(snapshot_mutex_)
-  // ServerDaemon thread only.
-  std::uint64_t last_due_push_ = 0;  // pushes_ after the last item due on arrival
-  std::vector<DaemonOutput::Answer> direct_;
-  std::uint64_t direct_queries_ = 0;
-  StateSnapshot direct_state_;
-  std::unique_ptr<Kinematics> direct_kinematics_;
-  std::vector<Eigen::Isometry3d> direct_roots_;
-  bool precise_ = false;     // RobotDaemon thread: precise_timing applied
-  bool spin_ = false;        // RobotDaemon thread: the next deadline is a start time or sample
-  Duration spin_budget_{0};  // RobotDaemon thread: spin time it may still use
-  std::chrono::steady_clock::time_point budget_time_{};
+  std::atomic<bool> flush_deferred_{false};  // Panic() could not take mutex_ to flush
 
   mutable std::mutex call_mutex_;
   CurrentCall call_;  // GUARDED_BY(call_mutex_)
 
   // RobotDaemon thread only (preallocated).
   std::thread thread_;
+  DeadlineWaiter waiter_;
+  std::function<bool()> woken_;  // the waiter's wake-up condition (under mutex_)
+  bool spin_ = false;            // the next deadline is a start time or sample
   std::vector<QueuedItem> due_;
   std::vector<Completion> completions_;
   std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
@@ -317,11 +293,12 @@ class RobotDaemon {
   RobotSample sample_;
   TimePoint next_update_ = TimePoint::min();
   std::int64_t samples_ = 0;
-  bool halted_ = false;
   bool last_iteration_ = false;     // Shutdown()'s: STOP, then a last sample
   std::string reported_condition_;  // the driver's last Driver::Fault() text
-  std::string last_fault_;          // the fault a throw latched, for the command's ERROR
   std::string state_problem_;       // what the last state read had that was not finite, or ""
+  // Published after every iteration; read by RobotSessions (declared last:
+  // it is built from the model and state_).
+  QuerySnapshot snapshot_;
 };
 
 }  // namespace robotalk

@@ -292,6 +292,12 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
         break;
     }
   }
+  // On receipt, from the state the RobotDaemon published, when that is what
+  // the driver would report now (query_snapshot.h); else in order, queued.
+  if (Reply reply; daemon_.snapshot().Answer(item, reply)) {
+    immediate.push_back(std::move(reply));
+    return;
+  }
   daemon_.Submit(std::move(item));
 }
 

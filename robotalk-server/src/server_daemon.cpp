@@ -1,5 +1,7 @@
 #include "server_daemon.h"
 
+#include "daemon_pump.h"
+
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_codec.h"
@@ -114,7 +116,9 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   ++serving_;
 }
 
-void ServerDaemon::SyncLatch(Robot& robot) {
+// The one place the panic latch file is written (Drain calls it, after the
+// RobotDaemon's output is taken and before anything is sent).
+void ServerDaemon::Persist(Robot& robot) {
   const std::string& name = robot.daemon->robot_name();
   const bool panic = robot.daemon->in_panic();
   if (panic == latch_.latched(name)) return;
@@ -307,18 +311,15 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
   }
   if (!Gate(robot, *robot_name, request, bytes, received)) return;
   ImmediateAnswer answer = robot.sessions->Handle(request, received);
-  SyncLatch(robot);  // on disk before the panic (or its reset) is acknowledged
   if (!request.header_error.empty()) {
     Log("robot '" + *robot_name + "': refused package from client " +
         Hex64(static_cast<std::uint64_t>(request.client_id)) + ": " + request.header_error);
   }
   if (answer.publish_config) transport_.Publish(ConfigChannel(*robot_name), robot.encoded_config);
-  if (answer.send) {
-    AnswerDirect(robot, answer.batch);
-    Send(*robot_name, answer.batch);
-  }
-  robot.daemon->FinishPanic();   // after the acknowledgement
-  Drain(robot, /*wait=*/false);  // a panic's flushed items, at once (RunOnce's Flush waits)
+  // The panic (or its reset) on disk, then the acknowledgement, then what the
+  // RobotDaemon has (without waiting for its lock: RunOnce's Flush waits).
+  Drain(robot, /*wait=*/false, answer.send ? &answer.batch : nullptr);
+  if (robot.daemon->FinishPanic()) Drain(robot, /*wait=*/false);  // a panic's flushed items, at once
   if (options_.congestion_max_pause.count() > 0) {
     // The paper's congestion injector (§VI-B): a random pause after each
     // received package, during which nothing else is received.
@@ -355,13 +356,12 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
       break;
   }
   ReplyBatch unknown;
-  if (request.panic && !gate_->keyed()) {
+  const bool raised = request.panic && !gate_->keyed();
+  if (raised) {
     // Open mode: a panic is honoured from anyone, in a session or not (a
     // client whose server restarted must still be able to stop the robot).
     robot.sessions->RaisePanic(request.client_id, received);
-    SyncLatch(robot);
     robot.daemon->FinishPanic();
-    Drain(robot);
     unknown.panic = PanicStatus::kTaken;
   } else if (request.panic) {
     unknown.panic = PanicStatus::kRefused;
@@ -371,13 +371,17 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
         std::to_string(request.session_id) + "; say hello and send it again";
     Log("robot '" + name + "': refused a panic of " + admission.who + " outside any session");
   }
-  if (request.client_id == 0) return false;
+  const bool answer = request.client_id != 0;
   unknown.client_id = request.client_id;
   unknown.session_id = request.session_id;
   unknown.session_status = SessionStatus::kUnknown;
   unknown.ack_sequence = request.sequence > 0 ? request.sequence : 0;
   unknown.server_receive = received;
-  Send(name, unknown);
+  if (raised) {
+    Drain(robot, /*wait=*/true, answer ? &unknown : nullptr);  // on disk before TAKEN is sent
+  } else if (answer) {
+    Send(name, unknown);
+  }
   return false;
 }
 
@@ -403,25 +407,14 @@ void ServerDaemon::OnHello(const std::string& channel, std::span<const std::uint
   transport_.Publish(HelloAnswerChannel(*robot_name, hello.body.client_id), EncodeHelloAnswer(answer));
 }
 
-void ServerDaemon::AnswerDirect(Robot& robot, ReplyBatch& ack) {
-  direct_output_.Clear();
-  robot.daemon->TakeDirect(direct_output_.replies);
-  if (direct_output_.replies.empty()) return;
-  to_send_.clear();
-  robot.sessions->File(direct_output_, to_send_);
-  for (ReplyBatch& batch : to_send_) {
-    if (batch.client_id == ack.client_id) {
-      for (Reply& r : batch.replies) ack.replies.push_back(std::move(r));
-    } else {
-      Send(robot.daemon->robot_name(), batch);
-    }
-  }
-}
-
-void ServerDaemon::Drain(Robot& robot, bool wait) {
-  robot.daemon->TakeOutput(robot.output, wait);
-  SyncLatch(robot);  // a driver fault latched by the RobotDaemon
+// The ServerDaemon's half of the pump (daemon_pump.h): the RobotDaemon's
+// output filed, the panic state on disk, then `ack` (the answer to the
+// package just handled), the state samples and the replies sent.
+void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
+  PumpOutput(*robot.daemon, *robot.sessions, robot.output, to_send_, wait);
+  Persist(robot);  // a driver fault latched by the RobotDaemon; a panic or reset just handled
   const std::string& name = robot.daemon->robot_name();
+  if (ack) Send(name, *ack);
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
     std::vector<std::uint8_t> bytes =
         EncodeStateSample(ToStateSample(name, robot.config_hash, robot.output.samples[i]));
@@ -430,8 +423,6 @@ void ServerDaemon::Drain(Robot& robot, bool wait) {
     transport_.Publish(channel, bytes);
   }
   for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
-  to_send_.clear();
-  robot.sessions->File(robot.output, to_send_);
   for (ReplyBatch& batch : to_send_) Send(name, batch);
   for (const std::string& line : robot.sessions->TakeLog()) Log(line);
 }

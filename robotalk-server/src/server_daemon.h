@@ -8,10 +8,12 @@
 // It also runs the session watchdog and the driver-call watchdog, and applies
 // one robot, one server while it starts (OnAnnounce).
 //
-// Fewer hops (issue 11): a query the RobotDaemon can answer on receipt
-// (RobotDaemon::Submit) travels in the same reply package as the
+// Fewer hops (issue 11): a query answered on receipt from the RobotDaemon's
+// published state (RobotSessions, query_snapshot.h) travels in the
 // acknowledgement; a panic is acknowledged before the RobotDaemon's lock is
-// waited for (RobotDaemon::FinishPanic comes after); log lines are written to
+// waited for (RobotDaemon::FinishPanic comes after); the panic latch file is
+// written in one place, Drain, before anything that acknowledges the
+// panic, its reset or a driver fault is sent; log lines are written to
 // stderr at the end of an iteration, after every publish, never between a
 // package's receipt and its acknowledgement.
 //
@@ -150,16 +152,15 @@ class ServerDaemon {
   void Refuse(Robot& robot, const std::string& why);
   void LogConflict(Robot& robot, const std::string& other, Duration served);
   void Send(const std::string& robot, ReplyBatch& batch);
-  void Drain(Robot& robot, bool wait = true);
-  // Files the replies RobotDaemon::Submit answered itself; the ones for
-  // `ack`'s client join it, the rest are sent.
-  void AnswerDirect(Robot& robot, ReplyBatch& ack);
+  // Takes and files the RobotDaemon's output (PumpOutput), writes the panic
+  // latch (Persist), then sends `ack` (if any), the state samples and the replies.
+  void Drain(Robot& robot, bool wait = true, ReplyBatch* ack = nullptr);
   void WriteLog();
   void ApplyPriority();
   void Announce(TimePoint now);
   void Watchdogs(TimePoint now);
   void Log(const std::string& line);
-  void SyncLatch(Robot& robot);
+  void Persist(Robot& robot);
 
   Transport& transport_;
   const Clock& clock_;
@@ -186,7 +187,6 @@ class ServerDaemon {
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes
-  DaemonOutput direct_output_;            // scratch for AnswerDirect
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

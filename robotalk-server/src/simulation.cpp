@@ -1,7 +1,6 @@
 #include "robotalk/simulation.h"
 
-#include "robot_daemon.h"
-#include "robot_sessions.h"
+#include "daemon_pump.h"
 #include "robotalk/config_codec.h"
 #include "state_encoding.h"
 
@@ -42,12 +41,10 @@ SimulationResult RunSimulation(std::string robot_name, std::string driver_name,
   daemon.Preallocate(output);
   std::vector<ReplyBatch> batches;
   const auto collect = [&] {
-    daemon.TakeOutput(output);
+    PumpOutput(daemon, sessions, output, batches);
     for (std::size_t i = 0; i < output.num_samples; ++i) {
       result.states.push_back(ToStateSample(robot_name, ConfigHash(daemon.model()), output.samples[i]));
     }
-    batches.clear();
-    sessions.File(output, batches);
     for (ReplyBatch& b : batches) {
       for (Reply& r : b.replies) replies[r.id] = std::move(r);
     }

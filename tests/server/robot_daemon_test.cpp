@@ -56,6 +56,15 @@ class RobotDaemonTest : public ::testing::Test {
     daemon_->TakeOutput(out_);
     return out_.replies;
   }
+  // What RobotSessions does with a state query due now: answered on receipt
+  // from the snapshot the RobotDaemon published (appended to `direct`), else queued.
+  void Ask(QueuedItem query, std::vector<DaemonOutput::Answer>& direct) {
+    if (Reply r; daemon_->snapshot().Answer(query, r)) {
+      direct.push_back({query.client_id, std::move(r)});
+      return;
+    }
+    daemon_->Submit(std::move(query));
+  }
 
   ManualClock clock_;
   FakeDriver* fake_ = nullptr;
@@ -168,54 +177,48 @@ TEST_F(RobotDaemonTest, RunsTheWatchdogsStopOnlyWhenTheRobotIsMoving) {
 // the outbox, an eventfd) even when the state it reads had not changed.
 TEST_F(RobotDaemonTest, AnswersAQueryOnReceiptFromTheStateOfItsLastIteration) {
   daemon_->Submit(Motion(1, CommandType::kJointSetPoint, {0.5}, 0));
-  daemon_->Submit(JointStateQuery(2));
   std::vector<DaemonOutput::Answer> direct;
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(2), direct);
   EXPECT_TRUE(direct.empty()) << "no snapshot yet: queued behind the set-point";
   auto replies = Run();
   ASSERT_EQ(replies.size(), 2u);
   EXPECT_EQ(replies[1].reply.values.at(0), 0.5) << "the query ran after the set-point";
 
   clock_.Advance(milliseconds(1));
-  daemon_->Submit(JointStateQuery(3));
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(3), direct);
   ASSERT_EQ(direct.size(), 1u) << "answered on receipt, without the RobotDaemon's thread";
   EXPECT_EQ(direct[0].client_id, kAlice);
   EXPECT_EQ(direct[0].reply.id, 3);
   EXPECT_EQ(direct[0].reply.signal, Signal::kSuccess);
   EXPECT_EQ(direct[0].reply.values.at(0), 0.5);
   EXPECT_EQ(direct[0].reply.exec_time, clock_.Now());
-  EXPECT_EQ(daemon_->direct_queries(), 1u);
+  EXPECT_EQ(daemon_->snapshot().answered(), 1u);
 }
 
 TEST_F(RobotDaemonTest, AQueryWaitsForACommandDueBeforeItAndForAStaleSnapshot) {
-  daemon_->Submit(JointStateQuery(1));
+  std::vector<DaemonOutput::Answer> direct;
+  Ask(JointStateQuery(1), direct);
   Run();  // snapshots from now on
   daemon_->Submit(Motion(2, CommandType::kJointSetPoint, {0.25}, 0));
-  daemon_->Submit(JointStateQuery(3));
-  std::vector<DaemonOutput::Answer> direct;
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(3), direct);
   EXPECT_TRUE(direct.empty()) << "the set-point has not run yet";
   auto replies = Run();
   ASSERT_EQ(replies.size(), 2u);
   EXPECT_EQ(replies[1].reply.values.at(0), 0.25);
 
   clock_.Advance(milliseconds(11));  // over the driver period (10 ms): Update is due
-  daemon_->Submit(JointStateQuery(4));
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(4), direct);
   EXPECT_TRUE(direct.empty()) << "older than a driver period: queued";
   EXPECT_EQ(Run().size(), 1u);
 
   clock_.Advance(milliseconds(1));
   std::vector<QueuedItem> flushed;
   daemon_->Panic(flushed);
-  daemon_->Submit(JointStateQuery(5));
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(5), direct);
   EXPECT_TRUE(direct.empty()) << "panic raised, the driver not halted yet: queued behind the halt";
   Run();
   clock_.Advance(milliseconds(1));
-  daemon_->Submit(JointStateQuery(6));
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(6), direct);
   EXPECT_EQ(direct.size(), 1u) << "halted, as the snapshot says";
 }
 
@@ -235,9 +238,8 @@ TEST_F(RobotDaemonTest, HaltsAndHoldsInPanicARobotWhoseDriverReportsAFault) {
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].reply.signal, Signal::kInterrupted) << "the running GOTO";
   // A query says why the robot is in panic (queued, not answered on receipt).
-  daemon_->Submit(JointStateQuery(2));
   std::vector<DaemonOutput::Answer> direct;
-  daemon_->TakeDirect(direct);
+  Ask(JointStateQuery(2), direct);
   EXPECT_TRUE(direct.empty());
   const auto answers = Run();
   ASSERT_EQ(answers.size(), 1u);

@@ -186,13 +186,33 @@ TEST_F(ServerDaemonTest, PublishesTheConfigurationWhenAskedAndStateWhenStreamed)
 namespace robotalk {
 namespace {
 
-// Issue 9: after kill -9 and a restart, a latched PANIC was gone.
-TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
-  const std::string latch = ::testing::TempDir() + "/panic_latch_test.txt";
-  std::remove(latch.c_str());
+// A latch file of its own (removed before and after), a clock, a bus and a client.
+class ServerDaemonPanicLatch : public ::testing::Test {
+ protected:
+  ServerDaemonPanicLatch() { std::remove(latch.c_str()); }
+  ~ServerDaemonPanicLatch() override { std::remove(latch.c_str()); }
+
+  const std::string latch = ::testing::TempDir() + "/panic_latch_" +
+                            ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
   ManualClock clock;
-  auto bus = std::make_shared<MemoryBus>();
-  MemoryTransport client(bus);
+  std::shared_ptr<MemoryBus> bus = std::make_shared<MemoryBus>();
+  MemoryTransport client{bus};
+
+  // Says hello to `server` and sends a set-point of 'pan' (id 1) that it
+  // admits; returns the session.
+  std::int64_t SendMove(ServerDaemon& server) {
+    const std::int64_t session =
+        SayHello(client, "bot", kAlice, [&] { server.RunOnce(Duration(0)); }).session_id;
+    Request move{.client_id = kAlice, .session_id = session, .sequence = 1};
+    move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+    client.Publish(RequestChannel("bot"), EncodeRequest(move));
+    server.RunOnce(Duration(0));
+    return session;
+  }
+};
+
+// Issue 9: after kill -9 and a restart, a latched PANIC was gone.
+TEST_F(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
   std::map<CommandId, Reply> replies;
   auto sub =
       client.Subscribe("ROBOTALK/bot/REPLY/.*", [&](const std::string&, std::span<const std::uint8_t> b) {
@@ -218,12 +238,7 @@ TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
   server.AddRobot(robot, SessionOptions{});
   EXPECT_TRUE(robot.in_panic()) << "the restarted server starts in panic";
   EXPECT_THAT(robot.fault(), HasSubstr("latched before this server started"));
-  const std::int64_t session =
-      SayHello(client, "bot", kAlice, [&] { server.RunOnce(Duration(0)); }).session_id;
-  Request move{.client_id = kAlice, .session_id = session, .sequence = 1};
-  move.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
-  client.Publish(RequestChannel("bot"), EncodeRequest(move));
-  server.RunOnce(Duration(0));
+  const std::int64_t session = SendMove(server);
   robot.RunOnce(clock.Now());
   client.HandleFor(Duration(0));
   EXPECT_EQ(replies.at(1).signal, Signal::kPanic);
@@ -236,7 +251,53 @@ TEST(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
   std::ifstream file(latch);
   std::string text((std::istreambuf_iterator<char>(file)), {});
   EXPECT_THAT(text, ::testing::Not(HasSubstr("bot\t"))) << "the reset is on disk too";
-  std::remove(latch.c_str());
+}
+
+// Reads the latch file whenever the server publishes a reply that answers
+// ERROR: what was on disk at the moment it left.
+class LatchAtErrorTransport final : public Transport {
+ public:
+  LatchAtErrorTransport(std::shared_ptr<MemoryBus> bus, std::string latch)
+      : inner_(std::move(bus)), latch_(std::move(latch)) {}
+  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+    if (ParseReplyChannel(channel)) {
+      for (const Reply& r : DecodeReplyBatch(bytes).replies) {
+        if (r.signal != Signal::kError) continue;
+        std::ifstream file(latch_);
+        on_disk_at_error.assign(std::istreambuf_iterator<char>(file), {});
+      }
+    }
+    inner_.Publish(channel, bytes);
+  }
+  std::unique_ptr<Subscription> Subscribe(const std::string& regex, Handler handler) override {
+    return inner_.Subscribe(regex, std::move(handler));
+  }
+  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
+  int fileno() const override { return inner_.fileno(); }
+  std::string url() const override { return inner_.url(); }
+
+  std::string on_disk_at_error;
+
+ private:
+  MemoryTransport inner_;
+  std::string latch_;
+};
+
+// Issue 20: the latch is written in one place (ServerDaemon::Drain), for a
+// panic the RobotDaemon latched itself (a driver fault) as for a client's,
+// before the fault's ERROR leaves.
+TEST_F(ServerDaemonPanicLatch, ADriverFaultIsOnDiskBeforeItsErrorIsSent) {
+  LatchAtErrorTransport transport(bus, latch);
+  auto driver = std::make_unique<FakeDriver>(PanRobot());
+  driver->throw_on_execute = "serial port write failed";
+  RobotDaemon robot("bot", "fake", std::move(driver), clock);
+  ServerDaemon server(transport, clock, ServerDaemonOptions{.panic_latch_path = latch});
+  server.AddRobot(robot, SessionOptions{});
+  SendMove(server);
+  robot.RunOnce(clock.Now());  // the driver throws: a fault, panic
+  server.RunOnce(Duration(0));
+  EXPECT_THAT(transport.on_disk_at_error,
+              HasSubstr("bot\tdriver 'fake' threw in Execute: serial port write failed"));
 }
 
 }  // namespace
