@@ -62,7 +62,8 @@ std::string RobotSessions::QueueRefusal(const Session& s) {
   }
   // Half the robot's bound is the clients' guaranteed shares; past its own, a
   // client draws on the other half only while it has room (header).
-  const std::size_t share = options_.max_robot_queue / (2 * std::max<std::size_t>(options_.max_sessions_per_robot, 1));
+  const std::size_t share =
+      options_.max_robot_queue / (2 * std::max<std::size_t>(options_.max_sessions_per_robot, 1));
   if (count_.own >= share && count_.total >= options_.max_robot_queue / 2) {
     return has() + std::to_string(share) + " while the robot's queues are full (" +
            std::to_string(count_.total) + " commands of all clients; each client may always queue " +

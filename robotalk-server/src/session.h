@@ -120,10 +120,10 @@ struct Session {
 
   // --- The session's identity: its own, never taken over (Continue).
   std::int64_t session_id = 0;
-  int robot = 0;             ///< the robot's number in the session table
-  bool live = false;         ///< false: pending (opened by a hello, no package accepted yet)
-  std::uint64_t order = 0;   ///< opening order: the oldest pending session is dropped first
-  Nonce hello_nonce{};       ///< the client nonce of the hello that opened it
+  int robot = 0;            ///< the robot's number in the session table
+  bool live = false;        ///< false: pending (opened by a hello, no package accepted yet)
+  std::uint64_t order = 0;  ///< opening order: the oldest pending session is dropped first
+  Nonce hello_nonce{};      ///< the client nonce of the hello that opened it
   struct Keyed {
     SessionKeys keys;
     const AccessEntry* client = nullptr;  ///< the access-list entry its key is bound to
@@ -135,7 +135,7 @@ struct Session {
   // --- The client's side on its robot; a newer session of the same client
   // and robot takes it over when it goes live (Continue).
   std::int64_t client_id;
-  std::string who;  ///< for logs: "client 503d..." or "'alice' (rt:1a2b:..., client 503d...)"
+  std::string who;       ///< for logs: "client 503d..." or "'alice' (rt:1a2b:..., client 503d...)"
   TimePoint created;     ///< the hello (or the first package without one)
   TimePoint last_heard;  ///< the last new, well-formed package: the session expires a timeout after it
   bool active = false;   ///< the robot serves it (a package was admitted): counts against its bound

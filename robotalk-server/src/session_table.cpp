@@ -96,8 +96,9 @@ HelloAnswer SessionTable::Answer(int robot, const Hello& hello, TimePoint now) {
     }
   }
   if (keyed() && used_nonces_.contains(hello.body.client_nonce)) {
-    return Refuse(answer, DescribeHello(hello.body) +
-                              ": replayed hello (its nonce opened a session of this server instance already)");
+    return Refuse(answer,
+                  DescribeHello(hello.body) +
+                      ": replayed hello (its nonce opened a session of this server instance already)");
   }
   std::optional<Session::Keyed> keys;
   if (keyed()) {
@@ -125,8 +126,8 @@ HelloAnswer SessionTable::Answer(int robot, const Hello& hello, TimePoint now) {
     auto& binding = bindings_[s.client_id];
     binding.key = hello.body.client_key;
     ++binding.sessions;
-    s.who = "'" + keys->client->name + "' (" + hello.body.client_key.Fingerprint() + ", " + Client(s.client_id) +
-            ")";
+    s.who = "'" + keys->client->name + "' (" + hello.body.client_key.Fingerprint() + ", " +
+            Client(s.client_id) + ")";
     s.keyed = std::move(keys);
   }
   return answer;
@@ -139,7 +140,8 @@ std::string SessionTable::Handshake(const Hello& hello, HelloAnswer& answer, Ses
   const ClientHello& h = hello.body;
   if (const auto bound = bindings_.find(h.client_id); bound != bindings_.end()) {
     if (!(bound->second.key == h.client_key)) {
-      return DescribeHello(h) + ": client id is bound to another key (" + bound->second.key.Fingerprint() + ")";
+      return DescribeHello(h) + ": client id is bound to another key (" + bound->second.key.Fingerprint() +
+             ")";
     }
   } else {
     const auto ids = std::count_if(bindings_.begin(), bindings_.end(),
@@ -197,8 +199,7 @@ void SessionTable::MakeRoom(std::int64_t client_id, const PublicKey* key, TimePo
 
 Session& SessionTable::Open(int robot, std::int64_t session_id, std::int64_t client_id, TimePoint now) {
   Session& s =
-      sessions_
-          .try_emplace(session_id, client_id, now, robots_[static_cast<std::size_t>(robot)].replies)
+      sessions_.try_emplace(session_id, client_id, now, robots_[static_cast<std::size_t>(robot)].replies)
           .first->second;
   s.session_id = session_id;
   s.robot = robot;
@@ -333,8 +334,8 @@ std::vector<Session> SessionTable::Expire(int robot, TimePoint now, Duration liv
   for (auto it = sessions_.begin(); it != sessions_.end();) {
     const auto next = std::next(it);
     const Session& s = it->second;
-    if (s.robot == robot && (s.live ? now - s.last_heard > live_timeout
-                                    : now - s.created >= options_.pending_timeout)) {
+    if (s.robot == robot &&
+        (s.live ? now - s.last_heard > live_timeout : now - s.created >= options_.pending_timeout)) {
       if (s.live) {
         expired.push_back(Remove(it));
       } else {

@@ -236,7 +236,8 @@ TEST_F(SessionMemoryTest, APanicFreesTheTimedServoEntriesOfTheCommandsItFlushed)
 class FloodedQueuesTest : public SessionMemoryTest {
  protected:
   FloodedQueuesTest()
-      : SessionMemoryTest(SessionOptions{.max_queue = 1000, .max_sessions = 8, .max_robot_queue = 64}) {}
+      : SessionMemoryTest(
+            SessionOptions{.max_queue = 1000, .max_sessions_per_robot = 8, .max_robot_queue = 64}) {}
   // Sends `n` future commands in one package; returns how many were refused.
   std::size_t Flood(std::int64_t client, std::int64_t seq, int n) {
     std::vector<Command> commands;

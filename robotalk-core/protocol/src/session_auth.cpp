@@ -182,14 +182,16 @@ ServerAuthenticator::ServerAuthenticator(KeyPair identity, const AccessList& acc
 }
 
 std::string DescribeHello(const ClientHello& hello) {
-  return "hello of client " + std::to_string(hello.client_id) + " (key " + hello.client_key.Fingerprint() + ")";
+  return "hello of client " + std::to_string(hello.client_id) + " (key " + hello.client_key.Fingerprint() +
+         ")";
 }
 
 HelloResult ServerAuthenticator::Answer(const ClientHello& hello) const {
   const auto refuse = [&](const std::string& why) { return HelloRefused{DescribeHello(hello) + ": " + why}; };
   const AccessEntry* client = Client(hello);
   if (client == nullptr) return refuse("key not in the access list");
-  if (!VerifySignature(hello.client_key, hello.SignedBytes(), hello.signature)) return refuse("bad signature");
+  if (!VerifySignature(hello.client_key, hello.SignedBytes(), hello.signature))
+    return refuse("bad signature");
   if (!ClientIdBelongsTo(hello.client_id, hello.client_key)) {
     return refuse("client id " + std::to_string(hello.client_id) +
                   " is not one of this key's (keyed mode: a client id's high bits come from its key; "

@@ -1,8 +1,8 @@
 // Authenticated sessions as pure maths: the handshake that binds a client id
 // to a key and derives session keys, and the per-package MAC. No session
-// state (the server's session table keeps it, with the replay window). No I/O, no clock of its own (times are passed in), no LCM: the
-// ServerDaemon / RobotClient carry the values (wire proposal in
-// docs/security.md). Every primitive is libsodium's.
+// state (the server's session table keeps it, with the replay window). No I/O, no clock of its own (times are
+// passed in), no LCM: the ServerDaemon / RobotClient carry the values (wire proposal in docs/security.md).
+// Every primitive is libsodium's.
 //
 //   client                                           server (instance nonce I, fresh per start)
 //   ClientHello{key C, client id, nonce Nc, X25519 eph. Ec, sig_C}  ->
