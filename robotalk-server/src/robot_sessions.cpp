@@ -114,6 +114,14 @@ std::vector<Reply> RobotSessions::Retransmitted(const Session& s, const Request&
 }
 
 ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
+  // A session the robot has not served (all its packages refused: rights,
+  // the robot full) holds nothing on it: any new package keeps it. A served
+  // one is kept only by packages it admits (below): a client that moved the
+  // robot and then sends only refused packages is stopped when it expires.
+  if (Session* s = table_.Find(robot_id_, r.client_id);
+      s != nullptr && !s->active && s->seen.Check(r.sequence) == SequenceWindow::Verdict::kNew) {
+    s->last_heard = received;
+  }
   if (!r.header_error.empty()) return Refuse(r, received);
   ImmediateAnswer answer;
   answer.batch.client_id = r.client_id;

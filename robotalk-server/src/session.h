@@ -135,11 +135,13 @@ struct Session {
   // --- The client's side on its robot; a newer session of the same client
   // and robot takes it over when it goes live (Continue).
   std::int64_t client_id;
-  std::string who;       ///< for logs: "client 503d..." or "'alice' (rt:1a2b:..., client 503d...)"
-  TimePoint created;     ///< the hello (or the first package without one)
-  TimePoint last_heard;  ///< the last new, well-formed package: the session expires a timeout after it
-  bool active = false;   ///< the robot serves it (a package was admitted): counts against its bound
-  SequenceWindow seen;   ///< the one replay / duplicate window
+  std::string who;    ///< for logs: "client 503d..." or "'alice' (rt:1a2b:..., client 503d...)"
+  TimePoint created;  ///< the hello (or the first package without one)
+  /// The last new package the robot admitted (any new one while it is not
+  /// `active`): the session expires a timeout after it.
+  TimePoint last_heard;
+  bool active = false;  ///< the robot serves it (a package was admitted): counts against its bound
+  SequenceWindow seen;  ///< the one replay / duplicate window
   ReplyCache replies;
   DelayHistory delays;  ///< one-way delays of its latest packages (playback's quick start)
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< unfinished ones, by playback id

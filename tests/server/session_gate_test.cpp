@@ -349,6 +349,19 @@ TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdl
   EXPECT_EQ(server_->sessions().session_count(), 0u);
 }
 
+TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsLastsWhileItSends) {
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
+  ASSERT_TRUE(monitor);
+  for (CommandId id = 1; id <= 5; ++id) {
+    Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, id, {0.5})));
+    ASSERT_EQ(batches_.back().session_status, SessionStatus::kOk) << "package " << id;
+    EXPECT_EQ(replies_.at(id).signal, Signal::kError);
+    clock_.Advance(std::chrono::milliseconds(1500));  // under the 2 s session timeout each time
+    Step();                                           // the watchdog
+  }
+  EXPECT_EQ(server_->sessions().session_count(), 1u);
+}
+
 TEST_F(KeyedGateTest, APanicRefusedForRightsIsAnsweredRefusedWithTheReasonAndDoesNothing) {
   // Issue 19 item 2: a query-only key's panic was reported as acknowledged
   // while the robot went on; another client's motion completed.
