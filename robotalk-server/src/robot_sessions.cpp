@@ -18,18 +18,27 @@ std::size_t QueuedItemBytes() {
   return 2 * sizeof(PlaybackSequence::Frame) + kEstimatorFrame + kTimedServo;
 }
 
+RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options,
+                             SessionTable& table)
+    : RobotSessions(daemon, config_hash, options, nullptr, &table) {}
+
 RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options)
+    : RobotSessions(daemon, config_hash, options, std::make_unique<SessionTable>(0, SessionTableOptions{}),
+                    nullptr) {}
+
+RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options,
+                             std::unique_ptr<SessionTable> own, SessionTable* table)
     : daemon_(daemon),
       robot_(daemon.robot_name()),
       config_hash_(config_hash),
       options_(options),
+      own_table_(std::move(own)),
+      table_(table != nullptr ? *table : *own_table_),
+      robot_id_(table_.AddRobot(robot_, options.replies)),
       joint_owner_(daemon.model().joints().size(), 0) {}
 
 Session& RobotSessions::SessionFor(std::int64_t client_id, TimePoint now) {
-  auto it = sessions_.find(client_id);
-  if (it == sessions_.end())
-    it = sessions_.emplace(client_id, Session(client_id, now, options_.replies)).first;
-  return it->second;
+  return table_.FindOrOpen(robot_id_, client_id, now);
 }
 
 std::size_t RobotSessions::Waiting(const Session& s) const {
@@ -41,7 +50,7 @@ std::string RobotSessions::QueueRefusal(const Session& s) {
     count_.known = true;
     count_.own = Waiting(s);
     count_.total = daemon_.queued_total();
-    for (const auto& [id, session] : sessions_) count_.total += session.buffered_frames();
+    for (const auto& [id, session] : table_.live(robot_id_)) count_.total += session->buffered_frames();
   }
   // Built only for a refusal: admission is the receive path.
   const auto has = [&] {
@@ -53,7 +62,8 @@ std::string RobotSessions::QueueRefusal(const Session& s) {
   }
   // Half the robot's bound is the clients' guaranteed shares; past its own, a
   // client draws on the other half only while it has room (header).
-  const std::size_t share = options_.max_robot_queue / (2 * std::max<std::size_t>(options_.max_sessions, 1));
+  const std::size_t share =
+      options_.max_robot_queue / (2 * std::max<std::size_t>(options_.max_sessions_per_robot, 1));
   if (count_.own >= share && count_.total >= options_.max_robot_queue / 2) {
     return has() + std::to_string(share) + " while the robot's queues are full (" +
            std::to_string(count_.total) + " commands of all clients; each client may always queue " +
@@ -67,9 +77,9 @@ std::string RobotSessions::QueueRefusal(const Session& s) {
 
 RobotSessions::SessionMemory RobotSessions::memory(std::int64_t client_id) const {
   SessionMemory m;
-  const auto it = sessions_.find(client_id);
-  if (it == sessions_.end()) return m;
-  const Session& s = it->second;
+  const Session* found = table_.Find(robot_id_, client_id);
+  if (found == nullptr) return m;
+  const Session& s = *found;
   m.reply_cache = s.replies.bytes();
   m.playbacks = s.playback_bytes();
   m.waiting = Waiting(s);
@@ -104,6 +114,14 @@ std::vector<Reply> RobotSessions::Retransmitted(const Session& s, const Request&
 }
 
 ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
+  // A session the robot has not served (all its packages refused: rights,
+  // the robot full) holds nothing on it: any new package keeps it. A served
+  // one is kept only by packages it admits (below): a client that moved the
+  // robot and then sends only refused packages is stopped when it expires.
+  if (Session* s = table_.Find(robot_id_, r.client_id);
+      s != nullptr && !s->active && s->seen.Check(r.sequence) == SequenceWindow::Verdict::kNew) {
+    s->last_heard = received;
+  }
   if (!r.header_error.empty()) return Refuse(r, received);
   ImmediateAnswer answer;
   answer.batch.client_id = r.client_id;
@@ -122,11 +140,13 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     for (CommandId id : r.item_ids()) immediate.push_back(MakeReply(id, Signal::kError, why, received));
     return answer;
   };
-  if (!sessions_.count(r.client_id) && sessions_.size() >= options_.max_sessions) {
-    return refuse_all("robot '" + robot_ + "' serves " + std::to_string(options_.max_sessions) +
+  if (const Session* known = table_.Find(robot_id_, r.client_id);
+      (known == nullptr || !known->active) && table_.active(robot_id_) >= options_.max_sessions_per_robot) {
+    return refuse_all("robot '" + robot_ + "' serves " + std::to_string(options_.max_sessions_per_robot) +
                       " clients already (the --max-sessions-per-robot bound); try again later");
   }
   Session& session = SessionFor(r.client_id, received);
+  session.active = true;
   session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
   const SequenceWindow::Verdict seen = session.seen.Observe(r.sequence);
   if (seen == SequenceWindow::Verdict::kTooManyGaps) {
@@ -186,8 +206,8 @@ ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint received) cons
   answer.batch.client_id = r.client_id;
   answer.batch.ack_sequence = r.sequence;
   answer.batch.server_receive = received;
-  if (auto it = sessions_.find(r.client_id); it != sessions_.end()) {
-    answer.batch.replies = Retransmitted(it->second, r, received);
+  if (const Session* s = table_.Find(robot_id_, r.client_id)) {
+    answer.batch.replies = Retransmitted(*s, r, received);
   }
   return answer;
 }
@@ -211,8 +231,8 @@ ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
   // Remember it in an existing session, so a retransmission of the same bad
   // package gets the same answer; a refused package neither opens nor
   // refreshes a session.
-  if (auto it = sessions_.find(r.client_id); it != sessions_.end() && r.sequence > 0) {
-    Session& session = it->second;
+  if (Session* s = table_.Find(robot_id_, r.client_id); s != nullptr && r.sequence > 0) {
+    Session& session = *s;
     if (session.seen.Observe(r.sequence) == SequenceWindow::Verdict::kNew) {
       session.replies.RecordPackage(r.sequence, ids);
       for (const Reply& reply : answer.batch.replies) session.replies.RecordReply(reply);
@@ -399,7 +419,8 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::stri
   log_.push_back("robot '" + robot_ + "': PANIC from " + who + (first ? "" : " (already in panic)"));
   flushed_.clear();
   daemon_.Panic(flushed_);
-  for (auto& [id, session] : sessions_) {
+  for (const auto& [id, s] : table_.live(robot_id_)) {
+    Session& session = *s;
     std::vector<std::int64_t> ended;
     for (auto& [pid, seq] : session.playbacks) {
       for (PlaybackSequence::Frame& frame : seq.frames) flushed_.push_back(std::move(frame.item));
@@ -421,10 +442,10 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::stri
 }
 
 void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {
-  auto it = sessions_.find(client_id);
-  if (it == sessions_.end()) return;  // an expired client
+  Session* s = table_.Find(robot_id_, client_id);
+  if (s == nullptr) return;           // an expired client
   NoteServoAnswer(client_id, reply);  // also a flushed one's: its entry is freed
-  it->second.replies.RecordReply(reply);
+  s->replies.RecordReply(reply);
   pending_[client_id].push_back(std::move(reply));
 }
 
@@ -486,9 +507,9 @@ bool RobotSessions::Superseded(Session& s, const QueuedItem& item, TimePoint now
 }
 
 void RobotSessions::NoteServoAnswer(std::int64_t client_id, const Reply& reply) {
-  const auto session = sessions_.find(client_id);
-  if (session == sessions_.end()) return;
-  Session& s = session->second;
+  Session* session = table_.Find(robot_id_, client_id);
+  if (session == nullptr) return;
+  Session& s = *session;
   const auto it = s.timed_servos.find(reply.id);
   if (it == s.timed_servos.end()) return;
   if (reply.signal == Signal::kSuccess || reply.signal == Signal::kModified) {
@@ -509,7 +530,7 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
   // took just before the watchdog expired its client was not covered by the
   // watchdog's stop: it is stopped now and nobody owns it. (The vector is
   // only filled in that rare case: this is every executed command's path.)
-  const bool vanished = sessions_.count(e.client_id) == 0;
+  const bool vanished = table_.Find(robot_id_, e.client_id) == nullptr;
   std::vector<int> to_stop;
   const auto take = [&](int j) {
     if (vanished) {
@@ -547,12 +568,10 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
 
 std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
   std::vector<ExpiredSession> expired;
-  for (auto it = sessions_.begin(); it != sessions_.end();) {
-    if (now - it->second.last_heard <= options_.session_timeout) {
-      ++it;
-      continue;
-    }
-    const std::int64_t client = it->first;
+  for (Session& s : table_.Expire(robot_id_, now, options_.session_timeout)) {
+    const std::int64_t client = s.client_id;
+    pending_.erase(client);
+    if (!s.active) continue;  // the robot never served it: nothing of it to stop
     flushed_.clear();
     daemon_.FlushClient(client, flushed_);
     // A STOP of only what it owns (Driver::StopOnly cannot refuse: its GOTO
@@ -566,7 +585,7 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
     const bool base = base_owner_ == client;
     if (base) base_owner_ = 0;
     const bool owned = base || !joints.empty();
-    expired.push_back({client, flushed_.size() + it->second.buffered_frames(), owned});
+    expired.push_back({client, flushed_.size() + s.buffered_frames(), owned});
     if (owned) {
       log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; stopping what it moved (" +
                      (base ? std::string("the base") : std::string()) +
@@ -575,8 +594,6 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
       daemon_.QueueStopOnly(std::move(joints), base);
     }
     daemon_.SetStream(client, Duration(0));
-    pending_.erase(client);
-    it = sessions_.erase(it);
   }
   return expired;
 }

@@ -1,5 +1,6 @@
-// The ServerDaemon's side of one robot: every client's session (duplicate
-// detection, acknowledgements, the reply cache), admission (each command and
+// The ServerDaemon's side of one robot: its clients' sessions (kept in the
+// server's session table: duplicate detection, acknowledgements, the reply
+// cache, expiry), admission (each command and
 // query checked against the model, start times and queue limits checked,
 // panic and PANIC_RESET acted on at once), playback buffering and its delay
 // estimate, and the watchdog that expires silent sessions. Admitted items go
@@ -13,10 +14,12 @@
 #include "robot_daemon.h"
 #include "robotalk/request.h"
 #include "session.h"
+#include "session_table.h"
 
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,15 +36,16 @@ struct SessionOptions {
   CommandLimits limits;
   /// When playback mode has seen enough frames to estimate its delay.
   PlaybackEstimatorOptions playback;
-  /// Most client sessions of this robot at once; a new client beyond is refused.
-  std::size_t max_sessions = 256;
+  /// Most client sessions this robot serves at once (--max-sessions-per-robot);
+  /// a new client beyond is refused.
+  std::size_t max_sessions_per_robot = kDefaultMaxSessionsPerRobot;
   /// Longest reply message kept and sent (bad input is never echoed in full).
   std::size_t max_message_bytes = 512;
   /// The server's refusal counters for the SERVER_COUNTERS query (name, value).
   std::function<std::vector<std::pair<const char*, double>>()> counters;
   /// Most items all clients of this robot may have waiting (queued and
   /// buffered playback frames; each costs QueuedItemBytes()). Half of it is
-  /// every client's guaranteed share, max_robot_queue / (2 · max_sessions)
+  /// every client's guaranteed share, max_robot_queue / (2 · max_sessions_per_robot)
   /// each, always admitted (within max_queue); the other half is shared:
   /// items past a client's share are admitted only while all clients' items
   /// are fewer than max_robot_queue / 2. So the robot never holds more than
@@ -74,6 +78,10 @@ struct ExpiredSession {
 
 class RobotSessions {
  public:
+  /// Keeps its sessions in the server's `table` (which must outlive it).
+  RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options, SessionTable& table);
+  /// On its own (a simulation, a test): a table of its own, open mode; a
+  /// package of a client without a session opens one.
   RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options = {});
 
   /// Handles one decoded request received at `received`.
@@ -89,12 +97,16 @@ class RobotSessions {
   /// watchdog's bookkeeping) and the replies this layer produced outside
   /// Handle (a panic's flushed items); appends what to send, one batch per client.
   void File(DaemonOutput& output, std::vector<ReplyBatch>& to_send);
-  /// Expires silent sessions; a STOP follows if one had moved the robot.
+  /// Expires this robot's silent and never-used sessions (SessionTable::Expire);
+  /// a STOP follows if one had moved the robot.
   std::vector<ExpiredSession> Expire(TimePoint now);
   /// Lines for the server log (panic, reset), taken once.
   std::vector<std::string> TakeLog();
 
-  std::size_t num_sessions() const { return sessions_.size(); }
+  /// Sessions this robot serves (SessionTable::active).
+  std::size_t num_sessions() const { return table_.active(robot_id_); }
+  /// This robot's number in the session table.
+  int robot_id() const { return robot_id_; }
   /// Who last commanded each joint / the base (0 = nobody since the last STOP).
   std::int64_t joint_owner(int joint) const { return joint_owner_[static_cast<std::size_t>(joint)]; }
   std::int64_t base_owner() const { return base_owner_; }
@@ -113,6 +125,8 @@ class RobotSessions {
   SessionMemory memory(std::int64_t client_id) const;
 
  private:
+  RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options,
+                std::unique_ptr<SessionTable> own, SessionTable* table);
   Session& SessionFor(std::int64_t client_id, TimePoint now);
   ImmediateAnswer Refuse(const Request& request, TimePoint received);
   void AdmitQuery(Session& s, const Query& q, TimePoint now, std::vector<Reply>& immediate,
@@ -142,7 +156,9 @@ class RobotSessions {
   const std::string robot_;
   const std::uint64_t config_hash_;
   const SessionOptions options_;
-  std::map<std::int64_t, Session> sessions_;
+  std::unique_ptr<SessionTable> own_table_;  // used on its own only
+  SessionTable& table_;
+  const int robot_id_;
   std::map<std::int64_t, std::vector<Reply>> pending_;  // replies made outside Handle, by client
   std::vector<std::string> log_;
   std::vector<QueuedItem> flushed_;

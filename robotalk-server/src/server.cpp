@@ -59,9 +59,9 @@ RobotSpec RobotSpec::Parse(const std::string& text) {
 namespace {
 
 // Keyed mode from the key and access-list files (errors name the file).
-SessionGateOptions GateOptions(const ServerOptions& options) {
-  SessionGateOptions gate;
-  gate.max_sessions = options.max_sessions;
+SessionTableOptions TableOptions(const ServerOptions& options) {
+  SessionTableOptions table;
+  table.max_sessions = options.max_sessions;
   if (options.key_file.empty() != options.clients_file.empty()) {
     throw Error("keyed mode needs both --key (the server's secret key) and --clients (the access list)");
   }
@@ -69,14 +69,14 @@ SessionGateOptions GateOptions(const ServerOptions& options) {
     std::fprintf(stderr,
                  "robotalk-server: open mode: any process on the LAN may command these robots "
                  "(--key and --clients turn on authentication; docs/security.md)\n");
-    return gate;
+    return table;
   }
-  gate.identity = std::make_shared<const KeyPair>(ReadSecretKeyFile(options.key_file));
-  gate.access = std::make_shared<const AccessList>(AccessList::ReadFile(options.clients_file));
+  table.identity = std::make_shared<const KeyPair>(ReadSecretKeyFile(options.key_file));
+  table.access = std::make_shared<const AccessList>(AccessList::ReadFile(options.clients_file));
   std::fprintf(stderr, "robotalk-server: keyed mode: %zu client keys from %s; server key %s\n",
-               gate.access->size(), options.clients_file.c_str(),
-               gate.identity->public_key.Fingerprint().c_str());
-  return gate;
+               table.access->size(), options.clients_file.c_str(),
+               table.identity->public_key.Fingerprint().c_str());
+  return table;
 }
 
 }  // namespace
@@ -108,7 +108,7 @@ class Server::Impl {
                             .log_lines_per_second = options_.log_lines_per_second,
                             .panic_latch_path = options_.panic_latch_path,
                             .allow_duplicate_robots = options_.allow_duplicate_robots,
-                            .gate = GateOptions(options_),
+                            .sessions = TableOptions(options_),
                             .traffic_layout = dynamic_cast<RoutedLcmTransport*>(transport) != nullptr
                                                   ? TrafficLayout::kSplit
                                                   : TrafficLayout::kSingle,
@@ -118,7 +118,7 @@ class Server::Impl {
     sessions.playback = PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction};
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
-    sessions.max_sessions = options_.max_sessions_per_robot;
+    sessions.max_sessions_per_robot = options_.max_sessions_per_robot;
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
                                             .precise_timing = options_.precise_timing};

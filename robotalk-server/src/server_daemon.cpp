@@ -43,8 +43,8 @@ ServerDaemon::ServerDaemon(Transport& transport, const Clock& clock, ServerDaemo
     std::random_device rd;
     server_id_ = static_cast<std::int64_t>((static_cast<std::uint64_t>(rd()) << 32) ^ rd());
   }
-  gate_ = std::make_unique<SessionGate>(server_id_, options_.gate);
-  if (gate_->keyed()) signer_.emplace(*options_.gate.identity, *gate_->instance_nonce());
+  table_ = std::make_unique<SessionTable>(server_id_, options_.sessions);
+  if (table_->keyed()) signer_.emplace(*options_.sessions.identity, *table_->instance_nonce());
   const auto subscribe = [this] {
     hello_subscription_ = transport_.Subscribe(
         kAnyHelloChannelRegex,
@@ -96,11 +96,11 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   if (robots_.count(name)) throw Error("ServerDaemon: robot name '" + name + "' is given twice");
   Robot robot{&daemon, nullptr, EncodeConfig(daemon.model()), ConfigHash(daemon.model()), {}};
   options.counters = [this] {
-    auto table = gate_->counters().Table();
+    auto table = table_->counters().Table();
     table.emplace_back("malformed", static_cast<double>(malformed_));
     return table;
   };
-  robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options);
+  robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options, *table_);
   if (signer_) signer_->Sign(ConfigChannel(name), robot.encoded_config);  // once: it never changes
   daemon.Preallocate(robot.output);
   daemon.set_output_ready_callback([this] { Wake(); });
@@ -330,16 +330,17 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
 
 bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
                         std::span<const std::uint8_t> bytes, TimePoint received) {
-  const SessionGate::Admission admission = gate_->Admit(name, request, bytes, received);
-  if (gate_->keyed()) request.sender = admission.who;
+  const SessionTable::Admission admission =
+      table_->Admit(robot.sessions->robot_id(), request, bytes, received);
+  if (table_->keyed()) request.sender = admission.who;
   switch (admission.verdict) {
-    case SessionGate::Verdict::kAccepted:
+    case SessionTable::Verdict::kAccepted:
       return true;
-    case SessionGate::Verdict::kNoRights:
+    case SessionTable::Verdict::kNoRights:
       request.header_error = admission.why;  // every item is answered ERROR, nothing runs
       Log("robot '" + name + "': refused " + admission.who + ": " + admission.why);
       return true;
-    case SessionGate::Verdict::kDuplicate: {
+    case SessionTable::Verdict::kDuplicate: {
       ImmediateAnswer answer = robot.sessions->Resend(request, received);
       if (request.panic) {
         // As the first copy was answered: its header and the key's rights are unchanged.
@@ -349,14 +350,14 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
       Send(name, answer.batch);
       return false;
     }
-    case SessionGate::Verdict::kRefused:
+    case SessionTable::Verdict::kRefused:
       Log("robot '" + name + "': dropped a package of " + admission.who + ": " + admission.why);
       return false;
-    case SessionGate::Verdict::kUnknownSession:
+    case SessionTable::Verdict::kUnknownSession:
       break;
   }
   ReplyBatch unknown;
-  const bool raised = request.panic && !gate_->keyed();
+  const bool raised = request.panic && !table_->keyed();
   if (raised) {
     // Open mode: a panic is honoured from anyone, in a session or not (a
     // client whose server restarted must still be able to stop the robot).
@@ -399,7 +400,7 @@ void ServerDaemon::OnHello(const std::string& channel, std::span<const std::uint
     Log("robot '" + *robot_name + "': dropped a malformed hello: " + e.what());
     return;
   }
-  const HelloAnswer answer = gate_->Answer(*robot_name, hello, received);
+  const HelloAnswer answer = table_->Answer(it->second.sessions->robot_id(), hello, received);
   if (answer.session_id == 0) {
     Log("robot '" + *robot_name + "': refused a hello of client " +
         Hex64(static_cast<std::uint64_t>(hello.body.client_id)) + ": " + answer.refusal);
@@ -430,11 +431,13 @@ void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
 void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
   const std::string channel = ReplyChannel(robot, batch.client_id);
   batch.server_id = server_id_;
-  if (batch.session_id == 0) batch.session_id = gate_->LiveSession(robot, batch.client_id);
+  if (batch.session_id == 0) {
+    batch.session_id = table_->LiveSession(robots_.at(robot).sessions->robot_id(), batch.client_id);
+  }
   const auto publish = [&](ReplyBatch& part) {
     part.server_send = clock_.Now();
     std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
-    if (part.session_status == SessionStatus::kOk && !gate_->Seal(part.session_id, bytes)) {
+    if (part.session_status == SessionStatus::kOk && !table_->Seal(part.session_id, bytes)) {
       return;  // its session closed: the client said hello again and failed these
     }
     for (int copies = faults_.Copies(); copies > 0; --copies) transport_.Publish(channel, bytes);
@@ -459,11 +462,11 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
 }
 
 void ServerDaemon::Watchdogs(TimePoint now) {
-  gate_->Expire(now);
   for (auto& [name, robot] : robots_) {
     if (robot.daemon->CheckOverrun(now)) Drain(robot);
+    // The one expiry (SessionTable::Expire): a package of an expired session
+    // is never executed again.
     for (const ExpiredSession& e : robot.sessions->Expire(now)) {
-      gate_->Close(name, e.client_id);  // a package of it is never executed again
       // Quiet for the ordinary case: a short-lived client (the CLI) that is done.
       if (e.dropped_commands == 0 && !e.moved_robot) continue;
       Log("robot '" + name + "': client " + Hex64(static_cast<std::uint64_t>(e.client_id)) +
@@ -479,7 +482,7 @@ void ServerDaemon::Announce(TimePoint now) {
   a.uptime = started_ == TimePoint::min() ? Duration(0) : now - started_;
   a.url_hint = transport_.url();
   a.traffic_layout = options_.traffic_layout;
-  a.keyed = gate_->keyed();
+  a.keyed = table_->keyed();
   for (const auto& [name, robot] : robots_) {
     if (!robot.refused.empty()) continue;
     const RobotModel& m = robot.daemon->model();

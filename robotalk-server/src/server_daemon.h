@@ -30,7 +30,7 @@
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/clock.h"
 #include "robotalk/transport.h"
-#include "session_gate.h"
+#include "session_table.h"
 
 #include <atomic>
 #include <cstdint>
@@ -77,8 +77,8 @@ struct ServerDaemonOptions {
   /// a serving robot); a conflict is only logged. Must exceed the announce
   /// period of the other servers (1 s by default).
   Duration startup_window = std::chrono::seconds(2);
-  /// Open or keyed mode (session_gate.h).
-  SessionGateOptions gate;
+  /// Open or keyed mode, the session bounds (session_table.h).
+  SessionTableOptions sessions;
   /// Announced so that clients on another layout say so (docs/protocol.md).
   TrafficLayout traffic_layout = TrafficLayout::kSingle;
   /// The thread Start() launches runs SCHED_FIFO at this priority when the
@@ -129,7 +129,8 @@ class ServerDaemon {
   std::int64_t server_id() const { return server_id_; }
   /// Packages dropped because their bytes could not be decoded at all.
   std::uint64_t malformed() const { return malformed_; }
-  const SessionGate& gate() const { return *gate_; }
+  /// The server's session table (all robots' sessions).
+  const SessionTable& sessions() const { return *table_; }
 
  private:
   struct Robot {
@@ -145,7 +146,7 @@ class ServerDaemon {
 
   void OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes);
   void OnHello(const std::string& channel, std::span<const std::uint8_t> bytes);
-  // The gate's verdict on a decoded request; false when Handle must not run.
+  // The session table's verdict on a decoded request; false when Handle must not run.
   bool Gate(Robot& robot, const std::string& name, Request& request, std::span<const std::uint8_t> bytes,
             TimePoint received);
   void OnAnnounce(std::span<const std::uint8_t> bytes);
@@ -170,7 +171,7 @@ class ServerDaemon {
   LogLimiter log_limiter_;  // per line and per second (log_limiter.h)
   std::map<std::string, std::string> latched_at_start_;
   std::map<std::string, Robot> robots_;
-  std::unique_ptr<SessionGate> gate_;
+  std::unique_ptr<SessionTable> table_;
   std::optional<BroadcastSigner> signer_;  // keyed mode: signs ANNOUNCE, CONFIG and STATE
   std::unique_ptr<Subscription> subscription_;
   std::unique_ptr<Subscription> hello_subscription_;

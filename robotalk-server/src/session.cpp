@@ -101,4 +101,18 @@ std::vector<Reply> ReplyCache::RepliesFor(std::int64_t sequence) const {
   return out;
 }
 
+void Session::Continue(Session&& previous) {
+  const std::int64_t id = session_id;
+  const bool is_live = live;
+  const std::uint64_t opened = order;
+  const Nonce nonce = hello_nonce;
+  std::optional<Keyed> key = std::move(keyed);
+  *this = std::move(previous);
+  session_id = id;
+  live = is_live;
+  order = opened;
+  hello_nonce = nonce;
+  keyed = std::move(key);
+}
+
 }  // namespace robotalk

@@ -1,13 +1,17 @@
-// One client's state on the server (the paper's CClientConnection), as the
-// ServerDaemon keeps it: the package sequences it has sent, the final replies
-// of its recent packages for re-sending to a retransmission, and its playback
-// sequences still buffering. Its command queue lives in the RobotDaemon's
-// Scheduler. Pure data, used by one thread (the ServerDaemon's RobotSessions).
+// One client session on the server (the paper's CClientConnection), the one
+// entry of the server's session table (session_table.h) for it: who it is
+// (session id, robot, client id; keyed mode: the key it is bound to and its
+// session keys), when it expires, the package sequences it has sent, the
+// final replies of its recent packages for re-sending to a retransmission,
+// and its playback sequences still buffering. Its command queue lives in the
+// RobotDaemon's Scheduler. Pure data, used by one thread (the ServerDaemon's).
 #pragma once
 
 #include "command_queue.h"
 #include "playback_estimator.h"
+#include "robotalk/access_list.h"
 #include "robotalk/command.h"
+#include "robotalk/session_auth.h"
 #include "sequence_window.h"
 
 #include <algorithm>
@@ -114,11 +118,30 @@ struct Session {
   Session(std::int64_t id, TimePoint now, ReplyCache::Limits reply_limits = {})
       : client_id(id), created(now), last_heard(now), replies(reply_limits) {}
 
+  // --- The session's identity: its own, never taken over (Continue).
+  std::int64_t session_id = 0;
+  int robot = 0;            ///< the robot's number in the session table
+  bool live = false;        ///< false: pending (opened by a hello, no package accepted yet)
+  std::uint64_t order = 0;  ///< opening order: the oldest pending session is dropped first
+  Nonce hello_nonce{};      ///< the client nonce of the hello that opened it
+  struct Keyed {
+    SessionKeys keys;
+    const AccessEntry* client = nullptr;  ///< the access-list entry its key is bound to
+    ClientHello hello;                    ///< as received: a repeat must equal it
+    ServerAnswer answer;                  ///< sent again to a repeat
+  };
+  std::optional<Keyed> keyed;  ///< keyed mode only
+
+  // --- The client's side on its robot; a newer session of the same client
+  // and robot takes it over when it goes live (Continue).
   std::int64_t client_id;
-  std::string who;  ///< for logs: the sender as the session gate names it
-  TimePoint created;
+  std::string who;    ///< for logs: "client 503d..." or "'alice' (rt:1a2b:..., client 503d...)"
+  TimePoint created;  ///< the hello (or the first package without one)
+  /// The last new package the robot admitted (any new one while it is not
+  /// `active`): the session expires a timeout after it.
   TimePoint last_heard;
-  SequenceWindow seen;
+  bool active = false;  ///< the robot serves it (a package was admitted): counts against its bound
+  SequenceWindow seen;  ///< the one replay / duplicate window
   ReplyCache replies;
   DelayHistory delays;  ///< one-way delays of its latest packages (playback's quick start)
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< unfinished ones, by playback id
@@ -151,12 +174,18 @@ struct Session {
   }
   /// Memory of its playback sequences: map nodes, buffers, estimators and
   /// the ended list.
-  std::size_t playback_bytes() const {
-    constexpr std::size_t kNode = sizeof(std::pair<const std::int64_t, PlaybackSequence>) + 4 * sizeof(void*);
-    std::size_t n = ended_playbacks.size() * sizeof(std::pair<std::int64_t, Ended>);
-    for (const auto& [id, seq] : playbacks) n += kNode + seq.bytes();
-    return n;
-  }
+  std::size_t playback_bytes() const;
+  /// Takes over the client's side of `previous` (an older session of the
+  /// same client on the same robot that this one replaces): its window,
+  /// replies, playbacks and servo bookkeeping; keeps its own identity.
+  void Continue(Session&& previous);
 };
+
+inline std::size_t Session::playback_bytes() const {
+  constexpr std::size_t kNode = sizeof(std::pair<const std::int64_t, PlaybackSequence>) + 4 * sizeof(void*);
+  std::size_t n = ended_playbacks.size() * sizeof(std::pair<std::int64_t, Ended>);
+  for (const auto& [id, seq] : playbacks) n += kNode + seq.bytes();
+  return n;
+}
 
 }  // namespace robotalk

@@ -325,7 +325,8 @@ TEST_F(RobotSessionsTest, NeverEchoesALongBadTargetInFull) {
 class FewSessionsTest : public RobotSessionsTest {
  protected:
   FewSessionsTest()
-      : RobotSessionsTest(BaseType::kDifferential, SessionOptions{.max_queue = 100, .max_sessions = 2}) {}
+      : RobotSessionsTest(BaseType::kDifferential,
+                          SessionOptions{.max_queue = 100, .max_sessions_per_robot = 2}) {}
 };
 
 TEST_F(FewSessionsTest, RefusesANewClientBeyondTheSessionBoundAndServesKnownOnes) {

@@ -29,7 +29,7 @@ constexpr std::int64_t kMallory = 0xBAD;
 // view of the bus: replies by id and every reply package's status.
 class GateTest : public ::testing::Test {
  protected:
-  explicit GateTest(SessionGateOptions gate = {}) : gate_(std::move(gate)) {
+  explicit GateTest(SessionTableOptions gate = {}) : gate_(std::move(gate)) {
     Restart();
     sub_ = client_.Subscribe("ROBOTALK/bot/REPLY/.*",
                              [this](const std::string&, std::span<const std::uint8_t> b) {
@@ -45,7 +45,7 @@ class GateTest : public ::testing::Test {
     auto driver = std::make_unique<FakeDriver>(PanRobot());
     fake_ = driver.get();
     robot_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
-    server_ = std::make_unique<ServerDaemon>(transport_, clock_, ServerDaemonOptions{.gate = gate_});
+    server_ = std::make_unique<ServerDaemon>(transport_, clock_, ServerDaemonOptions{.sessions = gate_});
     server_->AddRobot(*robot_, SessionOptions{});
   }
 
@@ -74,7 +74,7 @@ class GateTest : public ::testing::Test {
 
   std::size_t Executed() const { return fake_->calls.size(); }
 
-  SessionGateOptions gate_;
+  SessionTableOptions gate_;
   ManualClock clock_;
   std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
   MemoryTransport transport_{bus_};
@@ -96,7 +96,7 @@ TEST_F(GateTest, APackageOutsideAnySessionIsAnsweredSessionUnknownAndNotExecuted
     EXPECT_EQ(b.session_status, SessionStatus::kUnknown);
     EXPECT_TRUE(b.replies.empty());
   }
-  EXPECT_EQ(server_->gate().counters().unknown_session, 2u);
+  EXPECT_EQ(server_->sessions().counters().unknown_session, 2u);
 }
 
 TEST_F(GateTest, ARecordedSessionReplayedOnARestartedServerDoesNotRun) {
@@ -132,7 +132,7 @@ TEST_F(GateTest, AnotherClientsSessionIdIsRefused) {
   const std::int64_t session = OpenSession(kAlice);
   Publish(EncodeRequest(Move(kMallory, session, 1, 1)));
   EXPECT_EQ(Executed(), 0u);
-  EXPECT_EQ(server_->gate().counters().wrong_client, 1u);
+  EXPECT_EQ(server_->sessions().counters().wrong_client, 1u);
 }
 
 TEST_F(GateTest, CommandStatusTellsWhatBecameOfACommand) {
@@ -213,8 +213,8 @@ std::int64_t Id(const KeyPair& key, std::int64_t low) {
   return KeyedClientId(key.public_key, static_cast<std::uint32_t>(low));
 }
 
-SessionGateOptions Keyed() {
-  SessionGateOptions gate;
+SessionTableOptions Keyed() {
+  SessionTableOptions gate;
   gate.identity = std::make_shared<const KeyPair>(Key(1));
   const std::string list = Key(2).public_key.ToString() + " alice *=all\n" + Key(3).public_key.ToString() +
                            " monitor *=query,panic\n" + Key(4).public_key.ToString() + " viewer *=query\n";
@@ -286,7 +286,7 @@ TEST_F(KeyedGateTest, ExecutesSealedPackagesOnceAndDropsForgedOnes) {
   forged[forged.size() - 1] ^= 1;
   Publish(forged);
   EXPECT_EQ(Executed(), 1u);
-  EXPECT_EQ(server_->gate().counters().forged, 1u);
+  EXPECT_EQ(server_->sessions().counters().forged, 1u);
   EXPECT_EQ(replies_.count(2), 0u) << "a forged package gets no answer";
 }
 
@@ -334,7 +334,7 @@ TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
   EXPECT_EQ(replies_.at(11).signal, Signal::kError) << "nor stop the robot";
   Publish(Sealed(*alice, Commands(CommandType::kPanicReset, 12)));
   EXPECT_FALSE(robot_->in_panic());
-  EXPECT_EQ(server_->gate().counters().rights_refused, 2u);
+  EXPECT_EQ(server_->sessions().counters().rights_refused, 2u);
 }
 
 TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdle) {
@@ -346,7 +346,20 @@ TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdl
   Step();  // the watchdog
   Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, 2, {0.5})));
   EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown) << "closed, not kept for ever";
-  EXPECT_EQ(server_->gate().session_count(), 0u);
+  EXPECT_EQ(server_->sessions().session_count(), 0u);
+}
+
+TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsLastsWhileItSends) {
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
+  ASSERT_TRUE(monitor);
+  for (CommandId id = 1; id <= 5; ++id) {
+    Publish(Sealed(*monitor, Commands(CommandType::kJointSetPoint, id, {0.5})));
+    ASSERT_EQ(batches_.back().session_status, SessionStatus::kOk) << "package " << id;
+    EXPECT_EQ(replies_.at(id).signal, Signal::kError);
+    clock_.Advance(std::chrono::milliseconds(1500));  // under the 2 s session timeout each time
+    Step();                                           // the watchdog
+  }
+  EXPECT_EQ(server_->sessions().session_count(), 1u);
 }
 
 TEST_F(KeyedGateTest, APanicRefusedForRightsIsAnsweredRefusedWithTheReasonAndDoesNothing) {
@@ -407,17 +420,17 @@ TEST_F(GateTest, ARepeatedHelloGetsTheSameSessionAndPendingSessionsAreBoundedPer
   const auto step = [this] { Step(); };
   const std::int64_t first = SayHello(client_, "bot", kAlice, step, hello).session_id;
   EXPECT_EQ(SayHello(client_, "bot", kAlice, step, hello).session_id, first) << "its answer was lost: again";
-  EXPECT_EQ(server_->gate().session_count(), 1u);
+  EXPECT_EQ(server_->sessions().session_count(), 1u);
   std::int64_t last = 0;
   for (int i = 0; i < 5; ++i) last = OpenSession(kAlice);  // new hellos of one source, never used
-  EXPECT_EQ(server_->gate().session_count(), 2u) << "pending sessions per client id are bounded";
+  EXPECT_EQ(server_->sessions().session_count(), 2u) << "pending sessions per client id are bounded";
   Publish(EncodeRequest(Move(kAlice, last, 1, 1)));
   EXPECT_EQ(replies_.at(1).signal, Signal::kSuccess);
 }
 
 class SmallGateTest : public GateTest {
  protected:
-  SmallGateTest() : GateTest(SessionGateOptions{.max_sessions = 4}) {}
+  SmallGateTest() : GateTest(SessionTableOptions{.max_sessions = 4}) {}
 };
 
 TEST_F(SmallGateTest, AFloodOfHellosNeverLocksANewClientOutOrDropsALiveSession) {
@@ -430,7 +443,7 @@ TEST_F(SmallGateTest, AFloodOfHellosNeverLocksANewClientOutOrDropsALiveSession) 
   EXPECT_EQ(replies_.at(2).signal, Signal::kSuccess);
   Publish(EncodeRequest(Move(kAlice, live, 2, 3)));
   EXPECT_EQ(replies_.at(3).signal, Signal::kSuccess) << "a live session is never dropped for a hello";
-  EXPECT_LE(server_->gate().session_count(), 4u);
+  EXPECT_LE(server_->sessions().session_count(), 4u);
 }
 
 TEST_F(KeyedGateTest, OneHelloReplayedThousandsOfTimesLeavesRoomForEveryOtherKey) {
@@ -439,9 +452,10 @@ TEST_F(KeyedGateTest, OneHelloReplayedThousandsOfTimesLeavesRoomForEveryOtherKey
   const auto bytes = EncodeHello(Hello{.keyed = true, .body = recorded.hello()});
   for (int i = 0; i < 3000; ++i) client_.Publish(HelloChannel("bot"), bytes);
   Step();
-  EXPECT_EQ(server_->gate().session_count(), 1u) << "one hello, one pending session";
-  EXPECT_EQ(server_->gate().counters().hellos_refused, 0u) << "its copies are answered again, not refused";
-  EXPECT_EQ(server_->gate().counters().hello_repeats, 2999u) << "and counted (SERVER_COUNTERS)";
+  EXPECT_EQ(server_->sessions().session_count(), 1u) << "one hello, one pending session";
+  EXPECT_EQ(server_->sessions().counters().hellos_refused, 0u)
+      << "its copies are answered again, not refused";
+  EXPECT_EQ(server_->sessions().counters().hello_repeats, 2999u) << "and counted (SERVER_COUNTERS)";
   for (std::uint8_t key : {3, 4}) {
     auto other = Handshake(Key(key), Id(Key(key), kMallory));
     ASSERT_TRUE(other) << "key " << int{key};
@@ -452,7 +466,7 @@ TEST_F(KeyedGateTest, OneHelloReplayedThousandsOfTimesLeavesRoomForEveryOtherKey
 
 TEST_F(KeyedGateTest, PendingSessionsPerKeyAreBoundedAndTheGateForgetsTheDroppedOnes) {
   for (std::int64_t id = 1; id <= 6; ++id) ASSERT_TRUE(Handshake(Key(2), Id(Key(2), id)));  // never used
-  EXPECT_EQ(server_->gate().session_count(), 4u) << "4 pending per key, as the authenticator keeps them";
+  EXPECT_EQ(server_->sessions().session_count(), 4u) << "4 pending per key, as the authenticator keeps them";
   auto monitor = Handshake(Key(3), Id(Key(3), 1));
   ASSERT_TRUE(monitor);
   Publish(Sealed(*monitor, Commands(CommandType::kStop, 1)));

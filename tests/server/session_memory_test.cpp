@@ -236,7 +236,8 @@ TEST_F(SessionMemoryTest, APanicFreesTheTimedServoEntriesOfTheCommandsItFlushed)
 class FloodedQueuesTest : public SessionMemoryTest {
  protected:
   FloodedQueuesTest()
-      : SessionMemoryTest(SessionOptions{.max_queue = 1000, .max_sessions = 8, .max_robot_queue = 64}) {}
+      : SessionMemoryTest(
+            SessionOptions{.max_queue = 1000, .max_sessions_per_robot = 8, .max_robot_queue = 64}) {}
   // Sends `n` future commands in one package; returns how many were refused.
   std::size_t Flood(std::int64_t client, std::int64_t seq, int n) {
     std::vector<Command> commands;
@@ -289,15 +290,31 @@ TEST(ServerMemoryBound, TheDefaultBoundsKeepTheWholeServerUnder512MiB) {
   // a vector of pairs: twice that while it grows).
   const std::size_t playback = sizeof(PlaybackSequence) + 64 + 32 * sizeof(Duration);
   const std::size_t window = 2 * SequenceWindow::kMaxUnseen * sizeof(std::pair<std::int64_t, std::int64_t>);
-  const std::size_t per_session = session.replies.max_bytes + session.max_playbacks * playback + window +
-                                  Session::kMaxEnded * 16 + sizeof(Session) + 256;
+  // The session table's own part of a session (session_table.h): the entry
+  // (sizeof(Session): keyed mode's keys, hello and answer included) in its
+  // map node, its live-index, nonce-index and key-binding nodes, its `who`
+  // string; and, once per server, the nonces of the last kRememberedNonces
+  // closed sessions (a set node and a deque slot each).
+  constexpr std::size_t kNode = 4 * sizeof(void*);
+  const std::size_t table = kNode + sizeof(std::int64_t) + sizeof(Session) +        // sessions_
+                            kNode + 2 * sizeof(std::int64_t) +                      // the live index
+                            kNode + sizeof(Nonce) + sizeof(std::int64_t) +          // the nonce index
+                            kNode + 2 * sizeof(std::int64_t) + sizeof(PublicKey) +  // the key binding
+                            128;                                                    // `who`
+  const std::size_t remembered = SessionTable::kRememberedNonces * (kNode + 2 * sizeof(Nonce));
+  const std::size_t per_session =
+      session.replies.max_bytes + session.max_playbacks * playback + window + Session::kMaxEnded * 16 + table;
   const std::size_t queued = server.max_queued_total * QueuedItemBytes();
-  const std::size_t total = server.max_sessions * per_session + queued;
-  std::printf("a session at most %zu KiB; %zu sessions %zu MiB; queued %zu MiB; total %zu MiB\n",
-              per_session / 1024, server.max_sessions, server.max_sessions * per_session >> 20, queued >> 20,
-              total >> 20);
+  const std::size_t total = server.max_sessions * per_session + remembered + queued;
+  std::printf(
+      "a session at most %zu B (%zu KiB; the table's part %zu B); %zu sessions %zu MiB; remembered nonces "
+      "%zu "
+      "KiB; queued %zu MiB; total %zu MiB\n",
+      per_session, per_session / 1024, table, server.max_sessions, server.max_sessions * per_session >> 20,
+      remembered >> 10, queued >> 20, total >> 20);
   EXPECT_LT(per_session, 1u << 20);
   EXPECT_LT(total, 512u << 20) << "sessions " << server.max_sessions * per_session << " + queued " << queued;
+  EXPECT_EQ(SessionTableOptions{}.max_sessions, server.max_sessions) << "one default";
 }
 
 }  // namespace

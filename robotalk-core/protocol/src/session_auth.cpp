@@ -1,11 +1,9 @@
-// Handshake, MAC and replay window (session_auth.h). Only libsodium does
+// Handshake and MAC (session_auth.h). Only libsodium does
 // cryptography here; this file fixes the byte strings it is applied to.
 #include "robotalk/session_auth.h"
 
 #include <sodium.h>
 
-#include <algorithm>
-#include <iterator>
 #include <string_view>
 
 namespace robotalk {
@@ -68,10 +66,6 @@ std::uint32_t KeyPrefix(const PublicKey& key) {
   return (static_cast<std::uint32_t>(h[0]) << 24 | static_cast<std::uint32_t>(h[1]) << 16 |
           static_cast<std::uint32_t>(h[2]) << 8 | h[3]) &
          0x7fffffffU;
-}
-bool SameHello(const ClientHello& a, const ClientHello& b) {
-  return a.client_key == b.client_key && a.client_id == b.client_id && a.client_nonce == b.client_nonce &&
-         a.client_kx == b.client_kx && a.signature == b.signature;
 }
 }  // namespace
 
@@ -180,109 +174,32 @@ bool VerifyMac(std::span<const std::uint8_t, 32> key, std::int64_t session_id,
   return sodium_memcmp(expected.data(), mac.data(), kMacBytes) == 0;
 }
 
-ReplayWindow::Verdict ReplayWindow::Check(std::int64_t sequence) const {
-  if (sequence <= 0) return Verdict::kInvalid;
-  if (sequence > highest_) return Verdict::kNew;
-  if (highest_ - sequence >= kWindow) return Verdict::kTooOld;
-  const auto bit = static_cast<std::uint64_t>(sequence % kWindow);
-  return (seen_[bit / 64] >> (bit % 64)) & 1U ? Verdict::kDuplicate : Verdict::kNew;
-}
-
-ReplayWindow::Verdict ReplayWindow::Accept(std::int64_t sequence) {
-  const Verdict v = Check(sequence);
-  if (v != Verdict::kNew) return v;
-  if (sequence > highest_) {
-    // Clear the bits of the numbers the window slides over (highest_, sequence].
-    const std::int64_t clear = std::min<std::int64_t>(sequence - highest_, kWindow);
-    for (std::int64_t s = sequence - clear + 1; s <= sequence; ++s) {
-      const auto bit = static_cast<std::uint64_t>(s % kWindow);
-      seen_[bit / 64] &= ~(std::uint64_t{1} << (bit % 64));
-    }
-    highest_ = sequence;
-  }
-  const auto bit = static_cast<std::uint64_t>(sequence % kWindow);
-  seen_[bit / 64] |= std::uint64_t{1} << (bit % 64);
-  return v;
-}
-
-const char* ToString(PackageVerdict verdict) {
-  switch (verdict) {
-    case PackageVerdict::kAccepted:
-      return "accepted";
-    case PackageVerdict::kUnknownSession:
-      return "unknown session";
-    case PackageVerdict::kWrongClient:
-      return "session of another client";
-    case PackageVerdict::kForged:
-      return "bad MAC";
-    case PackageVerdict::kDuplicate:
-      return "duplicate";
-    case PackageVerdict::kTooOld:
-      return "sequence below the replay window";
-    case PackageVerdict::kInvalidSequence:
-      return "sequence not positive";
-  }
-  return "?";
-}
-
 // --- ServerAuthenticator -----------------------------------------------------
 
-ServerAuthenticator::ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce,
-                                         Limits limits)
-    : identity_(std::move(identity)), access_(access), instance_nonce_(instance_nonce), limits_(limits) {
+ServerAuthenticator::ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce)
+    : identity_(std::move(identity)), access_(access), instance_nonce_(instance_nonce) {
   InitSodium();
 }
 
-void ServerAuthenticator::Refuse(const std::string& why) {
-  ++counters_.handshakes_refused;
-  throw AuthError(why);
+std::string DescribeHello(const ClientHello& hello) {
+  return "hello of client " + std::to_string(hello.client_id) + " (key " + hello.client_key.Fingerprint() +
+         ")";
 }
 
-ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello, TimePoint now) {
-  const std::string who =
-      "hello of client " + std::to_string(hello.client_id) + " (key " + hello.client_key.Fingerprint() + ")";
-  // The cheap map lookup first: a hello from an unlisted key costs no
-  // signature verification (~50 us), so a flood of them costs little.
-  const AccessEntry* client = access_.Find(hello.client_key);
-  if (client == nullptr) Refuse(who + ": key not in the access list");
-  if (const auto seen = by_nonce_.find(hello.client_nonce); seen != by_nonce_.end()) {
-    // The same hello again: its client repeats it until an answer arrives,
-    // or someone replays a recording. Either way: the same answer, nothing
-    // new opened, no signature to check (the bytes are the ones verified).
-    const Session& s = sessions_.at(seen->second);
-    if (!SameHello(s.hello, hello)) Refuse(who + ": hello nonce already used by another hello");
-    ++counters_.hello_repeats;
-    return s.answer;
-  }
-  if (used_nonces_.contains(hello.client_nonce)) {
-    Refuse(who + ": replayed hello (its nonce opened a session of this server instance already)");
-  }
-  if (!VerifySignature(hello.client_key, hello.SignedBytes(), hello.signature)) {
-    Refuse(who + ": bad signature");
-  }
+HelloResult ServerAuthenticator::Answer(const ClientHello& hello) const {
+  const auto refuse = [&](const std::string& why) { return HelloRefused{DescribeHello(hello) + ": " + why}; };
+  const AccessEntry* client = Client(hello);
+  if (client == nullptr) return refuse("key not in the access list");
+  if (!VerifySignature(hello.client_key, hello.SignedBytes(), hello.signature))
+    return refuse("bad signature");
   if (!ClientIdBelongsTo(hello.client_id, hello.client_key)) {
-    Refuse(who + ": client id " + std::to_string(hello.client_id) +
-           " is not one of this key's (keyed mode: " +
-           "a client id's high bits come from its key; robotalk::KeyedClientId, docs/security.md)");
+    return refuse("client id " + std::to_string(hello.client_id) +
+                  " is not one of this key's (keyed mode: a client id's high bits come from its key; "
+                  "robotalk::KeyedClientId, docs/security.md)");
   }
-  const auto bound = bindings_.find(hello.client_id);
-  if (bound != bindings_.end() && !(bound->second.key == hello.client_key)) {
-    Refuse(who + ": client id is bound to another key (" + bound->second.key.Fingerprint() + ")");
-  }
-  if (bound == bindings_.end()) {
-    const auto ids = std::count_if(bindings_.begin(), bindings_.end(),
-                                   [&](const auto& b) { return b.second.key == hello.client_key; });
-    if (static_cast<std::size_t>(ids) >= limits_.max_client_ids_per_key) {
-      Refuse(who + ": '" + client->name + "' already holds " + std::to_string(ids) +
-             " client ids (limit max_client_ids_per_key)");
-    }
-  }
-  DropOldestPending(hello.client_key);
-  if (sessions_.size() >= limits_.max_sessions) {
-    Refuse(who + ": " + std::to_string(sessions_.size()) + " sessions open (limit max_sessions)");
-  }
-
-  ServerAnswer answer;
+  HelloAccepted out;
+  out.client = client;
+  ServerAnswer& answer = out.answer;
   answer.client_id = hello.client_id;
   answer.client_nonce = hello.client_nonce;
   answer.instance_nonce = instance_nonce_;
@@ -293,132 +210,13 @@ ServerAnswer ServerAuthenticator::Handshake(const ClientHello& hello, TimePoint 
   const int kx = crypto_kx_server_session_keys(rx.data(), tx.data(), answer.server_kx.data(),
                                                kx_secret.data(), hello.client_kx.data());
   sodium_memzero(kx_secret.data(), kx_secret.size());
-  if (kx != 0) Refuse(who + ": unusable key-exchange key");
+  if (kx != 0) return refuse("unusable key-exchange key");
   answer.signature = Sign(identity_, answer.SignedBytes(hello));
   // The server receives on the client's tx key: (tx_client, rx_client) = (rx, tx) here.
-  Session session{DeriveKeys(hello, answer, rx, tx),
-                  hello.client_id,
-                  client,
-                  false,
-                  ++counters_.handshakes,
-                  now,
-                  {},
-                  hello,
-                  answer};
+  out.keys = DeriveKeys(hello, answer, rx, tx);
   sodium_memzero(rx.data(), rx.size());
   sodium_memzero(tx.data(), tx.size());
-  const std::int64_t id = session.keys.session_id;
-  if (sessions_.contains(id)) Refuse(who + ": session id collision; retry");  // 2^-63: never in practice
-  sessions_.emplace(id, std::move(session));
-  by_nonce_[hello.client_nonce] = id;
-  auto& binding = bindings_[hello.client_id];
-  binding.key = hello.client_key;
-  ++binding.sessions;
-  return answer;
-}
-
-void ServerAuthenticator::DropOldestPending(const PublicKey& key) {
-  std::size_t pending = 0;
-  auto oldest = sessions_.end();
-  for (auto it = sessions_.begin(); it != sessions_.end(); ++it) {
-    if (it->second.live || !(it->second.client->key == key)) continue;
-    ++pending;
-    if (oldest == sessions_.end() || it->second.opened < oldest->second.opened) oldest = it;
-  }
-  if (pending >= limits_.max_pending_per_key && oldest != sessions_.end()) Erase(oldest);
-}
-
-void ServerAuthenticator::Erase(std::map<std::int64_t, Session>::iterator it, bool report) {
-  const std::int64_t client_id = it->second.client_id;
-  if (const auto live = live_.find(client_id); live != live_.end() && live->second == it->first)
-    live_.erase(live);
-  if (const auto b = bindings_.find(client_id); b != bindings_.end() && --b->second.sessions == 0) {
-    bindings_.erase(b);
-  }
-  // Its hello must not open a session again: remember its nonce (bounded).
-  const Nonce& nonce = it->second.hello.client_nonce;
-  by_nonce_.erase(nonce);
-  if (used_nonces_.insert(nonce).second) used_order_.push_back(nonce);
-  while (used_order_.size() > kRememberedNonces) {
-    used_nonces_.erase(used_order_.front());
-    used_order_.pop_front();
-  }
-  if (report) closed_.push_back(it->first);  // closed by the authenticator itself: TakeClosed() says so
-  sessions_.erase(it);
-}
-
-ServerAuthenticator::Verified ServerAuthenticator::Verify(std::int64_t session_id, std::int64_t client_id,
-                                                          std::int64_t sequence,
-                                                          std::span<const std::uint8_t> bytes,
-                                                          const Mac& mac) {
-  const auto it = sessions_.find(session_id);
-  if (it == sessions_.end()) {
-    ++counters_.unknown_session;
-    return {PackageVerdict::kUnknownSession, nullptr};
-  }
-  Session& s = it->second;
-  if (s.client_id != client_id) {
-    ++counters_.wrong_client;
-    return {PackageVerdict::kWrongClient, nullptr};
-  }
-  if (!VerifyMac(s.keys.client_to_server, session_id, bytes, mac)) {
-    ++counters_.forged;
-    return {PackageVerdict::kForged, nullptr};
-  }
-  switch (s.window.Accept(sequence)) {
-    case ReplayWindow::Verdict::kNew:
-      break;
-    case ReplayWindow::Verdict::kDuplicate:
-      ++counters_.duplicate;
-      return {PackageVerdict::kDuplicate, s.client};
-    case ReplayWindow::Verdict::kTooOld:
-      ++counters_.too_old;
-      return {PackageVerdict::kTooOld, s.client};
-    case ReplayWindow::Verdict::kInvalid:
-      ++counters_.too_old;
-      return {PackageVerdict::kInvalidSequence, s.client};
-  }
-  if (!s.live) {
-    // First authentic package: this session proves its client holds the
-    // ephemeral secret; it now replaces the client id's previous session.
-    s.live = true;
-    if (const auto prev = live_.find(client_id); prev != live_.end() && prev->second != session_id) {
-      const auto old = sessions_.find(prev->second);
-      if (old != sessions_.end()) Erase(old);
-    }
-    live_[client_id] = session_id;
-  }
-  return {PackageVerdict::kAccepted, s.client};
-}
-
-Mac ServerAuthenticator::SealReply(std::int64_t session_id, std::span<const std::uint8_t> bytes) const {
-  const auto it = sessions_.find(session_id);
-  if (it == sessions_.end()) throw AuthError("SealReply: unknown session " + std::to_string(session_id));
-  return ComputeMac(it->second.keys.server_to_client, session_id, bytes);
-}
-
-std::size_t ServerAuthenticator::ExpirePending(TimePoint now, Duration max_age) {
-  std::size_t closed = 0;
-  for (auto it = sessions_.begin(); it != sessions_.end();) {
-    const auto next = std::next(it);
-    if (!it->second.live && now - it->second.opened_at > max_age) {
-      Erase(it);
-      ++closed;
-    }
-    it = next;
-  }
-  return closed;
-}
-
-void ServerAuthenticator::Close(std::int64_t session_id) {
-  if (const auto it = sessions_.find(session_id); it != sessions_.end()) {
-    Erase(it, /*report=*/false);  // the caller closed it: it knows
-  }
-}
-
-std::int64_t ServerAuthenticator::LiveSession(std::int64_t client_id) const {
-  const auto it = live_.find(client_id);
-  return it == live_.end() ? 0 : it->second;
+  return out;
 }
 
 }  // namespace robotalk

@@ -31,6 +31,11 @@ struct RobotSpec {
   static RobotSpec Parse(const std::string& text);
 };
 
+/// The default of --max-sessions (ServerOptions::max_sessions).
+inline constexpr std::size_t kDefaultMaxSessions = 1024;
+/// The default of --max-sessions-per-robot (ServerOptions::max_sessions_per_robot).
+inline constexpr std::size_t kDefaultMaxSessionsPerRobot = 256;
+
 struct ServerOptions {
   /// LCM provider URL; "" uses LCM's default (or $LCM_DEFAULT_URL).
   std::string lcm_url;
@@ -72,10 +77,10 @@ struct ServerOptions {
   /// mode (any process on the LAN may command the robots).
   std::string key_file;
   std::string clients_file;
-  /// Most sessions (open and not yet used) in the whole server.
-  std::size_t max_sessions = 1024;
+  /// Most sessions (live and not yet used) in the whole server (`--max-sessions`).
+  std::size_t max_sessions = kDefaultMaxSessions;
   /// Most clients one robot serves at once (`--max-sessions-per-robot`).
-  std::size_t max_sessions_per_robot = 256;
+  std::size_t max_sessions_per_robot = kDefaultMaxSessionsPerRobot;
   /// 1 ns timer slack, a short final spin before each deadline and SCHED_FIFO
   /// for the server's threads where permitted (docs/server.md; costs CPU).
   /// ROBOTALK_PRECISE_TIMING=0 in the environment turns it off too.

@@ -1,8 +1,8 @@
 // Authenticated sessions as pure maths: the handshake that binds a client id
-// to a key and derives session keys, the per-package MAC, and the replay
-// window. No I/O, no clock of its own (times are passed in), no LCM: the
-// ServerDaemon / RobotClient carry the values (wire proposal in
-// docs/security.md). Every primitive is libsodium's.
+// to a key and derives session keys, and the per-package MAC. No session
+// state (the server's session table keeps it, with the replay window). No I/O, no clock of its own (times are
+// passed in), no LCM: the ServerDaemon / RobotClient carry the values (wire proposal in docs/security.md).
+// Every primitive is libsodium's.
 //
 //   client                                           server (instance nonce I, fresh per start)
 //   ClientHello{key C, client id, nonce Nc, X25519 eph. Ec, sig_C}  ->
@@ -15,11 +15,11 @@
 //
 // A recorded package carries a session id and a MAC under a key that depend
 // on I and on ephemeral secrets never sent: after a restart (new I) or in
-// another session it is refused; inside its session the replay window
-// refuses it as a duplicate.
+// another session it is refused; inside its session the server's sequence
+// window refuses it as a duplicate.
 //
-// Thread safety: none of these classes locks; use each from one thread (the
-// ServerDaemon's) or guard it. Free functions are thread-safe.
+// Thread safety: ClientHandshake: one thread; ServerAuthenticator and the
+// free functions: any thread.
 #pragma once
 
 #include "robotalk/access_list.h"
@@ -29,12 +29,10 @@
 
 #include <array>
 #include <cstdint>
-#include <deque>
-#include <map>
-#include <set>
 #include <span>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 namespace robotalk {
@@ -66,6 +64,8 @@ struct ClientHello {
   /// "robotalk-hello-v1" || key || client id (8 bytes LE) || nonce || kx: the
   /// signed bytes, independent of the wire encoding.
   std::vector<std::uint8_t> SignedBytes() const;
+  /// Every field equal: the same hello (sent again, or replayed).
+  friend bool operator==(const ClientHello&, const ClientHello&) = default;
 };
 
 /// Server -> client, second message.
@@ -137,161 +137,60 @@ Mac ComputeMac(std::span<const std::uint8_t, 32> key, std::int64_t session_id,
 bool VerifyMac(std::span<const std::uint8_t, 32> key, std::int64_t session_id,
                std::span<const std::uint8_t> bytes, const Mac& mac);
 
-/// Which sequence numbers of one session were accepted: a bitmap of the last
-/// kWindow numbers below the highest (RFC 6479 style, fixed memory).
-class ReplayWindow {
- public:
-  enum class Verdict { kNew, kDuplicate, kTooOld, kInvalid };
-  static constexpr std::int64_t kWindow = 1024;
-
-  /// What Accept would say; changes nothing. kInvalid: sequence <= 0.
-  Verdict Check(std::int64_t sequence) const;
-  /// Records `sequence` if new; returns Check's verdict.
-  Verdict Accept(std::int64_t sequence);
-  std::int64_t highest() const { return highest_; }
-
- private:
-  std::int64_t highest_ = 0;
-  std::array<std::uint64_t, kWindow / 64>
-      seen_{};  // bit (s mod kWindow) = s seen, for s in (highest-kWindow, highest]
+/// A hello the server accepts: the answer to send, the session's keys and
+/// the access-list entry of the hello's key.
+struct HelloAccepted {
+  ServerAnswer answer;
+  SessionKeys keys;
+  const AccessEntry* client = nullptr;
 };
-
-/// Why a package was or was not accepted.
-enum class PackageVerdict {
-  kAccepted,        ///< authentic and new: decode and execute it
-  kUnknownSession,  ///< no such session here (old server instance, expired, made up)
-  kWrongClient,     ///< the session belongs to another client id
-  kForged,          ///< the MAC does not match
-  kDuplicate,       ///< authentic, already accepted: re-send its replies, never execute or refresh
-  kTooOld,          ///< authentic, below the replay window
-  kInvalidSequence  ///< authentic, sequence <= 0
+/// A hello the server refuses, and why (sent back to the client in the answer).
+struct HelloRefused {
+  std::string why;
 };
-const char* ToString(PackageVerdict verdict);
+using HelloResult = std::variant<HelloAccepted, HelloRefused>;
 
-/// Counts of refusals, for a query and the (rate-limited) log.
-struct AuthCounters {
-  std::uint64_t handshakes = 0;
-  std::uint64_t handshakes_refused = 0;
-  std::uint64_t unknown_session = 0;
-  std::uint64_t wrong_client = 0;
-  std::uint64_t forged = 0;
-  std::uint64_t duplicate = 0;
-  std::uint64_t too_old = 0;        ///< and sequences <= 0
-  std::uint64_t hello_repeats = 0;  ///< a hello answered before (lost answer or replay): answered again
-};
-
-/// The server's authentication state for one server instance: answers
-/// hellos, binds client ids to keys, keeps the sessions, verifies packages.
-/// A new session stays pending until its first authentic package (proof that
-/// its client holds the ephemeral secret: a replayed hello opens nothing and
-/// never displaces a live session); only then does it replace the client
-/// id's previous session. Pending sessions are bounded per key and in all.
-/// A hello is recognised by its client nonce: the same hello again (its
-/// client repeats it until answered, or a recording is replayed) gets the
-/// same answer and opens nothing new, without a signature check; a hello
-/// whose nonce belonged to a session of this instance that has since closed
-/// is refused as a replay (the last kRememberedNonces closed sessions).
+/// The server's side of the handshake and of the per-package MACs, as pure
+/// functions of one server instance (its key, access list and instance
+/// nonce). It keeps no session: the server's session table does (which
+/// hellos it answered, which client id is bound to which key, the bounds).
+/// Thread safety: const after construction; safe from any thread.
 class ServerAuthenticator {
  public:
-  struct Limits {
-    std::size_t max_sessions = 1024;          ///< live + pending, whole server
-    std::size_t max_pending_per_key = 4;      ///< the oldest pending one is dropped
-    std::size_t max_client_ids_per_key = 64;  ///< client ids one key may bind at once
-  };
   /// `instance_nonce`: RandomNonce() at every server start. `access` must
   /// outlive this object.
-  ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce, Limits limits);
-  ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce)
-      : ServerAuthenticator(std::move(identity), access, instance_nonce, Limits{}) {}
+  ServerAuthenticator(KeyPair identity, const AccessList& access, Nonce instance_nonce);
   /// The list is kept by reference: a temporary would dangle.
-  ServerAuthenticator(KeyPair, const AccessList&&, Nonce, Limits) = delete;
   ServerAuthenticator(KeyPair, const AccessList&&, Nonce) = delete;
 
-  static constexpr std::size_t kRememberedNonces = 4096;
-  /// Answers `hello` and opens a pending session, or answers a hello seen
-  /// before (same nonce and bytes, its session still open) with its answer.
-  /// @throw AuthError (counted) when the signature is bad, the key is not in
-  ///   the access list, the client id is not one of the key's
-  ///   (ClientIdBelongsTo) or is bound to another key, the nonce was used
-  ///   (a replay), or a bound is hit.
-  /// `now`: when it arrived (any one clock; used only by ExpirePending).
-  ServerAnswer Handshake(const ClientHello& hello, TimePoint now);
-
-  /// Closes the pending sessions opened before `now - max_age` (hellos whose
-  /// client never sent an authentic package: lost answers, replayed hellos);
-  /// returns how many. Call it with the session timeout, e.g. from the
-  /// watchdog. Live sessions are the caller's to Close.
-  std::size_t ExpirePending(TimePoint now, Duration max_age);
-
-  struct Verified {
-    PackageVerdict verdict = PackageVerdict::kUnknownSession;
-    const AccessEntry* client = nullptr;  ///< set unless kUnknownSession / kWrongClient / kForged
-  };
-  /// Verifies one package: session, client id, MAC (constant time), replay
-  /// window, in that order; nothing changes unless the MAC is right. `bytes`
-  /// are the encoded package with its MAC field zeroed; `sequence` and
-  /// `client_id` come from those bytes. Counts every refusal.
-  Verified Verify(std::int64_t session_id, std::int64_t client_id, std::int64_t sequence,
-                  std::span<const std::uint8_t> bytes, const Mac& mac);
-
-  /// MAC of a reply package of `session_id` (server -> client key).
-  /// @throw AuthError for an unknown session.
-  Mac SealReply(std::int64_t session_id, std::span<const std::uint8_t> bytes) const;
-
-  /// Ends a session (expired or closed); its client id binding goes with
-  /// its last session.
-  void Close(std::int64_t session_id);
-
-  /// The live session of `client_id`, or 0.
-  std::int64_t LiveSession(std::int64_t client_id) const;
-  /// True when a hello with `client_nonce` was answered by this instance
-  /// (its session open, or among the remembered closed ones): Handshake
-  /// would answer it again or refuse it as a replay, opening nothing.
-  bool KnowsNonce(const Nonce& client_nonce) const {
-    return by_nonce_.contains(client_nonce) || used_nonces_.contains(client_nonce);
+  /// The access-list entry of the hello's key, or nullptr (a map lookup:
+  /// the cheap check, before any signature is verified).
+  const AccessEntry* Client(const ClientHello& hello) const { return access_.Find(hello.client_key); }
+  /// Checks `hello` on its own (key in the access list, signature, the
+  /// client id one of the key's: ClientIdBelongsTo) and answers it with a
+  /// fresh server nonce and ephemeral key; or refuses it, saying why. Never
+  /// throws for bad input.
+  HelloResult Answer(const ClientHello& hello) const;
+  /// Constant-time check of a package's MAC under the session's client -> server key.
+  static bool Verify(const SessionKeys& keys, std::span<const std::uint8_t> bytes, const Mac& mac) {
+    return VerifyMac(keys.client_to_server, keys.session_id, bytes, mac);
   }
-  /// The sessions this object closed on its own since the last call (a
-  /// pending one dropped for a bound, replaced by a newer live one, expired):
-  /// a caller that keeps its own table of sessions erases them too.
-  std::vector<std::int64_t> TakeClosed() { return std::exchange(closed_, {}); }
-  std::size_t session_count() const { return sessions_.size(); }
-  const AuthCounters& counters() const { return counters_; }
+  /// MAC of a reply package of the session (server -> client key).
+  static Mac Seal(const SessionKeys& keys, std::span<const std::uint8_t> bytes) {
+    return ComputeMac(keys.server_to_client, keys.session_id, bytes);
+  }
+
   const Nonce& instance_nonce() const { return instance_nonce_; }
   const PublicKey& public_key() const { return identity_.public_key; }
+  const AccessList& access() const { return access_; }
 
  private:
-  struct Session {
-    SessionKeys keys;
-    std::int64_t client_id = 0;
-    const AccessEntry* client = nullptr;
-    bool live = false;
-    std::uint64_t opened = 0;  // handshake counter at opening: orders pending sessions
-    TimePoint opened_at{};
-    ReplayWindow window;
-    ClientHello hello;    // as received: a repeat must equal it
-    ServerAnswer answer;  // sent again to a repeat
-  };
-  struct Binding {
-    PublicKey key;
-    std::size_t sessions = 0;
-  };
-  [[noreturn]] void Refuse(const std::string& why);
-  void DropOldestPending(const PublicKey& key);
-  // Forgets a session; with `report`, TakeClosed() lists it (the gate did not close it).
-  void Erase(std::map<std::int64_t, Session>::iterator it, bool report = true);
-
   KeyPair identity_;
   const AccessList& access_;
   Nonce instance_nonce_;
-  Limits limits_;
-  std::map<std::int64_t, Session> sessions_;   // by session id
-  std::map<std::int64_t, Binding> bindings_;   // client id -> key
-  std::map<std::int64_t, std::int64_t> live_;  // client id -> live session id
-  std::map<Nonce, std::int64_t> by_nonce_;     // client nonce -> session id, open sessions
-  std::set<Nonce> used_nonces_;                // nonces of closed sessions (the last kRememberedNonces)
-  std::deque<Nonce> used_order_;               // the same, oldest first
-  std::vector<std::int64_t> closed_;           // TakeClosed()
-  AuthCounters counters_;
 };
+
+/// "client 00000000000a11ce (key rt:...)": names a hello's sender in a refusal.
+std::string DescribeHello(const ClientHello& hello);
 
 }  // namespace robotalk
