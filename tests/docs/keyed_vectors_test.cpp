@@ -21,6 +21,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace robotalk {
@@ -181,7 +182,10 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
                                     Array<16>(In("instance_nonce")));
   g_nonces = {In("server_nonce")};
   g_secrets = {In("server_kx_secret")};
-  const ServerAnswer answer = authenticator.Handshake(hello, TimePoint{});
+  const HelloResult result = authenticator.Answer(hello);
+  ASSERT_TRUE(std::holds_alternative<HelloAccepted>(result)) << std::get<HelloRefused>(result).why;
+  const HelloAccepted& accepted = std::get<HelloAccepted>(result);
+  const ServerAnswer& answer = accepted.answer;
   Expect("server_kx", answer.server_kx);
   const Bytes answer_signed = answer.SignedBytes(hello);
   Expect("answer_signed", answer_signed);
@@ -222,11 +226,10 @@ TEST_F(KeyedVectors, TheHandshakeMacsAndSignaturesAreTheFilesBytes) {
   const Mac package_mac = ComputeMac(keys.client_to_server, keys.session_id, package);
   Expect("package_mac", package_mac);
   EXPECT_EQ(Hex(package_mac), Hex(Blake2b(16, keys.client_to_server, Cat({Le64(keys.session_id), package}))));
-  const auto verified = authenticator.Verify(keys.session_id, client_id, std::stoll(v.at("package_sequence")),
-                                             package, package_mac);
-  EXPECT_EQ(verified.verdict, PackageVerdict::kAccepted);
+  EXPECT_EQ(accepted.keys.session_id, keys.session_id);
+  EXPECT_TRUE(ServerAuthenticator::Verify(accepted.keys, package, package_mac));
   const Bytes reply = In("reply_before_mac");
-  const Mac reply_mac = authenticator.SealReply(keys.session_id, reply);
+  const Mac reply_mac = ServerAuthenticator::Seal(accepted.keys, reply);
   Expect("reply_mac", reply_mac);
   EXPECT_TRUE(VerifyMac(keys.server_to_client, keys.session_id, reply, reply_mac));
 
