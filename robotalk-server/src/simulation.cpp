@@ -2,7 +2,7 @@
 
 #include "robot_daemon.h"
 #include "robot_sessions.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "state_encoding.h"
 
 #include <map>

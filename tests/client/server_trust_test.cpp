@@ -10,7 +10,7 @@
 #include "kinematic_driver.h"
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
+#include "config_codec.h"
 #include "robotalk/keys.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
