@@ -1,6 +1,6 @@
 #include "robotalk/state_sample.h"
-#include "robotalk/error.h"
 #include "protocol_codec.h"
+#include "robotalk/error.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -3,8 +3,8 @@
 // client send them (scripts/fuzz.sh runs it before fuzzing), and the given
 // URDF files, each also as its configuration message.
 #include "config_codec.h"
-#include "robotalk/error.h"
 #include "protocol_codec.h"
+#include "robotalk/error.h"
 #include "robotalk/request.h"
 #include "robotalk/urdf_import.h"
 #include "robotalk_msgs/announce_t.hpp"
