@@ -139,6 +139,16 @@ TEST(SessionLog, CountsUndecodableMessagesInsteadOfThrowing) {
   EXPECT_THROW(log.MakeTimeline({.robot = "pioneer"}), LogError);
 }
 
+TEST(SessionLog, KeepsNothingOfAPackageWithAnItemThatDoesNotDecode) {
+  SessionLog log;
+  log.Add(kRequest, 10,
+          Package(kClient, 1, 5, kDelay,
+                  {{1, CommandType::kStop, 100, "", {}}, {2, static_cast<CommandType>(99), 200, "", {}}}));
+  EXPECT_EQ(log.channels().at(kRequest).undecodable, 1u);
+  EXPECT_TRUE(log.commands().empty());
+  EXPECT_TRUE(log.clients().empty());
+}
+
 TEST(Frames, RenameWindowAndSpeedApplyInThatOrder) {
   SessionLog log;
   log.Add(kRequest, 10,
