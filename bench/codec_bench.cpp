@@ -1,10 +1,11 @@
-// Google Benchmark of the protocol codec (robotalk/protocol_codec.h) and the
-// configuration codec (robotalk/config_codec.h): what every package costs a
-// client and the server in CPU before the network. Figures:
+// Google Benchmark of the protocol codec (protocol_codec.h) and the
+// configuration codec (config_codec.h), private headers of the protocol
+// library: what every package costs a client and the server in CPU before
+// the network. Figures:
 // docs/performance.md, "In-process".
 //   robotalk-codec-bench [--benchmark_format=json ...]
-#include "robotalk/config_codec.h"
-#include "robotalk/protocol_codec.h"
+#include "config_codec.h"
+#include "protocol_codec.h"
 #include "robotalk/urdf_import.h"
 
 #include <benchmark/benchmark.h>

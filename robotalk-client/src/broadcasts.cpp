@@ -7,7 +7,7 @@
 #include "client_impl.h"
 
 #include "robotalk/broadcast_signature.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/request.h"
 
 namespace robotalk {
@@ -42,7 +42,7 @@ void RobotClient::Impl::OnConfig(std::span<const std::uint8_t> signed_bytes) {
     const auto bytes = Authentic(channel, signed_bytes);
     if (!bytes) return;
     try {
-      const auto hash = static_cast<std::uint64_t>(DecodeConfigHeader(*bytes).hash);
+      const auto hash = DecodeConfigHash(*bytes);
       {
         std::lock_guard lock(mu_);
         if (configs_.Has(hash)) return;  // cached: skip decoding the blocks

@@ -2,7 +2,7 @@
 // answer, sealing packages and checking replies in keyed mode, and what
 // happens when the server no longer knows the session (a restart, an expiry).
 #include "client_impl.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/known_servers.h"
 #include "robotalk/request.h"
 

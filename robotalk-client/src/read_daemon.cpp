@@ -2,7 +2,7 @@
 // (replies -> ReturnCache, acks, clock samples, retransmission, heartbeats).
 #include "client_impl.h"
 
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/known_servers.h"
 
 #include "robotalk/routed_lcm_transport.h"

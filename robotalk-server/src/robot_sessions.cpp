@@ -2,7 +2,7 @@
 
 #include "robot_sessions_text.h"
 #include "robotalk/channels.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/request.h"
 
 namespace robotalk {
 

@@ -3,7 +3,7 @@
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
 #include "robotalk/routed_lcm_transport.h"
@@ -109,9 +109,7 @@ class Server::Impl {
                             .panic_latch_path = options_.panic_latch_path,
                             .allow_duplicate_robots = options_.allow_duplicate_robots,
                             .sessions = TableOptions(options_),
-                            .traffic_layout = dynamic_cast<RoutedLcmTransport*>(transport) != nullptr
-                                                  ? TrafficLayout::kSplit
-                                                  : TrafficLayout::kSingle,
+                            .traffic_layout = transport->traffic_layout(),
                             .fifo_priority = options_.precise_timing ? 5 : 0});
     SessionOptions sessions{options_.session_timeout, options_.max_queue, options_.max_future};
     sessions.limits.max_goto_distance = options_.max_goto_distance;

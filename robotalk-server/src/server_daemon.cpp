@@ -4,7 +4,7 @@
 
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
 #include "state_encoding.h"

@@ -1,7 +1,7 @@
 #include "robotalk/simulation.h"
 
 #include "daemon_pump.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "state_encoding.h"
 
 #include <map>

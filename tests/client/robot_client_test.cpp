@@ -13,7 +13,7 @@
 #include "client/real_server_support.h"
 #include "kinematic_driver.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "robotalk/server.h"

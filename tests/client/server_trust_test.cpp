@@ -7,10 +7,10 @@
 // The real server core (robotalk::Server, kinematic driver) and RobotClient
 // on one in-process MemoryBus; a "forger" endpoint is anyone else on the LAN.
 #include "client/real_server_support.h"
+#include "config_codec.h"
 #include "kinematic_driver.h"
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
 #include "robotalk/keys.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"

@@ -2,7 +2,6 @@
 #include "robotalk/broadcast_signature.h"
 
 #include "robotalk/channels.h"
-#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 
 #include <gtest/gtest.h>

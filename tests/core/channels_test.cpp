@@ -25,6 +25,22 @@ TEST(Channels, ParsesWhatItBuilds) {
   }
 }
 
+TEST(Channels, ParseChannelNamesTheKindOfEveryChannelItBuilds) {
+  EXPECT_EQ(ParseChannel(kAnnounceChannel), ChannelParts{});
+  EXPECT_EQ(ParseChannel(HelloChannel("pioneer")), (ChannelParts{ChannelKind::kHello, "pioneer", 0}));
+  EXPECT_EQ(ParseChannel(HelloAnswerChannel("pioneer", 0x4d2)),
+            (ChannelParts{ChannelKind::kHelloAnswer, "pioneer", 0x4d2}));
+  EXPECT_EQ(ParseChannel(RequestChannel("pioneer2")), (ChannelParts{ChannelKind::kRequest, "pioneer2", 0}));
+  EXPECT_EQ(ParseChannel("ROBOTALK/pioneer2/REPLY/00000000000004d2"),
+            (ChannelParts{ChannelKind::kReply, "pioneer2", 0x4d2}));
+  EXPECT_EQ(ParseChannel(ConfigChannel("arm")), (ChannelParts{ChannelKind::kConfig, "arm", 0}));
+  EXPECT_EQ(ParseChannel(StateChannel("arm")), (ChannelParts{ChannelKind::kState, "arm", 0}));
+  for (const char* other : {"OTHER/x/REQUEST", "ROBOTALK/x/REQUEST/more", "ROBOTALK/x/REPLY/2a",
+                            "ROBOTALK/x/NOISE", "ROBOTALK/ANNOUNCE/x", "LCM_SELF_TEST", ""}) {
+    EXPECT_FALSE(ParseChannel(other)) << other;
+  }
+}
+
 TEST(Channels, RefusesChannelsOfAnotherShape) {
   EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK//REQUEST"));
   EXPECT_FALSE(RobotOfRequestChannel("ROBOTALK/a/b/REQUEST"));

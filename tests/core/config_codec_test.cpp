@@ -1,4 +1,4 @@
-#include "robotalk/config_codec.h"
+#include "config_codec.h"
 #include "robotalk/error.h"
 #include "robotalk/robot_model.h"
 #include "robotalk/urdf_import.h"

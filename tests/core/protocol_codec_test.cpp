@@ -1,4 +1,4 @@
-#include "robotalk/protocol_codec.h"
+#include "protocol_codec.h"
 #include "robotalk/error.h"
 
 #include <gmock/gmock.h>

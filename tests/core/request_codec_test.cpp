@@ -1,5 +1,5 @@
+#include "protocol_codec.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "robotalk_msgs/announce_t.hpp"
 
@@ -93,6 +93,46 @@ TEST(RequestCodec, RefusesAnAnnouncementWithAZeroLengthStringOrAHostileCount) {
   }
   bytes.pop_back();
   EXPECT_THROW(DecodeAnnouncement(bytes), ProtocolError) << "truncated";
+}
+
+// Every reader of ANNOUNCE (the client, robotalk-web, robotalk-logplay) uses
+// this decoder: a hostile robot count must not reach LCM's, which would
+// allocate the array from it. (These were robotalk-web's tests of its own
+// guard, tests/web/announce_check_test.cpp, before the web used the codec.)
+std::vector<std::uint8_t> AnnouncementOf(int robots, const std::string& url = "udpm://x") {
+  Announcement a{.server_id = 42, .url_hint = url};
+  for (int i = 0; i < robots; ++i) a.robots.push_back({"robot" + std::to_string(i), "ode"});
+  return EncodeAnnouncement(a);
+}
+
+// Offset of num_robots: fingerprint, version, server id, time, uptime, url
+// (length + text + NUL), traffic_layout, keyed.
+std::size_t RobotCountOffset(const std::string& url) {
+  return 8 + 2 + 8 + 8 + 8 + 4 + url.size() + 1 + 1 + 1;
+}
+
+TEST(RequestCodec, DecodesAnnouncementsOfNoneOrSeveralRobots) {
+  for (int n : {0, 1, 3})
+    EXPECT_EQ(DecodeAnnouncement(AnnouncementOf(n)).robots.size(), static_cast<std::size_t>(n));
+}
+
+TEST(RequestCodec, RefusesAnAnnouncedRobotCountTheDatagramCannotHold) {
+  auto bytes = AnnouncementOf(1);
+  const std::size_t at = RobotCountOffset("udpm://x");
+  ASSERT_EQ(bytes[at + 3], 1);
+  bytes[at] = 0x10;  // 268 million robots in a datagram of ~80 bytes
+  EXPECT_THROW(DecodeAnnouncement(bytes), ProtocolError);
+  bytes[at] = 0xff;  // negative
+  EXPECT_THROW(DecodeAnnouncement(bytes), ProtocolError);
+}
+
+TEST(RequestCodec, RefusesATruncatedAnnouncementOrAnOverlongUrl) {
+  const auto bytes = AnnouncementOf(2);
+  for (std::size_t n : {std::size_t{0}, std::size_t{10}, std::size_t{37}, RobotCountOffset("udpm://x") + 2})
+    EXPECT_THROW(DecodeAnnouncement(std::span(bytes.data(), n)), ProtocolError) << n;
+  auto long_url = AnnouncementOf(1);
+  long_url[34] = 0x7f;  // url length far beyond the datagram
+  EXPECT_THROW(DecodeAnnouncement(long_url), ProtocolError);
 }
 
 // The C++ client sends every package through EncodeRequest: a heartbeat and

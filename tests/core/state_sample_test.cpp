@@ -1,6 +1,6 @@
 #include "robotalk/state_sample.h"
+#include "protocol_codec.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

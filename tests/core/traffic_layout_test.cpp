@@ -2,6 +2,8 @@
 
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
+#include "robotalk/memory_transport.h"
+#include "robotalk/routed_lcm_transport.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -105,6 +107,15 @@ TEST(TrafficLayout, DerivesEachLaneUrlFromTheMainUrlByPort) {
   EXPECT_THROW(LaneUrl(main, -1), TransportError);
   EXPECT_THROW(LaneUrl("memq://", 1), TransportError);
   EXPECT_THROW(LaneUrl("udpm://239.255.76.67:x?ttl=0", 1), TransportError);
+}
+
+// A server announces the layout its transport reports (no cast to the class).
+TEST(TrafficLayout, EachTransportReportsTheLayoutItsTrafficTravelsIn) {
+  // A RoutedLcmTransport opens no socket before its first Publish/Subscribe.
+  EXPECT_EQ(OpenLcmTransport("udpm://239.255.76.67:7667?ttl=0")->traffic_layout(), TrafficLayout::kSplit);
+  EXPECT_EQ(OpenLcmTransport("memq://")->traffic_layout(), TrafficLayout::kSingle);
+  MemoryTransport memory(std::make_shared<MemoryBus>());
+  EXPECT_EQ(memory.traffic_layout(), TrafficLayout::kSingle);
 }
 
 }  // namespace

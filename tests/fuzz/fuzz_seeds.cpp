@@ -2,9 +2,9 @@
 // target into OUT_DIR/<target>/, all valid messages as the server and the
 // client send them (scripts/fuzz.sh runs it before fuzzing), and the given
 // URDF files, each also as its configuration message.
-#include "robotalk/config_codec.h"
+#include "config_codec.h"
+#include "protocol_codec.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "robotalk/urdf_import.h"
 #include "robotalk_msgs/announce_t.hpp"

@@ -1,8 +1,8 @@
 #include "fuzz_targets.h"
 
-#include "robotalk/config_codec.h"
+#include "config_codec.h"
+#include "protocol_codec.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "robotalk/urdf_import.h"
 #include "robotalk_msgs/announce_t.hpp"

@@ -2,7 +2,7 @@
 // prints what a client decoding that file must print (see DecodeConfig.java and
 // decode_config.lua):
 //   robot=<name> links=<n> joints=<n> frames=<n> roots=<n> dofs=<n> hash=0x<16 hex> verified=yes
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/robot_model.h"
 
 #include <cinttypes>

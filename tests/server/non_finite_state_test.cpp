@@ -5,7 +5,6 @@
 #include "robot_daemon.h"
 
 #include "fake_driver.h"
-#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
 #include "state_encoding.h"
 

@@ -1,7 +1,6 @@
 #include "robot_sessions.h"
 
-#include "robotalk/config_codec.h"
-#include "robotalk/protocol_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/request.h"
 #include "sessions_fixture.h"
 #include "state_encoding.h"
@@ -154,19 +153,11 @@ TEST_F(FixedBaseSessionsTest, AnswersNaToABaseCommandOnAFixedBase) {
 }
 
 TEST_F(RobotSessionsTest, RefusesAMixedPackageWithErrorForEveryItem) {
-  // A mixed package can only be made on the wire: build it there and decode it.
-  robotalk_msgs::package_t p{};
-  p.header.protocol_version = kProtocolVersion;
-  p.header.client_id = kAlice;
-  p.header.sequence = 1;
-  p.header.payload_type = robotalk_msgs::package_header_t::PAYLOAD_COMMANDS;
-  p.commands.push_back(ToWire(Cmd(1, CommandType::kStop)));
-  p.queries.push_back(ToWire(Query{2, QueryType::kJointState, ""}));
-  p.num_commands = p.num_queries = 1;
-  p.header.payload_size = 1;
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(p.getEncodedSize()));
-  p.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  const Request request = DecodeRequest(bytes);
+  // A mixed package: the encoder writes what it is given; the decoder flags it.
+  Request mixed{.client_id = kAlice, .sequence = 1};
+  mixed.commands.push_back(Cmd(1, CommandType::kStop));
+  mixed.queries.push_back(Query{2, QueryType::kJointState, ""});
+  const Request request = DecodeRequest(EncodeRequest(mixed));
   ASSERT_THAT(request.header_error, HasSubstr("mixes"));
   auto r = Handle(request);
   ASSERT_EQ(r.size(), 2u);

@@ -5,7 +5,7 @@
 
 #include "fake_driver.h"
 #include "robot_sessions.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 #include "robotalk/request.h"
 #include "state_encoding.h"
 

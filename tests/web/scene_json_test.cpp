@@ -18,20 +18,16 @@ namespace {
 
 RobotModel Pioneer() { return LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model; }
 
-robotalk_msgs::robot_state_t SampleFor(const RobotModel& m, const Eigen::VectorXd& q, double x, double y,
-                                       double theta) {
-  robotalk_msgs::robot_state_t s{};
+StateSample SampleFor(const RobotModel& m, const Eigen::VectorXd& q, double x, double y, double theta) {
+  StateSample s;
   s.robot = m.name();
   s.sample = 7;
-  s.server_time_us = 1'500'000;
-  s.period_us = 33'000;
-  s.num_dofs = m.num_dofs();
-  s.position.assign(q.data(), q.data() + q.size());
-  s.velocity.assign(q.size(), 0.0);
-  s.effort.assign(q.size(), 0.0);
-  s.base[0] = x;
-  s.base[1] = y;
-  s.base[2] = theta;
+  s.server_time = TimePoint(std::chrono::microseconds(1'500'000));
+  s.period = std::chrono::microseconds(33'000);
+  s.positions.assign(q.data(), q.data() + q.size());
+  s.velocities.assign(q.size(), 0.0);
+  s.efforts.assign(q.size(), 0.0);
+  s.base = {.x = x, .y = y, .theta = theta};
   return s;
 }
 
@@ -112,7 +108,6 @@ TEST(StatePoser, RecoversATiltedRootFromAControlFramePose) {
   std::vector<Eigen::Isometry3d> roots{truth};
   kin.Update(q, roots);
   auto s = SampleFor(m, q, truth.translation().x(), truth.translation().y(), Yaw(truth));
-  s.num_frames = static_cast<int>(m.frames().size());
   for (size_t f = 0; f < m.frames().size(); ++f) {
     const Eigen::Isometry3d p = kin.frame_pose(static_cast<int>(f));
     const Eigen::Quaterniond r(p.linear());
@@ -137,8 +132,7 @@ TEST(StatePoser, RefusesASampleWithTheWrongNumberOfDofs) {
   const RobotModel m = Pioneer();
   StatePoser poser(m);
   auto s = SampleFor(m, Eigen::VectorXd::Zero(m.num_dofs()), 0, 0, 0);
-  s.position.pop_back();
-  s.num_dofs -= 1;
+  s.positions.pop_back();
   EXPECT_THROW(poser.Pose(s), ProtocolError);
 }
 

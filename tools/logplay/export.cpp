@@ -3,7 +3,7 @@
 
 #include "logplay.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -39,8 +39,8 @@ void WriteCommands(const SessionLog& log, std::ostream& out) {
          "values\n";
   for (const LoggedCommand& c : log.commands()) {
     out << Hex64(static_cast<std::uint64_t>(c.client_id)) << ',' << c.robot << ',' << c.sequence << ','
-        << (c.mode < 0 ? "panic" : ModeName(c.mode)) << ',' << c.command.id << ','
-        << (c.mode < 0 ? "PANIC" : ToString(c.command.type)) << ',' << c.command.target << ',' << c.start_us
+        << (c.panic ? "panic" : ModeName(c.mode)) << ',' << c.command.id << ','
+        << (c.panic ? "PANIC" : ToString(c.command.type)) << ',' << c.command.target << ',' << c.start_us
         << ',' << c.send_time_us << ',' << c.log_time_us << ','
         << (c.reply ? std::string(ToString(c.reply->signal)) : "") << ','
         << (c.reply ? std::to_string(ToWireMicros(c.reply->exec_time)) : "") << ',';

@@ -40,8 +40,8 @@ void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out
 
 /// A number as info, extract and export write it (%.10g).
 std::string Num(double v);
-/// "direct", "delay", "playback" (package_header_t::MODE_*), "?" otherwise.
-const char* ModeName(int mode);
+/// "direct", "delay", "playback".
+const char* ModeName(RequestMode mode);
 
 /// "old=new" -> {old, new}; throws UsageError.
 std::pair<std::string, std::string> ParseRename(const std::string& text);

@@ -2,7 +2,6 @@
 #include "logplay.h"
 #include "robotalk/channels.h"
 #include "robotalk/sequence_file.h"
-#include "robotalk_msgs/package_header_t.hpp"
 #include "sequence_runner.h"
 
 #include <lcm/lcm-cpp.hpp>
@@ -39,24 +38,28 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
   std::map<std::string, int> types, signals;
   int commands = 0;
   for (const LoggedCommand& lc : log.commands()) {
-    if (lc.client_id != c.id || lc.mode < 0) continue;
+    if (lc.client_id != c.id || lc.panic) continue;
     ++commands;
     ++types[ToString(lc.command.type)];
     if (lc.reply) ++signals[std::string(ToString(lc.reply->signal))];
   }
   out << "  " << Hex64(static_cast<std::uint64_t>(c.id)) << "  robot " << c.robot << "  packages "
       << c.packages << " (" << c.retransmissions << " retransmitted copies, " << c.heartbeats
-      << " heartbeats)  queries " << c.queries << (c.panics ? "  PANIC x" + std::to_string(c.panics) : "")
-      << "\n";
+      << " heartbeats)  queries " << c.queries << (c.panics ? "  PANIC x" + std::to_string(c.panics) : "");
+  if (c.hellos > 0) {
+    out << "  hellos " << c.hellos
+        << (c.hellos_refused ? " (" + std::to_string(c.hellos_refused) + " refused)" : std::string());
+  }
+  out << "\n";
   if (commands == 0) return;
   out << "      commands " << commands << " in " << (c.modes.size() == 1 ? "mode" : "modes");
-  for (int mode : c.modes) out << ' ' << ModeName(mode);
+  for (RequestMode mode : c.modes) out << ' ' << ModeName(mode);
   out << ":";
   for (const auto& [t, n] : types) out << ' ' << t << ' ' << n;
   int absolute = 0, now = 0, playback = 0;
   for (const LoggedCommand& lc : log.commands()) {
-    if (lc.client_id != c.id || lc.mode < 0) continue;
-    if (lc.mode == robotalk_msgs::package_header_t::MODE_PLAYBACK) {
+    if (lc.client_id != c.id || lc.panic) continue;
+    if (lc.mode == RequestMode::kPlayback) {
       ++playback;
     } else {
       ++(lc.start_us != 0 ? absolute : now);
@@ -88,17 +91,16 @@ std::string Num(double v) {
   return buf;
 }
 
-const char* ModeName(int mode) {
+const char* ModeName(RequestMode mode) {
   switch (mode) {
-    case robotalk_msgs::package_header_t::MODE_DIRECT:
+    case RequestMode::kDirect:
       return "direct";
-    case robotalk_msgs::package_header_t::MODE_DELAY:
+    case RequestMode::kDelay:
       return "delay";
-    case robotalk_msgs::package_header_t::MODE_PLAYBACK:
+    case RequestMode::kPlayback:
       return "playback";
-    default:
-      return "?";
   }
+  return "?";
 }
 
 SessionLog ReadLog(const std::string& path) {

@@ -49,7 +49,8 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
         order.Add(transport->ReceiveTime().time_since_epoch().count(), channel, bytes);
       });
   progress << "robotalk-logplay: recording " << transport->url()
-           << (dynamic_cast<RoutedLcmTransport*>(transport.get()) ? " (every lane of the split layout)" : "")
+           << (transport->traffic_layout() == TrafficLayout::kSplit ? " (every lane of the split layout)"
+                                                                    : "")
            << " to " << options.output << "\n";
   const SteadyClock clock;
   const TimePoint start = clock.Now();

@@ -1,34 +1,22 @@
 #include "session_log.h"
 
 #include "robotalk/channels.h"
-#include "robotalk/protocol_codec.h"
-#include "robotalk_msgs/announce_t.hpp"
+#include "robotalk/request.h"
 
 #include <algorithm>
 #include <limits>
 
 namespace robotalk::logplay {
+namespace {
 
-using robotalk_msgs::package_header_t;
-
-ChannelName ParseChannel(const std::string& channel) {
-  const std::string prefix = "ROBOTALK/";
-  if (channel.rfind(prefix, 0) != 0) return {};
-  const std::string rest = channel.substr(prefix.size());
-  if (rest == "ANNOUNCE") return {"", "ANNOUNCE", ""};
-  const auto slash = rest.find('/');
-  if (slash == std::string::npos) return {};
-  ChannelName n;
-  n.robot = rest.substr(0, slash);
-  std::string kind = rest.substr(slash + 1);
-  if (const auto s2 = kind.find('/'); s2 != std::string::npos) {
-    n.rest = kind.substr(s2 + 1);
-    kind = kind.substr(0, s2);
-  }
-  if (kind != "REQUEST" && kind != "REPLY" && kind != "CONFIG" && kind != "STATE") return {};
-  n.kind = kind;
-  return n;
+// The start time as its package carried it (0 = now; absolute micros; or a
+// playback offset in micros).
+std::int64_t StartMicros(const StartTime& s) {
+  if (s.is_now()) return 0;
+  return s.is_at() ? ToWireMicros(*s.time()) : ToWireMicros(*s.offset());
 }
+
+}  // namespace
 
 std::int64_t ParseClientId(const std::string& text) {
   try {
@@ -50,125 +38,147 @@ void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
   if (s.messages++ == 0) s.first_us = log_time_us;
   s.last_us = log_time_us;
   s.bytes += bytes.size();
-  const ChannelName name = ParseChannel(channel);
+  const std::optional<ChannelParts> name = ParseChannel(channel);
+  if (!name) return;
   try {
-    if (name.kind == "REQUEST") {
-      AddRequest(name.robot, log_time_us, bytes);
-    } else if (name.kind == "REPLY") {
-      AddReply(log_time_us, bytes);
-    } else if (name.kind == "ANNOUNCE") {
-      AddAnnounce(bytes);
-    } else if (name.kind == "STATE") {
-      AddState(log_time_us, bytes);
+    switch (name->kind) {
+      case ChannelKind::kRequest:
+        AddRequest(name->robot, log_time_us, bytes);
+        break;
+      case ChannelKind::kReply:
+        AddReply(bytes);
+        break;
+      case ChannelKind::kAnnounce:
+        AddAnnounce(bytes);
+        break;
+      case ChannelKind::kState:
+        AddState(log_time_us, bytes);
+        break;
+      case ChannelKind::kHello:
+        Client(DecodeHello(bytes).body.client_id, name->robot, log_time_us).hellos++;
+        break;
+      case ChannelKind::kHelloAnswer:
+        AddHelloAnswer(bytes);
+        break;
+      case ChannelKind::kConfig:
+        break;  // the robot's description: nothing a session's timeline needs
     }
   } catch (const std::exception&) {
     ++s.undecodable;  // a log holds whatever was on the bus; count it, go on
   }
 }
 
-void SessionLog::AddRequest(const std::string& robot, std::int64_t log_time_us,
-                            std::span<const std::uint8_t> bytes) {
-  const robotalk_msgs::package_t p = DecodePackage(bytes);
-  if (!CheckPackageHeader(p).empty()) throw LogError("inconsistent package");
-  const package_header_t& h = p.header;
-  LoggedClient& c = clients_[h.client_id];
+LoggedClient& SessionLog::Client(std::int64_t id, const std::string& robot, std::int64_t log_time_us) {
+  LoggedClient& c = clients_[id];
   if (c.id == 0) {
-    c.id = h.client_id;
+    c.id = id;
     c.robot = robot;
     c.first_log_us = log_time_us;
   }
   c.last_log_us = log_time_us;
-  const auto key = std::make_pair(h.client_id, h.sequence);
+  return c;
+}
+
+void SessionLog::AddRequest(const std::string& robot, std::int64_t log_time_us,
+                            std::span<const std::uint8_t> bytes) {
+  const Request r = DecodeRequest(bytes);
+  if (!r.header_error.empty() || !r.malformed.empty()) throw LogError("inconsistent package");
+  LoggedClient& c = Client(r.client_id, robot, log_time_us);
+  const auto key = std::make_pair(r.client_id, r.sequence);
   if (package_send_us_.count(key)) {
     ++c.retransmissions;  // executed once by the server: kept once here
     return;
   }
-  package_send_us_[key] = h.send_time_us;
+  const std::int64_t send_time_us = ToWireMicros(r.send_time);
+  package_send_us_[key] = send_time_us;
   ++c.packages;
-  if (h.panic) ++c.panics;
-  if (h.payload_size == 0 && !h.panic) ++c.heartbeats;
-  c.queries += static_cast<std::uint64_t>(p.num_queries);
-  if (h.panic) {
+  if (r.panic) ++c.panics;
+  if (r.queries.empty() && r.commands.empty() && !r.panic) ++c.heartbeats;
+  c.queries += r.queries.size();
+  if (r.panic) {
     LoggedCommand marker;  // a panic is shown, never replayed (see MakeTimeline)
-    marker.client_id = h.client_id;
+    marker.client_id = r.client_id;
     marker.robot = robot;
-    marker.sequence = h.sequence;
-    marker.mode = -1;
-    marker.send_time_us = h.send_time_us;
+    marker.sequence = r.sequence;
+    marker.panic = true;
+    marker.send_time_us = send_time_us;
     marker.log_time_us = log_time_us;
     commands_.push_back(std::move(marker));
     return;
   }
-  if (p.num_commands > 0) c.modes.insert(h.mode);
-  if (h.mode == package_header_t::MODE_PLAYBACK) playback_ids_.insert({h.client_id, h.playback_id});
-  for (const auto& wire : p.commands) {
-    LoggedCommand lc;
-    lc.client_id = h.client_id;
-    lc.robot = robot;
-    lc.sequence = h.sequence;
-    lc.mode = h.mode;
-    lc.playback_id = h.playback_id;
-    lc.command = FromWire(wire);
-    lc.start_us = wire.start_time_us;
-    lc.send_time_us = h.send_time_us;
-    lc.log_time_us = log_time_us;
-    const auto id_key = std::make_pair(h.client_id, wire.id);
+  if (!r.commands.empty()) c.modes.insert(r.mode);
+  if (r.mode == RequestMode::kPlayback) playback_ids_.insert({r.client_id, r.playback.id});
+  for (const Command& command : r.commands) {
+    const auto id_key = std::make_pair(r.client_id, command.id);
     if (command_index_.count(id_key)) continue;
+    LoggedCommand lc;
+    lc.client_id = r.client_id;
+    lc.robot = robot;
+    lc.sequence = r.sequence;
+    lc.mode = r.mode;
+    lc.playback_id = r.playback.id;
+    lc.command = command;
+    lc.start_us = StartMicros(command.start_time);
+    lc.send_time_us = send_time_us;
+    lc.log_time_us = log_time_us;
     command_index_[id_key] = commands_.size();
     commands_.push_back(std::move(lc));
   }
 }
 
-void SessionLog::AddReply(std::int64_t log_time_us, std::span<const std::uint8_t> bytes) {
-  (void)log_time_us;
-  const robotalk_msgs::reply_package_t p = DecodeReplyPackage(bytes);
-  auto client = clients_.find(p.client_id);
-  if (p.ack_sequence > 0 && client != clients_.end()) {
-    auto sent = package_send_us_.find({p.client_id, p.ack_sequence});
+void SessionLog::AddReply(std::span<const std::uint8_t> bytes) {
+  ReplyBatch b = DecodeReplyBatch(bytes);
+  if (!b.malformed.empty()) throw LogError("undecodable reply");
+  auto client = clients_.find(b.client_id);
+  if (b.ack_sequence > 0 && client != clients_.end()) {
+    auto sent = package_send_us_.find({b.client_id, b.ack_sequence});
     if (sent != package_send_us_.end() && sent->second != 0) {
       // One-way latency included: min over all acks is the best estimate.
-      const std::int64_t offset = p.server_receive_us - sent->second;
+      const std::int64_t offset = ToWireMicros(b.server_receive) - sent->second;
       auto& o = client->second.clock_offset_us;
       if (!o || offset < *o) o = offset;
     }
   }
-  for (const auto& wire : p.replies) {
-    Reply r = FromWire(wire);
-    if (client != clients_.end() && r.values.size() >= 2 && playback_ids_.count({p.client_id, r.id})) {
+  for (Reply& r : b.replies) {
+    if (client != clients_.end() && r.values.size() >= 2 && playback_ids_.count({b.client_id, r.id})) {
       // A playback sequence's delay reply (its id is the playback id): values[1] = the start.
       client->second.playback_start_us[r.id] = static_cast<std::int64_t>(r.values[1]);
     }
-    auto it = command_index_.find({p.client_id, r.id});
+    auto it = command_index_.find({b.client_id, r.id});
     if (it != command_index_.end() && !commands_[it->second].reply)
       commands_[it->second].reply = std::move(r);
   }
 }
 
+void SessionLog::AddHelloAnswer(std::span<const std::uint8_t> bytes) {
+  const HelloAnswer a = DecodeHelloAnswer(bytes);
+  auto client = clients_.find(a.body.client_id);
+  if (client != clients_.end() && a.session_id == 0) ++client->second.hellos_refused;
+}
+
 void SessionLog::AddAnnounce(std::span<const std::uint8_t> bytes) {
-  if (bytes.size() > (1u << 20)) throw LogError("oversized announce");
-  robotalk_msgs::announce_t a;
-  if (a.decode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0) throw LogError("bad announce");
-  for (const auto& r : a.robots) {
+  const Announcement a = DecodeAnnouncement(bytes);
+  for (const RobotAnnouncement& r : a.robots) {
     LoggedRobot& lr = robots_[{a.server_id, r.name}];
     lr.name = r.name;
     lr.driver = r.driver;
     lr.server_id = a.server_id;
-    lr.config_hash = static_cast<std::uint64_t>(r.config_hash);
+    lr.config_hash = r.config_hash;
     lr.total_dofs = r.total_dofs;
     lr.panic_seen = lr.panic_seen || r.panic;
   }
 }
 
 void SessionLog::AddState(std::int64_t log_time_us, std::span<const std::uint8_t> bytes) {
-  const robotalk_msgs::robot_state_t s = DecodeRobotState(bytes);
+  robotalk::StateSample s = DecodeStateSample(bytes);
   StateSample sample;
-  sample.robot = s.robot;
+  sample.robot = std::move(s.robot);
   sample.log_time_us = log_time_us;
-  sample.server_time_us = s.server_time_us;
+  sample.server_time_us = ToWireMicros(s.server_time);
   sample.panic = s.panic;
   sample.moving = s.moving;
-  sample.base.assign(std::begin(s.base), std::end(s.base));
-  sample.position = s.position;
+  sample.base = {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega};
+  sample.position = std::move(s.positions);
   states_.push_back(std::move(sample));
 }
 
@@ -187,7 +197,7 @@ std::set<std::int64_t> SessionLog::servers() const {
 
 std::optional<std::int64_t> SessionLog::ServerTime(const LoggedCommand& c) const {
   const LoggedClient& client = clients_.at(c.client_id);
-  if (c.mode == package_header_t::MODE_PLAYBACK) {
+  if (c.mode == RequestMode::kPlayback) {
     auto it = client.playback_start_us.find(c.playback_id);
     if (it == client.playback_start_us.end()) return std::nullopt;
     return it->second + c.start_us;
@@ -203,7 +213,7 @@ Timeline SessionLog::MakeTimeline(const Selection& selection) const {
   for (const LoggedCommand& c : commands_) {
     if (selection.client_id && c.client_id != *selection.client_id) continue;
     if (!selection.robot.empty() && c.robot != selection.robot) continue;
-    if (c.mode == -1) {
+    if (c.panic) {
       t.skipped.push_back("a panic from client " + Hex64(static_cast<std::uint64_t>(c.client_id)) +
                           " (never replayed)");
       continue;
@@ -237,7 +247,7 @@ Timeline SessionLog::MakeTimeline(const Selection& selection) const {
     std::set<int> kinds;  // 0 absolute start, 1 playback offset, 2 send time
     for (const LoggedCommand* c : chosen) {
       clients.insert(c->client_id);
-      kinds.insert(c->mode == package_header_t::MODE_PLAYBACK ? 1 : c->start_us != 0 ? 0 : 2);
+      kinds.insert(c->mode == RequestMode::kPlayback ? 1 : c->start_us != 0 ? 0 : 2);
     }
     if (clients.size() != 1 || kinds.size() != 1) {
       throw LogError(

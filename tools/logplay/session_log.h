@@ -1,12 +1,16 @@
 // SessionLog: what an LCM log of a RoboTalk session says, decoded with the
-// project's codec (robotalk/protocol_codec.h) and de-duplicated: robots and
-// servers (ANNOUNCE), each client's command stream (REQUEST packages, one
-// copy per (client, sequence): retransmissions are counted, not repeated),
-// the final replies (REPLY/<client>) and the broadcast state (STATE).
+// project's message layer (robotalk/request.h; channels parsed by
+// robotalk/channels.h) and de-duplicated: robots and servers (ANNOUNCE), each
+// client's hellos (HELLO, and the answers refusing them), its command stream
+// (REQUEST packages, one copy per (client, sequence): retransmissions are
+// counted, not repeated), the final replies (REPLY/<client>) and the
+// broadcast state (STATE).
 //
-// It is pure: events go in through Add() (log_reader.h feeds it from
+// It is pure: events go in through Add() (ReadLog feeds it from
 // lcm::LogFile), so tests build logs in memory. Undecodable messages on
-// RoboTalk channels are counted, never thrown.
+// RoboTalk channels are counted, never thrown; a package or reply package
+// with an item that does not decode, or an inconsistent header, is
+// undecodable as a whole (nothing of it is kept).
 //
 // Recovering a client's timing (Timeline): every command is placed on the
 // SERVER clock, whatever mode it was sent in:
@@ -25,6 +29,7 @@
 
 #include "robotalk/command.h"
 #include "robotalk/error.h"
+#include "robotalk/request.h"
 
 #include <cstdint>
 #include <map>
@@ -62,10 +67,11 @@ struct LoggedCommand {
   std::int64_t client_id = 0;
   std::string robot;
   std::int64_t sequence = 0;
-  int mode = 0;  ///< package_header_t::MODE_*
+  bool panic = false;  ///< a panic package's marker: no command, never replayed
+  RequestMode mode = RequestMode::kDirect;
   std::int64_t playback_id = 0;
-  Command command;  ///< start_time = the wire value (absolute, or an offset in playback; unset = 0)
-  std::int64_t start_us = 0;
+  Command command;                ///< start_time as sent: Now, At (server clock), After (playback offset)
+  std::int64_t start_us = 0;      ///< the same in micros (0 = now)
   std::int64_t send_time_us = 0;  ///< client clock
   std::int64_t log_time_us = 0;   ///< logger clock, first copy
   std::optional<Reply> reply;     ///< the final reply, when logged
@@ -75,7 +81,8 @@ struct LoggedClient {
   std::int64_t id = 0;
   std::string robot;
   std::uint64_t packages = 0, retransmissions = 0, heartbeats = 0, queries = 0, panics = 0;
-  std::set<int> modes;  ///< of its command packages
+  std::uint64_t hellos = 0, hellos_refused = 0;  ///< HELLOs sent; answers opening no session
+  std::set<RequestMode> modes;                   ///< of its command packages
   std::int64_t first_log_us = 0, last_log_us = 0;
   /// server - client clock (µs), from acknowledgements; nullopt without replies.
   std::optional<std::int64_t> clock_offset_us;
@@ -131,8 +138,10 @@ class SessionLog {
   Timeline MakeTimeline(const Selection& selection) const;
 
  private:
+  LoggedClient& Client(std::int64_t id, const std::string& robot, std::int64_t log_time_us);
   void AddRequest(const std::string& robot, std::int64_t log_time_us, std::span<const std::uint8_t> bytes);
-  void AddReply(std::int64_t log_time_us, std::span<const std::uint8_t> bytes);
+  void AddReply(std::span<const std::uint8_t> bytes);
+  void AddHelloAnswer(std::span<const std::uint8_t> bytes);
   void AddAnnounce(std::span<const std::uint8_t> bytes);
   void AddState(std::int64_t log_time_us, std::span<const std::uint8_t> bytes);
   std::optional<std::int64_t> ServerTime(const LoggedCommand& c) const;
@@ -148,13 +157,6 @@ class SessionLog {
   std::int64_t first_us_ = 0, last_us_ = 0;
   std::uint64_t events_ = 0;
 };
-
-/// "ROBOTALK/pioneer/REQUEST" -> {"pioneer", "REQUEST", ""};
-/// "ROBOTALK/pioneer/REPLY/00ab.." -> {"pioneer", "REPLY", "00ab.."}; kind "" if not ours.
-struct ChannelName {
-  std::string robot, kind, rest;
-};
-ChannelName ParseChannel(const std::string& channel);
 
 /// Parses a client id as printed (16 hex digits) or in decimal; throws LogError.
 std::int64_t ParseClientId(const std::string& text);

@@ -1,14 +1,11 @@
 #include "robot_tracker.h"
 
 #include "json_text.h"
-#include "robotalk/protocol_codec.h"
-
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/routed_lcm_transport.h"
-#include "robotalk_msgs/announce_t.hpp"
 #include "scene_json.h"
 
 #include <lcm/lcm-cpp.hpp>
@@ -30,8 +27,8 @@ using Steady = std::chrono::steady_clock;
 // The newest sample of one robot, written by its client's ReadDaemon.
 struct SampleSlot {
   std::mutex mutex;
-  robotalk_msgs::robot_state_t sample;  // GUARDED_BY(mutex)
-  std::uint64_t received = 0;           // GUARDED_BY(mutex)
+  StateSample sample;          // GUARDED_BY(mutex)
+  std::uint64_t received = 0;  // GUARDED_BY(mutex)
 };
 
 struct Robot {
@@ -67,19 +64,6 @@ enum class Task { kConnect, kStream };
 
 }  // namespace
 
-// The LCM typed decoder sizes robots[] from the count before checking the
-// bytes are there: check the count against the datagram first.
-bool AnnounceCountPlausible(std::span<const std::uint8_t> bytes) {
-  // The project's checked decoder walks every count and string against the
-  // datagram before LCM's decoder allocates (request.h).
-  try {
-    (void)DecodeAnnouncement(bytes);
-    return true;
-  } catch (const ProtocolError&) {
-    return false;
-  }
-}
-
 class RobotTracker::Impl {
  public:
   explicit Impl(const WebOptions& o) : options_(o), lcm_(MainLcmUrl(o.lcm_url)) {  // ANNOUNCE: main lane
@@ -109,18 +93,21 @@ class RobotTracker::Impl {
   }
 
   void OnAnnounce(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    if (!AnnounceCountPlausible({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size})) return;
-    robotalk_msgs::announce_t msg;
-    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) return;
+    Announcement announcement;
+    try {  // the checked decoder: hostile counts never reach an allocation (request.h)
+      announcement = DecodeAnnouncement({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+    } catch (const ProtocolError&) {
+      return;
+    }
     std::lock_guard lock(mutex_);
     const auto now = Steady::now();
-    for (const auto& r : msg.robots) {
+    for (const RobotAnnouncement& r : announcement.robots) {
       Robot& robot = robots_[r.name];
       robot.name = r.name;
-      robot.server_id = msg.server_id;
-      robot.announced_hash = static_cast<std::uint64_t>(r.config_hash);
+      robot.server_id = announcement.server_id;
+      robot.announced_hash = r.config_hash;
       robot.driver = r.driver;
-      robot.panic = r.panic != 0;
+      robot.panic = r.panic;
       robot.num_clients = r.num_clients;
       robot.last_announce = now;
     }
@@ -210,7 +197,7 @@ class RobotTracker::Impl {
             std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / options_.rate_hz));
         client->StartStateStream(period, [slot](const StateSample& s) {
           std::lock_guard l(slot->mutex);
-          slot->sample = ToWire(s);
+          slot->sample = s;
           ++slot->received;
         });
       } else {

@@ -26,7 +26,6 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -50,11 +49,6 @@ struct TrackerFrame {
   /// Samples received from LCM since the last Poll(), over every robot.
   std::uint64_t samples_received = 0;
 };
-
-/// True when an encoded announce_t's robot count fits in its `bytes` (LCM's
-/// generated decoder allocates the array from the count before checking, so
-/// a hostile count would allocate gigabytes). Pure; never throws.
-bool AnnounceCountPlausible(std::span<const std::uint8_t> bytes);
 
 class RobotTracker {
  public:

@@ -116,23 +116,20 @@ StatePoser::StatePoser(const RobotModel& model)
   needs_measured_root_ = reference_frame_ < 0 && model.roots().front().base == BaseType::kFloating;
 }
 
-void StatePoser::CheckSample(const robotalk_msgs::robot_state_t& s) const {
+// Not a check of the wire (the codec made those): the poser indexes its own
+// model's dofs with the sample's values.
+void StatePoser::CheckModel(const StateSample& s) const {
   const auto n = static_cast<size_t>(model_.num_dofs());
-  if (s.num_dofs != model_.num_dofs() || s.position.size() != n) {
-    throw ProtocolError("StatePoser: sample of robot '" + s.robot + "' has " + std::to_string(s.num_dofs) +
-                        " dofs, its model " + std::to_string(n));
-  }
-  for (double v : s.position) {
-    if (!std::isfinite(v))
-      throw ProtocolError("StatePoser: sample of robot '" + s.robot + "' has a non-finite position");
+  if (s.positions.size() != n) {
+    throw ProtocolError("StatePoser: sample of robot '" + s.robot + "' has " +
+                        std::to_string(s.positions.size()) + " dofs, its model " + std::to_string(n));
   }
 }
 
-Eigen::Isometry3d StatePoser::RootPose(const robotalk_msgs::robot_state_t& s) {
-  CheckSample(s);
-  for (Eigen::Index i = 0; i < q_.size(); ++i) q_[i] = s.position[static_cast<size_t>(i)];
-  const bool have_frame = reference_frame_ >= 0 && s.num_frames == static_cast<int>(model_.frames().size()) &&
-                          s.frame_poses.size() == model_.frames().size();
+Eigen::Isometry3d StatePoser::RootPose(const StateSample& s) {
+  CheckModel(s);
+  for (Eigen::Index i = 0; i < q_.size(); ++i) q_[i] = s.positions[static_cast<size_t>(i)];
+  const bool have_frame = reference_frame_ >= 0 && s.frame_poses.size() == model_.frames().size();
   if (have_frame) {
     const auto& p = s.frame_poses[static_cast<size_t>(reference_frame_)];
     Eigen::Isometry3d frame_world = Eigen::Isometry3d::Identity();
@@ -153,12 +150,12 @@ Eigen::Isometry3d StatePoser::RootPose(const robotalk_msgs::robot_state_t& s) {
   const Eigen::Matrix3d r0 = ref.linear();
   const double theta0 = std::atan2(r0(1, 0), r0(0, 0));
   Eigen::Isometry3d root = Eigen::Isometry3d::Identity();
-  root.translation() << s.base[0], s.base[1], ref.translation().z();
-  root.linear() = Eigen::AngleAxisd(s.base[2] - theta0, Eigen::Vector3d::UnitZ()) * r0;
+  root.translation() << s.base.x, s.base.y, ref.translation().z();
+  root.linear() = Eigen::AngleAxisd(s.base.theta - theta0, Eigen::Vector3d::UnitZ()) * r0;
   return root;
 }
 
-nlohmann::json StatePoser::Pose(const robotalk_msgs::robot_state_t& s) {
+nlohmann::json StatePoser::Pose(const StateSample& s) {
   const Eigen::Isometry3d root = RootPose(s);  // also checks the sample and fills q_
   roots_.front() = root;
   kin_.Update(q_, roots_);
@@ -166,16 +163,16 @@ nlohmann::json StatePoser::Pose(const robotalk_msgs::robot_state_t& s) {
   for (size_t l = 0; l < model_.links().size(); ++l)
     links.push_back(PoseJson(kin_.link_pose(static_cast<int>(l))));
   nlohmann::json q = nlohmann::json::array();
-  for (double v : s.position) q.push_back(Round6(v));
+  for (double v : s.positions) q.push_back(Round6(v));
   nlohmann::json base = nlohmann::json::array();
-  for (double v : s.base) base.push_back(Round6(v));
+  for (double v : {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega}) base.push_back(Round6(v));
   return {{"type", "state"},
           {"robot", s.robot},
           {"sample", s.sample},
-          {"t", static_cast<double>(s.server_time_us) * 1e-6},
-          {"period", static_cast<double>(s.period_us) * 1e-6},
-          {"panic", s.panic != 0},
-          {"moving", s.moving != 0},
+          {"t", static_cast<double>(ToWireMicros(s.server_time)) * 1e-6},
+          {"period", static_cast<double>(ToWireMicros(s.period)) * 1e-6},
+          {"panic", s.panic},
+          {"moving", s.moving},
           {"base", base},
           {"q", q},
           {"links", links}};

@@ -5,13 +5,18 @@
 //
 // Thread safety: the free functions are pure. A StatePoser is not thread-safe
 // (it owns a Kinematics buffer); use one per thread.
-// Errors: StatePoser::Pose throws ProtocolError when a sample does not match
-// the model (dof or frame counts); nothing else throws except std::bad_alloc.
+// Samples come validated by the codec (DecodeStateSample, request.h; the
+// client decodes with its model's dof count): counts agree, every value is
+// finite unless the sample is in panic (then a broken driver's NaN or inf,
+// written as 0 like every non-finite number here).
+// Errors: StatePoser::Pose throws ProtocolError when a sample was taken for
+// another model (its dof count differs); nothing else throws except
+// std::bad_alloc.
 #pragma once
 
 #include "robotalk/kinematics.h"
 #include "robotalk/robot_model.h"
-#include "robotalk_msgs/robot_state_t.hpp"
+#include "robotalk/state_sample.h"
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -54,7 +59,7 @@ class StatePoser {
   /// root and the sample its world pose, the root's full pose (height, tilt)
   /// is recovered from it; otherwise height and tilt are those of the last
   /// SetMeasuredRoot(), or the model's.
-  Eigen::Isometry3d RootPose(const robotalk_msgs::robot_state_t& sample);
+  Eigen::Isometry3d RootPose(const StateSample& sample);
 
   /// True when samples alone cannot give the root's height and tilt: a
   /// floating base without a control frame under it (a humanoid's pelvis).
@@ -66,10 +71,10 @@ class StatePoser {
   /// {"type":"state", "robot", "sample", "t" (s, server clock), "period" (s),
   /// "panic", "moving", "base":[x,y,θ,v,ω], "q":[...], "links":[[x,y,z,qw,qx,qy,qz]...]}
   /// Values are rounded to 1e-6 to keep the text short.
-  nlohmann::json Pose(const robotalk_msgs::robot_state_t& sample);
+  nlohmann::json Pose(const StateSample& sample);
 
  private:
-  void CheckSample(const robotalk_msgs::robot_state_t& sample) const;
+  void CheckModel(const StateSample& sample) const;
 
   const RobotModel& model_;
   Kinematics kin_;

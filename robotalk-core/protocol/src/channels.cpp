@@ -1,5 +1,7 @@
 #include "robotalk/channels.h"
 
+#include <utility>
+
 namespace robotalk {
 namespace {
 
@@ -64,6 +66,43 @@ std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel) {
 }
 std::optional<ReplyChannelParts> ParseHelloAnswerChannel(std::string_view channel) {
   return ParseClientChannel(channel, "/HELLO/");
+}
+
+const char* ToString(ChannelKind kind) {
+  switch (kind) {
+    case ChannelKind::kAnnounce:
+      return "ANNOUNCE";
+    case ChannelKind::kHello:
+      return "HELLO";
+    case ChannelKind::kHelloAnswer:
+      return "HELLO answer";
+    case ChannelKind::kRequest:
+      return "REQUEST";
+    case ChannelKind::kReply:
+      return "REPLY";
+    case ChannelKind::kConfig:
+      return "CONFIG";
+    case ChannelKind::kState:
+      return "STATE";
+  }
+  return "?";
+}
+
+std::optional<ChannelParts> ParseChannel(std::string_view channel) {
+  if (channel == kAnnounceChannel) return ChannelParts{};
+  using Robot = std::optional<std::string> (*)(std::string_view);
+  for (const auto& [kind, parse] :
+       {std::pair<ChannelKind, Robot>{ChannelKind::kRequest, &RobotOfRequestChannel},
+        {ChannelKind::kHello, &RobotOfHelloChannel},
+        {ChannelKind::kConfig, &RobotOfConfigChannel},
+        {ChannelKind::kState, &RobotOfStateChannel}}) {
+    if (auto robot = parse(channel)) return ChannelParts{kind, std::move(*robot), 0};
+  }
+  if (auto reply = ParseReplyChannel(channel))
+    return ChannelParts{ChannelKind::kReply, reply->robot, reply->client_id};
+  if (auto answer = ParseHelloAnswerChannel(channel))
+    return ChannelParts{ChannelKind::kHelloAnswer, answer->robot, answer->client_id};
+  return std::nullopt;
 }
 
 }  // namespace robotalk

@@ -1,8 +1,9 @@
-#include "robotalk/config_codec.h"
+#include "config_codec.h"
 
 #include "robotalk/broadcast_signature.h"
 
 #include "robotalk/error.h"
+#include "robotalk/transport.h"
 #include "wire_scanner.h"
 
 #include <algorithm>
@@ -57,18 +58,10 @@ std::uint64_t Fnv1a64(const std::uint8_t* data, std::size_t size) {
 
 // --- Message -> bytes -------------------------------------------------------
 
-// Sizes and counts must already agree with the vectors (the generated encoder
-// indexes the vectors by the count fields) and names must hold no NUL byte (it
-// measures strings with strlen but sizes them with size()).
-std::vector<std::uint8_t> EncodeMessage(const msgs::robot_config_t& msg) {
-  const int size = msg.getEncodedSize();
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  if (msg.encode(bytes.data(), 0, size) != size) {
-    std::fprintf(stderr, "robotalk: robot_config_t encoded to an unexpected size\n");
-    std::abort();
-  }
-  return bytes;
-}
+// EncodeMessage (transport.h): sizes and counts must already agree with the
+// vectors (the generated encoder indexes the vectors by the count fields) and
+// names must hold no NUL byte (it measures strings with strlen but sizes them
+// with size()); ToMessage makes both so.
 
 // The hash definition (docs/configuration_message.md): FNV-1a 64 over the
 // whole encoding, fingerprint included, with the 8 bytes of header.hash zero.
@@ -535,6 +528,10 @@ robotalk_msgs::config_header_t DecodeConfigHeader(std::span<const std::uint8_t> 
                                        std::to_string(kFormatVersion) + ")");
   }
   return header;
+}
+
+std::uint64_t DecodeConfigHash(std::span<const std::uint8_t> bytes) {
+  return static_cast<std::uint64_t>(DecodeConfigHeader(bytes).hash);
 }
 
 std::uint64_t ConfigHash(const RobotModel& model) {

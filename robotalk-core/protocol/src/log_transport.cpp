@@ -1,23 +1,16 @@
 #include "robotalk/log_transport.h"
 
+#include "subscription_table.h"
+
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
-#include <atomic>
-#include <mutex>
 #include <optional>
-#include <regex>
 #include <thread>
 #include <vector>
 
 namespace robotalk {
 namespace {
-
-struct Entry {
-  std::regex regex;
-  std::shared_ptr<const Transport::Handler> handler;
-  std::atomic<bool> active{true};
-};
 
 struct Event {
   std::int64_t timestamp_us = 0;
@@ -64,15 +57,6 @@ class LogCore {
     return *start_ + FromSeconds(std::max(offset_s, 0.0));
   }
 
-  std::vector<std::shared_ptr<Entry>> Matching(const std::string& channel) {
-    std::lock_guard lock(mu_);
-    std::vector<std::shared_ptr<Entry>> out;
-    for (const auto& s : subs_) {
-      if (std::regex_match(channel, s->regex)) out.push_back(s);
-    }
-    return out;
-  }
-
   const LogTransportOptions options_;
   lcm::LogFile log_;
   SteadyClock steady_;
@@ -82,32 +66,10 @@ class LogCore {
   std::int64_t first_us_ = 0;
   std::size_t read_ = 0;
   std::int64_t received_us_ = 0;  // the dispatched event's timestamp (HandleFor() thread)
-  std::mutex mu_;
-  std::vector<std::shared_ptr<Entry>> subs_;  // GUARDED_BY(mu_)
+  const std::shared_ptr<SubscriptionTable> subs_ = std::make_shared<SubscriptionTable>();
 };
 
 }  // namespace internal
-
-namespace {
-
-class LogSubscription final : public Subscription {
- public:
-  LogSubscription(std::weak_ptr<internal::LogCore> owner, std::shared_ptr<Entry> entry)
-      : owner_(std::move(owner)), entry_(std::move(entry)) {}
-  ~LogSubscription() override {
-    entry_->active = false;
-    if (auto owner = owner_.lock()) {
-      std::lock_guard lock(owner->mu_);
-      std::erase(owner->subs_, entry_);
-    }
-  }
-
- private:
-  std::weak_ptr<internal::LogCore> owner_;
-  std::shared_ptr<Entry> entry_;
-};
-
-}  // namespace
 
 LogTransport::LogTransport(LogTransportOptions options)
     : impl_(std::make_shared<internal::LogCore>(std::move(options))) {}
@@ -118,18 +80,7 @@ void LogTransport::Publish(const std::string& channel, std::span<const std::uint
 }
 
 std::unique_ptr<Subscription> LogTransport::Subscribe(const std::string& channel_regex, Handler handler) {
-  auto entry = std::make_shared<Entry>();
-  try {
-    entry->regex = std::regex(channel_regex, std::regex::extended);
-  } catch (const std::regex_error& e) {
-    throw TransportError("LogTransport: bad channel regex '" + channel_regex + "': " + e.what());
-  }
-  entry->handler = std::make_shared<const Handler>(std::move(handler));
-  {
-    std::lock_guard lock(impl_->mu_);
-    impl_->subs_.push_back(entry);
-  }
-  return std::make_unique<LogSubscription>(impl_, std::move(entry));
+  return SubscriptionTable::Subscribe(impl_->subs_, "LogTransport", channel_regex, std::move(handler));
 }
 
 int LogTransport::HandleFor(Duration timeout) {
@@ -151,15 +102,12 @@ int LogTransport::HandleFor(Duration timeout) {
     if (d.options_.paced && d.DueTime() > d.clock_.Now()) break;
     const Event event = std::move(*d.next_);
     d.ReadNext();
-    const auto matching = d.Matching(event.channel);
+    const auto matching = d.subs_->Matching(event.channel);
     if (matching.empty()) continue;
     ++dispatched;
-    for (const auto& s : matching) {
-      if (!s->active) continue;
-      const std::shared_ptr<const Handler> handler = s->handler;
-      d.received_us_ = event.timestamp_us;
-      (*handler)(event.channel, event.bytes);  // an exception leaves the rest of the log to the next call
-    }
+    d.received_us_ = event.timestamp_us;
+    // An exception leaves the rest of the log to the next call.
+    SubscriptionTable::Dispatch(matching, event.channel, event.bytes);
   }
   return dispatched;
 }

@@ -1,5 +1,7 @@
 #include "robotalk/memory_transport.h"
 
+#include "subscription_table.h"
+
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
@@ -11,7 +13,6 @@
 #include <climits>
 #include <cstring>
 #include <deque>
-#include <regex>
 
 namespace robotalk {
 
@@ -21,12 +22,6 @@ struct Message {
   std::string channel;
   std::shared_ptr<const std::vector<std::uint8_t>> bytes;  // shared by every endpoint
   WallTime published{};
-};
-
-struct SubscriptionEntry {
-  std::regex regex;
-  std::shared_ptr<const Transport::Handler> handler;
-  std::atomic<bool> active{true};
 };
 
 }  // namespace
@@ -40,14 +35,9 @@ class MemoryEndpoint {
   }
   ~MemoryEndpoint() { ::close(fd_); }
 
-  bool Wants(const std::string& channel) const {  // REQUIRES: mu_ held
-    return std::any_of(subs_.begin(), subs_.end(),
-                       [&](const auto& s) { return std::regex_match(channel, s->regex); });
-  }
-
   void Offer(const Message& m) {
     std::lock_guard lock(mu_);
-    if (!Wants(m.channel)) return;
+    if (!subs_->Wants(m.channel)) return;
     if (queue_.size() >= capacity_) {
       ++dropped_;
       return;
@@ -65,35 +55,13 @@ class MemoryEndpoint {
     [[maybe_unused]] auto n = ::read(fd_, &value, sizeof value);
   }
 
-  std::mutex mu_;
-  std::deque<Message> queue_;                             // GUARDED_BY(mu_)
-  std::vector<std::shared_ptr<SubscriptionEntry>> subs_;  // GUARDED_BY(mu_)
-  std::size_t dropped_ = 0;                               // GUARDED_BY(mu_)
+  std::mutex mu_;              // taken before subs_'s own lock, never inside it
+  std::deque<Message> queue_;  // GUARDED_BY(mu_)
+  std::size_t dropped_ = 0;    // GUARDED_BY(mu_)
+  const std::shared_ptr<SubscriptionTable> subs_ = std::make_shared<SubscriptionTable>();
   const std::size_t capacity_;
   int fd_ = -1;
 };
-
-namespace {
-
-class MemorySubscription final : public Subscription {
- public:
-  MemorySubscription(std::weak_ptr<MemoryEndpoint> endpoint, std::shared_ptr<SubscriptionEntry> entry)
-      : endpoint_(std::move(endpoint)), entry_(std::move(entry)) {}
-  ~MemorySubscription() override {
-    entry_->active = false;
-    auto endpoint = endpoint_.lock();
-    if (!endpoint) return;
-    std::lock_guard lock(endpoint->mu_);
-    auto& subs = endpoint->subs_;
-    subs.erase(std::remove(subs.begin(), subs.end(), entry_), subs.end());
-  }
-
- private:
-  std::weak_ptr<MemoryEndpoint> endpoint_;
-  std::shared_ptr<SubscriptionEntry> entry_;
-};
-
-}  // namespace
 
 std::size_t MemoryBus::published() const {
   std::lock_guard lock(mu_);
@@ -141,18 +109,7 @@ void MemoryTransport::Publish(const std::string& channel, std::span<const std::u
 }
 
 std::unique_ptr<Subscription> MemoryTransport::Subscribe(const std::string& channel_regex, Handler handler) {
-  auto entry = std::make_shared<SubscriptionEntry>();
-  try {
-    entry->regex = std::regex(channel_regex, std::regex::extended);
-  } catch (const std::regex_error& e) {
-    throw TransportError("MemoryTransport: bad channel regex '" + channel_regex + "': " + e.what());
-  }
-  entry->handler = std::make_shared<const Handler>(std::move(handler));
-  {
-    std::lock_guard lock(endpoint_->mu_);
-    endpoint_->subs_.push_back(entry);
-  }
-  return std::make_unique<MemorySubscription>(endpoint_, std::move(entry));
+  return SubscriptionTable::Subscribe(endpoint_->subs_, "MemoryTransport", channel_regex, std::move(handler));
 }
 
 int MemoryTransport::HandleFor(Duration timeout) {
@@ -172,24 +129,18 @@ int MemoryTransport::HandleFor(Duration timeout) {
   int handled = 0;
   for (; budget > 0; --budget) {
     Message m;
-    std::vector<std::shared_ptr<SubscriptionEntry>> matching;
+    SubscriptionTable::Matches matching;
     {
       std::lock_guard lock(ep.mu_);
       if (ep.queue_.empty()) break;
       m = std::move(ep.queue_.front());
       ep.queue_.pop_front();
       if (ep.queue_.empty()) ep.Drain();
-      for (const auto& s : ep.subs_) {
-        if (std::regex_match(m.channel, s->regex)) matching.push_back(s);
-      }
+      matching = ep.subs_->Matching(m.channel);
     }
     ++handled;
-    for (const auto& s : matching) {
-      if (!s->active) continue;  // unsubscribed by an earlier handler
-      const std::shared_ptr<const Handler> handler = s->handler;
-      received_ = m.published;
-      (*handler)(m.channel, *m.bytes);  // an exception leaves the rest queued
-    }
+    received_ = m.published;
+    SubscriptionTable::Dispatch(matching, m.channel, *m.bytes);  // an exception leaves the rest queued
   }
   return handled;
 }

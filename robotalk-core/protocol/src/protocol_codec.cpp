@@ -1,4 +1,4 @@
-#include "robotalk/protocol_codec.h"
+#include "protocol_codec.h"
 
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/error.h"
@@ -56,23 +56,6 @@ void ScanRobotState(WireScanner& s) {
   s.Skip(5 * 8, "base");
   const std::int32_t frames = s.Count("num_frames", 7 * 8);
   s.Skip(std::int64_t{7 * 8} * frames, "frame_poses");
-}
-
-template <typename Msg>
-Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* function, void (*scan)(WireScanner&)) {
-  if (bytes.size() > static_cast<size_t>(INT32_MAX))
-    throw ProtocolError(std::string(function) + ": message too large");
-  WireScanner s(function, bytes);
-  // The fingerprint first: a message of another type gives a clear error.
-  if (s.Int64("fingerprint") != Msg::getHash())
-    s.Fail("fingerprint", "does not match (another message type?)");
-  scan(s);
-  s.ExpectEnd();
-  Msg msg{};
-  if (msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
-    s.Fail("message", "LCM decode failed");
-  }
-  return msg;
 }
 
 }  // namespace
@@ -306,11 +289,12 @@ robotalk_msgs::robot_state_t ToWire(const StateSample& s) {
 }
 
 robotalk_msgs::package_t DecodePackage(std::span<const std::uint8_t> bytes) {
-  return DecodeChecked<robotalk_msgs::package_t>(bytes, "DecodePackage", &ScanPackage);
+  return DecodeChecked<robotalk_msgs::package_t>(bytes, "DecodePackage", kMaxLcmMessageBytes, &ScanPackage);
 }
 
 robotalk_msgs::reply_package_t DecodeReplyPackage(std::span<const std::uint8_t> bytes) {
-  return DecodeChecked<robotalk_msgs::reply_package_t>(bytes, "DecodeReplyPackage", &ScanReplyPackage);
+  return DecodeChecked<robotalk_msgs::reply_package_t>(bytes, "DecodeReplyPackage", kMaxLcmMessageBytes,
+                                                       &ScanReplyPackage);
 }
 
 std::int8_t CheckedPanicStatus(const robotalk_msgs::reply_package_t& p) {
@@ -325,7 +309,7 @@ std::int8_t CheckedPanicStatus(const robotalk_msgs::reply_package_t& p) {
 robotalk_msgs::robot_state_t DecodeRobotState(std::span<const std::uint8_t> bytes) {
   // A keyed server's signature suffix: verified (or not) by the caller.
   return DecodeChecked<robotalk_msgs::robot_state_t>(WithoutSignature(bytes), "DecodeRobotState",
-                                                     &ScanRobotState);
+                                                     kMaxLcmMessageBytes, &ScanRobotState);
 }
 
 std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {

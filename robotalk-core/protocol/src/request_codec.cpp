@@ -1,9 +1,10 @@
 // The codec of whole packages (request.h): the only place besides
 // protocol_codec.cpp that knows the LCM wire structs.
+#include "protocol_codec.h"
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/error.h"
-#include "robotalk/protocol_codec.h"
 #include "robotalk/request.h"
+#include "robotalk/transport.h"
 #include "robotalk_msgs/announce_t.hpp"
 #include "robotalk_msgs/hello_answer_t.hpp"
 #include "robotalk_msgs/hello_t.hpp"
@@ -11,19 +12,10 @@
 #include "wire_scanner.h"
 
 #include <cstring>
-#include <functional>
+#include <utility>
 
 namespace robotalk {
 namespace {
-
-template <typename Msg>
-std::vector<std::uint8_t> Encode(const Msg& msg) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  if (msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
-    throw ProtocolError(std::string("encoding ") + Msg::getTypeName() + " failed");
-  }
-  return bytes;
-}
 
 template <std::size_t N>
 void CopyBytes(std::array<std::uint8_t, N>& to, const std::uint8_t (&from)[N]) {
@@ -34,25 +26,10 @@ void CopyBytes(std::uint8_t (&to)[N], const std::array<std::uint8_t, N>& from) {
   std::memcpy(to, from.data(), N);
 }
 
-// The LCM decoders trust string lengths (length 0 -> std::length_error through
-// LCM's C callback): walk fixed-layout messages with the scanner first.
-template <typename Msg>
-Msg DecodeScanned(std::span<const std::uint8_t> bytes, const char* function,
-                  const std::function<void(WireScanner&)>& scan_body) {
-  constexpr std::size_t kMaxBytes = 64 * 1024;
-  if (bytes.size() > kMaxBytes) {
-    throw ProtocolError(std::string(function) + ": " + std::to_string(bytes.size()) + " bytes; at most " +
-                        std::to_string(kMaxBytes));
-  }
-  WireScanner scan(function, bytes);
-  if (scan.Int64("fingerprint") != Msg::getHash())
-    scan.Fail("fingerprint", "does not match (another message type?)");
-  scan_body(scan);
-  scan.ExpectEnd();
-  Msg m{};
-  if (m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
-    scan.Fail("message", "LCM decode failed");
-  }
+// A hello or its answer (DecodeChecked), with their version and client id checked.
+template <typename Msg, typename ScanBody>
+Msg DecodeHandshake(std::span<const std::uint8_t> bytes, const char* function, ScanBody&& scan_body) {
+  const Msg m = DecodeChecked<Msg>(bytes, function, kMaxSmallMessageBytes, std::forward<ScanBody>(scan_body));
   if (m.protocol_version != kProtocolVersion) {
     throw ProtocolError(std::string(function) + ": protocol version " + std::to_string(m.protocol_version) +
                         " is not supported (this side speaks " + std::to_string(kProtocolVersion) + ")");
@@ -129,7 +106,7 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
                             : robotalk_msgs::package_header_t::PAYLOAD_QUERIES;
   h.payload_size = commands ? p.num_commands : p.num_queries;
   CopyBytes(p.mac, r.mac);
-  return Encode(p);
+  return EncodeMessage(p);
 }
 
 std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
@@ -148,7 +125,7 @@ std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
   for (const Reply& r : b.replies) p.replies.push_back(ToWire(r));
   p.num_replies = static_cast<std::int32_t>(p.replies.size());
   CopyBytes(p.mac, b.mac);
-  return Encode(p);
+  return EncodeMessage(p);
 }
 
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
@@ -203,45 +180,37 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& a) {
     m.robots.push_back(info);
   }
   m.num_robots = static_cast<std::int32_t>(m.robots.size());
-  return Encode(m);
+  return EncodeMessage(m);
 }
 
-std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample) { return Encode(ToWire(sample)); }
+std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample) {
+  return EncodeMessage(ToWire(sample));
+}
 
 StateSample DecodeStateSample(std::span<const std::uint8_t> bytes, int expected_dofs) {
   return FromWire(DecodeRobotState(bytes), expected_dofs);
 }
 
 Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
-  bytes = WithoutSignature(bytes);  // a keyed server's; verified (or not) by the caller
-  // Walk the encoding with bounds checks before LCM's decoder runs: its
-  // generated code turns a string length of 0 or a negative count into
-  // std::length_error thrown through LCM's C callback (std::terminate; found
-  // by tests/fuzz). An ANNOUNCE is small.
-  constexpr std::size_t kMaxBytes = 64 * 1024;
-  if (bytes.size() > kMaxBytes) {
-    throw ProtocolError("DecodeAnnouncement: " + std::to_string(bytes.size()) + " bytes; at most " +
-                        std::to_string(kMaxBytes));
-  }
-  WireScanner scan("DecodeAnnouncement", bytes);
-  if (scan.Int64("fingerprint") != robotalk_msgs::announce_t::getHash()) {
-    scan.Fail("fingerprint", "does not match (another message type?)");
-  }
-  scan.Skip(2 + 8 + 8 + 8, "header");
-  scan.String("url_hint");
-  scan.Skip(1 + 1, "traffic_layout, keyed");
-  constexpr std::int64_t kMinRobotBytes = 2 * kLcmStringOverhead + 8 + 4 + 1 + 1 + 4;
-  const std::int32_t robots = scan.Count("num_robots", kMinRobotBytes);
-  for (std::int32_t i = 0; i < robots; ++i) {
-    scan.String("robot.name");
-    scan.String("robot.driver");
-    scan.Skip(8 + 4 + 1 + 1 + 4, "robot fields");
-  }
-  scan.ExpectEnd();
-  robotalk_msgs::announce_t m{};
-  if (m.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
-    scan.Fail("message", "LCM decode failed");
-  }
+  // A keyed server's signature suffix: verified (or not) by the caller. (A
+  // string length of 0 in an ANNOUNCE made LCM's decoder throw through its C
+  // callback, found by tests/fuzz: DecodeChecked walks it first.)
+  const auto m = DecodeChecked<robotalk_msgs::announce_t>(
+      WithoutSignature(bytes), "DecodeAnnouncement", kMaxSmallMessageBytes, [](WireScanner& scan) {
+        scan.Skip(2 + 8 + 8 + 8, "header");
+        scan.String("url_hint");
+        scan.Skip(1 + 1, "traffic_layout, keyed");
+        constexpr std::int64_t kMinRobotBytes = 2 * kLcmStringOverhead + 8 + 4 + 1 + 1 + 4;
+        const std::int32_t robots = scan.Count("num_robots", kMinRobotBytes);
+        for (std::int32_t i = 0; i < robots; ++i) {
+          scan.String("robot.name");
+          scan.String("robot.driver");
+          scan.Skip(8 + 4 + 1 + 1 + 4, "robot fields");
+        }
+      });
+  const auto fail = [](const char* field, const std::string& what) {
+    throw ProtocolError(std::string("DecodeAnnouncement: ") + field + ": " + what);
+  };
   Announcement a;
   a.server_id = m.server_id;
   a.server_time = FromWireMicros(m.server_time_us, "announce: server_time_us");
@@ -249,14 +218,14 @@ Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   a.url_hint = m.url_hint;
   if (m.traffic_layout != robotalk_msgs::announce_t::TRAFFIC_SINGLE &&
       m.traffic_layout != robotalk_msgs::announce_t::TRAFFIC_SPLIT) {
-    scan.Fail("traffic_layout", "unknown value " + std::to_string(m.traffic_layout));
+    fail("traffic_layout", "unknown value " + std::to_string(m.traffic_layout));
   }
   a.traffic_layout = static_cast<TrafficLayout>(m.traffic_layout);
   a.keyed = m.keyed != 0;
   for (const auto& r : m.robots) {
     if (r.base_type < robotalk_msgs::root_link_t::BASE_FIXED ||
         r.base_type > robotalk_msgs::root_link_t::BASE_FLOATING) {
-      scan.Fail("robot.base_type", "unknown value " + std::to_string(r.base_type));
+      fail("robot.base_type", "unknown value " + std::to_string(r.base_type));
     }
     a.robots.push_back({r.name, r.driver, static_cast<std::uint64_t>(r.config_hash), r.total_dofs,
                         static_cast<BaseType>(r.base_type), r.panic != 0, r.num_clients});
@@ -273,11 +242,11 @@ std::vector<std::uint8_t> EncodeHello(const Hello& hello) {
   CopyBytes(m.client_key, hello.body.client_key.bytes);
   CopyBytes(m.client_kx, hello.body.client_kx);
   CopyBytes(m.signature, hello.body.signature);
-  return Encode(m);
+  return EncodeMessage(m);
 }
 
 Hello DecodeHello(std::span<const std::uint8_t> bytes) {
-  const auto m = DecodeScanned<robotalk_msgs::hello_t>(
+  const auto m = DecodeHandshake<robotalk_msgs::hello_t>(
       bytes, "DecodeHello", [](WireScanner& scan) { scan.Skip(2 + 8 + 16 + 1 + 32 + 32 + 64, "fields"); });
   Hello h;
   h.keyed = m.keyed != 0;
@@ -303,12 +272,12 @@ std::vector<std::uint8_t> EncodeHelloAnswer(const HelloAnswer& a) {
   CopyBytes(m.server_kx, a.body.server_kx);
   CopyBytes(m.server_key, a.body.server_key.bytes);
   CopyBytes(m.signature, a.body.signature);
-  return Encode(m);
+  return EncodeMessage(m);
 }
 
 HelloAnswer DecodeHelloAnswer(std::span<const std::uint8_t> bytes) {
   const auto m =
-      DecodeScanned<robotalk_msgs::hello_answer_t>(bytes, "DecodeHelloAnswer", [](WireScanner& scan) {
+      DecodeHandshake<robotalk_msgs::hello_answer_t>(bytes, "DecodeHelloAnswer", [](WireScanner& scan) {
         scan.Skip(2 + 8 + 16 + 8 + 8, "fields");
         scan.String("refusal");
         scan.Skip(1 + 16 + 16 + 32 + 32 + 64, "keyed fields");

@@ -1,8 +1,11 @@
 // A bounds-checked reader of LCM's big-endian encoding, used to walk a
 // received message before LCM's generated decoder touches it: that decoder
 // sizes arrays from their count fields before checking the bytes are there,
-// so a hostile count would allocate gigabytes. Every failure throws
-// ProtocolError naming the function, the element, the field and the offset.
+// so a hostile count would allocate gigabytes (and a string length of 0
+// throws std::length_error, through LCM's C callback if it runs there).
+// Every failure throws ProtocolError naming the function, the element, the
+// field and the offset. DecodeChecked (below) is the codecs' one way from
+// received bytes to a wire struct.
 #pragma once
 
 #include "robotalk/error.h"
@@ -11,6 +14,7 @@
 #include <cstring>
 #include <span>
 #include <string>
+#include <utility>
 
 namespace robotalk {
 
@@ -102,5 +106,34 @@ class WireScanner {
   std::size_t pos_ = 0;
   std::string context_;
 };
+
+/// Received bytes as `Msg` (an lcm-gen type): at most `max_bytes`; the
+/// fingerprint first (another type gives a clear error); then `scan_body`
+/// walks the rest with the scanner (every count and string checked against
+/// the bytes left) before LCM's decoder allocates anything; every byte must
+/// belong to the message. Throws ProtocolError naming `function` and the field.
+template <typename Msg, typename ScanBody>
+Msg DecodeChecked(std::span<const std::uint8_t> bytes, const char* function, std::size_t max_bytes,
+                  ScanBody&& scan_body) {
+  if (bytes.size() > max_bytes) {
+    throw ProtocolError(std::string(function) + ": " + std::to_string(bytes.size()) + " bytes; at most " +
+                        std::to_string(max_bytes));
+  }
+  WireScanner scan(function, bytes);
+  if (scan.Int64("fingerprint") != Msg::getHash())
+    scan.Fail("fingerprint", "does not match (another message type?)");
+  std::forward<ScanBody>(scan_body)(scan);
+  scan.ExpectEnd();
+  Msg msg{};
+  if (msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())) != static_cast<int>(bytes.size())) {
+    scan.Fail("message", "LCM decode failed");
+  }
+  return msg;
+}
+
+/// The largest message LCM can decode (its sizes are int).
+inline constexpr std::size_t kMaxLcmMessageBytes = 0x7fffffff;
+/// The bound of the small fixed-layout messages (hello, answer, announce).
+inline constexpr std::size_t kMaxSmallMessageBytes = 64 * 1024;
 
 }  // namespace robotalk

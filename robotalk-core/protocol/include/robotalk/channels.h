@@ -67,4 +67,19 @@ std::optional<ReplyChannelParts> ParseReplyChannel(std::string_view channel);
 /// Robot and client id of "ROBOTALK/<robot>/HELLO/<16 lowercase hex digits>".
 std::optional<ReplyChannelParts> ParseHelloAnswerChannel(std::string_view channel);
 
+/// What a channel of the list above carries.
+enum class ChannelKind { kAnnounce, kHello, kHelloAnswer, kRequest, kReply, kConfig, kState };
+/// "ANNOUNCE", "HELLO", "HELLO answer", "REQUEST", "REPLY", "CONFIG", "STATE".
+const char* ToString(ChannelKind kind);
+
+struct ChannelParts {
+  ChannelKind kind = ChannelKind::kAnnounce;
+  std::string robot;           ///< empty for kAnnounce
+  std::int64_t client_id = 0;  ///< kHelloAnswer and kReply; 0 otherwise
+  bool operator==(const ChannelParts&) const = default;
+};
+/// Any channel of the list above, as the functions above parse it (for
+/// readers of every channel: logs, recorders); nullopt for any other.
+std::optional<ChannelParts> ParseChannel(std::string_view channel);
+
 }  // namespace robotalk

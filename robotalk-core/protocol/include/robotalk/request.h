@@ -77,7 +77,7 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes);
 /// playback fields are written in kPlayback only; `mac` goes in as given
 /// (keyed mode: seal the bytes afterwards, see WriteMacField). Throws
 /// ProtocolError for a start time whose kind does not belong in `mode`
-/// (protocol_codec.h) or a negative time.
+/// (command.h, StartTime: offsets in kPlayback only) or a negative time.
 std::vector<std::uint8_t> EncodeRequest(const Request& request);
 
 /// Whether the package a ReplyBatch acknowledges belonged to a live session.
@@ -140,8 +140,9 @@ std::vector<std::uint8_t> EncodeAnnouncement(const Announcement& announcement);
 
 /// A broadcast state sample (ROBOTALK/<robot>/STATE) as bytes.
 std::vector<std::uint8_t> EncodeStateSample(const StateSample& sample);
-/// Bytes to a validated StateSample (protocol_codec.h FromWire: counts,
-/// finite values, times; `expected_dofs` >= 0 also checks the dof count).
+/// Bytes to a validated StateSample (what state_sample.h promises: counts,
+/// finite values unless in panic, times; `expected_dofs` >= 0 also checks the
+/// dof count).
 /// Throws ProtocolError on truncated, hostile, foreign or invalid bytes. A
 /// keyed server's signature suffix is skipped, not verified
 /// (broadcast_signature.h).

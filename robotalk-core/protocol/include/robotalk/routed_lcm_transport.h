@@ -55,6 +55,7 @@ class RoutedLcmTransport final : public Transport {
   std::string url() const override;
   /// LCM's recv_utime of the message being dispatched, from its lane.
   WallTime ReceiveTime() const override;
+  TrafficLayout traffic_layout() const override { return TrafficLayout::kSplit; }
 
   /// Whether lane `lane` has a receive socket (exposed for tests).
   bool Receives(int lane) const;

@@ -26,15 +26,14 @@
 // the URL and the bad part.
 #pragma once
 
+#include "robotalk/transport.h"  // TrafficLayout
+
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
 
 namespace robotalk {
-
-/// On the wire as announce_t.traffic_layout (TRAFFIC_SINGLE = 0, TRAFFIC_SPLIT = 1).
-enum class TrafficLayout : std::int8_t { kSingle = 0, kSplit = 1 };
 
 /// Reply lanes of the split layout (a client's: client_id % kReplyLanes).
 inline constexpr int kReplyLanes = 64;

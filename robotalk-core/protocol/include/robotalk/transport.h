@@ -46,6 +46,11 @@ class Subscription {
   Subscription& operator=(const Subscription&) = delete;
 };
 
+/// How a transport lays RoboTalk's channels on LCM URLs (traffic_layout.h):
+/// every channel on one URL, or the split layout's lanes. On the wire as
+/// announce_t.traffic_layout (TRAFFIC_SINGLE = 0, TRAFFIC_SPLIT = 1).
+enum class TrafficLayout : std::int8_t { kSingle = 0, kSplit = 1 };
+
 /// Wall-clock time (the UNIX epoch, microseconds): when a message was
 /// received, as LCM stamps it (lcm_recv_buf_t::recv_utime).
 using WallTime = std::chrono::time_point<std::chrono::system_clock, std::chrono::microseconds>;
@@ -91,22 +96,37 @@ class Transport {
   /// the call.
   virtual WallTime ReceiveTime() const;
 
+  /// The layout this transport's traffic travels in (what a server announces,
+  /// so that its clients open the same): kSplit for RoutedLcmTransport, this
+  /// default kSingle for every other.
+  virtual TrafficLayout traffic_layout() const { return TrafficLayout::kSingle; }
+
  protected:
   Transport() = default;
   Transport(const Transport&) = delete;
   Transport& operator=(const Transport&) = delete;
 };
 
-/// Encodes `msg` (an lcm-gen type) and publishes it. Throws TransportError.
+/// `msg` (an lcm-gen type) as LCM bytes, fingerprint first: the one encoder
+/// of the project (the codecs and Publish<Msg> use it). Throws ProtocolError
+/// naming the type when LCM's encoder fails (a count field that disagrees
+/// with its array).
 template <typename Msg>
-void Publish(Transport& transport, const std::string& channel, const Msg& msg) {
+std::vector<std::uint8_t> EncodeMessage(const Msg& msg) {
   const int size = msg.getEncodedSize();
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
   if (msg.encode(bytes.data(), 0, size) != size) {
-    throw TransportError("Publish<" + std::string(Msg::getTypeName()) + "> on '" + channel +
-                         "': encoding failed");
+    throw ProtocolError(std::string("encoding ") + Msg::getTypeName() +
+                        " failed (do its counts match its arrays?)");
   }
-  transport.Publish(channel, bytes);
+  return bytes;
+}
+
+/// Encodes `msg` (an lcm-gen type, EncodeMessage) and publishes it. Throws
+/// ProtocolError when it cannot be encoded, TransportError when the send fails.
+template <typename Msg>
+void Publish(Transport& transport, const std::string& channel, const Msg& msg) {
+  transport.Publish(channel, EncodeMessage(msg));
 }
 
 /// Subscribes `channel_regex` and calls `handler` with each message decoded
@@ -114,7 +134,7 @@ void Publish(Transport& transport, const std::string& channel, const Msg& msg) {
 /// fingerprint, truncated) raises a ProtocolError naming the channel and the
 /// type, carried out of HandleFor() like a handler's exception. LCM's decoder
 /// trusts array counts; for bytes from untrusted senders use the raw
-/// Subscribe() with the bounds-checked decoders of protocol_codec.h.
+/// Subscribe() with the bounds-checked decoders of request.h.
 template <typename Msg>
 std::unique_ptr<Subscription> Subscribe(
     Transport& transport, const std::string& channel_regex,

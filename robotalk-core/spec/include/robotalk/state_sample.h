@@ -1,6 +1,11 @@
 // StateSample: one sample of a robot's broadcast state (broadcast mode,
-// ROBOTALK/<robot>/STATE) as a C++ value. The wire form is
-// robotalk_msgs::robot_state_t; protocol_codec.h converts and validates.
+// ROBOTALK/<robot>/STATE) as a C++ value. Its wire form is robot_state_t
+// (lcmtypes/robotalk_msgs/robot_state_t.lcm); the protocol library converts
+// (request.h: EncodeStateSample, DecodeStateSample) and is the one place that
+// validates it: a decoded sample has equal position, velocity and effort
+// counts (the model's, when the reader gives it), 7 values per frame pose,
+// times in range, and every value finite unless `panic` is set (then NaN or
+// inf is what a broken driver reported; the server halted the robot for it).
 // A plain value type: not synchronised.
 #pragma once
 

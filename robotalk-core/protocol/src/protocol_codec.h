@@ -1,5 +1,8 @@
-// Conversions between the C++ protocol values (command.h) and their LCM wire
-// forms (lcmtypes/robotalk_msgs), and safe decoding of received bytes.
+// Private to the protocol library (and the tests of its codec): conversions
+// between the C++ protocol values (command.h, state_sample.h) and their LCM
+// wire forms (lcmtypes/robotalk_msgs), and safe decoding of received bytes.
+// The rest of the project speaks the whole messages of request.h, which
+// request_codec.cpp builds from these.
 //
 // Decoding never trusts the sender: LCM's generated decoders allocate an
 // array from its count field before checking that the bytes are there, so a
