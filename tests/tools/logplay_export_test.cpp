@@ -4,9 +4,9 @@
 // a robot whose configuration the log lacks is named q0.. and said so.
 #include "export.h"
 #include "robotalk/channels.h"
-#include "robotalk/config_codec.h"
+#include "robotalk/config_message.h"
+#include "robotalk/request.h"
 #include "robotalk/urdf_import.h"
-#include "robotalk_msgs/robot_state_t.hpp"
 
 #include <gtest/gtest.h>
 
@@ -27,17 +27,14 @@ const char* kUrdf = R"(<robot name="rover">
 </robot>)";
 
 std::vector<std::uint8_t> State(const std::string& robot, std::vector<double> q) {
-  robotalk_msgs::robot_state_t s{};
-  s.server_time_us = 1'000'000;
+  robotalk::StateSample s;
+  s.server_time = TimePoint{std::chrono::seconds(1)};
   s.sample = 1;
   s.robot = robot;
-  s.num_dofs = static_cast<std::int32_t>(q.size());
-  s.position = q;
-  s.velocity = std::vector<double>(q.size(), 0.0);
-  s.effort = std::vector<double>(q.size(), 0.0);
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(s.getEncodedSize()));
-  s.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
+  s.velocities.assign(q.size(), 0.0);
+  s.efforts.assign(q.size(), 0.0);
+  s.positions = std::move(q);
+  return EncodeStateSample(s);
 }
 
 std::vector<std::string> Lines(const std::string& path) {
