@@ -36,25 +36,30 @@ export ROBOTALK_DEMO_KEEP=$keep
 
 # Build output as one progress line (a terminal) or a line every 10 %, not
 # make's target lists; everything else (apt, npm, warnings, errors) as is.
+# (A bash loop, not awk: mawk reads a pipe in blocks, so its progress would lag.)
 quiet_build() {
-  awk -v tty="$([ -t 1 ] && echo 1 || echo 0)" '
-    function flush_line() { if (pending) { printf "\n"; pending = 0 } }
-    /^\[ *[0-9]+%\]/ {
-      pct = $0; sub(/^\[ */, "", pct); sub(/%.*/, "", pct)
-      what = $0; sub(/^\[ *[0-9]+%\] /, "", what)
-      if (what ~ /^(Built target|Scanning dependencies|Consolidate compiler)/) what = ""
-      sub(/^(Building|Linking) [A-Z+]+ (object|executable|static library) /, "", what)
-      sub(/\.dir\//, " ", what)
-      if (tty) {
-        printf "\r\033[Kbuilding %3d%% %s", pct, substr(what, 1, 60); pending = 1; fflush()
-      } else if (int(pct / 10) != last) {
-        last = int(pct / 10); printf "building %d%%\n", pct; fflush()
-      }
-      next
-    }
-    /^(make|gmake)(\[[0-9]+\])?: /  { if ($0 !~ /Error|error/) next }
-    { flush_line(); print; fflush() }
-    END { if (pending) printf "\r\033[K" }'
+  local tty=0 line pct what last=-1 pending=0
+  [ -t 1 ] && tty=1
+  while IFS= read -r line; do
+    if [[ $line =~ ^\[\ *([0-9]+)%\]\ (.*)$ ]]; then
+      pct=${BASH_REMATCH[1]} what=${BASH_REMATCH[2]}
+      case $what in "Built target"* | "Scanning dependencies"* | "Consolidate compiler"*) what="" ;; esac
+      what=${what#Building CXX object } what=${what#Building C object } what=${what#Linking CXX executable }
+      if [ "$tty" = 1 ]; then
+        printf '\r\033[Kbuilding %3d%% %s' "$pct" "${what:0:60}"
+        pending=1
+      elif ((pct / 10 != last)); then
+        last=$((pct / 10))
+        echo "building $pct%"
+      fi
+      continue
+    fi
+    [[ $line =~ ^g?make(\[[0-9]+\])?:\  && ! $line =~ [Ee]rror ]] && continue
+    if ((pending)); then echo; pending=0; fi
+    printf '%s\n' "$line"
+  done
+  if ((pending)); then printf '\r\033[K'; fi
+  return 0
 }
 started=$SECONDS
 ROBOTALK_BUILD_TARGETS="robotalk-server robotalk robotalk-web" scripts/setup.sh 2>&1 | quiet_build

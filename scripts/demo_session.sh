@@ -36,6 +36,7 @@ stop_all() {
   local p
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
   for p in "${pids[@]}"; do wait "$p" 2>/dev/null; done
+  [ "$KEEP" = 1 ] && grep -h "stopping every robot" "$tmp/server.log"
   rm -rf "$tmp"
 }
 trap stop_all EXIT
