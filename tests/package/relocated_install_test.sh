@@ -27,9 +27,9 @@ bin=$prefix/bin
 
 # --- robotalk-spy -------------------------------------------------------------
 check "robotalk-spy --version" test "$("$bin/robotalk-spy" --version)" = "robotalk-spy $version"
-printf '#!/bin/sh\nprintf "%%s\\n" "$@"\n' >"$tmp/java"
-chmod +x "$tmp/java"
-JAVA=$tmp/java "$bin/robotalk-spy" --url "$url" >"$tmp/spy.args" 2>&1
+printf '#!/bin/sh\nprintf "%%s\\n" "$@"\n' >"$tmp/fake-java"
+chmod +x "$tmp/fake-java"
+JAVA=$tmp/fake-java "$bin/robotalk-spy" --url "$url" >"$tmp/spy.args" 2>&1
 classpath=$(sed -n '/^-cp$/{n;p;}' "$tmp/spy.args")
 types_jar=$(echo "$classpath" | tr ':' '\n' | grep robotalk_lcmtypes.jar)
 check "robotalk-spy's class path holds the moved types jar ($types_jar)" \
@@ -82,11 +82,12 @@ run_example() {  # run_example NAME PORT COMMAND...
   check "the $name example runs against the moved robotalk-server" test $? -eq 0
 }
 run_example c 7772 "$tmp/c/robotalk_c_example"
-if command -v java >/dev/null && [ -f "$tmp/java/robotalk_java_client.jar" ]; then
+if command -v java >/dev/null && command -v javac >/dev/null; then
+  check "the Java client jar was built" test -f "$tmp/java/robotalk_java_client.jar"
   run_example java 7773 java -Djava.net.preferIPv4Stack=true \
     -cp "$lcm_jar:$prefix/share/java/robotalk_lcmtypes.jar:$tmp/java/robotalk_java_client.jar" robotalk.client.Example
 else
-  echo "SKIP: the Java example (no java or no javac: scripts/setup.sh installs default-jdk-headless)"
+  echo "SKIP: the Java example (no java or javac: scripts/setup.sh installs default-jdk-headless)"
 fi
 if [ -x "$tmp/lua/run_example.sh" ]; then
   check "the Lua launcher uses the moved modules" grep -qF "$prefix/share/lua/5.2/?.lua" "$tmp/lua/run_example.sh"
@@ -96,7 +97,7 @@ else
 fi
 
 if [ "$failures" -ne 0 ]; then
-  for f in "$tmp"/web.out "$tmp"/spy.args "$tmp"/vars.log "$tmp"/run_*.log; do
+  for f in "$tmp"/web.out "$tmp"/spy.args "$tmp"/vars.log "$tmp"/{c,java,lua}.log "$tmp"/run_*.log; do
     [ -f "$f" ] && { echo "--- $f"; tail -30 "$f"; }
   done
 fi
