@@ -44,9 +44,10 @@ quiet_build() {
     if [[ $line =~ ^\[\ *([0-9]+)%\]\ (.*)$ ]]; then
       pct=${BASH_REMATCH[1]} what=${BASH_REMATCH[2]}
       case $what in "Built target"* | "Scanning dependencies"* | "Consolidate compiler"*) what="" ;; esac
-      what=${what#Building CXX object } what=${what#Building C object } what=${what#Linking CXX executable }
+      what=${what#Linking CXX executable } what=${what#Linking CXX static library }
+      what=${what##*/} what=${what%.o}  # the file being compiled or linked
       if [ "$tty" = 1 ]; then
-        printf '\r\033[Kbuilding %3d%% %s' "$pct" "${what:0:60}"
+        printf '\r\033[Kbuilding %3d%% %s' "$pct" "${what:0:50}"
         pending=1
       elif ((pct / 10 != last)); then
         last=$((pct / 10))
