@@ -31,11 +31,12 @@ wait_for() {
 }
 
 tmp=$(mktemp -d)
-pids=()
-stop_all() {
+pids=() server=
+stop_all() {  # the motion and the web view first, the server (it stops the robot) last
   local p
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
   for p in "${pids[@]}"; do wait "$p" 2>/dev/null; done
+  [ -z "$server" ] || { kill "$server" 2>/dev/null; wait "$server" 2>/dev/null; }
   [ "$KEEP" = 1 ] && grep -h "stopping every robot" "$tmp/server.log"
   rm -rf "$tmp"
 }
@@ -74,7 +75,6 @@ if [ -n "$web" ]; then
 else
   echo "(robotalk-web did not start: $(cat "$tmp/web.out"))"
 fi
-pids+=("$server")  # stopped last: it stops the robot
 
 wait_for "$tmp/server.log" "serving robot"
 step "A server with one robot on ODE physics: robotalk-server --robot pioneer=ode:$MODEL"
@@ -132,7 +132,7 @@ motion() {
   done
 }
 motion &
-pids=("$!" "${pids[@]}")  # stopped first
+pids=("$!" "${pids[@]}")
 step "Running until Ctrl-C: the server, robotalk-web and a slow scripted motion (home, the arcs, a look around)"
 if [ -n "$browser_url" ]; then
   echo "Watch it in a browser on this machine: $browser_url"
