@@ -31,9 +31,8 @@ int main(int argc, char** argv) {
   for (const char* module : {"three", "urdf-loader"}) {
     if (!fs::is_directory(fs::path(options.node_modules_dir) / module)) {
       std::cerr << "robotalk-web: " << options.node_modules_dir << "/" << module
-                << " is missing: run scripts/setup.sh (npm ci in tools/web) before building and installing, "
-                   "or give "
-                   "--node-modules\n";
+                << " is missing: give --node-modules, or run scripts/setup.sh (npm ci in tools/web) "
+                   "before building and installing\n";
       return 1;
     }
   }
