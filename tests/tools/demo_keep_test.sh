@@ -44,6 +44,7 @@ check "Ctrl-C ends the demo within 15 s" sh -c "! kill -0 $demo 2>/dev/null"
 wait "$demo"
 status=$?
 check "it exits 0 (got $status)" test "$status" -eq 0
+check "it says what it stops" grep -q "^Stopping: the motion, robotalk-web, then the server" "$tmp/demo.out"
 sleep 1
 left=$(ps -o pid=,args= -g "$demo")
 check "no process of the demo is left ($left)" test -z "$left"
