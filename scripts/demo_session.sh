@@ -114,15 +114,22 @@ cat "$tmp/server.log"
 [ "$KEEP" = 1 ] || exit 0
 # The slow scripted motion: home, the arcs with the head following, a look
 # around; again and again. Each command runs in the background so that the
-# loop stops at once when it is told to.
+# loop stops at once when it is told to (stop_all's TERM, or Ctrl-C's SIGINT
+# to the whole process group: a subshell does not keep this script's INT
+# trap). Its CLI is killed outright: a TERMed CLI would first wait for the
+# server to acknowledge a STOP, and on Ctrl-C the server is already going;
+# stop_all stops the server right after, and the server stops the robot as
+# it exits.
 motion() {
-  trap 'kill $c 2>/dev/null; exit 0' TERM
+  trap 'kill -KILL $c 2>/dev/null; wait $c 2>/dev/null; exit 0' TERM INT HUP
   while :; do
     for cmd in "send pioneer goto 0 0 0" "send pioneer --file examples/demo_arcs.txt --mode playback --paced" \
       "send pioneer joint_setpoint tilt -0.3" "send pioneer joint_setpoint pan 0.8" \
       "send pioneer joint_setpoint pan -0.8" "send pioneer joint_setpoint tilt 0"; do
+      # The binary itself, not the robotalk function: $c must be the CLI's pid,
+      # not a subshell's that would leave it running when killed.
       # shellcheck disable=SC2086  # the words of cmd are the CLI's arguments
-      robotalk $cmd >/dev/null 2>&1 &
+      "$BUILD_DIR"/robotalk-client/robotalk --url "$URL" --timeout 20 $cmd >/dev/null 2>&1 &
       c=$!
       wait $c
       sleep 1 &

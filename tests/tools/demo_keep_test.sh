@@ -46,7 +46,8 @@ status=$?
 check "it exits 0 (got $status)" test "$status" -eq 0
 check "it says what it stops" grep -q "^Stopping: the motion, robotalk-web, then the server" "$tmp/demo.out"
 sleep 1
-left=$(ps -o pid=,args= -g "$demo")
+# Still running in the demo's process group (an exited child its parent did not reap is not running).
+left=$(ps -eo pgid=,pid=,stat=,args= | awk -v g="$demo" '$1 == g && $3 !~ /^Z/')
 check "no process of the demo is left ($left)" test -z "$left"
 check "the server stopped every robot on its way out" grep -q "robotalk-server: .*, stopping every robot" "$tmp/demo.out"
 [ "$failures" -eq 0 ] || { echo "--- demo output"; cat "$tmp/demo.out"; }
