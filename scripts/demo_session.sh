@@ -138,7 +138,7 @@ motion() {
     done
   done
 }
-motion &
+motion 2>/dev/null &  # (no "Killed" notice when it stops its CLI)
 pids=("$!" "${pids[@]}")
 step "Running until Ctrl-C: the server, robotalk-web and a slow scripted motion (home, the arcs, a look around)"
 if [ -n "$browser_url" ]; then
