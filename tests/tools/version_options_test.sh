@@ -1,7 +1,7 @@
 #!/bin/sh
 # Every tool binary answers --version with "NAME X.Y.Z" (the CMake project
 # version) and names an unknown option as such (exit 2). No network.
-# usage: version_options_test.sh VERSION robotalk robotalk-describe robotalk-lcm-relay robotalk-logplay
+# usage: version_options_test.sh VERSION BINARY...
 set -u
 version=$1; shift
 fail=0

@@ -52,6 +52,8 @@ One run of the paper's Fig. 11 experiment (docs/experiment.md).
   --give-up S             client gives up on a silent package after S (default 5)
   --max-seconds S         hard bound on the whole run (default 300): exit 3 past it
   --print-ideal FILE      write the ideal path (t x y theta every 0.02 s) and exit
+  --version               print the version and exit
+  -h, --help              print this help and exit
 )";
 
 struct Options {
@@ -81,6 +83,9 @@ Options Parse(int argc, char** argv) {
     };
     if (a == "--help" || a == "-h") {
       std::cout << kUsage;
+      std::exit(0);
+    } else if (a == "--version") {
+      std::cout << "robotalk-fig11 " << ROBOTALK_VERSION << "\n";
       std::exit(0);
     } else if (a == "--url") {
       o.url = value();

@@ -1,6 +1,7 @@
 // robotalk-web: shows every robot on the LCM bus in a browser (docs/web.md).
 #include "robot_tracker.h"
 #include "robotalk/error.h"
+#include "web_install_dirs.h"
 #include "web_options.h"
 #include "web_server.h"
 
@@ -13,9 +14,10 @@ int main(int argc, char** argv) {
   WebOptions options;
   try {
     const char* ros_package_path = std::getenv("ROS_PACKAGE_PATH");
-    options =
-        ParseWebOptions(std::vector<std::string>(argv + 1, argv + argc), ROBOTALK_WEB_SOURCE_DIR "/www",
-                        ROBOTALK_WEB_SOURCE_DIR "/node_modules", ros_package_path ? ros_package_path : "");
+    const WebDirs dirs =
+        DefaultWebDirs(RunningBinaryDir(), ROBOTALK_WEB_DATA_FROM_BIN, ROBOTALK_WEB_SOURCE_DIR);
+    options = ParseWebOptions(std::vector<std::string>(argv + 1, argv + argc), dirs.www, dirs.node_modules,
+                              ros_package_path ? ros_package_path : "");
   } catch (const robotalk::Error& e) {
     std::cerr << "robotalk-web: " << e.what() << "\n";
     return 2;
@@ -32,7 +34,8 @@ int main(int argc, char** argv) {
   for (const char* module : {"three", "urdf-loader"}) {
     if (!fs::is_directory(fs::path(options.node_modules_dir) / module)) {
       std::cerr << "robotalk-web: " << options.node_modules_dir << "/" << module
-                << " is missing: run scripts/setup.sh (npm ci in tools/web), or give --node-modules\n";
+                << " is missing: give --node-modules, or run scripts/setup.sh (npm ci in tools/web) "
+                   "before building and installing\n";
       return 1;
     }
   }
