@@ -71,6 +71,11 @@ TEST(CommandTraits, FindsEachRowByItsCodeAndNoOther) {
   EXPECT_EQ(FindCommandTraits(0), nullptr);
   EXPECT_EQ(FindCommandTraits(static_cast<int>(kCommandTraits.size()) + 1), nullptr);
   EXPECT_EQ(ParseCommandType("setaccel"), std::nullopt);
+  // A value that is no type (a C++ cast) has the unknown row: no target, never a motion.
+  const auto bogus = static_cast<CommandType>(42);
+  EXPECT_STREQ(ToString(bogus), "UNKNOWN_COMMAND");
+  EXPECT_EQ(Traits(bogus).kind, CommandKind::kSession);
+  EXPECT_FALSE(IsMotionCommand(bogus));
 }
 
 TEST(CommandTraits, EveryCommandRoundTripsThroughItsSequenceFileText) {

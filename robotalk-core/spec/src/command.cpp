@@ -67,10 +67,7 @@ const char* ServoWord(ServoType t) {
 
 }  // namespace
 
-const char* ToString(CommandType t) {
-  const CommandTraits* traits = FindCommandTraits(static_cast<int>(t));
-  return traits ? traits->name : "UNKNOWN_COMMAND";
-}
+const char* ToString(CommandType t) { return Traits(t).name; }
 
 std::string ValueCountText(const CommandTraits& t) {
   if (t.min_values == kValuesPerDof) return "one value per dof";

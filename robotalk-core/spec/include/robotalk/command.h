@@ -75,9 +75,9 @@ struct CommandTraits {
   const char* max_value_names;  ///< what max_values are when it differs; "" otherwise
 };
 
-inline constexpr std::array<CommandTraits, 8> kCommandTraits{{
+inline constexpr auto kCommandTraits = std::to_array<CommandTraits>({
     // clang-format off
-    // type                          name              alias        target                kind                  servo                 keeps  values                        value names
+    // {type, name, alias, target, kind, servo, keeps_moving, min_values, max_values, value_names, max_value_names}
     {CommandType::kJointSetPoint, "JOINT_SETPOINT", nullptr,     CommandTarget::kJoint, CommandKind::kServo,   ServoType::kSetPoint, false, kValuesPerDof, kValuesPerDof, "", ""},
     {CommandType::kJointSpeed,    "JOINT_SPEED",    nullptr,     CommandTarget::kJoint, CommandKind::kServo,   ServoType::kSpeed,    true,  kValuesPerDof, kValuesPerDof, "", ""},
     {CommandType::kJointForce,    "JOINT_FORCE",    nullptr,     CommandTarget::kJoint, CommandKind::kServo,   ServoType::kForce,    true,  kValuesPerDof, kValuesPerDof, "", ""},
@@ -87,15 +87,25 @@ inline constexpr std::array<CommandTraits, 8> kCommandTraits{{
     {CommandType::kStop,          "STOP",           nullptr,     CommandTarget::kRobot, CommandKind::kStop,    ServoType::kNone,     false, 0, 0, "", ""},
     {CommandType::kPanicReset,    "PANIC_RESET",    nullptr,     CommandTarget::kRobot, CommandKind::kSession, ServoType::kNone,     false, 0, 0, "", ""},
     // clang-format on
-}};
+});
 
 /// The row of wire code `code`, or nullptr for a code no command has.
 constexpr const CommandTraits* FindCommandTraits(int code) {
   if (code < 1 || code > static_cast<int>(kCommandTraits.size())) return nullptr;
   return &kCommandTraits[static_cast<std::size_t>(code - 1)];
 }
-/// The row of `t`. REQUIRES: `t` is a command type (one FindCommandTraits knows).
-constexpr const CommandTraits& Traits(CommandType t) { return *FindCommandTraits(static_cast<int>(t)); }
+/// What Traits() answers for a value that is no command type (a cast in
+/// C++; the codec refuses such a code): no target, never queued.
+// clang-format off
+inline constexpr CommandTraits kUnknownCommandTraits{
+    CommandType{0}, "UNKNOWN_COMMAND", nullptr, CommandTarget::kRobot, CommandKind::kSession, ServoType::kNone,
+    false, 0, 0, "", ""};
+// clang-format on
+/// The row of `t` (kUnknownCommandTraits for a value no row has).
+constexpr const CommandTraits& Traits(CommandType t) {
+  const CommandTraits* row = FindCommandTraits(static_cast<int>(t));
+  return row ? *row : kUnknownCommandTraits;
+}
 
 /// The table is in wire-code order (so FindCommandTraits indexes it).
 constexpr bool CommandTraitsInCodeOrder() {
