@@ -45,14 +45,17 @@ void CheckCount(CommandType t, std::size_t n) {
   throw UsageError(std::string(traits.name) + " takes " + expected + ", got " + std::to_string(n));
 }
 
+// A command's word in a sequence file: its name in lower case.
+std::string Word(CommandType t) {
+  std::string word = ToString(t);
+  for (char& ch : word) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return word;
+}
+
 // "joint_setpoint, joint_speed, ...": the words a command may start with.
 std::string CommandWords() {
   std::string words;
-  for (const CommandTraits& t : kCommandTraits) {
-    std::string name = t.name;
-    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    words += (words.empty() ? "" : ", ") + name;
-  }
+  for (const CommandTraits& t : kCommandTraits) words += (words.empty() ? "" : ", ") + Word(t.type);
   return words;
 }
 
@@ -81,8 +84,7 @@ Command ParseCommandWords(const std::vector<std::string>& words) {
 }
 
 std::string FormatCommandWords(const Command& c) {
-  std::string text = ToString(c.type);
-  for (char& ch : text) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  std::string text = Word(c.type);
   if (!c.target.empty()) text += " " + c.target;
   for (const double v : c.values) {
     char number[32];
