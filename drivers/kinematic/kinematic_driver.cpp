@@ -325,7 +325,10 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
   // The server checked the command against the model (driver.h): a motion
   // command, a valid target of the right kind, its value count, finite values.
   Advance(now, completed);
-  const char* name = ToString(c.type);
+  if (Traits(c.type).target == CommandTarget::kBase && !mobile_base()) {
+    return Answer(Signal::kNa,
+                  std::string(ToString(c.type)) + ": robot " + Quote(model_.name()) + " has a fixed base");
+  }
   switch (c.type) {
     case CommandType::kJointSetPoint:
       return JointSetPoint(c);
@@ -337,17 +340,12 @@ DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
     case CommandType::kFrameSetPoint:
       return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks reachability
     case CommandType::kGoto:
+      return Goto(c);
     case CommandType::kSetSpeed:
-      if (!mobile_base()) {
-        return Answer(Signal::kNa,
-                      std::string(name) + ": robot " + Quote(model_.name()) + " has a fixed base");
-      }
-      return c.type == CommandType::kGoto ? Goto(c) : SetSpeed(c);
-    case CommandType::kStop:
-    case CommandType::kPanicReset:
-      break;  // never sent to a driver (driver.h)
+      return SetSpeed(c);
+    default:  // a type this driver has no handler for (STOP and PANIC_RESET never come here)
+      return driver_support::NotExecuted(c, "the kinematic driver");
   }
-  return Answer(Signal::kError, std::string(name) + " is not a motion command a driver executes");
 }
 
 void KinematicDriver::Stop(TimePoint now, std::vector<Completion>& interrupted) {

@@ -30,14 +30,10 @@ Twist2 RootTwist(const OdeWorld& world, const RobotModel& model) {
 }
 
 std::optional<DriverResult> CheckBaseValues(const DriverCommand& c) {
-  if (c.type == CommandType::kGoto && c.num_values != 3) {
-    return Answer(Signal::kError, "GOTO: expected 3 values (x y theta), got " + std::to_string(c.num_values));
-  }
-  if (c.type == CommandType::kSetSpeed && c.num_values != 2 && c.num_values != 3) {
-    return Answer(Signal::kError, "SETSPEED: expected 2 values (v omega) or 3 (vx vy omega), got " +
-                                      std::to_string(c.num_values));
-  }
-  return std::nullopt;
+  const CommandTraits& t = Traits(c.type);
+  if (ValueCountFits(t, static_cast<std::size_t>(c.num_values), 0)) return std::nullopt;
+  return Answer(Signal::kError, std::string(t.name) + ": expected " + ValueCountText(t) + ", got " +
+                                    std::to_string(c.num_values));
 }
 
 namespace {

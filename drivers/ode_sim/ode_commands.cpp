@@ -21,23 +21,20 @@ DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
   // The server checked the command against the model (driver.h): a motion
   // command, a valid target of the right kind, its value count, finite values.
   Advance(now, true, completed);
-  const char* name = ToString(c.type);
   switch (c.type) {
     case CommandType::kJointSetPoint:
     case CommandType::kJointSpeed:
     case CommandType::kJointForce:
-      return JointCommand(c);
+      return JointCommand(c);  // the servo of the command's type (kCommandTraits)
     case CommandType::kFrameSetPoint:
       return FrameSetPoint(c);  // driver_support::CheckFrameSetPoint checks reachability
     case CommandType::kGoto:
       return base_->Goto(c);
     case CommandType::kSetSpeed:
       return base_->SetSpeed(c);
-    case CommandType::kStop:
-    case CommandType::kPanicReset:
-      break;  // never sent to a driver (driver.h)
+    default:  // a type this driver has no handler for (STOP and PANIC_RESET never come here)
+      return driver_support::NotExecuted(c, "the ODE driver");
   }
-  return Answer(Signal::kError, std::string(name) + " is not a motion command a driver executes");
 }
 
 void OdeDriver::Impl::Stop(TimePoint now, std::vector<Completion>& interrupted) {
@@ -61,6 +58,7 @@ void OdeDriver::Impl::StopOnly(const StopScope& scope, TimePoint now, std::vecto
 
 DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
   const std::string name = ToString(c.type);
+  const ServoType servo = Traits(c.type).servo;
   const robotalk::Joint& joint = model_.joint(c.target);         // checked by the server (driver.h)
   if (auto busy = base_->Release(c.target, name)) return *busy;  // a wheel under a GOTO, a leg of a walk
   std::string note;
@@ -71,11 +69,11 @@ DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
     double got = want;
     std::string unit = Unit(dof.type);
     const char* what = "";
-    if (c.type == CommandType::kJointSetPoint) {
+    if (servo == ServoType::kSetPoint) {
       got = std::clamp(want, servos_.lower(i), servos_.upper(i));
       what = want > got ? "the upper limit" : "the lower limit";
       servos_.SetPoint(i, got);
-    } else if (c.type == CommandType::kJointSpeed) {
+    } else if (servo == ServoType::kSpeed) {
       got = std::clamp(want, -dof.limits.velocity, dof.limits.velocity);
       unit += "/s";
       what = "the velocity limit";

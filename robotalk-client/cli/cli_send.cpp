@@ -109,10 +109,9 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
   return status;
 }
 
-// Servo commands the server holds only while their client's session lives.
-bool HeldWhileAlive(CommandType t) {
-  return t == CommandType::kSetSpeed || t == CommandType::kJointSpeed || t == CommandType::kJointForce;
-}
+// Commands that move on until stopped (kCommandTraits): the server's watchdog
+// stops them when their client's session ends.
+bool HeldWhileAlive(CommandType t) { return Traits(t).keeps_moving; }
 
 int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::optional<double> at, bool hold,
             bool json) {
@@ -122,7 +121,7 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
   const bool motion = IsMotionCommand(type);
   Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
   PendingReply pending = client->Send(std::move(c));
-  const bool bar = ProgressOnTty() && (type == CommandType::kGoto || at);
+  const bool bar = ProgressOnTty() && (Traits(type).kind == CommandKind::kTask || at);
   const std::optional<Reply> r = AwaitReply(pending, [&](Duration waited) {
     if (bar && waited > std::chrono::milliseconds(300))
       std::cerr << "\r" << ToString(type) << " " << pending.id() << ": waiting for its end, "

@@ -23,6 +23,13 @@ const char* Unit(DofType t) { return t == DofType::kRevolute ? "rad" : "m"; }
 
 std::string Quote(const std::string& name) { return "'" + name + "'"; }
 
+DriverResult NotExecuted(const DriverCommand& c, const std::string& driver) {
+  const std::string name = ToString(c.type);
+  if (!IsMotionCommand(c.type))
+    return Answer(Signal::kError, name + " is not a motion command a driver executes");
+  return Answer(Signal::kNa, name + ": " + driver + " does not execute it");
+}
+
 Eigen::Vector3d FrameGoalPosition(const DriverCommand& c) { return {c.values[0], c.values[1], c.values[2]}; }
 
 Eigen::Quaterniond FrameGoalOrientation(const DriverCommand& c) {

@@ -402,10 +402,16 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   if (c.start_time.is_at()) item.start = *c.start_time.time();
   item.command.id = c.id;
   item.command.type = c.type;
-  if (c.type == CommandType::kFrameSetPoint) {
-    item.command.target = *model.FindFrame(c.target);
-  } else if (!c.target.empty()) {
-    item.command.target = *model.FindJoint(c.target);
+  switch (Traits(c.type).target) {  // CheckCommand found it
+    case CommandTarget::kJoint:
+      item.command.target = *model.FindJoint(c.target);
+      break;
+    case CommandTarget::kFrame:
+      item.command.target = *model.FindFrame(c.target);
+      break;
+    case CommandTarget::kBase:
+    case CommandTarget::kRobot:
+      break;
   }
   // CheckCommand bounds the count: at most 6 dofs, 7 pose values, 3 base values.
   item.command.num_values = static_cast<int>(c.values.size());
@@ -467,18 +473,19 @@ namespace {
 // The actuator a servo command drives, as a key: a joint's index, a control
 // frame's (offset), the base (-1); nullopt for tasks and whole-robot commands.
 std::optional<int> ServoActuator(const DriverCommand& c) {
-  switch (c.type) {
-    case CommandType::kJointSetPoint:
-    case CommandType::kJointSpeed:
-    case CommandType::kJointForce:
+  const CommandTraits& t = Traits(c.type);
+  if (t.kind != CommandKind::kServo) return std::nullopt;
+  switch (t.target) {
+    case CommandTarget::kJoint:
       return c.target;
-    case CommandType::kFrameSetPoint:
+    case CommandTarget::kFrame:
       return 1'000'000 + c.target;
-    case CommandType::kSetSpeed:
+    case CommandTarget::kBase:
       return -1;
-    default:
-      return std::nullopt;
+    case CommandTarget::kRobot:
+      break;
   }
+  return std::nullopt;
 }
 }  // namespace
 
@@ -521,7 +528,8 @@ void RobotSessions::NoteServoAnswer(std::int64_t client_id, const Reply& reply) 
 
 void RobotSessions::Own(const DaemonOutput::Executed& e) {
   const RobotModel& model = daemon_.model();
-  if (e.type == CommandType::kStop) {  // the whole robot is at rest: nobody owns anything
+  const CommandTraits& traits = Traits(e.type);
+  if (traits.kind == CommandKind::kStop) {  // the whole robot is at rest: nobody owns anything
     std::fill(joint_owner_.begin(), joint_owner_.end(), 0);
     base_owner_ = 0;
     return;
@@ -540,23 +548,20 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
     }
   };
   bool base = false;
-  switch (e.type) {
-    case CommandType::kJointSetPoint:
-    case CommandType::kJointSpeed:
-    case CommandType::kJointForce:
+  switch (traits.target) {
+    case CommandTarget::kJoint:
       take(e.target);
       break;
-    case CommandType::kFrameSetPoint:  // the joints on the frame's chain
+    case CommandTarget::kFrame:  // the joints on the frame's chain
       for (int j = model.parent_joint(model.frame(e.target).parent_link); j >= 0;
            j = model.parent_joint(model.joint(j).parent_link)) {
         if (!model.joint(j).dofs.empty()) take(j);
       }
       break;
-    case CommandType::kGoto:
-    case CommandType::kSetSpeed:
+    case CommandTarget::kBase:
       base = true;
       break;
-    default:
+    case CommandTarget::kRobot:
       return;
   }
   if (!vanished) {

@@ -20,7 +20,7 @@ std::set<std::string> UnknownTargets(const RobotModel& model, const std::vector<
   for (const TimedCommand& f : frames) {
     const Command& c = f.command;
     if (c.target.empty()) continue;
-    const bool frame = c.type == CommandType::kFrameSetPoint;
+    const bool frame = Traits(c.type).target == CommandTarget::kFrame;
     if (frame ? !model.FindFrame(c.target) : !model.FindJoint(c.target)) unknown.insert(c.target);
   }
   return unknown;

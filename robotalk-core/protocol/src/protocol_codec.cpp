@@ -2,6 +2,7 @@
 
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/error.h"
+#include "robotalk_msgs/command_t.hpp"
 #include "wire_scanner.h"
 
 #include <algorithm>
@@ -10,6 +11,33 @@
 
 namespace robotalk {
 namespace {
+
+// Wire codes: every row of kCommandTraits (command.h) is the command_t
+// constant of its name. A constant without a row is caught by
+// command_traits_test, which reads command_t.lcm.
+constexpr bool SameName(const char* a, const char* b) {
+  for (; *a && *a == *b; ++a, ++b) {
+  }
+  return *a == *b;
+}
+constexpr int TraitsCode(const char* name) {
+  for (const CommandTraits& t : kCommandTraits) {
+    if (SameName(t.name, name)) return static_cast<int>(t.type);
+  }
+  return -1;
+}
+#define ROBOTALK_WIRE_COMMAND(NAME)                                  \
+  static_assert(TraitsCode(#NAME) == robotalk_msgs::command_t::NAME, \
+                #NAME ": kCommandTraits (command.h) and command_t.lcm disagree")
+ROBOTALK_WIRE_COMMAND(JOINT_SETPOINT);
+ROBOTALK_WIRE_COMMAND(JOINT_SPEED);
+ROBOTALK_WIRE_COMMAND(JOINT_FORCE);
+ROBOTALK_WIRE_COMMAND(FRAME_SETPOINT);
+ROBOTALK_WIRE_COMMAND(GOTO);
+ROBOTALK_WIRE_COMMAND(SETSPEED);
+ROBOTALK_WIRE_COMMAND(STOP);
+ROBOTALK_WIRE_COMMAND(PANIC_RESET);
+#undef ROBOTALK_WIRE_COMMAND
 
 // Smallest encodings of the array elements (an empty string takes 5 bytes).
 constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead + 8 + 8;
@@ -171,7 +199,7 @@ robotalk_msgs::reply_t ToWire(const Reply& r) {
 Command FromWire(const robotalk_msgs::command_t& w) { return FromWire(w, Header::MODE_DIRECT); }
 
 Command FromWire(const robotalk_msgs::command_t& w, std::int8_t package_mode) {
-  if (w.type < 1 || w.type > static_cast<std::int8_t>(CommandType::kPanicReset)) {
+  if (!FindCommandTraits(w.type)) {
     throw ProtocolError("command " + std::to_string(w.id) + ": unknown command type " +
                         std::to_string(w.type));
   }

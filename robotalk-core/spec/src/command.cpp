@@ -33,10 +33,14 @@ std::string Label(const Command& c) {
   return c.target.empty() ? ToString(c.type) : std::string(ToString(c.type)) + " " + Quote(c.target);
 }
 
-std::optional<std::string> CheckValueCount(const Command& c, size_t expected, const char* what) {
-  if (c.values.size() == expected) return std::nullopt;
-  return Label(c) + ": expected " + std::to_string(expected) + " value" + (expected == 1 ? "" : "s") + what +
-         ", got " + std::to_string(c.values.size());
+// `dofs`: the target joint's, for a command of one value per dof.
+std::optional<std::string> CheckValueCount(const Command& c, std::size_t dofs = 0) {
+  const CommandTraits& t = Traits(c.type);
+  if (ValueCountFits(t, c.values.size(), dofs)) return std::nullopt;
+  const std::string expected = t.min_values == kValuesPerDof ? std::to_string(dofs) + " value" +
+                                                                   (dofs == 1 ? "" : "s") + " (one per dof)"
+                                                             : ValueCountText(t);
+  return Label(c) + ": expected " + expected + ", got " + std::to_string(c.values.size());
 }
 
 std::optional<std::string> CheckFinite(const Command& c) {
@@ -49,39 +53,30 @@ std::optional<std::string> CheckFinite(const Command& c) {
   return std::nullopt;
 }
 
-ServoType ServoOf(CommandType t) {
+// "set-point", "speed", "force": a servo type in a refusal.
+const char* ServoWord(ServoType t) {
   switch (t) {
-    case CommandType::kJointSpeed:
-      return ServoType::kSpeed;
-    case CommandType::kJointForce:
-      return ServoType::kForce;
+    case ServoType::kSpeed:
+      return "speed";
+    case ServoType::kForce:
+      return "force";
     default:
-      return ServoType::kSetPoint;
+      return "set-point";
   }
 }
 
 }  // namespace
 
-const char* ToString(CommandType t) {
-  switch (t) {
-    case CommandType::kJointSetPoint:
-      return "JOINT_SETPOINT";
-    case CommandType::kJointSpeed:
-      return "JOINT_SPEED";
-    case CommandType::kJointForce:
-      return "JOINT_FORCE";
-    case CommandType::kFrameSetPoint:
-      return "FRAME_SETPOINT";
-    case CommandType::kGoto:
-      return "GOTO";
-    case CommandType::kSetSpeed:
-      return "SETSPEED";
-    case CommandType::kStop:
-      return "STOP";
-    case CommandType::kPanicReset:
-      return "PANIC_RESET";
-  }
-  return "UNKNOWN_COMMAND";
+const char* ToString(CommandType t) { return Traits(t).name; }
+
+std::string ValueCountText(const CommandTraits& t) {
+  if (t.min_values == kValuesPerDof) return "one value per dof";
+  const auto count = [](int n, const char* names, const char* noun) {
+    return std::to_string(n) + noun + (*names ? std::string(" (") + names + ")" : "");
+  };
+  std::string text = count(t.min_values, t.value_names, t.min_values == 1 ? " value" : " values");
+  if (t.max_values != t.min_values) text += " or " + count(t.max_values, t.max_value_names, "");
+  return text;
 }
 
 const char* ToString(QueryType t) {
@@ -112,11 +107,9 @@ const char* ToString(QueryType t) {
 
 std::optional<CommandType> ParseCommandType(const std::string& name) {
   const std::string n = Upper(name);
-  for (int t = 1; t <= 8; ++t) {
-    auto type = static_cast<CommandType>(t);
-    if (n == ToString(type)) return type;
+  for (const CommandTraits& t : kCommandTraits) {
+    if (n == t.name || (t.alias && n == t.alias)) return t.type;
   }
-  if (n == "SET_SPEED") return CommandType::kSetSpeed;
   return std::nullopt;
 }
 
@@ -141,68 +134,61 @@ std::string ToString(const StartTime& s) {
   return "?";
 }
 
-bool IsMotionCommand(CommandType t) { return t != CommandType::kStop && t != CommandType::kPanicReset; }
-
 namespace {
 
 // The text of what is wrong with `c`; `signal` gets the signal to answer with.
 std::optional<std::string> CommandProblem(const RobotModel& model, const Command& c,
                                           const CommandLimits& limits, Signal* signal) {
   *signal = Signal::kError;
+  const CommandTraits* traits = FindCommandTraits(static_cast<int>(c.type));
+  if (!traits) return "unknown command type " + std::to_string(static_cast<int>(c.type));
   if (auto bad = CheckFinite(c)) return bad;
-  switch (c.type) {
-    case CommandType::kJointSetPoint:
-    case CommandType::kJointSpeed:
-    case CommandType::kJointForce: {
+  switch (traits->target) {
+    case CommandTarget::kJoint: {
       auto j = model.FindJoint(c.target);
       if (!j)
-        return std::string(ToString(c.type)) + ": robot " + Quote(model.name()) + " has no joint named " +
+        return std::string(traits->name) + ": robot " + Quote(model.name()) + " has no joint named " +
                Quote(c.target);
       const Joint& joint = model.joint(*j);
       if (joint.dofs.empty()) return Label(c) + ": the joint is fixed (0 dofs)";
-      if (auto bad = CheckValueCount(c, joint.dofs.size(), " (one per dof)")) return bad;
+      if (auto bad = CheckValueCount(c, joint.dofs.size())) return bad;
       if (joint.mimic) {
         *signal = Signal::kNa;
         return Label(c) + ": the joint follows " + Quote(model.joint(joint.mimic->leader_joint).name) +
                " (mimic)";
       }
-      if (!joint.servo_types.Has(ServoOf(c.type))) {
+      if (traits->servo != ServoType::kNone && !joint.servo_types.Has(traits->servo)) {
         *signal = Signal::kNa;
         return Label(c) + ": the joint accepts only " + joint.servo_types.ToString() + " commands";
       }
       return std::nullopt;
     }
-    case CommandType::kFrameSetPoint: {
+    case CommandTarget::kFrame: {
       auto f = model.FindFrame(c.target);
       if (!f)
-        return std::string("FRAME_SETPOINT: robot ") + Quote(model.name()) + " has no control frame named " +
+        return std::string(traits->name) + ": robot " + Quote(model.name()) + " has no control frame named " +
                Quote(c.target);
-      if (auto bad = CheckValueCount(c, 7, " (x y z qw qx qy qz)")) return bad;
+      if (auto bad = CheckValueCount(c)) return bad;
+      // A frame's values are a pose: x y z and a unit quaternion.
       const double norm = std::sqrt(c.values[3] * c.values[3] + c.values[4] * c.values[4] +
                                     c.values[5] * c.values[5] + c.values[6] * c.values[6]);
       if (std::abs(norm - 1) > kQuaternionTolerance) {
         return Label(c) + ": orientation quaternion has norm " + std::to_string(norm) + ", expected 1";
       }
-      if (!model.frame(*f).servo_types.Has(ServoType::kSetPoint)) {
+      if (traits->servo != ServoType::kNone && !model.frame(*f).servo_types.Has(traits->servo)) {
         *signal = Signal::kNa;
-        return Label(c) + ": the control frame accepts no set-point commands";
+        return Label(c) + ": the control frame accepts no " + ServoWord(traits->servo) + " commands";
       }
       return std::nullopt;
     }
-    case CommandType::kGoto:
-    case CommandType::kSetSpeed: {
+    case CommandTarget::kBase: {
       if (!c.target.empty()) return Label(c) + ": a base command takes no target";
-      if (c.type == CommandType::kGoto) {
-        if (auto bad = CheckValueCount(c, 3, " (x y theta)")) return bad;
-      } else if (c.values.size() != 2 && c.values.size() != 3) {
-        return Label(c) + ": expected 2 values (v omega) or 3 (vx vy omega), got " +
-               std::to_string(c.values.size());
-      }
+      if (auto bad = CheckValueCount(c)) return bad;
       if (model.roots().front().base == BaseType::kFixed) {
         *signal = Signal::kNa;
         return Label(c) + ": robot " + Quote(model.name()) + " has a fixed base";
       }
-      if (c.type == CommandType::kGoto) {
+      if (c.type == CommandType::kGoto) {  // the workspace bound of a goal position
         const double distance = std::hypot(c.values[0], c.values[1]);
         if (!(distance <= limits.max_goto_distance)) {
           char text[200];
@@ -214,10 +200,9 @@ std::optional<std::string> CommandProblem(const RobotModel& model, const Command
       }
       return std::nullopt;
     }
-    case CommandType::kStop:
-    case CommandType::kPanicReset:
+    case CommandTarget::kRobot:
       if (!c.target.empty()) return Label(c) + ": takes no target";
-      return CheckValueCount(c, 0, "");
+      return CheckValueCount(c);
   }
   return "unknown command type " + std::to_string(static_cast<int>(c.type));
 }

@@ -1,6 +1,8 @@
 #include "robotalk/sequence_file.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace robotalk {
@@ -28,35 +30,33 @@ double ParseNumber(const std::string& word, const std::string& what) {
 namespace {
 
 bool NeedsTarget(CommandType t) {
-  return t == CommandType::kJointSetPoint || t == CommandType::kJointSpeed || t == CommandType::kJointForce ||
-         t == CommandType::kFrameSetPoint;
+  const CommandTarget target = Traits(t).target;
+  return target == CommandTarget::kJoint || target == CommandTarget::kFrame;
 }
 
 void CheckCount(CommandType t, std::size_t n) {
-  const std::string name = ToString(t);
-  auto fail = [&](const std::string& expected) {
-    throw UsageError(name + " takes " + expected + ", got " + std::to_string(n));
-  };
-  switch (t) {
-    case CommandType::kGoto:
-      if (n != 3) fail("3 values (x y theta)");
-      break;
-    case CommandType::kSetSpeed:
-      if (n != 2 && n != 3) fail("2 values (v omega) or 3 (vx vy omega)");
-      break;
-    case CommandType::kFrameSetPoint:
-      if (n != 7) fail("7 values (x y z qw qx qy qz)");
-      break;
-    case CommandType::kStop:
-    case CommandType::kPanicReset:
-      if (n != 0) fail("no values");
-      break;
-    case CommandType::kJointSetPoint:
-    case CommandType::kJointSpeed:
-    case CommandType::kJointForce:
-      if (n == 0) fail("one value per dof of the joint");
-      break;
-  }
+  const CommandTraits& traits = Traits(t);
+  const bool per_dof = traits.min_values == kValuesPerDof;
+  // The joint's dofs are not known here: at least one value.
+  if (per_dof ? n > 0 : ValueCountFits(traits, n, 0)) return;
+  const std::string expected = per_dof                  ? "one value per dof of the joint"
+                               : traits.max_values == 0 ? "no values"
+                                                        : ValueCountText(traits);
+  throw UsageError(std::string(traits.name) + " takes " + expected + ", got " + std::to_string(n));
+}
+
+// A command's word in a sequence file: its name in lower case.
+std::string Word(CommandType t) {
+  std::string word = ToString(t);
+  for (char& ch : word) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return word;
+}
+
+// "joint_setpoint, joint_speed, ...": the words a command may start with.
+std::string CommandWords() {
+  std::string words;
+  for (const CommandTraits& t : kCommandTraits) words += (words.empty() ? "" : ", ") + Word(t.type);
+  return words;
 }
 
 }  // namespace
@@ -65,9 +65,7 @@ Command ParseCommandWords(const std::vector<std::string>& words) {
   if (words.empty()) throw UsageError("missing command name");
   const auto type = ParseCommandType(words[0]);
   if (!type) {
-    throw UsageError("unknown command '" + words[0] +
-                     "' (joint_setpoint, joint_speed, joint_force, frame_setpoint, goto, setspeed, stop, "
-                     "panic_reset)");
+    throw UsageError("unknown command '" + words[0] + "' (" + CommandWords() + ")");
   }
   Command c;
   c.type = *type;
@@ -83,6 +81,17 @@ Command ParseCommandWords(const std::vector<std::string>& words) {
   }
   CheckCount(*type, c.values.size());
   return c;
+}
+
+std::string FormatCommandWords(const Command& c) {
+  std::string text = Word(c.type);
+  if (!c.target.empty()) text += " " + c.target;
+  for (const double v : c.values) {
+    char number[32];
+    std::snprintf(number, sizeof number, " %.17g", v);
+    text += number;
+  }
+  return text;
 }
 
 std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::string& source) {

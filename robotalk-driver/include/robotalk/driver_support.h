@@ -16,6 +16,11 @@ namespace robotalk::driver_support {
 
 /// A final (not in-progress) result.
 DriverResult Answer(Signal signal, std::string message = {});
+/// What Execute() answers for a command type the driver has no handler for
+/// (the default of its dispatch): NA "<TYPE>: <driver> does not execute it"
+/// for a motion command, ERROR for one never sent to a driver (STOP and
+/// PANIC_RESET, driver.h). `driver`: "the kinematic driver".
+DriverResult NotExecuted(const DriverCommand& command, const std::string& driver);
 /// A number in a message: short and exact enough to read ("0.5411").
 std::string Num(double v);
 /// "rad" or "m".

@@ -1,12 +1,18 @@
 // Commands, queries and replies as C++ values, and their checks against a
-// robot model. The wire forms are robotalk_msgs::command_t / query_t / reply_t
-// (docs/protocol.md); protocol_codec.h converts.
+// robot model. Everything a command type means -- its name, wire code,
+// target, value counts, servo type, what it owns -- is one row of
+// kCommandTraits below; the codec, sequence files, the server's admission
+// and ownership, the CLI and the drivers' dispatch read it
+// (docs/architecture.md, "Adding a command"). Their wire forms are in
+// docs/protocol.md.
 #pragma once
 
 #include "robotalk/clock.h"
 #include "robotalk/robot_model.h"
 #include "robotalk/signal.h"
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -16,6 +22,8 @@ namespace robotalk {
 
 using CommandId = std::int64_t;
 
+/// A command type; its value is its wire code (command_t.lcm's constant of
+/// the same name), and its row in kCommandTraits says what it means.
 enum class CommandType : std::int8_t {
   kJointSetPoint = 1,  ///< target joint; one position per dof (rad | m)
   kJointSpeed = 2,     ///< target joint; one velocity per dof (rad/s | m/s)
@@ -26,6 +34,96 @@ enum class CommandType : std::int8_t {
   kStop = 7,           ///< stop every motion
   kPanicReset = 8,     ///< leave the panic state
 };
+
+/// What a command addresses: Command::target names a joint or a control
+/// frame, or is empty.
+enum class CommandTarget : std::int8_t {
+  kRobot,  ///< the whole robot (no target name)
+  kBase,   ///< the mobile base of the first root link (no target name); NA on a fixed base
+  kJoint,  ///< a joint by name: its dofs; owned by the commanding client
+  kFrame,  ///< a control frame by name: the joints of its chain are owned
+};
+
+/// How the server runs a command.
+enum class CommandKind : std::int8_t {
+  /// Sets an actuator's reference until the next one; answered at once. A
+  /// timed one that starts before a command of its client on the same
+  /// actuator that already ran is superseded (INTERRUPTED).
+  kServo,
+  kTask,     ///< moves toward a goal; answered when it ends (GOTO)
+  kStop,     ///< the driver's Stop(): every motion; ends every ownership
+  kSession,  ///< acted on by the server when admitted; never queued nor sent to a driver
+};
+
+/// Command::values holds one value per dof of the target joint.
+inline constexpr std::int8_t kValuesPerDof = -1;
+
+/// Everything that depends on a command type. The consumers switch on these
+/// fields, not on the type: a new type is a row here (and its constant in
+/// command_t.lcm, and the drivers that execute it).
+struct CommandTraits {
+  CommandType type;
+  const char* name;   ///< ToString(), the wire constant, the sequence-file word (any case)
+  const char* alias;  ///< another accepted word, or nullptr
+  CommandTarget target;
+  CommandKind kind;
+  ServoType servo;              ///< what the target joint or frame must accept; kNone for no check
+  bool keeps_moving;            ///< moves on until stopped (a speed or force); the CLI's --hold
+  std::int8_t min_values;       ///< kValuesPerDof, or a fixed count
+  std::int8_t max_values;       ///< == min_values unless two counts are accepted
+  const char* value_names;      ///< what min_values are ("x y theta"), for messages; "" for none
+  const char* max_value_names;  ///< what max_values are when it differs; "" otherwise
+};
+
+inline constexpr auto kCommandTraits = std::to_array<CommandTraits>({
+    // clang-format off
+    // {type, name, alias, target, kind, servo, keeps_moving, min_values, max_values, value_names, max_value_names}
+    {CommandType::kJointSetPoint, "JOINT_SETPOINT", nullptr,     CommandTarget::kJoint, CommandKind::kServo,   ServoType::kSetPoint, false, kValuesPerDof, kValuesPerDof, "", ""},
+    {CommandType::kJointSpeed,    "JOINT_SPEED",    nullptr,     CommandTarget::kJoint, CommandKind::kServo,   ServoType::kSpeed,    true,  kValuesPerDof, kValuesPerDof, "", ""},
+    {CommandType::kJointForce,    "JOINT_FORCE",    nullptr,     CommandTarget::kJoint, CommandKind::kServo,   ServoType::kForce,    true,  kValuesPerDof, kValuesPerDof, "", ""},
+    {CommandType::kFrameSetPoint, "FRAME_SETPOINT", nullptr,     CommandTarget::kFrame, CommandKind::kServo,   ServoType::kSetPoint, false, 7, 7, "x y z qw qx qy qz", ""},
+    {CommandType::kGoto,          "GOTO",           nullptr,     CommandTarget::kBase,  CommandKind::kTask,    ServoType::kNone,     false, 3, 3, "x y theta", ""},
+    {CommandType::kSetSpeed,      "SETSPEED",       "SET_SPEED", CommandTarget::kBase,  CommandKind::kServo,   ServoType::kNone,     true,  2, 3, "v omega", "vx vy omega"},
+    {CommandType::kStop,          "STOP",           nullptr,     CommandTarget::kRobot, CommandKind::kStop,    ServoType::kNone,     false, 0, 0, "", ""},
+    {CommandType::kPanicReset,    "PANIC_RESET",    nullptr,     CommandTarget::kRobot, CommandKind::kSession, ServoType::kNone,     false, 0, 0, "", ""},
+    // clang-format on
+});
+
+/// The row of wire code `code`, or nullptr for a code no command has.
+constexpr const CommandTraits* FindCommandTraits(int code) {
+  if (code < 1 || code > static_cast<int>(kCommandTraits.size())) return nullptr;
+  return &kCommandTraits[static_cast<std::size_t>(code - 1)];
+}
+/// What Traits() answers for a value that is no command type (a cast in
+/// C++; the codec refuses such a code): no target, never queued.
+// clang-format off
+inline constexpr CommandTraits kUnknownCommandTraits{
+    CommandType{0}, "UNKNOWN_COMMAND", nullptr, CommandTarget::kRobot, CommandKind::kSession, ServoType::kNone,
+    false, 0, 0, "", ""};
+// clang-format on
+/// The row of `t` (kUnknownCommandTraits for a value no row has).
+constexpr const CommandTraits& Traits(CommandType t) {
+  const CommandTraits* row = FindCommandTraits(static_cast<int>(t));
+  return row ? *row : kUnknownCommandTraits;
+}
+
+/// The table is in wire-code order (so FindCommandTraits indexes it).
+constexpr bool CommandTraitsInCodeOrder() {
+  for (std::size_t i = 0; i < kCommandTraits.size(); ++i) {
+    if (static_cast<std::size_t>(kCommandTraits[i].type) != i + 1) return false;
+  }
+  return true;
+}
+static_assert(CommandTraitsInCodeOrder(), "kCommandTraits: row i must hold the command with wire code i + 1");
+
+/// Whether `n` values fit `t` for a target joint of `dofs` dofs.
+constexpr bool ValueCountFits(const CommandTraits& t, std::size_t n, std::size_t dofs) {
+  if (t.min_values == kValuesPerDof) return n == dofs;
+  return n >= static_cast<std::size_t>(t.min_values) && n <= static_cast<std::size_t>(t.max_values);
+}
+/// The values `t` takes, for messages: "3 values (x y theta)", "2 values (v
+/// omega) or 3 (vx vy omega)", "0 values", "one value per dof".
+std::string ValueCountText(const CommandTraits& t);
 
 enum class QueryType : std::int8_t {
   kConfig = 1,             ///< the robot description (published on the CONFIG channel)
@@ -47,8 +145,8 @@ std::optional<CommandType> ParseCommandType(const std::string& name);
 std::optional<QueryType> ParseQueryType(const std::string& name);
 
 /// When a command starts: now, at a time on the SERVER clock, or after an
-/// offset from the start of a playback sequence. On the wire (command_t
-/// start_time_us, see protocol_codec.h) these are 0, server-clock micros in a
+/// offset from the start of a playback sequence. On the wire (a command's
+/// start_time_us, docs/protocol.md) these are 0, server-clock micros in a
 /// DIRECT/DELAY package, and offset micros in a PLAYBACK package.
 ///
 ///   Command c{.type = CommandType::kGoto, .start_time = StartTime::At(client.ServerNow() + 2s), ...};
@@ -131,8 +229,11 @@ struct Reply {
   std::vector<double> values;
 };
 
-/// True for the commands that move the robot (all but STOP and PANIC_RESET).
-bool IsMotionCommand(CommandType t);
+/// True for the commands that move the robot (servos and tasks: all but STOP and PANIC_RESET).
+constexpr bool IsMotionCommand(CommandType t) {
+  const CommandKind k = Traits(t).kind;
+  return k == CommandKind::kServo || k == CommandKind::kTask;
+}
 
 /// The default of CommandLimits::max_goto_distance (m).
 inline constexpr double kDefaultMaxGotoDistance = 100.0;

@@ -23,11 +23,13 @@ class UsageError : public Error {
 };
 
 /// Builds a command from its CLI words: name (case-insensitive, e.g. "goto",
-/// "JOINT_SETPOINT"), then a target for JOINT_* and FRAME_SETPOINT, then values.
-/// Checks the number of values where the protocol fixes it (GOTO 3, SETSPEED 2
-/// or 3, FRAME_SETPOINT 7, STOP and PANIC_RESET none, JOINT_* at least 1) and
-/// that every value is a finite number. Throws UsageError.
+/// "JOINT_SETPOINT"), then a target for a joint or frame command, then values.
+/// Checks the number of values where the protocol fixes it (kCommandTraits:
+/// GOTO 3, SETSPEED 2 or 3, FRAME_SETPOINT 7, STOP and PANIC_RESET none,
+/// JOINT_* at least 1) and that every value is a finite number. Throws UsageError.
 Command ParseCommandWords(const std::vector<std::string>& words);
+/// The inverse: "joint_setpoint pan 0.5" (values exact to the last bit).
+std::string FormatCommandWords(const Command& command);
 
 /// Parses a number (the whole word); throws UsageError naming `what`.
 double ParseNumber(const std::string& word, const std::string& what);
