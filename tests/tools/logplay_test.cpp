@@ -149,6 +149,33 @@ TEST(SessionLog, KeepsNothingOfAPackageWithAnItemThatDoesNotDecode) {
   EXPECT_TRUE(log.clients().empty());
 }
 
+// Issue 21: an lcm-logger log of a split-layout session holds the main lane
+// only (ANNOUNCE, CONFIG, STATE): replaying it must say why there is nothing
+// to replay and how to record one, not only "no command".
+TEST(SessionLog, ALogWithoutRequestsOfASplitLayoutServerSaysHowToRecordOne) {
+  SessionLog log;
+  Announcement a{.server_id = 7, .traffic_layout = TrafficLayout::kSplit};
+  a.robots.push_back({.name = "pioneer", .driver = "kinematic", .total_dofs = 4});
+  log.Add(kAnnounceChannel, 10, EncodeAnnouncement(a));
+  try {
+    log.MakeTimeline({.robot = "pioneer"});
+    FAIL() << "a log without requests has nothing to replay";
+  } catch (const LogError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no request"), std::string::npos) << what;
+    EXPECT_NE(what.find("split traffic layout"), std::string::npos) << what;
+    EXPECT_NE(what.find("robotalk-logplay record"), std::string::npos) << what;
+  }
+  // With requests from the robot in the log, the message stays the plain one.
+  log.Add(kRequest, 20, Package(kClient, 1, 100, kDelay, {{1, CommandType::kStop, 0, "", {}}}));
+  try {
+    log.MakeTimeline({.robot = "other"});
+    FAIL() << "no command of robot 'other'";
+  } catch (const LogError& e) {
+    EXPECT_EQ(std::string(e.what()).find("split traffic layout"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Frames, RenameWindowAndSpeedApplyInThatOrder) {
   SessionLog log;
   log.Add(kRequest, 10,

@@ -43,6 +43,7 @@ void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
   try {
     switch (name->kind) {
       case ChannelKind::kRequest:
+        ++request_messages_;
         AddRequest(name->robot, log_time_us, bytes);
         break;
       case ChannelKind::kReply:
@@ -158,6 +159,7 @@ void SessionLog::AddHelloAnswer(std::span<const std::uint8_t> bytes) {
 
 void SessionLog::AddAnnounce(std::span<const std::uint8_t> bytes) {
   const Announcement a = DecodeAnnouncement(bytes);
+  split_layout_seen_ = split_layout_seen_ || a.traffic_layout == TrafficLayout::kSplit;
   for (const RobotAnnouncement& r : a.robots) {
     LoggedRobot& lr = robots_[{a.server_id, r.name}];
     lr.name = r.name;
@@ -230,6 +232,15 @@ Timeline SessionLog::MakeTimeline(const Selection& selection) const {
     std::string what = selection.client_id
                            ? "client " + Hex64(static_cast<std::uint64_t>(*selection.client_id))
                            : "robot '" + selection.robot + "'";
+    if (request_messages_ == 0) {
+      // lcm-logger hears one URL: with the split layout that is the main lane only.
+      throw LogError("the log holds no request at all, so no command from " + what +
+                     (split_layout_seen_
+                          ? ": its server announced the split traffic layout, where requests and "
+                            "replies travel on ports of their own that lcm-logger does not hear"
+                          : "") +
+                     "; record a session with `robotalk-logplay record` (it listens on every lane)");
+    }
     throw LogError("the log holds no command from " + what + " (see `robotalk-logplay info`)");
   }
   std::vector<std::int64_t> times;

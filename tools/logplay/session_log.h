@@ -147,6 +147,8 @@ class SessionLog {
   std::optional<std::int64_t> ServerTime(const LoggedCommand& c) const;
 
   std::map<std::string, ChannelStats> channels_;
+  std::uint64_t request_messages_ = 0;  // on REQUEST channels, decodable or not
+  bool split_layout_seen_ = false;      // a server announced TrafficLayout::kSplit
   std::map<std::pair<std::int64_t, std::string>, LoggedRobot> robots_;  // (server, name)
   std::map<std::int64_t, LoggedClient> clients_;
   std::vector<LoggedCommand> commands_;
