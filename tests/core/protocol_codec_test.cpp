@@ -385,6 +385,12 @@ TEST(CommandNames, ParseWhatTheyPrint) {
   EXPECT_EQ(ParseCommandType("goto"), CommandType::kGoto);
   EXPECT_EQ(ParseCommandType("joint-setpoint"), CommandType::kJointSetPoint);
   EXPECT_EQ(ParseQueryType("base_pose"), QueryType::kBasePose);
+  // Every query type parses what it prints (COMMAND_STATUS and SERVER_COUNTERS did not).
+  for (int t = static_cast<int>(QueryType::kConfig); t <= static_cast<int>(QueryType::kServerCounters); ++t) {
+    auto type = static_cast<QueryType>(t);
+    EXPECT_EQ(ParseQueryType(ToString(type)), type) << ToString(type);
+  }
+  EXPECT_FALSE(ParseQueryType("fly"));
   EXPECT_FALSE(ParseCommandType("fly"));
   EXPECT_EQ(ToString(Signal::kInterrupted), "INTERRUPTED");
   EXPECT_EQ(SignalFromWire(6), Signal::kPanic);

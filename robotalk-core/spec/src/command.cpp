@@ -115,7 +115,7 @@ std::optional<CommandType> ParseCommandType(const std::string& name) {
 
 std::optional<QueryType> ParseQueryType(const std::string& name) {
   const std::string n = Upper(name);
-  for (int t = 1; t <= 8; ++t) {
+  for (int t = static_cast<int>(QueryType::kConfig); t <= static_cast<int>(QueryType::kServerCounters); ++t) {
     auto type = static_cast<QueryType>(t);
     if (n == ToString(type)) return type;
   }
