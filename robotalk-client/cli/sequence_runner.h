@@ -38,9 +38,6 @@ struct RunReport {
   int signal = 0;                          ///< the interrupting signal, 0 when none
   std::string interrupt_note;              ///< what was done about it (STOP sent ...)
   std::optional<Duration> playback_delay;  ///< playback: the server's choice
-  /// Always false: RunSequence now ends on a stop request in every mode (it
-  /// ran on an abandoned thread in playback before). Kept for callers.
-  bool worker_abandoned = false;
   /// Delay mode: frames whose outcome is unknown (the client gave up, or the
   /// server instance that had them restarted): index and why, every one of them.
   std::vector<std::pair<std::size_t, std::string>> unknown_outcomes;

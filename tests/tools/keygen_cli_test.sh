@@ -41,10 +41,10 @@ check "open secret key error names mode 0644" grep -q "mode 0644" "$tmp/err"
 
 # Bad arguments, --help, --version.
 "$keygen" >/dev/null 2>"$tmp/err"
-check "no --out exits 1" test $? -eq 1
+check "no --out exits 2 (a usage error, as every tool)" test $? -eq 2
 check "no --out says so" grep -q -- "--out FILE is required" "$tmp/err"
 "$keygen" --frobnicate >/dev/null 2>&1
-check "unknown option exits 1" test $? -eq 1
+check "unknown option exits 2 (a usage error, as every tool)" test $? -eq 2
 "$keygen" --out "$tmp/bad" --name "two words" >/dev/null 2>&1
 check "bad name exits 1" test $? -eq 1
 check "bad name writes nothing" test ! -e "$tmp/bad"

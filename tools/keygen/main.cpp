@@ -26,9 +26,10 @@ constexpr const char* kUsage =
     "  --fingerprint FILE  print the short fingerprint of a key file (.pub or secret)\n"
     "  --help, --version\n";
 
-int Fail(const std::string& message) {
+/// 1: the key could not be made or read; 2: a usage error (as every tool).
+int Fail(const std::string& message, int status = 1) {
   std::cerr << "robotalk-keygen: " << message << "\n";
-  return 1;
+  return status;
 }
 
 }  // namespace
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
     }
     const bool ok = (arg == "--out" && value(out)) || (arg == "--name" && value(name)) ||
                     (arg == "--fingerprint" && value(fingerprint));
-    if (!ok) return Fail("unknown or incomplete option '" + arg + "' (see --help)");
+    if (!ok) return Fail("unknown or incomplete option '" + arg + "' (see --help)", 2);
   }
   try {
     if (!fingerprint.empty()) {
@@ -64,7 +65,7 @@ int main(int argc, char** argv) {
       std::cout << key.Fingerprint() << " " << key.ToString() << "\n";
       return 0;
     }
-    if (out.empty()) return Fail("--out FILE is required (see --help)");
+    if (out.empty()) return Fail("--out FILE is required (see --help)", 2);
     if (name.empty()) name = std::filesystem::path(out).filename().string();
     const robotalk::KeyPair key = robotalk::KeyPair::Generate();
     robotalk::WriteKeyFiles(out, key, name);

@@ -89,10 +89,6 @@ int Replay(const SessionLog& log, const ReplayOptions& o, std::ostream& out) {
   if (report.signal) {
     std::cerr << "robotalk-logplay: interrupted by " << cli::Interrupter::Name(report.signal) << ": "
               << report.interrupt_note << "\n";
-    if (report.worker_abandoned) {
-      std::fflush(stdout);
-      std::_Exit(cli::Interrupter::ExitStatus(report.signal));
-    }
     return cli::Interrupter::ExitStatus(report.signal);
   }
   return all_ok ? 0 : 1;
