@@ -101,13 +101,19 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   std::vector<std::optional<PendingReply>> pending(frames.size());
   std::size_t answered = 0;
   std::chrono::steady_clock::time_point next_progress = std::chrono::steady_clock::now();
+  // Without on_progress, next_progress still moves on (an hour at a time):
+  // the waits below wake at it, and one left in the past made them spin.
   const auto progress = [&] {
     const auto now = std::chrono::steady_clock::now();
-    if (!hooks.on_progress || now < next_progress) return;
-    hooks.on_progress({answered, frames.size(), start_known ? ServerNow() - server_start : clock.Now() - t0,
-                       plan.duration});
-    next_progress =
-        now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(hooks.progress_every);
+    if (now < next_progress) return;
+    if (hooks.on_progress) {
+      hooks.on_progress({answered, frames.size(), start_known ? ServerNow() - server_start : clock.Now() - t0,
+                         plan.duration});
+    }
+    const Duration every = hooks.on_progress
+                               ? std::max<Duration>(hooks.progress_every, std::chrono::milliseconds(1))
+                               : Duration(std::chrono::hours(1));
+    next_progress = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(every);
   };
   // Sends the next package of the plan (due now).
   const auto send_next = [&] {

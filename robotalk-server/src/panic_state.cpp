@@ -14,6 +14,11 @@ bool PanicState::faulted() const {
   return faulted_;
 }
 
+bool PanicState::has_reason() const {
+  std::lock_guard lock(mutex_);
+  return !reason_.empty();
+}
+
 std::string PanicState::reason() const {
   std::lock_guard lock(mutex_);
   return reason_;

@@ -34,6 +34,9 @@ class PanicState {
   /// In panic because of a driver fault the RobotDaemon saw (Fault), not a
   /// client's panic, an overrun or the latch.
   bool faulted() const;
+  /// In panic with a reason (a fault, an overrun, the latch at start-up):
+  /// reason() without allocating.
+  bool has_reason() const;
   /// Why the robot is in panic: "" for a client's panic, else the fault.
   std::string reason() const;
   /// The text of the last Fault(), kept across a reset ("" before any).

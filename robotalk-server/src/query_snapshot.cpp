@@ -92,13 +92,13 @@ bool QuerySnapshot::Answer(const QueuedItem& item, Reply& reply) {
   if (item.has_start_time && item.start > now) return false;
   wanted_until_ = (now + std::chrono::seconds(1)).time_since_epoch().count();
   const bool halted_as_asked = panic_.in_panic();
-  const bool faulted = panic_.faulted();
+  // A fault, an overrun or the latch: the queued answer names the reason.
+  const bool named_panic = panic_.faulted() || panic_.has_reason();
   {
     std::lock_guard lock(mutex_);
     const Copy& p = published_;
-    // After a driver fault a query is queued: its answer names the fault.
     if (!p.valid || p.items_taken < last_due_push_ || now >= p.next_due || p.halted != halted_as_asked ||
-        faulted || now - p.time > p.max_age) {
+        named_panic || now - p.time > p.max_age) {
       return false;
     }
     read_ = p;  // same sizes: no allocation

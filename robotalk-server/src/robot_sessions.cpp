@@ -140,10 +140,26 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     for (CommandId id : r.item_ids()) immediate.push_back(MakeReply(id, Signal::kError, why, received));
     return answer;
   };
-  if (const Session* known = table_.Find(robot_id_, r.client_id);
+  if (Session* known = table_.Find(robot_id_, r.client_id);
       (known == nullptr || !known->active) && table_.active(robot_id_) >= options_.max_sessions_per_robot) {
-    return refuse_all("robot '" + robot_ + "' serves " + std::to_string(options_.max_sessions_per_robot) +
-                      " clients already (the --max-sessions-per-robot bound); try again later");
+    // Recorded in the session's window like any package, so that its replay
+    // is a duplicate, answered from the cache and never acted on again (its
+    // panic included), and does not keep the session alive.
+    if (known != nullptr) {
+      const SequenceWindow::Verdict seen = known->seen.Observe(r.sequence);
+      if (seen == SequenceWindow::Verdict::kDuplicate) {
+        immediate = Retransmitted(*known, r, received);
+        return answer;
+      }
+      if (seen == SequenceWindow::Verdict::kNew) known->replies.RecordPackage(r.sequence, r.item_ids());
+    }
+    refuse_all("robot '" + robot_ + "' serves " + std::to_string(options_.max_sessions_per_robot) +
+               " clients already (the --max-sessions-per-robot bound); try again later");
+    for (Reply& reply : immediate) {
+      Bound(reply);
+      if (known != nullptr) known->replies.RecordReply(reply);
+    }
+    return answer;
   }
   Session& session = SessionFor(r.client_id, received);
   session.active = true;

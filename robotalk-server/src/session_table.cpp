@@ -263,7 +263,9 @@ SessionTable::Admission SessionTable::Admit(int robot, const Request& r, std::sp
     rights = CheckRights(auth_->access(), *s.keyed->client, robot_name(robot), r);
   }
   if (!s.live) GoLive(s, now);  // authentic: it now replaces the client's previous session
-  if (s.seen.Check(r.sequence) == SequenceWindow::Verdict::kDuplicate) {
+  // (A sequence <= 0 is no package of a client's: RobotSessions answers the
+  // codec's header error, not "seen before".)
+  if (r.sequence > 0 && s.seen.Check(r.sequence) == SequenceWindow::Verdict::kDuplicate) {
     // A retransmission (or a replay inside the session): never run or refresh.
     out.verdict = Verdict::kDuplicate;
     out.why = rights;  // "" = had the rights

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <ctime>
+
 #include <cstdio>
 #include <stop_token>
 
@@ -169,6 +171,22 @@ TEST_F(SequenceRunnerTest, RunSequenceWithoutHooksReturnsEveryReplyInTheOrderGiv
   EXPECT_LT(r.replies[3].exec_time, r.replies[0].exec_time);  // frame 3 has offset 0
   EXPECT_FALSE(r.stopped);
   EXPECT_EQ(r.frames_sent, 4u);
+}
+
+// Review of issue 20: without on_progress, the waits woke at a progress time
+// left in the past and spun: a 1 s delay sequence took about 1 s of CPU.
+TEST_F(SequenceRunnerTest, RunSequenceWithoutHooksWaitsWithoutSpinning) {
+  const auto thread_cpu = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  };
+  const double before = thread_cpu();
+  const SequenceResult r = client_->RunSequence(PanFrames(5, milliseconds(200)),
+                                                {.mode = CommandMode::kDelay, .delay = milliseconds(200)});
+  const double used = thread_cpu() - before;
+  ASSERT_EQ(r.replies.size(), 5u);
+  EXPECT_LT(used, 0.1) << "the caller's thread used " << used << " s of CPU over a 1 s sequence";
 }
 
 }  // namespace

@@ -136,6 +136,13 @@ TEST(RobotDaemonOverrun, HoldsTheRobotInPanicWhenADriverCallOverrunsItsBound) {
   robot_daemon.join();
   daemon.RunOnce(clock.Now());  // halts the driver after the late return
   EXPECT_TRUE(blocking->halted);
+  // Review of issue 20: a query is not answered from the snapshot while the
+  // panic has a reason (an overrun, the latch): the RobotDaemon's answer names it.
+  const QueuedItem query = JointStateQuery(1);
+  Reply reply;
+  daemon.snapshot().Answer(query, reply);  // asks for snapshots
+  daemon.RunOnce(clock.Now());
+  EXPECT_FALSE(daemon.snapshot().Answer(query, reply)) << "answered without the panic's reason";
 }
 
 TEST_F(RobotDaemonTest, DoesNotAllocateInItsSteadyStateOfDriverUpdatesAndStateSamples) {

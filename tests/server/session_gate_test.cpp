@@ -46,7 +46,7 @@ class GateTest : public ::testing::Test {
     fake_ = driver.get();
     robot_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
     server_ = std::make_unique<ServerDaemon>(transport_, clock_, ServerDaemonOptions{.sessions = gate_});
-    server_->AddRobot(*robot_, SessionOptions{});
+    server_->AddRobot(*robot_, robot_options_);
   }
 
   void Step() {
@@ -75,6 +75,7 @@ class GateTest : public ::testing::Test {
   std::size_t Executed() const { return fake_->calls.size(); }
 
   SessionTableOptions gate_;
+  SessionOptions robot_options_;  // the robot's (Restart applies a change)
   ManualClock clock_;
   std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
   MemoryTransport transport_{bus_};
@@ -126,6 +127,19 @@ TEST_F(GateTest, APackageOfAnExpiredSessionIsNotExecutedAgain) {
   const std::int64_t fresh = OpenSession(kAlice);
   Publish(EncodeRequest(Move(kAlice, fresh, 2, 2)));
   EXPECT_EQ(replies_.at(2).signal, Signal::kSuccess);
+}
+
+// Review of issue 20: with one window, a package numbered 0 in a live open
+// session was answered "seen before" instead of the header error.
+TEST_F(GateTest, APackageNumberedZeroInASessionIsAnsweredWithTheHeaderError) {
+  const std::int64_t session = OpenSession(kAlice);
+  Publish(EncodeRequest(Move(kAlice, session, 1, 1)));
+  ASSERT_EQ(replies_.at(1).signal, Signal::kSuccess);
+  Publish(EncodeRequest(Move(kAlice, session, 0, 2)));
+  ASSERT_EQ(replies_.count(2), 1u);
+  EXPECT_EQ(replies_.at(2).signal, Signal::kError);
+  EXPECT_THAT(replies_.at(2).message, HasSubstr("not positive"));
+  EXPECT_EQ(Executed(), 1u);
 }
 
 TEST_F(GateTest, AnotherClientsSessionIdIsRefused) {
@@ -335,6 +349,32 @@ TEST_F(KeyedGateTest, RightsAreCheckedPerPackage) {
   Publish(Sealed(*alice, Commands(CommandType::kPanicReset, 12)));
   EXPECT_FALSE(robot_->in_panic());
   EXPECT_EQ(server_->sessions().counters().rights_refused, 2u);
+}
+
+// Review of issue 20: a package refused because the robot serves its
+// --max-sessions-per-robot clients already was not recorded in the session's
+// window, so its captured bytes, replayed, raised the panic again after the
+// reset and kept the session alive.
+TEST_F(KeyedGateTest, APanicRefusedByAFullRobotIsNotRaisedAgainByItsReplay) {
+  robot_options_.max_sessions_per_robot = 1;
+  Restart();
+  auto alice = Handshake(Key(2), Id(Key(2), kAlice));
+  auto monitor = Handshake(Key(3), Id(Key(3), kMallory));
+  ASSERT_TRUE(alice && monitor);
+  Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));  // Alice fills the robot
+  ASSERT_EQ(replies_.at(1).signal, Signal::kSuccess);
+  const auto captured = PublishPanic(*monitor);
+  EXPECT_TRUE(robot_->in_panic()) << "a panic is taken from a full robot's refused client";
+  Publish(Sealed(*alice, Commands(CommandType::kPanicReset, 3)));
+  ASSERT_FALSE(robot_->in_panic());
+  for (int i = 0; i < 3; ++i) {
+    clock_.Advance(std::chrono::seconds(1));
+    Publish(captured);  // the same bytes, again
+    EXPECT_FALSE(robot_->in_panic()) << "replay " << i << " raised the panic again";
+  }
+  Publish(Sealed(*monitor, Request{}));  // a heartbeat
+  EXPECT_EQ(batches_.back().session_status, SessionStatus::kUnknown)
+      << "replays kept the session alive past --session-timeout";
 }
 
 TEST_F(KeyedGateTest, ASessionWhosePackagesAreAllRefusedForRightsIsClosedWhenIdle) {
