@@ -97,8 +97,11 @@ show send pioneer joint_force pan 1.0
 step "A timed sequence (examples/demo_arcs.txt) in playback mode, frames paced as a live stream,"
 echo "   while another client watches the broadcast state stream (x y theta v omega every 0.5 s)"
 grep -v '^#' examples/demo_arcs.txt
-robotalk watch pioneer --period 0.5 --duration 8 &
+# The binary itself, not the robotalk function: $! is then watch's own pid,
+# which the cleanup stops on Ctrl-C.
+"$BUILD_DIR"/robotalk-client/robotalk --url "$URL" --timeout 20 watch pioneer --period 0.5 --duration 8 &
 watcher=$!
+pids+=("$watcher")
 show send pioneer --file examples/demo_arcs.txt --mode playback --paced
 wait $watcher
 show query pioneer base_pose

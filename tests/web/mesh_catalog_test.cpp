@@ -83,6 +83,8 @@ TEST_F(MeshCatalogTest, ResolvesPackageRelativeAndAbsoluteNamesToServedUrls) {
   EXPECT_EQ(c.File("0/link1.bin"), fs::canonical(root_ / "ws/src/arm_description/meshes/link1.bin"));
   EXPECT_EQ(c.File("0/../package.xml"), std::nullopt);
   EXPECT_EQ(c.File("0/nope.bin"), std::nullopt);
+  Write("ws/src/arm_description/meshes/.hidden", "secret");  // review of issue 20: no hidden files
+  EXPECT_EQ(c.File("0/.hidden"), std::nullopt);
   EXPECT_EQ(c.Json()["meshes"][0]["url"], "/mesh/r/0/link1.stl");
 }
 

@@ -25,14 +25,16 @@ TEST(ResolveWebPath, MapsThePageModulesAndUrdfFolders) {
   EXPECT_EQ(Resolve("/modules/three/build/three.module.js"), "/srv/nm/three/build/three.module.js");
   EXPECT_EQ(Resolve("/modules/urdf-loader/src/URDFLoader.js"), "/srv/nm/urdf-loader/src/URDFLoader.js");
   EXPECT_EQ(Resolve("/urdf/pioneer/p.urdf"), "/robots/pioneer/p.urdf");
-  EXPECT_EQ(Resolve("/urdf/pioneer/meshes/base.stl"), "/robots/pioneer/meshes/base.stl");
 }
 
 TEST(ResolveWebPath, RefusesEverythingElse) {
   for (const char* bad :
        {"", "app.js", "/../etc/passwd", "/modules/three/../../etc/passwd", "/modules/left-pad/x.js",
         "/urdf/arm/a.urdf", "/urdf/pioneer", "/urdf/pioneer/../../etc/passwd", "/a/b.js", "/%2e%2e/x",
-        "/a\\b", "/./app.js", "//etc/passwd"})
+        "/a\\b", "/./app.js", "//etc/passwd",
+        // Review of issue 20: /urdf/NAME/ served every file of the URDF's
+        // folder (dot-files, symlinks out of it); meshes have /mesh/ now.
+        "/urdf/pioneer/meshes/base.stl", "/urdf/pioneer/.ssh/id_rsa", "/urdf/pioneer/other.urdf"})
     EXPECT_EQ(Resolve(bad), "(refused)") << bad;
 }
 

@@ -198,7 +198,8 @@ std::optional<fs::path> MeshCatalog::File(std::string_view rest) const {
   if (m.file.empty() || name.empty()) return std::nullopt;
   if (name == m.file.filename().string()) return m.file;
   // A file the mesh refers to (a glTF's .bin, an .obj's .mtl, a texture):
-  // only from the mesh's own folder or below it.
+  // only from the mesh's own folder or below it, and no hidden file.
+  if (name.front() == '.' || name.find("/.") != std::string_view::npos) return std::nullopt;
   const auto companion = Canonical(m.file.parent_path() / name);
   std::error_code file_ec;
   if (!companion || !Under(*companion, m.file.parent_path()) || !fs::is_regular_file(*companion, file_ec))

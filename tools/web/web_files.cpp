@@ -43,7 +43,10 @@ std::optional<std::filesystem::path> ResolveWebPath(std::string_view target, con
     if (slash == std::string_view::npos) return std::nullopt;
     const auto it = options.urdf.find(std::string(rest.substr(0, slash)));
     if (it == options.urdf.end()) return std::nullopt;
-    return fs::path(it->second).parent_path() / rest.substr(slash + 1);
+    // The --urdf file itself, nothing else of its folder (meshes go through
+    // /mesh/, which serves only what the catalog resolved).
+    if (rest.substr(slash + 1) != fs::path(it->second).filename().string()) return std::nullopt;
+    return fs::path(it->second);
   }
   if (rel.find('/') != std::string_view::npos) return std::nullopt;
   return fs::path(options.www_dir) / rel;
