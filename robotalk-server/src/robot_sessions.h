@@ -86,7 +86,7 @@ class RobotSessions {
 
   /// Handles one decoded request received at `received`.
   ImmediateAnswer Handle(const Request& request, TimePoint received);
-  /// An authenticated retransmission (keyed mode's replay window saw it):
+  /// A retransmission the session table's window saw (open or keyed mode):
   /// acknowledges it with what is known of its items; runs nothing, opens
   /// and refreshes no session.
   ImmediateAnswer Resend(const Request& request, TimePoint received) const;

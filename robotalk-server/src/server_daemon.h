@@ -10,8 +10,9 @@
 //
 // Fewer hops (issue 11): a query answered on receipt from the RobotDaemon's
 // published state (RobotSessions, query_snapshot.h) travels in the
-// acknowledgement; a panic is acknowledged before the RobotDaemon's lock is
-// waited for (RobotDaemon::FinishPanic comes after); the panic latch file is
+// acknowledgement; a panic in a session is acknowledged before the
+// RobotDaemon's lock is waited for (RobotDaemon::FinishPanic comes after; an
+// open-mode panic outside any session is answered after it); the latch is
 // written in one place, Drain, before anything that acknowledges the
 // panic, its reset or a driver fault is sent; log lines are written to
 // stderr at the end of an iteration, after every publish, never between a

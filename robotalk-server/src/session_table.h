@@ -110,7 +110,9 @@ class SessionTable {
   /// Checks one decoded package of `robot` against its session (client id,
   /// keyed: MAC, sequence > 0, rights; the window's duplicates) and makes its
   /// session live. `bytes` are the package as received (the MAC is their
-  /// last 16 bytes). Refreshes nothing: RobotSessions::Handle does.
+  /// last 16 bytes). Going live stamps the session's first package (or takes
+  /// the previous session's state, Session::Continue); every later refresh
+  /// is RobotSessions::Handle's.
   Admission Admit(int robot, const Request& request, std::span<const std::uint8_t> bytes, TimePoint now);
 
   /// The live session of `client_id` on `robot`, or nullptr.
