@@ -234,6 +234,8 @@ TEST(Trajectory, ARecedingHorizonOfAThousandSplicesNeverStepsInVelocity) {
         points.push_back({Ms(t), V({target(t) + noise(rng)}), {}, {}});
       }
       traj.Splice(Ms(now), points);
+      traj.Forget(Ms(now));
+      EXPECT_LE(traj.num_knots(), 13);  // now, the knot before it, 11 waypoints
       for (int ms = 1; ms <= 10; ++ms, ++sampled) {
         traj.Sample(Ms(now + ms), &s);
         EXPECT_FALSE(s.holding);
@@ -253,6 +255,22 @@ TEST(Trajectory, ARecedingHorizonOfAThousandSplicesNeverStepsInVelocity) {
     EXPECT_LE(max_dv, 1.2 * max_a * 1e-3) << InterpolationName(kind);
     EXPECT_LT(max_dp, 0.005) << InterpolationName(kind);  // 0.5 π rad/s · 1 ms = 1.6 mrad, plus noise
   }
+}
+
+TEST(Trajectory, ForgettingThePastChangesNoLaterSample) {
+  const Trajectory original = Make(Interpolation::kQuintic, Rest(V({0, 0})), Points());
+  Trajectory traj = original;
+  traj.Forget(Ms(275));
+  EXPECT_EQ(traj.num_knots(), 4);  // 250 ms on
+  EXPECT_EQ(traj.start_time(), Ms(250));
+  for (double ms = 275; ms < 900; ms += 3) {
+    const TrajectorySample a = At(traj, Ms(ms)), b = At(original, Ms(ms));
+    EXPECT_EQ(a.position, b.position);
+    EXPECT_EQ(a.velocity, b.velocity);
+  }
+  traj.Forget(Ms(5000));  // into the hold: the last knot stays
+  EXPECT_EQ(traj.num_knots(), 1);
+  EXPECT_EQ(At(traj, Ms(6000)).position, V({-0.2, 0.6}));
 }
 
 TEST(Trajectory, HoldsAtRestAfterTheLastWaypoint) {

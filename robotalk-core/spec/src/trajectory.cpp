@@ -218,6 +218,21 @@ void Trajectory::Splice(TimePoint t, const std::vector<Waypoint>& waypoints) {
   AddKnots(waypoints);
 }
 
+void Trajectory::Forget(TimePoint t) {
+  const auto next = std::upper_bound(times_.begin(), times_.end(), t);
+  const auto drop = static_cast<std::size_t>(next - times_.begin()) - (next == times_.begin() ? 0 : 1);
+  if (drop == 0) return;
+  const auto n = static_cast<std::size_t>(num_dofs());
+  const auto kept = static_cast<Eigen::Index>(times_.size() - drop), first = static_cast<Eigen::Index>(drop);
+  times_.erase(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(drop));
+  given_v_.erase(given_v_.begin(), given_v_.begin() + static_cast<std::ptrdiff_t>(drop));
+  given_a_.erase(given_a_.begin(), given_a_.begin() + static_cast<std::ptrdiff_t>(drop));
+  p_ = p_.middleCols(first, kept).eval();
+  v_ = v_.middleCols(first, kept).eval();
+  a_ = a_.middleCols(first, kept).eval();
+  coeffs_.erase(coeffs_.begin(), coeffs_.begin() + static_cast<std::ptrdiff_t>(drop * n * kCoeffs));
+}
+
 void Trajectory::Resolve(std::size_t first) {
   const std::size_t last = times_.size() - 1;
   const int n = num_dofs();

@@ -126,6 +126,12 @@ class Trajectory {
   /// @throw Error naming the waypoint and value (the trajectory is unchanged).
   void Splice(TimePoint t, const std::vector<Waypoint>& waypoints);
 
+  /// Drops the knots of segments that end at or before `t` (the segment
+  /// holding t stays), so a trajectory spliced forever stays bounded; its
+  /// first remaining knot becomes the start. Samples at or after t do not
+  /// change; earlier ones return the new start.
+  void Forget(TimePoint t);
+
   /// A sample sized for this trajectory.
   TrajectorySample MakeSample() const;
   /// Samples at t into `out`. REQUIRES: out sized by MakeSample() (no allocation).
