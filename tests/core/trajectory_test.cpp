@@ -182,7 +182,7 @@ void ExpectSpliceContinuous(Interpolation kind, TimePoint splice) {
                        {splice + milliseconds(200), V({0.0, 0.0}), {}, {}}});
   const Jumps j = JumpAt(traj, splice);
   EXPECT_LT(j.p, kJump) << InterpolationName(kind);
-  if (kind != Interpolation::kLinear) {
+  if (kind == Interpolation::kCubic || kind == Interpolation::kQuintic) {
     EXPECT_LT(j.v, kJump) << InterpolationName(kind);
   }
   if (kind == Interpolation::kQuintic) {
@@ -196,12 +196,14 @@ void ExpectSpliceContinuous(Interpolation kind, TimePoint splice) {
 }
 
 TEST(Trajectory, SpliceInsideASegmentIsContinuousAndKeepsThePast) {
-  for (Interpolation kind : {Interpolation::kLinear, Interpolation::kCubic, Interpolation::kQuintic}) {
+  for (Interpolation kind :
+       {Interpolation::kStep, Interpolation::kLinear, Interpolation::kCubic, Interpolation::kQuintic}) {
     ExpectSpliceContinuous(kind, Ms(333.3));
   }
 }
 
 TEST(Trajectory, SpliceExactlyAtAKnotIsContinuousAndKeepsThePast) {
+  // (kStep is left out: it jumps at a knot by definition, splice or not.)
   for (Interpolation kind : {Interpolation::kLinear, Interpolation::kCubic, Interpolation::kQuintic}) {
     ExpectSpliceContinuous(kind, Ms(250));
   }
@@ -335,6 +337,24 @@ TEST(Trajectory, TimeScalingMakesATooFastTrajectoryFitItsLimits) {
       EXPECT_EQ(traj.knot(k).position, Points()[static_cast<std::size_t>(k - 1)].position);  // the path stays
     }
   }
+}
+
+TEST(Trajectory, TimeScalingFromASpliceLeavesThePastAndTheSpliceAlone) {
+  const Trajectory original = Make(Interpolation::kQuintic, Rest(V({0, 0})), Points());
+  Trajectory traj = original;
+  const TimePoint splice = Ms(333.3);
+  traj.Splice(splice, {{Ms(360), V({1.5, 1.0}), {}, {}}, {Ms(400), V({0.0, 0.0}), {}, {}}});
+  const TrajectoryLimits limits{{}, {}, V({40, 40}), V({2000, 2000})};
+  ASSERT_FALSE(traj.CheckLimits(limits, splice).within);
+  const TimeScaling scaled = traj.ScaleToLimits(limits, splice);
+  EXPECT_TRUE(scaled.changed);
+  EXPECT_TRUE(scaled.after.within) << scaled.after.violations;
+  for (double ms = 0; ms < 333; ms += 7) {
+    EXPECT_LT((At(traj, Ms(ms)).position - At(original, Ms(ms)).position).norm(), 1e-9) << ms;
+  }
+  const Jumps j = JumpAt(traj, splice);
+  EXPECT_LT(j.v, kJump);
+  EXPECT_LT(j.a, 1e-3);
 }
 
 TEST(Trajectory, TimeScalingLeavesAFittingTrajectoryAlone) {

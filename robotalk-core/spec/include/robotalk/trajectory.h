@@ -24,12 +24,11 @@
 //  - kQuintic: the quintic Hermite segment through positions, velocities and
 //    accelerations: C2.
 //
-// Before the start time a sample is knot 0. After the last knot the trajectory
-// holds (starvation): the last position with zero velocity; if the last knot's
-// velocity is not zero (kCubic, kQuintic: given, or the start state with no
-// waypoints), each dof decelerates to rest at its hold deceleration
-// (constant deceleration, so it stops v²/(2·a) past the last knot) and holds
-// there. kStep and kLinear hold the last position at once.
+// Before the start time a sample is the trajectory's value at the start time. After the last knot the
+// trajectory holds (starvation): the last position with zero velocity; if the last knot's velocity is not
+// zero (kCubic, kQuintic: given, or the start state with no waypoints), each dof decelerates to rest at its
+// hold deceleration (constant deceleration, so it stops v²/(2·a) past the last knot) and holds there. kStep
+// and kLinear hold the last position at once.
 //
 // Thread safety: none; const members may be called concurrently.
 // Real time: Sample() does not allocate once the sample is sized (MakeSample);
@@ -145,6 +144,8 @@ class Trajectory {
   /// acceleration stay within `limits` (position limits are reported, not
   /// fixed). Knot 0 (the actuator's state) is never changed; a stretched
   /// segment's knot velocities scale by 1/factor and accelerations by 1/factor².
+  /// `from` should be a knot's time (the start, or the time of a Splice): a
+  /// segment that began before it is not stretched.
   /// @throw Error on bad limits.
   TimeScaling ScaleToLimits(const TrajectoryLimits& limits, TimePoint from = TimePoint::min());
 
