@@ -136,13 +136,15 @@ class Server::Impl {
   ~Impl() { Stop(); }
 
   void Start() {
-    for (auto& robot : robots_) robot->Start();
-    server_daemon_->Start();
-    running_ = true;
     if (!options_.panic_latch_path.empty()) {
       std::fprintf(stderr, "robotalk-server: panic latch %s (a panic survives a restart)\n",
                    options_.panic_latch_path.c_str());
     }
+    // The ServerDaemon writes a robot's "starts in PANIC" as it starts, so
+    // that line comes before "serving robot" (tests and operators wait for it).
+    for (auto& robot : robots_) robot->Start();
+    server_daemon_->Start();
+    running_ = true;
     for (auto& robot : robots_) {
       std::fprintf(stderr, "robotalk-server: serving robot '%s' (%zu links, %d dofs, config %s) on '%s'\n",
                    robot->robot_name().c_str(), robot->model().links().size(), robot->model().num_dofs(),

@@ -227,6 +227,10 @@ void ServerDaemon::LogConflict(Robot& robot, const std::string& other, Duration 
 
 void ServerDaemon::Start() {
   if (running_.exchange(true)) return;
+  // What AddRobot said (a robot that starts in panic) before the thread
+  // starts: Server prints "serving robot" after this, so a reader waiting for
+  // that line already has these.
+  WriteLog();
   thread_ = std::thread([this] {
     ApplyPriority();
     while (running_) RunOnce(std::chrono::milliseconds(50));

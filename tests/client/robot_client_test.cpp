@@ -349,7 +349,31 @@ TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
        .when = [repeated = Repeated()](const std::string& channel, std::span<const std::uint8_t> bytes) {
          return !repeated(channel, bytes) && IsHeartbeat(channel, bytes);
        }});
-  ManualClock clock;
+  // Follows real time until Freeze(), then moves only when told to: the real
+  // server takes time between a CLOCK query's receipt and its answer, so a
+  // client clock standing still through Connect() would see a negative round
+  // trip in every sample and never synchronise. (A thread setting a
+  // ManualClock every 100 us lagged behind under load and failed Connect.)
+  class FollowThenManualClock final : public Clock {
+   public:
+    TimePoint Now() const override {
+      if (frozen_.load()) return TimePoint(Duration(manual_.load()));
+      return start_ + std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - real_start_);
+    }
+    // A reader between the two stores sees real time, below the frozen
+    // value: the clock never goes back.
+    void Freeze() {
+      manual_.store((Now() + milliseconds(1)).time_since_epoch().count());
+      frozen_.store(true);
+    }
+    void Advance(Duration d) { manual_.fetch_add(d.count()); }
+
+   private:
+    const TimePoint start_{seconds(1000)};
+    const std::chrono::steady_clock::time_point real_start_ = std::chrono::steady_clock::now();
+    std::atomic<bool> frozen_{false};
+    std::atomic<Duration::rep> manual_{0};
+  } clock;
   ClientOptions o = Options();
   o.clock = &clock;
   // An interval far longer than Connect() takes (below), and no resend or
@@ -358,23 +382,8 @@ TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
   o.retransmit_interval = o.retransmit_max_interval = std::chrono::minutes(10);
   o.give_up_after = std::chrono::hours(1);
   o.max_idle_wait = milliseconds(1);  // re-read the manual clock often
-  std::unique_ptr<RobotClient> client;
-  {
-    // The real server takes time between a CLOCK query's receipt and its
-    // answer: a client clock standing still through Connect() would see a
-    // negative round trip in every sample and never synchronise. So the
-    // manual clock follows real time until Connect() returned (far less than
-    // an interval); then only the test moves it.
-    const TimePoint manual_start = clock.Now();
-    const auto real_start = std::chrono::steady_clock::now();
-    std::jthread follow([&](std::stop_token stop) {
-      while (!stop.stop_requested()) {
-        clock.Set(manual_start + (std::chrono::steady_clock::now() - real_start));
-        std::this_thread::sleep_for(std::chrono::microseconds(100));
-      }
-    });
-    client = Connected(o);
-  }
+  std::unique_ptr<RobotClient> client = Connected(o);
+  clock.Freeze();  // from here on only the test moves it
   ASSERT_LT(clock.Now() - TimePoint(seconds(1000)), seconds(5)) << "Connect() took half an interval";
   const auto received = [&] { return server_net_.counts(heartbeats).matched; };
   EXPECT_EQ(received(), 0u);

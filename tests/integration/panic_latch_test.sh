@@ -33,6 +33,11 @@ check "the latch file names the robot" grep -q "^pioneer	" "$tmp/state/panic-lat
 kill9_server
 start_server $port "$tmp/s2.log"
 check "the restarted server says it starts in PANIC" grep -q "starts in PANIC, latched in" "$tmp/s2.log"
+# ... before "serving robot", the line start-up scripts wait for (it came
+# after, from the ServerDaemon's first loop: a loaded test read the log too early).
+panic_line=$(grep -n "starts in PANIC" "$tmp/s2.log" | head -1 | cut -d: -f1)
+serving_line=$(grep -n "serving robot" "$tmp/s2.log" | head -1 | cut -d: -f1)
+check "it says so before 'serving robot'" test "${panic_line:-999}" -lt "${serving_line:-0}"
 rt $port send pioneer goto 0.3 0 0 >"$tmp/after_restart" 2>&1
 check "the next command after the restart is refused" test $? -ne 0
 check "it answers PANIC" grep -q PANIC "$tmp/after_restart"
