@@ -14,19 +14,7 @@
 #include <new>
 #include <numbers>
 
-// Counts global operator new calls so a test can show Update() and ReadState()
-// do not allocate.
-namespace {
-long g_allocations = 0;
-}  // namespace
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "support/allocation_counter.h"  // g_allocations
 
 namespace robotalk {
 namespace {
