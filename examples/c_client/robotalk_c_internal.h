@@ -11,7 +11,7 @@
 #include "robotalk_msgs_reply_package_t.h"
 
 enum {
-  kProtocolVersion = 3,
+  kProtocolVersion = 4,
   kMaxPackages = 64,  /* outstanding packages */
   kMaxReplies = 1024, /* the reply cache (oldest dropped first) */
   kMaxIdsPerPackage = 64,

@@ -34,7 +34,7 @@ local lcm = require('lcm')
 local msgs = require('robotalk_msgs')
 
 local M = {}
-M.PROTOCOL_VERSION = 3
+M.PROTOCOL_VERSION = 4
 local RETRANSMIT_S, RECHECK_S, HEARTBEAT_S, HELLO_REPEAT_S, MAX_TRIES = 0.3, 1.0, 0.25, 0.2, 10
 local SIGNALS = { [-1] = 'UNKNOWN_OUTCOME', [0] = 'SUCCESS', 'MODIFIED', 'NA', 'BUSY', 'INTERRUPTED', 'ERROR', 'PANIC' }
 function M.signal_name(s) return SIGNALS[s] or '?' end

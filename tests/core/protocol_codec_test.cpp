@@ -352,6 +352,26 @@ TEST(CheckCommand, AcceptsWellFormedCommandsAndNamesWhatIsWrongOtherwise) {
   EXPECT_THAT(m6, HasSubstr("fixed base"));
 }
 
+// Issue 22: a waypoint's velocities and accelerations are one per dof (6 for a frame), finite, and only a
+// set-point waypoint has them.
+TEST(CheckCommand, AWaypointsRatesAreOnePerDofOrSixForAFrameAndFinite) {
+  const RobotModel m = TestRobot(BaseType::kDifferential);
+  Command joint{1, CommandType::kJointSetPoint, {}, "pan_tilt", {0.1, 0.2}, {0.5, -0.5}, {1, 2}};
+  EXPECT_EQ(Check(m, joint).first, Signal::kSuccess);
+  joint.accelerations.clear();  // velocities alone
+  EXPECT_EQ(Check(m, joint).first, Signal::kSuccess);
+  joint.velocities = {0.5};
+  EXPECT_EQ(Check(m, joint).second, "JOINT_SETPOINT 'pan_tilt': expected 0 or 2 velocities, got 1");
+  joint.velocities = {0.5, std::nan("")};
+  EXPECT_EQ(Check(m, joint).second, "JOINT_SETPOINT 'pan_tilt': velocity 1 is NaN");
+  Command frame{1, CommandType::kFrameSetPoint, {}, "camera", {0, 0, 1, 1, 0, 0, 0}, {0, 0, 0, 0, 0, 1}, {}};
+  EXPECT_EQ(Check(m, frame).first, Signal::kSuccess);
+  frame.accelerations = {1, 2, 3};
+  EXPECT_EQ(Check(m, frame).second, "FRAME_SETPOINT 'camera': expected 0 or 6 accelerations, got 3");
+  EXPECT_EQ(Check(m, {1, CommandType::kGoto, {}, "", {1, 2, 0}, {1, 0, 0}, {}}).second,
+            "GOTO: takes no velocities (only a JOINT_SETPOINT or FRAME_SETPOINT waypoint does)");
+}
+
 // Issue 19: `GOTO 1e308 0 0` was accepted (ODE drove at full speed).
 TEST(CheckCommand, RefusesAGotoBeyondTheBoundNamingTheTargetAndTheBound) {
   const RobotModel m = TestRobot(BaseType::kDifferential);

@@ -243,5 +243,53 @@ TEST(RequestCodec, AReplyBatchOfAnotherProtocolVersionIsRefusedNamingBothVersion
   }
 }
 
+// Issue 22/23 (protocol 4): the package's interpolation and max_late, and a waypoint's rates, travel.
+TEST(RequestCodec, CarriesTheInterpolationTheMaxLateAndAWaypointsRates) {
+  Request r{.client_id = 42, .sequence = 7, .mode = RequestMode::kDelay};
+  r.interpolation = Interpolation::kQuintic;
+  r.max_late = std::chrono::milliseconds(100);
+  r.commands.push_back(Command{1,
+                               CommandType::kJointSetPoint,
+                               StartTime::At(TimePoint(std::chrono::seconds(9))),
+                               "pan",
+                               {0.5},
+                               {0.25},
+                               {-1.0}});
+  const Request back = DecodeRequest(EncodeRequest(r));
+  EXPECT_TRUE(back.header_error.empty()) << back.header_error;
+  EXPECT_EQ(back.interpolation, Interpolation::kQuintic);
+  EXPECT_EQ(back.max_late, std::chrono::milliseconds(100));
+  ASSERT_EQ(back.commands.size(), 1u);
+  EXPECT_EQ(back.commands[0].velocities, std::vector<double>{0.25});
+  EXPECT_EQ(back.commands[0].accelerations, std::vector<double>{-1.0});
+
+  r.max_late = kMaxLateNever;
+  EXPECT_EQ(DecodeRequest(EncodeRequest(r)).max_late, kMaxLateNever);
+  r.max_late = kMaxLateServerDefault;
+  r.interpolation = Interpolation::kStep;
+  const Request old_style = DecodeRequest(EncodeRequest(r));
+  EXPECT_EQ(old_style.max_late, kMaxLateServerDefault);
+  EXPECT_EQ(old_style.interpolation, Interpolation::kStep);
+  r.max_late = -std::chrono::seconds(1);
+  EXPECT_THROW(EncodeRequest(r), ProtocolError);
+}
+
+TEST(RequestCodec, AnUnknownInterpolationOrANegativeMaxLateIsAHeaderError) {
+  robotalk_msgs::package_t p{};
+  p.header.protocol_version = kProtocolVersion;
+  p.header.client_id = 9;
+  p.header.sequence = 1;
+  p.header.payload_type = kQueries;
+  p.header.interpolation = 7;
+  EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error,
+            "package: unknown interpolation 7 (0 step, 1 linear, 2 cubic, 3 quintic)");
+  p.header.interpolation = Header::INTERPOLATION_CUBIC;
+  p.header.max_late_us = -5;
+  EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error,
+            "package: max_late_us -5 is negative (0 = the server's default, -1 = never)");
+  p.header.max_late_us = 0;
+  EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error, "");
+}
+
 }  // namespace
 }  // namespace robotalk

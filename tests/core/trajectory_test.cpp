@@ -401,5 +401,16 @@ TEST(Trajectory, BadInputIsRefusedNamingWhatWasWrong) {
               HasSubstr("start velocity[0] is nan"));
 }
 
+TEST(Interpolation, ParsesItsNamesInAnyCaseAndNothingElse) {
+  for (Interpolation i :
+       {Interpolation::kStep, Interpolation::kLinear, Interpolation::kCubic, Interpolation::kQuintic}) {
+    EXPECT_EQ(ParseInterpolation(InterpolationName(i)), i);
+  }
+  EXPECT_EQ(ParseInterpolation("Quintic"), Interpolation::kQuintic);
+  EXPECT_FALSE(ParseInterpolation("spline"));
+  EXPECT_FALSE(ParseInterpolation(""));
+  EXPECT_FALSE(ParseInterpolation("cubicx"));
+}
+
 }  // namespace
 }  // namespace robotalk

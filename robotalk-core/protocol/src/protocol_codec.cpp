@@ -41,11 +41,11 @@ ROBOTALK_WIRE_COMMAND(PANIC_RESET);
 
 // Smallest encodings of the array elements (an empty string takes 5 bytes).
 constexpr std::int64_t kMinQueryBytes = 8 + 1 + kLcmStringOverhead + 8 + 8;
-constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2;
+constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2 + 2 + 2;
 constexpr std::int64_t kMinReplyBytes = 8 + 1 + kLcmStringOverhead + 8 + 8 + 4;
 
 void ScanPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8 + 1 + 8, "header");
   const std::int32_t nq = s.Count("num_queries", kMinQueryBytes);
   for (std::int32_t i = 0; i < nq; ++i) {
     s.Skip(8 + 1, "query");
@@ -57,6 +57,8 @@ void ScanPackage(WireScanner& s) {
     s.Skip(8 + 1 + 8, "command");
     s.String("command.target");
     s.Skip(std::int64_t{8} * s.Count16("command.num_values", 8), "command.values");
+    s.Skip(std::int64_t{8} * s.Count16("command.num_velocities", 8), "command.velocities");
+    s.Skip(std::int64_t{8} * s.Count16("command.num_accelerations", 8), "command.accelerations");
   }
   s.Skip(kMacBytesOnWire, "mac");
 }
@@ -158,6 +160,16 @@ robotalk_msgs::command_t ToWire(const Command& c) {
   }
   w.num_values = static_cast<std::int16_t>(c.values.size());
   w.values = c.values;
+  // CheckCommand bounds these to 7 each; a client's own bad count is refused
+  // there with its name, so only the int16 range matters here.
+  if (c.velocities.size() > static_cast<std::size_t>(INT16_MAX) ||
+      c.accelerations.size() > static_cast<std::size_t>(INT16_MAX)) {
+    throw ProtocolError(CommandField(c.id, "too many velocities or accelerations"));
+  }
+  w.num_velocities = static_cast<std::int16_t>(c.velocities.size());
+  w.velocities = c.velocities;
+  w.num_accelerations = static_cast<std::int16_t>(c.accelerations.size());
+  w.accelerations = c.accelerations;
   return w;
 }
 
@@ -209,6 +221,8 @@ Command FromWire(const robotalk_msgs::command_t& w, std::int8_t package_mode) {
   c.start_time = StartFromWire(w, package_mode);
   c.target = w.target;
   c.values = w.values;
+  c.velocities = w.velocities;
+  c.accelerations = w.accelerations;
   return c;
 }
 
@@ -361,6 +375,18 @@ std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
              " us is out of range";
     }
     if (h.playback_id == 0) return "package: PLAYBACK id 0 is reserved";
+  }
+  if (h.interpolation < robotalk_msgs::package_header_t::INTERPOLATION_STEP ||
+      h.interpolation > robotalk_msgs::package_header_t::INTERPOLATION_QUINTIC) {
+    return "package: unknown interpolation " + std::to_string(h.interpolation) +
+           " (0 step, 1 linear, 2 cubic, 3 quintic)";
+  }
+  if (h.max_late_us < robotalk_msgs::package_header_t::MAX_LATE_NEVER) {
+    return "package: max_late_us " + std::to_string(h.max_late_us) +
+           " is negative (0 = the server's default, -1 = never)";
+  }
+  if (h.max_late_us > 0 && !TryDurationFromWireMicros(h.max_late_us)) {
+    return "package: max_late_us " + std::to_string(h.max_late_us) + " us is out of range";
   }
   if (h.sequence <= 0) return "package: sequence " + std::to_string(h.sequence) + " is not positive";
   if (p.num_queries > 0 && p.num_commands > 0) {

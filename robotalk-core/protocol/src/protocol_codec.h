@@ -23,7 +23,7 @@
 
 namespace robotalk {
 
-inline constexpr std::int16_t kProtocolVersion = 3;
+inline constexpr std::int16_t kProtocolVersion = 4;
 /// The `mac` field that ends package_t and reply_package_t.
 inline constexpr std::int64_t kMacBytesOnWire = 16;
 

@@ -60,6 +60,14 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes) {
   r.panic = h.panic;
   r.header_error = CheckPackageHeader(p);
   r.mode = static_cast<RequestMode>(h.mode);
+  if (r.header_error.empty()) {
+    r.interpolation = static_cast<Interpolation>(h.interpolation);
+    if (h.max_late_us == robotalk_msgs::package_header_t::MAX_LATE_NEVER) {
+      r.max_late = kMaxLateNever;
+    } else {
+      r.max_late = DurationFromWireMicros(h.max_late_us, "package: max_late_us");
+    }
+  }
   if (r.mode == RequestMode::kPlayback && r.header_error.empty()) {
     r.playback = {h.playback_id, h.playback_frames,
                   DurationFromWireMicros(h.playback_duration_us, "package: playback_duration_us")};
@@ -96,6 +104,14 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
     h.playback_id = r.playback.id;
     h.playback_frames = static_cast<std::int32_t>(r.playback.frames);
     h.playback_duration_us = ToWireMicros(r.playback.duration);
+  }
+  h.interpolation = static_cast<std::int8_t>(r.interpolation);
+  if (r.max_late == kMaxLateNever) {
+    h.max_late_us = robotalk_msgs::package_header_t::MAX_LATE_NEVER;
+  } else if (r.max_late < Duration::zero()) {
+    throw ProtocolError("package: negative max_late " + std::to_string(ToSeconds(r.max_late)) + " s");
+  } else {
+    h.max_late_us = ToWireMicros(r.max_late);
   }
   for (const Query& q : r.queries) p.queries.push_back(ToWire(q));
   for (const Command& c : r.commands) p.commands.push_back(ToWire(c, h.mode));

@@ -43,14 +43,35 @@ std::optional<std::string> CheckValueCount(const Command& c, std::size_t dofs = 
   return Label(c) + ": expected " + expected + ", got " + std::to_string(c.values.size());
 }
 
-std::optional<std::string> CheckFinite(const Command& c) {
-  for (size_t i = 0; i < c.values.size(); ++i) {
-    if (!std::isfinite(c.values[i])) {
-      return Label(c) + ": value " + std::to_string(i) + " is " +
-             (std::isnan(c.values[i]) ? "NaN" : "infinite");
+std::optional<std::string> CheckFinite(const Command& c, const std::vector<double>& values,
+                                       const char* noun) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      return Label(c) + ": " + noun + " " + std::to_string(i) + " is " +
+             (std::isnan(values[i]) ? "NaN" : "infinite");
     }
   }
   return std::nullopt;
+}
+
+std::optional<std::string> CheckFinite(const Command& c) {
+  if (auto bad = CheckFinite(c, c.values, "value")) return bad;
+  if (auto bad = CheckFinite(c, c.velocities, "velocity")) return bad;
+  return CheckFinite(c, c.accelerations, "acceleration");
+}
+
+// A waypoint's velocities and accelerations: none, or WaypointRateCount each.
+std::optional<std::string> CheckRateCount(const Command& c, std::size_t dofs = 0) {
+  const std::size_t expected = WaypointRateCount(c.type, dofs);
+  const auto check = [&](const std::vector<double>& v, const char* noun) -> std::optional<std::string> {
+    if (v.empty() || v.size() == expected) return std::nullopt;
+    if (expected == 0)
+      return Label(c) + ": takes no " + noun + " (only a JOINT_SETPOINT or FRAME_SETPOINT waypoint does)";
+    return Label(c) + ": expected 0 or " + std::to_string(expected) + " " + noun + ", got " +
+           std::to_string(v.size());
+  };
+  if (auto bad = check(c.velocities, "velocities")) return bad;
+  return check(c.accelerations, "accelerations");
 }
 
 // "set-point", "speed", "force": a servo type in a refusal.
@@ -152,6 +173,7 @@ std::optional<std::string> CommandProblem(const RobotModel& model, const Command
       const Joint& joint = model.joint(*j);
       if (joint.dofs.empty()) return Label(c) + ": the joint is fixed (0 dofs)";
       if (auto bad = CheckValueCount(c, joint.dofs.size())) return bad;
+      if (auto bad = CheckRateCount(c, joint.dofs.size())) return bad;
       if (joint.mimic) {
         *signal = Signal::kNa;
         return Label(c) + ": the joint follows " + Quote(model.joint(joint.mimic->leader_joint).name) +
@@ -169,6 +191,7 @@ std::optional<std::string> CommandProblem(const RobotModel& model, const Command
         return std::string(traits->name) + ": robot " + Quote(model.name()) + " has no control frame named " +
                Quote(c.target);
       if (auto bad = CheckValueCount(c)) return bad;
+      if (auto bad = CheckRateCount(c)) return bad;
       // A frame's values are a pose: x y z and a unit quaternion.
       const double norm = std::sqrt(c.values[3] * c.values[3] + c.values[4] * c.values[4] +
                                     c.values[5] * c.values[5] + c.values[6] * c.values[6]);
@@ -184,6 +207,7 @@ std::optional<std::string> CommandProblem(const RobotModel& model, const Command
     case CommandTarget::kBase: {
       if (!c.target.empty()) return Label(c) + ": a base command takes no target";
       if (auto bad = CheckValueCount(c)) return bad;
+      if (auto bad = CheckRateCount(c)) return bad;
       if (model.roots().front().base == BaseType::kFixed) {
         *signal = Signal::kNa;
         return Label(c) + ": robot " + Quote(model.name()) + " has a fixed base";
@@ -202,6 +226,7 @@ std::optional<std::string> CommandProblem(const RobotModel& model, const Command
     }
     case CommandTarget::kRobot:
       if (!c.target.empty()) return Label(c) + ": takes no target";
+      if (auto bad = CheckRateCount(c)) return bad;
       return CheckValueCount(c);
   }
   return "unknown command type " + std::to_string(static_cast<int>(c.type));

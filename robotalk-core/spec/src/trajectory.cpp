@@ -1,6 +1,7 @@
 #include "robotalk/trajectory.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -119,6 +120,19 @@ const char* InterpolationName(Interpolation interpolation) {
       return "quintic";
   }
   return "?";
+}
+
+std::optional<Interpolation> ParseInterpolation(std::string_view name) {
+  for (Interpolation i :
+       {Interpolation::kStep, Interpolation::kLinear, Interpolation::kCubic, Interpolation::kQuintic}) {
+    const std::string_view known = InterpolationName(i);
+    if (name.size() == known.size() &&
+        std::equal(name.begin(), name.end(), known.begin(),
+                   [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+      return i;
+    }
+  }
+  return std::nullopt;
 }
 
 Trajectory::Trajectory(Interpolation interpolation, TimePoint start_time, const TrajectoryState& start,

@@ -13,6 +13,7 @@
 #include "robotalk/session_auth.h"
 #include "robotalk/state_sample.h"
 #include "robotalk/traffic_layout.h"
+#include "robotalk/trajectory.h"
 
 #include <cstdint>
 #include <span>
@@ -35,6 +36,10 @@ struct PlaybackDeclaration {
   Duration duration{0};     ///< offset of its last command
 };
 
+/// A Request's max_late: the robot's default (--max-late) and "never expires".
+inline constexpr Duration kMaxLateServerDefault{0};
+inline constexpr Duration kMaxLateNever = Duration::max();
+
 /// An item of a package that did not decode: it is answered ERROR.
 struct MalformedItem {
   CommandId id = 0;
@@ -50,6 +55,13 @@ struct Request {
   bool panic = false;
   RequestMode mode = RequestMode::kDirect;
   PlaybackDeclaration playback;  ///< kPlayback only
+  /// How the package's timed JOINT_SETPOINT / FRAME_SETPOINT commands join
+  /// into each actuator's trajectory (docs/protocol.md, Trajectories); kStep
+  /// is protocol 3's behaviour. Every package of a playback sequence says the same.
+  Interpolation interpolation = Interpolation::kStep;
+  /// How late after its start time a command may still begin:
+  /// kMaxLateServerDefault, kMaxLateNever, or a limit (> 0).
+  Duration max_late = kMaxLateServerDefault;
   std::vector<Query> queries;
   std::vector<Command> commands;  ///< kPlayback: start_time holds the offset (see command.h)
   std::vector<MalformedItem> malformed;

@@ -200,12 +200,27 @@ class StartTime {
 /// "now", "at 12.5 s", "after 0.3 s" (server-clock seconds), for messages.
 std::string ToString(const StartTime& s);
 
+/// How many velocity (or acceleration) values a waypoint of `t` carries for
+/// a target joint of `dofs` dofs: one per dof (JOINT_SETPOINT), 6 for a
+/// FRAME_SETPOINT (vx vy vz wx wy wz in the world), 0 for a command that is
+/// never a waypoint.
+constexpr std::size_t WaypointRateCount(CommandType t, std::size_t dofs) {
+  if (t == CommandType::kJointSetPoint) return dofs;
+  if (t == CommandType::kFrameSetPoint) return 6;
+  return 0;
+}
+
 struct Command {
   CommandId id = 0;
   CommandType type = CommandType::kStop;
   StartTime start_time;
   std::string target;  ///< joint or control-frame name; empty for base / whole-robot commands
   std::vector<double> values;
+  /// A waypoint's velocity and acceleration (JOINT_SETPOINT, FRAME_SETPOINT
+  /// in an interpolated package): empty = chosen by the server's trajectory
+  /// (trajectory.h); else WaypointRateCount values. A step package ignores them.
+  std::vector<double> velocities;
+  std::vector<double> accelerations;
 };
 
 struct Query {

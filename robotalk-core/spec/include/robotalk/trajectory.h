@@ -40,15 +40,21 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace robotalk {
 
-enum class Interpolation { kStep, kLinear, kCubic, kQuintic };
+/// Its value is its wire code (package_header_t's INTERPOLATION_*).
+enum class Interpolation : std::int8_t { kStep = 0, kLinear = 1, kCubic = 2, kQuintic = 3 };
 
 /// "step", "linear", "cubic", "quintic".
 const char* InterpolationName(Interpolation interpolation);
+/// Parses those names (any case); nullopt for another word.
+std::optional<Interpolation> ParseInterpolation(std::string_view name);
 
 /// Position, velocity, acceleration of every dof (rad or m, per s, per s²).
 struct TrajectoryState {

@@ -42,7 +42,7 @@ import robotalk_msgs.reply_t;
 import robotalk_msgs.robot_config_t;
 
 public final class RobotalkClient implements AutoCloseable {
-  public static final short PROTOCOL_VERSION = 3;
+  public static final short PROTOCOL_VERSION = 4;
   static final long RETRANSMIT_US = 300_000, RECHECK_US = 1_000_000, HEARTBEAT_US = 250_000,
       HELLO_REPEAT_US = 200_000;
   static final int MAX_TRIES = 10;
