@@ -121,6 +121,10 @@ void KinematicDriver::StepDofs(double dt) {
   for (Eigen::Index i = 0; i < n; ++i) {
     if (dofs_.mimic_leader[static_cast<size_t>(i)] >= 0) continue;
     const double q0 = q_[i];
+    if (mode_[static_cast<size_t>(i)] == DofMode::kReference) {  // no new reference: hold
+      mode_[static_cast<size_t>(i)] = DofMode::kPosition;
+      target_[i] = q0;
+    }
     if (mode_[static_cast<size_t>(i)] == DofMode::kPosition) {
       const double d = target_[i] - q0;
       const double step = vmax_[i] * dt;
@@ -319,6 +323,22 @@ DriverResult KinematicDriver::FrameSetPoint(const DriverCommand& c) {
 }
 
 // ---------------------------------------------------------------- commands
+
+DriverResult KinematicDriver::Track(const JointReference& reference, TimePoint now,
+                                    std::vector<Completion>& completed) {
+  Advance(now, completed);
+  const int first = model_.dof_offset(reference.joint);
+  for (std::size_t k = 0; k < reference.position.size(); ++k) {
+    const int i = first + static_cast<int>(k);
+    q_[i] = std::clamp(reference.position[k], dofs_.lower[i], dofs_.upper[i]);
+    qd_[i] = reference.velocity[k];
+    target_[i] = q_[i];
+    speed_[i] = 0;
+    mode_[static_cast<size_t>(i)] = DofMode::kReference;
+  }
+  ApplyMimics(model_, q_);
+  return Answer(Signal::kSuccess);
+}
 
 DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {

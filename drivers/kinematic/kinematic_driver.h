@@ -73,6 +73,10 @@ class KinematicDriver final : public Driver {
   /// own time, not at the next Update), then starts `command`.
   DriverResult Execute(const DriverCommand& command, TimePoint now,
                        std::vector<Completion>& completed) override;
+  /// Puts the joint exactly where the reference says, at its velocity (an
+  /// ideal tracker: the trajectory's error is zero by construction).
+  DriverResult Track(const JointReference& reference, TimePoint now,
+                     std::vector<Completion>& completed) override;
   /// Integrates over the time since the previous Update()/Execute(); the first
   /// call only sets the time base. Appends a finished GOTO's completion.
   void Update(TimePoint now, std::vector<Completion>& completed) override;
@@ -93,7 +97,9 @@ class KinematicDriver final : public Driver {
   static constexpr double kGotoHeadingTolerance = 1e-2;
 
  private:
-  enum class DofMode : std::uint8_t { kPosition, kVelocity };
+  // kReference: set by Track() for this instant; the next step holds there
+  // unless Track() is called again.
+  enum class DofMode : std::uint8_t { kPosition, kVelocity, kReference };
   enum class BaseMode : std::uint8_t { kIdle, kSpeed, kGoto };
   enum class GotoPhase : std::uint8_t { kTurnToGoal, kDrive, kFinalTurn };
 

@@ -7,7 +7,7 @@
 namespace robotalk::ode_detail {
 
 JointServos::JointServos(const RobotModel& model, const OdeDriverOptions& options)
-    : table_(model), kp_(options.kp) {
+    : table_(model), kp_(options.kp), step_(1.0 / options.step_hz), horizon_(ToSeconds(options.period)) {
   const int n = model.num_dofs();
   vmax_ =
       table_.velocity.unaryExpr([&](double v) { return std::isfinite(v) ? v : options.default_velocity; });
@@ -25,6 +25,17 @@ JointServos::JointServos(const RobotModel& model, const OdeDriverOptions& option
   target_ = q0_;
   speed_.setZero(n);
   force_.setZero(n);
+  ref_accel_.setZero(n);
+  ref_age_.setZero(n);
+}
+
+void JointServos::Reference(Eigen::Index i, double p, double v, double a) {
+  mode_[static_cast<std::size_t>(i)] = Mode::kReference;
+  target_[i] = p;
+  speed_[i] = v;
+  ref_accel_[i] = a;
+  ref_age_[i] = 0;
+  force_[i] = 0;
 }
 
 void JointServos::SetPoint(Eigen::Index i, double q) {
@@ -72,6 +83,19 @@ void JointServos::Apply(OdeWorld& world) {
       case Mode::kVelocity:
         world.SetMotor(static_cast<int>(i), speed_[i], fmax_[i]);
         break;
+      case Mode::kReference: {
+        // The reference at this step and its velocity at mid-step (exact for
+        // a constant acceleration), advanced at most one control period.
+        const double age = std::min(ref_age_[i], horizon_);
+        const double mid = std::min(ref_age_[i] + step_ / 2, horizon_);
+        const double p = target_[i] + speed_[i] * age + 0.5 * ref_accel_[i] * age * age;
+        const double v = ref_age_[i] + step_ / 2 <= horizon_ ? speed_[i] + ref_accel_[i] * mid : 0.0;
+        const double want = std::clamp(p, table_.lower[i], table_.upper[i]);
+        world.SetMotor(static_cast<int>(i), std::clamp(v + kp_ * (want - q[i]), -vmax_[i], vmax_[i]),
+                       fmax_[i]);
+        ref_age_[i] += step_;
+        break;
+      }
       case Mode::kForce:
         world.SetEffort(static_cast<int>(i), force_[i]);
         break;
@@ -100,6 +124,10 @@ bool JointServos::Moving(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) co
         break;
       case Mode::kVelocity:
         if (speed_[i] != 0 || std::abs(qd[i]) > kMovingSpeed) return true;
+        break;
+      case Mode::kReference:
+        if (speed_[i] != 0 || std::abs(target_[i] - q[i]) > kTargetReached || std::abs(qd[i]) > kMovingSpeed)
+          return true;
         break;
       case Mode::kForce:
         if (force_[i] != 0) return true;

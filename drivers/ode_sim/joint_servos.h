@@ -40,6 +40,13 @@ class JointServos {
 
   /// Servo dof `i` to position `q` (REQUIRES: within the limits; not base_driven(i)).
   void SetPoint(Eigen::Index i, double q);
+  /// Track a trajectory's reference for dof `i` from this step on: position
+  /// `p`, velocity `v`, acceleration `a` (Driver::Track). Each step the motor
+  /// runs at the reference's velocity at mid-step plus kp times the position
+  /// error (velocity feed-forward; ODE's motor constraint supplies the force
+  /// the dynamics need), the reference advanced along its own polynomial for
+  /// at most one control period, then held.
+  void Reference(Eigen::Index i, double p, double v, double a);
   /// Run dof `i` at `v`; it stops and holds at a position limit.
   void Speed(Eigen::Index i, double v);
   /// Apply `f` to dof `i` (N·m or N), motor off.
@@ -59,13 +66,16 @@ class JointServos {
   bool Moving(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
 
  private:
-  enum class Mode : std::uint8_t { kPosition, kVelocity, kForce, kPassive, kMimic, kBase };
+  enum class Mode : std::uint8_t { kPosition, kVelocity, kForce, kPassive, kMimic, kBase, kReference };
 
   DofTable table_;
   double kp_;
+  double step_;     // s, one physics step
+  double horizon_;  // s, how far a reference is advanced (one control period)
   Eigen::VectorXd q0_, vmax_, fmax_;
   std::vector<Mode> mode_;
   Eigen::VectorXd target_, speed_, force_;
+  Eigen::VectorXd ref_accel_, ref_age_;  // kReference: target_ = p, speed_ = v at age 0
 };
 
 }  // namespace robotalk::ode_detail

@@ -16,6 +16,24 @@ using driver_support::Num;
 using driver_support::Quote;
 using driver_support::Unit;
 
+DriverResult OdeDriver::Impl::Track(const JointReference& reference, TimePoint now,
+                                    std::vector<Completion>& completed) {
+  Advance(now, true, completed);
+  const int first = model_.dof_offset(reference.joint);
+  for (std::size_t k = 0; k < reference.position.size(); ++k) {
+    const Eigen::Index i = first + static_cast<Eigen::Index>(k);
+    if (servos_.base_driven(i)) {
+      return {Signal::kNa, false,
+              "joint '" + model_.joint(reference.joint).name + "' is driven by the walking controller"};
+    }
+  }
+  for (std::size_t k = 0; k < reference.position.size(); ++k) {
+    servos_.Reference(first + static_cast<Eigen::Index>(k), reference.position[k], reference.velocity[k],
+                      reference.acceleration[k]);
+  }
+  return {};
+}
+
 DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {
   // The server checked the command against the model (driver.h): a motion

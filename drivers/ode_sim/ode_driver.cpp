@@ -133,6 +133,10 @@ DriverResult OdeDriver::Execute(const DriverCommand& command, TimePoint now,
                                 std::vector<Completion>& completed) {
   return impl_->Execute(command, now, completed);
 }
+DriverResult OdeDriver::Track(const JointReference& reference, TimePoint now,
+                              std::vector<Completion>& completed) {
+  return impl_->Track(reference, now, completed);
+}
 void OdeDriver::Update(TimePoint now, std::vector<Completion>& completed) {
   impl_->Advance(now, true, completed);
 }

@@ -121,6 +121,11 @@ class OdeDriver final : public Driver {
   /// Advances the simulation to `now` first, then starts `command`.
   DriverResult Execute(const DriverCommand& command, TimePoint now,
                        std::vector<Completion>& completed) override;
+  /// Advances the simulation to `now`, then servos the joint along the
+  /// reference: PD on position with velocity feed-forward at every physics
+  /// step (joint_servos.h). A leg the walking controller drives answers NA.
+  DriverResult Track(const JointReference& reference, TimePoint now,
+                     std::vector<Completion>& completed) override;
   /// Steps the physics as many fixed steps as fit up to `now` (at most
   /// max_catchup_ms of them); the first call only sets the time base.
   void Update(TimePoint now, std::vector<Completion>& completed) override;

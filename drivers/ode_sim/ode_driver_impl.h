@@ -45,6 +45,7 @@ class OdeDriver::Impl {
   Impl(RobotModel model, const OdeDriverOptions& options, std::vector<CollisionShape> shapes);
 
   DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed);
+  DriverResult Track(const JointReference& reference, TimePoint now, std::vector<Completion>& completed);
   void Stop(TimePoint now, std::vector<Completion>& interrupted);
   void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted);
   void Halt(std::vector<Completion>& interrupted) { StopAll("interrupted by panic", interrupted); }

@@ -2,7 +2,19 @@
 
 #include "robotalk/error.h"
 
+#include <algorithm>
+
 namespace robotalk {
+
+DriverResult Driver::Track(const JointReference& reference, TimePoint now,
+                           std::vector<Completion>& completed) {
+  DriverCommand setpoint;
+  setpoint.type = CommandType::kJointSetPoint;
+  setpoint.target = reference.joint;
+  setpoint.num_values = static_cast<int>(std::min(reference.position.size(), setpoint.values.size()));
+  std::copy_n(reference.position.begin(), setpoint.num_values, setpoint.values.begin());
+  return Execute(setpoint, now, completed);
+}
 
 void DriverRegistry::Register(const std::string& name, Factory factory) {
   if (!factories_.emplace(name, std::move(factory)).second) {

@@ -7,7 +7,9 @@
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 #include "robotalk/driver.h"
+#include "robotalk/trajectory.h"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +32,20 @@ struct QueuedItem {
   bool scoped_stop = false;
   std::vector<int> stop_joints;
   bool stop_base = false;
+  /// The package's interpolation. A JOINT_SETPOINT with a start time in a
+  /// package that is not kStep is a trajectory waypoint (is_waypoint()): the
+  /// RobotDaemon takes it when it arrives, not at its start time.
+  Interpolation interpolation = Interpolation::kStep;
+  /// A waypoint's given velocity and acceleration (the first num_rates used; 0 = chosen).
+  int num_velocities = 0;
+  int num_accelerations = 0;
+  std::array<double, 6> velocities{};
+  std::array<double, 6> accelerations{};
+
+  bool is_waypoint() const {
+    return !is_query && has_start_time && interpolation != Interpolation::kStep &&
+           command.type == CommandType::kJointSetPoint;
+  }
 
   /// Earlier start first; equal starts in arrival order.
   bool RunsBefore(const QueuedItem& o) const {

@@ -40,6 +40,8 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
                                      .spin_share = options.spin_share,
                                      .fifo_priority = options.fifo_priority}),
       woken_([this] { return wake_flag_ || !running_ || flush_deferred_.load(); }),
+      tracker_(driver_->model(),
+               TrackerOptions{.acceleration_limit = options.max_acceleration, .period = driver_->period()}),
       kinematics_(driver_->model()),
       snapshot_(driver_->model(), InitialState(driver_->model()), clock, panic_) {
   const RobotModel& m = model();
@@ -49,6 +51,9 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
     *v = Eigen::VectorXd::Zero(m.num_dofs());
   sample_.frame_poses.assign(7 * m.frames().size(), 0.0);
   due_.reserve(256);
+  waypoints_.reserve(256);
+  arrived_waypoints_.reserve(256);
+  tracked_.reserve(256);
   completions_.reserve(64);
   produced_.replies.reserve(256);
   produced_.executed.reserve(256);
@@ -105,6 +110,7 @@ void RobotDaemon::Shutdown() {
   {
     std::lock_guard lock(mutex_);
     scheduler_.FlushAll(waiting);
+    arrived_waypoints_.clear();
   }
   QueueStop(/*only_if_moving=*/false);
   last_iteration_ = true;
@@ -139,7 +145,13 @@ void RobotDaemon::Submit(QueuedItem item) {
     // wake-up per delayed command (issue 11: 64 clients x 100 Hz are CPU-bound
     // on thread switches). While it runs (no deadline yet) it is always told.
     wake = due || !sleeping_until_ || item.start < *sleeping_until_;
-    scheduler_.Push(std::move(item));
+    if (item.is_waypoint()) {
+      // Planned toward before its time: the thread takes it at its next iteration.
+      wake = true;
+      arrived_waypoints_.push_back(std::move(item));
+    } else {
+      scheduler_.Push(std::move(item));
+    }
     ++pushes_;
     if (due) snapshot_.NoteDue(pushes_);  // a snapshot older than this item is no answer
     if (wake) wake_flag_ = true;
@@ -149,12 +161,14 @@ void RobotDaemon::Submit(QueuedItem item) {
 
 std::size_t RobotDaemon::queued(std::int64_t client_id) const {
   std::lock_guard lock(mutex_);
-  return scheduler_.queued(client_id);
+  return scheduler_.queued(client_id) + static_cast<std::size_t>(std::count_if(
+                                            arrived_waypoints_.begin(), arrived_waypoints_.end(),
+                                            [&](const QueuedItem& i) { return i.client_id == client_id; }));
 }
 
 std::size_t RobotDaemon::queued_total() const {
   std::lock_guard lock(mutex_);
-  return scheduler_.size();
+  return scheduler_.size() + arrived_waypoints_.size();
 }
 
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
@@ -170,6 +184,8 @@ void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& rea
     lock.lock();
   }
   scheduler_.FlushAll(flushed);
+  for (QueuedItem& w : arrived_waypoints_) flushed.push_back(std::move(w));
+  arrived_waypoints_.clear();
   wake_flag_ = true;
   lock.unlock();
   wake_.notify_one();
@@ -189,6 +205,8 @@ void RobotDaemon::FlushForPanicLocked() {
   flush_deferred_ = false;
   std::vector<QueuedItem> flushed;
   scheduler_.FlushAll(flushed);
+  for (QueuedItem& w : arrived_waypoints_) flushed.push_back(std::move(w));
+  arrived_waypoints_.clear();
   wake_flag_ = true;
   const TimePoint now = clock_.Now();
   for (const QueuedItem& item : flushed) {
@@ -216,6 +234,10 @@ bool RobotDaemon::ResetPanic() {
 void RobotDaemon::FlushClient(std::int64_t client_id, std::vector<QueuedItem>& out) {
   std::lock_guard lock(mutex_);
   scheduler_.FlushClient(client_id, out);
+  const auto theirs = std::stable_partition(arrived_waypoints_.begin(), arrived_waypoints_.end(),
+                                            [&](const QueuedItem& i) { return i.client_id != client_id; });
+  for (auto it = theirs; it != arrived_waypoints_.end(); ++it) out.push_back(std::move(*it));
+  arrived_waypoints_.erase(theirs, arrived_waypoints_.end());
 }
 
 Duration RobotDaemon::SetStream(std::int64_t client_id, Duration period) {
@@ -368,6 +390,8 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     std::lock_guard lock(mutex_);
     if (flush_deferred_.load()) FlushForPanicLocked();
     scheduler_.TakeDue(now, due_);
+    waypoints_.clear();
+    std::swap(waypoints_, arrived_waypoints_);
     pushes_taken_ = pushes_;
     period = scheduler_.stream_period();
     sample_due = scheduler_.TakeSampleDue(now) || (last_iteration_ && period.count() > 0);
@@ -383,8 +407,10 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   // (the robot may already be let go) is a fault that halts it again.
   if (panic_.BeginResume()) Guarded("Resume", nullptr, now, [&] { driver_->Resume(); });
   for (const QueuedItem& item : due_) Execute(item, now);
+  AddWaypoints(now);
   bool state_fresh = false;  // state_ read after this iteration's Update
   if (now >= next_update_) {
+    TrackTrajectories(now);
     Guarded("Update", nullptr, now, [&] { driver_->Update(now, completions_); });
     std::string_view condition;  // the driver's own text: nothing allocated unless it changed
     if (Guarded("Fault", nullptr, now, [&] { condition = driver_->Fault(); }) == CallOutcome::kOk &&
@@ -443,6 +469,80 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   return next;
 }
 
+void RobotDaemon::EmitTracked() {
+  for (TrajectoryTracker::Answer& a : tracked_) Emit(a.client_id, std::move(a.reply));
+  tracked_.clear();
+}
+
+void RobotDaemon::AddWaypoints(TimePoint now) {
+  if (waypoints_.empty()) return;
+  if (panic_.in_panic() || panic_.driver_halted()) {
+    for (const QueuedItem& w : waypoints_) {
+      Reply r;
+      r.id = w.command.id;
+      r.signal = Signal::kInterrupted;
+      r.message = "the robot entered panic before the command ran";
+      r.exec_time = now;
+      Emit(w.client_id, std::move(r));
+    }
+  } else if (ReadState(now)) {  // an idle joint's trajectory starts where it is
+    trajectory_owners_.clear();
+    tracker_.Add(waypoints_, now, state_, tracked_, trajectory_owners_);
+    for (const auto& [client, joint] : trajectory_owners_) {
+      produced_.executed.push_back({client, CommandType::kJointSetPoint, joint});
+    }
+    EmitTracked();
+  }
+  waypoints_.clear();
+}
+
+void RobotDaemon::TrackTrajectories(TimePoint now) {
+  if (!tracker_.active()) return;
+  if (panic_.in_panic() || panic_.driver_halted()) {
+    tracker_.EndAll(now, "ended by panic", tracked_);
+    EmitTracked();
+    return;
+  }
+  tracker_.Sample(now, tracked_);
+  for (const JointReference& ref : tracker_.references()) {
+    DriverResult result;
+    if (Guarded("Track", nullptr, now, [&] { result = driver_->Track(ref, now, completions_); }) !=
+        CallOutcome::kOk) {
+      break;  // a fault: the next iteration ends every trajectory (panic)
+    }
+    if (result.signal != Signal::kSuccess && result.signal != Signal::kModified) {
+      tracker_.End(ref.joint, now,
+                   "driver '" + driver_name_ + "' refused to follow joint '" + model().joint(ref.joint).name +
+                       "': " + std::string(ToString(result.signal)) +
+                       (result.message.empty() ? "" : " " + result.message),
+                   tracked_);
+    }
+  }
+  EmitTracked();
+}
+
+void RobotDaemon::EndTrajectoriesFor(const QueuedItem& item, TimePoint now) {
+  if (!tracker_.active()) return;
+  const RobotModel& m = model();
+  const std::string why =
+      std::string("superseded by ") + ToString(item.command.type) + " " + std::to_string(item.command.id);
+  switch (Traits(item.command.type).target) {
+    case CommandTarget::kJoint:
+      tracker_.End(item.command.target, now, why, tracked_);
+      break;
+    case CommandTarget::kFrame:  // the joints on the frame's chain
+      for (int j = m.parent_joint(m.frame(item.command.target).parent_link); j >= 0;
+           j = m.parent_joint(m.joint(j).parent_link)) {
+        tracker_.End(j, now, why, tracked_);
+      }
+      break;
+    case CommandTarget::kBase:
+    case CommandTarget::kRobot:
+      break;
+  }
+  EmitTracked();
+}
+
 void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   Reply r;
   r.id = item.command.id;
@@ -471,6 +571,12 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     // vanished client owned (its GOTO included). Neither can be refused:
     // Stop() and StopOnly() answer nothing.
     const StopScope scope{.joints = item.stop_joints, .base = item.stop_base};
+    if (item.scoped_stop) {
+      for (int j : item.stop_joints) tracker_.End(j, now, "stopped: its client vanished", tracked_);
+    } else {
+      tracker_.EndAll(now, "stopped by STOP", tracked_);
+    }
+    EmitTracked();
     if (!driver_call(item.scoped_stop ? "StopOnly" : "Stop", [&] {
           if (item.scoped_stop) {
             driver_->StopOnly(scope, now, completions_);
@@ -496,6 +602,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     Emit(item.client_id, std::move(r));
     return;
   }
+  EndTrajectoriesFor(item, now);
   DriverCommand command = item.command;
   command.id = next_driver_id_++;
   DriverResult result;

@@ -43,6 +43,7 @@
 #include "robotalk/driver.h"
 #include "robotalk/kinematics.h"
 #include "scheduler.h"
+#include "trajectory_tracker.h"
 
 #include <Eigen/Core>
 #include <array>
@@ -79,6 +80,9 @@ struct RobotDaemonOptions {
   Duration final_spin = std::chrono::microseconds(50);
   double spin_share = 0.05;
   int fifo_priority = 10;
+  /// Trajectories' acceleration limit per dof (rad/s² | m/s², > 0): the
+  /// server's --max-acceleration (trajectory_tracker.h).
+  double max_acceleration = kDefaultTrajectoryAcceleration;
 };
 
 /// One broadcast state sample, preallocated for the model.
@@ -250,6 +254,14 @@ class RobotDaemon {
   // After a Halt that threw: a STOP, so the robot does not move on (a throw is logged).
   void StopInstead(TimePoint now);
   void Emit(std::int64_t client_id, Reply reply);
+  // Trajectories: the waypoints that arrived join their joints' trajectories
+  // (after this iteration's due items ran); every control period each active
+  // one is sampled and handed to the driver (Driver::Track).
+  void AddWaypoints(TimePoint now);
+  void TrackTrajectories(TimePoint now);
+  // A command that moves joints ends their trajectories first.
+  void EndTrajectoriesFor(const QueuedItem& item, TimePoint now);
+  void EmitTracked();
 
   const std::string robot_name_;
   const std::string driver_name_;
@@ -262,9 +274,10 @@ class RobotDaemon {
   // The inbox and outbox, shared with the ServerDaemon.
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  Scheduler scheduler_;     // GUARDED_BY(mutex_)
-  DaemonOutput outbox_;     // GUARDED_BY(mutex_)
-  bool wake_flag_ = false;  // GUARDED_BY(mutex_)
+  Scheduler scheduler_;                        // GUARDED_BY(mutex_)
+  std::vector<QueuedItem> arrived_waypoints_;  // GUARDED_BY(mutex_): QueuedItem::is_waypoint(), not yet taken
+  DaemonOutput outbox_;                        // GUARDED_BY(mutex_)
+  bool wake_flag_ = false;                     // GUARDED_BY(mutex_)
   /// The deadline the thread waits for; nullopt while it runs (Submit wakes it
   /// only for an item due before this).
   std::optional<TimePoint> sleeping_until_;  // GUARDED_BY(mutex_)
@@ -282,6 +295,10 @@ class RobotDaemon {
   std::function<bool()> woken_;  // the waiter's wake-up condition (under mutex_)
   bool spin_ = false;            // the next deadline is a start time or sample
   std::vector<QueuedItem> due_;
+  std::vector<QueuedItem> waypoints_;  // taken from arrived_waypoints_ this iteration
+  TrajectoryTracker tracker_;
+  std::vector<TrajectoryTracker::Answer> tracked_;  // the tracker's answers of this iteration
+  std::vector<std::pair<std::int64_t, int>> trajectory_owners_;
   std::vector<Completion> completions_;
   std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
   DaemonOutput produced_;

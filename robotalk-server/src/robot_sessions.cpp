@@ -200,7 +200,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   } else {
     for (const Query& q : r.queries) AdmitQuery(session, q, received, immediate, answer.publish_config);
     for (const Command& c : r.commands) {
-      auto item = Admit(session, c, received, immediate, /*playback=*/false);
+      auto item = Admit(session, c, received, immediate, /*playback=*/false, r.interpolation);
       if (item && !Superseded(session, *item, received, immediate)) daemon_.Submit(std::move(*item));
     }
   }
@@ -355,7 +355,8 @@ Reply RobotSessions::CommandStatus(const Session& s, const Query& q, TimePoint n
 }
 
 std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, TimePoint now,
-                                               std::vector<Reply>& immediate, bool playback) {
+                                               std::vector<Reply>& immediate, bool playback,
+                                               Interpolation interpolation) {
   const RobotModel& model = daemon_.model();
   if (c.type == CommandType::kPanicReset) {
     if (auto bad = CheckCommand(model, c, options_.limits)) {
@@ -432,6 +433,13 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   // CheckCommand bounds the count: at most 6 dofs, 7 pose values, 3 base values.
   item.command.num_values = static_cast<int>(c.values.size());
   std::copy(c.values.begin(), c.values.end(), item.command.values.begin());
+  // A waypoint's rates: CheckCommand bounds them to one per dof (a joint's
+  // at most 6) or 6 for a frame.
+  item.num_velocities = static_cast<int>(c.velocities.size());
+  std::copy(c.velocities.begin(), c.velocities.end(), item.velocities.begin());
+  item.num_accelerations = static_cast<int>(c.accelerations.size());
+  std::copy(c.accelerations.begin(), c.accelerations.end(), item.accelerations.begin());
+  item.interpolation = interpolation;
   return item;
 }
 

@@ -134,7 +134,7 @@ class RobotSessions {
   Reply CommandStatus(const Session& s, const Query& q, TimePoint now) const;
   // Checks a command; returns it ready to queue, or answers it in `immediate`.
   std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
-                                  bool playback);
+                                  bool playback, Interpolation interpolation = Interpolation::kStep);
   void AdmitPlayback(Session& s, const Request& request, TimePoint now, std::vector<Reply>& immediate);
   void Panic(std::int64_t client_id, TimePoint now, const std::string& sender = "");
   void Deliver(std::int64_t client_id, Reply reply);

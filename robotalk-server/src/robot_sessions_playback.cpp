@@ -63,6 +63,14 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
            false);
     return;
   }
+  if (created) seq.interpolation = r.interpolation;
+  if (seq.interpolation != r.interpolation) {
+    refuse(label + ": its packages are " + InterpolationName(seq.interpolation) + ", this one says " +
+               InterpolationName(r.interpolation) +
+               "; every package of a sequence has the same interpolation",
+           false);
+    return;
+  }
   if (!seq.first_arrival) {
     seq.first_arrival = now;
     seq.estimator->SetDelayHistory(s.delays.Recent(now));
@@ -70,7 +78,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   const std::optional<TimePoint> sent =
       r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
   for (const Command& c : r.commands) {
-    std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true);
+    std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true, r.interpolation);
     if (!item) {  // answered: one frame fewer to wait for
       ++seq.received;
       continue;

@@ -119,7 +119,8 @@ class Server::Impl {
     sessions.max_sessions_per_robot = options_.max_sessions_per_robot;
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
-                                            .precise_timing = options_.precise_timing};
+                                            .precise_timing = options_.precise_timing,
+                                            .max_acceleration = options_.max_acceleration};
     for (const RobotSpec& spec : specs) {
       for (const auto& robot : robots_) {
         if (robot->robot_name() == spec.name)

@@ -39,6 +39,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
   --log-executions                print one line per executed command (diagnostics)
+  --max-acceleration A            acceleration limit of every dof's trajectory, rad/s^2 or m/s^2
+                                  (interpolated waypoints; default 20)
   --driver-call-bound S           a driver call running longer than S seconds is a driver fault:
                                   its command answers ERROR, the robot is held in panic (default 2;
                                   0 = no bound)
@@ -135,6 +137,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.log_lines_per_second = static_cast<int>(ParseNumber(arg, value(), 1, 1e6));
       } else if (arg == "--driver-call-bound") {
         options.driver_call_bound = FromSeconds(ParseNumber(arg, value(), 0, 3600));
+      } else if (arg == "--max-acceleration") {
+        options.max_acceleration = ParseNumber(arg, value(), 1e-3, 1e6);
       } else if (arg == "--log-executions") {
         options.log_executions = true;
       } else if (arg == "--robot") {

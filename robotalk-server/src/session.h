@@ -107,6 +107,8 @@ struct PlaybackSequence {
   std::size_t total;
   Duration duration;
   std::size_t received = 0;
+  /// How its frames join (the first package's; every package must say the same).
+  Interpolation interpolation = Interpolation::kStep;
 
   /// Memory it holds beyond its map entry (buffer and estimator).
   std::size_t bytes() const {

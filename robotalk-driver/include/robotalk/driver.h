@@ -86,6 +86,16 @@ struct StopScope {
   bool base = false;
 };
 
+/// Where a joint should be at a time: a trajectory's sample (issue 22,
+/// docs/drivers.md "Following a trajectory"). Views the server's storage,
+/// valid for the call only; one value per dof of the joint each.
+struct JointReference {
+  int joint = -1;                        ///< RobotModel::joint index; never a mimic follower
+  std::span<const double> position;      ///< rad | m, within the dof's limits
+  std::span<const double> velocity;      ///< rad/s | m/s, within the velocity limit
+  std::span<const double> acceleration;  ///< rad/s² | m/s², within the server's acceleration limit
+};
+
 /// The robot's measured state. Sized by the server from the model once.
 struct RobotState {
   Eigen::VectorXd position;      ///< per dof (rad | m)
@@ -130,6 +140,18 @@ class Driver {
   virtual void StopOnly(const StopScope& /*scope*/, TimePoint now, std::vector<Completion>& interrupted) {
     Stop(now, interrupted);
   }
+  /// Follows `reference` from `now` on: called every control period, just
+  /// before Update(now), for each joint whose trajectory is active (a
+  /// JOINT_SETPOINT waypoint of an interpolated package), until the
+  /// trajectory has come to rest. The server samples the trajectory; the
+  /// driver tracks it (the kinematic driver exactly; the ODE driver with its
+  /// servo and velocity feed-forward). Not called between Halt() and Resume().
+  /// A non-SUCCESS/MODIFIED answer ends the joint's trajectory, its waypoints
+  /// answered with it. Default: a JOINT_SETPOINT of the reference's position,
+  /// which the driver chases as any set-point (so a driver that does not
+  /// override this still moves through the waypoints, a period behind).
+  virtual DriverResult Track(const JointReference& reference, TimePoint now,
+                             std::vector<Completion>& completed);
   /// Advances the robot to `now` (one period after the previous call);
   /// appends the completions of commands that finished.
   virtual void Update(TimePoint now, std::vector<Completion>& completed) = 0;

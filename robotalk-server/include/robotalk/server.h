@@ -53,6 +53,10 @@ struct ServerOptions {
   /// A GOTO target farther than this from the world origin (m) is refused
   /// with ERROR naming both (robotalk::CommandLimits).
   double max_goto_distance = kDefaultMaxGotoDistance;
+  /// The acceleration limit of every dof's trajectory (interpolated
+  /// waypoints: time-scaling and the hold after the last one), rad/s² or
+  /// m/s² (`--max-acceleration`; docs/protocol.md, Trajectories).
+  double max_acceleration = 20.0;
   /// Print one stderr line per executed command (diagnostics).
   bool log_executions = false;
   /// A driver call running longer than this is a driver fault: its command

@@ -1,0 +1,143 @@
+// The RobotDaemon's trajectories (issue 22): the timed JOINT_SETPOINT
+// waypoints of interpolated packages, joined per joint into a
+// robotalk::Trajectory and sampled every control period into the reference
+// the driver follows (Driver::Track). A pure class: no threads, no clock, no
+// driver calls; the RobotDaemon feeds it arrivals and times.
+//
+// The rules (docs/protocol.md, Trajectories):
+// - A waypoint is taken when it arrives. An idle joint's trajectory starts at
+//   that moment from the joint's measured position and velocity.
+// - A waypoint at or before the trajectory's last one replaces the remainder
+//   from its time on (a splice): the replaced waypoints answer INTERRUPTED,
+//   naming the command that replaced them, whichever client sent it ("last
+//   commanded wins", as ownership). Position and velocity (and acceleration,
+//   quintic) stay continuous.
+// - A waypoint appended after the last one re-plans only the segments that
+//   depend on it (the previous waypoint's velocity is chosen again now that
+//   its next one is known): a stream of single-waypoint packages runs
+//   smoothly, not stop-and-go.
+// - Limits: a waypoint outside the joint's position limits is clamped. A plan
+//   whose velocity (URDF) or acceleration (the server's --max-acceleration)
+//   exceeds the limits keeps its times -- the client's timing is the
+//   contract, and time-scaling would make every later waypoint of a stream
+//   land before the stretched ones -- and the reference is limited instead:
+//   it follows the plan exactly while the plan is within the limits, and
+//   otherwise approaches it at most at the velocity and acceleration limits
+//   until it is back on it. The waypoints concerned answer MODIFIED naming
+//   the limit and the value (and how far the reference was from them at
+//   their time). So no reference beyond a position, velocity or acceleration
+//   limit, and no velocity step beyond one period's worth of the acceleration
+//   limit, ever reaches a driver.
+// - After the last waypoint the trajectory holds (decelerating within the
+//   acceleration limit); it never extrapolates.
+// - A waypoint that arrives after its time: INTERRUPTED when a later waypoint
+//   of the joint is already planned; otherwise it is joined one control
+//   period from now (time-scaled if it must be) and answers MODIFIED.
+// - Each waypoint is answered when the trajectory passes it: SUCCESS, or
+//   MODIFIED with what was changed.
+//
+// Allocation: Sample() does not allocate once every joint has had a
+// trajectory (answers with a message allocate it); Add() and End() do.
+#pragma once
+
+#include "command_queue.h"
+#include "robotalk/command.h"
+#include "robotalk/driver.h"
+#include "robotalk/robot_model.h"
+#include "robotalk/trajectory.h"
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace robotalk {
+
+/// The default of TrackerOptions::acceleration_limit (rad/s² or m/s²).
+inline constexpr double kDefaultTrajectoryAcceleration = 20.0;
+
+struct TrackerOptions {
+  /// Per dof, for time-scaling and the hold after the last waypoint (> 0).
+  double acceleration_limit = kDefaultTrajectoryAcceleration;
+  /// The driver's control period: a late waypoint is joined this far ahead.
+  Duration period = std::chrono::milliseconds(10);
+};
+
+class TrajectoryTracker {
+ public:
+  struct Answer {
+    std::int64_t client_id = 0;
+    Reply reply;
+  };
+
+  TrajectoryTracker(const RobotModel& model, TrackerOptions options);
+
+  /// Adds the waypoints that arrived (QueuedItem::is_waypoint(), any joints,
+  /// in arrival order) at `now`; `state` is the robot's measured state.
+  /// Refused, replaced and superseded waypoints are answered in `answers`.
+  /// `started` gets (client, joint) for every joint whose trajectory this
+  /// made that client's (ownership).
+  void Add(std::span<const QueuedItem> waypoints, TimePoint now, const RobotState& state,
+           std::vector<Answer>& answers, std::vector<std::pair<std::int64_t, int>>& started);
+
+  /// Samples every active trajectory at `now` into references(); answers the
+  /// waypoints passed by `now`. A trajectory that has passed its last waypoint
+  /// and come to rest ends (its joint holds there: the last reference).
+  void Sample(TimePoint now, std::vector<Answer>& answers);
+  /// The references of the last Sample(): one per joint with an active trajectory.
+  std::span<const JointReference> references() const { return references_; }
+
+  /// Ends joint `joint`'s trajectory: every waypoint not yet passed answers
+  /// INTERRUPTED with `why`. No-op for a joint without one.
+  void End(int joint, TimePoint now, const std::string& why, std::vector<Answer>& answers);
+  /// Ends every trajectory.
+  void EndAll(TimePoint now, const std::string& why, std::vector<Answer>& answers);
+  /// Ends every trajectory of `client_id`'s joints (waypoints of others on them included).
+  bool active() const { return active_ > 0; }
+  bool active(int joint) const { return tracks_[static_cast<std::size_t>(joint)].trajectory.has_value(); }
+  /// Waypoints waiting to be passed, over every joint (for tests and bounds).
+  std::size_t pending() const;
+
+ private:
+  struct Pending {  // a waypoint not yet passed: the trajectory's last knots, in order
+    std::int64_t client_id = 0;
+    CommandId id = 0;
+    TimePoint requested{};  // the time the client asked for
+    Waypoint waypoint;      // as given (position clamped; rates as given or empty)
+    std::string note;       // why it is MODIFIED, or ""
+  };
+  struct Track {
+    std::optional<Trajectory> trajectory;
+    std::deque<Pending> pending;
+    TrajectorySample sample;
+    TrajectoryLimits limits;
+    // The reference handed to the driver (limited), and whether it is the plan's sample.
+    Eigen::VectorXd ref_position, ref_velocity, ref_acceleration;
+    TimePoint last_sample{};
+    bool on_plan = true;
+    bool fresh = false;      // started at last_sample: its first reference is its start state
+    std::int64_t owner = 0;  // the client of its latest waypoint
+    std::string limited;     // the first limit the reference met since the last waypoint passed
+    int first_dof = 0;
+    int dofs = 0;
+  };
+
+  void AddOne(int joint, const QueuedItem& item, TimePoint now, const RobotState& state,
+              std::vector<Answer>& answers, std::vector<std::pair<std::int64_t, int>>& started);
+  void Interrupt(Track& t, std::size_t from, TimePoint now, const std::string& why,
+                 std::vector<Answer>& answers);
+  // The reference from the plan's sample: the plan itself while it is within
+  // the limits and the reference is on it; else a rate-limited approach.
+  void Limit(Track& t, TimePoint now);
+
+  const RobotModel& model_;
+  TrackerOptions options_;
+  std::vector<Track> tracks_;  // per joint
+  std::vector<JointReference> references_;
+  int active_ = 0;
+};
+
+}  // namespace robotalk
