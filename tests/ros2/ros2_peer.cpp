@@ -274,14 +274,16 @@ int main(int argc, char** argv) {
   for (std::size_t k = 0; k < points.size(); ++k) {
     const TimePoint due = server_start + times[k];
     const std::array<double, 2> from = k == 0 ? std::array<double, 2>{0, 0} : points[k - 1];
-    const LcmSample* first_move = nullptr;
+    const LcmSample* first_move = nullptr;  // the first sample away from `from` once the robot was there
     const LcmSample* reached = nullptr;
+    bool was_at_from = false;
     for (const LcmSample& s : heard.lcm) {
-      const bool moved =
-          std::abs(s.positions[pan] - from[0]) > 1e-6 || std::abs(s.positions[tilt] - from[1]) > 1e-6;
+      const bool at_from =
+          std::abs(s.positions[pan] - from[0]) < 1e-9 && std::abs(s.positions[tilt] - from[1]) < 1e-9;
       const bool at = std::abs(s.positions[pan] - points[k][0]) < 1e-9 &&
                       std::abs(s.positions[tilt] - points[k][1]) < 1e-9;
-      if (!first_move && moved && s.server_time > due - 300ms) first_move = &s;
+      was_at_from = was_at_from || at_from;
+      if (!first_move && was_at_from && !at_from) first_move = &s;
       if (!reached && at) reached = &s;
     }
     const std::string name =
