@@ -36,8 +36,23 @@ cat "$tmp/peer.out"
 check "the DDS peer's checks pass (status $status)" test "$status" -eq 0
 check "the bridge says when the trajectory starts: $(grep trajectory "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': trajectory of 3 points starts in 0\.[3-6][0-9]* s, 6 JOINT_SETPOINTs" "$tmp/bridge.log"
-check "no command was refused: $(grep -v -e bridged -e trajectory "$tmp/bridge.log")" \
-  test -z "$(grep -v -e bridged -e "trajectory of" "$tmp/bridge.log")"
+"$peer" bad_trajectory pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer_bad.out" 2>&1
+status=$?
+cat "$tmp/peer_bad.out"
+check "a bad trajectory moves nothing (status $status)" test "$status" -eq 0
+check "and the bridge says why: $(grep refused "$tmp/bridge.log")" \
+  grep -q "robot 'pioneer': trajectory refused: JointTrajectory: joint_names\[0\] 'nek': robot 'pioneer' has no joint" "$tmp/bridge.log"
+
+# cmd_vel drives the base; a silent cmd_vel stops it (a dead teleop).
+"$peer" cmd_vel pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer_vel.out" 2>&1
+status=$?
+cat "$tmp/peer_vel.out"
+check "the cmd_vel checks pass (status $status)" test "$status" -eq 0
+check "the bridge says it stopped the base: $(grep cmd_vel "$tmp/bridge.log")" \
+  grep -q "robot 'pioneer': no cmd_vel for 0.5.* s: SETSPEED 0" "$tmp/bridge.log"
+
+check "no command was refused: $(grep -v -e bridged -e trajectory -e cmd_vel "$tmp/bridge.log")" \
+  test -z "$(grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel" "$tmp/bridge.log")"
 
 # SIGINT stops the bridge: it sends STOP to the
 # robot the bridge set moving, and the bridge exits 0.

@@ -47,6 +47,7 @@ double Ms(Duration d) { return std::chrono::duration<double, std::milli>(d).coun
 struct LcmSample {
   TimePoint server_time, received;
   std::vector<double> positions;
+  BaseState base;
 };
 struct JointStateSeen {
   RosTime stamp;
@@ -179,7 +180,7 @@ int main(int argc, char** argv) {
   client.Connect(robot);
   const RobotModel model = client.model();
   client.StartStateStream(std::chrono::milliseconds(period_ms), [&](const StateSample& s) {
-    LcmSample l{s.server_time, SteadyNow(), s.positions};
+    LcmSample l{s.server_time, SteadyNow(), s.positions, s.base};
     std::lock_guard lock(heard.mu);
     heard.lcm.push_back(std::move(l));
   });
@@ -198,6 +199,54 @@ int main(int argc, char** argv) {
     for (const auto& s : heard.joint_states) dds.push_back(Ms(s.received - SteadyOf(s.stamp)));
     Percentiles("LCM STATE (server sample -> peer)", lcm);
     Percentiles("DDS JointState (server sample -> bridge -> peer)", dds);
+    return failures ? 1 : 0;
+  }
+
+  if (mode == "cmd_vel") {
+    // Drives the base for 0.5 s at 10 Hz, then falls silent as a dead teleop
+    // would: the bridge must stop the base by itself.
+    DdsWriter twist_writer(participant, geometry_msgs_msg_dds__Twist__desc, ns + "/cmd_vel", kDefaultQos);
+    Check(WaitFor(heard, 5s, [&] { return twist_writer.matched_readers() > 0; }),
+          "the bridge subscribes to cmd_vel");
+    geometry_msgs_msg_dds__Twist_ twist{{0.2, 0, 0}, {0, 0, 0.1}};
+    for (int i = 0; i < 5; ++i) {
+      twist_writer.Write(&twist);
+      std::this_thread::sleep_for(100ms);
+    }
+    const TimePoint last_sent = client.ServerNow();
+    std::this_thread::sleep_for(1500ms);
+    std::lock_guard lock(heard.mu);
+    bool drove = false;
+    const LcmSample* stopped = nullptr;
+    for (const LcmSample& l : heard.lcm) {
+      drove = drove || std::abs(l.base.v - 0.2) < 1e-9;
+      if (!stopped && drove && l.server_time > last_sent && l.base.v == 0 && l.base.omega == 0) stopped = &l;
+    }
+    Check(drove, "cmd_vel drives the base (v 0.2 m/s in the STATE stream)");
+    Check(stopped && stopped->server_time < last_sent + 800ms,
+          "the base stops by itself once cmd_vel falls silent (" +
+              (stopped ? std::to_string(Ms(stopped->server_time - last_sent)) + " ms after the last"
+                       : "never") +
+              ")");
+    Check(!heard.lcm.empty() && heard.lcm.back().base.v == 0, "and stays stopped");
+    return failures ? 1 : 0;
+  }
+  if (mode == "bad_trajectory") {
+    std::vector<char*> jn = {const_cast<char*>("nek")};
+    double value = 0.3;
+    trajectory_msgs_msg_dds__JointTrajectoryPoint_ point{};
+    point.positions = {1, 1, &value, false};
+    trajectory_msgs_msg_dds__JointTrajectory_ msg{};
+    msg.header.frame_id = const_cast<char*>("");
+    msg.joint_names = {1, 1, jn.data(), false};
+    msg.points = {1, 1, &point, false};
+    Check(WaitFor(heard, 5s, [&] { return trajectory_writer.matched_readers() > 0; }),
+          "the bridge subscribes to joint_trajectory");
+    trajectory_writer.Write(&msg);
+    std::this_thread::sleep_for(500ms);
+    std::lock_guard lock(heard.mu);
+    Check(!heard.lcm.empty() && heard.lcm.back().positions == heard.lcm.front().positions,
+          "a trajectory naming an unknown joint moves nothing");
     return failures ? 1 : 0;
   }
 
