@@ -197,8 +197,35 @@ int main(int argc, char** argv) {
     std::vector<double> lcm, dds;
     for (const auto& s : heard.lcm) lcm.push_back(Ms(s.received - client.ClientTime(s.server_time)));
     for (const auto& s : heard.joint_states) dds.push_back(Ms(s.received - SteadyOf(s.stamp)));
+    // Added latency per sample on this process's clock alone: the JointState
+    // received minus the same sample's STATE received. A JointState is
+    // matched to the STATE sample whose time is nearest its stamp (the two
+    // clock-sync estimates differ by far less than a period).
+    std::vector<double> added;
+    std::size_t unmatched = 0;
+    std::size_t from = 0;
+    for (const auto& j : heard.joint_states) {
+      const TimePoint at = SteadyOf(j.stamp);
+      while (from + 1 < heard.lcm.size() && client.ClientTime(heard.lcm[from + 1].server_time) <= at) ++from;
+      const LcmSample* best = nullptr;
+      for (std::size_t i = from; i < std::min(from + 2, heard.lcm.size()); ++i) {
+        const Duration d(std::abs((client.ClientTime(heard.lcm[i].server_time) - at).count()));
+        if (d < std::chrono::milliseconds(period_ms) / 3 &&
+            (!best || d < Duration(std::abs((client.ClientTime(best->server_time) - at).count())))) {
+          best = &heard.lcm[i];
+        }
+      }
+      if (best) {
+        added.push_back(Ms(j.received - best->received));
+      } else {
+        ++unmatched;
+      }
+    }
     Percentiles("LCM STATE (server sample -> peer)", lcm);
     Percentiles("DDS JointState (server sample -> bridge -> peer)", dds);
+    Percentiles("added: JointState received - the same sample's STATE received", added);
+    std::printf("JointStates not matched to a STATE sample: %zu of %zu\n", unmatched,
+                heard.joint_states.size());
     return failures ? 1 : 0;
   }
 
