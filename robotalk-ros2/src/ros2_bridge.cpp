@@ -51,15 +51,20 @@ struct Pending {
 // One bridged robot. Built whole by the connector thread, then shared.
 struct RobotLink {
   std::string name, token, prefix, root_frame;
-  std::unique_ptr<RobotClient> client;
   std::unique_ptr<RobotModel> model;
   BaseType base = BaseType::kFixed;
-  std::unique_ptr<RobotFrames> frames;  // ReadDaemon thread only
+  std::unique_ptr<RobotFrames> frames;  // publish_mu
   std::unique_ptr<JointStateBuffer> joint_state_buffer;
   TfBuffer tf_buffer;
   std::string urdf;
   std::unique_ptr<DdsWriter> joint_states, odom, description;
   std::unique_ptr<DdsReader> trajectory, cmd_vel;
+
+  // Held by the stream callback while it publishes: Close() takes it to know
+  // no sample is being published with what it is about to destroy (the
+  // client may still call back after StopStateStream, or when that fails).
+  std::mutex publish_mu;
+  bool closed = false;  // GUARDED_BY(publish_mu)
 
   std::mutex mu;
   std::vector<Pending> pending;  // GUARDED_BY(mu)
@@ -68,9 +73,12 @@ struct RobotLink {
   std::atomic<bool> base_moving{false};
   std::atomic<bool> twist_note_told{false};
 
-  // ReadDaemon thread only until the client stops.
+  // publish_mu.
   std::vector<std::int64_t> latencies_ns;
   std::uint64_t samples = 0, publish_failures = 0;
+
+  // Last: destroyed first, which joins its ReadDaemon before the writers go.
+  std::unique_ptr<RobotClient> client;
 };
 
 class Ros2Bridge::Impl {
@@ -237,6 +245,8 @@ class Ros2Bridge::Impl {
 
   void OnSample(RobotLink& r, const StateSample& s) {
     const auto in = std::chrono::steady_clock::now();
+    std::lock_guard lock(r.publish_mu);
+    if (r.closed) return;
     try {
       const RosTime stamp = ToRosTime(ToSystem(r.client->ClientTime(s.server_time)));
       r.joint_states->Write(&r.joint_state_buffer->Fill(stamp, s));
@@ -370,6 +380,10 @@ class Ros2Bridge::Impl {
       std::lock_guard lock(r.mu);
       moved = r.set_moving;
     }
+    {
+      std::lock_guard lock(r.publish_mu);
+      r.closed = true;
+    }
     try {
       r.client->StopStateStream();
       if (moved) {
@@ -388,7 +402,7 @@ class Ros2Bridge::Impl {
   std::vector<FrameTransform> static_all_;  // GUARDED_BY(static_mu_)
   TfBuffer static_buffer_;                  // GUARDED_BY(static_mu_)
 
-  std::mutex mu_;
+  mutable std::mutex mu_;
   std::condition_variable cv_;
   bool stopping_ = false;                                     // GUARDED_BY(mu_)
   std::set<std::string> wanted_;                              // GUARDED_BY(mu_)
@@ -407,8 +421,15 @@ std::string Ros2Bridge::Impl::StatsText() const {
   const double wall = std::chrono::duration<double>(end_ - start_).count();
   out << "robotalk-ros2 stats: wall " << wall << " s, CPU " << cpu(usage_end_) - cpu(usage_start_) << " s ("
       << 100.0 * (cpu(usage_end_) - cpu(usage_start_)) / std::max(wall, 1e-9) << " % of one core)\n";
+  std::lock_guard lock(mu_);
   for (const auto& [name, r] : robots_) {
-    std::vector<std::int64_t> l = r->latencies_ns;
+    std::vector<std::int64_t> l;
+    std::uint64_t samples = 0;
+    {
+      std::lock_guard publish(r->publish_mu);
+      l = r->latencies_ns;
+      samples = r->samples;
+    }
     std::sort(l.begin(), l.end());
     const auto pct = [&](double p) {
       return l.empty()
@@ -416,7 +437,7 @@ std::string Ros2Bridge::Impl::StatsText() const {
                  : l[std::min(l.size() - 1, static_cast<std::size_t>(p * static_cast<double>(l.size())))] *
                        1e-3;
     };
-    out << "robot " << name << ": " << r->samples << " samples published; STATE in -> DDS out (us): p50 "
+    out << "robot " << name << ": " << samples << " samples published; STATE in -> DDS out (us): p50 "
         << pct(0.5) << " p90 " << pct(0.9) << " p99 " << pct(0.99) << " max " << pct(1.0) << "\n";
   }
   return out.str();

@@ -210,7 +210,7 @@ int main(int argc, char** argv) {
       const LcmSample* best = nullptr;
       for (std::size_t i = from; i < std::min(from + 2, heard.lcm.size()); ++i) {
         const Duration d(std::abs((client.ClientTime(heard.lcm[i].server_time) - at).count()));
-        if (d < std::chrono::milliseconds(period_ms) / 3 &&
+        if (d < Duration(std::chrono::milliseconds(period_ms)) / 3 &&
             (!best || d < Duration(std::abs((client.ClientTime(best->server_time) - at).count())))) {
           best = &heard.lcm[i];
         }
