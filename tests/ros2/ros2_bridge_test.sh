@@ -30,24 +30,22 @@ pids+=("$bridge_pid")
 for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge.log" 2>/dev/null && break; sleep 0.1; done
 check "the bridge connects with its key: $(cat "$tmp/bridge.log")" grep -q "robot 'pioneer' bridged (DDS domain 25)" "$tmp/bridge.log"
 
-"$peer" check pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer.out" 2>&1
-status=$?
-cat "$tmp/peer.out"
-check "the DDS peer's checks pass (status $status)" test "$status" -eq 0
+peer_checks() {  # peer_checks MODE WHAT: ros2_peer MODE's own checks, printed, must all pass
+  "$peer" "$1" pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer_$1.out" 2>&1
+  local status=$?
+  cat "$tmp/peer_$1.out"
+  check "$2 (ros2_peer $1: status $status)" test "$status" -eq 0
+}
+
+peer_checks check "joint states, tf and the robot description follow the robot; a trajectory runs on time"
 check "the bridge says when the trajectory starts: $(grep trajectory "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': trajectory of 3 points starts in 0\.[3-6][0-9]* s, 6 JOINT_SETPOINTs" "$tmp/bridge.log"
-"$peer" bad_trajectory pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer_bad.out" 2>&1
-status=$?
-cat "$tmp/peer_bad.out"
-check "a bad trajectory moves nothing (status $status)" test "$status" -eq 0
+peer_checks bad_trajectory "a bad trajectory moves nothing"
 check "and the bridge says why: $(grep refused "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': trajectory refused: JointTrajectory: joint_names\[0\] 'nek': robot 'pioneer' has no joint" "$tmp/bridge.log"
 
 # cmd_vel drives the base; a silent cmd_vel stops it (a dead teleop).
-"$peer" cmd_vel pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer_vel.out" 2>&1
-status=$?
-cat "$tmp/peer_vel.out"
-check "the cmd_vel checks pass (status $status)" test "$status" -eq 0
+peer_checks cmd_vel "cmd_vel drives the base, and a silent cmd_vel stops it"
 check "the bridge says it stopped the base: $(grep cmd_vel "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': no cmd_vel for 0.5.* s: SETSPEED 0" "$tmp/bridge.log"
 
