@@ -207,7 +207,6 @@ class Ros2Bridge::Impl {
                                                  ns + "/robot_description", kLatchedQos);
     const auto description = MakeString(r->urdf);
     r->description->Write(&description);
-    PublishStatic(*r);
     RobotLink* raw = r.get();
     r->client->StartStateStream(options_.period, [this, raw](const StateSample& s) { OnSample(*raw, s); });
     std::string topics = ns + "/joint_states, /tf, /tf_static, " + ns + "/robot_description";
@@ -229,6 +228,7 @@ class Ros2Bridge::Impl {
         topics += ", " + ns + "/cmd_vel";
       }
     }
+    PublishStatic(*r);  // last: a robot that failed to connect adds none (it is tried again)
     Log("robot '" + name + "' bridged (DDS domain " + std::to_string(options_.domain) + "): publishes " +
         topics);
     return r;
