@@ -7,6 +7,11 @@
 //     robot_description, tf_static, joint_states, tf and odom arrive and
 //     follow the STATE stream; a JointTrajectory stamped 0.6 s ahead moves
 //     the robot through its points on time. Exit 0 when every check passes.
+//   ros2_peer bad_trajectory ROBOT --url URL [--key FILE]
+//     a JointTrajectory naming an unknown joint moves nothing.
+//   ros2_peer cmd_vel ROBOT --url URL [--key FILE]
+//     Twists at 10 Hz for 0.5 s drive the base; once they stop, the base
+//     stops within 0.8 s (the bridge's cmd_vel timeout) and stays stopped.
 //   ros2_peer measure ROBOT --url URL [--key FILE] --seconds S
 //     per sample, LCM latency (server sample time -> STATE received here) and
 //     DDS latency (the same sample time, as JointState's stamp -> JointState
