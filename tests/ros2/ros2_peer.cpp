@@ -324,6 +324,8 @@ int main(int argc, char** argv) {
             tilt = model.dof_offset(model.JointIndex("tilt"));
   const std::vector<std::array<double, 2>> points = {{0.2, -0.1}, {-0.2, 0.2}, {0.4, 0.0}};
   const std::vector<Duration> times = {0ms, 400ms, 800ms};
+  Check(WaitFor(heard, 5s, [&] { return trajectory_writer.matched_readers() > 0; }),
+        "the bridge subscribes to joint_trajectory");
   const TimePoint server_start = client.ServerNow() + 600ms;
   const RosTime stamp = ToRosTime(SystemNow() + 600ms);
   {
@@ -343,8 +345,6 @@ int main(int argc, char** argv) {
     msg.header.frame_id = const_cast<char*>("");
     msg.joint_names = {2, 2, jn.data(), false};
     msg.points = {static_cast<uint32_t>(pts.size()), static_cast<uint32_t>(pts.size()), pts.data(), false};
-    Check(WaitFor(heard, 5s, [&] { return trajectory_writer.matched_readers() > 0; }),
-          "the bridge subscribes to joint_trajectory");
     trajectory_writer.Write(&msg);
   }
   std::this_thread::sleep_for(600ms + 800ms + 700ms);
