@@ -71,8 +71,9 @@ TEST_F(LogplayInterpolationTest, AnInterpolatedSessionReplaysWithItsInterpolatio
   for (const Request& r : replayed) {
     for (const Command& c : r.commands) {
       EXPECT_TRUE(c.start_time.is_at());  // every frame is timed on replay
-      if (c.target == "pan" && c.values == std::vector<double>{0.04})
+      if (c.target == "pan" && c.values == std::vector<double>{0.04}) {
         EXPECT_EQ(c.velocities, std::vector<double>{0.5});
+      }
     }
   }
 

@@ -123,7 +123,14 @@ std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions&
     c.id = 0;
     c.start_time.reset();
     if (auto it = options.rename.find(c.target); it != options.rename.end()) c.target = it->second;
-    frames.push_back({FromSeconds((f.offset_s - options.from_s) / options.speed), std::move(c)});
+    // F times faster: a waypoint's velocities F times, its accelerations F² times.
+    for (double& v : c.velocities) v *= options.speed;
+    for (double& a : c.accelerations) a *= options.speed * options.speed;
+    // A set-point sent without a start time was a step whatever its package
+    // said; replayed, every frame is timed, so it says step again.
+    const bool was_timed = f.source->mode == RequestMode::kPlayback || f.source->start_us != 0;
+    frames.push_back({FromSeconds((f.offset_s - options.from_s) / options.speed), std::move(c),
+                      was_timed ? f.source->interpolation : Interpolation::kStep});
   }
   if (frames.empty()) throw LogError("the window holds no command");
   return frames;
