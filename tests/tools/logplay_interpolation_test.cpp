@@ -10,6 +10,8 @@
 
 #include <gmock/gmock.h>
 
+#include <sstream>
+
 namespace robotalk {
 namespace {
 
@@ -45,6 +47,9 @@ TEST_F(LogplayInterpolationTest, AnInterpolatedSessionReplaysWithItsInterpolatio
   logplay::SessionLog log;
   std::int64_t t = 1;
   for (const auto& [channel, bytes] : Heard()) log.Add(channel, t++, bytes);
+  std::ostringstream info;
+  logplay::PrintInfo(log, "session.lcmlog", info);
+  EXPECT_THAT(info.str(), ::testing::HasSubstr("; interpolation step 1, cubic 3, quintic 2"));
   const logplay::Timeline timeline = log.MakeTimeline({.client_id = client_->client_id()});
   ASSERT_EQ(timeline.frames.size(), 6u);
   const std::vector<TimedCommand> frames = logplay::ToFrames(timeline, {.speed = 2.0});

@@ -40,6 +40,10 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
 /// `info`: channels, span, servers, robots, clients and their command streams.
 void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out);
 
+/// "; interpolation cubic 40, step 2": how many of `each` travelled in
+/// packages of each interpolation; "" when all are step (info, replay).
+std::string DescribeInterpolations(const std::vector<Interpolation>& each);
+
 /// A number as info, extract and export write it (%.10g).
 std::string Num(double v);
 /// "direct", "delay", "playback".

@@ -69,6 +69,11 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
   if (absolute) out << " absolute " << absolute;
   if (now) out << " now " << now;
   if (playback) out << " playback offsets " << playback;
+  std::vector<Interpolation> interpolations;
+  for (const LoggedCommand& lc : log.commands()) {
+    if (lc.client_id == c.id && !lc.panic) interpolations.push_back(lc.interpolation);
+  }
+  out << DescribeInterpolations(interpolations);
   try {
     const Timeline t = log.MakeTimeline({.client_id = c.id});
     out << "; " << t.frames.size() << " frames over " << cli::FormatSeconds(t.frames.back().offset_s) << " ("
@@ -84,6 +89,17 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
 }
 
 }  // namespace
+
+std::string DescribeInterpolations(const std::vector<Interpolation>& each) {
+  std::map<Interpolation, int> count;
+  for (const Interpolation i : each) ++count[i];
+  if (count.empty() || (count.size() == 1 && count.begin()->first == Interpolation::kStep)) return "";
+  std::string text;
+  for (const auto& [interpolation, n] : count)
+    text += (text.empty() ? "; interpolation " : ", ") + std::string(InterpolationName(interpolation)) + " " +
+            std::to_string(n);
+  return text;
+}
 
 std::string Num(double v) {
   char buf[40];

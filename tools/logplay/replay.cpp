@@ -26,17 +26,11 @@ std::set<std::string> UnknownTargets(const RobotModel& model, const std::vector<
   return unknown;
 }
 
-// "; interpolation cubic 40, step 2": each recorded package's interpolation
-// travels with its frames (RunSequence groups them); "" when all are step.
-std::string Interpolations(const std::vector<TimedCommand>& frames) {
-  std::map<Interpolation, int> count;
-  for (const TimedCommand& f : frames) ++count[f.interpolation.value_or(Interpolation::kStep)];
-  if (count.size() == 1 && count.begin()->first == Interpolation::kStep) return "";
-  std::string text = "; interpolation";
-  for (const auto& [interpolation, n] : count)
-    text += std::string(text.back() == 'n' ? " " : ", ") + InterpolationName(interpolation) + " " +
-            std::to_string(n);
-  return text;
+// "; interpolation cubic 40, step 2", or "" when every frame is a step.
+std::string InterpolationsOf(const std::vector<TimedCommand>& frames) {
+  std::vector<Interpolation> each;
+  for (const TimedCommand& f : frames) each.push_back(f.interpolation.value_or(Interpolation::kStep));
+  return DescribeInterpolations(each);
 }
 
 std::string Describe(const Selection& s) {
@@ -68,7 +62,7 @@ int Replay(const SessionLog& log, const ReplayOptions& o, std::ostream& out) {
   const Duration duration = frames.back().offset;
   out << "replaying " << frames.size() << " commands of " << Describe(selection) << " onto '" << o.robot
       << "' in " << ToString(o.sequence.mode) << " mode over " << cli::FormatDuration(duration)
-      << " (timing from " << timeline.clock << " clock" << Interpolations(frames) << ")\n"
+      << " (timing from " << timeline.clock << " clock" << InterpolationsOf(frames) << ")\n"
       << std::flush;
 
   std::map<std::string, int> signals;
