@@ -145,5 +145,16 @@ TEST(SequenceFile, TheExampleSquareParses) {
   EXPECT_EQ(entries.back().command.type, CommandType::kStop);
 }
 
+TEST(SequenceFile, TheExamplePanWaypointsParsesInterpolated) {
+  std::ifstream in(std::string(ROBOTALK_EXAMPLES_DIR) + "/pan_waypoints.txt");
+  ASSERT_TRUE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  const SequenceFile file = ParseSequenceFile(text.str(), "pan_waypoints.txt");
+  EXPECT_EQ(file.interpolation, Interpolation::kCubic);
+  EXPECT_EQ(file.entries.size(), 7u);
+  EXPECT_EQ(file.entries.back().command.accelerations, std::vector<double>{0.0});
+}
+
 }  // namespace
 }  // namespace robotalk::cli
