@@ -22,7 +22,12 @@ struct SequenceFlags {
   SequenceOptions options;
   bool any = false;                            // a mode flag was given (only valid with --file)
   std::optional<Interpolation> interpolation;  // --interpolation: overrides the file's
+  bool delay_given = false;                    // --delay
 };
+
+// Delay mode's default lead for an interpolated sequence: its first
+// waypoints must arrive before their time, or the server skips them.
+constexpr Duration kInterpolatedDelay = std::chrono::milliseconds(500);
 
 // --mode direct|delay|playback, --delay S, --paced, --interpolation WORD.
 SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
@@ -42,6 +47,7 @@ SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
     if (d < 0) throw UsageError("--delay " + delay + " is negative");
     if (f.options.mode != CommandMode::kDelay) throw UsageError("--delay goes with --mode delay");
     f.options.delay = FromSeconds(d);
+    f.delay_given = true;
     f.any = true;
   }
   if (TakeOption(args, "--paced", nullptr)) {
@@ -88,6 +94,8 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
     throw UsageError(std::string("interpolation ") + InterpolationName(options.interpolation) +
                      " needs --mode delay or playback (a direct frame has no start time, so it is a step)");
   }
+  if (options.mode == CommandMode::kDelay && options.interpolation != Interpolation::kStep && !flags.delay_given)
+    options.delay = kInterpolatedDelay;
   std::vector<TimedCommand> frames;
   bool rates = false;
   for (const auto& e : entries) {
