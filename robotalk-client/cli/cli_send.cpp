@@ -94,7 +94,8 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
     throw UsageError(std::string("interpolation ") + InterpolationName(options.interpolation) +
                      " needs --mode delay or playback (a direct frame has no start time, so it is a step)");
   }
-  if (options.mode == CommandMode::kDelay && options.interpolation != Interpolation::kStep && !flags.delay_given)
+  if (options.mode == CommandMode::kDelay && options.interpolation != Interpolation::kStep &&
+      !flags.delay_given)
     options.delay = kInterpolatedDelay;
   std::vector<TimedCommand> frames;
   bool rates = false;

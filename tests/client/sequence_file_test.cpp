@@ -135,22 +135,23 @@ TEST(SequenceFile, ABadInterpolationOrRateNamesTheWordAndWhatIsAccepted) {
             "seq.txt:1: FRAME_SETPOINT takes 7 values (x y z qw qx qy qz), got 3");
 }
 
-TEST(SequenceFile, TheExampleSquareParses) {
-  std::ifstream in(std::string(ROBOTALK_EXAMPLES_DIR) + "/square.txt");
-  ASSERT_TRUE(in.good());
+// The text of examples/<name>.
+std::string Example(const std::string& name) {
+  std::ifstream in(std::string(ROBOTALK_EXAMPLES_DIR) + "/" + name);
+  EXPECT_TRUE(in.good()) << name;
   std::stringstream text;
   text << in.rdbuf();
-  const auto entries = ParseSequence(text.str(), "square.txt");
+  return text.str();
+}
+
+TEST(SequenceFile, TheExampleSquareParses) {
+  const auto entries = ParseSequence(Example("square.txt"), "square.txt");
   EXPECT_EQ(entries.size(), 10u);
   EXPECT_EQ(entries.back().command.type, CommandType::kStop);
 }
 
 TEST(SequenceFile, TheExamplePanWaypointsParsesInterpolated) {
-  std::ifstream in(std::string(ROBOTALK_EXAMPLES_DIR) + "/pan_waypoints.txt");
-  ASSERT_TRUE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  const SequenceFile file = ParseSequenceFile(text.str(), "pan_waypoints.txt");
+  const SequenceFile file = ParseSequenceFile(Example("pan_waypoints.txt"), "pan_waypoints.txt");
   EXPECT_EQ(file.interpolation, Interpolation::kCubic);
   EXPECT_EQ(file.entries.size(), 7u);
   EXPECT_EQ(file.entries.back().command.accelerations, std::vector<double>{0.0});
