@@ -5,6 +5,8 @@
 #include "sequence_plan.h"
 #include "trajectory_frames.h"
 
+#include <type_traits>
+
 namespace robotalk {
 namespace {
 
