@@ -292,24 +292,46 @@ class Ros2Bridge::Impl {
     SendTrajectory(r, std::move(plan.commands), start);
   }
 
-  // Step set-points in delay mode (packages of at most 100 commands).
+  // Each joint's points as one cubic trajectory in delay mode (issue 22):
+  // the server interpolates between them and splices a newer trajectory in.
+  // As JTC, the joint holds until header.stamp: a first point after it gets
+  // a waypoint at the stamp where the joint is now (a first point at the
+  // stamp is reached at the stamp, moving there from where it is now).
   void SendTrajectory(RobotLink& r, std::vector<Command> commands, TimePoint start) {
-    constexpr std::size_t kBatch = 100;
-    for (std::size_t i = 0; i < commands.size(); i += kBatch) {
-      std::vector<Command> batch(
-          commands.begin() + static_cast<std::ptrdiff_t>(i),
-          commands.begin() + static_cast<std::ptrdiff_t>(std::min(commands.size(), i + kBatch)));
-      std::vector<std::string> whats;
-      for (const Command& c : batch) {
-        std::ostringstream w;
-        w << "JOINT_SETPOINT '" << c.target << "' at +" << Seconds(*c.start_time.time() - start) << " s";
-        whats.push_back(w.str());
-      }
+    std::vector<JointTrajectory> joints;
+    for (Command& c : commands) {
+      auto it = std::find_if(joints.begin(), joints.end(),
+                             [&](const JointTrajectory& j) { return j.joint == c.target; });
+      if (it == joints.end()) it = joints.insert(joints.end(), JointTrajectory{c.target, {}});
+      it->points.push_back(TrajectoryPoint{.time_from_start = *c.start_time.time() - start,
+                                           .positions = std::move(c.values),
+                                           .velocities = std::move(c.velocities),
+                                           .accelerations = std::move(c.accelerations)});
+    }
+    const TrajectoryOptions options{
+        .mode = CommandMode::kDelay, .interpolation = Interpolation::kCubic, .start = start};
+    for (JointTrajectory& j : joints) {
       try {
-        auto replies = r.client->SendBatch(std::move(batch), CommandMode::kDelay);
-        for (std::size_t k = 0; k < replies.size(); ++k) Track(r, std::move(replies[k]), whats[k], true);
+        if (!j.points.empty() && j.points.front().time_from_start > Duration::zero()) {
+          const Reply now = r.client->JointState(j.joint);
+          if (now.signal == Signal::kSuccess && !now.values.empty()) {
+            const std::size_t dofs = j.points.front().positions.size();
+            j.points.insert(j.points.begin(),
+                            TrajectoryPoint{.time_from_start = Duration::zero(),
+                                            .positions = std::vector<double>(
+                                                now.values.begin(),
+                                                now.values.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                                                         dofs, now.values.size())))});
+          }
+        }
+        auto replies = r.client->SendTrajectory(j, options);
+        for (std::size_t k = 0; k < replies.size(); ++k) {
+          std::ostringstream w;
+          w << "JOINT_SETPOINT '" << j.joint << "' at +" << Seconds(j.points[k].time_from_start) << " s";
+          Track(r, std::move(replies[k]), w.str(), true);
+        }
       } catch (const std::exception& e) {
-        Log("robot '" + r.name + "': sending the trajectory: " + e.what());
+        Log("robot '" + r.name + "': sending the trajectory of joint '" + j.joint + "': " + e.what());
         return;
       }
     }

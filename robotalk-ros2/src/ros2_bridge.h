@@ -14,10 +14,10 @@
 //   rt/<robot>/cmd_vel             geometry_msgs/Twist              -> SETSPEED now (bases that move)
 // A JointTrajectory's header.stamp (ROS time, the system clock) is when its
 // time_from_start 0 is, converted to the server's clock through the client's
-// clock sync; a zero stamp means on receipt. Its points are sent as step
-// set-points (the client has no interpolation API yet: once RobotClient sends
-// Request::interpolation, cubic is a one-line change in SendTrajectory). An
-// empty trajectory sends STOP.
+// clock sync; a zero stamp means on receipt. Each joint's points are sent as
+// one cubic trajectory (RobotClient::SendTrajectory, issue 22): the server
+// interpolates between them and a newer trajectory splices in. An empty
+// trajectory sends STOP.
 //
 // Safety: a base moving under cmd_vel gets SETSPEED 0 when cmd_vel falls
 // silent for `cmd_vel_timeout`; on shutdown the bridge sends STOP to every

@@ -107,8 +107,8 @@ struct TrajectoryCommands {
 };
 
 /// Turns a JointTrajectory into one JOINT_SETPOINT per RoboTalk joint per
-/// point, at `start` + time_from_start on the server clock (step set-points:
-/// the joint goes to each point at its time). Points whose time is before
+/// point, at `start` + time_from_start on the server clock (the bridge sends
+/// each joint's as one cubic trajectory through them). Points whose time is before
 /// `now` are dropped except the last of them, which is sent at `now` (the
 /// robot goes where the trajectory says it is by now, as JTC samples a
 /// trajectory that started in the past). Every command passes CheckCommand

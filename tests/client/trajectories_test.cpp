@@ -106,12 +106,15 @@ TEST_F(RobotClientWireTest, ASequenceSentInterpolatedCarriesItOnEveryPackageAndA
     frames.push_back({milliseconds(30 * i),
                       Command{.type = CommandType::kJointSetPoint, .target = "tilt", .values = {-0.01 * i}}});
   }
+  // A step frame between waypoints of the same joint would end the joint's
+  // trajectory (docs/protocol.md, Trajectories): this one moves another joint.
   frames[3].interpolation = Interpolation::kStep;
+  frames[3].command.target = "pan";
   TakeSent();
   SequenceResult result = client_->RunSequence(
       frames,
       {.delay = milliseconds(100), .paced = false, .batch = 200, .interpolation = Interpolation::kCubic});
-  for (const Reply& r : result.replies) EXPECT_TRUE(Succeeded(r.signal)) << r.message;
+  for (const Reply& r : result.replies) EXPECT_TRUE(Succeeded(r.signal)) << ToString(r.signal) << ": " << r.message;
   std::vector<std::pair<Interpolation, std::size_t>> kinds;
   for (const Request& r : CommandPackages(TakeSent())) kinds.emplace_back(r.interpolation, r.commands.size());
   EXPECT_THAT(kinds, ::testing::ElementsAre(std::pair{Interpolation::kCubic, std::size_t{3}},
