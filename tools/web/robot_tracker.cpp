@@ -314,7 +314,7 @@ TrackerFrame RobotTracker::Impl::Poll() {
     for (auto& [name, r] : robots_) {
       Housekeep(r, now, drop);
       list.push_back(RobotJson(r));
-      if (r.model_message) frame.models.push_back({name, r.generation, r.model_message});
+      if (r.model_message) frame.models.push_back({name, r.generation, r.model_message, r.model});
       if (!r.client || !r.slot || !r.poser) continue;
       if (watching_ && r.poser->needs_measured_root()) MeasureRoot(r);
       std::lock_guard slot_lock(r.slot->mutex);
@@ -325,6 +325,7 @@ TrackerFrame RobotTracker::Impl::Poll() {
         nlohmann::json s = r.poser->Pose(r.slot->sample);
         s["generation"] = r.generation;
         frame.states.push_back(JsonText(s));
+        frame.poses.push_back(std::move(s));
       } catch (const Error& e) {
         r.message = e.what();
       }

@@ -19,6 +19,7 @@
 // Connection failures are reported in the robot's status, not thrown.
 #pragma once
 
+#include "robotalk/robot_model.h"
 #include "web_options.h"
 
 #include <nlohmann/json.hpp>
@@ -41,11 +42,14 @@ struct TrackerFrame {
     std::string robot;
     std::uint64_t generation = 0;
     std::shared_ptr<const std::string> message;
+    std::shared_ptr<const RobotModel> model;  ///< the model the message describes
   };
   std::vector<Model> models;
   /// {"type":"state"} messages (StatePoser::Pose), one per robot with a sample
   /// newer than the last Poll().
   std::vector<std::string> states;
+  /// The same states as objects (the Foxglove endpoint's input).
+  std::vector<nlohmann::json> poses;
   /// Samples received from LCM since the last Poll(), over every robot.
   std::uint64_t samples_received = 0;
 };

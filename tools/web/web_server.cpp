@@ -1,5 +1,6 @@
 #include "web_server.h"
 
+#include "foxglove_endpoint.h"
 #include "json_text.h"
 #include "mesh_catalog.h"
 #include "robotalk/error.h"
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <deque>
 #include <map>
 #include <string>
@@ -139,6 +141,12 @@ class WebServer::Impl {
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(1.0 / o.rate_hz));
     for (const auto& [robot, urdf] : o.urdf) meshes_[robot] = ResolveMeshes(robot, urdf, o.package_paths);
+    // PANIC from Foxglove only when the bridge holds a key: a keyed server
+    // then decides by the bridge's rights (docs/interop.md).
+    FoxgloveEndpoint::PanicHandler panic;
+    if (std::getenv("ROBOTALK_KEY") != nullptr)
+      panic = [this](const std::string& robot, auto done) { tracker_.Panic(robot, std::move(done)); };
+    foxglove_ = std::make_unique<FoxgloveEndpoint>(ioc_, std::move(panic));
   }
 
   const std::map<std::string, MeshCatalog>& meshes() const { return meshes_; }
@@ -171,6 +179,12 @@ class WebServer::Impl {
     stream->expires_after(std::chrono::seconds(30));
     http::async_read(*stream, *buffer, *req, [this, stream, buffer, req](beast::error_code ec, std::size_t) {
       if (ec) return;
+      if (websocket::is_upgrade(*req) &&
+          FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
+        stream->expires_never();
+        foxglove_->Accept(stream->release_socket(), std::move(*req));
+        return;
+      }
       if (websocket::is_upgrade(*req) &&
           std::string_view(req->target().data(), req->target().size()) == "/ws") {
         stream->expires_never();
@@ -268,8 +282,9 @@ class WebServer::Impl {
     TrackerFrame f = tracker_.Poll();
     std::erase_if(sessions_,
                   [](const std::shared_ptr<WsSession>& s) { return s.use_count() == 1 && !s->open(); });
-    tracker_.SetWatching(
-        std::any_of(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->open(); }));
+    tracker_.SetWatching(foxglove_->connected() || std::any_of(sessions_.begin(), sessions_.end(),
+                                                               [](const auto& s) { return s->open(); }));
+    foxglove_->Update(f);
     const std::string robots = JsonText(f.robots);
     if (!robots_ || *robots_ != robots) {
       robots_ = std::make_shared<const std::string>(robots);
@@ -318,6 +333,7 @@ class WebServer::Impl {
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
   std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start
+  std::unique_ptr<FoxgloveEndpoint> foxglove_;
 };
 
 WebServer::WebServer(const WebOptions& options, RobotTracker& tracker)
