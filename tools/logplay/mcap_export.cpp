@@ -133,7 +133,7 @@ class Exporter {
   }
 
   void State(const std::string& robot, std::uint64_t log_ns, std::span<const std::uint8_t> bytes) {
-    const StateSample s = DecodeStateSample(bytes);
+    const robotalk::StateSample s = DecodeStateSample(bytes);
     const auto it = robots_.find(robot);
     if (it == robots_.end() || !it->second.model ||
         s.positions.size() != static_cast<std::size_t>(it->second.model->num_dofs())) {

@@ -52,7 +52,7 @@ json Status(int level, const std::string& message) {
 
 const json& PanicRequestSchema() {
   static const json s = {
-      {"type", "object"}, {"properties", {{"robot", {{"type", "string"}}}}}, {"required", {"robot"}}};
+      {"type", "object"}, {"properties", {{"robot", {{"type", "string"}}}}}, {"required", json::array({"robot"})}};
   return s;
 }
 const json& PanicResponseSchema() {
@@ -269,7 +269,7 @@ class FoxgloveEndpoint::Impl {
                  {"capabilities", capabilities},
                  {"metadata", {{"robots", std::to_string(robots_.size())}}},
                  {"sessionId", session_id_}};
-    if (panic_) info["supportedEncodings"] = {"json"};
+    if (panic_) info["supportedEncodings"] = json::array({"json"});
     std::vector<std::string> g{JsonText(info)};
     std::vector<std::string> names;
     for (const auto& [name, r] : robots_) names.push_back(name);
@@ -288,7 +288,7 @@ class FoxgloveEndpoint::Impl {
                               {"schemaName", "robotalk.Panic_Response"},
                               {"schemaEncoding", "jsonschema"},
                               {"schema", PanicResponseSchema().dump()}}}};
-      g.push_back(JsonText(json{{"op", "advertiseServices"}, {"services", {service}}}));
+      g.push_back(JsonText(json{{"op", "advertiseServices"}, {"services", json::array({service})}}));
     }
     return g;
   }

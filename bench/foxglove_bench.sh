@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The Foxglove endpoint's added latency and CPU (docs/performance.md,
+# "Foxglove endpoint"), in one run per rate: a kinematic Pioneer, robotalk-web
+# at --rate R (it asks for the state stream at R), one Foxglove client
+# subscribed to the robot's five channels (foxglove_bench.mjs), and beside it
+# the floor: the same STATE stream's latency on LCM
+# (robotalk-bench-state-latency). Both measure arrival minus the sample's
+# server time on CLOCK_MONOTONIC. Run inside a private network namespace:
+#   scripts/netns_run.sh bench/foxglove_bench.sh [BUILD_DIR] [SECONDS]
+set -u
+build=${1:-build}; secs=${2:-10}
+root=$(cd "$(dirname "$0")/.." && pwd)
+url="udpm://239.255.76.67:7861?ttl=0"
+tick=$(getconf CLK_TCK)
+cpu() { awk '{print $14 + $15}' "/proc/$1/stat"; }
+run() {  # run RATE_HZ
+  "$build/robotalk-server/robotalk-server" --robot "pioneer=kinematic:$root/models/pioneer2dx_pantilt.urdf" \
+    --url "$url" --duration $((secs + 20)) 2>/dev/null &
+  local server=$!
+  local out; out=$(mktemp)
+  "$build/tools/web/robotalk-web" --port 0 --lcm-url "$url" --rate "$1" >"$out" 2>&1 &
+  local web=$!
+  local port=""
+  for _ in $(seq 50); do port=$(grep -o '127.0.0.1:[0-9]*' "$out" | cut -d: -f2); [ -n "$port" ] && break; sleep 0.1; done
+  local fox; fox=$(mktemp)
+  node "$root/bench/foxglove_bench.mjs" "$port" pioneer "$secs" >"$fox" &
+  local node_pid=$!
+  sleep 3  # connect, subscribe, stream
+  local floor; floor=$(mktemp)
+  "$build/bench/robotalk-bench-state-latency" --url "$url" --robot pioneer --seconds "$((secs - 3))" >"$floor" &
+  local c0; c0=$(cpu "$web")
+  sleep "$((secs - 3))"
+  local c1; c1=$(cpu "$web")
+  wait "$node_pid"
+  sleep 0.5
+  echo "{\"rate_hz\": $1, \"bridge_cpu_percent\": $(awk -v c="$((c1 - c0))" -v t="$tick" -v s="$((secs - 3))" 'BEGIN{printf "%.1f", 100*c/t/s}'), \"foxglove\": $(cat "$fox"), \"lcm\": $(cat "$floor")}"
+  kill "$web" "$server" 2>/dev/null
+  wait 2>/dev/null
+  rm -f "$out" "$fox" "$floor"
+}
+run 100
+run 1000
