@@ -42,14 +42,16 @@ std::vector<int> Walk(const std::string& b, std::size_t from) {
 }
 
 TEST(McapWriter, WritesChunksWithMessageIndexesAndAnIndexedSummary) {
-  const std::string path = (std::filesystem::temp_directory_path() / "robotalk_mcap_writer_test.mcap").string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "robotalk_mcap_writer_test.mcap").string();
   {
     McapWriter w(path, 200);  // small chunks: several of them
     const auto s = w.AddSchema("robotalk.Test", "jsonschema", R"({"type":"object"})");
     EXPECT_EQ(w.AddSchema("robotalk.Test", "jsonschema", R"({"type":"object"})"), s);
     const auto a = w.AddChannel(s, "/a", "json"), c = w.AddChannel(s, "/c", "json");
     EXPECT_EQ(w.AddChannel(s, "/a", "json"), a);
-    for (int i = 0; i < 20; ++i) w.Write(i % 2 ? a : c, 1000 + i, 900 + i, R"({"i":)" + std::to_string(i) + "}");
+    for (int i = 0; i < 20; ++i)
+      w.Write(i % 2 ? a : c, 1000 + i, 900 + i, R"({"i":)" + std::to_string(i) + "}");
     EXPECT_THROW(w.AddChannel(9, "/bad", "json"), Error);
     EXPECT_THROW(w.Write(77, 0, 0, "{}"), Error);
     w.Close();

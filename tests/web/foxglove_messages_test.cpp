@@ -16,7 +16,8 @@ namespace robotalk::web::foxglove {
 namespace {
 
 std::shared_ptr<const RobotModel> Pioneer() {
-  return std::make_shared<const RobotModel>(LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model);
+  return std::make_shared<const RobotModel>(
+      LoadUrdfFile(testing::ProjectModel("pioneer2dx_pantilt.urdf")).model);
 }
 
 nlohmann::json PoseOf(const RobotModel& m, double pan, double x, double theta) {
@@ -37,8 +38,9 @@ nlohmann::json PoseOf(const RobotModel& m, double pan, double x, double theta) {
 Eigen::Isometry3d Iso(const nlohmann::json& t) {
   Eigen::Isometry3d x = Eigen::Isometry3d::Identity();
   x.translation() << t["translation"]["x"], t["translation"]["y"], t["translation"]["z"];
-  x.linear() = Eigen::Quaterniond(t["rotation"]["w"], t["rotation"]["x"], t["rotation"]["y"], t["rotation"]["z"])
-                   .toRotationMatrix();
+  x.linear() =
+      Eigen::Quaterniond(t["rotation"]["w"], t["rotation"]["x"], t["rotation"]["y"], t["rotation"]["z"])
+          .toRotationMatrix();
   return x;
 }
 

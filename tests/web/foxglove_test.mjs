@@ -106,6 +106,19 @@ async function live(port, robot, keyedPort) {
         t && BigInt(t.json.timestamp.sec) * 1000000000n + BigInt(t.json.timestamp.nsec) === t.timestamp,
         t && `${JSON.stringify(t.json.timestamp)} vs ${t.timestamp}`);
   check("status carries panic, moving and the base", status && status.panic === false && status.base.length === 5, JSON.stringify(status));
+  // The robot moves (foxglove_test.sh sends pan 0.4): the joint states follow.
+  const pan = () => {
+    const last = got("joint_states").at(-1)?.json;
+    return last ? last.position[last.name.indexOf("pan")] : NaN;
+  };
+  check("joint states follow the robot (pan reaches its set-point 0.4)",
+        await until("pan", () => Math.abs(pan() - 0.4) < 0.01), `pan=${pan()}`);
+  const lastOf = (topic) => got(topic).at(-1);
+  await until("same sample", () => lastOf("base_pose")?.timestamp === lastOf("status")?.timestamp);
+  const bp = lastOf("base_pose"), st = lastOf("status");
+  check("base pose and status of one sample agree on x and y",
+        bp && st && bp.timestamp === st.timestamp && Math.abs(bp.json.pose.position.x - st.json.base[0]) < 1e-5 &&
+        Math.abs(bp.json.pose.position.y - st.json.base[1]) < 1e-5, `${JSON.stringify(bp?.json.pose)} vs ${JSON.stringify(st?.json.base)}`);
   // No key: a call is refused with a reason (the protocol's serviceCallFailure).
   c.client.sendServiceCallRequest({ serviceId: 1, callId: 7, encoding: "json", data: new TextEncoder().encode(`{"robot":"${robot}"}`) });
   check("a service call to a bridge without a key is refused, naming the key",

@@ -51,8 +51,9 @@ json Status(int level, const std::string& message) {
 }
 
 const json& PanicRequestSchema() {
-  static const json s = {
-      {"type", "object"}, {"properties", {{"robot", {{"type", "string"}}}}}, {"required", json::array({"robot"})}};
+  static const json s = {{"type", "object"},
+                         {"properties", {{"robot", {{"type", "string"}}}}},
+                         {"required", json::array({"robot"})}};
   return s;
 }
 const json& PanicResponseSchema() {
