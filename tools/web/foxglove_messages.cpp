@@ -91,8 +91,13 @@ SchemaInfo StatusSchema() {
               {"base", ArrayOf(Number())}}));
 }
 
-json Vec(const Eigen::Vector3d& v) { return {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
-json Quat(const Eigen::Quaterniond& q) { return {{"x", q.x()}, {"y", q.y()}, {"z", q.z()}, {"w", q.w()}}; }
+// Rounded to 1e-6 (µm, µrad), as the page's poses (scene_json.h): the text
+// stays short, and a product of poses writes 0.3, not 0.30000000000000004.
+double R6(double v) { return std::isfinite(v) ? std::round(v * 1e6) / 1e6 : 0.0; }
+json Vec(const Eigen::Vector3d& v) { return {{"x", R6(v.x())}, {"y", R6(v.y())}, {"z", R6(v.z())}}; }
+json Quat(const Eigen::Quaterniond& q) {
+  return {{"x", R6(q.x())}, {"y", R6(q.y())}, {"z", R6(q.z())}, {"w", R6(q.w())}};
+}
 
 // A pose written by StatePoser::Pose: [x, y, z, qw, qx, qy, qz].
 Eigen::Isometry3d PoseOf(const json& p, const char* what) {

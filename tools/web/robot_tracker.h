@@ -69,6 +69,12 @@ class RobotTracker {
   /// and cancelled when none is (heartbeats keep the sessions). Any thread.
   void SetWatching(bool watching);
 
+  /// Called (on a client's ReadDaemon thread, after the sample is stored)
+  /// for every state sample received, so the web loop can send it at once
+  /// instead of at its next tick. Set it before the first SetWatching(true);
+  /// it must be quick and must not call back into the tracker.
+  void SetOnSample(std::function<void()> on_sample);
+
   /// Sends a panic package to `robot` on a thread of its own and calls `done`
   /// there with an empty string on success or the reason it failed (not
   /// connected, no acknowledgement).

@@ -13,6 +13,7 @@
 #include <boost/beast/websocket.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <deque>
@@ -147,6 +148,13 @@ class WebServer::Impl {
     if (std::getenv("ROBOTALK_KEY") != nullptr)
       panic = [this](const std::string& robot, auto done) { tracker_.Panic(robot, std::move(done)); };
     foxglove_ = std::make_unique<FoxgloveEndpoint>(ioc_, std::move(panic));
+    // A sample is sent when it arrives, not at the next tick (a tick that
+    // polls just before each sample would add a whole period); at most one
+    // wake-up in flight. The listener may outlive this server: it holds the
+    // io_context, which runs no handler once Run() has returned.
+    tracker_.SetOnSample([ioc = ioc_, posted = sample_posted_, this] {
+      if (!posted->exchange(true)) asio::post(*ioc, [this] { OnSample(); });
+    });
   }
 
   const std::map<std::string, MeshCatalog>& meshes() const { return meshes_; }
@@ -156,7 +164,6 @@ class WebServer::Impl {
   void Run() {
     signals_.async_wait([this](beast::error_code, int) { Stop(); });
     Accept();
-    next_tick_ = std::chrono::steady_clock::now();
     Tick();
     ioc_->run();
   }
@@ -279,6 +286,7 @@ class WebServer::Impl {
   }
 
   void Tick() {
+    const auto now = std::chrono::steady_clock::now();
     TrackerFrame f = tracker_.Poll();
     std::erase_if(sessions_,
                   [](const std::shared_ptr<WsSession>& s) { return s.use_count() == 1 && !s->open(); });
@@ -298,14 +306,35 @@ class WebServer::Impl {
       }
     }
     for (std::string& s : f.states) Broadcast(std::make_shared<const std::string>(std::move(s)), true);
-    // Absolute deadlines: the rate does not drift with the work done per tick.
-    next_tick_ += period_;
-    const auto now = std::chrono::steady_clock::now();
-    if (next_tick_ < now) next_tick_ = now;
-    tick_.expires_at(next_tick_);
+    if (!f.states.empty()) next_send_ = std::max(next_send_, now) + period_;
+    Arm(now + period_, true);  // housekeeping (robots, models) goes on without samples
+  }
+
+  // The next tick at `at`; unless `force`, only when that is earlier than the one armed.
+  void Arm(std::chrono::steady_clock::time_point at, bool force) {
+    if (!force && armed_ && armed_at_ <= at) return;
+    armed_ = true;
+    armed_at_ = at;
+    tick_.expires_at(at);
     tick_.async_wait([this](beast::error_code ec) {
-      if (!ec) Tick();
+      if (ec) return;  // re-armed
+      armed_ = false;
+      Tick();
     });
+  }
+
+  // States go out as they arrive, `rate` times a second on average: a send
+  // moves the next one a period on (from when it was due, so a stream at the
+  // rate itself, arriving a little early or late, is never held back); a
+  // sample more than a quarter period before that waits for a tick then.
+  void OnSample() {
+    sample_posted_->store(false);
+    const auto now = std::chrono::steady_clock::now();
+    const auto due = next_send_ - period_ / 4;
+    if (now >= due)
+      Tick();
+    else
+      Arm(due, false);
   }
 
   void OnPanic(std::weak_ptr<WsSession> session, const std::string& robot) {
@@ -328,7 +357,9 @@ class WebServer::Impl {
   asio::steady_timer tick_;
   asio::signal_set signals_;
   std::chrono::steady_clock::duration period_{};
-  std::chrono::steady_clock::time_point next_tick_{};
+  std::chrono::steady_clock::time_point next_send_{}, armed_at_{};  // of states; of the armed tick
+  bool armed_ = false;
+  std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
   std::vector<std::shared_ptr<WsSession>> sessions_;
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
