@@ -306,7 +306,8 @@ class WebServer::Impl {
       }
     }
     for (std::string& s : f.states) Broadcast(std::make_shared<const std::string>(std::move(s)), true);
-    if (!f.states.empty()) next_send_ = std::max(next_send_, now) + period_;
+    Credit(now);
+    if (!f.states.empty()) send_credit_ = std::max(0.0, send_credit_ - 1.0);
     Arm(now + period_, true);  // housekeeping (robots, models) goes on without samples
   }
 
@@ -323,18 +324,29 @@ class WebServer::Impl {
     });
   }
 
-  // States go out as they arrive, `rate` times a second on average: a send
-  // moves the next one a period on (from when it was due, so a stream at the
-  // rate itself, arriving a little early or late, is never held back); a
-  // sample more than a quarter period before that waits for a tick then.
+  // States go out as they arrive, `rate` times a second on average: a token
+  // bucket earns a send per period and holds at most kMaxCredit. A stream at
+  // the rate itself (each sample a period after the last, give or take a
+  // quarter) is sent as it arrives, whatever its phase; a faster one waits for
+  // the next credit; a sample without credit is sent by a tick when it comes.
+  static constexpr double kMaxCredit = 1.25;
+
+  double Credit(std::chrono::steady_clock::time_point now) {
+    const double earned = std::chrono::duration<double>(now - credit_at_).count() * options_.rate_hz;
+    send_credit_ = std::min(kMaxCredit, send_credit_ + earned);
+    credit_at_ = now;
+    return send_credit_;
+  }
+
   void OnSample() {
     sample_posted_->store(false);
     const auto now = std::chrono::steady_clock::now();
-    const auto due = next_send_ - period_ / 4;
-    if (now >= due)
+    const double credit = Credit(now);
+    if (credit >= 1.0)
       Tick();
     else
-      Arm(due, false);
+      Arm(now + std::chrono::duration_cast<std::chrono::steady_clock::duration>((1.0 - credit) * period_),
+          false);
   }
 
   void OnPanic(std::weak_ptr<WsSession> session, const std::string& robot) {
@@ -357,7 +369,8 @@ class WebServer::Impl {
   asio::steady_timer tick_;
   asio::signal_set signals_;
   std::chrono::steady_clock::duration period_{};
-  std::chrono::steady_clock::time_point next_send_{}, armed_at_{};  // of states; of the armed tick
+  std::chrono::steady_clock::time_point credit_at_{}, armed_at_{};  // of send_credit_; of the armed tick
+  double send_credit_ = kMaxCredit;
   bool armed_ = false;
   std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
   std::vector<std::shared_ptr<WsSession>> sessions_;
