@@ -9,7 +9,12 @@
 # (robotalk-bench-state-latency). Both measure arrival minus the sample's
 # server time on CLOCK_MONOTONIC. Run inside a private network namespace:
 #   scripts/netns_run.sh bench/foxglove_bench.sh [BUILD_DIR] [SECONDS]
+# RT="chrt -f 5" in the environment runs the bridge, the Foxglove client and
+# the LCM floor listener under SCHED_FIFO (root), as the server's daemons
+# run: on a loaded machine, this separates the path's own latency from the
+# scheduler's wait for a core.
 set -u
+rt=${RT:-}
 build=${1:-build}; secs=${2:-10}
 root=$(cd "$(dirname "$0")/.." && pwd)
 url="udpm://239.255.76.67:7861?ttl=0"
@@ -20,7 +25,7 @@ run() {  # run STREAM_HZ
     --url "$url" --duration $((secs + 20)) 2>/dev/null &
   local server=$!
   local out; out=$(mktemp)
-  "$build/tools/web/robotalk-web" --port 0 --lcm-url "$url" --rate 100 >"$out" 2>&1 &
+  $rt "$build/tools/web/robotalk-web" --port 0 --lcm-url "$url" --rate 100 >"$out" 2>&1 &
   local web=$!
   local port=""
   for _ in $(seq 50); do port=$(grep -o '127.0.0.1:[0-9]*' "$out" | cut -d: -f2); [ -n "$port" ] && break; sleep 0.1; done
@@ -30,11 +35,11 @@ run() {  # run STREAM_HZ
     watch=$!
   fi
   local fox; fox=$(mktemp)
-  node "$root/bench/foxglove_bench.mjs" "$port" pioneer "$secs" >"$fox" &
+  $rt node "$root/bench/foxglove_bench.mjs" "$port" pioneer "$secs" >"$fox" &
   local node_pid=$!
   sleep 3  # connect, subscribe, stream
   local floor; floor=$(mktemp)
-  "$build/bench/robotalk-bench-state-latency" --url "$url" --robot pioneer --seconds "$((secs - 3))" >"$floor" &
+  $rt "$build/bench/robotalk-bench-state-latency" --url "$url" --robot pioneer --seconds "$((secs - 3))" >"$floor" &
   local c0; c0=$(cpu "$web")
   sleep "$((secs - 3))"
   local c1; c1=$(cpu "$web")

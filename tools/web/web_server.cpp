@@ -325,11 +325,14 @@ class WebServer::Impl {
   }
 
   // States go out as they arrive, `rate` times a second on average: a token
-  // bucket earns a send per period and holds at most kMaxCredit. A stream at
-  // the rate itself (each sample a period after the last, give or take a
-  // quarter) is sent as it arrives, whatever its phase; a faster one waits for
-  // the next credit; a sample without credit is sent by a tick when it comes.
-  static constexpr double kMaxCredit = 1.25;
+  // bucket earns a send per period and holds at most kMaxCredit. A sample
+  // with a whole send of credit goes out at once; one without waits for the
+  // tick at which the credit is earned. A stream at the rate itself keeps
+  // about one send in hand, so a sample arriving late and the next one on
+  // time are both sent as they arrive (with a cap of 1, credit lost to a
+  // late sample would never come back, and every later sample would wait
+  // for it); faster streams are decimated to the rate, two sends at most at once.
+  static constexpr double kMaxCredit = 2.0;
 
   double Credit(std::chrono::steady_clock::time_point now) {
     const double earned = std::chrono::duration<double>(now - credit_at_).count() * options_.rate_hz;
