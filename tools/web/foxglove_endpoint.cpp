@@ -2,6 +2,7 @@
 
 #include "foxglove_messages.h"
 #include "json_text.h"
+#include "ws_connection.h"
 
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
@@ -20,7 +21,6 @@ namespace {
 namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace http = beast::http;
-namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 using nlohmann::json;
 namespace fg = foxglove;
@@ -62,87 +62,18 @@ const json& PanicResponseSchema() {
   return s;
 }
 
-struct Out {
-  std::shared_ptr<const std::string> data;
-  bool binary = false;
-};
+// One Foxglove client: its connection and its subscriptions.
+struct Session {
+  std::shared_ptr<WsConnection> connection;
+  std::map<std::uint32_t, std::uint32_t> subscriptions;            // client's id -> channel id
+  std::map<std::uint32_t, std::uint32_t> subscription_of_channel;  // the reverse
 
-class Session : public std::enable_shared_from_this<Session> {
- public:
-  using OnText = std::function<void(const std::shared_ptr<Session>&, const std::string&)>;
-  using OnBinary = std::function<void(const std::shared_ptr<Session>&, const std::string&)>;
-
-  Session(tcp::socket socket, OnText on_text, OnBinary on_binary)
-      : ws_(std::move(socket)), on_text_(std::move(on_text)), on_binary_(std::move(on_binary)) {}
-
-  void Start(http::request<http::string_body> req, std::vector<std::string> greeting) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& res) {
-      res.set(http::field::sec_websocket_protocol, FoxgloveEndpoint::kSubprotocol);
-      res.set(http::field::server, "robotalk-web");
-    }));
-    ws_.read_message_max(kMaxClientMessage);
-    ws_.async_accept(req, [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
-      if (ec) return;
-      self->open_ = true;
-      for (const std::string& g : greeting) self->SendText(g);
-      self->Read();
-    });
+  void SendText(const std::string& text) const {
+    connection->Send(std::make_shared<const std::string>(text), false, false);
   }
-
-  bool open() const { return open_; }
-  void SendText(const std::string& text) { Send({std::make_shared<const std::string>(text), false}, false); }
-  void SendBinary(std::string bytes, bool droppable) {
-    Send({std::make_shared<const std::string>(std::move(bytes)), true}, droppable);
+  void SendBinary(std::string bytes, bool droppable) const {
+    connection->Send(std::make_shared<const std::string>(std::move(bytes)), true, droppable);
   }
-
-  // Subscriptions: client id -> channel id, and the reverse.
-  std::map<std::uint32_t, std::uint32_t> subscriptions;
-  std::map<std::uint32_t, std::uint32_t> subscription_of_channel;
-
- private:
-  void Send(Out m, bool droppable) {
-    if (!open_) return;
-    if (droppable && queue_.size() >= kMaxQueuedStates) return;
-    queue_.push_back(std::move(m));
-    if (queue_.size() == 1) Write();
-  }
-
-  void Write() {
-    ws_.binary(queue_.front().binary);
-    ws_.async_write(asio::buffer(*queue_.front().data),
-                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                      if (ec) {
-                        self->open_ = false;
-                        return;
-                      }
-                      self->queue_.pop_front();
-                      if (!self->queue_.empty()) self->Write();
-                    });
-  }
-
-  void Read() {
-    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) {
-        self->open_ = false;
-        return;
-      }
-      const std::string data = beast::buffers_to_string(self->in_.data());
-      self->in_.consume(self->in_.size());
-      if (self->ws_.got_text())
-        self->on_text_(self, data);
-      else
-        self->on_binary_(self, data);
-      self->Read();
-    });
-  }
-
-  websocket::stream<beast::tcp_stream> ws_;
-  OnText on_text_;
-  OnBinary on_binary_;
-  beast::flat_buffer in_;
-  std::deque<Out> queue_;
-  bool open_ = false;
 };
 
 struct RobotChannels {
@@ -161,16 +92,28 @@ class FoxgloveEndpoint::Impl {
       : ioc_(std::move(ioc)), panic_(std::move(panic)) {}
 
   void Accept(tcp::socket socket, http::request<http::string_body> req) {
-    auto session = std::make_shared<Session>(
-        std::move(socket), [this](const auto& s, const std::string& t) { OnText(s, t); },
-        [this](const auto& s, const std::string& b) { OnBinary(s, b); });
-    sessions_.push_back(session);
-    session->Start(std::move(req), Greeting());
+    auto connection = std::make_shared<WsConnection>(
+        std::move(socket), kMaxClientMessage, kMaxQueuedStates,
+        [this](const std::shared_ptr<WsConnection>& c, const std::string& data, bool text) {
+          for (const auto& s : sessions_) {
+            if (s->connection != c) continue;
+            if (text)
+              OnText(s, data);
+            else
+              OnBinary(s, data);
+            return;
+          }
+        });
+    sessions_.push_back(std::make_shared<Session>(Session{connection, {}, {}}));
+    std::vector<WsConnection::Message> greeting;
+    for (std::string& g : Greeting()) greeting.push_back(std::make_shared<const std::string>(std::move(g)));
+    connection->Start(std::move(req), std::move(greeting), kSubprotocol);
   }
 
   void Update(const TrackerFrame& frame) {
-    std::erase_if(sessions_,
-                  [](const std::shared_ptr<Session>& s) { return s.use_count() == 1 && !s->open(); });
+    std::erase_if(sessions_, [](const std::shared_ptr<Session>& s) {
+      return !s->connection->open() && s->connection.use_count() == 1;  // no operation pending on it
+    });
     for (const TrackerFrame::Model& m : frame.models) {
       if (!m.model) continue;
       auto [it, added] = robots_.try_emplace(m.robot);
@@ -222,7 +165,7 @@ class FoxgloveEndpoint::Impl {
 
   bool connected() const {
     for (const auto& s : sessions_)
-      if (s->open()) return true;
+      if (s->connection->open()) return true;
     return false;
   }
 
@@ -368,16 +311,17 @@ class FoxgloveEndpoint::Impl {
     if (!req.is_object() || !req.contains("robot") || !req["robot"].is_string())
       return failure("robotalk-web: /robotalk/panic: the request must be {\"robot\": NAME}");
     const std::string robot = req["robot"].get<std::string>();
-    std::weak_ptr<Session> weak = s;
+    std::weak_ptr<WsConnection> weak = s->connection;
     panic_(robot, [ioc = ioc_, weak, service, call, robot](const std::string& error) {
       asio::post(*ioc, [weak, service, call, robot, error] {
-        auto session = weak.lock();
-        if (!session) return;
+        auto connection = weak.lock();
+        if (!connection) return;
+        Session session{connection, {}, {}};
         if (!error.empty()) {
-          session->SendText(JsonText(json{{"op", "serviceCallFailure"},
-                                          {"serviceId", service},
-                                          {"callId", call},
-                                          {"message", "PANIC " + robot + ": " + error}}));
+          session.SendText(JsonText(json{{"op", "serviceCallFailure"},
+                                         {"serviceId", service},
+                                         {"callId", call},
+                                         {"message", "PANIC " + robot + ": " + error}}));
           return;
         }
         std::string r;
@@ -387,7 +331,7 @@ class FoxgloveEndpoint::Impl {
         PutLe(r, 4, 4);
         r += "json";
         r += JsonText(json{{"ok", true}, {"message", "robot '" + robot + "' is in panic"}});
-        session->SendBinary(std::move(r), false);
+        session.SendBinary(std::move(r), false);
       });
     });
   }

@@ -5,6 +5,7 @@
 #include "mesh_catalog.h"
 #include "robotalk/error.h"
 #include "web_files.h"
+#include "ws_connection.h"
 
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
@@ -52,75 +53,6 @@ bool Traverses(std::string_view path) {
   }
   return false;
 }
-
-class WsSession : public std::enable_shared_from_this<WsSession> {
- public:
-  using PanicHandler = std::function<void(std::weak_ptr<WsSession>, const std::string& robot)>;
-
-  WsSession(tcp::socket socket, PanicHandler on_panic)
-      : ws_(std::move(socket)), on_panic_(std::move(on_panic)) {}
-
-  void Start(http::request<http::string_body> req, std::vector<Message> greeting) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.read_message_max(kMaxPageMessage);
-    ws_.async_accept(req, [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
-      if (ec) return;
-      self->open_ = true;
-      for (const Message& m : greeting) self->Send(m, false);
-      self->Read();
-    });
-  }
-
-  bool open() const { return open_; }
-
-  // REQUIRES: the io thread.
-  void Send(const Message& m, bool droppable) {
-    if (!open_) return;
-    if (droppable && queue_.size() >= kMaxQueuedFrames) {
-      ++dropped_;
-      return;
-    }
-    queue_.push_back(m);
-    if (queue_.size() == 1) Write();
-  }
-
- private:
-  void Write() {
-    ws_.text(true);
-    ws_.async_write(asio::buffer(*queue_.front()),
-                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                      if (ec) {
-                        self->open_ = false;
-                        return;
-                      }
-                      self->queue_.pop_front();
-                      if (!self->queue_.empty()) self->Write();
-                    });
-  }
-
-  void Read() {
-    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) {
-        self->open_ = false;
-        return;
-      }
-      const std::string text = beast::buffers_to_string(self->in_.data());
-      self->in_.consume(self->in_.size());
-      const nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
-      if (msg.is_object() && msg.value("type", "") == "panic" && msg.contains("robot") &&
-          msg["robot"].is_string())
-        self->on_panic_(self->weak_from_this(), msg["robot"].get<std::string>());
-      self->Read();
-    });
-  }
-
-  websocket::stream<beast::tcp_stream> ws_;
-  PanicHandler on_panic_;
-  beast::flat_buffer in_;
-  std::deque<Message> queue_;
-  bool open_ = false;
-  std::uint64_t dropped_ = 0;
-};
 
 }  // namespace
 
@@ -195,9 +127,10 @@ class WebServer::Impl {
       if (websocket::is_upgrade(*req) &&
           std::string_view(req->target().data(), req->target().size()) == "/ws") {
         stream->expires_never();
-        auto session = std::make_shared<WsSession>(
-            stream->release_socket(),
-            [this](std::weak_ptr<WsSession> s, const std::string& robot) { OnPanic(std::move(s), robot); });
+        auto session =
+            std::make_shared<WsConnection>(stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
+                                           [this](const std::shared_ptr<WsConnection>& s,
+                                                  const std::string& text, bool) { OnPageMessage(s, text); });
         sessions_.push_back(session);
         session->Start(std::move(*req), Greeting());
         return;
@@ -282,14 +215,14 @@ class WebServer::Impl {
   }
 
   void Broadcast(const Message& m, bool droppable) {
-    for (auto& s : sessions_) s->Send(m, droppable);
+    for (auto& s : sessions_) s->Send(m, false, droppable);
   }
 
   void Tick() {
     const auto now = std::chrono::steady_clock::now();
     TrackerFrame f = tracker_.Poll();
     std::erase_if(sessions_,
-                  [](const std::shared_ptr<WsSession>& s) { return s.use_count() == 1 && !s->open(); });
+                  [](const std::shared_ptr<WsConnection>& s) { return s.use_count() == 1 && !s->open(); });
     tracker_.SetWatching(foxglove_->connected() || std::any_of(sessions_.begin(), sessions_.end(),
                                                                [](const auto& s) { return s->open(); }));
     foxglove_->Update(f);
@@ -352,7 +285,15 @@ class WebServer::Impl {
           false);
   }
 
-  void OnPanic(std::weak_ptr<WsSession> session, const std::string& robot) {
+  // The page sends only {"type":"panic","robot":NAME}; anything else is ignored.
+  void OnPageMessage(const std::shared_ptr<WsConnection>& session, const std::string& text) {
+    const nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
+    if (msg.is_object() && msg.value("type", "") == "panic" && msg.contains("robot") &&
+        msg["robot"].is_string())
+      OnPanic(session, msg["robot"].get<std::string>());
+  }
+
+  void OnPanic(std::weak_ptr<WsConnection> session, const std::string& robot) {
     // The callback runs on a tracker thread that may outlive this server: it
     // keeps the io_context alive itself and reaches the session weakly.
     tracker_.Panic(robot, [ioc = ioc_, session, robot](const std::string& error) {
@@ -360,7 +301,7 @@ class WebServer::Impl {
           {"type", "panic_result"}, {"robot", robot}, {"ok", error.empty()}, {"message", error}};
       auto msg = std::make_shared<const std::string>(JsonText(r));
       asio::post(*ioc, [session, msg] {
-        if (auto s = session.lock()) s->Send(msg, false);
+        if (auto s = session.lock()) s->Send(msg, false, false);
       });
     });
   }
@@ -376,7 +317,7 @@ class WebServer::Impl {
   double send_credit_ = kMaxCredit;
   bool armed_ = false;
   std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
-  std::vector<std::shared_ptr<WsSession>> sessions_;
+  std::vector<std::shared_ptr<WsConnection>> sessions_;
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
   std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start
