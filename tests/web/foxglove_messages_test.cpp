@@ -97,6 +97,8 @@ TEST(RobotMessages, SceneHasAnEntityPerLinkLockedToItsFrame) {
   const RobotMessages m(model);
   const nlohmann::json scene = m.Scene(42);
   ASSERT_EQ(scene["entities"].size(), model->links().size());
+  ASSERT_EQ(scene["deletions"].size(), 1u);  // the previous model's entities, all of them
+  EXPECT_EQ(scene["deletions"][0]["type"], 1);
   for (std::size_t l = 0; l < model->links().size(); ++l) {
     const auto& e = scene["entities"][l];
     EXPECT_EQ(e["frame_id"], model->name() + "/" + model->links()[l].name);

@@ -231,7 +231,10 @@ json RobotMessages::Scene(std::int64_t time_ns) const {
                         {"cubes", json::array({cube})},
                         {"spheres", spheres[l]}});
   }
-  return {{"deletions", json::array()}, {"entities", entities}};
+  // A new model replaces the robot's scene: every entity of this topic older
+  // than this one goes (type 1 = all), so links the old model had do not stay.
+  const json deletion = {{"timestamp", TimeJson(time_ns)}, {"type", 1}, {"id", ""}};
+  return {{"deletions", json::array({deletion})}, {"entities", entities}};
 }
 
 RobotMessages::State RobotMessages::FromPose(const json& pose) const {

@@ -9,7 +9,8 @@
 //   /ROBOT/scene         foxglove.SceneUpdate      per link: its equivalent inertia box and
 //                                                   spheres at its joint centres, locked to
 //                                                   the link's frame (sent when the model is
-//                                                   known, and to each new subscriber)
+//                                                   known, and to each new subscriber); it
+//                                                   deletes the topic's older entities
 //   /ROBOT/joint_states  robotalk.JointState       dof names and positions (rad | m)
 //   /ROBOT/base_pose     foxglove.PoseInFrame      the first root link's pose in "world"
 //   /ROBOT/status        robotalk.RobotStatus      sample, panic, moving, base x y θ v ω
