@@ -227,6 +227,9 @@ int RunExportMcap(Args& a, const std::string& out) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "robotalk-logplay: wrote " << r.messages << " messages (" << r.bytes << " bytes) from "
             << r.events << " events (" << r.log_bytes << " bytes) in " << s << " s to " << out << "\n";
+  if (r.messages == 0)
+    std::cerr << "robotalk-logplay: warning: " << path << " holds no RoboTalk messages (" << r.events
+              << " LCM events): " << out << " has none\n";
   std::cout << out << "\n";
   return 0;
 }
