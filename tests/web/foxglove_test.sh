@@ -35,16 +35,17 @@ for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && grep -q "ser
 logger=$!
 for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
 
-start_web() {  # start_web OUT URL [env...]: prints the port
+start_web() {  # start_web OUT URL [env...]: sets $web_port (not in a subshell: lib.sh stops $pids)
   local out=$1 u=$2; shift 2
   env "$@" "$web" --port 0 --lcm-url "$u" >"$out" 2>&1 &
   pids+=($!)
-  local port=""
-  for _ in $(seq 50); do port=$(grep -o '127.0.0.1:[0-9]*' "$out" | cut -d: -f2); [ -n "$port" ] && break; sleep 0.1; done
-  echo "$port"
+  web_port=""
+  for _ in $(seq 50); do web_port=$(grep -o '127.0.0.1:[0-9]*' "$out" | cut -d: -f2); [ -n "$web_port" ] && break; sleep 0.1; done
 }
-port=$(start_web "$tmp/web.out" "$url")
-keyed_port=$(start_web "$tmp/keyed_web.out" "$keyed_url" ROBOTALK_KEY="$tmp/web")
+start_web "$tmp/web.out" "$url"
+port=$web_port
+start_web "$tmp/keyed_web.out" "$keyed_url" ROBOTALK_KEY="$tmp/web"
+keyed_port=$web_port
 check "both bridges listen" test -n "$port" -a -n "$keyed_port"
 
 # Some traffic to record: a short sequence while Foxglove watches.
