@@ -2,11 +2,13 @@
 #include "export.h"
 #include "interrupt.h"
 #include "logplay.h"
+#include "mcap_export.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -46,6 +48,9 @@ Records and reads LCM logs of RoboTalk sessions. See docs/logplay.md.
                                  named from the logged configuration), DIR/joints.csv
                                  and DIR/session.png (base path; each joint's trace on
                                  its own axis, python3-matplotlib)
+  export LOG --mcap OUT.mcap     the session as an MCAP file for Foxglove: the channels
+                                 robotalk-web's Foxglove endpoint publishes live, and
+                                 every request and reply as JSON (docs/interop.md)
 
   --map old=new   rename a joint or control frame (repeatable)
   --window A:B    only the commands between A and B seconds into the recording
@@ -215,7 +220,22 @@ int RunRecord(Args& a) {
   return 0;
 }
 
+int RunExportMcap(Args& a, const std::string& out) {
+  const std::string path = a.Log();
+  const auto start = std::chrono::steady_clock::now();
+  const lp::McapExportResult r = lp::ExportMcap(path, out, std::cerr);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cerr << "robotalk-logplay: wrote " << r.messages << " messages (" << r.bytes << " bytes) from "
+            << r.events << " events (" << r.log_bytes << " bytes) in " << s << " s to " << out << "\n";
+  if (r.messages == 0)
+    std::cerr << "robotalk-logplay: warning: " << path << " holds no RoboTalk messages (" << r.events
+              << " LCM events): " << out << " has none\n";
+  std::cout << out << "\n";
+  return 0;
+}
+
 int RunExport(Args& a) {
+  if (auto mcap = a.One("--mcap")) return RunExportMcap(a, *mcap);
   const std::string dir = a.One("-o").value_or("logplay_export");
   const bool plot = !a.Flag("--no-plot");
   const std::string path = a.Log();

@@ -85,6 +85,10 @@ class RobotTracker::Impl {
 
   TrackerFrame Poll();
   void SetWatching(bool watching) { watching_ = watching; }
+  void SetOnSample(std::function<void()> f) {
+    std::lock_guard lock(mutex_);
+    on_sample_ = std::move(f);
+  }
   void Panic(const std::string& robot, std::function<void(const std::string&)> done);
 
  private:
@@ -180,12 +184,14 @@ class RobotTracker::Impl {
   void SetStream(const std::string& name) {
     std::shared_ptr<RobotClient> client;
     std::shared_ptr<SampleSlot> slot;
+    std::function<void()> on_sample;
     const bool want = watching_;
     {
       std::lock_guard lock(mutex_);
       auto it = robots_.find(name);
       if (it == robots_.end()) return;
       it->second.stream_task = false;
+      on_sample = on_sample_;
       client = it->second.client;
       slot = it->second.slot;
     }
@@ -195,10 +201,13 @@ class RobotTracker::Impl {
       if (want) {
         const auto period =
             std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / options_.rate_hz));
-        client->StartStateStream(period, [slot](const StateSample& s) {
-          std::lock_guard l(slot->mutex);
-          slot->sample = s;
-          ++slot->received;
+        client->StartStateStream(period, [slot, on_sample](const StateSample& s) {
+          {
+            std::lock_guard l(slot->mutex);
+            slot->sample = s;
+            ++slot->received;
+          }
+          if (on_sample) on_sample();
         });
       } else {
         client->StopStateStream();
@@ -227,6 +236,7 @@ class RobotTracker::Impl {
   std::map<std::string, Robot> robots_;             // GUARDED_BY(mutex_)
   std::deque<std::pair<std::string, Task>> queue_;  // GUARDED_BY(mutex_)
   std::atomic<bool> watching_{false};
+  std::function<void()> on_sample_;  // GUARDED_BY(mutex_)
   std::vector<std::thread> panics_;  // GUARDED_BY(mutex_)
   std::thread listener_, worker_;
 };
@@ -314,7 +324,7 @@ TrackerFrame RobotTracker::Impl::Poll() {
     for (auto& [name, r] : robots_) {
       Housekeep(r, now, drop);
       list.push_back(RobotJson(r));
-      if (r.model_message) frame.models.push_back({name, r.generation, r.model_message});
+      if (r.model_message) frame.models.push_back({name, r.generation, r.model_message, r.model});
       if (!r.client || !r.slot || !r.poser) continue;
       if (watching_ && r.poser->needs_measured_root()) MeasureRoot(r);
       std::lock_guard slot_lock(r.slot->mutex);
@@ -325,6 +335,7 @@ TrackerFrame RobotTracker::Impl::Poll() {
         nlohmann::json s = r.poser->Pose(r.slot->sample);
         s["generation"] = r.generation;
         frame.states.push_back(JsonText(s));
+        frame.poses.push_back(std::move(s));
       } catch (const Error& e) {
         r.message = e.what();
       }
@@ -353,6 +364,7 @@ void RobotTracker::Impl::Panic(const std::string& robot, std::function<void(cons
 RobotTracker::RobotTracker(const WebOptions& options) : impl_(std::make_unique<Impl>(options)) {}
 RobotTracker::~RobotTracker() = default;
 void RobotTracker::SetWatching(bool watching) { impl_->SetWatching(watching); }
+void RobotTracker::SetOnSample(std::function<void()> on_sample) { impl_->SetOnSample(std::move(on_sample)); }
 TrackerFrame RobotTracker::Poll() { return impl_->Poll(); }
 void RobotTracker::Panic(const std::string& robot, std::function<void(const std::string&)> done) {
   impl_->Panic(robot, std::move(done));

@@ -19,6 +19,7 @@
 // Connection failures are reported in the robot's status, not thrown.
 #pragma once
 
+#include "robotalk/robot_model.h"
 #include "web_options.h"
 
 #include <nlohmann/json.hpp>
@@ -41,11 +42,14 @@ struct TrackerFrame {
     std::string robot;
     std::uint64_t generation = 0;
     std::shared_ptr<const std::string> message;
+    std::shared_ptr<const RobotModel> model;  ///< the model the message describes
   };
   std::vector<Model> models;
   /// {"type":"state"} messages (StatePoser::Pose), one per robot with a sample
   /// newer than the last Poll().
   std::vector<std::string> states;
+  /// The same states as objects (the Foxglove endpoint's input).
+  std::vector<nlohmann::json> poses;
   /// Samples received from LCM since the last Poll(), over every robot.
   std::uint64_t samples_received = 0;
 };
@@ -64,6 +68,12 @@ class RobotTracker {
   /// Whether any page is open. The state streams are asked for while one is
   /// and cancelled when none is (heartbeats keep the sessions). Any thread.
   void SetWatching(bool watching);
+
+  /// Called (on a client's ReadDaemon thread, after the sample is stored)
+  /// for every state sample received, so the web loop can send it at once
+  /// instead of at its next tick. Set it before the first SetWatching(true);
+  /// it must be quick and must not call back into the tracker.
+  void SetOnSample(std::function<void()> on_sample);
 
   /// Sends a panic package to `robot` on a thread of its own and calls `done`
   /// there with an empty string on success or the reason it failed (not

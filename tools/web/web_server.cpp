@@ -1,9 +1,11 @@
 #include "web_server.h"
 
+#include "foxglove_endpoint.h"
 #include "json_text.h"
 #include "mesh_catalog.h"
 #include "robotalk/error.h"
 #include "web_files.h"
+#include "ws_connection.h"
 
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
@@ -12,7 +14,9 @@
 #include <boost/beast/websocket.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <deque>
 #include <map>
 #include <string>
@@ -50,75 +54,6 @@ bool Traverses(std::string_view path) {
   return false;
 }
 
-class WsSession : public std::enable_shared_from_this<WsSession> {
- public:
-  using PanicHandler = std::function<void(std::weak_ptr<WsSession>, const std::string& robot)>;
-
-  WsSession(tcp::socket socket, PanicHandler on_panic)
-      : ws_(std::move(socket)), on_panic_(std::move(on_panic)) {}
-
-  void Start(http::request<http::string_body> req, std::vector<Message> greeting) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.read_message_max(kMaxPageMessage);
-    ws_.async_accept(req, [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
-      if (ec) return;
-      self->open_ = true;
-      for (const Message& m : greeting) self->Send(m, false);
-      self->Read();
-    });
-  }
-
-  bool open() const { return open_; }
-
-  // REQUIRES: the io thread.
-  void Send(const Message& m, bool droppable) {
-    if (!open_) return;
-    if (droppable && queue_.size() >= kMaxQueuedFrames) {
-      ++dropped_;
-      return;
-    }
-    queue_.push_back(m);
-    if (queue_.size() == 1) Write();
-  }
-
- private:
-  void Write() {
-    ws_.text(true);
-    ws_.async_write(asio::buffer(*queue_.front()),
-                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                      if (ec) {
-                        self->open_ = false;
-                        return;
-                      }
-                      self->queue_.pop_front();
-                      if (!self->queue_.empty()) self->Write();
-                    });
-  }
-
-  void Read() {
-    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) {
-        self->open_ = false;
-        return;
-      }
-      const std::string text = beast::buffers_to_string(self->in_.data());
-      self->in_.consume(self->in_.size());
-      const nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
-      if (msg.is_object() && msg.value("type", "") == "panic" && msg.contains("robot") &&
-          msg["robot"].is_string())
-        self->on_panic_(self->weak_from_this(), msg["robot"].get<std::string>());
-      self->Read();
-    });
-  }
-
-  websocket::stream<beast::tcp_stream> ws_;
-  PanicHandler on_panic_;
-  beast::flat_buffer in_;
-  std::deque<Message> queue_;
-  bool open_ = false;
-  std::uint64_t dropped_ = 0;
-};
-
 }  // namespace
 
 class WebServer::Impl {
@@ -139,6 +74,19 @@ class WebServer::Impl {
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(1.0 / o.rate_hz));
     for (const auto& [robot, urdf] : o.urdf) meshes_[robot] = ResolveMeshes(robot, urdf, o.package_paths);
+    // PANIC from Foxglove only when the bridge holds a key: a keyed server
+    // then decides by the bridge's rights (docs/interop.md).
+    FoxgloveEndpoint::PanicHandler panic;
+    if (std::getenv("ROBOTALK_KEY") != nullptr)
+      panic = [this](const std::string& robot, auto done) { tracker_.Panic(robot, std::move(done)); };
+    foxglove_ = std::make_unique<FoxgloveEndpoint>(ioc_, std::move(panic));
+    // A sample is sent when it arrives, not at the next tick (a tick that
+    // polls just before each sample would add a whole period); at most one
+    // wake-up in flight. The listener may outlive this server: it holds the
+    // io_context, which runs no handler once Run() has returned.
+    tracker_.SetOnSample([ioc = ioc_, posted = sample_posted_, this] {
+      if (!posted->exchange(true)) asio::post(*ioc, [this] { OnSample(); });
+    });
   }
 
   const std::map<std::string, MeshCatalog>& meshes() const { return meshes_; }
@@ -148,7 +96,6 @@ class WebServer::Impl {
   void Run() {
     signals_.async_wait([this](beast::error_code, int) { Stop(); });
     Accept();
-    next_tick_ = std::chrono::steady_clock::now();
     Tick();
     ioc_->run();
   }
@@ -172,11 +119,18 @@ class WebServer::Impl {
     http::async_read(*stream, *buffer, *req, [this, stream, buffer, req](beast::error_code ec, std::size_t) {
       if (ec) return;
       if (websocket::is_upgrade(*req) &&
+          FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
+        stream->expires_never();
+        foxglove_->Accept(stream->release_socket(), std::move(*req));
+        return;
+      }
+      if (websocket::is_upgrade(*req) &&
           std::string_view(req->target().data(), req->target().size()) == "/ws") {
         stream->expires_never();
-        auto session = std::make_shared<WsSession>(
-            stream->release_socket(),
-            [this](std::weak_ptr<WsSession> s, const std::string& robot) { OnPanic(std::move(s), robot); });
+        auto session =
+            std::make_shared<WsConnection>(stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
+                                           [this](const std::shared_ptr<WsConnection>& s,
+                                                  const std::string& text, bool) { OnPageMessage(s, text); });
         sessions_.push_back(session);
         session->Start(std::move(*req), Greeting());
         return;
@@ -261,15 +215,17 @@ class WebServer::Impl {
   }
 
   void Broadcast(const Message& m, bool droppable) {
-    for (auto& s : sessions_) s->Send(m, droppable);
+    for (auto& s : sessions_) s->Send(m, false, droppable);
   }
 
   void Tick() {
+    const auto now = std::chrono::steady_clock::now();
     TrackerFrame f = tracker_.Poll();
     std::erase_if(sessions_,
-                  [](const std::shared_ptr<WsSession>& s) { return s.use_count() == 1 && !s->open(); });
-    tracker_.SetWatching(
-        std::any_of(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->open(); }));
+                  [](const std::shared_ptr<WsConnection>& s) { return s.use_count() == 1 && !s->open(); });
+    tracker_.SetWatching(foxglove_->connected() || std::any_of(sessions_.begin(), sessions_.end(),
+                                                               [](const auto& s) { return s->open(); }));
+    foxglove_->Update(f);
     const std::string robots = JsonText(f.robots);
     if (!robots_ || *robots_ != robots) {
       robots_ = std::make_shared<const std::string>(robots);
@@ -283,17 +239,61 @@ class WebServer::Impl {
       }
     }
     for (std::string& s : f.states) Broadcast(std::make_shared<const std::string>(std::move(s)), true);
-    // Absolute deadlines: the rate does not drift with the work done per tick.
-    next_tick_ += period_;
-    const auto now = std::chrono::steady_clock::now();
-    if (next_tick_ < now) next_tick_ = now;
-    tick_.expires_at(next_tick_);
+    Credit(now);
+    if (!f.states.empty()) send_credit_ = std::max(0.0, send_credit_ - 1.0);
+    Arm(now + period_, true);  // housekeeping (robots, models) goes on without samples
+  }
+
+  // The next tick at `at`; unless `force`, only when that is earlier than the one armed.
+  void Arm(std::chrono::steady_clock::time_point at, bool force) {
+    if (!force && armed_ && armed_at_ <= at) return;
+    armed_ = true;
+    armed_at_ = at;
+    tick_.expires_at(at);
     tick_.async_wait([this](beast::error_code ec) {
-      if (!ec) Tick();
+      if (ec) return;  // re-armed
+      armed_ = false;
+      Tick();
     });
   }
 
-  void OnPanic(std::weak_ptr<WsSession> session, const std::string& robot) {
+  // States go out as they arrive, `rate` times a second on average: a token
+  // bucket earns a send per period and holds at most kMaxCredit. A sample
+  // with a whole send of credit goes out at once; one without waits for the
+  // tick at which the credit is earned. A stream at the rate itself keeps
+  // about one send in hand, so a sample arriving late and the next one on
+  // time are both sent as they arrive (with a cap of 1, credit lost to a
+  // late sample would never come back, and every later sample would wait
+  // for it); faster streams are decimated to the rate, two sends at most at once.
+  static constexpr double kMaxCredit = 2.0;
+
+  double Credit(std::chrono::steady_clock::time_point now) {
+    const double earned = std::chrono::duration<double>(now - credit_at_).count() * options_.rate_hz;
+    send_credit_ = std::min(kMaxCredit, send_credit_ + earned);
+    credit_at_ = now;
+    return send_credit_;
+  }
+
+  void OnSample() {
+    sample_posted_->store(false);
+    const auto now = std::chrono::steady_clock::now();
+    const double credit = Credit(now);
+    if (credit >= 1.0)
+      Tick();
+    else
+      Arm(now + std::chrono::duration_cast<std::chrono::steady_clock::duration>((1.0 - credit) * period_),
+          false);
+  }
+
+  // The page sends only {"type":"panic","robot":NAME}; anything else is ignored.
+  void OnPageMessage(const std::shared_ptr<WsConnection>& session, const std::string& text) {
+    const nlohmann::json msg = nlohmann::json::parse(text, nullptr, false);
+    if (msg.is_object() && msg.value("type", "") == "panic" && msg.contains("robot") &&
+        msg["robot"].is_string())
+      OnPanic(session, msg["robot"].get<std::string>());
+  }
+
+  void OnPanic(std::weak_ptr<WsConnection> session, const std::string& robot) {
     // The callback runs on a tracker thread that may outlive this server: it
     // keeps the io_context alive itself and reaches the session weakly.
     tracker_.Panic(robot, [ioc = ioc_, session, robot](const std::string& error) {
@@ -301,7 +301,7 @@ class WebServer::Impl {
           {"type", "panic_result"}, {"robot", robot}, {"ok", error.empty()}, {"message", error}};
       auto msg = std::make_shared<const std::string>(JsonText(r));
       asio::post(*ioc, [session, msg] {
-        if (auto s = session.lock()) s->Send(msg, false);
+        if (auto s = session.lock()) s->Send(msg, false, false);
       });
     });
   }
@@ -313,11 +313,15 @@ class WebServer::Impl {
   asio::steady_timer tick_;
   asio::signal_set signals_;
   std::chrono::steady_clock::duration period_{};
-  std::chrono::steady_clock::time_point next_tick_{};
-  std::vector<std::shared_ptr<WsSession>> sessions_;
+  std::chrono::steady_clock::time_point credit_at_{}, armed_at_{};  // of send_credit_; of the armed tick
+  double send_credit_ = kMaxCredit;
+  bool armed_ = false;
+  std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
+  std::vector<std::shared_ptr<WsConnection>> sessions_;
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
   std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start
+  std::unique_ptr<FoxgloveEndpoint> foxglove_;
 };
 
 WebServer::WebServer(const WebOptions& options, RobotTracker& tracker)

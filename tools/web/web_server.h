@@ -4,10 +4,13 @@
 // them), each such robot's mesh catalog at /meshes/NAME and the mesh files
 // it resolved at /mesh/NAME/... (mesh_catalog.h; a request path with a "."
 // or ".." segment, a backslash or a percent escape is refused 403, naming
-// it), and one WebSocket at /ws that carries JSON: every
-// `1/rate` s it polls the RobotTracker and pushes the robots list when it
-// changed, each new model, and each robot's newest state. It reads one kind of
-// message from the page: {"type":"panic","robot":NAME}.
+// it), and one WebSocket at /ws that carries JSON: it polls the RobotTracker
+// when a state sample arrives (at most `rate` times a second) and every
+// `1/rate` s without samples, and pushes the robots list when it changed,
+// each new model, and each robot's newest state. It reads one kind of
+// message from the page: {"type":"panic","robot":NAME}. Upgrades offering
+// the foxglove.websocket.v1 subprotocol go to the FoxgloveEndpoint
+// (foxglove_endpoint.h), fed by the same polls.
 //
 // Thread safety: everything runs on the thread that calls Run(); Stop() may
 // be called from any thread (or a signal handler's strand via asio).

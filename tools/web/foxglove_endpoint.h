@@ -1,0 +1,65 @@
+// FoxgloveEndpoint: robotalk-web's side of the Foxglove WebSocket protocol
+// (subprotocol "foxglove.websocket.v1", JSON messages with JSON Schemas;
+// docs/interop.md). A WebSocket upgrade on any path that offers that
+// subprotocol is handed here by WebServer; the page's /ws stays as it was.
+//
+// Per connection it sends serverInfo, advertises the channels of every robot
+// with a model (foxglove_messages.h; more as robots appear) and, when the
+// bridge was given a panic handler, one service "/robotalk/panic"
+// (request {"robot": NAME}). It reads subscribe / unsubscribe and service
+// calls; anything else gets a status message naming it. Each robot's state
+// reaches a subscriber at the web loop's rate (--rate, decimated by the
+// tracker); a subscriber of /ROBOT/scene gets the current scene at once.
+// A client that cannot keep up loses state messages, never an advertisement,
+// a scene or a service answer.
+//
+// Thread safety: everything on the io_context's thread (Update, Accept);
+// the panic handler's `done` may be called from any thread.
+// Errors: nothing thrown to the caller; a bad client message closes nothing,
+// it is answered with a status (level 2) naming what was wrong.
+#pragma once
+
+#include "robot_tracker.h"
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/http/message.hpp>
+#include <boost/beast/http/string_body.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace robotalk::web {
+
+class FoxgloveEndpoint {
+ public:
+  /// Sends a panic to `robot` and calls `done` (any thread) with "" or why it failed.
+  using PanicHandler =
+      std::function<void(const std::string& robot, std::function<void(const std::string& error)> done)>;
+  /// The subprotocol this endpoint speaks.
+  static constexpr const char* kSubprotocol = "foxglove.websocket.v1";
+
+  /// `panic` empty: no services are offered (the endpoint is read-only).
+  FoxgloveEndpoint(std::shared_ptr<boost::asio::io_context> ioc, PanicHandler panic);
+  ~FoxgloveEndpoint();
+  FoxgloveEndpoint(const FoxgloveEndpoint&) = delete;
+  FoxgloveEndpoint& operator=(const FoxgloveEndpoint&) = delete;
+
+  /// Whether an upgrade request offers kSubprotocol (Sec-WebSocket-Protocol).
+  static bool Offered(const boost::beast::http::request<boost::beast::http::string_body>& request);
+  /// Takes a connection whose upgrade request offered kSubprotocol.
+  void Accept(boost::asio::ip::tcp::socket socket,
+              boost::beast::http::request<boost::beast::http::string_body> request);
+  /// One web-loop tick: new models (advertised, scenes sent) and the newest
+  /// state of each robot (to the subscribers of its channels).
+  void Update(const TrackerFrame& frame);
+  /// Whether any Foxglove client is connected (the tracker streams while one is).
+  bool connected() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace robotalk::web

@@ -1,0 +1,72 @@
+#include "ws_connection.h"
+
+#include <boost/asio.hpp>
+
+namespace robotalk::web {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+
+WsConnection::WsConnection(asio::ip::tcp::socket socket, std::size_t max_message, std::size_t max_droppable,
+                           OnMessage on_message)
+    : ws_(std::move(socket)),
+      max_message_(max_message),
+      max_droppable_(max_droppable),
+      on_message_(std::move(on_message)) {}
+
+void WsConnection::Start(http::request<http::string_body> request, std::vector<Message> greeting,
+                         const std::string& subprotocol) {
+  ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+  ws_.set_option(websocket::stream_base::decorator([subprotocol](websocket::response_type& res) {
+    res.set(http::field::server, "robotalk-web");
+    if (!subprotocol.empty()) res.set(http::field::sec_websocket_protocol, subprotocol);
+  }));
+  ws_.read_message_max(max_message_);
+  ws_.async_accept(request,
+                   [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
+                     if (ec) return;
+                     self->open_ = true;
+                     for (const Message& m : greeting) self->Send(m, false, false);
+                     self->Read();
+                   });
+}
+
+void WsConnection::Send(const Message& m, bool binary, bool droppable) {
+  if (!open_) return;
+  if (droppable && queue_.size() >= max_droppable_) {
+    ++dropped_;
+    return;
+  }
+  queue_.emplace_back(m, binary);
+  if (queue_.size() == 1) Write();
+}
+
+void WsConnection::Write() {
+  ws_.binary(queue_.front().second);
+  ws_.async_write(asio::buffer(*queue_.front().first),
+                  [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                    if (ec) {
+                      self->open_ = false;
+                      return;
+                    }
+                    self->queue_.pop_front();
+                    if (!self->queue_.empty()) self->Write();
+                  });
+}
+
+void WsConnection::Read() {
+  ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+    if (ec) {
+      self->open_ = false;
+      return;
+    }
+    const std::string data = beast::buffers_to_string(self->in_.data());
+    self->in_.consume(self->in_.size());
+    self->on_message_(self, data, self->ws_.got_text());
+    self->Read();
+  });
+}
+
+}  // namespace robotalk::web

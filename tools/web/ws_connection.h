@@ -1,0 +1,61 @@
+// WsConnection: one server-side WebSocket of robotalk-web, on Boost.Beast:
+// the page's /ws (web_server.cpp) and each Foxglove client
+// (foxglove_endpoint.cpp). It accepts the upgrade (answering with a
+// subprotocol when given), sends a greeting, keeps a write queue and hands
+// every message it reads to a callback. A client that cannot keep up loses
+// droppable messages once `max_droppable` are queued, never the others.
+//
+// Thread safety: everything on the io_context's thread.
+// Errors: none thrown; a failed accept, read or write closes the connection
+// (open() turns false) and the owner drops it.
+#pragma once
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace robotalk::web {
+
+class WsConnection : public std::enable_shared_from_this<WsConnection> {
+ public:
+  using Message = std::shared_ptr<const std::string>;
+  /// Called with each message read: its bytes and whether it was text.
+  using OnMessage =
+      std::function<void(const std::shared_ptr<WsConnection>&, const std::string& data, bool text)>;
+
+  /// Messages longer than `max_message` bytes close the connection.
+  WsConnection(boost::asio::ip::tcp::socket socket, std::size_t max_message, std::size_t max_droppable,
+               OnMessage on_message);
+
+  /// Accepts the upgrade `request`; then sends `greeting` (text) and reads.
+  /// A non-empty `subprotocol` is named in the answer (Sec-WebSocket-Protocol).
+  void Start(boost::beast::http::request<boost::beast::http::string_body> request,
+             std::vector<Message> greeting, const std::string& subprotocol = "");
+  bool open() const { return open_; }
+  /// Queues one message (text or binary); a droppable one is dropped when the
+  /// queue is full.
+  void Send(const Message& m, bool binary, bool droppable);
+  std::uint64_t dropped() const { return dropped_; }
+
+ private:
+  void Write();
+  void Read();
+
+  boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  std::size_t max_message_, max_droppable_;
+  OnMessage on_message_;
+  boost::beast::flat_buffer in_;
+  std::deque<std::pair<Message, bool>> queue_;  // message, binary
+  bool open_ = false;
+  std::uint64_t dropped_ = 0;
+};
+
+}  // namespace robotalk::web
