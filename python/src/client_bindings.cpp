@@ -91,8 +91,8 @@ class PyRobotClient {
 
   // Sends `command` and waits for its final reply as RobotClient::Execute
   // does, interruptibly; a KeyboardInterrupt during a motion command sends STOP.
-  Reply Execute(Command command) {
-    auto c = Client("execute");
+  Reply Execute(Command command, const char* call = "execute") {
+    auto c = Client(call);
     Duration wait = c->options().timeout;
     if (auto at = command.start_time.time()) wait += std::max(Duration::zero(), *at - c->ServerNow());
     const bool motion = IsMotionCommand(command.type);
@@ -112,9 +112,9 @@ class PyRobotClient {
                        std::to_string(Seconds(wait)) + " s");
   }
 
-  py::object Run(Command command, bool wait) {
-    if (wait) return py::cast(Execute(std::move(command)));
-    auto c = Client("send");
+  py::object Run(Command command, bool wait, const char* call = "execute") {
+    if (wait) return py::cast(Execute(std::move(command), call));
+    auto c = Client(call);
     const std::string what = Describe(command);
     PendingReply p = [&] {
       py::gil_scoped_release release;
@@ -440,7 +440,9 @@ void BindClient(py::module_& m) {
           "Raises TimeoutError when unanswered, PanicRefusedError when the server refused it.")
       .def(
           "reset_panic",
-          [](PyRobotClient& p) { return p.Execute(Command{.type = CommandType::kPanicReset}); },
+          [](PyRobotClient& p) {
+            return p.Execute(Command{.type = CommandType::kPanicReset}, "reset_panic");
+          },
           "PANIC_RESET; its Reply.")
       .def(
           "set_joint",
@@ -450,7 +452,7 @@ void BindClient(py::module_& m) {
                                  .start_time = Start(start),
                                  .target = joint,
                                  .values = ToValues(v, "set_joint positions")},
-                         wait);
+                         wait, "set_joint");
           },
           py::arg("joint"), py::arg("positions"), py::arg("start") = py::none(), py::kw_only(),
           py::arg("wait") = true, "JOINT_SETPOINT: one position per dof of `joint` (rad | m).")
@@ -462,7 +464,7 @@ void BindClient(py::module_& m) {
                                  .start_time = Start(start),
                                  .target = joint,
                                  .values = ToValues(v, "joint_speed velocities")},
-                         wait);
+                         wait, "joint_speed");
           },
           py::arg("joint"), py::arg("velocities"), py::arg("start") = py::none(), py::kw_only(),
           py::arg("wait") = true, "JOINT_SPEED: one velocity per dof (rad/s | m/s).")
@@ -474,7 +476,7 @@ void BindClient(py::module_& m) {
                                  .start_time = Start(start),
                                  .target = joint,
                                  .values = ToValues(v, "joint_force efforts")},
-                         wait);
+                         wait, "joint_force");
           },
           py::arg("joint"), py::arg("efforts"), py::arg("start") = py::none(), py::kw_only(),
           py::arg("wait") = true, "JOINT_FORCE: one effort per dof (N m | N).")
@@ -486,7 +488,7 @@ void BindClient(py::module_& m) {
                                  .start_time = Start(start),
                                  .target = frame,
                                  .values = ToValues(pose, "frame_setpoint pose")},
-                         wait);
+                         wait, "frame_setpoint");
           },
           py::arg("frame"), py::arg("pose"), py::arg("start") = py::none(), py::kw_only(),
           py::arg("wait") = true, "FRAME_SETPOINT: a control frame's world pose x y z qw qx qy qz.")
@@ -495,7 +497,7 @@ void BindClient(py::module_& m) {
           [](PyRobotClient& p, double x, double y, double theta, std::optional<double> start, bool wait) {
             return p.Run(
                 Command{.type = CommandType::kGoto, .start_time = Start(start), .values = {x, y, theta}},
-                wait);
+                wait, "goto");
           },
           py::arg("x"), py::arg("y"), py::arg("theta"), py::arg("start") = py::none(), py::kw_only(),
           py::arg("wait") = true,
@@ -506,7 +508,7 @@ void BindClient(py::module_& m) {
           [](PyRobotClient& p, double v, double omega, std::optional<double> start, bool wait) {
             return p.Run(
                 Command{.type = CommandType::kSetSpeed, .start_time = Start(start), .values = {v, omega}},
-                wait);
+                wait, "set_speed");
           },
           py::arg("v"), py::arg("omega"), py::arg("start") = py::none(), py::kw_only(),
           py::arg("wait") = true,
@@ -514,7 +516,7 @@ void BindClient(py::module_& m) {
       .def(
           "stop",
           [](PyRobotClient& p, std::optional<double> start, bool wait) {
-            return p.Run(Command{.type = CommandType::kStop, .start_time = Start(start)}, wait);
+            return p.Run(Command{.type = CommandType::kStop, .start_time = Start(start)}, wait, "stop");
           },
           py::arg("start") = py::none(), py::kw_only(), py::arg("wait") = true, "STOP every motion.")
       .def("_run_sequence",

@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 import robotalk
-from conftest import Server, program, url_of
+from conftest import Server, program
+from test_client import settle
 
 SPACING = 0.05  # s between frames
 
@@ -59,6 +60,7 @@ def test_direct_sequence_waits_for_each_reply(server: Server) -> None:
 def test_state_stream_iterates_samples(server: Server) -> None:
     with robotalk.connect("pioneer", server.url) as robot:
         robot.set_joint("pan", [0.4])
+        settle(robot, "pan", 0.4)
         with robot.state_stream(0.01) as stream:
             assert stream.period == pytest.approx(0.01)
             samples = []
