@@ -24,8 +24,7 @@ from __future__ import annotations
 import os
 import warnings
 from datetime import timedelta
-from types import TracebackType
-from typing import Callable, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Type, Union
+from typing import Callable, Iterable, List, NamedTuple, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -66,7 +65,7 @@ from ._robotalk import (
     parse_sequence,
 )
 from ._robotalk import _load_urdf, _parse_urdf, _robots
-from ._stream import StateStream
+from ._stream import ClosesOnExit, StateStream
 
 __version__ = "0.1.0"
 
@@ -135,7 +134,7 @@ def robots(url: Optional[str] = None, listen: Seconds = 1.5) -> List[AnnouncedRo
     return _robots(url, listen)
 
 
-class RobotClient(_RobotClient):
+class RobotClient(_RobotClient, ClosesOnExit):
     """A client of RoboTalk robots: the C++ RobotClient (docs/client.md) in Python.
 
     ``RobotClient(url=None, *, key=None, server_key=None, known_servers=None,
@@ -157,14 +156,6 @@ class RobotClient(_RobotClient):
 
     def __enter__(self) -> "RobotClient":
         return self
-
-    def __exit__(
-        self,
-        exc_type: Optional[Type[BaseException]],
-        exc: Optional[BaseException],
-        tb: Optional[TracebackType],
-    ) -> None:
-        self.close()
 
     def close(self) -> None:
         """Ends the state stream and stops the client. Sends nothing: a moving robot

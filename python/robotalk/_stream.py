@@ -23,7 +23,22 @@ if TYPE_CHECKING:
     from . import RobotClient
 
 
-class StateStream:
+class ClosesOnExit:
+    """A context manager whose block's end calls ``self.close()``."""
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __exit__(
+        self,
+        exc_type: Optional[Type[BaseException]],
+        exc: Optional[BaseException],
+        tb: Optional[TracebackType],
+    ) -> None:
+        self.close()
+
+
+class StateStream(ClosesOnExit):
     """A running state stream (``RobotClient.state_stream()``).
 
     Iterate it (``for sample in stream``: blocks until the next sample, ends
@@ -111,14 +126,6 @@ class StateStream:
 
     def __enter__(self) -> "StateStream":
         return self
-
-    def __exit__(
-        self,
-        exc_type: Optional[Type[BaseException]],
-        exc: Optional[BaseException],
-        tb: Optional[TracebackType],
-    ) -> None:
-        self.close()
 
     def __repr__(self) -> str:
         state = "closed" if self.closed else "running"

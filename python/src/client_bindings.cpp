@@ -107,9 +107,7 @@ class PyRobotClient {
       if (motion) StopAfterInterrupt(*c, &e);
       throw;
     }
-    // The C++ PendingReply::Wait's message.
-    throw TimeoutError(what + " (id " + std::to_string(pending.id()) + "): no reply within " +
-                       std::to_string(Seconds(wait)) + " s");
+    throw NoReply(what, pending.id(), wait);
   }
 
   py::object Run(Command command, bool wait, const char* call = "execute") {
@@ -134,8 +132,7 @@ class PyRobotClient {
     if (!wait) return py::cast(std::make_unique<PyPendingReply>(std::move(p), what));
     const Duration timeout = c->options().timeout;
     if (auto r = WaitInterruptibly(p, timeout)) return py::cast(*r);
-    throw TimeoutError(what + " (id " + std::to_string(p.id()) + "): no reply within " +
-                       std::to_string(Seconds(timeout)) + " s");
+    throw NoReply(what, p.id(), timeout);
   }
 
   // A query's values; SignalError unless it succeeded.
@@ -316,26 +313,11 @@ void BindClient(py::module_& m) {
       .def(
           "get",
           [](StateQueue& q, py::object timeout) -> std::optional<StateSample> {
-            // Waits in slices so that Ctrl-C reaches a main thread iterating the stream.
-            const auto start = std::chrono::steady_clock::now();
-            const std::optional<Duration> most =
+            // In slices, so that Ctrl-C reaches a main thread iterating the stream.
+            return WaitInSlices<StateSample>(
                 timeout.is_none() ? std::nullopt
-                                  : std::optional<Duration>(ToNonNegativeDuration(timeout, "get"));
-            for (;;) {
-              Duration slice = kSignalCheckInterval;
-              if (most)
-                slice = std::clamp<Duration>(*most - (std::chrono::steady_clock::now() - start), Duration(0),
-                                             slice);
-              std::optional<StateSample> s;
-              {
-                py::gil_scoped_release release;
-                s = q.Pop(slice);
-              }
-              if (s) return s;
-              if (q.closed()) return std::nullopt;
-              if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-              if (most && std::chrono::steady_clock::now() - start >= *most) return std::nullopt;
-            }
+                                  : std::optional<Duration>(ToNonNegativeDuration(timeout, "get")),
+                [&](Duration slice) { return q.Pop(slice); }, [&] { return q.closed(); });
           },
           py::arg("timeout") = py::none())
       .def("close", &StateQueue::Close)

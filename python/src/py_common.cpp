@@ -65,24 +65,19 @@ std::vector<double> ToValues(py::handle values, const char* what) {
 
 std::optional<Reply> WaitInterruptibly(PendingReply& pending, std::optional<Duration> most,
                                        std::mutex* guard) {
-  const auto start = std::chrono::steady_clock::now();
-  for (;;) {
-    Duration slice = kSignalCheckInterval;
-    if (most) {
-      const Duration left = *most - (std::chrono::steady_clock::now() - start);
-      slice = std::clamp(left, Duration::zero(), kSignalCheckInterval);
-    }
-    std::optional<Reply> reply;
-    {
-      py::gil_scoped_release release;
-      std::unique_lock<std::mutex> lock;
-      if (guard) lock = std::unique_lock(*guard);
-      reply = pending.WaitFor(slice);
-    }
-    if (reply) return reply;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (most && std::chrono::steady_clock::now() - start >= *most) return std::nullopt;
-  }
+  return WaitInSlices<Reply>(
+      most,
+      [&](Duration slice) {
+        std::unique_lock<std::mutex> lock;
+        if (guard) lock = std::unique_lock(*guard);
+        return pending.WaitFor(slice);
+      },
+      [] { return false; });
+}
+
+TimeoutError NoReply(const std::string& what, CommandId id, Duration waited) {
+  return TimeoutError(what + " (id " + std::to_string(id) + "): no reply within " +
+                      std::to_string(Seconds(waited)) + " s");
 }
 
 std::string Describe(const Command& c) {

@@ -10,6 +10,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
+#include <chrono>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -41,6 +43,32 @@ std::vector<double> ToValues(py::handle values, const char* what);
 /// reply wakes the wait at once, whatever this is.
 inline constexpr Duration kSignalCheckInterval = std::chrono::milliseconds(50);
 
+/// The one wait of the bindings: calls `attempt(slice)` with the GIL released
+/// (it waits at most `slice` for its value) until it returns a value,
+/// `finished()` says no value will come, or `most` passed (nullopt: no
+/// limit); between attempts, with the GIL, it runs Python's signal handlers
+/// every kSignalCheckInterval, throwing pybind11::error_already_set for what
+/// they raise (KeyboardInterrupt). REQUIRES: the GIL is held.
+template <typename T, typename Attempt, typename Finished>
+std::optional<T> WaitInSlices(std::optional<Duration> most, Attempt&& attempt, Finished&& finished) {
+  const auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    Duration slice = kSignalCheckInterval;
+    if (most) {
+      const Duration left = *most - (std::chrono::steady_clock::now() - start);
+      slice = std::clamp(left, Duration::zero(), kSignalCheckInterval);
+    }
+    std::optional<T> value;
+    {
+      py::gil_scoped_release release;
+      value = attempt(slice);
+    }
+    if (value || finished()) return value;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (most && std::chrono::steady_clock::now() - start >= *most) return std::nullopt;
+  }
+}
+
 /// Waits for `pending` with the GIL released, at most `most` (nullopt: until
 /// the reply or the client gives up on it), waking every
 /// kSignalCheckInterval to run Python's signal handlers: a KeyboardInterrupt
@@ -51,6 +79,10 @@ inline constexpr Duration kSignalCheckInterval = std::chrono::milliseconds(50);
 /// a PendingReply is not thread-safe, a Python object may be shared.
 std::optional<Reply> WaitInterruptibly(PendingReply& pending, std::optional<Duration> most,
                                        std::mutex* guard = nullptr);
+
+/// The TimeoutError of a wait that got no reply, with the C++
+/// PendingReply::Wait's message: "GOTO (id 12): no reply within 5.000000 s".
+TimeoutError NoReply(const std::string& what, CommandId id, Duration waited);
 
 /// "GOTO", "JOINT_SETPOINT 'pan'" (as the C++ client names a call in messages).
 std::string Describe(const Command& c);

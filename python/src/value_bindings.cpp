@@ -18,9 +18,7 @@ std::optional<Reply> PyPendingReply::Poll() {
 
 Reply PyPendingReply::Wait(std::optional<Duration> timeout) {
   if (auto r = WaitInterruptibly(pending_, timeout, &mu_)) return *r;
-  // The C++ PendingReply::Wait's message.
-  throw TimeoutError(what_ + " (id " + std::to_string(id()) + "): no reply within " +
-                     std::to_string(Seconds(*timeout)) + " s");
+  throw NoReply(what_, id(), *timeout);
 }
 
 std::optional<Reply> PyPendingReply::WaitFor(Duration most) {
