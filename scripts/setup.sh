@@ -12,6 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless lua5.2
   iproute2 util-linux python3 python3-matplotlib
+  pybind11-dev python3-dev python3-numpy python3-pytest mypy  # the Python package (python/, docs/python.md)
   libboost-dev nlohmann-json3-dev chromium chromium-driver
   libjchart2d-java xvfb x11-apps  # robotalk-spy (lcm-spy charts); its test: a virtual X server and xwd
   libsodium-dev

@@ -9,6 +9,7 @@
 #   cmake  every robotalk:: target it names is one the package exports
 #   java   compiled by javac against the installed bindings (where javac is)
 #   xml    well-formed (a fragment's "..." lines dropped)
+#   python parsed (ast.parse: the syntax of Python 3)
 #   text   not code: output, diagrams, synopses; left alone
 # A fence with no language fails (write ```text when it is not code).
 # A marker is an HTML comment on the line just before the fence:
@@ -137,6 +138,9 @@ for meta in "$tmp/blocks"/*.meta; do
     xml)
       check "$where: well-formed XML" python3 -c 'import sys, xml.dom.minidom
 xml.dom.minidom.parseString("".join(l for l in open(sys.argv[1]) if l.strip() != "..."))' "$src"
+      ;;
+    python)
+      check "$where: Python syntax" python3 -c 'import ast, sys; ast.parse(open(sys.argv[1]).read())' "$src"
       ;;
     text) ;;
     untagged)
