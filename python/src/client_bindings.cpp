@@ -408,6 +408,66 @@ void BindClient(py::module_& m) {
           "server_counters",
           [](PyRobotClient& p) { return p.RunQuery(Query{.type = QueryType::kServerCounters}, true); },
           "The server's refusal counters (values; the message names them).")
+      .def(
+          "send_trajectory",
+          [](PyRobotClient& p, const std::string& target, std::vector<double> times,
+             std::vector<std::vector<double>> positions, std::optional<std::vector<std::vector<double>>> velocities,
+             std::optional<std::vector<std::vector<double>>> accelerations, const std::string& interpolation,
+             const std::string& mode, std::optional<double> start, py::object delay, bool frame) {
+            auto c = p.Client("send_trajectory");
+            const auto kind = ParseInterpolation(interpolation);
+            if (!kind) {
+              throw UsageError("send_trajectory: unknown interpolation '" + interpolation +
+                                "' (step, linear, cubic, quintic)");
+            }
+            const auto rows = [&](const std::optional<std::vector<std::vector<double>>>& v, const char* what) {
+              if (v && v->size() != times.size()) {
+                throw UsageError(std::string("send_trajectory: ") + what + " has " + std::to_string(v->size()) +
+                                  " rows for " + std::to_string(times.size()) + " times");
+              }
+            };
+            if (positions.size() != times.size()) {
+              throw UsageError("send_trajectory: positions has " + std::to_string(positions.size()) + " rows for " +
+                                std::to_string(times.size()) + " times");
+            }
+            rows(velocities, "velocities");
+            rows(accelerations, "accelerations");
+            std::vector<TrajectoryPoint> points;
+            for (std::size_t i = 0; i < times.size(); ++i) {
+              points.push_back(TrajectoryPoint{.time_from_start = FromSeconds(times[i]),
+                                               .positions = positions[i],
+                                               .velocities = velocities ? (*velocities)[i] : std::vector<double>{},
+                                               .accelerations =
+                                                   accelerations ? (*accelerations)[i] : std::vector<double>{}});
+            }
+            const TrajectoryOptions options{.mode = ParseMode(mode, "send_trajectory"),
+                                            .interpolation = *kind,
+                                            .start = Start(start),
+                                            .delay = ToNonNegativeDuration(delay, "delay")};
+            std::vector<PendingReply> sent;
+            {
+              py::gil_scoped_release release;
+              sent = frame ? c->SendTrajectory(FrameTrajectory{target, std::move(points)}, options)
+                           : c->SendTrajectory(JointTrajectory{target, std::move(points)}, options);
+            }
+            std::vector<std::unique_ptr<PyPendingReply>> out;
+            for (std::size_t i = 0; i < sent.size(); ++i) {
+              out.push_back(std::make_unique<PyPendingReply>(
+                  std::move(sent[i]), std::string(frame ? "FRAME_SETPOINT '" : "JOINT_SETPOINT '") + target +
+                                          "' point " + std::to_string(i)));
+            }
+            return out;
+          },
+          py::arg("target"), py::arg("times"), py::arg("positions"), py::kw_only(),
+          py::arg("velocities") = py::none(), py::arg("accelerations") = py::none(),
+          py::arg("interpolation") = "cubic", py::arg("mode") = "delay", py::arg("start") = py::none(),
+          py::arg("delay") = 0.1, py::arg("frame") = false,
+          "A trajectory (issue 22): a joint's (or, frame=True, a control frame's) points at `times`\n"
+          "(seconds from its start), one row of positions each (a frame: x y z qw qx qy qz),\n"
+          "optional velocity and acceleration rows; the server interpolates ('step', 'linear',\n"
+          "'cubic', 'quintic') and splices a newer one in. 'delay' mode starts at `start` (server\n"
+          "time) or `delay` s from now; 'playback' lets the server choose. A PendingReply per point,\n"
+          "answered when the trajectory passes it (docs/protocol.md, Trajectories).")
       .def("send_batch", &PyRobotClient::SendBatch, py::arg("commands"), py::arg("mode") = "direct",
            "Several commands in ONE package ('direct', or 'delay' for commands stamped ahead);\n"
            "a PendingReply each.")

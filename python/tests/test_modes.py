@@ -47,6 +47,18 @@ def test_sequence_keeps_its_timing(server: Server, mode: str) -> None:
             assert result.playback_delay is not None and result.playback_delay >= 0
 
 
+def test_a_cubic_trajectory_passes_through_its_points_on_time(server: Server) -> None:
+    with robotalk.connect("pioneer", server.url) as robot:
+        times = [0.2, 0.4, 0.6]
+        pending = robot.send_trajectory("pan", times, [[0.05], [0.1], [0.05]], interpolation="cubic", delay=0.3)
+        replies = [p.wait(5.0) for p in pending]
+        assert [r.signal for r in replies] == ["SUCCESS"] * 3, [r.message for r in replies]
+        spacing = np.diff([r.exec_time for r in replies])
+        assert np.allclose(spacing, 0.2, atol=1e-3), spacing
+        with pytest.raises(robotalk.UsageError, match="unknown interpolation 'spline'"):
+            robot.send_trajectory("pan", [0.1], [[0.0]], interpolation="spline")
+
+
 def test_direct_sequence_waits_for_each_reply(server: Server) -> None:
     with robotalk.connect("pioneer", server.url) as robot:
         result = robot.run_sequence([(0.0, robotalk.Command.parse("joint_setpoint tilt 0.1")),
