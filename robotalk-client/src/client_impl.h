@@ -46,6 +46,8 @@ struct PackageOptions {
   bool ask_for_delay = false;
   /// A CLOCK query: the ack of a package sent once is a clock sample.
   bool clock_query = false;
+  /// The package's deadline (Request::max_late); nullopt: ClientOptions::max_late.
+  std::optional<Duration> max_late;
 };
 
 class RobotClient::Impl {

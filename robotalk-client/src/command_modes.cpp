@@ -82,13 +82,14 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   client::SequencePacer pacer(plan, t0);
 
   std::optional<PendingReply> delay_reply;
-  PackageOptions package{.mode = RequestMode::kDirect};
+  PackageOptions package{.mode = RequestMode::kDirect, .max_late = options.max_late};
   TimePoint server_start{};  // known from the start in delay mode, after the delay reply in playback
   bool start_known = false;
   if (options.mode == CommandMode::kPlayback) {
     package = {.mode = RequestMode::kPlayback,
                .playback = {impl_->NewId(), static_cast<std::int64_t>(frames.size()), plan.duration},
-               .ask_for_delay = true};
+               .ask_for_delay = true,
+               .max_late = options.max_late};
     impl_->cache_->Expect(package.playback.id);
     delay_reply = impl_->MakePending(package.playback.id, "PLAYBACK " + std::to_string(package.playback.id));
   } else if (options.mode == CommandMode::kDelay) {

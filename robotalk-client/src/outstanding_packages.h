@@ -102,6 +102,8 @@ class OutstandingPackages {
   std::size_t size() const { return packages_.size(); }
   /// The current retransmission timeout, timer back-off included (see above).
   Duration retransmit_timeout() const;
+  /// The smoothed round trip (RFC 6298 SRTT; nullopt before the first sample).
+  std::optional<Duration> smoothed_round_trip() const { return srtt_; }
   /// Total resends so far.
   std::uint64_t retransmissions() const { return retransmissions_; }
 
