@@ -129,7 +129,7 @@ TEST(LinkHealth, HeavyLossAndALongRoundTripAreBad) {
     if (i % 2 == 0) continue;
     l.Send(i, milliseconds(10 * i), milliseconds(20), false, milliseconds(1500));
   }
-  l.health.Tick(At(milliseconds(1000) + l.health.options().loss_horizon));
+  l.health.Tick(At(milliseconds(1100) + l.health.options().loss_horizon));
   const LinkHealth::Verdict v = l.health.Evaluate();
   EXPECT_EQ(v.level, LinkHealth::Level::kBad);
   EXPECT_EQ(v.why, "loss 49.5 % > 25.0 %, round trip 1500 ms > 1000 ms");

@@ -45,7 +45,7 @@ constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2 + 2
 constexpr std::int64_t kMinReplyBytes = 8 + 1 + kLcmStringOverhead + 8 + 8 + 4;
 
 void ScanPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8 + 1 + 8, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8 + 1 + 8 + 8, "header");
   const std::int32_t nq = s.Count("num_queries", kMinQueryBytes);
   for (std::int32_t i = 0; i < nq; ++i) {
     s.Skip(8 + 1, "query");
@@ -86,6 +86,7 @@ void ScanRobotState(WireScanner& s) {
   s.Skip(5 * 8, "base");
   const std::int32_t frames = s.Count("num_frames", 7 * 8);
   s.Skip(std::int64_t{7 * 8} * frames, "frame_poses");
+  s.Skip(8 + 1 + 8 + 8 + 8 + 8 + 8, "link");
 }
 
 }  // namespace
@@ -305,6 +306,11 @@ StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
   }
   if (!std::isfinite(w.link_loss) || w.link_loss < 0 || w.link_loss > 1) {
     throw ProtocolError(label + "link_loss " + std::to_string(w.link_loss) + " is not in [0, 1]");
+  }
+  for (const auto& [name, value] : {std::pair{"link_round_trip_us", w.link_round_trip_us},
+                                    std::pair{"link_jitter_us", w.link_jitter_us}, std::pair{"link_late", w.link_late},
+                                    std::pair{"link_expired", w.link_expired}}) {
+    if (value < 0) throw ProtocolError(label + name + " " + std::to_string(value) + " is negative");
   }
   s.link = {.client_id = w.link_client_id,
             .level = static_cast<LinkState::Level>(w.link_level),
