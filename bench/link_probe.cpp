@@ -22,10 +22,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <random>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -39,7 +39,8 @@ void PrintCounters(RobotClient& client) {
   const Reply r = client.ServerCounters();
   std::istringstream names(r.message);
   std::string name;
-  for (std::size_t i = 0; names >> name && i < r.values.size(); ++i) std::printf("%s=%.9g\n", name.c_str(), r.values[i]);
+  for (std::size_t i = 0; names >> name && i < r.values.size(); ++i)
+    std::printf("%s=%.9g\n", name.c_str(), r.values[i]);
 }
 
 int Health(RobotClient& client, int n, int period_ms) {
@@ -79,24 +80,28 @@ int Stall(RobotClient& client) {
   std::vector<PendingReply> replies;
   const auto send_on_time = [&](int k) {
     // Sent `ahead` before its start on the server clock.
-    while (client.ServerNow() < t0 + k * frame - ahead) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    while (client.ServerNow() < t0 + k * frame - ahead)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     for (PendingReply& p : client.SendBatch({make(k)}, CommandMode::kDelay)) replies.push_back(std::move(p));
   };
   for (int k = 0; k < kBefore; ++k) send_on_time(k);
   // The stall: nothing leaves for 5 s; then the held frames in a burst.
   const int first_after = kBefore + kStall;
-  while (client.ServerNow() < t0 + first_after * frame - ahead) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  while (client.ServerNow() < t0 + first_after * frame - ahead)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   for (int k = kBefore; k < first_after; k += 25) {
     std::vector<Command> batch;
     for (int j = k; j < std::min(k + 25, first_after); ++j) batch.push_back(make(j));
-    for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay)) replies.push_back(std::move(p));
+    for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay))
+      replies.push_back(std::move(p));
   }
   for (int k = first_after; k < first_after + kAfter; ++k) send_on_time(k);
   for (std::size_t k = 0; k < replies.size(); ++k) {
     const char* part = k < kBefore ? "before" : k < static_cast<std::size_t>(first_after) ? "burst" : "after";
     try {
       const Reply r = replies[k].Wait(std::chrono::seconds(10));
-      std::printf("frame %zu %s %s %.6f\n", k, part, std::string(ToString(r.signal)).c_str(), ToSeconds(r.lateness));
+      std::printf("frame %zu %s %s %.6f\n", k, part, std::string(ToString(r.signal)).c_str(),
+                  ToSeconds(r.lateness));
     } catch (const std::exception& e) {
       std::printf("frame %zu %s NONE 0\n", k, part);
     }
@@ -122,7 +127,8 @@ int Deadlines(RobotClient& client, int n, unsigned seed) {
       c.start_time = StartTime::At(now + FromSeconds(offset(rng)));
       batch.push_back(std::move(c));
     }
-    for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay)) replies.push_back(std::move(p));
+    for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay))
+      replies.push_back(std::move(p));
     next += std::chrono::milliseconds(10);
     std::this_thread::sleep_until(next);
   }
@@ -144,9 +150,10 @@ int Deadlines(RobotClient& client, int n, unsigned seed) {
       ++unanswered;
     }
   }
-  std::printf("commands=%d\nexecuted=%ld\nexpired=%ld\nother=%ld\nunanswered=%ld\nviolations=%ld\n"
-              "max_executed_lateness_s=%.6f\n",
-              n, executed, expired, other, unanswered, violations, max_executed_lateness);
+  std::printf(
+      "commands=%d\nexecuted=%ld\nexpired=%ld\nother=%ld\nunanswered=%ld\nviolations=%ld\n"
+      "max_executed_lateness_s=%.6f\n",
+      n, executed, expired, other, unanswered, violations, max_executed_lateness);
   PrintCounters(client);
   return 0;
 }
@@ -155,8 +162,9 @@ int Deadlines(RobotClient& client, int n, unsigned seed) {
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr,
-                 "usage: robotalk-bench-link URL ROBOT health N PERIOD_MS | stall MAX_LATE | deadlines N SEED\n");
+    std::fprintf(
+        stderr,
+        "usage: robotalk-bench-link URL ROBOT health N PERIOD_MS | stall MAX_LATE | deadlines N SEED\n");
     return 2;
   }
   try {

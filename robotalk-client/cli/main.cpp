@@ -104,8 +104,9 @@ int main(int argc, char** argv) {
         } else if (args[i] == "--max-late") {
           const std::string& v = args[++i];
           const double s = v == "never" ? 0 : ParseNumber(v, "--max-late");
-          if (v != "never" && !(s > 0)) throw UsageError("--max-late " + v + ": expected seconds > 0 or never");
-          g.max_late = v == "never" ? kMaxLateNever : FromSeconds(s);
+          if (v != "never" && !(s > 0))
+            throw UsageError("--max-late " + v + ": expected seconds > 0 or never");
+          g.max_late = v == "never" ? robotalk::kMaxLateNever : robotalk::FromSeconds(s);
         } else {
           g.timeout_s = ParseNumber(args[++i], "--timeout");
           if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");

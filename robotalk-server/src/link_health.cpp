@@ -136,8 +136,9 @@ LinkFigures LinkHealth::Figures() const {
   f.jitter = Duration(static_cast<Duration::rep>(jitter_us_ * 1000));
   f.loss = f.expected == 0 ? 0.0 : static_cast<double>(f.lost) / static_cast<double>(f.expected);
   const std::uint64_t expected = current_.expected + previous_.expected;
-  f.recent_loss =
-      expected == 0 ? 0.0 : static_cast<double>(current_.lost + previous_.lost) / static_cast<double>(expected);
+  f.recent_loss = expected == 0
+                      ? 0.0
+                      : static_cast<double>(current_.lost + previous_.lost) / static_cast<double>(expected);
   f.recent_expired = current_.expired + previous_.expired;
   return f;
 }
@@ -160,12 +161,14 @@ LinkHealth::Verdict LinkHealth::Evaluate() const {
       add(buf);
     }
     if (f.jitter > t.jitter) {
-      std::snprintf(buf, sizeof buf, "jitter %.1f ms > %.1f ms", ToSeconds(f.jitter) * 1e3, ToSeconds(t.jitter) * 1e3);
+      std::snprintf(buf, sizeof buf, "jitter %.1f ms > %.1f ms", ToSeconds(f.jitter) * 1e3,
+                    ToSeconds(t.jitter) * 1e3);
       add(buf);
     }
     if (f.recent_expired >= t.expired && t.expired > 0) {
       std::snprintf(buf, sizeof buf, "%llu expired commands (limit %llu)",
-                    static_cast<unsigned long long>(f.recent_expired), static_cast<unsigned long long>(t.expired));
+                    static_cast<unsigned long long>(f.recent_expired),
+                    static_cast<unsigned long long>(t.expired));
       add(buf);
     }
     return why;

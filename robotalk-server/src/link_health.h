@@ -46,7 +46,7 @@
 namespace robotalk {
 
 struct LinkThresholds {
-  double loss = 0.05;                                 ///< recent loss rate
+  double loss = 0.05;                                    ///< recent loss rate
   Duration round_trip = std::chrono::milliseconds(250);  ///< reported round trip
   Duration jitter = std::chrono::milliseconds(50);
   std::uint64_t expired = 1;  ///< expired commands in the recent window
@@ -58,7 +58,9 @@ struct LinkHealthOptions {
   Duration late_threshold = std::chrono::milliseconds(5);
   Duration window = std::chrono::seconds(5);
   LinkThresholds warn;
-  LinkThresholds stop{.loss = 0.25, .round_trip = std::chrono::seconds(1), .jitter = std::chrono::milliseconds(250),
+  LinkThresholds stop{.loss = 0.25,
+                      .round_trip = std::chrono::seconds(1),
+                      .jitter = std::chrono::milliseconds(250),
                       .expired = 10};
 };
 
@@ -97,7 +99,8 @@ class LinkHealth {
   /// One package. `duplicate`: the session saw its sequence before. `sent`:
   /// the client's clock when sent (TimePoint{} = unknown). `round_trip`: the
   /// client's report (0 = none).
-  void OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received, Duration round_trip);
+  void OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
+                 Duration round_trip);
   /// One final reply to the client (late, expired).
   void OnReply(Duration lateness, bool expired, TimePoint now);
   /// Decides the fate of numbers missing past the horizon, rolls the window.

@@ -31,7 +31,8 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
     return;
   }
   if (daemon_.in_panic()) {
-    for (const Command& c : r.commands) Admit(s, c, now, immediate, /*playback=*/true, r.max_late);  // PANIC each
+    for (const Command& c : r.commands)
+      Admit(s, c, now, immediate, /*playback=*/true, r.max_late);  // PANIC each
     if (!s.playbacks.count(d.id) || !s.playbacks.at(d.id).start) {
       immediate.push_back(
           MakeReply(d.id, Signal::kPanic, label + ": the robot is in panic; it does not start", now));

@@ -290,7 +290,8 @@ TEST(RequestCodec, AnUnknownInterpolationOrANegativeMaxLateIsAHeaderError) {
   p.header.max_late_us = 0;
   EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error, "");
   p.header.round_trip_us = -3;
-  EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error, "package: round_trip_us -3 is negative or out of range");
+  EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error,
+            "package: round_trip_us -3 is negative or out of range");
 }
 
 // Issue 23: the client's smoothed round trip travels (the server's link health reports it).

@@ -77,8 +77,9 @@ TEST(StateSample, RefusesSizesThatDisagreeWithTheCounts) {
 // Issue 23: the motion owner's link health travels; a level or loss out of range is refused.
 TEST(StateSample, CarriesTheMotionOwnersLinkAndRefusesABadOne) {
   EXPECT_EQ(DecodeStateSample(Encode(ToWire(Sample())), 2).link, Sample().link);
-  EXPECT_EQ(LinkSummary(Sample().link),
-            "client 000000000000503d: degraded, round trip 41.0 ms, jitter 1.5 ms, loss 6.2 %, 3 late, 2 expired");
+  EXPECT_EQ(
+      LinkSummary(Sample().link),
+      "client 000000000000503d: degraded, round trip 41.0 ms, jitter 1.5 ms, loss 6.2 %, 3 late, 2 expired");
   EXPECT_EQ(LinkSummary(LinkState{}), "");
   auto w = ToWire(Sample());
   w.link_level = 9;

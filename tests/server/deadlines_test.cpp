@@ -55,7 +55,8 @@ TEST_F(DeadlinesTest, ALateSetPointPastTheRobotsDefaultIsNotExecutedAndIsCounted
 }
 
 TEST_F(DeadlinesTest, WithinItsLimitALateSetPointRunsLate) {
-  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan", clock_.Now() - milliseconds(90))}));
+  Handle(Package(kAlice, 1,
+                 {Cmd(1, CommandType::kJointSetPoint, {0.5}, "pan", clock_.Now() - milliseconds(90))}));
   Run();
   ASSERT_EQ(fake_->calls.size(), 1u);
   EXPECT_EQ(Replies(kAlice).at(1).signal, Signal::kSuccess);
@@ -90,7 +91,8 @@ TEST_F(DeadlinesTest, AGotoRunsLateUnlessItsPackageCarriesALimit) {
   Run();
   ASSERT_EQ(fake_->calls.size(), 1u) << "a GOTO keeps 'run late'";
   fake_->goto_id.reset();
-  Request limited = Package(kAlice, 2, {Cmd(2, CommandType::kGoto, {2, 0, 0}, "", clock_.Now() - seconds(2))});
+  Request limited =
+      Package(kAlice, 2, {Cmd(2, CommandType::kGoto, {2, 0, 0}, "", clock_.Now() - seconds(2))});
   limited.max_late = milliseconds(500);
   Handle(limited);
   Run();
@@ -99,13 +101,15 @@ TEST_F(DeadlinesTest, AGotoRunsLateUnlessItsPackageCarriesALimit) {
 }
 
 TEST_F(DeadlinesTest, APackageMayAskForNoDeadlineOrItsOwn) {
-  Request never = Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", clock_.Now() - seconds(10))});
+  Request never =
+      Package(kAlice, 1, {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", clock_.Now() - seconds(10))});
   never.max_late = kMaxLateNever;
   Handle(never);
   Run();
   ASSERT_EQ(fake_->calls.size(), 1u);
   EXPECT_EQ(Replies(kAlice).at(1).lateness, seconds(10));
-  Request tight = Package(kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan", clock_.Now() - milliseconds(30))});
+  Request tight = Package(
+      kAlice, 2, {Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan", clock_.Now() - milliseconds(30))});
   tight.max_late = milliseconds(20);
   Handle(tight);
   Run();
@@ -123,7 +127,8 @@ TEST_F(DeadlinesTest, AStopAlwaysRunsHoweverLate) {
 
 class NoDefaultDeadlineTest : public RobotSessionsTest {
  protected:
-  NoDefaultDeadlineTest() : RobotSessionsTest(BaseType::kDifferential, SessionOptions{.max_late = kNeverExpires}) {}
+  NoDefaultDeadlineTest()
+      : RobotSessionsTest(BaseType::kDifferential, SessionOptions{.max_late = kNeverExpires}) {}
 };
 
 TEST_F(NoDefaultDeadlineTest, ARobotWithoutADefaultRunsLateServoCommandsLate) {
@@ -187,7 +192,8 @@ SessionOptions ShortHorizon(bool link_stop) {
 
 class LinkTest : public RobotSessionsTest {
  protected:
-  explicit LinkTest(bool link_stop = false) : RobotSessionsTest(BaseType::kDifferential, ShortHorizon(link_stop)) {}
+  explicit LinkTest(bool link_stop = false)
+      : RobotSessionsTest(BaseType::kDifferential, ShortHorizon(link_stop)) {}
   // Alice's packages first .. first+39 every 20 ms, every other one lost,
   // then 0.3 s of silence (past the horizon).
   void LoseHalf(std::int64_t first) {

@@ -19,12 +19,14 @@ TEST(EffectiveMaxLate, ServoCommandsTakeTheRobotsDefaultUnlessThePackageGivesOne
 
 TEST(EffectiveMaxLate, AGotoRunsLateUnlessItCarriesALimit) {
   EXPECT_EQ(EffectiveMaxLate(CommandType::kGoto, true, Duration(0), milliseconds(100)), kNeverExpires);
-  EXPECT_EQ(EffectiveMaxLate(CommandType::kGoto, true, milliseconds(500), milliseconds(100)), milliseconds(500));
+  EXPECT_EQ(EffectiveMaxLate(CommandType::kGoto, true, milliseconds(500), milliseconds(100)),
+            milliseconds(500));
 }
 
 TEST(EffectiveMaxLate, AStopOrACommandDueNowNeverExpires) {
   EXPECT_EQ(EffectiveMaxLate(CommandType::kStop, true, milliseconds(1), milliseconds(1)), kNeverExpires);
-  EXPECT_EQ(EffectiveMaxLate(CommandType::kJointSpeed, false, milliseconds(1), milliseconds(1)), kNeverExpires);
+  EXPECT_EQ(EffectiveMaxLate(CommandType::kJointSpeed, false, milliseconds(1), milliseconds(1)),
+            kNeverExpires);
 }
 
 TEST(ExpiryRefusal, NamesHowLateItArrivedAndTheLimit) {

@@ -277,19 +277,25 @@ TEST(ImpairedChannel, AnOutageHoldsItsWindowAndReleasesItAsABurst) {
         << "message " << i;
   }
   EXPECT_EQ(channel.stats().held, 5u);
-  ImpairedChannel plain(Everything(), 9), stalled([] {
-    ImpairmentParams q = Everything();
-    q.outage_at = milliseconds(50);
-    q.outage = milliseconds(100);
-    return q;
-  }(), 9);
-  const std::vector<Releases> a = Feed(plain, 200, milliseconds(10)), b = Feed(stalled, 200, milliseconds(10));
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].lost, b[i].lost) << "the same fates, message " << i;
-  EXPECT_THROW(ImpairedChannel([] {
-                 ImpairmentParams q;
-                 q.outage = -milliseconds(1);
-                 return q;
-               }(), 1),
+  ImpairedChannel plain(Everything(), 9), stalled(
+                                              [] {
+                                                ImpairmentParams q = Everything();
+                                                q.outage_at = milliseconds(50);
+                                                q.outage = milliseconds(100);
+                                                return q;
+                                              }(),
+                                              9);
+  const std::vector<Releases> a = Feed(plain, 200, milliseconds(10)),
+                              b = Feed(stalled, 200, milliseconds(10));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ(a[i].lost, b[i].lost) << "the same fates, message " << i;
+  EXPECT_THROW(ImpairedChannel(
+                   [] {
+                     ImpairmentParams q;
+                     q.outage = -milliseconds(1);
+                     return q;
+                   }(),
+                   1),
                std::invalid_argument);
 }
 

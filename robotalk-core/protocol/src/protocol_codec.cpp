@@ -307,9 +307,9 @@ StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
   if (!std::isfinite(w.link_loss) || w.link_loss < 0 || w.link_loss > 1) {
     throw ProtocolError(label + "link_loss " + std::to_string(w.link_loss) + " is not in [0, 1]");
   }
-  for (const auto& [name, value] : {std::pair{"link_round_trip_us", w.link_round_trip_us},
-                                    std::pair{"link_jitter_us", w.link_jitter_us}, std::pair{"link_late", w.link_late},
-                                    std::pair{"link_expired", w.link_expired}}) {
+  for (const auto& [name, value] :
+       {std::pair{"link_round_trip_us", w.link_round_trip_us}, std::pair{"link_jitter_us", w.link_jitter_us},
+        std::pair{"link_late", w.link_late}, std::pair{"link_expired", w.link_expired}}) {
     if (value < 0) throw ProtocolError(label + name + " " + std::to_string(value) + " is negative");
   }
   s.link = {.client_id = w.link_client_id,

@@ -63,11 +63,12 @@ inline const char* ToString(LinkState::Level level) {
 inline std::string LinkSummary(const LinkState& l) {
   if (l.client_id == 0) return "";
   char buf[200];
-  std::snprintf(buf, sizeof buf,
-                "client %016llx: %s, round trip %.1f ms, jitter %.1f ms, loss %.1f %%, %lld late, %lld expired",
-                static_cast<unsigned long long>(l.client_id), ToString(l.level), ToSeconds(l.round_trip) * 1e3,
-                ToSeconds(l.jitter) * 1e3, l.loss * 100, static_cast<long long>(l.late),
-                static_cast<long long>(l.expired));
+  std::snprintf(
+      buf, sizeof buf,
+      "client %016llx: %s, round trip %.1f ms, jitter %.1f ms, loss %.1f %%, %lld late, %lld expired",
+      static_cast<unsigned long long>(l.client_id), ToString(l.level), ToSeconds(l.round_trip) * 1e3,
+      ToSeconds(l.jitter) * 1e3, l.loss * 100, static_cast<long long>(l.late),
+      static_cast<long long>(l.expired));
   return buf;
 }
 
