@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <exception>
 #include <random>
 #include <sstream>
@@ -113,28 +114,12 @@ int Stall(RobotClient& client) {
 int Deadlines(RobotClient& client, int n, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> offset(-0.3, 0.05);
-  std::vector<PendingReply> replies;
-  replies.reserve(static_cast<std::size_t>(n));
-  auto next = std::chrono::steady_clock::now();
-  for (int sent = 0; sent < n;) {
-    std::vector<Command> batch;
-    const TimePoint now = client.ServerNow();
-    for (int j = 0; j < 50 && sent < n; ++j, ++sent) {
-      Command c;
-      c.type = CommandType::kJointSetPoint;
-      c.target = "pan";
-      c.values = {0.001 * (sent % 100)};
-      c.start_time = StartTime::At(now + FromSeconds(offset(rng)));
-      batch.push_back(std::move(c));
-    }
-    for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay))
-      replies.push_back(std::move(p));
-    next += std::chrono::milliseconds(10);
-    std::this_thread::sleep_until(next);
-  }
   long executed = 0, expired = 0, other = 0, violations = 0, unanswered = 0;
   double max_executed_lateness = 0;
-  for (PendingReply& p : replies) {
+  // Replies are collected as the stream goes (the client keeps at most
+  // ClientOptions::return_cache_capacity uncollected ones).
+  std::deque<PendingReply> waiting;
+  const auto collect = [&](PendingReply& p) {
     try {
       const Reply r = p.Wait(std::chrono::seconds(20));
       if (r.signal == Signal::kSuccess || r.signal == Signal::kModified) {
@@ -149,7 +134,29 @@ int Deadlines(RobotClient& client, int n, unsigned seed) {
     } catch (const std::exception&) {
       ++unanswered;
     }
+  };
+  auto next = std::chrono::steady_clock::now();
+  for (int sent = 0; sent < n;) {
+    std::vector<Command> batch;
+    const TimePoint now = client.ServerNow();
+    for (int j = 0; j < 50 && sent < n; ++j, ++sent) {
+      Command c;
+      c.type = CommandType::kJointSetPoint;
+      c.target = "pan";
+      c.values = {0.001 * (sent % 100)};
+      c.start_time = StartTime::At(now + FromSeconds(offset(rng)));
+      batch.push_back(std::move(c));
+    }
+    for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay))
+      waiting.push_back(std::move(p));
+    while (waiting.size() > 2000) {
+      collect(waiting.front());
+      waiting.pop_front();
+    }
+    next += std::chrono::milliseconds(10);
+    std::this_thread::sleep_until(next);
   }
+  for (PendingReply& p : waiting) collect(p);
   std::printf(
       "commands=%d\nexecuted=%ld\nexpired=%ld\nother=%ld\nunanswered=%ld\nviolations=%ld\n"
       "max_executed_lateness_s=%.6f\n",

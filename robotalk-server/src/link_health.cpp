@@ -50,6 +50,7 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     const auto d = received.time_since_epoch().count() - sent.time_since_epoch().count();
     transit = Duration(d);
   }
+  bool in_order = true;  // a late copy (reordered, retransmitted) says nothing of the jitter
   if (!started_) {
     started_ = true;
     highest_ = sequence;
@@ -67,6 +68,7 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     highest_ = sequence;
     Decide(false);
   } else if (const auto it = missing_.find(sequence); it != missing_.end()) {
+    in_order = false;
     missing_.erase(it);
     // Reordered (came a little late) or a retransmission (its first copy was
     // lost): told apart by how much longer than the fastest it travelled.
@@ -80,9 +82,10 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     }
     Decide(retransmission);
   } else {
+    in_order = false;
     ++f_.retransmitted;  // a number already decided lost: its retransmission came at last
   }
-  if (transit) {
+  if (transit && in_order) {
     if (last_transit_) {
       const double d = std::abs(static_cast<double>((*transit - *last_transit_).count())) / 1000.0;
       jitter_us_ += (d - jitter_us_) / 16.0;

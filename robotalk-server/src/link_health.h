@@ -13,7 +13,9 @@
 //   - round trip: the latest the client reported; one-way delay = half of it
 //     (the clock sync's symmetric assumption, docs/protocol.md);
 //   - jitter: RFC 3550's inter-arrival jitter of the transit (arrival − send
-//     time: the clocks' offset cancels in its differences), J += (|D| − J)/16;
+//     time: the clocks' offset cancels in its differences), J += (|D| − J)/16,
+//     over the packages that arrive in order (a retransmission carries its
+//     first send time: its transit is the resend wait, not the network's);
 //   - loss: first copies that never came. A sequence number below the highest
 //     that was not received is missing; when it arrives its transit tells a
 //     reordered copy (within `reorder_tolerance`, or 3 × jitter when larger,
