@@ -57,7 +57,7 @@ for run in nodeadline deadline; do
   for _ in $(seq 100); do grep -q "serving robot" "$logs/server_$label.log" 2>/dev/null && break; sleep 0.1; done
   echo "== $label: delay 1 s, --max-late $late, a 5 s client -> server stall" >&2
   timeout 80 "$client" --url "$A" --mode delay --delay 1 --max-late "$late" --length 3 --duration 14.4 \
-    --label "$label" --congestion "5 s stall, then a burst" --out "$runs/$label" --max-seconds 75 \
+    --label "$label" --congestion "5 s stall then a burst" --out "$runs/$label" --max-seconds 75 \
     --retransmit-interval 0.3 --give-up 30 || { echo "run_fig11_stall.sh: $label failed" >&2; status=1; }
   kill -INT "$rpid" 2>/dev/null; wait "$rpid" 2>/dev/null
   kill "$spid" 2>/dev/null; wait "$spid" 2>/dev/null
