@@ -12,9 +12,10 @@
 //     --max-late) or "never". Prints one line per frame: "frame K PART SIGNAL
 //     LATENESS_S" (PART = before, burst, after), then the counters.
 //   robotalk-bench-link URL ROBOT deadlines N SEED
-//     N 'pan' set-points in delay mode, 50 per package every 10 ms, each
-//     starting U[-0.3, +0.05] s from the server clock when sent (seeded):
-//     about half are past the robot's deadline when they arrive. Prints
+//     N 'pan' set-points in delay mode, 50 per package every 10 ms, starting
+//     between 0.3 s before and 0.05 s after the server clock when sent (a
+//     sawtooth, rising: see Deadlines): about half are past the robot's
+//     deadline when they arrive. Prints
 //     commands, executed, expired, other, and violations = executed later
 //     than the deadline (0.1 s + the wire's microsecond rounding).
 // Exits 1 when the robot does not answer.
@@ -112,8 +113,13 @@ int Stall(RobotClient& client) {
 }
 
 int Deadlines(RobotClient& client, int n, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> offset(-0.3, 0.05);
+  // Command k starts at base + k * 0.2 ms + offset_k, offset_k a triangle
+  // wave between -0.3 s and +0.05 s with a 1 s period (5000 commands): the
+  // starts rise monotonically (no command is superseded by a later one that
+  // already ran, docs/protocol.md) and, sent at 5000 a second, about half
+  // arrive past the robot's 0.1 s deadline. SEED shifts the phase.
+  const double phase = static_cast<double>(seed % 1000) / 1000.0;
+  const TimePoint base = client.ServerNow();
   long executed = 0, expired = 0, other = 0, violations = 0, unanswered = 0;
   double max_executed_lateness = 0;
   // Replies are collected as the stream goes (the client keeps at most
@@ -138,13 +144,14 @@ int Deadlines(RobotClient& client, int n, unsigned seed) {
   auto next = std::chrono::steady_clock::now();
   for (int sent = 0; sent < n;) {
     std::vector<Command> batch;
-    const TimePoint now = client.ServerNow();
     for (int j = 0; j < 50 && sent < n; ++j, ++sent) {
       Command c;
       c.type = CommandType::kJointSetPoint;
       c.target = "pan";
       c.values = {0.001 * (sent % 100)};
-      c.start_time = StartTime::At(now + FromSeconds(offset(rng)));
+      const double x = std::fmod(phase + sent / 5000.0, 1.0);
+      const double offset = -0.3 + 0.35 * (1 - std::abs(2 * x - 1));
+      c.start_time = StartTime::At(base + FromSeconds(0.0002 * sent + offset));
       batch.push_back(std::move(c));
     }
     for (PendingReply& p : client.SendBatch(std::move(batch), CommandMode::kDelay))

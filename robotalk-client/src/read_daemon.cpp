@@ -360,7 +360,7 @@ Request RobotClient::Impl::NextRequest(TimePoint now) const {
                  .session_id = session_id_,
                  .sequence = next_sequence_,
                  .send_time = now,
-                 .round_trip = outstanding_.smoothed_round_trip().value_or(Duration(0))};
+                 .round_trip = outstanding_.recent_min_round_trip().value_or(Duration(0))};
 }
 
 void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {

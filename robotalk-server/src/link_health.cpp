@@ -20,10 +20,13 @@ const char* ToString(LinkHealth::Level level) {
   return "unknown";
 }
 
-Duration LinkHealth::Floor() const {
-  Duration floor = Duration::max();
-  for (std::size_t i = 0; i < transit_count_; ++i) floor = std::min(floor, transits_[i]);
-  return floor;
+std::pair<Duration, Duration> LinkHealth::TransitRange() const {
+  Duration lo = Duration::max(), hi = Duration::min();
+  for (std::size_t i = 0; i < transit_count_; ++i) {
+    lo = std::min(lo, transits_[i]);
+    hi = std::max(hi, transits_[i]);
+  }
+  return {lo, hi};
 }
 
 void LinkHealth::Decide(bool lost) {
@@ -50,7 +53,9 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     const auto d = received.time_since_epoch().count() - sent.time_since_epoch().count();
     transit = Duration(d);
   }
-  bool in_order = true;  // a late copy (reordered, retransmitted) says nothing of the jitter
+  // A retransmission's transit is the client's resend wait, not the network's:
+  // it counts in neither the jitter nor the transit range.
+  bool resent = false;
   if (!started_) {
     started_ = true;
     highest_ = sequence;
@@ -68,13 +73,14 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     highest_ = sequence;
     Decide(false);
   } else if (const auto it = missing_.find(sequence); it != missing_.end()) {
-    in_order = false;
     missing_.erase(it);
     // Reordered (came a little late) or a retransmission (its first copy was
-    // lost): told apart by how much longer than the fastest it travelled.
-    const Duration tolerance =
-        std::max(options_.reorder_tolerance, Duration(static_cast<Duration::rep>(3 * jitter_us_ * 1000)));
-    const bool retransmission = transit && transit_count_ > 0 && *transit - Floor() > tolerance;
+    // lost, and this copy carries the first one's send time, so its transit
+    // includes the client's resend wait): told apart by how much slower it
+    // travelled than the slowest recent first copy.
+    const bool retransmission =
+        transit && transit_count_ > 0 && *transit - TransitRange().second > options_.reorder_tolerance;
+    resent = retransmission;
     if (retransmission) {
       ++f_.retransmitted;
     } else {
@@ -82,10 +88,10 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     }
     Decide(retransmission);
   } else {
-    in_order = false;
+    resent = true;
     ++f_.retransmitted;  // a number already decided lost: its retransmission came at last
   }
-  if (transit && in_order) {
+  if (transit && !resent) {
     if (last_transit_) {
       const double d = std::abs(static_cast<double>((*transit - *last_transit_).count())) / 1000.0;
       jitter_us_ += (d - jitter_us_) / 16.0;
@@ -137,6 +143,13 @@ void LinkHealth::Tick(TimePoint now) {
 LinkFigures LinkHealth::Figures() const {
   LinkFigures f = f_;
   f.jitter = Duration(static_cast<Duration::rep>(jitter_us_ * 1000));
+  if (transit_count_ > 0) {
+    // How much longer than the fastest recent package the recent ones took on average.
+    const Duration floor = TransitRange().first;
+    Duration::rep excess = 0;
+    for (std::size_t i = 0; i < transit_count_; ++i) excess += (transits_[i] - floor).count();
+    f.queueing = Duration(excess / static_cast<Duration::rep>(transit_count_));
+  }
   f.loss = f.expected == 0 ? 0.0 : static_cast<double>(f.lost) / static_cast<double>(f.expected);
   const std::uint64_t expected = current_.expected + previous_.expected;
   f.recent_loss = expected == 0
@@ -158,9 +171,9 @@ LinkHealth::Verdict LinkHealth::Evaluate() const {
       std::snprintf(buf, sizeof buf, "loss %.1f %% > %.1f %%", 100 * f.recent_loss, 100 * t.loss);
       add(buf);
     }
-    if (f.round_trip && *f.round_trip > t.round_trip) {
-      std::snprintf(buf, sizeof buf, "round trip %.0f ms > %.0f ms", ToSeconds(*f.round_trip) * 1e3,
-                    ToSeconds(t.round_trip) * 1e3);
+    if (const std::optional<Duration> delay = f.delay(); delay && *delay > t.delay) {
+      std::snprintf(buf, sizeof buf, "delay %.0f ms > %.0f ms", ToSeconds(*delay) * 1e3,
+                    ToSeconds(t.delay) * 1e3);
       add(buf);
     }
     if (f.jitter > t.jitter) {

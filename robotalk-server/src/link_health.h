@@ -5,22 +5,29 @@
 //
 // Inputs, per package of the session (OnPackage): its sequence number, whether
 // the session's SequenceWindow saw it before, the client's send time (its own
-// clock) and the client's smoothed round trip (header round_trip_us, RFC 6298
-// SRTT of its acknowledged packages); per final reply (OnReply): its lateness,
+// clock) and the client's round trip (header round_trip_us: the least of its
+// recent acknowledged packages'); per final reply (OnReply): its lateness,
 // and whether it expired (expiry.h).
 //
 // Figures (Figures()):
-//   - round trip: the latest the client reported; one-way delay = half of it
-//     (the clock sync's symmetric assumption, docs/protocol.md);
+//   - round trip: the latest the client reported, its least round trip over
+//     its recent acknowledged packages (the path without queueing, and
+//     without its own scheduling delays when it is loaded);
+//   - delay (one-way, client -> server): half that round trip (the clock
+//     sync's symmetric assumption, docs/protocol.md) plus the queueing: how
+//     much longer than the fastest the recent packages took on average
+//     (their transits, arrival − send time, compared among themselves: the
+//     clocks' offset cancels);
 //   - jitter: RFC 3550's inter-arrival jitter of the transit (arrival − send
 //     time: the clocks' offset cancels in its differences), J += (|D| − J)/16,
 //     over the packages that arrive in order (a retransmission carries its
 //     first send time: its transit is the resend wait, not the network's);
 //   - loss: first copies that never came. A sequence number below the highest
 //     that was not received is missing; when it arrives its transit tells a
-//     reordered copy (within `reorder_tolerance`, or 3 × jitter when larger,
-//     of the lowest transit of the recent packages) from a retransmission
-//     (later: its first copy was lost). A number still missing after
+//     reordered copy (at most `reorder_tolerance` slower than the slowest of
+//     the recent in-order packages) from a retransmission (slower: it carries
+//     its first copy's send time, so its transit includes the client's resend
+//     wait, at least its 100 ms minimum timeout; the first copy was lost). A number still missing after
 //     `loss_horizon` is lost (a heartbeat is never retransmitted). Loss is
 //     lost / expected (the sequence numbers from the first to the highest,
 //     minus those still undecided), cumulative and over the recent window;
@@ -44,12 +51,13 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace robotalk {
 
 struct LinkThresholds {
-  double loss = 0.05;                                    ///< recent loss rate
-  Duration round_trip = std::chrono::milliseconds(250);  ///< reported round trip
+  double loss = 0.05;                               ///< recent loss rate
+  Duration delay = std::chrono::milliseconds(125);  ///< one-way delay (LinkFigures::delay)
   Duration jitter = std::chrono::milliseconds(50);
   std::uint64_t expired = 1;  ///< expired commands in the recent window
 };
@@ -61,7 +69,7 @@ struct LinkHealthOptions {
   Duration window = std::chrono::seconds(5);
   LinkThresholds warn;
   LinkThresholds stop{.loss = 0.25,
-                      .round_trip = std::chrono::seconds(1),
+                      .delay = std::chrono::milliseconds(500),
                       .jitter = std::chrono::milliseconds(250),
                       .expired = 10};
 };
@@ -69,6 +77,7 @@ struct LinkHealthOptions {
 /// What the server knows of one session's link.
 struct LinkFigures {
   std::optional<Duration> round_trip;  ///< as the client reported it; nullopt: not yet
+  Duration queueing{0};                ///< mean transit over the least, recent packages
   Duration jitter{0};
   std::uint64_t packages = 0;       ///< distinct packages received
   std::uint64_t expected = 0;       ///< sequence numbers whose fate is known
@@ -82,8 +91,9 @@ struct LinkFigures {
   double loss = 0;         ///< lost / expected, cumulative
   double recent_loss = 0;  ///< over the recent window
   std::uint64_t recent_expired = 0;
+  /// One-way: half the round trip plus the queueing; nullopt before a round trip is known.
   std::optional<Duration> delay() const {
-    return round_trip ? std::optional<Duration>(*round_trip / 2) : std::nullopt;
+    return round_trip ? std::optional<Duration>(*round_trip / 2 + queueing) : std::nullopt;
   }
 };
 
@@ -117,7 +127,8 @@ class LinkHealth {
     std::uint64_t expected = 0, lost = 0, expired = 0;
   };
   void Decide(bool lost);
-  Duration Floor() const;
+  // The least and the greatest transit of the recent in-order packages.
+  std::pair<Duration, Duration> TransitRange() const;
 
   LinkHealthOptions options_;
   LinkFigures f_;
