@@ -6,20 +6,6 @@
 
 namespace robotalk {
 
-const char* ToString(LinkHealth::Level level) {
-  switch (level) {
-    case LinkHealth::Level::kGood:
-      return "good";
-    case LinkHealth::Level::kDegraded:
-      return "degraded";
-    case LinkHealth::Level::kBad:
-      return "bad";
-    case LinkHealth::Level::kUnknown:
-      break;
-  }
-  return "unknown";
-}
-
 std::pair<Duration, Duration> LinkHealth::TransitRange() const {
   Duration lo = Duration::max(), hi = Duration::min();
   for (std::size_t i = 0; i < transit_count_; ++i) {

@@ -45,6 +45,7 @@
 #pragma once
 
 #include "robotalk/clock.h"
+#include "robotalk/state_sample.h"
 
 #include <array>
 #include <cstdint>
@@ -99,7 +100,8 @@ struct LinkFigures {
 
 class LinkHealth {
  public:
-  enum class Level : std::int8_t { kUnknown = 0, kGood = 1, kDegraded = 2, kBad = 3 };
+  /// The state stream's levels (unknown, good, degraded, bad; ToString in state_sample.h).
+  using Level = LinkState::Level;
   struct Verdict {
     Level level = Level::kUnknown;
     std::string why;  ///< the figures past their threshold, "" when good
@@ -143,8 +145,5 @@ class LinkHealth {
   TimePoint window_start_{};
   bool window_started_ = false;
 };
-
-/// "good", "degraded", "bad" or "unknown".
-const char* ToString(LinkHealth::Level level);
 
 }  // namespace robotalk

@@ -51,7 +51,7 @@ LinkState RobotSessions::MotionLink() const {
   if (s == nullptr) return out;
   const LinkFigures f = s->link.Figures();
   out.client_id = motion_owner_;
-  out.level = static_cast<LinkState::Level>(s->link.Evaluate().level);
+  out.level = s->link.Evaluate().level;
   out.round_trip = f.round_trip.value_or(Duration(0));
   out.jitter = f.jitter;
   out.loss = f.recent_loss;

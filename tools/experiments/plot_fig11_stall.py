@@ -19,12 +19,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from plot_fig11 import read_csv  # noqa: E402  (beside this script)
+
 RUNS = [("stall_nodeadline", "no deadline (--max-late never)"), ("stall_deadline", "deadline 0.1 s (default)")]
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def main():
