@@ -7,12 +7,13 @@
 namespace robotalk {
 
 std::pair<Duration, Duration> LinkHealth::TransitRange() const {
-  Duration lo = Duration::max(), hi = Duration::min();
-  for (std::size_t i = 0; i < transit_count_; ++i) {
-    lo = std::min(lo, transits_[i]);
-    hi = std::max(hi, transits_[i]);
-  }
-  return {lo, hi};
+  // The 90th percentile, not the greatest: one package its sender or this
+  // server was slow to handle (a loaded machine) must not widen the range
+  // past a retransmission's wait.
+  std::array<Duration, 64> sorted = transits_;
+  const auto end = sorted.begin() + static_cast<std::ptrdiff_t>(transit_count_);
+  std::sort(sorted.begin(), end);
+  return {sorted[0], sorted[(transit_count_ - 1) * 9 / 10]};
 }
 
 void LinkHealth::Decide(bool lost) {
@@ -44,7 +45,12 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
   bool resent = false;
   if (!started_) {
     started_ = true;
-    highest_ = sequence;
+    highest_ = lowest_ = sequence;
+    Decide(false);
+  } else if (sequence < lowest_) {
+    // Sent before the first that came (reordered at the start): not lost.
+    lowest_ = sequence;
+    ++f_.reordered;
     Decide(false);
   } else if (sequence > highest_) {
     // Numbers skipped are missing until they come or the horizon passes; a
@@ -63,7 +69,7 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     // Reordered (came a little late) or a retransmission (its first copy was
     // lost, and this copy carries the first one's send time, so its transit
     // includes the client's resend wait): told apart by how much slower it
-    // travelled than the slowest recent first copy.
+    // travelled than the slowest recent first copies (their 90th percentile).
     const bool retransmission =
         transit && transit_count_ > 0 && *transit - TransitRange().second > options_.reorder_tolerance;
     resent = retransmission;

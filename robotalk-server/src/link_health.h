@@ -24,8 +24,8 @@
 //     first send time: its transit is the resend wait, not the network's);
 //   - loss: first copies that never came. A sequence number below the highest
 //     that was not received is missing; when it arrives its transit tells a
-//     reordered copy (at most `reorder_tolerance` slower than the slowest of
-//     the recent in-order packages) from a retransmission (slower: it carries
+//     reordered copy (at most `reorder_tolerance` slower than the 90th
+//     percentile of the recent first copies) from a retransmission (slower: it carries
 //     its first copy's send time, so its transit includes the client's resend
 //     wait, at least its 100 ms minimum timeout; the first copy was lost). A number still missing after
 //     `loss_horizon` is lost (a heartbeat is never retransmitted). Loss is
@@ -129,13 +129,14 @@ class LinkHealth {
     std::uint64_t expected = 0, lost = 0, expired = 0;
   };
   void Decide(bool lost);
-  // The least and the greatest transit of the recent in-order packages.
+  // The least and the 90th percentile of the recent first copies' transits.
+  // REQUIRES: transit_count_ > 0.
   std::pair<Duration, Duration> TransitRange() const;
 
   LinkHealthOptions options_;
   LinkFigures f_;
   bool started_ = false;
-  std::int64_t highest_ = 0;
+  std::int64_t highest_ = 0, lowest_ = 0;
   std::map<std::int64_t, TimePoint> missing_;  // sequence -> when a higher one arrived
   std::array<Duration, 64> transits_{};
   std::size_t transit_next_ = 0, transit_count_ = 0;
