@@ -48,7 +48,10 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     highest_ = lowest_ = sequence;
     Decide(false);
   } else if (sequence < lowest_) {
-    // Sent before the first that came (reordered at the start): not lost.
+    // Sent before the first that came (reordered at the start): not lost;
+    // the numbers between it and that first one are missing now.
+    for (std::int64_t s = sequence + 1; s < lowest_ && missing_.size() < kMaxMissing; ++s)
+      missing_.emplace(s, received);
     lowest_ = sequence;
     ++f_.reordered;
     Decide(false);
