@@ -39,6 +39,7 @@ class Bench:
         self.timer = f"{b}/bench/robotalk-bench-timer"
         self.client = f"{b}/bench/robotalk-bench-client"
         self.relay = f"{b}/tools/lcm_relay/robotalk-lcm-relay"
+        self.link = f"{b}/bench/robotalk-bench-link"
         self.model = f"{ROOT}/models/pioneer2dx_pantilt.urdf"
         self.tmp = tempfile.mkdtemp(prefix="robotalk-bench-")
         self.server = None
@@ -353,6 +354,52 @@ class Bench:
                 time.sleep(2.5)
         return {"figure": "playback", "frames": frames, "period_ms": 100, "runs": runs}
 
+    @staticmethod
+    def key_values(text):
+        out = {}
+        for line in (text or "").splitlines():
+            k, eq, v = line.partition("=")
+            if eq and " " not in k:
+                try:
+                    out[k] = float(v)
+                except ValueError:
+                    out[k] = v
+        return out
+
+    @staticmethod
+    def relay_stats(text, direction):
+        for line in (text or "").splitlines():
+            if line.startswith(direction + ":"):
+                return {k: float(v) for k, _, v in (f.partition("=") for f in line.split()[1:])}
+        return {}
+
+    def links(self):
+        """Issue 23: deadline enforcement (commands through a lossy, jittery relay, about half past the
+        robot's 0.1 s deadline when they arrive: none may run later than it) and link-health accuracy
+        (the session's reported loss and delay against what the relay injected), per relay profile."""
+        n = 20000 if self.quick else 100000
+        profiles = [("lan: 2 ms, 1 % loss", ["--latency-ms", "2", "--a2b-loss", "0.01"]),
+                    ("20 ms, 5 % loss", ["--latency-ms", "20", "--a2b-loss", "0.05"]),
+                    ("wan: 100 ms +-50 ms, 1 % loss", ["--latency-ms", "100", "--jitter-ms", "50", "--loss", "0.01"])]
+        runs = []
+        for seed, (name, impair) in enumerate(profiles, start=11):
+            self.start_server(url=URL_B)
+            relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, *impair, "--seed", str(seed),
+                                "--duration", "900", "--stats"])
+            time.sleep(0.3)
+            health = subprocess.run([self.link, URL_A, ROBOT, "health", "2000", "5"], capture_output=True, text=True,
+                                    timeout=120)
+            dl = subprocess.run([self.link, URL_A, ROBOT, "deadlines", str(n), str(seed)], capture_output=True,
+                                text=True, timeout=900)
+            relay.send_signal(2)
+            rout, _ = relay.communicate(timeout=10)
+            self.stop_server()
+            runs.append({"profile": name, "relay_args": impair, "health": self.key_values(health.stdout),
+                         "deadlines": self.key_values(dl.stdout), "relay_a2b": self.relay_stats(rout, "a2b"),
+                         "relay_b2a": self.relay_stats(rout, "b2a"), "rc": [health.returncode, dl.returncode]})
+            time.sleep(2.5)
+        return {"figure": "links", "commands": n, "runs": runs}
+
     def micro(self):
         out = {}
         for name in ("robotalk-kinematics-bench", "robotalk-codec-bench"):
@@ -376,7 +423,8 @@ class Bench:
         return {"figure": "ode", "output": r.stdout, "rc": r.returncode, "shared_robots": os.path.exists(shared)}
 
 
-FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "micro", "ode"]
+FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "links", "micro",
+           "ode"]
 
 
 def main():

@@ -196,6 +196,8 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
             << "; Ctrl-C ends)\n";
   std::mutex mu;
   double samples = 0;                           // GUARDED_BY(mu)
+  LinkState shown_link;                         // GUARDED_BY(mu): the link line last printed
+  TimePoint link_shown_at{};                    // GUARDED_BY(mu)
   TimePoint last_sample = SteadyClock().Now();  // GUARDED_BY(mu)
   const Duration actual = client->StartStateStream(FromSeconds(period_s), [&](const StateSample& s) {
     std::lock_guard lock(mu);
@@ -211,6 +213,18 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
       std::cout << line;
       for (double q : s.positions) std::cout << ' ' << q;
       std::cout << '\n' << std::flush;
+      // The motion owner's link (issue 23), on stderr so the sample lines stay
+      // one per sample: when its client or level changes, and every 5 s while
+      // it is not good.
+      const LinkState& l = s.link;
+      const bool changed = l.client_id != shown_link.client_id || l.level != shown_link.level;
+      const bool poor = l.level >= LinkState::Level::kDegraded;
+      if (changed || (poor && SteadyClock().Now() - link_shown_at > std::chrono::seconds(5))) {
+        std::cerr << "robotalk: link "
+                  << (l.client_id == 0 ? std::string("(nobody moves the robot)") : LinkSummary(l)) << '\n';
+        shown_link = l;
+        link_shown_at = SteadyClock().Now();
+      }
     }
     ++samples;
   });

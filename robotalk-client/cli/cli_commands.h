@@ -18,6 +18,7 @@ struct GlobalOptions {
   std::string key_file;       ///< --key; "" = $ROBOTALK_KEY or open mode
   std::string server_key;     ///< --server-key: pin the server's public key
   std::string known_servers;  ///< --known-servers: the pin file ("" = the default)
+  Duration max_late{0};       ///< --max-late: ClientOptions::max_late (0 = the robot's default)
 };
 
 /// Pulls `--name VALUE` (or the flag `--name` when value is null) out of

@@ -103,6 +103,7 @@ ClientOptions MakeOptions(const GlobalOptions& g) {
   ClientOptions o;
   o.lcm_url = g.url;
   o.timeout = FromSeconds(g.timeout_s);
+  o.max_late = g.max_late;
   o.connect_timeout = FromSeconds(g.timeout_s);
   o.key_file = g.key_file;
   o.server_key_file = g.server_key;
@@ -184,7 +185,15 @@ std::string StateJson(const StateSample& s) {
                                          {"base", {s.base.x, s.base.y, s.base.theta, s.base.v, s.base.omega}},
                                          {"position", s.positions},
                                          {"velocity", s.velocities},
-                                         {"effort", s.efforts}});
+                                         {"effort", s.efforts},
+                                         {"link",
+                                          {{"client_id", Hex64(static_cast<std::uint64_t>(s.link.client_id))},
+                                           {"level", ToString(s.link.level)},
+                                           {"round_trip_s", ToSeconds(s.link.round_trip)},
+                                           {"jitter_s", ToSeconds(s.link.jitter)},
+                                           {"loss", s.link.loss},
+                                           {"late", s.link.late},
+                                           {"expired", s.link.expired}}}});
 }
 
 std::string RobotsJson(const std::vector<AnnouncedRobot>& robots) {

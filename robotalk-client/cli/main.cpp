@@ -58,6 +58,11 @@ Global options:
                  keyed mode without --server-key: where each robot's server key
                  is pinned on first use (default $ROBOTALK_KNOWN_SERVERS or
                  ~/.robotalk/known_servers); a server with another key is refused
+  --max-late S|never
+                 deadline of every command sent: one that would begin more than S
+                 seconds after its start time is not executed (INTERRUPTED
+                 "expired ..."); default: the robot's --max-late for set-points,
+                 speeds and forces, none for a GOTO
   --version      the version
   --help         this text (also after a command)
 
@@ -89,7 +94,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> rest;
     for (std::size_t i = 0; i < args.size(); ++i) {
       if (args[i] == "--url" || args[i] == "--timeout" || args[i] == "--key" || args[i] == "--server-key" ||
-          args[i] == "--known-servers") {
+          args[i] == "--known-servers" || args[i] == "--max-late") {
         if (i + 1 == args.size()) throw UsageError(args[i] + " needs a value");
         if (args[i] == "--url") {
           g.url = args[++i];
@@ -99,6 +104,12 @@ int main(int argc, char** argv) {
           g.server_key = args[++i];
         } else if (args[i] == "--known-servers") {
           g.known_servers = args[++i];
+        } else if (args[i] == "--max-late") {
+          const std::string& v = args[++i];
+          const double s = v == "never" ? 0 : ParseNumber(v, "--max-late");
+          if (v != "never" && !(s > 0))
+            throw UsageError("--max-late " + v + ": expected seconds > 0 or never");
+          g.max_late = v == "never" ? robotalk::kMaxLateNever : robotalk::FromSeconds(s);
         } else {
           g.timeout_s = ParseNumber(args[++i], "--timeout");
           if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");

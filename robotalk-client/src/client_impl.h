@@ -48,6 +48,8 @@ struct PackageOptions {
   bool clock_query = false;
   /// How its timed set-points join into trajectories (request.h).
   Interpolation interpolation = Interpolation::kStep;
+  /// The package's deadline (Request::max_late); nullopt: ClientOptions::max_late.
+  std::optional<Duration> max_late;
 };
 
 namespace client {

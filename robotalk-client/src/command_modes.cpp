@@ -73,6 +73,7 @@ SequenceSend RobotClient::Impl::BeginSequence(const SequenceOptions& options, st
   SequenceSend sequence;
   sequence.mode = options.mode;
   sequence.package.mode = RequestMode::kDirect;
+  sequence.package.max_late = options.max_late;
   if (options.mode == CommandMode::kPlayback) {
     sequence.package.mode = RequestMode::kPlayback;
     sequence.package.playback = {NewId(), static_cast<std::int64_t>(frames), duration};

@@ -35,7 +35,16 @@ Duration OutstandingPackages::IntervalAt(int step) const {
   return std::max(base, Duration(static_cast<Duration::rep>(ns)));
 }
 
+std::optional<Duration> OutstandingPackages::recent_min_round_trip() const {
+  if (recent_count_ == 0) return std::nullopt;
+  return *std::min_element(recent_rtts_.begin(),
+                           recent_rtts_.begin() + static_cast<std::ptrdiff_t>(recent_count_));
+}
+
 void OutstandingPackages::AddRoundTrip(Duration rtt) {
+  recent_rtts_[recent_next_] = rtt;
+  recent_next_ = (recent_next_ + 1) % kRecentRoundTrips;
+  recent_count_ = std::min(recent_count_ + 1, kRecentRoundTrips);
   timer_backoff_ = 0;
   if (!srtt_) {
     srtt_ = rtt;

@@ -34,6 +34,7 @@
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <set>
@@ -102,6 +103,13 @@ class OutstandingPackages {
   std::size_t size() const { return packages_.size(); }
   /// The current retransmission timeout, timer back-off included (see above).
   Duration retransmit_timeout() const;
+  /// The smoothed round trip (RFC 6298 SRTT; nullopt before the first sample).
+  std::optional<Duration> smoothed_round_trip() const { return srtt_; }
+  /// The least round trip of the last kRecentRoundTrips samples (nullopt
+  /// before the first): the path without queueing and without this
+  /// process's own scheduling delays (the header's round_trip_us).
+  std::optional<Duration> recent_min_round_trip() const;
+  static constexpr std::size_t kRecentRoundTrips = 32;
   /// Total resends so far.
   std::uint64_t retransmissions() const { return retransmissions_; }
 
@@ -131,6 +139,8 @@ class OutstandingPackages {
   Duration BaseTimeout() const;
   void AddRoundTrip(Duration rtt);
   std::optional<Duration> srtt_;
+  std::array<Duration, kRecentRoundTrips> recent_rtts_{};
+  std::size_t recent_next_ = 0, recent_count_ = 0;
   Duration rttvar_{0};
   static constexpr int kMaxTimerBackoff = 6;  // at most 64 × the RTO
   int timer_backoff_ = 0;

@@ -154,6 +154,7 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     request.mode = options.mode;
     request.playback = options.playback;
     request.interpolation = options.interpolation;
+    request.max_late = options.max_late.value_or(options_.max_late);
     // Ids are taken from next_id_ only once the package is encoded: a
     // package EncodeRequest refuses consumes nothing.
     CommandId id = next_id_;
@@ -356,8 +357,11 @@ void RobotClient::Impl::Tick(TimePoint now) {
 }
 
 Request RobotClient::Impl::NextRequest(TimePoint now) const {
-  return Request{
-      .client_id = client_id_, .session_id = session_id_, .sequence = next_sequence_, .send_time = now};
+  return Request{.client_id = client_id_,
+                 .session_id = session_id_,
+                 .sequence = next_sequence_,
+                 .send_time = now,
+                 .round_trip = outstanding_.recent_min_round_trip().value_or(Duration(0))};
 }
 
 void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {

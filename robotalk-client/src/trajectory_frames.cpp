@@ -71,6 +71,7 @@ SequenceOptions TrajectorySequence(const TrajectoryOptions& options, const std::
   s.paced = false;
   s.batch = std::clamp<std::size_t>(kPackageBudget / std::max<std::size_t>(largest, 1), 1, 200);
   s.interpolation = options.interpolation;
+  s.max_late = options.max_late;
   return s;
 }
 

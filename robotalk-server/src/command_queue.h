@@ -21,6 +21,10 @@ struct QueuedItem {
   std::uint64_t arrival = 0;           ///< server-wide arrival counter
   std::int64_t client_id = 0;          ///< 0 = the server itself (watchdog STOP)
   bool has_start_time = false;         ///< false = "now" (no lateness to report)
+  /// How late after `start` it may still begin (expiry.h: EffectiveMaxLate,
+  /// set on admission); Duration::max() = never expires.
+  Duration max_late = Duration::max();
+  TimePoint received{};  ///< when its package reached the server (the expiry's text)
   bool is_query = false;
   DriverCommand command;  ///< when !is_query; command.id is the client's id
   QueryType query = QueryType::kJointState;

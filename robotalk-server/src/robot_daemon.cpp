@@ -1,5 +1,7 @@
 #include "robot_daemon.h"
 
+#include "expiry.h"
+
 #include "robotalk/signal.h"
 
 #include <algorithm>
@@ -599,6 +601,16 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   if (panic_.in_panic() || panic_.driver_halted()) {
     r.signal = Signal::kInterrupted;
     r.message = "the robot entered panic before the command ran";
+    Emit(item.client_id, std::move(r));
+    return;
+  }
+  if (item.has_start_time && r.lateness > item.max_late) {  // issue 23: past its deadline
+    const ExpiryHold hold = HoldAfterExpiry(item.command.type, item.command.target);
+    const int joint = hold.joint;
+    const StopScope scope{.joints = std::span<const int>(&joint, hold.joint >= 0 ? 1 : 0), .base = hold.base};
+    if (hold.any() && !driver_call("StopOnly", [&] { driver_->StopOnly(scope, now, completions_); })) return;
+    r.signal = Signal::kInterrupted;
+    r.message = *ExpiryRefusal(r.lateness, item.max_late, item.received - item.start);
     Emit(item.client_id, std::move(r));
     return;
   }

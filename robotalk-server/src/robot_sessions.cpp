@@ -162,9 +162,14 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     return answer;
   }
   Session& session = SessionFor(r.client_id, received);
+  if (!session.active) session.link = LinkHealth(options_.link);
   session.active = true;
   session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
   const SequenceWindow::Verdict seen = session.seen.Observe(r.sequence);
+  if (seen != SequenceWindow::Verdict::kTooManyGaps) {
+    session.link.OnPackage(r.sequence, seen == SequenceWindow::Verdict::kDuplicate, r.send_time, received,
+                           r.round_trip);
+  }
   if (seen == SequenceWindow::Verdict::kTooManyGaps) {
     // A client numbers its packages 1, 2, 3...: a jump that leaves this many
     // numbers unreceived is not one of its packages (sequence_window.h).
@@ -200,7 +205,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   } else {
     for (const Query& q : r.queries) AdmitQuery(session, q, received, immediate, answer.publish_config);
     for (const Command& c : r.commands) {
-      auto item = Admit(session, c, received, immediate, /*playback=*/false, r.interpolation);
+      auto item = Admit(session, c, received, immediate, /*playback=*/false, r.max_late, r.interpolation);
       if (item && !Superseded(session, *item, received, immediate)) daemon_.Submit(std::move(*item));
     }
   }
@@ -292,8 +297,10 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
           r.values.push_back(value);
         }
       }
-      r.message += (r.message.empty() ? "" : " ") + std::string("refused_packages");
+      r.message += (r.message.empty() ? "" : " ") + std::string("refused_packages expired_commands");
       r.values.push_back(static_cast<double>(refused_packages_));
+      r.values.push_back(static_cast<double>(expired_commands_));
+      AppendLinkCounters(s, r);
       immediate.push_back(std::move(r));
       return;
     }
@@ -356,7 +363,7 @@ Reply RobotSessions::CommandStatus(const Session& s, const Query& q, TimePoint n
 
 std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, TimePoint now,
                                                std::vector<Reply>& immediate, bool playback,
-                                               Interpolation interpolation) {
+                                               Duration max_late, Interpolation interpolation) {
   const RobotModel& model = daemon_.model();
   if (c.type == CommandType::kPanicReset) {
     if (auto bad = CheckCommand(model, c, options_.limits)) {
@@ -417,6 +424,8 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   item.client_id = s.client_id;
   item.has_start_time = !c.start_time.is_now();
   if (c.start_time.is_at()) item.start = *c.start_time.time();
+  item.received = now;
+  item.max_late = EffectiveMaxLate(c.type, item.has_start_time, max_late, options_.max_late);
   item.command.id = c.id;
   item.command.type = c.type;
   switch (Traits(c.type).target) {  // CheckCommand found it
@@ -475,6 +484,9 @@ void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {
   Session* s = table_.Find(robot_id_, client_id);
   if (s == nullptr) return;           // an expired client
   NoteServoAnswer(client_id, reply);  // also a flushed one's: its entry is freed
+  const bool expired = IsExpiryReply(reply);
+  if (expired) ++expired_commands_;
+  s->link.OnReply(reply.lateness, expired, reply.exec_time);
   s->replies.RecordReply(reply);
   pending_[client_id].push_back(std::move(reply));
 }
@@ -556,6 +568,7 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
   if (traits.kind == CommandKind::kStop) {  // the whole robot is at rest: nobody owns anything
     std::fill(joint_owner_.begin(), joint_owner_.end(), 0);
     base_owner_ = 0;
+    motion_owner_ = 0;
     return;
   }
   // What the command moves becomes its client's. A command the RobotDaemon
@@ -589,6 +602,7 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
       return;
   }
   if (!vanished) {
+    motion_owner_ = e.client_id;
     if (base) base_owner_ = e.client_id;
   } else if (base || !to_stop.empty()) {
     daemon_.QueueStopOnly(std::move(to_stop), base);
@@ -596,6 +610,7 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
 }
 
 std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
+  CheckLinks(now);
   std::vector<ExpiredSession> expired;
   for (Session& s : table_.Expire(robot_id_, now, options_.session_timeout)) {
     const std::int64_t client = s.client_id;
@@ -603,25 +618,8 @@ std::vector<ExpiredSession> RobotSessions::Expire(TimePoint now) {
     if (!s.active) continue;  // the robot never served it: nothing of it to stop
     flushed_.clear();
     daemon_.FlushClient(client, flushed_);
-    // A STOP of only what it owns (Driver::StopOnly cannot refuse: its GOTO
-    // is interrupted); another client's motion runs on.
-    std::vector<int> joints;
-    for (std::size_t j = 0; j < joint_owner_.size(); ++j) {
-      if (joint_owner_[j] != client) continue;
-      joints.push_back(static_cast<int>(j));
-      joint_owner_[j] = 0;
-    }
-    const bool base = base_owner_ == client;
-    if (base) base_owner_ = 0;
-    const bool owned = base || !joints.empty();
-    expired.push_back({client, flushed_.size() + s.buffered_frames(), owned});
-    if (owned) {
-      log_.push_back("robot '" + robot_ + "': " + Client(client) + " vanished; stopping what it moved (" +
-                     (base ? std::string("the base") : std::string()) +
-                     (base && !joints.empty() ? ", " : "") +
-                     (joints.empty() ? std::string() : std::to_string(joints.size()) + " joint(s)") + ")");
-      daemon_.QueueStopOnly(std::move(joints), base);
-    }
+    const std::size_t dropped = flushed_.size() + s.buffered_frames();
+    expired.push_back({client, dropped, StopOwned(client, Client(client) + " vanished")});
     daemon_.SetStream(client, Duration(0));
   }
   return expired;

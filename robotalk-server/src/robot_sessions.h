@@ -11,8 +11,11 @@
 // checks and messages all happen here, outside any lock the RobotDaemon needs.
 #pragma once
 
+#include "expiry.h"
+#include "link_health.h"
 #include "robot_daemon.h"
 #include "robotalk/request.h"
+#include "robotalk/state_sample.h"
 #include "session.h"
 #include "session_table.h"
 
@@ -55,6 +58,13 @@ struct SessionOptions {
   std::size_t max_playbacks = 16;
   /// Each session's reply cache.
   ReplyCache::Limits replies;
+  /// Deadlines (expiry.h): the limit of a timed servo command whose package
+  /// gives none (--max-late); Duration::max() = never.
+  Duration max_late = kDefaultServoMaxLate;
+  /// Each session's link health: its tolerances and thresholds.
+  LinkHealthOptions link;
+  /// Stop what a session owns when its link is past a stop threshold (--link-stop).
+  bool link_stop = false;
 };
 
 /// What one waiting item (a queued command or query, a buffered playback
@@ -112,6 +122,14 @@ class RobotSessions {
   std::int64_t base_owner() const { return base_owner_; }
   /// Packages refused before admission, by reason (sequence jump, server full, ...).
   std::uint64_t refused_packages() const { return refused_packages_; }
+  /// Commands not executed past their deadline (expiry.h), all clients.
+  std::uint64_t expired_commands() const { return expired_commands_; }
+  /// The client that last moved the robot (0 = nobody since the last STOP).
+  std::int64_t motion_owner() const { return motion_owner_; }
+  /// The link health of `motion_owner()`'s session, for the state stream.
+  LinkState MotionLink() const;
+  /// A client's link figures (nullopt: no such session).
+  std::optional<LinkFigures> link(std::int64_t client_id) const;
   /// Memory a client's session holds, as its bounds count it (0 when there
   /// is no such session).
   struct SessionMemory {
@@ -133,8 +151,10 @@ class RobotSessions {
                   bool& publish_config);
   Reply CommandStatus(const Session& s, const Query& q, TimePoint now) const;
   // Checks a command; returns it ready to queue, or answers it in `immediate`.
+  // `max_late`: its package's (Request::max_late).
   std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
-                                  bool playback, Interpolation interpolation = Interpolation::kStep);
+                                  bool playback, Duration max_late,
+                                  Interpolation interpolation = Interpolation::kStep);
   void AdmitPlayback(Session& s, const Request& request, TimePoint now, std::vector<Reply>& immediate);
   void Panic(std::int64_t client_id, TimePoint now, const std::string& sender = "");
   void Deliver(std::int64_t client_id, Reply reply);
@@ -151,6 +171,12 @@ class RobotSessions {
   // later-starting one of the same client on the same actuator has run.
   bool Superseded(Session& s, const QueuedItem& item, TimePoint now, std::vector<Reply>& immediate);
   void NoteServoAnswer(std::int64_t client_id, const Reply& reply);
+  // Link health (robot_sessions_link.cpp): the SERVER_COUNTERS figures of a
+  // session; the warnings and the --link-stop policy, every Expire() tick.
+  void AppendLinkCounters(const Session& s, Reply& reply) const;
+  void CheckLinks(TimePoint now);
+  // Stops what `client` owns (Driver::StopOnly); returns whether it owned anything.
+  bool StopOwned(std::int64_t client, const std::string& why);
 
   RobotDaemon& daemon_;
   const std::string robot_;
@@ -165,6 +191,8 @@ class RobotSessions {
   std::vector<std::int64_t> joint_owner_;  // per joint: the client that last commanded it
   std::int64_t base_owner_ = 0;
   std::uint64_t refused_packages_ = 0;
+  std::uint64_t expired_commands_ = 0;
+  std::int64_t motion_owner_ = 0;
   // Items waiting, the client's own and all clients': counted when a
   // package's first item asks (the RobotDaemon only takes items meanwhile),
   // then kept up to date as its items are admitted.

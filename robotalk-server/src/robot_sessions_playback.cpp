@@ -31,7 +31,8 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
     return;
   }
   if (daemon_.in_panic()) {
-    for (const Command& c : r.commands) Admit(s, c, now, immediate, /*playback=*/true);  // PANIC each
+    for (const Command& c : r.commands)
+      Admit(s, c, now, immediate, /*playback=*/true, r.max_late);  // PANIC each
     if (!s.playbacks.count(d.id) || !s.playbacks.at(d.id).start) {
       immediate.push_back(
           MakeReply(d.id, Signal::kPanic, label + ": the robot is in panic; it does not start", now));
@@ -78,7 +79,8 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   const std::optional<TimePoint> sent =
       r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
   for (const Command& c : r.commands) {
-    std::optional<QueuedItem> item = Admit(s, c, now, immediate, /*playback=*/true, r.interpolation);
+    std::optional<QueuedItem> item =
+        Admit(s, c, now, immediate, /*playback=*/true, r.max_late, r.interpolation);
     if (!item) {  // answered: one frame fewer to wait for
       ++seq.received;
       continue;

@@ -117,10 +117,15 @@ class Server::Impl {
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     sessions.max_sessions_per_robot = options_.max_sessions_per_robot;
+    sessions.link_stop = options_.link_stop;
     const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
                                             .driver_call_bound = options_.driver_call_bound,
                                             .precise_timing = options_.precise_timing,
                                             .max_acceleration = options_.max_acceleration};
+    for (const auto& [name, limit] : options_.robot_max_late) {
+      if (std::none_of(specs.begin(), specs.end(), [&](const RobotSpec& s) { return s.name == name; }))
+        throw Error("Server: --max-late " + name + "=...: no robot '" + name + "' is served");
+    }
     for (const RobotSpec& spec : specs) {
       for (const auto& robot : robots_) {
         if (robot->robot_name() == spec.name)
@@ -129,6 +134,8 @@ class Server::Impl {
       DriverConfig config{spec.name, spec.urdf_path, spec.options};
       robots_.push_back(std::make_unique<RobotDaemon>(
           spec.name, spec.driver, registry.Create(spec.driver, config), clock_, daemon_options));
+      const auto own_limit = options_.robot_max_late.find(spec.name);
+      sessions.max_late = own_limit != options_.robot_max_late.end() ? own_limit->second : options_.max_late;
       server_daemon_->AddRobot(*robots_.back(), sessions);
     }
     url_ = transport->url();

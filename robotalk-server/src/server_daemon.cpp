@@ -421,8 +421,9 @@ void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
   const std::string& name = robot.daemon->robot_name();
   if (ack) Send(name, *ack);
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
-    std::vector<std::uint8_t> bytes =
-        EncodeStateSample(ToStateSample(name, robot.config_hash, robot.output.samples[i]));
+    StateSample sample = ToStateSample(name, robot.config_hash, robot.output.samples[i]);
+    sample.link = robot.sessions->MotionLink();  // the motion owner's link health (issue 23)
+    std::vector<std::uint8_t> bytes = EncodeStateSample(sample);
     const std::string channel = StateChannel(name);
     if (signer_) signer_->Sign(channel, bytes);  // keyed: readers verify the server key (issue 19)
     transport_.Publish(channel, bytes);

@@ -28,6 +28,12 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   equally by its robots; half is each client's guaranteed
                                   share (default 65536)
   --max-future S                  refuse start times more than S seconds ahead, or in the past (default 3600)
+  --max-late S|never|NAME=S       deadlines: a timed servo command (set-point, speed, force)
+                                  whose package gives no limit is not executed (INTERRUPTED
+                                  "expired ...") when it would begin more than S seconds after
+                                  its start time; NAME=S for one robot (default 0.1; docs/server.md)
+  --link-stop                     stop what a client session owns when its link health passes a
+                                  stop threshold (loss 25 %, round trip 1 s, ...; off by default)
   --max-goto-distance M           refuse a GOTO whose target is more than M metres from the world
                                   origin (default 100)
   --duration S                    exit after S seconds (default: run until SIGINT/SIGTERM)
@@ -155,6 +161,21 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.max_goto_distance = ParseNumber(arg, value(), 0, 1e7);
       } else if (arg == "--max-future") {
         options.max_future = FromSeconds(ParseNumber(arg, value(), 0, 86400 * 7));
+      } else if (arg == "--max-late") {
+        const std::string text = value();
+        const std::size_t eq = text.find('=');
+        const std::string limit = eq == std::string::npos ? text : text.substr(eq + 1);
+        const Duration d = limit == "never" ? Duration::max()
+                                            : FromSeconds(ParseNumber(arg, limit.c_str(), 1e-6, 86400 * 7));
+        if (eq == std::string::npos) {
+          options.max_late = d;
+        } else if (eq == 0) {
+          throw Error("--max-late: '" + text + "' names no robot (NAME=S)");
+        } else {
+          options.robot_max_late[text.substr(0, eq)] = d;
+        }
+      } else if (arg == "--link-stop") {
+        options.link_stop = true;
       } else if (arg == "--congestion-max-pause") {
         options.congestion_max_pause = FromSeconds(ParseNumber(arg, value(), 0, 10));
       } else if (arg == "--playback-min-frames") {

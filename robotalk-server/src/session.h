@@ -8,6 +8,7 @@
 #pragma once
 
 #include "command_queue.h"
+#include "link_health.h"
 #include "playback_estimator.h"
 #include "robotalk/access_list.h"
 #include "robotalk/command.h"
@@ -146,6 +147,11 @@ struct Session {
   SequenceWindow seen;  ///< the one replay / duplicate window
   ReplyCache replies;
   DelayHistory delays;  ///< one-way delays of its latest packages (playback's quick start)
+  LinkHealth link;      ///< how its link is doing (link_health.h)
+  /// The link level last logged, when, and whether --link-stop acted on it.
+  LinkHealth::Level link_logged = LinkHealth::Level::kUnknown;
+  TimePoint link_logged_at{};
+  bool link_stopped = false;
   std::map<std::int64_t, PlaybackSequence> playbacks;  ///< unfinished ones, by playback id
   /// Timed servo commands queued and not yet answered: id -> (start, actuator).
   std::unordered_map<CommandId, std::pair<TimePoint, int>> timed_servos;

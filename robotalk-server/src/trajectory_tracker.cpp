@@ -1,5 +1,7 @@
 #include "trajectory_tracker.h"
 
+#include "expiry.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -258,6 +260,14 @@ bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, cons
   // Late: after its time. Skipped when a later waypoint is planned (the
   // trajectory already runs past it); else joined one period from now.
   if (w.time <= now) {
+    // Past its deadline (issue 23, the package's max_late or the robot's
+    // --max-late): not executed, as any expired servo command.
+    if (std::optional<std::string> expired =
+            ExpiryRefusal(now - w.time, item.max_late, item.received - item.start)) {
+      answers.push_back({item.client_id, MakeAnswer(item.command.id, Signal::kInterrupted,
+                                                    *expired + " (" + label + ")", now, now - w.time)});
+      return false;
+    }
     const bool later_planned = !t.pending.empty() && t.pending.back().waypoint.time > now;
     if (later_planned) {
       answers.push_back({item.client_id,

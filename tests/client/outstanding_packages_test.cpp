@@ -140,6 +140,25 @@ TEST(OutstandingPackages, AdaptsTheTimeoutToASlowServer) {
   EXPECT_GE(o.retransmit_timeout(), milliseconds(600)) << "no resend before an answer could come";
 }
 
+// Issue 23: the round trip every package reports (header round_trip_us) is
+// the least of the recent samples: a late ack (this process busy) does not
+// inflate it; a resent package gives no sample (Karn); old samples age out.
+TEST(OutstandingPackages, ReportsTheLeastOfItsRecentRoundTrips) {
+  OutstandingPackages o(Policy());
+  EXPECT_EQ(o.recent_min_round_trip(), std::nullopt);
+  std::int64_t seq = 0;
+  const auto sample = [&](Duration rtt) {
+    const TimePoint sent = kT0 + seconds(++seq);
+    o.Add(seq, Bytes(1), {{.id = seq}}, sent);
+    o.OnAck(seq, sent + rtt);
+  };
+  for (int ms : {45, 40, 70, 41}) sample(milliseconds(ms));
+  EXPECT_EQ(o.recent_min_round_trip(), milliseconds(40));
+  EXPECT_EQ(o.smoothed_round_trip() > milliseconds(40), true);
+  for (std::size_t i = 0; i < OutstandingPackages::kRecentRoundTrips; ++i) sample(milliseconds(60));
+  EXPECT_EQ(o.recent_min_round_trip(), milliseconds(60)) << "the 40 ms sample aged out";
+}
+
 TEST(OutstandingPackages, ResendUsesTheSameBytes) {
   OutstandingPackages o(Policy());
   o.Add(7, Bytes(7), {{.id = 1}}, kT0);

@@ -94,7 +94,7 @@ TEST(ProtocolCodec, RefusesEveryTruncationOfAPackage) {
 
 TEST(ProtocolCodec, RefusesHostileCountsWithoutAllocating) {
   const auto bytes = Encode(SamplePackage());
-  const size_t num_commands_at = 8 + 70 + 4;  // fingerprint, header, num_queries
+  const size_t num_commands_at = 8 + 78 + 4;  // fingerprint, header (protocol 4: 78 bytes), num_queries
   for (std::uint32_t hostile : {0x7fffffffu, 0x80000000u, 0xffffffffu, 100000u}) {
     auto bad = bytes;
     for (int i = 0; i < 4; ++i)

@@ -289,6 +289,18 @@ TEST(RequestCodec, AnUnknownInterpolationOrANegativeMaxLateIsAHeaderError) {
             "package: max_late_us -5 is negative (0 = the server's default, -1 = never)");
   p.header.max_late_us = 0;
   EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error, "");
+  p.header.round_trip_us = -3;
+  EXPECT_EQ(DecodeRequest(EncodeMessage(p)).header_error,
+            "package: round_trip_us -3 is negative or out of range");
+}
+
+// Issue 23: the client's smoothed round trip travels (the server's link health reports it).
+TEST(RequestCodec, CarriesTheClientsRoundTrip) {
+  Request r{.client_id = 42, .sequence = 7};
+  r.round_trip = std::chrono::microseconds(40'250);
+  EXPECT_EQ(DecodeRequest(EncodeRequest(r)).round_trip, std::chrono::microseconds(40'250));
+  r.round_trip = Duration(0);
+  EXPECT_EQ(DecodeRequest(EncodeRequest(r)).round_trip, Duration(0));
 }
 
 }  // namespace

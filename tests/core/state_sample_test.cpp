@@ -27,6 +27,13 @@ StateSample Sample() {
   s.efforts = {0, 0.5};
   s.base = {1, 2, 0.5, 0.3, -0.1};
   s.frame_poses = {{1, 2, 3, 1, 0, 0, 0}};
+  s.link = {.client_id = 0x503d,
+            .level = LinkState::Level::kDegraded,
+            .round_trip = std::chrono::microseconds(41'000),
+            .jitter = std::chrono::microseconds(1'500),
+            .loss = 0.0625,
+            .late = 3,
+            .expired = 2};
   return s;
 }
 
@@ -65,6 +72,24 @@ TEST(StateSample, RefusesSizesThatDisagreeWithTheCounts) {
   w = ToWire(Sample());
   w.frame_poses[0].pop_back();
   EXPECT_THAT(FromWireError(w), HasSubstr("frame_poses[0] is not 7 values"));
+}
+
+// Issue 23: the motion owner's link health travels; a level or loss out of range is refused.
+TEST(StateSample, CarriesTheMotionOwnersLinkAndRefusesABadOne) {
+  EXPECT_EQ(DecodeStateSample(Encode(ToWire(Sample())), 2).link, Sample().link);
+  EXPECT_EQ(
+      LinkSummary(Sample().link),
+      "client 000000000000503d: degraded, round trip 41.0 ms, jitter 1.5 ms, loss 6.2 %, 3 late, 2 expired");
+  EXPECT_EQ(LinkSummary(LinkState{}), "");
+  auto w = ToWire(Sample());
+  w.link_level = 9;
+  EXPECT_THAT(FromWireError(w), HasSubstr("unknown link_level 9"));
+  w = ToWire(Sample());
+  w.link_loss = std::nan("");
+  EXPECT_THAT(FromWireError(w), HasSubstr("link_loss nan is not in [0, 1]"));
+  w = ToWire(Sample());
+  w.link_round_trip_us = -1;
+  EXPECT_THAT(FromWireError(w), HasSubstr("link_round_trip_us -1 is negative"));
 }
 
 TEST(StateSample, ChecksTheDofCountAgainstTheModel) {

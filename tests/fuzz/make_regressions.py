@@ -44,32 +44,29 @@ def write(target, name, data):
 NAN, INF = math.nan, math.inf
 I32_MAX = 0x7FFFFFFF
 
-# package_t, commands_mode0: header ends at 78 (protocol 4: interpolation
-# @69, max_late_us @70); num_queries @78 (0), num_commands @82 (8), command 0
-# @86: id, type @94, start @95, target @103 ("pan": length 4), num_values
-# @111 (int16, 1), values @113, num_velocities @121 (0).
+# package_t, commands_mode0 (protocol 4: the header gained interpolation,
+# max_late_us and round_trip_us, 17 bytes): header ends at 86; num_queries
+# @86 (0), num_commands @90 (8), command 0 @94: id, type @102, start @103,
+# target @111 ("pan": length 4), num_values @119 (int16, 1), values @121.
 p = read("package", "commands_mode0")
-write("package", "truncated_in_a_command", p[:99])
-write("package", "header_only", p[:78])
+write("package", "truncated_in_a_command", p[:107])
+write("package", "header_only", p[:86])
 write("package", "wrong_fingerprint", put(p, 0, ">B", p[0] ^ 0xFF))
 for name, v in [("num_commands_max", I32_MAX), ("num_commands_negative", -1)]:
-    write("package", name, put(p, 82, ">i", v, expect=8))
+    write("package", name, put(p, 90, ">i", v, expect=8))
 write("package", "payload_size_disagrees", put(p, 36, ">i", 1000, expect=8))
 for name, v in [("target_length_zero", 0), ("target_length_max", I32_MAX), ("target_length_negative", -5)]:
-    write("package", name, put(p, 103, ">i", v, expect=4))
+    write("package", name, put(p, 111, ">i", v, expect=4))
 for name, v in [("num_values_negative", -1), ("num_values_max", 0x7FFF)]:
-    write("package", name, put(p, 111, ">h", v, expect=1))
-write("package", "value_nan", put(p, 113, ">d", NAN, expect=0.5))
-write("package", "value_infinite", put(p, 113, ">d", INF, expect=0.5))
-for name, v in [("num_velocities_negative", -1), ("num_velocities_max", 0x7FFF)]:
-    write("package", name, put(p, 121, ">h", v, expect=0))
-write("package", "interpolation_unknown", put(p, 69, ">b", 9, expect=0))
-write("package", "max_late_negative", put(p, 70, ">q", -7, expect=0))
-write("package", "start_time_negative", put(p, 95, ">q", -(1 << 62), expect=0))
-write("package", "type_unknown", put(p, 94, ">b", 99, expect=1))
+    write("package", name, put(p, 119, ">h", v, expect=1))
+write("package", "value_nan", put(p, 121, ">d", NAN, expect=0.5))
+write("package", "value_infinite", put(p, 121, ">d", INF, expect=0.5))
+write("package", "start_time_negative", put(p, 103, ">q", -(1 << 62), expect=0))
+write("package", "type_unknown", put(p, 102, ">b", 99, expect=1))
 write("package", "mode_unknown", put(p, 40, ">b", 77, expect=0))
+write("package", "round_trip_negative", put(p, 78, ">q", -1, expect=0))
 q = read("package", "query_7")  # STATE_STREAM with a period
-write("package", "num_queries_max", put(q, 78, ">i", I32_MAX, expect=1))
+write("package", "num_queries_max", put(q, 86, ">i", I32_MAX, expect=1))
 
 # reply_package_t, replies: panic_refusal @36 (length 1), num_replies @65 (7),
 # reply 0 @69: id, signal @77, message @78 (length 1), exec @83, lateness @91,
@@ -87,7 +84,9 @@ write("reply_package", "value_nan", put(r, 103, ">d", NAN, expect=0.1))
 write("reply_package", "signal_unknown", put(r, 77, ">b", 42, expect=0))
 
 # robot_state_t: robot @32 ("pioneer": length 8), num_dofs @54 (2),
-# position @58, velocity @74, effort @90, base @106, num_frames @146 (1).
+# position @58, velocity @74, effort @90, base @106, num_frames @146 (1),
+# then the frame and (protocol 4) the link fields; link_level is the 9th byte
+# from the end of the link block (client id 8 bytes before it).
 s = read("robot_state", "state")
 write("robot_state", "truncated_in_the_positions", s[:62])
 for name, v in [("num_dofs_max", I32_MAX), ("num_dofs_negative", -2), ("num_dofs_more_than_sent", 3)]:

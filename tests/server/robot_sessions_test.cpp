@@ -40,11 +40,12 @@ TEST_F(RobotSessionsTest, RunsARecentPastStartAtOnceAndRefusesOneBeyondTheLimitE
   // The codec admits any start within +-292 years (kMaxWireMicros): the
   // furthest past one must be refused without overflowing (UBSan).
   const TimePoint hostile(-std::chrono::duration_cast<Duration>(std::chrono::microseconds(kMaxWireMicros)));
-  auto immediate =
-      Handle(Package(kAlice, 1,
-                     {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", now - seconds(10)),
-                      Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan", now - std::chrono::hours(2)),
-                      Cmd(3, CommandType::kJointSetPoint, {0.3}, "pan", hostile)}));
+  Request package = Package(kAlice, 1,
+                            {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", now - seconds(10)),
+                             Cmd(2, CommandType::kJointSetPoint, {0.2}, "pan", now - std::chrono::hours(2)),
+                             Cmd(3, CommandType::kJointSetPoint, {0.3}, "pan", hostile)});
+  package.max_late = kMaxLateNever;  // "run late" (the default limit: deadlines_test.cpp)
+  auto immediate = Handle(package);
   ASSERT_EQ(immediate.count(1), 0u) << "10 s late is run, late";
   EXPECT_EQ(immediate.at(2).signal, Signal::kError);
   EXPECT_THAT(immediate.at(2).message, HasSubstr("start time is 7200 s in the past of the server clock"));
@@ -72,7 +73,9 @@ TEST_F(RobotSessionsTest, OrdersCommandsOfAllClientsByStartTimeThenArrival) {
   const TimePoint t = clock_.Now() + seconds(1);
   Handle(Package(kAlice, 1, {Cmd(1, CommandType::kStop, {}, "", t + seconds(40))}));
   Handle(Package(kBob, 1, {Cmd(1, CommandType::kGoto, {1, 0, 0}, "", t + seconds(20))}));
-  Handle(Package(kBob, 2, {Cmd(2, CommandType::kJointSetPoint, {0.1}, "pan", t + seconds(20))}));
+  Request setpoint = Package(kBob, 2, {Cmd(2, CommandType::kJointSetPoint, {0.1}, "pan", t + seconds(20))});
+  setpoint.max_late = kMaxLateNever;  // it runs 40 s late below
+  Handle(setpoint);
   clock_.Set(t + seconds(60));
   Run();
   ASSERT_EQ(fake_->calls.size(), 3u);

@@ -260,6 +260,45 @@ TEST(ImpairedChannel, DuplicateCopiesHaveTheirOwnDelay) {
   EXPECT_GT(different, 190);
 }
 
+// Issue 23: a stalled link holds what arrives in its window and then lets it
+// all go at once; before and after, nothing changes; no random number is drawn.
+TEST(ImpairedChannel, AnOutageHoldsItsWindowAndReleasesItAsABurst) {
+  ImpairmentParams p;
+  p.latency = milliseconds(10);
+  p.outage_at = milliseconds(1000);
+  p.outage = milliseconds(500);
+  ImpairedChannel channel(p, 3);
+  const std::vector<Releases> r = Feed(channel, 30, milliseconds(100));  // arrivals 0 .. 2.9 s
+  for (int i = 0; i < 30; ++i) {
+    const TimePoint arrival = kStart + i * milliseconds(100);
+    const bool held = i >= 10 && i < 15;  // arrivals in [1.0, 1.5) s
+    EXPECT_EQ(r[static_cast<std::size_t>(i)].at[0],
+              held ? kStart + milliseconds(1500) : arrival + milliseconds(10))
+        << "message " << i;
+  }
+  EXPECT_EQ(channel.stats().held, 5u);
+  ImpairedChannel plain(Everything(), 9), stalled(
+                                              [] {
+                                                ImpairmentParams q = Everything();
+                                                q.outage_at = milliseconds(50);
+                                                q.outage = milliseconds(100);
+                                                return q;
+                                              }(),
+                                              9);
+  const std::vector<Releases> a = Feed(plain, 200, milliseconds(10)),
+                              b = Feed(stalled, 200, milliseconds(10));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ(a[i].lost, b[i].lost) << "the same fates, message " << i;
+  EXPECT_THROW(ImpairedChannel(
+                   [] {
+                     ImpairmentParams q;
+                     q.outage = -milliseconds(1);
+                     return q;
+                   }(),
+                   1),
+               std::invalid_argument);
+}
+
 TEST(ImpairedChannel, RejectsOutOfRangeParametersNamingTheField) {
   ImpairmentParams p;
   p.loss = 1.5;

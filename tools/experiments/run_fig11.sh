@@ -61,7 +61,9 @@ trap 'rm -rf "$logs"' EXIT
 # The client never resends within a run: the link is lossless loopback, and
 # the client's fixed 100 ms retransmission would multiply the congested
 # link's load (docs/experiment.md, "Retransmission under congestion").
-client_net=(--retransmit-interval 120 --give-up 600)
+# The paper's delay mode has no deadlines: a late frame runs late (issue 23's
+# default 0.1 s deadline would refuse them; run_fig11_stall.sh compares both).
+client_net=(--retransmit-interval 120 --give-up 600 --max-late never)
 
 status=0
 for condition in none congestion; do

@@ -33,6 +33,8 @@ void Validate(const ImpairmentParams& params) {
   CheckDuration("jitter", params.jitter);
   CheckDuration("reorder_delay", params.reorder_delay);
   CheckDuration("congestion_max", params.congestion_max);
+  CheckDuration("outage_at", params.outage_at);
+  CheckDuration("outage", params.outage);
 }
 
 ImpairedChannel::ImpairedChannel(const ImpairmentParams& params, std::uint64_t seed)
@@ -104,6 +106,14 @@ Releases ImpairedChannel::Admit(TimePoint arrival) {
     r.at[i] = r.link_exit + CopyDelay(r.reordered[i], u_j1[i], u_j2[i]);
   }
   stats_.copies += static_cast<std::uint64_t>(r.count);
+  if (!first_arrival_) first_arrival_ = arrival;
+  if (params_.outage > Duration::zero()) {
+    const TimePoint from = *first_arrival_ + params_.outage_at, until = from + params_.outage;
+    if (arrival >= from && arrival < until) {
+      ++stats_.held;
+      for (int i = 0; i < r.count; ++i) r.at[i] = std::max(r.at[i], until);
+    }
+  }
   return r;
 }
 

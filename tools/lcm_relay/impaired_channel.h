@@ -11,6 +11,11 @@
 //   3. copies:      one copy, two with probability `duplicate`;
 //   4. per copy:    release = link exit + max(0, latency + jitter)
 //                   (+ reorder_delay with probability `reorder`).
+//   5. outage:      a message arriving within the outage window (from
+//                   `outage_at` after the channel's first message, for
+//                   `outage`) is held: its copies leave no earlier than
+//                   the window's end, all at once (a stalled Wi-Fi link's
+//                   burst; issue 23). Draws no random numbers.
 //   Jitter is U[-jitter, +jitter] (kUniform) or N(0, jitter^2) clamped to
 //   +-3 jitter (kNormal). Jitter larger than the send interval reorders too.
 //
@@ -25,6 +30,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <random>
 
 #include <robotalk/clock.h>
@@ -43,6 +49,8 @@ struct ImpairmentParams {
   double reorder = 0.0;        ///< probability a copy is held back by reorder_delay
   Duration reorder_delay{0};   ///< extra delay of a held-back copy
   Duration congestion_max{0};  ///< link service time is U[0, congestion_max]; 0 = no link
+  Duration outage_at{0};       ///< the outage starts this long after the first message
+  Duration outage{0};          ///< how long it holds everything; 0 = none
 };
 
 /// Throws std::invalid_argument naming the field and value if `params` is out of range.
@@ -65,6 +73,7 @@ struct ChannelStats {
   std::uint64_t duplicated = 0;
   std::uint64_t reordered = 0;  ///< copies held back
   std::uint64_t copies = 0;     ///< release times handed out
+  std::uint64_t held = 0;       ///< messages held by the outage
 };
 
 class ImpairedChannel {
@@ -90,6 +99,7 @@ class ImpairedChannel {
   ImpairmentParams params_;
   std::mt19937_64 rng_;
   TimePoint link_free_{};
+  std::optional<TimePoint> first_arrival_;  // the outage window counts from here
   ChannelStats stats_;
 };
 

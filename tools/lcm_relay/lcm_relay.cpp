@@ -264,13 +264,14 @@ std::string FormatStats(const RelayStats& stats) {
     std::snprintf(
         buf, sizeof buf,
         "%s: received=%llu filtered=%llu lost=%llu duplicated=%llu reordered=%llu published=%llu "
-        "publish_errors=%llu unreleased=%llu echoes=%llu mean_delay_ms=%.3f max_delay_ms=%.3f\n",
+        "publish_errors=%llu unreleased=%llu echoes=%llu held=%llu mean_delay_ms=%.3f max_delay_ms=%.3f\n",
         name, static_cast<unsigned long long>(d.received), static_cast<unsigned long long>(d.filtered),
         static_cast<unsigned long long>(d.channel.lost),
         static_cast<unsigned long long>(d.channel.duplicated),
         static_cast<unsigned long long>(d.channel.reordered), static_cast<unsigned long long>(d.published),
         static_cast<unsigned long long>(d.publish_errors), static_cast<unsigned long long>(d.unreleased),
-        static_cast<unsigned long long>(d.echoes), mean_ms, ToSeconds(d.max_delay) * 1e3);
+        static_cast<unsigned long long>(d.echoes), static_cast<unsigned long long>(d.channel.held), mean_ms,
+        ToSeconds(d.max_delay) * 1e3);
     out += buf;
   };
   line("a2b", stats.a2b);

@@ -67,6 +67,10 @@ bool ApplyDirection(const std::string& option, const std::string& name, const st
     p.reorder_delay = ParseMillis(option, value);
   } else if (name == "congestion-max-ms") {
     p.congestion_max = ParseMillis(option, value);
+  } else if (name == "outage-at-ms") {
+    p.outage_at = ParseMillis(option, value);
+  } else if (name == "outage-ms") {
+    p.outage = ParseMillis(option, value);
   } else if (name == "channels") {
     try {
       std::regex check(value);
@@ -85,7 +89,7 @@ bool TakesValue(std::string name) {
   if (name.rfind("a2b-", 0) == 0 || name.rfind("b2a-", 0) == 0) name = name.substr(4);
   for (const char* known :
        {"a", "b", "seed", "duration", "echo-window-ms", "latency-ms", "jitter-ms", "jitter-dist", "loss",
-        "dup", "reorder", "reorder-delay-ms", "congestion-max-ms", "channels"}) {
+        "dup", "reorder", "reorder-delay-ms", "congestion-max-ms", "outage-at-ms", "outage-ms", "channels"}) {
     if (name == known) return true;
   }
   return false;
@@ -235,6 +239,9 @@ Impairments (set both directions; --a2b-NAME / --b2a-NAME set one and win):
   --reorder-delay-ms MS   extra delay of a held-back copy
   --congestion-max-ms X   congested link: a single-server FIFO holding each
                           message U[0, X] ms before the next may pass
+  --outage-at-ms MS, --outage-ms MS
+                          an outage: messages arriving from MS after the first
+                          one, for MS, are held and then released at once
   --channels REGEX        forward only channels fully matching REGEX (default .*)
 
 Example: --a udpm://239.255.76.67:7667?ttl=0 --b udpm://239.255.76.67:7767?ttl=0

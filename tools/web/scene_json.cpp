@@ -173,6 +173,8 @@ nlohmann::json StatePoser::Pose(const StateSample& s) {
           {"period", static_cast<double>(ToWireMicros(s.period)) * 1e-6},
           {"panic", s.panic},
           {"moving", s.moving},
+          {"link", LinkSummary(s.link)},
+          {"link_level", ToString(s.link.level)},
           {"base", base},
           {"q", q},
           {"links", links}};

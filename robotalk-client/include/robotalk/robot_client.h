@@ -24,6 +24,7 @@
 #include "robotalk/client_errors.h"
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
+#include "robotalk/request.h"  // kMaxLateServerDefault, kMaxLateNever
 #include "robotalk/robot_model.h"
 #include "robotalk/state_sample.h"
 #include "robotalk/trajectory.h"
@@ -75,6 +76,13 @@ struct ClientOptions {
   /// Stop resending a package the server has said nothing about for this long;
   /// its waiters fail with TimeoutError.
   Duration give_up_after = std::chrono::seconds(5);
+  /// Deadline of every command this client sends (docs/server.md, Deadlines):
+  /// how late after its start time it may still begin; past it the server
+  /// answers INTERRUPTED "expired: ..." and does not execute it.
+  /// kMaxLateServerDefault (the robot's --max-late for servo commands; a GOTO
+  /// runs late), kMaxLateNever, or a limit (> 0). SequenceOptions::max_late
+  /// overrides it for a sequence.
+  Duration max_late = kMaxLateServerDefault;
   /// An idle client sends an empty package this often (server session watchdog).
   Duration heartbeat_interval = std::chrono::milliseconds(250);
   /// CLOCK round trips at Connect(); the one with the smallest round trip wins.
@@ -193,6 +201,8 @@ struct SequenceOptions {
   /// Delay mode: the server time of offset 0; nullopt: the synchronised
   /// server clock when the sequence starts + `delay`.
   std::optional<TimePoint> start;
+  /// The frames' deadline (ClientOptions::max_late's values); nullopt: ClientOptions::max_late.
+  std::optional<Duration> max_late;
 };
 
 /// One waypoint of a trajectory (docs/client.md, "Trajectories").
@@ -232,6 +242,8 @@ struct TrajectoryOptions {
   /// Delay mode: the server time of time_from_start 0; nullopt: ServerNow() + `delay`.
   std::optional<TimePoint> start;
   Duration delay = std::chrono::milliseconds(100);
+  /// The points' deadline (ClientOptions::max_late's values); nullopt: ClientOptions::max_late.
+  std::optional<Duration> max_late;
 };
 
 /// How far a running sequence is (SequenceHooks::on_progress).

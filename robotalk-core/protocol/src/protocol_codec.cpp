@@ -45,7 +45,7 @@ constexpr std::int64_t kMinCommandBytes = 8 + 1 + 8 + kLcmStringOverhead + 2 + 2
 constexpr std::int64_t kMinReplyBytes = 8 + 1 + kLcmStringOverhead + 8 + 8 + 4;
 
 void ScanPackage(WireScanner& s) {
-  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8 + 1 + 8, "header");
+  s.Skip(2 + 8 + 8 + 8 + 1 + 1 + 4 + 1 + 8 + 4 + 8 + 8 + 1 + 8 + 8, "header");
   const std::int32_t nq = s.Count("num_queries", kMinQueryBytes);
   for (std::int32_t i = 0; i < nq; ++i) {
     s.Skip(8 + 1, "query");
@@ -86,6 +86,7 @@ void ScanRobotState(WireScanner& s) {
   s.Skip(5 * 8, "base");
   const std::int32_t frames = s.Count("num_frames", 7 * 8);
   s.Skip(std::int64_t{7 * 8} * frames, "frame_poses");
+  s.Skip(8 + 1 + 8 + 8 + 8 + 8 + 8, "link");
 }
 
 }  // namespace
@@ -299,6 +300,25 @@ StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
   s.velocities = w.velocity;
   s.efforts = w.effort;
   s.base = BaseState{w.base[0], w.base[1], w.base[2], w.base[3], w.base[4]};
+  if (w.link_level < robotalk_msgs::robot_state_t::LINK_UNKNOWN ||
+      w.link_level > robotalk_msgs::robot_state_t::LINK_BAD) {
+    throw ProtocolError(label + "unknown link_level " + std::to_string(w.link_level));
+  }
+  if (!std::isfinite(w.link_loss) || w.link_loss < 0 || w.link_loss > 1) {
+    throw ProtocolError(label + "link_loss " + std::to_string(w.link_loss) + " is not in [0, 1]");
+  }
+  for (const auto& [name, value] :
+       {std::pair{"link_round_trip_us", w.link_round_trip_us}, std::pair{"link_jitter_us", w.link_jitter_us},
+        std::pair{"link_late", w.link_late}, std::pair{"link_expired", w.link_expired}}) {
+    if (value < 0) throw ProtocolError(label + name + " " + std::to_string(value) + " is negative");
+  }
+  s.link = {.client_id = w.link_client_id,
+            .level = static_cast<LinkState::Level>(w.link_level),
+            .round_trip = DurationFromWireMicros(w.link_round_trip_us, label + "link_round_trip_us"),
+            .jitter = DurationFromWireMicros(w.link_jitter_us, label + "link_jitter_us"),
+            .loss = w.link_loss,
+            .late = w.link_late,
+            .expired = w.link_expired};
   return s;
 }
 
@@ -327,6 +347,13 @@ robotalk_msgs::robot_state_t ToWire(const StateSample& s) {
   w.base[4] = s.base.omega;
   w.num_frames = static_cast<std::int32_t>(s.frame_poses.size());
   for (const PoseValues& p : s.frame_poses) w.frame_poses.emplace_back(p.begin(), p.end());
+  w.link_client_id = s.link.client_id;
+  w.link_level = static_cast<std::int8_t>(s.link.level);
+  w.link_round_trip_us = ToWireMicros(s.link.round_trip);
+  w.link_jitter_us = ToWireMicros(s.link.jitter);
+  w.link_loss = s.link.loss;
+  w.link_late = s.link.late;
+  w.link_expired = s.link.expired;
   return w;
 }
 
@@ -387,6 +414,9 @@ std::string CheckPackageHeader(const robotalk_msgs::package_t& p) {
   }
   if (h.max_late_us > 0 && !TryDurationFromWireMicros(h.max_late_us)) {
     return "package: max_late_us " + std::to_string(h.max_late_us) + " us is out of range";
+  }
+  if (h.round_trip_us < 0 || !TryDurationFromWireMicros(h.round_trip_us)) {
+    return "package: round_trip_us " + std::to_string(h.round_trip_us) + " is negative or out of range";
   }
   if (h.sequence <= 0) return "package: sequence " + std::to_string(h.sequence) + " is not positive";
   if (p.num_queries > 0 && p.num_commands > 0) {

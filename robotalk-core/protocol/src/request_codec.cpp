@@ -67,6 +67,7 @@ Request DecodeRequest(std::span<const std::uint8_t> bytes) {
     } else {
       r.max_late = DurationFromWireMicros(h.max_late_us, "package: max_late_us");
     }
+    r.round_trip = DurationFromWireMicros(h.round_trip_us, "package: round_trip_us");
   }
   if (r.mode == RequestMode::kPlayback && r.header_error.empty()) {
     r.playback = {h.playback_id, h.playback_frames,
@@ -113,6 +114,7 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
   } else {
     h.max_late_us = ToWireMicros(r.max_late);
   }
+  h.round_trip_us = r.round_trip > Duration::zero() ? ToWireMicros(r.round_trip) : 0;
   for (const Query& q : r.queries) p.queries.push_back(ToWire(q));
   for (const Command& c : r.commands) p.commands.push_back(ToWire(c, h.mode));
   p.num_queries = static_cast<std::int32_t>(p.queries.size());

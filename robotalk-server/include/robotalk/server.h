@@ -50,6 +50,15 @@ struct ServerOptions {
   /// Start times further ahead than this, or further in the past, are
   /// refused with ERROR.
   Duration max_future = std::chrono::hours(1);
+  /// Deadlines (issue 23; docs/server.md, Deadlines): how late after its
+  /// start time a timed servo command may still begin when its package gives
+  /// no limit (`--max-late S`); Duration::max() = never. `robot_max_late`
+  /// overrides it per robot name (`--max-late NAME=S`).
+  Duration max_late = std::chrono::milliseconds(100);
+  std::map<std::string, Duration> robot_max_late;
+  /// Link health (docs/server.md): stop what a session owns when its link
+  /// passes a stop threshold (`--link-stop`; off by default).
+  bool link_stop = false;
   /// A GOTO target farther than this from the world origin (m) is refused
   /// with ERROR naming both (robotalk::CommandLimits).
   double max_goto_distance = kDefaultMaxGotoDistance;

@@ -185,7 +185,8 @@ function onState(s) {
 function readout(c, s) {
   const [x, y, th, v, w] = s.base;
   return `sample ${s.sample}  t ${s.t.toFixed(2)} s  x ${x.toFixed(3)} y ${y.toFixed(3)} θ ${th.toFixed(3)}  ` +
-         `v ${v.toFixed(2)} ω ${w.toFixed(2)}  path ${c.view.pathLength.toFixed(2)} m` + (s.moving ? '  moving' : '');
+         `v ${v.toFixed(2)} ω ${w.toFixed(2)}  path ${c.view.pathLength.toFixed(2)} m` + (s.moving ? '  moving' : '') +
+         (s.link ? `  link ${s.link}` : '');
 }
 
 function animate(now) {

@@ -62,6 +62,10 @@ struct Request {
   /// How late after its start time a command may still begin:
   /// kMaxLateServerDefault, kMaxLateNever, or a limit (> 0).
   Duration max_late = kMaxLateServerDefault;
+  /// The client's round trip to the server, the least of its recent
+  /// acknowledged packages' (0 = not measured yet); the server's link health
+  /// reports it.
+  Duration round_trip{0};
   std::vector<Query> queries;
   std::vector<Command> commands;  ///< kPlayback: start_time holds the offset (see command.h)
   std::vector<MalformedItem> malformed;
