@@ -308,14 +308,17 @@ bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, cons
   }
   std::vector<Waypoint> batch;
   TimePoint splice = now;
-  if (keep > 0) {
-    const Pending& before = t.pending[keep - 1];
-    if (before.waypoint.time > now) {
-      // Splice at the knot before it, when that is still ahead.
-      const TimePoint prior = keep >= 2 ? t.pending[keep - 2].waypoint.time : traj.knot_time(0);
-      splice = std::max(prior, now);
-      batch.push_back(before.waypoint);
-    }
+  // The waypoints whose chosen rates depend on the new one are planned again:
+  // the one before it (its velocity), and for quintic the one before that
+  // too (its acceleration depends on the next velocity) -- those still ahead.
+  const std::size_t again = traj.interpolation() == Interpolation::kQuintic ? 2 : 1;
+  std::size_t from = keep;
+  while (from > 0 && keep - from < again && t.pending[from - 1].waypoint.time > now) --from;
+  if (from < keep) {
+    // Splice at the knot before them, when that is still ahead.
+    const TimePoint prior = from >= 1 ? t.pending[from - 1].waypoint.time : traj.knot_time(0);
+    splice = std::max(prior, now);
+    for (std::size_t i = from; i < keep; ++i) batch.push_back(t.pending[i].waypoint);
   }
   batch.push_back(w);
   try {

@@ -277,6 +277,18 @@ TEST_F(TrackerTest, ALateWaypointIsSkippedWhenALaterOneIsPlannedElseJoinedOnePer
   EXPECT_THAT(AnswerTo(3)->reply.message, HasSubstr("after its time: joined"));
 }
 
+// Issue 23: a late waypoint past its deadline is not joined: it expires.
+TEST_F(TrackerTest, ALateWaypointPastItsDeadlineExpires) {
+  QueuedItem late = Waypoint(1, 0, kT0, {0.3});
+  late.max_late = milliseconds(50);
+  late.received = kT0 + milliseconds(80);
+  Add({late}, kT0 + milliseconds(80));
+  ASSERT_NE(AnswerTo(1), nullptr);
+  EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kInterrupted);
+  EXPECT_THAT(AnswerTo(1)->reply.message, ::testing::StartsWith("expired: arrived 0.08 s after its start"));
+  EXPECT_FALSE(tracker_.active()) << "an expired waypoint starts nothing";
+}
+
 TEST_F(TrackerTest, EndInterruptsEveryWaypointNotYetPassed) {
   Add({Waypoint(1, 0, kT0 + milliseconds(100), {0.01}), Waypoint(2, 0, kT0 + milliseconds(200), {0.02}),
        Waypoint(3, 1, kT0 + milliseconds(200), {0.02, 0.01})},
