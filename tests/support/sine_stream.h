@@ -1,0 +1,197 @@
+// Issue 22's tracking measurement, shared by tests/drivers/ode_tracking_test.cpp
+// and bench/trajectory_bench.cpp: a RobotDaemon on a ManualClock (in-process,
+// no network) runs a driver while a delay-mode client streams a sine on one
+// joint as timed JOINT_SETPOINT waypoints (QueuedItems with start times and
+// an interpolation, submitted `delay` ahead of their times, as the server
+// queues a delay-mode client's frames). Every control period the joint's
+// measured position is compared with the continuous sine.
+// Header-only: needs robotalk::server and the server's src/ on the include path.
+#pragma once
+
+#include "robot_daemon.h"
+#include "robotalk/clock.h"
+#include "robotalk/driver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+namespace robotalk::testing {
+
+/// A driver that forwards every call to `inner` and keeps the last reference
+/// handed to each dof (Driver::Track), so a run can read the reference the
+/// server sampled beside the state the driver measured.
+class RecordingDriver final : public Driver {
+ public:
+  explicit RecordingDriver(std::unique_ptr<Driver> inner)
+      : inner_(std::move(inner)),
+        ref_position_(static_cast<std::size_t>(inner_->model().num_dofs()), NAN),
+        ref_velocity_(ref_position_.size(), NAN),
+        ref_time_(ref_position_.size(), TimePoint::min()) {}
+  const RobotModel& model() const override { return inner_->model(); }
+  Duration period() const override { return inner_->period(); }
+  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
+    return inner_->Execute(c, now, done);
+  }
+  DriverResult Track(const JointReference& r, TimePoint now, std::vector<Completion>& done) override {
+    const auto first = static_cast<std::size_t>(model().dof_offset(r.joint));
+    for (std::size_t k = 0; k < r.position.size(); ++k) {
+      ref_position_[first + k] = r.position[k];
+      ref_velocity_[first + k] = r.velocity[k];
+      ref_time_[first + k] = now;
+    }
+    return inner_->Track(r, now, done);
+  }
+  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
+  void ReadState(RobotState& state) const override { inner_->ReadState(state); }
+  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
+  void StopOnly(const StopScope& s, TimePoint now, std::vector<Completion>& done) override {
+    inner_->StopOnly(s, now, done);
+  }
+  void Halt(std::vector<Completion>& done) override { inner_->Halt(done); }
+  void Resume() override { inner_->Resume(); }
+  std::string_view Fault() const override { return inner_->Fault(); }
+
+  /// The last reference of dof `i`, and when it was handed over (min: never).
+  double ref_position(int i) const { return ref_position_[static_cast<std::size_t>(i)]; }
+  double ref_velocity(int i) const { return ref_velocity_[static_cast<std::size_t>(i)]; }
+  TimePoint ref_time(int i) const { return ref_time_[static_cast<std::size_t>(i)]; }
+
+ private:
+  std::unique_ptr<Driver> inner_;
+  std::vector<double> ref_position_, ref_velocity_;
+  std::vector<TimePoint> ref_time_;
+};
+
+/// A RobotDaemon on a ManualClock with a RecordingDriver around `driver`.
+class ManualDaemon {
+ public:
+  static constexpr std::int64_t kClient = 0xC11E;
+  static TimePoint Origin() { return TimePoint(std::chrono::seconds(1000)); }
+
+  explicit ManualDaemon(std::unique_ptr<Driver> driver, RobotDaemonOptions options = {.precise_timing = false})
+      : recording_(new RecordingDriver(std::move(driver))),
+        daemon_("robot", "driver", std::unique_ptr<Driver>(recording_), clock_, options) {
+    daemon_.Preallocate(out_);
+    state_.position = Eigen::VectorXd::Zero(model().num_dofs());
+    state_.velocity = state_.position;
+    state_.effort = state_.position;
+  }
+  const RobotModel& model() const { return recording_->model(); }
+  const RecordingDriver& driver() const { return *recording_; }
+  RobotDaemon& daemon() { return daemon_; }
+  ManualClock& clock() { return clock_; }
+  Duration period() const { return recording_->period(); }
+
+  /// Runs the daemon at every deadline up to `t`, and at `t`; counts the
+  /// answers by signal. Reads the driver's state at `t`.
+  void RunTo(TimePoint t) {
+    while (clock_.Now() < t) {
+      clock_.Set(std::min(daemon_.RunOnce(clock_.Now()), t));
+      Drain();
+    }
+    daemon_.RunOnce(clock_.Now());
+    Drain();
+    recording_->ReadState(state_);
+  }
+  const RobotState& state() const { return state_; }
+  /// Answers so far: SUCCESS, MODIFIED, and every other signal.
+  int succeeded = 0, modified = 0, other = 0;
+  /// Takes the outbox (the ServerDaemon's side), counting the answers.
+  void Drain() {
+    daemon_.TakeOutput(out_);
+    for (const auto& a : out_.replies) {
+      (a.reply.signal == Signal::kSuccess    ? succeeded
+       : a.reply.signal == Signal::kModified ? modified
+                                             : other)++;
+    }
+  }
+
+  /// A JOINT_SETPOINT waypoint of joint `joint` at `at` (value `q`).
+  static QueuedItem Waypoint(CommandId id, int joint, TimePoint at, double q, Interpolation interpolation) {
+    QueuedItem item;
+    item.client_id = kClient;
+    item.command.id = id;
+    item.command.type = CommandType::kJointSetPoint;
+    item.command.target = joint;
+    item.command.num_values = 1;
+    item.command.values[0] = q;
+    item.has_start_time = true;
+    item.start = at;
+    item.interpolation = interpolation;
+    return item;
+  }
+
+ private:
+  ManualClock clock_{Origin()};
+  RecordingDriver* recording_;  // owned by daemon_
+  RobotDaemon daemon_;
+  DaemonOutput out_;
+  RobotState state_;
+};
+
+struct SineStream {
+  int joint = 0;  ///< the model's joint index (one dof)
+  Interpolation interpolation = Interpolation::kQuintic;
+  double frame_hz = 100;   ///< the client's frame rate
+  double amplitude = 0.5;  ///< rad
+  double sine_hz = 0.5;
+  Duration delay = std::chrono::milliseconds(300);  ///< each frame's start time: its sending time + delay
+  double seconds = 5;                               ///< the client streams this long
+  double settle = 1;  ///< the error is measured from the first start time + settle
+};
+
+struct SineResult {
+  double max_error = 0, rms_error = 0;  ///< measured position against the continuous sine (rad)
+  double max_ref_error = 0;             ///< the server's reference against it (NAN: none handed over)
+  int samples = 0, succeeded = 0, modified = 0, other = 0;
+  std::vector<double> time, sine, measured;  ///< every control period, from the first frame (s, rad)
+};
+
+/// Streams `s` to a fresh daemon around `driver`; the error is sampled every
+/// control period from the first start time + settle to the last start time.
+inline SineResult RunSineStream(std::unique_ptr<Driver> driver, const SineStream& s) {
+  ManualDaemon d(std::move(driver));
+  const TimePoint t0 = ManualDaemon::Origin();
+  const int dof = d.model().dof_offset(s.joint);
+  const auto sine = [&](TimePoint t) {
+    return s.amplitude * std::sin(2 * std::numbers::pi * s.sine_hz * ToSeconds(t - t0));
+  };
+  const Duration frame = FromSeconds(1.0 / s.frame_hz);
+  const TimePoint measure_from = t0 + s.delay + FromSeconds(s.settle);
+  const TimePoint end = t0 + FromSeconds(s.seconds) + s.delay;
+  SineResult r;
+  r.max_ref_error = NAN;
+  double sum2 = 0;
+  CommandId id = 0;
+  TimePoint next_frame = t0;
+  for (TimePoint t = t0; t <= end; t += d.period()) {
+    for (; next_frame <= t && next_frame <= t0 + FromSeconds(s.seconds); next_frame += frame) {
+      const TimePoint at = next_frame + s.delay;
+      d.daemon().Submit(ManualDaemon::Waypoint(++id, s.joint, at, sine(at), s.interpolation));
+    }
+    d.RunTo(t);
+    const double q = d.state().position[dof];
+    r.time.push_back(ToSeconds(t - t0));
+    r.sine.push_back(sine(t));
+    r.measured.push_back(q);
+    if (t < measure_from) continue;
+    const double e = std::abs(q - sine(t));
+    r.max_error = std::max(r.max_error, e);
+    sum2 += e * e;
+    ++r.samples;
+    if (d.driver().ref_time(dof) == t) {
+      const double er = std::abs(d.driver().ref_position(dof) - sine(t));
+      r.max_ref_error = std::isnan(r.max_ref_error) ? er : std::max(r.max_ref_error, er);
+    }
+  }
+  r.rms_error = r.samples > 0 ? std::sqrt(sum2 / r.samples) : NAN;
+  r.succeeded = d.succeeded;
+  r.modified = d.modified;
+  r.other = d.other;
+  return r;
+}
+
+}  // namespace robotalk::testing
