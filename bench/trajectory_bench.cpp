@@ -18,9 +18,9 @@
 #include "kinematic_driver.h"
 #include "ode_driver.h"
 #include "robotalk/urdf_import.h"
-#include "sine_stream.h"
+#include "support/sine_stream.h"
 
-#include "allocation_counter.h"
+#include "support/allocation_counter.h"
 
 #include <chrono>
 #include <cstdio>
@@ -47,11 +47,13 @@ std::unique_ptr<Driver> MakeDriver(const std::string& name, const std::string& u
   DriverRegistry registry;
   RegisterKinematicDriver(registry);
   RegisterOdeDriver(registry);
-  return registry.Create(name, DriverConfig{.robot_name = "", .urdf_path = urdf, .options = std::move(options)});
+  return registry.Create(name,
+                         DriverConfig{.robot_name = "", .urdf_path = urdf, .options = std::move(options)});
 }
 
 void SineTable(const std::string& urdf, const std::string& csv) {
-  std::printf("| driver | frames | interpolation | max error (rad) | RMS error (rad) | answers S/M/other |\n");
+  std::printf(
+      "| driver | frames | interpolation | max error (rad) | RMS error (rad) | answers S/M/other |\n");
   std::printf("|---|---|---|---|---|---|\n");
   SineResult ode10_step, ode10_quintic;
   for (const char* driver : {"kinematic", "ode"}) {
@@ -64,7 +66,7 @@ void SineTable(const std::string& urdf, const std::string& csv) {
         s.frame_hz = hz;
         s.seconds = 6;
         const SineResult r = RunSineStream(std::move(d), s);
-        std::printf("| %s | %.0f Hz | %s | %.4f | %.4f | %d/%d/%d |\n", driver, hz,
+        std::printf("| %s | %.0f Hz | %s | %.5f | %.5f | %d/%d/%d |\n", driver, hz,
                     std::string(InterpolationName(in)).c_str(), r.max_error, r.rms_error, r.succeeded,
                     r.modified, r.other);
         if (std::strcmp(driver, "ode") == 0 && hz == 10.0 && in == Interpolation::kStep) ode10_step = r;
@@ -95,7 +97,7 @@ void RecedingHorizon(const std::string& urdf, int splices) {
   const Duration tick = std::chrono::milliseconds(10);
   const double amax = RobotDaemonOptions{}.max_acceleration;
   double max_dv = 0, last_v = NAN, last_p = NAN, max_jitter = 0;
-  int frozen = 0, missing = 0;
+  int frozen = 0, missing = 0, modified_before = -1;
   CommandId id = 0;
   TimePoint control = t0;  // the next control period
   for (int i = 0; i < splices; ++i) {
@@ -105,7 +107,8 @@ void RecedingHorizon(const std::string& urdf, int splices) {
     // The control periods before the batch arrives, then the arrival.
     for (; control < arrives; control += d.period()) {
       d.RunTo(control);
-      if (control < t0 + std::chrono::milliseconds(100)) continue;  // from rest onto the sine
+      if (control < t0 + std::chrono::seconds(1)) continue;  // from rest onto the sine: limited at first
+      if (modified_before < 0) modified_before = d.modified;
       if (d.driver().ref_time(dof) != control) {
         ++missing;
         continue;
@@ -124,12 +127,17 @@ void RecedingHorizon(const std::string& urdf, int splices) {
     d.RunTo(arrives);
   }
   std::printf(
-      "receding horizon, kinematic iiwa14 '%s': %d splices (every 10 ms a 200 ms quintic trajectory from 20 ms "
+      "receding horizon, kinematic iiwa14 '%s': %d splices (every 10 ms a 200 ms quintic trajectory from 20 "
+      "ms "
       "ahead; arrival 5 ms ± 3 ms late, uniform, seeded, max %.1f ms): largest velocity step between periods "
       "%.4f rad/s against one period's worth of the acceleration limit %.4f rad/s (%.0f rad/s² × %.0f ms); "
-      "freezes %d; periods without a reference %d; answers S/M/other %d/%d/%d\n",
+      "freezes %d; periods without a reference %d (both from the first second on); answers "
+      "SUCCESS/MODIFIED/other %d/%d/%d (MODIFIED from the first second on: %d; other: the replaced "
+      "waypoints, "
+      "INTERRUPTED)\n",
       kJoint, splices, 1e3 * max_jitter, max_dv, amax * ToSeconds(d.period()), amax,
-      1e3 * ToSeconds(d.period()), frozen, missing, d.succeeded, d.modified, d.other);
+      1e3 * ToSeconds(d.period()), frozen, missing, d.succeeded, d.modified, d.other,
+      d.modified - modified_before);
 }
 
 // (c): a 31-joint chain (revolute, ±3 rad, 4 rad/s) on the kinematic driver at 1 ms.
@@ -148,11 +156,21 @@ RobotModel Chain(int joints) {
   return b.Build();
 }
 
+// Per-period wall times and allocations, apart for the periods in which
+// waypoints arrived (the RobotDaemon takes them into the trajectories then).
 struct Cost {
-  double min_round_us = 1e9;  // the fastest round's mean (the machine is shared)
-  std::vector<double> per_period_us;
-  long allocations = 0, periods = 0, arrival_allocations = 0, arrival_periods = 0;
+  std::vector<double> plain_us, arrival_us;
+  long plain_allocations = 0, arrival_allocations = 0;
+  double sum_us = 0;
+  long periods = 0;
 };
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<std::size_t>(k)];
+}
 
 void DaemonCost(int rounds) {
   constexpr int kJoints = 31, kPeriods = 1000;
@@ -163,10 +181,14 @@ void DaemonCost(int rounds) {
   RobotState bare_state;
   std::vector<Completion> done;
   const TimePoint t0 = ManualDaemon::Origin();
-  const auto wave = [&](int j, TimePoint t) { return 0.5 * std::sin(std::numbers::pi * ToSeconds(t - t0) + j); };
+  const auto wave = [&](int j, TimePoint t) {
+    return 0.5 * std::sin(std::numbers::pi * ToSeconds(t - t0) + j);
+  };
   CommandId id = 0;
   Cost c_busy, c_idle, c_bare;
-  for (Cost* c : {&c_busy, &c_idle, &c_bare}) c->per_period_us.reserve(static_cast<std::size_t>(rounds * kPeriods));
+  for (Cost* c : {&c_busy, &c_idle, &c_bare})
+    c->plain_us.reserve(static_cast<std::size_t>(rounds * kPeriods));
+  c_busy.arrival_us.reserve(static_cast<std::size_t>(rounds * kPeriods));
   TimePoint t = t0;
   const auto stream = [&](TimePoint now) {  // a delay-mode client at 100 Hz, 100 ms ahead, every joint
     if ((now - t0) % std::chrono::milliseconds(10) != Duration(0)) return false;
@@ -187,54 +209,49 @@ void DaemonCost(int rounds) {
     const auto w0 = WallClock::now();
     once();
     const double us = std::chrono::duration<double, std::micro>(WallClock::now() - w0).count();
-    const long allocs = g_allocations - a0;
-    c.per_period_us.push_back(us);
-    (arrival ? c.arrival_allocations : c.allocations) += allocs;
-    ++(arrival ? c.arrival_periods : c.periods);
-    return us;
+    (arrival ? c.arrival_allocations : c.plain_allocations) += g_allocations - a0;
+    (arrival ? c.arrival_us : c.plain_us).push_back(us);
+    c.sum_us += us;
+    ++c.periods;
   };
-  for (int round = 0; round < rounds; ++round) {
-    double sb = 0, si = 0, sf = 0;
-    for (int k = 0; k < kPeriods; ++k, t += std::chrono::milliseconds(1)) {
-      const bool arrival = stream(t);
-      busy.clock().Set(t);
-      idle.clock().Set(t);
-      sb += measure(c_busy, arrival, [&] { busy.daemon().RunOnce(t); });
-      si += measure(c_idle, false, [&] { idle.daemon().RunOnce(t); });
-      sf += measure(c_bare, false, [&] {
-        bare.Update(t, done);
-        bare.ReadState(bare_state);
-      });
-      busy.Drain();  // the ServerDaemon's side: not timed
-      idle.Drain();
-    }
-    c_busy.min_round_us = std::min(c_busy.min_round_us, sb / kPeriods);
-    c_idle.min_round_us = std::min(c_idle.min_round_us, si / kPeriods);
-    c_bare.min_round_us = std::min(c_bare.min_round_us, sf / kPeriods);
+  // The three interleaved, period by period, so the shared machine's load hits them alike.
+  for (int k = 0; k < rounds * kPeriods; ++k, t += std::chrono::milliseconds(1)) {
+    const bool arrival = stream(t);
+    busy.clock().Set(t);
+    idle.clock().Set(t);
+    measure(c_busy, arrival, [&] { busy.daemon().RunOnce(t); });
+    measure(c_idle, false, [&] { idle.daemon().RunOnce(t); });
+    measure(c_bare, false, [&] {
+      bare.Update(t, done);
+      bare.ReadState(bare_state);
+    });
+    busy.Drain();  // the ServerDaemon's side: not timed
+    idle.Drain();
   }
-  const auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
+  std::printf(
+      "| per 1 ms period (%d periods, manual clock, interleaved) | median µs | p99 µs | median, %% of 1 ms "
+      "| allocations per period |\n|---|---|---|---|---|\n",
+      rounds * kPeriods);
+  const auto row = [](const std::string& what, const std::vector<double>& us, long allocations) {
+    const double med = Percentile(us, 0.5);
+    std::printf("| %s | %.2f | %.2f | %.3f %% | %.2f |\n", what.c_str(), med, Percentile(us, 0.99),
+                med / 10.0,
+                static_cast<double>(allocations) / static_cast<double>(std::max<std::size_t>(us.size(), 1)));
   };
-  const auto row = [&](const char* what, const Cost& c) {
-    const double med = median(c.per_period_us);
-    std::printf("| %s | %.2f | %.2f | %.2f %% | %.3f | %s |\n", what, c.min_round_us, med, med / 10.0,
-                c.periods ? static_cast<double>(c.allocations) / static_cast<double>(c.periods) : 0.0,
-                c.arrival_periods ? (std::to_string(c.arrival_allocations / c.arrival_periods) + " per arrival (" +
-                                     std::to_string(kJoints) + " waypoints)")
-                                        .c_str()
-                                  : "—");
-  };
-  std::printf("| per 1 ms period (%d rounds × %d periods, manual clock) | µs, fastest round's mean | µs, median "
-              "| median, %% of 1 ms | allocations per period without arrivals | allocations in a period with "
-              "arrivals |\n|---|---|---|---|---|---|\n",
-              rounds, kPeriods);
-  row("bare loop: KinematicDriver Update + ReadState, 31 dofs", c_bare);
-  row("RobotDaemon::RunOnce, 31 dofs, no trajectory", c_idle);
-  row("RobotDaemon::RunOnce, 31 dofs interpolating (quintic; 100 Hz waypoints, delay mode)", c_busy);
-  std::printf("interpolation's own cost per period (median busy − idle): %.2f µs = %.2f %% of 1 ms\n",
-              median(c_busy.per_period_us) - median(c_idle.per_period_us),
-              (median(c_busy.per_period_us) - median(c_idle.per_period_us)) / 10.0);
+  row("floor: bare loop, KinematicDriver Update + ReadState, 31 dofs", c_bare.plain_us,
+      c_bare.plain_allocations);
+  row("RobotDaemon::RunOnce, 31 dofs, no trajectory", c_idle.plain_us, c_idle.plain_allocations);
+  row("RobotDaemon::RunOnce, 31 dofs interpolating (quintic), periods without arrivals", c_busy.plain_us,
+      c_busy.plain_allocations);
+  row("same, periods in which 31 waypoints arrived (1 in 10: a 100 Hz delay-mode client)", c_busy.arrival_us,
+      c_busy.arrival_allocations);
+  std::printf(
+      "mean per period over all periods: interpolating %.2f µs (%.2f %% of 1 ms), idle daemon %.2f µs, "
+      "bare loop %.2f µs; interpolating / idle %.1f×\n",
+      c_busy.sum_us / static_cast<double>(c_busy.periods),
+      c_busy.sum_us / static_cast<double>(c_busy.periods) / 10.0,
+      c_idle.sum_us / static_cast<double>(c_idle.periods),
+      c_bare.sum_us / static_cast<double>(c_bare.periods), c_busy.sum_us / c_idle.sum_us);
 }
 
 }  // namespace
@@ -253,9 +270,10 @@ int main(int argc, char** argv) {
   }
   const std::string urdf = shared + "/iiwa14.urdf";
   if (std::ifstream(urdf).good()) {
-    std::printf("(a) iiwa14 '%s', 0.5 Hz 0.5 rad sine, delay mode 300 ms, 6 s; error every 10 ms control "
-                "period after a settling second:\n\n",
-                kJoint);
+    std::printf(
+        "(a) iiwa14 '%s', 0.5 Hz 0.5 rad sine, delay mode 300 ms, 6 s; error every 10 ms control "
+        "period after a settling second:\n\n",
+        kJoint);
     SineTable(urdf, csv);
     std::printf("\n(b) ");
     RecedingHorizon(urdf, quick ? 1000 : 10000);

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace robotalk::testing {
@@ -71,7 +72,8 @@ class ManualDaemon {
   static constexpr std::int64_t kClient = 0xC11E;
   static TimePoint Origin() { return TimePoint(std::chrono::seconds(1000)); }
 
-  explicit ManualDaemon(std::unique_ptr<Driver> driver, RobotDaemonOptions options = {.precise_timing = false})
+  explicit ManualDaemon(std::unique_ptr<Driver> driver,
+                        RobotDaemonOptions options = {.precise_timing = false})
       : recording_(new RecordingDriver(std::move(driver))),
         daemon_("robot", "driver", std::unique_ptr<Driver>(recording_), clock_, options) {
     daemon_.Preallocate(out_);
@@ -99,10 +101,13 @@ class ManualDaemon {
   const RobotState& state() const { return state_; }
   /// Answers so far: SUCCESS, MODIFIED, and every other signal.
   int succeeded = 0, modified = 0, other = 0;
+  /// The message of the last answer that was not SUCCESS.
+  std::string last_note;
   /// Takes the outbox (the ServerDaemon's side), counting the answers.
   void Drain() {
     daemon_.TakeOutput(out_);
     for (const auto& a : out_.replies) {
+      if (a.reply.signal != Signal::kSuccess) last_note = a.reply.message;
       (a.reply.signal == Signal::kSuccess    ? succeeded
        : a.reply.signal == Signal::kModified ? modified
                                              : other)++;
@@ -141,17 +146,20 @@ struct SineStream {
   Duration delay = std::chrono::milliseconds(300);  ///< each frame's start time: its sending time + delay
   double seconds = 5;                               ///< the client streams this long
   double settle = 1;  ///< the error is measured from the first start time + settle
+  // ... to the time the client sends its last frame: a trajectory comes to
+  // rest at its last known waypoint, which a stream that ends does not follow.
 };
 
 struct SineResult {
   double max_error = 0, rms_error = 0;  ///< measured position against the continuous sine (rad)
   double max_ref_error = 0;             ///< the server's reference against it (NAN: none handed over)
   int samples = 0, succeeded = 0, modified = 0, other = 0;
+  std::string last_note;                     ///< the message of the last answer that was not SUCCESS
   std::vector<double> time, sine, measured;  ///< every control period, from the first frame (s, rad)
 };
 
 /// Streams `s` to a fresh daemon around `driver`; the error is sampled every
-/// control period from the first start time + settle to the last start time.
+/// control period from the first start time + settle to the last frame's sending.
 inline SineResult RunSineStream(std::unique_ptr<Driver> driver, const SineStream& s) {
   ManualDaemon d(std::move(driver));
   const TimePoint t0 = ManualDaemon::Origin();
@@ -177,7 +185,7 @@ inline SineResult RunSineStream(std::unique_ptr<Driver> driver, const SineStream
     r.time.push_back(ToSeconds(t - t0));
     r.sine.push_back(sine(t));
     r.measured.push_back(q);
-    if (t < measure_from) continue;
+    if (t < measure_from || t > t0 + FromSeconds(s.seconds)) continue;
     const double e = std::abs(q - sine(t));
     r.max_error = std::max(r.max_error, e);
     sum2 += e * e;
@@ -191,6 +199,7 @@ inline SineResult RunSineStream(std::unique_ptr<Driver> driver, const SineStream
   r.succeeded = d.succeeded;
   r.modified = d.modified;
   r.other = d.other;
+  r.last_note = d.last_note;
   return r;
 }
 
