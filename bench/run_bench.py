@@ -376,7 +376,28 @@ class Bench:
         return {"figure": "ode", "output": r.stdout, "rc": r.returncode, "shared_robots": os.path.exists(shared)}
 
 
-FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "micro", "ode"]
+    def trajectory(self):
+        """Issue 22: tracking of interpolated sines, the receding-horizon client, the
+        RobotDaemon's cost per period (bench/trajectory_bench.cpp; in-process, manual clock)."""
+        exe = f"{os.path.abspath(self.args.build)}/bench/robotalk-trajectory-bench"
+        shared = os.environ.get("ROBOTALK_SHARED_ROBOTS", os.path.join(ROOT, "..", "shared", "robots"))
+        if not os.path.exists(exe):
+            return {"figure": "trajectory", "error": "robotalk-trajectory-bench not built"}
+        csv_path = os.path.join(self.args.out, "trajectory_ode_10hz.csv")
+        cmd = [exe, shared, "--csv", csv_path] + (["--quick"] if self.quick else [])
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        plot = {}
+        if os.path.exists(csv_path):  # kept in the JSON, so the figure can be redrawn from the results alone
+            with open(csv_path) as f:
+                rows = [line.strip().split(",") for line in f if line.strip()]
+            os.remove(csv_path)
+            plot = {name: [float(row[i]) for row in rows[1:]] for i, name in enumerate(rows[0])}
+        return {"figure": "trajectory", "output": r.stdout, "stderr": r.stderr[-400:], "rc": r.returncode,
+                "shared_robots": os.path.exists(shared), "plot_ode_10hz": plot}
+
+
+FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "micro", "ode",
+           "trajectory"]
 
 
 def main():
