@@ -266,7 +266,7 @@ void DaemonCost(int rounds) {
   row("same, periods in which 31 waypoints arrived (1 in 10: a 100 Hz delay-mode client)", c_busy.arrival_us,
       c_busy.arrival_allocations);
   std::printf(
-      "mean per period over all periods: interpolating %.2f µs (%.2f %% of 1 ms), idle daemon %.2f µs, "
+      "\nmean per period over all periods: interpolating %.2f µs (%.2f %% of 1 ms), idle daemon %.2f µs, "
       "bare loop %.2f µs; interpolating / idle %.1f×\n",
       c_busy.sum_us / static_cast<double>(c_busy.periods),
       c_busy.sum_us / static_cast<double>(c_busy.periods) / 10.0,
@@ -312,7 +312,7 @@ void TrackerAllocations() {
     }
   }
   std::printf(
-      "TrajectoryTracker alone (1 joint, quintic, a 100 Hz stream 100 ms ahead, %d waypoints after 1,000 "
+      "\nTrajectoryTracker alone (1 joint, quintic, a 100 Hz stream 100 ms ahead, %d waypoints after 1,000 "
       "of warm-up): Add() of one waypoint %.1f allocations, median %.2f µs; Sample() %.2f allocations\n",
       n, static_cast<double>(add_allocations) / n, Percentile(add_us, 0.5),
       static_cast<double>(sample_allocations) / n);
