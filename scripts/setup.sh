@@ -16,6 +16,7 @@ PACKAGES=(
   libjchart2d-java xvfb x11-apps  # robotalk-spy (lcm-spy charts); its test: a virtual X server and xwd
   libsodium-dev
   lua-posix  # examples/lua_client: a sub-second monotonic clock (Lua 5.2 has none)
+  cyclonedds-dev cyclonedds-tools  # robotalk-ros2: Cyclone DDS and its idlc
 )
 # robotalk-web's page modules come from the npm registry: Node.js and npm from
 # Debian unless a node with npm is already installed (e.g. NodeSource's).

@@ -1,6 +1,7 @@
 /* The C client example: connects to a robot, loads its configuration, sends
  * a GOTO (direct mode), then a short timed sequence of pan/tilt set-points in
- * delay mode, and prints every reply. Same steps and output as the Java
+ * delay mode, then one interpolated (cubic) sequence of pan waypoints, and
+ * prints every reply. Same steps and output as the Java
  * example (examples/java_client); tests/examples/client_example_test.sh runs it.
  *   robotalk_c_example [--url URL] [--robot NAME] [--delay S] [--pause S]
  *                      [--key FILE] [--server-key FILE.pub]
@@ -18,6 +19,8 @@
 
 #define SEQUENCE_FRAMES 4
 static const double kFrameSpacing = 0.25; /* s between the sequence's frames */
+#define TRAJECTORY_POINTS 3
+static const double kPointSpacing = 0.2; /* s between the trajectory's waypoints */
 
 static void print_reply(const char* what, const rtc_reply* r) {
   printf("reply %" PRId64 " %s: %s%s%s exec_us=%" PRId64 " late_ms=%.1f\n", r->id, what,
@@ -98,6 +101,42 @@ static int run(rtc_client* c, double delay_s, double pause_s) {
   for (int k = 1; k < SEQUENCE_FRAMES; ++k)
     printf(" %.3f", (replies[k].exec_time_us - replies[k - 1].exec_time_us) / 1e6);
   printf("\n");
+
+  /* An interpolated sequence: pan's waypoints in one cubic package (delay mode),
+   * the middle one with its velocity; each is answered when the trajectory
+   * passes it. It ends where the sequence above left pan, at 0.3. Sent only when
+   * everything so far succeeded: a client whose sequence failed moves nothing more. */
+  if (!failures) {
+    double way[TRAJECTORY_POINTS] = {0.33, 0.36, 0.3};
+    double way_velocity[TRAJECTORY_POINTS] = {0.0, 0.1, 0.0};
+    robotalk_msgs_command_t points[TRAJECTORY_POINTS];
+    int64_t point_ids[TRAJECTORY_POINTS];
+    const int64_t traj_start_us = rtc_server_now_us(c) + (int64_t)(delay_s * 1e6);
+    for (int k = 0; k < TRAJECTORY_POINTS; ++k) {
+      points[k] =
+          (robotalk_msgs_command_t){.type = ROBOTALK_MSGS_COMMAND_T_JOINT_SETPOINT,
+                                    .start_time_us = traj_start_us + (int64_t)((k + 1) * kPointSpacing * 1e6),
+                                    .target = "pan",
+                                    .num_values = 1,
+                                    .values = &way[k],
+                                    .num_velocities = k == 1,
+                                    .velocities = &way_velocity[k]};
+    }
+    if (rtc_send_interpolated(c, ROBOTALK_MSGS_PACKAGE_HEADER_T_MODE_DELAY,
+                              ROBOTALK_MSGS_PACKAGE_HEADER_T_INTERPOLATION_CUBIC, points,
+                              TRAJECTORY_POINTS) < 0)
+      return -1;
+    for (int k = 0; k < TRAJECTORY_POINTS; ++k) point_ids[k] = points[k].id;
+    rtc_reply point_replies[TRAJECTORY_POINTS];
+    if (rtc_wait(c, point_ids, TRAJECTORY_POINTS, 10.0 + delay_s, point_replies) != 0) return -1;
+    for (int k = 0; k < TRAJECTORY_POINTS; ++k) {
+      char what[64];
+      snprintf(what, sizeof what, "trajectory cubic +%.2f s pan %.2f", (k + 1) * kPointSpacing, way[k]);
+      print_reply(what, &point_replies[k]);
+      failures += point_replies[k].signal != ROBOTALK_MSGS_REPLY_T_SUCCESS &&
+                  point_replies[k].signal != ROBOTALK_MSGS_REPLY_T_MODIFIED;
+    }
+  }
 
   /* The last set-point was taken when answered; give the joint time to get there. */
   if (rtc_pause(c, 0.5) != 0) return -1;

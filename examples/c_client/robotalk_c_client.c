@@ -278,12 +278,18 @@ int64_t rtc_send_queries(rtc_client* c, robotalk_msgs_query_t* queries, int n) {
 }
 
 int64_t rtc_send_commands(rtc_client* c, int8_t mode, robotalk_msgs_command_t* commands, int n) {
+  return rtc_send_interpolated(c, mode, ROBOTALK_MSGS_PACKAGE_HEADER_T_INTERPOLATION_STEP, commands, n);
+}
+
+int64_t rtc_send_interpolated(rtc_client* c, int8_t mode, int8_t interpolation,
+                              robotalk_msgs_command_t* commands, int n) {
   int64_t ids[kMaxIdsPerPackage];
   if (n > kMaxIdsPerPackage) return rtci_set_error(c, "at most %d items per package", kMaxIdsPerPackage), -1;
   for (int i = 0; i < n; ++i) ids[i] = commands[i].id = c->next_id++;
   robotalk_msgs_package_t pkg;
   memset(&pkg, 0, sizeof pkg);
   fill_header(c, &pkg.header, ROBOTALK_MSGS_PACKAGE_HEADER_T_PAYLOAD_COMMANDS, n, mode);
+  pkg.header.interpolation = interpolation;
   pkg.num_commands = n;
   pkg.commands = commands;
   return track_and_send(c, &pkg, ids, n);

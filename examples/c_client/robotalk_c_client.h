@@ -1,4 +1,4 @@
-/* A small RoboTalk client in C (protocol 3, open and keyed mode), written from
+/* A small RoboTalk client in C (protocol 4, open and keyed mode), written from
  * docs/protocol.md, docs/writing_a_client.md and docs/security.md with LCM's C
  * API, the C bindings lcm-gen makes of lcmtypes/robotalk_msgs
  * (robotalk::lcmtypes_c) and libsodium (keyed mode: robotalk_c_keyed.h).
@@ -94,6 +94,13 @@ int rtc_clock_stale(const rtc_client* c);
  * sequence (> 0), or -1. mode: robotalk_msgs_package_header_t MODE_*. */
 int64_t rtc_send_queries(rtc_client* c, robotalk_msgs_query_t* queries, int n);
 int64_t rtc_send_commands(rtc_client* c, int8_t mode, robotalk_msgs_command_t* commands, int n);
+/* The same with the package's interpolation (package_header_t INTERPOLATION_*):
+ * its timed JOINT_SETPOINT / FRAME_SETPOINT commands are the waypoints of a
+ * trajectory (docs/protocol.md, Trajectories); a command's velocities and
+ * accelerations (num_velocities = 0: chosen by the server) are its rates.
+ * rtc_send_commands sends INTERPOLATION_STEP. */
+int64_t rtc_send_interpolated(rtc_client* c, int8_t mode, int8_t interpolation,
+                              robotalk_msgs_command_t* commands, int n);
 
 /* Waits until every id in ids[0..n) has its final reply, for at most
  * timeout_s, keeping heartbeats and retransmissions going; copies the replies

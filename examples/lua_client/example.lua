@@ -1,8 +1,9 @@
 --[[ The Lua client example: connects to a robot, loads its configuration,
 sends a GOTO, then a short timed sequence of pan/tilt set-points in direct
 mode (each frame sent at its time by the client's clock, start time "now",
-and its reply awaited before the next), and prints every reply. Same output
-as the C and Java examples; tests/examples/client_example_test.sh runs it.
+and its reply awaited before the next), then one interpolated (cubic)
+sequence of pan waypoints in playback mode, and prints every reply. Same
+output as the C and Java examples; tests/examples/client_example_test.sh runs it.
   LUA_PATH="<lua modules dir>/?.lua;<lua modules dir>/?/init.lua;examples/lua_client/?.lua;;" \
   lua5.2 examples/lua_client/example.lua [--url URL] [--robot NAME] [--pause S]
 --pause S: wait S seconds after the GOTO (keeping the session); the test
@@ -83,6 +84,27 @@ end
 local s = 'spacing_s:'
 for k = 2, #exec do s = s .. string.format(' %.3f', (exec[k] - exec[k - 1]) / 1e6) end
 print(s)
+
+-- An interpolated sequence: pan's waypoints in one cubic playback package
+-- (offsets; the server picks the start), the middle one with its velocity;
+-- each is answered when the trajectory passes it. It ends at 0.3, where the
+-- sequence above left pan. Sent only when everything so far succeeded: a
+-- client whose sequence failed moves nothing more.
+if ok then
+  local point_spacing, way = 0.2, { 0.33, 0.36, 0.3 }
+  local points = {}
+  for k, q in ipairs(way) do
+    points[k] = rt.new_command(msgs.command_t.JOINT_SETPOINT, 'pan', math.floor(k * point_spacing * 1e6 + 0.5), { q },
+      k == 2 and { 0.1 } or nil)
+  end
+  local point_replies
+  point_replies, e = client:playback(msgs.package_header_t.INTERPOLATION_CUBIC, points, 10)
+  if not point_replies then fail(e) end
+  for k, q in ipairs(way) do
+    print_reply(string.format('trajectory cubic +%.2f s pan %.2f', k * point_spacing, q), point_replies[k])
+    ok = ok and (point_replies[k].signal == msgs.reply_t.SUCCESS or point_replies[k].signal == msgs.reply_t.MODIFIED)
+  end
+end
 
 local paused, perr = client:pause(0.5)  -- let the last set-point get there
 if not paused then fail(perr) end

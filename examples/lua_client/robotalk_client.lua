@@ -323,12 +323,40 @@ function Client:query(qtype, target, timeout_s)
   return r and r[1], err
 end
 
+-- A command_t: its type, target, start time (us), values and (a waypoint's,
+-- optional) velocities.
+function M.new_command(ctype, target, start_time_us, values, velocities)
+  local c = msgs.command_t:new()
+  c.type, c.target, c.start_time_us = ctype, target or '', start_time_us or 0
+  c.values, c.velocities = values or {}, velocities or {}
+  c.num_values, c.num_velocities = #c.values, #c.velocities
+  return c
+end
+
+-- A playback sequence in one package (docs/protocol.md, Modes): each
+-- command's start_time_us is its offset from the sequence start, and the
+-- server chooses when that is (no clock sync needed). `interpolation`
+-- (package_header_t.INTERPOLATION_*) joins its set-points into a trajectory
+-- (docs/protocol.md, Trajectories). Blocks until every command has its final
+-- reply (at most timeout_s); returns the replies in order.
+function Client:playback(interpolation, commands, timeout_s)
+  local pkg = new_package()
+  pkg.header.payload_type = msgs.package_header_t.PAYLOAD_COMMANDS
+  pkg.header.mode = msgs.package_header_t.MODE_PLAYBACK
+  pkg.header.interpolation = interpolation
+  pkg.header.playback_id = self.next_id  -- an id of this client's, as its commands' are
+  self.next_id = self.next_id + 1
+  pkg.header.playback_frames = #commands
+  for _, c in ipairs(commands) do
+    pkg.header.playback_duration_us = math.max(pkg.header.playback_duration_us, c.start_time_us)
+  end
+  pkg.num_commands, pkg.commands = #commands, commands
+  return self:exchange(pkg, timeout_s or 5)
+end
+
 -- One command in direct mode (start time 0 = now), blocking until its final reply.
 function Client:command(ctype, target, values, timeout_s)
-  local c = msgs.command_t:new()
-  c.type, c.target, c.start_time_us = ctype, target or '', 0
-  c.values = values or {}
-  c.num_values = #c.values
+  local c = M.new_command(ctype, target, 0, values)
   local pkg = new_package()
   pkg.header.payload_type = msgs.package_header_t.PAYLOAD_COMMANDS
   pkg.header.mode = msgs.package_header_t.MODE_DIRECT

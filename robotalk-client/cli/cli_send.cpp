@@ -20,10 +20,16 @@ namespace {
 
 struct SequenceFlags {
   SequenceOptions options;
-  bool any = false;  // a mode flag was given (only valid with --file)
+  bool any = false;                            // a mode flag was given (only valid with --file)
+  std::optional<Interpolation> interpolation;  // --interpolation: overrides the file's
+  bool delay_given = false;                    // --delay
 };
 
-// --mode direct|delay|playback, --delay S, --paced.
+// Delay mode's default lead for an interpolated sequence: its first
+// waypoints must arrive before their time, or the server skips them.
+constexpr Duration kInterpolatedDelay = std::chrono::milliseconds(500);
+
+// --mode direct|delay|playback, --delay S, --paced, --interpolation WORD.
 SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
   SequenceFlags f;
   f.options.mode = CommandMode::kDelay;
@@ -41,10 +47,16 @@ SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
     if (d < 0) throw UsageError("--delay " + delay + " is negative");
     if (f.options.mode != CommandMode::kDelay) throw UsageError("--delay goes with --mode delay");
     f.options.delay = FromSeconds(d);
+    f.delay_given = true;
     f.any = true;
   }
   if (TakeOption(args, "--paced", nullptr)) {
     f.options.paced = true;
+    f.any = true;
+  }
+  std::string interpolation;
+  if (TakeOption(args, "--interpolation", &interpolation)) {
+    f.interpolation = ParseInterpolationWord(interpolation, "--interpolation");
     f.any = true;
   }
   if (f.options.mode == CommandMode::kDirect) f.options.paced = true;  // a handshake per frame, at its time
@@ -69,14 +81,33 @@ int Interrupted(int signal, const std::string& note) {
 }
 
 int SendFile(const GlobalOptions& g, const std::string& robot, const std::string& path,
-             const SequenceOptions& options, bool json) {
+             const SequenceFlags& flags, bool json) {
   std::ifstream file(path);
   if (!file) throw UsageError("cannot read sequence file '" + path + "'");
   std::stringstream text;
   text << file.rdbuf();
-  const auto entries = ParseSequence(text.str(), path);  // all lines checked before connecting
+  const SequenceFile sequence = ParseSequenceFile(text.str(), path);  // all lines checked before connecting
+  const auto& entries = sequence.entries;
+  SequenceOptions options = flags.options;
+  options.interpolation = flags.interpolation.value_or(sequence.interpolation.value_or(Interpolation::kStep));
+  if (options.mode == CommandMode::kDirect && options.interpolation != Interpolation::kStep) {
+    throw UsageError(std::string("interpolation ") + InterpolationName(options.interpolation) +
+                     " needs --mode delay or playback (a direct frame has no start time, so it is a step)");
+  }
+  if (options.mode == CommandMode::kDelay && options.interpolation != Interpolation::kStep &&
+      !flags.delay_given)
+    options.delay = kInterpolatedDelay;
   std::vector<TimedCommand> frames;
-  for (const auto& e : entries) frames.push_back({FromSeconds(e.offset_s), e.command});
+  bool rates = false;
+  for (const auto& e : entries) {
+    frames.push_back({FromSeconds(e.offset_s), e.command});
+    rates = rates || !e.command.velocities.empty() || !e.command.accelerations.empty();
+  }
+  if (rates && options.interpolation == Interpolation::kStep) {
+    std::cerr << "robotalk: note: " << path
+              << " gives velocities or accelerations, which a step sequence ignores "
+                 "(--interpolation cubic, or an 'interpolation' line, uses them)\n";
+  }
 
   const auto client = ConnectClient(g, robot);
   Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
@@ -171,14 +202,19 @@ int RunSend(const GlobalOptions& g, const std::vector<std::string>& in) {
   if (args.empty()) {
     throw UsageError(
         "usage: robotalk send ROBOT COMMAND ARGS... [--at S] [--hold] | send ROBOT --file SEQ.txt [--mode M] "
-        "[--delay S] [--paced]");
+        "[--delay S] [--paced] [--interpolation step|linear|cubic|quintic]");
   }
   if (has_file) {
     if (args.size() != 1 || has_at || hold) throw UsageError("send ROBOT --file SEQ.txt takes nothing else");
-    return SendFile(g, args[0], file, sequence.options, json);
+    return SendFile(g, args[0], file, sequence, json);
   }
-  if (sequence.any) throw UsageError("--mode, --delay and --paced go with --file");
+  if (sequence.any) throw UsageError("--mode, --delay, --paced and --interpolation go with --file");
   Command c = ParseCommandWords({args.begin() + 1, args.end()});
+  if (!c.velocities.empty() || !c.accelerations.empty()) {
+    throw UsageError(
+        "velocity and acceleration are a waypoint's: give them in a sequence file with an interpolation "
+        "(send ROBOT --file SEQ.txt --interpolation cubic)");
+  }
   if (hold && !HeldWhileAlive(c.type))
     throw UsageError("--hold goes with setspeed, joint_speed or joint_force");
   std::optional<double> delay;

@@ -30,12 +30,15 @@ constexpr const char* kUsage = R"(usage: robotalk [--url URL] [--timeout S] [--k
                                       --hold: keep a setspeed / joint_speed / joint_force
                                       until Ctrl-C, then STOP (without it the server's
                                       watchdog stops the robot ~2 s after robotalk exits)
-  send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced] [--json]
+  send ROBOT --file SEQ.txt [--mode M] [--delay S] [--paced] [--interpolation I] [--json]
                                       a timed sequence (format: docs/client.md); M is
                                       direct (a handshake per frame), delay (start =
-                                      server clock + S, default 0) or playback (the
-                                      server picks the delay); --paced sends each frame
-                                      at its time instead of all at once
+                                      server clock + S, default 0, interpolated 0.5) or
+                                      playback (the server picks the delay); --paced
+                                      sends each frame at its time instead of all at
+                                      once; I is step, linear, cubic or quintic: how the
+                                      set-points join into a trajectory (overrides the
+                                      file's 'interpolation' line)
   watch ROBOT [--period S] [--duration S] [--count N] [--json]
                                       broadcast mode: print the state stream (default 0.1 s);
                                       exits 1 when the server is gone (3 s without STATE

@@ -46,6 +46,21 @@ struct PackageOptions {
   bool ask_for_delay = false;
   /// A CLOCK query: the ack of a package sent once is a clock sample.
   bool clock_query = false;
+  /// How its timed set-points join into trajectories (request.h).
+  Interpolation interpolation = Interpolation::kStep;
+};
+
+namespace client {
+struct PlannedSend;
+}
+
+/// A sequence on its way (RunSequence, SendTrajectory): the options of its
+/// packages and the server time of its offset 0.
+struct SequenceSend {
+  CommandMode mode = CommandMode::kDelay;
+  PackageOptions package;
+  TimePoint server_start{};  ///< delay: from the start; playback: once the delay reply is in
+  bool start_known = false;
 };
 
 class RobotClient::Impl {
@@ -66,6 +81,15 @@ class RobotClient::Impl {
                    const PackageOptions& options = {});
   /// A fresh id from the client's command-id space (for a playback sequence).
   CommandId NewId();
+  /// Opens a sequence of `frames` frames whose last offset is `duration`,
+  /// started at `t0` on the client's clock. Playback: declares it, and
+  /// `delay_reply` waits for the server's delay reply.
+  SequenceSend BeginSequence(const SequenceOptions& options, std::size_t frames, Duration duration,
+                             TimePoint t0, std::optional<PendingReply>* delay_reply);
+  /// Sends one planned package: the commands of `send.frames` (moved out of
+  /// `frames`) with their start times; one PendingReply per frame, in order.
+  std::vector<PendingReply> SendPlanned(std::vector<TimedCommand>& frames, const client::PlannedSend& send,
+                                        SequenceSend& sequence);
   /// Tells the retransmission bookkeeping when items will run (server clock).
   void SetStartTimes(const std::vector<std::pair<CommandId, TimePoint>>& server_starts);
   void OnState(std::span<const std::uint8_t> bytes);

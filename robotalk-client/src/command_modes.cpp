@@ -67,6 +67,50 @@ CommandId RobotClient::Impl::NewId() {
   return next_id_++;
 }
 
+SequenceSend RobotClient::Impl::BeginSequence(const SequenceOptions& options, std::size_t frames,
+                                              Duration duration, TimePoint t0,
+                                              std::optional<PendingReply>* delay_reply) {
+  SequenceSend sequence;
+  sequence.mode = options.mode;
+  sequence.package.mode = RequestMode::kDirect;
+  if (options.mode == CommandMode::kPlayback) {
+    sequence.package.mode = RequestMode::kPlayback;
+    sequence.package.playback = {NewId(), static_cast<std::int64_t>(frames), duration};
+    sequence.package.ask_for_delay = true;
+    cache_->Expect(sequence.package.playback.id);
+    *delay_reply =
+        MakePending(sequence.package.playback.id, "PLAYBACK " + std::to_string(sequence.package.playback.id));
+  } else if (options.mode == CommandMode::kDelay) {
+    sequence.package.mode = RequestMode::kDelay;
+    TimePoint server_t0;
+    {
+      std::lock_guard lock(mu_);
+      server_t0 = clock_sync_.ServerTime(t0);
+    }
+    sequence.server_start = options.start.value_or(server_t0 + options.delay);
+    sequence.start_known = true;
+  }
+  return sequence;
+}
+
+std::vector<PendingReply> RobotClient::Impl::SendPlanned(std::vector<TimedCommand>& frames,
+                                                         const client::PlannedSend& send,
+                                                         SequenceSend& sequence) {
+  std::vector<Command> commands;
+  for (std::size_t i : send.frames) {
+    Command c = std::move(frames[i].command);
+    c.start_time = client::FrameStart(sequence.mode, frames[i].offset, sequence.server_start);
+    commands.push_back(std::move(c));
+  }
+  sequence.package.interpolation = send.interpolation;
+  const Sent sent = SendPackage(std::move(commands), {}, sequence.package);
+  sequence.package.ask_for_delay = false;  // only the first package asks
+  std::vector<PendingReply> pending;
+  for (std::size_t j = 0; j < send.frames.size(); ++j)
+    pending.push_back(MakePending(sent.ids[j], "sequence frame " + std::to_string(send.frames[j])));
+  return pending;
+}
+
 SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options,
                                         const SequenceHooks& hooks) {
   if (!connected()) throw ClientError("RobotClient::RunSequence: not connected (call Connect first)");
@@ -82,21 +126,11 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   client::SequencePacer pacer(plan, t0);
 
   std::optional<PendingReply> delay_reply;
-  PackageOptions package{.mode = RequestMode::kDirect};
-  TimePoint server_start{};  // known from the start in delay mode, after the delay reply in playback
-  bool start_known = false;
-  if (options.mode == CommandMode::kPlayback) {
-    package = {.mode = RequestMode::kPlayback,
-               .playback = {impl_->NewId(), static_cast<std::int64_t>(frames.size()), plan.duration},
-               .ask_for_delay = true};
-    impl_->cache_->Expect(package.playback.id);
-    delay_reply = impl_->MakePending(package.playback.id, "PLAYBACK " + std::to_string(package.playback.id));
-  } else if (options.mode == CommandMode::kDelay) {
-    package.mode = RequestMode::kDelay;
-    server_start = ServerTime(t0) + options.delay;
-    result.server_start = server_start;
-    start_known = true;
-  }
+  SequenceSend sequence = impl_->BeginSequence(options, frames.size(), plan.duration, t0, &delay_reply);
+  // Known from the start in delay mode, after the delay reply in playback.
+  TimePoint& server_start = sequence.server_start;
+  bool& start_known = sequence.start_known;
+  if (options.mode == CommandMode::kDelay) result.server_start = server_start;
 
   std::vector<std::optional<PendingReply>> pending(frames.size());
   std::size_t answered = 0;
@@ -118,18 +152,8 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
   // Sends the next package of the plan (due now).
   const auto send_next = [&] {
     const client::PlannedSend& send = *pacer.NextDue(clock.Now());
-    std::vector<Command> commands;
-    for (std::size_t i : send.frames) {
-      Command c = std::move(frames[i].command);
-      c.start_time = client::FrameStart(options.mode, frames[i].offset, server_start);
-      commands.push_back(std::move(c));
-    }
-    auto sent = impl_->SendPackage(std::move(commands), {}, package);
-    package.ask_for_delay = false;  // only the first package asks
-    for (std::size_t j = 0; j < send.frames.size(); ++j) {
-      pending[send.frames[j]] =
-          impl_->MakePending(sent.ids[j], "sequence frame " + std::to_string(send.frames[j]));
-    }
+    std::vector<PendingReply> sent = impl_->SendPlanned(frames, send, sequence);
+    for (std::size_t j = 0; j < send.frames.size(); ++j) pending[send.frames[j]] = std::move(sent[j]);
     result.frames_sent += send.frames.size();
   };
   // Waits for frame i's reply until `until` on the client's clock (nullopt:

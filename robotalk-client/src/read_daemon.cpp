@@ -153,6 +153,7 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     request.panic = options.panic;
     request.mode = options.mode;
     request.playback = options.playback;
+    request.interpolation = options.interpolation;
     // Ids are taken from next_id_ only once the package is encoded: a
     // package EncodeRequest refuses consumes nothing.
     CommandId id = next_id_;

@@ -12,6 +12,22 @@ SequencePlan PlanSequence(const std::vector<TimedCommand>& frames, const Sequenc
                         std::to_string(ToSeconds(frames[i].offset)) + " s)");
     }
   }
+  const auto interpolation = [&](std::size_t i) {
+    return frames[i].interpolation.value_or(options.interpolation);
+  };
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const Interpolation in = interpolation(i);
+    if (options.mode == CommandMode::kDirect && in != Interpolation::kStep) {
+      throw ClientError("RobotClient::RunSequence: frame " + std::to_string(i) + ": interpolation " +
+                        InterpolationName(in) +
+                        " needs mode delay or playback (a direct frame has no start time, so it is a step)");
+    }
+    if (options.mode == CommandMode::kPlayback && in != interpolation(0)) {
+      throw ClientError("RobotClient::RunSequence: a playback sequence has one interpolation: frame " +
+                        std::to_string(i) + " is " + InterpolationName(in) + ", frame 0 " +
+                        InterpolationName(interpolation(0)));
+    }
+  }
   SequencePlan plan;
   if (frames.empty()) return plan;
   std::vector<std::size_t> order(frames.size());
@@ -22,11 +38,13 @@ SequencePlan PlanSequence(const std::vector<TimedCommand>& frames, const Sequenc
   // Direct mode is a handshake: one frame per package whatever the batch.
   const bool one_each = options.paced || options.mode == CommandMode::kDirect;
   const std::size_t batch = one_each ? 1 : std::max<std::size_t>(options.batch, 1);
-  for (std::size_t k = 0; k < order.size(); k += batch) {
+  for (std::size_t k = 0; k < order.size();) {
     PlannedSend send;
     send.send_at = options.paced ? frames[order[k]].offset : Duration(0);
-    send.frames.assign(order.begin() + static_cast<std::ptrdiff_t>(k),
-                       order.begin() + static_cast<std::ptrdiff_t>(std::min(order.size(), k + batch)));
+    send.interpolation = interpolation(order[k]);
+    for (; k < order.size() && send.frames.size() < batch && interpolation(order[k]) == send.interpolation;
+         ++k)
+      send.frames.push_back(order[k]);
     plan.sends.push_back(std::move(send));
   }
   return plan;

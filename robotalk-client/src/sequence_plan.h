@@ -9,6 +9,10 @@
 //   playback: start time After(offset); the server chooses the delay
 //   paced:    one frame per package at its offset; not paced: packages of
 //             `batch` frames, all due at once
+//   interpolation: each package carries one (a frame's own, else the
+//             sequence's); frames of different interpolations never share a
+//             package, a playback sequence has one, and a direct sequence
+//             only step (its frames have no start time)
 //
 // Thread safety: value types and pure functions.
 #pragma once
@@ -23,8 +27,9 @@ namespace robotalk::client {
 
 /// One package of a sequence.
 struct PlannedSend {
-  Duration send_at{0};              ///< when it leaves, after the sequence's first send
-  std::vector<std::size_t> frames;  ///< indices into the caller's frames, in offset order
+  Duration send_at{0};                                 ///< when it leaves, after the sequence's first send
+  std::vector<std::size_t> frames;                     ///< indices into the caller's frames, in offset order
+  Interpolation interpolation = Interpolation::kStep;  ///< the package's
 };
 
 struct SequencePlan {
@@ -33,7 +38,9 @@ struct SequencePlan {
 };
 
 /// Plans `frames` in `options`. Frames leave in offset order (equal offsets
-/// in the order given). Throws ClientError for a negative offset.
+/// in the order given). Throws ClientError for a negative offset, an
+/// interpolation other than step in direct mode, and two interpolations in
+/// one playback sequence.
 SequencePlan PlanSequence(const std::vector<TimedCommand>& frames, const SequenceOptions& options);
 
 /// The start time a frame at `offset` carries in `mode`; `server_start` is the

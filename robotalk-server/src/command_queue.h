@@ -32,7 +32,7 @@ struct QueuedItem {
   bool scoped_stop = false;
   std::vector<int> stop_joints;
   bool stop_base = false;
-  /// The package's interpolation. A JOINT_SETPOINT with a start time in a
+  /// The package's interpolation. A JOINT_SETPOINT or FRAME_SETPOINT with a start time in a
   /// package that is not kStep is a trajectory waypoint (is_waypoint()): the
   /// RobotDaemon takes it when it arrives, not at its start time.
   Interpolation interpolation = Interpolation::kStep;
@@ -44,7 +44,7 @@ struct QueuedItem {
 
   bool is_waypoint() const {
     return !is_query && has_start_time && interpolation != Interpolation::kStep &&
-           command.type == CommandType::kJointSetPoint;
+           (command.type == CommandType::kJointSetPoint || command.type == CommandType::kFrameSetPoint);
   }
 
   /// Earlier start first; equal starts in arrival order.

@@ -488,8 +488,8 @@ void RobotDaemon::AddWaypoints(TimePoint now) {
   } else if (ReadState(now)) {  // an idle joint's trajectory starts where it is
     trajectory_owners_.clear();
     tracker_.Add(waypoints_, now, state_, tracked_, trajectory_owners_);
-    for (const auto& [client, joint] : trajectory_owners_) {
-      produced_.executed.push_back({client, CommandType::kJointSetPoint, joint});
+    for (const TrajectoryTracker::Started& o : trajectory_owners_) {
+      produced_.executed.push_back({o.client_id, o.type, o.target});
     }
     EmitTracked();
   }

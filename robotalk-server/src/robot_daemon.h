@@ -298,7 +298,7 @@ class RobotDaemon {
   std::vector<QueuedItem> waypoints_;  // taken from arrived_waypoints_ this iteration
   TrajectoryTracker tracker_;
   std::vector<TrajectoryTracker::Answer> tracked_;  // the tracker's answers of this iteration
-  std::vector<std::pair<std::int64_t, int>> trajectory_owners_;
+  std::vector<TrajectoryTracker::Started> trajectory_owners_;
   std::vector<Completion> completions_;
   std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
   DaemonOutput produced_;

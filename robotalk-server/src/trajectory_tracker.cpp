@@ -37,7 +37,12 @@ std::string Append(const std::string& note, const std::string& more) {
 }  // namespace
 
 TrajectoryTracker::TrajectoryTracker(const RobotModel& model, TrackerOptions options)
-    : model_(model), options_(options), tracks_(static_cast<std::size_t>(model.joints().size())) {
+    : model_(model),
+      options_(options),
+      tracks_(static_cast<std::size_t>(model.joints().size())),
+      frame_tracks_(model.frames().size()),
+      kinematics_(model),
+      ik_(model) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
     Track& t = tracks_[j];
@@ -55,35 +60,73 @@ TrajectoryTracker::TrajectoryTracker(const RobotModel& model, TrackerOptions opt
       t.limits.velocity[k] = std::isfinite(l.velocity) ? l.velocity : kInf;
     }
   }
+  for (std::size_t f = 0; f < frame_tracks_.size(); ++f) {
+    Track& t = frame_tracks_[f];
+    t.frame = static_cast<int>(f);
+    t.dofs = 6;
+    t.limits.acceleration = Eigen::VectorXd::Constant(6, options.acceleration_limit);
+    const std::span<const std::uint8_t> mask = ik_.default_mask(static_cast<int>(f));
+    for (std::size_t j = 0; j < tracks_.size(); ++j) {
+      const int first = model.dof_offset(static_cast<int>(j));
+      for (int k = 0; k < tracks_[j].dofs; ++k) {
+        if (mask[static_cast<std::size_t>(first + k)]) {
+          t.chain.push_back(static_cast<int>(j));
+          break;
+        }
+      }
+    }
+  }
+  // A joint a frame's trajectory moves gets its references from the
+  // inverse kinematics, limited as its own (sized once).
+  for (Track& t : tracks_) {
+    for (Eigen::VectorXd* v : {&t.sample.position, &t.sample.velocity, &t.sample.acceleration,
+                               &t.ref_position, &t.ref_velocity, &t.ref_acceleration, &t.solved_velocity}) {
+      *v = Eigen::VectorXd::Zero(t.dofs);
+    }
+  }
+  ik_start_ = Eigen::VectorXd::Zero(model.num_dofs());
   references_.reserve(tracks_.size());
 }
 
 std::size_t TrajectoryTracker::pending() const {
   std::size_t n = 0;
   for (const Track& t : tracks_) n += t.pending.size();
+  for (const Track& t : frame_tracks_) n += t.pending.size();
   return n;
 }
 
 void TrajectoryTracker::Add(std::span<const QueuedItem> waypoints, TimePoint now, const RobotState& state,
-                            std::vector<Answer>& answers,
-                            std::vector<std::pair<std::int64_t, int>>& started) {
+                            std::vector<Answer>& answers, std::vector<Started>& started) {
   // Waypoints in time order per joint (ties in arrival order), so a package's
   // batch appends rather than splicing into itself.
   std::vector<const QueuedItem*> order;
   order.reserve(waypoints.size());
   for (const QueuedItem& w : waypoints) order.push_back(&w);
   std::stable_sort(order.begin(), order.end(), [](const QueuedItem* a, const QueuedItem* b) {
+    if (a->command.type != b->command.type) return a->command.type < b->command.type;
     return a->command.target != b->command.target ? a->command.target < b->command.target
                                                   : a->start < b->start;
   });
-  for (const QueuedItem* w : order) AddOne(w->command.target, *w, now, state, answers, started);
+  for (const QueuedItem* w : order) {
+    if (w->command.type == CommandType::kFrameSetPoint) {
+      AddFrameWaypoint(*w, now, state, answers, started);
+    } else {
+      AddJointWaypoint(*w, now, state, answers, started);
+    }
+  }
 }
 
-void TrajectoryTracker::AddOne(int joint, const QueuedItem& item, TimePoint now, const RobotState& state,
-                               std::vector<Answer>& answers,
-                               std::vector<std::pair<std::int64_t, int>>& started) {
+void TrajectoryTracker::AddJointWaypoint(const QueuedItem& item, TimePoint now, const RobotState& state,
+                                         std::vector<Answer>& answers, std::vector<Started>& started) {
+  const int joint = item.command.target;
   Track& t = tracks_[static_cast<std::size_t>(joint)];
   const std::string label = std::string("JOINT_SETPOINT '") + model_.joint(joint).name + "'";
+  if (t.moved_by >= 0) {  // a frame's trajectory moves it: the joint's own waypoint replaces that
+    EndFrame(t.moved_by, now,
+             "FRAME_SETPOINT '" + model_.frame(t.moved_by).name + "': superseded by " + label + " command " +
+                 std::to_string(item.command.id),
+             answers);
+  }
   Pending p;
   p.client_id = item.client_id;
   p.id = item.command.id;
@@ -106,13 +149,111 @@ void TrajectoryTracker::AddOne(int joint, const QueuedItem& item, TimePoint now,
   if (item.num_accelerations == t.dofs) {
     w.acceleration = Eigen::Map<const Eigen::VectorXd>(item.accelerations.data(), t.dofs);
   }
+  const bool idle = !t.trajectory;
+  TrajectoryState start;
+  start.position = state.position.segment(t.first_dof, t.dofs);
+  start.velocity = state.velocity.segment(t.first_dof, t.dofs);
+  if (!Join(t, label, std::move(p), item, now, start, answers)) return;
+  if (idle || t.owner != item.client_id)
+    started.push_back({item.client_id, CommandType::kJointSetPoint, joint});
+  t.owner = item.client_id;
+}
 
+void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, const RobotState& state,
+                                         std::vector<Answer>& answers, std::vector<Started>& started) {
+  const int frame = item.command.target;
+  Track& t = frame_tracks_[static_cast<std::size_t>(frame)];
+  const std::string label = std::string("FRAME_SETPOINT '") + model_.frame(frame).name + "'";
+  if (t.trajectory && t.trajectory->interpolation() != item.interpolation) {
+    EndFrame(frame, now,
+             label + ": superseded by command " + std::to_string(item.command.id) + " (" +
+                 InterpolationName(item.interpolation) + ")",
+             answers);
+  }
+  const bool idle = !t.trajectory;
+  TrajectoryState start;
+  if (idle) {
+    // Its joints leave whatever trajectory they had; it starts where the frame is.
+    for (int j : t.chain) {
+      Track& joint = tracks_[static_cast<std::size_t>(j)];
+      if (joint.moved_by >= 0) {
+        EndFrame(joint.moved_by, now,
+                 "FRAME_SETPOINT '" + model_.frame(joint.moved_by).name + "': superseded by " + label +
+                     " command " + std::to_string(item.command.id),
+                 answers);
+      }
+      if (joint.trajectory) {
+        EndTrack(joint, now,
+                 "JOINT_SETPOINT '" + model_.joint(j).name + "': superseded by " + label + " command " +
+                     std::to_string(item.command.id),
+                 answers);
+      }
+    }
+    roots_.clear();
+    for (const Pose& r : state.root_poses) roots_.push_back(r.ToIsometry());
+    kinematics_.Update(state.position, roots_);
+    const Eigen::Isometry3d pose = kinematics_.frame_pose(frame);
+    t.base = Eigen::Quaterniond(pose.rotation());
+    const Eigen::Matrix<double, 6, 1> twist = kinematics_.FrameJacobian(frame) * state.velocity;
+    start.position = Eigen::VectorXd::Zero(6);
+    start.position.head<3>() = pose.translation();
+    start.velocity = Eigen::VectorXd::Zero(6);
+    start.velocity.head<3>() = twist.head<3>();
+    start.velocity.tail<3>() = t.base.conjugate() * Eigen::Vector3d(twist.tail<3>());
+    ik_start_ = state.position;
+  }
+  Pending p;
+  p.client_id = item.client_id;
+  p.id = item.command.id;
+  p.requested = item.start;
+  Waypoint& w = p.waypoint;
+  w.time = item.start;
+  const auto& v = item.command.values;
+  Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+  q.normalize();
+  if (q.dot(t.base) < 0) q.coeffs() = -q.coeffs();  // the same rotation, the short way from the base
+  const Eigen::AngleAxisd relative(t.base.conjugate() * q);
+  w.position = Eigen::VectorXd(6);
+  w.position << v[0], v[1], v[2], relative.angle() * relative.axis();
+  // Given rates are world twists: the rotation part in the base's axes (the
+  // rotation vector's rate, exact while the rotation turns about one axis).
+  const auto twist = [&](const std::array<double, 6>& r) {
+    Eigen::VectorXd out(6);
+    out.head<3>() = Eigen::Vector3d(r[0], r[1], r[2]);
+    out.tail<3>() = t.base.conjugate() * Eigen::Vector3d(r[3], r[4], r[5]);
+    return out;
+  };
+  if (item.num_velocities == 6) w.velocity = twist(item.velocities);
+  if (item.num_accelerations == 6) w.acceleration = twist(item.accelerations);
+  if (!Join(t, label, std::move(p), item, now, start, answers)) return;
+  if (idle) {
+    for (int j : t.chain) {
+      Track& joint = tracks_[static_cast<std::size_t>(j)];
+      joint.moved_by = frame;
+      joint.ref_position = state.position.segment(joint.first_dof, joint.dofs);
+      joint.ref_velocity = state.velocity.segment(joint.first_dof, joint.dofs);
+      joint.ref_acceleration.setZero();
+      joint.solved_velocity = joint.ref_velocity;
+      joint.last_sample = now;
+      joint.fresh = true;
+      joint.on_plan = true;
+      joint.limited.clear();
+    }
+  }
+  if (idle || t.owner != item.client_id)
+    started.push_back({item.client_id, CommandType::kFrameSetPoint, frame});
+  t.owner = item.client_id;
+}
+
+bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, const QueuedItem& item,
+                             TimePoint now, const TrajectoryState& start, std::vector<Answer>& answers) {
+  Waypoint& w = p.waypoint;
   // A trajectory of another interpolation is replaced from now, as a splice.
   if (t.trajectory && t.trajectory->interpolation() != item.interpolation) {
-    End(joint, now,
-        label + ": superseded by command " + std::to_string(item.command.id) + " (" +
-            InterpolationName(item.interpolation) + ")",
-        answers);
+    EndTrack(t, now,
+             label + ": superseded by command " + std::to_string(item.command.id) + " (" +
+                 InterpolationName(item.interpolation) + ")",
+             answers);
   }
   // Late: after its time. Skipped when a later waypoint is planned (the
   // trajectory already runs past it); else joined one period from now.
@@ -124,26 +265,23 @@ void TrajectoryTracker::AddOne(int joint, const QueuedItem& item, TimePoint now,
                                     label + ": arrived " + Seconds(now - w.time) +
                                         " after its time; a later waypoint is already planned; not executed",
                                     now, now - w.time)});
-      return;
+      return false;
     }
     p.note = Append(p.note, "arrived " + Seconds(now - w.time) + " after its time: joined " +
                                 Seconds(options_.period) + " from its arrival");
     w.time = now + options_.period;
   }
-
   const bool idle = !t.trajectory;
   if (idle) {
-    TrajectoryState start;
-    start.position = state.position.segment(t.first_dof, t.dofs);
-    start.velocity = state.velocity.segment(t.first_dof, t.dofs);
     t.trajectory.emplace(item.interpolation, now, start, t.limits.acceleration);
     t.sample = t.trajectory->MakeSample();
     t.ref_position = start.position;
-    t.ref_velocity = start.velocity;
+    t.ref_velocity = start.velocity.size() ? start.velocity : Eigen::VectorXd::Zero(t.dofs);
     t.ref_acceleration = Eigen::VectorXd::Zero(t.dofs);
     t.last_sample = now;
     t.on_plan = true;
     t.fresh = true;
+    t.limited.clear();
     ++active_;
   }
   Trajectory& traj = *t.trajectory;
@@ -179,11 +317,10 @@ void TrajectoryTracker::AddOne(int joint, const QueuedItem& item, TimePoint now,
       t.trajectory.reset();
       --active_;
     }
-    return;
+    return false;
   }
   t.pending.push_back(std::move(p));
-  if (idle || t.owner != item.client_id) started.emplace_back(item.client_id, joint);
-  t.owner = item.client_id;
+  return true;
 }
 
 void TrajectoryTracker::Interrupt(Track& t, std::size_t from, TimePoint now, const std::string& why,
@@ -195,8 +332,26 @@ void TrajectoryTracker::Interrupt(Track& t, std::size_t from, TimePoint now, con
   t.pending.erase(t.pending.begin() + static_cast<std::ptrdiff_t>(from), t.pending.end());
 }
 
+void TrajectoryTracker::AnswerPassed(Track& t, TimePoint now, const std::string& label,
+                                     std::vector<Answer>& answers) {
+  while (!t.pending.empty() && t.pending.front().waypoint.time <= now) {
+    Pending& p = t.pending.front();
+    const Duration late = p.waypoint.time > p.requested ? p.waypoint.time - p.requested : Duration(0);
+    if (!t.limited.empty()) {  // since the previous waypoint
+      p.note = Append(p.note, "reference limited: " + label + " " + t.limited);
+      if (t.frame < 0) {
+        const double off = (t.ref_position - t.sample.position).cwiseAbs().maxCoeff();
+        p.note += "; the reference was " + Number(off) + " from it at its time";
+      }
+      t.limited.clear();
+    }
+    const Signal signal = p.note.empty() ? Signal::kSuccess : Signal::kModified;
+    answers.push_back({p.client_id, MakeAnswer(p.id, signal, std::move(p.note), p.waypoint.time, late)});
+    t.pending.pop_front();
+  }
+}
+
 void TrajectoryTracker::Sample(TimePoint now, std::vector<Answer>& answers) {
-  const auto label_of = [this](int joint) { return "JOINT_SETPOINT '" + model_.joint(joint).name + "'"; };
   references_.clear();
   for (std::size_t j = 0; j < tracks_.size(); ++j) {
     Track& t = tracks_[j];
@@ -204,18 +359,8 @@ void TrajectoryTracker::Sample(TimePoint now, std::vector<Answer>& answers) {
     Trajectory& traj = *t.trajectory;
     traj.Sample(now, &t.sample);
     Limit(t, now);
-    while (!t.pending.empty() && t.pending.front().waypoint.time <= now) {
-      Pending& p = t.pending.front();
-      const Duration late = p.waypoint.time > p.requested ? p.waypoint.time - p.requested : Duration(0);
-      if (!t.limited.empty()) {  // since the previous waypoint
-        const double off = (t.ref_position - t.sample.position).cwiseAbs().maxCoeff();
-        p.note = Append(p.note, "reference limited: " + label_of(static_cast<int>(j)) + " " + t.limited +
-                                    "; the reference was " + Number(off) + " from it at its time");
-        t.limited.clear();
-      }
-      const Signal signal = p.note.empty() ? Signal::kSuccess : Signal::kModified;
-      answers.push_back({p.client_id, MakeAnswer(p.id, signal, std::move(p.note), p.waypoint.time, late)});
-      t.pending.pop_front();
+    if (!t.pending.empty() && t.pending.front().waypoint.time <= now) {
+      AnswerPassed(t, now, "JOINT_SETPOINT '" + model_.joint(static_cast<int>(j)).name + "'", answers);
     }
     references_.push_back(JointReference{static_cast<int>(j),
                                          {t.ref_position.data(), static_cast<std::size_t>(t.dofs)},
@@ -229,6 +374,65 @@ void TrajectoryTracker::Sample(TimePoint now, std::vector<Answer>& answers) {
     } else if (traj.num_knots() > 64) {
       traj.Forget(now);  // bounded however long a stream runs
     }
+  }
+  for (Track& f : frame_tracks_) {
+    if (f.trajectory) SampleFrame(f, now, answers);
+  }
+}
+
+void TrajectoryTracker::SampleFrame(Track& f, TimePoint now, std::vector<Answer>& answers) {
+  Trajectory& traj = *f.trajectory;
+  traj.Sample(now, &f.sample);
+  const double dt = std::clamp(ToSeconds(now - f.last_sample), 1e-4, 1.0);
+  const bool first = f.fresh;
+  if (now <= f.last_sample && !first) return;
+  f.fresh = false;
+  f.last_sample = now;
+  // The pose: the position, and the base orientation turned by the rotation vector.
+  const Eigen::Vector3d r = f.sample.position.tail<3>();
+  const double angle = r.norm();
+  const Eigen::Quaterniond orientation =
+      angle > 0 ? f.base * Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle)) : f.base;
+  const InverseKinematics::Result solved =
+      ik_.Solve(f.frame, f.sample.position.head<3>(), orientation, ik_start_, roots_);
+  ik_start_ = ik_.solution();
+  bool joints_on_plan = true, at_rest = true;
+  for (int j : f.chain) {
+    Track& t = tracks_[static_cast<std::size_t>(j)];
+    for (int k = 0; k < t.dofs; ++k) {
+      const double q = ik_start_[t.first_dof + k];
+      const double v = first ? t.ref_velocity[k] : (q - t.sample.position[k]) / dt;
+      t.sample.acceleration[k] = first ? 0.0 : (v - t.solved_velocity[k]) / dt;
+      t.sample.velocity[k] = v;
+      t.solved_velocity[k] = v;
+      t.sample.position[k] = q;
+    }
+    t.sample.holding = f.sample.holding;
+    Limit(t, now);
+    if (!t.limited.empty() && f.limited.empty())
+      f.limited = "joint '" + model_.joint(j).name + "': " + t.limited;
+    t.limited.clear();
+    joints_on_plan = joints_on_plan && t.on_plan;
+    at_rest = at_rest && t.ref_velocity.isZero(0.0);
+    references_.push_back(JointReference{j,
+                                         {t.ref_position.data(), static_cast<std::size_t>(t.dofs)},
+                                         {t.ref_velocity.data(), static_cast<std::size_t>(t.dofs)},
+                                         {t.ref_acceleration.data(), static_cast<std::size_t>(t.dofs)}});
+  }
+  if (!f.pending.empty() && f.pending.front().waypoint.time <= now) {
+    const std::string label = "FRAME_SETPOINT '" + model_.frame(f.frame).name + "'";
+    if (!solved.within_tolerance) {
+      char text[160];
+      std::snprintf(text, sizeof text, "the inverse kinematics ended %.3g m and %.3g rad from the pose",
+                    solved.position_error, solved.orientation_error);
+      f.pending.front().note = Append(f.pending.front().note, text);
+    }
+    AnswerPassed(f, now, label, answers);
+  }
+  if (f.pending.empty() && f.sample.holding && f.sample.velocity.isZero(0.0) && joints_on_plan && at_rest) {
+    EndFrame(f.frame, now, "", answers);
+  } else if (traj.num_knots() > 64) {
+    traj.Forget(now);
   }
 }
 
@@ -295,16 +499,33 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
   t.on_plan = on_plan;
 }
 
-void TrajectoryTracker::End(int joint, TimePoint now, const std::string& why, std::vector<Answer>& answers) {
-  Track& t = tracks_[static_cast<std::size_t>(joint)];
+void TrajectoryTracker::EndTrack(Track& t, TimePoint now, const std::string& why,
+                                 std::vector<Answer>& answers) {
   if (!t.trajectory) return;
   Interrupt(t, 0, now, why, answers);
   t.trajectory.reset();
   --active_;
 }
 
+void TrajectoryTracker::EndFrame(int frame, TimePoint now, const std::string& why,
+                                 std::vector<Answer>& answers) {
+  Track& f = frame_tracks_[static_cast<std::size_t>(frame)];
+  EndTrack(f, now, why, answers);
+  for (int j : f.chain) {
+    if (tracks_[static_cast<std::size_t>(j)].moved_by == frame)
+      tracks_[static_cast<std::size_t>(j)].moved_by = -1;
+  }
+}
+
+void TrajectoryTracker::End(int joint, TimePoint now, const std::string& why, std::vector<Answer>& answers) {
+  Track& t = tracks_[static_cast<std::size_t>(joint)];
+  if (t.moved_by >= 0) EndFrame(t.moved_by, now, why, answers);
+  EndTrack(t, now, why, answers);
+}
+
 void TrajectoryTracker::EndAll(TimePoint now, const std::string& why, std::vector<Answer>& answers) {
-  for (std::size_t j = 0; j < tracks_.size(); ++j) End(static_cast<int>(j), now, why, answers);
+  for (std::size_t f = 0; f < frame_tracks_.size(); ++f) EndFrame(static_cast<int>(f), now, why, answers);
+  for (Track& t : tracks_) EndTrack(t, now, why, answers);
 }
 
 }  // namespace robotalk

@@ -43,6 +43,8 @@
 #include "command_queue.h"
 #include "robotalk/command.h"
 #include "robotalk/driver.h"
+#include "robotalk/inverse_kinematics.h"
+#include "robotalk/kinematics.h"
 #include "robotalk/robot_model.h"
 #include "robotalk/trajectory.h"
 
@@ -72,6 +74,13 @@ class TrajectoryTracker {
     std::int64_t client_id = 0;
     Reply reply;
   };
+  /// A trajectory now a client's (ownership): of a joint, or of a control frame.
+  struct Started {
+    std::int64_t client_id = 0;
+    CommandType type = CommandType::kJointSetPoint;
+    int target = -1;
+    bool operator==(const Started&) const = default;
+  };
 
   TrajectoryTracker(const RobotModel& model, TrackerOptions options);
 
@@ -81,7 +90,7 @@ class TrajectoryTracker {
   /// `started` gets (client, joint) for every joint whose trajectory this
   /// made that client's (ownership).
   void Add(std::span<const QueuedItem> waypoints, TimePoint now, const RobotState& state,
-           std::vector<Answer>& answers, std::vector<std::pair<std::int64_t, int>>& started);
+           std::vector<Answer>& answers, std::vector<Started>& started);
 
   /// Samples every active trajectory at `now` into references(); answers the
   /// waypoints passed by `now`. A trajectory that has passed its last waypoint
@@ -90,14 +99,13 @@ class TrajectoryTracker {
   /// The references of the last Sample(): one per joint with an active trajectory.
   std::span<const JointReference> references() const { return references_; }
 
-  /// Ends joint `joint`'s trajectory: every waypoint not yet passed answers
-  /// INTERRUPTED with `why`. No-op for a joint without one.
+  /// Ends joint `joint`'s trajectory (or the frame trajectory that moves
+  /// it): every waypoint not yet passed answers INTERRUPTED with `why`. No-op
+  /// for a joint without one.
   void End(int joint, TimePoint now, const std::string& why, std::vector<Answer>& answers);
   /// Ends every trajectory.
   void EndAll(TimePoint now, const std::string& why, std::vector<Answer>& answers);
-  /// Ends every trajectory of `client_id`'s joints (waypoints of others on them included).
   bool active() const { return active_ > 0; }
-  bool active(int joint) const { return tracks_[static_cast<std::size_t>(joint)].trajectory.has_value(); }
   /// Waypoints waiting to be passed, over every joint (for tests and bounds).
   std::size_t pending() const;
 
@@ -123,10 +131,31 @@ class TrajectoryTracker {
     std::string limited;     // the first limit the reference met since the last waypoint passed
     int first_dof = 0;
     int dofs = 0;
+    // A control frame's track (6 dofs: x y z and the rotation vector of its
+    // orientation relative to `base`), or -1 for a joint's.
+    int frame = -1;
+    Eigen::Quaterniond base = Eigen::Quaterniond::Identity();
+    std::vector<int> chain;  // a frame's: the joints its inverse kinematics moves
+    // A joint's: the frame whose trajectory moves it (-1: none), and the
+    // last solution's velocity (for the acceleration of the next).
+    int moved_by = -1;
+    Eigen::VectorXd solved_velocity;
   };
 
-  void AddOne(int joint, const QueuedItem& item, TimePoint now, const RobotState& state,
-              std::vector<Answer>& answers, std::vector<std::pair<std::int64_t, int>>& started);
+  void AddJointWaypoint(const QueuedItem& item, TimePoint now, const RobotState& state,
+                        std::vector<Answer>& answers, std::vector<Started>& started);
+  void AddFrameWaypoint(const QueuedItem& item, TimePoint now, const RobotState& state,
+                        std::vector<Answer>& answers, std::vector<Started>& started);
+  // Joins `p` to `t`'s trajectory (starting it at `now` from `start` when
+  // idle): late, splice and replacement rules. False when refused (answered).
+  bool Join(Track& t, const std::string& label, Pending p, const QueuedItem& item, TimePoint now,
+            const TrajectoryState& start, std::vector<Answer>& answers);
+  void EndTrack(Track& t, TimePoint now, const std::string& why, std::vector<Answer>& answers);
+  void EndFrame(int frame, TimePoint now, const std::string& why, std::vector<Answer>& answers);
+  // Answers the waypoints of `t` passed by `now`; `label` names its target.
+  void AnswerPassed(Track& t, TimePoint now, const std::string& label, std::vector<Answer>& answers);
+  // A frame trajectory's period: its pose by inverse kinematics, the chain's references.
+  void SampleFrame(Track& f, TimePoint now, std::vector<Answer>& answers);
   void Interrupt(Track& t, std::size_t from, TimePoint now, const std::string& why,
                  std::vector<Answer>& answers);
   // The reference from the plan's sample: the plan itself while it is within
@@ -135,7 +164,12 @@ class TrajectoryTracker {
 
   const RobotModel& model_;
   TrackerOptions options_;
-  std::vector<Track> tracks_;  // per joint
+  std::vector<Track> tracks_;        // per joint
+  std::vector<Track> frame_tracks_;  // per control frame
+  Kinematics kinematics_;
+  InverseKinematics ik_;
+  Eigen::VectorXd ik_start_;  // where the next solve starts (the last solution)
+  std::vector<Eigen::Isometry3d> roots_;
   std::vector<JointReference> references_;
   int active_ = 0;
 };

@@ -39,6 +39,18 @@ expect_msg 2 "unknown option '--bogus'" --bogus robots
 expect_msg 2 "unknown option '--bogus'" send pioneer goto 1 0 0 --bogus
 expect_msg 2 "unknown option '-x'" query pioneer base_pose -x
 expect_msg 2 "--hold goes with setspeed" send pioneer goto 1 0 0 --hold
+# Interpolation (issue 22): the flag's and the file's bad words are named with the accepted ones.
+seq=$(mktemp)
+printf 'interpolation cubic\n0 joint_setpoint pan 0.1 velocity 0.2\n' > "$seq"
+expect_msg 2 "--interpolation: 'cubc' is not an interpolation (step, linear, cubic, quintic)" \
+  send pioneer --file "$seq" --interpolation cubc
+expect_msg 2 "interpolation cubic needs --mode delay or playback" send pioneer --file "$seq" --mode direct
+expect_msg 2 "--mode, --delay, --paced and --interpolation go with --file" send pioneer goto 1 0 0 --interpolation cubic
+expect_msg 2 "velocity and acceleration are a waypoint's" send pioneer joint_setpoint pan 0.1 velocity 0.2
+printf 'interpolation smooth\n0 stop\n' > "$seq"
+expect_msg 2 "$seq:1: interpolation: 'smooth' is not an interpolation (step, linear, cubic, quintic)" \
+  send pioneer --file "$seq"
+rm -f "$seq"
 expect_msg 0 "robotalk " --version
 "$cli" --version | grep -Eq '^robotalk [0-9]+\.[0-9]+\.[0-9]+$' || { echo "FAIL: --version format"; fail=1; }
 [ $fail = 0 ] && echo "cli usage: all passed"

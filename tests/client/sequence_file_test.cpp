@@ -65,14 +65,96 @@ TEST(SequenceFile, CommandWordsForTheSendSubcommand) {
   EXPECT_THROW(ParseCommandWords({"setspeed", "0.1"}), UsageError);
 }
 
-TEST(SequenceFile, TheExampleSquareParses) {
-  std::ifstream in(std::string(ROBOTALK_EXAMPLES_DIR) + "/square.txt");
-  ASSERT_TRUE(in.good());
+// Issue 22 item 7: a sequence file's interpolation line and waypoint rates.
+TEST(SequenceFile, TakesAnInterpolationLineAndAWaypointsVelocitiesAndAccelerations) {
+  const SequenceFile file = ParseSequenceFile(
+      "# pan, smoothly\n"
+      "interpolation Cubic   # any case\n"
+      "0 joint_setpoint pan 0\n"
+      "0.5 joint_setpoint pan 0.3 velocity 0.4\n"
+      "1 joint_setpoint pan_tilt 0 0.1 velocities 0 0 accelerations 0 0.5\n"
+      "1.5 frame_setpoint camera 1 0 0.3 1 0 0 0 acceleration 0 0 0 0 0 0 velocity 0 0 0 0 0 0.1\n"
+      "2 stop\n",
+      "seq.txt");
+  EXPECT_EQ(file.interpolation, Interpolation::kCubic);
+  ASSERT_EQ(file.entries.size(), 5u);
+  EXPECT_TRUE(file.entries[0].command.velocities.empty());
+  EXPECT_EQ(file.entries[1].command.values, std::vector<double>{0.3});
+  EXPECT_EQ(file.entries[1].command.velocities, std::vector<double>{0.4});
+  EXPECT_EQ(file.entries[2].command.velocities, (std::vector<double>{0, 0}));
+  EXPECT_EQ(file.entries[2].command.accelerations, (std::vector<double>{0, 0.5}));
+  EXPECT_EQ(file.entries[3].command.values.size(), 7u);
+  EXPECT_EQ(file.entries[3].command.velocities.back(), 0.1);
+  EXPECT_EQ(file.entries[3].command.accelerations.size(), 6u);
+  // Without the line: none (step), and ParseSequence gives the commands alone.
+  EXPECT_FALSE(ParseSequenceFile("0 stop\n", "seq.txt").interpolation);
+  EXPECT_EQ(ParseSequence("interpolation quintic\n0 stop\n", "seq.txt").size(), 1u);
+  // What FormatCommandWords writes reads back.
+  const Command c = file.entries[2].command;
+  const Command back = ParseCommandWords(SplitWords(FormatCommandWords(c)));
+  EXPECT_EQ(back.values, c.values);
+  EXPECT_EQ(back.velocities, c.velocities);
+  EXPECT_EQ(back.accelerations, c.accelerations);
+  EXPECT_EQ(FormatCommandWords(file.entries[1].command),
+            "joint_setpoint pan 0.29999999999999999 velocity 0.40000000000000002");
+}
+
+TEST(SequenceFile, ABadInterpolationOrRateNamesTheWordAndWhatIsAccepted) {
+  EXPECT_EQ(ErrorOf("interpolation cubc\n0 stop\n"),
+            "seq.txt:1: interpolation: 'cubc' is not an interpolation (step, linear, cubic, quintic)");
+  EXPECT_EQ(ErrorOf("interpolation\n0 stop\n"),
+            "seq.txt:1: interpolation takes one word (step, linear, cubic, quintic)");
+  EXPECT_EQ(ErrorOf("interpolation cubic\ninterpolation linear\n0 stop\n"),
+            "seq.txt:2: interpolation given twice (first on line 1)");
+  EXPECT_EQ(ErrorOf("0 stop\ninterpolation linear\n"),
+            "seq.txt:2: the interpolation line goes before the first command");
+  EXPECT_EQ(ErrorOf("cubic\n0 stop\n"),
+            "seq.txt:1: 'cubic' is an interpolation: write 'interpolation cubic'");
+  EXPECT_EQ(ErrorOf("0 joint_setpoint pan 0.1 velocity 0.1 0.2\n"),
+            "seq.txt:1: JOINT_SETPOINT velocity takes one value per position (1), got 2");
+  EXPECT_EQ(
+      ErrorOf("0 frame_setpoint camera 1 0 0.3 1 0 0 0 velocity 0 0 0\n"),
+      "seq.txt:1: FRAME_SETPOINT velocity takes 6 values (linear x y z, then angular x y z, in the world), "
+      "got 3");
+  EXPECT_EQ(ErrorOf("0 joint_setpoint pan 0.1 velocity\n"),
+            "seq.txt:1: JOINT_SETPOINT: velocity needs its values");
+  EXPECT_EQ(ErrorOf("0 joint_setpoint pan 0.1 velocity 1 velocity 2\n"),
+            "seq.txt:1: JOINT_SETPOINT: velocity given twice");
+  EXPECT_EQ(
+      ErrorOf("0 joint_setpoint pan 0.1 velocity nan\n"),
+      "seq.txt:1: JOINT_SETPOINT velocity 1: 'nan' is not finite (a joint_setpoint ends with its values, "
+      "then optionally velocity V... and acceleration A...)");
+  EXPECT_EQ(ErrorOf("0 joint_setpoint pan 0.1 velocty 0.2\n"),
+            "seq.txt:1: JOINT_SETPOINT value 2: 'velocty' is not a number (a joint_setpoint ends with its "
+            "values, then optionally velocity V... and acceleration A...)");
+  EXPECT_EQ(ErrorOf("0 goto 1 0 0 velocity 1 0 0\n"),
+            "seq.txt:1: GOTO takes no velocity (only a joint_setpoint or frame_setpoint waypoint does)");
+  EXPECT_EQ(ErrorOf("0 joint_setpoint pan velocity 0.1\n"),
+            "seq.txt:1: JOINT_SETPOINT takes one value per dof of the joint, got 0");
+  EXPECT_EQ(ErrorOf("0 frame_setpoint camera 1 0 0.3 velocity 0 0 0 0 0 0\n"),
+            "seq.txt:1: FRAME_SETPOINT takes 7 values (x y z qw qx qy qz), got 3");
+}
+
+// The text of examples/<name>.
+std::string Example(const std::string& name) {
+  std::ifstream in(std::string(ROBOTALK_EXAMPLES_DIR) + "/" + name);
+  EXPECT_TRUE(in.good()) << name;
   std::stringstream text;
   text << in.rdbuf();
-  const auto entries = ParseSequence(text.str(), "square.txt");
+  return text.str();
+}
+
+TEST(SequenceFile, TheExampleSquareParses) {
+  const auto entries = ParseSequence(Example("square.txt"), "square.txt");
   EXPECT_EQ(entries.size(), 10u);
   EXPECT_EQ(entries.back().command.type, CommandType::kStop);
+}
+
+TEST(SequenceFile, TheExamplePanWaypointsParsesInterpolated) {
+  const SequenceFile file = ParseSequenceFile(Example("pan_waypoints.txt"), "pan_waypoints.txt");
+  EXPECT_EQ(file.interpolation, Interpolation::kCubic);
+  EXPECT_EQ(file.entries.size(), 7u);
+  EXPECT_EQ(file.entries.back().command.accelerations, std::vector<double>{0.0});
 }
 
 }  // namespace

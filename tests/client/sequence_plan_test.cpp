@@ -54,6 +54,59 @@ TEST(PlanSequence, RefusesANegativeOffsetNamingTheFrame) {
   EXPECT_TRUE(PlanSequence({}, {}).sends.empty());
 }
 
+// Issue 22 item 7: every package carries one interpolation.
+TEST(PlanSequence, EveryPackageCarriesTheSequencesInterpolationAndAFramesOwnSplitsTheBatch) {
+  auto frames = Frames({0, 10, 20, 30, 40});
+  auto plan = PlanSequence(
+      frames,
+      {.mode = CommandMode::kDelay, .paced = false, .batch = 200, .interpolation = Interpolation::kCubic});
+  ASSERT_EQ(plan.sends.size(), 1u);
+  EXPECT_EQ(plan.sends[0].interpolation, Interpolation::kCubic);
+  // A frame of its own interpolation (a replayed session of step and cubic
+  // packages) travels in a package of its own kind.
+  frames[2].interpolation = Interpolation::kStep;
+  plan = PlanSequence(
+      frames,
+      {.mode = CommandMode::kDelay, .paced = false, .batch = 200, .interpolation = Interpolation::kCubic});
+  EXPECT_THAT(FramesOf(plan), ElementsAre(ElementsAre(0, 1), ElementsAre(2), ElementsAre(3, 4)));
+  std::vector<Interpolation> kinds;
+  for (const auto& s : plan.sends) kinds.push_back(s.interpolation);
+  EXPECT_THAT(kinds, ElementsAre(Interpolation::kCubic, Interpolation::kStep, Interpolation::kCubic));
+  // Paced: one frame a package, each with its frame's interpolation.
+  plan = PlanSequence(frames,
+                      {.mode = CommandMode::kDelay, .paced = true, .interpolation = Interpolation::kLinear});
+  ASSERT_EQ(plan.sends.size(), 5u);
+  EXPECT_EQ(plan.sends[1].interpolation, Interpolation::kLinear);
+  EXPECT_EQ(plan.sends[2].interpolation, Interpolation::kStep);
+}
+
+TEST(PlanSequence, RefusesAnInterpolationInDirectModeAndTwoInOnePlaybackSequence) {
+  const auto error = [](const std::vector<TimedCommand>& frames, const SequenceOptions& options) {
+    try {
+      PlanSequence(frames, options);
+    } catch (const ClientError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no ClientError");
+  };
+  EXPECT_EQ(error(Frames({0, 10}), {.mode = CommandMode::kDirect, .interpolation = Interpolation::kQuintic}),
+            "RobotClient::RunSequence: frame 0: interpolation quintic needs mode delay or playback (a direct "
+            "frame has no start time, so it is a step)");
+  auto frames = Frames({0, 10, 20});
+  frames[2].interpolation = Interpolation::kLinear;
+  EXPECT_EQ(error(frames, {.mode = CommandMode::kPlayback, .interpolation = Interpolation::kCubic}),
+            "RobotClient::RunSequence: a playback sequence has one interpolation: frame 2 is linear, frame 0 "
+            "cubic");
+  // Step in direct mode, and one interpolation in playback, are fine.
+  EXPECT_EQ(PlanSequence(Frames({0, 10}), {.mode = CommandMode::kDirect}).sends.size(), 2u);
+  frames[2].interpolation = Interpolation::kCubic;
+  EXPECT_EQ(
+      PlanSequence(frames,
+                   {.mode = CommandMode::kPlayback, .paced = false, .interpolation = Interpolation::kCubic})
+          .sends.size(),
+      1u);
+}
+
 TEST(FrameStart, CarriesTheStartEachModeNeeds) {
   const TimePoint server_start(std::chrono::seconds(50));
   EXPECT_EQ(FrameStart(CommandMode::kDirect, milliseconds(300), server_start), StartTime::Now());

@@ -31,16 +31,18 @@ RobotModel Arm() {
   wrist.dofs = {Dof{.axis = Eigen::Vector3d::UnitY(), .limits = {.lower = -3, .upper = 3, .velocity = 4}},
                 Dof{.axis = Eigen::Vector3d::UnitX(), .limits = {.lower = -3, .upper = 3, .velocity = 4}}};
   b.AddJoint(elbow, "base", "upper").AddJoint(wrist, "upper", "hand");
+  b.AddControlFrame(ControlFrame{.name = "tool", .servo_types = ServoType::kSetPoint}, "hand");
   b.SetRoot("base", Pose{}, BaseType::kFixed);
   return b.Build();
 }
 
 QueuedItem Waypoint(CommandId id, int joint, TimePoint at, std::vector<double> q,
-                    Interpolation interpolation = Interpolation::kCubic, std::int64_t client = kAlice) {
+                    Interpolation interpolation = Interpolation::kCubic, std::int64_t client = kAlice,
+                    CommandType type = CommandType::kJointSetPoint) {
   QueuedItem item;
   item.client_id = client;
   item.command.id = id;
-  item.command.type = CommandType::kJointSetPoint;
+  item.command.type = type;
   item.command.target = joint;
   item.command.num_values = static_cast<int>(q.size());
   std::copy(q.begin(), q.end(), item.command.values.begin());
@@ -63,7 +65,7 @@ class TrackerTest : public ::testing::Test {
   RobotModel model_ = Arm();
   TrajectoryTracker tracker_{model_, TrackerOptions{.acceleration_limit = 20, .period = milliseconds(10)}};
   std::vector<TrajectoryTracker::Answer> answers_;
-  std::vector<std::pair<std::int64_t, int>> started_;
+  std::vector<TrajectoryTracker::Started> started_;
 
   void Add(std::vector<QueuedItem> items, TimePoint now) {
     tracker_.Add(items, now, Rest(model_), answers_, started_);
@@ -90,7 +92,7 @@ class TrackerTest : public ::testing::Test {
 TEST_F(TrackerTest, PassesThroughEachWaypointAtItsTimeAndAnswersItThen) {
   Add({Waypoint(1, 0, kT0 + milliseconds(1000), {0.2}), Waypoint(2, 0, kT0 + milliseconds(2000), {0.5})},
       kT0);
-  EXPECT_EQ(started_, (std::vector<std::pair<std::int64_t, int>>{{kAlice, 0}}));
+  EXPECT_EQ(started_, (std::vector<TrajectoryTracker::Started>{{kAlice, CommandType::kJointSetPoint, 0}}));
   Run(kT0, kT0 + milliseconds(990));
   EXPECT_EQ(AnswerTo(1), nullptr) << "answered before its time";
   Run(kT0 + milliseconds(1000), kT0 + milliseconds(1000));
@@ -159,7 +161,8 @@ TEST_F(TrackerTest, ASpliceReplacesTheRemainderContinuouslyAndInterruptsWhatItRe
   EXPECT_THAT(AnswerTo(2)->reply.message, HasSubstr("superseded by command 9 of another client"));
   EXPECT_EQ(AnswerTo(3)->reply.signal, Signal::kInterrupted);
   EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kSuccess);
-  EXPECT_EQ(started_.back(), (std::pair<std::int64_t, int>{kBob, 0})) << "bob owns the joint now";
+  EXPECT_EQ(started_.back(), (TrajectoryTracker::Started{kBob, CommandType::kJointSetPoint, 0}))
+      << "bob owns the joint now";
   Run(kT0 + milliseconds(1270), kT0 + milliseconds(1750));
   EXPECT_NEAR(tracker_.references()[0].position[0], 0.5, 1e-6);
 }
@@ -326,13 +329,13 @@ class TrackedDaemonTest : public ::testing::Test {
   DaemonOutput out_;
 };
 
-TEST_F(TrackedDaemonTest, TheKinematicDriverFollowsACubicSineWithinAMilliradian) {
+TEST_F(TrackedDaemonTest, TheKinematicDriverFollowsACubicSineBetweenItsWaypoints) {
   const auto sine = [](TimePoint t) { return 0.5 * std::sin(std::numbers::pi * ToSeconds(t - kT0)); };
   double max_error = 0;
   for (int k = 0; k < 150; ++k) {  // 10 Hz frames, 0.3 s ahead, over 15 s
     const TimePoint at = kT0 + milliseconds(300 + 100 * k);
     daemon_.Submit(Waypoint(k + 1, 0, at, {sine(at)}, Interpolation::kCubic));
-    RunTo(kT0 + milliseconds(100 * (k + 1)));
+    RunTo(kT0 + milliseconds(100 * (k + 1) + 50));  // between waypoints
     if (k > 5) max_error = std::max(max_error, std::abs(Elbow() - sine(clock_.Now())));
   }
   EXPECT_LT(max_error, 3e-3);
@@ -387,6 +390,47 @@ TEST_F(TrackedDaemonTest, APanicEndsTheTrajectoryAndNoReferenceReachesTheDriverA
     }
   }
   EXPECT_TRUE(answered);
+}
+
+// A FRAME_SETPOINT trajectory: the frame's orientation turns about z (the
+// elbow's axis); the pose is interpolated in task space and solved by the
+// inverse kinematics every period, so the elbow follows the angle.
+TEST_F(TrackedDaemonTest, AFrameTrajectoryIsInterpolatedInTaskSpaceAndSolvedEveryPeriod) {
+  const auto angle = [](TimePoint t) { return 0.3 * std::sin(std::numbers::pi * ToSeconds(t - kT0)); };
+  const auto pose = [&](TimePoint t) {
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(angle(t), Eigen::Vector3d::UnitZ()));
+    return std::vector<double>{0, 0, 0, q.w(), q.x(), q.y(), q.z()};
+  };
+  double max_error = 0;
+  std::vector<DaemonOutput::Answer> answers;
+  for (int k = 0; k < 40; ++k) {  // 10 Hz frames, 0.3 s ahead, over 4 s
+    const TimePoint at = kT0 + milliseconds(300 + 100 * k);
+    daemon_.Submit(
+        Waypoint(k + 1, 0, at, pose(at), Interpolation::kCubic, kAlice, CommandType::kFrameSetPoint));
+    for (auto& a : RunTo(kT0 + milliseconds(100 * (k + 1) + 50))) answers.push_back(a);  // between waypoints
+    if (k > 5) max_error = std::max(max_error, std::abs(Elbow() - angle(clock_.Now())));
+  }
+  EXPECT_LT(max_error, 5e-3);
+  int success = 0;
+  for (const auto& a : answers) {
+    if (a.reply.id >= 1 && a.reply.id <= 40) success += a.reply.signal == Signal::kSuccess;
+  }
+  EXPECT_GT(success, 30) << "frame waypoints passed on time";
+}
+
+// A joint waypoint on a joint a frame trajectory moves replaces that trajectory.
+TEST_F(TrackerTest, AJointWaypointOnAFramesChainEndsTheFrameTrajectory) {
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()));
+  Add({Waypoint(1, 0, kT0 + milliseconds(1000), {0, 0, 0, q.w(), q.x(), q.y(), q.z()}, Interpolation::kCubic,
+                kAlice, CommandType::kFrameSetPoint)},
+      kT0);
+  EXPECT_EQ(started_.back(), (TrajectoryTracker::Started{kAlice, CommandType::kFrameSetPoint, 0}));
+  Run(kT0, kT0 + milliseconds(200));
+  EXPECT_FALSE(tracker_.references().empty()) << "the frame's chain gets references";
+  Add({Waypoint(2, 0, kT0 + milliseconds(1500), {0.1})}, kT0 + milliseconds(200));
+  ASSERT_NE(AnswerTo(1), nullptr);
+  EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kInterrupted);
+  EXPECT_THAT(AnswerTo(1)->reply.message, HasSubstr("superseded by JOINT_SETPOINT 'elbow' command 2"));
 }
 
 }  // namespace

@@ -24,11 +24,13 @@ struct FrameOptions {
   std::map<std::string, std::string> rename;  ///< --map old=new: joint / frame names
   double from_s = 0;                          ///< --window A:B, on the recorded offsets
   double to_s = std::numeric_limits<double>::infinity();
-  double speed = 1.0;  ///< --speed: offsets are divided by it
+  double speed = 1.0;  ///< --speed: offsets are divided by it (a waypoint's velocities times it,
+                       ///< accelerations times its square)
 };
 
 /// The selected frames, renamed, windowed (re-based to the window's start)
-/// and scaled. Throws LogError when the window holds nothing.
+/// and scaled, each with its package's interpolation (step for a frame sent
+/// without a start time). Throws LogError when the window holds nothing.
 std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions& options);
 
 /// A sequence file `robotalk send --file` plays: a comment header, then one
@@ -37,6 +39,10 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
 
 /// `info`: channels, span, servers, robots, clients and their command streams.
 void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out);
+
+/// "; interpolation cubic 40, step 2": how many of `each` travelled in
+/// packages of each interpolation; "" when all are step (info, replay).
+std::string DescribeInterpolations(const std::vector<Interpolation>& each);
 
 /// A number as info, extract and export write it (%.10g).
 std::string Num(double v);

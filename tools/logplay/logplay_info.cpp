@@ -69,6 +69,11 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
   if (absolute) out << " absolute " << absolute;
   if (now) out << " now " << now;
   if (playback) out << " playback offsets " << playback;
+  std::vector<Interpolation> interpolations;
+  for (const LoggedCommand& lc : log.commands()) {
+    if (lc.client_id == c.id && !lc.panic) interpolations.push_back(lc.interpolation);
+  }
+  out << DescribeInterpolations(interpolations);
   try {
     const Timeline t = log.MakeTimeline({.client_id = c.id});
     out << "; " << t.frames.size() << " frames over " << cli::FormatSeconds(t.frames.back().offset_s) << " ("
@@ -84,6 +89,17 @@ void PrintClient(const SessionLog& log, const LoggedClient& c, std::ostream& out
 }
 
 }  // namespace
+
+std::string DescribeInterpolations(const std::vector<Interpolation>& each) {
+  std::map<Interpolation, int> count;
+  for (const Interpolation i : each) ++count[i];
+  if (count.empty() || (count.size() == 1 && count.begin()->first == Interpolation::kStep)) return "";
+  std::string text;
+  for (const auto& [interpolation, n] : count)
+    text += (text.empty() ? "; interpolation " : ", ") + std::string(InterpolationName(interpolation)) + " " +
+            std::to_string(n);
+  return text;
+}
 
 std::string Num(double v) {
   char buf[40];
@@ -123,7 +139,14 @@ std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions&
     c.id = 0;
     c.start_time.reset();
     if (auto it = options.rename.find(c.target); it != options.rename.end()) c.target = it->second;
-    frames.push_back({FromSeconds((f.offset_s - options.from_s) / options.speed), std::move(c)});
+    // F times faster: a waypoint's velocities F times, its accelerations F² times.
+    for (double& v : c.velocities) v *= options.speed;
+    for (double& a : c.accelerations) a *= options.speed * options.speed;
+    // A set-point sent without a start time was a step whatever its package
+    // said; replayed, every frame is timed, so it says step again.
+    const bool was_timed = f.source->mode == RequestMode::kPlayback || f.source->start_us != 0;
+    frames.push_back({FromSeconds((f.offset_s - options.from_s) / options.speed), std::move(c),
+                      was_timed ? f.source->interpolation : Interpolation::kStep});
   }
   if (frames.empty()) throw LogError("the window holds no command");
   return frames;

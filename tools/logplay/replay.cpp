@@ -26,6 +26,13 @@ std::set<std::string> UnknownTargets(const RobotModel& model, const std::vector<
   return unknown;
 }
 
+// "; interpolation cubic 40, step 2", or "" when every frame is a step.
+std::string InterpolationsOf(const std::vector<TimedCommand>& frames) {
+  std::vector<Interpolation> each;
+  for (const TimedCommand& f : frames) each.push_back(f.interpolation.value_or(Interpolation::kStep));
+  return DescribeInterpolations(each);
+}
+
 std::string Describe(const Selection& s) {
   if (s.client_id) return "client " + Hex64(static_cast<std::uint64_t>(*s.client_id));
   return "robot '" + s.robot + "'";
@@ -55,7 +62,7 @@ int Replay(const SessionLog& log, const ReplayOptions& o, std::ostream& out) {
   const Duration duration = frames.back().offset;
   out << "replaying " << frames.size() << " commands of " << Describe(selection) << " onto '" << o.robot
       << "' in " << ToString(o.sequence.mode) << " mode over " << cli::FormatDuration(duration)
-      << " (timing from " << timeline.clock << " clock)\n"
+      << " (timing from " << timeline.clock << " clock" << InterpolationsOf(frames) << ")\n"
       << std::flush;
 
   std::map<std::string, int> signals;

@@ -118,6 +118,7 @@ void SessionLog::AddRequest(const std::string& robot, std::int64_t log_time_us,
     lc.sequence = r.sequence;
     lc.mode = r.mode;
     lc.playback_id = r.playback.id;
+    lc.interpolation = r.interpolation;
     lc.command = command;
     lc.start_us = StartMicros(command.start_time);
     lc.send_time_us = send_time_us;

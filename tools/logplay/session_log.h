@@ -70,6 +70,7 @@ struct LoggedCommand {
   bool panic = false;  ///< a panic package's marker: no command, never replayed
   RequestMode mode = RequestMode::kDirect;
   std::int64_t playback_id = 0;
+  Interpolation interpolation = Interpolation::kStep;  ///< its package's (replayed with it)
   Command command;                ///< start_time as sent: Now, At (server clock), After (playback offset)
   std::int64_t start_us = 0;      ///< the same in micros (0 = now)
   std::int64_t send_time_us = 0;  ///< client clock

@@ -34,7 +34,9 @@ class PanicRefusedError : public Error {
 };
 
 /// The client cannot do what was asked: not connected, already connected, LCM
-/// could not be initialised, a package too large, or the client is closing.
+/// could not be initialised, a package too large, the client is closing, or
+/// an argument it checks is wrong (SendTrajectory: the message names the
+/// point and the value).
 class ClientError : public Error {
  public:
   using Error::Error;

@@ -26,6 +26,7 @@
 #include "robotalk/command.h"
 #include "robotalk/robot_model.h"
 #include "robotalk/state_sample.h"
+#include "robotalk/trajectory.h"
 #include "robotalk/transport.h"
 
 #include <cstdint>
@@ -168,6 +169,10 @@ std::optional<CommandMode> ParseCommandMode(const std::string& name);
 struct TimedCommand {
   Duration offset{0};
   Command command;
+  /// The interpolation of the package this frame travels in; nullopt: the
+  /// sequence's (SequenceOptions::interpolation). Frames of different
+  /// interpolations never share a package; a playback sequence has one.
+  std::optional<Interpolation> interpolation;
 };
 
 struct SequenceOptions {
@@ -180,6 +185,53 @@ struct SequenceOptions {
   bool paced = true;
   /// Frames per package when not paced (direct mode always sends one).
   std::size_t batch = 200;
+  /// How the sequence's timed JOINT_SETPOINT / FRAME_SETPOINT frames join
+  /// into each actuator's trajectory (docs/client.md, "Trajectories"): put on
+  /// every package of the sequence. kStep (the default) is protocol 3's
+  /// behaviour. Another one needs timed frames: delay or playback mode.
+  Interpolation interpolation = Interpolation::kStep;
+  /// Delay mode: the server time of offset 0; nullopt: the synchronised
+  /// server clock when the sequence starts + `delay`.
+  std::optional<TimePoint> start;
+};
+
+/// One waypoint of a trajectory (docs/client.md, "Trajectories").
+struct TrajectoryPoint {
+  /// When the actuator passes through it, after the trajectory's start;
+  /// >= 0 and strictly increasing from point to point.
+  Duration time_from_start{0};
+  /// A joint: one position per dof (rad or m). A control frame: its pose in
+  /// the world, x y z qw qx qy qz.
+  std::vector<double> positions;
+  /// Empty: chosen by the server (smooth through the points). Else one per
+  /// dof; a frame: 6, vx vy vz wx wy wz in the world (m/s, rad/s).
+  std::vector<double> velocities;
+  /// Empty: chosen by the server (quintic uses them). Else as `velocities`, per s.
+  std::vector<double> accelerations;
+};
+
+/// A joint's timed waypoints (JOINT_SETPOINT commands).
+struct JointTrajectory {
+  std::string joint;
+  std::vector<TrajectoryPoint> points;
+};
+
+/// A control frame's timed waypoints (FRAME_SETPOINT commands), interpolated
+/// in task space by the server.
+struct FrameTrajectory {
+  std::string frame;
+  std::vector<TrajectoryPoint> points;
+};
+
+struct TrajectoryOptions {
+  /// kDelay: the points run at `start` + time_from_start on the server clock;
+  /// kPlayback: the server chooses the start (no clock sync needed). kDirect
+  /// is refused: a direct command has no start time, so it is a step.
+  CommandMode mode = CommandMode::kDelay;
+  Interpolation interpolation = Interpolation::kCubic;
+  /// Delay mode: the server time of time_from_start 0; nullopt: ServerNow() + `delay`.
+  std::optional<TimePoint> start;
+  Duration delay = std::chrono::milliseconds(100);
 };
 
 /// How far a running sequence is (SequenceHooks::on_progress).
@@ -348,9 +400,36 @@ class RobotClient {
   /// Sends `frames` in `options.mode` and waits for every reply (each at most
   /// ClientOptions::timeout after its start, unless `hooks` say otherwise);
   /// each wait wakes at once when its reply arrives. Returns the replies in
-  /// the order given. Throws TimeoutError, UnknownOutcomeError, ClientError.
+  /// the order given. Every package carries its frames' interpolation
+  /// (TimedCommand::interpolation, else SequenceOptions::interpolation).
+  /// Throws TimeoutError, UnknownOutcomeError, ClientError (also for an
+  /// interpolation other than step in direct mode, or two in one playback
+  /// sequence, before anything is sent).
   SequenceResult RunSequence(std::vector<TimedCommand> frames, const SequenceOptions& options,
                              const SequenceHooks& hooks = {});
+
+  // --- Trajectories (docs/client.md, "Trajectories") -----------------------------
+  /// Sends a joint's or a control frame's waypoints at once, every package
+  /// carrying `options.interpolation` and each point's velocities and
+  /// accelerations; non-blocking. Returns one PendingReply per point, in
+  /// order: each is answered at its time (SUCCESS when the trajectory passes
+  /// it, MODIFIED when time-scaled or clamped to a limit, INTERRUPTED when
+  /// replaced). Points of a trajectory the server already runs splice into
+  /// it (docs/protocol.md, Trajectories). Throws ClientError naming the point
+  /// and the value for a bad argument (no points, a negative or not
+  /// increasing time, a wrong number of positions, velocities or
+  /// accelerations, NaN, an unknown joint or frame, mode kDirect), and when
+  /// not connected; nothing is sent then.
+  std::vector<PendingReply> SendTrajectory(const JointTrajectory& trajectory,
+                                           const TrajectoryOptions& options = {});
+  std::vector<PendingReply> SendTrajectory(const FrameTrajectory& trajectory,
+                                           const TrajectoryOptions& options = {});
+  /// The same, blocking: waits for every point's reply as RunSequence does
+  /// (`hooks` as there). Throws as SendTrajectory and RunSequence do.
+  SequenceResult RunTrajectory(const JointTrajectory& trajectory, const TrajectoryOptions& options = {},
+                               const SequenceHooks& hooks = {});
+  SequenceResult RunTrajectory(const FrameTrajectory& trajectory, const TrajectoryOptions& options = {},
+                               const SequenceHooks& hooks = {});
 
   /// Broadcast mode: asks the server to publish the robot's state every
   /// `period` on ROBOTALK/<robot>/STATE (one stream per robot, shared with
@@ -391,6 +470,7 @@ class RobotClient {
   TrustedServer trusted_server() const;
 
  private:
+  std::vector<PendingReply> SendFrames(std::vector<TimedCommand> frames, const TrajectoryOptions& options);
   class Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -45,11 +45,35 @@ void CheckCount(CommandType t, std::size_t n) {
   throw UsageError(std::string(traits.name) + " takes " + expected + ", got " + std::to_string(n));
 }
 
-// A command's word in a sequence file: its name in lower case.
-std::string Word(CommandType t) {
-  std::string word = ToString(t);
+std::string Lower(std::string word) {
   for (char& ch : word) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   return word;
+}
+
+// A command's word in a sequence file: its name in lower case.
+std::string Word(CommandType t) { return Lower(ToString(t)); }
+
+// "step, linear, cubic, quintic".
+std::string InterpolationWords() {
+  std::string words;
+  for (Interpolation i :
+       {Interpolation::kStep, Interpolation::kLinear, Interpolation::kCubic, Interpolation::kQuintic})
+    words += (words.empty() ? "" : ", ") + std::string(InterpolationName(i));
+  return words;
+}
+
+// The words that start a waypoint's velocities or accelerations.
+struct RateWord {
+  const char* word;
+  bool acceleration;
+};
+constexpr RateWord kRateWords[] = {
+    {"velocity", false}, {"velocities", false}, {"acceleration", true}, {"accelerations", true}};
+const RateWord* FindRateWord(const std::string& word) {
+  for (const RateWord& r : kRateWords) {
+    if (word == r.word) return &r;
+  }
+  return nullptr;
 }
 
 // "joint_setpoint, joint_speed, ...": the words a command may start with.
@@ -75,27 +99,76 @@ Command ParseCommandWords(const std::vector<std::string>& words) {
     c.target = words[1];
     i = 2;
   }
+  const std::string name = ToString(*type);
+  const bool waypoint = WaypointRateCount(*type, 1) > 0;
+  std::vector<double>* into = &c.values;
+  std::string noun = name + " value ";
+  bool rates = false;  // a velocity or acceleration word came
   for (; i < words.size(); ++i) {
-    c.values.push_back(ParseNumber(
-        words[i], std::string(ToString(*type)) + " value " + std::to_string(c.values.size() + 1)));
+    if (const RateWord* rate = FindRateWord(words[i])) {
+      if (!waypoint) {
+        throw UsageError(name + " takes no " + words[i] +
+                         " (only a joint_setpoint or frame_setpoint waypoint does)");
+      }
+      if (!rates) CheckCount(*type, c.values.size());
+      rates = true;
+      into = rate->acceleration ? &c.accelerations : &c.velocities;
+      if (!into->empty()) throw UsageError(name + ": " + words[i] + " given twice");
+      noun = name + " " + std::string(rate->acceleration ? "acceleration " : "velocity ");
+      if (i + 1 == words.size() || FindRateWord(words[i + 1])) {
+        throw UsageError(name + ": " + words[i] + " needs its values");
+      }
+      continue;
+    }
+    try {
+      into->push_back(ParseNumber(words[i], noun + std::to_string(into->size() + 1)));
+    } catch (const UsageError& e) {
+      // Past the positions of a waypoint, a word may be a misspelt keyword.
+      if (!waypoint) throw;
+      throw UsageError(std::string(e.what()) + " (a " + Word(*type) +
+                       " ends with its values, then optionally velocity V... and acceleration A...)");
+    }
   }
-  CheckCount(*type, c.values.size());
+  if (!rates) CheckCount(*type, c.values.size());
+  const std::size_t expected = WaypointRateCount(*type, c.values.size());
+  for (const auto& [values, word] :
+       {std::pair{&c.velocities, "velocity"}, {&c.accelerations, "acceleration"}}) {
+    if (values->empty() || values->size() == expected) continue;
+    throw UsageError(name + " " + word + " takes " +
+                     (*type == CommandType::kFrameSetPoint
+                          ? std::string("6 values (linear x y z, then angular x y z, in the world)")
+                          : "one value per position (" + std::to_string(expected) + ")") +
+                     ", got " + std::to_string(values->size()));
+  }
   return c;
 }
 
 std::string FormatCommandWords(const Command& c) {
   std::string text = Word(c.type);
   if (!c.target.empty()) text += " " + c.target;
-  for (const double v : c.values) {
-    char number[32];
-    std::snprintf(number, sizeof number, " %.17g", v);
-    text += number;
-  }
+  const auto append = [&text](const std::vector<double>& values) {
+    for (const double v : values) {
+      char number[32];
+      std::snprintf(number, sizeof number, " %.17g", v);
+      text += number;
+    }
+  };
+  append(c.values);
+  if (!c.velocities.empty()) text += " velocity";
+  append(c.velocities);
+  if (!c.accelerations.empty()) text += " acceleration";
+  append(c.accelerations);
   return text;
 }
 
-std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::string& source) {
-  std::vector<SequenceEntry> entries;
+Interpolation ParseInterpolationWord(const std::string& word, const std::string& what) {
+  if (auto interpolation = ParseInterpolation(word)) return *interpolation;
+  throw UsageError(what + ": '" + word + "' is not an interpolation (" + InterpolationWords() + ")");
+}
+
+SequenceFile ParseSequenceFile(const std::string& text, const std::string& source) {
+  SequenceFile file;
+  int interpolation_line = 0;
   std::istringstream in(text);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
@@ -104,19 +177,38 @@ std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::str
     if (words.empty()) continue;
     const std::string where = source + ":" + std::to_string(number) + ": ";
     try {
+      if (ParseInterpolation(words[0]) || Lower(words[0]) == "interpolation") {
+        if (Lower(words[0]) != "interpolation") {
+          throw UsageError("'" + words[0] + "' is an interpolation: write 'interpolation " + words[0] + "'");
+        }
+        if (interpolation_line) {
+          throw UsageError("interpolation given twice (first on line " + std::to_string(interpolation_line) +
+                           ")");
+        }
+        if (!file.entries.empty()) throw UsageError("the interpolation line goes before the first command");
+        if (words.size() != 2)
+          throw UsageError("interpolation takes one word (" + InterpolationWords() + ")");
+        file.interpolation = ParseInterpolationWord(words[1], "interpolation");
+        interpolation_line = number;
+        continue;
+      }
       SequenceEntry e;
       e.line = number;
       e.offset_s = ParseNumber(words[0], "start time");
       if (e.offset_s < 0) throw UsageError("start time " + words[0] + " is negative");
       if (words.size() < 2) throw UsageError("missing command after the start time");
       e.command = ParseCommandWords({words.begin() + 1, words.end()});
-      entries.push_back(std::move(e));
+      file.entries.push_back(std::move(e));
     } catch (const UsageError& err) {
       throw UsageError(where + err.what());
     }
   }
-  if (entries.empty()) throw UsageError(source + ": no commands");
-  return entries;
+  if (file.entries.empty()) throw UsageError(source + ": no commands");
+  return file;
+}
+
+std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::string& source) {
+  return ParseSequenceFile(text, source).entries;
 }
 
 }  // namespace robotalk

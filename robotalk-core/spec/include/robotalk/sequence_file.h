@@ -1,16 +1,24 @@
 // The text forms of commands: command words as the `robotalk` CLI takes them,
 // and sequence files (docs/client.md "Sequence files"), one command per line,
 //
-//   <start seconds> <command> [target] values...
+//   <start seconds> <command> [target] values... [velocity V...] [acceleration A...]
 //
-// with `#` comments and blank lines. <start seconds> is relative to the send
-// time of the sequence (>= 0). Pure; no I/O beyond the text given. Shared by
-// the CLI, robotalk-logplay and the server's --simulate.
+// with `#` comments and blank lines, and at most one line
+//
+//   interpolation step|linear|cubic|quintic
+//
+// before the first command. <start seconds> is relative to the send time of
+// the sequence (>= 0). `velocity` / `acceleration` follow the values of a
+// joint_setpoint (one per dof) or frame_setpoint (6: vx vy vz wx wy wz): a
+// waypoint's (docs/client.md, "Trajectories"). Pure; no I/O beyond the text
+// given. Shared by the CLI, robotalk-logplay and the server's --simulate.
 #pragma once
 
 #include "robotalk/command.h"
 #include "robotalk/error.h"
+#include "robotalk/trajectory.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,13 +31,21 @@ class UsageError : public Error {
 };
 
 /// Builds a command from its CLI words: name (case-insensitive, e.g. "goto",
-/// "JOINT_SETPOINT"), then a target for a joint or frame command, then values.
+/// "JOINT_SETPOINT"), then a target for a joint or frame command, then values,
+/// then (JOINT_SETPOINT, FRAME_SETPOINT) optionally `velocity` and
+/// `acceleration` (or `velocities`, `accelerations`), each followed by its values.
 /// Checks the number of values where the protocol fixes it (kCommandTraits:
 /// GOTO 3, SETSPEED 2 or 3, FRAME_SETPOINT 7, STOP and PANIC_RESET none,
-/// JOINT_* at least 1) and that every value is a finite number. Throws UsageError.
+/// JOINT_* at least 1), of velocities and accelerations (WaypointRateCount:
+/// one per position of a JOINT_SETPOINT, 6 for a FRAME_SETPOINT) and that
+/// every value is a finite number. Throws UsageError.
 Command ParseCommandWords(const std::vector<std::string>& words);
-/// The inverse: "joint_setpoint pan 0.5" (values exact to the last bit).
+/// The inverse: "joint_setpoint pan 0.5 velocity 0.1" (values exact to the last bit).
 std::string FormatCommandWords(const Command& command);
+
+/// An interpolation's name, any case ("cubic"); throws UsageError
+/// "<what>: 'cubc' is not an interpolation (step, linear, cubic, quintic)".
+Interpolation ParseInterpolationWord(const std::string& word, const std::string& what);
 
 /// Parses a number (the whole word); throws UsageError naming `what`.
 double ParseNumber(const std::string& word, const std::string& what);
@@ -40,8 +56,16 @@ struct SequenceEntry {
   Command command;      ///< start_time unset; id 0
 };
 
+struct SequenceFile {
+  std::vector<SequenceEntry> entries;
+  /// The file's `interpolation` line; nullopt when it has none (step).
+  std::optional<Interpolation> interpolation;
+};
+
 /// Parses a sequence file's text. Throws UsageError "<source>:<line>: what"
 /// for the first bad line; an empty sequence is an error too.
+SequenceFile ParseSequenceFile(const std::string& text, const std::string& source);
+/// Its commands only (the --simulate of a server, robotalk-logplay's check of what it writes).
 std::vector<SequenceEntry> ParseSequence(const std::string& text, const std::string& source);
 
 /// Splits on blanks (no quoting).
@@ -52,8 +76,10 @@ std::vector<std::string> SplitWords(const std::string& line);
 namespace robotalk::cli {
 // The CLI's names for them (its usage errors are UsageErrors too).
 using robotalk::ParseCommandWords;
+using robotalk::ParseInterpolationWord;
 using robotalk::ParseNumber;
 using robotalk::ParseSequence;
+using robotalk::ParseSequenceFile;
 using robotalk::SequenceEntry;
 using robotalk::SplitWords;
 using robotalk::UsageError;

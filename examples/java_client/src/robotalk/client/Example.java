@@ -1,6 +1,7 @@
 // The Java client example: connects to a robot, loads its configuration,
 // sends a GOTO (direct mode), then a short timed sequence of pan/tilt
-// set-points in delay mode, and prints every reply. Same steps and output as
+// set-points in delay mode, then one interpolated (cubic) sequence of pan
+// waypoints, and prints every reply. Same steps and output as
 // the C example (examples/c_client); tests/examples/client_example_test.sh runs it.
 //   java -cp lcm.jar:robotalk_lcmtypes.jar:robotalk_java_client.jar robotalk.client.Example
 //        [--url URL] [--robot NAME] [--delay S] [--pause S]
@@ -17,6 +18,7 @@ import robotalk_msgs.robot_config_t;
 
 public final class Example {
   static final double FRAME_SPACING_S = 0.25;
+  static final double POINT_SPACING_S = 0.2;
 
   static void printReply(String what, reply_t r) {
     System.out.printf("reply %d %s: %s%s exec_us=%d late_ms=%.1f%n", r.id, what, RobotalkClient.signalName(r.signal),
@@ -80,6 +82,28 @@ public final class Example {
       if (k > 0) spacing.append(String.format(" %.3f", (replies[k].exec_time_us - replies[k - 1].exec_time_us) / 1e6));
     }
     System.out.println(spacing);
+
+    // An interpolated sequence: pan's waypoints in one cubic package (delay mode), the middle one with its
+    // velocity; each is answered when the trajectory passes it. It ends where the sequence left pan, at 0.3.
+    // Sent only when everything so far succeeded: a client whose sequence failed moves nothing more.
+    if (ok) {
+      double[] way = {0.33, 0.36, 0.3};
+      command_t[] points = new command_t[way.length];
+      long trajStartUs = client.serverNowUs() + (long) (delayS * 1e6);
+      for (int k = 0; k < way.length; k++) {
+        points[k] = command(command_t.JOINT_SETPOINT, trajStartUs + (long) ((k + 1) * POINT_SPACING_S * 1e6), "pan", way[k]);
+      }
+      points[1].num_velocities = 1;
+      points[1].velocities = new double[] {0.1};
+      client.sendInterpolated(package_header_t.MODE_DELAY, package_header_t.INTERPOLATION_CUBIC, points);
+      long[] pointIds = new long[points.length];
+      for (int k = 0; k < points.length; k++) pointIds[k] = points[k].id;
+      reply_t[] pointReplies = client.await(10.0 + delayS, pointIds);
+      for (int k = 0; k < points.length; k++) {
+        printReply(String.format("trajectory cubic +%.2f s pan %.2f", (k + 1) * POINT_SPACING_S, way[k]), pointReplies[k]);
+        ok &= pointReplies[k].signal == reply_t.SUCCESS || pointReplies[k].signal == reply_t.MODIFIED;
+      }
+    }
 
     client.pause(0.5);  // the last set-point was taken when answered; let the joint get there
     reply_t pose = client.query(query_t.BASE_POSE, "", 5.0);

@@ -331,9 +331,19 @@ public final class RobotalkClient implements AutoCloseable {
 
   /** Sends one package of commands, non-blocking; sets each command's id. mode: package_header_t.MODE_*. */
   public long sendCommands(byte mode, command_t... commands) throws IOException {
+    return sendInterpolated(mode, package_header_t.INTERPOLATION_STEP, commands);
+  }
+
+  /**
+   * The same with the package's interpolation (package_header_t.INTERPOLATION_*): its timed JOINT_SETPOINT /
+   * FRAME_SETPOINT commands are the waypoints of a trajectory (docs/protocol.md, Trajectories), each command's
+   * velocities and accelerations its rates (none: chosen by the server).
+   */
+  public long sendInterpolated(byte mode, byte interpolation, command_t... commands) throws IOException {
     long[] ids = new long[commands.length];
     for (int i = 0; i < commands.length; i++) ids[i] = commands[i].id = nextId++;
     package_t pkg = newPackage(package_header_t.PAYLOAD_COMMANDS, commands.length, mode);
+    pkg.header.interpolation = interpolation;
     pkg.num_commands = commands.length;
     pkg.commands = commands;
     return track(pkg, ids);

@@ -1,0 +1,132 @@
+#include "ros2_options.h"
+
+#include "robotalk/error.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace robotalk::ros2 {
+namespace {
+
+double ParseNumber(const std::string& option, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
+    throw Error(option + ": '" + text + "' is not a number");
+  }
+  return v;
+}
+
+Duration Seconds(double s) { return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s)); }
+
+std::uint32_t ParseDomain(const std::string& option, const std::string& text) {
+  // DDS's port mapping leaves room for domain ids 0..232 (ROS 2's
+  // "The ROS_DOMAIN_ID" concept page).
+  const double v = ParseNumber(option, text);
+  if (v < 0 || v > 232 || v != std::floor(v))
+    throw Error(option + ": '" + text + "' is not a DDS domain id (0..232)");
+  return static_cast<std::uint32_t>(v);
+}
+
+}  // namespace
+
+std::string Ros2Usage() {
+  return "usage: robotalk-ros2 [options]\n"
+         "Bridges RoboTalk robots to ROS 2 over DDS (Cyclone DDS; no ROS install needed):\n"
+         "per robot, publishes /<robot>/joint_states, /tf, /tf_static, /<robot>/robot_description\n"
+         "and /<robot>/odom (moving bases), and turns /<robot>/joint_trajectory and\n"
+         "/<robot>/cmd_vel into RoboTalk commands.\n"
+         "  --robot NAME        bridge this robot (repeatable; default: every robot announced)\n"
+         "  --url URL           LCM URL (default: LCM_DEFAULT_URL or LCM's default)\n"
+         "  --key FILE          keyed mode: the bridge's secret key (default $ROBOTALK_KEY)\n"
+         "  --server-key FILE   keyed mode: the server's public key (else the known-servers pin)\n"
+         "  --domain N          DDS domain = ROS_DOMAIN_ID (default $ROS_DOMAIN_ID, else 0)\n"
+         "  --dds-interface IF  network interface (name or address) for DDS (default:\n"
+         "                      CYCLONEDDS_URI, else Cyclone's choice)\n"
+         "  --rate HZ           joint_states / tf / odom rate = STATE stream rate (default 100)\n"
+         "  --frame-prefix P    prefix of tf frame ids; {robot} = the robot's name\n"
+         "                      (default '{robot}/'; '' for none, as with one robot)\n"
+         "  --world-frame F     frame of the root links and odometry (default world)\n"
+         "  --urdf NAME=FILE    publish this URDF as NAME's robot_description (repeatable;\n"
+         "                      default: one written from the configuration, without geometry)\n"
+         "  --cmd-vel-timeout S SETSPEED 0 when a moving base hears no cmd_vel for S s (default 0.5)\n"
+         "  --read-only         publish only; subscribe to no command topic\n"
+         "  --duration S        exit after S seconds\n"
+         "  --stats             print latency and CPU figures on exit\n"
+         "  --version           print the version and exit\n"
+         "  -h, --help          print this help and exit\n";
+}
+
+Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::string& ros_domain_id) {
+  Ros2Options o;
+  if (!ros_domain_id.empty()) o.domain = ParseDomain("ROS_DOMAIN_ID", ros_domain_id);
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw Error(a + ": needs a value");
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      o.help = true;
+    } else if (a == "--version") {
+      o.version = true;
+    } else if (a == "--robot") {
+      const std::string& name = value();
+      if (name.empty()) throw Error("--robot: the name is empty");
+      o.robots.push_back(name);
+    } else if (a == "--url") {
+      o.lcm_url = value();
+    } else if (a == "--key") {
+      o.key_file = value();
+    } else if (a == "--server-key") {
+      o.server_key_file = value();
+    } else if (a == "--domain") {
+      o.domain = ParseDomain(a, value());
+    } else if (a == "--dds-interface") {
+      o.dds_interface = value();
+    } else if (a == "--rate") {
+      const double hz = ParseNumber(a, value());
+      if (hz < 1 || hz > 1000)
+        throw Error("--rate: " + args[i] + " Hz is outside 1..1000 (the STATE stream's range)");
+      o.period = Seconds(1.0 / hz);
+    } else if (a == "--frame-prefix") {
+      o.frame_prefix = value();
+    } else if (a == "--world-frame") {
+      o.world_frame = value();
+      if (o.world_frame.empty()) throw Error("--world-frame: the name is empty");
+    } else if (a == "--urdf") {
+      const std::string& v = value();
+      const auto eq = v.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == v.size()) {
+        throw Error("--urdf: '" + v + "' is not NAME=FILE");
+      }
+      o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
+    } else if (a == "--cmd-vel-timeout") {
+      const double s = ParseNumber(a, value());
+      if (s <= 0 || s > 60) throw Error("--cmd-vel-timeout: " + args[i] + " s is outside (0, 60]");
+      o.cmd_vel_timeout = Seconds(s);
+    } else if (a == "--read-only") {
+      o.read_only = true;
+    } else if (a == "--duration") {
+      const double s = ParseNumber(a, value());
+      if (s <= 0) throw Error("--duration: " + args[i] + " s is not positive");
+      o.duration = Seconds(s);
+    } else if (a == "--stats") {
+      o.stats = true;
+    } else {
+      throw Error("unknown option '" + a + "' (see --help)");
+    }
+  }
+  return o;
+}
+
+std::string FramePrefixFor(const std::string& frame_prefix, const std::string& robot) {
+  std::string out = frame_prefix;
+  for (std::size_t at = out.find("{robot}"); at != std::string::npos;
+       at = out.find("{robot}", at + robot.size())) {
+    out.replace(at, 7, robot);
+  }
+  return out;
+}
+
+}  // namespace robotalk::ros2

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# robotalk-ros2 end to end (issue 25 item 4): a keyed server, the bridge with
+# its own key, and the tests' own DDS program (ros2_peer, built from the same
+# IDL) as the ROS 2 side. Runs inside a private network namespace (CTest wraps
+# it with scripts/netns_run.sh); Cyclone DDS is bound to lo there by an
+# explicit configuration (CYCLONEDDS_URI), so no DDS or LCM traffic leaves it.
+#   ros2_bridge_test.sh SERVER KEYGEN BRIDGE PEER MODELS_DIR
+set -u
+server_bin=$1 keygen=$2 bridge=$3 peer=$4 models=$5
+url="udpm://239.255.76.67:7625?ttl=0"
+. "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, pids, check
+export CYCLONEDDS_URI="file://$(cd "$(dirname "$0")" && pwd)/cyclonedds_loopback.xml"
+export ROS_DOMAIN_ID=25
+
+for who in server bridge peer; do "$keygen" --out "$tmp/$who" --name "$who" >/dev/null; done
+{
+  echo "$(cat "$tmp/bridge.pub") *=all"
+  echo "$(cat "$tmp/peer.pub") *=query"
+} >"$tmp/clients"
+chmod 644 "$tmp/clients"
+
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
+  --key "$tmp/server" --clients "$tmp/clients" --duration 60 2>"$tmp/server.log" &
+server_pid=$!
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+
+"$bridge" --robot pioneer --url "$url" --key "$tmp/bridge" --duration 40 >"$tmp/bridge.out" 2>"$tmp/bridge.log" &
+bridge_pid=$!
+pids+=("$bridge_pid")
+for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge.log" 2>/dev/null && break; sleep 0.1; done
+check "the bridge connects with its key: $(cat "$tmp/bridge.log")" grep -q "robot 'pioneer' bridged (DDS domain 25)" "$tmp/bridge.log"
+
+peer_checks() {  # peer_checks MODE WHAT: ros2_peer MODE's own checks, printed, must all pass
+  "$peer" "$1" pioneer --url "$url" --key "$tmp/peer" >"$tmp/peer_$1.out" 2>&1
+  local status=$?
+  cat "$tmp/peer_$1.out"
+  check "$2 (ros2_peer $1: status $status)" test "$status" -eq 0
+}
+
+peer_checks check "joint states, tf and the robot description follow the robot; a trajectory runs on time"
+check "the bridge says when the trajectory starts: $(grep trajectory "$tmp/bridge.log")" \
+  grep -q "robot 'pioneer': trajectory of 3 points starts in 0\.[3-6][0-9]* s, 6 JOINT_SETPOINTs" "$tmp/bridge.log"
+peer_checks bad_trajectory "a bad trajectory moves nothing"
+check "and the bridge says why: $(grep refused "$tmp/bridge.log")" \
+  grep -q "robot 'pioneer': trajectory refused: JointTrajectory: joint_names\[0\] 'nek': robot 'pioneer' has no joint" "$tmp/bridge.log"
+
+# cmd_vel drives the base; a silent cmd_vel stops it (a dead teleop).
+peer_checks cmd_vel "cmd_vel drives the base, and a silent cmd_vel stops it"
+check "the bridge says it stopped the base: $(grep cmd_vel "$tmp/bridge.log")" \
+  grep -q "robot 'pioneer': no cmd_vel for 0.5.* s: SETSPEED 0" "$tmp/bridge.log"
+
+# The bridge's own lines only (Cyclone DDS may log on the same stderr).
+unexpected=$(grep "^robotalk-ros2:" "$tmp/bridge.log" |
+  grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel")
+check "no command was refused: $unexpected" test -z "$unexpected"
+
+# SIGINT stops the bridge: it sends STOP to the
+# robot the bridge set moving, and the bridge exits 0.
+kill -INT "$bridge_pid"
+wait "$bridge_pid"
+status=$?
+check "the bridge exits 0 on SIGINT (status $status)" test "$status" -eq 0
+check "and sends STOP to the robot it set moving: $(tail -1 "$tmp/bridge.log")" \
+  grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$tmp/bridge.log"
+
+echo "passed $pass, failed $failures"
+[ "$failures" -eq 0 ]
