@@ -286,7 +286,7 @@ void TrackerAllocations() {
   RobotState state;
   state.position = state.velocity = state.effort = Eigen::VectorXd::Zero(1);
   std::vector<TrajectoryTracker::Answer> answers;
-  std::vector<std::pair<std::int64_t, int>> started;
+  std::vector<TrajectoryTracker::Started> started;
   answers.reserve(64);
   started.reserve(64);
   const TimePoint t0 = ManualDaemon::Origin();
