@@ -4,9 +4,10 @@
 // quintic trajectory (20 points, 10 ms apart) starting 20 ms ahead of the
 // synchronised server clock, on one joint, with RobotClient::SendTrajectory.
 // The server's kinematic driver follows the reference exactly, so the STATE
-// stream (10 ms) carries it: the largest velocity step between consecutive
-// samples, freezes (a sample with the previous one's position) and missing
-// samples, from the first second on. One line of text.
+// stream (5 ms, twice per 10 ms period) carries it: the largest velocity step
+// between consecutive references, freezes (a reference held longer than one
+// and a half periods) and missing samples, from the first second on. One
+// line of text.
 //   robotalk-receding-client --url URL --robot NAME --joint NAME [--splices N]
 #include "bench_util.h"
 #include "robotalk/robot_client.h"
@@ -34,24 +35,40 @@ int main(int argc, char** argv) {
     const TimePoint t0 = c.ServerNow() + std::chrono::milliseconds(50);
     const auto target = [&](TimePoint t) { return 0.5 * std::sin(std::numbers::pi * ToSeconds(t - t0)); };
 
+    // The STATE stream at twice the control rate: a sample sees each period's
+    // reference at least once, so consecutive distinct references are
+    // consecutive periods (unless the server ran a period late).
     std::mutex m;
     double max_dv = 0, last_v = NAN, last_p = NAN;
+    TimePoint changed{};
+    Duration max_dv_after{0};  // server time between the first samples of the two references
     std::int64_t last_sample = -1;
-    long frozen = 0, missing = 0, samples = 0;
-    c.StartStateStream(std::chrono::milliseconds(10), [&](const StateSample& s) {
+    long frozen = 0, missing = 0, samples = 0, references = 0;
+    bool in_freeze = false;
+    c.StartStateStream(std::chrono::milliseconds(5), [&](const StateSample& s) {
       std::lock_guard lock(m);
       if (s.server_time < t0 + std::chrono::seconds(1)) return;  // from rest onto the sine
       const double p = s.positions[static_cast<std::size_t>(dof)],
                    v = s.velocities[static_cast<std::size_t>(dof)];
       if (last_sample >= 0 && s.sample != last_sample + 1) missing += s.sample - last_sample - 1;
-      if (last_sample >= 0 && s.sample == last_sample + 1) {
-        max_dv = std::max(max_dv, std::abs(v - last_v));
-        if (p == last_p) ++frozen;
-      }
       last_sample = s.sample;
+      ++samples;
+      if (p == last_p) {  // the same reference: a freeze once it outlives one and a half periods
+        if (!in_freeze && s.server_time - changed > std::chrono::milliseconds(15)) {
+          ++frozen;
+          in_freeze = true;
+        }
+        return;
+      }
+      if (!std::isnan(last_v) && std::abs(v - last_v) > max_dv) {
+        max_dv = std::abs(v - last_v);
+        max_dv_after = s.server_time - changed;
+      }
+      ++references;
+      in_freeze = false;
+      changed = s.server_time;
       last_v = v;
       last_p = p;
-      ++samples;
     });
     TrajectoryOptions options;
     options.mode = CommandMode::kDelay;
@@ -75,9 +92,13 @@ int main(int argc, char** argv) {
     c.StopStateStream();
     std::lock_guard lock(m);
     std::printf(
-        "through robotalk-lcm-relay: %d splices (%ld points), STATE samples %ld from the first second on: "
-        "largest velocity step between consecutive samples %.4f rad/s; freezes %ld; missing samples %ld\n",
-        splices, sent, samples, max_dv, frozen, missing);
+        "through robotalk-lcm-relay: %d splices (%ld points); STATE at 5 ms, %ld samples, %ld distinct "
+        "references "
+        "from the first second on: largest velocity step between consecutive references %.4f rad/s (their "
+        "first "
+        "samples %.1f ms apart); freezes "
+        "(a reference held > 15 ms) %ld; missing samples %ld\n",
+        splices, sent, samples, references, max_dv, 1e3 * ToSeconds(max_dv_after), frozen, missing);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "robotalk-receding-client: %s\n", e.what());

@@ -108,7 +108,8 @@ void SineTable(const std::string& urdf, const std::string& csv) {
 }
 
 // (b): kinematic iiwa14 (it follows the reference exactly; the figure is the
-// reference's, which the server computes the same for any driver).
+// reference's, which the server computes the same for any driver). The
+// client's ticks are 3.7 ms off the control periods, as a real client's are.
 void RecedingHorizon(const std::string& urdf, int splices) {
   ManualDaemon d(MakeDriver("kinematic", urdf));
   const int joint = d.model().JointIndex(kJoint);
@@ -124,7 +125,7 @@ void RecedingHorizon(const std::string& urdf, int splices) {
   CommandId id = 0;
   TimePoint control = t0;  // the next control period
   for (int i = 0; i < splices; ++i) {
-    const TimePoint sent = t0 + i * tick;
+    const TimePoint sent = t0 + std::chrono::microseconds(3700) + i * tick;  // not on the control periods
     const TimePoint arrives = sent + std::chrono::microseconds(jitter_us(rng));
     max_jitter = std::max(max_jitter, ToSeconds(arrives - sent));
     // The control periods before the batch arrives, then the arrival.
