@@ -8,6 +8,7 @@
 // Header-only: needs robotalk::server and the server's src/ on the include path.
 #pragma once
 
+#include "observed_driver.h"
 #include "robot_daemon.h"
 #include "robotalk/clock.h"
 #include "robotalk/driver.h"
@@ -21,52 +22,35 @@
 
 namespace robotalk::testing {
 
-/// A driver that forwards every call to `inner` and keeps the last reference
-/// handed to each dof (Driver::Track), so a run can read the reference the
-/// server sampled beside the state the driver measured.
-class RecordingDriver final : public Driver {
+/// Keeps the last reference the server handed to each dof (Driver::Track),
+/// so a run can read it beside the state the driver measured.
+class ReferenceRecorder final : public DriverObserver {
  public:
-  explicit RecordingDriver(std::unique_ptr<Driver> inner)
-      : inner_(std::move(inner)),
-        ref_position_(static_cast<std::size_t>(inner_->model().num_dofs()), NAN),
-        ref_velocity_(ref_position_.size(), NAN),
-        ref_time_(ref_position_.size(), TimePoint::min()) {}
-  const RobotModel& model() const override { return inner_->model(); }
-  Duration period() const override { return inner_->period(); }
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
-    return inner_->Execute(c, now, done);
-  }
-  DriverResult Track(const JointReference& r, TimePoint now, std::vector<Completion>& done) override {
-    const auto first = static_cast<std::size_t>(model().dof_offset(r.joint));
+  explicit ReferenceRecorder(const RobotModel& model)
+      : model_(model),
+        position_(static_cast<std::size_t>(model.num_dofs()), NAN),
+        velocity_(position_.size(), NAN),
+        time_(position_.size(), TimePoint::min()) {}
+  void Tracked(const JointReference& r, TimePoint now) override {
+    const auto first = static_cast<std::size_t>(model_.dof_offset(r.joint));
     for (std::size_t k = 0; k < r.position.size(); ++k) {
-      ref_position_[first + k] = r.position[k];
-      ref_velocity_[first + k] = r.velocity[k];
-      ref_time_[first + k] = now;
+      position_[first + k] = r.position[k];
+      velocity_[first + k] = r.velocity[k];
+      time_[first + k] = now;
     }
-    return inner_->Track(r, now, done);
   }
-  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
-  void ReadState(RobotState& state) const override { inner_->ReadState(state); }
-  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
-  void StopOnly(const StopScope& s, TimePoint now, std::vector<Completion>& done) override {
-    inner_->StopOnly(s, now, done);
-  }
-  void Halt(std::vector<Completion>& done) override { inner_->Halt(done); }
-  void Resume() override { inner_->Resume(); }
-  std::string_view Fault() const override { return inner_->Fault(); }
-
   /// The last reference of dof `i`, and when it was handed over (min: never).
-  double ref_position(int i) const { return ref_position_[static_cast<std::size_t>(i)]; }
-  double ref_velocity(int i) const { return ref_velocity_[static_cast<std::size_t>(i)]; }
-  TimePoint ref_time(int i) const { return ref_time_[static_cast<std::size_t>(i)]; }
+  double ref_position(int i) const { return position_[static_cast<std::size_t>(i)]; }
+  double ref_velocity(int i) const { return velocity_[static_cast<std::size_t>(i)]; }
+  TimePoint ref_time(int i) const { return time_[static_cast<std::size_t>(i)]; }
 
  private:
-  std::unique_ptr<Driver> inner_;
-  std::vector<double> ref_position_, ref_velocity_;
-  std::vector<TimePoint> ref_time_;
+  const RobotModel& model_;
+  std::vector<double> position_, velocity_;
+  std::vector<TimePoint> time_;
 };
 
-/// A RobotDaemon on a ManualClock with a RecordingDriver around `driver`.
+/// A RobotDaemon on a ManualClock with an ObservedDriver around `driver`.
 class ManualDaemon {
  public:
   static constexpr std::int64_t kClient = 0xC11E;
@@ -74,18 +58,20 @@ class ManualDaemon {
 
   explicit ManualDaemon(std::unique_ptr<Driver> driver,
                         RobotDaemonOptions options = {.precise_timing = false})
-      : recording_(new RecordingDriver(std::move(driver))),
-        daemon_("robot", "driver", std::unique_ptr<Driver>(recording_), clock_, options) {
+      : recorder_(std::make_shared<ReferenceRecorder>(driver->model())),
+        observed_(new ObservedDriver(std::move(driver), recorder_)),
+        daemon_("robot", "driver", std::unique_ptr<Driver>(observed_), clock_, options) {
     daemon_.Preallocate(out_);
     state_.position = Eigen::VectorXd::Zero(model().num_dofs());
     state_.velocity = state_.position;
     state_.effort = state_.position;
   }
-  const RobotModel& model() const { return recording_->model(); }
-  const RecordingDriver& driver() const { return *recording_; }
+  const RobotModel& model() const { return observed_->model(); }
+  /// The references the driver was handed.
+  const ReferenceRecorder& driver() const { return *recorder_; }
   RobotDaemon& daemon() { return daemon_; }
   ManualClock& clock() { return clock_; }
-  Duration period() const { return recording_->period(); }
+  Duration period() const { return observed_->period(); }
 
   /// Runs the daemon at every deadline up to `t`, and at `t`; counts the
   /// answers by signal. Reads the driver's state at `t`.
@@ -96,7 +82,7 @@ class ManualDaemon {
     }
     daemon_.RunOnce(clock_.Now());
     Drain();
-    recording_->ReadState(state_);
+    observed_->ReadState(state_);
   }
   const RobotState& state() const { return state_; }
   /// Answers so far: SUCCESS, MODIFIED, and every other signal.
@@ -131,7 +117,8 @@ class ManualDaemon {
 
  private:
   ManualClock clock_{Origin()};
-  RecordingDriver* recording_;  // owned by daemon_
+  std::shared_ptr<ReferenceRecorder> recorder_;  // declared before the daemon: it outlives the driver
+  ObservedDriver* observed_;                     // owned by daemon_
   RobotDaemon daemon_;
   DaemonOutput out_;
   RobotState state_;
