@@ -34,7 +34,7 @@ start=$(date +%s)
 # would double the time a clean clone needs before the first figure.
 bench_targets="robotalk-server robotalk robotalk-lcm-relay robotalk-bench-raw robotalk-bench-timer
   robotalk-bench-client robotalk-kinematics-bench robotalk-codec-bench robotalk-ode-bench
-  robotalk-trajectory-bench"
+  robotalk-trajectory-bench robotalk-receding-client"
 if ((setup)); then ROBOTALK_BUILD_TARGETS=$(echo $bench_targets) scripts/setup.sh; fi
 echo "bench: built in $(( $(date +%s) - start )) s; running the suite" >&2
 rc=0
