@@ -21,6 +21,8 @@ import statistics
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
+# Figures with a section of their own (between their own markers), not in the main table.
+OWN_SECTIONS = {"trajectory": ("<!-- trajectory:begin -->", "<!-- trajectory:end -->")}
 
 
 def load(d):
@@ -270,7 +272,7 @@ def plot(res, figdir):
 
 def describe(res):
     """The run most figures come from; figures re-run later (--only) are named."""
-    metas = [(name, r["meta"]) for name, r in res.items() if "meta" in r]
+    metas = [(name, r["meta"]) for name, r in res.items() if "meta" in r and name not in OWN_SECTIONS]
     if not metas:
         return "no run"
     runs = {}
@@ -284,6 +286,52 @@ def describe(res):
     later = [f"{', '.join(sorted(names))} re-run {date} UTC at {commit}"
              for (date, commit), names in sorted(runs.items()) if (date, commit) != main_key]
     return text + (f" ({'; '.join(later)})" if later else "")
+
+
+def replace_between(doc, begin, end, text):
+    if begin not in doc or end not in doc:
+        raise SystemExit(f"markers {begin} / {end} not found")
+    head, rest = doc.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    return head + begin + "\n" + text + "\n" + end + tail
+
+
+def trajectory_section(res, figdir):
+    """Issue 22's section: robotalk-trajectory-bench's output as it printed it, and the
+    ODE iiwa14 10 Hz plot (step vs quintic vs the continuous sine)."""
+    r = res.get("trajectory")
+    if not r:
+        return None
+    m = r.get("meta", {})
+    head = (f"Measured {m.get('date_utc')} UTC, commit {m.get('commit')}, {'quick' if m.get('quick') else 'full'} "
+            f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs "
+            "(`robotalk-trajectory-bench`, bench/trajectory_bench.cpp).")
+    if r.get("error") or r.get("rc"):
+        return head + "\n\nNot measured: " + str(r.get("error") or r.get("stderr"))
+    plot = r.get("plot_ode_10hz") or {}
+    if plot.get("time_s"):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 5.2), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+        t = plot["time_s"]
+        ax.plot(t, plot["sine"], "k-", lw=1, label="continuous sine")
+        ax.plot(t, plot["step"], "-", lw=1, label="step (today's default)")
+        ax.plot(t, plot["quintic"], "--", lw=1, label="quintic")
+        ax.set_ylabel("iiwa_joint_6 (rad)")
+        ax.set_title("ODE iiwa14, 0.5 Hz sine streamed at 10 Hz frames (delay mode, 300 ms)", fontsize=10)
+        ax.legend(fontsize=8, loc="lower left")
+        ax.grid(alpha=0.3)
+        ax2.plot(t, [a - b for a, b in zip(plot["step"], plot["sine"])], "-", lw=1, label="step − sine")
+        ax2.plot(t, [a - b for a, b in zip(plot["quintic"], plot["sine"])], "--", lw=1, label="quintic − sine")
+        ax2.set_xlabel("time from the first frame (s), every 10 ms control period")
+        ax2.set_ylabel("error (rad)")
+        ax2.legend(fontsize=8, loc="lower left")
+        ax2.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(figdir, "trajectory_ode_10hz.png"), dpi=110)
+        plt.close(fig)
+    return head + "\n\n" + r.get("output", "").strip() + "\n\n![ODE iiwa14 10 Hz: step vs quintic](figures/trajectory_ode_10hz.png)"
 
 
 def main():
@@ -324,9 +372,13 @@ def main():
         raise SystemExit(f"{args.doc}: markers {BEGIN} / {END} not found")
     head, rest = doc.split(BEGIN, 1)
     _, tail = rest.split(END, 1)
-    with open(args.doc, "w") as f:
-        f.write(head + BEGIN + "\n" + "\n".join(lines) + "\n" + END + tail)
+    doc = head + BEGIN + "\n" + "\n".join(lines) + "\n" + END + tail
     os.makedirs(args.figdir, exist_ok=True)
+    section = trajectory_section(latest, args.figdir)
+    if section is not None:
+        doc = replace_between(doc, *OWN_SECTIONS["trajectory"], section)
+    with open(args.doc, "w") as f:
+        f.write(doc)
     plot(latest if latest else before, args.figdir)
     print(f"gen_performance: wrote {args.doc} and {args.figdir}/perf_*.png")
 

@@ -82,12 +82,13 @@ class Bench:
                 p.kill()
                 p.wait()
 
-    def start_server(self, url=URL, extra=(), env=None):
-        """env: extra environment, e.g. ROBOTALK_PRECISE_TIMING=0 (the RobotDaemon's timing option off)."""
+    def start_server(self, url=URL, extra=(), env=None, robot=None):
+        """env: extra environment, e.g. ROBOTALK_PRECISE_TIMING=0 (the RobotDaemon's timing option off);
+        robot: the --robot value (default: the kinematic pioneer)."""
         self.stop_server()
         log = open(f"{self.tmp}/server.log", "w+")
         self.server = subprocess.Popen(
-            [self.server_bin, "--robot", f"{ROBOT}=kinematic:{self.model}", "--url", url,
+            [self.server_bin, "--robot", robot or f"{ROBOT}=kinematic:{self.model}", "--url", url,
              "--duration", "3600", *extra], stdout=subprocess.DEVNULL, stderr=log, text=True,
             env={**os.environ, **(env or {})})
         for _ in range(100):
@@ -423,8 +424,46 @@ class Bench:
         return {"figure": "ode", "output": r.stdout, "rc": r.returncode, "shared_robots": os.path.exists(shared)}
 
 
+    def trajectory(self):
+        """Issue 22: tracking of interpolated sines, the receding-horizon client, the
+        RobotDaemon's cost per period (bench/trajectory_bench.cpp; in-process, manual clock)."""
+        exe = f"{os.path.abspath(self.args.build)}/bench/robotalk-trajectory-bench"
+        shared = os.environ.get("ROBOTALK_SHARED_ROBOTS", os.path.join(ROOT, "..", "shared", "robots"))
+        if not os.path.exists(exe):
+            return {"figure": "trajectory", "error": "robotalk-trajectory-bench not built"}
+        csv_path = os.path.join(self.args.out, "trajectory_ode_10hz.csv")
+        cmd = [exe, shared, "--csv", csv_path] + (["--quick"] if self.quick else [])
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        plot = {}
+        if os.path.exists(csv_path):  # kept in the JSON, so the figure can be redrawn from the results alone
+            with open(csv_path) as f:
+                rows = [line.strip().split(",") for line in f if line.strip()]
+            os.remove(csv_path)
+            plot = {name: [float(row[i]) for row in rows[1:]] for i, name in enumerate(rows[0])}
+        output = r.stdout
+        # (b) through the network: robotalk-lcm-relay adds 5 ms ± 3 ms (uniform) on the client → server leg.
+        client = f"{os.path.abspath(self.args.build)}/bench/robotalk-receding-client"
+        iiwa = os.path.join(shared, "iiwa14.urdf")
+        if os.path.exists(client) and os.path.exists(iiwa):
+            self.start_server(url=URL_B, robot=f"iiwa=kinematic:{iiwa}")
+            splices = 1000 if self.quick else 10000
+            relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, "--a2b-latency-ms", "5", "--a2b-jitter-ms",
+                                "3", "--a2b-jitter-dist", "uniform", "--seed", "22",
+                                "--duration", str(splices // 100 + 60)])
+            time.sleep(0.3)
+            c = subprocess.run([client, "--url", URL_A, "--robot", "iiwa", "--joint", "iiwa_joint_6",
+                                "--splices", str(splices)], capture_output=True, text=True,
+                               timeout=splices // 100 + 60)
+            self.stop(relay)
+            self.stop_server()
+            output += "\n(b, network) " + (c.stdout.strip() if c.returncode == 0 else
+                                           f"failed ({c.returncode}): {c.stderr.strip()[-300:]}") + "\n"
+        return {"figure": "trajectory", "output": output, "stderr": r.stderr[-400:], "rc": r.returncode,
+                "shared_robots": os.path.exists(shared), "plot_ode_10hz": plot}
+
+
 FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "links", "micro",
-           "ode"]
+           "ode", "trajectory"]
 
 
 def main():

@@ -33,7 +33,8 @@ start=$(date +%s)
 # Only what the suite runs: the whole project (its tests, Java, the web page)
 # would double the time a clean clone needs before the first figure.
 bench_targets="robotalk-server robotalk robotalk-lcm-relay robotalk-bench-raw robotalk-bench-timer
-  robotalk-bench-client robotalk-bench-link robotalk-kinematics-bench robotalk-codec-bench robotalk-ode-bench"
+  robotalk-bench-client robotalk-bench-link robotalk-kinematics-bench robotalk-codec-bench robotalk-ode-bench
+  robotalk-trajectory-bench robotalk-receding-client"
 if ((setup)); then ROBOTALK_BUILD_TARGETS=$(echo $bench_targets) scripts/setup.sh; fi
 echo "bench: built in $(( $(date +%s) - start )) s; running the suite" >&2
 rc=0

@@ -1,6 +1,6 @@
 // A driver wrapper for tests that must see what the server asked of a real
 // driver: it forwards every call to the wrapped driver and first tells an
-// observer about Execute, Halt and Resume. The observer runs on the
+// observer about Execute, Track, Halt and Resume. The observer runs on the
 // RobotDaemon's thread; it must lock whatever the test thread reads.
 #pragma once
 
@@ -16,6 +16,7 @@ class DriverObserver {
  public:
   virtual ~DriverObserver() = default;
   virtual void Executed(const DriverCommand& /*command*/, TimePoint /*now*/) {}
+  virtual void Tracked(const JointReference& /*reference*/, TimePoint /*now*/) {}
   virtual void Halted(bool /*halted*/) {}
 };
 
@@ -28,6 +29,10 @@ class ObservedDriver final : public Driver {
   DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
     observer_->Executed(c, now);
     return inner_->Execute(c, now, done);
+  }
+  DriverResult Track(const JointReference& r, TimePoint now, std::vector<Completion>& done) override {
+    observer_->Tracked(r, now);
+    return inner_->Track(r, now, done);
   }
   void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
   void ReadState(RobotState& s) const override { inner_->ReadState(s); }
