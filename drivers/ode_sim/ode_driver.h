@@ -90,9 +90,12 @@ struct OdeDriverOptions {
   /// of each leg, '+'-separated "left_hip+left_knee+right_hip+right_knee";
   /// empty = guessed from common names. Key "gait_joints".
   std::string gait_joints;
-  /// Experimental: a floating base with feet walks on physics (docs/ode_sim.md,
-  /// "Walking"; it still falls on long walks); false (default) = the root
-  /// moves kinematically (the scripted gait). Key "walk".
+  /// A floating base with feet (a box sole on each of left_foot/right_foot)
+  /// walks on physics: ZMP preview plan, leg IK, fall detection
+  /// (docs/ode_sim.md, "Walking"). A model that cannot walk moves its root
+  /// kinematically and says why (GOTO/SETSPEED answers, one line on stderr);
+  /// with solver=quickstep the driver refuses walking (Error). false
+  /// (default) = the root moves kinematically (the scripted gait). Key "walk".
   bool walk = false;
 
   /// Parses DriverConfig::options. Throws Error naming an unknown key (and the

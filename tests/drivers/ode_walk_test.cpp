@@ -17,6 +17,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 namespace robotalk {
@@ -188,6 +189,94 @@ TEST(OdeWalk, AStandingWalkerIsNotMovingAndAWalkingOneIs) {
   const auto [stopped, of_stopped] = moving_samples(1.0);
   EXPECT_LT(stopped, of_stopped / 2) << "standing again after the STOP";
   EXPECT_FALSE(w.driver->walk_status()->fallen);
+}
+
+// The issue's reproducers (issue 26, item 2): a command at the instant that
+// made the walk fall or rock: restarting after STOP, SETSPEED 0 or panic,
+// and a STOP in the first shift of weight. Times from the first command.
+struct Timed {
+  double at;  // s after the first command
+  std::function<void(Walker&)> act;
+};
+// Runs the script, then `after` s more; the robot never falls nor tilts
+// much, and ends standing on both soles (neither unloaded).
+void ExpectNoFallNorRocking(const std::vector<Timed>& script, double after, const std::string& what) {
+  Walker w;
+  w.Run(1.0);
+  const TimePoint t0 = w.driver->sim_time();
+  for (const Timed& a : script) {
+    w.Run(a.at - ToSeconds(w.driver->sim_time() - t0));
+    a.act(w);
+  }
+  const auto fallen = [&] { return w.driver->walk_status()->fallen; };
+  w.Run(after, fallen);
+  w.Run(20.0, [&] { return fallen() || !w.driver->walk_status()->stepping; });
+  w.Run(1.0, fallen);
+  const walking::WalkStatus s = *w.driver->walk_status();
+  EXPECT_FALSE(s.fallen) << what;
+  EXPECT_LT(w.max_tilt, 0.1) << what;
+  EXPECT_FALSE(s.stepping) << what;
+  const double weight = w.driver->model().total_mass() * 9.81;
+  for (int i = 0; i < 2; ++i)
+    EXPECT_GT(s.foot_force[i], 0.25 * weight) << what << ": foot " << i << " unloaded";
+  EXPECT_LT(std::max(s.foot_tilt[0], s.foot_tilt[1]), 0.01) << what;
+}
+
+void Goto(Walker& w, double x, double y, double th) { w.Exec(CommandType::kGoto, {x, y, th}); }
+
+TEST(OdeWalkRestart, StopThenGotoAPointOneSecondLater) {
+  ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {1.3, [](Walker& w) { w.Stop(); }},
+                          {1.4, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {4.0, [](Walker& w) { w.Stop(); }}},
+                         2.0, "stop 1.3 s, goto 1.4 s");
+}
+
+TEST(OdeWalkRestart, StopThenGotoOneSecondLater) {
+  ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {2.3, [](Walker& w) { w.Stop(); }},
+                          {3.5, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {6.0, [](Walker& w) { w.Stop(); }}},
+                         2.0, "stop 2.3 s, goto 3.5 s");
+}
+
+TEST(OdeWalkRestart, SetSpeedZeroAndBack) {
+  ExpectNoFallNorRocking({{0.0,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0.09, 0});
+                           }},
+                          {1.5,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0, 0});
+                           }},
+                          {2.5,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0.09, 0});
+                           }},
+                          {5.0,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0, 0});
+                           }}},
+                         1.0, "setspeed 0.09, 0 at 1.5 s, 0.09 at 2.5 s");
+}
+
+TEST(OdeWalkRestart, PanicResetGoto) {
+  ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {1.4,
+                           [](Walker& w) {
+                             w.driver->Halt(w.done);
+                             w.driver->Resume();
+                           }},
+                          {1.5, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {4.0, [](Walker& w) { w.Stop(); }}},
+                         2.0, "panic at 1.4 s, reset, goto");
+}
+
+TEST(OdeWalkRestart, StopInTheFirstShiftOfWeight) {
+  for (double at : {1.2, 1.6}) {
+    ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }}, {at, [](Walker& w) { w.Stop(); }}},
+                           0.5, "stop at " + std::to_string(at) + " s");
+  }
 }
 
 // The simple humanoid on soles 3 cm wide (a copy of the model in a temporary

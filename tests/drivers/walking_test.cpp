@@ -214,6 +214,129 @@ TEST(WalkPattern, StopSoonEndsWithinTwoStepsInDoubleSupport) {
   for (int tick : {3300, 3800, 3950, 5000}) StopAt(tick);
 }
 
+// Replanning at any instant (issue 26, item 2): a command at every phase of
+// the gait. The reference ZMP never jumps (at most a shift's slope per tick),
+// the model's ZMP stays inside the planned support with a margin, and a stop
+// ends standing with the feet side by side.
+struct Sweep {
+  GaitParams g;
+  WalkPattern w{g, 0.001, 5, 9.81};
+  Eigen::Vector2d ref;
+  double worst_jump = 0;
+  double worst_outside = 0;  // m the model's ZMP came closer than the margin to the support's edge
+
+  Sweep() {
+    w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+    ref = w.zmp_ref();
+  }
+  void Goto(const Pose2& goal) {
+    const WalkPattern::Splice from = w.DropUnstarted();
+    std::vector<Footstep> steps;
+    std::vector<Pose2> centres;
+    for (const PlannedStep& p :
+         PlanFootsteps(from.centre, goal, g, 400, nullptr, from.side_free ? nullptr : &from.next)) {
+      steps.push_back(p.step);
+      centres.push_back(p.centre);
+    }
+    w.Append(steps, centres);
+  }
+  // SETSPEED's queue (as the ode driver keeps it): forward steps appended
+  // whenever fewer than 3.2 s are planned.
+  void Queue(double dx) {
+    while (w.planned_ahead() < 3.2) {
+      const WalkPattern::Splice at = w.AppendPoint();
+      const Side next = at.side_free ? Side::kLeft : at.next;
+      const Pose2 c = StepBy(at.centre, dx, 0, 0, next, g);
+      w.Append({Footstep{next, FootAt(c, next, g)}}, {c});
+    }
+  }
+  void Run(double seconds, double queue_dx = 0) {
+    for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) {
+      if (queue_dx != 0) Queue(queue_dx);
+      w.Tick();
+      worst_jump = std::max(worst_jump, (w.zmp_ref() - ref).norm());
+      ref = w.zmp_ref();
+      if (!w.InSupport(w.zmp(), 0.01)) worst_outside = std::max(worst_outside, w.time());
+    }
+  }
+  void ExpectStoppedSideBySide(const std::string& what) {
+    for (int i = 0; i < 10000 && !w.settled(2e-3); ++i) Run(0.001);
+    EXPECT_TRUE(w.standing()) << what;
+    const Pose2 l = w.foot(Side::kLeft), r = w.foot(Side::kRight);
+    EXPECT_NEAR(std::hypot(l.x - r.x, l.y - r.y), g.foot_separation, 1e-6) << what << ": feet side by side";
+    // A shift moves the reference foot to foot in double_support: the steepest slope.
+    EXPECT_LT(worst_jump, 1.5e-3) << what << ": the reference ZMP jumped";
+    EXPECT_EQ(worst_outside, 0) << what << ": the model's ZMP left the support (last at t=" << worst_outside
+                                << ")";
+  }
+};
+
+TEST(WalkPattern, StopThenGotoAtEveryPhaseKeepsTheZmpContinuousAndInside) {
+  for (int ms = 0; ms <= 2000; ms += 100) {
+    Sweep s;
+    s.Goto({1.5, 0, 0});
+    s.Run(0.3 + ms * 1e-3);
+    s.w.StopSoon();
+    s.Run(0.1);
+    s.Goto({1.5, 0, 0});  // STOP then GOTO 0.1 s later (the issue's 1.3 s / 1.4 s)
+    s.Run(4.0);
+    s.w.StopSoon();  // ... and a STOP, a long pause, a GOTO again (its 2.3 s / 3.5 s)
+    s.Run(1.2);
+    s.Goto({0.5, 0.3, 1.0});
+    for (int i = 0; i < 60000 && !s.w.settled(2e-3); ++i) s.Run(0.001);
+    EXPECT_TRUE(s.w.settled(2e-3)) << ms;
+    s.ExpectStoppedSideBySide("stop at " + std::to_string(300 + ms) + " ms");
+    EXPECT_NEAR(s.w.final_centre().x, 0.5, 1e-9);
+  }
+}
+
+TEST(WalkPattern, SpeedZeroAndBackAtEveryPhaseKeepsTheZmpContinuousAndInside) {
+  for (int ms = 0; ms <= 2000; ms += 100) {
+    Sweep s;
+    s.Run(0.5, 0.1);  // SETSPEED 0.09 m/s
+    s.Run(ms * 1e-3, 0.1);
+    s.w.StopSoon();  // SETSPEED 0
+    s.Run(1.0);
+    s.w.DropUnstarted();  // SETSPEED again
+    s.Run(4.0, 0.1);
+    s.w.StopSoon();
+    s.ExpectStoppedSideBySide("speed 0 at " + std::to_string(500 + ms) + " ms");
+    EXPECT_GT(s.w.final_centre().x, 0.15) << "it walked; speed 0 at " << 500 + ms << " ms";
+  }
+}
+
+TEST(WalkPattern, AStopInTheFirstShiftOfWeightShiftsBackWithoutAJump) {
+  // The walk starts with start_lead (1 s) standing, then the 0.8 s shift onto
+  // the first stance foot: a STOP there completes the shift and shifts back.
+  for (int ms = 900; ms <= 1750; ms += 50) {
+    Sweep s;
+    s.Goto({1.0, 0, 0});
+    s.Run(ms * 1e-3);
+    const int started = s.w.started_steps();
+    s.w.StopSoon();
+    s.ExpectStoppedSideBySide("stop at " + std::to_string(ms) + " ms");
+    EXPECT_EQ(s.w.started_steps(), started) << "no step was taken";
+  }
+}
+
+TEST(WalkPattern, AWalkCommandChangesNothingWithinThePreviewLead) {
+  // The reference over the next start_lead seconds is the same whatever is
+  // appended or dropped: the preview saw it coming.
+  for (int ms = 0; ms <= 3000; ms += 150) {
+    Sweep a, b;
+    for (Sweep* s : {&a, &b}) {
+      s->Goto({2.0, 0, 0});
+      s->Run(ms * 1e-3);
+    }
+    b.Goto({-0.5, 0.5, 2.0});
+    for (int i = 0; i < static_cast<int>(a.g.start_lead * 1000) - 1; ++i) {
+      a.Run(0.001);
+      b.Run(0.001);
+      ASSERT_LT((a.w.zmp_ref() - b.w.zmp_ref()).norm(), 1e-12) << ms << " ms, tick " << i;
+    }
+  }
+}
+
 TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {
   const RobotModel m = LoadUrdfFile(testing::ProjectModel("simple_humanoid.urdf")).model;
   const int lf = m.LinkIndex("left_foot"), rf = m.LinkIndex("right_foot");
