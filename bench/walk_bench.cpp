@@ -6,10 +6,13 @@
 // Figures go to docs/ode_sim.md ("Walking").
 //   robotalk-walk-bench [--model URDF] [--goals N] [--seed S] [--trace CSV] [--trace-goal K]
 //                       [--option key=value]... [--goal x,y,theta] [--stop S] [--verbose N] [--stand S]
+//                       [--timeout S]
 // Diagnostics: --goal walks to one goal relative to the start instead;
 // --stop sends STOP S seconds into each walk; --verbose prints the measured
 // and planned state every N x 10 ms (pelvis, tilt, CoM error, feet, sole
 // tilts, centre of pressure, contact forces and counts, tracking error);
+// --timeout S (default 120): a GOTO still running after S simulated seconds
+// is stopped and counts as TIMEOUT, a failure;
 // --stand prints S seconds of the start-up stance first.
 #include "ode_driver.h"
 
@@ -39,6 +42,7 @@ struct Args {
   int stand = 0;  // --stand S: seconds to stand and print before the goals
   bool fixed_goal = false;
   double goal[3] = {0, 0, 0};  // --goal x,y,theta: one goal instead of random ones
+  double timeout = 120;        // --timeout S: simulated seconds a GOTO may run before it counts as TIMEOUT
   int verbose = 0;             // --verbose N: print the walk every N x 10 ms
   double stop_after = -1;      // --stop S: STOP each walk S s after its GOTO (then wait for standing)
   std::map<std::string, std::string> options = {{"walk", "true"}};
@@ -64,6 +68,8 @@ Args Parse(int argc, char** argv) {
       a.stop_after = std::atof(v.c_str());
     } else if (k == "--verbose") {
       a.verbose = std::atoi(v.c_str());
+    } else if (k == "--timeout") {
+      a.timeout = std::atof(v.c_str());
     } else if (k == "--trace-goal") {
       a.trace_goal = std::atoi(v.c_str());
     } else if (k == "--option") {
@@ -115,15 +121,13 @@ void WriteTrace(std::ofstream& trace, const walking::WalkStatus& s, double t) {
 struct Outcome {
   Signal signal = Signal::kError;
   std::string message;
-  bool timed_out = false;    // still running after kTimeout: neither a success nor an answer
+  bool timed_out = false;    // still running after --timeout: neither a success nor an answer
   double sim = 0, wall = 0;  // s
 };
 
-constexpr double kTimeout = 120;  // s of simulated time per GOTO
-
 // One GOTO to c (values x y theta): steps until it completes, a fall, or
 // (--stop) the end of the stepping after a STOP. A GOTO still running after
-// kTimeout is stopped and reported TIMEOUT (a failure), whatever it answers then.
+// --timeout is stopped and reported TIMEOUT (a failure), whatever it answers then.
 Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& args, std::ofstream* trace) {
   std::vector<Completion> done;
   const TimePoint t0 = ode->sim_time();
@@ -131,7 +135,7 @@ Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& ar
   const DriverResult res = d->Execute(c, t0, done);
   Outcome out{.signal = res.signal, .message = res.message};
   bool stopped = false;
-  const int max_iterations = static_cast<int>(kTimeout * 100);
+  const int max_iterations = static_cast<int>(args.timeout * 100);
   int i = 0;
   for (; res.in_progress && (done.empty() || stopped) && i < max_iterations; ++i) {
     const double t = ToSeconds(ode->sim_time() - t0);
@@ -156,7 +160,7 @@ Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& ar
     out.signal = done[0].signal;
     out.message = done[0].message;
   }
-  if (out.timed_out) out.message = "still running after " + std::to_string(static_cast<int>(kTimeout)) + " s";
+  if (out.timed_out) out.message = "still running after " + std::to_string(args.timeout) + " s";
   return out;
 }
 

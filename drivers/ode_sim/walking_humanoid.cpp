@@ -105,11 +105,13 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole_z);
   g.foot_separation = lp.y() - rp.y();
   if (options.solver == "quickstep") {
-    // Measured (docs/ode_sim.md, "Walking"): on quickstep's 50 iterations the
-    // soles' contacts do not converge and the walk falls within 1-2 steps.
+    // Measured (docs/ode_sim.md, "Walking"): with quickstep's 50 iterations
+    // (and with 200) the simple humanoid fell 4-5 s into its first GOTO; with
+    // 1000 it walked, but slower than dWorldStep. So no quickstep walking.
     throw Error(
         "OdeDriver: walk=true needs solver=step: the walking humanoid falls on quickstep "
-        "(its sole contacts do not converge); drop solver=quickstep or walk=true");
+        "(measured: with 50 and with 200 iterations it fell 4-5 s into its first GOTO); "
+        "drop solver=quickstep or walk=true");
   }
   auto w = std::unique_ptr<WalkingHumanoid>(new WalkingHumanoid(model, {*l, *r}, sole_z, g, gravity, step));
   w->pelvis_z_ = -lp.z() * (1 - kKneeDrop);

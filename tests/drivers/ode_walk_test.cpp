@@ -7,6 +7,7 @@
 // The soles are spring-dampers on the ground (docs/ode_sim.md, "Walking"):
 // the tests check that they carry the robot's weight on four contacts each.
 #include "ode_driver.h"
+#include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
 
@@ -316,6 +317,38 @@ TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
   EXPECT_EQ(again.signal, Signal::kError);
   EXPECT_NE(again.message.find("fallen"), std::string::npos) << again.message;
   EXPECT_EQ(w.Exec(CommandType::kSetSpeed, {0.05, 0}).signal, Signal::kError);
+}
+
+// Issue 26, item 6: walk=true is never silently ignored. A model that cannot
+// walk (atlas.urdf: its feet are contact points, no sole box) moves its root
+// kinematically and its answers say why; quickstep, on which the walk falls,
+// is refused with the reason.
+TEST(OdeWalk, AModelThatCannotWalkSaysWhyAndQuickstepIsRefused) {
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  std::unique_ptr<Driver> atlas =
+      registry.Create("ode", DriverConfig{.robot_name = "atlas",
+                                          .urdf_path = testing::SharedRobot("atlas.urdf"),
+                                          .options = {{"walk", "true"}, {"base", "floating"}}});
+  EXPECT_FALSE(static_cast<OdeDriver*>(atlas.get())->walk_status().has_value());
+  DriverCommand c;
+  c.id = 1;
+  c.type = CommandType::kSetSpeed;
+  c.num_values = 2;
+  c.values[0] = 0.1;
+  std::vector<Completion> done;
+  const DriverResult r = atlas->Execute(c, TimePoint{}, done);
+  EXPECT_EQ(r.signal, Signal::kModified);
+  EXPECT_NE(r.message.find("walk=true ignored: foot 'l_foot' has no box collision shape"), std::string::npos)
+      << r.message;
+  try {
+    registry.Create("ode", DriverConfig{.robot_name = "",
+                                        .urdf_path = ProjectModel("simple_humanoid.urdf"),
+                                        .options = {{"walk", "true"}, {"solver", "quickstep"}}});
+    ADD_FAILURE() << "walk=true with solver=quickstep was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("walk=true needs solver=step"), std::string::npos) << e.what();
+  }
 }
 
 TEST(OdeWalk, TheSameCommandsGiveTheSameWalk) {
