@@ -8,6 +8,13 @@
 // models/simple_humanoid.urdf on the ode driver (walk=true) at 1 kHz.
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
 //                       [--after S] [--option key=value]...
+//   robotalk-walk-sweep --push standing|walking [--seed S]: per direction (8,
+//     every 45 degrees from ahead, counter-clockwise) the largest impulse on the
+//     pelvis survived (a 0.1 s push through OdeDriver::PushForTesting, found by
+//     bisection to 1.25 N s); walking at the gait's full forward speed, the
+//     push lands at a seeded instant of the gait cycle.
+//   robotalk-walk-sweep --arms 1: both shoulders swung together +-1 rad every
+//     0.5 s for 6 s, standing and walking: fell or not.
 // Transitions (t = the swept instant, s after the first command):
 //   stop_goto        GOTO 1 m; STOP at t; GOTO 1 m at t + 0.1 s
 //   stop_wait_goto   GOTO 1 m; STOP at t; GOTO 1 m at t + 1.2 s
@@ -24,6 +31,8 @@
 #include <ctime>
 #include <functional>
 #include <map>
+#include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -36,6 +45,9 @@ struct Args {
   std::string transition = "all";
   double from = 1.0, span = 2.0, after = 4.0;
   int every_ms = 20;
+  std::string push;   // --push standing|walking: the largest impulse survived per direction instead
+  bool arms = false;  // --arms 1: both arms swung together +-1 rad every 0.5 s, standing and walking
+  unsigned seed = 1;
   std::map<std::string, std::string> options = {{"walk", "true"}};
 };
 
@@ -51,6 +63,12 @@ Args Parse(int argc, char** argv) {
       a.span = std::atof(v.c_str());
     } else if (k == "--every") {
       a.every_ms = std::atoi(v.c_str());
+    } else if (k == "--push") {
+      a.push = v;
+    } else if (k == "--arms") {
+      a.arms = v == "1";
+    } else if (k == "--seed") {
+      a.seed = static_cast<unsigned>(std::atoi(v.c_str()));
     } else if (k == "--after") {
       a.after = std::atof(v.c_str());
     } else if (k == "--option") {
@@ -84,6 +102,15 @@ struct Run {
   }
   void Goto() { Exec(CommandType::kGoto, {1.0, 0, 0}); }
   void Speed(double v) { Exec(CommandType::kSetSpeed, {v, 0}); }
+  void Joint(const char* name, double q) {
+    DriverCommand c;
+    c.id = ++id;
+    c.type = CommandType::kJointSetPoint;
+    c.target = ode->model().JointIndex(name);
+    c.num_values = 1;
+    c.values[0] = q;
+    d->Execute(c, ode->sim_time(), done);
+  }
   void Stop() { d->Stop(ode->sim_time(), done); }
   void Panic() {
     d->Halt(done);
@@ -143,11 +170,10 @@ const std::map<std::string, Script>& Transitions() {
 }
 
 // One run from a fresh driver; returns whether it fell, and the worst tilt.
+std::unique_ptr<Driver> NewDriver(const Args& args);
+
 bool FellOnce(const Args& args, const Script& script, double t, double* tilt) {
-  DriverRegistry registry;
-  RegisterOdeDriver(registry);
-  std::unique_ptr<Driver> d = registry.Create(
-      "ode", DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+  std::unique_ptr<Driver> d = NewDriver(args);
   Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
   r.ode->Step(1000, r.done);  // into the stance
   const TimePoint t0 = r.ode->sim_time();
@@ -162,10 +188,78 @@ bool FellOnce(const Args& args, const Script& script, double t, double* tilt) {
   return !ok;
 }
 
+std::unique_ptr<Driver> NewDriver(const Args& args) {
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  return registry.Create("ode",
+                         DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+}
+
+// Survives an impulse of `j` N s toward `angle` (rad from ahead), pushed at `at` s?
+bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at) {
+  std::unique_ptr<Driver> d = NewDriver(args);
+  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+  r.ode->Step(1000, r.done);
+  const TimePoint t0 = r.ode->sim_time();
+  if (walking) r.Speed(1.0);  // clamped to the gait's full speed
+  if (!r.Until(t0, at)) return false;
+  constexpr double kPushTime = 0.1;
+  r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
+                        FromSeconds(kPushTime));
+  return r.Until(t0, at + args.after);
+}
+
+int Pushes(const Args& args) {
+  const bool walking = args.push == "walking";
+  if (!walking && args.push != "standing") {
+    std::fprintf(stderr, "--push standing or --push walking\n");
+    return 2;
+  }
+  std::mt19937 rng(args.seed);
+  std::uniform_real_distribution<double> phase(0, 1.1);  // one gait period
+  std::printf("push %s: direction_deg  survived_N_s  fell_at_N_s  push_at_s\n", args.push.c_str());
+  for (int k = 0; k < 8; ++k) {
+    const double angle = k * std::numbers::pi / 4;
+    const double at = walking ? 5.0 + phase(rng) : 2.0;
+    double lo = 0, hi = 80;
+    if (SurvivesPush(args, walking, angle, hi, at)) lo = hi;
+    while (hi - lo > 1.25 && lo < hi) {
+      const double mid = 0.5 * (lo + hi);
+      (SurvivesPush(args, walking, angle, mid, at) ? lo : hi) = mid;
+    }
+    std::printf("%20d  %12.2f  %11.2f  %9.2f\n", k * 45, lo, hi, at);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+int ArmSwing(const Args& args) {
+  for (bool walking : {false, true}) {
+    std::unique_ptr<Driver> d = NewDriver(args);
+    Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+    r.ode->Step(1000, r.done);
+    const TimePoint t0 = r.ode->sim_time();
+    if (walking) r.Speed(1.0);
+    bool ok = r.Until(t0, 2.0);
+    for (int i = 0; ok && i < 12; ++i) {
+      const double q = i % 2 == 0 ? 1.0 : -1.0;
+      r.Joint("left_shoulder_pitch", q);
+      r.Joint("right_shoulder_pitch", q);
+      ok = r.Until(t0, 2.5 + 0.5 * i);
+    }
+    ok = ok && r.Until(t0, 9.0);
+    std::printf("arms swung +-1 rad every 0.5 s, %s: %s (worst tilt %.3f rad)\n",
+                walking ? "walking" : "standing", ok ? "stood" : "FELL", r.max_tilt);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
+  if (!args.push.empty()) return Pushes(args);
+  if (args.arms) return ArmSwing(args);
   if (args.transition != "all" && !Transitions().count(args.transition)) {
     std::fprintf(stderr, "unknown transition %s\n", args.transition.c_str());
     return 2;

@@ -152,6 +152,11 @@ class OdeDriver final : public Driver {
   std::optional<walking::WalkStatus> walk_status() const;
   /// World pose of a link's frame, from the physics.
   Eigen::Isometry3d LinkPose(int link) const;
+  /// Test hook (issue 26): pushes the first root (a humanoid's pelvis) at its
+  /// centre of mass with `force` (N, world frame) during the next `duration`
+  /// of simulated time, an impulse of force x duration. No command, option
+  /// or server path reaches it: tests and robotalk-walk-sweep --push call it.
+  void PushForTesting(const Eigen::Vector3d& force, Duration duration);
   /// Bodies, geoms and fused links of the simulation (for docs and tests).
   struct Stats {
     int bodies = 0, geoms = 0, fused_links = 0, mesh_boxes = 0, skipped_meshes = 0;
