@@ -4,6 +4,7 @@
 // polygon of the planned steps, and the leg IK on the simple humanoid.
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
+#include "walking/dcm_stabilizer.h"
 #include "walking/footstep_planner.h"
 #include "walking/leg_ik.h"
 #include "walking/walk_pattern.h"
@@ -333,6 +334,101 @@ TEST(WalkPattern, AWalkCommandChangesNothingWithinThePreviewLead) {
       a.Run(0.001);
       b.Run(0.001);
       ASSERT_LT((a.w.zmp_ref() - b.w.zmp_ref()).norm(), 1e-12) << ms << " ms, tick " << i;
+    }
+  }
+}
+
+// The DCM stabilizer (issue 26, item 1) on a simulated linear inverted
+// pendulum: the ZMP it commands is where the pendulum's ZMP goes (ideal
+// ankles), a push is a sudden CoM velocity.
+std::vector<Eigen::Vector2d> Rect(double x0, double x1, double y0, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};  // counter-clockwise
+}
+
+TEST(DcmStabilizer, ClampToPolygonKeepsInsidePointsAndClampsOthersToTheShrunkEdge) {
+  const auto sq = Rect(-1, 1, -1, 1);
+  EXPECT_TRUE(ClampToPolygon({0.5, 0.2}, sq, 0.1).isApprox(Eigen::Vector2d(0.5, 0.2)));
+  EXPECT_TRUE(ClampToPolygon({3, 0.2}, sq, 0.1).isApprox(Eigen::Vector2d(0.9, 0.2)));
+  EXPECT_TRUE(ClampToPolygon({3, 3}, sq, 0.1).isApprox(Eigen::Vector2d(0.9, 0.9)));
+  EXPECT_TRUE(ClampToPolygon({0.95, 0}, sq, 0.1).isApprox(Eigen::Vector2d(0.9, 0)));
+  EXPECT_TRUE(ClampToPolygon({5, 0}, Rect(0, 0.1, 0, 0.1), 0.2).isApprox(Eigen::Vector2d(0.05, 0.05)))
+      << "thinner than twice the margin: the centroid";
+}
+
+struct Lipm {
+  double zc = 0.6, g = 9.81, dt = 0.001;
+  Eigen::Vector2d c = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero();
+  void Step(const Eigen::Vector2d& p) {
+    v += g / zc * (c - p) * dt;
+    c += v * dt;
+  }
+};
+
+// Standing on both soles with the CoM over `ref`, pushed to `v0`; returns
+// the CoM's distance from `ref` after 3 s (stabilized or open loop).
+double AfterPush(const Eigen::Vector2d& v0, bool stabilized, bool* saturated = nullptr) {
+  Lipm m;
+  const Eigen::Vector2d ref(0.03, 0);
+  m.c = ref;
+  m.v = v0;
+  const DcmStabilizer s(m.zc, m.g);
+  const auto support = Rect(-0.09, 0.15, -0.15, 0.15);
+  const Eigen::Vector2d zero = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 3000; ++i) {
+    const DcmStabilizer::Output o = s.Update(m.c, m.v, ref, zero, ref, support, 0);
+    if (saturated) *saturated = *saturated || o.saturated;
+    EXPECT_LE(o.zmp.x(), 0.15 - 0.01 + 1e-9);
+    m.Step(stabilized ? o.zmp : ref);
+    if ((m.c - ref).norm() > 1) break;
+  }
+  return (m.c - ref).norm();
+}
+
+TEST(DcmStabilizer, TheAnklesRecoverAPushTheOpenLoopPlanFallsFrom) {
+  // The ankles hold the DCM while it stays over the sole: 0.11 m ahead of
+  // the CoM's 0.03 m at most (0.15 m toe, 0.01 m margin), so v0 < 0.11 w = 0.44 m/s.
+  for (const Eigen::Vector2d& v0 :
+       {Eigen::Vector2d(0.35, 0), Eigen::Vector2d(-0.2, 0), Eigen::Vector2d(0, 0.4)}) {
+    EXPECT_LT(AfterPush(v0, true), 1e-3) << v0.transpose();
+    EXPECT_GT(AfterPush(v0, false), 0.3) << v0.transpose() << ": the open-loop plan does not recover";
+  }
+  bool saturated = false;
+  EXPECT_GT(AfterPush({0.6, 0}, true, &saturated), 0.3) << "beyond the sole, ankles alone cannot";
+  EXPECT_TRUE(saturated);
+}
+
+TEST(DcmStabilizer, BeyondTheAnklesAStepToTheCapturePointRecovers) {
+  // On one foot, the other about to land in place (0.3 s), pushed forward
+  // at 0.6 m/s: the ankles saturate; landing the foot where the stabilizer
+  // says catches the DCM, landing it as planned does not.
+  for (const bool adjust : {true, false}) {
+    Lipm m;
+    const Eigen::Vector2d foot(0.03, 0);
+    m.c = foot;
+    m.v = {0.6, 0.1};
+    const DcmStabilizer s(m.zc, m.g);
+    const Eigen::Vector2d zero = Eigen::Vector2d::Zero();
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+    for (int i = 0; i < 300; ++i) {
+      const auto support = Rect(foot.x() - 0.12, foot.x() + 0.12, -0.06, 0.06);
+      const DcmStabilizer::Output o = s.Update(m.c, m.v, foot, zero, foot, support, 0.3 - i * m.dt);
+      if (i == 0) {
+        EXPECT_TRUE(o.saturated);
+        offset = o.step_offset;
+      }
+      m.Step(o.zmp);
+    }
+    EXPECT_GT(offset.x(), 0.2) << "step forward, where the push carries the DCM";
+    const Eigen::Vector2d landed = foot + (adjust ? offset : Eigen::Vector2d::Zero());
+    for (int i = 0; i < 3000; ++i) {
+      const auto support = Rect(landed.x() - 0.12, landed.x() + 0.12, landed.y() - 0.06, landed.y() + 0.06);
+      m.Step(s.Update(m.c, m.v, landed, zero, landed, support, 0).zmp);
+      if ((m.c - landed).norm() > 1) break;
+    }
+    if (adjust) {
+      EXPECT_LT((m.c - landed).norm(), 0.01) << "captured";
+    } else {
+      EXPECT_GT((m.c - landed).norm(), 0.3) << "the planned foothold does not capture it";
     }
   }
 }
