@@ -9,7 +9,7 @@
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
 //                       [--after S] [--option key=value]...
 //   robotalk-walk-sweep --push standing|walking [--seed S]: per direction (8,
-//     every 45 degrees from ahead, counter-clockwise) the largest impulse on the
+//     every 45 degrees, 0 = a push forward, counter-clockwise) the largest impulse on the
 //     pelvis survived (a 0.1 s push through OdeDriver::PushForTesting, found by
 //     bisection to 1.25 N s); walking at the gait's full forward speed, the
 //     push lands at a seeded instant of the gait cycle.
