@@ -6,10 +6,13 @@
 // Figures go to docs/ode_sim.md ("Walking").
 //   robotalk-walk-bench [--model URDF] [--goals N] [--seed S] [--trace CSV] [--trace-goal K]
 //                       [--option key=value]... [--goal x,y,theta] [--stop S] [--verbose N] [--stand S]
+//                       [--timeout S]
 // Diagnostics: --goal walks to one goal relative to the start instead;
 // --stop sends STOP S seconds into each walk; --verbose prints the measured
 // and planned state every N x 10 ms (pelvis, tilt, CoM error, feet, sole
 // tilts, centre of pressure, contact forces and counts, tracking error);
+// --timeout S (default 120): a GOTO still running after S simulated seconds
+// is stopped and counts as TIMEOUT, a failure;
 // --stand prints S seconds of the start-up stance first.
 #include "ode_driver.h"
 
@@ -36,13 +39,12 @@ struct Args {
   unsigned seed = 1;
   std::string trace;
   int trace_goal = 0;
-  int stand = 0;
+  int stand = 0;  // --stand S: seconds to stand and print before the goals
   bool fixed_goal = false;
   double goal[3] = {0, 0, 0};  // --goal x,y,theta: one goal instead of random ones
-  int verbose = 0;
-  double stop_after =
-      -1;  // --stop S: STOP each walk S s after its GOTO (then wait for standing)             // --verbose N:
-           // print the walk every N * 10 ms  // seconds to stand and print before the goals
+  double timeout = 120;        // --timeout S: simulated seconds a GOTO may run before it counts as TIMEOUT
+  int verbose = 0;             // --verbose N: print the walk every N x 10 ms
+  double stop_after = -1;      // --stop S: STOP each walk S s after its GOTO (then wait for standing)
   std::map<std::string, std::string> options = {{"walk", "true"}};
 };
 
@@ -66,6 +68,8 @@ Args Parse(int argc, char** argv) {
       a.stop_after = std::atof(v.c_str());
     } else if (k == "--verbose") {
       a.verbose = std::atoi(v.c_str());
+    } else if (k == "--timeout") {
+      a.timeout = std::atof(v.c_str());
     } else if (k == "--trace-goal") {
       a.trace_goal = std::atoi(v.c_str());
     } else if (k == "--option") {
@@ -117,11 +121,13 @@ void WriteTrace(std::ofstream& trace, const walking::WalkStatus& s, double t) {
 struct Outcome {
   Signal signal = Signal::kError;
   std::string message;
+  bool timed_out = false;    // still running after --timeout: neither a success nor an answer
   double sim = 0, wall = 0;  // s
 };
 
-// One GOTO to c (values x y theta): steps until it completes (at most 120 s),
-// a fall, or (--stop) the end of the stepping after a STOP.
+// One GOTO to c (values x y theta): steps until it completes, a fall, or
+// (--stop) the end of the stepping after a STOP. A GOTO still running after
+// --timeout is stopped and reported TIMEOUT (a failure), whatever it answers then.
 Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& args, std::ofstream* trace) {
   std::vector<Completion> done;
   const TimePoint t0 = ode->sim_time();
@@ -129,7 +135,9 @@ Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& ar
   const DriverResult res = d->Execute(c, t0, done);
   Outcome out{.signal = res.signal, .message = res.message};
   bool stopped = false;
-  for (int i = 0; res.in_progress && (done.empty() || stopped) && i < 12000; ++i) {
+  const int max_iterations = static_cast<int>(args.timeout * 100);
+  int i = 0;
+  for (; res.in_progress && (done.empty() || stopped) && i < max_iterations; ++i) {
     const double t = ToSeconds(ode->sim_time() - t0);
     if (!stopped && args.stop_after >= 0 && t >= args.stop_after) {
       d->Stop(ode->sim_time(), done);
@@ -143,10 +151,16 @@ Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& ar
   }
   out.wall = std::chrono::duration<double>(WallClock::now() - w0).count();
   out.sim = ToSeconds(ode->sim_time() - t0);
+  if (res.in_progress && done.empty() && !stopped && i >= max_iterations) {
+    out.timed_out = true;
+    d->Stop(ode->sim_time(), done);  // the walk must not go on into the next goal
+    ode->Step(5000, done);
+  }
   if (!done.empty()) {
     out.signal = done[0].signal;
     out.message = done[0].message;
   }
+  if (out.timed_out) out.message = "still running after " + std::to_string(args.timeout) + " s";
   return out;
 }
 
@@ -200,7 +214,7 @@ int main(int argc, char** argv) {
     const double ed = std::hypot(s.pelvis.x - c.values[0], s.pelvis.y - c.values[1]);
     const double eth = std::abs(walking::Wrap(s.pelvis.theta - c.values[2]));
     if (s.fallen) ++falls;
-    if (o.signal == Signal::kSuccess) ++successes;
+    if (o.signal == Signal::kSuccess && !o.timed_out) ++successes;
     worst_d = std::max(worst_d, ed);
     worst_th = std::max(worst_th, eth);
     sum_d += ed;
@@ -208,8 +222,9 @@ int main(int argc, char** argv) {
     walk_time += o.sim;
     wall_total += o.wall;
     std::printf("%-4d  %7.3f  %7.3f  %7.3f  %-11s  %6.1f  %6.3f  %9.3f  %9.4f  %11.5f  %4.1f %s\n", g,
-                c.values[0], c.values[1], c.values[2], std::string(ToString(o.signal)).c_str(), o.sim, r,
-                r / o.sim, ed, eth, o.sim / o.wall, o.message.c_str());
+                c.values[0], c.values[1], c.values[2],
+                o.timed_out ? "TIMEOUT" : std::string(ToString(o.signal)).c_str(), o.sim, r, r / o.sim, ed,
+                eth, o.sim / o.wall, o.message.c_str());
     std::fflush(stdout);
     if (s.fallen) break;
   }

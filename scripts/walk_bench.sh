@@ -8,14 +8,18 @@
 #
 #   scripts/walk_bench.sh [--goals N] [--seed S] [--trace-goal K]
 # Environment: ROBOTALK_BUILD_DIR (default build), WALK_PLOT (default
-# docs/figures/walk_topview.png). Exit status 0 only for N/N successes, no fall.
+# docs/figures/walk_topview.png); WALK_SWEEP=1 also runs robotalk-walk-sweep:
+# the phase sweep of every transition (WALK_SWEEP_EVERY ms, default 20),
+# the push survival standing and walking, and the arm swing (issue 26; an
+# hour or more of CPU at 20 ms). Exit status 0 only for N/N successes, no
+# fall (and, with WALK_SWEEP=1, no fall in the sweep).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
 PLOT=${WALK_PLOT:-docs/figures/walk_topview.png}
 TRACE=$(mktemp --suffix=.csv)
 trap 'rm -f "$TRACE"' EXIT
-flock /tmp/rt-build.lock cmake --build "$BUILD_DIR" --target robotalk-walk-bench -j2 >/dev/null
+flock /tmp/rt-build.lock cmake --build "$BUILD_DIR" --target robotalk-walk-bench robotalk-walk-sweep -j2 >/dev/null
 status=0
 "$BUILD_DIR/bench/robotalk-walk-bench" --goals 20 --seed 1 --trace "$TRACE" "$@" || status=$?
 PY=python3
@@ -25,5 +29,11 @@ if "$PY" -c 'import matplotlib' 2>/dev/null; then
   "$PY" scripts/plot_walk.py "$TRACE" "$PLOT" && echo "top view: $PLOT"
 else
   echo "python3-matplotlib not installed: no plot (scripts/setup.sh installs it)"
+fi
+if [ "${WALK_SWEEP:-0}" = 1 ]; then
+  "$BUILD_DIR/bench/robotalk-walk-sweep" --every "${WALK_SWEEP_EVERY:-20}" --after 3 || status=$?
+  "$BUILD_DIR/bench/robotalk-walk-sweep" --push standing --after 4
+  "$BUILD_DIR/bench/robotalk-walk-sweep" --push walking --after 4
+  "$BUILD_DIR/bench/robotalk-walk-sweep" --arms 1
 fi
 exit $status

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <utility>
 
@@ -322,8 +323,9 @@ std::optional<int> FindAny(const RobotModel& m, std::initializer_list<const char
 // ground but do not carry the robot): the look of walking, not walking.
 class KinematicRoot final : public PlanarBase {
  public:
-  KinematicRoot(const RobotModel& model, const OdeDriverOptions& options, double step)
-      : PlanarBase(model, options), step_(step) {}
+  /// `no_walk`: why walk=true was not granted ("" when it was not asked).
+  KinematicRoot(const RobotModel& model, const OdeDriverOptions& options, double step, std::string no_walk)
+      : PlanarBase(model, options), step_(step), no_walk_(std::move(no_walk)) {}
 
   void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>&) override {
     world.kinematic_first_root = true;
@@ -335,7 +337,8 @@ class KinematicRoot final : public PlanarBase {
 
  private:
   void Limit(driver_support::BaseTwist& t) const override {
-    t.Note("the root moves kinematically (" + std::string(ToString(model_.roots().front().base)) + " base)");
+    t.Note("the root moves kinematically (" + std::string(ToString(model_.roots().front().base)) + " base" +
+           NoWalk() + ")");
   }
   void Drive(const Twist2& t, double vy, double theta) override {
     const double c = std::cos(theta), s = std::sin(theta);
@@ -358,12 +361,15 @@ class KinematicRoot final : public PlanarBase {
             .signal = Signal::kModified,
             .message = std::string("GOTO: reached by moving the root kinematically (") +
                        ToString(model_.roots().front().base) + " base; " +
-                       (gait_dof_[0] >= 0 ? "the legs followed a scripted gait)" : "no gait)")};
+                       (gait_dof_[0] >= 0 ? "the legs followed a scripted gait" : "no gait") + NoWalk() +
+                       ")"};
   }
+  std::string NoWalk() const { return no_walk_.empty() ? "" : "; walk=true ignored: " + no_walk_; }
 
   double step_;                         // s
   int gait_dof_[4] = {-1, -1, -1, -1};  // left hip, left knee, right hip, right knee
   double phase_ = 0;
+  std::string no_walk_;
 };
 
 void KinematicRoot::Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>&) {
@@ -404,13 +410,18 @@ std::unique_ptr<BaseController> MakeBaseController(const RobotModel& model, cons
       return std::make_unique<WheeledBase>(model, options);
     case BaseType::kFloating:
       if (options.walk) {
-        // A model that cannot walk (no feet, no soles) moves kinematically instead.
+        // A model that cannot walk (no feet, no soles) moves kinematically
+        // instead: its GOTO/SETSPEED answers say why, and so does one line here.
         std::string why;
-        if (auto walker = WalkingHumanoid::Create(model, shapes, options.gravity, step, &why)) return walker;
+        if (auto walker = WalkingHumanoid::Create(model, shapes, options, step, &why)) return walker;
+        std::fprintf(stderr,
+                     "robotalk ode driver: '%s': walk=true ignored: %s; the root moves kinematically\n",
+                     model.name().c_str(), why.c_str());
+        return std::make_unique<KinematicRoot>(model, options, step, why);
       }
       [[fallthrough]];
     case BaseType::kHolonomic:
-      return std::make_unique<KinematicRoot>(model, options, step);
+      return std::make_unique<KinematicRoot>(model, options, step, "");
   }
   return std::make_unique<FixedBase>(model);
 }

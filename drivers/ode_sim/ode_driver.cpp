@@ -95,6 +95,10 @@ void OdeDriver::Impl::Step(int n, std::vector<Completion>& completed) {
   for (int s = 0; s < n; ++s) {
     base_->Control(completed);  // the base first: it may set the wheels' or the gait's servos
     servos_.Apply(*world_);
+    if (push_steps_ > 0) {
+      world_->AddRootForce(push_);
+      --push_steps_;
+    }
     world_->Step();
     ++steps_;
   }
@@ -156,6 +160,9 @@ Duration OdeDriver::dropped_time() const { return impl_->dropped_time(); }
 std::string_view OdeDriver::Fault() const { return impl_->fault(); }
 std::optional<walking::WalkStatus> OdeDriver::walk_status() const { return impl_->walk_status(); }
 Eigen::Isometry3d OdeDriver::LinkPose(int link) const { return impl_->world().LinkPose(link); }
+void OdeDriver::PushForTesting(const Eigen::Vector3d& force, Duration duration) {
+  impl_->Push(force, duration);
+}
 OdeDriver::Stats OdeDriver::stats() const {
   const OdeWorld& w = impl_->world();
   return Stats{.bodies = w.num_bodies(),

@@ -90,9 +90,12 @@ struct OdeDriverOptions {
   /// of each leg, '+'-separated "left_hip+left_knee+right_hip+right_knee";
   /// empty = guessed from common names. Key "gait_joints".
   std::string gait_joints;
-  /// Experimental: a floating base with feet walks on physics (docs/ode_sim.md,
-  /// "Walking"; it still falls on long walks); false (default) = the root
-  /// moves kinematically (the scripted gait). Key "walk".
+  /// A floating base with feet (a box sole on each of left_foot/right_foot)
+  /// walks on physics: ZMP preview plan, leg IK, fall detection
+  /// (docs/ode_sim.md, "Walking"). A model that cannot walk moves its root
+  /// kinematically and says why (GOTO/SETSPEED answers, one line on stderr);
+  /// with solver=quickstep the driver refuses walking (Error). false
+  /// (default) = the root moves kinematically (the scripted gait). Key "walk".
   bool walk = false;
 
   /// Parses DriverConfig::options. Throws Error naming an unknown key (and the
@@ -154,6 +157,11 @@ class OdeDriver final : public Driver {
   std::optional<walking::WalkStatus> walk_status() const;
   /// World pose of a link's frame, from the physics.
   Eigen::Isometry3d LinkPose(int link) const;
+  /// Test hook (issue 26): pushes the first root (a humanoid's pelvis) at its
+  /// centre of mass with `force` (N, world frame) during the next `duration`
+  /// of simulated time, an impulse of force x duration. No command, option
+  /// or server path reaches it: tests and robotalk-walk-sweep --push call it.
+  void PushForTesting(const Eigen::Vector3d& force, Duration duration);
   /// Bodies, geoms and fused links of the simulation (for docs and tests).
   struct Stats {
     int bodies = 0, geoms = 0, fused_links = 0, mesh_boxes = 0, skipped_meshes = 0;

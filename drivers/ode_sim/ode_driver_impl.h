@@ -62,6 +62,10 @@ class OdeDriver::Impl {
   std::string_view fault() const { return base_->fault(); }
   std::optional<walking::WalkStatus> walk_status() const { return base_->walk_status(); }
   const ode_detail::OdeWorld& world() const { return *world_; }
+  void Push(const Eigen::Vector3d& force, Duration duration) {
+    push_ = force;
+    push_steps_ = duration / step_;
+  }
 
  private:
   void StopAll(const char* why, std::vector<Completion>& completed);
@@ -81,6 +85,8 @@ class OdeDriver::Impl {
   // the measured root poses it starts from, one per RobotModel::roots() entry.
   InverseKinematics ik_;
   std::vector<Eigen::Isometry3d> root_poses_;
+  Eigen::Vector3d push_ = Eigen::Vector3d::Zero();  // PushForTesting: the force, for push_steps_ more steps
+  std::int64_t push_steps_ = 0;
 };
 
 }  // namespace robotalk

@@ -400,6 +400,10 @@ void OdeWorld::SetRootVelocity(const Eigen::Vector3d& v, const Eigen::Vector3d& 
   dBodySetAngularVel(b, w.x(), w.y(), w.z());
 }
 
+void OdeWorld::AddRootForce(const Eigen::Vector3d& force) {
+  dBodyAddForce(body_of_[static_cast<size_t>(model_.roots().front().link)], force.x(), force.y(), force.z());
+}
+
 void OdeWorld::SetContactSpring(int link, double stiffness, double damping) {
   const double hk = options_.step * stiffness;
   for (Geom& g : geoms_) {

@@ -76,6 +76,9 @@ class OdeWorld {
   void SetContactSpring(int link, double stiffness, double damping);
   /// Velocity of a kinematic first root, world frame (m/s, rad/s).
   void SetRootVelocity(const Eigen::Vector3d& v, const Eigen::Vector3d& w);
+  /// Adds `force` (N, world frame) at the first root's centre of mass for
+  /// the next Step() only (OdeDriver::PushForTesting).
+  void AddRootForce(const Eigen::Vector3d& force);
 
   /// One fixed step: ground contacts, dynamics, joint read-out.
   void Step();

@@ -2,6 +2,7 @@
 #include "walking_humanoid.h"
 
 #include "robotalk/driver_support.h"
+#include "robotalk/error.h"
 #include "walking/footstep_planner.h"
 
 #include <algorithm>
@@ -68,7 +69,9 @@ Pose2 Inverse(const Pose2& a) {
 
 std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model,
                                                          const std::vector<CollisionShape>& shapes,
-                                                         double gravity, double step, std::string* why) {
+                                                         const OdeDriverOptions& options, double step,
+                                                         std::string* why) {
+  const double gravity = options.gravity;
   if (model.roots().empty() || model.roots().front().base != BaseType::kFloating) {
     *why = "not a floating base";
     return nullptr;
@@ -101,6 +104,15 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   const Eigen::Vector3d lp = kin.link_pose(*l) * Eigen::Vector3d(0, 0, sole_z);
   const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole_z);
   g.foot_separation = lp.y() - rp.y();
+  if (options.solver == "quickstep") {
+    // Measured (docs/ode_sim.md, "Walking"): with quickstep's 50 iterations
+    // (and with 200) the simple humanoid fell 4-5 s into its first GOTO; with
+    // 1000 it walked, but slower than dWorldStep. So no quickstep walking.
+    throw Error(
+        "OdeDriver: walk=true needs solver=step: the walking humanoid falls on quickstep "
+        "(measured: with 50 and with 200 iterations it fell 4-5 s into its first GOTO); "
+        "drop solver=quickstep or walk=true");
+  }
   auto w = std::unique_ptr<WalkingHumanoid>(new WalkingHumanoid(model, {*l, *r}, sole_z, g, gravity, step));
   w->pelvis_z_ = -lp.z() * (1 - kKneeDrop);
   // The stance: the CoM above the feet's ZMP points puts the pelvis at the stance centre.
@@ -208,12 +220,10 @@ void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
 
 void WalkingHumanoid::PlanGoto() {
   MapFrames();
-  Side next = Side::kLeft;
-  const Pose2 from = pattern_.DropUnstarted(&next);
+  const walking::WalkPattern::Splice from = pattern_.DropUnstarted();
   const Pose2 goal = ToPlan(goal_);
-  const bool standing = pattern_.standing();
   const std::vector<walking::PlannedStep> plan =
-      walking::PlanFootsteps(from, goal, g_, 400, nullptr, standing ? nullptr : &next);
+      walking::PlanFootsteps(from.centre, goal, g_, 400, nullptr, from.side_free ? nullptr : &from.next);
   std::vector<Footstep> steps;
   std::vector<Pose2> centres;
   for (const walking::PlannedStep& p : plan) {
@@ -306,18 +316,21 @@ DriverResult WalkingHumanoid::SetSpeed(const DriverCommand& c) {
     Stop("", none);
   } else {
     mode_ = Mode::kSpeed;
-    Side next = Side::kLeft;
-    pattern_.DropUnstarted(&next);
+    pattern_.DropUnstarted();
     KeepSpeedStepsQueued();
   }
   return note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + note);
 }
 
 void WalkingHumanoid::KeepSpeedStepsQueued() {
-  while (pattern_.unstarted_steps() < kQueuedSpeedSteps) {
-    const Pose2 centre = pattern_.final_centre();
-    Side next = pattern_.next_side();
-    if (pattern_.standing()) next = (vy_ < 0 || (vy_ == 0 && omega_ < 0)) ? Side::kRight : Side::kLeft;
+  // Steps are planned far enough ahead that appending the next never cuts
+  // into the preview's look-ahead (the walk goes on without a pause).
+  const double ahead = g_.start_lead + kQueuedSpeedSteps * g_.step_period();
+  while (pattern_.unstarted_steps() < kQueuedSpeedSteps || pattern_.planned_ahead() < ahead) {
+    const walking::WalkPattern::Splice at = pattern_.AppendPoint();
+    const Pose2 centre = at.centre;
+    Side next = at.next;
+    if (at.side_free) next = (vy_ < 0 || (vy_ == 0 && omega_ < 0)) ? Side::kRight : Side::kLeft;
     const double period = g_.step_period();
     const double dy = vy_ * 2 * period * (vy_ * walking::SideSign(next) > 0 ? 1.0 : 0.0);
     const Pose2 c = walking::StepBy(centre, v_ * period, dy, omega_ * period, next, g_);

@@ -60,9 +60,11 @@ class WalkingHumanoid final : public BaseController {
   /// The controller if `model` can walk: a floating first root and two feet
   /// found by name (left_foot/right_foot, l_foot/r_foot) with a box
   /// collision shape each; else nullptr and *why says what is missing.
+  /// Throws Error for a model that can walk with solver=quickstep (it falls there).
   static std::unique_ptr<WalkingHumanoid> Create(const RobotModel& model,
-                                                 const std::vector<CollisionShape>& shapes, double gravity,
-                                                 double step, std::string* why);
+                                                 const std::vector<CollisionShape>& shapes,
+                                                 const OdeDriverOptions& options, double step,
+                                                 std::string* why);
   /// A free root standing on the ground.
   void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>&) override {
     world.place_on_ground = true;

@@ -7,6 +7,7 @@
 // The soles are spring-dampers on the ground (docs/ode_sim.md, "Walking"):
 // the tests check that they carry the robot's weight on four contacts each.
 #include "ode_driver.h"
+#include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
 
@@ -17,6 +18,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 namespace robotalk {
@@ -190,6 +192,94 @@ TEST(OdeWalk, AStandingWalkerIsNotMovingAndAWalkingOneIs) {
   EXPECT_FALSE(w.driver->walk_status()->fallen);
 }
 
+// The issue's reproducers (issue 26, item 2): a command at the instant that
+// made the walk fall or rock: restarting after STOP, SETSPEED 0 or panic,
+// and a STOP in the first shift of weight. Times from the first command.
+struct Timed {
+  double at;  // s after the first command
+  std::function<void(Walker&)> act;
+};
+// Runs the script, then `after` s more; the robot never falls nor tilts
+// much, and ends standing on both soles (neither unloaded).
+void ExpectNoFallNorRocking(const std::vector<Timed>& script, double after, const std::string& what) {
+  Walker w;
+  w.Run(1.0);
+  const TimePoint t0 = w.driver->sim_time();
+  for (const Timed& a : script) {
+    w.Run(a.at - ToSeconds(w.driver->sim_time() - t0));
+    a.act(w);
+  }
+  const auto fallen = [&] { return w.driver->walk_status()->fallen; };
+  w.Run(after, fallen);
+  w.Run(20.0, [&] { return fallen() || !w.driver->walk_status()->stepping; });
+  w.Run(1.0, fallen);
+  const walking::WalkStatus s = *w.driver->walk_status();
+  EXPECT_FALSE(s.fallen) << what;
+  EXPECT_LT(w.max_tilt, 0.1) << what;
+  EXPECT_FALSE(s.stepping) << what;
+  const double weight = w.driver->model().total_mass() * 9.81;
+  for (int i = 0; i < 2; ++i)
+    EXPECT_GT(s.foot_force[i], 0.25 * weight) << what << ": foot " << i << " unloaded";
+  EXPECT_LT(std::max(s.foot_tilt[0], s.foot_tilt[1]), 0.01) << what;
+}
+
+void Goto(Walker& w, double x, double y, double th) { w.Exec(CommandType::kGoto, {x, y, th}); }
+
+TEST(OdeWalkRestart, StopThenGotoAPointOneSecondLater) {
+  ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {1.3, [](Walker& w) { w.Stop(); }},
+                          {1.4, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {4.0, [](Walker& w) { w.Stop(); }}},
+                         2.0, "stop 1.3 s, goto 1.4 s");
+}
+
+TEST(OdeWalkRestart, StopThenGotoOneSecondLater) {
+  ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {2.3, [](Walker& w) { w.Stop(); }},
+                          {3.5, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {6.0, [](Walker& w) { w.Stop(); }}},
+                         2.0, "stop 2.3 s, goto 3.5 s");
+}
+
+TEST(OdeWalkRestart, SetSpeedZeroAndBack) {
+  ExpectNoFallNorRocking({{0.0,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0.09, 0});
+                           }},
+                          {1.5,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0, 0});
+                           }},
+                          {2.5,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0.09, 0});
+                           }},
+                          {5.0,
+                           [](Walker& w) {
+                             w.Exec(CommandType::kSetSpeed, {0, 0});
+                           }}},
+                         1.0, "setspeed 0.09, 0 at 1.5 s, 0.09 at 2.5 s");
+}
+
+TEST(OdeWalkRestart, PanicResetGoto) {
+  ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {1.4,
+                           [](Walker& w) {
+                             w.driver->Halt(w.done);
+                             w.driver->Resume();
+                           }},
+                          {1.5, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                          {4.0, [](Walker& w) { w.Stop(); }}},
+                         2.0, "panic at 1.4 s, reset, goto");
+}
+
+TEST(OdeWalkRestart, StopInTheFirstShiftOfWeight) {
+  for (double at : {1.2, 1.6}) {
+    ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }}, {at, [](Walker& w) { w.Stop(); }}},
+                           0.5, "stop at " + std::to_string(at) + " s");
+  }
+}
+
 // The simple humanoid on soles 3 cm wide (a copy of the model in a temporary
 // file): it stands, but the first step tips it over the stance sole's edge.
 TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
@@ -227,6 +317,58 @@ TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
   EXPECT_EQ(again.signal, Signal::kError);
   EXPECT_NE(again.message.find("fallen"), std::string::npos) << again.message;
   EXPECT_EQ(w.Exec(CommandType::kSetSpeed, {0.05, 0}).signal, Signal::kError);
+}
+
+// Issue 26, item 6: walk=true is never silently ignored. A model that cannot
+// walk (atlas.urdf: its feet are contact points, no sole box) moves its root
+// kinematically and its answers say why; quickstep, on which the walk falls,
+// is refused with the reason.
+TEST(OdeWalk, AModelThatCannotWalkSaysWhyAndQuickstepIsRefused) {
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  std::unique_ptr<Driver> atlas =
+      registry.Create("ode", DriverConfig{.robot_name = "atlas",
+                                          .urdf_path = testing::SharedRobot("atlas.urdf"),
+                                          .options = {{"walk", "true"}, {"base", "floating"}}});
+  EXPECT_FALSE(static_cast<OdeDriver*>(atlas.get())->walk_status().has_value());
+  DriverCommand c;
+  c.id = 1;
+  c.type = CommandType::kSetSpeed;
+  c.num_values = 2;
+  c.values[0] = 0.1;
+  std::vector<Completion> done;
+  const DriverResult r = atlas->Execute(c, TimePoint{}, done);
+  EXPECT_EQ(r.signal, Signal::kModified);
+  EXPECT_NE(r.message.find("walk=true ignored: foot 'l_foot' has no box collision shape"), std::string::npos)
+      << r.message;
+  try {
+    registry.Create("ode", DriverConfig{.robot_name = "",
+                                        .urdf_path = ProjectModel("simple_humanoid.urdf"),
+                                        .options = {{"walk", "true"}, {"solver", "quickstep"}}});
+    ADD_FAILURE() << "walk=true with solver=quickstep was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("walk=true needs solver=step"), std::string::npos) << e.what();
+  }
+}
+
+// Pushes as a test input (issue 26, item 4): OdeDriver::PushForTesting, a
+// 0.1 s push on the pelvis. Standing, the open-loop walker takes 15 N s from
+// behind (robotalk-walk-sweep --push standing measured 23.75 N s survived,
+// 25 fell); 40 N s topples it, and the fall is detected and reported.
+TEST(OdeWalk, APushOnThePelvisIsSurvivedOrReportedAsAFall) {
+  for (const double impulse : {15.0, 40.0}) {
+    Walker w;
+    w.Run(2.0);
+    w.driver->PushForTesting(Eigen::Vector3d(impulse / 0.1, 0, 0), FromSeconds(0.1));
+    w.Run(4.0, [&] { return w.driver->walk_status()->fallen; });
+    if (impulse < 20) {
+      EXPECT_FALSE(w.driver->walk_status()->fallen) << impulse << " N s";
+      EXPECT_EQ(w.driver->Fault(), "");
+    } else {
+      EXPECT_TRUE(w.driver->walk_status()->fallen) << impulse << " N s";
+      EXPECT_NE(w.driver->Fault().find("fallen"), std::string::npos);
+    }
+  }
 }
 
 TEST(OdeWalk, TheSameCommandsGiveTheSameWalk) {

@@ -4,6 +4,7 @@
 // polygon of the planned steps, and the leg IK on the simple humanoid.
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
+#include "walking/dcm_stabilizer.h"
 #include "walking/footstep_planner.h"
 #include "walking/leg_ik.h"
 #include "walking/walk_pattern.h"
@@ -212,6 +213,224 @@ void StopAt(int tick) {
 TEST(WalkPattern, StopSoonEndsWithinTwoStepsInDoubleSupport) {
   // Steps start every 1.1 s from 1.8 s: single support 0.8 s, double 0.3 s.
   for (int tick : {3300, 3800, 3950, 5000}) StopAt(tick);
+}
+
+// Replanning at any instant (issue 26, item 2): a command at every phase of
+// the gait. The reference ZMP never jumps (at most a shift's slope per tick),
+// the model's ZMP stays inside the planned support with a margin, and a stop
+// ends standing with the feet side by side.
+struct Sweep {
+  GaitParams g;
+  WalkPattern w{g, 0.001, 5, 9.81};
+  Eigen::Vector2d ref;
+  double worst_jump = 0;
+  double worst_outside = 0;  // m the model's ZMP came closer than the margin to the support's edge
+
+  Sweep() {
+    w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+    ref = w.zmp_ref();
+  }
+  void Goto(const Pose2& goal) {
+    const WalkPattern::Splice from = w.DropUnstarted();
+    std::vector<Footstep> steps;
+    std::vector<Pose2> centres;
+    for (const PlannedStep& p :
+         PlanFootsteps(from.centre, goal, g, 400, nullptr, from.side_free ? nullptr : &from.next)) {
+      steps.push_back(p.step);
+      centres.push_back(p.centre);
+    }
+    w.Append(steps, centres);
+  }
+  // SETSPEED's queue (as the ode driver keeps it): forward steps appended
+  // whenever fewer than 3.2 s are planned.
+  void Queue(double dx) {
+    while (w.planned_ahead() < 3.2) {
+      const WalkPattern::Splice at = w.AppendPoint();
+      const Side next = at.side_free ? Side::kLeft : at.next;
+      const Pose2 c = StepBy(at.centre, dx, 0, 0, next, g);
+      w.Append({Footstep{next, FootAt(c, next, g)}}, {c});
+    }
+  }
+  void Run(double seconds, double queue_dx = 0) {
+    for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) {
+      if (queue_dx != 0) Queue(queue_dx);
+      w.Tick();
+      worst_jump = std::max(worst_jump, (w.zmp_ref() - ref).norm());
+      ref = w.zmp_ref();
+      if (!w.InSupport(w.zmp(), 0.01)) worst_outside = std::max(worst_outside, w.time());
+    }
+  }
+  void ExpectStoppedSideBySide(const std::string& what) {
+    for (int i = 0; i < 10000 && !w.settled(2e-3); ++i) Run(0.001);
+    EXPECT_TRUE(w.standing()) << what;
+    const Pose2 l = w.foot(Side::kLeft), r = w.foot(Side::kRight);
+    EXPECT_NEAR(std::hypot(l.x - r.x, l.y - r.y), g.foot_separation, 1e-6) << what << ": feet side by side";
+    // A shift moves the reference foot to foot in double_support: the steepest slope.
+    EXPECT_LT(worst_jump, 1.5e-3) << what << ": the reference ZMP jumped";
+    EXPECT_EQ(worst_outside, 0) << what << ": the model's ZMP left the support (last at t=" << worst_outside
+                                << ")";
+  }
+};
+
+TEST(WalkPattern, StopThenGotoAtEveryPhaseKeepsTheZmpContinuousAndInside) {
+  for (int ms = 0; ms <= 2000; ms += 100) {
+    Sweep s;
+    s.Goto({1.5, 0, 0});
+    s.Run(0.3 + ms * 1e-3);
+    s.w.StopSoon();
+    s.Run(0.1);
+    s.Goto({1.5, 0, 0});  // STOP then GOTO 0.1 s later (the issue's 1.3 s / 1.4 s)
+    s.Run(4.0);
+    s.w.StopSoon();  // ... and a STOP, a long pause, a GOTO again (its 2.3 s / 3.5 s)
+    s.Run(1.2);
+    s.Goto({0.5, 0.3, 1.0});
+    for (int i = 0; i < 60000 && !s.w.settled(2e-3); ++i) s.Run(0.001);
+    EXPECT_TRUE(s.w.settled(2e-3)) << ms;
+    s.ExpectStoppedSideBySide("stop at " + std::to_string(300 + ms) + " ms");
+    EXPECT_NEAR(s.w.final_centre().x, 0.5, 1e-9);
+  }
+}
+
+TEST(WalkPattern, SpeedZeroAndBackAtEveryPhaseKeepsTheZmpContinuousAndInside) {
+  for (int ms = 0; ms <= 2000; ms += 100) {
+    Sweep s;
+    s.Run(0.5, 0.1);  // SETSPEED 0.09 m/s
+    s.Run(ms * 1e-3, 0.1);
+    s.w.StopSoon();  // SETSPEED 0
+    s.Run(1.0);
+    s.w.DropUnstarted();  // SETSPEED again
+    s.Run(4.0, 0.1);
+    s.w.StopSoon();
+    s.ExpectStoppedSideBySide("speed 0 at " + std::to_string(500 + ms) + " ms");
+    EXPECT_GT(s.w.final_centre().x, 0.15) << "it walked; speed 0 at " << 500 + ms << " ms";
+  }
+}
+
+TEST(WalkPattern, AStopInTheFirstShiftOfWeightShiftsBackWithoutAJump) {
+  // The walk starts with start_lead (1 s) standing, then the 0.8 s shift onto
+  // the first stance foot: a STOP there completes the shift and shifts back.
+  for (int ms = 900; ms <= 1750; ms += 50) {
+    Sweep s;
+    s.Goto({1.0, 0, 0});
+    s.Run(ms * 1e-3);
+    const int started = s.w.started_steps();
+    s.w.StopSoon();
+    s.ExpectStoppedSideBySide("stop at " + std::to_string(ms) + " ms");
+    EXPECT_EQ(s.w.started_steps(), started) << "no step was taken";
+  }
+}
+
+TEST(WalkPattern, AWalkCommandChangesNothingWithinThePreviewLead) {
+  // The reference over the next start_lead seconds is the same whatever is
+  // appended or dropped: the preview saw it coming.
+  for (int ms = 0; ms <= 3000; ms += 150) {
+    Sweep a, b;
+    for (Sweep* s : {&a, &b}) {
+      s->Goto({2.0, 0, 0});
+      s->Run(ms * 1e-3);
+    }
+    b.Goto({-0.5, 0.5, 2.0});
+    for (int i = 0; i < static_cast<int>(a.g.start_lead * 1000) - 1; ++i) {
+      a.Run(0.001);
+      b.Run(0.001);
+      ASSERT_LT((a.w.zmp_ref() - b.w.zmp_ref()).norm(), 1e-12) << ms << " ms, tick " << i;
+    }
+  }
+}
+
+// The DCM stabilizer (issue 26, item 1) on a simulated linear inverted
+// pendulum: the ZMP it commands is where the pendulum's ZMP goes (ideal
+// ankles), a push is a sudden CoM velocity.
+std::vector<Eigen::Vector2d> Rect(double x0, double x1, double y0, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};  // counter-clockwise
+}
+
+TEST(DcmStabilizer, ClampToPolygonKeepsInsidePointsAndClampsOthersToTheShrunkEdge) {
+  const auto sq = Rect(-1, 1, -1, 1);
+  EXPECT_TRUE(ClampToPolygon({0.5, 0.2}, sq, 0.1).isApprox(Eigen::Vector2d(0.5, 0.2)));
+  EXPECT_TRUE(ClampToPolygon({3, 0.2}, sq, 0.1).isApprox(Eigen::Vector2d(0.9, 0.2)));
+  EXPECT_TRUE(ClampToPolygon({3, 3}, sq, 0.1).isApprox(Eigen::Vector2d(0.9, 0.9)));
+  EXPECT_TRUE(ClampToPolygon({0.95, 0}, sq, 0.1).isApprox(Eigen::Vector2d(0.9, 0)));
+  EXPECT_TRUE(ClampToPolygon({5, 0}, Rect(0, 0.1, 0, 0.1), 0.2).isApprox(Eigen::Vector2d(0.05, 0.05)))
+      << "thinner than twice the margin: the centroid";
+}
+
+struct Lipm {
+  double zc = 0.6, g = 9.81, dt = 0.001;
+  Eigen::Vector2d c = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero();
+  void Step(const Eigen::Vector2d& p) {
+    v += g / zc * (c - p) * dt;
+    c += v * dt;
+  }
+};
+
+// Standing on both soles with the CoM over `ref`, pushed to `v0`; returns
+// the CoM's distance from `ref` after 3 s (stabilized or open loop).
+double AfterPush(const Eigen::Vector2d& v0, bool stabilized, bool* saturated = nullptr) {
+  Lipm m;
+  const Eigen::Vector2d ref(0.03, 0);
+  m.c = ref;
+  m.v = v0;
+  const DcmStabilizer s(m.zc, m.g);
+  const auto support = Rect(-0.09, 0.15, -0.15, 0.15);
+  const Eigen::Vector2d zero = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 3000; ++i) {
+    const DcmStabilizer::Output o = s.Update(m.c, m.v, ref, zero, ref, support, 0);
+    if (saturated) *saturated = *saturated || o.saturated;
+    EXPECT_LE(o.zmp.x(), 0.15 - 0.01 + 1e-9);
+    m.Step(stabilized ? o.zmp : ref);
+    if ((m.c - ref).norm() > 1) break;
+  }
+  return (m.c - ref).norm();
+}
+
+TEST(DcmStabilizer, TheAnklesRecoverAPushTheOpenLoopPlanFallsFrom) {
+  // The ankles hold the DCM while it stays over the sole: 0.11 m ahead of
+  // the CoM's 0.03 m at most (0.15 m toe, 0.01 m margin), so v0 < 0.11 w = 0.44 m/s.
+  for (const Eigen::Vector2d& v0 :
+       {Eigen::Vector2d(0.35, 0), Eigen::Vector2d(-0.2, 0), Eigen::Vector2d(0, 0.4)}) {
+    EXPECT_LT(AfterPush(v0, true), 1e-3) << v0.transpose();
+    EXPECT_GT(AfterPush(v0, false), 0.3) << v0.transpose() << ": the open-loop plan does not recover";
+  }
+  bool saturated = false;
+  EXPECT_GT(AfterPush({0.6, 0}, true, &saturated), 0.3) << "beyond the sole, ankles alone cannot";
+  EXPECT_TRUE(saturated);
+}
+
+TEST(DcmStabilizer, BeyondTheAnklesAStepToTheCapturePointRecovers) {
+  // On one foot, the other about to land in place (0.3 s), pushed forward
+  // at 0.6 m/s: the ankles saturate; landing the foot where the stabilizer
+  // says catches the DCM, landing it as planned does not.
+  for (const bool adjust : {true, false}) {
+    Lipm m;
+    const Eigen::Vector2d foot(0.03, 0);
+    m.c = foot;
+    m.v = {0.6, 0.1};
+    const DcmStabilizer s(m.zc, m.g);
+    const Eigen::Vector2d zero = Eigen::Vector2d::Zero();
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+    for (int i = 0; i < 300; ++i) {
+      const auto support = Rect(foot.x() - 0.12, foot.x() + 0.12, -0.06, 0.06);
+      const DcmStabilizer::Output o = s.Update(m.c, m.v, foot, zero, foot, support, 0.3 - i * m.dt);
+      if (i == 0) {
+        EXPECT_TRUE(o.saturated);
+        offset = o.step_offset;
+      }
+      m.Step(o.zmp);
+    }
+    EXPECT_GT(offset.x(), 0.2) << "step forward, where the push carries the DCM";
+    const Eigen::Vector2d landed = foot + (adjust ? offset : Eigen::Vector2d::Zero());
+    for (int i = 0; i < 3000; ++i) {
+      const auto support = Rect(landed.x() - 0.12, landed.x() + 0.12, landed.y() - 0.06, landed.y() + 0.06);
+      m.Step(s.Update(m.c, m.v, landed, zero, landed, support, 0).zmp);
+      if ((m.c - landed).norm() > 1) break;
+    }
+    if (adjust) {
+      EXPECT_LT((m.c - landed).norm(), 0.01) << "captured";
+    } else {
+      EXPECT_GT((m.c - landed).norm(), 0.3) << "the planned foothold does not capture it";
+    }
+  }
 }
 
 TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {

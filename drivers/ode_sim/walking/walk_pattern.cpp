@@ -54,6 +54,7 @@ WalkPattern::WalkPattern(const GaitParams& g, double tick, int preview_every, do
   future_x_.resize(static_cast<size_t>(px_.horizon_samples()));
   future_y_.resize(future_x_.size());
   steps_.reserve(512);
+  phases_.reserve(1024);
   Reset({}, Eigen::Vector2d::Zero());
 }
 
@@ -61,8 +62,12 @@ void WalkPattern::Reset(const Pose2& centre, const Eigen::Vector2d& com) {
   steps_.clear();
   rest_[0] = foot_[0] = FootAt(centre, Side::kLeft, g_);
   rest_[1] = foot_[1] = FootAt(centre, Side::kRight, g_);
+  rest_centre_ = centre;
   height_[0] = height_[1] = 0;
-  final_centre_ = centre;
+  const Eigen::Vector2d mid = 0.5 * (ZmpPoint(rest_[0]) + ZmpPoint(rest_[1]));
+  phases_.clear();
+  phases_.push_back(
+      Phase{.start = tick_, .end = tick_, .from = mid, .to = mid, .kind = Kind::kHold, .next = -1});
   px_.Reset(com.x());
   py_.Reset(com.y());
   cx_ = px_.state();
@@ -70,132 +75,193 @@ void WalkPattern::Reset(const Pose2& centre, const Eigen::Vector2d& com) {
   sample_x_ = cx_;
   sample_y_ = cy_;
   ux_ = uy_ = 0;
-  walk_start_ = tick_;
 }
 
 Eigen::Vector2d WalkPattern::ZmpPoint(const Pose2& foot) const { return foot.Apply(g_.zmp_x, 0); }
 
-std::int64_t WalkPattern::EndTick() const {
-  return steps_.empty() ? walk_start_ : steps_.back().start + ss_ticks_ + end_ticks_;
-}
-
-int WalkPattern::StepAt(std::int64_t tick) const {
-  if (steps_.empty() || tick < steps_.front().start) return -1;
-  const auto k = (tick - steps_.front().start) / (ss_ticks_ + ds_ticks_);
-  return static_cast<int>(std::min<std::int64_t>(k, static_cast<std::int64_t>(steps_.size()) - 1));
+int WalkPattern::PhaseAt(std::int64_t tick) const {
+  if (tick < phases_.front().start) return -1;
+  const auto it = std::upper_bound(phases_.begin(), phases_.end(), tick,
+                                   [](std::int64_t t, const Phase& p) { return t < p.end; });
+  return static_cast<int>(it - phases_.begin());
 }
 
 Eigen::Vector2d WalkPattern::ZmpAt(std::int64_t tick) const {
-  const Eigen::Vector2d mid0 = 0.5 * (ZmpPoint(rest_[0]) + ZmpPoint(rest_[1]));
-  if (steps_.empty() || tick <= walk_start_) return mid0;
-  const int k = StepAt(tick);
-  if (k < 0) {  // the first shift of weight onto the first stance foot
-    const double s = static_cast<double>(tick - walk_start_) / static_cast<double>(start_ticks_);
-    return mid0 + std::min(1.0, s) * (ZmpPoint(steps_.front().stance) - mid0);
-  }
-  const Scheduled& st = steps_[static_cast<size_t>(k)];
-  const Eigen::Vector2d stance = ZmpPoint(st.stance);
-  const std::int64_t local = tick - st.start;
-  if (local < ss_ticks_) return stance;
-  const Eigen::Vector2d landed = ZmpPoint(st.step.pose);
-  if (k + 1 < static_cast<int>(steps_.size())) {
-    const double s = static_cast<double>(local - ss_ticks_) / static_cast<double>(ds_ticks_);
-    return stance + std::min(1.0, s) * (landed - stance);
-  }
-  const double s = static_cast<double>(local - ss_ticks_) / static_cast<double>(end_ticks_);
-  return stance + std::min(1.0, s) * (0.5 * (stance + landed) - stance);
+  const int k = PhaseAt(tick);
+  if (k < 0) return phases_.front().from;
+  if (k >= static_cast<int>(phases_.size())) return phases_.back().to;
+  const Phase& p = phases_[static_cast<size_t>(k)];
+  const double s = static_cast<double>(tick - p.start) / static_cast<double>(p.end - p.start);
+  return p.from + s * (p.to - p.from);
 }
+
+// The first tick from t where the schedule may be cut without changing the
+// reference before it: a phase boundary, or any tick of a standing hold. In
+// single support that is after the landing and the shift onto the landed foot.
+std::int64_t WalkPattern::CutTick(std::int64_t t) const {
+  const int k = PhaseAt(t);
+  if (k < 0 || k >= static_cast<int>(phases_.size())) return t;
+  const Phase& p = phases_[static_cast<size_t>(k)];
+  if (t == p.start || p.kind == Kind::kHold) return t;
+  if (p.kind == Kind::kSingle && k + 1 < static_cast<int>(phases_.size()) &&
+      phases_[static_cast<size_t>(k) + 1].kind == Kind::kShift) {
+    return phases_[static_cast<size_t>(k) + 1].end;
+  }
+  return p.end;
+}
+
+std::int64_t WalkPattern::AppendTick() const {
+  if (!steps_.empty() && steps_.back().land >= tick_ + lead_ticks_) return steps_.back().land;
+  return CutTick(tick_ + lead_ticks_);
+}
+
+WalkPattern::Splice WalkPattern::SpliceAt(std::int64_t t) const {
+  Splice sp;
+  sp.centre = rest_centre_;
+  for (const Scheduled& s : steps_) {
+    if (s.start < t) sp.centre = s.centre;
+  }
+  const int k = PhaseAt(t - 1);
+  if (k >= 0 && k < static_cast<int>(phases_.size()) && phases_[static_cast<size_t>(k)].end == t &&
+      phases_[static_cast<size_t>(k)].next >= 0) {
+    sp.next = static_cast<Side>(phases_[static_cast<size_t>(k)].next);
+    sp.side_free = false;
+  }
+  return sp;
+}
+
+void WalkPattern::Prune() {
+  size_t n = 0;
+  while (n < steps_.size() && steps_[n].land <= tick_) {
+    rest_[static_cast<int>(steps_[n].step.side)] = steps_[n].step.pose;
+    rest_centre_ = steps_[n].centre;
+    ++n;
+  }
+  steps_.erase(steps_.begin(), steps_.begin() + static_cast<std::ptrdiff_t>(n));
+  size_t m = 0;
+  while (m + 1 < phases_.size() && phases_[m].end <= tick_) ++m;
+  phases_.erase(phases_.begin(), phases_.begin() + static_cast<std::ptrdiff_t>(m));
+}
+
+void WalkPattern::Cut(std::int64_t t) {
+  Prune();
+  const Eigen::Vector2d at = ZmpAt(t);
+  while (!steps_.empty() && steps_.back().start >= t) steps_.pop_back();
+  while (phases_.size() > 1 && phases_.back().start >= t) phases_.pop_back();
+  Phase& last = phases_.back();
+  if (last.end > t) {  // inside a hold (CutTick cuts nothing else inside)
+    last.end = std::max(t, last.start);
+    last.to = at;
+  } else if (last.end < t) {
+    AddPhase(t - last.end, last.to, Kind::kHold, -1);
+  }
+}
+
+void WalkPattern::AddPhase(std::int64_t ticks, const Eigen::Vector2d& to, Kind kind, int next) {
+  const Phase& last = phases_.back();
+  phases_.push_back(Phase{
+      .start = last.end, .end = last.end + ticks, .from = last.to, .to = to, .kind = kind, .next = next});
+}
+
+WalkPattern::Splice WalkPattern::DropUnstarted() {
+  const std::int64_t t = CutTick(tick_ + lead_ticks_);
+  const Splice sp = SpliceAt(t);
+  Cut(t);
+  return sp;
+}
+
+WalkPattern::Splice WalkPattern::AppendPoint() const { return SpliceAt(AppendTick()); }
 
 void WalkPattern::Append(const std::vector<Footstep>& steps, const std::vector<Pose2>& centres) {
   if (steps.empty()) return;
-  // In the last step's double support the schedule goes on (the next step
-  // starts where it would have); later, in the end shift or standing, the
-  // walk starts again from the feet as they are.
-  const bool restart = steps_.empty() || tick_ >= steps_.back().start + ss_ticks_ + ds_ticks_;
-  if (restart) {
-    rest_[0] = foot_[0];
-    rest_[1] = foot_[1];
-    steps_.clear();
-    walk_start_ = tick_ + lead_ticks_;  // the preview needs to see a start ahead
-  }
+  AppendAt(AppendTick(), steps, centres);
+}
+
+void WalkPattern::AppendAt(std::int64_t t, const std::vector<Footstep>& steps,
+                           const std::vector<Pose2>& centres) {
+  Cut(t);
+  const bool from_stance = phases_.back().kind == Kind::kSingle;  // the weight on a foot, about to shift
   Pose2 last[2] = {rest_[0], rest_[1]};
   for (const Scheduled& s : steps_) last[static_cast<int>(s.step.side)] = s.step.pose;
+  Eigen::Vector2d z = phases_.back().to;
   for (size_t i = 0; i < steps.size(); ++i) {
     Scheduled s;
     s.step = steps[i];
     s.centre = centres[i];
-    s.from = last[static_cast<int>(s.step.side)];
-    s.stance = last[static_cast<int>(Other(s.step.side))];
-    s.start = steps_.empty() ? walk_start_ + start_ticks_ : steps_.back().start + ss_ticks_ + ds_ticks_;
+    const int sw = static_cast<int>(s.step.side);
+    s.from = last[sw];
+    s.stance = last[1 - sw];
+    const Eigen::Vector2d p = ZmpPoint(s.stance);
+    if ((p - z).norm() > 1e-9) {
+      AddPhase(i > 0 || from_stance ? ds_ticks_ : start_ticks_, p, Kind::kShift, sw);
+    }
+    s.start = phases_.back().end;
+    s.land = s.start + ss_ticks_;
+    AddPhase(ss_ticks_, p, Kind::kSingle, 1 - sw);
     steps_.push_back(s);
-    last[static_cast<int>(s.step.side)] = s.step.pose;
+    last[sw] = s.step.pose;
+    z = p;
   }
-  final_centre_ = steps_.back().centre;
+  const Scheduled& l = steps_.back();
+  AddPhase(end_ticks_, 0.5 * (ZmpPoint(l.stance) + ZmpPoint(l.step.pose)), Kind::kEnd, -1);
 }
 
-void WalkPattern::Reschedule(size_t keep) {
-  steps_.resize(keep);
-  if (!steps_.empty()) final_centre_ = steps_.back().centre;
-}
-
-Pose2 WalkPattern::DropUnstarted(Side* next_swing) {
-  size_t keep = 0;
-  while (keep < steps_.size() && steps_[keep].start <= tick_) ++keep;
-  Reschedule(keep);
-  if (steps_.empty()) {
-    // No step has started: the stance is the rest one.
-    final_centre_ = {0.5 * (rest_[0].x + rest_[1].x), 0.5 * (rest_[0].y + rest_[1].y),
-                     Wrap(rest_[1].theta + 0.5 * Wrap(rest_[0].theta - rest_[1].theta))};
-    const Eigen::Vector2d back = final_centre_.Apply(-g_.ankle_x, 0) - final_centre_.xy();
-    final_centre_.x += back.x();
-    final_centre_.y += back.y();
-    if (next_swing) *next_swing = Side::kLeft;
-    return final_centre_;
-  }
-  if (next_swing) *next_swing = Other(steps_.back().step.side);
-  return final_centre_;
-}
-
+// The step in the air lands; the next one (whose single support the preview
+// already sees) becomes the step that brings its foot alongside, or, with the
+// feet already side by side, a stand on its stance foot without a swing; then
+// the shift back to the middle. The reference is unchanged until that step's
+// end: at least single_support ahead (whatever the phase, a stop never
+// changes what the preview already counts on sooner).
 Pose2 WalkPattern::StopSoon() {
-  Side next = Side::kLeft;
-  const Pose2 centre = DropUnstarted(&next);
-  if (steps_.empty()) {
-    rest_[0] = foot_[0];
-    rest_[1] = foot_[1];
-    walk_start_ = tick_;
-    return centre;
-  }
-  const Scheduled& last = steps_.back();
-  const Pose2 along = FootAt(centre, next, g_);
-  if (!SamePose(last.stance, along)) Append({Footstep{next, along}}, {centre});
+  Prune();
+  size_t n = 0;
+  while (n < steps_.size() && steps_[n].start <= tick_) ++n;
+  if (n == steps_.size()) return final_centre();  // nothing ahead: the schedule already ends
+  const Pose2 centre = n > 0 ? steps_[n - 1].centre : rest_centre_;
+  Scheduled& st = steps_[n];
+  const Pose2 along = FootAt(centre, st.step.side, g_);
+  st.step.pose = along;
+  st.centre = centre;
+  st.swing = !SamePose(st.from, along);
+  const std::int64_t land = st.land;
+  const Eigen::Vector2d mid = 0.5 * (ZmpPoint(st.stance) + ZmpPoint(along));
+  Cut(land);
+  AddPhase(end_ticks_, mid, Kind::kEnd, -1);
   return centre;
 }
 
-bool WalkPattern::standing() const { return steps_.empty() || tick_ >= EndTick(); }
+const WalkPattern::Scheduled* WalkPattern::Swinging() const {
+  for (const Scheduled& s : steps_) {
+    if (s.start <= tick_ && tick_ < s.land) return &s;
+  }
+  return nullptr;
+}
+
+bool WalkPattern::standing() const {
+  if (tick_ < phases_.back().end) return false;
+  return std::none_of(steps_.begin(), steps_.end(), [&](const Scheduled& s) { return s.land > tick_; });
+}
 
 bool WalkPattern::settled(double tolerance) const {
   return standing() && (com() - zmp_ref()).norm() <= tolerance && com_velocity().norm() <= tolerance;
 }
 
 int WalkPattern::unstarted_steps() const {
-  int n = 0;
-  for (auto it = steps_.rbegin(); it != steps_.rend() && it->start > tick_; ++it) ++n;
-  return n;
+  return static_cast<int>(
+      std::count_if(steps_.begin(), steps_.end(), [&](const Scheduled& s) { return s.start > tick_; }));
 }
 
-double WalkPattern::time_to_end() const {
-  return standing() ? 0.0 : static_cast<double>(EndTick() - tick_) * tick_s_;
+double WalkPattern::planned_ahead() const {
+  if (steps_.empty() || steps_.back().land <= tick_) return 0;
+  return static_cast<double>(steps_.back().land - tick_) * tick_s_;
 }
 
 Side WalkPattern::support_side() const {
-  if (double_support()) return Side::kLeft;
-  return Other(steps_[static_cast<size_t>(StepAt(tick_))].step.side);
+  const Scheduled* s = Swinging();
+  return s ? Other(s->step.side) : Side::kLeft;
 }
 
-bool WalkPattern::double_support() const {
-  const int k = StepAt(tick_);
-  return k < 0 || tick_ - steps_[static_cast<size_t>(k)].start >= ss_ticks_;
-}
+bool WalkPattern::double_support() const { return Swinging() == nullptr; }
 
 Eigen::Vector2d WalkPattern::zmp() const {
   const double k = -g_.com_height / 9.81;  // only for the read-out; the preview uses its own g
@@ -203,21 +269,23 @@ Eigen::Vector2d WalkPattern::zmp() const {
 }
 
 void WalkPattern::UpdateFeet() {
-  const int k = StepAt(tick_);
+  foot_[0] = rest_[0];
+  foot_[1] = rest_[1];
   height_[0] = height_[1] = 0;
-  if (k < 0) {
-    foot_[0] = rest_[0];
-    foot_[1] = rest_[1];
-    return;
+  for (const Scheduled& st : steps_) {
+    if (st.start > tick_) break;
+    const int sw = static_cast<int>(st.step.side);
+    if (tick_ >= st.land) {
+      foot_[sw] = st.step.pose;
+      continue;
+    }
+    if (!st.swing) continue;  // a stand on the stance foot (StopSoon)
+    if (st.start == tick_) ++started_;
+    const double s = static_cast<double>(tick_ - st.start) / static_cast<double>(ss_ticks_);
+    const double m = std::clamp((s - 0.1) / 0.8, 0.0, 1.0);
+    foot_[sw] = Lerp(st.from, st.step.pose, 0.5 * (1 - std::cos(std::numbers::pi * m)));
+    height_[sw] = g_.step_height * 0.5 * (1 - std::cos(2 * std::numbers::pi * s));
   }
-  const Scheduled& st = steps_[static_cast<size_t>(k)];
-  const int sw = static_cast<int>(st.step.side);
-  foot_[1 - sw] = st.stance;
-  const double s =
-      std::clamp(static_cast<double>(tick_ - st.start) / static_cast<double>(ss_ticks_), 0.0, 1.0);
-  const double m = std::clamp((s - 0.1) / 0.8, 0.0, 1.0);
-  foot_[sw] = Lerp(st.from, st.step.pose, 0.5 * (1 - std::cos(std::numbers::pi * m)));
-  height_[sw] = g_.step_height * 0.5 * (1 - std::cos(2 * std::numbers::pi * s));
 }
 
 void WalkPattern::Tick() {
@@ -240,16 +308,12 @@ void WalkPattern::Tick() {
   const double t = static_cast<double>(phase == 0 ? every_ : phase) * tick_s_;
   cx_ = ZmpPreview::Propagate(sample_x_, ux_, t);
   cy_ = ZmpPreview::Propagate(sample_y_, uy_, t);
-  const int k = StepAt(tick_);
-  if (k >= 0 && steps_[static_cast<size_t>(k)].start == tick_) ++started_;
   UpdateFeet();
 }
 
 bool WalkPattern::InSupport(const Eigen::Vector2d& p, double margin) const {
-  const int k = StepAt(tick_);
-  if (k >= 0 && !double_support()) {
-    return InFoot(foot_[1 - static_cast<int>(steps_[static_cast<size_t>(k)].step.side)], g_, p, margin);
-  }
+  if (const Scheduled* s = Swinging())
+    return InFoot(foot_[1 - static_cast<int>(s->step.side)], g_, p, margin);
   // Convex hull of both soles (monotone chain), then the point against each edge.
   std::array<Eigen::Vector2d, 8> pts;
   const auto a = Corners(foot_[0], g_), b = Corners(foot_[1], g_);

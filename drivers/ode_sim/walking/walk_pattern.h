@@ -3,16 +3,26 @@
 // mass that ZMP preview control (zmp_preview.h) derives from it. Pure maths,
 // no ODE; the ode driver turns its output into joint targets (leg_ik.h).
 //
-// The schedule, from Append() on a standing robot: `start_lead` s standing
-// still (the preview must see the start coming: ZMP preview control moves the
-// CoM about a second ahead of its reference), a weight shift of `start_shift` s from the
-// centre of the feet onto the first stance foot, then per step `single_support`
-// s of swing (ZMP at the stance foot's ZMP point) and `double_support` s of
-// shifting onto the landed foot, the last step followed by `end_shift` s back
-// to the centre of both feet, then standing. Steps can be appended while
-// walking (SETSPEED keeps the queue ahead of the preview horizon) and the
-// queue can be cut short (STOP: the step in the air, if any, and one step
-// bringing the other foot alongside).
+// The ZMP reference is a chain of phases, each a straight move (or a hold)
+// between two points over a number of ticks: standing (hold at the middle of
+// the feet's ZMP points), a first shift of `start_shift` s onto the first
+// stance foot, per step `single_support` s on the stance foot (the other
+// foot swings) and `double_support` s of shifting onto the landed foot, and
+// after the last step `end_shift` s back to the middle of both feet.
+//
+// Replanning is a splice: the schedule is cut at a phase boundary (or inside
+// a standing hold), everything before the cut stays as it was, and the new
+// steps continue from the reference's value there. So the reference is
+// continuous whatever the command and its instant. A walk command (Append,
+// DropUnstarted) cuts no earlier than `start_lead` s ahead: the preview sees
+// every change of its reference at least that long before it happens (ZMP
+// preview control moves the CoM about a second ahead of a change). A stop
+// (StopSoon) keeps the step in the
+// air; the next step, whose single support the preview already counts on,
+// brings its foot alongside instead (or, with the feet side by side, the
+// weight stays on its stance foot for that time without a swing), and the
+// weight shifts back to the middle after it. So a stop changes the reference
+// no sooner than single_support ahead, whatever its phase.
 //
 // Swing foot: lifts and sets down with zero vertical speed (height
 // step_height * (1 - cos 2 pi s) / 2), moves horizontally and turns within
@@ -20,8 +30,8 @@
 //
 // Time: ticks of `tick` seconds (the driver's 1 ms); the preview runs every
 // `preview_every` ticks and the CoM in between follows the same jerk.
-// Thread safety: none (one thread). Allocation: the schedule grows when steps
-// are appended; Tick() does not allocate.
+// Thread safety: none (one thread). Allocation: planning (Append,
+// DropUnstarted, StopSoon) grows and prunes the schedule; Tick() does not allocate.
 #pragma once
 
 #include "walking/gait.h"
@@ -40,18 +50,29 @@ class WalkPattern {
 
   /// Standing with both feet around `centre`, the CoM at `com` (xy), at rest.
   void Reset(const Pose2& centre, const Eigen::Vector2d& com);
-  /// Appends steps (with their centres) to the schedule; starts walking if
-  /// standing or in the final shift of weight (after `start_lead`), else the
-  /// first new step follows the last one's double support without a pause.
+
+  /// Where new steps start after a splice: the stance centre they are
+  /// planned from, and the side of the first swing: forced (the weight is on
+  /// the other foot, or shifting to it) or free (standing).
+  struct Splice {
+    Pose2 centre;
+    Side next = Side::kLeft;
+    bool side_free = true;
+  };
+  /// Cuts the schedule `start_lead` s ahead (at the next boundary), dropping
+  /// the steps that would start after the cut (GOTO and SETSPEED re-plan);
+  /// returns where new steps start.
+  Splice DropUnstarted();
+  /// Where Append() would continue now without dropping anything.
+  Splice AppendPoint() const;
+  /// Appends steps (with their centres) after the last one, or after the
+  /// cut `start_lead` s ahead when the schedule ends sooner. REQUIRES: the
+  /// first step's side is AppendPoint().next unless side_free; steps alternate.
   void Append(const std::vector<Footstep>& steps, const std::vector<Pose2>& centres);
-  /// Cuts the schedule: keeps the step in the air (or, in double support,
-  /// none), then one step that brings the other foot alongside. Returns the
-  /// final stance centre.
+  /// STOP: keeps the step in the air, then at most one step bringing the
+  /// other foot alongside (above), then the shift back to the middle of the
+  /// feet. Returns the final stance centre.
   Pose2 StopSoon();
-  /// Drops the steps that have not started yet, keeping the one in the air
-  /// (for SETSPEED to re-plan); returns the centre they would start from
-  /// and the side of the next swing.
-  Pose2 DropUnstarted(Side* next_swing);
   /// One tick forward.
   void Tick();
 
@@ -64,8 +85,8 @@ class WalkPattern {
   bool settled(double tolerance = 1e-3) const;
   /// Steps scheduled but not yet started (the one in the air excluded).
   int unstarted_steps() const;
-  /// Time until the end of the schedule's last step, s (0 when standing).
-  double time_to_end() const;
+  /// Time from now until the last scheduled step lands, s (0 when none is ahead).
+  double planned_ahead() const;
   bool double_support() const;
   /// The foot that carries the robot: the stance foot in single support, else the left.
   Side support_side() const;
@@ -78,9 +99,7 @@ class WalkPattern {
   Eigen::Vector2d zmp() const;
   Eigen::Vector2d zmp_ref() const { return ZmpAt(tick_); }
   /// The stance centre of the last scheduled step (or the standing one).
-  const Pose2& final_centre() const { return final_centre_; }
-  /// The side of the next step to append (left when none is scheduled).
-  Side next_side() const { return steps_.empty() ? Side::kLeft : Other(steps_.back().step.side); }
+  const Pose2& final_centre() const { return steps_.empty() ? rest_centre_ : steps_.back().centre; }
   /// Steps whose swing has started since construction.
   int started_steps() const { return started_; }
   /// The feet's support polygon now contains p (m)? For tests: a foot's
@@ -90,19 +109,33 @@ class WalkPattern {
   double time() const { return static_cast<double>(tick_) * tick_s_; }
 
  private:
+  enum class Kind : std::uint8_t { kHold, kShift, kSingle, kEnd };
+  struct Phase {
+    std::int64_t start = 0, end = 0;  // ticks [start, end)
+    Eigen::Vector2d from = Eigen::Vector2d::Zero(), to = Eigen::Vector2d::Zero();
+    Kind kind = Kind::kHold;
+    int next = -1;  // the side that swings after this phase ends, -1: free
+  };
   struct Scheduled {
     Footstep step;
     Pose2 centre;
-    Pose2 from;              // the swing foot before the step
-    Pose2 stance;            // the other foot during the step
-    std::int64_t start = 0;  // tick where single support starts
+    Pose2 from;                        // the swing foot before the step
+    Pose2 stance;                      // the other foot during the step
+    std::int64_t start = 0, land = 0;  // single support [start, land)
+    bool swing = true;                 // false: the foot stays (a stop with the feet side by side)
   };
   Eigen::Vector2d ZmpPoint(const Pose2& foot) const;
   Eigen::Vector2d ZmpAt(std::int64_t tick) const;
-  int StepAt(std::int64_t tick) const;  // index of the step whose period holds tick, or -1 / size
-  std::int64_t EndTick() const;
+  int PhaseAt(std::int64_t tick) const;  // index of the phase holding tick, or -1 (before) / size (after)
+  std::int64_t CutTick(std::int64_t t) const;
+  std::int64_t AppendTick() const;
+  Splice SpliceAt(std::int64_t t) const;
+  void Cut(std::int64_t t);
+  void Prune();
+  void AddPhase(std::int64_t ticks, const Eigen::Vector2d& to, Kind kind, int next);
+  void AppendAt(std::int64_t t, const std::vector<Footstep>& steps, const std::vector<Pose2>& centres);
   void UpdateFeet();
-  void Reschedule(size_t keep);
+  const Scheduled* Swinging() const;  // the step in single support now, or null
 
   GaitParams g_;
   double tick_s_;
@@ -114,12 +147,12 @@ class WalkPattern {
   double ux_ = 0, uy_ = 0;
   Eigen::Vector3d sample_x_ = Eigen::Vector3d::Zero(), sample_y_ = Eigen::Vector3d::Zero();
   std::int64_t tick_ = 0;
-  std::int64_t walk_start_ = 0;  // tick where the start shift begins
-  std::vector<Scheduled> steps_;
-  Pose2 rest_[2];  // the feet when the schedule started
+  std::vector<Phase> phases_;     // contiguous; never empty
+  std::vector<Scheduled> steps_;  // in order; landed ones pruned when planning
+  Pose2 rest_[2];                 // the feet after the pruned steps
+  Pose2 rest_centre_;             // their stance centre
   Pose2 foot_[2];
   double height_[2] = {0, 0};
-  Pose2 final_centre_;
   int started_ = 0;
 };
 

@@ -1,0 +1,297 @@
+// The walking humanoid's phase sweep (issue 26, item 2; not a test): for each
+// transition — a command that cuts into a running walk and a command that
+// restarts it — the cutting command is sent at every `--every` ms over
+// `--span` s of the gait (from `--from` s after the first command), each run
+// from a fresh driver, and the run counts as a fall when the torso tilts past
+// the driver's bound within `--after` s of the last command. Prints per
+// transition the runs, falls and the worst tilt, and the instants that fell.
+// models/simple_humanoid.urdf on the ode driver (walk=true) at 1 kHz.
+//   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
+//                       [--after S] [--option key=value]...
+//   robotalk-walk-sweep --push standing|walking [--seed S]: per direction (8,
+//     every 45 degrees, 0 = a push forward, counter-clockwise) the largest impulse on the
+//     pelvis survived (a 0.1 s push through OdeDriver::PushForTesting, found by
+//     bisection to 1.25 N s); walking at the gait's full forward speed, the
+//     push lands at a seeded instant of the gait cycle.
+//   robotalk-walk-sweep --arms 1: both shoulders swung together +-1 rad every
+//     0.5 s for 6 s, standing and walking: fell or not.
+// Transitions (t = the swept instant, s after the first command):
+//   stop_goto        GOTO 1 m; STOP at t; GOTO 1 m at t + 0.1 s
+//   stop_wait_goto   GOTO 1 m; STOP at t; GOTO 1 m at t + 1.2 s
+//   speed_zero_back  SETSPEED 0.09; SETSPEED 0 at t; SETSPEED 0.09 at t + 1 s
+//   panic_reset_goto GOTO 1 m; panic (Halt) at t, reset; GOTO 1 m at t + 0.1 s
+//   stop             GOTO 1 m; STOP at t (the first shift of weight, a step, ...)
+// docs/ode_sim.md ("Walking", "Replanning") has the table.
+#include "ode_driver.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <functional>
+#include <map>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace robotalk;
+
+namespace {
+
+struct Args {
+  std::string model = std::string(ROBOTALK_BENCH_MODELS) + "/simple_humanoid.urdf";
+  std::string transition = "all";
+  double from = 1.0, span = 2.0, after = 4.0;
+  int every_ms = 20;
+  std::string push;   // --push standing|walking: the largest impulse survived per direction instead
+  bool arms = false;  // --arms 1: both arms swung together +-1 rad every 0.5 s, standing and walking
+  unsigned seed = 1;
+  std::map<std::string, std::string> options = {{"walk", "true"}};
+};
+
+Args Parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i], v = argv[i + 1];
+    if (k == "--transition") {
+      a.transition = v;
+    } else if (k == "--from") {
+      a.from = std::atof(v.c_str());
+    } else if (k == "--span") {
+      a.span = std::atof(v.c_str());
+    } else if (k == "--every") {
+      a.every_ms = std::atoi(v.c_str());
+    } else if (k == "--push") {
+      a.push = v;
+    } else if (k == "--arms") {
+      a.arms = v == "1";
+    } else if (k == "--seed") {
+      a.seed = static_cast<unsigned>(std::atoi(v.c_str()));
+    } else if (k == "--after") {
+      a.after = std::atof(v.c_str());
+    } else if (k == "--option") {
+      const size_t eq = v.find('=');
+      a.options[v.substr(0, eq)] = eq == std::string::npos ? "" : v.substr(eq + 1);
+    } else {
+      std::fprintf(stderr, "unknown argument %s\n", k.c_str());
+      std::exit(2);
+    }
+  }
+  if (a.every_ms <= 0 || a.span < 0 || a.after <= 0) {
+    std::fprintf(stderr, "--every must be > 0 ms, --span >= 0, --after > 0\n");
+    std::exit(2);
+  }
+  return a;
+}
+
+struct Run {
+  OdeDriver* ode;
+  Driver* d;
+  std::vector<Completion> done;
+  CommandId id = 0;
+  double max_tilt = 0;
+  void Exec(CommandType type, std::vector<double> values) {
+    DriverCommand c;
+    c.id = ++id;
+    c.type = type;
+    c.num_values = static_cast<int>(values.size());
+    for (size_t i = 0; i < values.size(); ++i) c.values[i] = values[i];
+    d->Execute(c, ode->sim_time(), done);
+  }
+  void Goto() { Exec(CommandType::kGoto, {1.0, 0, 0}); }
+  void Speed(double v) { Exec(CommandType::kSetSpeed, {v, 0}); }
+  void Joint(const char* name, double q) {
+    DriverCommand c;
+    c.id = ++id;
+    c.type = CommandType::kJointSetPoint;
+    c.target = ode->model().JointIndex(name);
+    c.num_values = 1;
+    c.values[0] = q;
+    d->Execute(c, ode->sim_time(), done);
+  }
+  void Stop() { d->Stop(ode->sim_time(), done); }
+  void Panic() {
+    d->Halt(done);
+    d->Resume();
+  }
+  // Steps to `t` s after t0; false once fallen.
+  bool Until(TimePoint t0, double t) {
+    while (ToSeconds(ode->sim_time() - t0) < t - 1e-9) {
+      ode->Step(10, done);
+      const walking::WalkStatus s = *ode->walk_status();
+      max_tilt = std::max(max_tilt, s.tilt);
+      if (s.fallen) return false;
+    }
+    return true;
+  }
+};
+
+// A transition: the actions at their times (t = the swept instant).
+struct Timed {
+  double at;
+  std::function<void(Run&)> act;
+};
+using Script = std::function<std::vector<Timed>(double t)>;
+
+const std::map<std::string, Script>& Transitions() {
+  static const std::map<std::string, Script> all = {
+      {"stop_goto",
+       [](double t) {
+         return std::vector<Timed>{{0, [](Run& r) { r.Goto(); }},
+                                   {t, [](Run& r) { r.Stop(); }},
+                                   {t + 0.1, [](Run& r) { r.Goto(); }}};
+       }},
+      {"stop_wait_goto",
+       [](double t) {
+         return std::vector<Timed>{{0, [](Run& r) { r.Goto(); }},
+                                   {t, [](Run& r) { r.Stop(); }},
+                                   {t + 1.2, [](Run& r) { r.Goto(); }}};
+       }},
+      {"speed_zero_back",
+       [](double t) {
+         return std::vector<Timed>{{0, [](Run& r) { r.Speed(0.09); }},
+                                   {t, [](Run& r) { r.Speed(0); }},
+                                   {t + 1.0, [](Run& r) { r.Speed(0.09); }}};
+       }},
+      {"panic_reset_goto",
+       [](double t) {
+         return std::vector<Timed>{{0, [](Run& r) { r.Goto(); }},
+                                   {t, [](Run& r) { r.Panic(); }},
+                                   {t + 0.1, [](Run& r) { r.Goto(); }}};
+       }},
+      {"stop",
+       [](double t) {
+         return std::vector<Timed>{{0, [](Run& r) { r.Goto(); }}, {t, [](Run& r) { r.Stop(); }}};
+       }},
+  };
+  return all;
+}
+
+// One run from a fresh driver; returns whether it fell, and the worst tilt.
+std::unique_ptr<Driver> NewDriver(const Args& args);
+
+bool FellOnce(const Args& args, const Script& script, double t, double* tilt) {
+  std::unique_ptr<Driver> d = NewDriver(args);
+  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+  r.ode->Step(1000, r.done);  // into the stance
+  const TimePoint t0 = r.ode->sim_time();
+  const std::vector<Timed> steps = script(t);
+  bool ok = true;
+  for (const Timed& a : steps) {
+    ok = ok && r.Until(t0, a.at);
+    if (ok) a.act(r);
+  }
+  ok = ok && r.Until(t0, steps.back().at + args.after);
+  *tilt = r.max_tilt;
+  return !ok;
+}
+
+std::unique_ptr<Driver> NewDriver(const Args& args) {
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  return registry.Create("ode",
+                         DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+}
+
+// Survives an impulse of `j` N s toward `angle` (rad from ahead), pushed at `at` s?
+bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at) {
+  std::unique_ptr<Driver> d = NewDriver(args);
+  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+  r.ode->Step(1000, r.done);
+  const TimePoint t0 = r.ode->sim_time();
+  if (walking) r.Speed(1.0);  // clamped to the gait's full speed
+  if (!r.Until(t0, at)) return false;
+  constexpr double kPushTime = 0.1;
+  r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
+                        FromSeconds(kPushTime));
+  return r.Until(t0, at + args.after);
+}
+
+int Pushes(const Args& args) {
+  const bool walking = args.push == "walking";
+  if (!walking && args.push != "standing") {
+    std::fprintf(stderr, "--push standing or --push walking\n");
+    return 2;
+  }
+  std::mt19937 rng(args.seed);
+  std::uniform_real_distribution<double> phase(0, 1.1);  // one gait period
+  std::printf("push %s: direction_deg  survived_N_s  fell_at_N_s  push_at_s\n", args.push.c_str());
+  for (int k = 0; k < 8; ++k) {
+    const double angle = k * std::numbers::pi / 4;
+    const double at = walking ? 5.0 + phase(rng) : 2.0;
+    double lo = 0, hi = 80;
+    if (SurvivesPush(args, walking, angle, hi, at)) lo = hi;
+    while (hi - lo > 1.25 && lo < hi) {
+      const double mid = 0.5 * (lo + hi);
+      (SurvivesPush(args, walking, angle, mid, at) ? lo : hi) = mid;
+    }
+    std::printf("%20d  %12.2f  %11.2f  %9.2f\n", k * 45, lo, hi, at);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+int ArmSwing(const Args& args) {
+  for (bool walking : {false, true}) {
+    std::unique_ptr<Driver> d = NewDriver(args);
+    Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+    r.ode->Step(1000, r.done);
+    const TimePoint t0 = r.ode->sim_time();
+    if (walking) r.Speed(1.0);
+    bool ok = r.Until(t0, 2.0);
+    for (int i = 0; ok && i < 12; ++i) {
+      const double q = i % 2 == 0 ? 1.0 : -1.0;
+      r.Joint("left_shoulder_pitch", q);
+      r.Joint("right_shoulder_pitch", q);
+      ok = r.Until(t0, 2.5 + 0.5 * i);
+    }
+    ok = ok && r.Until(t0, 9.0);
+    std::printf("arms swung +-1 rad every 0.5 s, %s: %s (worst tilt %.3f rad)\n",
+                walking ? "walking" : "standing", ok ? "stood" : "FELL", r.max_tilt);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = Parse(argc, argv);
+  if (!args.push.empty()) return Pushes(args);
+  if (args.arms) return ArmSwing(args);
+  if (args.transition != "all" && !Transitions().count(args.transition)) {
+    std::fprintf(stderr, "unknown transition %s\n", args.transition.c_str());
+    return 2;
+  }
+  const int n = static_cast<int>(std::floor(args.span * 1000 / args.every_ms + 1e-9)) + 1;
+  std::printf("transition        runs  falls  worst_tilt_rad  fell_at_s\n");
+  int total_falls = 0;
+  const std::clock_t cpu0 = std::clock();
+  double simulated = 0;
+  for (const auto& [name, script] : Transitions()) {
+    if (args.transition != "all" && args.transition != name) continue;
+    int falls = 0;
+    double worst = 0;
+    std::string fell_at;
+    for (int i = 0; i < n; ++i) {
+      const double t = args.from + i * args.every_ms * 1e-3;
+      double tilt = 0;
+      if (FellOnce(args, script, t, &tilt)) {
+        ++falls;
+        char at[16];
+        std::snprintf(at, sizeof at, " %.2f", t);
+        fell_at += at;
+      }
+      worst = std::max(worst, tilt);
+      simulated += 1.0 + script(t).back().at + args.after;
+    }
+    total_falls += falls;
+    std::printf("%-16s  %4d  %5d  %14.3f %s\n", name.c_str(), n, falls, worst, fell_at.c_str());
+    std::fflush(stdout);
+  }
+  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  std::printf("\nfalls %d; %.0f simulated s in %.0f CPU s (%.1f per CPU second)\n", total_falls, simulated,
+              cpu, simulated / cpu);
+  return total_falls == 0 ? 0 : 1;
+}
