@@ -411,34 +411,37 @@ void BindClient(py::module_& m) {
       .def(
           "send_trajectory",
           [](PyRobotClient& p, const std::string& target, std::vector<double> times,
-             std::vector<std::vector<double>> positions, std::optional<std::vector<std::vector<double>>> velocities,
+             std::vector<std::vector<double>> positions,
+             std::optional<std::vector<std::vector<double>>> velocities,
              std::optional<std::vector<std::vector<double>>> accelerations, const std::string& interpolation,
              const std::string& mode, std::optional<double> start, py::object delay, bool frame) {
             auto c = p.Client("send_trajectory");
             const auto kind = ParseInterpolation(interpolation);
             if (!kind) {
               throw UsageError("send_trajectory: unknown interpolation '" + interpolation +
-                                "' (step, linear, cubic, quintic)");
+                               "' (step, linear, cubic, quintic)");
             }
-            const auto rows = [&](const std::optional<std::vector<std::vector<double>>>& v, const char* what) {
+            const auto rows = [&](const std::optional<std::vector<std::vector<double>>>& v,
+                                  const char* what) {
               if (v && v->size() != times.size()) {
-                throw UsageError(std::string("send_trajectory: ") + what + " has " + std::to_string(v->size()) +
-                                  " rows for " + std::to_string(times.size()) + " times");
+                throw UsageError(std::string("send_trajectory: ") + what + " has " +
+                                 std::to_string(v->size()) + " rows for " + std::to_string(times.size()) +
+                                 " times");
               }
             };
             if (positions.size() != times.size()) {
-              throw UsageError("send_trajectory: positions has " + std::to_string(positions.size()) + " rows for " +
-                                std::to_string(times.size()) + " times");
+              throw UsageError("send_trajectory: positions has " + std::to_string(positions.size()) +
+                               " rows for " + std::to_string(times.size()) + " times");
             }
             rows(velocities, "velocities");
             rows(accelerations, "accelerations");
             std::vector<TrajectoryPoint> points;
             for (std::size_t i = 0; i < times.size(); ++i) {
-              points.push_back(TrajectoryPoint{.time_from_start = FromSeconds(times[i]),
-                                               .positions = positions[i],
-                                               .velocities = velocities ? (*velocities)[i] : std::vector<double>{},
-                                               .accelerations =
-                                                   accelerations ? (*accelerations)[i] : std::vector<double>{}});
+              points.push_back(TrajectoryPoint{
+                  .time_from_start = FromSeconds(times[i]),
+                  .positions = positions[i],
+                  .velocities = velocities ? (*velocities)[i] : std::vector<double>{},
+                  .accelerations = accelerations ? (*accelerations)[i] : std::vector<double>{}});
             }
             const TrajectoryOptions options{.mode = ParseMode(mode, "send_trajectory"),
                                             .interpolation = *kind,

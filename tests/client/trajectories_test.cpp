@@ -114,7 +114,8 @@ TEST_F(RobotClientWireTest, ASequenceSentInterpolatedCarriesItOnEveryPackageAndA
   SequenceResult result = client_->RunSequence(
       frames,
       {.delay = milliseconds(100), .paced = false, .batch = 200, .interpolation = Interpolation::kCubic});
-  for (const Reply& r : result.replies) EXPECT_TRUE(Succeeded(r.signal)) << ToString(r.signal) << ": " << r.message;
+  for (const Reply& r : result.replies)
+    EXPECT_TRUE(Succeeded(r.signal)) << ToString(r.signal) << ": " << r.message;
   std::vector<std::pair<Interpolation, std::size_t>> kinds;
   for (const Request& r : CommandPackages(TakeSent())) kinds.emplace_back(r.interpolation, r.commands.size());
   EXPECT_THAT(kinds, ::testing::ElementsAre(std::pair{Interpolation::kCubic, std::size_t{3}},

@@ -24,7 +24,7 @@
 #include "robotalk/client_errors.h"
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
-#include "robotalk/request.h"  // kMaxLateServerDefault, kMaxLateNever
+#include "robotalk/max_late.h"
 #include "robotalk/robot_model.h"
 #include "robotalk/state_sample.h"
 #include "robotalk/trajectory.h"

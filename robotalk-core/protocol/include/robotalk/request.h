@@ -10,6 +10,7 @@
 
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
+#include "robotalk/max_late.h"
 #include "robotalk/session_auth.h"
 #include "robotalk/state_sample.h"
 #include "robotalk/traffic_layout.h"
@@ -36,9 +37,6 @@ struct PlaybackDeclaration {
   Duration duration{0};     ///< offset of its last command
 };
 
-/// A Request's max_late: the robot's default (--max-late) and "never expires".
-inline constexpr Duration kMaxLateServerDefault{0};
-inline constexpr Duration kMaxLateNever = Duration::max();
 
 /// An item of a package that did not decode: it is answered ERROR.
 struct MalformedItem {
