@@ -515,6 +515,14 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
 void TrajectoryTracker::EndTrack(Track& t, TimePoint now, const std::string& why,
                                  std::vector<Answer>& answers) {
   if (!t.trajectory) return;
+  // Waypoints whose time has come were passed (the next control period would
+  // have answered them): only the ones still ahead are interrupted.
+  if (!t.pending.empty() && t.pending.front().waypoint.time <= now) {
+    const std::string label =
+        t.frame >= 0 ? "FRAME_SETPOINT '" + model_.frame(t.frame).name + "'"
+                     : "JOINT_SETPOINT '" + model_.joint(static_cast<int>(&t - tracks_.data())).name + "'";
+    AnswerPassed(t, now, label, answers);
+  }
   Interrupt(t, 0, now, why, answers);
   t.trajectory.reset();
   --active_;

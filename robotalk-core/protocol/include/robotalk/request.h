@@ -37,7 +37,6 @@ struct PlaybackDeclaration {
   Duration duration{0};     ///< offset of its last command
 };
 
-
 /// An item of a package that did not decode: it is answered ERROR.
 struct MalformedItem {
   CommandId id = 0;
