@@ -292,7 +292,8 @@ TEST_F(TrackerTest, ALateWaypointPastItsDeadlineExpires) {
 // A waypoint whose time came between two control periods was passed: a
 // STOP (or a step command) right after it does not call it INTERRUPTED.
 TEST_F(TrackerTest, AWaypointDueBeforeAnEndInTheSamePeriodCountsAsPassed) {
-  Add({Waypoint(1, 0, kT0 + milliseconds(100), {0.01}), Waypoint(2, 0, kT0 + milliseconds(200), {0.02})}, kT0);
+  Add({Waypoint(1, 0, kT0 + milliseconds(100), {0.01}), Waypoint(2, 0, kT0 + milliseconds(200), {0.02})},
+      kT0);
   Run(kT0, kT0 + milliseconds(90));
   tracker_.EndAll(kT0 + milliseconds(105), "stopped by STOP", answers_);
   ASSERT_NE(AnswerTo(1), nullptr);
