@@ -166,6 +166,13 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
   const int frame = item.command.target;
   Track& t = frame_tracks_[static_cast<std::size_t>(frame)];
   const std::string label = std::string("FRAME_SETPOINT '") + model_.frame(frame).name + "'";
+  if (t.chain.empty()) {  // as a step FRAME_SETPOINT would be answered by the drivers
+    answers.push_back(
+        {item.client_id, MakeAnswer(item.command.id, Signal::kNa,
+                                    label + ": no joint between the frame and its root accepts set-points",
+                                    now, Duration(0))});
+    return;
+  }
   if (t.trajectory && t.trajectory->interpolation() != item.interpolation) {
     EndFrame(frame, now,
              label + ": superseded by command " + std::to_string(item.command.id) + " (" +
