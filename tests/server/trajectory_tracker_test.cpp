@@ -32,6 +32,7 @@ RobotModel Arm() {
                 Dof{.axis = Eigen::Vector3d::UnitX(), .limits = {.lower = -3, .upper = 3, .velocity = 4}}};
   b.AddJoint(elbow, "base", "upper").AddJoint(wrist, "upper", "hand");
   b.AddControlFrame(ControlFrame{.name = "tool", .servo_types = ServoType::kSetPoint}, "hand");
+  b.AddControlFrame(ControlFrame{.name = "plate", .servo_types = ServoType::kSetPoint}, "base");
   b.SetRoot("base", Pose{}, BaseType::kFixed);
   return b.Build();
 }
@@ -299,6 +300,16 @@ TEST_F(TrackerTest, AWaypointDueBeforeAnEndInTheSamePeriodCountsAsPassed) {
   ASSERT_NE(AnswerTo(1), nullptr);
   EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kSuccess);
   EXPECT_EQ(AnswerTo(2)->reply.signal, Signal::kInterrupted);
+}
+
+TEST_F(TrackerTest, AFrameWaypointNoJointCanMoveAnswersNa) {
+  Add({Waypoint(1, 1, kT0 + milliseconds(500), {0, 0, 0, 1, 0, 0, 0}, Interpolation::kCubic, kAlice,
+                CommandType::kFrameSetPoint)},
+      kT0);
+  ASSERT_NE(AnswerTo(1), nullptr);
+  EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kNa);
+  EXPECT_THAT(AnswerTo(1)->reply.message, HasSubstr("FRAME_SETPOINT 'plate': no joint"));
+  EXPECT_FALSE(tracker_.active());
 }
 
 TEST_F(TrackerTest, EndInterruptsEveryWaypointNotYetPassed) {
