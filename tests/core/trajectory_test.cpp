@@ -137,19 +137,58 @@ TEST(Trajectory, TheFirstSegmentStartsFromTheActuatorsState) {
   EXPECT_EQ(cubic.velocity, start.velocity);
 }
 
-TEST(Trajectory, VelocitiesNotGivenFollowTheMonotoneRuleAndNeverOvershoot) {
-  // Equal spacing: v = 2 d0 d1 / (d0 + d1); zero at a turn and at the end.
+TEST(Trajectory, VelocitiesNotGivenFollowTheThreePointRuleAndPlateausStayFlat) {
+  // Equal spacing: v = (d0 + d1) / 2; zero next to a repeated position and at the end.
   const Trajectory traj = Make(Interpolation::kCubic, Rest(V({0})),
                                {{Ms(100), V({0.1}), {}, {}},
                                 {Ms(200), V({0.4}), {}, {}},
                                 {Ms(300), V({0.4}), {}, {}},
                                 {Ms(400), V({0.0}), {}, {}}});
-  EXPECT_NEAR(traj.knot(1).velocity[0], 2 * 1.0 * 3.0 / 4.0, 1e-12);
+  EXPECT_NEAR(traj.knot(1).velocity[0], (1.0 + 3.0) / 2, 1e-12);
   EXPECT_EQ(traj.knot(2).velocity[0], 0.0);  // a plateau
+  EXPECT_EQ(traj.knot(3).velocity[0], 0.0);
   EXPECT_EQ(traj.knot(4).velocity[0], 0.0);  // the end
   const LimitCheck check = traj.CheckLimits({});
-  EXPECT_NEAR(check.max_position[0], 0.4, 1e-12);
+  EXPECT_NEAR(check.max_position[0], 0.4, 1e-12);  // approaching a stop does not pass it
   EXPECT_NEAR(check.min_position[0], 0.0, 1e-12);
+  // Uneven spacing: the slope of the parabola through the three waypoints.
+  const Trajectory uneven =
+      Make(Interpolation::kCubic, Rest(V({0})),
+           {{Ms(100), V({0.2}), {}, {}}, {Ms(400), V({0.8}), {}, {}}, {Ms(500), V({0.9}), {}, {}}});
+  const double d0 = 0.6 / 0.3, d1 = 0.1 / 0.1;
+  EXPECT_NEAR(uneven.knot(2).velocity[0], (0.1 * d0 + 0.3 * d1) / 0.4, 1e-12);
+}
+
+TEST(Trajectory, ATurnPassesItsWaypointByAtMostAQuarterOfVelocityTimesDuration) {
+  // 0 -> 1 -> 0.9: the curve turns after the middle waypoint, as a smooth
+  // motion through those points would; by at most h·|v|/4 (h = 0.1 s).
+  const Trajectory traj = Make(Interpolation::kCubic, Rest(V({0})),
+                               {{Ms(100), V({0.0}), {}, {}},
+                                {Ms(200), V({1.0}), {}, {}},
+                                {Ms(300), V({0.9}), {}, {}},
+                                {Ms(400), V({0.9}), {}, {}}});
+  const double v = traj.knot(2).velocity[0];
+  EXPECT_NEAR(v, (10.0 - 1.0) / 2, 1e-12);
+  const LimitCheck check = traj.CheckLimits({});
+  EXPECT_GT(check.max_position[0], 1.0);
+  EXPECT_LE(check.max_position[0], 1.0 + 0.1 * v / 4);
+}
+
+TEST(Trajectory, ASineSampledAtTenHertzIsFollowedWithinAMilliradian) {
+  // docs/performance.md's kinematic goal (issue 22): a 0.5 Hz, 0.5 rad sine
+  // streamed as 10 Hz position-only waypoints, cubic and quintic.
+  for (double phase : {0.0, 0.3, 1.1}) {
+    auto sine = [phase](double t) { return 0.5 * std::sin(std::numbers::pi * t + phase); };
+    std::vector<Waypoint> points;
+    for (int k = 1; k <= 40; ++k) points.push_back({Ms(100.0 * k), V({sine(0.1 * k)}), {}, {}});
+    for (Interpolation kind : {Interpolation::kCubic, Interpolation::kQuintic}) {
+      const Trajectory traj = Make(kind, Rest(V({sine(0)})), points);
+      double worst = 0;
+      for (double ms = 300; ms <= 3700; ms += 1)
+        worst = std::max(worst, std::abs(At(traj, Ms(ms)).position[0] - sine(ms / 1000)));
+      EXPECT_LT(worst, 0.001) << InterpolationName(kind) << " phase " << phase;
+    }
+  }
 }
 
 TEST(Trajectory, AccelerationsNotGivenAreTheCentralDifferenceOfVelocities) {

@@ -257,13 +257,10 @@ void Trajectory::Resolve(std::size_t first) {
     const auto c = static_cast<Eigen::Index>(k);
     for (int i = 0; i < n; ++i) {
       const double d0 = (p_(i, c) - p_(i, c - 1)) / h0, d1 = (p_(i, c + 1) - p_(i, c)) / h1;
-      // Fritsch–Butland: a weighted harmonic mean never overshoots the waypoints.
-      if (d0 * d1 <= 0) {
-        v_(i, c) = 0;
-      } else {
-        const double w0 = 2 * h1 + h0, w1 = h1 + 2 * h0;
-        v_(i, c) = (w0 + w1) / (w0 / d0 + w1 / d1);
-      }
+      // The slope of the parabola through the knot and its neighbours (second
+      // order: a smooth motion sampled at its waypoints is followed closely);
+      // zero next to a repeated position, so a plateau or a stop stays flat.
+      v_(i, c) = d0 == 0 || d1 == 0 ? 0.0 : (h1 * d0 + h0 * d1) / (h0 + h1);
     }
   }
   for (std::size_t k = first; k <= last && interpolation_ == Interpolation::kQuintic; ++k) {

@@ -8,9 +8,14 @@
 // after it is a knot. Velocities and accelerations not given are chosen when
 // the waypoints are added, from that batch and the knot before it, and never
 // change afterwards (so a splice never moves the past):
-//  - velocity (kCubic, kQuintic): the monotone (Fritsch–Butland, "PCHIP")
-//    weighted harmonic mean of the two adjacent slopes, zero where the slopes
-//    differ in sign or one is zero; zero at the last waypoint of a batch.
+//  - velocity (kCubic, kQuintic): the three-point rule, the slope of the
+//    parabola through the knot and its neighbours, (h1·d0 + h0·d1)/(h0 + h1)
+//    for the adjacent slopes d0, d1 over spacings h0, h1; zero where one of
+//    them is zero (a repeated position: a plateau, a stop); zero at the last
+//    waypoint of a batch. At a turn the curve may pass the turning waypoint
+//    (a cubic by at most h·|v|/4 for a segment of duration h whose knots'
+//    velocities are at most |v|); the server clamps references to the joint
+//    limits whatever the plan.
 //  - acceleration (kQuintic): the central difference of the knot velocities
 //    either side, (v[k+1] - v[k-1]) / (t[k+1] - t[k-1]); zero at the last
 //    waypoint of a batch.
