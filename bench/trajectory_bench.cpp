@@ -1,7 +1,7 @@
 // Issue 22's figures (not a test; scripts/bench.sh runs it, docs/performance.md
 // "Trajectories (issue 22)"). Everything runs in-process: a RobotDaemon on a
 // ManualClock (tests/support/sine_stream.h), no network.
-//   robotalk-trajectory-bench SHARED_ROBOTS_DIR [--csv FILE] [--quick]
+//   robotalk-trajectory-bench SHARED_ROBOTS_DIR [--csv FILE] [--quick] [--cost-only]
 // (a) the iiwa14 sine (0.5 Hz, 0.5 rad, on iiwa_joint_6) streamed by a
 //     delay-mode client (300 ms ahead) at 10 Hz and 100 Hz frames, on the
 //     kinematic and ODE drivers, step / linear / cubic / quintic: max and RMS
@@ -28,26 +28,9 @@
 #include <random>
 #include <string>
 
-// Every heap allocation, not only operator new's (support/allocation_counter):
-// Eigen's matrices allocate with malloc. glibc's own entry points do the work.
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
-namespace {
-long g_mallocs = 0;
-}  // namespace
-extern "C" void* malloc(std::size_t n) noexcept {
-  ++g_mallocs;
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t size) noexcept {
-  ++g_mallocs;
-  return __libc_calloc(n, size);
-}
-extern "C" void* realloc(void* p, std::size_t n) noexcept {
-  ++g_mallocs;
-  return __libc_realloc(p, n);
-}
+// Every heap allocation, not only operator new's: Eigen's matrices allocate
+// with malloc (tests/support/allocation_counter counts both).
+#include "support/allocation_counter.h"  // g_mallocs
 
 using namespace robotalk;
 using robotalk::testing::ManualDaemon;
@@ -326,18 +309,22 @@ void TrackerAllocations() {
 
 int main(int argc, char** argv) {
   std::string shared = "../shared/robots", csv;
-  bool quick = false;
+  bool quick = false, cost_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
       csv = argv[++i];
     } else if (std::strcmp(argv[i], "--quick") == 0) {
       quick = true;
+    } else if (std::strcmp(argv[i], "--cost-only") == 0) {
+      cost_only = true;
     } else {
       shared = argv[i];
     }
   }
   const std::string urdf = shared + "/iiwa14.urdf";
-  if (std::ifstream(urdf).good()) {
+  if (cost_only) {
+    std::printf("(a), (b): not measured (--cost-only)\n");
+  } else if (std::ifstream(urdf).good()) {
     std::printf(
         "(a) iiwa14 '%s', 0.5 Hz 0.5 rad sine, delay mode 300 ms, 6 s of frames; measured position against "
         "the continuous sine every control period (kinematic: 1 ms; ode: 10 ms, its default), from the first "

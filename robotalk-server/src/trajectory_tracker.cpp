@@ -38,6 +38,15 @@ std::string Append(const std::string& note, const std::string& more) {
 
 }  // namespace
 
+TrajectoryTracker::Pending& TrajectoryTracker::PendingQueue::push_back() {
+  if (count_ == slots_.size()) {  // full: unroll the ring, then double it
+    std::rotate(slots_.begin(), slots_.begin() + static_cast<std::ptrdiff_t>(head_), slots_.end());
+    head_ = 0;
+    slots_.resize(std::max<std::size_t>(4, 2 * slots_.size()));
+  }
+  return (*this)[count_++];
+}
+
 TrajectoryTracker::TrajectoryTracker(const RobotModel& model, TrackerOptions options)
     : model_(model),
       options_(options),
@@ -78,6 +87,17 @@ TrajectoryTracker::TrajectoryTracker(const RobotModel& model, TrackerOptions opt
       }
     }
   }
+  for (std::size_t j = 0; j < tracks_.size(); ++j)
+    tracks_[j].label = std::string("JOINT_SETPOINT '") + model.joint(static_cast<int>(j)).name + "'";
+  for (std::size_t f = 0; f < frame_tracks_.size(); ++f)
+    frame_tracks_[f].label = std::string("FRAME_SETPOINT '") + model.frame(static_cast<int>(f)).name + "'";
+  // The buffers an addition reuses, sized once.
+  for (std::vector<Track>* tracks : {&tracks_, &frame_tracks_}) {
+    for (Track& t : *tracks) {
+      t.incoming.waypoint.position = Eigen::VectorXd::Zero(t.dofs);
+      t.batch.assign(3, Waypoint{{}, Eigen::VectorXd::Zero(t.dofs), {}, {}});
+    }
+  }
   // A joint a frame's trajectory moves gets its references from the
   // inverse kinematics, limited as its own (sized once).
   for (Track& t : tracks_) {
@@ -88,6 +108,7 @@ TrajectoryTracker::TrajectoryTracker(const RobotModel& model, TrackerOptions opt
   }
   ik_start_ = Eigen::VectorXd::Zero(model.num_dofs());
   references_.reserve(tracks_.size());
+  order_.reserve(64);
 }
 
 std::size_t TrajectoryTracker::pending() const {
@@ -101,13 +122,15 @@ void TrajectoryTracker::Add(std::span<const QueuedItem> waypoints, TimePoint now
                             std::vector<Answer>& answers, std::vector<Started>& started) {
   // Waypoints in time order per joint (ties in arrival order), so a package's
   // batch appends rather than splicing into itself.
-  std::vector<const QueuedItem*> order;
-  order.reserve(waypoints.size());
+  std::vector<const QueuedItem*>& order = order_;
+  order.clear();
   for (const QueuedItem& w : waypoints) order.push_back(&w);
-  std::stable_sort(order.begin(), order.end(), [](const QueuedItem* a, const QueuedItem* b) {
+  // std::sort, not stable_sort (which allocates): ties in arrival order by
+  // their place in `waypoints`.
+  std::sort(order.begin(), order.end(), [](const QueuedItem* a, const QueuedItem* b) {
     if (a->command.type != b->command.type) return a->command.type < b->command.type;
-    return a->command.target != b->command.target ? a->command.target < b->command.target
-                                                  : a->start < b->start;
+    if (a->command.target != b->command.target) return a->command.target < b->command.target;
+    return a->start != b->start ? a->start < b->start : a < b;
   });
   for (const QueuedItem* w : order) {
     if (w->command.type == CommandType::kFrameSetPoint) {
@@ -122,20 +145,20 @@ void TrajectoryTracker::AddJointWaypoint(const QueuedItem& item, TimePoint now, 
                                          std::vector<Answer>& answers, std::vector<Started>& started) {
   const int joint = item.command.target;
   Track& t = tracks_[static_cast<std::size_t>(joint)];
-  const std::string label = std::string("JOINT_SETPOINT '") + model_.joint(joint).name + "'";
+  const std::string& label = t.label;
   if (t.moved_by >= 0) {  // a frame's trajectory moves it: the joint's own waypoint replaces that
     EndFrame(t.moved_by, now,
              "FRAME_SETPOINT '" + model_.frame(t.moved_by).name + "': superseded by " + label + " command " +
                  std::to_string(item.command.id),
              answers);
   }
-  Pending p;
+  Pending& p = t.incoming;
   p.client_id = item.client_id;
   p.id = item.command.id;
   p.requested = item.start;
+  p.note.clear();
   Waypoint& w = p.waypoint;
   w.time = item.start;
-  w.position.resize(t.dofs);
   for (int k = 0; k < t.dofs; ++k) {
     const double want = item.command.values[static_cast<std::size_t>(k)];
     const double got = std::clamp(want, t.limits.position_min[k], t.limits.position_max[k]);
@@ -145,17 +168,23 @@ void TrajectoryTracker::AddJointWaypoint(const QueuedItem& item, TimePoint now, 
                                   (want > got ? "upper" : "lower") + " limit " + Number(got));
     }
   }
-  if (item.num_velocities == t.dofs) {
-    w.velocity = Eigen::Map<const Eigen::VectorXd>(item.velocities.data(), t.dofs);
-  }
-  if (item.num_accelerations == t.dofs) {
-    w.acceleration = Eigen::Map<const Eigen::VectorXd>(item.accelerations.data(), t.dofs);
-  }
+  // Given rates, or empty (chosen); the vectors keep their memory while the kind does not change.
+  const auto rates = [&t](Eigen::VectorXd& out, int given, const std::array<double, 6>& values) {
+    if (given == t.dofs) {
+      out = Eigen::Map<const Eigen::VectorXd>(values.data(), t.dofs);
+    } else if (out.size() != 0) {
+      out.resize(0);
+    }
+  };
+  rates(w.velocity, item.num_velocities, item.velocities);
+  rates(w.acceleration, item.num_accelerations, item.accelerations);
   const bool idle = !t.trajectory;
-  TrajectoryState start;
-  start.position = state.position.segment(t.first_dof, t.dofs);
-  start.velocity = state.velocity.segment(t.first_dof, t.dofs);
-  if (!Join(t, label, std::move(p), item, now, start, answers)) return;
+  TrajectoryState start;  // where an idle joint's trajectory starts
+  if (idle) {
+    start.position = state.position.segment(t.first_dof, t.dofs);
+    start.velocity = state.velocity.segment(t.first_dof, t.dofs);
+  }
+  if (!Join(t, label, p, item, now, start, answers)) return;
   if (idle || t.owner != item.client_id)
     started.push_back({item.client_id, CommandType::kJointSetPoint, joint});
   t.owner = item.client_id;
@@ -165,7 +194,7 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
                                          std::vector<Answer>& answers, std::vector<Started>& started) {
   const int frame = item.command.target;
   Track& t = frame_tracks_[static_cast<std::size_t>(frame)];
-  const std::string label = std::string("FRAME_SETPOINT '") + model_.frame(frame).name + "'";
+  const std::string& label = t.label;
   if (t.chain.empty()) {  // as a step FRAME_SETPOINT would be answered by the drivers
     answers.push_back(
         {item.client_id, MakeAnswer(item.command.id, Signal::kNa,
@@ -211,10 +240,11 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
     start.velocity.tail<3>() = t.base.conjugate() * Eigen::Vector3d(twist.tail<3>());
     ik_start_ = state.position;
   }
-  Pending p;
+  Pending& p = t.incoming;
   p.client_id = item.client_id;
   p.id = item.command.id;
   p.requested = item.start;
+  p.note.clear();
   Waypoint& w = p.waypoint;
   w.time = item.start;
   const auto& v = item.command.values;
@@ -222,19 +252,21 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
   q.normalize();
   if (q.dot(t.base) < 0) q.coeffs() = -q.coeffs();  // the same rotation, the short way from the base
   const Eigen::AngleAxisd relative(t.base.conjugate() * q);
-  w.position = Eigen::VectorXd(6);
   w.position << v[0], v[1], v[2], relative.angle() * relative.axis();
   // Given rates are world twists: the rotation part in the base's axes (the
   // rotation vector's rate, exact while the rotation turns about one axis).
-  const auto twist = [&](const std::array<double, 6>& r) {
-    Eigen::VectorXd out(6);
+  const auto twist = [&t](Eigen::VectorXd& out, int given, const std::array<double, 6>& r) {
+    if (given != 6) {
+      if (out.size() != 0) out.resize(0);
+      return;
+    }
+    out.resize(6);
     out.head<3>() = Eigen::Vector3d(r[0], r[1], r[2]);
     out.tail<3>() = t.base.conjugate() * Eigen::Vector3d(r[3], r[4], r[5]);
-    return out;
   };
-  if (item.num_velocities == 6) w.velocity = twist(item.velocities);
-  if (item.num_accelerations == 6) w.acceleration = twist(item.accelerations);
-  if (!Join(t, label, std::move(p), item, now, start, answers)) return;
+  twist(w.velocity, item.num_velocities, item.velocities);
+  twist(w.acceleration, item.num_accelerations, item.accelerations);
+  if (!Join(t, label, p, item, now, start, answers)) return;
   if (idle) {
     for (int j : t.chain) {
       Track& joint = tracks_[static_cast<std::size_t>(j)];
@@ -254,7 +286,7 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
   t.owner = item.client_id;
 }
 
-bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, const QueuedItem& item,
+bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending& p, const QueuedItem& item,
                              TimePoint now, const TrajectoryState& start, std::vector<Answer>& answers) {
   Waypoint& w = p.waypoint;
   // A trajectory of another interpolation is replaced from now, as a splice.
@@ -313,7 +345,7 @@ bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, cons
                                                                : " of another client (last commanded wins)"),
               answers);
   }
-  std::vector<Waypoint> batch;
+  std::size_t batch = 0;  // t.batch's used entries
   TimePoint splice = now;
   // The waypoints whose chosen rates depend on the new one are planned again:
   // the one before it (its velocity), and for quintic the one before that
@@ -325,11 +357,11 @@ bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, cons
     // Splice at the knot before them, when that is still ahead.
     const TimePoint prior = from >= 1 ? t.pending[from - 1].waypoint.time : traj.knot_time(0);
     splice = std::max(prior, now);
-    for (std::size_t i = from; i < keep; ++i) batch.push_back(t.pending[i].waypoint);
+    for (std::size_t i = from; i < keep; ++i) t.batch[batch++] = t.pending[i].waypoint;
   }
-  batch.push_back(w);
+  t.batch[batch++] = w;
   try {
-    traj.Splice(splice, batch);
+    traj.Splice(splice, std::span<const Waypoint>(t.batch.data(), batch));
   } catch (const Error& e) {  // a time the trajectory cannot take: refused, nothing changed
     answers.push_back({item.client_id, MakeAnswer(item.command.id, Signal::kError, label + ": " + e.what(),
                                                   now, Duration(0))});
@@ -339,7 +371,7 @@ bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending p, cons
     }
     return false;
   }
-  t.pending.push_back(std::move(p));
+  t.pending.push_back() = p;
   return true;
 }
 
@@ -349,7 +381,7 @@ void TrajectoryTracker::Interrupt(Track& t, std::size_t from, TimePoint now, con
     answers.push_back(
         {t.pending[i].client_id, MakeAnswer(t.pending[i].id, Signal::kInterrupted, why, now, Duration(0))});
   }
-  t.pending.erase(t.pending.begin() + static_cast<std::ptrdiff_t>(from), t.pending.end());
+  t.pending.truncate(from);
 }
 
 void TrajectoryTracker::AnswerPassed(Track& t, TimePoint now, const std::string& label,
@@ -380,7 +412,7 @@ void TrajectoryTracker::Sample(TimePoint now, std::vector<Answer>& answers) {
     traj.Sample(now, &t.sample);
     Limit(t, now);
     if (!t.pending.empty() && t.pending.front().waypoint.time <= now) {
-      AnswerPassed(t, now, "JOINT_SETPOINT '" + model_.joint(static_cast<int>(j)).name + "'", answers);
+      AnswerPassed(t, now, t.label, answers);
     }
     references_.push_back(JointReference{static_cast<int>(j),
                                          {t.ref_position.data(), static_cast<std::size_t>(t.dofs)},
@@ -440,14 +472,13 @@ void TrajectoryTracker::SampleFrame(Track& f, TimePoint now, std::vector<Answer>
                                          {t.ref_acceleration.data(), static_cast<std::size_t>(t.dofs)}});
   }
   if (!f.pending.empty() && f.pending.front().waypoint.time <= now) {
-    const std::string label = "FRAME_SETPOINT '" + model_.frame(f.frame).name + "'";
     if (!solved.within_tolerance) {
       char text[160];
       std::snprintf(text, sizeof text, "the inverse kinematics ended %.3g m and %.3g rad from the pose",
                     solved.position_error, solved.orientation_error);
       f.pending.front().note = Append(f.pending.front().note, text);
     }
-    AnswerPassed(f, now, label, answers);
+    AnswerPassed(f, now, f.label, answers);
   }
   if (f.pending.empty() && f.sample.holding && f.sample.velocity.isZero(0.0) && joints_on_plan && at_rest) {
     EndFrame(f.frame, now, "", answers);
@@ -524,12 +555,7 @@ void TrajectoryTracker::EndTrack(Track& t, TimePoint now, const std::string& why
   if (!t.trajectory) return;
   // Waypoints whose time has come were passed (the next control period would
   // have answered them): only the ones still ahead are interrupted.
-  if (!t.pending.empty() && t.pending.front().waypoint.time <= now) {
-    const std::string label =
-        t.frame >= 0 ? "FRAME_SETPOINT '" + model_.frame(t.frame).name + "'"
-                     : "JOINT_SETPOINT '" + model_.joint(static_cast<int>(&t - tracks_.data())).name + "'";
-    AnswerPassed(t, now, label, answers);
-  }
+  if (!t.pending.empty() && t.pending.front().waypoint.time <= now) AnswerPassed(t, now, t.label, answers);
   Interrupt(t, 0, now, why, answers);
   t.trajectory.reset();
   --active_;

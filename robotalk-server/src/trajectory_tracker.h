@@ -36,8 +36,11 @@
 // - Each waypoint is answered when the trajectory passes it: SUCCESS, or
 //   MODIFIED with what was changed.
 //
-// Allocation: Sample() does not allocate once every joint has had a
-// trajectory (answers with a message allocate it); Add() and End() do.
+// Allocation: once every joint has had a trajectory and each has held its
+// most waypoints, neither Sample() nor Add() of a waypoint appended to a
+// running trajectory allocates; an answer with a message (MODIFIED,
+// INTERRUPTED, a refusal) allocates its text, and so do End(), a trajectory's
+// start and a frame trajectory's start.
 #pragma once
 
 #include "command_queue.h"
@@ -50,7 +53,6 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <span>
 #include <string>
@@ -117,9 +119,36 @@ class TrajectoryTracker {
     Waypoint waypoint;      // as given (position clamped; rates as given or empty)
     std::string note;       // why it is MODIFIED, or ""
   };
+  // The waypoints not yet passed, oldest first. Its slots (and the vectors in
+  // them) are reused: it allocates only to grow past the most it has held.
+  class PendingQueue {
+   public:
+    bool empty() const { return count_ == 0; }
+    std::size_t size() const { return count_; }
+    Pending& operator[](std::size_t i) { return slots_[(head_ + i) % slots_.size()]; }
+    const Pending& operator[](std::size_t i) const { return slots_[(head_ + i) % slots_.size()]; }
+    Pending& front() { return (*this)[0]; }
+    Pending& back() { return (*this)[count_ - 1]; }
+    const Pending& back() const { return (*this)[count_ - 1]; }
+    void pop_front() {
+      head_ = (head_ + 1) % slots_.size();
+      --count_;
+    }
+    /// Keeps the first `n`.
+    void truncate(std::size_t n) { count_ = std::min(count_, n); }
+    /// A slot at the back, holding whatever it held last: assign it.
+    Pending& push_back();
+
+   private:
+    std::vector<Pending> slots_;
+    std::size_t head_ = 0, count_ = 0;
+  };
   struct Track {
     std::optional<Trajectory> trajectory;
-    std::deque<Pending> pending;
+    std::string label;  // "JOINT_SETPOINT 'name'" / "FRAME_SETPOINT 'name'", for answers
+    PendingQueue pending;
+    Pending incoming;             // the waypoint being added (reused)
+    std::vector<Waypoint> batch;  // the waypoints spliced in by one addition (reused; at most 3)
     TrajectorySample sample;
     TrajectoryLimits limits;
     // The reference handed to the driver (limited), and whether it is the plan's sample.
@@ -148,7 +177,8 @@ class TrajectoryTracker {
                         std::vector<Answer>& answers, std::vector<Started>& started);
   // Joins `p` to `t`'s trajectory (starting it at `now` from `start` when
   // idle): late, splice and replacement rules. False when refused (answered).
-  bool Join(Track& t, const std::string& label, Pending p, const QueuedItem& item, TimePoint now,
+  // `start` is used only when the track is idle. `p` is t.incoming.
+  bool Join(Track& t, const std::string& label, Pending& p, const QueuedItem& item, TimePoint now,
             const TrajectoryState& start, std::vector<Answer>& answers);
   void EndTrack(Track& t, TimePoint now, const std::string& why, std::vector<Answer>& answers);
   void EndFrame(int frame, TimePoint now, const std::string& why, std::vector<Answer>& answers);
@@ -171,6 +201,7 @@ class TrajectoryTracker {
   Eigen::VectorXd ik_start_;  // where the next solve starts (the last solution)
   std::vector<Eigen::Isometry3d> roots_;
   std::vector<JointReference> references_;
+  std::vector<const QueuedItem*> order_;  // Add()'s waypoints in time order (reused)
   int active_ = 0;
 };
 

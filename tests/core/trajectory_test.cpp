@@ -10,7 +10,7 @@
 #include <numbers>
 #include <random>
 
-#include "support/allocation_counter.h"  // g_allocations
+#include "support/allocation_counter.h"  // g_allocations, g_mallocs
 
 namespace robotalk {
 namespace {
@@ -333,6 +333,32 @@ TEST(Trajectory, SampleDoesNotAllocate) {
   const long before = g_allocations;
   for (int ms = -10; ms < 1000; ++ms) traj.Sample(Ms(ms), &s);
   EXPECT_EQ(g_allocations, before);
+}
+
+TEST(Trajectory, SplicingAStreamDoesNotAllocateOnceSized) {
+  // As the server's tracker does with a stream: splice the next waypoint at
+  // the knot before the last, re-planning it, and forget the passed knots.
+  Trajectory traj(Interpolation::kQuintic, Ms(0), Rest(V({0, 0})), V({20, 20}));
+  std::vector<Waypoint> batch(2, Waypoint{Ms(0), V({0, 0}), {}, {}});
+  TrajectorySample s = traj.MakeSample();
+  long during = 0;
+  for (int k = 1; k < 600; ++k) {
+    const double t = 0.01 * k;
+    const long before = g_mallocs;
+    batch[0].time = Ms(10.0 * k);
+    batch[0].position = batch[1].position;
+    batch[1].time = Ms(10.0 * (k + 1));
+    batch[1].position << std::sin(t), std::cos(t);
+    if (k == 1) {
+      traj.Append(std::span<const Waypoint>(batch.data() + 1, 1));
+    } else {
+      traj.Splice(Ms(10.0 * (k - 1)), batch);
+    }
+    traj.Sample(Ms(10.0 * k - 5), &s);
+    if (traj.num_knots() > 64) traj.Forget(Ms(10.0 * k - 5));
+    if (k >= 300) during += g_mallocs - before;
+  }
+  EXPECT_EQ(during, 0);
 }
 
 TEST(Trajectory, CheckLimitsReportsTheLargestVelocityAndAccelerationPerDof) {

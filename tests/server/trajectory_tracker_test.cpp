@@ -12,6 +12,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "support/allocation_counter.h"  // g_mallocs
+
 namespace robotalk {
 namespace {
 
@@ -140,6 +142,32 @@ TEST_F(TrackerTest, AStreamOfSingleWaypointsMovesSmoothlyNotStopAndGo) {
       EXPECT_EQ(a.reply.signal, Signal::kSuccess) << a.reply.message;
     }
   }
+}
+
+TEST_F(TrackerTest, AStreamOfWaypointsAppendedToARunningTrajectoryDoesNotAllocate) {
+  // Issue 22's goal: no allocation on the control path, the periods in which
+  // waypoints arrive included, once warmed up (every buffer at its size, past
+  // the knot bound). Quintic (the widest re-plan), on a 1-dof and a 2-dof joint.
+  answers_.reserve(256);
+  started_.reserve(16);
+  std::vector<QueuedItem> batch;
+  batch.reserve(2);
+  const RobotState rest = Rest(model_);
+  const auto wave = [](TimePoint t) { return 0.5 * std::sin(std::numbers::pi * ToSeconds(t - kT0)); };
+  long during = 0;
+  for (int k = 0; k < 400; ++k) {
+    const TimePoint now = kT0 + milliseconds(10 * k), at = now + milliseconds(100);
+    batch.clear();
+    batch.push_back(Waypoint(2 * k + 1, 0, at, {wave(at)}, Interpolation::kQuintic));
+    batch.push_back(Waypoint(2 * k + 2, 1, at, {wave(at), -wave(at)}, Interpolation::kQuintic));
+    answers_.clear();
+    const long before = g_mallocs;
+    tracker_.Add(batch, now, rest, answers_, started_);
+    tracker_.Sample(now, answers_);
+    if (k >= 200) during += g_mallocs - before;
+  }
+  EXPECT_EQ(during, 0) << "allocations in 200 periods with arrivals";
+  for (const auto& a : answers_) EXPECT_EQ(a.reply.signal, Signal::kSuccess) << a.reply.message;
 }
 
 TEST_F(TrackerTest, ASpliceReplacesTheRemainderContinuouslyAndInterruptsWhatItReplaced) {

@@ -151,18 +151,32 @@ Trajectory::Trajectory(Interpolation interpolation, TimePoint start_time, const 
     }
   }
   times_.push_back(start_time);
-  p_ = start.position;
-  v_ = start.velocity.size() ? start.velocity : Eigen::VectorXd::Zero(n);
-  a_ = start.acceleration.size() ? start.acceleration : Eigen::VectorXd::Zero(n);
+  constexpr Eigen::Index kInitialKnots = 8;
+  p_ = Eigen::MatrixXd::Zero(n, kInitialKnots);
+  v_ = Eigen::MatrixXd::Zero(n, kInitialKnots);
+  a_ = Eigen::MatrixXd::Zero(n, kInitialKnots);
+  p_.col(0) = start.position;
+  if (start.velocity.size()) v_.col(0) = start.velocity;
+  if (start.acceleration.size()) a_.col(0) = start.acceleration;
   given_v_.push_back(true);
   given_a_.push_back(true);
+  splice_sample_ = MakeSample();
 }
 
-void Trajectory::CheckWaypoints(TimePoint after, const std::vector<Waypoint>& waypoints) const {
+void Trajectory::CheckWaypoints(TimePoint after, std::span<const Waypoint> waypoints) const {
   const int n = num_dofs();
+  const auto fine = [n](const Eigen::VectorXd& v, bool optional) {
+    return (optional && v.size() == 0) || (v.size() == n && v.allFinite());
+  };
   TimePoint previous = after;
   for (std::size_t i = 0; i < waypoints.size(); ++i) {
     const Waypoint& w = waypoints[i];
+    // The text is built only for a waypoint that is refused (no allocation otherwise).
+    if (w.time > previous && fine(w.position, false) && fine(w.velocity, true) &&
+        fine(w.acceleration, true)) {
+      previous = w.time;
+      continue;
+    }
     const std::string name = "Trajectory: waypoint " + std::to_string(i);
     if (w.time <= previous) {
       throw Error(
@@ -174,37 +188,43 @@ void Trajectory::CheckWaypoints(TimePoint after, const std::vector<Waypoint>& wa
     CheckVector(name + ": position", w.position, n, false);
     CheckVector(name + ": velocity", w.velocity, n, true);
     CheckVector(name + ": acceleration", w.acceleration, n, true);
-    previous = w.time;
   }
 }
 
-void Trajectory::AddKnots(const std::vector<Waypoint>& waypoints) {
-  const std::size_t first = times_.size();
-  const Eigen::Index n = num_dofs(), k0 = static_cast<Eigen::Index>(first);
-  const Eigen::Index total = k0 + static_cast<Eigen::Index>(waypoints.size());
-  p_.conservativeResize(n, total);
-  v_.conservativeResize(n, total);
-  a_.conservativeResize(n, total);
-  for (std::size_t i = 0; i < waypoints.size(); ++i) {
-    const Waypoint& w = waypoints[i];
-    const Eigen::Index k = k0 + static_cast<Eigen::Index>(i);
-    times_.push_back(w.time);
-    p_.col(k) = w.position;
-    given_v_.push_back(w.velocity.size() != 0);
-    given_a_.push_back(w.acceleration.size() != 0);
-    v_.col(k) = given_v_.back() ? w.velocity : Eigen::VectorXd::Zero(n);
-    a_.col(k) = given_a_.back() ? w.acceleration : Eigen::VectorXd::Zero(n);
+void Trajectory::AddKnot(TimePoint time, const Eigen::VectorXd& position, const Eigen::VectorXd& velocity,
+                         const Eigen::VectorXd& acceleration) {
+  const auto k = static_cast<Eigen::Index>(times_.size());
+  if (k == p_.cols()) {  // the knot storage grows by doubling and never shrinks: no allocation once sized
+    for (Eigen::MatrixXd* m : {&p_, &v_, &a_}) m->conservativeResize(Eigen::NoChange, 2 * k);
   }
+  times_.push_back(time);
+  p_.col(k) = position;
+  given_v_.push_back(velocity.size() != 0);
+  given_a_.push_back(acceleration.size() != 0);
+  if (given_v_.back()) {
+    v_.col(k) = velocity;
+  } else {
+    v_.col(k).setZero();
+  }
+  if (given_a_.back()) {
+    a_.col(k) = acceleration;
+  } else {
+    a_.col(k).setZero();
+  }
+}
+
+void Trajectory::AddKnots(std::span<const Waypoint> waypoints, std::size_t first) {
+  for (const Waypoint& w : waypoints) AddKnot(w.time, w.position, w.velocity, w.acceleration);
   Resolve(first);
   Rebuild(first);
 }
 
-void Trajectory::Append(const std::vector<Waypoint>& waypoints) {
+void Trajectory::Append(std::span<const Waypoint> waypoints) {
   CheckWaypoints(times_.back(), waypoints);
-  AddKnots(waypoints);
+  AddKnots(waypoints, times_.size());
 }
 
-void Trajectory::Splice(TimePoint t, const std::vector<Waypoint>& waypoints) {
+void Trajectory::Splice(TimePoint t, std::span<const Waypoint> waypoints) {
   t = std::max(t, times_.front());
   CheckWaypoints(t, waypoints);
   // Keep every knot at or before t; a knot exactly at t keeps its state, which
@@ -212,24 +232,19 @@ void Trajectory::Splice(TimePoint t, const std::vector<Waypoint>& waypoints) {
   const auto keep =
       static_cast<std::size_t>(std::upper_bound(times_.begin(), times_.end(), t) - times_.begin());
   const bool at_knot = times_[keep - 1] == t;
-  TrajectorySample s = MakeSample();
+  TrajectorySample& s = splice_sample_;
   if (!at_knot) Sample(t, &s);
-  const Eigen::Index n = num_dofs(), kept = static_cast<Eigen::Index>(keep);
   times_.resize(keep);
   given_v_.resize(keep);
   given_a_.resize(keep);
-  p_.conservativeResize(n, kept);
-  v_.conservativeResize(n, kept);
-  a_.conservativeResize(n, kept);
-  coeffs_.resize((keep - 1) * static_cast<std::size_t>(n) * kCoeffs);
+  coeffs_.resize((keep - 1) * static_cast<std::size_t>(num_dofs()) * kCoeffs);
   if (!at_knot) {
     // The sampled state becomes a knot: Hermite interpolation of a polynomial's
     // own end values reproduces it, so the segment before t keeps its shape
     // (except a decelerating hold, replaced by the segment to t's state).
-    Waypoint w{t, s.position, s.velocity, s.acceleration};
-    AddKnots({w});
+    AddKnot(t, s.position, s.velocity, s.acceleration);
   }
-  AddKnots(waypoints);
+  AddKnots(waypoints, keep);
 }
 
 void Trajectory::Forget(TimePoint t) {
@@ -241,9 +256,9 @@ void Trajectory::Forget(TimePoint t) {
   times_.erase(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(drop));
   given_v_.erase(given_v_.begin(), given_v_.begin() + static_cast<std::ptrdiff_t>(drop));
   given_a_.erase(given_a_.begin(), given_a_.begin() + static_cast<std::ptrdiff_t>(drop));
-  p_ = p_.middleCols(first, kept).eval();
-  v_ = v_.middleCols(first, kept).eval();
-  a_ = a_.middleCols(first, kept).eval();
+  for (Eigen::MatrixXd* m : {&p_, &v_, &a_}) {  // in place (columns are contiguous): no allocation
+    std::copy(m->data() + first * m->rows(), m->data() + (first + kept) * m->rows(), m->data());
+  }
   coeffs_.erase(coeffs_.begin(), coeffs_.begin() + static_cast<std::ptrdiff_t>(drop * n * kCoeffs));
 }
 
@@ -325,7 +340,7 @@ void Trajectory::Evaluate(std::size_t segment, double tau, int dof, double* p, d
 }
 
 void Trajectory::EvaluateHold(double tau, int dof, double* p, double* v, double* a) const {
-  const Eigen::Index last = p_.cols() - 1;
+  const auto last = static_cast<Eigen::Index>(times_.size()) - 1;
   const double p0 = p_(dof, last);
   const bool smooth = interpolation_ == Interpolation::kCubic || interpolation_ == Interpolation::kQuintic;
   const double v0 = smooth ? v_(dof, last) : 0.0;

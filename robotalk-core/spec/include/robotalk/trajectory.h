@@ -37,7 +37,9 @@
 //
 // Thread safety: none; const members may be called concurrently.
 // Real time: Sample() does not allocate once the sample is sized (MakeSample);
-// the other members allocate.
+// Append(), Splice() and Forget() do not allocate once the knot storage has
+// grown to the most knots the trajectory has held (it doubles when full, and
+// never shrinks); the constructor, CheckLimits() and ScaleToLimits() allocate.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -47,6 +49,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -126,7 +129,8 @@ class Trajectory {
 
   /// Adds waypoints after the last knot; their times strictly increasing and
   /// after it. @throw Error naming the waypoint and value.
-  void Append(const std::vector<Waypoint>& waypoints);
+  void Append(std::span<const Waypoint> waypoints);
+  void Append(const std::vector<Waypoint>& waypoints) { Append(std::span<const Waypoint>(waypoints)); }
 
   /// Replaces everything after `t` with `waypoints` (times strictly after t,
   /// increasing): the trajectory up to t is unchanged and a knot at t carries
@@ -134,7 +138,10 @@ class Trajectory {
   /// continuous there to the order of the interpolation. t before the start
   /// is the start; t after the last knot splices onto the hold.
   /// @throw Error naming the waypoint and value (the trajectory is unchanged).
-  void Splice(TimePoint t, const std::vector<Waypoint>& waypoints);
+  void Splice(TimePoint t, std::span<const Waypoint> waypoints);
+  void Splice(TimePoint t, const std::vector<Waypoint>& waypoints) {
+    Splice(t, std::span<const Waypoint>(waypoints));
+  }
 
   /// Drops the knots of segments that end at or before `t` (the segment
   /// holding t stays), so a trajectory spliced forever stays bounded; its
@@ -175,14 +182,20 @@ class Trajectory {
   void Rebuild(std::size_t first);  // coefficients of segments >= first-1
   void Evaluate(std::size_t segment, double tau, int dof, double* p, double* v, double* a) const;
   void EvaluateHold(double tau, int dof, double* p, double* v, double* a) const;
-  void CheckWaypoints(TimePoint after, const std::vector<Waypoint>& waypoints) const;
-  void AddKnots(const std::vector<Waypoint>& waypoints);
+  void CheckWaypoints(TimePoint after, std::span<const Waypoint> waypoints) const;
+  // Appends one knot (empty velocity / acceleration: not given, chosen by Resolve).
+  void AddKnot(TimePoint time, const Eigen::VectorXd& position, const Eigen::VectorXd& velocity,
+               const Eigen::VectorXd& acceleration);
+  // Appends `waypoints`, then chooses rates and coefficients from knot `first` on.
+  void AddKnots(std::span<const Waypoint> waypoints, std::size_t first);
 
   Interpolation interpolation_;
   Eigen::VectorXd hold_deceleration_;
   std::vector<TimePoint> times_;
-  // Knot states, one column per knot; given_* marks values the caller gave.
+  // Knot states, one column per knot (the first num_knots() columns: the
+  // rest is capacity); given_* marks values the caller gave.
   Eigen::MatrixXd p_, v_, a_;
+  TrajectorySample splice_sample_;  // Splice()'s state at the splice time (sized once)
   std::vector<bool> given_v_, given_a_;
   // Segment coefficients, 6 per dof per segment: value = sum c[i] tau^i.
   std::vector<double> coeffs_;
