@@ -42,6 +42,12 @@ int main(int argc, char** argv) {
     double max_dv = 0, last_v = NAN, last_p = NAN;
     TimePoint changed{};
     Duration max_dv_after{0};  // server time between the first samples of the two references
+    // The kinematic driver's state is its reference, which moves by the mean
+    // of its velocities over the period (exactly when the tracker limits it,
+    // to within a·dt²/12 on the plan): dt = 2·Δp / (v0 + v1) gives the
+    // period the server actually ran, and Δv / dt the acceleration, to check
+    // against the limit whatever the period (away from turns, |v0 + v1| > 0.5).
+    double max_accel = 0, max_accel_dv = 0, max_accel_dt = 0;
     std::int64_t last_sample = -1;
     long frozen = 0, missing = 0, samples = 0, references = 0;
     bool in_freeze = false;
@@ -63,6 +69,14 @@ int main(int argc, char** argv) {
       if (!std::isnan(last_v) && std::abs(v - last_v) > max_dv) {
         max_dv = std::abs(v - last_v);
         max_dv_after = s.server_time - changed;
+      }
+      if (!std::isnan(last_v) && std::abs(v + last_v) > 0.5) {
+        const double dt = 2 * (p - last_p) / (v + last_v);
+        if (dt > 0 && std::abs(v - last_v) / dt > max_accel) {
+          max_accel = std::abs(v - last_v) / dt;
+          max_accel_dv = std::abs(v - last_v);
+          max_accel_dt = dt;
+        }
       }
       ++references;
       in_freeze = false;
@@ -97,8 +111,11 @@ int main(int argc, char** argv) {
         "from the first second on: largest velocity step between consecutive references %.4f rad/s (their "
         "first "
         "samples %.1f ms apart); freezes "
-        "(a reference held > 15 ms) %ld; missing samples %ld\n",
-        splices, sent, samples, references, max_dv, 1e3 * ToSeconds(max_dv_after), frozen, missing);
+        "(a reference held > 15 ms) %ld; missing samples %ld; largest acceleration between consecutive "
+        "references over the period the server ran (2·Δp / (v0 + v1), where |v0 + v1| > 0.5 rad/s) %.2f "
+        "rad/s² (a step of %.4f rad/s over %.2f ms)\n",
+        splices, sent, samples, references, max_dv, 1e3 * ToSeconds(max_dv_after), frozen, missing, max_accel,
+        max_accel_dv, 1e3 * max_accel_dt);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "robotalk-receding-client: %s\n", e.what());

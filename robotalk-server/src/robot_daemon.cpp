@@ -533,10 +533,7 @@ void RobotDaemon::EndTrajectoriesFor(const QueuedItem& item, TimePoint now) {
       tracker_.End(item.command.target, now, why, tracked_);
       break;
     case CommandTarget::kFrame:  // the joints on the frame's chain
-      for (int j = m.parent_joint(m.frame(item.command.target).parent_link); j >= 0;
-           j = m.parent_joint(m.joint(j).parent_link)) {
-        tracker_.End(j, now, why, tracked_);
-      }
+      for (int j : m.frame_chain(item.command.target)) tracker_.End(j, now, why, tracked_);
       break;
     case CommandTarget::kBase:
     case CommandTarget::kRobot:

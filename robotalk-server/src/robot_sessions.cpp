@@ -590,8 +590,7 @@ void RobotSessions::Own(const DaemonOutput::Executed& e) {
       take(e.target);
       break;
     case CommandTarget::kFrame:  // the joints on the frame's chain
-      for (int j = model.parent_joint(model.frame(e.target).parent_link); j >= 0;
-           j = model.parent_joint(model.joint(j).parent_link)) {
+      for (int j : model.frame_chain(e.target)) {
         if (!model.joint(j).dofs.empty()) take(j);
       }
       break;

@@ -84,6 +84,17 @@ TEST(RobotModel, MakesEveryParentlessLinkAFixedRoot) {
   EXPECT_EQ(m.parent_joint(2), 1);
 }
 
+TEST(RobotModel, AFramesChainIsItsJointsUpToTheRootChildFirst) {
+  RobotModelBuilder b = TwoLinkArm();
+  b.AddLink(Body("loose"));
+  b.AddControlFrame(ControlFrame{.name = "shoulder_plate", .servo_types = ServoType::kSetPoint}, "upper");
+  b.AddControlFrame(ControlFrame{.name = "floor", .servo_types = ServoType::kSetPoint}, "loose");
+  RobotModel m = b.Build();
+  EXPECT_THAT(m.frame_chain(m.FrameIndex("tool")), ::testing::ElementsAre(1, 0));
+  EXPECT_THAT(m.frame_chain(m.FrameIndex("shoulder_plate")), ::testing::ElementsAre(0));
+  EXPECT_TRUE(m.frame_chain(m.FrameIndex("floor")).empty());
+}
+
 TEST(RobotModel, KeepsDeclaredRootPoseAndBaseType) {
   RobotModelBuilder b = TwoLinkArm();
   Pose pose{.translation = {1, 2, 0}, .rotation = Eigen::Quaterniond::Identity()};

@@ -23,10 +23,9 @@ InverseKinematics::InverseKinematics(const RobotModel& model) : model_(model), k
   jac_.setZero(6, n);
   // Per control frame, the set-point joints on the path to its root. Mimic
   // joints are left out: they follow their leaders.
-  for (const ControlFrame& frame : model_.frames()) {
+  for (std::size_t f = 0; f < model_.frames().size(); ++f) {
     std::vector<std::uint8_t> mask(static_cast<size_t>(n), 0);
-    for (int j = model_.parent_joint(frame.parent_link); j >= 0;
-         j = model_.parent_joint(model_.joint(j).parent_link)) {
+    for (int j : model_.frame_chain(static_cast<int>(f))) {
       const Joint& joint = model_.joint(j);
       if (joint.mimic || !joint.servo_types.Has(ServoType::kSetPoint)) continue;
       for (size_t k = 0; k < joint.dofs.size(); ++k) mask[static_cast<size_t>(model_.dof_offset(j)) + k] = 1;

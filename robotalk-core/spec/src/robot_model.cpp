@@ -235,6 +235,15 @@ void RobotModel::Validate() {
     }
     Fail(name_, "not a tree: the joints form a cycle through links " + cycle);
   }
+
+  // Each control frame's chain: the joints from its link up to its root.
+  frame_chains_.assign(frames_.size(), {});
+  for (std::size_t f = 0; f < frames_.size(); ++f) {
+    for (int j = parent_joint_[static_cast<size_t>(frames_[f].parent_link)]; j >= 0;
+         j = parent_joint_[static_cast<size_t>(joints_[static_cast<size_t>(j)].parent_link)]) {
+      frame_chains_[f].push_back(j);
+    }
+  }
 }
 
 namespace {

@@ -55,6 +55,9 @@ class RobotModel {
   int dof_offset(int joint) const { return dof_offsets_.at(static_cast<size_t>(joint)); }
   /// The joint whose child is `link`, or -1 for a root link.
   int parent_joint(int link) const { return parent_joint_.at(static_cast<size_t>(link)); }
+  /// The joints between control frame `frame` and its root, the frame's own
+  /// link's parent joint first (what a command on the frame moves, and owns).
+  std::span<const int> frame_chain(int frame) const { return frame_chains_.at(static_cast<size_t>(frame)); }
   /// Joint indices ordered parents-before-children (a valid FK sweep order).
   std::span<const int> topological_joint_order() const { return joint_order_; }
   /// The root link at the top of `link`'s subtree.
@@ -78,6 +81,7 @@ class RobotModel {
   std::vector<int> dof_offsets_;
   std::vector<int> parent_joint_;
   std::vector<int> joint_order_;
+  std::vector<std::vector<int>> frame_chains_;
   std::vector<int> root_of_;
   std::unordered_map<std::string, int> link_by_name_, joint_by_name_, frame_by_name_;
 };
