@@ -141,18 +141,22 @@ void ExpectSceneIsTheUrdfGeometry(const std::string& path, const std::vector<std
     for (const UrdfShape& s : catalog.shapes) collision = collision || (s.link == link && s.collision);
     for (const UrdfShape& s : catalog.shapes) {
       if (s.link != link || s.collision != collision) continue;
-      if (s.kind == UrdfShape::Kind::kMesh && catalog.MeshOf(s)->url.empty())
+      if (s.kind == UrdfShape::Kind::kMesh && catalog.MeshOf(s)->url.empty()) {
         ++unresolved;
-      else
+      } else {
         ++want[s.kind];
+      }
     }
     EXPECT_EQ(e["cubes"].size(), want[UrdfShape::Kind::kBox] + (unresolved ? 1 : 0));
     EXPECT_EQ(e["cylinders"].size(), want[UrdfShape::Kind::kCylinder]);
     EXPECT_EQ(e["spheres"].size(), want[UrdfShape::Kind::kSphere]);
     EXPECT_EQ(e["models"].size(), want[UrdfShape::Kind::kMesh]);
-    for (const auto& m : e["models"])
+    for (const auto& m : e["models"]) {
       EXPECT_EQ(m["url"].get<std::string>().rfind("http://h:1/mesh/" + model->name() + "/", 0), 0u) << m;
-    if (unresolved) EXPECT_NE(Meta(e, "mesh"), "") << "an unresolved mesh is named with its reason";
+    }
+    if (unresolved) {
+      EXPECT_NE(Meta(e, "mesh"), "") << "an unresolved mesh is named with its reason";
+    }
     primitives += e["cubes"].size() + e["cylinders"].size() + e["spheres"].size() + e["models"].size();
   }
   EXPECT_GT(primitives, 0u);
@@ -196,8 +200,10 @@ TEST(RobotMessages, SceneEmbedsAResolvedMeshWhenAskedAndLinksItOtherwise) {
   const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
   const RobotMessages m(model, ResolveMeshes(model->name(), path, {web_data}));
   std::map<std::string, nlohmann::json> linked, embedded;
-  for (const auto& e : m.Scene(0, {.url_base = "http://127.0.0.1:8080"})["entities"]) linked[e["id"]] = e;
-  for (const auto& e : m.Scene(0, {.embed = true})["entities"]) embedded[e["id"]] = e;
+  const nlohmann::json live = m.Scene(0, {.url_base = "http://127.0.0.1:8080"});
+  const nlohmann::json recorded = m.Scene(0, {.embed = true});
+  for (const auto& e : live["entities"]) linked[e["id"]] = e;
+  for (const auto& e : recorded["entities"]) embedded[e["id"]] = e;
   const auto& arm = linked.at("mesh_bot/arm")["models"].at(0);
   EXPECT_EQ(arm["url"], "http://127.0.0.1:8080/mesh/mesh_bot/1/arm.stl");
   EXPECT_EQ(arm["media_type"], "model/stl");
