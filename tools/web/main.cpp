@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
       }
       if (told > 0)
         std::cerr << "robotalk-web: " << name << ": " << told << " of " << catalog.meshes.size()
-                  << " meshes not resolved; the page draws their links from the configuration\n";
+                  << " meshes not resolved; the page draws their links from the configuration, Foxglove's "
+                     "scene as inertia boxes\n";
     }
     std::cout << "robotalk-web: open http://" << (options.bind == "0.0.0.0" ? "127.0.0.1" : options.bind)
               << ":" << server.port() << "/" << std::endl;
