@@ -34,6 +34,9 @@ constexpr std::uint32_t kPanicServiceId = 1;
 // State messages queued per client beyond which new ones are dropped (5
 // channels per robot per tick: a few ticks of a few robots).
 constexpr std::size_t kMaxQueuedStates = 64;
+// Scene texts kept per robot, one per Host clients named (a client may send
+// any Host header: the cache is bounded, a scene is rebuilt when it must be).
+constexpr std::size_t kMaxCachedScenes = 8;
 // Client messages are small JSON ops and service calls.
 constexpr std::size_t kMaxClientMessage = 64 * 1024;
 
@@ -193,6 +196,7 @@ class FoxgloveEndpoint::Impl {
     const auto sub =
         s.subscription_of_channel.find(r.first_id + static_cast<std::uint32_t>(fg::Topic::kScene));
     if (sub == s.subscription_of_channel.end()) return;
+    if (r.scenes.size() >= kMaxCachedScenes && !r.scenes.count(s.url_base)) r.scenes.clear();
     auto [scene, added] = r.scenes.try_emplace(s.url_base);
     if (added) scene->second = JsonText(r.messages->Scene(r.scene_time_ns, {.url_base = s.url_base}));
     s.SendBinary(MessageData(sub->second, r.scene_time_ns, scene->second), false);

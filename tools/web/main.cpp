@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
     for (const auto& [name, catalog] : server.meshes()) {  // the page notes the same under the robot's view
       if (!catalog.error.empty())
         std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.error << "\n";
+      else if (!catalog.geometry_error.empty())
+        std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.geometry_error
+                  << " (Foxglove's scene shows its inertia boxes)\n";
       std::size_t told = 0;
       for (const MeshEntry& m : catalog.meshes) {
         if (!m.error.empty() && ++told <= 5)
