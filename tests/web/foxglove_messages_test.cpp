@@ -9,9 +9,11 @@
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 namespace robotalk::web::foxglove {
@@ -212,6 +214,7 @@ TEST(RobotMessages, SceneEmbedsAResolvedMeshWhenAskedAndLinksItOtherwise) {
   EXPECT_EQ(packed["url"], "");
   EXPECT_EQ(packed["media_type"], "model/stl");
   EXPECT_FALSE(packed["data"].get<std::string>().empty());
+  EXPECT_EQ(Meta(embedded.at("mesh_bot/arm"), "geometry"), "urdf visual") << "mesh_bot has no <collision>";
   // tool's package is missing: its inertia box, and why.
   const auto& tool = linked.at("mesh_bot/tool");
   EXPECT_EQ(tool["cubes"].size(), 1u);
@@ -231,6 +234,26 @@ TEST(RobotMessages, FromPoseOfAnotherModelThrowsNamingTheRobot) {
   }
   pose.erase("t");
   EXPECT_THROW(m.FromPose(pose), Error);
+}
+
+TEST(RobotMessages, SceneRefersToAGltfByItsFileEvenWhenEmbedding) {
+  // A .gltf names its buffers beside it: embedded alone it would not load.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("foxglove_gltf_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "part.gltf") << "{}";
+  std::ofstream(dir / "r.urdf")
+      << "<robot name='r'><link name='a'><inertial><mass value='1'/><inertia ixx='1' "
+         "ixy='0' ixz='0' iyy='1' iyz='0' izz='1'/></inertial><collision><geometry>"
+         "<mesh filename='part.gltf'/></geometry></collision></link></robot>";
+  const std::string path = (dir / "r.urdf").string();
+  const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
+  const nlohmann::json scene = RobotMessages(model, ResolveMeshes("r", path, {})).Scene(0, {.embed = true});
+  const auto& m = scene["entities"].at(0)["models"].at(0);
+  EXPECT_EQ(m["url"], "file://" + fs::canonical(dir / "part.gltf").string());
+  EXPECT_EQ(m["data"], "");
+  EXPECT_EQ(m["media_type"], "model/gltf+json");
+  fs::remove_all(dir);
 }
 
 }  // namespace
