@@ -380,8 +380,8 @@ json RobotMessages::Scene(std::int64_t time_ns, const MeshLinks& links) const {
   for (std::size_t l = 0; l < model_->links().size(); ++l) {
     if (!geometry_) {
       entities.push_back(InertiaEntity(l, time_ns,
-                                       "the robot's configuration carries no geometry; give the bridge "
-                                       "--urdf ROBOT=PATH to see the URDF's"));
+                                       "the robot's configuration carries no geometry; give robotalk-web "
+                                       "or robotalk-logplay export --urdf ROBOT=PATH to see the URDF's"));
     } else if (!geometry_->error.empty() || !geometry_->geometry_error.empty()) {
       entities.push_back(InertiaEntity(
           l, time_ns,
