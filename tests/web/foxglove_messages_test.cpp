@@ -2,14 +2,18 @@
 // robotalk-logplay export --mcap writes (foxglove_messages.h).
 #include "foxglove_messages.h"
 
+#include "mesh_catalog.h"
 #include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 #include "scene_json.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
 namespace robotalk::web::foxglove {
@@ -105,7 +109,116 @@ TEST(RobotMessages, SceneHasAnEntityPerLinkLockedToItsFrame) {
     EXPECT_TRUE(e["frame_locked"].get<bool>());
     EXPECT_EQ(e["cubes"].size(), 1u);
     EXPECT_EQ(e["timestamp"]["nsec"], 42);
+    EXPECT_EQ(e["metadata"][0]["key"], "geometry");
+    EXPECT_EQ(e["metadata"][0]["value"], "inertia box") << "without a URDF the scene says what it shows";
   }
+}
+
+std::string Meta(const nlohmann::json& entity, const std::string& key) {
+  for (const auto& kv : entity["metadata"])
+    if (kv["key"] == key) return kv["value"];
+  return "";
+}
+
+// Every link of a URDF robot is drawn from the URDF: its <collision> shapes
+// (its <visual> ones when it has no <collision>), one primitive each, a mesh
+// as a model when it resolves and the inertia box beside a note when not.
+void ExpectSceneIsTheUrdfGeometry(const std::string& path, const std::vector<std::string>& package_paths) {
+  SCOPED_TRACE(path);
+  const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
+  const MeshCatalog catalog = ResolveMeshes(model->name(), path, package_paths);
+  ASSERT_EQ(catalog.error, "");
+  ASSERT_FALSE(catalog.shapes.empty());
+  const nlohmann::json scene = RobotMessages(model, catalog).Scene(7, {.url_base = "http://h:1"});
+  ASSERT_EQ(scene["entities"].size(), model->links().size());
+  std::size_t primitives = 0;
+  for (std::size_t l = 0; l < model->links().size(); ++l) {
+    const std::string& link = model->links()[l].name;
+    const nlohmann::json& e = scene["entities"][l];
+    SCOPED_TRACE(link);
+    EXPECT_EQ(e["frame_id"], model->name() + "/" + link);
+    std::map<UrdfShape::Kind, std::size_t> want;
+    std::size_t unresolved = 0;
+    bool collision = false;
+    for (const UrdfShape& s : catalog.shapes) collision = collision || (s.link == link && s.collision);
+    for (const UrdfShape& s : catalog.shapes) {
+      if (s.link != link || s.collision != collision) continue;
+      if (s.kind == UrdfShape::Kind::kMesh && catalog.MeshOf(s)->url.empty()) {
+        ++unresolved;
+      } else {
+        ++want[s.kind];
+      }
+    }
+    EXPECT_EQ(e["cubes"].size(), want[UrdfShape::Kind::kBox] + (unresolved ? 1 : 0));
+    EXPECT_EQ(e["cylinders"].size(), want[UrdfShape::Kind::kCylinder]);
+    EXPECT_EQ(e["spheres"].size(), want[UrdfShape::Kind::kSphere]);
+    EXPECT_EQ(e["models"].size(), want[UrdfShape::Kind::kMesh]);
+    for (const auto& m : e["models"]) {
+      EXPECT_EQ(m["url"].get<std::string>().rfind("http://h:1/mesh/" + model->name() + "/", 0), 0u) << m;
+    }
+    if (unresolved) {
+      EXPECT_NE(Meta(e, "mesh"), "") << "an unresolved mesh is named with its reason";
+    }
+    primitives += e["cubes"].size() + e["cylinders"].size() + e["spheres"].size() + e["models"].size();
+  }
+  EXPECT_GT(primitives, 0u);
+}
+
+TEST(RobotMessages, SceneOfAUrdfIsItsCollisionGeometry) {
+  ExpectSceneIsTheUrdfGeometry(testing::ProjectModel("pioneer2dx_pantilt.urdf"), {});
+  ExpectSceneIsTheUrdfGeometry(testing::ProjectModel("simple_humanoid.urdf"), {});
+  const std::string web_data = std::string(ROBOTALK_MODELS_DIR) + "/../tests/web/data";
+  ExpectSceneIsTheUrdfGeometry(web_data + "/mesh_bot/urdf/mesh_bot.urdf", {web_data});
+}
+
+TEST(RobotMessages, SceneOfTheSharedRobotsIsTheirUrdfGeometry) {
+  ROBOTALK_REQUIRE_SHARED_ROBOTS();
+  for (const char* robot : {"ur5.urdf", "iiwa14.urdf", "pr2.urdf", "atlas.urdf", "pioneer3dx.urdf"})
+    ExpectSceneIsTheUrdfGeometry(testing::SharedRobot(robot), {});
+}
+
+TEST(RobotMessages, SceneOfPioneerHasItsBoxesCylindersAndSphere) {
+  const std::string path = testing::ProjectModel("pioneer2dx_pantilt.urdf");
+  const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
+  const nlohmann::json scene = RobotMessages(model, ResolveMeshes("pioneer", path, {})).Scene(0, {});
+  std::map<std::string, nlohmann::json> by_link;
+  for (const auto& e : scene["entities"]) by_link[e["id"]] = e;
+  const std::string p = model->name() + "/";
+  const auto& base = by_link.at(p + "base_link")["cubes"].at(0);
+  EXPECT_EQ(base["size"], (nlohmann::json{{"x", 0.44}, {"y", 0.38}, {"z", 0.22}}));
+  EXPECT_EQ(base["pose"]["position"], (nlohmann::json{{"x", -0.1}, {"y", 0.0}, {"z", 0.17}}));
+  EXPECT_EQ(Meta(by_link.at(p + "base_link"), "geometry"), "urdf collision");
+  const auto& wheel = by_link.at(p + "left_wheel")["cylinders"].at(0);
+  EXPECT_EQ(wheel["size"], (nlohmann::json{{"x", 0.195}, {"y", 0.195}, {"z", 0.05}}));
+  EXPECT_NEAR(wheel["pose"]["orientation"]["x"].get<double>(), std::sqrt(0.5), 1e-6);
+  const auto& caster = by_link.at(p + "caster")["spheres"].at(0);
+  EXPECT_EQ(caster["size"], (nlohmann::json{{"x", 0.075}, {"y", 0.075}, {"z", 0.075}}));
+  EXPECT_EQ(Meta(by_link.at(p + "ptu_base"), "geometry"), "urdf visual") << "no <collision>: its <visual>";
+}
+
+TEST(RobotMessages, SceneEmbedsAResolvedMeshWhenAskedAndLinksItOtherwise) {
+  const std::string web_data = std::string(ROBOTALK_MODELS_DIR) + "/../tests/web/data";
+  const std::string path = web_data + "/mesh_bot/urdf/mesh_bot.urdf";
+  const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
+  const RobotMessages m(model, ResolveMeshes(model->name(), path, {web_data}));
+  std::map<std::string, nlohmann::json> linked, embedded;
+  const nlohmann::json live = m.Scene(0, {.url_base = "http://127.0.0.1:8080"});
+  const nlohmann::json recorded = m.Scene(0, {.embed = true});
+  for (const auto& e : live["entities"]) linked[e["id"]] = e;
+  for (const auto& e : recorded["entities"]) embedded[e["id"]] = e;
+  const auto& arm = linked.at("mesh_bot/arm")["models"].at(0);
+  EXPECT_EQ(arm["url"], "http://127.0.0.1:8080/mesh/mesh_bot/1/arm.stl");
+  EXPECT_EQ(arm["media_type"], "model/stl");
+  EXPECT_EQ(arm["data"], "");
+  const auto& packed = embedded.at("mesh_bot/arm")["models"].at(0);
+  EXPECT_EQ(packed["url"], "");
+  EXPECT_EQ(packed["media_type"], "model/stl");
+  EXPECT_FALSE(packed["data"].get<std::string>().empty());
+  EXPECT_EQ(Meta(embedded.at("mesh_bot/arm"), "geometry"), "urdf visual") << "mesh_bot has no <collision>";
+  // tool's package is missing: its inertia box, and why.
+  const auto& tool = linked.at("mesh_bot/tool");
+  EXPECT_EQ(tool["cubes"].size(), 1u);
+  EXPECT_NE(Meta(tool, "mesh").find("missing_pkg"), std::string::npos) << tool;
 }
 
 TEST(RobotMessages, FromPoseOfAnotherModelThrowsNamingTheRobot) {
@@ -121,6 +234,26 @@ TEST(RobotMessages, FromPoseOfAnotherModelThrowsNamingTheRobot) {
   }
   pose.erase("t");
   EXPECT_THROW(m.FromPose(pose), Error);
+}
+
+TEST(RobotMessages, SceneRefersToAGltfByItsFileEvenWhenEmbedding) {
+  // A .gltf names its buffers beside it: embedded alone it would not load.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("foxglove_gltf_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "part.gltf") << "{}";
+  std::ofstream(dir / "r.urdf")
+      << "<robot name='r'><link name='a'><inertial><mass value='1'/><inertia ixx='1' "
+         "ixy='0' ixz='0' iyy='1' iyz='0' izz='1'/></inertial><collision><geometry>"
+         "<mesh filename='part.gltf'/></geometry></collision></link></robot>";
+  const std::string path = (dir / "r.urdf").string();
+  const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
+  const nlohmann::json scene = RobotMessages(model, ResolveMeshes("r", path, {})).Scene(0, {.embed = true});
+  const auto& m = scene["entities"].at(0)["models"].at(0);
+  EXPECT_EQ(m["url"], "file://" + fs::canonical(dir / "part.gltf").string());
+  EXPECT_EQ(m["data"], "");
+  EXPECT_EQ(m["media_type"], "model/gltf+json");
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -5,8 +5,9 @@
 # key, and `robotalk-logplay export --mcap` of the session recorded meanwhile,
 # compared with the same log's CSV export.
 # Two servers on two LCM URLs: an open one (recorded, watched by a bridge
-# without a key) and a keyed one (its bridge holds a key with query and
-# panic rights). Runs inside a private network namespace (netns_run.sh):
+# without a key, given the robot's URDF: its scene is the URDF's geometry)
+# and a keyed one (its bridge holds a key with query and panic rights, and
+# no URDF: its scene is the equivalent inertia boxes). Runs inside a private network namespace (netns_run.sh):
 #   foxglove_test.sh SERVER CLI WEB LOGPLAY KEYGEN MODELS_DIR
 set -u
 server_bin=$1 cli=$2 web=$3 logplay=$4 keygen=$5 models=$6
@@ -35,16 +36,37 @@ for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && grep -q "ser
 logger=$!
 for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
 
-start_web() {  # start_web OUT URL [env...]: sets $web_port (not in a subshell: lib.sh stops $pids)
-  local out=$1 u=$2; shift 2
-  env "$@" "$web" --port 0 --lcm-url "$u" >"$out" 2>&1 &
+# The robot's URDF as the bridge and the export get it: the shipped pioneer
+# with a material on base_link's visual and the caster's collision sphere
+# replaced by a mesh of the web tests' package (tests/web/data/mesh_bot).
+mesh="$here/data/mesh_bot/meshes/arm.stl"
+urdf="$tmp/pioneer_geometry.urdf"
+python3 - "$models/pioneer2dx_pantilt.urdf" "$urdf" <<'PY' || { echo "FAIL: cannot write $urdf"; exit 1; }
+import sys, xml.etree.ElementTree as ET
+tree = ET.parse(sys.argv[1]); robot = tree.getroot()
+red = ET.Element("material", name="signal_red"); ET.SubElement(red, "color", rgba="0.8 0.1 0.1 1")
+robot.insert(0, red)
+link = {l.get("name"): l for l in robot.findall("link")}
+ET.SubElement(link["base_link"].find("visual"), "material", name="signal_red")
+geometry = link["caster"].find("collision/geometry")
+geometry.remove(geometry.find("sphere"))
+ET.SubElement(geometry, "mesh", filename="package://mesh_bot/meshes/arm.stl", scale="0.5 0.5 0.5")
+tree.write(sys.argv[2])
+PY
+geometry_opts=(--urdf "$robot=$urdf" --package-path "$here/data")
+
+start_web() {  # start_web OUT URL [env...] -- [web options...]: sets $web_port (not in a subshell: lib.sh stops $pids)
+  local out=$1 u=$2 envs=(); shift 2
+  while [ $# -gt 0 ] && [ "$1" != "--" ]; do envs+=("$1"); shift; done
+  shift
+  env "${envs[@]}" "$web" --port 0 --lcm-url "$u" "$@" >"$out" 2>&1 &
   pids+=($!)
   web_port=""
   for _ in $(seq 50); do web_port=$(grep -o '127.0.0.1:[0-9]*' "$out" | cut -d: -f2); [ -n "$web_port" ] && break; sleep 0.1; done
 }
-start_web "$tmp/web.out" "$url"
+start_web "$tmp/web.out" "$url" -- "${geometry_opts[@]}"
 port=$web_port
-start_web "$tmp/keyed_web.out" "$keyed_url" ROBOTALK_KEY="$tmp/web"
+start_web "$tmp/keyed_web.out" "$keyed_url" ROBOTALK_KEY="$tmp/web" --
 keyed_port=$web_port
 check "both bridges listen" test -n "$port" -a -n "$keyed_port"
 
@@ -57,7 +79,7 @@ cat >"$tmp/seq.txt" <<'SEQ'
 SEQ
 "$cli" --url "$url" send "$robot" --file "$tmp/seq.txt" >"$tmp/send.out" 2>&1 &
 sender=$!
-node "$here/foxglove_test.mjs" live "$port" "$robot" "$keyed_port"
+node "$here/foxglove_test.mjs" live "$port" "$robot" "$keyed_port" "$mesh"
 check "Foxglove live (foxglove_test.mjs live)" test $? -eq 0
 wait "$sender"
 check "the recorded sequence succeeds: $(cat "$tmp/send.out")" test "$(grep -c SUCCESS "$tmp/send.out")" -eq 4
@@ -72,6 +94,14 @@ check "export --mcap says what it wrote" grep -q "wrote [0-9]* messages" "$tmp/e
 check "the CSV export of the same log" test -s "$tmp/csv/state.csv"
 node "$here/foxglove_test.mjs" mcap "$tmp/session.mcap" "$tmp/csv/state.csv" "$tmp/csv/commands.csv" "$robot"
 check "Foxglove from MCAP (foxglove_test.mjs mcap)" test $? -eq 0
+
+"$logplay" export "$tmp/session.lcmlog" --mcap "$tmp/geometry.mcap" "${geometry_opts[@]}" >/dev/null 2>"$tmp/geometry.err"
+check "export --mcap --urdf exits 0: $(cat "$tmp/geometry.err")" test $? -eq 0
+node "$here/foxglove_test.mjs" mcap-scene "$tmp/geometry.mcap" "$robot" "$mesh"
+check "Foxglove from MCAP, given the URDF (foxglove_test.mjs mcap-scene)" test $? -eq 0
+"$logplay" export "$tmp/session.lcmlog" --mcap "$tmp/x.mcap" --urdf "$robot=$tmp/none.urdf" >/dev/null 2>"$tmp/nourdf.err"
+check "export --mcap with a missing --urdf file fails with status 2" test $? -eq 2
+check "and names the file: $(cat "$tmp/nourdf.err")" grep -q "none.urdf" "$tmp/nourdf.err"
 
 "$logplay" export "$tmp/session.lcmlog" --mcap "$tmp/no/such/dir/x.mcap" >/dev/null 2>"$tmp/bad.err"
 check "an unwritable --mcap path fails with status 1" test $? -eq 1

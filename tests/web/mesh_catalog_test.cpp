@@ -36,13 +36,14 @@ class MeshCatalogTest : public ::testing::Test {
     std::ofstream(root_ / rel) << text;
   }
 
-  // A URDF in robot/ with one link per mesh filename.
+  // A URDF in robot/ with one link per mesh filename, its <visual> and its
+  // <collision> both naming it.
   MeshCatalog Resolve(const std::vector<std::string>& filenames, const std::vector<std::string>& paths) {
     std::string xml = "<robot name=\"r\">";
     for (std::size_t i = 0; i < filenames.size(); ++i) {
       xml += "<link name=\"l" + std::to_string(i) + "\"><visual><geometry><mesh filename=\"" + filenames[i] +
-             "\"/></geometry></visual><collision><geometry><mesh filename=\"ignored.stl\"/></geometry>"
-             "</collision></link>";
+             "\"/></geometry></visual><collision><geometry><mesh filename=\"" + filenames[i] +
+             "\"/></geometry></collision></link>";
     }
     Write("robot/r.urdf", xml + "</robot>");
     return ResolveMeshes("r", (root_ / "robot/r.urdf").string(), paths);
@@ -66,8 +67,14 @@ TEST_F(MeshCatalogTest, ResolvesPackageRelativeAndAbsoluteNamesToServedUrls) {
       Resolve({"package://arm_description/meshes/link1.stl", "package://gripper/meshes/finger.dae",
                "meshes/base.stl", "file://" + (root_ / "robot/meshes/base.stl").string()},
               {(root_ / "ws").string()});
-  ASSERT_EQ(c.meshes.size(), 4u) << "visuals only, not collisions";
+  ASSERT_EQ(c.meshes.size(), 8u) << "the visuals, then the collisions";
   for (const MeshEntry& m : c.meshes) EXPECT_EQ(m.error, "") << m.uri;
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(c.meshes[i].collision, i >= 4) << i;
+  EXPECT_EQ(c.meshes[4].link, "l0");
+  EXPECT_EQ(c.meshes[4].url, "/mesh/r/4/link1.stl");
+  EXPECT_EQ(c.meshes[4].file, c.meshes[0].file);
+  EXPECT_EQ(c.shapes.size(), 0u) << "four links without joints: urdfdom refuses the tree";
+  EXPECT_NE(c.geometry_error, "");
   EXPECT_EQ(c.meshes[0].link, "l0");
   EXPECT_EQ(c.meshes[0].url, "/mesh/r/0/link1.stl");
   EXPECT_EQ(c.meshes[1].file, fs::canonical(root_ / "ws/src/renamed_dir/meshes/finger.dae"));
@@ -93,7 +100,7 @@ TEST_F(MeshCatalogTest, RefusesNamesThatLeaveThePackagePathsAndTheUrdfFolder) {
       Resolve({"package://arm_description/../../../secret/key.stl", "../secret/key.stl",
                "package://arm_description/escape/key.stl", (root_ / "secret/key.stl").string()},
               {(root_ / "ws").string()});
-  ASSERT_EQ(c.meshes.size(), 4u);
+  ASSERT_EQ(c.meshes.size(), 8u);
   for (const MeshEntry& m : c.meshes) {
     EXPECT_EQ(m.url, "") << m.uri;
     EXPECT_TRUE(m.file.empty()) << m.uri;
@@ -125,7 +132,33 @@ TEST_F(MeshCatalogTest, SaysWhichPackageIsMissingAndWhereItLooked) {
   EXPECT_EQ(c.meshes[2].error, "not a package://PACKAGE/PATH");
   EXPECT_EQ(c.meshes[3].error,
             "scheme of 'https://example.com/x.stl' not supported (package://, file://, or a path)");
-  EXPECT_EQ(c.unresolved(), 4u);
+  EXPECT_EQ(c.unresolved(), 8u);
+}
+
+TEST_F(MeshCatalogTest, ReadsTheShapesAndFindsEachMeshShapesEntry) {
+  Write("robot/arm.urdf",
+        "<robot name='arm'><material name='blue'><color rgba='0 0 1 1'/></material>"
+        "<link name='base'><visual><geometry><box size='1 2 3'/></geometry><material name='blue'/></visual>"
+        "<collision><origin xyz='0 0 0.5'/><geometry><cylinder radius='0.1' "
+        "length='0.4'/></geometry></collision>"
+        "</link><link name='tip'><collision><geometry><mesh filename='meshes/base.stl' scale='2 2 2'/>"
+        "</geometry></collision></link><joint name='j' type='fixed'><parent link='base'/><child link='tip'/>"
+        "</joint></robot>");
+  const MeshCatalog c = ResolveMeshes("arm", (root_ / "robot/arm.urdf").string(), {});
+  ASSERT_EQ(c.geometry_error, "");
+  ASSERT_EQ(c.shapes.size(), 3u);
+  EXPECT_EQ(c.shapes[0].kind, UrdfShape::Kind::kBox);
+  EXPECT_FALSE(c.shapes[0].collision);
+  ASSERT_TRUE(c.shapes[0].rgba.has_value()) << "the robot-level material the visual names";
+  EXPECT_EQ(*c.shapes[0].rgba, Eigen::Vector4d(0, 0, 1, 1));
+  EXPECT_EQ(c.shapes[1].kind, UrdfShape::Kind::kCylinder);
+  EXPECT_TRUE(c.shapes[1].collision);
+  EXPECT_EQ(c.shapes[1].size, Eigen::Vector3d(0.1, 0.4, 0));
+  EXPECT_EQ(c.shapes[1].origin.translation, Eigen::Vector3d(0, 0, 0.5));
+  EXPECT_EQ(c.MeshOf(c.shapes[1]), nullptr);
+  ASSERT_NE(c.MeshOf(c.shapes[2]), nullptr);
+  EXPECT_EQ(c.MeshOf(c.shapes[2])->file, fs::canonical(root_ / "robot/meshes/base.stl"));
+  EXPECT_EQ(c.shapes[2].size, Eigen::Vector3d(2, 2, 2));
 }
 
 TEST_F(MeshCatalogTest, AnUnreadableUrdfIsAnErrorNotAThrow) {

@@ -48,9 +48,12 @@ Records and reads LCM logs of RoboTalk sessions. See docs/logplay.md.
                                  named from the logged configuration), DIR/joints.csv
                                  and DIR/session.png (base path; each joint's trace on
                                  its own axis, python3-matplotlib)
-  export LOG --mcap OUT.mcap     the session as an MCAP file for Foxglove: the channels
+  export LOG --mcap OUT.mcap [--urdf ROBOT=PATH]... [--package-path DIRS]
+                                 the session as an MCAP file for Foxglove: the channels
                                  robotalk-web's Foxglove endpoint publishes live, and
-                                 every request and reply as JSON (docs/interop.md)
+                                 every request and reply as JSON (docs/interop.md);
+                                 a robot given its URDF is drawn from it (meshes
+                                 embedded), the others as equivalent inertia boxes
 
   --map old=new   rename a joint or control frame (repeatable)
   --window A:B    only the commands between A and B seconds into the recording
@@ -221,9 +224,17 @@ int RunRecord(Args& a) {
 }
 
 int RunExportMcap(Args& a, const std::string& out) {
+  const std::vector<std::string> urdf = a.All("--urdf"), package_paths = a.All("--package-path");
   const std::string path = a.Log();
   const auto start = std::chrono::steady_clock::now();
-  const lp::McapExportResult r = lp::ExportMcap(path, out, std::cerr);
+  lp::McapGeometry geometry;
+  try {
+    const char* ros = std::getenv("ROS_PACKAGE_PATH");
+    geometry = lp::ParseGeometryOptions(urdf, package_paths, ros ? ros : "");
+  } catch (const robotalk::Error& e) {
+    throw UsageError(e.what());
+  }
+  const lp::McapExportResult r = lp::ExportMcap(path, out, std::cerr, geometry);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "robotalk-logplay: wrote " << r.messages << " messages (" << r.bytes << " bytes) from "
             << r.events << " events (" << r.log_bytes << " bytes) in " << s << " s to " << out << "\n";

@@ -9,12 +9,15 @@
 #include "robotalk/config_message.h"
 #include "robotalk/request.h"
 #include "scene_json.h"
+#include "web_options.h"
 
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <set>
 
@@ -77,7 +80,8 @@ struct Robot {
 
 class Exporter {
  public:
-  explicit Exporter(const std::string& path) : mcap_(path) {}
+  Exporter(const std::string& path, std::map<std::string, web::MeshCatalog> geometry)
+      : mcap_(path), geometry_(std::move(geometry)) {}
 
   void Event(const std::string& channel, std::int64_t log_us, std::span<const std::uint8_t> bytes) {
     const std::optional<ChannelParts> parts = ParseChannel(channel);
@@ -126,10 +130,12 @@ class Exporter {
     if (r.model && r.config_hash == hash) return;  // the same description again (another client connected)
     r.model = std::make_shared<const RobotModel>(DecodeConfig(bytes));
     r.poser = std::make_unique<web::StatePoser>(*r.model);
-    r.messages = std::make_unique<fg::RobotMessages>(r.model);
+    const auto urdf = geometry_.find(robot);
+    r.messages = std::make_unique<fg::RobotMessages>(
+        r.model, urdf == geometry_.end() ? std::nullopt : std::optional<web::MeshCatalog>(urdf->second));
     r.config_hash = hash;
     Put(fg::TopicName(robot, fg::Topic::kScene), fg::SchemaOf(fg::Topic::kScene), log_ns, log_ns,
-        r.messages->Scene(static_cast<std::int64_t>(log_ns)));
+        r.messages->Scene(static_cast<std::int64_t>(log_ns), {.embed = true}));
   }
 
   void State(const std::string& robot, std::uint64_t log_ns, std::span<const std::uint8_t> bytes) {
@@ -164,6 +170,7 @@ class Exporter {
   }
 
   McapWriter mcap_;
+  const std::map<std::string, web::MeshCatalog> geometry_;
   std::map<std::string, Robot> robots_;
   std::map<std::string, std::uint16_t> channels_;
   std::set<std::string> undecodable_channels_;
@@ -171,13 +178,42 @@ class Exporter {
 
 }  // namespace
 
-McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap_path,
-                            std::ostream& warnings) {
+McapGeometry ParseGeometryOptions(const std::vector<std::string>& urdf,
+                                  const std::vector<std::string>& package_paths,
+                                  const std::string& ros_package_path) {
+  McapGeometry g;
+  for (const std::string& v : urdf) {
+    auto [robot, path] = web::ParseUrdfOption(v);
+    if (!std::filesystem::is_regular_file(path)) throw Error("--urdf " + v + ": no such file");
+    g.urdf[robot] = path;
+  }
+  for (const std::string& v : package_paths) web::AppendPackagePaths(v, g.package_paths);
+  if (!ros_package_path.empty()) web::AppendPackagePaths(ros_package_path, g.package_paths);
+  return g;
+}
+
+McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap_path, std::ostream& warnings,
+                            const McapGeometry& geometry) {
   lcm::LogFile file(log_path, "r");
   if (!file.good()) throw LogError("cannot open LCM log '" + log_path + "'");
+  std::map<std::string, web::MeshCatalog> catalogs;
+  for (const auto& [robot, path] : geometry.urdf) {
+    web::MeshCatalog& c = catalogs[robot] = web::ResolveMeshes(robot, path, geometry.package_paths);
+    if (!c.error.empty() || !c.geometry_error.empty())
+      warnings << "robotalk-logplay: --urdf " << robot << ": " << c.error << c.geometry_error
+               << " (the scene shows its inertia boxes)\n";
+    std::size_t told = 0;
+    for (const web::MeshEntry& m : c.meshes)
+      if (!m.error.empty() && ++told <= 5)
+        warnings << "robotalk-logplay: " << robot << ": link '" << m.link << "': mesh " << m.uri << ": "
+                 << m.error << "\n";
+    if (told > 0)
+      warnings << "robotalk-logplay: " << robot << ": " << told << " of " << c.meshes.size()
+               << " meshes not resolved; their links show their inertia boxes\n";
+  }
   std::unique_ptr<Exporter> exporter;
   try {
-    exporter = std::make_unique<Exporter>(mcap_path);
+    exporter = std::make_unique<Exporter>(mcap_path, std::move(catalogs));
   } catch (const Error& e) {
     throw LogError(std::string("export --mcap: ") + e.what());
   }

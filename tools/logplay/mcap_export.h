@@ -9,6 +9,9 @@
 //   /ROBOT/replies   robotalk.ReplyBatch  every REPLY batch
 // Every message's log time is the LCM logger's receive time; its publish
 // time is the sample's server time for states (the log time otherwise).
+// A robot given a URDF (McapGeometry, --urdf ROBOT=PATH) is drawn from it as
+// robotalk-web draws it live, its meshes embedded in the scene; the others as
+// their equivalent inertia boxes (the configuration carries no geometry).
 // A robot's states before its first logged configuration cannot be posed:
 // they are counted and named on `warnings`, as are undecodable messages.
 //
@@ -20,7 +23,9 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <map>
 #include <string>
+#include <vector>
 
 namespace robotalk::logplay {
 
@@ -33,7 +38,18 @@ struct McapExportResult {
   std::uint64_t undecodable = 0;  ///< RoboTalk messages that did not decode
 };
 
-McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap_path,
-                            std::ostream& warnings);
+/// The robots' URDFs: --urdf ROBOT=PATH, --package-path DIRS (then ROS_PACKAGE_PATH).
+struct McapGeometry {
+  std::map<std::string, std::string> urdf;  ///< robot -> URDF file
+  std::vector<std::string> package_paths;   ///< where package:// meshes are found
+};
+/// From the option values; throws robotalk::Error naming a value that is not
+/// NAME=PATH, a URDF file that does not exist, a path list naming no folder.
+McapGeometry ParseGeometryOptions(const std::vector<std::string>& urdf,
+                                  const std::vector<std::string>& package_paths,
+                                  const std::string& ros_package_path);
+
+McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap_path, std::ostream& warnings,
+                            const McapGeometry& geometry = {});
 
 }  // namespace robotalk::logplay

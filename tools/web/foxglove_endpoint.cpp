@@ -34,6 +34,9 @@ constexpr std::uint32_t kPanicServiceId = 1;
 // State messages queued per client beyond which new ones are dropped (5
 // channels per robot per tick: a few ticks of a few robots).
 constexpr std::size_t kMaxQueuedStates = 64;
+// Scene texts kept per robot, one per Host clients named (a client may send
+// any Host header: the cache is bounded, a scene is rebuilt when it must be).
+constexpr std::size_t kMaxCachedScenes = 8;
 // Client messages are small JSON ops and service calls.
 constexpr std::size_t kMaxClientMessage = 64 * 1024;
 
@@ -65,6 +68,7 @@ const json& PanicResponseSchema() {
 // One Foxglove client: its connection and its subscriptions.
 struct Session {
   std::shared_ptr<WsConnection> connection;
+  std::string url_base;  // "http://" + the Host the client connected to: where meshes are served
   std::map<std::uint32_t, std::uint32_t> subscriptions;            // client's id -> channel id
   std::map<std::uint32_t, std::uint32_t> subscription_of_channel;  // the reverse
 
@@ -80,7 +84,7 @@ struct RobotChannels {
   std::uint32_t first_id = 0;  // channel of kRobotTopics[i] is first_id + i
   std::uint64_t generation = 0;
   std::unique_ptr<fg::RobotMessages> messages;
-  std::string scene;  // the SceneUpdate as JSON text
+  std::map<std::string, std::string> scenes;  // the SceneUpdate as JSON text, by url_base (mesh URLs)
   std::int64_t scene_time_ns = 0;
 };
 
@@ -88,8 +92,8 @@ struct RobotChannels {
 
 class FoxgloveEndpoint::Impl {
  public:
-  Impl(std::shared_ptr<asio::io_context> ioc, PanicHandler panic)
-      : ioc_(std::move(ioc)), panic_(std::move(panic)) {}
+  Impl(std::shared_ptr<asio::io_context> ioc, PanicHandler panic, std::map<std::string, MeshCatalog> geometry)
+      : ioc_(std::move(ioc)), panic_(std::move(panic)), geometry_(std::move(geometry)) {}
 
   void Accept(tcp::socket socket, http::request<http::string_body> req) {
     auto connection = std::make_shared<WsConnection>(
@@ -104,7 +108,11 @@ class FoxgloveEndpoint::Impl {
             return;
           }
         });
-    sessions_.push_back(std::make_shared<Session>(Session{connection, {}, {}}));
+    const auto host = req.find(http::field::host);
+    const std::string url_base = host == req.end()
+                                     ? std::string()
+                                     : "http://" + std::string(host->value().data(), host->value().size());
+    sessions_.push_back(std::make_shared<Session>(Session{connection, url_base, {}, {}}));
     std::vector<WsConnection::Message> greeting;
     for (std::string& g : Greeting()) greeting.push_back(std::make_shared<const std::string>(std::move(g)));
     connection->Start(std::move(req), std::move(greeting), kSubprotocol);
@@ -124,11 +132,13 @@ class FoxgloveEndpoint::Impl {
         next_channel_id_ += static_cast<std::uint32_t>(fg::kRobotTopics.size());
       }
       r.generation = m.generation;
-      r.messages = std::make_unique<fg::RobotMessages>(m.model);
+      const auto urdf = geometry_.find(m.robot);
+      r.messages = std::make_unique<fg::RobotMessages>(
+          m.model, urdf == geometry_.end() ? std::nullopt : std::optional<MeshCatalog>(urdf->second));
       r.scene_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
                             std::chrono::system_clock::now().time_since_epoch())
                             .count();
-      r.scene = JsonText(r.messages->Scene(r.scene_time_ns));
+      r.scenes.clear();
       if (added) {
         const std::string advertise = JsonText(Advertise({m.robot}));
         for (auto& s : sessions_) s->SendText(advertise);
@@ -181,11 +191,15 @@ class FoxgloveEndpoint::Impl {
     return b;
   }
 
-  void SendScene(Session& s, const RobotChannels& r) {
+  // Written once per model and mesh URL base, sent to each subscriber once.
+  static void SendScene(Session& s, RobotChannels& r) {
     const auto sub =
         s.subscription_of_channel.find(r.first_id + static_cast<std::uint32_t>(fg::Topic::kScene));
-    if (sub != s.subscription_of_channel.end())
-      s.SendBinary(MessageData(sub->second, r.scene_time_ns, r.scene), false);
+    if (sub == s.subscription_of_channel.end()) return;
+    if (r.scenes.size() >= kMaxCachedScenes && !r.scenes.count(s.url_base)) r.scenes.clear();
+    auto [scene, added] = r.scenes.try_emplace(s.url_base);
+    if (added) scene->second = JsonText(r.messages->Scene(r.scene_time_ns, {.url_base = s.url_base}));
+    s.SendBinary(MessageData(sub->second, r.scene_time_ns, scene->second), false);
   }
 
   json Advertise(const std::vector<std::string>& robots) const {
@@ -268,8 +282,8 @@ class FoxgloveEndpoint::Impl {
     }
     const auto id = sub["id"].get<std::uint32_t>();
     const auto channel = sub["channelId"].get<std::uint32_t>();
-    const RobotChannels* robot = nullptr;
-    for (const auto& [name, r] : robots_)
+    RobotChannels* robot = nullptr;
+    for (auto& [name, r] : robots_)
       if (channel >= r.first_id && channel < r.first_id + fg::kRobotTopics.size()) robot = &r;
     if (!robot) {
       s->SendText(JsonText(Status(2, "robotalk-web: subscribe: no channel " + std::to_string(channel))));
@@ -316,7 +330,7 @@ class FoxgloveEndpoint::Impl {
       asio::post(*ioc, [weak, service, call, robot, error] {
         auto connection = weak.lock();
         if (!connection) return;
-        Session session{connection, {}, {}};
+        Session session{connection, {}, {}, {}};
         if (!error.empty()) {
           session.SendText(JsonText(json{{"op", "serviceCallFailure"},
                                          {"serviceId", service},
@@ -338,6 +352,7 @@ class FoxgloveEndpoint::Impl {
 
   std::shared_ptr<asio::io_context> ioc_;
   PanicHandler panic_;
+  const std::map<std::string, MeshCatalog> geometry_;
   std::vector<std::shared_ptr<Session>> sessions_;
   std::map<std::string, RobotChannels> robots_;
   std::uint32_t next_channel_id_ = 1;
@@ -346,8 +361,9 @@ class FoxgloveEndpoint::Impl {
                                                      .count());
 };
 
-FoxgloveEndpoint::FoxgloveEndpoint(std::shared_ptr<asio::io_context> ioc, PanicHandler panic)
-    : impl_(std::make_unique<Impl>(std::move(ioc), std::move(panic))) {}
+FoxgloveEndpoint::FoxgloveEndpoint(std::shared_ptr<asio::io_context> ioc, PanicHandler panic,
+                                   std::map<std::string, MeshCatalog> geometry)
+    : impl_(std::make_unique<Impl>(std::move(ioc), std::move(panic), std::move(geometry))) {}
 FoxgloveEndpoint::~FoxgloveEndpoint() = default;
 
 bool FoxgloveEndpoint::Offered(const http::request<http::string_body>& request) {

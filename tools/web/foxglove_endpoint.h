@@ -9,7 +9,11 @@
 // (request {"robot": NAME}). It reads subscribe / unsubscribe and service
 // calls; anything else gets a status message naming it. Each robot's state
 // reaches a subscriber at the web loop's rate (--rate, decimated by the
-// tracker); a subscriber of /ROBOT/scene gets the current scene at once.
+// tracker); a subscriber of /ROBOT/scene gets the current scene at once, and
+// again only when the robot's model changes (never with a state). A robot
+// the bridge has a URDF for (--urdf) is drawn from it; its meshes' URLs are
+// http://HOST/mesh/..., HOST as the client's upgrade request named the
+// bridge (its Host header), where WebServer serves them.
 // A client that cannot keep up loses state messages, never an advertisement,
 // a scene or a service answer.
 //
@@ -19,6 +23,7 @@
 // it is answered with a status (level 2) naming what was wrong.
 #pragma once
 
+#include "mesh_catalog.h"
 #include "robot_tracker.h"
 
 #include <boost/asio/io_context.hpp>
@@ -27,6 +32,7 @@
 #include <boost/beast/http/string_body.hpp>
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -41,7 +47,9 @@ class FoxgloveEndpoint {
   static constexpr const char* kSubprotocol = "foxglove.websocket.v1";
 
   /// `panic` empty: no services are offered (the endpoint is read-only).
-  FoxgloveEndpoint(std::shared_ptr<boost::asio::io_context> ioc, PanicHandler panic);
+  /// `geometry`: each --urdf robot's URDF as read at start (by robot name).
+  FoxgloveEndpoint(std::shared_ptr<boost::asio::io_context> ioc, PanicHandler panic,
+                   std::map<std::string, MeshCatalog> geometry = {});
   ~FoxgloveEndpoint();
   FoxgloveEndpoint(const FoxgloveEndpoint&) = delete;
   FoxgloveEndpoint& operator=(const FoxgloveEndpoint&) = delete;

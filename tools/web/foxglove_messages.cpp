@@ -5,8 +5,14 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
+#include <variant>
 
 namespace robotalk::web::foxglove {
 namespace {
@@ -53,13 +59,30 @@ SchemaInfo TransformsSchema() {
 
 SchemaInfo SceneSchema() {
   const json cube = Object({{"pose", PoseSchema()}, {"size", Vector3Schema()}, {"color", ColorSchema()}});
+  const json cylinder = Object({{"pose", PoseSchema()},
+                                {"size", Vector3Schema()},
+                                {"bottom_scale", Number()},
+                                {"top_scale", Number()},
+                                {"color", ColorSchema()}});
+  json base64 = String();
+  base64["contentEncoding"] = "base64";
+  const json model = Object({{"pose", PoseSchema()},
+                             {"scale", Vector3Schema()},
+                             {"color", ColorSchema()},
+                             {"override_color", Boolean()},
+                             {"url", String()},
+                             {"media_type", String()},
+                             {"data", base64}});
   json entity = Object({{"timestamp", TimeSchema()},
                         {"frame_id", String()},
                         {"id", String()},
                         {"lifetime", TimeSchema()},
                         {"frame_locked", Boolean()},
+                        {"metadata", ArrayOf(Object({{"key", String()}, {"value", String()}}))},
                         {"cubes", ArrayOf(cube)},
-                        {"spheres", ArrayOf(cube)}});
+                        {"spheres", ArrayOf(cube)},
+                        {"cylinders", ArrayOf(cylinder)},
+                        {"models", ArrayOf(model)}});
   const json deletion = Object({{"timestamp", TimeSchema()}, {"type", Integer()}, {"id", String()}});
   return Make("foxglove.SceneUpdate", "foxglove.SceneUpdate",
               Object({{"deletions", ArrayOf(deletion)}, {"entities", ArrayOf(entity)}}));
@@ -117,6 +140,79 @@ json Transform(std::int64_t ns, const std::string& parent, const std::string& ch
           {"child_frame_id", child},
           {"translation", Vec(x.translation())},
           {"rotation", Quat(Eigen::Quaterniond(x.linear()))}};
+}
+
+json PoseJson(const Pose& p) { return {{"position", Vec(p.translation)}, {"orientation", Quat(p.rotation)}}; }
+json ColorJson(const Eigen::Vector4d& c) {
+  return {{"r", R6(c[0])}, {"g", R6(c[1])}, {"b", R6(c[2])}, {"a", R6(c[3])}};
+}
+const Eigen::Vector4d kInertiaColor(0.45, 0.6, 0.8, 0.7);
+const Eigen::Vector4d kUrdfColor(0.72, 0.74, 0.78, 1.0);  // a shape without a material
+
+json KeyValue(const std::string& key, const std::string& value) { return {{"key", key}, {"value", value}}; }
+
+// An entity of link frame `frame` with no primitives yet.
+json Entity(std::int64_t ns, const std::string& frame, json metadata) {
+  return {{"timestamp", TimeJson(ns)}, {"frame_id", frame},        {"id", frame},
+          {"lifetime", TimeJson(0)},   {"frame_locked", true},     {"metadata", std::move(metadata)},
+          {"cubes", json::array()},    {"spheres", json::array()}, {"cylinders", json::array()},
+          {"models", json::array()}};
+}
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+// The media types Foxglove's 3D panel loads models of; "" lets it guess from the URL.
+std::string MediaType(const std::filesystem::path& file) {
+  const std::string ext = Lower(file.extension().string());
+  if (ext == ".stl") return "model/stl";
+  if (ext == ".glb") return "model/gltf-binary";
+  if (ext == ".gltf") return "model/gltf+json";
+  if (ext == ".dae") return "model/vnd.collada+xml";
+  if (ext == ".obj") return "model/obj";
+  return "";
+}
+
+std::string Base64(const std::string& in) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < in.size(); i += 3) {
+    std::uint32_t v = static_cast<std::uint8_t>(in[i]) << 16;
+    if (i + 1 < in.size()) v |= static_cast<std::uint32_t>(static_cast<std::uint8_t>(in[i + 1])) << 8;
+    if (i + 2 < in.size()) v |= static_cast<std::uint8_t>(in[i + 2]);
+    out += kDigits[(v >> 18) & 63];
+    out += kDigits[(v >> 12) & 63];
+    out += i + 1 < in.size() ? kDigits[(v >> 6) & 63] : '=';
+    out += i + 2 < in.size() ? kDigits[v & 63] : '=';
+  }
+  return out;
+}
+
+// The foxglove.ModelPrimitive of a resolved mesh, or why there is none.
+std::variant<json, std::string> Model(const UrdfShape& s, const MeshEntry& m, const MeshLinks& links,
+                                      const std::optional<Eigen::Vector4d>& rgba) {
+  std::string url, data;
+  if (!links.embed) {
+    url = links.url_base + m.url;
+  } else if (Lower(m.file.extension().string()) == ".gltf") {
+    url = "file://" + m.file.string();
+  } else {
+    std::ifstream in(m.file, std::ios::binary);
+    std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (!in.good() && !in.eof()) return "cannot read " + m.file.string();
+    data = Base64(bytes);
+  }
+  return json{{"pose", PoseJson(s.origin)},
+              {"scale", Vec(s.size)},
+              {"color", ColorJson(rgba.value_or(kUrdfColor))},
+              {"override_color", rgba.has_value()},
+              {"url", url},
+              {"media_type", MediaType(m.file)},
+              {"data", data}};
 }
 
 const json& Field(const json& pose, const char* name) {
@@ -185,8 +281,8 @@ json TimeJson(std::int64_t ns) {
   return {{"sec", ns / 1'000'000'000}, {"nsec", ns % 1'000'000'000}};
 }
 
-RobotMessages::RobotMessages(std::shared_ptr<const RobotModel> model)
-    : model_(std::move(model)), dof_names_(DofNames(*model_)) {
+RobotMessages::RobotMessages(std::shared_ptr<const RobotModel> model, std::optional<MeshCatalog> geometry)
+    : model_(std::move(model)), geometry_(std::move(geometry)), dof_names_(DofNames(*model_)) {
   const std::string prefix = model_->name() + "/";
   std::set<std::string> link_names;
   for (const Link& l : model_->links()) {
@@ -200,36 +296,99 @@ RobotMessages::RobotMessages(std::shared_ptr<const RobotModel> model)
 std::string RobotMessages::LinkFrame(std::size_t l) const { return link_frames_.at(l); }
 std::string RobotMessages::ControlFrameId(std::size_t f) const { return control_frames_.at(f); }
 
-json RobotMessages::Scene(std::int64_t time_ns) const {
-  const json body_color = {{"r", 0.45}, {"g", 0.6}, {"b", 0.8}, {"a", 0.7}};
-  const json joint_color = {{"r", 0.95}, {"g", 0.7}, {"b", 0.2}, {"a", 1.0}};
-  std::vector<json> spheres(model_->links().size(), json::array());
-  const double r = 0.03;
-  auto sphere = [&](const Eigen::Vector3d& at) {
+json RobotMessages::InertiaEntity(std::size_t l, std::int64_t time_ns, const std::string& note) const {
+  const Link& link = model_->links()[l];
+  json e = Entity(time_ns, link_frames_[l], {KeyValue("geometry", "inertia box"), KeyValue("note", note)});
+  const InertiaBox box = EquivalentInertiaBox(link);
+  e["cubes"].push_back({{"pose", {{"position", Vec(link.com)}, {"orientation", Quat(box.rotation)}}},
+                        {"size", Vec(box.sides)},
+                        {"color", ColorJson(kInertiaColor)}});
+  auto sphere = [&](const Eigen::Vector3d& at) {  // joint centres, as the page draws its bones
     return json{{"pose", {{"position", Vec(at)}, {"orientation", Quat(Eigen::Quaterniond::Identity())}}},
-                {"size", Vec(Eigen::Vector3d::Constant(r))},
-                {"color", joint_color}};
+                {"size", Vec(Eigen::Vector3d::Constant(0.03))},
+                {"color", ColorJson({0.95, 0.7, 0.2, 1.0})}};
   };
-  for (const Joint& j : model_->joints()) {  // joint centres, as the page draws its bones
-    spheres[static_cast<std::size_t>(j.parent_link)].push_back(
-        sphere(model_->link(j.parent_link).com + j.inboard));
-    spheres[static_cast<std::size_t>(j.child_link)].push_back(
-        sphere(model_->link(j.child_link).com + j.outboard));
+  for (const Joint& j : model_->joints()) {
+    if (static_cast<std::size_t>(j.parent_link) == l) e["spheres"].push_back(sphere(link.com + j.inboard));
+    if (static_cast<std::size_t>(j.child_link) == l) e["spheres"].push_back(sphere(link.com + j.outboard));
   }
+  return e;
+}
+
+json RobotMessages::UrdfEntity(std::size_t l, std::int64_t time_ns, const MeshLinks& links) const {
+  const std::string& name = model_->links()[l].name;
+  const MeshCatalog& g = *geometry_;
+  if (std::find(g.links.begin(), g.links.end(), name) == g.links.end())
+    return InertiaEntity(l, time_ns,
+                         "link '" + name + "' is not in the --urdf file: its equivalent inertia box");
+  bool collision = false, visual = false;
+  std::optional<Eigen::Vector4d> link_rgba;  // a collision shape takes its link's first visual colour
+  for (const UrdfShape& s : g.shapes) {
+    if (s.link != name) continue;
+    collision = collision || s.collision;
+    visual = visual || !s.collision;
+    if (!s.collision && s.rgba && !link_rgba) link_rgba = s.rgba;
+  }
+  json e = Entity(time_ns, link_frames_[l],
+                  {KeyValue("geometry", collision ? "urdf collision"
+                                        : visual  ? "urdf visual"
+                                                  : "none")});
+  std::string mesh_errors;
+  for (const UrdfShape& s : g.shapes) {
+    if (s.link != name || s.collision != collision) continue;
+    const std::optional<Eigen::Vector4d> rgba = s.rgba ? s.rgba : link_rgba;
+    const json color = ColorJson(rgba.value_or(kUrdfColor));
+    const double r = s.size.x();
+    switch (s.kind) {
+      case UrdfShape::Kind::kBox:
+        e["cubes"].push_back({{"pose", PoseJson(s.origin)}, {"size", Vec(s.size)}, {"color", color}});
+        break;
+      case UrdfShape::Kind::kCylinder:
+        e["cylinders"].push_back({{"pose", PoseJson(s.origin)},
+                                  {"size", Vec({2 * r, 2 * r, s.size.y()})},
+                                  {"bottom_scale", 1.0},
+                                  {"top_scale", 1.0},
+                                  {"color", color}});
+        break;
+      case UrdfShape::Kind::kSphere:
+        e["spheres"].push_back({{"pose", PoseJson(s.origin)},
+                                {"size", Vec(Eigen::Vector3d::Constant(2 * r))},
+                                {"color", color}});
+        break;
+      case UrdfShape::Kind::kMesh: {
+        const MeshEntry* m = g.MeshOf(s);
+        std::variant<json, std::string> model = std::string("not in the mesh catalog");
+        if (m && !m->url.empty()) model = Model(s, *m, links, rgba);
+        if (const json* j = std::get_if<json>(&model))
+          e["models"].push_back(*j);
+        else
+          mesh_errors += (mesh_errors.empty() ? "" : "; ") + s.mesh + ": " +
+                         (m && !m->error.empty() ? m->error : std::get<std::string>(model));
+        break;
+      }
+    }
+  }
+  if (!mesh_errors.empty()) {  // the link is still seen: its inertia box beside the reason
+    e["cubes"].push_back(InertiaEntity(l, time_ns, "")["cubes"][0]);
+    e["metadata"].push_back(KeyValue("mesh", mesh_errors + " (drawn as its equivalent inertia box)"));
+  }
+  return e;
+}
+
+json RobotMessages::Scene(std::int64_t time_ns, const MeshLinks& links) const {
   json entities = json::array();
   for (std::size_t l = 0; l < model_->links().size(); ++l) {
-    const Link& link = model_->links()[l];
-    const InertiaBox box = EquivalentInertiaBox(link);
-    const json cube = {{"pose", {{"position", Vec(link.com)}, {"orientation", Quat(box.rotation)}}},
-                       {"size", Vec(box.sides)},
-                       {"color", body_color}};
-    entities.push_back({{"timestamp", TimeJson(time_ns)},
-                        {"frame_id", link_frames_[l]},
-                        {"id", link_frames_[l]},
-                        {"lifetime", TimeJson(0)},
-                        {"frame_locked", true},
-                        {"cubes", json::array({cube})},
-                        {"spheres", spheres[l]}});
+    if (!geometry_) {
+      entities.push_back(InertiaEntity(l, time_ns,
+                                       "the robot's configuration carries no geometry; give robotalk-web "
+                                       "or robotalk-logplay export --urdf ROBOT=PATH to see the URDF's"));
+    } else if (!geometry_->error.empty() || !geometry_->geometry_error.empty()) {
+      entities.push_back(InertiaEntity(
+          l, time_ns,
+          "the --urdf file's geometry could not be read: " + geometry_->error + geometry_->geometry_error));
+    } else {
+      entities.push_back(UrdfEntity(l, time_ns, links));
+    }
   }
   // A new model replaces the robot's scene: every entity of this topic older
   // than this one goes (type 1 = all), so links the old model had do not stay.

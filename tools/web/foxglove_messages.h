@@ -6,11 +6,18 @@
 //
 //   /ROBOT/tf            foxglove.FrameTransforms  world -> root link, parent link -> child
 //                                                   link per joint, link -> control frame
-//   /ROBOT/scene         foxglove.SceneUpdate      per link: its equivalent inertia box and
-//                                                   spheres at its joint centres, locked to
-//                                                   the link's frame (sent when the model is
-//                                                   known, and to each new subscriber); it
-//                                                   deletes the topic's older entities
+//   /ROBOT/scene         foxglove.SceneUpdate      one entity per link, locked to the link's
+//                                                   frame: with the robot's URDF (--urdf) its
+//                                                   <collision> shapes (its <visual> ones when
+//                                                   it has none) as cubes, cylinders, spheres
+//                                                   and models (meshes), in the <visual>
+//                                                   material's colour; without one its
+//                                                   equivalent inertia box and spheres at its
+//                                                   joint centres. Each entity's metadata says
+//                                                   which ("geometry"). Sent when the model is
+//                                                   known and to each new subscriber, never
+//                                                   with a state; it deletes the topic's older
+//                                                   entities
 //   /ROBOT/joint_states  robotalk.JointState       dof names and positions (rad | m)
 //   /ROBOT/base_pose     foxglove.PoseInFrame      the first root link's pose in "world"
 //   /ROBOT/status        robotalk.RobotStatus      sample, panic, moving, base x y θ v ω
@@ -25,6 +32,7 @@
 // a pose object lacks one or has the wrong number of links (another model's).
 #pragma once
 
+#include "mesh_catalog.h"
 #include "robotalk/robot_model.h"
 
 #include <nlohmann/json.hpp>
@@ -32,6 +40,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,18 +69,32 @@ const SchemaInfo& ReplySchema();
 /// {"sec", "nsec"} of `ns` nanoseconds (negative times clamp to 0).
 nlohmann::json TimeJson(std::int64_t ns);
 
+/// How a scene refers to a mesh file of the robot's MeshCatalog.
+struct MeshLinks {
+  /// Live: the model's `url` is url_base + the catalog's url
+  /// ("http://HOST:PORT", where robotalk-web serves it).
+  std::string url_base;
+  /// MCAP: the file's bytes go in the model's `data` (base64), so that the
+  /// recording plays back anywhere; a .gltf, which names files beside it,
+  /// is referred to as file://PATH instead.
+  bool embed = false;
+};
+
 /// One robot's messages for one model.
 class RobotMessages {
  public:
-  explicit RobotMessages(std::shared_ptr<const RobotModel> model);
+  /// `geometry`: the robot's URDF as ResolveMeshes read it; none: the scene
+  /// shows equivalent inertia boxes (the configuration carries no geometry).
+  explicit RobotMessages(std::shared_ptr<const RobotModel> model, std::optional<MeshCatalog> geometry = {});
 
   const RobotModel& model() const { return *model_; }
   /// The frame id of link `l`, of control frame `f`.
   std::string LinkFrame(std::size_t l) const;
   std::string ControlFrameId(std::size_t f) const;
 
-  /// The foxglove.SceneUpdate of the model, stamped `time_ns`.
-  nlohmann::json Scene(std::int64_t time_ns) const;
+  /// The foxglove.SceneUpdate of the model, stamped `time_ns`. Reads the
+  /// mesh files when `links.embed`.
+  nlohmann::json Scene(std::int64_t time_ns, const MeshLinks& links = {}) const;
 
   struct State {
     std::int64_t time_ns = 0;  ///< the sample's server time
@@ -82,7 +105,11 @@ class RobotMessages {
   State FromPose(const nlohmann::json& pose) const;
 
  private:
+  nlohmann::json InertiaEntity(std::size_t l, std::int64_t time_ns, const std::string& note) const;
+  nlohmann::json UrdfEntity(std::size_t l, std::int64_t time_ns, const MeshLinks& links) const;
+
   std::shared_ptr<const RobotModel> model_;
+  std::optional<MeshCatalog> geometry_;
   std::vector<std::string> link_frames_, control_frames_, dof_names_;
 };
 

@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
     for (const auto& [name, catalog] : server.meshes()) {  // the page notes the same under the robot's view
       if (!catalog.error.empty())
         std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.error << "\n";
+      else if (!catalog.geometry_error.empty())
+        std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.geometry_error
+                  << " (Foxglove's scene shows its inertia boxes)\n";
       std::size_t told = 0;
       for (const MeshEntry& m : catalog.meshes) {
         if (!m.error.empty() && ++told <= 5)
@@ -63,7 +66,8 @@ int main(int argc, char** argv) {
       }
       if (told > 0)
         std::cerr << "robotalk-web: " << name << ": " << told << " of " << catalog.meshes.size()
-                  << " meshes not resolved; the page draws their links from the configuration\n";
+                  << " meshes not resolved; the page draws their links from the configuration, Foxglove's "
+                     "scene as inertia boxes\n";
     }
     std::cout << "robotalk-web: open http://" << (options.bind == "0.0.0.0" ? "127.0.0.1" : options.bind)
               << ":" << server.port() << "/" << std::endl;

@@ -160,20 +160,37 @@ MeshCatalog ResolveMeshes(const std::string& robot, const std::string& urdf_path
   for (std::size_t i = 0; i < package_paths.size(); ++i) r.searched += (i ? ", " : " ") + package_paths[i];
   const TiXmlElement* root = doc.RootElement();
   for (const TiXmlElement* link = root ? root->FirstChildElement("link") : nullptr; link;
-       link = link->NextSiblingElement("link")) {
-    const char* link_name = link->Attribute("name");
-    for (const TiXmlElement* visual = link->FirstChildElement("visual"); visual;
-         visual = visual->NextSiblingElement("visual")) {
-      const TiXmlElement* geometry = visual->FirstChildElement("geometry");
-      const TiXmlElement* mesh = geometry ? geometry->FirstChildElement("mesh") : nullptr;
-      const char* filename = mesh ? mesh->Attribute("filename") : nullptr;
-      if (!filename) continue;
-      MeshEntry m{.link = link_name ? link_name : "", .uri = filename};
-      r.Resolve(m, robot, catalog.meshes.size());
-      catalog.meshes.push_back(std::move(m));
+       link = link->NextSiblingElement("link"))
+    if (const char* name = link->Attribute("name")) catalog.links.emplace_back(name);
+  for (const char* element : {"visual", "collision"}) {
+    for (const TiXmlElement* link = root ? root->FirstChildElement("link") : nullptr; link;
+         link = link->NextSiblingElement("link")) {
+      const char* link_name = link->Attribute("name");
+      for (const TiXmlElement* e = link->FirstChildElement(element); e; e = e->NextSiblingElement(element)) {
+        const TiXmlElement* geometry = e->FirstChildElement("geometry");
+        const TiXmlElement* mesh = geometry ? geometry->FirstChildElement("mesh") : nullptr;
+        const char* filename = mesh ? mesh->Attribute("filename") : nullptr;
+        if (!filename) continue;
+        MeshEntry m{.link = link_name ? link_name : "", .uri = filename, .collision = element[0] == 'c'};
+        r.Resolve(m, robot, catalog.meshes.size());
+        catalog.meshes.push_back(std::move(m));
+      }
     }
   }
+  try {
+    catalog.shapes = LoadUrdfShapes(urdf->string());
+  } catch (const std::exception& e) {
+    catalog.geometry_error = e.what();
+  }
   return catalog;
+}
+
+const MeshEntry* MeshCatalog::MeshOf(const UrdfShape& shape) const {
+  if (shape.kind != UrdfShape::Kind::kMesh) return nullptr;
+  for (const MeshEntry& m : meshes) {
+    if (m.link == shape.link && m.collision == shape.collision && m.uri == shape.mesh) return &m;
+  }
+  return nullptr;
 }
 
 nlohmann::json MeshCatalog::Json() const {
@@ -182,7 +199,8 @@ nlohmann::json MeshCatalog::Json() const {
     list.push_back({{"link", m.link},
                     {"uri", m.uri},
                     {"url", m.url.empty() ? nlohmann::json(nullptr) : nlohmann::json(m.url)},
-                    {"error", m.error}});
+                    {"error", m.error},
+                    {"collision", m.collision}});
   }
   return {{"robot", robot}, {"error", error}, {"meshes", list}};
 }

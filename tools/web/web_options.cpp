@@ -28,6 +28,19 @@ void AppendPaths(const std::string& list, std::vector<std::string>& paths) {
 
 }  // namespace
 
+std::pair<std::string, std::string> ParseUrdfOption(const std::string& v) {
+  const auto eq = v.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == v.size())
+    throw Error("--urdf: '" + v + "' is not NAME=PATH");
+  return {v.substr(0, eq), v.substr(eq + 1)};
+}
+
+void AppendPackagePaths(const std::string& v, std::vector<std::string>& paths) {
+  const std::size_t before = paths.size();
+  AppendPaths(v, paths);
+  if (paths.size() == before) throw Error("--package-path: '" + v + "' names no folder");
+}
+
 std::string WebUsage() {
   return "usage: robotalk-web [options]\n"
          "Shows every robot announced on the LCM bus in a browser: a 3D view moving with\n"
@@ -85,16 +98,10 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
         throw Error("--robot-timeout: " + args[i] +
                     " s is shorter than 1.5 s (servers announce every second)");
     } else if (a == "--urdf") {
-      const std::string& v = value();
-      const auto eq = v.find('=');
-      if (eq == std::string::npos || eq == 0 || eq + 1 == v.size())
-        throw Error("--urdf: '" + v + "' is not NAME=PATH");
-      o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
+      auto [name, path] = ParseUrdfOption(value());
+      o.urdf[name] = path;
     } else if (a == "--package-path") {
-      const std::string& v = value();
-      const std::size_t before = o.package_paths.size();
-      AppendPaths(v, o.package_paths);
-      if (o.package_paths.size() == before) throw Error("--package-path: '" + v + "' names no folder");
+      AppendPackagePaths(value(), o.package_paths);
     } else if (a == "--www") {
       o.www_dir = value();
     } else if (a == "--node-modules") {

@@ -6,6 +6,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace robotalk::web {
@@ -43,6 +44,13 @@ struct WebOptions {
 /// --package-path folders.
 WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::string& default_www,
                            const std::string& default_modules, const std::string& ros_package_path = "");
+
+/// The NAME and PATH of a --urdf NAME=PATH value (robotalk-web, and
+/// robotalk-logplay export --mcap); throws Error naming a value that is not.
+std::pair<std::string, std::string> ParseUrdfOption(const std::string& value);
+/// Appends the folders of a --package-path value (colon-separated); throws
+/// Error when it names none.
+void AppendPackagePaths(const std::string& value, std::vector<std::string>& paths);
 
 /// The --help text.
 std::string WebUsage();

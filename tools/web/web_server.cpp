@@ -79,7 +79,7 @@ class WebServer::Impl {
     FoxgloveEndpoint::PanicHandler panic;
     if (std::getenv("ROBOTALK_KEY") != nullptr)
       panic = [this](const std::string& robot, auto done) { tracker_.Panic(robot, std::move(done)); };
-    foxglove_ = std::make_unique<FoxgloveEndpoint>(ioc_, std::move(panic));
+    foxglove_ = std::make_unique<FoxgloveEndpoint>(ioc_, std::move(panic), meshes_);
     // A sample is sent when it arrives, not at the next tick (a tick that
     // polls just before each sample would add a whole period); at most one
     // wake-up in flight. The listener may outlive this server: it holds the
@@ -177,7 +177,8 @@ class WebServer::Impl {
       return send(std::move(res));
     }
     std::optional<std::filesystem::path> path;
-    if (StartsWith(path_part, "/mesh/")) {  // only the files the catalog resolved
+    const bool mesh = StartsWith(path_part, "/mesh/");
+    if (mesh) {  // only the files the catalog resolved
       const std::string_view rest = path_part.substr(6);
       const auto it = meshes_.find(std::string(rest.substr(0, rest.find('/'))));
       if (it != meshes_.end() && rest.find('/') != std::string_view::npos)
@@ -199,6 +200,8 @@ class WebServer::Impl {
     http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body)),
                                         std::make_tuple(http::status::ok, req.version())};
     res.set(http::field::content_type, ContentTypeFor(*path));
+    // Foxglove's 3D panel, a page of another origin, fetches the scene's meshes.
+    if (mesh) res.set(http::field::access_control_allow_origin, "*");
     send(std::move(res));
   }
 

@@ -10,6 +10,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -253,6 +255,26 @@ ServoTypes ParseServo(const TiXmlElement& e, const char* attribute, const std::s
 }
 
 }  // namespace
+
+std::string ReadLimited(const std::string& path, std::size_t max_bytes, const std::string& who) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UrdfError(who + ": cannot open '" + path + "'");
+  const std::string limit =
+      "the limit of " + std::to_string(max_bytes) + " bytes (UrdfImportOptions::max_file_bytes)";
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > max_bytes)
+    throw UrdfError(path + ": " + std::to_string(size) + " bytes is more than " + limit);
+  std::string text;
+  std::vector<char> chunk(64 * 1024);
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    text.append(chunk.data(), static_cast<size_t>(in.gcount()));
+    if (text.size() > max_bytes) throw UrdfError(path + ": the text is longer than " + limit);
+  }
+  if (in.bad()) throw UrdfError(who + ": cannot read '" + path + "'");
+  return text;
+}
 
 urdf::ModelInterfaceSharedPtr ParseQuietly(const std::string& xml, UrdfdomMessages& messages) {
   CaptureHandler::Guard guard(messages);

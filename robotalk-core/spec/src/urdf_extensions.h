@@ -44,6 +44,12 @@ urdf::ModelInterfaceSharedPtr ParseQuietly(const std::string& xml, UrdfdomMessag
 /// element, so it never reports less depth than TinyXML would recurse.
 void CheckXmlDepth(std::string_view xml, int max_depth, const std::string& source);
 
+/// The text of the file at `path`, never more than `max_bytes` + 1 of it in
+/// memory (a pipe has no size to ask for beforehand). Throws UrdfError:
+/// "<who>: cannot open '<path>'", or "<path>: ... is more than the limit of
+/// <max_bytes> bytes (UrdfImportOptions::max_file_bytes)".
+std::string ReadLimited(const std::string& path, std::size_t max_bytes, const std::string& who);
+
 /// "'name'".
 std::string Quote(const std::string& s);
 

@@ -575,24 +575,7 @@ RobotModel Importer::Build(const std::string& robot_name) {
 }  // namespace
 
 UrdfImportResult LoadUrdfFile(const std::string& path, const UrdfImportOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UrdfError("LoadUrdfFile: cannot open '" + path + "'");
-  // Never more than max_file_bytes + 1 in memory, whatever the file is
-  // (a pipe has no size to ask for beforehand).
-  const std::string limit =
-      "the limit of " + std::to_string(options.max_file_bytes) + " bytes (UrdfImportOptions::max_file_bytes)";
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (!ec && size > options.max_file_bytes)
-    throw UrdfError(path + ": " + std::to_string(size) + " bytes is more than " + limit);
-  std::string text;
-  std::vector<char> chunk(64 * 1024);
-  while (in) {
-    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-    text.append(chunk.data(), static_cast<size_t>(in.gcount()));
-    if (text.size() > options.max_file_bytes) throw UrdfError(path + ": the text is longer than " + limit);
-  }
-  if (in.bad()) throw UrdfError("LoadUrdfFile: cannot read '" + path + "'");
+  const std::string text = urdf_detail::ReadLimited(path, options.max_file_bytes, "LoadUrdfFile");
   return ParseUrdf(text, options, path);
 }
 

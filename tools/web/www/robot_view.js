@@ -159,7 +159,8 @@ export class RobotView {
       return r.json();
     });
     const byUri = new Map();
-    for (const m of catalog.meshes) byUri.set(m.uri, [...(byUri.get(m.uri) || []), m]);
+    // The page draws the visuals; the collision meshes are Foxglove's scene's.
+    for (const m of catalog.meshes.filter((e) => !e.collision)) byUri.set(m.uri, [...(byUri.get(m.uri) || []), m]);
     const text = await fetch(url).then((r) => {
       if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
       return r.text();
