@@ -38,9 +38,10 @@ std::optional<DriverResult> CheckBaseValues(const DriverCommand& c) {
 }
 
 DriverResult BaseController::TrackSpeed(const BaseReference&) {
-  return Answer(Signal::kNa,
-                "SETSPEED: this base plans its own speed changes (a walking humanoid's step planner, one step at a "
-                "time): a SETSPEED ramp is not followed; send its SETSPEED frames in a step package");
+  return Answer(
+      Signal::kNa,
+      "SETSPEED: this base plans its own speed changes (a walking humanoid's step planner, one step at a "
+      "time): a SETSPEED ramp is not followed; send its SETSPEED frames in a step package");
 }
 
 namespace {
@@ -145,7 +146,8 @@ class PlanarBase : public BaseController {
     if (mode_ == Mode::kIdle) return;
     const walking::Pose2 at = RootPose2(*world_, model_);
     // A ramp's twist advances along its rate within the control period.
-    const double s = std::min(static_cast<double>(rate_steps_++) / options_.step_hz, ToSeconds(options_.period));
+    const double s =
+        std::min(static_cast<double>(rate_steps_++) / options_.step_hz, ToSeconds(options_.period));
     Twist2 t{.v = cmd_.vx + rate_.vx * s, .omega = cmd_.omega + rate_.omega * s};
     double vy = cmd_.vy + rate_.vy * s;
     if (mode_ == Mode::kGoto) {
@@ -194,8 +196,8 @@ class PlanarBase : public BaseController {
   struct Speed {
     double vx = 0, vy = 0, omega = 0;
   };
-  Speed cmd_;   // SETSPEED, body frame (m/s, m/s, rad/s)
-  Speed rate_;  // a ramp's rate (m/s², m/s², rad/s²); 0 for a SETSPEED
+  Speed cmd_;            // SETSPEED, body frame (m/s, m/s, rad/s)
+  Speed rate_;           // a ramp's rate (m/s², m/s², rad/s²); 0 for a SETSPEED
   long rate_steps_ = 0;  // physics steps since the twist was set
 };
 

@@ -545,15 +545,17 @@ void RobotDaemon::TrackBaseRamp(TimePoint now) {
   ramped_.clear();
   if (!sampled) return;
   DriverResult result;
-  if (Guarded("TrackBase", nullptr, now, [&] { result = driver_->TrackBase(ramp_.reference(), now, completions_); }) !=
-      CallOutcome::kOk) {
+  if (Guarded("TrackBase", nullptr, now, [&] {
+        result = driver_->TrackBase(ramp_.reference(), now, completions_);
+      }) != CallOutcome::kOk) {
     return;  // a fault: the next iteration ends the ramp (panic)
   }
   if (result.signal == Signal::kModified) {
     ramp_.NoteDriver(result.message);
   } else if (result.signal != Signal::kSuccess) {
-    EndRamp(now, "driver '" + driver_name_ + "' refused to follow the base's speed ramp: " +
-                     std::string(ToString(result.signal)) + (result.message.empty() ? "" : " " + result.message));
+    EndRamp(now, "driver '" + driver_name_ +
+                     "' refused to follow the base's speed ramp: " + std::string(ToString(result.signal)) +
+                     (result.message.empty() ? "" : " " + result.message));
   }
 }
 

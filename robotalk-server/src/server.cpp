@@ -142,8 +142,10 @@ class Server::Impl {
       const auto base = options_.robot_base_acceleration.find(spec.name);
       const BaseAccelerationLimit& accel =
           base != options_.robot_base_acceleration.end() ? base->second : options_.base_acceleration;
-      if (!(accel.linear > 0) || !(accel.angular > 0) || !std::isfinite(accel.linear) || !std::isfinite(accel.angular))
-        throw Error("Server: robot '" + spec.name + "': the base acceleration limit must be > 0 (m/s², rad/s²)");
+      if (!(accel.linear > 0) || !(accel.angular > 0) || !std::isfinite(accel.linear) ||
+          !std::isfinite(accel.angular))
+        throw Error("Server: robot '" + spec.name +
+                    "': the base acceleration limit must be > 0 (m/s², rad/s²)");
       daemon_options.base_linear_acceleration = accel.linear;
       daemon_options.base_angular_acceleration = accel.angular;
       robots_.push_back(std::make_unique<RobotDaemon>(

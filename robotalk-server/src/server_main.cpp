@@ -186,7 +186,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::size_t comma = limits.find(',');
         BaseAccelerationLimit limit;
         limit.linear = ParseNumber(arg, limits.substr(0, comma).c_str(), 1e-3, 1e3);
-        if (comma != std::string::npos) limit.angular = ParseNumber(arg, limits.substr(comma + 1).c_str(), 1e-3, 1e3);
+        if (comma != std::string::npos)
+          limit.angular = ParseNumber(arg, limits.substr(comma + 1).c_str(), 1e-3, 1e3);
         if (eq == std::string::npos) {
           options.base_acceleration = limit;
         } else {

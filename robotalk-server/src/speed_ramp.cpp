@@ -79,7 +79,8 @@ void SpeedRamp::AddFrame(const QueuedItem& item, TimePoint now, const BaseRefere
     const Duration late = now - item.start;
     const bool later_planned = active_ && !pending_.empty() && pending_.back().knot.time > now;
     if (std::optional<std::string> expired = ExpiryRefusal(late, item.max_late, item.received - item.start)) {
-      answers.push_back({item.client_id, MakeAnswer(c.id, Signal::kInterrupted, *expired + " (SETSPEED)", now, late)});
+      answers.push_back(
+          {item.client_id, MakeAnswer(c.id, Signal::kInterrupted, *expired + " (SETSPEED)", now, late)});
       // The change it asked for did not happen at its time: the base does not
       // run on at the old twist (as an expired step SETSPEED stops it), it
       // comes to rest within the limit.
@@ -92,14 +93,15 @@ void SpeedRamp::AddFrame(const QueuedItem& item, TimePoint now, const BaseRefere
       return;
     }
     if (later_planned) {
-      answers.push_back({item.client_id,
-                         MakeAnswer(c.id, Signal::kInterrupted,
-                                    "SETSPEED: arrived " + Seconds(late) +
-                                        " after its time; a later frame is already planned; not executed",
-                                    now, late)});
+      answers.push_back(
+          {item.client_id, MakeAnswer(c.id, Signal::kInterrupted,
+                                      "SETSPEED: arrived " + Seconds(late) +
+                                          " after its time; a later frame is already planned; not executed",
+                                      now, late)});
       return;
     }
-    f.note = "arrived " + Seconds(late) + " after its time: joined " + Seconds(options_.period) + " from its arrival";
+    f.note = "arrived " + Seconds(late) + " after its time: joined " + Seconds(options_.period) +
+             " from its arrival";
     f.knot.time = now + options_.period;
   }
   const bool starting = !active_;
@@ -110,8 +112,8 @@ void SpeedRamp::AddFrame(const QueuedItem& item, TimePoint now, const BaseRefere
   while (!pending_.empty() && pending_.back().knot.time >= f.knot.time) {
     Frame& old = pending_.back();
     answers.push_back({old.client_id, MakeAnswer(old.id, Signal::kInterrupted,
-                                                 "SETSPEED: superseded by command " + std::to_string(c.id), now,
-                                                 Duration(0))});
+                                                 "SETSPEED: superseded by command " + std::to_string(c.id),
+                                                 now, Duration(0))});
     pending_.pop_back();
   }
   if (pending_.empty() && from_.time < now) from_ = Knot{now, at_now};  // the next segment starts now
@@ -173,8 +175,9 @@ void SpeedRamp::Approach(TimePoint now) {
                            Number(options_.linear_acceleration) + " m/s²";
     } else {
       limited_ = a_w > options_.angular_acceleration * (1 + kSlack)
-                     ? "the plan's angular acceleration " + Number(a_w) + " rad/s² exceeds the base's limit " +
-                           Number(options_.angular_acceleration) + " rad/s²"
+                     ? "the plan's angular acceleration " + Number(a_w) +
+                           " rad/s² exceeds the base's limit " + Number(options_.angular_acceleration) +
+                           " rad/s²"
                      : "catching up with the plan at the base's angular limit " +
                            Number(options_.angular_acceleration) + " rad/s²";
     }
@@ -247,7 +250,8 @@ void SpeedRamp::NoteDriver(std::string_view message) {
 void SpeedRamp::End(TimePoint now, const std::string& why, std::vector<Answer>& answers) {
   if (!active_) return;
   for (Frame& f : pending_) {
-    answers.push_back({f.client_id, MakeAnswer(f.id, Signal::kInterrupted, "SETSPEED: " + why, now, Duration(0))});
+    answers.push_back(
+        {f.client_id, MakeAnswer(f.id, Signal::kInterrupted, "SETSPEED: " + why, now, Duration(0))});
   }
   pending_.clear();
   limited_.clear();

@@ -122,8 +122,8 @@ class SpeedRamp {
     std::string note;       // why it is MODIFIED, or ""
   };
 
-  void AddFrame(const QueuedItem& item, TimePoint now, const BaseReference& current, std::vector<Answer>& answers,
-                std::int64_t& owner);
+  void AddFrame(const QueuedItem& item, TimePoint now, const BaseReference& current,
+                std::vector<Answer>& answers, std::int64_t& owner);
   struct Segment {  // the plan's segment at a time: linear from `from` to `to` (none: holds `from`)
     const Knot* from;
     const Knot* to;

@@ -66,7 +66,8 @@ QueuedItem Now(CommandId id, CommandType type, std::vector<double> values = {}, 
 class RampedDaemonTest : public ::testing::Test {
  protected:
   explicit RampedDaemonTest(BaseType base = BaseType::kDifferential)
-      : driver_(new KinematicDriver(Rover(base), KinematicDriverOptions{.base_max_v = 2, .base_max_omega = 4})),
+      : driver_(
+            new KinematicDriver(Rover(base), KinematicDriverOptions{.base_max_v = 2, .base_max_omega = 4})),
         daemon_("rover", "kinematic", std::unique_ptr<Driver>(driver_), clock_,
                 RobotDaemonOptions{.precise_timing = false}) {
     daemon_.Preallocate(out_);
@@ -143,8 +144,8 @@ class RandomStream : public RampedDaemonTest {
       for (auto& a : RunTo(kT0 + milliseconds(100 * (k + 1)))) answers.push_back(a);
     }
     for (auto& a : RunTo(kT0 + milliseconds(100 * kFrames + 2000))) answers.push_back(a);
-    *modified = static_cast<int>(
-        std::count_if(answers.begin(), answers.end(), [](const auto& a) { return a.reply.signal == Signal::kModified; }));
+    *modified = static_cast<int>(std::count_if(
+        answers.begin(), answers.end(), [](const auto& a) { return a.reply.signal == Signal::kModified; }));
     int other = 0;
     for (const auto& a : answers) {
       if (a.reply.signal != Signal::kSuccess && a.reply.signal != Signal::kModified) ++other;
@@ -162,10 +163,11 @@ TEST(SpeedRampDaemon, RandomFramesRampWithinTheLimitWhereAStepPackageJumps) {
   RandomStream ramped, stepped;
   const auto [ramp_lin, ramp_ang] = ramped.Run(Interpolation::kLinear, &ramp_modified, &ramp_rest);
   const auto [step_lin, step_ang] = stepped.Run(Interpolation::kStep, &step_modified, &step_rest);
-  std::printf("largest base acceleration between control periods (10 ms), 100 random frames at 10 Hz:\n"
-              "  linear (ramped): %.4g m/s^2, %.4g rad/s^2 (limit %g, %g); %d frames MODIFIED\n"
-              "  step:            %.4g m/s^2, %.4g rad/s^2\n",
-              ramp_lin, ramp_ang, kLinear, kAngular, ramp_modified, step_lin, step_ang);
+  std::printf(
+      "largest base acceleration between control periods (10 ms), 100 random frames at 10 Hz:\n"
+      "  linear (ramped): %.4g m/s^2, %.4g rad/s^2 (limit %g, %g); %d frames MODIFIED\n"
+      "  step:            %.4g m/s^2, %.4g rad/s^2\n",
+      ramp_lin, ramp_ang, kLinear, kAngular, ramp_modified, step_lin, step_ang);
   EXPECT_LE(ramp_lin, kLinear * (1 + 1e-9));
   EXPECT_LE(ramp_ang, kAngular * (1 + 1e-9));
   EXPECT_GT(ramp_modified, 0) << "the limit bit (up to 12 m/s² between frames) and the frames said so";

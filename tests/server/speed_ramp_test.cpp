@@ -135,9 +135,10 @@ TEST_F(SpeedRampTest, ATooSteepFrameIsApproachedAtTheLimitAndAnswersModifiedNami
   const Reply* r = Find(1);
   ASSERT_NE(r, nullptr);
   EXPECT_EQ(r->signal, Signal::kModified);
-  EXPECT_EQ(r->message,
-            "SETSPEED: ramp limited: the plan's angular acceleration 20 rad/s² exceeds the base's limit 6 rad/s²; "
-            "the reference was 1.4 rad/s from it at its time");
+  EXPECT_EQ(
+      r->message,
+      "SETSPEED: ramp limited: the plan's angular acceleration 20 rad/s² exceeds the base's limit 6 rad/s²; "
+      "the reference was 1.4 rad/s from it at its time");
   EXPECT_NEAR(ramp_.reference().omega, 0.6, 1e-12);
   SampleTo(kT0 + milliseconds(110), kT0 + milliseconds(500));
   EXPECT_EQ(ramp_.reference().omega, 2.0);
