@@ -1,6 +1,7 @@
 #include "speed_ramp.h"
 
 #include "expiry.h"
+#include "planner_answers.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,30 +11,14 @@
 namespace robotalk {
 namespace {
 
-std::string Seconds(Duration d) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g s", ToSeconds(d));
-  return text;
-}
+using planner_answers::Append;
+using planner_answers::MakeAnswer;
+using planner_answers::Seconds;
 
-std::string Number(double x) {
+std::string Number(double x) {  // 3 significant digits: "5", "0.4", "1.4"
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", x);
   return text;
-}
-
-Reply MakeAnswer(CommandId id, Signal signal, std::string message, TimePoint exec, Duration lateness) {
-  Reply r;
-  r.id = id;
-  r.signal = signal;
-  r.message = std::move(message);
-  r.exec_time = exec;
-  r.lateness = lateness;
-  return r;
-}
-
-std::string Append(const std::string& note, const std::string& more) {
-  return note.empty() ? more : note + "; " + more;
 }
 
 // Slack on the limit: a plan exactly at the limit is followed, not flagged.
