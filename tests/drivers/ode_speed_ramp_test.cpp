@@ -119,5 +119,21 @@ TEST(OdeSpeedRamp, ThePioneerDrivesARampedStreamNearTheLimitWhereStepsJump) {
   EXPECT_LT(std::abs(ramp.final_omega), 0.02);
 }
 
+// The walking humanoid changes speed by its own step planner (it re-plans on
+// every SETSPEED): it refuses a per-period ramp, and the ramp's frames then
+// answer INTERRUPTED naming why (docs/drivers.md, TrackBase).
+TEST(OdeSpeedRamp, TheWalkingHumanoidRefusesARampAndSaysWhy) {
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  auto walker = registry.Create("ode", DriverConfig{.robot_name = "walker",
+                                                    .urdf_path = ProjectModel("simple_humanoid.urdf"),
+                                                    .options = {{"walk", "true"}}});
+  ASSERT_TRUE(dynamic_cast<OdeDriver&>(*walker).walk_status().has_value()) << "the humanoid walks";
+  std::vector<Completion> done;
+  const DriverResult r = walker->TrackBase(BaseReference{.vx = 0.05}, kT0, done);
+  EXPECT_EQ(r.signal, Signal::kNa);
+  EXPECT_NE(r.message.find("step planner"), std::string::npos) << r.message;
+}
+
 }  // namespace
 }  // namespace robotalk
