@@ -517,23 +517,6 @@ void RobotDaemon::AddWaypoints(TimePoint now) {
   waypoints_.clear();
 }
 
-void RobotDaemon::AddSpeedFrames(TimePoint now) {
-  if (speed_frames_.empty()) return;
-  const BaseReference measured{.vx = state_.base_v, .vy = state_.base_vy, .omega = state_.base_omega};
-  const std::int64_t owner = ramp_.Add(speed_frames_, now, measured, ramped_);
-  if (owner != 0) produced_.executed.push_back({owner, CommandType::kSetSpeed, -1});
-  for (SpeedRamp::Answer& a : ramped_) Emit(a.client_id, std::move(a.reply));
-  ramped_.clear();
-  speed_frames_.clear();
-}
-
-void RobotDaemon::EndRamp(TimePoint now, const std::string& why) {
-  if (!ramp_.active()) return;
-  ramp_.End(now, why, ramped_);
-  for (SpeedRamp::Answer& a : ramped_) Emit(a.client_id, std::move(a.reply));
-  ramped_.clear();
-}
-
 void RobotDaemon::TrackBaseRamp(TimePoint now) {
   if (!ramp_.active()) return;
   if (panic_.in_panic() || panic_.driver_halted()) {

@@ -211,12 +211,8 @@ void SpeedRamp::AnswerPassed(TimePoint now, std::vector<Answer>& answers) {
 
 bool SpeedRamp::Sample(TimePoint now, std::vector<Answer>& answers) {
   if (!active_) return false;
-  if (now > last_sample_) {
-    Approach(now);  // toward the plan at `now` (past the knots passed since the last sample)
-    AnswerPassed(now, answers);
-  } else {
-    AnswerPassed(now, answers);
-  }
+  if (now > last_sample_) Approach(now);  // toward the plan at `now` (past the knots passed since)
+  AnswerPassed(now, answers);
   if (pending_.empty() && ref_.vx == from_.twist.vx && ref_.vy == from_.twist.vy &&
       ref_.omega == from_.twist.omega) {
     active_ = false;  // there: the base keeps this twist, as after a SETSPEED
