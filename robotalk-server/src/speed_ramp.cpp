@@ -152,6 +152,9 @@ void SpeedRamp::Approach(TimePoint now) {
     const double a_v =
         span > 0 ? std::hypot(to.twist.vx - a.twist.vx, to.twist.vy - a.twist.vy) / span : HUGE_VAL;
     const double a_w = span > 0 ? std::abs(to.twist.omega - a.twist.omega) / span : HUGE_VAL;
+    // The frame it concerns: the one ending that segment (a frame passed
+    // earlier in this same period was met; the next one was not).
+    limited_until_ = to.time;
     if (clip_v) {
       limited_ = a_v > options_.linear_acceleration * (1 + kSlack)
                      ? "the plan's linear acceleration " + Number(a_v) + " m/s² exceeds the base's limit " +
@@ -186,7 +189,7 @@ void SpeedRamp::AnswerPassed(TimePoint now, std::vector<Answer>& answers) {
   while (!pending_.empty() && pending_.front().knot.time <= now) {
     Frame& f = pending_.front();
     const Duration late = f.knot.time > f.requested ? f.knot.time - f.requested : Duration(0);
-    if (!limited_.empty()) {
+    if (!limited_.empty() && limited_until_ <= f.knot.time) {
       f.note = Append(f.note, "ramp limited: " + limited_);
       const double gap_v = std::hypot(ref_.vx - f.knot.twist.vx, ref_.vy - f.knot.twist.vy);
       const double gap_w = std::abs(ref_.omega - f.knot.twist.omega);

@@ -143,8 +143,9 @@ class SpeedRamp {
   std::deque<Frame> pending_;
   BaseReference ref_;
   TimePoint last_sample_{};
-  std::string limited_;      // the first limit the reference met since the last frame passed
-  std::string driver_note_;  // the driver's MODIFIED text since the last frame passed
+  std::string limited_;        // the first limit the reference met since the last frame passed
+  TimePoint limited_until_{};  // ... on the way to the frame at this time
+  std::string driver_note_;    // the driver's MODIFIED text since the last frame passed
 };
 
 }  // namespace robotalk

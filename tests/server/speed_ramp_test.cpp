@@ -145,6 +145,20 @@ TEST_F(SpeedRampTest, ATooSteepFrameIsApproachedAtTheLimitAndAnswersModifiedNami
   EXPECT_LE(max_angular_, 6 * (1 + 1e-9));
 }
 
+// A frame passed inside a control period whose sample is already limited on
+// the way to the next frame was met: the next one answers MODIFIED, not it.
+TEST_F(SpeedRampTest, TheLimitIsChargedToTheFrameItKeptTheReferenceFrom) {
+  Add(Frame(1, kT0 + milliseconds(105), {0.0, 0.0}), kT0);
+  Add(Frame(2, kT0 + milliseconds(205), {1.0, 0.0}), kT0);  // 10 m/s²
+  SampleTo(kT0, kT0 + milliseconds(300));
+  ASSERT_NE(Find(1), nullptr);
+  EXPECT_EQ(Find(1)->signal, Signal::kSuccess) << Find(1)->message;
+  ASSERT_NE(Find(2), nullptr);
+  EXPECT_EQ(Find(2)->signal, Signal::kModified);
+  EXPECT_THAT(Find(2)->message,
+              HasSubstr("the plan's linear acceleration 10 m/s² exceeds the base's limit 3 m/s²"));
+}
+
 TEST_F(SpeedRampTest, ASpliceReplacesTheLaterFramesAndTheReferenceDoesNotJump) {
   Add(Frame(1, kT0 + milliseconds(200), {0.4, 0}), kT0);
   Add(Frame(2, kT0 + milliseconds(400), {0.4, 0}), kT0);
