@@ -103,7 +103,7 @@ TEST(OdeSpeedRamp, ThePioneerDrivesARampedStreamNearTheLimitWhereStepsJump) {
   std::printf(
       "ODE Pioneer, 40 random SETSPEED frames at 10 Hz: largest measured base acceleration between "
       "control periods (10 ms)\n"
-      "  linear (ramped): %.4g m/s^2, %.4g rad/s^2 (limit %g, 6); %d SUCCESS, %d MODIFIED\n"
+      "  linear (ramped): %.6g m/s^2, %.6g rad/s^2 (limit %g, 6); %d SUCCESS, %d MODIFIED\n"
       "  step:            %.4g m/s^2, %.4g rad/s^2\n",
       ramp.max_linear, ramp.max_angular, kLinear, ramp.success, ramp.modified, step.max_linear,
       step.max_angular);

@@ -165,7 +165,7 @@ TEST(SpeedRampDaemon, RandomFramesRampWithinTheLimitWhereAStepPackageJumps) {
   const auto [step_lin, step_ang] = stepped.Run(Interpolation::kStep, &step_modified, &step_rest);
   std::printf(
       "largest base acceleration between control periods (10 ms), 100 random frames at 10 Hz:\n"
-      "  linear (ramped): %.4g m/s^2, %.4g rad/s^2 (limit %g, %g); %d frames MODIFIED\n"
+      "  linear (ramped): %.6g m/s^2, %.6g rad/s^2 (limit %g, %g); %d frames MODIFIED\n"
       "  step:            %.4g m/s^2, %.4g rad/s^2\n",
       ramp_lin, ramp_ang, kLinear, kAngular, ramp_modified, step_lin, step_ang);
   EXPECT_LE(ramp_lin, kLinear * (1 + 1e-9));
