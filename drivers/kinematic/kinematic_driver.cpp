@@ -340,6 +340,17 @@ DriverResult KinematicDriver::Track(const JointReference& reference, TimePoint n
   return Answer(Signal::kSuccess);
 }
 
+DriverResult KinematicDriver::TrackBase(const BaseReference& reference, TimePoint now,
+                                        std::vector<Completion>& completed) {
+  DriverResult result = Execute(driver_support::SetSpeedOf(reference), now, completed);
+  if (result.signal == Signal::kSuccess || result.signal == Signal::kModified) {
+    v_ = cmd_vx_;  // an ideal base: at the reference now, not one period later
+    vy_ = cmd_vy_;
+    omega_ = cmd_omega_;
+  }
+  return result;
+}
+
 DriverResult KinematicDriver::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {
   // The server checked the command against the model (driver.h): a motion
@@ -422,6 +433,7 @@ void KinematicDriver::ReadState(RobotState& state) const {
   for (size_t i = 0; i < root_world_.size(); ++i) state.root_poses[i] = Pose::FromIsometry(root_world_[i]);
   state.base_v = v_;
   state.base_omega = omega_;
+  state.base_vy = vy_;
   bool moving = base_mode_ != BaseMode::kIdle || v_ != 0 || vy_ != 0 || omega_ != 0;
   for (Eigen::Index i = 0; i < q_.size() && !moving; ++i) {
     if (dofs_.mimic_leader[static_cast<size_t>(i)] >= 0) continue;  // follows its leader

@@ -77,6 +77,11 @@ class KinematicDriver final : public Driver {
   /// ideal tracker: the trajectory's error is zero by construction).
   DriverResult Track(const JointReference& reference, TimePoint now,
                      std::vector<Completion>& completed) override;
+  /// Drives the base exactly at the reference's twist from `now` (as a
+  /// SETSPEED: shaped to the base and its limits, BUSY during a GOTO, NA on
+  /// a fixed base); its reported twist is the reference's at once.
+  DriverResult TrackBase(const BaseReference& reference, TimePoint now,
+                         std::vector<Completion>& completed) override;
   /// Integrates over the time since the previous Update()/Execute(); the first
   /// call only sets the time base. Appends a finished GOTO's completion.
   void Update(TimePoint now, std::vector<Completion>& completed) override;

@@ -42,6 +42,9 @@ class BaseController {
   virtual DriverResult Goto(const DriverCommand& c) = 0;
   /// SETSPEED v ω or vx vy ω. NA on a fixed base.
   virtual DriverResult SetSpeed(const DriverCommand& c) = 0;
+  /// A SETSPEED ramp's reference (Driver::TrackBase), every control period.
+  /// Default: NA (a base that plans its own speed changes, the walker's).
+  virtual DriverResult TrackSpeed(const BaseReference& reference);
   /// STOP and panic: the base stops; a GOTO in progress completes
   /// INTERRUPTED ("GOTO: " + why).
   virtual void Stop(const std::string& why, std::vector<Completion>& completed) = 0;

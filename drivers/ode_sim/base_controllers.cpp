@@ -37,6 +37,13 @@ std::optional<DriverResult> CheckBaseValues(const DriverCommand& c) {
                                     std::to_string(c.num_values));
 }
 
+DriverResult BaseController::TrackSpeed(const BaseReference&) {
+  return Answer(
+      Signal::kNa,
+      "SETSPEED: this base plans its own speed changes (a walking humanoid's step planner, one step at a "
+      "time): a SETSPEED ramp is not followed; send its SETSPEED frames in a step package");
+}
+
 namespace {
 
 // ---------------------------------------------------------------- fixed
@@ -49,6 +56,7 @@ class FixedBase final : public BaseController {
   void Attach(OdeWorld&, JointServos&, const std::vector<CollisionShape>&) override {}
   DriverResult Goto(const DriverCommand& c) override { return Refuse(c); }
   DriverResult SetSpeed(const DriverCommand& c) override { return Refuse(c); }
+  DriverResult TrackSpeed(const BaseReference& r) override { return SetSpeed(driver_support::SetSpeedOf(r)); }
   void Stop(const std::string&, std::vector<Completion>&) override {}
   bool Drives(int) const override { return false; }
   std::optional<DriverResult> Release(int, std::string_view) override { return std::nullopt; }
@@ -106,9 +114,23 @@ class PlanarBase : public BaseController {
         c, model_.roots().front().base, options_.base_max_v, options_.base_max_omega);
     Limit(t);
     cmd_ = {t.vx, t.vy, t.omega};
+    rate_ = {};
+    rate_steps_ = 0;
     mode_ = (t.vx == 0 && t.vy == 0 && t.omega == 0) ? Mode::kIdle : Mode::kSpeed;
     if (mode_ == Mode::kIdle) Brake();
     return t.note.empty() ? Answer(Signal::kSuccess) : Answer(Signal::kModified, "SETSPEED: " + t.note);
+  }
+
+  // The ramp's twist now, and its rate: Control() advances the twist along
+  // it at every physics step, for at most one control period (the next
+  // reference comes by then), so the wheels follow a ramp, not a staircase.
+  DriverResult TrackSpeed(const BaseReference& r) override {
+    DriverResult result = SetSpeed(driver_support::SetSpeedOf(r));
+    if (mode_ == Mode::kSpeed && (result.signal == Signal::kSuccess || result.signal == Signal::kModified)) {
+      // Unless the twist was shaped to a limit (then it holds there).
+      if (cmd_.vx == r.vx && cmd_.vy == r.vy && cmd_.omega == r.omega) rate_ = {r.ax, r.ay, r.alpha};
+    }
+    return result;
   }
 
   void Stop(const std::string& why, std::vector<Completion>& completed) override {
@@ -123,8 +145,11 @@ class PlanarBase : public BaseController {
   void Control(std::vector<Completion>& completed) override {
     if (mode_ == Mode::kIdle) return;
     const walking::Pose2 at = RootPose2(*world_, model_);
-    Twist2 t{.v = cmd_.vx, .omega = cmd_.omega};
-    double vy = cmd_.vy;
+    // A ramp's twist advances along its rate within the control period.
+    const double s =
+        std::min(static_cast<double>(rate_steps_++) / options_.step_hz, ToSeconds(options_.period));
+    Twist2 t{.v = cmd_.vx + rate_.vx * s, .omega = cmd_.omega + rate_.omega * s};
+    double vy = cmd_.vy + rate_.vy * s;
     if (mode_ == Mode::kGoto) {
       t = goto_.Update(at.x, at.y, at.theta);
       vy = 0;
@@ -156,6 +181,7 @@ class PlanarBase : public BaseController {
   void Idle() {
     mode_ = Mode::kIdle;
     cmd_ = {};
+    rate_ = {};
   }
 
   const RobotModel& model_;
@@ -170,7 +196,9 @@ class PlanarBase : public BaseController {
   struct Speed {
     double vx = 0, vy = 0, omega = 0;
   };
-  Speed cmd_;  // SETSPEED, body frame (m/s, m/s, rad/s)
+  Speed cmd_;            // SETSPEED, body frame (m/s, m/s, rad/s)
+  Speed rate_;           // a ramp's rate (m/s², m/s², rad/s²); 0 for a SETSPEED
+  long rate_steps_ = 0;  // physics steps since the twist was set
 };
 
 // ---------------------------------------------------------------- wheels

@@ -34,6 +34,12 @@ DriverResult OdeDriver::Impl::Track(const JointReference& reference, TimePoint n
   return {};
 }
 
+DriverResult OdeDriver::Impl::TrackBase(const BaseReference& reference, TimePoint now,
+                                        std::vector<Completion>& completed) {
+  Advance(now, true, completed);
+  return base_->TrackSpeed(reference);
+}
+
 DriverResult OdeDriver::Impl::Execute(const DriverCommand& c, TimePoint now,
                                       std::vector<Completion>& completed) {
   // The server checked the command against the model (driver.h): a motion

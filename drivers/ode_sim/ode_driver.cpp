@@ -122,6 +122,11 @@ void OdeDriver::Impl::ReadState(RobotState& state) const {
   const ode_detail::Twist2 t = base_->twist();
   state.base_v = t.v;
   state.base_omega = t.omega;
+  if (const BaseType b = model_.roots().front().base; b == BaseType::kHolonomic || b == BaseType::kFloating) {
+    // The lateral part of a root that can move sideways.
+    const int root = model_.roots().front().link;
+    state.base_vy = world_->LinkLinearVelocity(root).dot(world_->LinkPose(root).linear().col(1));
+  }
   state.moving = base_->moving() || std::abs(t.v) > ode_detail::kMovingSpeed ||
                  std::abs(t.omega) > ode_detail::kMovingSpeed || servos_.Moving(world_->q(), world_->qd());
 }
@@ -137,6 +142,11 @@ DriverResult OdeDriver::Execute(const DriverCommand& command, TimePoint now,
                                 std::vector<Completion>& completed) {
   return impl_->Execute(command, now, completed);
 }
+DriverResult OdeDriver::TrackBase(const BaseReference& reference, TimePoint now,
+                                  std::vector<Completion>& completed) {
+  return impl_->TrackBase(reference, now, completed);
+}
+
 DriverResult OdeDriver::Track(const JointReference& reference, TimePoint now,
                               std::vector<Completion>& completed) {
   return impl_->Track(reference, now, completed);

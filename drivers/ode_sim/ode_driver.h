@@ -129,6 +129,13 @@ class OdeDriver final : public Driver {
   /// step (joint_servos.h). A leg the walking controller drives answers NA.
   DriverResult Track(const JointReference& reference, TimePoint now,
                      std::vector<Completion>& completed) override;
+  /// Advances the simulation to `now`, then drives the base along the
+  /// reference: a wheeled or kinematic root runs, at every physics step,
+  /// the reference's twist advanced by its rate (for at most one control
+  /// period). A walking humanoid answers NA (its step planner changes speed
+  /// one step at a time: send its SETSPEED in a step package).
+  DriverResult TrackBase(const BaseReference& reference, TimePoint now,
+                         std::vector<Completion>& completed) override;
   /// Steps the physics as many fixed steps as fit up to `now` (at most
   /// max_catchup_ms of them); the first call only sets the time base.
   void Update(TimePoint now, std::vector<Completion>& completed) override;

@@ -46,6 +46,7 @@ class OdeDriver::Impl {
 
   DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& completed);
   DriverResult Track(const JointReference& reference, TimePoint now, std::vector<Completion>& completed);
+  DriverResult TrackBase(const BaseReference& reference, TimePoint now, std::vector<Completion>& completed);
   void Stop(TimePoint now, std::vector<Completion>& interrupted);
   void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& interrupted);
   void Halt(std::vector<Completion>& interrupted) { StopAll("interrupted by panic", interrupted); }

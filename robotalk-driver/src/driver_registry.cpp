@@ -1,5 +1,6 @@
 #include "robotalk/driver.h"
 
+#include "robotalk/driver_support.h"
 #include "robotalk/error.h"
 
 #include <algorithm>
@@ -14,6 +15,11 @@ DriverResult Driver::Track(const JointReference& reference, TimePoint now,
   setpoint.num_values = static_cast<int>(std::min(reference.position.size(), setpoint.values.size()));
   std::copy_n(reference.position.begin(), setpoint.num_values, setpoint.values.begin());
   return Execute(setpoint, now, completed);
+}
+
+DriverResult Driver::TrackBase(const BaseReference& reference, TimePoint now,
+                               std::vector<Completion>& completed) {
+  return Execute(driver_support::SetSpeedOf(reference), now, completed);
 }
 
 void DriverRegistry::Register(const std::string& name, Factory factory) {

@@ -93,6 +93,15 @@ BaseTwist ShapeBaseSpeed(const DriverCommand& c, BaseType base, double max_v, do
   return t;
 }
 
+DriverCommand SetSpeedOf(const BaseReference& reference) {
+  DriverCommand speed;
+  speed.type = CommandType::kSetSpeed;
+  const bool lateral = reference.lateral || reference.vy != 0.0;
+  speed.num_values = lateral ? 3 : 2;
+  speed.values = {reference.vx, lateral ? reference.vy : reference.omega, reference.omega};
+  return speed;
+}
+
 double WrapAngle(double radians) { return std::remainder(radians, 2 * std::numbers::pi); }
 
 OptionReader::OptionReader(std::string driver, const std::map<std::string, std::string>& options)

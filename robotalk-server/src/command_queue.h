@@ -51,6 +51,13 @@ struct QueuedItem {
            (command.type == CommandType::kJointSetPoint || command.type == CommandType::kFrameSetPoint);
   }
 
+  /// A SETSPEED with a start time in a package that is not kStep: a frame of
+  /// the base's speed ramp (speed_ramp.h), taken when it arrives.
+  bool is_speed_frame() const {
+    return !is_query && has_start_time && interpolation != Interpolation::kStep &&
+           command.type == CommandType::kSetSpeed;
+  }
+
   /// Earlier start first; equal starts in arrival order.
   bool RunsBefore(const QueuedItem& o) const {
     return start != o.start ? start < o.start : arrival < o.arrival;

@@ -44,6 +44,11 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
       woken_([this] { return wake_flag_ || !running_ || flush_deferred_.load(); }),
       tracker_(driver_->model(),
                TrackerOptions{.acceleration_limit = options.max_acceleration, .period = driver_->period()}),
+      ramp_(SpeedRampOptions{.linear_acceleration = options.base_linear_acceleration,
+                             .angular_acceleration = options.base_angular_acceleration,
+                             .period = driver_->period(),
+                             .mobile = driver_->model().roots().front().base != BaseType::kFixed,
+                             .robot = driver_->model().name()}),
       kinematics_(driver_->model()),
       snapshot_(driver_->model(), InitialState(driver_->model()), clock, panic_) {
   const RobotModel& m = model();
@@ -56,6 +61,8 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
   waypoints_.reserve(256);
   arrived_waypoints_.reserve(256);
   tracked_.reserve(256);
+  speed_frames_.reserve(256);
+  ramped_.reserve(256);
   completions_.reserve(64);
   produced_.replies.reserve(256);
   produced_.executed.reserve(256);
@@ -147,7 +154,7 @@ void RobotDaemon::Submit(QueuedItem item) {
     // wake-up per delayed command (issue 11: 64 clients x 100 Hz are CPU-bound
     // on thread switches). While it runs (no deadline yet) it is always told.
     wake = due || !sleeping_until_ || item.start < *sleeping_until_;
-    if (item.is_waypoint()) {
+    if (item.is_waypoint() || item.is_speed_frame()) {
       // Planned toward before its time: the thread takes it at its next iteration.
       wake = true;
       arrived_waypoints_.push_back(std::move(item));
@@ -413,6 +420,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   bool state_fresh = false;  // state_ read after this iteration's Update
   if (now >= next_update_) {
     TrackTrajectories(now);
+    TrackBaseRamp(now);
     Guarded("Update", nullptr, now, [&] { driver_->Update(now, completions_); });
     std::string_view condition;  // the driver's own text: nothing allocated unless it changed
     if (Guarded("Fault", nullptr, now, [&] { condition = driver_->Fault(); }) == CallOutcome::kOk &&
@@ -487,15 +495,51 @@ void RobotDaemon::AddWaypoints(TimePoint now) {
       r.exec_time = now;
       Emit(w.client_id, std::move(r));
     }
-  } else if (ReadState(now)) {  // an idle joint's trajectory starts where it is
-    trajectory_owners_.clear();
-    tracker_.Add(waypoints_, now, state_, tracked_, trajectory_owners_);
-    for (const TrajectoryTracker::Started& o : trajectory_owners_) {
-      produced_.executed.push_back({o.client_id, o.type, o.target});
+  } else if (ReadState(now)) {  // an idle joint's trajectory starts where it is (the ramp: the base's twist)
+    // SETSPEED frames go to the base's ramp; the rest keep their order.
+    speed_frames_.clear();
+    for (QueuedItem& w : waypoints_) {
+      if (w.is_speed_frame()) speed_frames_.push_back(std::move(w));
     }
-    EmitTracked();
+    waypoints_.erase(std::remove_if(waypoints_.begin(), waypoints_.end(),
+                                    [](const QueuedItem& w) { return w.is_speed_frame(); }),
+                     waypoints_.end());
+    if (!waypoints_.empty()) {
+      trajectory_owners_.clear();
+      tracker_.Add(waypoints_, now, state_, tracked_, trajectory_owners_);
+      for (const TrajectoryTracker::Started& o : trajectory_owners_) {
+        produced_.executed.push_back({o.client_id, o.type, o.target});
+      }
+      EmitTracked();
+    }
+    AddSpeedFrames(now);
   }
   waypoints_.clear();
+}
+
+void RobotDaemon::TrackBaseRamp(TimePoint now) {
+  if (!ramp_.active()) return;
+  if (panic_.in_panic() || panic_.driver_halted()) {
+    EndRamp(now, "ended by panic");
+    return;
+  }
+  const bool sampled = ramp_.Sample(now, ramped_);
+  for (SpeedRamp::Answer& a : ramped_) Emit(a.client_id, std::move(a.reply));
+  ramped_.clear();
+  if (!sampled) return;
+  DriverResult result;
+  if (Guarded("TrackBase", nullptr, now, [&] {
+        result = driver_->TrackBase(ramp_.reference(), now, completions_);
+      }) != CallOutcome::kOk) {
+    return;  // a fault: the next iteration ends the ramp (panic)
+  }
+  if (result.signal == Signal::kModified) {
+    ramp_.NoteDriver(result.message);
+  } else if (result.signal != Signal::kSuccess) {
+    EndRamp(now, "driver '" + driver_name_ +
+                     "' refused to follow the base's speed ramp: " + std::string(ToString(result.signal)) +
+                     (result.message.empty() ? "" : " " + result.message));
+  }
 }
 
 void RobotDaemon::TrackTrajectories(TimePoint now) {
@@ -524,10 +568,12 @@ void RobotDaemon::TrackTrajectories(TimePoint now) {
 }
 
 void RobotDaemon::EndTrajectoriesFor(const QueuedItem& item, TimePoint now) {
-  if (!tracker_.active()) return;
+  if (!tracker_.active() && !ramp_.active()) return;
   const RobotModel& m = model();
   const std::string why =
       std::string("superseded by ") + ToString(item.command.type) + " " + std::to_string(item.command.id);
+  if (Traits(item.command.type).target == CommandTarget::kBase) EndRamp(now, why);  // a GOTO, a step SETSPEED
+  if (!tracker_.active()) return;
   switch (Traits(item.command.type).target) {
     case CommandTarget::kJoint:
       tracker_.End(item.command.target, now, why, tracked_);
@@ -572,8 +618,10 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     const StopScope scope{.joints = item.stop_joints, .base = item.stop_base};
     if (item.scoped_stop) {
       for (int j : item.stop_joints) tracker_.End(j, now, "stopped: its client vanished", tracked_);
+      if (item.stop_base) EndRamp(now, "stopped: its client vanished");
     } else {
       tracker_.EndAll(now, "stopped by STOP", tracked_);
+      EndRamp(now, "stopped by STOP");
     }
     EmitTracked();
     if (!driver_call(item.scoped_stop ? "StopOnly" : "Stop", [&] {
@@ -605,6 +653,7 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     const ExpiryHold hold = HoldAfterExpiry(item.command.type, item.command.target);
     const int joint = hold.joint;
     const StopScope scope{.joints = std::span<const int>(&joint, hold.joint >= 0 ? 1 : 0), .base = hold.base};
+    if (hold.base) EndRamp(now, "stopped: SETSPEED " + std::to_string(item.command.id) + " expired");
     if (hold.any() && !driver_call("StopOnly", [&] { driver_->StopOnly(scope, now, completions_); })) return;
     r.signal = Signal::kInterrupted;
     r.message = *ExpiryRefusal(r.lateness, item.max_late, item.received - item.start);

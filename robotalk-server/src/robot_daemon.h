@@ -43,6 +43,7 @@
 #include "robotalk/driver.h"
 #include "robotalk/kinematics.h"
 #include "scheduler.h"
+#include "speed_ramp.h"
 #include "trajectory_tracker.h"
 
 #include <Eigen/Core>
@@ -83,6 +84,11 @@ struct RobotDaemonOptions {
   /// Trajectories' acceleration limit per dof (rad/s² | m/s², > 0): the
   /// server's --max-acceleration (trajectory_tracker.h).
   double max_acceleration = kDefaultTrajectoryAcceleration;
+  /// The base's acceleration limit for SETSPEED ramps (m/s² of the planar
+  /// speed, rad/s² of the yaw rate; > 0): the server's --max-base-acceleration
+  /// (speed_ramp.h).
+  double base_linear_acceleration = kDefaultBaseLinearAcceleration;
+  double base_angular_acceleration = kDefaultBaseAngularAcceleration;
 };
 
 /// One broadcast state sample, preallocated for the model.
@@ -259,9 +265,15 @@ class RobotDaemon {
   // one is sampled and handed to the driver (Driver::Track).
   void AddWaypoints(TimePoint now);
   void TrackTrajectories(TimePoint now);
-  // A command that moves joints ends their trajectories first.
+  // A command that moves joints ends their trajectories first (the base's
+  // ramp, for a base command).
   void EndTrajectoriesFor(const QueuedItem& item, TimePoint now);
   void EmitTracked();
+  // The base's SETSPEED ramp: frames that arrived join it; every control
+  // period it is sampled and handed to the driver (Driver::TrackBase).
+  void AddSpeedFrames(TimePoint now);
+  void TrackBaseRamp(TimePoint now);
+  void EndRamp(TimePoint now, const std::string& why);
 
   const std::string robot_name_;
   const std::string driver_name_;
@@ -299,6 +311,9 @@ class RobotDaemon {
   TrajectoryTracker tracker_;
   std::vector<TrajectoryTracker::Answer> tracked_;  // the tracker's answers of this iteration
   std::vector<TrajectoryTracker::Started> trajectory_owners_;
+  std::vector<QueuedItem> speed_frames_;  // this iteration's SETSPEED frames (QueuedItem::is_speed_frame())
+  SpeedRamp ramp_;
+  std::vector<SpeedRamp::Answer> ramped_;  // the ramp's answers of this iteration
   std::vector<Completion> completions_;
   std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
   DaemonOutput produced_;

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <regex>
@@ -118,13 +119,19 @@ class Server::Impl {
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     sessions.max_sessions_per_robot = options_.max_sessions_per_robot;
     sessions.link_stop = options_.link_stop;
-    const RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
-                                            .driver_call_bound = options_.driver_call_bound,
-                                            .precise_timing = options_.precise_timing,
-                                            .max_acceleration = options_.max_acceleration};
+    RobotDaemonOptions daemon_options{.log_executions = options_.log_executions,
+                                      .driver_call_bound = options_.driver_call_bound,
+                                      .precise_timing = options_.precise_timing,
+                                      .max_acceleration = options_.max_acceleration};
+    static_assert(BaseAccelerationLimit{}.linear == kDefaultBaseLinearAcceleration &&
+                  BaseAccelerationLimit{}.angular == kDefaultBaseAngularAcceleration);
     for (const auto& [name, limit] : options_.robot_max_late) {
       if (std::none_of(specs.begin(), specs.end(), [&](const RobotSpec& s) { return s.name == name; }))
         throw Error("Server: --max-late " + name + "=...: no robot '" + name + "' is served");
+    }
+    for (const auto& [name, limit] : options_.robot_base_acceleration) {
+      if (std::none_of(specs.begin(), specs.end(), [&](const RobotSpec& s) { return s.name == name; }))
+        throw Error("Server: --max-base-acceleration " + name + "=...: no robot '" + name + "' is served");
     }
     for (const RobotSpec& spec : specs) {
       for (const auto& robot : robots_) {
@@ -132,6 +139,15 @@ class Server::Impl {
           throw Error("Server: robot name '" + spec.name + "' is given twice");
       }
       DriverConfig config{spec.name, spec.urdf_path, spec.options};
+      const auto base = options_.robot_base_acceleration.find(spec.name);
+      const BaseAccelerationLimit& accel =
+          base != options_.robot_base_acceleration.end() ? base->second : options_.base_acceleration;
+      if (!(accel.linear > 0) || !(accel.angular > 0) || !std::isfinite(accel.linear) ||
+          !std::isfinite(accel.angular))
+        throw Error("Server: robot '" + spec.name +
+                    "': the base acceleration limit must be > 0 (m/s², rad/s²)");
+      daemon_options.base_linear_acceleration = accel.linear;
+      daemon_options.base_angular_acceleration = accel.angular;
       robots_.push_back(std::make_unique<RobotDaemon>(
           spec.name, spec.driver, registry.Create(spec.driver, config), clock_, daemon_options));
       const auto own_limit = options_.robot_max_late.find(spec.name);

@@ -47,6 +47,10 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --log-executions                print one line per executed command (diagnostics)
   --max-acceleration A            acceleration limit of every dof's trajectory, rad/s^2 or m/s^2
                                   (interpolated waypoints; default 20)
+  --max-base-acceleration LIN[,ANG]|NAME=LIN[,ANG]
+                                  a mobile base's acceleration limit, m/s^2 and rad/s^2: the SETSPEED
+                                  frames of interpolated packages ramp within it; NAME= for one
+                                  robot (default 3,6: a Clearpath Husky's; docs/server.md)
   --driver-call-bound S           a driver call running longer than S seconds is a driver fault:
                                   its command answers ERROR, the robot is held in panic (default 2;
                                   0 = no bound)
@@ -173,6 +177,21 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
           throw Error("--max-late: '" + text + "' names no robot (NAME=S)");
         } else {
           options.robot_max_late[text.substr(0, eq)] = d;
+        }
+      } else if (arg == "--max-base-acceleration") {
+        const std::string text = value();
+        const std::size_t eq = text.find('=');
+        if (eq == 0) throw Error("--max-base-acceleration: '" + text + "' names no robot (NAME=LIN[,ANG])");
+        const std::string limits = eq == std::string::npos ? text : text.substr(eq + 1);
+        const std::size_t comma = limits.find(',');
+        BaseAccelerationLimit limit;
+        limit.linear = ParseNumber(arg, limits.substr(0, comma).c_str(), 1e-3, 1e3);
+        if (comma != std::string::npos)
+          limit.angular = ParseNumber(arg, limits.substr(comma + 1).c_str(), 1e-3, 1e3);
+        if (eq == std::string::npos) {
+          options.base_acceleration = limit;
+        } else {
+          options.robot_base_acceleration[text.substr(0, eq)] = limit;
         }
       } else if (arg == "--link-stop") {
         options.link_stop = true;

@@ -1,6 +1,7 @@
 #include "trajectory_tracker.h"
 
 #include "expiry.h"
+#include "planner_answers.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,30 +11,14 @@
 namespace robotalk {
 namespace {
 
-std::string Seconds(Duration d) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g s", ToSeconds(d));
-  return text;
-}
+using planner_answers::Append;
+using planner_answers::MakeAnswer;
+using planner_answers::Seconds;
 
 std::string Number(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.4g", x);
   return text;
-}
-
-Reply MakeAnswer(CommandId id, Signal signal, std::string message, TimePoint exec, Duration lateness) {
-  Reply r;
-  r.id = id;
-  r.signal = signal;
-  r.message = std::move(message);
-  r.exec_time = exec;
-  r.lateness = lateness;
-  return r;
-}
-
-std::string Append(const std::string& note, const std::string& more) {
-  return note.empty() ? more : note + "; " + more;
 }
 
 }  // namespace

@@ -551,5 +551,47 @@ TEST_F(RobotClientTest, ListRobotsDedupesAnnouncements) {
   EXPECT_NE(robots[0].server_id, robots[1].server_id);
 }
 
+// Issue 22: SETSPEED frames of a linear sequence ramp within the robot's own
+// base acceleration limit (ServerOptions::robot_base_acceleration, the
+// server's --max-base-acceleration NAME=LIN,ANG), end to end through a client.
+TEST_F(RobotClientTest, ALinearSequencesSetSpeedFramesRampWithinTheRobotsOwnBaseLimit) {
+  ServerOptions options = DefaultServerOptions();
+  options.robot_base_acceleration[kRobot] = BaseAccelerationLimit{.linear = 1.0, .angular = 2.0};
+  StartServer(options);
+  auto client = Connected(Options());
+  const auto speed = CommandType::kSetSpeed;
+  const std::vector<TimedCommand> frames = {{milliseconds(0), {.type = speed, .values = {0.0, 0.0}}},
+                                            {milliseconds(200), {.type = speed, .values = {0.5, 0.0}}},
+                                            {milliseconds(1200), {.type = speed, .values = {0.0, 0.0}}}};
+  const SequenceResult r =
+      client->RunSequence(frames, {.delay = milliseconds(300), .interpolation = Interpolation::kLinear});
+  ASSERT_EQ(r.replies.size(), 3u);
+  EXPECT_EQ(r.replies[0].signal, Signal::kSuccess) << r.replies[0].message;
+  EXPECT_EQ(r.replies[1].signal, Signal::kModified);
+  EXPECT_THAT(r.replies[1].message,
+              HasSubstr("the plan's linear acceleration 2.5 m/s² exceeds the base's limit 1 m/s²"));
+  EXPECT_NE(r.replies[2].signal, Signal::kInterrupted) << r.replies[2].message;
+  EXPECT_NE(r.replies[2].signal, Signal::kError) << r.replies[2].message;
+}
+
+TEST(ServerOptionsTest, ABaseLimitForARobotNotServedIsRefusedByName) {
+  DriverRegistry registry;
+  RegisterKinematicDriver(registry);
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport net(bus);
+  ServerOptions options;
+  options.precise_timing = false;
+  options.robot_base_acceleration["rover"] = BaseAccelerationLimit{};
+  const RobotSpec spec{
+      kRobot, "kinematic", std::string(ROBOTALK_MODELS_DIR) + "/pioneer2dx_pantilt.urdf", {}};
+  SteadyClock clock;
+  try {
+    Server server(net, options, std::vector<RobotSpec>{spec}, registry, clock);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--max-base-acceleration rover=...: no robot 'rover' is served"));
+  }
+}
+
 }  // namespace
 }  // namespace robotalk

@@ -157,5 +157,12 @@ TEST(SequenceFile, TheExamplePanWaypointsParsesInterpolated) {
   EXPECT_EQ(file.entries.back().command.accelerations, std::vector<double>{0.0});
 }
 
+TEST(SequenceFile, TheExampleSpeedRampParsesInterpolated) {
+  const SequenceFile file = ParseSequenceFile(Example("speed_ramp.txt"), "speed_ramp.txt");
+  EXPECT_EQ(file.interpolation, Interpolation::kLinear);
+  ASSERT_EQ(file.entries.size(), 8u);
+  EXPECT_EQ(file.entries.back().command.type, CommandType::kSetSpeed);
+}
+
 }  // namespace
 }  // namespace robotalk::cli

@@ -34,6 +34,9 @@ class ObservedDriver final : public Driver {
     observer_->Tracked(r, now);
     return inner_->Track(r, now, done);
   }
+  DriverResult TrackBase(const BaseReference& r, TimePoint now, std::vector<Completion>& done) override {
+    return inner_->TrackBase(r, now, done);
+  }
   void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
   void ReadState(RobotState& s) const override { inner_->ReadState(s); }
   void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }

@@ -21,5 +21,12 @@ check "the robot drove" awk -F, 'END { exit !($2 > 1.0) }' "$tmp/a.csv"
 "$server" --robot "a=ode:$models/pioneer2dx_pantilt.urdf" --robot "b=ode:$models/pioneer2dx_pantilt.urdf" \
   --simulate "$examples/demo_arcs.txt" >/dev/null 2>"$tmp/two.err"
 check "two robots refused" grep -q "exactly one --robot" "$tmp/two.err"
+# The base acceleration limit's bad values are refused by name (before anything runs).
+for bad in "0|'0' is not a number in [0.001, 1000]" "1,x|'x' is not a number" "=1,2|'=1,2' names no robot (NAME=LIN[,ANG])"; do
+  "$server" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --max-base-acceleration "${bad%%|*}" \
+    --simulate "$examples/speed_ramp.txt" >/dev/null 2>"$tmp/bad.err"
+  check "--max-base-acceleration ${bad%%|*} refused (exit 2)" test $? -eq 2
+  check "--max-base-acceleration ${bad%%|*}: says why" grep -qF -- "--max-base-acceleration: ${bad#*|}" "$tmp/bad.err"
+done
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]

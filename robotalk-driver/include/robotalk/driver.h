@@ -96,6 +96,20 @@ struct JointReference {
   std::span<const double> acceleration;  ///< rad/s² | m/s², within the server's acceleration limit
 };
 
+/// Where the base's speed should be: a SETSPEED ramp's sample (issue 22,
+/// docs/drivers.md "Following a base speed ramp"). The body twist of the
+/// first root, as SETSPEED gives it.
+struct BaseReference {
+  double vx = 0.0;     ///< forward speed, m/s
+  double vy = 0.0;     ///< lateral speed, m/s (0 unless a frame gave vx vy ω)
+  double omega = 0.0;  ///< yaw rate, rad/s
+  /// The twist's rate toward the ramp one period on (m/s², rad/s²), within
+  /// the server's base acceleration limit: for a driver that interpolates
+  /// within the period. The twist is the reference from now on.
+  double ax = 0.0, ay = 0.0, alpha = 0.0;
+  bool lateral = false;  ///< the frame gave vy (3 values): Track's default sends "vx vy ω", else "v ω"
+};
+
 /// The robot's measured state. Sized by the server from the model once.
 struct RobotState {
   Eigen::VectorXd position;      ///< per dof (rad | m)
@@ -104,6 +118,7 @@ struct RobotState {
   std::vector<Pose> root_poses;  ///< per RobotModel::roots() entry, in the world
   double base_v = 0.0;           ///< forward speed of the first root, m/s
   double base_omega = 0.0;       ///< yaw rate of the first root, rad/s
+  double base_vy = 0.0;          ///< lateral speed of the first root (body frame), m/s
   bool moving = false;           ///< any actuator or the base is commanded to move
 };
 
@@ -152,6 +167,20 @@ class Driver {
   /// override this still moves through the waypoints, a period behind).
   virtual DriverResult Track(const JointReference& reference, TimePoint now,
                              std::vector<Completion>& completed);
+  /// Drives the base at `reference` from `now` on: called every control
+  /// period, just before Update(now), while a SETSPEED ramp is active (the
+  /// timed SETSPEED frames of an interpolated package, which the server
+  /// ramps within its base acceleration limit). After the last call the
+  /// base keeps the last twist, as after a SETSPEED. Not called between
+  /// Halt() and Resume(); STOP, panic, the watchdog, a GOTO and a step
+  /// SETSPEED end the ramp first. A non-SUCCESS/MODIFIED answer ends the
+  /// ramp (its frames answer INTERRUPTED naming the driver's reason); a
+  /// MODIFIED one's message goes to the frame being approached. Default: a
+  /// SETSPEED of the reference's twist ("v ω", or "vx vy ω" when
+  /// `reference.lateral`), through Execute(), so a driver that does not
+  /// override this drives the ramp as a staircase of one twist per period.
+  virtual DriverResult TrackBase(const BaseReference& reference, TimePoint now,
+                                 std::vector<Completion>& completed);
   /// Advances the robot to `now` (one period after the previous call);
   /// appends the completions of commands that finished.
   virtual void Update(TimePoint now, std::vector<Completion>& completed) = 0;

@@ -91,4 +91,8 @@ struct BaseTwist {
 /// REQUIRES: `command` is a SETSPEED with 2 (v ω) or 3 (vx vy ω) values.
 BaseTwist ShapeBaseSpeed(const DriverCommand& command, BaseType base, double max_v, double max_omega);
 
+/// The SETSPEED of a base reference's twist: "vx vy ω" when it is lateral
+/// (or vy is not 0), else "v ω" (Driver::TrackBase's default).
+DriverCommand SetSpeedOf(const BaseReference& reference);
+
 }  // namespace robotalk::driver_support

@@ -36,6 +36,14 @@ inline constexpr std::size_t kDefaultMaxSessions = 1024;
 /// The default of --max-sessions-per-robot (ServerOptions::max_sessions_per_robot).
 inline constexpr std::size_t kDefaultMaxSessionsPerRobot = 256;
 
+/// A mobile base's acceleration limit for SETSPEED ramps (the SETSPEED frames
+/// of interpolated packages; docs/server.md, "Base speed ramps"). The
+/// defaults are a Clearpath Husky's, as its diff_drive_controller ships them.
+struct BaseAccelerationLimit {
+  double linear = 3.0;   ///< m/s², of the planar speed (> 0)
+  double angular = 6.0;  ///< rad/s², of the yaw rate (> 0)
+};
+
 struct ServerOptions {
   /// LCM provider URL; "" uses LCM's default (or $LCM_DEFAULT_URL).
   std::string lcm_url;
@@ -66,6 +74,11 @@ struct ServerOptions {
   /// waypoints: time-scaling and the hold after the last one), rad/s² or
   /// m/s² (`--max-acceleration`; docs/protocol.md, Trajectories).
   double max_acceleration = 20.0;
+  /// The base acceleration limit of SETSPEED ramps
+  /// (`--max-base-acceleration LIN[,ANG]`); `robot_base_acceleration`
+  /// overrides it per robot name (`--max-base-acceleration NAME=LIN[,ANG]`).
+  BaseAccelerationLimit base_acceleration;
+  std::map<std::string, BaseAccelerationLimit> robot_base_acceleration;
   /// Print one stderr line per executed command (diagnostics).
   bool log_executions = false;
   /// A driver call running longer than this is a driver fault: its command
