@@ -8,7 +8,10 @@
 // between consecutive references, freezes (a reference held longer than one
 // and a half periods) and missing samples, from the first second on. One
 // line of text.
+// The last lines repeat the figures as key=value for tests
+// (tests/integration/receding_relay_test.sh).
 //   robotalk-receding-client --url URL --robot NAME --joint NAME [--splices N]
+//       [--freeze-ms MS (15)] [--min-speed RAD_S (0.5): the acceleration estimate's |v0 + v1| floor]
 #include "bench_util.h"
 #include "robotalk/robot_client.h"
 
@@ -31,6 +34,8 @@ int main(int argc, char** argv) {
     c.Connect(a.Str("robot", "iiwa"));
     const std::string joint = a.Str("joint", "iiwa_joint_6");
     const int splices = static_cast<int>(a.Num("splices", 10000));
+    const Duration freeze = FromSeconds(a.Num("freeze-ms", 15) / 1e3);
+    const double min_speed = a.Num("min-speed", 0.5);
     const int dof = c.model().dof_offset(c.model().JointIndex(joint));
     const TimePoint t0 = c.ServerNow() + std::chrono::milliseconds(50);
     const auto target = [&](TimePoint t) { return 0.5 * std::sin(std::numbers::pi * ToSeconds(t - t0)); };
@@ -60,7 +65,7 @@ int main(int argc, char** argv) {
       last_sample = s.sample;
       ++samples;
       if (p == last_p) {  // the same reference: a freeze once it outlives one and a half periods
-        if (!in_freeze && s.server_time - changed > std::chrono::milliseconds(15)) {
+        if (!in_freeze && s.server_time - changed > freeze) {
           ++frozen;
           in_freeze = true;
         }
@@ -70,7 +75,7 @@ int main(int argc, char** argv) {
         max_dv = std::abs(v - last_v);
         max_dv_after = s.server_time - changed;
       }
-      if (!std::isnan(last_v) && std::abs(v + last_v) > 0.5) {
+      if (!std::isnan(last_v) && std::abs(v + last_v) > min_speed) {
         const double dt = 2 * (p - last_p) / (v + last_v);
         if (dt > 0 && std::abs(v - last_v) / dt > max_accel) {
           max_accel = std::abs(v - last_v) / dt;
@@ -111,11 +116,13 @@ int main(int argc, char** argv) {
         "from the first second on: largest velocity step between consecutive references %.4f rad/s (their "
         "first "
         "samples %.1f ms apart); freezes "
-        "(a reference held > 15 ms) %ld; missing samples %ld; largest acceleration between consecutive "
-        "references over the period the server ran (2·Δp / (v0 + v1), where |v0 + v1| > 0.5 rad/s) %.2f "
+        "(a reference held > %.0f ms) %ld; missing samples %ld; largest acceleration between consecutive "
+        "references over the period the server ran (2·Δp / (v0 + v1), where |v0 + v1| > %.2g rad/s) %.2f "
         "rad/s² (a step of %.4f rad/s over %.2f ms)\n",
-        splices, sent, samples, references, max_dv, 1e3 * ToSeconds(max_dv_after), frozen, missing, max_accel,
-        max_accel_dv, 1e3 * max_accel_dt);
+        splices, sent, samples, references, max_dv, 1e3 * ToSeconds(max_dv_after), 1e3 * ToSeconds(freeze),
+        frozen, missing, min_speed, max_accel, max_accel_dv, 1e3 * max_accel_dt);
+    std::printf("references=%ld\nmax_step=%.6f\nmax_acceleration=%.4f\nfreezes=%ld\nmissing=%ld\n",
+                references, max_dv, max_accel, frozen, missing);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "robotalk-receding-client: %s\n", e.what());

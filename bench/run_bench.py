@@ -456,7 +456,7 @@ class Bench:
                                timeout=splices // 100 + 60)
             self.stop(relay)
             self.stop_server()
-            output += "\n(b, network) " + (c.stdout.strip() if c.returncode == 0 else
+            output += "\n(b, network) " + (c.stdout.strip().splitlines()[0] if c.returncode == 0 else
                                            f"failed ({c.returncode}): {c.stderr.strip()[-300:]}") + "\n"
         return {"figure": "trajectory", "output": output, "stderr": r.stderr[-400:], "rc": r.returncode,
                 "shared_robots": os.path.exists(shared), "plot_ode_10hz": plot}

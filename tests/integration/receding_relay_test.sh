@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Issue 22's receding-horizon client through the network: robotalk-server
+# (kinematic Pioneer, whose driver's state is its reference) on side B,
+# robotalk-lcm-relay adding 5 ms ± 3 ms (uniform) client -> server, and
+# robotalk-receding-client on side A sending, every 10 ms, a 200 ms quintic
+# trajectory of the pan joint from 20 ms ahead (400 splices, 4 s). Run inside
+# a private network namespace (scripts/netns_run.sh). Asserts:
+#   no freeze: the reference never held for 100 ms (a starved horizon holds
+#       for good; 100 ms, not one period, so a period the loaded machine ran
+#       late is not counted);
+#   no jump: the largest acceleration between consecutive references, over
+#       the period the server ran (2·Δp / (v0 + v1) of the reference, where
+#       |v0 + v1| > 1 rad/s: within 10 % on the plan, exact when limited), is
+#       within the server's 20 rad/s² limit plus that 10 % and 15 % for the
+#       STATE samples' rounding; no sample missing;
+#   it moved: at least half the periods showed a new reference.
+# usage: receding_relay_test.sh SERVER RELAY CLIENT MODELS_DIR   (about 15 s)
+set -u
+server=$1 relay=$2 client=$3 models=$4
+A='udpm://239.255.76.67:7941?ttl=0'
+B='udpm://239.255.76.67:8041?ttl=0'
+tmp=$(mktemp -d)
+fail=0
+no() { echo "FAIL: $*"; fail=1; }
+val() { sed -n "s/^$2=//p" "$1" | head -1; }
+
+"$server" --robot pioneer=kinematic:"$models"/pioneer2dx_pantilt.urdf --url "$B" --duration 40 \
+  --no-panic-latch 2>"$tmp/server.log" &
+spid=$!
+"$relay" --a "$A" --b "$B" --a2b-latency-ms 5 --a2b-jitter-ms 3 --a2b-jitter-dist uniform --seed 22 \
+  --duration 35 >"$tmp/relay.log" 2>&1 &
+rpid=$!
+trap 'kill $spid $rpid 2>/dev/null; rm -rf "$tmp"' EXIT
+for _ in $(seq 100); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+sleep 0.3
+
+timeout 30 "$client" --url "$A" --robot pioneer --joint pan --splices 400 --freeze-ms 100 --min-speed 1.0 \
+  >"$tmp/out" 2>&1 || no "the client failed: $(tail -3 "$tmp/out")"
+cat "$tmp/out"
+refs=$(val "$tmp/out" references) accel=$(val "$tmp/out" max_acceleration)
+freezes=$(val "$tmp/out" freezes) missing=$(val "$tmp/out" missing)
+[ "${freezes:-1}" = 0 ] || no "$freezes freezes (a reference held 100 ms)"
+[ "${missing:-1}" = 0 ] || no "$missing STATE samples missing"
+awk -v a="${accel:-999}" 'BEGIN { exit !(a <= 20 * 1.25) }' ||
+  no "an acceleration of $accel rad/s² between references, beyond the 20 rad/s² limit"
+# 400 splices over 4 s, the first second not counted: ~300 periods of 10 ms.
+[ "${refs:-0}" -ge 150 ] || no "only ${refs:-0} distinct references (the joint did not follow)"
+[ $fail = 0 ] && echo "PASS: receding horizon through the relay"
+exit $fail
