@@ -97,6 +97,10 @@ struct OdeDriverOptions {
   /// with solver=quickstep the driver refuses walking (Error). false
   /// (default) = the root moves kinematically (the scripted gait). Key "walk".
   bool walk = false;
+  /// With walk=true: the DCM stabilizer closes the balance loop from the
+  /// measured CoM and contact forces (docs/ode_sim.md, "Balance feedback").
+  /// false = the open-loop pattern (for comparison). Key "stabilizer".
+  bool stabilizer = true;
 
   /// Parses DriverConfig::options. Throws Error naming an unknown key (and the
   /// known ones) or a bad value: "ode driver: option step_hz='0': expected a rate > 0 (Hz)".

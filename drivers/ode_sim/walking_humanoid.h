@@ -24,6 +24,7 @@
 #include "ode_walk_status.h"
 #include "ode_world.h"
 #include "robotalk/driver.h"
+#include "walking/dcm_stabilizer.h"
 #include "walking/leg_ik.h"
 #include "walking/walk_pattern.h"
 
@@ -140,6 +141,18 @@ class WalkingHumanoid final : public BaseController {
   std::string fall_;  // written once, when the fall is detected
   double tilt_ = 0;
   void MeasureContacts();
+  void Balance();
+  // Balance feedback (options.stabilizer): the DCM stabilizer's ZMP command
+  // as an offset of the planned CoM (plan frame), from the measured CoM.
+  bool stabilize_ = true;
+  std::optional<walking::DcmStabilizer> dcm_;
+  std::optional<walking::ComOffset> com_offset_;
+  walking::DcmStabilizer::Output balance_;
+  Eigen::Vector2d com_world_prev_ = Eigen::Vector2d::Zero(), com_velocity_ = Eigen::Vector2d::Zero();
+  bool zmp_valid_ = false;
+  void AdjustStep();
+  int adjusted_step_ = -1;  // started_steps() of the step AdjustStep() moves
+  Eigen::Vector2d step_target_ = Eigen::Vector2d::Zero(), step_applied_ = Eigen::Vector2d::Zero();
   double foot_force_[2] = {0, 0};
   int foot_contacts_[2] = {0, 0};
   Eigen::Vector2d zmp_measured_ = Eigen::Vector2d::Zero();  // world

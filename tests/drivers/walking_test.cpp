@@ -433,6 +433,76 @@ TEST(DcmStabilizer, BeyondTheAnklesAStepToTheCapturePointRecovers) {
   }
 }
 
+// ComOffset: the ZMP command on a position-controlled robot. The robot here
+// is the LIPM whose ground reaction comes from servos that track the CoM
+// reference (the plan plus the offset) with stiffness kp and damping kd per
+// unit mass: p = c - (ref'' + kp (ref - c) + kd (ref' - c')) / w^2, lagging
+// 20 ms and limited to the soles (the CoP the stabilizer measures). Returns
+// the CoM's largest excursion from the plan after a push to v0, and checks
+// that it came back.
+double PushedExcursion(double v0, bool stabilized, double kp_over_w2) {
+  Lipm m;
+  const Eigen::Vector2d ref(0.03, 0), zero = Eigen::Vector2d::Zero();
+  m.c = ref;
+  m.v = Eigen::Vector2d(v0, 0);
+  const DcmStabilizer s(m.zc, m.g);
+  const double w2 = s.omega() * s.omega(), kp = kp_over_w2 * w2, kd = std::sqrt(2 * kp);
+  ComOffset offset(s.omega());
+  const auto support = Rect(-0.09, 0.15, -0.15, 0.15);
+  Eigen::Vector2d cop = ref, accel = zero;
+  double worst = 0;
+  for (int i = 0; i < 3000; ++i) {
+    if (stabilized) {
+      const Eigen::Vector2d before = offset.velocity();
+      offset.Update(s.Update(m.c, m.v, ref, zero, ref, support, 0), m.c, ref, ref, &cop, m.dt);
+      accel = (offset.velocity() - before) / m.dt;
+      EXPECT_LE(offset.offset().cwiseAbs().maxCoeff(), ComOffsetGains{}.max_offset + 1e-12) << "bounded";
+    }
+    const Eigen::Vector2d wanted =
+        m.c - (accel + kp * (ref + offset.offset() - m.c) + kd * (offset.velocity() - m.v)) / w2;
+    cop += (ClampToPolygon(wanted, support, 0) - cop) * (m.dt / 0.02);
+    m.Step(cop);
+    worst = std::max(worst, (m.c - ref).norm());
+    if (worst > 1) break;
+  }
+  EXPECT_LT((m.c - ref).norm(), 2e-3)
+      << "recovered: v0 " << v0 << (stabilized ? ", stabilized" : ", open loop");
+  return worst;
+}
+
+TEST(ComOffset, WithCompliantServosTheStabilizerHoldsAPushAsTheStiffestAnklesWould) {
+  for (const double v0 : {0.2, 0.3, -0.3}) {
+    const double stiff = PushedExcursion(v0, false, 4.0);  // servos 4x gravity's toppling stiffness
+    const double soft = PushedExcursion(v0, false, 0.5), stabilized = PushedExcursion(v0, true, 0.5);
+    EXPECT_LT(stabilized, 1.25 * stiff) << v0;
+    EXPECT_LT(stabilized, 0.7 * soft) << v0 << ": the soft servos alone let the CoM run farther";
+  }
+}
+
+TEST(ComOffset, WithThePlanTrackedTheOffsetReturnsToZeroAndMeasuredCopCorrectsALaggingZmp) {
+  const DcmStabilizer s(0.6, 9.81);
+  ComOffset offset(s.omega());
+  const Eigen::Vector2d ref(0.03, 0.01), zero = Eigen::Vector2d::Zero();
+  const auto support = Rect(-0.09, 0.15, -0.15, 0.15);
+  // A perfectly tracked offset (the CoM is the reference plus the offset), nudged away.
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector2d c = ref + offset.offset() + (i == 0 ? Eigen::Vector2d(0.01, -0.01) : zero);
+    const Eigen::Vector2d v = offset.velocity();
+    offset.Update(s.Update(c, v, ref, zero, ref, support, 0), c, ref, ref, nullptr, 1e-3);
+  }
+  EXPECT_LT(offset.offset().norm(), 1e-3) << "back to the plan";
+  EXPECT_LT(offset.velocity().norm(), 1e-3);
+  // The CoP feedback: the ZMP commanded ahead of the measured one accelerates the CoM reference back.
+  offset.Reset();
+  DcmStabilizer::Output o;
+  o.zmp = Eigen::Vector2d(0.05, 0);
+  const Eigen::Vector2d cop(0.0, 0);
+  offset.Update(o, o.zmp, o.zmp, o.zmp, &cop, 1e-3);
+  EXPECT_LT(offset.velocity().x(), 0);
+  EXPECT_THROW(ComOffset(0.0), std::invalid_argument);
+  EXPECT_THROW(ComOffset(3.0, ComOffsetGains{.max_offset = -1}), std::invalid_argument);
+}
+
 TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {
   const RobotModel m = LoadUrdfFile(testing::ProjectModel("simple_humanoid.urdf")).model;
   const int lf = m.LinkIndex("left_foot"), rf = m.LinkIndex("right_foot");
