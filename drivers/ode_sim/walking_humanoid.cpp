@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <numbers>
 #include <span>
 
@@ -129,16 +128,8 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;
-  auto env = [](const char* n, double d) { const char* v = std::getenv(n); return v ? std::atof(v) : d; };  // TUNING
-  walking::DcmGains dg;
-  dg.k = env("RT_K", dg.k);
-  dg.margin = env("RT_MARGIN", dg.margin);
-  walking::ComOffsetGains cg;
-  cg.zmp_gain = env("RT_ZG", cg.zmp_gain);
-  cg.max_offset = env("RT_MAXOFF", cg.max_offset);
-  cg.max_speed = env("RT_MAXSPEED", cg.max_speed);
-  w->dcm_.emplace(w->g_.com_height, gravity, dg);
-  w->com_offset_.emplace(w->dcm_->omega(), cg);
+  w->dcm_.emplace(w->g_.com_height, gravity);
+  w->com_offset_.emplace(w->dcm_->omega());
   return w;
 }
 
@@ -267,12 +258,7 @@ void WalkingHumanoid::StopOnly(const StopScope& scope, std::vector<Completion>& 
 }
 
 bool WalkingHumanoid::moving() const {
-  if (!pattern_.standing()) return true;
-  const Eigen::VectorXd& qd = world_->qd();
-  for (Eigen::Index i = 0; i < qd.size(); ++i) {
-    if (Owns(i) && std::abs(qd[i]) > kMovingSpeed) return true;
-  }
-  return false;
+  return !fallen_ && (!pattern_.standing() || tick_ < settle_ticks_ + ramp_ticks_);
 }
 
 DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {

@@ -93,7 +93,9 @@ class WalkingHumanoid final : public BaseController {
   void Control(std::vector<Completion>& completed) override;
 
   Twist2 twist() const override { return RootTwist(*world_, model_); }
-  /// Stepping, or a leg still moving (settling at start-up, after a stop).
+  /// A walk in progress: stepping (the steps and the last shift of weight
+  /// of a STOP included), or the start-up's settling into the stance. Not
+  /// the legs' balancing sway nor the soles' contact bounce while standing.
   bool moving() const override;
   /// The fall in words, "" before one: "the robot has fallen (torso tilt 0.71 rad)".
   std::string_view fault() const override { return fall_; }

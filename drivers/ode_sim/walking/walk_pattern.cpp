@@ -237,13 +237,14 @@ Eigen::Vector2d WalkPattern::AdjustLanding(const Eigen::Vector2d& offset, double
   if (k == steps_.size() || !steps_[k].swing) return Eigen::Vector2d::Zero();
   Scheduled& st = steps_[k];
   // In the stance foot's frame: the landing stays on the swing foot's side,
-  // at least the planned separation's 80 % away, and within `reach`.
+  // no nearer to it sideways than planned (a foot moved inward narrows the
+  // support and never crosses to catch a push toward the stance side), within `reach`.
   const Pose2& stance = st.stance;
   const double c = std::cos(stance.theta), s = std::sin(stance.theta);
-  const Eigen::Vector2d want = st.planned.xy() + offset - stance.xy();
+  const Eigen::Vector2d want = st.planned.xy() + offset - stance.xy(), plan = st.planned.xy() - stance.xy();
   Eigen::Vector2d local(c * want.x() + s * want.y(), -s * want.x() + c * want.y());
-  const double side = SideSign(st.step.side);
-  local.y() = side * std::max(side * local.y(), 0.8 * g_.foot_separation);
+  const double side = SideSign(st.step.side), planned_y = -s * plan.x() + c * plan.y();
+  local.y() = side * std::max(side * local.y(), std::max(side * planned_y, 0.8 * g_.foot_separation));
   if (local.norm() > reach) local *= reach / local.norm();
   const Eigen::Vector2d land =
       stance.xy() + Eigen::Vector2d(c * local.x() - s * local.y(), s * local.x() + c * local.y());
