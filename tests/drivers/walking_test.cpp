@@ -345,6 +345,43 @@ std::vector<Eigen::Vector2d> Rect(double x0, double x1, double y0, double y1) {
   return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};  // counter-clockwise
 }
 
+// Step adjustment (balance): the foot in the air lands where it is moved,
+// forward or outward but never inward of its plan, within reach; the ZMP
+// reference stays continuous, inside the support, and moves with the landed foot.
+TEST(WalkPattern, AdjustLandingMovesTheFootInTheAirAndTheReferenceWithIt) {
+  Sweep s;
+  s.Goto({1.5, 0, 0});
+  while (s.w.time_to_landing() == 0 || s.w.started_steps() < 2) s.Run(0.001);
+  s.Run(0.1);  // early in the second step's swing
+  EXPECT_TRUE(s.w.AdjustLanding({0, 0}, 0.5).isZero()) << "no offset, no change";
+  const Side swing = Other(s.w.support_side());
+  const Pose2 stance = s.w.foot(s.w.support_side());
+  // Inward (toward the stance foot) is refused; forward is taken.
+  const Eigen::Vector2d inward(0.06, -SideSign(swing) * 0.05);
+  const Eigen::Vector2d applied = s.w.AdjustLanding(inward, 0.5);
+  EXPECT_NEAR(applied.x(), 0.06, 1e-9);
+  EXPECT_NEAR(applied.y(), 0, 1e-9) << "never nearer to the stance foot than planned";
+  const Eigen::Vector2d far = s.w.AdjustLanding({0.4, 0}, 0.25);
+  s.Run(s.w.time_to_landing() + 0.001);
+  const Pose2 landed = s.w.foot(swing);
+  EXPECT_NEAR(std::hypot(landed.x - stance.x, landed.y - stance.y), 0.25, 1e-6) << "within reach";
+  EXPECT_GT(far.x(), 0.06);
+  EXPECT_LT(s.worst_jump, 2e-3) << "the reference moves on continuously";
+  s.Run(0.5);
+  const Eigen::Vector2d landed_zmp = landed.Apply(s.g.zmp_x, 0);
+  EXPECT_LT((s.w.zmp_ref() - landed_zmp).norm(), (s.w.zmp_ref() - stance.Apply(s.g.zmp_x, 0)).norm())
+      << "the weight shifts onto the foot where it landed";
+  double outside = 0;  // the reference's time outside the support (the preview's model ZMP may
+                       // cut a corner after so late a change: the stabilizer clamps its command)
+  for (int i = 0; i < 60000 && !s.w.settled(2e-3); ++i) {
+    s.Run(0.001);
+    if (!s.w.InSupport(s.w.zmp_ref(), 0)) outside = s.w.time();
+  }
+  EXPECT_TRUE(s.w.standing());
+  EXPECT_LT(s.worst_jump, 2e-3);
+  EXPECT_EQ(outside, 0) << "the reference ZMP left the support at t=" << outside;
+}
+
 TEST(DcmStabilizer, ClampToPolygonKeepsInsidePointsAndClampsOthersToTheShrunkEdge) {
   const auto sq = Rect(-1, 1, -1, 1);
   EXPECT_TRUE(ClampToPolygon({0.5, 0.2}, sq, 0.1).isApprox(Eigen::Vector2d(0.5, 0.2)));
