@@ -17,7 +17,9 @@
 //     instant of the gait cycle, the same per direction for every column),
 //     with and/or without the balance feedback (option stabilizer), in one
 //     table, then the arm swing below for the same stabilizer settings.
-//   robotalk-walk-sweep --probe standing|walking,DEG,N_S: one push; survived or not.
+//   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
+//     after the start of the walk, default 5.5; standing 2); survived or not; --trace
+//     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them).
 //   robotalk-walk-sweep --arms 1 [--stabilizer ...]: both shoulders swung
 //     together +-1 rad every 0.5 s for 6 s, standing and walking: fell or not.
 // Transitions (t = the swept instant, s after the first command):
@@ -318,8 +320,15 @@ int Probe(const Args& args) {
     return 2;
   }
   const bool walking = args.probe.substr(0, a) == "walking";
-  const double deg = std::atof(args.probe.substr(a + 1, b - a - 1).c_str());
-  const double j = std::atof(args.probe.substr(b + 1).c_str());
+  const double deg = std::atof(args.probe.substr(a + 1, args.probe.find(',', a + 1) - a - 1).c_str());
+  const std::string rest = args.probe.substr(b + 1);
+  // N_S or DEG,N_S,AT: then b pointed at AT's comma.
+  double j = std::atof(rest.c_str()), at = walking ? 5.5 : 2.0;
+  const size_t c = args.probe.find(',', a + 1);
+  if (c != b) {
+    j = std::atof(args.probe.substr(c + 1, b - c - 1).c_str());
+    at = std::atof(rest.c_str());
+  }
   for (const Args& s : Settings(args)) {
     std::FILE* trace = nullptr;
     if (!args.trace.empty()) {
@@ -335,10 +344,10 @@ int Probe(const Args& args) {
           "zmp_ref_y,zmp_cmd_x,zmp_cmd_y,saturated,tilt,lfoot_x,lfoot_y,lfoot_th,lfoot_h,lfoot_f,"
           "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y\n");
     }
-    const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, walking ? 5.5 : 2.0, trace);
+    const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);
-    std::printf("%s %.0f deg %.2f N s, stabilizer %s: %s\n", walking ? "walking" : "standing", deg, j,
-                s.options.at("stabilizer").c_str(), ok ? "survived" : "FELL");
+    std::printf("%s %.0f deg %.2f N s at %.2f s, stabilizer %s: %s\n", walking ? "walking" : "standing", deg,
+                j, at, s.options.at("stabilizer").c_str(), ok ? "survived" : "FELL");
   }
   return 0;
 }
