@@ -20,6 +20,7 @@
 //   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
 //     after the start of the walk, default 5.5; standing 2); survived or not; --trace
 //     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them).
+//   robotalk-walk-sweep --rtf S [--stabilizer ...]: CPU per physics step walking S s.
 //   robotalk-walk-sweep --arms 1 [--stabilizer ...]: both shoulders swung
 //     together +-1 rad every 0.5 s for 6 s, standing and walking: fell or not.
 // Transitions (t = the swept instant, s after the first command):
@@ -57,6 +58,7 @@ struct Args {
   std::string trace;  // --trace FILE: the probe's walk status every 10 ms as CSV (tools: plot_walk_push.py)
   std::string stabilizer = "both";  // --stabilizer on|off|both (the push table and the arm swing)
   double resolution = 2.5;          // N s, of the push bisection
+  double rtf = 0;     // --rtf S: S simulated seconds of walking per stabilizer setting, CPU per physics step
   bool arms = false;  // --arms 1: both arms swung together +-1 rad every 0.5 s, standing and walking
   unsigned seed = 1;
   std::map<std::string, std::string> options = {{"walk", "true"}};
@@ -84,6 +86,8 @@ Args Parse(int argc, char** argv) {
       a.stabilizer = v;
     } else if (k == "--resolution") {
       a.resolution = std::atof(v.c_str());
+    } else if (k == "--rtf") {
+      a.rtf = std::atof(v.c_str());
     } else if (k == "--arms") {
       a.arms = v == "1";
     } else if (k == "--seed") {
@@ -352,6 +356,27 @@ int Probe(const Args& args) {
   return 0;
 }
 
+// --rtf S: the cost of the walking controller: S s walking at full speed
+// (after the 1 s stance), CPU time of this process per 1 ms physics step, with
+// and without the stabilizer (the same physics and pattern).
+int Rtf(const Args& args) {
+  for (const Args& s : Settings(args)) {
+    std::unique_ptr<Driver> d = NewDriver(s);
+    Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+    r.ode->Step(1000, r.done);
+    r.Speed(1.0);
+    const std::clock_t cpu0 = std::clock();
+    const int steps = static_cast<int>(args.rtf * 1000);
+    r.ode->Step(steps, r.done);
+    const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    std::printf(
+        "walking %.0f s, stabilizer %s: %.1f us CPU per 1 ms step, real-time factor %.2f per CPU second%s\n",
+        args.rtf, s.options.at("stabilizer") == "true" ? "on" : "off", cpu / steps * 1e6, args.rtf / cpu,
+        r.ode->walk_status()->fallen ? " (FELL)" : "");
+  }
+  return 0;
+}
+
 int ArmSwing(const Args& args) {
   for (const Args& s : Settings(args)) {
     for (bool walking : {false, true}) {
@@ -381,6 +406,7 @@ int ArmSwing(const Args& args) {
 int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   if (!args.probe.empty()) return Probe(args);
+  if (args.rtf > 0) return Rtf(args);
   if (!args.push.empty()) return Pushes(args);
   if (args.arms) return ArmSwing(args);
   if (args.transition != "all" && !Transitions().count(args.transition)) {
