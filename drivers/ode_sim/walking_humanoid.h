@@ -2,8 +2,11 @@
 // (docs/ode_sim.md, "Walking"): GOTO, SETSPEED, STOP and panic as steps of
 // a ZMP-preview walking pattern (walking/walk_pattern.h), whole-leg joint
 // targets from InverseKinematics (walking/leg_ik.h) tracked by the ODE
-// hinge motors at every physics step, and fall detection. The root is a
-// free ODE body: the robot stands on its contacts and can fall.
+// hinge motors at every physics step, balance feedback (walking/
+// dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
+// reference and the swing foot's landing; option stabilizer), and fall
+// detection. The root is a free ODE body: the robot stands on its contacts
+// and can fall.
 //
 // Frames: the pattern lives in its own planar frame; each plan maps a goal
 // from the world into it with the support foot's pose measured at planning
@@ -89,7 +92,8 @@ class WalkingHumanoid final : public BaseController {
   /// The walk stops with the base, or when a leg it drives is in the scope
   /// (stopping more than asked is safe).
   void StopOnly(const StopScope& scope, std::vector<Completion>& completed) override;
-  /// One physics step's control: the pattern, IK, motors, fall check, GOTO completion.
+  /// One physics step's control: the pattern, balance feedback, IK, motors,
+  /// fall check, GOTO completion.
   void Control(std::vector<Completion>& completed) override;
 
   Twist2 twist() const override { return RootTwist(*world_, model_); }
