@@ -101,6 +101,10 @@ struct OdeDriverOptions {
   /// measured CoM and contact forces (docs/ode_sim.md, "Balance feedback").
   /// false = the open-loop pattern (for comparison). Key "stabilizer".
   bool stabilizer = true;
+  /// With the stabilizer: also move the foot in the air toward the capture
+  /// point when the ankles saturate. Measured to make walking pushes worse
+  /// (docs/ode_sim.md, "Balance feedback"), so off by default. Key "step_adjustment".
+  bool step_adjustment = false;
 
   /// Parses DriverConfig::options. Throws Error naming an unknown key (and the
   /// known ones) or a bad value: "ode driver: option step_hz='0': expected a rate > 0 (Hz)".

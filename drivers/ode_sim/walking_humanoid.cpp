@@ -128,6 +128,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;
+  w->adjust_steps_ = options.stabilizer && options.step_adjustment;
   w->dcm_.emplace(w->g_.com_height, gravity);
   w->com_offset_.emplace(w->dcm_->omega());
   return w;
@@ -472,7 +473,7 @@ void WalkingHumanoid::Balance() {
 void WalkingHumanoid::AdjustStep() {
   constexpr double kAdjustRate = 1.0;   // m/s
   constexpr double kLateAdjust = 0.15;  // s
-  if (!stabilize_ || tick_ < settle_ticks_) return;
+  if (!adjust_steps_ || tick_ < settle_ticks_) return;
   if (pattern_.started_steps() != adjusted_step_) {
     adjusted_step_ = pattern_.started_steps();
     step_target_.setZero();

@@ -151,6 +151,7 @@ class WalkingHumanoid final : public BaseController {
   // Balance feedback (options.stabilizer): the DCM stabilizer's ZMP command
   // as an offset of the planned CoM (plan frame), from the measured CoM.
   bool stabilize_ = true;
+  bool adjust_steps_ = false;  // options.step_adjustment
   std::optional<walking::DcmStabilizer> dcm_;
   std::optional<walking::ComOffset> com_offset_;
   walking::DcmStabilizer::Output balance_;
