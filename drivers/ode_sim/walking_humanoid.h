@@ -2,9 +2,10 @@
 // (docs/ode_sim.md, "Walking"): GOTO, SETSPEED, STOP and panic as steps of
 // a ZMP-preview walking pattern (walking/walk_pattern.h), whole-leg joint
 // targets from InverseKinematics (walking/leg_ik.h) tracked by the ODE
-// hinge motors at every physics step, balance feedback (walking/
+// hinge motors at every physics step, optional balance feedback (walking/
 // dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
-// reference and the swing foot's landing; option stabilizer), and fall
+// reference and the swing foot's landing; options stabilizer,
+// step_adjustment), and fall
 // detection. The root is a free ODE body: the robot stands on its contacts
 // and can fall.
 //
