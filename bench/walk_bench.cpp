@@ -16,6 +16,7 @@
 // --stand prints S seconds of the start-up stance first.
 #include "ode_driver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -128,6 +129,31 @@ struct Outcome {
 // One GOTO to c (values x y theta): steps until it completes, a fall, or
 // (--stop) the end of the stepping after a STOP. A GOTO still running after
 // --timeout is stopped and reported TIMEOUT (a failure), whatever it answers then.
+// The measured centre of pressure against the plan's ZMP and the
+// stabilizer's ZMP command, every 10 ms while stepping (m).
+struct CopErrors {
+  std::vector<double> to_plan, to_command;
+  void Add(const walking::WalkStatus& s) {
+    if (!s.stepping) return;
+    to_plan.push_back((s.zmp - s.zmp_ref).norm());
+    if (s.zmp_command.norm() > 0) to_command.push_back((s.zmp - s.zmp_command).norm());
+  }
+};
+CopErrors cop_errors;
+
+// "median a / 95th b / max c cm" of v.
+std::string Percentiles(std::vector<double> v) {
+  if (v.empty()) return "none";
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double p) {
+    return 100 * v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
+  };
+  char out[96];
+  std::snprintf(out, sizeof out, "median %.2f / 95th %.2f / max %.2f cm (%zu samples)", at(0.5), at(0.95),
+                at(1.0), v.size());
+  return out;
+}
+
 Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& args, std::ofstream* trace) {
   std::vector<Completion> done;
   const TimePoint t0 = ode->sim_time();
@@ -146,6 +172,7 @@ Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& ar
     if (ode->walk_status()->fallen) break;
     if (stopped && !ode->walk_status()->stepping && t > args.stop_after + 3) break;
     ode->Step(10, done);
+    cop_errors.Add(*ode->walk_status());
     if (args.verbose > 0 && i % args.verbose == 0) PrintWalk(*ode->walk_status(), t + 0.01);
     if (trace && i % 2 == 0) WriteTrace(*trace, *ode->walk_status(), t + 0.01);
   }
@@ -234,5 +261,9 @@ int main(int argc, char** argv) {
       "(%.1f per CPU second of this process)\n",
       successes, args.goals, falls, sum_d / args.goals, worst_d, worst_th, walked / walk_time,
       walk_time / wall_total, walk_time / (static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC));
+  std::printf("centre of pressure from the plan's ZMP while stepping: %s\n",
+              Percentiles(cop_errors.to_plan).c_str());
+  std::printf("centre of pressure from the stabilizer's ZMP command while stepping: %s\n",
+              Percentiles(cop_errors.to_command).c_str());
   return successes == args.goals && falls == 0 ? 0 : 1;
 }

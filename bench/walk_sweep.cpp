@@ -8,13 +8,21 @@
 // models/simple_humanoid.urdf on the ode driver (walk=true) at 1 kHz.
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
 //                       [--after S] [--option key=value]...
-//   robotalk-walk-sweep --push standing|walking [--seed S]: per direction (8,
-//     every 45 degrees, 0 = a push forward, counter-clockwise) the largest impulse on the
-//     pelvis survived (a 0.1 s push through OdeDriver::PushForTesting, found by
-//     bisection to 1.25 N s); walking at the gait's full forward speed, the
-//     push lands at a seeded instant of the gait cycle.
-//   robotalk-walk-sweep --arms 1: both shoulders swung together +-1 rad every
-//     0.5 s for 6 s, standing and walking: fell or not.
+//   robotalk-walk-sweep --push standing|walking|all [--stabilizer on|off|both]
+//     [--resolution N_S] [--seed S]: per direction (8, every 45 degrees, 0 = a
+//     push forward, counter-clockwise) the largest impulse on the pelvis
+//     survived (a 0.1 s push through OdeDriver::PushForTesting, found by
+//     bisection in [0, 80] N s to --resolution, default 2.5), standing and/or
+//     walking at the gait's full forward speed (the push lands at a seeded
+//     instant of the gait cycle, the same per direction for every column),
+//     with and/or without the balance feedback (option stabilizer), in one
+//     table, then the arm swing below for the same stabilizer settings.
+//   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
+//     after the start of the walk, default 5.5; standing 2); survived or not; --trace
+//     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them).
+//   robotalk-walk-sweep --rtf S [--stabilizer ...]: CPU per physics step walking S s.
+//   robotalk-walk-sweep --arms 1 [--stabilizer ...]: both shoulders swung
+//     together +-1 rad every 0.5 s for 6 s, standing and walking: fell or not.
 // Transitions (t = the swept instant, s after the first command):
 //   stop_goto        GOTO 1 m; STOP at t; GOTO 1 m at t + 0.1 s
 //   stop_wait_goto   GOTO 1 m; STOP at t; GOTO 1 m at t + 1.2 s
@@ -45,7 +53,12 @@ struct Args {
   std::string transition = "all";
   double from = 1.0, span = 2.0, after = 4.0;
   int every_ms = 20;
-  std::string push;   // --push standing|walking: the largest impulse survived per direction instead
+  std::string push;   // --push standing|walking|all: the largest impulse survived per direction instead
+  std::string probe;  // --probe standing|walking,DEG,N_S: one push
+  std::string trace;  // --trace FILE: the probe's walk status every 10 ms as CSV (tools: plot_walk_push.py)
+  std::string stabilizer = "both";  // --stabilizer on|off|both (the push table and the arm swing)
+  double resolution = 2.5;          // N s, of the push bisection
+  double rtf = 0;     // --rtf S: S simulated seconds of walking per stabilizer setting, CPU per physics step
   bool arms = false;  // --arms 1: both arms swung together +-1 rad every 0.5 s, standing and walking
   unsigned seed = 1;
   std::map<std::string, std::string> options = {{"walk", "true"}};
@@ -65,6 +78,16 @@ Args Parse(int argc, char** argv) {
       a.every_ms = std::atoi(v.c_str());
     } else if (k == "--push") {
       a.push = v;
+    } else if (k == "--probe") {
+      a.probe = v;
+    } else if (k == "--trace") {
+      a.trace = v;
+    } else if (k == "--stabilizer") {
+      a.stabilizer = v;
+    } else if (k == "--resolution") {
+      a.resolution = std::atof(v.c_str());
+    } else if (k == "--rtf") {
+      a.rtf = std::atof(v.c_str());
     } else if (k == "--arms") {
       a.arms = v == "1";
     } else if (k == "--seed") {
@@ -79,8 +102,12 @@ Args Parse(int argc, char** argv) {
       std::exit(2);
     }
   }
-  if (a.every_ms <= 0 || a.span < 0 || a.after <= 0) {
-    std::fprintf(stderr, "--every must be > 0 ms, --span >= 0, --after > 0\n");
+  if (a.every_ms <= 0 || a.span < 0 || a.after <= 0 || !(a.resolution > 0)) {
+    std::fprintf(stderr, "--every must be > 0 ms, --span >= 0, --after > 0, --resolution > 0\n");
+    std::exit(2);
+  }
+  if (a.stabilizer != "on" && a.stabilizer != "off" && a.stabilizer != "both") {
+    std::fprintf(stderr, "--stabilizer on, off or both, not '%s'\n", a.stabilizer.c_str());
     std::exit(2);
   }
   return a;
@@ -92,6 +119,7 @@ struct Run {
   std::vector<Completion> done;
   CommandId id = 0;
   double max_tilt = 0;
+  std::FILE* trace = nullptr;  // --trace: one CSV row per 10 ms
   void Exec(CommandType type, std::vector<double> values) {
     DriverCommand c;
     c.id = ++id;
@@ -112,6 +140,17 @@ struct Run {
     d->Execute(c, ode->sim_time(), done);
   }
   void Stop() { d->Stop(ode->sim_time(), done); }
+  void Trace(const walking::WalkStatus& s) {
+    std::fprintf(trace, "%.3f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%d,%.4f",
+                 ToSeconds(ode->sim_time().time_since_epoch()), s.com.x(), s.com.y(), s.com_plan.x(),
+                 s.com_plan.y(), s.dcm.x(), s.dcm.y(), s.dcm_ref.x(), s.dcm_ref.y(), s.zmp.x(), s.zmp.y(),
+                 s.zmp_ref.x(), s.zmp_ref.y(), s.zmp_command.x(), s.zmp_command.y(), s.saturated ? 1 : 0,
+                 s.tilt);
+    for (int i = 0; i < 2; ++i)
+      std::fprintf(trace, ",%.5f,%.5f,%.5f,%.5f,%.2f", s.foot[i].x, s.foot[i].y, s.foot[i].theta,
+                   s.foot_height[i], s.foot_force[i]);
+    std::fprintf(trace, ",%.5f,%.5f\n", s.com_offset.x(), s.com_offset.y());
+  }
   void Panic() {
     d->Halt(done);
     d->Resume();
@@ -122,6 +161,7 @@ struct Run {
       ode->Step(10, done);
       const walking::WalkStatus s = *ode->walk_status();
       max_tilt = std::max(max_tilt, s.tilt);
+      if (trace) Trace(s);
       if (s.fallen) return false;
     }
     return true;
@@ -196,9 +236,10 @@ std::unique_ptr<Driver> NewDriver(const Args& args) {
 }
 
 // Survives an impulse of `j` N s toward `angle` (rad from ahead), pushed at `at` s?
-bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at) {
+bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at,
+                  std::FILE* trace = nullptr) {
   std::unique_ptr<Driver> d = NewDriver(args);
-  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get(), .trace = trace};
   r.ode->Step(1000, r.done);
   const TimePoint t0 = r.ode->sim_time();
   if (walking) r.Speed(1.0);  // clamped to the gait's full speed
@@ -209,47 +250,153 @@ bool SurvivesPush(const Args& args, bool walking, double angle, double j, double
   return r.Until(t0, at + args.after);
 }
 
+// The stabilizer settings asked for (--stabilizer), as driver options.
+std::vector<Args> Settings(const Args& args) {
+  std::vector<Args> out;
+  for (const char* on : {"off", "on"}) {
+    if (args.stabilizer != "both" && args.stabilizer != on) continue;
+    Args a = args;
+    a.options["stabilizer"] = std::string(on) == "on" ? "true" : "false";
+    out.push_back(a);
+  }
+  return out;
+}
+
+// The largest impulse survived to `resolution` in [0, kMaxPush] (a coarse bisection).
+double Largest(const Args& args, bool walking, double angle, double at) {
+  constexpr double kMaxPush = 80;
+  if (SurvivesPush(args, walking, angle, kMaxPush, at)) return kMaxPush;
+  double lo = 0, hi = kMaxPush;
+  while (hi - lo > args.resolution) {
+    const double mid = 0.5 * (lo + hi);
+    (SurvivesPush(args, walking, angle, mid, at) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+int ArmSwing(const Args& args);
+
 int Pushes(const Args& args) {
-  const bool walking = args.push == "walking";
-  if (!walking && args.push != "standing") {
-    std::fprintf(stderr, "--push standing or --push walking\n");
+  if (args.push != "standing" && args.push != "walking" && args.push != "all") {
+    std::fprintf(stderr, "--push standing, walking or all\n");
     return 2;
   }
+  std::vector<std::pair<bool, const Args*>> columns;  // (walking, settings)
+  const std::vector<Args> settings = Settings(args);
+  std::printf("largest impulse survived (N s, 0.1 s push on the pelvis, bisection to %.2f N s)\n",
+              args.resolution);
+  std::printf("direction_deg");
+  for (bool walking : {false, true}) {
+    if (args.push != "all" && (args.push == "walking") != walking) continue;
+    for (const Args& a : settings) {
+      columns.emplace_back(walking, &a);
+      std::printf("  %s_stab_%s", walking ? "walking" : "standing",
+                  a.options.at("stabilizer") == "true" ? "on" : "off");
+    }
+  }
+  std::printf("  push_at_s\n");
   std::mt19937 rng(args.seed);
   std::uniform_real_distribution<double> phase(0, 1.1);  // one gait period
-  std::printf("push %s: direction_deg  survived_N_s  fell_at_N_s  push_at_s\n", args.push.c_str());
+  std::vector<double> worst(columns.size(), 1e9);
   for (int k = 0; k < 8; ++k) {
     const double angle = k * std::numbers::pi / 4;
-    const double at = walking ? 5.0 + phase(rng) : 2.0;
-    double lo = 0, hi = 80;
-    if (SurvivesPush(args, walking, angle, hi, at)) lo = hi;
-    while (hi - lo > 1.25 && lo < hi) {
-      const double mid = 0.5 * (lo + hi);
-      (SurvivesPush(args, walking, angle, mid, at) ? lo : hi) = mid;
+    const double walk_at = 5.0 + phase(rng);
+    std::printf("%13d", k * 45);
+    for (size_t c = 0; c < columns.size(); ++c) {
+      const double j = Largest(*columns[c].second, columns[c].first, angle, columns[c].first ? walk_at : 2.0);
+      worst[c] = std::min(worst[c], j);
+      std::printf("  %*.2f", 16, j);
+      std::fflush(stdout);
     }
-    std::printf("%20d  %12.2f  %11.2f  %9.2f\n", k * 45, lo, hi, at);
-    std::fflush(stdout);
+    std::printf("  %9.2f\n", walk_at);
+  }
+  std::printf("%13s", "min");
+  for (double w : worst) std::printf("  %*.2f", 16, w);
+  std::printf("\n\n");
+  return ArmSwing(args);
+}
+
+// --probe standing|walking,DEG,N_S
+int Probe(const Args& args) {
+  const size_t a = args.probe.find(','), b = args.probe.rfind(',');
+  if (a == std::string::npos || a == b) {
+    std::fprintf(stderr, "--probe standing|walking,DEG,N_S\n");
+    return 2;
+  }
+  const bool walking = args.probe.substr(0, a) == "walking";
+  const double deg = std::atof(args.probe.substr(a + 1, args.probe.find(',', a + 1) - a - 1).c_str());
+  const std::string rest = args.probe.substr(b + 1);
+  // N_S or DEG,N_S,AT: then b pointed at AT's comma.
+  double j = std::atof(rest.c_str()), at = walking ? 5.5 : 2.0;
+  const size_t c = args.probe.find(',', a + 1);
+  if (c != b) {
+    j = std::atof(args.probe.substr(c + 1, b - c - 1).c_str());
+    at = std::atof(rest.c_str());
+  }
+  for (const Args& s : Settings(args)) {
+    std::FILE* trace = nullptr;
+    if (!args.trace.empty()) {
+      const std::string name = args.trace + (s.options.at("stabilizer") == "true" ? ".on.csv" : ".off.csv");
+      trace = std::fopen(name.c_str(), "w");
+      if (!trace) {
+        std::fprintf(stderr, "cannot write %s\n", name.c_str());
+        return 1;
+      }
+      std::fprintf(
+          trace,
+          "t,com_x,com_y,com_plan_x,com_plan_y,dcm_x,dcm_y,dcm_ref_x,dcm_ref_y,cop_x,cop_y,zmp_ref_x,"
+          "zmp_ref_y,zmp_cmd_x,zmp_cmd_y,saturated,tilt,lfoot_x,lfoot_y,lfoot_th,lfoot_h,lfoot_f,"
+          "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y\n");
+    }
+    const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
+    if (trace) std::fclose(trace);
+    std::printf("%s %.0f deg %.2f N s at %.2f s, stabilizer %s: %s\n", walking ? "walking" : "standing", deg,
+                j, at, s.options.at("stabilizer").c_str(), ok ? "survived" : "FELL");
+  }
+  return 0;
+}
+
+// --rtf S: the cost of the walking controller: S s walking at full speed
+// (after the 1 s stance), CPU time of this process per 1 ms physics step, with
+// and without the stabilizer (the same physics and pattern).
+int Rtf(const Args& args) {
+  for (const Args& s : Settings(args)) {
+    std::unique_ptr<Driver> d = NewDriver(s);
+    Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+    r.ode->Step(1000, r.done);
+    r.Speed(1.0);
+    const std::clock_t cpu0 = std::clock();
+    const int steps = static_cast<int>(args.rtf * 1000);
+    r.ode->Step(steps, r.done);
+    const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    std::printf(
+        "walking %.0f s, stabilizer %s: %.1f us CPU per 1 ms step, real-time factor %.2f per CPU second%s\n",
+        args.rtf, s.options.at("stabilizer") == "true" ? "on" : "off", cpu / steps * 1e6, args.rtf / cpu,
+        r.ode->walk_status()->fallen ? " (FELL)" : "");
   }
   return 0;
 }
 
 int ArmSwing(const Args& args) {
-  for (bool walking : {false, true}) {
-    std::unique_ptr<Driver> d = NewDriver(args);
-    Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
-    r.ode->Step(1000, r.done);
-    const TimePoint t0 = r.ode->sim_time();
-    if (walking) r.Speed(1.0);
-    bool ok = r.Until(t0, 2.0);
-    for (int i = 0; ok && i < 12; ++i) {
-      const double q = i % 2 == 0 ? 1.0 : -1.0;
-      r.Joint("left_shoulder_pitch", q);
-      r.Joint("right_shoulder_pitch", q);
-      ok = r.Until(t0, 2.5 + 0.5 * i);
+  for (const Args& s : Settings(args)) {
+    for (bool walking : {false, true}) {
+      std::unique_ptr<Driver> d = NewDriver(s);
+      Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+      r.ode->Step(1000, r.done);
+      const TimePoint t0 = r.ode->sim_time();
+      if (walking) r.Speed(1.0);
+      bool ok = r.Until(t0, 2.0);
+      for (int i = 0; ok && i < 12; ++i) {
+        const double q = i % 2 == 0 ? 1.0 : -1.0;
+        r.Joint("left_shoulder_pitch", q);
+        r.Joint("right_shoulder_pitch", q);
+        ok = r.Until(t0, 2.5 + 0.5 * i);
+      }
+      ok = ok && r.Until(t0, 9.0);
+      std::printf("arms swung +-1 rad every 0.5 s, %s, stabilizer %s: %s (worst tilt %.3f rad)\n",
+                  walking ? "walking" : "standing", s.options.at("stabilizer") == "true" ? "on" : "off",
+                  ok ? "stood" : "FELL", r.max_tilt);
     }
-    ok = ok && r.Until(t0, 9.0);
-    std::printf("arms swung +-1 rad every 0.5 s, %s: %s (worst tilt %.3f rad)\n",
-                walking ? "walking" : "standing", ok ? "stood" : "FELL", r.max_tilt);
   }
   return 0;
 }
@@ -258,6 +405,8 @@ int ArmSwing(const Args& args) {
 
 int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
+  if (!args.probe.empty()) return Probe(args);
+  if (args.rtf > 0) return Rtf(args);
   if (!args.push.empty()) return Pushes(args);
   if (args.arms) return ArmSwing(args);
   if (args.transition != "all" && !Transitions().count(args.transition)) {

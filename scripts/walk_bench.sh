@@ -10,8 +10,10 @@
 # Environment: ROBOTALK_BUILD_DIR (default build), WALK_PLOT (default
 # docs/figures/walk_topview.png); WALK_SWEEP=1 also runs robotalk-walk-sweep:
 # the phase sweep of every transition (WALK_SWEEP_EVERY ms, default 20),
-# the push survival standing and walking, and the arm swing (issue 26; an
-# hour or more of CPU at 20 ms). Exit status 0 only for N/N successes, no
+# the push survival standing and walking with and without the stabilizer
+# (WALK_PUSH_RESOLUTION N·s, default 5), the arm swing, and the CPU per
+# physics step with and without the stabilizer (issue 26; an hour or more of
+# CPU at 20 ms). Exit status 0 only for N/N successes, no
 # fall (and, with WALK_SWEEP=1, no fall in the sweep).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,8 +34,9 @@ else
 fi
 if [ "${WALK_SWEEP:-0}" = 1 ]; then
   "$BUILD_DIR/bench/robotalk-walk-sweep" --every "${WALK_SWEEP_EVERY:-20}" --after 3 || status=$?
-  "$BUILD_DIR/bench/robotalk-walk-sweep" --push standing --after 4
-  "$BUILD_DIR/bench/robotalk-walk-sweep" --push walking --after 4
-  "$BUILD_DIR/bench/robotalk-walk-sweep" --arms 1
+  # Pushes in 8 directions, standing and walking, with and without the
+  # stabilizer, then the arm swing (both settings): one table.
+  "$BUILD_DIR/bench/robotalk-walk-sweep" --push all --after 8 --resolution "${WALK_PUSH_RESOLUTION:-5}"
+  "$BUILD_DIR/bench/robotalk-walk-sweep" --rtf 10
 fi
 exit $status

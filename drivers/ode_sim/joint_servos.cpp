@@ -13,6 +13,9 @@ JointServos::JointServos(const RobotModel& model, const OdeDriverOptions& option
       table_.velocity.unaryExpr([&](double v) { return std::isfinite(v) ? v : options.default_velocity; });
   fmax_ = table_.effort.unaryExpr([&](double f) { return std::isfinite(f) ? f : options.default_effort; });
   mode_.assign(static_cast<std::size_t>(n), Mode::kPosition);
+  settled_.assign(static_cast<std::size_t>(n), 0);
+  away_.assign(static_cast<std::size_t>(n), 0);
+  bounce_steps_ = std::max(1, static_cast<int>(std::lround(kBounce / step_)));
   for (int i = 0; i < n; ++i) {
     if (table_.is_mimic(i)) {
       mode_[static_cast<std::size_t>(i)] = Mode::kMimic;
@@ -31,6 +34,7 @@ JointServos::JointServos(const RobotModel& model, const OdeDriverOptions& option
 
 void JointServos::Reference(Eigen::Index i, double p, double v, double a) {
   mode_[static_cast<std::size_t>(i)] = Mode::kReference;
+  settled_[static_cast<std::size_t>(i)] = 0;
   target_[i] = p;
   speed_[i] = v;
   ref_accel_[i] = a;
@@ -40,6 +44,7 @@ void JointServos::Reference(Eigen::Index i, double p, double v, double a) {
 
 void JointServos::SetPoint(Eigen::Index i, double q) {
   mode_[static_cast<std::size_t>(i)] = Mode::kPosition;
+  settled_[static_cast<std::size_t>(i)] = 0;
   target_[i] = q;
   speed_[i] = 0;
   force_[i] = 0;
@@ -47,6 +52,7 @@ void JointServos::SetPoint(Eigen::Index i, double q) {
 
 void JointServos::Speed(Eigen::Index i, double v) {
   mode_[static_cast<std::size_t>(i)] = Mode::kVelocity;
+  settled_[static_cast<std::size_t>(i)] = 0;
   speed_[i] = v;
 }
 
@@ -59,6 +65,7 @@ void JointServos::Hold(Eigen::Index i, OdeWorld& world) {
   const Mode m = mode_[static_cast<std::size_t>(i)];
   if (m == Mode::kMimic || m == Mode::kPassive || m == Mode::kBase) return;
   mode_[static_cast<std::size_t>(i)] = Mode::kVelocity;
+  settled_[static_cast<std::size_t>(i)] = 0;
   target_[i] = std::clamp(world.q()[i], table_.lower[i], table_.upper[i]);
   speed_[i] = 0;
   force_[i] = 0;
@@ -74,6 +81,20 @@ void JointServos::Apply(OdeWorld& world) {
         ((q[i] >= table_.upper[i] && speed_[i] > 0) || (q[i] <= table_.lower[i] && speed_[i] < 0))) {
       SetPoint(i, std::clamp(q[i], table_.lower[i],
                              table_.upper[i]));  // a speed command stops and holds at a limit
+    }
+    // A set-point is reached within kTargetReached (a joint on its stop
+    // bounces faster than kMovingSpeed); a hold when the joint is at rest.
+    if (!settled_[u] && mode_[u] == Mode::kPosition && std::abs(target_[i] - q[i]) <= kTargetReached)
+      settled_[u] = 1;
+    // A settled dof off its target: counted, so that a bounce (a step or two) is not a move.
+    away_[u] = settled_[u] && std::abs(target_[i] - q[i]) > kTargetReached
+                   ? static_cast<std::uint16_t>(std::min<int>(away_[u] + 1, 60000))
+                   : std::uint16_t{0};
+    if (!settled_[u] && std::abs(qd[i]) <= kMovingSpeed) {
+      if (mode_[u] == Mode::kVelocity && speed_[i] == 0) {
+        target_[i] = std::clamp(q[i], table_.lower[i], table_.upper[i]);  // where it came to rest
+        settled_[u] = 1;
+      }
     }
     switch (mode_[u]) {
       case Mode::kPosition:
@@ -120,10 +141,10 @@ bool JointServos::Moving(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) co
   for (Eigen::Index i = 0; i < q.size(); ++i) {
     switch (mode_[static_cast<std::size_t>(i)]) {
       case Mode::kPosition:
-        if (std::abs(target_[i] - q[i]) > kTargetReached || std::abs(qd[i]) > kMovingSpeed) return true;
+        if (!settled_[static_cast<std::size_t>(i)] || Away(i)) return true;
         break;
       case Mode::kVelocity:
-        if (speed_[i] != 0 || std::abs(qd[i]) > kMovingSpeed) return true;
+        if (speed_[i] != 0 || !settled_[static_cast<std::size_t>(i)] || Away(i)) return true;
         break;
       case Mode::kReference:
         if (speed_[i] != 0 || std::abs(target_[i] - q[i]) > kTargetReached || std::abs(qd[i]) > kMovingSpeed)

@@ -22,6 +22,9 @@ namespace robotalk::ode_detail {
 inline constexpr double kMovingSpeed =
     1e-3;  ///< rad/s or m/s: below this a dof (or the base) counts as still
 inline constexpr double kTargetReached = 2e-3;  ///< rad or m: a set-point counts as reached
+/// s: a dof that reached its set-point moves again when it stays off it this
+/// long (a joint against its stop bounces off it for a step or two).
+inline constexpr double kBounce = 0.02;
 
 class JointServos {
  public:
@@ -62,7 +65,12 @@ class JointServos {
 
   /// One physics step: every dof's motor or effort from its mode.
   void Apply(OdeWorld& world);
-  /// Whether a servoed dof moves or has not reached its set-point.
+  /// Whether a servo has a live target: a set-point not reached yet (within
+  /// kTargetReached), a hold not yet at rest (slower than kMovingSpeed), a
+  /// speed, a force or a trajectory reference. A settled dof moves again only
+  /// when a new command comes or it stays kTargetReached off its target for
+  /// kBounce: a joint held against its stop bounces off it now and then
+  /// (contact bounce, up to 2 rad/s for a step) and is not moving.
   bool Moving(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;
 
  private:
@@ -74,6 +82,10 @@ class JointServos {
   double horizon_;  // s, how far a reference is advanced (one control period)
   Eigen::VectorXd q0_, vmax_, fmax_;
   std::vector<Mode> mode_;
+  std::vector<std::uint8_t> settled_;  // kPosition, or kVelocity at speed 0: reached and came to rest
+  std::vector<std::uint16_t> away_;    // settled, physics steps in a row off the target
+  int bounce_steps_ = 1;               // kBounce in physics steps
+  bool Away(Eigen::Index i) const { return away_[static_cast<std::size_t>(i)] >= bounce_steps_; }
   Eigen::VectorXd target_, speed_, force_;
   Eigen::VectorXd ref_accel_, ref_age_;  // kReference: target_ = p, speed_ = v at age 0
 };

@@ -127,8 +127,11 @@ void OdeDriver::Impl::ReadState(RobotState& state) const {
     const int root = model_.roots().front().link;
     state.base_vy = world_->LinkLinearVelocity(root).dot(world_->LinkPose(root).linear().col(1));
   }
-  state.moving = base_->moving() || std::abs(t.v) > ode_detail::kMovingSpeed ||
-                 std::abs(t.omega) > ode_detail::kMovingSpeed || servos_.Moving(world_->q(), world_->qd());
+  // A walker's pelvis sways while it balances: its base moves when it walks
+  // (WalkingHumanoid::moving()); the other bases also when their root does.
+  const bool root_moves = !base_->walk_status() && (std::abs(t.v) > ode_detail::kMovingSpeed ||
+                                                    std::abs(t.omega) > ode_detail::kMovingSpeed);
+  state.moving = base_->moving() || root_moves || servos_.Moving(world_->q(), world_->qd());
 }
 
 // ---------------------------------------------------------------- OdeDriver

@@ -65,6 +65,8 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
   }
   r.Bool("merge_chains", &o.merge_chains);
   r.Bool("walk", &o.walk);
+  r.Bool("stabilizer", &o.stabilizer);
+  r.Bool("step_adjustment", &o.step_adjustment);
   r.Number("max_catchup_ms", &o.max_catchup_ms, kPositive, "a number of milliseconds > 0");
   r.Number("virtual_mass", &o.virtual_mass, kPositive, "a mass > 0 (kg)");
   if (r.Text("gait_joints", &o.gait_joints) && SplitPlus(o.gait_joints).size() != 4) {

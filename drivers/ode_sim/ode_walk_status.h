@@ -49,6 +49,12 @@ struct WalkStatus {
   Eigen::Vector2d zmp =
       Eigen::Vector2d::Zero();  ///< centre of pressure of the ground forces (plan frame mapped to the world)
   double tracking_error = 0;    ///< largest |q_ref - q| over the leg joints, rad
+  // Balance feedback (zero with stabilizer=false or during the start-up):
+  Eigen::Vector2d dcm = Eigen::Vector2d::Zero();          ///< measured DCM c + c'/w, m
+  Eigen::Vector2d dcm_ref = Eigen::Vector2d::Zero();      ///< planned DCM, m
+  Eigen::Vector2d zmp_command = Eigen::Vector2d::Zero();  ///< the stabilizer's ZMP, inside the support, m
+  Eigen::Vector2d com_offset = Eigen::Vector2d::Zero();   ///< CoM reference minus the plan's (world axes), m
+  bool saturated = false;  ///< the ZMP the stabilizer wanted lay outside the support
 };
 
 }  // namespace robotalk::walking

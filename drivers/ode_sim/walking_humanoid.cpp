@@ -127,6 +127,10 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
+  w->stabilize_ = options.stabilizer;
+  w->adjust_steps_ = options.stabilizer && options.step_adjustment;
+  w->dcm_.emplace(w->g_.com_height, gravity);
+  w->com_offset_.emplace(w->dcm_->omega());
   return w;
 }
 
@@ -199,7 +203,8 @@ void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
   const Pose2& l = pattern_.foot(Side::kLeft);
   const Pose2& r = pattern_.foot(Side::kRight);
   const double yaw = Wrap(r.theta + 0.5 * Wrap(l.theta - r.theta));
-  const Eigen::Vector2d com = pattern_.com();
+  const Eigen::Vector2d com =
+      pattern_.com() + (com_offset_ ? com_offset_->offset() : Eigen::Vector2d::Zero());
   Pose2 p{0, 0, yaw};
   const Eigen::Vector2d off = p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y());
   p.x = com.x() - off.x();
@@ -254,12 +259,7 @@ void WalkingHumanoid::StopOnly(const StopScope& scope, std::vector<Completion>& 
 }
 
 bool WalkingHumanoid::moving() const {
-  if (!pattern_.standing()) return true;
-  const Eigen::VectorXd& qd = world_->qd();
-  for (Eigen::Index i = 0; i < qd.size(); ++i) {
-    if (Owns(i) && std::abs(qd[i]) > kMovingSpeed) return true;
-  }
-  return false;
+  return !fallen_ && (!pattern_.standing() || tick_ < settle_ticks_ + ramp_ticks_);
 }
 
 DriverResult WalkingHumanoid::Goto(const DriverCommand& c) {
@@ -395,6 +395,8 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   MeasureContacts();
   if (mode_ == Mode::kSpeed) KeepSpeedStepsQueued();
   pattern_.Tick();
+  Balance();
+  AdjustStep();
   Eigen::Isometry3d pelvis;
   std::array<Eigen::Isometry3d, 2> soles;
   DesiredPelvis(&pelvis, &soles);
@@ -436,7 +438,54 @@ void WalkingHumanoid::MeasureContacts() {
     fz += c.force.z();
     moment += c.force.z() * c.position;
   }
-  if (fz > 1e-6) zmp_measured_ = moment.head<2>() / fz;
+  zmp_valid_ = fz > 1e-6;
+  if (zmp_valid_) zmp_measured_ = moment.head<2>() / fz;
+}
+
+// The measured CoM (the model's kinematics at the measured joints and root)
+// and its velocity (differenced, low-passed over kComFilter), the measured
+// CoP, into the plan frame; the stabilizer's ZMP command becomes the CoM
+// reference's offset (walking/dcm_stabilizer.h). Off during the start-up.
+void WalkingHumanoid::Balance() {
+  constexpr double kComFilter = 0.01;  // s
+  const Eigen::Vector3d com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
+  const Eigen::Vector2d xy = com.head<2>();
+  if (tick_ <= 1) com_world_prev_ = xy;
+  com_velocity_ += ((xy - com_world_prev_) / step_ - com_velocity_) * std::min(1.0, step_ / kComFilter);
+  com_world_prev_ = xy;
+  if (!stabilize_ || tick_ < settle_ticks_) return;
+  const double c = std::cos(plan_to_world_.theta), s = std::sin(plan_to_world_.theta);
+  const Eigen::Vector2d v(c * com_velocity_.x() + s * com_velocity_.y(),
+                          -s * com_velocity_.x() + c * com_velocity_.y());
+  const Eigen::Vector2d at = ToPlan({xy.x(), xy.y(), 0}).xy();
+  const Eigen::Vector2d cop = ToPlan({zmp_measured_.x(), zmp_measured_.y(), 0}).xy();
+  std::array<Eigen::Vector2d, 16> support;
+  const int n = pattern_.SupportPolygon(support);
+  balance_ = dcm_->Update(at, v, pattern_.com(), pattern_.com_velocity(), pattern_.zmp_ref(),
+                          std::span(support.data(), static_cast<size_t>(n)), pattern_.time_to_landing());
+  com_offset_->Update(balance_, at, pattern_.com(), pattern_.zmp_ref(), zmp_valid_ ? &cop : nullptr, step_);
+}
+
+// Step adjustment: while the ankles cannot hold the DCM (the stabilizer's
+// ZMP saturated) the foot in the air is moved toward where the DCM will be
+// at its touch-down, at most kAdjustRate fast (its swing stays smooth) and
+// not in the last kLateAdjust s of its swing; the last target is kept.
+void WalkingHumanoid::AdjustStep() {
+  constexpr double kAdjustRate = 1.0;   // m/s
+  constexpr double kLateAdjust = 0.15;  // s
+  if (!adjust_steps_ || tick_ < settle_ticks_) return;
+  if (pattern_.started_steps() != adjusted_step_) {
+    adjusted_step_ = pattern_.started_steps();
+    step_target_.setZero();
+    step_applied_.setZero();
+  }
+  if (pattern_.time_to_landing() <= kLateAdjust) return;
+  if (balance_.saturated && balance_.step_offset.norm() > 0) step_target_ = balance_.step_offset;
+  const double r = kAdjustRate * step_;
+  const Eigen::Vector2d next = step_applied_ + (step_target_ - step_applied_).cwiseMax(-r).cwiseMin(r);
+  if ((next - step_applied_).norm() > 1e-12) {
+    step_applied_ = pattern_.AdjustLanding(next, g_.foot_separation + 2 * g_.step_forward + 0.05);
+  }
 }
 
 walking::WalkStatus WalkingHumanoid::status() const {
@@ -466,6 +515,14 @@ walking::WalkStatus WalkingHumanoid::status() const {
     s.foot_tilt[i] = std::acos(std::clamp(f.linear()(2, 2), -1.0, 1.0));
   }
   s.com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
+  if (stabilize_ && tick_ >= settle_ticks_) {
+    s.dcm = ToWorld({balance_.dcm.x(), balance_.dcm.y(), 0}).xy();
+    s.dcm_ref = ToWorld({balance_.dcm_ref.x(), balance_.dcm_ref.y(), 0}).xy();
+    s.zmp_command = ToWorld({balance_.zmp.x(), balance_.zmp.y(), 0}).xy();
+    s.com_offset =
+        Pose2{0, 0, plan_to_world_.theta}.Apply(com_offset_->offset().x(), com_offset_->offset().y());
+    s.saturated = balance_.saturated;
+  }
   return s;
 }
 

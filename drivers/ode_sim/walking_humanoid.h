@@ -2,8 +2,12 @@
 // (docs/ode_sim.md, "Walking"): GOTO, SETSPEED, STOP and panic as steps of
 // a ZMP-preview walking pattern (walking/walk_pattern.h), whole-leg joint
 // targets from InverseKinematics (walking/leg_ik.h) tracked by the ODE
-// hinge motors at every physics step, and fall detection. The root is a
-// free ODE body: the robot stands on its contacts and can fall.
+// hinge motors at every physics step, optional balance feedback (walking/
+// dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
+// reference and the swing foot's landing; options stabilizer,
+// step_adjustment), and fall
+// detection. The root is a free ODE body: the robot stands on its contacts
+// and can fall.
 //
 // Frames: the pattern lives in its own planar frame; each plan maps a goal
 // from the world into it with the support foot's pose measured at planning
@@ -24,6 +28,7 @@
 #include "ode_walk_status.h"
 #include "ode_world.h"
 #include "robotalk/driver.h"
+#include "walking/dcm_stabilizer.h"
 #include "walking/leg_ik.h"
 #include "walking/walk_pattern.h"
 
@@ -88,11 +93,14 @@ class WalkingHumanoid final : public BaseController {
   /// The walk stops with the base, or when a leg it drives is in the scope
   /// (stopping more than asked is safe).
   void StopOnly(const StopScope& scope, std::vector<Completion>& completed) override;
-  /// One physics step's control: the pattern, IK, motors, fall check, GOTO completion.
+  /// One physics step's control: the pattern, balance feedback, IK, motors,
+  /// fall check, GOTO completion.
   void Control(std::vector<Completion>& completed) override;
 
   Twist2 twist() const override { return RootTwist(*world_, model_); }
-  /// Stepping, or a leg still moving (settling at start-up, after a stop).
+  /// A walk in progress: stepping (the steps and the last shift of weight
+  /// of a STOP included), or the start-up's settling into the stance. Not
+  /// the legs' balancing sway nor the soles' contact bounce while standing.
   bool moving() const override;
   /// The fall in words, "" before one: "the robot has fallen (torso tilt 0.71 rad)".
   std::string_view fault() const override { return fall_; }
@@ -140,6 +148,19 @@ class WalkingHumanoid final : public BaseController {
   std::string fall_;  // written once, when the fall is detected
   double tilt_ = 0;
   void MeasureContacts();
+  void Balance();
+  // Balance feedback (options.stabilizer): the DCM stabilizer's ZMP command
+  // as an offset of the planned CoM (plan frame), from the measured CoM.
+  bool stabilize_ = true;
+  bool adjust_steps_ = false;  // options.step_adjustment
+  std::optional<walking::DcmStabilizer> dcm_;
+  std::optional<walking::ComOffset> com_offset_;
+  walking::DcmStabilizer::Output balance_;
+  Eigen::Vector2d com_world_prev_ = Eigen::Vector2d::Zero(), com_velocity_ = Eigen::Vector2d::Zero();
+  bool zmp_valid_ = false;
+  void AdjustStep();
+  int adjusted_step_ = -1;  // started_steps() of the step AdjustStep() moves
+  Eigen::Vector2d step_target_ = Eigen::Vector2d::Zero(), step_applied_ = Eigen::Vector2d::Zero();
   double foot_force_[2] = {0, 0};
   int foot_contacts_[2] = {0, 0};
   Eigen::Vector2d zmp_measured_ = Eigen::Vector2d::Zero();  // world

@@ -345,6 +345,43 @@ std::vector<Eigen::Vector2d> Rect(double x0, double x1, double y0, double y1) {
   return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};  // counter-clockwise
 }
 
+// Step adjustment (balance): the foot in the air lands where it is moved,
+// forward or outward but never inward of its plan, within reach; the ZMP
+// reference stays continuous, inside the support, and moves with the landed foot.
+TEST(WalkPattern, AdjustLandingMovesTheFootInTheAirAndTheReferenceWithIt) {
+  Sweep s;
+  s.Goto({1.5, 0, 0});
+  while (s.w.time_to_landing() == 0 || s.w.started_steps() < 2) s.Run(0.001);
+  s.Run(0.1);  // early in the second step's swing
+  EXPECT_TRUE(s.w.AdjustLanding({0, 0}, 0.5).isZero()) << "no offset, no change";
+  const Side swing = Other(s.w.support_side());
+  const Pose2 stance = s.w.foot(s.w.support_side());
+  // Inward (toward the stance foot) is refused; forward is taken.
+  const Eigen::Vector2d inward(0.06, -SideSign(swing) * 0.05);
+  const Eigen::Vector2d applied = s.w.AdjustLanding(inward, 0.5);
+  EXPECT_NEAR(applied.x(), 0.06, 1e-9);
+  EXPECT_NEAR(applied.y(), 0, 1e-9) << "never nearer to the stance foot than planned";
+  const Eigen::Vector2d far = s.w.AdjustLanding({0.4, 0}, 0.25);
+  s.Run(s.w.time_to_landing() + 0.001);
+  const Pose2 landed = s.w.foot(swing);
+  EXPECT_NEAR(std::hypot(landed.x - stance.x, landed.y - stance.y), 0.25, 1e-6) << "within reach";
+  EXPECT_GT(far.x(), 0.06);
+  EXPECT_LT(s.worst_jump, 2e-3) << "the reference moves on continuously";
+  s.Run(0.5);
+  const Eigen::Vector2d landed_zmp = landed.Apply(s.g.zmp_x, 0);
+  EXPECT_LT((s.w.zmp_ref() - landed_zmp).norm(), (s.w.zmp_ref() - stance.Apply(s.g.zmp_x, 0)).norm())
+      << "the weight shifts onto the foot where it landed";
+  double outside = 0;  // the reference's time outside the support (the preview's model ZMP may
+                       // cut a corner after so late a change: the stabilizer clamps its command)
+  for (int i = 0; i < 60000 && !s.w.settled(2e-3); ++i) {
+    s.Run(0.001);
+    if (!s.w.InSupport(s.w.zmp_ref(), 0)) outside = s.w.time();
+  }
+  EXPECT_TRUE(s.w.standing());
+  EXPECT_LT(s.worst_jump, 2e-3);
+  EXPECT_EQ(outside, 0) << "the reference ZMP left the support at t=" << outside;
+}
+
 TEST(DcmStabilizer, ClampToPolygonKeepsInsidePointsAndClampsOthersToTheShrunkEdge) {
   const auto sq = Rect(-1, 1, -1, 1);
   EXPECT_TRUE(ClampToPolygon({0.5, 0.2}, sq, 0.1).isApprox(Eigen::Vector2d(0.5, 0.2)));
@@ -431,6 +468,76 @@ TEST(DcmStabilizer, BeyondTheAnklesAStepToTheCapturePointRecovers) {
       EXPECT_GT((m.c - landed).norm(), 0.3) << "the planned foothold does not capture it";
     }
   }
+}
+
+// ComOffset: the ZMP command on a position-controlled robot. The robot here
+// is the LIPM whose ground reaction comes from servos that track the CoM
+// reference (the plan plus the offset) with stiffness kp and damping kd per
+// unit mass: p = c - (ref'' + kp (ref - c) + kd (ref' - c')) / w^2, lagging
+// 20 ms and limited to the soles (the CoP the stabilizer measures). Returns
+// the CoM's largest excursion from the plan after a push to v0, and checks
+// that it came back.
+double PushedExcursion(double v0, bool stabilized, double kp_over_w2) {
+  Lipm m;
+  const Eigen::Vector2d ref(0.03, 0), zero = Eigen::Vector2d::Zero();
+  m.c = ref;
+  m.v = Eigen::Vector2d(v0, 0);
+  const DcmStabilizer s(m.zc, m.g);
+  const double w2 = s.omega() * s.omega(), kp = kp_over_w2 * w2, kd = std::sqrt(2 * kp);
+  ComOffset offset(s.omega());
+  const auto support = Rect(-0.09, 0.15, -0.15, 0.15);
+  Eigen::Vector2d cop = ref, accel = zero;
+  double worst = 0;
+  for (int i = 0; i < 3000; ++i) {
+    if (stabilized) {
+      const Eigen::Vector2d before = offset.velocity();
+      offset.Update(s.Update(m.c, m.v, ref, zero, ref, support, 0), m.c, ref, ref, &cop, m.dt);
+      accel = (offset.velocity() - before) / m.dt;
+      EXPECT_LE(offset.offset().cwiseAbs().maxCoeff(), ComOffsetGains{}.max_offset + 1e-12) << "bounded";
+    }
+    const Eigen::Vector2d wanted =
+        m.c - (accel + kp * (ref + offset.offset() - m.c) + kd * (offset.velocity() - m.v)) / w2;
+    cop += (ClampToPolygon(wanted, support, 0) - cop) * (m.dt / 0.02);
+    m.Step(cop);
+    worst = std::max(worst, (m.c - ref).norm());
+    if (worst > 1) break;
+  }
+  EXPECT_LT((m.c - ref).norm(), 2e-3)
+      << "recovered: v0 " << v0 << (stabilized ? ", stabilized" : ", open loop");
+  return worst;
+}
+
+TEST(ComOffset, WithCompliantServosTheStabilizerHoldsAPushAsTheStiffestAnklesWould) {
+  for (const double v0 : {0.2, 0.3, -0.3}) {
+    const double stiff = PushedExcursion(v0, false, 4.0);  // servos 4x gravity's toppling stiffness
+    const double soft = PushedExcursion(v0, false, 0.5), stabilized = PushedExcursion(v0, true, 0.5);
+    EXPECT_LT(stabilized, 1.25 * stiff) << v0;
+    EXPECT_LT(stabilized, 0.7 * soft) << v0 << ": the soft servos alone let the CoM run farther";
+  }
+}
+
+TEST(ComOffset, WithThePlanTrackedTheOffsetReturnsToZeroAndMeasuredCopCorrectsALaggingZmp) {
+  const DcmStabilizer s(0.6, 9.81);
+  ComOffset offset(s.omega());
+  const Eigen::Vector2d ref(0.03, 0.01), zero = Eigen::Vector2d::Zero();
+  const auto support = Rect(-0.09, 0.15, -0.15, 0.15);
+  // A perfectly tracked offset (the CoM is the reference plus the offset), nudged away.
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector2d c = ref + offset.offset() + (i == 0 ? Eigen::Vector2d(0.01, -0.01) : zero);
+    const Eigen::Vector2d v = offset.velocity();
+    offset.Update(s.Update(c, v, ref, zero, ref, support, 0), c, ref, ref, nullptr, 1e-3);
+  }
+  EXPECT_LT(offset.offset().norm(), 1e-3) << "back to the plan";
+  EXPECT_LT(offset.velocity().norm(), 1e-3);
+  // The CoP feedback: the ZMP commanded ahead of the measured one accelerates the CoM reference back.
+  offset.Reset();
+  DcmStabilizer::Output o;
+  o.zmp = Eigen::Vector2d(0.05, 0);
+  const Eigen::Vector2d cop(0.0, 0);
+  offset.Update(o, o.zmp, o.zmp, o.zmp, &cop, 1e-3);
+  EXPECT_LT(offset.velocity().x(), 0);
+  EXPECT_THROW(ComOffset(0.0), std::invalid_argument);
+  EXPECT_THROW(ComOffset(3.0, ComOffsetGains{.max_offset = -1}), std::invalid_argument);
 }
 
 TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {

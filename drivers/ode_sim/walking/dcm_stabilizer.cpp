@@ -100,4 +100,32 @@ DcmStabilizer::Output DcmStabilizer::Update(const Eigen::Vector2d& com, const Ei
   return o;
 }
 
+ComOffset::ComOffset(double omega, ComOffsetGains gains) : omega_(omega), gains_(gains) {
+  if (!(omega > 0) || !(gains.max_offset >= 0) || !(gains.max_speed >= 0)) {
+    throw std::invalid_argument("ComOffset: omega must be > 0, max_offset and max_speed >= 0");
+  }
+}
+
+void ComOffset::Reset() {
+  offset_.setZero();
+  velocity_.setZero();
+}
+
+const Eigen::Vector2d& ComOffset::Update(const DcmStabilizer::Output& o, const Eigen::Vector2d& com,
+                                         const Eigen::Vector2d& com_ref, const Eigen::Vector2d& zmp_ref,
+                                         const Eigen::Vector2d* cop, double dt) {
+  const double w2 = omega_ * omega_;
+  // The CoM acceleration that puts the ZMP at the command, less the plan's own.
+  Eigen::Vector2d a = w2 * ((com - o.zmp) - (com_ref - zmp_ref));
+  if (cop) a -= gains_.zmp_gain * (o.zmp - *cop);
+  velocity_ += a * dt;
+  for (int i = 0; i < 2; ++i) {
+    velocity_[i] = std::clamp(velocity_[i], -gains_.max_speed, gains_.max_speed);
+    const double next = std::clamp(offset_[i] + velocity_[i] * dt, -gains_.max_offset, gains_.max_offset);
+    if (next != offset_[i] + velocity_[i] * dt) velocity_[i] = 0;  // at the bound: stop there
+    offset_[i] = next;
+  }
+  return offset_;
+}
+
 }  // namespace robotalk::walking

@@ -18,7 +18,17 @@
 // the new support under the DCM, the capture point (Englsberger et al. 2011,
 // Pratt et al. 2006).
 //
-// Threading: none needed (Update is const). Allocation: none.
+// On a position-controlled robot (the ODE walker's leg servos hold their
+// joints stiffly) a ZMP is commanded through the CoM: the ground pushes at
+// p = c - c''/w^2, so the CoM reference is accelerated by w^2 (c - p): ComOffset
+// integrates that, minus the plan's own acceleration, into an offset added to
+// the planned CoM, with a feedback of the measured centre of pressure (the
+// contact forces) on what the ZMP command asked. With perfect tracking the
+// offset d obeys d'' = -k w d - (w + k) d' (it returns to the plan); the
+// measured CoM's departures (a push, the body tipping on a sole edge) drive it.
+//
+// Threading: none needed (DcmStabilizer::Update is const; ComOffset is one
+// thread's). Allocation: none.
 #pragma once
 
 #include <Eigen/Core>
@@ -65,6 +75,34 @@ class DcmStabilizer {
  private:
   double omega_;
   DcmGains gains_;
+};
+
+struct ComOffsetGains {
+  double zmp_gain = 20.0;    ///< 1/s^2: CoM acceleration per metre of ZMP command the CoP misses
+  double max_offset = 0.05;  ///< m: the offset's bound (each axis)
+  double max_speed = 0.5;    ///< m/s: the offset's rate bound (each axis)
+};
+
+/// The stabilizer's ZMP command as an offset of the CoM reference (above).
+class ComOffset {
+ public:
+  /// omega > 0 (the stabilizer's), else std::invalid_argument.
+  explicit ComOffset(double omega, ComOffsetGains gains = {});
+  /// Back to no offset, at rest.
+  void Reset();
+  /// One control step of `dt` s from the stabilizer's output `o` for the
+  /// measured CoM `com`, the plan (com_ref, zmp_ref) and the measured centre
+  /// of pressure (nullptr: none, e.g. in the air). Returns the offset (m).
+  const Eigen::Vector2d& Update(const DcmStabilizer::Output& o, const Eigen::Vector2d& com,
+                                const Eigen::Vector2d& com_ref, const Eigen::Vector2d& zmp_ref,
+                                const Eigen::Vector2d* cop, double dt);
+  const Eigen::Vector2d& offset() const { return offset_; }
+  const Eigen::Vector2d& velocity() const { return velocity_; }
+
+ private:
+  double omega_;
+  ComOffsetGains gains_;
+  Eigen::Vector2d offset_ = Eigen::Vector2d::Zero(), velocity_ = Eigen::Vector2d::Zero();
 };
 
 }  // namespace robotalk::walking

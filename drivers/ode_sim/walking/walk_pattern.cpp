@@ -187,6 +187,7 @@ void WalkPattern::AppendAt(std::int64_t t, const std::vector<Footstep>& steps,
   for (size_t i = 0; i < steps.size(); ++i) {
     Scheduled s;
     s.step = steps[i];
+    s.planned = s.step.pose;
     s.centre = centres[i];
     const int sw = static_cast<int>(s.step.side);
     s.from = last[sw];
@@ -220,7 +221,7 @@ Pose2 WalkPattern::StopSoon() {
   const Pose2 centre = n > 0 ? steps_[n - 1].centre : rest_centre_;
   Scheduled& st = steps_[n];
   const Pose2 along = FootAt(centre, st.step.side, g_);
-  st.step.pose = along;
+  st.step.pose = st.planned = along;
   st.centre = centre;
   st.swing = !SamePose(st.from, along);
   const std::int64_t land = st.land;
@@ -228,6 +229,47 @@ Pose2 WalkPattern::StopSoon() {
   Cut(land);
   AddPhase(end_ticks_, mid, Kind::kEnd, -1);
   return centre;
+}
+
+Eigen::Vector2d WalkPattern::AdjustLanding(const Eigen::Vector2d& offset, double reach) {
+  size_t k = 0;
+  while (k < steps_.size() && !(steps_[k].start <= tick_ && tick_ < steps_[k].land)) ++k;
+  if (k == steps_.size() || !steps_[k].swing) return Eigen::Vector2d::Zero();
+  Scheduled& st = steps_[k];
+  // In the stance foot's frame: the landing stays on the swing foot's side,
+  // no nearer to it sideways than planned (a foot moved inward narrows the
+  // support and never crosses to catch a push toward the stance side), within `reach`.
+  const Pose2& stance = st.stance;
+  const double c = std::cos(stance.theta), s = std::sin(stance.theta);
+  const Eigen::Vector2d want = st.planned.xy() + offset - stance.xy(), plan = st.planned.xy() - stance.xy();
+  Eigen::Vector2d local(c * want.x() + s * want.y(), -s * want.x() + c * want.y());
+  const double side = SideSign(st.step.side), planned_y = -s * plan.x() + c * plan.y();
+  local.y() = side * std::max(side * local.y(), std::max(side * planned_y, 0.8 * g_.foot_separation));
+  if (local.norm() > reach) local *= reach / local.norm();
+  const Eigen::Vector2d land =
+      stance.xy() + Eigen::Vector2d(c * local.x() - s * local.y(), s * local.x() + c * local.y());
+  const Eigen::Vector2d old_z = ZmpPoint(st.step.pose);
+  st.step.pose.x = land.x();
+  st.step.pose.y = land.y();
+  const Eigen::Vector2d new_z = ZmpPoint(st.step.pose), d = new_z - old_z;
+  // The reference from the landing on: the foot's ZMP point, and the end
+  // shift's middle when this step or the next one is the last.
+  const Eigen::Vector2d mid_this = 0.5 * (old_z + ZmpPoint(st.stance));
+  const Eigen::Vector2d mid_next =
+      k + 1 < steps_.size() ? Eigen::Vector2d(0.5 * (old_z + ZmpPoint(steps_[k + 1].step.pose))) : mid_this;
+  const auto moved = [&](const Eigen::Vector2d& p) -> Eigen::Vector2d {
+    if ((p - old_z).norm() < 1e-9) return new_z;
+    if ((p - mid_this).norm() < 1e-9 || (p - mid_next).norm() < 1e-9) return p + 0.5 * d;
+    return p;
+  };
+  for (Phase& p : phases_) {
+    if (p.start < st.land) continue;
+    p.from = moved(p.from);
+    p.to = moved(p.to);
+  }
+  if (k + 1 < steps_.size()) steps_[k + 1].stance = st.step.pose;
+  if (k + 2 < steps_.size()) steps_[k + 2].from = st.step.pose;
+  return st.step.pose.xy() - st.planned.xy();
 }
 
 const WalkPattern::Scheduled* WalkPattern::Swinging() const {
@@ -311,17 +353,24 @@ void WalkPattern::Tick() {
   UpdateFeet();
 }
 
-bool WalkPattern::InSupport(const Eigen::Vector2d& p, double margin) const {
-  if (const Scheduled* s = Swinging())
-    return InFoot(foot_[1 - static_cast<int>(s->step.side)], g_, p, margin);
-  // Convex hull of both soles (monotone chain), then the point against each edge.
+double WalkPattern::time_to_landing() const {
+  const Scheduled* s = Swinging();
+  return s && s->swing ? static_cast<double>(s->land - tick_) * tick_s_ : 0.0;
+}
+
+int WalkPattern::SupportPolygon(std::array<Eigen::Vector2d, 16>& hull) const {
+  if (const Scheduled* s = Swinging()) {
+    const auto c = Corners(foot_[1 - static_cast<int>(s->step.side)], g_);
+    std::copy(c.begin(), c.end(), hull.begin());
+    return 4;
+  }
+  // Convex hull of both soles (monotone chain, counter-clockwise).
   std::array<Eigen::Vector2d, 8> pts;
   const auto a = Corners(foot_[0], g_), b = Corners(foot_[1], g_);
   std::copy(a.begin(), a.end(), pts.begin());
   std::copy(b.begin(), b.end(), pts.begin() + 4);
   std::sort(pts.begin(), pts.end(),
             [](const auto& u, const auto& v) { return u.x() < v.x() || (u.x() == v.x() && u.y() < v.y()); });
-  std::array<Eigen::Vector2d, 16> hull;
   int n = 0;
   for (int i = 0; i < 8; ++i) {
     while (n >= 2 && Cross(hull[n - 2], hull[n - 1], pts[i]) <= 0) --n;
@@ -331,7 +380,12 @@ bool WalkPattern::InSupport(const Eigen::Vector2d& p, double margin) const {
     while (n >= lo && Cross(hull[n - 2], hull[n - 1], pts[i]) <= 0) --n;
     hull[n++] = pts[i];
   }
-  --n;
+  return n - 1;
+}
+
+bool WalkPattern::InSupport(const Eigen::Vector2d& p, double margin) const {
+  std::array<Eigen::Vector2d, 16> hull;
+  const int n = SupportPolygon(hull);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector2d e = hull[(i + 1) % n] - hull[i];
     const double len = e.norm();

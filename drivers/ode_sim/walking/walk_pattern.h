@@ -39,6 +39,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -75,6 +76,14 @@ class WalkPattern {
   Pose2 StopSoon();
   /// One tick forward.
   void Tick();
+  /// Step adjustment (balance): the foot in the air lands `offset` (m, plan
+  /// frame) from where it was planned to (not from where the last adjustment
+  /// put it), bounded so that it lands beside the stance foot, never across
+  /// it nor farther than `reach` (m) from it. The ZMP reference moves with the
+  /// landed foot from the landing on (the shift onto it, its stance, the end
+  /// shift); the next steps start from it. Returns the offset applied; zero
+  /// in double support.
+  Eigen::Vector2d AdjustLanding(const Eigen::Vector2d& offset, double reach);
 
   /// True when no step is scheduled or running and the end shift is over.
   bool standing() const;
@@ -105,6 +114,10 @@ class WalkPattern {
   /// The feet's support polygon now contains p (m)? For tests: a foot's
   /// sole rectangle, or in double support the convex hull of both.
   bool InSupport(const Eigen::Vector2d& p, double margin = 0) const;
+  /// That polygon's corners, counter-clockwise, into `out`; returns how many.
+  int SupportPolygon(std::array<Eigen::Vector2d, 16>& out) const;
+  /// Time until the foot in the air lands, s; 0 in double support.
+  double time_to_landing() const;
   const GaitParams& gait() const { return g_; }
   double time() const { return static_cast<double>(tick_) * tick_s_; }
 
@@ -123,6 +136,7 @@ class WalkPattern {
     Pose2 stance;                      // the other foot during the step
     std::int64_t start = 0, land = 0;  // single support [start, land)
     bool swing = true;                 // false: the foot stays (a stop with the feet side by side)
+    Pose2 planned;                     // step.pose before AdjustLanding
   };
   Eigen::Vector2d ZmpPoint(const Pose2& foot) const;
   Eigen::Vector2d ZmpAt(std::int64_t tick) const;
