@@ -26,6 +26,19 @@
 // a predicted worst delay (the least seen + quick_jitter_factor × the
 // spread), plus a small margin. Otherwise (no history, a client without
 // send times, a congested channel) the paper's estimate above.
+//
+// Adaptive start (issue 23 item 3, the default): the quick start's 2.5 ×
+// spread + 10 ms was most of its start latency where the channel's jitter is
+// a few milliseconds. With a schedule that may stretch the gaps between
+// frames afterwards (playback_schedule.h), the start need not cover every
+// frame to come: it is decided at the first frame whenever the delays are
+// known (any spread), from the worst recent delay (the history's and the
+// frames' max) plus `adaptive_margin`; a frame slower than that gets its gap
+// stretched, within the schedule's bound. Where the spread exceeds one frame
+// interval a queue can build that the history (sparse packages, no queue)
+// cannot show: the spread beyond one interval is added again
+// (quick_jitter_factor − 1) times. A client without send times gets the
+// paper's estimate, then the stretch.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -57,7 +70,21 @@ struct PlaybackEstimatorOptions {
   double quick_jitter_factor = 2.5;
   /// Added on top (the RobotDaemon's wake-up, the decision itself).
   Duration quick_margin = std::chrono::milliseconds(10);
+  /// The adaptive start (see above; off: the quick start or the paper's).
+  bool adaptive = true;
+  /// Added to the worst recent delay; also the schedule's margin.
+  Duration adaptive_margin = std::chrono::milliseconds(2);
+  /// And the spread × this / the delays seen: the max of n samples falls
+  /// short of the channel's by about spread / n (uniform jitter), so twice that.
+  double adaptive_headroom = 3.0;
+  /// With the adaptive start, each gap between frames may play up to this
+  /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
+  double max_stretch = 0.10;
 };
+
+/// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
+/// (73 years; two such delays still subtract and add without overflow).
+std::optional<Duration> OneWayDelay(TimePoint sent, TimePoint arrival);
 
 /// The one-way delays (arrival − client send time) of one client's latest
 /// packages, for PlaybackEstimator's quick start. Not thread-safe (one
@@ -98,8 +125,14 @@ class PlaybackEstimator {
     return frames_.capacity() * sizeof(Frame) + history_.capacity() * sizeof(Duration);
   }
   bool ready() const { return quick() || frames_.size() >= needed_; }
-  /// Whether the start is decided by the quick start (see above).
+  /// Whether the start is decided at the first frames from send times (the
+  /// quick or the adaptive start, see above).
   bool quick() const;
+  /// Whether the start is the adaptive one (see above).
+  bool adaptive() const { return options_.adaptive && delay_spread().has_value(); }
+  /// With the adaptive start, the worst delay it covers + its margin (the
+  /// schedule's playout delay, PlaybackSchedule); else nullopt.
+  std::optional<Duration> playout_delay() const;
   /// Max − min of the recent one-way delays and the frames' (nullopt: too
   /// few, or a frame without a send time).
   std::optional<Duration> delay_spread() const;
@@ -119,7 +152,9 @@ class PlaybackEstimator {
     TimePoint arrival;
     std::optional<Duration> delay;  // arrival − send time
   };
-  TimePoint QuickStartTime() const;  // REQUIRES: quick()
+  // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
+  TimePoint StartCovering(Duration worst, Duration margin) const;
+  Duration AdaptiveWorst() const;  // REQUIRES: adaptive()
   std::size_t total_;
   Duration duration_;
   PlaybackEstimatorOptions options_;
