@@ -67,7 +67,7 @@ bool PlaybackEstimator::quick() const {
   return spread && ToSeconds(*spread) <= options_.quick_max_spread * interval;
 }
 
-Duration PlaybackEstimator::AdaptiveWorst() const {
+Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
   Duration most = Duration::min();
   for (const Frame& f : frames_) most = std::max(most, *f.delay);
   for (Duration d : history_) most = std::max(most, d);
@@ -80,12 +80,12 @@ Duration PlaybackEstimator::AdaptiveWorst() const {
   // sparse packages never met: it is covered quick_jitter_factor times.
   const double excess = std::max(0.0, ToSeconds(spread) - options_.quick_max_spread * interval);
   return most + FromSeconds(excess * options_.quick_jitter_factor +
-                            ToSeconds(spread) * options_.adaptive_headroom / static_cast<double>(samples));
+                            ToSeconds(spread) * headroom / static_cast<double>(samples));
 }
 
 std::optional<Duration> PlaybackEstimator::playout_delay() const {
   if (!adaptive()) return std::nullopt;
-  return AdaptiveWorst() + options_.adaptive_margin;
+  return AdaptiveWorst(options_.adaptive_headroom) + options_.adaptive_margin;
 }
 
 TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin) const {
@@ -155,7 +155,7 @@ Duration PlaybackEstimator::ExtraLagBound(Duration remaining) const {
 }
 
 TimePoint PlaybackEstimator::StartTime() const {
-  if (adaptive()) return StartCovering(AdaptiveWorst(), options_.adaptive_margin);
+  if (adaptive()) return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin);
   if (quick()) {
     // The worst delay a later frame may have is predicted as the least seen
     // plus quick_jitter_factor times the spread (the history is a sample:

@@ -29,16 +29,18 @@
 //
 // Adaptive start (issue 23 item 3, the default): the quick start's 2.5 ×
 // spread + 10 ms was most of its start latency where the channel's jitter is
-// a few milliseconds. With a schedule that may stretch the gaps between
-// frames afterwards (playback_schedule.h), the start need not cover every
-// frame to come: it is decided at the first frame whenever the delays are
-// known (any spread), from the worst recent delay (the history's and the
-// frames' max) plus `adaptive_margin`; a frame slower than that gets its gap
-// stretched, within the schedule's bound. Where the spread exceeds one frame
-// interval a queue can build that the history (sparse packages, no queue)
-// cannot show: the spread beyond one interval is added again
-// (quick_jitter_factor − 1) times. A client without send times gets the
-// paper's estimate, then the stretch.
+// a few milliseconds. With a schedule that stretches the gaps between frames
+// afterwards, within a bound (playback_schedule.h), the start need not cover
+// every frame to come. It is decided at the first frame whenever the delays
+// are known (any spread), to cover the worst recent delay (the history's and
+// the frames' max) + spread / n (n delays seen: the max of n samples falls
+// short of the channel's by about that) + `adaptive_margin`. The schedule
+// then grows that buffer to the worst delay + 4 × spread / n by stretching
+// the first gaps (at most max_stretch each), and further for any frame
+// slower than it. Where the spread exceeds one frame interval a queue can
+// build that the history (sparse packages, no queue) cannot show: the spread
+// beyond one interval is added quick_jitter_factor times. A client without
+// send times gets the paper's estimate, then the stretch.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -76,7 +78,10 @@ struct PlaybackEstimatorOptions {
   Duration adaptive_margin = std::chrono::milliseconds(2);
   /// And the spread × this / the delays seen: the max of n samples falls
   /// short of the channel's by about spread / n (uniform jitter), so twice that.
-  double adaptive_headroom = 3.0;
+  double adaptive_headroom = 4.0;
+  /// The start covers only this much of the headroom (same unit); the
+  /// schedule reaches the rest by stretching the first gaps within max_stretch.
+  double start_headroom = 1.0;
   /// With the adaptive start, each gap between frames may play up to this
   /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
   double max_stretch = 0.10;
@@ -154,7 +159,7 @@ class PlaybackEstimator {
   };
   // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
   TimePoint StartCovering(Duration worst, Duration margin) const;
-  Duration AdaptiveWorst() const;  // REQUIRES: adaptive()
+  Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
   std::size_t total_;
   Duration duration_;
   PlaybackEstimatorOptions options_;

@@ -193,9 +193,9 @@ TEST(AdaptivePlayback, OnAJitteryChannelStartsNearTheHindsightMinimumAndFramesAr
   std::printf("U[0, 40] ms: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio,
               s.late_runs, s.worst_stretch);
   // 10 connect-time delays are a small sample of the channel: in 2 runs of
-  // 1000 a frame came more than the headroom + one gap's stretch later.
+  // 1000 a frame came later than the buffer had grown by then.
   EXPECT_LE(s.late_runs, 5);
-  EXPECT_LE(s.median_ratio, 1.4);
+  EXPECT_LE(s.median_ratio, 1.25);
   EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
 }
 
@@ -208,8 +208,10 @@ TEST(AdaptivePlayback, OnAWanProfileStartsNearTheHindsightMinimumAndFramesAreRar
   });
   std::printf("WAN: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio, s.late_runs,
               s.worst_stretch);
-  EXPECT_LE(s.late_runs, 20);  // 12 of 1000: the same small sample, a 100 ms spread
-  EXPECT_LE(s.median_ratio, 1.4);
+  // 16 of 1000 runs: the same small sample of a 100 ms spread, a frame
+  // slower than the start covered before two gaps could stretch for it.
+  EXPECT_LE(s.late_runs, 25);
+  EXPECT_LE(s.median_ratio, 1.25);
   EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
 }
 
@@ -231,10 +233,10 @@ TEST(AdaptivePlayback, OnACongestedLinkAQueueBuildsAndTheStartCoversIt) {
     std::printf("X = %.0f: median ratio %.2f, late runs %d of 300 (%d frames), worst gap stretch %.3f\n", x,
                 s.median_ratio, s.late_runs, s.late_frames, s.worst_stretch);
     // Up to X = 100 a frame's service fits in its interval; at 150 a queue
-    // builds faster than a gap may stretch: 51 runs of 300 had late frames
+    // builds faster than a gap may stretch: 43 runs of 300 had late frames
     // (the known limit, docs/performance.md).
     EXPECT_LE(s.late_runs, x < 120 ? 3 : 60) << "X = " << x;
-    EXPECT_LE(s.median_ratio, 1.5) << "X = " << x;
+    EXPECT_LE(s.median_ratio, x < 120 ? 1.25 : 1.5) << "X = " << x;
     EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
   }
 }
