@@ -297,6 +297,13 @@ def replace_between(doc, begin, end, text):
     return head + begin + "\n" + text + "\n" + end + tail
 
 
+def measured_head(r, tail):
+    """"Measured <date> UTC, commit …, mode, load average …" + tail, from a figure's JSON."""
+    m = r.get("meta", {})
+    return (f"Measured {m.get('date_utc')} UTC, commit {m.get('commit')}, {'quick' if m.get('quick') else 'full'} "
+            f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs" + tail)
+
+
 def playback_estimators_section(res):
     """Issue 23 item 3's table: per relay profile, the paper's estimator, the quick start and the
     adaptive start (same relay seeds, interleaved): start latency / hindsight minimum per run, late
@@ -304,11 +311,8 @@ def playback_estimators_section(res):
     r = res.get("playback_estimators")
     if not r:
         return None
-    m = r.get("meta", {})
-    head = (f"Measured {m.get('date_utc')} UTC, commit {m.get('commit')}, {'quick' if m.get('quick') else 'full'} "
-            f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs; "
-            f"{r.get('frames')} frames at 10 Hz per run, {r.get('wall_s')} s in all "
-            "(`scripts/bench.sh --only playback_estimators`).")
+    head = measured_head(r, f"; {r.get('frames')} frames at 10 Hz per run, {r.get('wall_s')} s in all "
+                            "(`scripts/bench.sh --only playback_estimators`).")
     if r.get("error"):
         return head + "\n\nNot measured: " + str(r["error"])
     names = {"paper": "paper's estimator", "quick": "quick start (issue 11, before)", "adaptive": "adaptive (now)"}
@@ -344,10 +348,7 @@ def trajectory_section(res, figdir):
     r = res.get("trajectory")
     if not r:
         return None
-    m = r.get("meta", {})
-    head = (f"Measured {m.get('date_utc')} UTC, commit {m.get('commit')}, {'quick' if m.get('quick') else 'full'} "
-            f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs "
-            "(`robotalk-trajectory-bench`, bench/trajectory_bench.cpp).")
+    head = measured_head(r, " (`robotalk-trajectory-bench`, bench/trajectory_bench.cpp).")
     if r.get("error") or r.get("rc"):
         return head + "\n\nNot measured: " + str(r.get("error") or r.get("stderr"))
     plot = r.get("plot_ode_10hz") or {}

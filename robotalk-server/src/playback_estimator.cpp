@@ -68,19 +68,28 @@ bool PlaybackEstimator::quick() const {
 }
 
 Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
-  Duration most = Duration::min();
-  for (const Frame& f : frames_) most = std::max(most, *f.delay);
-  for (Duration d : history_) most = std::max(most, d);
-  const std::size_t samples = frames_.size() + history_.size();
-  const Duration spread = *delay_spread();
+  std::vector<Duration> delays = history_;  // quick(): every frame has a delay
+  for (const Frame& f : frames_) delays.push_back(*f.delay);
+  std::sort(delays.begin(), delays.end());
   const double interval = total_ > 1 ? ToSeconds(duration_) / static_cast<double>(total_ - 1) : 1.0;
+  // A package whose first copy was lost arrives as its retransmission, which
+  // carries its first send time: its delay includes the client's resend wait
+  // (100 ms at least, doubling). Such outliers, more than max(2 × (median −
+  // least), one frame interval) above the median, are not the channel's
+  // jitter and are left out (a later frame that is that slow gets its gap
+  // stretched, or is late).
+  const Duration least = delays.front(), median = delays[delays.size() / 2];
+  const Duration fence = median + std::max(2 * (median - least), FromSeconds(interval));
+  std::size_t kept = delays.size();
+  while (kept > 1 && delays[kept - 1] > fence) --kept;
+  const Duration most = delays[kept - 1], spread = most - least;
   // Delays that vary by less than a frame interval cannot build a queue of
   // frames: the worst recent delay, and the schedule's stretch for a slower
   // frame. The spread beyond one interval may accumulate in a queue that
   // sparse packages never met: it is covered quick_jitter_factor times.
   const double excess = std::max(0.0, ToSeconds(spread) - options_.quick_max_spread * interval);
   return most + FromSeconds(excess * options_.quick_jitter_factor +
-                            ToSeconds(spread) * headroom / static_cast<double>(samples));
+                            ToSeconds(spread) * headroom / static_cast<double>(kept));
 }
 
 std::optional<Duration> PlaybackEstimator::playout_delay() const {

@@ -251,6 +251,21 @@ TEST(AdaptivePlayback, TheOldEstimatorsRemainOptions) {
   EXPECT_GT(paper.median_ratio, 5.0) << "waits for 5 frames";
 }
 
+TEST(AdaptivePlayback, ARetransmittedPackageInTheHistoryDoesNotInflateTheStart) {
+  // WAN delays 275-325 ms; one connect-time package was lost twice and came
+  // as its retransmission 300 ms after its first send time (+ 300 ms).
+  std::vector<Duration> history;
+  for (int i = 0; i < 10; ++i) history.push_back(milliseconds(275 + 5 * i));
+  history.push_back(milliseconds(600));
+  PlaybackEstimator est(40, milliseconds(3900));
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(300));
+  ASSERT_TRUE(est.adaptive());
+  // Covers the 320 ms worst + 45 ms / 11 + 2 ms, less this frame's 300 ms.
+  EXPECT_EQ(est.StartTime(), kT0 + milliseconds(22) + FromSeconds(0.045 / 11));
+  EXPECT_EQ(*est.playout_delay(), milliseconds(322) + FromSeconds(4 * 0.045 / 11));
+}
+
 TEST(AdaptivePlayback, AClientWithoutSendTimesGetsThePapersStartThenTheStretch) {
   PlaybackEstimator est(40, milliseconds(3900));
   est.SetDelayHistory(std::vector<Duration>(10, milliseconds(1)));
