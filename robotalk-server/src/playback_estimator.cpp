@@ -56,8 +56,39 @@ std::optional<Duration> PlaybackEstimator::delay_spread() const {
   return *hi - *lo;
 }
 
+double PlaybackEstimator::interval() const {
+  return total_ > 1 ? ToSeconds(duration_) / static_cast<double>(total_ - 1) : 1.0;
+}
+
+std::optional<PlaybackEstimator::Spread> PlaybackEstimator::FencedSpread() const {
+  if (!delay_spread()) return std::nullopt;  // too few, or a frame without a send time
+  std::vector<Duration> delays = history_;
+  for (const Frame& f : frames_) delays.push_back(*f.delay);
+  std::sort(delays.begin(), delays.end());
+  // A package whose first copy was lost arrives as its retransmission, which
+  // carries its first send time: its delay includes the client's resend wait
+  // (100 ms at least by default, doubling). Such outliers, more than
+  // max(8 × (median − least), 50 ms) above the median, are not the
+  // channel's jitter and are left out (a later frame that is that slow gets
+  // its gap stretched, or is late).
+  const Duration least = delays.front(), median = delays[delays.size() / 2];
+  const Duration fence = median + std::max(8 * (median - least), Duration(std::chrono::milliseconds(50)));
+  std::size_t kept = delays.size();
+  while (kept > 1 && delays[kept - 1] > fence) --kept;
+  return Spread{least, delays[kept - 1], kept};
+}
+
+bool PlaybackEstimator::adaptive() const {
+  // The whole spread, outliers included: the paper's congestion (a server
+  // pausing after each package) shows as a few slow packages among fast ones.
+  if (!options_.adaptive) return false;
+  const std::optional<Duration> spread = delay_spread();
+  return spread && ToSeconds(*spread) <= options_.adaptive_max_spread * interval();
+}
+
 bool PlaybackEstimator::quick() const {
   if (adaptive()) return true;
+  if (options_.adaptive) return false;  // the adaptive start's fallback is the paper's estimate
   if (!options_.quick_start) return false;
   const std::optional<Duration> spread = delay_spread();
   // A spread this small beside the frame interval is a channel that keeps up
@@ -68,28 +99,15 @@ bool PlaybackEstimator::quick() const {
 }
 
 Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
-  std::vector<Duration> delays = history_;  // quick(): every frame has a delay
-  for (const Frame& f : frames_) delays.push_back(*f.delay);
-  std::sort(delays.begin(), delays.end());
-  const double interval = total_ > 1 ? ToSeconds(duration_) / static_cast<double>(total_ - 1) : 1.0;
-  // A package whose first copy was lost arrives as its retransmission, which
-  // carries its first send time: its delay includes the client's resend wait
-  // (100 ms at least, doubling). Such outliers, more than max(2 × (median −
-  // least), one frame interval) above the median, are not the channel's
-  // jitter and are left out (a later frame that is that slow gets its gap
-  // stretched, or is late).
-  const Duration least = delays.front(), median = delays[delays.size() / 2];
-  const Duration fence = median + std::max(2 * (median - least), FromSeconds(interval));
-  std::size_t kept = delays.size();
-  while (kept > 1 && delays[kept - 1] > fence) --kept;
-  const Duration most = delays[kept - 1], spread = most - least;
+  const Spread s = *FencedSpread();
+  const Duration spread = s.most - s.least;
   // Delays that vary by less than a frame interval cannot build a queue of
   // frames: the worst recent delay, and the schedule's stretch for a slower
   // frame. The spread beyond one interval may accumulate in a queue that
   // sparse packages never met: it is covered quick_jitter_factor times.
-  const double excess = std::max(0.0, ToSeconds(spread) - options_.quick_max_spread * interval);
-  return most + FromSeconds(excess * options_.quick_jitter_factor +
-                            ToSeconds(spread) * headroom / static_cast<double>(kept));
+  const double excess = std::max(0.0, ToSeconds(spread) - options_.quick_max_spread * interval());
+  return s.most + FromSeconds(excess * options_.quick_jitter_factor +
+                              ToSeconds(spread) * headroom / static_cast<double>(s.kept));
 }
 
 std::optional<Duration> PlaybackEstimator::playout_delay() const {

@@ -32,15 +32,15 @@
 // a few milliseconds. With a schedule that stretches the gaps between frames
 // afterwards, within a bound (playback_schedule.h), the start need not cover
 // every frame to come. It is decided at the first frame whenever the delays
-// are known (any spread), to cover the worst recent delay (the history's and
-// the frames' max) + spread / n (n delays seen: the max of n samples falls
-// short of the channel's by about that) + `adaptive_margin`. The schedule
-// then grows that buffer to the worst delay + 4 × spread / n by stretching
-// the first gaps (at most max_stretch each), and further for any frame
-// slower than it. Where the spread exceeds one frame interval a queue can
-// build that the history (sparse packages, no queue) cannot show: the spread
-// beyond one interval is added quick_jitter_factor times. A client without
-// send times gets the paper's estimate, then the stretch.
+// are known and spread by at most adaptive_max_spread intervals, to cover the worst recent delay (the
+// history's and the frames' max) + spread / n (n delays seen: the max of n samples falls short of the
+// channel's by about that) + `adaptive_margin`. The schedule then grows that buffer to the worst delay + 4 ×
+// spread / n by stretching the first gaps (at most max_stretch each), and further for any frame slower than
+// it. Where the spread exceeds one frame interval a queue can build that the history (sparse packages, no
+// queue) cannot show: the spread beyond one interval is added quick_jitter_factor times, and beyond
+// `adaptive_max_spread` intervals (the paper's congestion experiment, Fig. 11)
+// the paper's estimate is used instead. A client without send times gets the
+// paper's estimate too; the stretch applies either way.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -74,6 +74,10 @@ struct PlaybackEstimatorOptions {
   Duration quick_margin = std::chrono::milliseconds(10);
   /// The adaptive start (see above; off: the quick start or the paper's).
   bool adaptive = true;
+  /// Above this spread (in frame intervals) the delays may be a queue's
+  /// (the paper's congestion): the adaptive start gives way to the paper's
+  /// estimate, which waits for frames and projects their drift.
+  double adaptive_max_spread = 1.2;
   /// Added to the worst recent delay; also the schedule's margin.
   Duration adaptive_margin = std::chrono::milliseconds(2);
   /// And the spread × this / the delays seen: the max of n samples falls
@@ -134,7 +138,7 @@ class PlaybackEstimator {
   /// quick or the adaptive start, see above).
   bool quick() const;
   /// Whether the start is the adaptive one (see above).
-  bool adaptive() const { return options_.adaptive && delay_spread().has_value(); }
+  bool adaptive() const;
   /// With the adaptive start, the worst delay it covers + its margin (the
   /// schedule's playout delay, PlaybackSchedule); else nullopt.
   std::optional<Duration> playout_delay() const;
@@ -160,6 +164,12 @@ class PlaybackEstimator {
   // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
   TimePoint StartCovering(Duration worst, Duration margin) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
+  struct Spread {
+    Duration least, most;  // of the recent delays, retransmissions left out
+    std::size_t kept;      // delays within the fence
+  };
+  std::optional<Spread> FencedSpread() const;
+  double interval() const;  // the declared mean frame interval, s
   std::size_t total_;
   Duration duration_;
   PlaybackEstimatorOptions options_;

@@ -232,11 +232,14 @@ TEST(AdaptivePlayback, OnACongestedLinkAQueueBuildsAndTheStartCoversIt) {
     });
     std::printf("X = %.0f: median ratio %.2f, late runs %d of 300 (%d frames), worst gap stretch %.3f\n", x,
                 s.median_ratio, s.late_runs, s.late_frames, s.worst_stretch);
-    // Up to X = 100 a frame's service fits in its interval; at 150 a queue
-    // builds faster than a gap may stretch: 43 runs of 300 had late frames
+    // Up to X = 100 a frame's service fits in its interval. At 150 the
+    // connect-time delays spread by more than 1.2 intervals in most runs: the
+    // paper's estimate (median 14.9x); 36 runs of 300 still had a frame late
     // (the known limit, docs/performance.md).
     EXPECT_LE(s.late_runs, x < 120 ? 3 : 60) << "X = " << x;
-    EXPECT_LE(s.median_ratio, x < 120 ? 1.25 : 1.5) << "X = " << x;
+    if (x < 120) {
+      EXPECT_LE(s.median_ratio, 1.25) << "X = " << x;
+    }
     EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
   }
 }
@@ -252,18 +255,39 @@ TEST(AdaptivePlayback, TheOldEstimatorsRemainOptions) {
 }
 
 TEST(AdaptivePlayback, ARetransmittedPackageInTheHistoryDoesNotInflateTheStart) {
-  // WAN delays 275-325 ms; one connect-time package was lost twice and came
-  // as its retransmission 300 ms after its first send time (+ 300 ms).
+  // A LAN (1.0-1.9 ms); one connect-time package was lost and came as its
+  // retransmission 100 ms after its first send time (+ 1 ms).
   std::vector<Duration> history;
-  for (int i = 0; i < 10; ++i) history.push_back(milliseconds(275 + 5 * i));
-  history.push_back(milliseconds(600));
+  for (int i = 0; i < 10; ++i) history.push_back(std::chrono::microseconds(1000 + 100 * i));
+  history.push_back(milliseconds(101));
   PlaybackEstimator est(40, milliseconds(3900));
   est.SetDelayHistory(history);
-  est.Add(Duration(0), kT0, kT0 - milliseconds(300));
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
   ASSERT_TRUE(est.adaptive());
-  // Covers the 320 ms worst + 45 ms / 11 + 2 ms, less this frame's 300 ms.
-  EXPECT_EQ(est.StartTime(), kT0 + milliseconds(22) + FromSeconds(0.045 / 11));
-  EXPECT_EQ(*est.playout_delay(), milliseconds(322) + FromSeconds(4 * 0.045 / 11));
+  // Covers the 1.9 ms worst + 0.9 ms / 11 + 2 ms, less this frame's 1 ms.
+  EXPECT_EQ(est.StartTime(), kT0 + std::chrono::microseconds(2900) + FromSeconds(0.0009 / 11));
+  // Beyond 1.2 frame intervals (a retransmission on a WAN, or the paper's
+  // congestion) the spread gets the paper's estimate: slower, never fooled.
+  history.back() = milliseconds(130);
+  PlaybackEstimator wide(40, milliseconds(3900));
+  wide.SetDelayHistory(history);
+  wide.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  EXPECT_FALSE(wide.adaptive());
+}
+
+TEST(AdaptivePlayback, ThePapersCongestionGetsThePapersEstimate) {
+  // Fig. 11's injector: the server pauses U[0, 0.25] s after each package, a
+  // queue at 10 Hz; the connect-time delays spread by more than 1.5 frame
+  // intervals, so the start waits for 5 frames and projects their drift.
+  std::vector<Duration> history;
+  for (int i = 0; i < 10; ++i) history.push_back(milliseconds(25 * i));
+  PlaybackEstimator est(129, milliseconds(12800));
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(100));
+  EXPECT_FALSE(est.adaptive());
+  EXPECT_FALSE(est.quick());
+  EXPECT_FALSE(est.ready()) << "waits for frames";
+  EXPECT_FALSE(est.playout_delay().has_value());
 }
 
 TEST(AdaptivePlayback, AClientWithoutSendTimesGetsThePapersStartThenTheStretch) {
