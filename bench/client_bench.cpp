@@ -338,14 +338,39 @@ int Playback(const Args& a) {
   so.paced = true;
   const SequenceResult r = c.RunSequence(std::move(seq), so);
   std::vector<double> late;
-  long late_frames = 0;
+  long late_frames = 0, not_run = 0, over_bound = 0;
+  // The timing as played (issue 23): each gap between successive frames'
+  // execution times against the recorded 'period'; a gap longer than the
+  // server's stretch bound (+ 1 ms of the RobotDaemon's wake-up) is a pause
+  // for a late frame.
+  const double bound = a.Num("stretch-bound", 0.10);
+  double max_stretch = 0;
+  std::optional<TimePoint> previous;
   for (const Reply& rep : r.replies) {
     late.push_back(Us(rep.lateness));
     if (rep.lateness > std::chrono::milliseconds(1)) ++late_frames;
+    if (rep.signal != Signal::kSuccess && rep.signal != Signal::kModified) {
+      ++not_run;
+      previous.reset();
+      continue;
+    }
+    if (previous) {
+      const double gap = ToSeconds(rep.exec_time - *previous), recorded = ToSeconds(period);
+      max_stretch = std::max(max_stretch, gap / recorded - 1);
+      if (gap > recorded * (1 + bound) + 0.001) ++over_bound;
+    }
+    previous = rep.exec_time;
   }
+  const double total_stretch = r.replies.size() >= 2
+                                   ? ToSeconds(r.replies.back().exec_time - r.replies.front().exec_time) -
+                                         ToSeconds(period) * static_cast<double>(r.replies.size() - 1)
+                                   : 0;
   auto f = StatsFields(c);
   f.insert(f.begin(), {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
-                       Summary("lateness_us", late), Field("late_frames", static_cast<double>(late_frames))});
+                       Summary("lateness_us", late), Field("late_frames", static_cast<double>(late_frames)),
+                       Field("not_run", static_cast<double>(not_run)),
+                       Field("gaps_over_bound", static_cast<double>(over_bound)),
+                       Field("max_gap_stretch", max_stretch), Field("total_stretch_s", total_stretch)});
   PrintJson(f);
   return 0;
 }

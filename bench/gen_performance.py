@@ -22,7 +22,8 @@ import statistics
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
 # Figures with a section of their own (between their own markers), not in the main table.
-OWN_SECTIONS = {"trajectory": ("<!-- trajectory:begin -->", "<!-- trajectory:end -->")}
+OWN_SECTIONS = {"trajectory": ("<!-- trajectory:begin -->", "<!-- trajectory:end -->"),
+                "playback_estimators": ("<!-- playback23:begin -->", "<!-- playback23:end -->")}
 
 
 def load(d):
@@ -296,16 +297,58 @@ def replace_between(doc, begin, end, text):
     return head + begin + "\n" + text + "\n" + end + tail
 
 
+def measured_head(r, tail):
+    """"Measured <date> UTC, commit …, mode, load average …" + tail, from a figure's JSON."""
+    m = r.get("meta", {})
+    return (f"Measured {m.get('date_utc')} UTC, commit {m.get('commit')}, {'quick' if m.get('quick') else 'full'} "
+            f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs" + tail)
+
+
+def playback_estimators_section(res):
+    """Issue 23 item 3's table: per relay profile, the paper's estimator, the quick start and the
+    adaptive start (same relay seeds, interleaved): start latency / hindsight minimum per run, late
+    frames, the timing's stretch."""
+    r = res.get("playback_estimators")
+    if not r:
+        return None
+    head = measured_head(r, f"; {r.get('frames')} frames at 10 Hz per run, {r.get('wall_s')} s in all "
+                            "(`scripts/bench.sh --only playback_estimators`).")
+    if r.get("error"):
+        return head + "\n\nNot measured: " + str(r["error"])
+    names = {"paper": "paper's estimator", "quick": "quick start (issue 11, before)", "adaptive": "adaptive (now)"}
+    lines = [head, "", "| relay profile (client → server) | estimator | start latency (per run) | hindsight minimum "
+             "| ratio (per run) | late frames | pauses past the bound | largest gap stretch | whole-sequence stretch |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for prof in dict.fromkeys(x["profile"] for x in r.get("runs", [])):
+        for est in ("paper", "quick", "adaptive"):
+            rs = [x for x in r["runs"] if x["profile"] == prof and x["estimator"] == est]
+            if not rs:
+                continue
+            ch = [get(x, "robotalk", "chosen_delay_s") for x in rs]
+            hs = [get(x, "arrivals", "hindsight_min_s") for x in rs]
+            ratios = [f"{c / h:.2f}" if c is not None and h else "—" for c, h in zip(ch, hs)]
+            late = sum(int(get(x, "robotalk", "late_frames") or 0) + int(get(x, "robotalk", "not_run") or 0)
+                       for x in rs)
+            n = sum(int(get(x, "robotalk", "lateness_us", "n") or 0) for x in rs)
+            over = sum(int(get(x, "robotalk", "gaps_over_bound") or 0) for x in rs)
+            gs = max((get(x, "robotalk", "max_gap_stretch") or 0) for x in rs)
+            ts = max((get(x, "robotalk", "total_stretch_s") or 0) for x in rs)
+            err = [x["robotalk"].get("error") for x in rs if isinstance(x.get("robotalk"), dict)
+                   and x["robotalk"].get("error")]
+            fmt_s = ", ".join(f"{c * 1e3:.1f} ms" if c is not None else "—" for c in ch)
+            fmt_h = ", ".join(f"{h * 1e3:.1f} ms" if h is not None else "—" for h in hs)
+            lines.append(f"| {prof} | {names[est]} | {fmt_s} | {fmt_h} | {', '.join(ratios)} | {late} of {n} | "
+                         f"{over} | {gs * 100:.1f} % | {ts * 1e3:.1f} ms |" + (f" (error: {err[0][:80]})" if err else ""))
+    return "\n".join(lines)
+
+
 def trajectory_section(res, figdir):
     """Issue 22's section: robotalk-trajectory-bench's output as it printed it, and the
     ODE iiwa14 10 Hz plot (step vs quintic vs the continuous sine)."""
     r = res.get("trajectory")
     if not r:
         return None
-    m = r.get("meta", {})
-    head = (f"Measured {m.get('date_utc')} UTC, commit {m.get('commit')}, {'quick' if m.get('quick') else 'full'} "
-            f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs "
-            "(`robotalk-trajectory-bench`, bench/trajectory_bench.cpp).")
+    head = measured_head(r, " (`robotalk-trajectory-bench`, bench/trajectory_bench.cpp).")
     if r.get("error") or r.get("rc"):
         return head + "\n\nNot measured: " + str(r.get("error") or r.get("stderr"))
     plot = r.get("plot_ode_10hz") or {}
@@ -377,6 +420,9 @@ def main():
     section = trajectory_section(latest, args.figdir)
     if section is not None:
         doc = replace_between(doc, *OWN_SECTIONS["trajectory"], section)
+    section = playback_estimators_section(latest)
+    if section is not None and OWN_SECTIONS["playback_estimators"][0] in doc:
+        doc = replace_between(doc, *OWN_SECTIONS["playback_estimators"], section)
     with open(args.doc, "w") as f:
         f.write(doc)
     plot(latest if latest else before, args.figdir)

@@ -355,6 +355,47 @@ class Bench:
                 time.sleep(2.5)
         return {"figure": "playback", "frames": frames, "period_ms": 100, "runs": runs}
 
+    def playback_estimators(self):
+        """Issue 23 item 3: the paper's estimator, issue 11's quick start and the adaptive start with its
+        bounded stretch, in one run: for each relay profile (the congestion levels U[0, X] ms client ->
+        server, and the WAN profiles) the three interleaved on the same relay seed, each on a fresh
+        server; start latency / the hindsight minimum (the arrival log on the server's side), late
+        frames, and the stretch of the timing as played (the replies' execution times)."""
+        frames = 20 if self.quick else 40
+        profiles = [("U[0, 0] ms", ["--a2b-congestion-max-ms", "0"]),
+                    ("U[0, 50] ms", ["--a2b-congestion-max-ms", "50"]),
+                    ("U[0, 100] ms", ["--a2b-congestion-max-ms", "100"]),
+                    ("U[0, 150] ms", ["--a2b-congestion-max-ms", "150"]),
+                    ("WAN 100 ms +-50 ms, 1 % loss", ["--profile", "wan"]),
+                    ("WAN 300 ms +-50 ms, 1 % loss", ["--profile", "wan-300"])]
+        if self.quick:
+            profiles = [profiles[0], profiles[2], profiles[4]]
+        reps = 1 if self.quick else 2
+        estimators = ("paper", "quick", "adaptive")
+        runs = []
+        seed = 101
+        for name, impair in profiles:
+            for _ in range(reps):
+                for est in estimators:  # interleaved on the same relay seed
+                    self.start_server(url=URL_B, extra=["--playback-estimator", est])
+                    relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, *impair, "--seed", str(seed),
+                                        "--duration", "120"])
+                    time.sleep(0.3)
+                    log = self.start([self.raw, "arrivals", "--url", URL_B, "--robot", ROBOT, "--frames",
+                                      str(frames), "--timeout", "50"])
+                    time.sleep(0.2)  # the arrival log subscribed before the first frame
+                    a = self.run([self.client, "playback", "--url", URL_A, "--frames", str(frames),
+                                  "--period-ms", "100", "--stretch-bound", "0.1"], timeout=60)
+                    arr = self.collect(log, 50, "arrivals")
+                    self.stop(relay)
+                    self.stop_server()
+                    runs.append({"profile": name, "relay_args": impair, "seed": seed, "estimator": est,
+                                 "robotalk": a, "arrivals": arr})
+                    time.sleep(0.5)
+                seed += 1
+        return {"figure": "playback_estimators", "frames": frames, "period_ms": 100, "stretch_bound": 0.1,
+                "runs": runs}
+
     @staticmethod
     def key_values(text):
         out = {}
@@ -462,7 +503,8 @@ class Bench:
                 "shared_robots": os.path.exists(shared), "plot_ode_10hz": plot}
 
 
-FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback", "links", "micro",
+FIGURES = ["query", "timed", "panic", "throughput", "scale", "cli", "memory", "jitter", "playback",
+           "playback_estimators", "links", "micro",
            "ode", "trajectory"]
 
 

@@ -14,10 +14,7 @@ PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration
   frames_.reserve(std::min<std::size_t>(needed_, 1024));  // a declaration is a claim, not memory to reserve
 }
 
-namespace {
-// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
-// (73 years; two such delays still subtract without overflow).
-std::optional<Duration> DelayOf(TimePoint sent, TimePoint arrival) {
+std::optional<Duration> OneWayDelay(TimePoint sent, TimePoint arrival) {
   Duration::rep d = 0;
   if (__builtin_sub_overflow(arrival.time_since_epoch().count(), sent.time_since_epoch().count(), &d))
     return std::nullopt;
@@ -25,10 +22,9 @@ std::optional<Duration> DelayOf(TimePoint sent, TimePoint arrival) {
   if (d > kBound || d < -kBound) return std::nullopt;
   return Duration(d);
 }
-}  // namespace
 
 void DelayHistory::Add(TimePoint sent, TimePoint received) {
-  const std::optional<Duration> d = DelayOf(sent, received);
+  const std::optional<Duration> d = OneWayDelay(sent, received);
   if (!d) return;
   ring_[next_] = {received, *d};
   next_ = (next_ + 1) % kCapacity;
@@ -46,7 +42,7 @@ std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const
 }
 
 void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent) {
-  frames_.push_back({offset, arrival, sent ? DelayOf(*sent, arrival) : std::nullopt});
+  frames_.push_back({offset, arrival, sent ? OneWayDelay(*sent, arrival) : std::nullopt});
 }
 
 std::optional<Duration> PlaybackEstimator::delay_spread() const {
@@ -60,7 +56,39 @@ std::optional<Duration> PlaybackEstimator::delay_spread() const {
   return *hi - *lo;
 }
 
+double PlaybackEstimator::interval() const {
+  return total_ > 1 ? ToSeconds(duration_) / static_cast<double>(total_ - 1) : 1.0;
+}
+
+std::optional<PlaybackEstimator::Spread> PlaybackEstimator::FencedSpread() const {
+  if (!delay_spread()) return std::nullopt;  // too few, or a frame without a send time
+  std::vector<Duration> delays = history_;
+  for (const Frame& f : frames_) delays.push_back(*f.delay);
+  std::sort(delays.begin(), delays.end());
+  // A package whose first copy was lost arrives as its retransmission, which
+  // carries its first send time: its delay includes the client's resend wait
+  // (100 ms at least by default, doubling). Such outliers, more than
+  // max(8 × (median − least), 50 ms) above the median, are not the
+  // channel's jitter and are left out (a later frame that is that slow gets
+  // its gap stretched, or is late).
+  const Duration least = delays.front(), median = delays[delays.size() / 2];
+  const Duration fence = median + std::max(8 * (median - least), Duration(std::chrono::milliseconds(50)));
+  std::size_t kept = delays.size();
+  while (kept > 1 && delays[kept - 1] > fence) --kept;
+  return Spread{least, delays[kept - 1], kept};
+}
+
+bool PlaybackEstimator::adaptive() const {
+  // The whole spread, outliers included: the paper's congestion (a server
+  // pausing after each package) shows as a few slow packages among fast ones.
+  if (!options_.adaptive) return false;
+  const std::optional<Duration> spread = delay_spread();
+  return spread && ToSeconds(*spread) <= options_.adaptive_max_spread * interval();
+}
+
 bool PlaybackEstimator::quick() const {
+  if (adaptive()) return true;
+  if (options_.adaptive) return false;  // the adaptive start's fallback is the paper's estimate
   if (!options_.quick_start) return false;
   const std::optional<Duration> spread = delay_spread();
   // A spread this small beside the frame interval is a channel that keeps up
@@ -70,25 +98,37 @@ bool PlaybackEstimator::quick() const {
   return spread && ToSeconds(*spread) <= options_.quick_max_spread * interval;
 }
 
-TimePoint PlaybackEstimator::QuickStartTime() const {
-  // The worst delay a later frame may have is predicted as the least seen
-  // plus quick_jitter_factor times the spread (the history is a sample: its
-  // max underestimates the channel's). Offset 0 plays when the latest frame
-  // seen (arrival − offset) would plus that worst delay's excess over the
-  // frame's own; never before the decision (as StartTime).
+Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
+  const Spread s = *FencedSpread();
+  const Duration spread = s.most - s.least;
+  // Delays that vary by less than a frame interval cannot build a queue of
+  // frames: the worst recent delay, and the schedule's stretch for a slower
+  // frame. The spread beyond one interval may accumulate in a queue that
+  // sparse packages never met: it is covered quick_jitter_factor times.
+  const double excess = std::max(0.0, ToSeconds(spread) - options_.quick_max_spread * interval());
+  return s.most + FromSeconds(excess * options_.quick_jitter_factor +
+                              ToSeconds(spread) * headroom / static_cast<double>(s.kept));
+}
+
+std::optional<Duration> PlaybackEstimator::playout_delay() const {
+  if (!adaptive()) return std::nullopt;
+  return AdaptiveWorst(options_.adaptive_headroom) + options_.adaptive_margin;
+}
+
+TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin) const {
+  // Offset 0 plays when the latest frame seen (arrival − offset) would plus
+  // the worst delay's excess over the frame's own; never before the decision
+  // (as StartTime).
   const Frame* anchor = &frames_.front();  // quick(): every frame has a delay
-  Duration least = *anchor->delay, first_offset = Duration::max();
+  Duration first_offset = Duration::max();
   TimePoint decided = TimePoint::min();
   for (const Frame& f : frames_) {
     if (f.arrival - f.offset > anchor->arrival - anchor->offset) anchor = &f;
-    least = std::min(least, *f.delay);
     first_offset = std::min(first_offset, f.offset);
     decided = std::max(decided, f.arrival);
   }
-  for (Duration d : history_) least = std::min(least, d);
-  const Duration worst = least + FromSeconds(ToSeconds(*delay_spread()) * options_.quick_jitter_factor);
   const Duration excess = std::max(Duration(0), worst - *anchor->delay);
-  return std::max(anchor->arrival - anchor->offset + excess, decided - first_offset) + options_.quick_margin;
+  return std::max(anchor->arrival - anchor->offset + excess, decided - first_offset) + margin;
 }
 
 Duration PlaybackEstimator::mean_command_interval() const {
@@ -142,7 +182,17 @@ Duration PlaybackEstimator::ExtraLagBound(Duration remaining) const {
 }
 
 TimePoint PlaybackEstimator::StartTime() const {
-  if (quick()) return QuickStartTime();
+  if (adaptive()) return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin);
+  if (quick()) {
+    // The worst delay a later frame may have is predicted as the least seen
+    // plus quick_jitter_factor times the spread (the history is a sample:
+    // its max underestimates the channel's).
+    Duration least = Duration::max();
+    for (const Frame& f : frames_) least = std::min(least, *f.delay);
+    for (Duration d : history_) least = std::min(least, d);
+    return StartCovering(least + FromSeconds(ToSeconds(*delay_spread()) * options_.quick_jitter_factor),
+                         options_.quick_margin);
+  }
   // Frames seen must be there before they play: start >= a_i - o_i.
   TimePoint lag = TimePoint::min();
   Duration first_offset = Duration::max(), last_offset = Duration::min();

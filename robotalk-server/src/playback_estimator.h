@@ -26,6 +26,21 @@
 // a predicted worst delay (the least seen + quick_jitter_factor × the
 // spread), plus a small margin. Otherwise (no history, a client without
 // send times, a congested channel) the paper's estimate above.
+//
+// Adaptive start (issue 23 item 3, the default): the quick start's 2.5 ×
+// spread + 10 ms was most of its start latency where the channel's jitter is
+// a few milliseconds. With a schedule that stretches the gaps between frames
+// afterwards, within a bound (playback_schedule.h), the start need not cover
+// every frame to come. It is decided at the first frame whenever the delays
+// are known and spread by at most adaptive_max_spread intervals, to cover the worst recent delay (the
+// history's and the frames' max) + spread / n (n delays seen: the max of n samples falls short of the
+// channel's by about that) + `adaptive_margin`. The schedule then grows that buffer to the worst delay + 4 ×
+// spread / n by stretching the first gaps (at most max_stretch each), and further for any frame slower than
+// it. Where the spread exceeds one frame interval a queue can build that the history (sparse packages, no
+// queue) cannot show: the spread beyond one interval is added quick_jitter_factor times, and beyond
+// `adaptive_max_spread` intervals (the paper's congestion experiment, Fig. 11)
+// the paper's estimate is used instead. A client without send times gets the
+// paper's estimate too; the stretch applies either way.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -57,7 +72,28 @@ struct PlaybackEstimatorOptions {
   double quick_jitter_factor = 2.5;
   /// Added on top (the RobotDaemon's wake-up, the decision itself).
   Duration quick_margin = std::chrono::milliseconds(10);
+  /// The adaptive start (see above; off: the quick start or the paper's).
+  bool adaptive = true;
+  /// Above this spread (in frame intervals) the delays may be a queue's
+  /// (the paper's congestion): the adaptive start gives way to the paper's
+  /// estimate, which waits for frames and projects their drift.
+  double adaptive_max_spread = 1.2;
+  /// Added to the worst recent delay; also the schedule's margin.
+  Duration adaptive_margin = std::chrono::milliseconds(2);
+  /// And the spread × this / the delays seen: the max of n samples falls
+  /// short of the channel's by about spread / n (uniform jitter), so twice that.
+  double adaptive_headroom = 4.0;
+  /// The start covers only this much of the headroom (same unit); the
+  /// schedule reaches the rest by stretching the first gaps within max_stretch.
+  double start_headroom = 1.0;
+  /// With the adaptive start, each gap between frames may play up to this
+  /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
+  double max_stretch = 0.10;
 };
+
+/// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
+/// (73 years; two such delays still subtract and add without overflow).
+std::optional<Duration> OneWayDelay(TimePoint sent, TimePoint arrival);
 
 /// The one-way delays (arrival − client send time) of one client's latest
 /// packages, for PlaybackEstimator's quick start. Not thread-safe (one
@@ -98,8 +134,14 @@ class PlaybackEstimator {
     return frames_.capacity() * sizeof(Frame) + history_.capacity() * sizeof(Duration);
   }
   bool ready() const { return quick() || frames_.size() >= needed_; }
-  /// Whether the start is decided by the quick start (see above).
+  /// Whether the start is decided at the first frames from send times (the
+  /// quick or the adaptive start, see above).
   bool quick() const;
+  /// Whether the start is the adaptive one (see above).
+  bool adaptive() const;
+  /// With the adaptive start, the worst delay it covers + its margin (the
+  /// schedule's playout delay, PlaybackSchedule); else nullopt.
+  std::optional<Duration> playout_delay() const;
   /// Max − min of the recent one-way delays and the frames' (nullopt: too
   /// few, or a frame without a send time).
   std::optional<Duration> delay_spread() const;
@@ -119,7 +161,15 @@ class PlaybackEstimator {
     TimePoint arrival;
     std::optional<Duration> delay;  // arrival − send time
   };
-  TimePoint QuickStartTime() const;  // REQUIRES: quick()
+  // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
+  TimePoint StartCovering(Duration worst, Duration margin) const;
+  Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
+  struct Spread {
+    Duration least, most;  // of the recent delays, retransmissions left out
+    std::size_t kept;      // delays within the fence
+  };
+  std::optional<Spread> FencedSpread() const;
+  double interval() const;  // the declared mean frame interval, s
   std::size_t total_;
   Duration duration_;
   PlaybackEstimatorOptions options_;

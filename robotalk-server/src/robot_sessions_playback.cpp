@@ -4,6 +4,9 @@
 #include "robot_sessions.h"
 #include "robot_sessions_text.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace robotalk {
 
 using namespace sessions_text;
@@ -78,6 +81,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   }
   const std::optional<TimePoint> sent =
       r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
+  const std::optional<Duration> delay = sent ? OneWayDelay(*sent, now) : std::nullopt;
   for (const Command& c : r.commands) {
     std::optional<QueuedItem> item =
         Admit(s, c, now, immediate, /*playback=*/true, r.max_late, r.interpolation);
@@ -95,11 +99,11 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
     }
     item->has_start_time = true;
     if (seq.start) {  // already playing: straight to the RobotDaemon
-      item->start = *seq.start + offset;
+      item->start = seq.schedule->Place(offset, now, delay).at;
       if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
     } else {
       seq.estimator->Add(offset, now, sent);
-      seq.frames.push_back({offset, std::move(*item)});
+      seq.frames.push_back({offset, std::move(*item), now, delay});
     }
   }
   if (!seq.start && seq.estimator->ready()) Start(s, d.id, seq, now, immediate);
@@ -113,18 +117,36 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
 void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, TimePoint now,
                           std::vector<Reply>& immediate) {
   const PlaybackEstimator& estimator = *seq.estimator;
+  const PlaybackEstimatorOptions& o = options_.playback;
   seq.start = estimator.StartTime();
+  // The adaptive start's schedule may stretch the gaps between frames; the
+  // quick and the paper's starts keep every frame at start + its offset.
+  const double stretch = o.adaptive ? o.max_stretch : 0.0;
+  seq.schedule.emplace(*seq.start, estimator.playout_delay(),
+                       PlaybackScheduleOptions{.max_stretch = stretch, .margin = o.adaptive_margin});
+  // The buffered frames, in offset order (the schedule stretches forward).
+  std::stable_sort(seq.frames.begin(), seq.frames.end(),
+                   [](const auto& a, const auto& b) { return a.offset < b.offset; });
   for (PlaybackSequence::Frame& frame : seq.frames) {
-    frame.item.start = *seq.start + frame.offset;
+    frame.item.start = seq.schedule->Place(frame.offset, frame.arrival, frame.delay).at;
     if (!Superseded(s, frame.item, now, immediate)) daemon_.Submit(std::move(frame.item));
   }
   std::vector<PlaybackSequence::Frame>().swap(seq.frames);
   const Duration delay = *seq.start - *seq.first_arrival;
-  const std::string why = estimator.quick()
-                              ? "quick start: this client's packages' one-way delays vary by " +
-                                    Seconds(*estimator.delay_spread())
-                              : "mean " + Seconds(estimator.mean_command_interval()) + " between commands, " +
-                                    Seconds(estimator.mean_arrival_interval()) + " between arrivals";
+  std::string why;
+  if (estimator.adaptive()) {
+    why = "adaptive start: this client's recent one-way delays vary by " + Seconds(*estimator.delay_spread());
+  } else if (estimator.quick()) {
+    why = "quick start: this client's packages' one-way delays vary by " + Seconds(*estimator.delay_spread());
+  } else {
+    why = "mean " + Seconds(estimator.mean_command_interval()) + " between commands, " +
+          Seconds(estimator.mean_arrival_interval()) + " between arrivals";
+  }
+  if (stretch > 0) {
+    why += "; a gap between frames plays up to " +
+           std::to_string(static_cast<int>(std::lround(stretch * 100))) +
+           " % longer when the next frame is slow";
+  }
   Reply reply = MakeReply(id, Signal::kSuccess,
                           "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +
                               " after its first frame arrived (" + why + ")",

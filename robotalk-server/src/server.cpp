@@ -115,6 +115,9 @@ class Server::Impl {
     SessionOptions sessions{options_.session_timeout, options_.max_queue, options_.max_future};
     sessions.limits.max_goto_distance = options_.max_goto_distance;
     sessions.playback = PlaybackEstimatorOptions{options_.playback_min_frames, options_.playback_fraction};
+    sessions.playback.quick_start = options_.playback_estimator != "paper";
+    sessions.playback.adaptive = options_.playback_estimator == "adaptive";
+    sessions.playback.max_stretch = options_.playback_stretch;
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     sessions.max_sessions_per_robot = options_.max_sessions_per_robot;

@@ -41,6 +41,12 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   [0, S] s in the ServerDaemon after each received package
   --playback-min-frames N         frames playback mode waits for before estimating (default 5;
                                   also at least 10% of the declared sequence)
+  --playback-estimator E          how a playback sequence's start is decided: adaptive (default:
+                                  at its first frame from the client's worst recent one-way
+                                  delay, then gaps stretch when a frame is slower), quick
+                                  (issue 11's start, fixed timing) or paper (wait for frames)
+  --playback-stretch F            adaptive: how much longer than recorded a gap between two
+                                  frames may play (default 0.1: 10 %; 0: never)
   --inject-reply-drop P           test only: drop each reply package with probability P
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
@@ -199,6 +205,15 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.congestion_max_pause = FromSeconds(ParseNumber(arg, value(), 0, 10));
       } else if (arg == "--playback-min-frames") {
         options.playback_min_frames = static_cast<size_t>(ParseNumber(arg, value(), 2, 1e6));
+      } else if (arg == "--playback-estimator") {
+        options.playback_estimator = value();
+        if (options.playback_estimator != "adaptive" && options.playback_estimator != "quick" &&
+            options.playback_estimator != "paper") {
+          throw Error("--playback-estimator '" + options.playback_estimator +
+                      "': expected adaptive, quick or paper");
+        }
+      } else if (arg == "--playback-stretch") {
+        options.playback_stretch = ParseNumber(arg, value(), 0, 1);
       } else if (arg == "--duration") {
         duration = ParseNumber(arg, value(), 0, 1e9);
       } else if (arg == "--inject-reply-drop") {

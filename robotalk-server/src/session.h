@@ -10,6 +10,7 @@
 #include "command_queue.h"
 #include "link_health.h"
 #include "playback_estimator.h"
+#include "playback_schedule.h"
 #include "robotalk/access_list.h"
 #include "robotalk/command.h"
 #include "robotalk/session_auth.h"
@@ -101,9 +102,12 @@ struct PlaybackSequence {
   struct Frame {
     Duration offset;  ///< from the sequence start
     QueuedItem item;  ///< its start is set once the sequence's start is known
+    TimePoint arrival;
+    std::optional<Duration> delay;  ///< arrival − client send time (OneWayDelay)
   };
-  std::vector<Frame> frames;       ///< the playback queue
-  std::optional<TimePoint> start;  ///< when offset 0 plays, once estimated
+  std::vector<Frame> frames;                 ///< the playback queue
+  std::optional<TimePoint> start;            ///< when offset 0 plays, once estimated
+  std::optional<PlaybackSchedule> schedule;  ///< when each frame plays, once started
   std::optional<TimePoint> first_arrival;
   std::size_t total;
   Duration duration;

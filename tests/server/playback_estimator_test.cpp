@@ -91,7 +91,7 @@ TEST(PlaybackEstimator, ReportsTheMeanIntervals) {
   EXPECT_EQ(est.mean_arrival_interval(), milliseconds(120));
 }
 
-// --- Quick start from send times -------------------------------------------
+// --- Quick start from send times (issue 11; an option since issue 23) -------
 
 // A paced client (frame i sent at offset i) on a channel whose one-way delay
 // is delay(k) for the k-th package (history first, then the frames); the
@@ -106,7 +106,7 @@ struct QuickRun {
 template <typename Delay>
 QuickRun RunPaced(std::size_t frames, Duration period, std::size_t history, Delay delay) {
   const Duration skew = std::chrono::seconds(5000);
-  PlaybackEstimator est(frames, period * static_cast<int>(frames - 1));
+  PlaybackEstimator est(frames, period * static_cast<int>(frames - 1), {.adaptive = false});
   DelayHistory h;
   std::size_t k = 0;
   for (; k < history; ++k) {  // connect: hello, clock rounds, CONFIG, heartbeats
@@ -185,7 +185,7 @@ TEST(PlaybackEstimator, ACongestedChannelOrAClientWithoutSendTimesGetsThePapersE
   EXPECT_TRUE(fresh.quick);
   EXPECT_EQ(fresh.delay, milliseconds(300) + PlaybackEstimatorOptions{}.quick_margin);
   // Frames without send times never start quickly.
-  PlaybackEstimator est(40, milliseconds(3900));
+  PlaybackEstimator est(40, milliseconds(3900), {.adaptive = false});
   est.SetDelayHistory(std::vector<Duration>(10, milliseconds(1)));
   est.Add(Duration(0), kT0);
   EXPECT_FALSE(est.ready());
@@ -193,7 +193,7 @@ TEST(PlaybackEstimator, ACongestedChannelOrAClientWithoutSendTimesGetsThePapersE
 }
 
 TEST(PlaybackEstimator, QuickStartCanBeSwitchedOff) {
-  PlaybackEstimator est(40, milliseconds(3900), {.quick_start = false});
+  PlaybackEstimator est(40, milliseconds(3900), {.quick_start = false, .adaptive = false});
   est.SetDelayHistory(std::vector<Duration>(10, milliseconds(1)));
   est.Add(Duration(0), kT0, kT0 - milliseconds(1));
   EXPECT_FALSE(est.quick());

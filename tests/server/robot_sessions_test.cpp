@@ -465,13 +465,47 @@ TEST_F(RobotSessionsTest, PlaybackStartsAtTheFirstFrameFromTheSessionsSendTimesW
   ASSERT_TRUE(immediate.count(kPlayback)) << "decided at the first frame";
   const Reply& r = immediate.at(kPlayback);
   EXPECT_EQ(r.signal, Signal::kSuccess);
-  EXPECT_THAT(r.message, HasSubstr("quick start"));
-  // 10 ms margin + 2.5 x the 200 us spread less this frame's 100 us excess over the least.
+  EXPECT_THAT(r.message, HasSubstr("adaptive start"));
+  EXPECT_THAT(r.message, HasSubstr("up to 10 % longer"));
+  // The worst delay (500 us) + the 200 us spread / 7 delays, less this
+  // frame's 400 us, + the 2 ms margin: 2.13 ms (the quick start: 10.1 ms).
   const Duration delay = FromSeconds(r.values.at(0));
-  EXPECT_GE(delay, milliseconds(10));
-  EXPECT_LE(delay, milliseconds(11));
-  EXPECT_EQ(FromWireMicros(static_cast<std::int64_t>(r.values.at(1))),
-            first_arrival + std::chrono::duration_cast<std::chrono::microseconds>(delay));
+  EXPECT_GE(delay, std::chrono::microseconds(2100));
+  EXPECT_LE(delay, std::chrono::microseconds(2160));
+  const TimePoint start = FromWireMicros(static_cast<std::int64_t>(r.values.at(1)));
+  EXPECT_EQ(start, first_arrival + std::chrono::duration_cast<std::chrono::microseconds>(delay));
+  // Frames 1-9 every 100 ms, taking 400 us, except frame 4 (6 ms: later than
+  // the start covered). Its gap stretches; none runs before it arrived.
+  std::vector<TimePoint> arrivals = {first_arrival};
+  for (int i = 1; i < 10; ++i) {
+    const Duration took = std::chrono::microseconds(i == 4 ? 6000 : 400);
+    const TimePoint arrival = first_arrival + period * i + took - std::chrono::microseconds(400);
+    while (clock_.Now() + milliseconds(1) <= arrival) {
+      clock_.Advance(milliseconds(1));
+      Run();
+    }
+    clock_.Set(arrival);
+    const Command frame =
+        Cmd(1 + i, CommandType::kJointSetPoint, {0.1 * i}, "pan", StartTime::After(period * i));
+    Handle(stamped(Playback(kAlice, ++seq, kPlayback, 10, period * 9, {frame}), took));
+    arrivals.push_back(arrival);
+  }
+  for (int k = 0; k < 300; ++k) {
+    clock_.Advance(milliseconds(1));
+    Run();
+  }
+  ASSERT_EQ(fake_->calls.size(), 10u);
+  for (int i = 0; i < 10; ++i) {
+    const TimePoint at = fake_->calls[static_cast<size_t>(i)].at;
+    EXPECT_GE(at, arrivals[static_cast<size_t>(i)] + milliseconds(1))
+        << "frame " << i << " ran before it arrived";
+    if (i == 0) continue;
+    const double gap = ToSeconds(at - fake_->calls[static_cast<size_t>(i) - 1].at);
+    EXPECT_GE(gap, 0.099) << "frame " << i;  // within one 1 ms step of the RobotDaemon
+    EXPECT_LE(gap, 0.111) << "frame " << i << ": a gap stretches by 10 % at most";
+  }
+  const double stretched = ToSeconds(fake_->calls[4].at - fake_->calls[3].at);
+  EXPECT_GT(stretched, 0.102) << "frame 4's gap took its extra delay";
 }
 
 TEST_F(RobotSessionsTest, PlaybackWithoutSendTimesWaitsForFramesAsThePaperDoes) {

@@ -374,6 +374,35 @@ TEST(RelayOptions, PerDirectionOptionsWinOverSharedOnesInAnyOrder) {
   EXPECT_DOUBLE_EQ(o.duration_s, 2.5);
 }
 
+TEST(RelayOptions, TheWanProfileSetsBothDirectionsAndOtherOptionsOverrideIt) {
+  const std::vector<std::string> base = {"--a", "udpm://239.255.76.67:7100", "--b",
+                                         "udpm://239.255.76.67:7300"};
+  auto with = [&](std::vector<std::string> extra) {
+    extra.insert(extra.begin(), base.begin(), base.end());
+    return ParseRelayOptions(extra);
+  };
+  const RelayOptions wan = with({"--profile", "wan"});
+  for (const DirectionOptions* d : {&wan.a2b, &wan.b2a}) {
+    EXPECT_EQ(d->impairment.latency, std::chrono::milliseconds(100));
+    EXPECT_EQ(d->impairment.jitter, std::chrono::milliseconds(50));
+    EXPECT_EQ(d->impairment.jitter_distribution, JitterDistribution::kUniform);
+    EXPECT_DOUBLE_EQ(d->impairment.loss, 0.01);
+  }
+  EXPECT_EQ(with({"--profile", "wan-300"}).b2a.impairment.latency, std::chrono::milliseconds(300));
+  // Given before or after the profile, an option overrides its part.
+  const RelayOptions o = with({"--loss", "0", "--profile", "wan", "--b2a-latency-ms", "5"});
+  EXPECT_DOUBLE_EQ(o.a2b.impairment.loss, 0.0);
+  EXPECT_EQ(o.a2b.impairment.latency, std::chrono::milliseconds(100));
+  EXPECT_EQ(o.b2a.impairment.latency, std::chrono::milliseconds(5));
+  EXPECT_EQ(o.b2a.impairment.jitter, std::chrono::milliseconds(50));
+  try {
+    with({"--profile", "moon"});
+    ADD_FAILURE() << "an unknown profile was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--profile 'moon'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RelayOptions, RejectsBadValuesNamingTheOption) {
   for (const std::vector<std::string>& bad : {std::vector<std::string>{"--loss", "1.2"},
                                               {"--dup", "x"},

@@ -87,9 +87,9 @@ bool ApplyDirection(const std::string& option, const std::string& name, const st
 // Whether `name` (without "--") is an option that takes a value.
 bool TakesValue(std::string name) {
   if (name.rfind("a2b-", 0) == 0 || name.rfind("b2a-", 0) == 0) name = name.substr(4);
-  for (const char* known :
-       {"a", "b", "seed", "duration", "echo-window-ms", "latency-ms", "jitter-ms", "jitter-dist", "loss",
-        "dup", "reorder", "reorder-delay-ms", "congestion-max-ms", "outage-at-ms", "outage-ms", "channels"}) {
+  for (const char* known : {"a", "b", "seed", "duration", "echo-window-ms", "profile", "latency-ms",
+                            "jitter-ms", "jitter-dist", "loss", "dup", "reorder", "reorder-delay-ms",
+                            "congestion-max-ms", "outage-at-ms", "outage-ms", "channels"}) {
     if (name == known) return true;
   }
   return false;
@@ -129,6 +129,21 @@ int UdpmPort(const std::string& url) {
   }
 }
 
+ImpairmentParams RelayProfile(const std::string& name) {
+  ImpairmentParams p;
+  if (name == "wan" || name == "wan-300") {
+    // Issue 23: a WAN-like path, 100-300 ms of delay with +-50 ms of jitter
+    // and 1 % loss; "wan" is its short end, "wan-300" its long end.
+    p.latency = std::chrono::milliseconds(name == "wan" ? 100 : 300);
+    p.jitter = std::chrono::milliseconds(50);
+    p.jitter_distribution = JitterDistribution::kUniform;
+    p.loss = 0.01;
+  } else {
+    throw std::invalid_argument("ParseRelayOptions: --profile '" + name + "': expected wan or wan-300");
+  }
+  return p;
+}
+
 RelayOptions ParseRelayOptions(const std::vector<std::string>& args) {
   RelayOptions o;
   // Pass 1 splits "--opt=value" / "--opt value"; pass 2 applies unprefixed
@@ -162,9 +177,17 @@ RelayOptions ParseRelayOptions(const std::vector<std::string>& args) {
       items.push_back({arg, args[++i]});
     }
   }
+  // A profile first: every other impairment option overrides its part.
+  for (const auto& [option, value] : items) {
+    if (option != "--profile") continue;
+    const ImpairmentParams profile = RelayProfile(value);
+    o.a2b.impairment = profile;
+    o.b2a.impairment = profile;
+  }
   for (const auto& [option, value] : items) {
     const std::string name = option.substr(2);
     if (name.rfind("a2b-", 0) == 0 || name.rfind("b2a-", 0) == 0) continue;
+    if (name == "profile") continue;  // applied above
     if (name == "a") {
       o.url_a = value;
     } else if (name == "b") {
@@ -228,6 +251,10 @@ side), both ways, through a seeded impaired channel per direction.
   --stats                 print per-direction counters at exit
   --echo-window-ms MS     how long to recognise our own publications (default 2000)
   --version               the version
+
+  --profile NAME          preset impairments of both directions, which the options
+                          below override: wan (100 ms +-50 ms uniform, 1 % loss),
+                          wan-300 (300 ms +-50 ms uniform, 1 % loss)
 
 Impairments (set both directions; --a2b-NAME / --b2a-NAME set one and win):
   --latency-ms MS         fixed delay

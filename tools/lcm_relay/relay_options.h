@@ -34,6 +34,11 @@ struct RelayOptions {
 /// Throws std::invalid_argument naming the option and the bad value.
 RelayOptions ParseRelayOptions(const std::vector<std::string>& args);
 
+/// The impairments of a --profile: "wan" (100 ms +-50 ms uniform,
+/// 1 % loss) or "wan-300" (300 ms +-50 ms, 1 % loss). Throws
+/// std::invalid_argument naming an unknown profile.
+ImpairmentParams RelayProfile(const std::string& name);
+
 /// The --help text.
 std::string RelayUsage();
 

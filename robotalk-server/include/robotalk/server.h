@@ -119,6 +119,12 @@ struct ServerOptions {
   /// Frames playback mode waits for before estimating its delay.
   std::size_t playback_min_frames = 5;
   double playback_fraction = 0.1;
+  /// How playback's start is decided (docs/server.md, Playback): "adaptive"
+  /// (at the first frame, from the worst recent delay; gaps may stretch by
+  /// playback_stretch), "quick" (issue 11's quick start, fixed timing) or
+  /// "paper" (the paper's estimate only, fixed timing).
+  std::string playback_estimator = "adaptive";
+  double playback_stretch = 0.10;
   /// Test fault injection on outgoing reply packages (seeded): probability
   /// that one is dropped, and that one is sent twice.
   double reply_drop_probability = 0.0;

@@ -1,0 +1,303 @@
+// Issue 23 item 3: the adaptive start and the bounded stretch of playback's
+// schedule, on a manual timeline (no clock: every time is given).
+#include "playback_schedule.h"
+#include "playback_estimator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <random>
+
+namespace robotalk {
+namespace {
+
+using std::chrono::milliseconds;
+
+const TimePoint kT0(std::chrono::seconds(100));
+const Duration kMargin = milliseconds(2);
+
+TEST(PlaybackSchedule, WithoutStretchEveryFramePlaysAtStartPlusItsOffset) {
+  PlaybackSchedule s(kT0, std::nullopt, {.max_stretch = 0});
+  EXPECT_EQ(s.Place(Duration(0), kT0 - milliseconds(5)).at, kT0);
+  EXPECT_EQ(s.Place(milliseconds(100), kT0 + milliseconds(99)).at, kT0 + milliseconds(100));
+  // Arriving after its time: late, and the schedule does not move.
+  const auto late = s.Place(milliseconds(200), kT0 + milliseconds(250));
+  EXPECT_TRUE(late.late);
+  EXPECT_EQ(late.at, kT0 + milliseconds(200));
+  EXPECT_EQ(s.Place(milliseconds(300), kT0 + milliseconds(260)).at, kT0 + milliseconds(300));
+  EXPECT_EQ(s.late_frames(), 1u);
+  EXPECT_EQ(s.stretch(), Duration(0));
+}
+
+TEST(PlaybackSchedule, AFrameSlowerThanTheBufferStretchesItsGapWithinTheBound) {
+  PlaybackSchedule s(kT0, std::nullopt, {.max_stretch = 0.05, .margin = kMargin});
+  EXPECT_EQ(s.Place(Duration(0), kT0 - milliseconds(5)).at, kT0);
+  // Due at +100 ms, here at +101 ms: plays at +103 (its arrival + the margin), a 3 % longer gap.
+  const auto p = s.Place(milliseconds(100), kT0 + milliseconds(101));
+  EXPECT_FALSE(p.late);
+  EXPECT_EQ(p.at, kT0 + milliseconds(103));
+  EXPECT_NEAR(s.max_gap_stretch(), 0.03, 1e-9);
+  // The next gap is measured from the stretched frame: the delay is kept, not caught up.
+  EXPECT_EQ(s.Place(milliseconds(200), kT0 + milliseconds(150)).at, kT0 + milliseconds(203));
+  EXPECT_EQ(s.stretch(), milliseconds(3));
+  EXPECT_EQ(s.late_frames(), 0u);
+}
+
+TEST(PlaybackSchedule, AFramePastTheBoundIsLateAndTheSequencePausesForIt) {
+  PlaybackSchedule s(kT0, std::nullopt, {.max_stretch = 0.05, .margin = kMargin});
+  s.Place(Duration(0), kT0 - milliseconds(5));
+  // The bound allows +105 ms; it arrives at +120: late, plays at +122.
+  const auto p = s.Place(milliseconds(100), kT0 + milliseconds(120));
+  EXPECT_TRUE(p.late);
+  EXPECT_EQ(p.at, kT0 + milliseconds(122));
+  EXPECT_EQ(s.late_frames(), 1u);
+  EXPECT_EQ(s.max_gap_stretch(), 0.0) << "a pause is counted as late, not as a stretch";
+  // The frames after it keep its headroom: on time again.
+  const auto next = s.Place(milliseconds(200), kT0 + milliseconds(205));
+  EXPECT_FALSE(next.late);
+  EXPECT_EQ(next.at, kT0 + milliseconds(222));
+}
+
+TEST(PlaybackSchedule, AReorderedFramePlaysBetweenItsNeighboursWithinTheBound) {
+  PlaybackSchedule s(kT0, std::nullopt, {.max_stretch = 0.05, .margin = kMargin});
+  s.Place(Duration(0), kT0 - milliseconds(5));
+  EXPECT_EQ(s.Place(milliseconds(200), kT0 + milliseconds(208)).at, kT0 + milliseconds(210));  // +5 %
+  // Offset 100 arrives after offset 200: 100 ms before it, the first gap takes the stretch.
+  const auto p = s.Place(milliseconds(100), kT0 + milliseconds(209));
+  EXPECT_EQ(p.at, kT0 + milliseconds(110));
+  EXPECT_TRUE(p.late) << "its time had passed when it came";
+  const auto q = s.Place(milliseconds(200), kT0 + milliseconds(150));  // a second command at 200 ms
+  EXPECT_EQ(q.at, kT0 + milliseconds(210));
+  EXPECT_FALSE(q.late);
+}
+
+TEST(PlaybackSchedule, ASlowFrameRaisesThePlayoutDelaySoTheNextGetItsHeadroom) {
+  // Playout delay 10 ms (send time + 10 ms); frame 1 takes 12 ms.
+  PlaybackSchedule s(kT0, milliseconds(10), {.max_stretch = 0.05, .margin = kMargin});
+  s.Place(Duration(0), kT0 - milliseconds(5), milliseconds(5));
+  const auto p1 = s.Place(milliseconds(100), kT0 + milliseconds(102), milliseconds(12));
+  EXPECT_EQ(p1.at, kT0 + milliseconds(104));  // 12 + 2 ms margin after its send time at +90
+  EXPECT_EQ(*s.playout_delay(), milliseconds(14));
+  // Frame 2, sent at +190, took 1 ms: plays 14 ms after its send time, not at +191.
+  EXPECT_EQ(s.Place(milliseconds(200), kT0 + milliseconds(191), milliseconds(1)).at, kT0 + milliseconds(204));
+  // A frame the client sent 8 ms behind its pacing (at +298), fast (1 ms):
+  // 14 ms after its send time would be +312, but a gap stretches 5 % at most.
+  EXPECT_EQ(s.Place(milliseconds(300), kT0 + milliseconds(299), milliseconds(1)).at, kT0 + milliseconds(309));
+  EXPECT_NEAR(s.max_gap_stretch(), 0.05, 1e-9);
+  EXPECT_EQ(s.late_frames(), 0u);
+}
+
+// --- The adaptive start with its schedule, on simulated channels ------------
+
+struct SimRun {
+  int late = 0;
+  Duration start_delay{};  // offset 0's time − the first arrival
+  Duration hindsight{};    // the least delay after the first arrival with no frame late
+  double max_gap_stretch = 0;
+  Duration stretch{};  // of the last frame
+};
+
+// A paced client (frame i sent at offset i), `history` connect-time packages
+// before it, one-way delay delay(k) for the k-th package; its clock reads
+// 5000 s ahead. `options` decides how the start is estimated.
+SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
+                const std::function<Duration(std::size_t)>& delay, PlaybackEstimatorOptions options = {}) {
+  const Duration skew = std::chrono::seconds(5000);
+  PlaybackEstimator est(frames, period * static_cast<int>(frames - 1), options);
+  DelayHistory h;
+  std::size_t k = 0;
+  for (; k < history; ++k) {
+    const TimePoint sent = kT0 - milliseconds(500) + milliseconds(20) * static_cast<int>(k);
+    h.Add(sent + skew, sent + delay(k));
+  }
+  struct Frame {
+    Duration offset;
+    TimePoint arrival, sent;
+  };
+  std::vector<Frame> all;
+  for (std::size_t i = 0; i < frames; ++i, ++k) {
+    const TimePoint sent = kT0 + period * static_cast<int>(i);
+    all.push_back({period * static_cast<int>(i), sent + delay(k), sent + skew});
+  }
+  std::stable_sort(all.begin(), all.end(),
+                   [](const Frame& a, const Frame& b) { return a.arrival < b.arrival; });
+  const TimePoint first = all.front().arrival;
+  SimRun run;
+  for (const Frame& f : all) run.hindsight = std::max(run.hindsight, f.arrival - first - f.offset);
+  est.SetDelayHistory(h.Recent(first));
+  std::optional<PlaybackSchedule> schedule;
+  std::vector<const Frame*> buffered;
+  for (const Frame& f : all) {
+    if (!schedule) {
+      est.Add(f.offset, f.arrival, f.sent);
+      buffered.push_back(&f);
+      if (!est.ready()) continue;
+      const TimePoint start = est.StartTime();
+      run.start_delay = start - first;
+      schedule.emplace(start, est.playout_delay(),
+                       PlaybackScheduleOptions{.max_stretch = options.adaptive ? options.max_stretch : 0,
+                                               .margin = options.adaptive_margin});
+      std::stable_sort(buffered.begin(), buffered.end(),
+                       [](const Frame* a, const Frame* b) { return a->offset < b->offset; });
+      for (const Frame* b : buffered) {
+        const auto p = schedule->Place(b->offset, b->arrival, OneWayDelay(b->sent, b->arrival));
+        if (p.late || p.at < b->arrival) ++run.late;
+      }
+      continue;
+    }
+    const auto p = schedule->Place(f.offset, f.arrival, OneWayDelay(f.sent, f.arrival));
+    if (p.late || p.at < f.arrival) ++run.late;
+  }
+  run.max_gap_stretch = schedule->max_gap_stretch();
+  run.stretch = schedule->stretch();
+  return run;
+}
+
+struct Summary {
+  int late_runs = 0, late_frames = 0;
+  double median_ratio = 0, worst_stretch = 0;
+};
+
+// `runs` seeded channels; the ratio is the start delay over the hindsight
+// minimum, both + the 2 ms margin every start needs (a frame must be in the
+// RobotDaemon's queue before it is due).
+Summary Many(int runs, const std::function<Duration(std::mt19937_64&, std::size_t)>& channel,
+             PlaybackEstimatorOptions options = {}) {
+  Summary s;
+  std::vector<double> ratios;
+  for (int seed = 1; seed <= runs; ++seed) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    const SimRun r = Simulate(
+        40, milliseconds(100), 10, [&](std::size_t k) { return channel(rng, k); }, options);
+    s.late_frames += r.late;
+    if (r.late > 0) ++s.late_runs;
+    s.worst_stretch = std::max(s.worst_stretch, r.max_gap_stretch);
+    ratios.push_back(ToSeconds(r.start_delay) / ToSeconds(r.hindsight + kMargin));
+  }
+  std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
+  s.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
+  return s;
+}
+
+Duration Uniform(std::mt19937_64& rng, double lo_ms, double hi_ms) {
+  return FromSeconds(std::uniform_real_distribution<double>(lo_ms, hi_ms)(rng) / 1000.0);
+}
+
+TEST(AdaptivePlayback, OnAJitteryChannelStartsNearTheHindsightMinimumAndFramesAreRarelyLate) {
+  // Delays uniform in [0, 40] ms at 10 Hz: 1000 seeded channels. The quick
+  // start (2.5 x spread + 10 ms, fixed timing) had a median 2.7x (its test in
+  // playback_estimator_test.cpp) with no late run.
+  const Summary s = Many(1000, [](std::mt19937_64& rng, std::size_t) { return Uniform(rng, 0, 40); });
+  std::printf("U[0, 40] ms: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio,
+              s.late_runs, s.worst_stretch);
+  // 10 connect-time delays are a small sample of the channel: in 2 runs of
+  // 1000 a frame came later than the buffer had grown by then.
+  EXPECT_LE(s.late_runs, 5);
+  EXPECT_LE(s.median_ratio, 1.25);
+  EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
+}
+
+TEST(AdaptivePlayback, OnAWanProfileStartsNearTheHindsightMinimumAndFramesAreRarelyLate) {
+  // 100-300 ms of delay (the path's, fixed per run), +-50 ms jitter.
+  const Summary s = Many(1000, [](std::mt19937_64& rng, std::size_t k) {
+    static thread_local Duration base{};
+    if (k == 0) base = Uniform(rng, 100, 300);
+    return base + Uniform(rng, -50, 50);
+  });
+  std::printf("WAN: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio, s.late_runs,
+              s.worst_stretch);
+  // 16 of 1000 runs: the same small sample of a 100 ms spread, a frame
+  // slower than the start covered before two gaps could stretch for it.
+  EXPECT_LE(s.late_runs, 25);
+  EXPECT_LE(s.median_ratio, 1.25);
+  EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
+}
+
+TEST(AdaptivePlayback, OnACongestedLinkAQueueBuildsAndTheStartCoversIt) {
+  // The relay's congestion: a FIFO link whose service is U[0, X] ms per
+  // message; connect-time packages are sparse (no queue), frames every 100 ms.
+  for (double x : {50.0, 100.0, 150.0}) {
+    TimePoint busy{};
+    const Summary s = Many(300, [&](std::mt19937_64& rng, std::size_t k) {
+      const Duration service = Uniform(rng, 0, x);
+      if (k < 10) {
+        busy = TimePoint{};
+        return service;
+      }
+      const TimePoint sent = kT0 + milliseconds(100) * static_cast<int>(k - 10);
+      busy = std::max(busy, sent) + service;
+      return busy - sent;
+    });
+    std::printf("X = %.0f: median ratio %.2f, late runs %d of 300 (%d frames), worst gap stretch %.3f\n", x,
+                s.median_ratio, s.late_runs, s.late_frames, s.worst_stretch);
+    // Up to X = 100 a frame's service fits in its interval. At 150 the
+    // connect-time delays spread by more than 1.2 intervals in most runs: the
+    // paper's estimate (median 14.9x); 36 runs of 300 still had a frame late
+    // (the known limit, docs/performance.md).
+    EXPECT_LE(s.late_runs, x < 120 ? 3 : 60) << "X = " << x;
+    if (x < 120) {
+      EXPECT_LE(s.median_ratio, 1.25) << "X = " << x;
+    }
+    EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
+  }
+}
+
+TEST(AdaptivePlayback, TheOldEstimatorsRemainOptions) {
+  auto jitter = [](std::mt19937_64& rng, std::size_t) { return Uniform(rng, 0, 40); };
+  const Summary quick = Many(200, jitter, {.adaptive = false});
+  EXPECT_EQ(quick.worst_stretch, 0.0) << "fixed timing";
+  EXPECT_GT(quick.median_ratio, 2.0);
+  const Summary paper = Many(50, jitter, {.quick_start = false, .adaptive = false});
+  EXPECT_EQ(paper.late_frames, 0);
+  EXPECT_GT(paper.median_ratio, 5.0) << "waits for 5 frames";
+}
+
+TEST(AdaptivePlayback, ARetransmittedPackageInTheHistoryDoesNotInflateTheStart) {
+  // A LAN (1.0-1.9 ms); one connect-time package was lost and came as its
+  // retransmission 100 ms after its first send time (+ 1 ms).
+  std::vector<Duration> history;
+  for (int i = 0; i < 10; ++i) history.push_back(std::chrono::microseconds(1000 + 100 * i));
+  history.push_back(milliseconds(101));
+  PlaybackEstimator est(40, milliseconds(3900));
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  ASSERT_TRUE(est.adaptive());
+  // Covers the 1.9 ms worst + 0.9 ms / 11 + 2 ms, less this frame's 1 ms.
+  EXPECT_EQ(est.StartTime(), kT0 + std::chrono::microseconds(2900) + FromSeconds(0.0009 / 11));
+  // Beyond 1.2 frame intervals (a retransmission on a WAN, or the paper's
+  // congestion) the spread gets the paper's estimate: slower, never fooled.
+  history.back() = milliseconds(130);
+  PlaybackEstimator wide(40, milliseconds(3900));
+  wide.SetDelayHistory(history);
+  wide.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  EXPECT_FALSE(wide.adaptive());
+}
+
+TEST(AdaptivePlayback, ThePapersCongestionGetsThePapersEstimate) {
+  // Fig. 11's injector: the server pauses U[0, 0.25] s after each package, a
+  // queue at 10 Hz; the connect-time delays spread by more than 1.5 frame
+  // intervals, so the start waits for 5 frames and projects their drift.
+  std::vector<Duration> history;
+  for (int i = 0; i < 10; ++i) history.push_back(milliseconds(25 * i));
+  PlaybackEstimator est(129, milliseconds(12800));
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(100));
+  EXPECT_FALSE(est.adaptive());
+  EXPECT_FALSE(est.quick());
+  EXPECT_FALSE(est.ready()) << "waits for frames";
+  EXPECT_FALSE(est.playout_delay().has_value());
+}
+
+TEST(AdaptivePlayback, AClientWithoutSendTimesGetsThePapersStartThenTheStretch) {
+  PlaybackEstimator est(40, milliseconds(3900));
+  est.SetDelayHistory(std::vector<Duration>(10, milliseconds(1)));
+  est.Add(Duration(0), kT0);
+  EXPECT_FALSE(est.ready());
+  EXPECT_FALSE(est.adaptive());
+  EXPECT_FALSE(est.playout_delay().has_value());
+}
+
+}  // namespace
+}  // namespace robotalk
