@@ -20,6 +20,8 @@
 #include <cstdio>
 #include <mutex>
 #include <numbers>
+#include <sstream>
+#include <string>
 #include <thread>
 
 using namespace robotalk;
@@ -109,6 +111,16 @@ int main(int argc, char** argv) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     c.StopStateStream();
+    // The server's own figure: the largest velocity change of any reference
+    // over the period it actually ran (SERVER_COUNTERS).
+    double server_accel = NAN;
+    {
+      const Reply r = c.ServerCounters();
+      std::istringstream names(r.message);
+      std::string name;
+      for (std::size_t i = 0; names >> name && i < r.values.size(); ++i)
+        if (name == "reference_max_acceleration") server_accel = r.values[i];
+    }
     std::lock_guard lock(m);
     std::printf(
         "through robotalk-lcm-relay: %d splices (%ld points); STATE at 5 ms, %ld samples, %ld distinct "
@@ -118,11 +130,14 @@ int main(int argc, char** argv) {
         "samples %.1f ms apart); freezes "
         "(a reference held > %.0f ms) %ld; missing samples %ld; largest acceleration between consecutive "
         "references over the period the server ran (2·Δp / (v0 + v1), where |v0 + v1| > %.2g rad/s) %.2f "
-        "rad/s² (a step of %.4f rad/s over %.2f ms)\n",
+        "rad/s² (a step of %.4f rad/s over %.2f ms); the server's own largest |Δv| / (its period) of any "
+        "reference: %.4f rad/s²\n",
         splices, sent, samples, references, max_dv, 1e3 * ToSeconds(max_dv_after), 1e3 * ToSeconds(freeze),
-        frozen, missing, min_speed, max_accel, max_accel_dv, 1e3 * max_accel_dt);
-    std::printf("references=%ld\nmax_step=%.6f\nmax_acceleration=%.4f\nfreezes=%ld\nmissing=%ld\n",
-                references, max_dv, max_accel, frozen, missing);
+        frozen, missing, min_speed, max_accel, max_accel_dv, 1e3 * max_accel_dt, server_accel);
+    std::printf(
+        "references=%ld\nmax_step=%.6f\nmax_acceleration=%.4f\nserver_max_acceleration=%.6f\nfreezes=%ld\n"
+        "missing=%ld\n",
+        references, max_dv, max_accel, server_accel, frozen, missing);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "robotalk-receding-client: %s\n", e.what());

@@ -550,6 +550,7 @@ void RobotDaemon::TrackTrajectories(TimePoint now) {
     return;
   }
   tracker_.Sample(now, tracked_);
+  max_reference_acceleration_.store(tracker_.max_reference_acceleration(), std::memory_order_relaxed);
   for (const JointReference& ref : tracker_.references()) {
     DriverResult result;
     if (Guarded("Track", nullptr, now, [&] { result = driver_->Track(ref, now, completions_); }) !=

@@ -177,6 +177,11 @@ class RobotDaemon {
   std::size_t queued(std::int64_t client_id) const;
   /// Items of every client (and the server's) waiting.
   std::size_t queued_total() const;
+  /// TrajectoryTracker::max_reference_acceleration(), as of the last period
+  /// (any thread).
+  double max_reference_acceleration() const {
+    return max_reference_acceleration_.load(std::memory_order_relaxed);
+  }
   /// Panic: removes every waiting item (appended to `flushed`), latches
   /// panic and asks the thread to halt the driver.
   void Panic(std::vector<QueuedItem>& flushed, const std::string& reason = {});
@@ -297,6 +302,7 @@ class RobotDaemon {
   std::uint64_t pushes_ = 0;                 // GUARDED_BY(mutex_): items submitted so far
   std::string timing_;                       // GUARDED_BY(mutex_)
   std::atomic<bool> flush_deferred_{false};  // Panic() could not take mutex_ to flush
+  std::atomic<double> max_reference_acceleration_{0};
 
   mutable std::mutex call_mutex_;
   CurrentCall call_;  // GUARDED_BY(call_mutex_)

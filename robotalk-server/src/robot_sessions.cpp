@@ -297,9 +297,11 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
           r.values.push_back(value);
         }
       }
-      r.message += (r.message.empty() ? "" : " ") + std::string("refused_packages expired_commands");
+      r.message += (r.message.empty() ? "" : " ") +
+                   std::string("refused_packages expired_commands reference_max_acceleration");
       r.values.push_back(static_cast<double>(refused_packages_));
       r.values.push_back(static_cast<double>(expired_commands_));
+      r.values.push_back(daemon_.max_reference_acceleration());
       AppendLinkCounters(s, r);
       immediate.push_back(std::move(r));
       return;

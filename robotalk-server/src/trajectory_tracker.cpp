@@ -92,6 +92,9 @@ TrajectoryTracker::TrajectoryTracker(const RobotModel& model, TrackerOptions opt
     }
   }
   ik_start_ = Eigen::VectorXd::Zero(model.num_dofs());
+  int widest = 6;  // a frame's track
+  for (const Track& t : tracks_) widest = std::max(widest, t.dofs);
+  velocity_before_ = Eigen::VectorXd::Zero(widest);
   references_.reserve(tracks_.size());
   order_.reserve(64);
 }
@@ -479,6 +482,7 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
   const double dt = std::clamp(ToSeconds(now - t.last_sample), 1e-4, 1.0);
   t.last_sample = now;
   bool on_plan = true;
+  velocity_before_.head(t.dofs) = t.ref_velocity;
   for (int k = 0; k < t.dofs; ++k) {
     const double amax = t.limits.acceleration[k], vmax = t.limits.velocity[k];
     const double lo = t.limits.position_min[k], hi = t.limits.position_max[k];
@@ -533,6 +537,12 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
     t.ref_acceleration[k] = a1;
   }
   t.on_plan = on_plan;
+  if (!first) {
+    for (int k = 0; k < t.dofs; ++k) {
+      max_reference_acceleration_ =
+          std::max(max_reference_acceleration_, std::abs(t.ref_velocity[k] - velocity_before_[k]) / dt);
+    }
+  }
 }
 
 void TrajectoryTracker::EndTrack(Track& t, TimePoint now, const std::string& why,

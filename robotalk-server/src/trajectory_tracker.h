@@ -108,6 +108,11 @@ class TrajectoryTracker {
   /// Ends every trajectory.
   void EndAll(TimePoint now, const std::string& why, std::vector<Answer>& answers);
   bool active() const { return active_ > 0; }
+  /// The largest |velocity change| / (time since the previous reference) of
+  /// any reference handed out so far, over every joint (rad/s² or m/s²): what
+  /// the acceleration limit bounds, measured on the server's own periods
+  /// (SERVER_COUNTERS' reference_max_acceleration).
+  double max_reference_acceleration() const { return max_reference_acceleration_; }
   /// Waypoints waiting to be passed, over every joint (for tests and bounds).
   std::size_t pending() const;
 
@@ -203,6 +208,8 @@ class TrajectoryTracker {
   std::vector<JointReference> references_;
   std::vector<const QueuedItem*> order_;  // Add()'s waypoints in time order (reused)
   int active_ = 0;
+  double max_reference_acceleration_ = 0;
+  Eigen::VectorXd velocity_before_;  // Limit()'s previous reference velocity (sized once)
 };
 
 }  // namespace robotalk

@@ -13,6 +13,9 @@
 #       |v0 + v1| > 1 rad/s: within 10 % on the plan, exact when limited), is
 #       within the server's 20 rad/s² limit plus that 10 % and 15 % for the
 #       STATE samples' rounding; no sample missing;
+#   the server's own figure (SERVER_COUNTERS reference_max_acceleration: the
+#       largest velocity change of any reference over the period it actually
+#       ran) is within the limit, exactly;
 #   it moved: at least half the periods showed a new reference.
 # usage: receding_relay_test.sh SERVER RELAY CLIENT MODELS_DIR   (about 15 s)
 set -u
@@ -38,11 +41,15 @@ timeout 30 "$client" --url "$A" --robot pioneer --joint pan --splices 400 --free
   >"$tmp/out" 2>&1 || no "the client failed: $(tail -3 "$tmp/out")"
 cat "$tmp/out"
 refs=$(val "$tmp/out" references) accel=$(val "$tmp/out" max_acceleration)
+server_accel=$(val "$tmp/out" server_max_acceleration)
 freezes=$(val "$tmp/out" freezes) missing=$(val "$tmp/out" missing)
 [ "${freezes:-1}" = 0 ] || no "$freezes freezes (a reference held 100 ms)"
 [ "${missing:-1}" = 0 ] || no "$missing STATE samples missing"
 awk -v a="${accel:-999}" 'BEGIN { exit !(a <= 20 * 1.25) }' ||
   no "an acceleration of $accel rad/s² between references, beyond the 20 rad/s² limit"
+# The server's own figure, over the periods it actually ran: the limit, exactly.
+awk -v a="${server_accel:-nan}" 'BEGIN { exit !(a + 0 == a && a > 0 && a <= 20 * (1 + 1e-6)) }' ||
+  no "the server handed out a reference $server_accel rad/s² from the previous one, beyond the 20 rad/s² limit"
 # 400 splices over 4 s, the first second not counted: ~300 periods of 10 ms.
 [ "${refs:-0}" -ge 150 ] || no "only ${refs:-0} distinct references (the joint did not follow)"
 [ $fail = 0 ] && echo "PASS: receding horizon through the relay"

@@ -243,6 +243,9 @@ TEST_F(TrackerTest, ATooFastPlanIsFollowedWithinTheLimitsAndAnswersModifiedNamin
   }
   EXPECT_LE(vmax, 2 * (1 + 1e-6));
   EXPECT_LE(amax, 20 * (1 + 1e-6));
+  // The tracker's own record of it (SERVER_COUNTERS' reference_max_acceleration): the limit, reached.
+  EXPECT_NEAR(tracker_.max_reference_acceleration(), amax, 1e-6);
+  EXPECT_NEAR(tracker_.max_reference_acceleration(), 20, 1e-6);
   EXPECT_NEAR(tracker_.references().empty() ? 1.5 : tracker_.references()[0].position[0], 1.5, 1e-6);
   ASSERT_NE(AnswerTo(1), nullptr);
   EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kModified);
