@@ -166,8 +166,9 @@ void TrajectoryTracker::AddJointWaypoint(const QueuedItem& item, TimePoint now, 
   };
   rates(w.velocity, item.num_velocities, item.velocities);
   rates(w.acceleration, item.num_accelerations, item.accelerations);
-  const bool idle = !t.trajectory;
-  TrajectoryState start;  // where an idle joint's trajectory starts
+  // Idle, or about to be: Join replaces a trajectory of another interpolation.
+  const bool idle = !t.trajectory || t.trajectory->interpolation() != item.interpolation;
+  TrajectoryState start;  // where the joint's new trajectory starts
   if (idle) {
     start.position = state.position.segment(t.first_dof, t.dofs);
     start.velocity = state.velocity.segment(t.first_dof, t.dofs);

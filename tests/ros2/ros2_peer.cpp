@@ -375,7 +375,10 @@ int main(int argc, char** argv) {
     const double off = nearest ? std::max(std::abs(nearest->positions[pan] - points[k][0]),
                                           std::abs(nearest->positions[tilt] - points[k][1]))
                                : 1e9;
-    const double allowed = nearest ? 3.0 * std::abs(Ms(nearest->server_time - due)) / 1000 + 1e-6 : 0;
+    // A STATE sample carries the state of the server's last control period
+    // (the kinematic driver's 10 ms), up to one period before its own time.
+    const double allowed =
+        nearest ? 3.0 * (std::abs(Ms(nearest->server_time - due)) + 10.0) / 1000 + 1e-6 : 0;
     Check(nearest && off <= allowed,
           name + ": passed at its time (" + std::to_string(off) + " rad from it, " +
               (nearest ? std::to_string(Ms(nearest->server_time - due)) : "?") + " ms from due)");

@@ -170,6 +170,29 @@ TEST_F(TrackerTest, AStreamOfWaypointsAppendedToARunningTrajectoryDoesNotAllocat
   for (const auto& a : answers_) EXPECT_EQ(a.reply.signal, Signal::kSuccess) << a.reply.message;
 }
 
+TEST_F(TrackerTest, AWaypointOfAnotherInterpolationReplacesTheRunningTrajectoryFromWhereTheJointIs) {
+  // A cubic trajectory running, then a quintic waypoint on the same joint:
+  // the cubic one is superseded and the quintic one starts from the measured
+  // state (it once started from nothing and threw out of the RobotDaemon).
+  Add({Waypoint(1, 0, kT0 + milliseconds(200), {0.3}), Waypoint(2, 0, kT0 + milliseconds(400), {0.5})}, kT0);
+  Run(kT0, kT0 + milliseconds(100));
+  RobotState here = Rest(model_);
+  here.position[0] = tracker_.references()[0].position[0];
+  here.velocity[0] = tracker_.references()[0].velocity[0];
+  tracker_.Add(
+      std::vector<QueuedItem>{Waypoint(3, 0, kT0 + milliseconds(500), {0.2}, Interpolation::kQuintic)},
+      kT0 + milliseconds(100), here, answers_, started_);
+  ASSERT_NE(AnswerTo(1), nullptr);
+  EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kInterrupted);
+  EXPECT_THAT(AnswerTo(1)->reply.message, HasSubstr("superseded by command 3 (quintic)"));
+  const std::vector<double> q = Run(kT0 + milliseconds(100), kT0 + milliseconds(700));
+  ASSERT_FALSE(q.empty());
+  EXPECT_NEAR(q.front(), here.position[0], 1e-9) << "starts from where the joint is";
+  ASSERT_NE(AnswerTo(3), nullptr);
+  EXPECT_EQ(AnswerTo(3)->reply.signal, Signal::kSuccess) << AnswerTo(3)->reply.message;
+  EXPECT_NEAR(q.back(), 0.2, 1e-9);
+}
+
 TEST_F(TrackerTest, ASpliceReplacesTheRemainderContinuouslyAndInterruptsWhatItReplaced) {
   Add({Waypoint(1, 0, kT0 + milliseconds(1000), {0.5}), Waypoint(2, 0, kT0 + milliseconds(2000), {1.0}),
        Waypoint(3, 0, kT0 + milliseconds(3000), {1.5})},
