@@ -32,7 +32,7 @@
 //   acceleration limit); it never extrapolates.
 // - A waypoint that arrives after its time: INTERRUPTED when a later waypoint
 //   of the joint is already planned; otherwise it is joined one control
-//   period from now (time-scaled if it must be) and answers MODIFIED.
+//   period from now (its reference limited if it must be) and answers MODIFIED.
 // - Each waypoint is answered when the trajectory passes it: SUCCESS, or
 //   MODIFIED with what was changed.
 //
@@ -64,7 +64,7 @@ namespace robotalk {
 inline constexpr double kDefaultTrajectoryAcceleration = 20.0;
 
 struct TrackerOptions {
-  /// Per dof, for time-scaling and the hold after the last waypoint (> 0).
+  /// Per dof, for the reference limiter and the hold after the last waypoint (> 0).
   double acceleration_limit = kDefaultTrajectoryAcceleration;
   /// The driver's control period: a late waypoint is joined this far ahead.
   Duration period = std::chrono::milliseconds(10);
