@@ -21,6 +21,17 @@ std::string Number(double x) {
   return text;
 }
 
+// "<whose>: superseded by <by> command <id>", what a replaced waypoint answers.
+std::string SupersededBy(const std::string& whose, const std::string& by, CommandId id) {
+  return whose + ": superseded by " + by + " command " + std::to_string(id);
+}
+
+// What a trajectory of another interpolation answers when `item` replaces it.
+std::string SupersededByInterpolation(const std::string& whose, const QueuedItem& item) {
+  return whose + ": superseded by command " + std::to_string(item.command.id) + " (" +
+         InterpolationName(item.interpolation) + ")";
+}
+
 }  // namespace
 
 TrajectoryTracker::Pending& TrajectoryTracker::PendingQueue::push_back() {
@@ -136,17 +147,14 @@ void TrajectoryTracker::AddJointWaypoint(const QueuedItem& item, TimePoint now, 
   const std::string& label = t.label;
   if (t.moved_by >= 0) {  // a frame's trajectory moves it: the joint's own waypoint replaces that
     EndFrame(t.moved_by, now,
-             "FRAME_SETPOINT '" + model_.frame(t.moved_by).name + "': superseded by " + label + " command " +
-                 std::to_string(item.command.id),
+             SupersededBy(frame_tracks_[static_cast<std::size_t>(t.moved_by)].label, label, item.command.id),
              answers);
   }
-  Pending& p = t.incoming;
-  p.client_id = item.client_id;
-  p.id = item.command.id;
-  p.requested = item.start;
-  p.note.clear();
+  // A trajectory of another interpolation is replaced from now, as a splice.
+  if (t.trajectory && t.trajectory->interpolation() != item.interpolation)
+    EndTrack(t, now, SupersededByInterpolation(label, item), answers);
+  Pending& p = Incoming(t, item);
   Waypoint& w = p.waypoint;
-  w.time = item.start;
   for (int k = 0; k < t.dofs; ++k) {
     const double want = item.command.values[static_cast<std::size_t>(k)];
     const double got = std::clamp(want, t.limits.position_min[k], t.limits.position_max[k]);
@@ -166,9 +174,8 @@ void TrajectoryTracker::AddJointWaypoint(const QueuedItem& item, TimePoint now, 
   };
   rates(w.velocity, item.num_velocities, item.velocities);
   rates(w.acceleration, item.num_accelerations, item.accelerations);
-  // Idle, or about to be: Join replaces a trajectory of another interpolation.
-  const bool idle = !t.trajectory || t.trajectory->interpolation() != item.interpolation;
-  TrajectoryState start;  // where the joint's new trajectory starts
+  const bool idle = !t.trajectory;
+  TrajectoryState start;  // where an idle joint's trajectory starts
   if (idle) {
     start.position = state.position.segment(t.first_dof, t.dofs);
     start.velocity = state.velocity.segment(t.first_dof, t.dofs);
@@ -191,12 +198,8 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
                                     now, Duration(0))});
     return;
   }
-  if (t.trajectory && t.trajectory->interpolation() != item.interpolation) {
-    EndFrame(frame, now,
-             label + ": superseded by command " + std::to_string(item.command.id) + " (" +
-                 InterpolationName(item.interpolation) + ")",
-             answers);
-  }
+  if (t.trajectory && t.trajectory->interpolation() != item.interpolation)
+    EndFrame(frame, now, SupersededByInterpolation(label, item), answers);
   const bool idle = !t.trajectory;
   TrajectoryState start;
   if (idle) {
@@ -205,16 +208,11 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
       Track& joint = tracks_[static_cast<std::size_t>(j)];
       if (joint.moved_by >= 0) {
         EndFrame(joint.moved_by, now,
-                 "FRAME_SETPOINT '" + model_.frame(joint.moved_by).name + "': superseded by " + label +
-                     " command " + std::to_string(item.command.id),
+                 SupersededBy(frame_tracks_[static_cast<std::size_t>(joint.moved_by)].label, label,
+                              item.command.id),
                  answers);
       }
-      if (joint.trajectory) {
-        EndTrack(joint, now,
-                 "JOINT_SETPOINT '" + model_.joint(j).name + "': superseded by " + label + " command " +
-                     std::to_string(item.command.id),
-                 answers);
-      }
+      if (joint.trajectory) EndTrack(joint, now, SupersededBy(joint.label, label, item.command.id), answers);
     }
     roots_.clear();
     for (const Pose& r : state.root_poses) roots_.push_back(r.ToIsometry());
@@ -229,13 +227,8 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
     start.velocity.tail<3>() = t.base.conjugate() * Eigen::Vector3d(twist.tail<3>());
     ik_start_ = state.position;
   }
-  Pending& p = t.incoming;
-  p.client_id = item.client_id;
-  p.id = item.command.id;
-  p.requested = item.start;
-  p.note.clear();
+  Pending& p = Incoming(t, item);
   Waypoint& w = p.waypoint;
-  w.time = item.start;
   const auto& v = item.command.values;
   Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
   q.normalize();
@@ -275,16 +268,19 @@ void TrajectoryTracker::AddFrameWaypoint(const QueuedItem& item, TimePoint now, 
   t.owner = item.client_id;
 }
 
+TrajectoryTracker::Pending& TrajectoryTracker::Incoming(Track& t, const QueuedItem& item) {
+  Pending& p = t.incoming;
+  p.client_id = item.client_id;
+  p.id = item.command.id;
+  p.requested = item.start;
+  p.note.clear();
+  p.waypoint.time = item.start;
+  return p;
+}
+
 bool TrajectoryTracker::Join(Track& t, const std::string& label, Pending& p, const QueuedItem& item,
                              TimePoint now, const TrajectoryState& start, std::vector<Answer>& answers) {
   Waypoint& w = p.waypoint;
-  // A trajectory of another interpolation is replaced from now, as a splice.
-  if (t.trajectory && t.trajectory->interpolation() != item.interpolation) {
-    EndTrack(t, now,
-             label + ": superseded by command " + std::to_string(item.command.id) + " (" +
-                 InterpolationName(item.interpolation) + ")",
-             answers);
-  }
   // Late: after its time. Skipped when a later waypoint is planned (the
   // trajectory already runs past it); else joined one period from now.
   if (w.time <= now) {

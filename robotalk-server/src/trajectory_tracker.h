@@ -180,9 +180,12 @@ class TrajectoryTracker {
                         std::vector<Answer>& answers, std::vector<Started>& started);
   void AddFrameWaypoint(const QueuedItem& item, TimePoint now, const RobotState& state,
                         std::vector<Answer>& answers, std::vector<Started>& started);
+  // t.incoming, set for `item` (the position and rates are the caller's to fill).
+  Pending& Incoming(Track& t, const QueuedItem& item);
   // Joins `p` to `t`'s trajectory (starting it at `now` from `start` when
   // idle): late, splice and replacement rules. False when refused (answered).
-  // `start` is used only when the track is idle. `p` is t.incoming.
+  // `start` is used only when the track is idle (a trajectory of another
+  // interpolation was ended by the caller). `p` is t.incoming.
   bool Join(Track& t, const std::string& label, Pending& p, const QueuedItem& item, TimePoint now,
             const TrajectoryState& start, std::vector<Answer>& answers);
   void EndTrack(Track& t, TimePoint now, const std::string& why, std::vector<Answer>& answers);
