@@ -5,6 +5,7 @@
 #   pids+=($!)    any other background process: killed at exit
 #   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
 #   $pass, $failures        the counts
+#   value_of FILE KEY       the value of the first "KEY=value" line of FILE
 #   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
 tmp=$(mktemp -d)
 export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
@@ -24,3 +25,4 @@ check() {  # check NAME COMMAND...
   local name=$1; shift
   if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
 }
+value_of() { sed -n "s/^$2=//p" "$1" | head -1; }

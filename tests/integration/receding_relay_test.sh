@@ -18,39 +18,35 @@
 #       ran) is within the limit, exactly;
 #   it moved: at least half the periods showed a new reference.
 # usage: receding_relay_test.sh SERVER RELAY CLIENT MODELS_DIR   (about 15 s)
+. "$(dirname "$0")/../lib.sh"
 set -u
 server=$1 relay=$2 client=$3 models=$4
 A='udpm://239.255.76.67:7941?ttl=0'
 B='udpm://239.255.76.67:8041?ttl=0'
-tmp=$(mktemp -d)
-fail=0
-no() { echo "FAIL: $*"; fail=1; }
-val() { sed -n "s/^$2=//p" "$1" | head -1; }
 
 "$server" --robot pioneer=kinematic:"$models"/pioneer2dx_pantilt.urdf --url "$B" --duration 40 \
   --no-panic-latch 2>"$tmp/server.log" &
-spid=$!
+server_pid=$!
 "$relay" --a "$A" --b "$B" --a2b-latency-ms 5 --a2b-jitter-ms 3 --a2b-jitter-dist uniform --seed 22 \
   --duration 35 >"$tmp/relay.log" 2>&1 &
-rpid=$!
-trap 'kill $spid $rpid 2>/dev/null; rm -rf "$tmp"' EXIT
+pids+=($!)
 for _ in $(seq 100); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
 sleep 0.3
 
-timeout 30 "$client" --url "$A" --robot pioneer --joint pan --splices 400 --freeze-ms 100 --min-speed 1.0 \
-  >"$tmp/out" 2>&1 || no "the client failed: $(tail -3 "$tmp/out")"
+check "the client ran" timeout 30 "$client" --url "$A" --robot pioneer --joint pan --splices 400 \
+  --freeze-ms 100 --min-speed 1.0 >"$tmp/out" 2>&1
 cat "$tmp/out"
-refs=$(val "$tmp/out" references) accel=$(val "$tmp/out" max_acceleration)
-server_accel=$(val "$tmp/out" server_max_acceleration)
-freezes=$(val "$tmp/out" freezes) missing=$(val "$tmp/out" missing)
-[ "${freezes:-1}" = 0 ] || no "$freezes freezes (a reference held 100 ms)"
-[ "${missing:-1}" = 0 ] || no "$missing STATE samples missing"
-awk -v a="${accel:-999}" 'BEGIN { exit !(a <= 20 * 1.25) }' ||
-  no "an acceleration of $accel rad/s² between references, beyond the 20 rad/s² limit"
+refs=$(value_of "$tmp/out" references) accel=$(value_of "$tmp/out" max_acceleration)
+server_accel=$(value_of "$tmp/out" server_max_acceleration)
+freezes=$(value_of "$tmp/out" freezes) missing=$(value_of "$tmp/out" missing)
+check "no freeze (a reference held 100 ms): ${freezes:-?}" [ "${freezes:-1}" = 0 ]
+check "no STATE sample missing: ${missing:-?}" [ "${missing:-1}" = 0 ]
+check "the client's estimate, ${accel:-?} rad/s² between references, within the 20 rad/s² limit + 25 %" \
+  awk -v a="${accel:-999}" 'BEGIN { exit !(a <= 20 * 1.25) }'
 # The server's own figure, over the periods it actually ran: the limit, exactly.
-awk -v a="${server_accel:-nan}" 'BEGIN { exit !(a + 0 == a && a > 0 && a <= 20 * (1 + 1e-6)) }' ||
-  no "the server handed out a reference $server_accel rad/s² from the previous one, beyond the 20 rad/s² limit"
+check "the server's largest reference acceleration, ${server_accel:-?} rad/s², within the 20 rad/s² limit" \
+  awk -v a="${server_accel:-nan}" 'BEGIN { exit !(a + 0 == a && a > 0 && a <= 20 * (1 + 1e-6)) }'
 # 400 splices over 4 s, the first second not counted: ~300 periods of 10 ms.
-[ "${refs:-0}" -ge 150 ] || no "only ${refs:-0} distinct references (the joint did not follow)"
-[ $fail = 0 ] && echo "PASS: receding horizon through the relay"
-exit $fail
+check "the joint followed: ${refs:-0} distinct references" [ "${refs:-0}" -ge 150 ]
+echo "passed $pass, failed $failures"
+[ "$failures" = 0 ]
