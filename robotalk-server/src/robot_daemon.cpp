@@ -360,9 +360,9 @@ RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem
   return CallOutcome::kThrew;
 }
 
-void RobotDaemon::Fault(const std::string& what, TimePoint now) {
+void RobotDaemon::Fault(const std::string& what, TimePoint now, std::string_view kind) {
   const bool halt = panic_.Fault(what);
-  produced_.log.push_back("robot '" + robot_name_ + "': DRIVER FAULT: " + what +
+  produced_.log.push_back("robot '" + robot_name_ + "': " + std::string(kind) + ": " + what +
                           "; robot halted, in panic until PANIC_RESET");
   if (!halt) return;
   try {
@@ -384,6 +384,33 @@ void RobotDaemon::StopInstead(TimePoint now) {
     produced_.log.push_back("robot '" + robot_name_ + "': driver '" + driver_name_ +
                             "' threw in Stop too, after Halt: the robot may still move");
   }
+}
+
+void RobotDaemon::PlannerFault(const std::string& what, TimePoint now, std::span<const QueuedItem> arriving) {
+  Fault(what, now, "SERVER FAULT");
+  const std::string why = "ended by panic: " + what;
+  // Without sampling or re-planning: the planner that threw is not trusted.
+  tracker_.Abandon(now, why, tracked_);
+  ramp_.End(now, why, ramped_);
+  const auto answered = [&](const QueuedItem& item) {
+    const auto is = [&](const auto& a) {
+      return a.client_id == item.client_id && a.reply.id == item.command.id;
+    };
+    return std::any_of(tracked_.begin(), tracked_.end(), is) ||
+           std::any_of(ramped_.begin(), ramped_.end(), is);
+  };
+  for (const QueuedItem& item : arriving) {
+    if (answered(item)) continue;
+    Reply r;
+    r.id = item.command.id;
+    r.signal = Signal::kInterrupted;
+    r.message = "not executed: " + what + "; robot '" + robot_name_ + "' halted (panic) until PANIC_RESET";
+    r.exec_time = now;
+    Emit(item.client_id, std::move(r));
+  }
+  EmitTracked();
+  for (SpeedRamp::Answer& a : ramped_) Emit(a.client_id, std::move(a.reply));
+  ramped_.clear();
 }
 
 void RobotDaemon::Emit(std::int64_t client_id, Reply reply) {
@@ -434,7 +461,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     // Every period, watched or not: a non-finite state is a fault at once.
     state_fresh = ReadState(now);
   }
-  const bool sampled = sample_due && (Sample(now, period, state_fresh), true);
+  const bool sampled = sample_due && Sample(now, period, state_fresh);  // none from a state not read
   for (const Completion& c : completions_) {
     auto owner = in_progress_.find(c.id);
     if (owner == in_progress_.end()) continue;
@@ -484,36 +511,51 @@ void RobotDaemon::EmitTracked() {
   tracked_.clear();
 }
 
+void RobotDaemon::InterruptInPanic(std::span<const QueuedItem> items, TimePoint now) {
+  const std::string why = panic_.has_reason() ? ": " + panic_.reason() : std::string();
+  for (const QueuedItem& item : items) {
+    Reply r;
+    r.id = item.command.id;
+    r.signal = Signal::kInterrupted;
+    r.message = "the robot entered panic before the command ran" + why;
+    r.exec_time = now;
+    Emit(item.client_id, std::move(r));
+  }
+}
+
 void RobotDaemon::AddWaypoints(TimePoint now) {
   if (waypoints_.empty()) return;
-  if (panic_.in_panic() || panic_.driver_halted()) {
-    for (const QueuedItem& w : waypoints_) {
-      Reply r;
-      r.id = w.command.id;
-      r.signal = Signal::kInterrupted;
-      r.message = "the robot entered panic before the command ran";
-      r.exec_time = now;
-      Emit(w.client_id, std::move(r));
-    }
-  } else if (ReadState(now)) {  // an idle joint's trajectory starts where it is (the ramp: the base's twist)
-    // SETSPEED frames go to the base's ramp; the rest keep their order.
-    speed_frames_.clear();
-    for (QueuedItem& w : waypoints_) {
-      if (w.is_speed_frame()) speed_frames_.push_back(std::move(w));
-    }
-    waypoints_.erase(std::remove_if(waypoints_.begin(), waypoints_.end(),
-                                    [](const QueuedItem& w) { return w.is_speed_frame(); }),
-                     waypoints_.end());
-    if (!waypoints_.empty()) {
-      trajectory_owners_.clear();
-      tracker_.Add(waypoints_, now, state_, tracked_, trajectory_owners_);
+  // An idle joint's trajectory starts where it is (the ramp: at the base's
+  // twist), so the state is read first -- and a read that fails or finds a
+  // non-finite value halts the robot: the waypoints then answer as in panic.
+  const bool halted = panic_.in_panic() || panic_.driver_halted();
+  if (halted || !ReadState(now) || panic_.in_panic()) {
+    InterruptInPanic(waypoints_, now);
+    waypoints_.clear();
+    return;
+  }
+  // SETSPEED frames go to the base's ramp; the rest keep their order.
+  speed_frames_.clear();
+  for (QueuedItem& w : waypoints_) {
+    if (w.is_speed_frame()) speed_frames_.push_back(std::move(w));
+  }
+  waypoints_.erase(std::remove_if(waypoints_.begin(), waypoints_.end(),
+                                  [](const QueuedItem& w) { return w.is_speed_frame(); }),
+                   waypoints_.end());
+  if (!waypoints_.empty()) {
+    trajectory_owners_.clear();
+    if (GuardedPlanner("trajectory tracker", now, waypoints_,
+                       [&] { tracker_.Add(waypoints_, now, state_, tracked_, trajectory_owners_); })) {
       for (const TrajectoryTracker::Started& o : trajectory_owners_) {
         produced_.executed.push_back({o.client_id, o.type, o.target});
       }
       EmitTracked();
+    } else {  // the robot is halted: the speed frames too
+      InterruptInPanic(speed_frames_, now);
+      speed_frames_.clear();
     }
-    AddSpeedFrames(now);
   }
+  AddSpeedFrames(now);
   waypoints_.clear();
 }
 
@@ -523,7 +565,8 @@ void RobotDaemon::TrackBaseRamp(TimePoint now) {
     EndRamp(now, "ended by panic");
     return;
   }
-  const bool sampled = ramp_.Sample(now, ramped_);
+  bool sampled = false;
+  if (!GuardedPlanner("speed ramp", now, {}, [&] { sampled = ramp_.Sample(now, ramped_); })) return;
   for (SpeedRamp::Answer& a : ramped_) Emit(a.client_id, std::move(a.reply));
   ramped_.clear();
   if (!sampled) return;
@@ -549,7 +592,7 @@ void RobotDaemon::TrackTrajectories(TimePoint now) {
     EmitTracked();
     return;
   }
-  tracker_.Sample(now, tracked_);
+  if (!GuardedPlanner("trajectory tracker", now, {}, [&] { tracker_.Sample(now, tracked_); })) return;
   max_reference_acceleration_.store(tracker_.max_reference_acceleration(), std::memory_order_relaxed);
   for (const JointReference& ref : tracker_.references()) {
     DriverResult result;
@@ -700,9 +743,8 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
   }
   if (!state_problem_.empty()) {  // a broken sensor: no value is trusted
     reply.signal = Signal::kError;
-    reply.message = std::string(ToString(item.query)) + ": driver '" + driver_name_ +
-                    "' reports a non-finite state: " + state_problem_ + "; robot '" + robot_name_ +
-                    "' halted (panic) until PANIC_RESET";
+    reply.message = std::string(ToString(item.query)) + ": driver '" + driver_name_ + "' reports " +
+                    state_problem_ + "; robot '" + robot_name_ + "' halted (panic) until PANIC_RESET";
     return;
   }
   AnswerQueryFrom(model(), state_, kinematics_, roots_, item, reply);
@@ -715,7 +757,13 @@ void RobotDaemon::AnswerQuery(const QueuedItem& item, Reply& reply) {
 bool RobotDaemon::ReadState(TimePoint now) {
   if (Guarded("ReadState", nullptr, now, [&] { driver_->ReadState(state_); }) != CallOutcome::kOk)
     return false;
-  std::optional<std::string> problem = NonFiniteState(model(), state_);
+  std::optional<std::string> problem = MisfitState(model(), state_);
+  const bool misfit = problem.has_value();
+  if (misfit) {
+    *problem = "a state that does not fit the model: " + *problem;
+  } else if ((problem = NonFiniteState(model(), state_))) {
+    *problem = "a non-finite state: " + *problem;
+  }
   if (!problem) {
     if (!state_problem_.empty()) state_problem_.clear();
     return true;
@@ -723,13 +771,14 @@ bool RobotDaemon::ReadState(TimePoint now) {
   state_problem_ = std::move(*problem);
   // A broken sensor: the robot cannot be driven safely on it. The fault's
   // text is the same while the value stays bad (the log prints it once).
-  Fault("driver '" + driver_name_ + "' reports a non-finite state: " + state_problem_, now);
-  return true;
+  Fault("driver '" + driver_name_ + "' reports " + state_problem_, now);
+  return !misfit;  // non-finite values are still sent, in panic; a misfit cannot be read
 }
 
-void RobotDaemon::Sample(TimePoint now, Duration period, bool state_fresh) {
-  if (!state_fresh && !ReadState(now)) return;
+bool RobotDaemon::Sample(TimePoint now, Duration period, bool state_fresh) {
+  if (!state_fresh && !ReadState(now)) return false;
   FillSample(now, period);  // in panic; non-finite values are sent as they are (docs/protocol.md)
+  return true;
 }
 
 }  // namespace robotalk

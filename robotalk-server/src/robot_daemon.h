@@ -55,6 +55,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -138,6 +139,10 @@ struct DaemonOutput {
 /// field ("joint 'pan' dof 0 position is NaN", "root 'base' x is +inf",
 /// "base v is NaN"); nullopt when every value is finite. Allocates only then.
 std::optional<std::string> NonFiniteState(const RobotModel& model, const RobotState& state);
+/// What in `state` does not fit `model` (a driver's bug: every later read of
+/// it would run past the end): "position has 0 values, the model has 1 dofs",
+/// "root_poses has 0 poses, the model has 1 roots"; nullopt when it fits.
+std::optional<std::string> MisfitState(const RobotModel& model, const RobotState& state);
 
 class RobotDaemon {
  public:
@@ -252,16 +257,32 @@ class RobotDaemon {
   void Audit(const QueuedItem& item, const DriverResult& result, bool accepted);
   // Reads the driver's state into state_ with the fault guard; a non-finite
   // value is a driver fault (halt, panic; issue 19) and state_problem_ names
-  // it. False when the call threw.
+  // it; a state that does not fit the model (sizes) too. False when the call
+  // threw or the state does not fit (nothing in state_ may be read then).
   bool ReadState(TimePoint now);
-  void Sample(TimePoint now, Duration period, bool state_fresh);
+  // False when the state could not be read: no sample (an old one is never sent again).
+  bool Sample(TimePoint now, Duration period, bool state_fresh);
   void FillSample(TimePoint now, Duration period);  // from state_, just read
   enum class CallOutcome { kOk, kThrew, kOverran };
   // Runs one driver call with the fault guard (a throw latches a fault;
   // an overrun was latched by CheckOverrun and its command answered there).
   template <typename F>
   CallOutcome Guarded(const char* name, const QueuedItem* item, TimePoint now, F&& call);
-  void Fault(const std::string& what, TimePoint now);
+  // Latches a fault and halts the driver. `kind` opens the log line: a
+  // driver's ("DRIVER FAULT") or the server's own ("SERVER FAULT").
+  void Fault(const std::string& what, TimePoint now, std::string_view kind = "DRIVER FAULT");
+  // Runs one call of the server's own planners (the TrajectoryTracker, the
+  // SpeedRamp). They are pure code, but a throw out of one would end this
+  // thread with the robot following its last reference: it is a fault like
+  // a driver's (PlannerFault). False when the call threw.
+  template <typename F>
+  bool GuardedPlanner(const char* name, TimePoint now, std::span<const QueuedItem> arriving, F&& call);
+  // Halts the robot (panic, "SERVER FAULT"); every waypoint and frame the
+  // planners hold, and every one of `arriving` not yet answered, answers
+  // INTERRUPTED once: nothing is left unanswered, nothing runs on.
+  void PlannerFault(const std::string& what, TimePoint now, std::span<const QueuedItem> arriving);
+  // Answers each of `items` INTERRUPTED: the robot entered panic (naming why) before it ran.
+  void InterruptInPanic(std::span<const QueuedItem> items, TimePoint now);
   // After a Halt that threw: a STOP, so the robot does not move on (a throw is logged).
   void StopInstead(TimePoint now);
   void Emit(std::int64_t client_id, Reply reply);
@@ -333,10 +354,25 @@ class RobotDaemon {
   std::int64_t samples_ = 0;
   bool last_iteration_ = false;     // Shutdown()'s: STOP, then a last sample
   std::string reported_condition_;  // the driver's last Driver::Fault() text
-  std::string state_problem_;       // what the last state read had that was not finite, or ""
+  std::string state_problem_;  // what was wrong with the last state read ("a non-finite state: …"), or ""
   // Published after every iteration; read by RobotSessions (declared last:
   // it is built from the model and state_).
   QuerySnapshot snapshot_;
 };
+
+template <typename F>
+bool RobotDaemon::GuardedPlanner(const char* name, TimePoint now, std::span<const QueuedItem> arriving,
+                                 F&& call) {
+  try {
+    call();
+    return true;
+  } catch (const std::exception& e) {
+    PlannerFault(std::string("the server's ") + name + " threw: " + e.what(), now, arriving);
+  } catch (...) {
+    PlannerFault(std::string("the server's ") + name + " threw an exception that is not a std::exception",
+                 now, arriving);
+  }
+  return false;
+}
 
 }  // namespace robotalk

@@ -9,7 +9,12 @@ namespace robotalk {
 void RobotDaemon::AddSpeedFrames(TimePoint now) {
   if (speed_frames_.empty()) return;
   const BaseReference measured{.vx = state_.base_v, .vy = state_.base_vy, .omega = state_.base_omega};
-  const std::int64_t owner = ramp_.Add(speed_frames_, now, measured, ramped_);
+  std::int64_t owner = 0;
+  if (!GuardedPlanner("speed ramp", now, speed_frames_,
+                      [&] { owner = ramp_.Add(speed_frames_, now, measured, ramped_); })) {
+    speed_frames_.clear();
+    return;
+  }
   if (owner != 0) produced_.executed.push_back({owner, CommandType::kSetSpeed, -1});
   for (SpeedRamp::Answer& a : ramped_) Emit(a.client_id, std::move(a.reply));
   ramped_.clear();

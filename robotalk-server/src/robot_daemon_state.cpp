@@ -53,6 +53,23 @@ std::optional<std::string> NonFiniteState(const RobotModel& model, const RobotSt
   return "a value is not finite";  // sizes that do not match the model
 }
 
+std::optional<std::string> MisfitState(const RobotModel& model, const RobotState& state) {
+  const Eigen::Index dofs = model.num_dofs();
+  static constexpr const char* kWhat[3] = {"position", "velocity", "effort"};
+  const Eigen::VectorXd* vectors[3] = {&state.position, &state.velocity, &state.effort};
+  for (int w = 0; w < 3; ++w) {
+    if (vectors[w]->size() != dofs) {
+      return std::string(kWhat[w]) + " has " + std::to_string(vectors[w]->size()) +
+             " values, the model has " + std::to_string(dofs) + " dofs";
+    }
+  }
+  if (state.root_poses.size() != model.roots().size()) {
+    return "root_poses has " + std::to_string(state.root_poses.size()) + " poses, the model has " +
+           std::to_string(model.roots().size()) + " roots";
+  }
+  return std::nullopt;
+}
+
 std::string RobotDaemon::timing() const {
   std::lock_guard lock(mutex_);
   return timing_;

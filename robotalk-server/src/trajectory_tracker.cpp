@@ -574,4 +574,16 @@ void TrajectoryTracker::EndAll(TimePoint now, const std::string& why, std::vecto
   for (Track& t : tracks_) EndTrack(t, now, why, answers);
 }
 
+void TrajectoryTracker::Abandon(TimePoint now, const std::string& why, std::vector<Answer>& answers) {
+  for (std::vector<Track>* kind : {&frame_tracks_, &tracks_}) {
+    for (Track& t : *kind) {
+      Interrupt(t, 0, now, t.label + ": " + why, answers);
+      t.trajectory.reset();
+      t.moved_by = -1;
+    }
+  }
+  references_.clear();
+  active_ = 0;
+}
+
 }  // namespace robotalk

@@ -107,6 +107,10 @@ class TrajectoryTracker {
   void End(int joint, TimePoint now, const std::string& why, std::vector<Answer>& answers);
   /// Ends every trajectory.
   void EndAll(TimePoint now, const std::string& why, std::vector<Answer>& answers);
+  /// After a throw out of this tracker (a server fault): drops every
+  /// trajectory without sampling or planning; every waypoint it holds answers
+  /// INTERRUPTED with `why`, passed or not (none is known to have run).
+  void Abandon(TimePoint now, const std::string& why, std::vector<Answer>& answers);
   bool active() const { return active_ > 0; }
   /// The largest |velocity change| / (time since the previous reference) of
   /// any reference handed out so far, over every joint (rad/s² or m/s²): what

@@ -9,6 +9,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -428,6 +429,42 @@ TEST_F(TrackedDaemonTest, TheKinematicDriverFollowsACubicSineBetweenItsWaypoints
     if (k > 5) max_error = std::max(max_error, std::abs(Elbow() - sine(clock_.Now())));
   }
   EXPECT_LT(max_error, 3e-3);
+}
+
+// The tracker is the server's own code, but a throw out of it ended the
+// RobotDaemon's thread with the robot following its last reference. Here an
+// allocation fails in the middle of adding waypoints (the first of a joint's
+// trajectory allocates): a SERVER FAULT halts the robot, and every waypoint,
+// held or arriving, answers INTERRUPTED exactly once.
+TEST_F(TrackedDaemonTest, AThrowInsideTheTrackerHaltsTheRobotAndAnswersEveryWaypointOnce) {
+  daemon_.Submit(Waypoint(1, 0, kT0 + milliseconds(500), {0.4}));
+  daemon_.Submit(Waypoint(2, 0, kT0 + milliseconds(900), {0.6}));
+  std::vector<DaemonOutput::Answer> replies = RunTo(kT0 + milliseconds(100));
+  ASSERT_TRUE(replies.empty());
+  daemon_.Submit(Waypoint(3, 1, kT0 + milliseconds(600), {0.1, 0.2}));  // the wrist: a new trajectory
+  daemon_.Submit(Waypoint(4, 1, kT0 + milliseconds(800), {0.2, 0.3}));
+  g_fail_allocation = 1;
+  daemon_.RunOnce(clock_.Now());
+  g_fail_allocation = 0;
+  daemon_.TakeOutput(out_);
+  replies = out_.replies;
+  EXPECT_TRUE(daemon_.in_panic());
+  EXPECT_THAT(daemon_.fault(), HasSubstr("the server's trajectory tracker threw: std::bad_alloc"));
+  ASSERT_FALSE(out_.log.empty());
+  EXPECT_THAT(out_.log.front(), HasSubstr("SERVER FAULT"));
+  const double halted_at = Elbow();
+  EXPECT_GT(halted_at, 0.0) << "the elbow's trajectory ran until the fault";
+  for (const auto& a : RunTo(kT0 + milliseconds(1500))) replies.push_back(a);
+  for (CommandId id : {1, 2, 3, 4}) {
+    EXPECT_EQ(std::count_if(replies.begin(), replies.end(), [id](const auto& a) { return a.reply.id == id; }),
+              1)
+        << "waypoint " << id;
+  }
+  for (const auto& a : replies) {
+    EXPECT_EQ(a.reply.signal, Signal::kInterrupted) << a.reply.message;
+    EXPECT_THAT(a.reply.message, HasSubstr("trajectory tracker threw"));
+  }
+  EXPECT_DOUBLE_EQ(Elbow(), halted_at) << "the elbow stopped where the fault halted it";
 }
 
 TEST_F(TrackedDaemonTest, AStepPackageStillJumpsAsBefore) {

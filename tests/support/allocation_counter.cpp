@@ -5,6 +5,7 @@
 
 long g_allocations = 0;
 long g_mallocs = 0;
+long g_fail_allocation = 0;
 
 // glibc's own entry points do the work of the replaced malloc family.
 extern "C" void* __libc_malloc(std::size_t);
@@ -28,6 +29,7 @@ extern "C" void* realloc(void* p, std::size_t n) noexcept {
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void* operator new(std::size_t size) {
   ++g_allocations;
+  if (g_fail_allocation > 0 && --g_fail_allocation == 0) throw std::bad_alloc();
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }

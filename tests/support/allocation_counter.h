@@ -10,3 +10,7 @@
 extern long g_allocations;
 /// Every heap allocation: operator new's and Eigen's (which calls malloc directly).
 extern long g_mallocs;
+/// Fault injection: when > 0, the g_fail_allocation-th operator new from now
+/// throws std::bad_alloc (counting down; 0: never). What the code under test
+/// does when an allocation fails where it may (a throw it must contain).
+extern long g_fail_allocation;
