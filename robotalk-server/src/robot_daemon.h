@@ -375,4 +375,39 @@ bool RobotDaemon::GuardedPlanner(const char* name, TimePoint now, std::span<cons
   return false;
 }
 
+template <typename F>
+RobotDaemon::CallOutcome RobotDaemon::Guarded(const char* name, const QueuedItem* item, TimePoint now,
+                                              F&& call) {
+  {
+    std::lock_guard lock(call_mutex_);
+    call_ = CurrentCall{name,
+                        now,
+                        item ? item->client_id : 0,
+                        item ? item->command.id : 0,
+                        item != nullptr && item->client_id != 0,
+                        false};
+  }
+  std::string error;
+  bool threw = false;
+  try {
+    call();
+  } catch (const std::exception& e) {
+    threw = true;
+    error = e.what();
+  } catch (...) {
+    threw = true;
+    error = "an exception that is not a std::exception";
+  }
+  bool overran = false;
+  {
+    std::lock_guard lock(call_mutex_);
+    overran = call_.overran;
+    call_ = CurrentCall{};
+  }
+  if (overran) return CallOutcome::kOverran;
+  if (!threw) return CallOutcome::kOk;
+  Fault("driver '" + driver_name_ + "' threw in " + name + ": " + error, now);
+  return CallOutcome::kThrew;
+}
+
 }  // namespace robotalk
