@@ -221,6 +221,20 @@ TEST(RobotMessages, SceneEmbedsAResolvedMeshWhenAskedAndLinksItOtherwise) {
   EXPECT_NE(Meta(tool, "mesh").find("missing_pkg"), std::string::npos) << tool;
 }
 
+TEST(RobotMessages, AMeshOverTheEmbeddingLimitIsDrawnAsItsInertiaBoxSayingWhy) {
+  const std::string web_data = std::string(ROBOTALK_MODELS_DIR) + "/../tests/web/data";
+  const std::string path = web_data + "/mesh_bot/urdf/mesh_bot.urdf";
+  const auto model = std::make_shared<const RobotModel>(LoadUrdfFile(path).model);
+  const RobotMessages m(model, ResolveMeshes(model->name(), path, {web_data}));
+  std::map<std::string, nlohmann::json> by_id;
+  const nlohmann::json scene = m.Scene(0, {.embed = true, .max_embedded_bytes = 16});
+  for (const auto& e : scene["entities"]) by_id[e["id"]] = e;
+  const auto& arm = by_id.at("mesh_bot/arm");
+  EXPECT_TRUE(arm["models"].empty()) << arm;
+  EXPECT_EQ(arm["cubes"].size(), 1u);
+  EXPECT_NE(Meta(arm, "mesh").find("over the 16-byte limit of an embedded mesh"), std::string::npos) << arm;
+}
+
 TEST(RobotMessages, FromPoseOfAnotherModelThrowsNamingTheRobot) {
   const auto model = Pioneer();
   const RobotMessages m(model);

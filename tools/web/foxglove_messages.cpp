@@ -201,6 +201,13 @@ std::variant<json, std::string> Model(const UrdfShape& s, const MeshEntry& m, co
   } else if (Lower(m.file.extension().string()) == ".gltf") {
     url = "file://" + m.file.string();
   } else {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(m.file, ec);
+    if (ec) return "cannot read " + m.file.string() + ": " + ec.message();
+    if (size > links.max_embedded_bytes) {
+      return m.file.string() + " is " + std::to_string(size) + " bytes, over the " +
+             std::to_string(links.max_embedded_bytes) + "-byte limit of an embedded mesh";
+    }
     std::ifstream in(m.file, std::ios::binary);
     std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     if (!in.good() && !in.eof()) return "cannot read " + m.file.string();

@@ -78,6 +78,10 @@ struct MeshLinks {
   /// recording plays back anywhere; a .gltf, which names files beside it,
   /// is referred to as file://PATH instead.
   bool embed = false;
+  /// The largest mesh file embedded (a recording holds each once per
+  /// scene): a larger one is drawn as its link's inertia box, the scene's
+  /// metadata saying why, rather than growing the file without bound.
+  std::uintmax_t max_embedded_bytes = std::uintmax_t{32} << 20;
 };
 
 /// One robot's messages for one model.
