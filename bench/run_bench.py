@@ -379,7 +379,7 @@ class Bench:
                     ("quick", ["--playback-estimator", "quick"], [], 0.0),
                     ("adaptive", adaptive, [], 2.0),  # the server's default, a client without redundancy
                     ("adaptive_copies", adaptive, ["--copies", "2"], 2.0),
-                    ("adaptive_copies_queue", adaptive + ["--playback-queue-start", "on"], ["--copies", "2"], 2.0),
+                    ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0),
                     ("adaptive_m05", ["--playback-estimator", "adaptive", "--playback-margin", "0.5"], [], 0.5))
         runs = []
         seed = 101
