@@ -313,7 +313,8 @@ if [ -n "$check_only" ]; then check "$check_only"; exit; fi
 if [ -z "${ROBOTALK_SOAK_IN_NETNS:-}" ]; then
   export ROBOTALK_SOAK_IN_NETNS=1
   exec "$root/scripts/netns_run.sh" "$0" --seconds "$seconds" --seed "$seed" --per-mode "$per_mode" \
-    --kills "$kills" --build "$build" $([ "$keep" = 1 ] && echo --keep) $([ "$keyed" = 1 ] && echo --keyed)
+    --kills "$kills" --build "$build" --playback-copies "$copies" $([ "$keep" = 1 ] && echo --keep) \
+    $([ "$keyed" = 1 ] && echo --keyed)
 fi
 
 server_bin=$build/robotalk-server/robotalk-server
