@@ -315,20 +315,32 @@ def playback_estimators_section(res):
                             "(`scripts/bench.sh --only playback_estimators`).")
     if r.get("error"):
         return head + "\n\nNot measured: " + str(r["error"])
-    names = {"paper": "paper's estimator", "quick": "quick start (issue 11, before)", "adaptive": "adaptive (now)"}
+    names = {"paper": "paper's estimator", "quick": "quick start (issue 11)",
+             "adaptive": "adaptive (the default; before: the same)",
+             "adaptive_copies": "adaptive, client sends 2 copies",
+             "adaptive_queue": "adaptive + queue start (option)",
+             "adaptive_m05": "adaptive, 0.5 ms hand-over margin"}
     lines = [head, "", "| relay profile (client → server) | estimator | start latency (per run) | hindsight minimum "
-             "| ratio (per run) | late frames | pauses past the bound | largest gap stretch | whole-sequence stretch |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| ratio (per run) | hindsight + hand-over | ratio to it | late frames | pauses past the bound "
+             "| largest gap stretch | whole-sequence stretch |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    verdicts = []
     for prof in dict.fromkeys(x["profile"] for x in r.get("runs", [])):
-        for est in ("paper", "quick", "adaptive"):
+        for est in names:
             rs = [x for x in r["runs"] if x["profile"] == prof and x["estimator"] == est]
             if not rs:
                 continue
+            margin = [(x.get("margin_ms") or 0.0) / 1e3 for x in rs]
             ch = [get(x, "robotalk", "chosen_delay_s") for x in rs]
             hs = [get(x, "arrivals", "hindsight_min_s") for x in rs]
-            ratios = [f"{c / h:.2f}" if c is not None and h else "—" for c, h in zip(ch, hs)]
-            late = sum(int(get(x, "robotalk", "late_frames") or 0) + int(get(x, "robotalk", "not_run") or 0)
-                       for x in rs)
+            ratios = [c / h if c is not None and h else None for c, h in zip(ch, hs)]
+            ratios_own = [c / (h + m) if c is not None and h is not None and h + m > 0 else None
+                          for c, h, m in zip(ch, hs, margin)]
+            # A frame past the stretch bound plays at its arrival (a pause): late for the verdict too.
+            late_each = [int(get(x, "robotalk", "late_frames") or 0) + int(get(x, "robotalk", "not_run") or 0)
+                         for x in rs]
+            paused_each = [int(get(x, "robotalk", "gaps_over_bound") or 0) for x in rs]
+            late = sum(late_each)
             n = sum(int(get(x, "robotalk", "lateness_us", "n") or 0) for x in rs)
             over = sum(int(get(x, "robotalk", "gaps_over_bound") or 0) for x in rs)
             gs = max((get(x, "robotalk", "max_gap_stretch") or 0) for x in rs)
@@ -337,8 +349,20 @@ def playback_estimators_section(res):
                    and x["robotalk"].get("error")]
             fmt_s = ", ".join(f"{c * 1e3:.1f} ms" if c is not None else "—" for c in ch)
             fmt_h = ", ".join(f"{h * 1e3:.1f} ms" if h is not None else "—" for h in hs)
-            lines.append(f"| {prof} | {names[est]} | {fmt_s} | {fmt_h} | {', '.join(ratios)} | {late} of {n} | "
+            fmt_ho = ", ".join(f"{(h + m) * 1e3:.1f} ms" if h is not None else "—" for h, m in zip(hs, margin))
+            fr = ", ".join(f"{x:.2f}" if x is not None else "—" for x in ratios)
+            fro = ", ".join(f"{x:.2f}" if x is not None else "—" for x in ratios_own)
+            lines.append(f"| {prof} | {names[est]} | {fmt_s} | {fmt_h} | {fr} | {fmt_ho} | {fro} | {late} of {n} | "
                          f"{over} | {gs * 100:.1f} % | {ts * 1e3:.1f} ms |" + (f" (error: {err[0][:80]})" if err else ""))
+            met = [x is not None and x <= 1.25 and lt == 0 and pz == 0
+                   for x, lt, pz in zip(ratios, late_each, paused_each)]
+            met_own = [x is not None and x <= 1.25 and lt == 0 and pz == 0
+                       for x, lt, pz in zip(ratios_own, late_each, paused_each)]
+            verdicts.append((prof, names[est], sum(met), sum(met_own), len(rs)))
+    lines += ["", "Runs with ratio ≤ 1.25, no late frame and no pause past the bound (to the hindsight minimum; to "
+              "it + the server's hand-over margin):", "", "| relay profile | estimator | runs met (hindsight) | runs met (+ hand-over) |",
+              "|---|---|---|---|"]
+    lines += [f"| {p} | {e} | {a} of {k} | {b} of {k} |" for p, e, a, b, k in verdicts]
     return "\n".join(lines)
 
 

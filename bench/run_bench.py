@@ -371,13 +371,24 @@ class Bench:
         if self.quick:
             profiles = [profiles[0], profiles[2], profiles[4]]
         reps = 1 if self.quick else 2
-        estimators = ("paper", "quick", "adaptive")
+        # (name, server arguments, client arguments, the server's hand-over margin in ms: a frame of
+        # the adaptive schedule must have arrived that long before it plays; the fixed schedules of
+        # the paper and the quick start call a frame late only once it arrives after its time).
+        adaptive = ["--playback-estimator", "adaptive", "--playback-margin", "2"]
+        variants = (("paper", ["--playback-estimator", "paper"], [], 0.0),
+                    ("quick", ["--playback-estimator", "quick"], [], 0.0),
+                    ("adaptive", adaptive, [], 2.0),  # the server's default, a client without redundancy
+                    ("adaptive_copies", adaptive, ["--copies", "2"], 2.0),
+                    ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0),
+                    ("adaptive_m05", ["--playback-estimator", "adaptive", "--playback-margin", "0.5"], [], 0.5))
         runs = []
         seed = 101
         for name, impair in profiles:
             for _ in range(reps):
-                for est in estimators:  # interleaved on the same relay seed
-                    self.start_server(url=URL_B, extra=["--playback-estimator", est])
+                for est, server_args, client_args, margin_ms in variants:  # interleaved on one relay seed
+                    if est == "adaptive_m05" and not name.startswith(("U[0, 0]", "U[0, 50]")):
+                        continue  # the hand-over margin matters only where the floor is a few ms
+                    self.start_server(url=URL_B, extra=server_args)
                     relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, *impair, "--seed", str(seed),
                                         "--duration", "120"])
                     time.sleep(0.3)
@@ -385,12 +396,13 @@ class Bench:
                                       str(frames), "--timeout", "50"])
                     time.sleep(0.2)  # the arrival log subscribed before the first frame
                     a = self.run([self.client, "playback", "--url", URL_A, "--frames", str(frames),
-                                  "--period-ms", "100", "--stretch-bound", "0.1"], timeout=60)
+                                  "--period-ms", "100", "--stretch-bound", "0.1", *client_args], timeout=60)
                     arr = self.collect(log, 50, "arrivals")
                     self.stop(relay)
                     self.stop_server()
                     runs.append({"profile": name, "relay_args": impair, "seed": seed, "estimator": est,
-                                 "robotalk": a, "arrivals": arr})
+                                 "margin_ms": margin_ms, "server_args": server_args,
+                                 "client_args": client_args, "robotalk": a, "arrivals": arr})
                     time.sleep(0.5)
                 seed += 1
         return {"figure": "playback_estimators", "frames": frames, "period_ms": 100, "stretch_bound": 0.1,

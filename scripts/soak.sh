@@ -2,6 +2,7 @@
 # The soak (issue 9, item 9; docs/soak.md). Its 60 s form runs in ctest (soak_60s, label soak).
 #
 #   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep] [--keyed]
+#                   [--playback-copies 1|2]   (ClientOptions::playback_copies of every client)
 #   scripts/soak.sh --check-only DIR     the checks again on a kept run's files
 #
 # One robotalk-server (kinematic driver, models/pioneer2dx_pantilt.urdf,
@@ -28,7 +29,7 @@
 # answers before they are killed; the relay stops by itself after N + 120 s.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
-seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only="" keyed=0
+seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only="" keyed=0 copies=1
 while [ $# -gt 0 ]; do
   case $1 in
     --seconds) seconds=$2; shift 2 ;;
@@ -38,6 +39,7 @@ while [ $# -gt 0 ]; do
     --build) build=$2; shift 2 ;;
     --keep) keep=1; shift ;;
     --keyed) keyed=1; shift ;;
+    --playback-copies) copies=$2; shift 2 ;;
     --check-only) check_only=$2; shift 2 ;;
     -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     *) echo "soak.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
@@ -311,7 +313,8 @@ if [ -n "$check_only" ]; then check "$check_only"; exit; fi
 if [ -z "${ROBOTALK_SOAK_IN_NETNS:-}" ]; then
   export ROBOTALK_SOAK_IN_NETNS=1
   exec "$root/scripts/netns_run.sh" "$0" --seconds "$seconds" --seed "$seed" --per-mode "$per_mode" \
-    --kills "$kills" --build "$build" $([ "$keep" = 1 ] && echo --keep) $([ "$keyed" = 1 ] && echo --keyed)
+    --kills "$kills" --build "$build" --playback-copies "$copies" $([ "$keep" = 1 ] && echo --keep) \
+    $([ "$keyed" = 1 ] && echo --keyed)
 fi
 
 server_bin=$build/robotalk-server/robotalk-server
@@ -374,7 +377,7 @@ start_client() {  # start_client MODE SECONDS
   n_clients=$((n_clients + 1))
   local out=$tmp/client$n_clients.jsonl
   ROBOTALK_KEY=$(key_of "$n_clients") "$client_bin" --mode "$1" --url "$url_a" --robot pioneer --seconds "$2" \
-    --seed $((seed * 1000 + n_clients)) --out "$out" 2>"$tmp/client$n_clients.err" &
+    --seed $((seed * 1000 + n_clients)) --playback-copies "$copies" --out "$out" 2>"$tmp/client$n_clients.err" &
   client_pids[$!]=$out
   echo "$!" "$1" "$out" >>"$tmp/clients"
 }

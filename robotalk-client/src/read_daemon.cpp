@@ -56,6 +56,11 @@ RobotClient::Impl::Impl(ClientOptions options)
     }
     transport_ = own_transport_.get();
   }
+  if (options_.playback_copies < 1 || options_.playback_copies > 2) {
+    throw ClientError("RobotClient: ClientOptions::playback_copies is " +
+                      std::to_string(options_.playback_copies) +
+                      "; expected 1 (each playback package once) or 2 (twice)");
+  }
   LoadKeys();
   if (identity_) {
     // Keyed mode: the client id is one of the key's (docs/security.md,
@@ -195,7 +200,10 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
   // No wake-up of the ReadDaemon (a context switch per command): it never
   // sleeps longer than retransmit_interval (IdleWait), and a new package's
   // first resend is at least that far away.
-  Publish(channel, bytes);
+  // Playback redundancy: the copy is a duplicate by sequence number, which
+  // the server drops (it re-acknowledges it; the frames run once).
+  const int copies = options.mode == RequestMode::kPlayback ? options_.playback_copies : 1;
+  for (int k = 0; k < copies; ++k) Publish(channel, bytes);
   return sent;
 }
 

@@ -31,14 +31,29 @@ void DelayHistory::Add(TimePoint sent, TimePoint received) {
   size_ = std::min(size_ + 1, kCapacity);
 }
 
-std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const {
-  std::vector<Duration> out;
+std::vector<DelayHistory::Sample> DelayHistory::RecentSamples(TimePoint now, Duration window) const {
+  std::vector<Sample> out;
   out.reserve(size_);
   for (std::size_t k = 0; k < size_; ++k) {
     const Sample& s = ring_[(next_ + kCapacity - size_ + k) % kCapacity];
-    if (now - s.received <= window) out.push_back(s.delay);
+    if (now - s.received <= window) out.push_back(s);
   }
   return out;
+}
+
+std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const {
+  std::vector<Duration> out;
+  for (const Sample& s : RecentSamples(now, window)) out.push_back(s.delay);
+  return out;
+}
+
+void PlaybackEstimator::SetDelayHistory(const std::vector<DelayHistory::Sample>& samples) {
+  history_.clear();
+  history_received_.clear();
+  for (const DelayHistory::Sample& s : samples) {
+    history_.push_back(s.delay);
+    history_received_.push_back(s.received);
+  }
 }
 
 void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent) {
@@ -78,12 +93,117 @@ std::optional<PlaybackEstimator::Spread> PlaybackEstimator::FencedSpread() const
   return Spread{least, delays[kept - 1], kept};
 }
 
-bool PlaybackEstimator::adaptive() const {
+bool PlaybackEstimator::SpreadWithinGate() const {
   // The whole spread, outliers included: the paper's congestion (a server
   // pausing after each package) shows as a few slow packages among fast ones.
-  if (!options_.adaptive) return false;
   const std::optional<Duration> spread = delay_spread();
   return spread && ToSeconds(*spread) <= options_.adaptive_max_spread * interval();
+}
+
+bool PlaybackEstimator::adaptive() const {
+  if (!options_.adaptive || !delay_spread()) return false;
+  return SpreadWithinGate() || (options_.queue_start && QueueFollowable());
+}
+
+bool PlaybackEstimator::QueueFollowable() const {
+  // The frames' queue drifts by (mean service - T) a frame, which the
+  // stretch follows up to max_stretch × T. A channel that may be slower than
+  // that (the mean's upper confidence bound, of the few services seen) gets
+  // the paper's estimate, which waits for frames and projects their drift.
+  // Re-checked at every frame before the start is decided: paced frames
+  // show the pauses that sparse packages may not (Fig. 11's injector).
+  const std::vector<double> s = Services();
+  const auto n = static_cast<double>(s.size());
+  double mean = 0, var = 0;
+  for (double x : s) mean += x / n;
+  for (double x : s) var += (x - mean) * (x - mean);
+  const double sd = s.size() > 1 ? std::sqrt(var / (n - 1)) : mean;
+  return mean + options_.confidence_z * sd / std::sqrt(n) <= interval() * (1.0 + options_.max_stretch);
+}
+
+bool PlaybackEstimator::ready() const {
+  if (!queued()) return quick() || frames_.size() >= needed_;
+  if (frames_.size() >= needed_) return true;
+  // The queue start is decided once the next frame may come after it: until
+  // then nothing plays, and each frame that comes first adds its service
+  // (paced frames show the sequence's own queue, which sparse packages may
+  // not: Fig. 11's server pauses after each package).
+  TimePoint latest = TimePoint::min();
+  for (const Frame& f : frames_) latest = std::max(latest, f.arrival);
+  return StartTime() - latest < FromSeconds(interval());
+}
+
+bool PlaybackEstimator::queued() const { return adaptive() && !SpreadWithinGate(); }
+
+std::vector<double> PlaybackEstimator::Services() const {
+  // The packages seen (the history's and the frames'), in arrival order. On a
+  // FIFO bottleneck whose least delay is d_min, package j would arrive at
+  // u_j = a_j - (d_j - d_min) with an empty queue; it waited for the one
+  // before it until max(a_{j-1}, u_j), so its own service took
+  // s_j = a_j - max(a_{j-1}, u_j) (Lindley's recursion read backwards). A
+  // delay beyond the fence (a retransmission: its resend wait) is no service.
+  struct Seen {
+    TimePoint arrival;
+    Duration delay;
+    bool known_arrival;
+  };
+  std::vector<Seen> seen;
+  for (std::size_t k = 0; k < history_.size(); ++k) {
+    const bool known = history_received_.size() == history_.size();
+    seen.push_back({known ? history_received_[k] : TimePoint{}, history_[k], known});
+  }
+  for (const Frame& f : frames_) seen.push_back({f.arrival, *f.delay, true});  // both in arrival order
+  const Spread fenced = *FencedSpread();
+  std::vector<double> service;  // s
+  std::optional<TimePoint> previous;
+  for (const Seen& p : seen) {
+    const Duration excess = p.delay - fenced.least;
+    Duration s = excess;  // arrival unknown: as if it had not queued (the larger service)
+    if (p.known_arrival && previous)
+      s = std::min(excess, p.arrival - std::max(*previous, p.arrival - excess));
+    if (p.known_arrival) previous = p.arrival;
+    if (p.delay <= fenced.most) service.push_back(ToSeconds(s));
+  }
+  return service;  // not empty: the fence keeps the least
+}
+
+Duration PlaybackEstimator::QueueWorst() const {
+  const std::vector<double> service = Services();
+  const Duration least = FencedSpread()->least;
+  // The sequence's frames, one every interval T, queue behind each other:
+  // frame i waits w_i = max(0, w_{i-1} + s_{i-1} - T) (Lindley) and arrives
+  // d_min + w_i + s_i. Resampled from the services seen (a fixed seed: the
+  // estimate is a pure function of its inputs), the worst of each simulated
+  // sequence; the start covers their queue_quantile. A channel slower than
+  // the sequence (mean s > T, the paper's Fig. 11) drifts, and the simulated
+  // worst grows with the sequence's length as the real one will.
+  const double t = interval();
+  const std::size_t frames = std::min(total_, kQueueHorizon);
+  const std::size_t runs = std::max<std::size_t>(options_.queue_resamples, 1);
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  const auto draw = [&] {  // splitmix64
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return service[(z ^ (z >> 31)) % service.size()];
+  };
+  std::vector<double> worst(runs);
+  for (double& w_max : worst) {
+    double wait = 0, previous_s = 0, total = 0;
+    for (std::size_t i = 0; i < frames; ++i) {
+      wait = std::max(0.0, wait + previous_s - t);
+      previous_s = draw();
+      total += previous_s;
+      w_max = std::max(w_max, wait + previous_s);
+    }
+    // Beyond the horizon, a drifting queue keeps growing at its drift.
+    const double drift = total / static_cast<double>(frames) - t;
+    if (drift > 0) w_max += drift * static_cast<double>(total_ - frames);
+  }
+  const auto q = static_cast<std::size_t>(
+      std::clamp(options_.queue_quantile, 0.0, 1.0) * static_cast<double>(runs - 1) + 0.5);
+  std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(q), worst.end());
+  return least + FromSeconds(worst[q]);
 }
 
 bool PlaybackEstimator::quick() const {
@@ -99,6 +219,7 @@ bool PlaybackEstimator::quick() const {
 }
 
 Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
+  if (queued()) return QueueWorst();
   const Spread s = *FencedSpread();
   const Duration spread = s.most - s.least;
   // Delays that vary by less than a frame interval cannot build a queue of
@@ -182,6 +303,11 @@ Duration PlaybackEstimator::ExtraLagBound(Duration remaining) const {
 }
 
 TimePoint PlaybackEstimator::StartTime() const {
+  if (queued()) {
+    // Still undecided after the paper's count of frames: the later of both.
+    const TimePoint start = StartCovering(QueueWorst(), options_.adaptive_margin);
+    return frames_.size() >= needed_ ? std::max(start, PaperStart()) : start;
+  }
   if (adaptive()) return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin);
   if (quick()) {
     // The worst delay a later frame may have is predicted as the least seen
@@ -193,6 +319,10 @@ TimePoint PlaybackEstimator::StartTime() const {
     return StartCovering(least + FromSeconds(ToSeconds(*delay_spread()) * options_.quick_jitter_factor),
                          options_.quick_margin);
   }
+  return PaperStart();
+}
+
+TimePoint PlaybackEstimator::PaperStart() const {
   // Frames seen must be there before they play: start >= a_i - o_i.
   TimePoint lag = TimePoint::min();
   Duration first_offset = Duration::max(), last_offset = Duration::min();

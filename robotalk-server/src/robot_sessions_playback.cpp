@@ -77,7 +77,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   }
   if (!seq.first_arrival) {
     seq.first_arrival = now;
-    seq.estimator->SetDelayHistory(s.delays.Recent(now));
+    seq.estimator->SetDelayHistory(s.delays.RecentSamples(now));
   }
   const std::optional<TimePoint> sent =
       r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
@@ -134,7 +134,10 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
   std::vector<PlaybackSequence::Frame>().swap(seq.frames);
   const Duration delay = *seq.start - *seq.first_arrival;
   std::string why;
-  if (estimator.adaptive()) {
+  if (estimator.queued()) {
+    why = "queue start: this client's recent one-way delays vary by " + Seconds(*estimator.delay_spread()) +
+          ", more than a frame interval; covers the queue its frames will build";
+  } else if (estimator.adaptive()) {
     why = "adaptive start: this client's recent one-way delays vary by " + Seconds(*estimator.delay_spread());
   } else if (estimator.quick()) {
     why = "quick start: this client's packages' one-way delays vary by " + Seconds(*estimator.delay_spread());

@@ -118,6 +118,8 @@ class Server::Impl {
     sessions.playback.quick_start = options_.playback_estimator != "paper";
     sessions.playback.adaptive = options_.playback_estimator == "adaptive";
     sessions.playback.max_stretch = options_.playback_stretch;
+    sessions.playback.adaptive_margin = options_.playback_margin;
+    sessions.playback.queue_start = options_.playback_queue_start;
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     sessions.max_sessions_per_robot = options_.max_sessions_per_robot;

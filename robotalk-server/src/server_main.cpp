@@ -47,6 +47,11 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   (issue 11's start, fixed timing) or paper (wait for frames)
   --playback-stretch F            adaptive: how much longer than recorded a gap between two
                                   frames may play (default 0.1: 10 %; 0: never)
+  --playback-margin MS            adaptive: a frame plays no sooner than MS milliseconds after
+                                  it arrived (its hand-over to the robot's thread; default 2)
+  --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals
+                                  start from a simulated queue of the sequence's frames (on)
+                                  or wait for frames (off, default: the paper's estimate)
   --inject-reply-drop P           test only: drop each reply package with probability P
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
@@ -214,6 +219,12 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         }
       } else if (arg == "--playback-stretch") {
         options.playback_stretch = ParseNumber(arg, value(), 0, 1);
+      } else if (arg == "--playback-margin") {
+        options.playback_margin = FromSeconds(ParseNumber(arg, value(), 0, 1000) / 1000);
+      } else if (arg == "--playback-queue-start") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-queue-start '" + v + "': expected on or off");
+        options.playback_queue_start = v == "on";
       } else if (arg == "--duration") {
         duration = ParseNumber(arg, value(), 0, 1e9);
       } else if (arg == "--inject-reply-drop") {

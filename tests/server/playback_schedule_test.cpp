@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <random>
 
 namespace robotalk {
@@ -100,17 +101,20 @@ struct SimRun {
 };
 
 // A paced client (frame i sent at offset i), `history` connect-time packages
-// before it, one-way delay delay(k) for the k-th package; its clock reads
-// 5000 s ahead. `options` decides how the start is estimated.
+// before it (each a round trip: sent once the one before it arrived, and at
+// least 20 ms after it), one-way delay delay(k, sent) for the k-th package;
+// its clock reads 5000 s ahead. `options` decides how the start is estimated.
 SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
-                const std::function<Duration(std::size_t)>& delay, PlaybackEstimatorOptions options = {}) {
+                const std::function<Duration(std::size_t, TimePoint)>& delay,
+                PlaybackEstimatorOptions options = {}) {
   const Duration skew = std::chrono::seconds(5000);
   PlaybackEstimator est(frames, period * static_cast<int>(frames - 1), options);
   DelayHistory h;
   std::size_t k = 0;
-  for (; k < history; ++k) {
-    const TimePoint sent = kT0 - milliseconds(500) + milliseconds(20) * static_cast<int>(k);
-    h.Add(sent + skew, sent + delay(k));
+  for (TimePoint next = kT0 - std::chrono::seconds(4); k < history; ++k) {
+    const TimePoint sent = next, arrival = sent + delay(k, sent);
+    h.Add(sent + skew, arrival);
+    next = std::max(sent + milliseconds(20), arrival + milliseconds(1));
   }
   struct Frame {
     Duration offset;
@@ -119,14 +123,14 @@ SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
   std::vector<Frame> all;
   for (std::size_t i = 0; i < frames; ++i, ++k) {
     const TimePoint sent = kT0 + period * static_cast<int>(i);
-    all.push_back({period * static_cast<int>(i), sent + delay(k), sent + skew});
+    all.push_back({period * static_cast<int>(i), sent + delay(k, sent), sent + skew});
   }
   std::stable_sort(all.begin(), all.end(),
                    [](const Frame& a, const Frame& b) { return a.arrival < b.arrival; });
   const TimePoint first = all.front().arrival;
   SimRun run;
   for (const Frame& f : all) run.hindsight = std::max(run.hindsight, f.arrival - first - f.offset);
-  est.SetDelayHistory(h.Recent(first));
+  est.SetDelayHistory(h.RecentSamples(first));
   std::optional<PlaybackSchedule> schedule;
   std::vector<const Frame*> buffered;
   for (const Frame& f : all) {
@@ -163,14 +167,16 @@ struct Summary {
 // `runs` seeded channels; the ratio is the start delay over the hindsight
 // minimum, both + the 2 ms margin every start needs (a frame must be in the
 // RobotDaemon's queue before it is due).
-Summary Many(int runs, const std::function<Duration(std::mt19937_64&, std::size_t)>& channel,
-             PlaybackEstimatorOptions options = {}) {
+using Channel = std::function<Duration(std::mt19937_64&, std::size_t, TimePoint)>;
+Summary Many(int runs, const Channel& channel, PlaybackEstimatorOptions options = {},
+             std::size_t frames = 40) {
   Summary s;
   std::vector<double> ratios;
   for (int seed = 1; seed <= runs; ++seed) {
     std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
     const SimRun r = Simulate(
-        40, milliseconds(100), 10, [&](std::size_t k) { return channel(rng, k); }, options);
+        frames, milliseconds(100), 10, [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); },
+        options);
     s.late_frames += r.late;
     if (r.late > 0) ++s.late_runs;
     s.worst_stretch = std::max(s.worst_stretch, r.max_gap_stretch);
@@ -189,7 +195,8 @@ TEST(AdaptivePlayback, OnAJitteryChannelStartsNearTheHindsightMinimumAndFramesAr
   // Delays uniform in [0, 40] ms at 10 Hz: 1000 seeded channels. The quick
   // start (2.5 x spread + 10 ms, fixed timing) had a median 2.7x (its test in
   // playback_estimator_test.cpp) with no late run.
-  const Summary s = Many(1000, [](std::mt19937_64& rng, std::size_t) { return Uniform(rng, 0, 40); });
+  const Summary s =
+      Many(1000, [](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, 40); });
   std::printf("U[0, 40] ms: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio,
               s.late_runs, s.worst_stretch);
   // 10 connect-time delays are a small sample of the channel: in 2 runs of
@@ -201,7 +208,7 @@ TEST(AdaptivePlayback, OnAJitteryChannelStartsNearTheHindsightMinimumAndFramesAr
 
 TEST(AdaptivePlayback, OnAWanProfileStartsNearTheHindsightMinimumAndFramesAreRarelyLate) {
   // 100-300 ms of delay (the path's, fixed per run), +-50 ms jitter.
-  const Summary s = Many(1000, [](std::mt19937_64& rng, std::size_t k) {
+  const Summary s = Many(1000, [](std::mt19937_64& rng, std::size_t k, TimePoint) {
     static thread_local Duration base{};
     if (k == 0) base = Uniform(rng, 100, 300);
     return base + Uniform(rng, -50, 50);
@@ -215,37 +222,84 @@ TEST(AdaptivePlayback, OnAWanProfileStartsNearTheHindsightMinimumAndFramesAreRar
   EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
 }
 
+// The relay's congestion: a FIFO link whose service is U[0, X] ms per message.
+Channel Fifo(double x_ms) {
+  auto busy = std::make_shared<TimePoint>();
+  return [busy, x_ms](std::mt19937_64& rng, std::size_t k, TimePoint sent) {
+    if (k == 0) *busy = TimePoint{};
+    *busy = std::max(*busy, sent) + Uniform(rng, 0, x_ms);
+    return *busy - sent;
+  };
+}
+
+// Fig. 11's injector: the server pauses U[0, P] ms after each package it
+// reads, so it reads the next one no sooner than that pause's end.
+Channel ServerPauses(double p_ms) {
+  auto free_at = std::make_shared<TimePoint>();
+  return [free_at, p_ms](std::mt19937_64& rng, std::size_t k, TimePoint sent) {
+    if (k == 0) *free_at = TimePoint{};
+    const TimePoint read = std::max(sent + milliseconds(1), *free_at);
+    *free_at = read + Uniform(rng, 0, p_ms);
+    return read - sent;
+  };
+}
+
 TEST(AdaptivePlayback, OnACongestedLinkAQueueBuildsAndTheStartCoversIt) {
-  // The relay's congestion: a FIFO link whose service is U[0, X] ms per
-  // message; connect-time packages are sparse (no queue), frames every 100 ms.
+  // Frames every 100 ms; connect-time packages are round trips (no queue).
+  // Beyond a spread of 1.2 frame intervals the paper's estimate decides by
+  // default (X = 150: median 14.9x); with the queue start (an option, see
+  // the next test) the start is decided within the first frames.
+  const PlaybackEstimatorOptions queue{.queue_start = true};
   for (double x : {50.0, 100.0, 150.0}) {
-    TimePoint busy{};
-    const Summary s = Many(300, [&](std::mt19937_64& rng, std::size_t k) {
-      const Duration service = Uniform(rng, 0, x);
-      if (k < 10) {
-        busy = TimePoint{};
-        return service;
-      }
-      const TimePoint sent = kT0 + milliseconds(100) * static_cast<int>(k - 10);
-      busy = std::max(busy, sent) + service;
-      return busy - sent;
-    });
-    std::printf("X = %.0f: median ratio %.2f, late runs %d of 300 (%d frames), worst gap stretch %.3f\n", x,
-                s.median_ratio, s.late_runs, s.late_frames, s.worst_stretch);
-    // Up to X = 100 a frame's service fits in its interval. At 150 the
-    // connect-time delays spread by more than 1.2 intervals in most runs: the
-    // paper's estimate (median 14.9x); 36 runs of 300 still had a frame late
-    // (the known limit, docs/performance.md).
-    EXPECT_LE(s.late_runs, x < 120 ? 3 : 60) << "X = " << x;
-    if (x < 120) {
-      EXPECT_LE(s.median_ratio, 1.25) << "X = " << x;
-    }
+    const Summary s = Many(300, Fifo(x));
+    const Summary q = Many(300, Fifo(x), queue);
+    std::printf(
+        "X = %.0f: median ratio %.2f, late runs %d of 300 (%d frames), worst gap stretch %.3f; "
+        "queue start %.2f, %d of 300 (%d frames)\n",
+        x, s.median_ratio, s.late_runs, s.late_frames, s.worst_stretch, q.median_ratio, q.late_runs,
+        q.late_frames);
     EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
+    EXPECT_LE(q.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
+    if (x < 120) {  // a frame's service fits in its interval
+      EXPECT_LE(s.late_runs, 3) << "X = " << x;
+      EXPECT_LE(s.median_ratio, 1.25) << "X = " << x;
+      EXPECT_LE(q.median_ratio, 1.25) << "X = " << x;
+      continue;
+    }
+    // A queue at 75 % load: the paper's estimate 14.9x with 36 runs of 300
+    // late; the queue start 1.42x with 52: ten services seen cannot tell the
+    // worst of 40 frames to 25 %.
+    EXPECT_GT(s.median_ratio, 5.0);
+    EXPECT_LE(q.median_ratio, 1.6);
+    EXPECT_LE(q.late_runs, 70);
   }
 }
 
+TEST(AdaptivePlayback, ThePapersCongestionGetsThePapersEstimateBecauseNeitherStartCanSeeItsDrift) {
+  // Fig. 11 (129 frames at 10 Hz): the server reads 8 packages a second, the
+  // client sends 10, so every frame comes later than the one before (~2.8 s
+  // over the sequence). A start that covers only the delays seen (the jitter
+  // start at any spread) leaves a 25 % drift to a stretch bounded to 10 %:
+  // every run has frames past the bound (fig11_congestion failed with it).
+  // The queue start sees the drift only in the services of sparse
+  // connect-time packages, most of which met no pause: it misses it in a
+  // fifth of the runs. The paper's estimate (the default beyond 1.2 frame
+  // intervals) waits for 13 frames, which show it.
+  const Summary jitter = Many(100, ServerPauses(250), {.adaptive_max_spread = 1e9}, 129);
+  const Summary queued = Many(100, ServerPauses(250), {.queue_start = true}, 129);
+  const Summary paper = Many(100, ServerPauses(250), {}, 129);
+  std::printf(
+      "Fig. 11 injector, runs late of 100: jitter start %d (%d frames), queue start %d (%d frames), "
+      "paper's %d (median ratio %.2f)\n",
+      jitter.late_runs, jitter.late_frames, queued.late_runs, queued.late_frames, paper.late_runs,
+      paper.median_ratio);
+  EXPECT_EQ(jitter.late_runs, 100) << "the cause, reproduced";
+  EXPECT_GE(queued.late_runs, 5);
+  EXPECT_EQ(paper.late_runs, 0);
+}
+
 TEST(AdaptivePlayback, TheOldEstimatorsRemainOptions) {
-  auto jitter = [](std::mt19937_64& rng, std::size_t) { return Uniform(rng, 0, 40); };
+  auto jitter = [](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, 40); };
   const Summary quick = Many(200, jitter, {.adaptive = false});
   EXPECT_EQ(quick.worst_stretch, 0.0) << "fixed timing";
   EXPECT_GT(quick.median_ratio, 2.0);
@@ -267,27 +321,77 @@ TEST(AdaptivePlayback, ARetransmittedPackageInTheHistoryDoesNotInflateTheStart) 
   // Covers the 1.9 ms worst + 0.9 ms / 11 + 2 ms, less this frame's 1 ms.
   EXPECT_EQ(est.StartTime(), kT0 + std::chrono::microseconds(2900) + FromSeconds(0.0009 / 11));
   // Beyond 1.2 frame intervals (a retransmission on a WAN, or the paper's
-  // congestion) the spread gets the paper's estimate: slower, never fooled.
+  // congestion) the queue start decides when on; the retransmission is no service
+  // either: the worst, 1.9 ms, + 2 ms, less this frame's 1 ms.
   history.back() = milliseconds(130);
-  PlaybackEstimator wide(40, milliseconds(3900));
+  PlaybackEstimator wide(40, milliseconds(3900), {.queue_start = true});
   wide.SetDelayHistory(history);
   wide.Add(Duration(0), kT0, kT0 - milliseconds(1));
-  EXPECT_FALSE(wide.adaptive());
+  EXPECT_TRUE(wide.queued());
+  EXPECT_EQ(wide.StartTime(), kT0 + std::chrono::microseconds(2900));
 }
 
-TEST(AdaptivePlayback, ThePapersCongestionGetsThePapersEstimate) {
-  // Fig. 11's injector: the server pauses U[0, 0.25] s after each package, a
-  // queue at 10 Hz; the connect-time delays spread by more than 1.5 frame
-  // intervals, so the start waits for 5 frames and projects their drift.
-  std::vector<Duration> history;
-  for (int i = 0; i < 10; ++i) history.push_back(milliseconds(25 * i));
-  PlaybackEstimator est(129, milliseconds(12800));
+TEST(QueueStart, ReadsEachServiceFromABurstAndCoversTheWorstWhereNoQueueCanBuild) {
+  // Six connect-time packages sent at once (1 ms path): the first served at
+  // once, the next five 30 ms each, so they queue: delays 1, 31, ..., 151 ms,
+  // a spread of 1.5 frame intervals (the paper's estimate before). Each
+  // package's service is what it added behind the one before (30 ms); at 10
+  // Hz no queue of frames builds from 30 ms services, so the start covers
+  // the worst service: 31 ms of delay, 30 more than this frame's, + 2 ms.
+  const TimePoint burst = kT0 - std::chrono::seconds(2);
+  std::vector<DelayHistory::Sample> history{{burst + milliseconds(1), milliseconds(1)}};
+  for (int j = 1; j <= 5; ++j)
+    history.push_back({burst + milliseconds(1 + 30 * j), milliseconds(1 + 30 * j)});
+  PlaybackEstimator est(40, milliseconds(3900), {.queue_start = true});
   est.SetDelayHistory(history);
-  est.Add(Duration(0), kT0, kT0 - milliseconds(100));
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  ASSERT_TRUE(est.ready());
+  EXPECT_TRUE(est.queued());
+  EXPECT_EQ(est.StartTime(), kT0 + milliseconds(32));
+  EXPECT_EQ(est.playout_delay(), milliseconds(33));
+  // Without the queue start (the default): the paper's estimate, which waits for frames.
+  PlaybackEstimator paper(40, milliseconds(3900));
+  paper.SetDelayHistory(history);
+  paper.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  EXPECT_FALSE(paper.ready());
+}
+
+TEST(QueueStart, WaitsWhileTheNextFrameMayComeFirstAndLearnsFromEachFrame) {
+  // Services of 0 to 160 ms (the history's arrivals unknown: a delay's
+  // excess over the least is taken as its service): a queue of 100 ms
+  // frames builds, so the start lies beyond the next frame's arrival; until
+  // the next frame may come after it, each frame adds its service and the
+  // start is decided again. It is never before the latest frame's arrival.
+  std::vector<Duration> history;
+  for (int j = 0; j < 10; ++j) history.push_back(milliseconds(1 + 40 * (j % 5)));
+  PlaybackEstimator est(40, milliseconds(3900), {.queue_start = true});
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  ASSERT_TRUE(est.queued());
+  EXPECT_FALSE(est.ready());
+  const TimePoint first = est.StartTime();
+  EXPECT_GT(first - kT0, milliseconds(160)) << "the worst service and the queue behind it";
+  int frames = 1;
+  for (; !est.ready() && frames < 5; ++frames) {
+    const TimePoint arrival = kT0 + milliseconds(100) * frames;
+    est.Add(milliseconds(100) * frames, arrival, arrival - milliseconds(1));
+  }
+  ASSERT_TRUE(est.ready()) << "before the paper's 5 frames";
+  EXPECT_TRUE(est.queued());
+  EXPECT_GE(est.StartTime(), kT0 + milliseconds(100) * (frames - 1) + milliseconds(2));
+}
+
+TEST(QueueStart, AChannelThatMayBeSlowerThanTheSequenceGetsThePapersEstimate) {
+  // Services of 0 to 250 ms, 125 on average at 100 ms frames: a drift the
+  // 10 % stretch cannot follow. Not the queue start: the paper's, after 5 frames.
+  std::vector<Duration> history;
+  for (int j = 0; j < 10; ++j) history.push_back(milliseconds(1 + 250 * j / 9));
+  PlaybackEstimator est(40, milliseconds(3900), {.queue_start = true});
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  EXPECT_FALSE(est.queued());
   EXPECT_FALSE(est.adaptive());
-  EXPECT_FALSE(est.quick());
   EXPECT_FALSE(est.ready()) << "waits for frames";
-  EXPECT_FALSE(est.playout_delay().has_value());
 }
 
 TEST(AdaptivePlayback, AClientWithoutSendTimesGetsThePapersStartThenTheStretch) {

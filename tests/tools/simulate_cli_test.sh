@@ -28,5 +28,14 @@ for bad in "0|'0' is not a number in [0.001, 1000]" "1,x|'x' is not a number" "=
   check "--max-base-acceleration ${bad%%|*} refused (exit 2)" test $? -eq 2
   check "--max-base-acceleration ${bad%%|*}: says why" grep -qF -- "--max-base-acceleration: ${bad#*|}" "$tmp/bad.err"
 done
+# The playback options' bad values too (issue 23 item 3).
+for bad in "--playback-queue-start|maybe|--playback-queue-start 'maybe': expected on or off" \
+           "--playback-margin|-1|--playback-margin: '-1' is not a number in [0, 1000]"; do
+  IFS='|' read -r flag value why <<<"$bad"
+  "$server" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" "$flag" "$value" \
+    --simulate "$examples/speed_ramp.txt" >/dev/null 2>"$tmp/bad.err"
+  check "$flag $value refused (exit 2)" test $? -eq 2
+  check "$flag $value: says why" grep -qF -- "$why" "$tmp/bad.err"
+done
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -83,6 +83,13 @@ struct ClientOptions {
   /// runs late), kMaxLateNever, or a limit (> 0). SequenceOptions::max_late
   /// overrides it for a sequence.
   Duration max_late = kMaxLateServerDefault;
+  /// Playback redundancy (RFC 2198's idea, docs/protocol.md "Playback"): each
+  /// MODE_PLAYBACK package leaves this many times at once (1 or 2; 1: once).
+  /// The server runs and answers each frame once (a copy is a duplicate by
+  /// sequence number); a frame whose first copy the network loses still
+  /// arrives in time, instead of one retransmission timeout (>= 100 ms)
+  /// later. Costs one more copy of every playback package (and of its ack).
+  int playback_copies = 1;
   /// An idle client sends an empty package this often (server session watchdog).
   Duration heartbeat_interval = std::chrono::milliseconds(250);
   /// CLOCK round trips at Connect(); the one with the smallest round trip wins.

@@ -125,6 +125,13 @@ struct ServerOptions {
   /// "paper" (the paper's estimate only, fixed timing).
   std::string playback_estimator = "adaptive";
   double playback_stretch = 0.10;
+  /// Adaptive: a frame plays no sooner than this after it arrived (its
+  /// hand-over to the RobotDaemon; PlaybackScheduleOptions::margin).
+  Duration playback_margin = std::chrono::milliseconds(2);
+  /// Adaptive: delays spread by more than 1.2 frame intervals get the queue
+  /// start (a simulated queue of the sequence's frames) when on; off (the
+  /// default): the paper's estimate.
+  bool playback_queue_start = false;
   /// Test fault injection on outgoing reply packages (seeded): probability
   /// that one is dropped, and that one is sent twice.
   double reply_drop_probability = 0.0;
