@@ -18,7 +18,8 @@ Pose2 StepBy(const Pose2& centre, double dx, double dy, double dyaw, Side swing,
   const double cx = std::clamp(dx, -g.step_back, g.step_forward);
   double cy = std::clamp(dy, -g.step_side, g.step_side);
   if (cy * SideSign(swing) < 0) cy = 0;  // never step toward the stance foot
-  const double cyaw = std::clamp(dyaw, -g.step_yaw, g.step_yaw);
+  const double yaw_limit = dyaw * SideSign(swing) >= 0 ? g.step_yaw : g.step_yaw_in;  // toes apart / together
+  const double cyaw = std::clamp(dyaw, -yaw_limit, yaw_limit);
   if (clamped) *clamped = cx != dx || cyaw != dyaw || std::abs(cy - dy) > kTinyLateral;
   const Eigen::Vector2d p = centre.Apply(cx, cy);
   return {p.x(), p.y(), Wrap(centre.theta + cyaw)};

@@ -33,7 +33,8 @@ struct GaitParams {
   double step_forward = 0.10;  ///< m
   double step_back = 0.05;     ///< m
   double step_side = 0.05;     ///< m, only toward the swing foot's side
-  double step_yaw = 0.2;       ///< rad
+  double step_yaw = 0.2;       ///< rad, turning toward the swing foot's side (toes apart)
+  double step_yaw_in = 0.2;    ///< rad, turning toward the stance foot's side (toes together), <= step_yaw
   // Timing.
   double single_support = 0.8;  ///< s
   double double_support = 0.3;  ///< s
