@@ -319,15 +319,13 @@ DriverResult WalkingHumanoid::SetSpeed(const DriverCommand& c) {
                   "SETSPEED: a walk to a GOTO is in progress (command " + std::to_string(goto_id_) + ")");
   }
   const double want[3] = {c.values[0], c.num_values == 3 ? c.values[1] : 0.0, c.values[c.num_values - 1]};
-  const walking::GaitSpeeds top = walking::SpeedsOf(g_);
-  const double lim_lo[3] = {-top.back, -top.side, -top.turn};
-  const double lim_hi[3] = {top.forward, top.side, top.turn};
+  const std::array<double, 3> clamped = walking::ClampSpeed(want[0], want[1], want[2], g_);
   const char* names[3] = {"v", "vy", "omega"};
   const char* units[3] = {"m/s", "m/s", "rad/s"};
   double got[3];
   std::string note;
   for (int i = 0; i < 3; ++i) {
-    got[i] = std::clamp(want[i], lim_lo[i], lim_hi[i]);
+    got[i] = clamped[static_cast<size_t>(i)];
     if (got[i] != want[i]) {
       note += std::string(note.empty() ? "" : "; ") + names[i] + " " + Num(want[i]) + " " + units[i] +
               " clamped to the gait's limit " + Num(got[i]) + " " + units[i];
@@ -381,7 +379,8 @@ void WalkingHumanoid::FinishGoto(std::vector<Completion>& completed) {
   const Pose2 at = MeasuredPelvis();
   const double d = std::hypot(at.x - goal_.x, at.y - goal_.y);
   const double e = std::abs(Wrap(at.theta - goal_.theta));
-  if (d <= kTolerance && e <= kHeadingTolerance) {
+  const bool precise = d <= kPrecision && e <= kHeadingPrecision;
+  if (d <= kTolerance && e <= kHeadingTolerance && (precise || tries_ > kRetries)) {
     completed.push_back(Completion{.id = goto_id_, .signal = Signal::kSuccess, .message = {}});
     mode_ = Mode::kIdle;
     return;

@@ -163,6 +163,27 @@ TEST(OdeWalk, SetSpeedWalksAtTheClampedRateAndPanicStopsStepping) {
   EXPECT_LT(w.max_tilt, 0.2);
 }
 
+// The derived gait (walking/gait_limits.h) walks at the 0.25 m/s:
+// SETSPEED 1 m/s is clamped to the gait's limit, and over four steady steps
+// (after the start's weight shift and two steps) the pelvis covers >= 0.25
+// m/s without falling or tilting.
+TEST(OdeWalk, TheDerivedGaitWalksAQuarterMetrePerSecond) {
+  Walker w;
+  w.Run(1.0);
+  const DriverResult r = w.Exec(CommandType::kSetSpeed, {1.0, 0.0});
+  EXPECT_EQ(r.signal, Signal::kModified) << r.message;
+  w.Run(10.0, [&] { return w.driver->walk_status()->steps_taken >= 3; });
+  const double x0 = w.Pelvis().x;
+  const TimePoint t0 = w.driver->sim_time();
+  w.Run(10.0, [&] { return w.driver->walk_status()->steps_taken >= 7; });
+  const double v = (w.Pelvis().x - x0) / ToSeconds(w.driver->sim_time() - t0);
+  std::printf("SETSPEED 1 (%s): %.3f m/s over 4 steps, max tilt %.3f rad\n", r.message.c_str(), v,
+              w.max_tilt);
+  EXPECT_GE(v, 0.25);
+  EXPECT_FALSE(w.driver->walk_status()->fallen);
+  EXPECT_LT(w.max_tilt, 0.2);
+}
+
 // RobotState::moving tells a walk from standing: the server sends its STOP
 // on giving a robot up only when it moves. Moving means a walk in progress or
 // a joint servo with a live target (a set-point not reached yet), not the

@@ -1,6 +1,8 @@
 // The gait from the model: see gait_limits.h.
 #include "walking/gait_limits.h"
 
+#include "walking/footstep_planner.h"
+
 #include "robotalk/kinematics.h"
 #include "robotalk/robot_model.h"
 
@@ -225,6 +227,17 @@ GaitParams DeriveGait(const LegGeometry& leg, const GaitParams& base, double gra
 GaitSpeeds SpeedsOf(const GaitParams& g) {
   const double t = g.step_period();
   return {g.step_forward / t, g.step_back / t, g.step_side / (2 * t), (g.step_yaw + g.step_yaw_in) / (2 * t)};
+}
+
+std::array<double, 3> ClampSpeed(double v, double vy, double omega, const GaitParams& g) {
+  const GaitSpeeds top = SpeedsOf(g);
+  v = std::clamp(v, -top.back, top.forward);
+  vy = std::clamp(vy, -top.side, top.side);
+  const double period = g.step_period();
+  const double r = StepFraction(v * period, 2 * vy * period, g);
+  if (r > 1) v /= r, vy /= r;
+  const double turn = top.turn * (1 - kTurnWhileStepping * std::min(r, 1.0));
+  return {v, vy, std::clamp(omega, -turn, turn)};
 }
 
 }  // namespace robotalk::walking

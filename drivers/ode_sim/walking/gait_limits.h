@@ -30,6 +30,7 @@
 
 #include "walking/gait.h"
 
+#include <array>
 #include <string>
 
 namespace robotalk {
@@ -84,6 +85,11 @@ struct GaitSpeeds {
   double forward = 0, back = 0, side = 0, turn = 0;
 };
 GaitSpeeds SpeedsOf(const GaitParams& g);
+
+/// A SETSPEED twist (v, vy m/s, omega rad/s) within the gait: each within
+/// SpeedsOf(g), (v, vy) within the ellipse of their limits, omega within
+/// what the translation leaves (footstep_planner.h's StepBy rules).
+std::array<double, 3> ClampSpeed(double v, double vy, double omega, const GaitParams& g);
 
 /// The smallest distance between the two soles (rectangles around their
 /// ankles) at these poses, m; negative when they overlap (by the overlap
