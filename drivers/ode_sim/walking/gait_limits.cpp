@@ -18,7 +18,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 // How much of each limit the gait uses (the rest is the servos' and the
-// balance's margin). Chosen with the measurements in docs/ode_sim.md.
+// balance's margin). First choices, not tuned; docs/ode_sim.md has what they walk.
 constexpr double kDoubleSupportTc = 0.75;   // double support, x Tc
 constexpr double kSingleTc = 2.0;           // single support, x Tc
 constexpr double kMaxStretch = 0.96;        // of thigh + shank: the straightest leg
@@ -29,7 +29,7 @@ constexpr double kHipRollUse = 0.6;         // of the outward hip roll range
 constexpr double kHipYawUse = 0.8;          // of the hip yaw range
 constexpr double kSoleClearance = 0.01;     // m between the soles when turning
 constexpr double kStepHeightOfLeg = 0.067;  // swing height, of thigh + shank
-constexpr double kRound = 0.01;             // s and m: derived values rounded down to this
+constexpr double kRound = 0.01;             // s and m: lengths rounded down, durations up to this
 
 double RoundDown(double v) { return std::floor(v / kRound + 1e-9) * kRound; }
 double RoundUp(double v) { return std::ceil(v / kRound - 1e-9) * kRound; }

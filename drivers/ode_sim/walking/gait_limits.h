@@ -21,8 +21,9 @@
 // - Sideways: the outward hip roll and the reach (the swing foot lands
 //   `step_side` beyond its place while the hip is still over the stance foot).
 // - Turning: half a step's turn per hip yaw (the pelvis turns midway between
-//   the feet) within kHipYawUse of the range, and the soles, turned by a
-//   step's yaw about their ankles, at least kSoleClearance apart.
+//   the feet) within kHipYawUse of the range, and the soles at least
+//   kSoleClearance apart with one foot turned about the stance centre:
+//   toes apart (step_yaw) and toes together (step_yaw_in) separately.
 // - Swing height: kStepHeightOfLeg of the leg length.
 //
 // Thread safety: free functions, no state.
