@@ -185,6 +185,28 @@ TEST(OdeWalk, TheDerivedGaitWalksAQuarterMetrePerSecond) {
   EXPECT_LT(w.max_tilt, 0.2);
 }
 
+// gait=slow restores the old gait, a per-value option overrides the derived
+// one (the SETSPEED clamp says which), and a bad gait option is refused naming it.
+TEST(OdeWalk, TheGaitOptionsChooseTheGaitAndBadOnesAreRefused) {
+  const auto limit = [](const std::map<std::string, std::string>& options) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), options);
+    return w.Exec(CommandType::kSetSpeed, {9.0, 0.0}).message;
+  };
+  EXPECT_NE(limit({}).find("limit 0.289474 m/s"), std::string::npos) << limit({});
+  EXPECT_NE(limit({{"gait", "slow"}}).find("limit 0.0909091 m/s"), std::string::npos);
+  EXPECT_NE(limit({{"step_length", "0.15"}}).find("limit 0.197368 m/s"), std::string::npos)
+      << "0.15 m every 0.76 s";
+  for (const auto& [key, value] : std::map<std::string, std::string>{
+           {"gait", "fastest"}, {"step_length", "-0.1"}, {"single_support", "0"}, {"step_yaw", "x"}}) {
+    try {
+      OdeDriverOptions::FromMap({{key, value}});
+      ADD_FAILURE() << key << "=" << value << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
+
 // RobotState::moving tells a walk from standing: the server sends its STOP
 // on giving a robot up only when it moves. Moving means a walk in progress or
 // a joint servo with a live target (a set-point not reached yet), not the
