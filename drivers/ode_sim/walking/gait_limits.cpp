@@ -220,6 +220,9 @@ GaitParams DeriveGait(const LegGeometry& leg, const GaitParams& base, double gra
   g.step_yaw = RoundDown(std::min(b.hip_yaw_turn, outward));
   g.step_yaw_in = std::min(g.step_yaw, RoundDown(inward));
   g.step_height = RoundDown(kStepHeightOfLeg * length + 0.005);
+  // A goal within two forward steps is stepped to directly (sideways,
+  // backwards): cheaper than turning toward it and back.
+  g.approach_radius = std::max(base.approach_radius, 2 * g.step_forward);
   if (bounds) *bounds = b;
   return g;
 }
