@@ -6,7 +6,7 @@
 // Figures go to docs/ode_sim.md ("Walking").
 //   robotalk-walk-bench [--model URDF] [--goals N] [--seed S] [--trace CSV] [--trace-goal K]
 //                       [--option key=value]... [--goal x,y,theta] [--stop S] [--verbose N] [--stand S]
-//                       [--timeout S]
+//                       [--timeout S] [--speeds N]
 // Diagnostics: --goal walks to one goal relative to the start instead;
 // --stop sends STOP S seconds into each walk; --verbose prints the measured
 // and planned state every N x 10 ms (pelvis, tilt, CoM error, feet, sole
@@ -14,6 +14,13 @@
 // --timeout S (default 120): a GOTO still running after S simulated seconds
 // is stopped and counts as TIMEOUT, a failure;
 // --stand prints S seconds of the start-up stance first.
+// --speeds N: instead of goals, the steady SETSPEED speeds: per direction
+// (forward, back, left, right, turn left, turn right; each asked far above
+// the gait's limit, so clamped to it) from a fresh driver, the pelvis'
+// displacement (in the start's frame) and turn over N pairs of steps (from
+// the lift-off of the 4th step to that of the (4 + 2N)th: the sway at the
+// same phase at both ends), then STOP; falls, worst tilt and the centre of pressure from the
+// plan's ZMP while stepping.
 #include "ode_driver.h"
 
 #include <algorithm>
@@ -46,6 +53,7 @@ struct Args {
   double timeout = 120;        // --timeout S: simulated seconds a GOTO may run before it counts as TIMEOUT
   int verbose = 0;             // --verbose N: print the walk every N x 10 ms
   double stop_after = -1;      // --stop S: STOP each walk S s after its GOTO (then wait for standing)
+  int speeds = 0;              // --speeds N: the steady SETSPEED table over N pairs of steps per direction
   std::map<std::string, std::string> options = {{"walk", "true"}};
 };
 
@@ -71,6 +79,8 @@ Args Parse(int argc, char** argv) {
       a.verbose = std::atoi(v.c_str());
     } else if (k == "--timeout") {
       a.timeout = std::atof(v.c_str());
+    } else if (k == "--speeds") {
+      a.speeds = std::atoi(v.c_str());
     } else if (k == "--trace-goal") {
       a.trace_goal = std::atoi(v.c_str());
     } else if (k == "--option") {
@@ -191,10 +201,78 @@ Outcome WalkTo(Driver* d, OdeDriver* ode, const DriverCommand& c, const Args& ar
   return out;
 }
 
+// --speeds: the steady SETSPEED table; returns the falls.
+int SpeedTable(const Args& args) {
+  struct Direction {
+    const char* name;
+    double v, vy, omega;
+  };
+  const Direction dirs[] = {{"forward", 9, 0, 0}, {"back", -9, 0, 0},     {"left", 0, 9, 0},
+                            {"right", 0, -9, 0},  {"turn left", 0, 0, 9}, {"turn right", 0, 0, -9}};
+  std::printf(
+      "direction    along_m/s  side_m/s  turn_rad/s  max_tilt  fell  CoP-to-plan  (SETSPEED answer)\n");
+  int falls = 0;
+  for (const Direction& dir : dirs) {
+    DriverRegistry registry;
+    RegisterOdeDriver(registry);
+    std::unique_ptr<Driver> d = registry.Create(
+        "ode", DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+    auto* ode = static_cast<OdeDriver*>(d.get());
+    std::vector<Completion> done;
+    ode->Step(1500, done);
+    DriverCommand c;
+    c.id = 1;
+    c.type = CommandType::kSetSpeed;
+    c.num_values = 3;
+    c.values[0] = dir.v;
+    c.values[1] = dir.vy;
+    c.values[2] = dir.omega;
+    const DriverResult r = d->Execute(c, ode->sim_time(), done);
+    CopErrors cop;
+    double tilt = 0, yaw = 0, last = ode->walk_status()->pelvis.theta;  // yaw: unwrapped
+    const auto run = [&](double seconds, auto until) {
+      for (int i = 0; i < static_cast<int>(seconds * 100) && !until(); ++i) {
+        ode->Step(10, done);
+        const walking::WalkStatus s = *ode->walk_status();
+        tilt = std::max(tilt, s.tilt);
+        yaw += walking::Wrap(s.pelvis.theta - last);
+        last = s.pelvis.theta;
+        if (s.fallen) return;
+        cop.Add(s);
+      }
+    };
+    run(20, [&] { return ode->walk_status()->steps_taken >= 3 || ode->walk_status()->fallen; });
+    const walking::Pose2 p0 = ode->walk_status()->pelvis;
+    const TimePoint t0 = ode->sim_time();
+    const double yaw0 = yaw;
+    // Whole pairs of steps, lift-off to lift-off: the sway is at the same phase at both ends.
+    const int until_steps = ode->walk_status()->steps_taken + 2 * args.speeds;
+    run(60, [&] { return ode->walk_status()->fallen || ode->walk_status()->steps_taken >= until_steps; });
+    const walking::Pose2 p1 = ode->walk_status()->pelvis;
+    const double yaw1 = yaw;
+    const double dt = ToSeconds(ode->sim_time() - t0);
+    const double c0 = std::cos(p0.theta), s0 = std::sin(p0.theta);
+    const double along = (c0 * (p1.x - p0.x) + s0 * (p1.y - p0.y)) / dt;
+    const double side = (-s0 * (p1.x - p0.x) + c0 * (p1.y - p0.y)) / dt;
+    const double turn = (yaw1 - yaw0) / dt;
+    d->Stop(ode->sim_time(), done);
+    run(10, [&] { return !ode->walk_status()->stepping || ode->walk_status()->fallen; });
+    run(1, [] { return false; });
+    const bool fell = ode->walk_status()->fallen;
+    falls += fell ? 1 : 0;
+    std::printf("%-11s  %9.3f  %8.3f  %10.3f  %8.3f  %-4s  %s  (%s %s)\n", dir.name, along, side, turn, tilt,
+                fell ? "yes" : "no", Percentiles(cop.to_plan).c_str(),
+                std::string(ToString(r.signal)).c_str(), r.message.c_str());
+    std::fflush(stdout);
+  }
+  return falls;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
+  if (args.speeds > 0) return SpeedTable(args) == 0 ? 0 : 1;
   DriverRegistry registry;
   RegisterOdeDriver(registry);
   std::unique_ptr<Driver> d = registry.Create(

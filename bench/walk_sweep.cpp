@@ -26,7 +26,8 @@
 // Transitions (t = the swept instant, s after the first command):
 //   stop_goto        GOTO 1 m; STOP at t; GOTO 1 m at t + 0.1 s
 //   stop_wait_goto   GOTO 1 m; STOP at t; GOTO 1 m at t + 1.2 s
-//   speed_zero_back  SETSPEED 0.09; SETSPEED 0 at t; SETSPEED 0.09 at t + 1 s
+//   speed_zero_back  SETSPEED full; SETSPEED 0 at t; SETSPEED full at t + 1 s (full:
+//                    1 m/s, clamped to the gait's forward limit)
 //   panic_reset_goto GOTO 1 m; panic (Halt) at t, reset; GOTO 1 m at t + 0.1 s
 //   stop             GOTO 1 m; STOP at t (the first shift of weight, a step, ...)
 // docs/ode_sim.md ("Walking", "Replanning") has the table.
@@ -168,6 +169,9 @@ struct Run {
   }
 };
 
+// SETSPEED's forward speed for "the gait's full speed": the driver clamps it.
+constexpr double kFullSpeed = 1.0;
+
 // A transition: the actions at their times (t = the swept instant).
 struct Timed {
   double at;
@@ -191,9 +195,9 @@ const std::map<std::string, Script>& Transitions() {
        }},
       {"speed_zero_back",
        [](double t) {
-         return std::vector<Timed>{{0, [](Run& r) { r.Speed(0.09); }},
+         return std::vector<Timed>{{0, [](Run& r) { r.Speed(kFullSpeed); }},
                                    {t, [](Run& r) { r.Speed(0); }},
-                                   {t + 1.0, [](Run& r) { r.Speed(0.09); }}};
+                                   {t + 1.0, [](Run& r) { r.Speed(kFullSpeed); }}};
        }},
       {"panic_reset_goto",
        [](double t) {
@@ -242,7 +246,7 @@ bool SurvivesPush(const Args& args, bool walking, double angle, double j, double
   Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get(), .trace = trace};
   r.ode->Step(1000, r.done);
   const TimePoint t0 = r.ode->sim_time();
-  if (walking) r.Speed(1.0);  // clamped to the gait's full speed
+  if (walking) r.Speed(kFullSpeed);
   if (!r.Until(t0, at)) return false;
   constexpr double kPushTime = 0.1;
   r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
@@ -364,7 +368,7 @@ int Rtf(const Args& args) {
     std::unique_ptr<Driver> d = NewDriver(s);
     Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
     r.ode->Step(1000, r.done);
-    r.Speed(1.0);
+    r.Speed(kFullSpeed);
     const std::clock_t cpu0 = std::clock();
     const int steps = static_cast<int>(args.rtf * 1000);
     r.ode->Step(steps, r.done);
@@ -384,7 +388,7 @@ int ArmSwing(const Args& args) {
       Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
       r.ode->Step(1000, r.done);
       const TimePoint t0 = r.ode->sim_time();
-      if (walking) r.Speed(1.0);
+      if (walking) r.Speed(kFullSpeed);
       bool ok = r.Until(t0, 2.0);
       for (int i = 0; ok && i < 12; ++i) {
         const double q = i % 2 == 0 ? 1.0 : -1.0;

@@ -3,7 +3,8 @@
 # builds robotalk-walk-bench, walks 20 seeded GOTO goals (up to 2 m, any
 # heading) with models/simple_humanoid.urdf on the ode driver (walk=true) at
 # 1 kHz, prints per goal the answer, end error, speed and falls and the
-# real-time factor, and plots the top view of one walk (footsteps, ZMP, CoM)
+# real-time factor, then the steady SETSPEED speed forward, back, sideways
+# and turning (--speeds 4), and plots the top view of one walk (footsteps, ZMP, CoM)
 # with python3-matplotlib when it is installed (scripts/setup.sh installs it).
 #
 #   scripts/walk_bench.sh [--goals N] [--seed S] [--trace-goal K]
@@ -24,6 +25,8 @@ trap 'rm -f "$TRACE"' EXIT
 flock /tmp/rt-build.lock cmake --build "$BUILD_DIR" --target robotalk-walk-bench robotalk-walk-sweep -j2 >/dev/null
 status=0
 "$BUILD_DIR/bench/robotalk-walk-bench" --goals 20 --seed 1 --trace "$TRACE" "$@" || status=$?
+# The steady SETSPEED speeds per direction (the gait's limits walked).
+"$BUILD_DIR/bench/robotalk-walk-bench" --speeds 4 || status=$?
 PY=python3
 [ -x /usr/bin/python3 ] && PY=/usr/bin/python3  # Debian's, where python3-matplotlib lives
 if "$PY" -c 'import matplotlib' 2>/dev/null; then

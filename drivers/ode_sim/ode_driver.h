@@ -108,6 +108,19 @@ struct OdeDriverOptions {
   /// point when the ankles saturate. Measured to make walking pushes worse
   /// (docs/ode_sim.md, "Balance feedback"), so off by default. Key "step_adjustment".
   bool step_adjustment = false;
+  /// With walk=true, the gait (docs/ode_sim.md, "Walking"): "fast" (default)
+  /// derives step length, duration and turn from the model's legs
+  /// (walking/gait_limits.h); "slow" is the earlier 0.10 m / 1.1 s gait
+  /// (0.09 m/s). Key "gait".
+  std::string gait = "fast";
+  /// Overrides of the chosen gait where the model cannot say (0 = the
+  /// gait's own): per step step_length, step_back, step_side (m),
+  /// step_yaw (rad); single_support, double_support (s); step_height (m).
+  /// Keys of the same names; values > 0.
+  struct GaitOverrides {
+    double step_length = 0, step_back = 0, step_side = 0, step_yaw = 0;
+    double single_support = 0, double_support = 0, step_height = 0;
+  } gait_overrides;
 
   /// Parses DriverConfig::options. Throws Error naming an unknown key (and the
   /// known ones) or a bad value: "ode driver: option step_hz='0': expected a rate > 0 (Hz)".

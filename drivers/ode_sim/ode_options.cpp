@@ -67,6 +67,15 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
   r.Bool("walk", &o.walk);
   r.Bool("stabilizer", &o.stabilizer);
   r.Bool("step_adjustment", &o.step_adjustment);
+  if (r.Text("gait", &o.gait) && o.gait != "fast" && o.gait != "slow") r.Fail("gait", "fast or slow");
+  auto& go = o.gait_overrides;
+  r.Number("step_length", &go.step_length, kPositive, "a step length > 0 (m)");
+  r.Number("step_back", &go.step_back, kPositive, "a step length > 0 (m)");
+  r.Number("step_side", &go.step_side, kPositive, "a sideways step > 0 (m)");
+  r.Number("step_yaw", &go.step_yaw, kPositive, "a turn per step > 0 (rad)");
+  r.Number("single_support", &go.single_support, kPositive, "a duration > 0 (s)");
+  r.Number("double_support", &go.double_support, kPositive, "a duration > 0 (s)");
+  r.Number("step_height", &go.step_height, kPositive, "a swing height > 0 (m)");
   r.Number("max_catchup_ms", &o.max_catchup_ms, kPositive, "a number of milliseconds > 0");
   r.Number("virtual_mass", &o.virtual_mass, kPositive, "a mass > 0 (kg)");
   if (r.Text("gait_joints", &o.gait_joints) && SplitPlus(o.gait_joints).size() != 4) {
@@ -101,6 +110,17 @@ void OdeDriverOptions::Validate() const {
   non_negative("wheel_separation", wheel_separation);
   positive("max_catchup_ms", max_catchup_ms);
   positive("virtual_mass", virtual_mass);
+  if (gait != "fast" && gait != "slow")
+    throw Error("OdeDriver: gait = '" + gait + "', expected fast or slow");
+  for (auto [name, v] : {std::pair{"step_length", gait_overrides.step_length},
+                         {"step_back", gait_overrides.step_back},
+                         {"step_side", gait_overrides.step_side},
+                         {"step_yaw", gait_overrides.step_yaw},
+                         {"single_support", gait_overrides.single_support},
+                         {"double_support", gait_overrides.double_support},
+                         {"step_height", gait_overrides.step_height}}) {
+    non_negative(name, v);
+  }
   if (solver != "step" && solver != "quickstep")
     throw Error("OdeDriver: solver = '" + solver + "', expected step or quickstep");
 }

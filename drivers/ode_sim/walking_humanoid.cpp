@@ -4,6 +4,7 @@
 #include "robotalk/driver_support.h"
 #include "robotalk/error.h"
 #include "walking/footstep_planner.h"
+#include "walking/gait_limits.h"
 
 #include <algorithm>
 #include <cmath>
@@ -46,6 +47,29 @@ std::optional<int> FindAnyLink(const RobotModel& m, std::initializer_list<const 
     if (auto l = m.FindLink(n)) return l;
   }
   return std::nullopt;
+}
+
+// The gait (options gait, step_length, ...; walking/gait_limits.h): derived
+// from the leg, or the slow one (also where the leg cannot be measured), then overridden.
+walking::GaitParams ChooseGait(const RobotModel& m, int foot, double sole_z, double pelvis_height,
+                               const walking::GaitParams& base, const OdeDriverOptions& options) {
+  std::string why;
+  const walking::LegGeometry leg = walking::MeasureLeg(m, foot, sole_z, pelvis_height, &why);
+  walking::GaitParams g = options.gait == "fast" && why.empty()
+                              ? walking::DeriveGait(leg, base, options.gravity > 0 ? options.gravity : 9.81)
+                              : walking::SlowGait(base);
+  const OdeDriverOptions::GaitOverrides& o = options.gait_overrides;
+  for (auto [field, value] : {std::pair{&g.step_forward, o.step_length},
+                              {&g.step_back, o.step_back},
+                              {&g.step_side, o.step_side},
+                              {&g.step_yaw, o.step_yaw},
+                              {&g.single_support, o.single_support},
+                              {&g.double_support, o.double_support},
+                              {&g.step_height, o.step_height}}) {
+    if (value > 0) *field = value;
+  }
+  if (o.step_yaw > 0) g.step_yaw_in = std::min(g.step_yaw_in, o.step_yaw);
+  return g;
 }
 
 Eigen::Isometry3d Planar(const Pose2& p, double z) {
@@ -126,6 +150,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     w->g_.ankle_x = w->com_in_pelvis_.x() - w->g_.zmp_x;
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
+  w->g_ = ChooseGait(model, *l, sole_z, -lp.z() * (1 - kKneeDrop), w->g_, options);
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;
   w->adjust_steps_ = options.stabilizer && options.step_adjustment;
@@ -293,16 +318,14 @@ DriverResult WalkingHumanoid::SetSpeed(const DriverCommand& c) {
     return Answer(Signal::kBusy,
                   "SETSPEED: a walk to a GOTO is in progress (command " + std::to_string(goto_id_) + ")");
   }
-  const double period = g_.step_period();
   const double want[3] = {c.values[0], c.num_values == 3 ? c.values[1] : 0.0, c.values[c.num_values - 1]};
-  const double lim_lo[3] = {-g_.step_back / period, -g_.step_side / (2 * period), -g_.step_yaw / period};
-  const double lim_hi[3] = {g_.step_forward / period, g_.step_side / (2 * period), g_.step_yaw / period};
+  const std::array<double, 3> clamped = walking::ClampSpeed(want[0], want[1], want[2], g_);
   const char* names[3] = {"v", "vy", "omega"};
   const char* units[3] = {"m/s", "m/s", "rad/s"};
   double got[3];
   std::string note;
   for (int i = 0; i < 3; ++i) {
-    got[i] = std::clamp(want[i], lim_lo[i], lim_hi[i]);
+    got[i] = clamped[static_cast<size_t>(i)];
     if (got[i] != want[i]) {
       note += std::string(note.empty() ? "" : "; ") + names[i] + " " + Num(want[i]) + " " + units[i] +
               " clamped to the gait's limit " + Num(got[i]) + " " + units[i];
@@ -333,7 +356,11 @@ void WalkingHumanoid::KeepSpeedStepsQueued() {
     if (at.side_free) next = (vy_ < 0 || (vy_ == 0 && omega_ < 0)) ? Side::kRight : Side::kLeft;
     const double period = g_.step_period();
     const double dy = vy_ * 2 * period * (vy_ * walking::SideSign(next) > 0 ? 1.0 : 0.0);
-    const Pose2 c = walking::StepBy(centre, v_ * period, dy, omega_ * period, next, g_);
+    // A turn alternates steps toes apart (up to step_yaw) and together (up to step_yaw_in).
+    const double turn = std::abs(omega_) * period, inward = std::min(turn, g_.step_yaw_in);
+    const double yaw =
+        std::copysign(omega_ * walking::SideSign(next) >= 0 ? 2 * turn - inward : inward, omega_);
+    const Pose2 c = walking::StepBy(centre, v_ * period, dy, yaw, next, g_);
     pattern_.Append({Footstep{next, walking::FootAt(c, next, g_)}}, {c});
   }
 }
@@ -352,7 +379,8 @@ void WalkingHumanoid::FinishGoto(std::vector<Completion>& completed) {
   const Pose2 at = MeasuredPelvis();
   const double d = std::hypot(at.x - goal_.x, at.y - goal_.y);
   const double e = std::abs(Wrap(at.theta - goal_.theta));
-  if (d <= kTolerance && e <= kHeadingTolerance) {
+  const bool precise = d <= kPrecision && e <= kHeadingPrecision;
+  if (d <= kTolerance && e <= kHeadingTolerance && (precise || tries_ > kRetries)) {
     completed.push_back(Completion{.id = goto_id_, .signal = Signal::kSuccess, .message = {}});
     mode_ = Mode::kIdle;
     return;

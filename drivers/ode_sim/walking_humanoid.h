@@ -56,6 +56,10 @@ class WalkingHumanoid final : public BaseController {
   /// GOTO: success within these (m, rad), as the issue asks; re-plans at most kRetries times.
   static constexpr double kTolerance = 0.05, kHeadingTolerance = 0.05;
   static constexpr int kRetries = 4;
+  /// GOTO: the walk ends within these (m, rad) where kRetries re-plans
+  /// allow: the feet slip a few mm per step (more on long fast steps), and
+  /// a corrective step from the measured pose takes it back.
+  static constexpr double kPrecision = 0.005, kHeadingPrecision = 0.01;
   /// A GOTO is judged when the planned CoM has come to rest over the feet:
   /// within this (m) of the reference ZMP and slower than this per second.
   static constexpr double kSettled = 2e-3;

@@ -111,14 +111,15 @@ TEST(OdeWalk, GotoWalksThereAndAnswersSuccessWithoutFalling) {
   EXPECT_LT(std::abs(walking::Wrap(p.theta - 0.4)), 0.05);
   EXPECT_FALSE(w.driver->walk_status()->fallen);
   EXPECT_LT(w.max_tilt, 0.2);
-  EXPECT_GE(w.driver->walk_status()->steps_taken, 6);
+  EXPECT_GE(w.driver->walk_status()->steps_taken, 3)
+      << "it stepped there (0.5 m and a turn: 3 steps or more)";
 }
 
 TEST(OdeWalk, StopMidWalkEndsInDoubleSupportWithinTwoSteps) {
   Walker w;
   w.Run(1.0);
   ASSERT_TRUE(w.Exec(CommandType::kGoto, {1.5, 0, 0}).in_progress);
-  w.Run(5.0);
+  w.Run(3.5);  // the second step of the walk
   ASSERT_TRUE(w.driver->walk_status()->stepping);
   const int steps = w.driver->walk_status()->steps_taken;
   const double x = w.Pelvis().x;
@@ -146,8 +147,8 @@ TEST(OdeWalk, SetSpeedWalksAtTheClampedRateAndPanicStopsStepping) {
   EXPECT_NE(r.message.find("clamped"), std::string::npos) << r.message;
   w.Run(8.0);
   const double x = w.Pelvis().x;
-  EXPECT_GT(x, 0.3);
-  EXPECT_LT(x, 1.0);
+  EXPECT_GT(x, 1.0) << "8 s at the gait's limit (0.29 m/s), the first 1.8 s standing and shifting weight";
+  EXPECT_LT(x, 8 * 0.3) << "no faster than the clamp";
   const int steps = w.driver->walk_status()->steps_taken;
   std::vector<Completion> interrupted;
   w.driver->Halt(interrupted);  // panic (the server sends nothing more until Resume())
@@ -161,6 +162,49 @@ TEST(OdeWalk, SetSpeedWalksAtTheClampedRateAndPanicStopsStepping) {
   w.Run(1.0);
   EXPECT_FALSE(w.driver->walk_status()->fallen);
   EXPECT_LT(w.max_tilt, 0.2);
+}
+
+// The derived gait (walking/gait_limits.h) walks at the 0.25 m/s:
+// SETSPEED 1 m/s is clamped to the gait's limit, and over four steady steps
+// (after the start's weight shift and two steps) the pelvis covers >= 0.25
+// m/s without falling or tilting.
+TEST(OdeWalk, TheDerivedGaitWalksAQuarterMetrePerSecond) {
+  Walker w;
+  w.Run(1.0);
+  const DriverResult r = w.Exec(CommandType::kSetSpeed, {1.0, 0.0});
+  EXPECT_EQ(r.signal, Signal::kModified) << r.message;
+  w.Run(10.0, [&] { return w.driver->walk_status()->steps_taken >= 3; });
+  const double x0 = w.Pelvis().x;
+  const TimePoint t0 = w.driver->sim_time();
+  w.Run(10.0, [&] { return w.driver->walk_status()->steps_taken >= 7; });
+  const double v = (w.Pelvis().x - x0) / ToSeconds(w.driver->sim_time() - t0);
+  std::printf("SETSPEED 1 (%s): %.3f m/s over 4 steps, max tilt %.3f rad\n", r.message.c_str(), v,
+              w.max_tilt);
+  EXPECT_GE(v, 0.25);
+  EXPECT_FALSE(w.driver->walk_status()->fallen);
+  EXPECT_LT(w.max_tilt, 0.2);
+}
+
+// gait=slow restores the old gait, a per-value option overrides the derived
+// one (the SETSPEED clamp says which), and a bad gait option is refused naming it.
+TEST(OdeWalk, TheGaitOptionsChooseTheGaitAndBadOnesAreRefused) {
+  const auto limit = [](const std::map<std::string, std::string>& options) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), options);
+    return w.Exec(CommandType::kSetSpeed, {9.0, 0.0}).message;
+  };
+  EXPECT_NE(limit({}).find("limit 0.289474 m/s"), std::string::npos) << limit({});
+  EXPECT_NE(limit({{"gait", "slow"}}).find("limit 0.0909091 m/s"), std::string::npos);
+  EXPECT_NE(limit({{"step_length", "0.15"}}).find("limit 0.197368 m/s"), std::string::npos)
+      << "0.15 m every 0.76 s";
+  for (const auto& [key, value] : std::map<std::string, std::string>{
+           {"gait", "fastest"}, {"step_length", "-0.1"}, {"single_support", "0"}, {"step_yaw", "x"}}) {
+    try {
+      OdeDriverOptions::FromMap({{key, value}});
+      ADD_FAILURE() << key << "=" << value << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
 }
 
 // RobotState::moving tells a walk from standing: the server sends its STOP
@@ -273,6 +317,20 @@ TEST(OdeWalkRestart, SetSpeedZeroAndBack) {
                              w.Exec(CommandType::kSetSpeed, {0, 0});
                            }}},
                          1.0, "setspeed 0.09, 0 at 1.5 s, 0.09 at 2.5 s");
+}
+
+// A reduced phase sweep at the derived gait (the full one: robotalk-walk-sweep):
+// STOP then GOTO 0.1 s later in the first step's single support, in the
+// double support after it and in the second step's single support (the
+// other foot): no fall, no rocking.
+TEST(OdeWalkRestart, StopThenGotoAtThreePhasesOfTheFastGait) {
+  for (const double t : {2.05, 2.45, 2.85}) {
+    ExpectNoFallNorRocking({{0.0, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                            {t, [](Walker& w) { w.Stop(); }},
+                            {t + 0.1, [](Walker& w) { Goto(w, 1.0, 0, 0); }},
+                            {t + 1.6, [](Walker& w) { w.Stop(); }}},
+                           1.0, "stop at " + std::to_string(t) + " s, goto 0.1 s later");
+  }
 }
 
 TEST(OdeWalkRestart, PanicResetGoto) {

@@ -15,13 +15,25 @@ constexpr double kTinyLateral = 1e-9;  // m: no lateral component
 
 Pose2 StepBy(const Pose2& centre, double dx, double dy, double dyaw, Side swing, const GaitParams& g,
              bool* clamped) {
-  const double cx = std::clamp(dx, -g.step_back, g.step_forward);
+  double cx = std::clamp(dx, -g.step_back, g.step_forward);
   double cy = std::clamp(dy, -g.step_side, g.step_side);
   if (cy * SideSign(swing) < 0) cy = 0;  // never step toward the stance foot
-  const double cyaw = std::clamp(dyaw, -g.step_yaw, g.step_yaw);
+  // Together: the translation within the ellipse of the forward (backward)
+  // and sideways limits, the turn within what the translation leaves.
+  const double r = StepFraction(cx, cy, g);
+  if (r > 1) cx /= r, cy /= r;
+  const double yaw_limit =
+      (dyaw * SideSign(swing) >= 0 ? g.step_yaw : g.step_yaw_in) *  // toes apart / together
+      (1 - kTurnWhileStepping * std::min(r, 1.0));
+  const double cyaw = std::clamp(dyaw, -yaw_limit, yaw_limit);
   if (clamped) *clamped = cx != dx || cyaw != dyaw || std::abs(cy - dy) > kTinyLateral;
   const Eigen::Vector2d p = centre.Apply(cx, cy);
   return {p.x(), p.y(), Wrap(centre.theta + cyaw)};
+}
+
+double StepFraction(double dx, double dy, const GaitParams& g) {
+  const double lx = dx >= 0 ? g.step_forward : g.step_back;
+  return std::hypot(lx > 0 ? dx / lx : 0.0, g.step_side > 0 ? dy / g.step_side : 0.0);
 }
 
 Pose2 StepToward(const Pose2& centre, const Pose2& goal, Side swing, const GaitParams& g) {

@@ -3,10 +3,14 @@
 // Pure maths, no ODE, no I/O; allocates only the returned vector.
 //
 // A step moves the stance centre (gait.h) by (dx, dy, dyaw) in its own frame,
-// clamped to GaitParams' limits: dx in [-step_back, step_forward], |dyaw| <=
-// step_yaw, and a sideways dy only toward the swing foot's side (|dy| <=
-// step_side; a step toward the stance foot would cross the legs), so a
-// lateral walk moves on every second step. The swing foot lands at
+// clamped to GaitParams' limits: dx in [-step_back, step_forward], a
+// sideways dy only toward the swing foot's side (|dy| <= step_side; a step
+// toward the stance foot would cross the legs), so a lateral walk moves on
+// every second step; (dx, dy) together within the ellipse of those limits
+// (a diagonal step is no longer than the leg reaches); |dyaw| <= step_yaw
+// turning toward the swing foot's side (toes apart), <= step_yaw_in toward
+// the stance foot's (toes together), both less while the step translates
+// (StepFraction). The swing foot lands at
 // FootAt(new centre, side). Toward a goal farther than approach_radius the
 // centre turns toward the goal and walks forward (translating only when the
 // goal lies within walk_cone of ahead); closer, it steps straight to the goal
@@ -27,6 +31,13 @@ namespace robotalk::walking {
 /// the request was changed.
 Pose2 StepBy(const Pose2& centre, double dx, double dy, double dyaw, Side swing, const GaitParams& g,
              bool* clamped = nullptr);
+
+/// How much of the step limits a translation (dx, dy) uses: 1 on the
+/// ellipse through (step_forward or -step_back, 0) and (0, +-step_side).
+double StepFraction(double dx, double dy, const GaitParams& g);
+/// A step turns at most (1 - kTurnWhileStepping x StepFraction) of step_yaw
+/// (step_yaw_in): a full-length step turns half as much as a turn in place.
+inline constexpr double kTurnWhileStepping = 0.5;
 
 /// One step of `swing` from `centre` toward `goal` (the rules above).
 Pose2 StepToward(const Pose2& centre, const Pose2& goal, Side swing, const GaitParams& g);

@@ -26,14 +26,17 @@ struct Footstep {
   Pose2 pose;  ///< the foot's ankle point on the ground and its yaw
 };
 
-/// The gait. Defaults are the slow, robust gait of models/simple_humanoid.urdf
-/// (docs/ode_sim.md, "Walking"); the ode driver fills the geometry from the model.
+/// The gait. Defaults are the slow gait of models/simple_humanoid.urdf
+/// (0.10 m every 1.1 s; the pure tests use them); the ode driver fills the
+/// geometry from the model and by default derives the steps and timing from
+/// the legs (gait_limits.h, option gait=fast; docs/ode_sim.md, "Walking").
 struct GaitParams {
   // Step limits, per step, of the stance centre in its own frame.
   double step_forward = 0.10;  ///< m
   double step_back = 0.05;     ///< m
   double step_side = 0.05;     ///< m, only toward the swing foot's side
-  double step_yaw = 0.2;       ///< rad
+  double step_yaw = 0.2;       ///< rad, turning toward the swing foot's side (toes apart)
+  double step_yaw_in = 0.2;    ///< rad, turning toward the stance foot's side (toes together), <= step_yaw
   // Timing.
   double single_support = 0.8;  ///< s
   double double_support = 0.3;  ///< s
