@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <span>
 
@@ -82,39 +83,56 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     *why = "no feet named left_foot/right_foot or l_foot/r_foot";
     return nullptr;
   }
-  walking::GaitParams g;
-  const CollisionShape* box = nullptr;
-  for (const CollisionShape& s : shapes) {
-    if (s.link == model.link(*l).name && s.kind == CollisionShape::Kind::kBox) box = &s;
-  }
-  if (!box) {
-    *why = "foot '" + model.link(*l).name + "' has no box collision shape (the sole)";
-    return nullptr;
-  }
-  const Eigen::Vector3d t = box->origin.translation, size = box->size;
-  g.foot_front = t.x() + size.x() / 2;
-  g.foot_back = size.x() / 2 - t.x();
-  g.foot_half_width = size.y() / 2 - std::abs(t.y());
-  g.zmp_x = (g.foot_front - g.foot_back) / 2;
-  const double sole_z = t.z() - size.z() / 2;
-  // Feet apart as in the model at q = 0; the pelvis sinks so that the knees bend.
+  // The soles: a box per foot, or the bounding rectangle of the foot's
+  // lowest contact points (collision_shapes.h, FindSole), which Prepare()
+  // makes a box (kSoleBoxThickness) in place of the points.
+  std::optional<Sole> sole[2];
+  bool points[2] = {false, false};
   Kinematics kin(model);
   std::vector<Eigen::Isometry3d> roots(model.roots().size(), Eigen::Isometry3d::Identity());
   kin.Update(Eigen::VectorXd::Zero(model.num_dofs()), roots);
+  for (int s = 0; s < 2; ++s) {
+    const int foot = s == 0 ? *l : *r;
+    const std::string& name = model.link(foot).name;
+    sole[s] = FindSole(name, shapes, why);
+    if (!sole[s]) return nullptr;
+    points[s] = sole[s]->from_points;
+    if (points[s]) sole[s] = FindSole(name, {sole[s]->Box(name, kSoleBoxThickness)}, why);
+    const double up = kin.link_pose(foot).linear()(2, 2);
+    if (up < std::cos(kMaxSoleTilt)) {
+      *why = "foot '" + name + "' is not flat at the model's zero pose (its z axis " +
+             Num(std::acos(std::clamp(up, -1.0, 1.0))) +
+             " rad from vertical): its sole is not found from its shapes";
+      return nullptr;
+    }
+  }
+  walking::GaitParams g;
+  g.foot_front = sole[0]->front;
+  g.foot_back = sole[0]->back;
+  g.foot_half_width = std::min(sole[0]->left, sole[0]->right);
+  g.zmp_x = (g.foot_front - g.foot_back) / 2;
+  const double sole_z = sole[0]->z;
+  // Feet apart as in the model at q = 0; the pelvis sinks so that the knees bend.
   const Eigen::Vector3d lp = kin.link_pose(*l) * Eigen::Vector3d(0, 0, sole_z);
   const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole_z);
   g.foot_separation = lp.y() - rp.y();
   if (options.solver == "quickstep") {
-    // Measured (docs/ode_sim.md, "Walking"): with quickstep's 50 iterations
-    // (and with 200) the simple humanoid fell 4-5 s into its first GOTO; with
-    // 1000 it walked, but slower than dWorldStep. So no quickstep walking.
+    // Measured (docs/ode_sim.md, "Walking" and "Published humanoids"):
+    // with quickstep's 50 iterations (and with 200) the simple humanoid fell
+    // 4-5 s into its first GOTO; with 1000 it walked, but slower than
+    // dWorldStep. Atlas (175 kg on 0.125 kg tali) cannot even stand on 50 or
+    // 200: its joints sag 0.08-0.11 rad and it falls within 2 s; with 1000
+    // it stands but falls in its second step. So no quickstep walking.
     throw Error(
-        "OdeDriver: walk=true needs solver=step: the walking humanoid falls on quickstep "
-        "(measured: with 50 and with 200 iterations it fell 4-5 s into its first GOTO); "
+        "OdeDriver: walk=true needs solver=step: a walking humanoid falls on quickstep "
+        "(measured: the simple humanoid with 50 and with 200 iterations fell 4-5 s into its first GOTO; "
+        "atlas sags and falls standing); "
         "drop solver=quickstep or walk=true");
   }
   auto w = std::unique_ptr<WalkingHumanoid>(new WalkingHumanoid(model, {*l, *r}, sole_z, g, gravity, step));
   w->pelvis_z_ = -lp.z() * (1 - kKneeDrop);
+  w->soles_ = {*sole[0], *sole[1]};
+  w->sole_from_points_ = {points[0], points[1]};
   // The stance: the CoM above the feet's ZMP points puts the pelvis at the stance centre.
   for (int it = 0; it < 3; ++it) {
     std::array<Eigen::Isometry3d, 2> soles{Planar(walking::FootAt({}, Side::kLeft, w->g_), 0),
@@ -126,12 +144,31 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     w->g_.ankle_x = w->com_in_pelvis_.x() - w->g_.zmp_x;
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
+  w->sole_spring_ = SoleSpringFor(model.total_mass(), w->g_.com_height,
+                                  std::min(sole[0]->spread, sole[1]->spread), gravity);
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;
   w->adjust_steps_ = options.stabilizer && options.step_adjustment;
   w->dcm_.emplace(w->g_.com_height, gravity);
   w->com_offset_.emplace(w->dcm_->omega());
   return w;
+}
+
+WalkingHumanoid::SoleSpring WalkingHumanoid::SoleSpringFor(double mass, double com_height, double spread,
+                                                           double gravity) {
+  // The tuned model's rocking: ω0² = k0·S0 / (m0 h0²) − g0 / h0, damping
+  // ratio ζ0 = c0·S0 / (2 m0 h0² ω0). Kept: k = m h² (ω0² + g / h) / S and
+  // c = 2 ζ0 m h² ω0 / S, i.e. c scales by (m h² / S) / (m0 h0² / S0).
+  constexpr double kTunedGravity = 9.81;
+  const double i0 = kSoleTunedMass * kSoleTunedComHeight * kSoleTunedComHeight;  // kg m²
+  const double omega0_sq = kSoleStiffness * kSoleTunedSpread / i0 - kTunedGravity / kSoleTunedComHeight;
+  const double inertia = mass * com_height * com_height;
+  const auto rounded = [](double scale) { return std::round(scale * 1000) / 1000; };
+  SoleSpring s;
+  s.stiffness =
+      kSoleStiffness * rounded(inertia * (omega0_sq + gravity / com_height) / spread / kSoleStiffness);
+  s.damping = kSoleDamping * rounded((inertia / spread) / (i0 / kSoleTunedSpread));
+  return s;
 }
 
 WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
@@ -148,9 +185,26 @@ WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> fee
   for (Eigen::VectorXd* v : {&q_ref_, &q_prev_, &q_start_, &q_stance_}) v->setZero(n);
 }
 
+void WalkingHumanoid::Prepare(OdeWorldOptions& world, std::vector<CollisionShape>& shapes) {
+  world.place_on_ground = true;
+  // A sole from contact points stands on its box: measured on atlas.urdf
+  // (docs/ode_sim.md, "Published humanoids"), the box's four contacts walk
+  // as well as the eight points and step 1.6x faster.
+  for (int s = 0; s < 2; ++s) {
+    if (!sole_from_points_[static_cast<size_t>(s)]) continue;
+    const std::string& link = model_.link(feet_[static_cast<size_t>(s)]).name;
+    const Sole& sole = soles_[static_cast<size_t>(s)];
+    std::erase_if(shapes, [&](const CollisionShape& c) {
+      return c.link == link && c.kind == CollisionShape::Kind::kSphere &&
+             c.origin.translation.z() - c.size.x() <= sole.z + kSoleFlatness;
+    });
+    shapes.push_back(sole.Box(link, kSoleBoxThickness));
+  }
+}
+
 void WalkingHumanoid::Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>&) {
   world_ = &world;
-  for (int f : feet_) world_->SetContactSpring(f, kSoleStiffness, kSoleDamping);
+  for (int f : feet_) world_->SetContactSpring(f, sole_spring_.stiffness, sole_spring_.damping);
   vmax_ = servos.vmax();
   fmax_ = servos.fmax();
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(owned_.size()); ++i) {

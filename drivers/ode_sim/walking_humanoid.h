@@ -50,7 +50,30 @@ class WalkingHumanoid final : public BaseController {
   /// heel to toe for seconds; its stance foot then turns on one corner.
   /// Here the weight presses each corner ~0.6 mm in, so a sole lies flat on
   /// four contacts, and the damping stops the rocking (docs/ode_sim.md).
+  /// Tuned on models/simple_humanoid.urdf: kSoleTunedMass kg, its CoM
+  /// kSoleTunedComHeight m up in the stance, box soles 0.12 m wide
+  /// (kSoleTunedSpread, Sole::spread); other models get SoleSpringFor's.
+  /// A sole derived from contact points becomes a box this thick (m) above
+  /// the sole plane, in place of the points (Prepare()).
+  static constexpr double kSoleBoxThickness = 0.02;
+  /// A foot's z axis within this (rad) of vertical at the model's zero pose:
+  /// its sole (found in the link frame) lies flat.
+  static constexpr double kMaxSoleTilt = 0.01;
   static constexpr double kSoleStiffness = 2e5, kSoleDamping = 4e3;
+  static constexpr double kSoleTunedMass = 52.5, kSoleTunedComHeight = 0.7275, kSoleTunedSpread = 0.0144;
+  struct SoleSpring {
+    double stiffness = kSoleStiffness, damping = kSoleDamping;  ///< per contact, N/m and N·s/m
+  };
+  /// The sole spring of a model of `mass` (kg) whose CoM stands `com_height`
+  /// (m) above soles of `spread` (Sole::spread, m²) under `gravity` (m/s²):
+  /// the whole robot rocking sideways on a sole (a mass m at height h on a
+  /// rolling stiffness k × spread: ω² = k·spread / (m h²) − g / h) keeps the
+  /// tuned model's frequency (ω ≈ 9.5 rad/s) and damping ratio. Measured on
+  /// atlas.urdf (docs/ode_sim.md, "Published humanoids"): scaling by mass
+  /// per contact alone (each contact sinking as deep) left the sole too soft
+  /// for its 1.17 m high CoM: it rolled onto its outer edge and fell in the
+  /// fourth step. Scales within 0.1 % of 1 are 1 (the tuned model keeps its values exactly).
+  static SoleSpring SoleSpringFor(double mass, double com_height, double spread, double gravity);
   /// Torso tilt beyond which the robot counts as fallen, rad.
   static constexpr double kFallTilt = 0.6;
   /// GOTO: success within these (m, rad), as the issue asks; re-plans at most kRetries times.
@@ -71,9 +94,9 @@ class WalkingHumanoid final : public BaseController {
                                                  const OdeDriverOptions& options, double step,
                                                  std::string* why);
   /// A free root standing on the ground.
-  void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>&) override {
-    world.place_on_ground = true;
-  }
+  /// A free root standing on the ground; a foot whose sole was derived from
+  /// contact points keeps them (docs/ode_sim.md, "Published humanoids").
+  void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>& shapes) override;
   /// Binds the world (after the driver built it), takes the leg dofs from
   /// the joint servos and plans the stance.
   void Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>& shapes) override;
@@ -106,6 +129,10 @@ class WalkingHumanoid final : public BaseController {
   std::string_view fault() const override { return fall_; }
   std::optional<walking::WalkStatus> walk_status() const override { return status(); }
   walking::WalkStatus status() const;
+  /// The gait, its geometry (feet, soles, CoM height) from the model.
+  const walking::GaitParams& gait() const { return g_; }
+  /// The soles' contact spring of this model (SoleSpringFor).
+  const SoleSpring& sole_spring() const { return sole_spring_; }
 
  private:
   enum class Mode : std::uint8_t { kIdle, kGoto, kSpeed };
@@ -165,6 +192,9 @@ class WalkingHumanoid final : public BaseController {
   int foot_contacts_[2] = {0, 0};
   Eigen::Vector2d zmp_measured_ = Eigen::Vector2d::Zero();  // world
   double tracking_error_ = 0;
+  SoleSpring sole_spring_;
+  std::array<Sole, 2> soles_;                           // as boxes
+  std::array<bool, 2> sole_from_points_{false, false};  // Prepare() replaces the points by the box
 };
 
 }  // namespace robotalk::ode_detail

@@ -8,24 +8,23 @@
 // ../shared.
 #include "collision_shapes.h"
 #include "ode_driver.h"
+#include "point_footed_humanoid.h"
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
 #include "walking_humanoid.h"
 
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <regex>
-#include <sstream>
 
 namespace robotalk {
 namespace {
 
 using ode_detail::WalkingHumanoid;
+using testing::ContactPoint;
+using testing::PointFootedHumanoid;
+using testing::SixPointSoles;
+using testing::TempUrdf;
 
 CollisionShape Sphere(const std::string& link, double x, double y, double z, double radius = 0) {
   CollisionShape s;
@@ -180,42 +179,8 @@ TEST(SoleFromModel, TheSoleSpringKeepsTheTunedRockingForAHeavierTallerRobot) {
   EXPECT_GT(atlas.stiffness, 1.3 * W::kSoleStiffness * (175.1 / 8) / (W::kSoleTunedMass / 4));
 }
 
-// A synthetic point-footed humanoid: models/simple_humanoid.urdf with each
-// foot's box replaced by six contact points (spheres of radius 0) at the
-// box's bottom corners and mid-sides, plus a bumper above the sole.
-std::string PointFootedHumanoid(const std::string& points) {
-  std::ifstream in(testing::ProjectModel("simple_humanoid.urdf"));
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::regex foot_collision(
-      R"((<link name="(left|right)_foot">[\s\S]*?)<collision>[\s\S]*?</collision>)");
-  return std::regex_replace(text.str(), foot_collision, "$1" + points);
-}
-
-std::string SixPoints() {
-  std::string points;
-  for (double x : {-0.09, 0.03, 0.15}) {
-    for (double y : {-0.06, 0.06}) {
-      points += "<collision><origin xyz=\"" + std::to_string(x) + " " + std::to_string(y) +
-                " -0.07\"/><geometry><sphere radius=\"0\"/></geometry></collision>";
-    }
-  }
-  return points +
-         "<collision><origin xyz=\"0 0 -0.02\"/><geometry><sphere radius=\"0.01\"/></geometry></collision>";
-}
-
-struct TempUrdf {
-  explicit TempUrdf(const std::string& text)
-      : path((std::filesystem::temp_directory_path() / ("sole_test_" + std::to_string(::getpid()) + ".urdf"))
-                 .string()) {
-    std::ofstream(path) << text;
-  }
-  ~TempUrdf() { std::filesystem::remove(path); }
-  std::string path;
-};
-
 TEST(SoleFromModel, APointFootedHumanoidGetsItsGaitGeometryFromThePoints) {
-  const TempUrdf urdf(PointFootedHumanoid(SixPoints()));
+  const TempUrdf urdf("sole_test", PointFootedHumanoid(SixPointSoles()));
   const RobotModel model = LoadUrdfFile(urdf.path).model;
   const std::vector<CollisionShape> shapes = LoadCollisionShapes(urdf.path);
   std::string why;
@@ -233,19 +198,37 @@ TEST(SoleFromModel, APointFootedHumanoidGetsItsGaitGeometryFromThePoints) {
   EXPECT_DOUBLE_EQ(g.foot_half_width, b.foot_half_width);
   EXPECT_DOUBLE_EQ(g.foot_separation, b.foot_separation);
   EXPECT_NEAR(g.com_height, b.com_height, 1e-9);
-  // Six contacts a sole share the box's four corners' rolling stiffness.
-  const double spread = 6 * 0.06 * 0.06;
-  EXPECT_NEAR(walker->sole_spring().stiffness * spread,
-              WalkingHumanoid::kSoleStiffness * WalkingHumanoid::kSoleTunedSpread,
-              0.002 * WalkingHumanoid::kSoleStiffness * WalkingHumanoid::kSoleTunedSpread);
-  EXPECT_EQ(boxed->sole_spring().stiffness, WalkingHumanoid::kSoleStiffness);
+  // Its points become the box the sole is (its spring is then the tuned one).
+  EXPECT_EQ(walker->sole_spring().stiffness, WalkingHumanoid::kSoleStiffness);
+  EXPECT_EQ(walker->sole_spring().damping, WalkingHumanoid::kSoleDamping);
+  std::vector<CollisionShape> world_shapes = shapes;
+  ode_detail::OdeWorldOptions world;
+  walker->Prepare(world, world_shapes);
+  EXPECT_TRUE(world.place_on_ground);
+  for (const char* foot : {"left_foot", "right_foot"}) {
+    int spheres = 0, boxes = 0;
+    for (const CollisionShape& c : world_shapes) {
+      if (c.link != foot) continue;
+      spheres += c.kind == CollisionShape::Kind::kSphere;
+      if (c.kind != CollisionShape::Kind::kBox) continue;
+      ++boxes;
+      const std::optional<Sole> sole = FindSole(foot, {c}, &why);
+      ASSERT_TRUE(sole.has_value()) << why;
+      EXPECT_NEAR(sole->front, 0.15, 1e-9);
+      EXPECT_NEAR(sole->back, 0.09, 1e-9);
+      EXPECT_NEAR(sole->left, 0.06, 1e-9);
+      EXPECT_NEAR(sole->right, 0.06, 1e-9);
+      EXPECT_NEAR(sole->z, -0.07, 1e-9);
+    }
+    EXPECT_EQ(spheres, 1) << foot << ": the bumper above the sole stays, the sole's points go";
+    EXPECT_EQ(boxes, 1) << foot;
+  }
 }
 
 TEST(SoleFromModel, AHumanoidWhoseFeetHaveNoSoleIsRefusedWithTheReason) {
   // Two points a foot: no sole.
-  const TempUrdf urdf(PointFootedHumanoid(
-      "<collision><origin xyz=\"-0.09 0 -0.07\"/><geometry><sphere radius=\"0\"/></geometry></collision>"
-      "<collision><origin xyz=\"0.15 0 -0.07\"/><geometry><sphere radius=\"0\"/></geometry></collision>"));
+  const TempUrdf urdf("sole_test",
+                      PointFootedHumanoid(ContactPoint(-0.09, 0, -0.07) + ContactPoint(0.15, 0, -0.07)));
   std::string why;
   EXPECT_EQ(WalkingHumanoid::Create(LoadUrdfFile(urdf.path).model, LoadCollisionShapes(urdf.path),
                                     OdeDriverOptions{}, 1e-3, &why),
