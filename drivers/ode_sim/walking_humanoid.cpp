@@ -77,10 +77,10 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     *why = "not a floating base";
     return nullptr;
   }
-  const std::optional<int> l = FindAnyLink(model, {"left_foot", "l_foot", "LFoot"});
-  const std::optional<int> r = FindAnyLink(model, {"right_foot", "r_foot", "RFoot"});
+  const std::optional<int> l = FindAnyLink(model, {"left_foot", "l_foot", "LFoot", "l_ankle"});
+  const std::optional<int> r = FindAnyLink(model, {"right_foot", "r_foot", "RFoot", "r_ankle"});
   if (!l || !r) {
-    *why = "no feet named left_foot/right_foot or l_foot/r_foot";
+    *why = "no feet named left_foot/right_foot, l_foot/r_foot, LFoot/RFoot or l_ankle/r_ankle (Romeo's)";
     return nullptr;
   }
   // The soles: a box per foot, or the bounding rectangle of the foot's
