@@ -51,14 +51,12 @@ std::optional<Sole> FindSole(const std::string& link, const std::vector<Collisio
       return std::nullopt;
     }
     const Eigen::Vector3d t = box->origin.translation, size = box->size;
-    const double narrow = std::min(size.x(), size.y());
     return Sole{.front = t.x() + size.x() / 2,
                 .back = size.x() / 2 - t.x(),
                 .left = t.y() + size.y() / 2,
                 .right = size.y() / 2 - t.y(),
                 .z = t.z() - size.z() / 2,
                 .contacts = 4,
-                .spread = narrow * narrow,
                 .from_points = false};
   }
   // Contact points: the spheres' lowest points.
@@ -82,15 +80,6 @@ std::optional<Sole> FindSole(const std::string& link, const std::vector<Collisio
     ++n;
   }
   const Eigen::Vector2d extent = hi - lo;
-  // The second moment about the centroid: Σ p² - n p̄².
-  Eigen::Vector2d sum = Eigen::Vector2d::Zero(), sum2 = Eigen::Vector2d::Zero();
-  for (const CollisionShape& s : shapes) {
-    if (s.link != link || s.kind != Kind::kSphere) continue;
-    if (s.origin.translation.z() - s.size.x() > lowest + kSoleFlatness) continue;
-    const Eigen::Vector2d p = s.origin.translation.head<2>();
-    sum += p;
-    sum2 += p.cwiseProduct(p);
-  }
   if (n < 3 || extent.minCoeff() < kMinExtent) {
     *why = foot + "'s lowest contact points (" + std::to_string(n) + " within " +
            driver_support::Num(kSoleFlatness * 1000) + " mm of the lowest) span " +
@@ -104,7 +93,6 @@ std::optional<Sole> FindSole(const std::string& link, const std::vector<Collisio
               .right = -lo.y(),
               .z = lowest,
               .contacts = n,
-              .spread = (sum2 - sum.cwiseProduct(sum) / static_cast<double>(n)).minCoeff(),
               .from_points = true};
 }
 

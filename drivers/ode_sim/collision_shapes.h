@@ -41,10 +41,6 @@ struct Sole {
   /// The ground contacts of the sole lying flat: 4 for a box (its corners),
   /// else the number of contact points in the sole plane.
   int contacts = 0;
-  /// The contacts' second moment about their centroid along the sole's
-  /// narrower axis, Σ d² (m²): with a spring k per contact the sole resists
-  /// rolling over by k × spread (N·m/rad). A box's is its width² (4 corners).
-  double spread = 0;
   bool from_points = false;  ///< true: derived from contact points, not from a box
   /// The sole as a box shape of `link`, `thickness` thick above the sole plane.
   CollisionShape Box(const std::string& link, double thickness) const;

@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <numbers>
 #include <span>
 
@@ -107,14 +106,15 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     }
   }
   walking::GaitParams g;
-  g.foot_front = sole[0]->front;
-  g.foot_back = sole[0]->back;
-  g.foot_half_width = std::min(sole[0]->left, sole[0]->right);
+  // The footstep geometry is the smaller of the two soles (mirrored).
+  g.foot_front = std::min(sole[0]->front, sole[1]->front);
+  g.foot_back = std::min(sole[0]->back, sole[1]->back);
+  g.foot_half_width = std::min({sole[0]->left, sole[0]->right, sole[1]->left, sole[1]->right});
   g.zmp_x = (g.foot_front - g.foot_back) / 2;
   const double sole_z = sole[0]->z;
   // Feet apart as in the model at q = 0; the pelvis sinks so that the knees bend.
   const Eigen::Vector3d lp = kin.link_pose(*l) * Eigen::Vector3d(0, 0, sole_z);
-  const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole_z);
+  const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole[1]->z);
   g.foot_separation = lp.y() - rp.y();
   if (options.solver == "quickstep") {
     // Measured (docs/ode_sim.md, "Walking" and "Published humanoids"):
@@ -129,7 +129,8 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
         "atlas sags and falls standing); "
         "drop solver=quickstep or walk=true");
   }
-  auto w = std::unique_ptr<WalkingHumanoid>(new WalkingHumanoid(model, {*l, *r}, sole_z, g, gravity, step));
+  auto w = std::unique_ptr<WalkingHumanoid>(
+      new WalkingHumanoid(model, {*l, *r}, {sole_z, sole[1]->z}, g, gravity, step));
   w->pelvis_z_ = -lp.z() * (1 - kKneeDrop);
   w->soles_ = {*sole[0], *sole[1]};
   w->sole_from_points_ = {points[0], points[1]};
@@ -144,8 +145,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     w->g_.ankle_x = w->com_in_pelvis_.x() - w->g_.zmp_x;
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
-  w->sole_spring_ = SoleSpringFor(model.total_mass(), w->g_.com_height,
-                                  std::min(sole[0]->spread, sole[1]->spread), gravity);
+  w->sole_spring_ = SoleSpringFor(model.total_mass(), w->g_.com_height, gravity);
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;
   w->adjust_steps_ = options.stabilizer && options.step_adjustment;
@@ -154,29 +154,30 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   return w;
 }
 
-WalkingHumanoid::SoleSpring WalkingHumanoid::SoleSpringFor(double mass, double com_height, double spread,
-                                                           double gravity) {
-  // The tuned model's rocking: ω0² = k0·S0 / (m0 h0²) − g0 / h0, damping
-  // ratio ζ0 = c0·S0 / (2 m0 h0² ω0). Kept: k = m h² (ω0² + g / h) / S and
-  // c = 2 ζ0 m h² ω0 / S, i.e. c scales by (m h² / S) / (m0 h0² / S0).
+WalkingHumanoid::SoleSpring WalkingHumanoid::SoleSpringFor(double mass, double com_height, double gravity) {
+  // The tuned model's rocking on the tuned sole (w0 wide): ω0² = k0 w0² /
+  // (m0 h0²) − g0 / h0, damping ratio ζ0 = c0 w0² / (2 m0 h0² ω0). Kept on
+  // that sole: k = m h² (ω0² + g / h) / w0², c scales by m h² / (m0 h0²).
   constexpr double kTunedGravity = 9.81;
+  const double w0_sq = kSoleTunedWidth * kSoleTunedWidth;
   const double i0 = kSoleTunedMass * kSoleTunedComHeight * kSoleTunedComHeight;  // kg m²
-  const double omega0_sq = kSoleStiffness * kSoleTunedSpread / i0 - kTunedGravity / kSoleTunedComHeight;
+  const double omega0_sq = kSoleStiffness * w0_sq / i0 - kTunedGravity / kSoleTunedComHeight;
   const double inertia = mass * com_height * com_height;
   const auto rounded = [](double scale) { return std::round(scale * 1000) / 1000; };
   SoleSpring s;
   s.stiffness =
-      kSoleStiffness * rounded(inertia * (omega0_sq + gravity / com_height) / spread / kSoleStiffness);
-  s.damping = kSoleDamping * rounded((inertia / spread) / (i0 / kSoleTunedSpread));
+      kSoleStiffness * rounded(inertia * (omega0_sq + gravity / com_height) / w0_sq / kSoleStiffness);
+  s.damping = kSoleDamping * rounded(inertia / i0);
   return s;
 }
 
-WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
-                                 const walking::GaitParams& g, double gravity, double step)
+WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet,
+                                 std::array<double, 2> sole_z, const walking::GaitParams& g, double gravity,
+                                 double step)
     : model_(model),
       g_(g),
       pattern_(g, step, kPreviewEvery, gravity),
-      ik_(model, feet, {Eigen::Vector3d(0, 0, sole_z), Eigen::Vector3d(0, 0, sole_z)}),
+      ik_(model, feet, {Eigen::Vector3d(0, 0, sole_z[0]), Eigen::Vector3d(0, 0, sole_z[1])}),
       step_(step),
       feet_(feet) {
   const auto mask = ik_.leg_mask();

@@ -51,29 +51,32 @@ class WalkingHumanoid final : public BaseController {
   /// Here the weight presses each corner ~0.6 mm in, so a sole lies flat on
   /// four contacts, and the damping stops the rocking (docs/ode_sim.md).
   /// Tuned on models/simple_humanoid.urdf: kSoleTunedMass kg, its CoM
-  /// kSoleTunedComHeight m up in the stance, box soles 0.12 m wide
-  /// (kSoleTunedSpread, Sole::spread); other models get SoleSpringFor's.
+  /// kSoleTunedComHeight m up in the stance, box soles kSoleTunedWidth wide;
+  /// other models get SoleSpringFor's.
+  static constexpr double kSoleStiffness = 2e5, kSoleDamping = 4e3;
+  static constexpr double kSoleTunedMass = 52.5, kSoleTunedComHeight = 0.7275, kSoleTunedWidth = 0.12;
+  struct SoleSpring {
+    double stiffness = kSoleStiffness, damping = kSoleDamping;  ///< per contact, N/m and N·s/m
+  };
+  /// The sole spring of a model of `mass` (kg) whose CoM stands
+  /// `com_height` (m) above its soles under `gravity` (m/s²). The robot
+  /// rocking sideways on a sole (a mass m at height h on the rolling
+  /// stiffness of four corner springs k, w apart: k w², so ω² = k w² / (m h²)
+  /// − g / h) keeps the tuned model's frequency (9.5 rad/s) and damping ratio
+  /// on a sole of the tuned width; a narrower sole rolls more easily, as a
+  /// rubber pad's would (and the 3 cm soles of OdeWalk.ARobotThatFalls... still
+  /// fall). Measured on atlas.urdf (docs/ode_sim.md, "Published humanoids"):
+  /// scaled by mass per contact alone (each contact sinking as deep), its
+  /// sole was too soft for its 1.17 m high CoM: it rolled onto its outer
+  /// edge and fell in the fourth step. Scales within 0.1 % of 1 are 1 (the
+  /// tuned model keeps its values exactly).
+  static SoleSpring SoleSpringFor(double mass, double com_height, double gravity);
   /// A sole derived from contact points becomes a box this thick (m) above
   /// the sole plane, in place of the points (Prepare()).
   static constexpr double kSoleBoxThickness = 0.02;
   /// A foot's z axis within this (rad) of vertical at the model's zero pose:
   /// its sole (found in the link frame) lies flat.
   static constexpr double kMaxSoleTilt = 0.01;
-  static constexpr double kSoleStiffness = 2e5, kSoleDamping = 4e3;
-  static constexpr double kSoleTunedMass = 52.5, kSoleTunedComHeight = 0.7275, kSoleTunedSpread = 0.0144;
-  struct SoleSpring {
-    double stiffness = kSoleStiffness, damping = kSoleDamping;  ///< per contact, N/m and N·s/m
-  };
-  /// The sole spring of a model of `mass` (kg) whose CoM stands `com_height`
-  /// (m) above soles of `spread` (Sole::spread, m²) under `gravity` (m/s²):
-  /// the whole robot rocking sideways on a sole (a mass m at height h on a
-  /// rolling stiffness k × spread: ω² = k·spread / (m h²) − g / h) keeps the
-  /// tuned model's frequency (ω ≈ 9.5 rad/s) and damping ratio. Measured on
-  /// atlas.urdf (docs/ode_sim.md, "Published humanoids"): scaling by mass
-  /// per contact alone (each contact sinking as deep) left the sole too soft
-  /// for its 1.17 m high CoM: it rolled onto its outer edge and fell in the
-  /// fourth step. Scales within 0.1 % of 1 are 1 (the tuned model keeps its values exactly).
-  static SoleSpring SoleSpringFor(double mass, double com_height, double spread, double gravity);
   /// Torso tilt beyond which the robot counts as fallen, rad.
   static constexpr double kFallTilt = 0.6;
   /// GOTO: success within these (m, rad), as the issue asks; re-plans at most kRetries times.
@@ -141,7 +144,7 @@ class WalkingHumanoid final : public BaseController {
 
  private:
   enum class Mode : std::uint8_t { kIdle, kGoto, kSpeed };
-  WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
+  WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, std::array<double, 2> sole_z,
                   const walking::GaitParams& g, double gravity, double step);
   walking::Pose2 MeasuredPelvis() const;
   walking::Pose2 MeasuredFoot(
