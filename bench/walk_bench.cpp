@@ -3,7 +3,9 @@
 // models/simple_humanoid.urdf on the ode driver at 1 kHz; prints per goal the
 // answer, end error, walking time and speed, falls, and the real-time factor;
 // optionally writes a trace of one walk (footsteps, ZMP, CoM) for plotting.
-// Figures go to docs/ode_sim.md ("Walking").
+// Figures go to docs/ode_sim.md ("Walking"). Another humanoid: --model URDF
+// and its driver options, e.g. --model ../shared/robots/atlas.urdf --option
+// base=floating ("Published humanoids").
 //   robotalk-walk-bench [--model URDF] [--goals N] [--seed S] [--trace CSV] [--trace-goal K]
 //                       [--option key=value]... [--goal x,y,theta] [--stop S] [--verbose N] [--stand S]
 //                       [--timeout S] [--speeds N]

@@ -100,45 +100,64 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     *why = "not a floating base";
     return nullptr;
   }
-  const std::optional<int> l = FindAnyLink(model, {"left_foot", "l_foot", "LFoot"});
-  const std::optional<int> r = FindAnyLink(model, {"right_foot", "r_foot", "RFoot"});
+  const std::optional<int> l = FindAnyLink(model, {"left_foot", "l_foot", "LFoot", "l_ankle"});
+  const std::optional<int> r = FindAnyLink(model, {"right_foot", "r_foot", "RFoot", "r_ankle"});
   if (!l || !r) {
-    *why = "no feet named left_foot/right_foot or l_foot/r_foot";
+    *why = "no feet named left_foot/right_foot, l_foot/r_foot, LFoot/RFoot or l_ankle/r_ankle (Romeo's)";
     return nullptr;
   }
-  walking::GaitParams g;
-  const CollisionShape* box = nullptr;
-  for (const CollisionShape& s : shapes) {
-    if (s.link == model.link(*l).name && s.kind == CollisionShape::Kind::kBox) box = &s;
-  }
-  if (!box) {
-    *why = "foot '" + model.link(*l).name + "' has no box collision shape (the sole)";
-    return nullptr;
-  }
-  const Eigen::Vector3d t = box->origin.translation, size = box->size;
-  g.foot_front = t.x() + size.x() / 2;
-  g.foot_back = size.x() / 2 - t.x();
-  g.foot_half_width = size.y() / 2 - std::abs(t.y());
-  g.zmp_x = (g.foot_front - g.foot_back) / 2;
-  const double sole_z = t.z() - size.z() / 2;
-  // Feet apart as in the model at q = 0; the pelvis sinks so that the knees bend.
+  // The soles: a box per foot, or the bounding rectangle of the foot's
+  // lowest contact points (collision_shapes.h, FindSole), which Prepare()
+  // makes a box (kSoleBoxThickness) in place of the points.
+  std::optional<Sole> sole[2];
+  bool points[2] = {false, false};
   Kinematics kin(model);
   std::vector<Eigen::Isometry3d> roots(model.roots().size(), Eigen::Isometry3d::Identity());
   kin.Update(Eigen::VectorXd::Zero(model.num_dofs()), roots);
+  for (int s = 0; s < 2; ++s) {
+    const int foot = s == 0 ? *l : *r;
+    const std::string& name = model.link(foot).name;
+    sole[s] = FindSole(name, shapes, why);
+    if (!sole[s]) return nullptr;
+    points[s] = sole[s]->from_points;
+    if (points[s]) sole[s] = FindSole(name, {sole[s]->Box(name, kSoleBoxThickness)}, why);
+    const double up = kin.link_pose(foot).linear()(2, 2);
+    if (up < std::cos(kMaxSoleTilt)) {
+      *why = "foot '" + name + "' is not flat at the model's zero pose (its z axis " +
+             Num(std::acos(std::clamp(up, -1.0, 1.0))) +
+             " rad from vertical): its sole is not found from its shapes";
+      return nullptr;
+    }
+  }
+  walking::GaitParams g;
+  // The footstep geometry is the smaller of the two soles (mirrored).
+  g.foot_front = std::min(sole[0]->front, sole[1]->front);
+  g.foot_back = std::min(sole[0]->back, sole[1]->back);
+  g.foot_half_width = std::min({sole[0]->left, sole[0]->right, sole[1]->left, sole[1]->right});
+  g.zmp_x = (g.foot_front - g.foot_back) / 2;
+  const double sole_z = sole[0]->z;
+  // Feet apart as in the model at q = 0; the pelvis sinks so that the knees bend.
   const Eigen::Vector3d lp = kin.link_pose(*l) * Eigen::Vector3d(0, 0, sole_z);
-  const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole_z);
+  const Eigen::Vector3d rp = kin.link_pose(*r) * Eigen::Vector3d(0, 0, sole[1]->z);
   g.foot_separation = lp.y() - rp.y();
   if (options.solver == "quickstep") {
-    // Measured (docs/ode_sim.md, "Walking"): with quickstep's 50 iterations
-    // (and with 200) the simple humanoid fell 4-5 s into its first GOTO; with
-    // 1000 it walked, but slower than dWorldStep. So no quickstep walking.
+    // Measured (docs/ode_sim.md, "Walking" and "Published humanoids"):
+    // with quickstep's 50 iterations (and with 200) the simple humanoid fell
+    // 4-5 s into its first GOTO; with 1000 it walked, but slower than
+    // dWorldStep. Atlas (175 kg on 0.125 kg tali) cannot even stand on 50 or
+    // 200: its joints sag 0.08-0.11 rad and it falls within 2 s; with 1000
+    // it stands but falls in its second step. So no quickstep walking.
     throw Error(
-        "OdeDriver: walk=true needs solver=step: the walking humanoid falls on quickstep "
-        "(measured: with 50 and with 200 iterations it fell 4-5 s into its first GOTO); "
+        "OdeDriver: walk=true needs solver=step: a walking humanoid falls on quickstep "
+        "(measured: the simple humanoid with 50 and with 200 iterations fell 4-5 s into its first GOTO; "
+        "atlas sags and falls standing); "
         "drop solver=quickstep or walk=true");
   }
-  auto w = std::unique_ptr<WalkingHumanoid>(new WalkingHumanoid(model, {*l, *r}, sole_z, g, gravity, step));
+  auto w = std::unique_ptr<WalkingHumanoid>(
+      new WalkingHumanoid(model, {*l, *r}, {sole_z, sole[1]->z}, g, gravity, step));
   w->pelvis_z_ = -lp.z() * (1 - kKneeDrop);
+  w->soles_ = {*sole[0], *sole[1]};
+  w->sole_from_points_ = {points[0], points[1]};
   // The stance: the CoM above the feet's ZMP points puts the pelvis at the stance centre.
   for (int it = 0; it < 3; ++it) {
     std::array<Eigen::Isometry3d, 2> soles{Planar(walking::FootAt({}, Side::kLeft, w->g_), 0),
@@ -151,6 +170,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
   w->g_ = ChooseGait(model, *l, sole_z, -lp.z() * (1 - kKneeDrop), w->g_, options);
+  w->sole_spring_ = SoleSpringFor(model.total_mass(), w->g_.com_height, gravity);
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;
   w->adjust_steps_ = options.stabilizer && options.step_adjustment;
@@ -159,12 +179,30 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   return w;
 }
 
-WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
-                                 const walking::GaitParams& g, double gravity, double step)
+WalkingHumanoid::SoleSpring WalkingHumanoid::SoleSpringFor(double mass, double com_height, double gravity) {
+  // The tuned model's rocking on the tuned sole (w0 wide): ω0² = k0 w0² /
+  // (m0 h0²) − g0 / h0, damping ratio ζ0 = c0 w0² / (2 m0 h0² ω0). Kept on
+  // that sole: k = m h² (ω0² + g / h) / w0², c scales by m h² / (m0 h0²).
+  constexpr double kTunedGravity = 9.81;
+  const double w0_sq = kSoleTunedWidth * kSoleTunedWidth;
+  const double i0 = kSoleTunedMass * kSoleTunedComHeight * kSoleTunedComHeight;  // kg m²
+  const double omega0_sq = kSoleStiffness * w0_sq / i0 - kTunedGravity / kSoleTunedComHeight;
+  const double inertia = mass * com_height * com_height;
+  const auto rounded = [](double scale) { return std::round(scale * 1000) / 1000; };
+  SoleSpring s;
+  s.stiffness =
+      kSoleStiffness * rounded(inertia * (omega0_sq + gravity / com_height) / w0_sq / kSoleStiffness);
+  s.damping = kSoleDamping * rounded(inertia / i0);
+  return s;
+}
+
+WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet,
+                                 std::array<double, 2> sole_z, const walking::GaitParams& g, double gravity,
+                                 double step)
     : model_(model),
       g_(g),
       pattern_(g, step, kPreviewEvery, gravity),
-      ik_(model, feet, {Eigen::Vector3d(0, 0, sole_z), Eigen::Vector3d(0, 0, sole_z)}),
+      ik_(model, feet, {Eigen::Vector3d(0, 0, sole_z[0]), Eigen::Vector3d(0, 0, sole_z[1])}),
       step_(step),
       feet_(feet) {
   const auto mask = ik_.leg_mask();
@@ -173,9 +211,26 @@ WalkingHumanoid::WalkingHumanoid(const RobotModel& model, std::array<int, 2> fee
   for (Eigen::VectorXd* v : {&q_ref_, &q_prev_, &q_start_, &q_stance_}) v->setZero(n);
 }
 
+void WalkingHumanoid::Prepare(OdeWorldOptions& world, std::vector<CollisionShape>& shapes) {
+  world.place_on_ground = true;
+  // A sole from contact points stands on its box: measured on atlas.urdf
+  // (docs/ode_sim.md, "Published humanoids"), the box's four contacts walk
+  // as well as the eight points and step 1.6x faster.
+  for (int s = 0; s < 2; ++s) {
+    if (!sole_from_points_[static_cast<size_t>(s)]) continue;
+    const std::string& link = model_.link(feet_[static_cast<size_t>(s)]).name;
+    const Sole& sole = soles_[static_cast<size_t>(s)];
+    std::erase_if(shapes, [&](const CollisionShape& c) {
+      return c.link == link && c.kind == CollisionShape::Kind::kSphere &&
+             c.origin.translation.z() - c.size.x() <= sole.z + kSoleFlatness;
+    });
+    shapes.push_back(sole.Box(link, kSoleBoxThickness));
+  }
+}
+
 void WalkingHumanoid::Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>&) {
   world_ = &world;
-  for (int f : feet_) world_->SetContactSpring(f, kSoleStiffness, kSoleDamping);
+  for (int f : feet_) world_->SetContactSpring(f, sole_spring_.stiffness, sole_spring_.damping);
   vmax_ = servos.vmax();
   fmax_ = servos.fmax();
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(owned_.size()); ++i) {

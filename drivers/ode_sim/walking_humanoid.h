@@ -13,7 +13,7 @@
 // from the world into it with the support foot's pose measured at planning
 // time (if the feet slipped the two would drift apart; the GOTO's closed
 // loop re-plans from the measured pose). The soles' contacts are made
-// compliant (kSoleStiffness) so that they lie flat on the ground.
+// compliant (SoleSpringFor: kSoleStiffness scaled to the model) so that they lie flat on the ground.
 //
 // It is the walking one of the driver's bases (base_controller.h): it owns
 // the leg dofs (the joint servos leave them to it) and answers GOTO,
@@ -50,7 +50,33 @@ class WalkingHumanoid final : public BaseController {
   /// heel to toe for seconds; its stance foot then turns on one corner.
   /// Here the weight presses each corner ~0.6 mm in, so a sole lies flat on
   /// four contacts, and the damping stops the rocking (docs/ode_sim.md).
+  /// Tuned on models/simple_humanoid.urdf: kSoleTunedMass kg, its CoM
+  /// kSoleTunedComHeight m up in the stance, box soles kSoleTunedWidth wide;
+  /// other models get SoleSpringFor's.
   static constexpr double kSoleStiffness = 2e5, kSoleDamping = 4e3;
+  static constexpr double kSoleTunedMass = 52.5, kSoleTunedComHeight = 0.7275, kSoleTunedWidth = 0.12;
+  struct SoleSpring {
+    double stiffness = kSoleStiffness, damping = kSoleDamping;  ///< per contact, N/m and N·s/m
+  };
+  /// The sole spring of a model of `mass` (kg) whose CoM stands
+  /// `com_height` (m) above its soles under `gravity` (m/s²). The robot
+  /// rocking sideways on a sole (a mass m at height h on the rolling
+  /// stiffness of four corner springs k, w apart: k w², so ω² = k w² / (m h²)
+  /// − g / h) keeps the tuned model's frequency (9.5 rad/s) and damping ratio
+  /// on a sole of the tuned width; a narrower sole rolls more easily, as a
+  /// rubber pad's would (and the 3 cm soles of OdeWalk.ARobotThatFalls... still
+  /// fall). Measured on atlas.urdf (docs/ode_sim.md, "Published humanoids"):
+  /// scaled by mass per contact alone (each contact sinking as deep), its
+  /// sole was too soft for its 1.17 m high CoM: it rolled onto its outer
+  /// edge and fell in the fourth step. Scales within 0.1 % of 1 are 1 (the
+  /// tuned model keeps its values exactly).
+  static SoleSpring SoleSpringFor(double mass, double com_height, double gravity);
+  /// A sole derived from contact points becomes a box this thick (m) above
+  /// the sole plane, in place of the points (Prepare()).
+  static constexpr double kSoleBoxThickness = 0.02;
+  /// A foot's z axis within this (rad) of vertical at the model's zero pose:
+  /// its sole (found in the link frame) lies flat.
+  static constexpr double kMaxSoleTilt = 0.01;
   /// Torso tilt beyond which the robot counts as fallen, rad.
   static constexpr double kFallTilt = 0.6;
   /// GOTO: success within these (m, rad), as the issue asks; re-plans at most kRetries times.
@@ -67,17 +93,22 @@ class WalkingHumanoid final : public BaseController {
   static constexpr int kReplanSteps = 4;
 
   /// The controller if `model` can walk: a floating first root and two feet
-  /// found by name (left_foot/right_foot, l_foot/r_foot) with a box
-  /// collision shape each; else nullptr and *why says what is missing.
+  /// found by name (left_foot/right_foot, l_foot/r_foot, LFoot/RFoot,
+  /// l_ankle/r_ankle), flat at the zero pose, with a sole each (FindSole: a
+  /// box, or contact points stood on as their box); else nullptr and *why
+  /// says what is missing. The gait's geometry, the CoM height and the sole
+  /// spring (SoleSpringFor) come from the model.
   /// Throws Error for a model that can walk with solver=quickstep (it falls there).
   static std::unique_ptr<WalkingHumanoid> Create(const RobotModel& model,
                                                  const std::vector<CollisionShape>& shapes,
                                                  const OdeDriverOptions& options, double step,
                                                  std::string* why);
   /// A free root standing on the ground.
-  void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>&) override {
-    world.place_on_ground = true;
-  }
+  /// A free root standing on the ground; a foot whose sole was derived from
+  /// contact points stands on that sole as a box instead of on the points
+  /// (measured on atlas.urdf: as steady, 1.6x faster; docs/ode_sim.md,
+  /// "Published humanoids").
+  void Prepare(OdeWorldOptions& world, std::vector<CollisionShape>& shapes) override;
   /// Binds the world (after the driver built it), takes the leg dofs from
   /// the joint servos and plans the stance.
   void Attach(OdeWorld& world, JointServos& servos, const std::vector<CollisionShape>& shapes) override;
@@ -110,10 +141,14 @@ class WalkingHumanoid final : public BaseController {
   std::string_view fault() const override { return fall_; }
   std::optional<walking::WalkStatus> walk_status() const override { return status(); }
   walking::WalkStatus status() const;
+  /// The gait, its geometry (feet, soles, CoM height) from the model.
+  const walking::GaitParams& gait() const { return g_; }
+  /// The soles' contact spring of this model (SoleSpringFor).
+  const SoleSpring& sole_spring() const { return sole_spring_; }
 
  private:
   enum class Mode : std::uint8_t { kIdle, kGoto, kSpeed };
-  WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, double sole_z,
+  WalkingHumanoid(const RobotModel& model, std::array<int, 2> feet, std::array<double, 2> sole_z,
                   const walking::GaitParams& g, double gravity, double step);
   walking::Pose2 MeasuredPelvis() const;
   walking::Pose2 MeasuredFoot(
@@ -169,6 +204,9 @@ class WalkingHumanoid final : public BaseController {
   int foot_contacts_[2] = {0, 0};
   Eigen::Vector2d zmp_measured_ = Eigen::Vector2d::Zero();  // world
   double tracking_error_ = 0;
+  SoleSpring sole_spring_;
+  std::array<Sole, 2> soles_;                           // as boxes
+  std::array<bool, 2> sole_from_points_{false, false};  // Prepare() replaces the points by the box
 };
 
 }  // namespace robotalk::ode_detail

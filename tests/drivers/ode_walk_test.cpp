@@ -7,6 +7,7 @@
 // The soles are spring-dampers on the ground (docs/ode_sim.md, "Walking"):
 // the tests check that they carry the robot's weight on four contacts each.
 #include "ode_driver.h"
+#include "point_footed_humanoid.h"
 #include "robotalk/error.h"
 #include "robotalk/urdf_import.h"
 #include "test_paths.h"
@@ -392,9 +393,11 @@ TEST(OdeWalk, ARobotThatFallsHaltsAndAnswersTheGotoInterrupted) {
 }
 
 // Issue 26, item 6: walk=true is never silently ignored. A model that cannot
-// walk (atlas.urdf: its feet are contact points, no sole box) moves its root
-// kinematically and its answers say why; quickstep, on which the walk falls,
-// is refused with the reason.
+// walk (a synthetic humanoid whose feet are two contact points each: no
+// sole) moves its root kinematically and its answers say why, and the
+// driver's log says it once; quickstep, on which the walk falls, is refused
+// with the reason. (atlas.urdf, this test's model before, now walks:
+// tests/drivers/ode_atlas_walk_test.cpp.)
 TEST(OdeWalk, AModelThatCannotWalkSaysWhyAndQuickstepIsRefused) {
   DriverRegistry registry;
   RegisterOdeDriver(registry);
@@ -406,24 +409,38 @@ TEST(OdeWalk, AModelThatCannotWalkSaysWhyAndQuickstepIsRefused) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("walk=true needs solver=step"), std::string::npos) << e.what();
   }
-  // The model that cannot walk is a published one: the quickstep part above
-  // runs without it.
-  if (!::robotalk::testing::HaveSharedRobots()) GTEST_SKIP() << "Atlas part: no " << ROBOTALK_SHARED_ROBOTS;
-  std::unique_ptr<Driver> atlas =
-      registry.Create("ode", DriverConfig{.robot_name = "atlas",
-                                          .urdf_path = testing::SharedRobot("atlas.urdf"),
-                                          .options = {{"walk", "true"}, {"base", "floating"}}});
-  EXPECT_FALSE(static_cast<OdeDriver*>(atlas.get())->walk_status().has_value());
+  const testing::TempUrdf urdf("no_soles",
+                               testing::PointFootedHumanoid(testing::ContactPoint(-0.09, 0, -0.07) +
+                                                            testing::ContactPoint(0.15, 0, -0.07)));
+  ::testing::internal::CaptureStderr();
+  std::unique_ptr<Driver> bladed = registry.Create(
+      "ode", DriverConfig{.robot_name = "", .urdf_path = urdf.path, .options = {{"walk", "true"}}});
+  EXPECT_FALSE(static_cast<OdeDriver*>(bladed.get())->walk_status().has_value());
+  const std::string why = "walk=true ignored: foot 'left_foot''s lowest contact points (2 within 1 mm";
+  auto* ode = static_cast<OdeDriver*>(bladed.get());
+  std::vector<Completion> done;
   DriverCommand c;
   c.id = 1;
   c.type = CommandType::kSetSpeed;
   c.num_values = 2;
   c.values[0] = 0.1;
-  std::vector<Completion> done;
-  const DriverResult r = atlas->Execute(c, TimePoint{}, done);
-  EXPECT_EQ(r.signal, Signal::kModified);
-  EXPECT_NE(r.message.find("walk=true ignored: foot 'l_foot' has no box collision shape"), std::string::npos)
-      << r.message;
+  const DriverResult speed = ode->Execute(c, ode->sim_time(), done);
+  EXPECT_EQ(speed.signal, Signal::kModified);
+  EXPECT_NE(speed.message.find(why), std::string::npos) << speed.message;
+  ode->Stop(ode->sim_time(), done);
+  c.id = 2;
+  c.type = CommandType::kGoto;
+  c.num_values = 3;
+  c.values[0] = 0.05;
+  ASSERT_TRUE(ode->Execute(c, ode->sim_time(), done).in_progress);
+  for (int i = 0; i < 300 && done.empty(); ++i) ode->Step(10, done);
+  ASSERT_EQ(done.size(), 1u);
+  EXPECT_EQ(done[0].signal, Signal::kModified);
+  EXPECT_NE(done[0].message.find(why), std::string::npos) << done[0].message;
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  const size_t first = log.find(why);
+  EXPECT_NE(first, std::string::npos) << log;
+  EXPECT_EQ(log.find(why, first + 1), std::string::npos) << "said once:\n" << log;
 }
 
 // Pushes as a test input (issue 26, item 4): OdeDriver::PushForTesting, a
