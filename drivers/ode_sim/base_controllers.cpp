@@ -441,7 +441,11 @@ std::unique_ptr<BaseController> MakeBaseController(const RobotModel& model, cons
         // A model that cannot walk (no feet, no soles) moves kinematically
         // instead: its GOTO/SETSPEED answers say why, and so does one line here.
         std::string why;
-        if (auto walker = WalkingHumanoid::Create(model, shapes, options, step, &why)) return walker;
+        if (auto walker = WalkingHumanoid::Create(model, shapes, options, step, &why)) {
+          std::fprintf(stderr, "robotalk ode driver: '%s': walks with %s\n", model.name().c_str(),
+                       walker->gait_said().c_str());
+          return walker;
+        }
         std::fprintf(stderr,
                      "robotalk ode driver: '%s': walk=true ignored: %s; the root moves kinematically\n",
                      model.name().c_str(), why.c_str());

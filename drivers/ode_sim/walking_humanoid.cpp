@@ -51,13 +51,24 @@ std::optional<int> FindAnyLink(const RobotModel& m, std::initializer_list<const 
 
 // The gait (options gait, step_length, ...; walking/gait_limits.h): derived
 // from the leg, or the slow one (also where the leg cannot be measured), then overridden.
+// *said: which gait and why, in words, for the driver's start-up line.
 walking::GaitParams ChooseGait(const RobotModel& m, int foot, double sole_z, double pelvis_height,
-                               const walking::GaitParams& base, const OdeDriverOptions& options) {
+                               const walking::GaitParams& base, const OdeDriverOptions& options,
+                               std::string* said) {
   std::string why;
   const walking::LegGeometry leg = walking::MeasureLeg(m, foot, sole_z, pelvis_height, &why);
-  walking::GaitParams g = options.gait == "fast" && why.empty()
+  const bool derived = options.gait == "fast" && why.empty();
+  walking::GaitParams g = derived
                               ? walking::DeriveGait(leg, base, options.gravity > 0 ? options.gravity : 9.81)
                               : walking::SlowGait(base);
+  if (derived) {
+    *said = "gait from the leg (thigh " + Num(leg.thigh) + " m, shank " + Num(leg.shank) + " m, joints " +
+            Num(leg.joint_speed) + " rad/s)";
+  } else if (options.gait != "fast") {
+    *said = "the slow gait (gait=" + options.gait + ")";
+  } else {
+    *said = "the slow gait: the leg cannot be measured: " + why;
+  }
   const OdeDriverOptions::GaitOverrides& o = options.gait_overrides;
   for (auto [field, value] : {std::pair{&g.step_forward, o.step_length},
                               {&g.step_back, o.step_back},
@@ -69,6 +80,9 @@ walking::GaitParams ChooseGait(const RobotModel& m, int foot, double sole_z, dou
     if (value > 0) *field = value;
   }
   if (o.step_yaw > 0) g.step_yaw_in = std::min(g.step_yaw_in, o.step_yaw);
+  *said += ": steps " + Num(g.step_forward) + " m forward, " + Num(g.step_back) + " back, " +
+           Num(g.step_side) + " sideways, " + Num(g.step_yaw) + " rad turning, every " +
+           Num(g.single_support) + " + " + Num(g.double_support) + " s";
   return g;
 }
 
@@ -169,7 +183,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     w->g_.ankle_x = w->com_in_pelvis_.x() - w->g_.zmp_x;
   }
   w->g_.com_height = w->pelvis_z_ + w->com_in_pelvis_.z();
-  w->g_ = ChooseGait(model, *l, sole_z, -lp.z() * (1 - kKneeDrop), w->g_, options);
+  w->g_ = ChooseGait(model, *l, sole_z, -lp.z() * (1 - kKneeDrop), w->g_, options, &w->gait_said_);
   w->sole_spring_ = SoleSpringFor(model.total_mass(), w->g_.com_height, gravity);
   w->pattern_ = walking::WalkPattern(w->g_, step, kPreviewEvery, gravity);
   w->stabilize_ = options.stabilizer;

@@ -143,6 +143,8 @@ class WalkingHumanoid final : public BaseController {
   walking::WalkStatus status() const;
   /// The gait, its geometry (feet, soles, CoM height) from the model.
   const walking::GaitParams& gait() const { return g_; }
+  /// Which gait and why, with its steps (the driver's start-up line).
+  const std::string& gait_said() const { return gait_said_; }
   /// The soles' contact spring of this model (SoleSpringFor).
   const SoleSpring& sole_spring() const { return sole_spring_; }
 
@@ -163,6 +165,7 @@ class WalkingHumanoid final : public BaseController {
 
   const RobotModel& model_;
   walking::GaitParams g_;
+  std::string gait_said_;
   walking::WalkPattern pattern_;
   mutable walking::LegIk ik_;  // status() computes the measured CoM with its kinematics
   OdeWorld* world_ = nullptr;

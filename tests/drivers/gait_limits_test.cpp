@@ -96,6 +96,26 @@ TEST(GaitLimits, ShorterLegsOrSlowerJointsGiveASlowerGait) {
   EXPECT_LE(DeriveGait(stiff_yaw, h.base, 9.81).step_yaw, 2 * 0.8 * 0.05 + 1e-9);
 }
 
+// Atlas's legs (0.8 m, 12 rad/s joints): only the reach bounded its step,
+// and it fell on it (docs/ode_sim.md). The step is at most kMaxStepOfLeg
+// (0.37) of thigh + shank whatever the joints' speed allows.
+TEST(GaitLimits, FastJointsOnLongLegsStepAtMostAMeasuredShareOfTheLeg) {
+  const Humanoid h;
+  LegGeometry fast = h.leg;
+  fast.joint_speed = 12;
+  GaitBounds b;
+  const GaitParams g = DeriveGait(fast, h.base, 9.81, &b);
+  EXPECT_NEAR(b.speed_step, b.reach_step, 1e-6) << "the joints' speed no longer bounds the step";
+  EXPECT_GT(b.reach_step, b.leg_step);
+  EXPECT_NEAR(b.leg_step, 0.37 * (fast.thigh + fast.shank), 1e-12);
+  EXPECT_LE(g.step_forward, b.leg_step);
+  EXPECT_GT(g.step_forward, b.leg_step - 0.0100001);
+  // The simple humanoid's own step is bounded by its joints' speed, as before.
+  GaitBounds own;
+  EXPECT_DOUBLE_EQ(DeriveGait(h.leg, h.base, 9.81, &own).step_forward, 0.22);
+  EXPECT_LT(own.speed_step, own.leg_step);
+}
+
 TEST(GaitLimits, TurningStepsKeepTheSolesApart) {
   const Humanoid h;
   const GaitParams g = DeriveGait(h.leg, h.base, 9.81);

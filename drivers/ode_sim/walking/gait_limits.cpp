@@ -19,10 +19,15 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 // How much of each limit the gait uses (the rest is the servos' and the
 // balance's margin). First choices, not tuned; docs/ode_sim.md has what they walk.
-constexpr double kDoubleSupportTc = 0.75;   // double support, x Tc
-constexpr double kSingleTc = 2.0;           // single support, x Tc
-constexpr double kMaxStretch = 0.96;        // of thigh + shank: the straightest leg
-constexpr double kJointSpeedUse = 0.8;      // of the slowest pitch joint's velocity limit
+constexpr double kDoubleSupportTc = 0.75;  // double support, x Tc
+constexpr double kSingleTc = 2.0;          // single support, x Tc
+constexpr double kMaxStretch = 0.96;       // of thigh + shank: the straightest leg
+constexpr double kJointSpeedUse = 0.8;     // of the slowest pitch joint's velocity limit
+// The longest forward step, of thigh + shank. Measured, not derived: the
+// simple humanoid's swing-rate step (0.22 m of a 0.6 m leg) walks; Atlas
+// (0.8 m leg, 12 rad/s joints: only the reach bounds it) fell in its first
+// goal on its reach-limited step and walks 20 goals at 0.29 m (docs/ode_sim.md).
+constexpr double kMaxStepOfLeg = 0.37;
 constexpr double kSwingWindow = 0.8;        // of single support: the foot moves (walk_pattern.h)
 constexpr double kBackFraction = 0.5;       // backward step, of the forward one
 constexpr double kHipRollUse = 0.6;         // of the outward hip roll range
@@ -189,7 +194,8 @@ GaitParams DeriveGait(const LegGeometry& leg, const GaitParams& base, double gra
     (SwingRate(mid, single, period, leg.hip_height) <= rate ? lo : hi) = mid;
   }
   b.speed_step = lo;
-  g.step_forward = RoundDown(std::min(b.reach_step, b.speed_step));
+  b.leg_step = kMaxStepOfLeg * length;
+  g.step_forward = RoundDown(std::min({b.reach_step, b.speed_step, b.leg_step}));
   g.step_back = RoundDown(kBackFraction * g.step_forward);
   // Sideways: the swing foot lands step_side beyond its place, the hip still
   // over the stance foot's side: its leg reaches out by separation/2 +

@@ -16,7 +16,9 @@
 //   half a step before and behind the hip in double support); and the
 //   swing's joint rate: the foot's peak speed relative to the hip (a
 //   cosine move within the swing window) within kJointSpeedUse of the
-//   slowest pitch joint's velocity limit. Backwards: kBackFraction of forward (the
+//   slowest pitch joint's velocity limit; and at most kMaxStepOfLeg of thigh
+//   + shank (a measured bound, not derived: Atlas, whose fast joints leave
+//   only the reach, fell on its reach-limited step). Backwards: kBackFraction of forward (the
 //   heel edge is shorter and the swing foot cannot see).
 // - Sideways: the outward hip roll and the reach (the swing foot lands
 //   `step_side` beyond its place while the hip is still over the stance foot).
@@ -65,6 +67,7 @@ LegGeometry MeasureLeg(const RobotModel& model, int foot, double sole_z, double 
 struct GaitBounds {
   double tc = 0;                           ///< s, LIPM time constant
   double reach_step = 0, speed_step = 0;   ///< m, forward step by the knee's reach / the swing rate
+  double leg_step = 0;                     ///< m, forward step by the leg's length (measured bound)
   double roll_side = 0, reach_side = 0;    ///< m, sideways step by the hip roll / the reach
   double hip_yaw_turn = 0, sole_turn = 0;  ///< rad per step by the hip yaw / the soles' clearance
   double sole_turn_in = 0;                 ///< rad per step toward the stance foot (toes together)
