@@ -99,7 +99,7 @@ TEST(GaitLimits, ShorterLegsOrSlowerJointsGiveASlowerGait) {
 // Atlas's legs (0.8 m, 12 rad/s joints): only the reach bounded its step,
 // and it fell on it (docs/ode_sim.md). The step is at most kMaxStepOfLeg
 // (0.37) of thigh + shank whatever the joints' speed allows.
-TEST(GaitLimits, FastJointsAndAWideHipRollStepAtMostAMeasuredShareOfTheLeg) {
+TEST(GaitLimits, FastJointsOnLongLegsStepAtMostAMeasuredShareOfTheLeg) {
   const Humanoid h;
   LegGeometry fast = h.leg;
   fast.joint_speed = 12;
@@ -110,20 +110,10 @@ TEST(GaitLimits, FastJointsAndAWideHipRollStepAtMostAMeasuredShareOfTheLeg) {
   EXPECT_NEAR(b.leg_step, 0.37 * (fast.thigh + fast.shank), 1e-12);
   EXPECT_LE(g.step_forward, b.leg_step);
   EXPECT_GT(g.step_forward, b.leg_step - 0.0100001);
-  LegGeometry wide_roll = fast;  // Atlas's hip roll: the measured share bounds the side step
-  wide_roll.hip_roll_out = 1.2;
-  GaitBounds w;
-  const GaitParams side = DeriveGait(wide_roll, h.base, 9.81, &w);
-  EXPECT_GT(std::min(w.roll_side, w.reach_side), w.leg_side);
-  EXPECT_NEAR(w.leg_side, 0.27 * (fast.thigh + fast.shank), 1e-12);
-  EXPECT_LE(side.step_side, w.leg_side);
-  EXPECT_GT(side.step_side, w.leg_side - 0.0100001);
   // The simple humanoid's own step is bounded by its joints' speed, as before.
   GaitBounds own;
-  const GaitParams simple = DeriveGait(h.leg, h.base, 9.81, &own);
-  EXPECT_DOUBLE_EQ(simple.step_forward, 0.22);
+  EXPECT_DOUBLE_EQ(DeriveGait(h.leg, h.base, 9.81, &own).step_forward, 0.22);
   EXPECT_LT(own.speed_step, own.leg_step);
-  EXPECT_DOUBLE_EQ(simple.step_side, 0.16) << "its hip roll bounds its side step, as before";
 }
 
 TEST(GaitLimits, TurningStepsKeepTheSolesApart) {

@@ -28,11 +28,6 @@ constexpr double kJointSpeedUse = 0.8;     // of the slowest pitch joint's veloc
 // (0.8 m leg, 12 rad/s joints: only the reach bounds it) fell in its first
 // goal on its reach-limited step and walks 20 goals at 0.29 m (docs/ode_sim.md).
 constexpr double kMaxStepOfLeg = 0.37;
-// The longest sideways step, of thigh + shank, measured the same way: the
-// simple humanoid's hip-roll-bound 0.16 m of its 0.6 m leg walks; Atlas's
-// 0.23 m (its wide hip roll) fell stepping sideways while turning to a goal
-// 0.56 m away, and 0.21 m (this bound) and 0.18 m walked that goal.
-constexpr double kMaxSideOfLeg = 0.27;
 constexpr double kSwingWindow = 0.8;        // of single support: the foot moves (walk_pattern.h)
 constexpr double kBackFraction = 0.5;       // backward step, of the forward one
 constexpr double kHipRollUse = 0.6;         // of the outward hip roll range
@@ -210,8 +205,7 @@ GaitParams DeriveGait(const LegGeometry& leg, const GaitParams& base, double gra
   b.roll_side = std::max(0.0, leg.hip_height * std::tan(kHipRollUse * leg.hip_roll_out) - out0);
   b.reach_side =
       std::max(0.0, std::sqrt(std::max(0.0, stretched * stretched - leg.hip_height * leg.hip_height)) - out0);
-  b.leg_side = kMaxSideOfLeg * length;
-  g.step_side = RoundDown(std::min({b.roll_side, b.reach_side, b.leg_side}));
+  g.step_side = RoundDown(std::min(b.roll_side, b.reach_side));
   // Turning: the pelvis turns midway between the feet, so a hip yaws half a
   // step's turn; and the soles keep kSoleClearance apart with one foot turned
   // about the stance centre (outward: toes apart; inward: toes together).

@@ -21,9 +21,7 @@
 //   only the reach, fell on its reach-limited step). Backwards: kBackFraction of forward (the
 //   heel edge is shorter and the swing foot cannot see).
 // - Sideways: the outward hip roll and the reach (the swing foot lands
-//   `step_side` beyond its place while the hip is still over the stance
-//   foot); and at most kMaxSideOfLeg of thigh + shank (measured, as the
-//   forward one: Atlas's wide hip roll allowed a step it fell on).
+//   `step_side` beyond its place while the hip is still over the stance foot).
 // - Turning: half a step's turn per hip yaw (the pelvis turns midway between
 //   the feet) within kHipYawUse of the range, and the soles at least
 //   kSoleClearance apart with one foot turned about the stance centre:
@@ -71,7 +69,6 @@ struct GaitBounds {
   double reach_step = 0, speed_step = 0;   ///< m, forward step by the knee's reach / the swing rate
   double leg_step = 0;                     ///< m, forward step by the leg's length (measured bound)
   double roll_side = 0, reach_side = 0;    ///< m, sideways step by the hip roll / the reach
-  double leg_side = 0;                     ///< m, sideways step by the leg's length (measured bound)
   double hip_yaw_turn = 0, sole_turn = 0;  ///< rad per step by the hip yaw / the soles' clearance
   double sole_turn_in = 0;                 ///< rad per step toward the stance foot (toes together)
 };
