@@ -5,6 +5,7 @@
 #include "robot_daemon.h"
 
 #include "fake_driver.h"
+#include "queued_items.h"
 #include "robotalk/request.h"
 #include "state_encoding.h"
 
@@ -41,21 +42,8 @@ class BrokenSensorDriver final : public testing::FakeDriver {
   bool lose_root = false;  // a driver's bug: a state of the wrong shape
 };
 
-// A waypoint of an interpolated package for the pan joint, due at `at`.
-QueuedItem Waypoint(CommandId id, TimePoint at, double q) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.command.id = id;
-  item.command.type = CommandType::kJointSetPoint;
-  item.command.target = 0;
-  item.command.num_values = 1;
-  item.command.values[0] = q;
-  item.has_start_time = true;
-  item.start = at;
-  item.received = at - milliseconds(300);
-  item.interpolation = Interpolation::kCubic;
-  return item;
-}
+// A waypoint of an interpolated package for the pan joint (0), due at `at`.
+QueuedItem Waypoint(CommandId id, TimePoint at, double q) { return testing::Waypoint(id, 0, at, {q}); }
 
 QueuedItem Query(CommandId id, QueryType type) {
   QueuedItem item;

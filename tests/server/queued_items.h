@@ -1,11 +1,13 @@
 // Items as the ServerDaemon hands them to a RobotDaemon, for RobotDaemon
-// tests: a motion command and a joint-state query of one client.
+// tests: a motion command, a trajectory waypoint and a joint-state query of
+// one client.
 #pragma once
 
 #include "scheduler.h"
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace robotalk::testing {
@@ -20,6 +22,20 @@ inline QueuedItem Motion(CommandId id, CommandType type, std::vector<double> val
   item.command.target = target;
   item.command.num_values = static_cast<int>(values.size());
   std::copy(values.begin(), values.end(), item.command.values.begin());
+  return item;
+}
+
+/// A waypoint of an interpolated package (QueuedItem::is_waypoint()): a
+/// JOINT_SETPOINT (or `type`) of `target` due at `at`.
+inline QueuedItem Waypoint(CommandId id, int target, TimePoint at, std::vector<double> values,
+                           Interpolation interpolation = Interpolation::kCubic,
+                           std::int64_t client = kItemClient,
+                           CommandType type = CommandType::kJointSetPoint) {
+  QueuedItem item = Motion(id, type, std::move(values), target);
+  item.client_id = client;
+  item.has_start_time = true;
+  item.start = at;
+  item.interpolation = interpolation;
   return item;
 }
 

@@ -4,6 +4,7 @@
 // is checked end to end without a network.
 #include "trajectory_tracker.h"
 #include "kinematic_driver.h"
+#include "queued_items.h"
 #include "robot_daemon.h"
 
 #include <gmock/gmock.h>
@@ -40,21 +41,7 @@ RobotModel Arm() {
   return b.Build();
 }
 
-QueuedItem Waypoint(CommandId id, int joint, TimePoint at, std::vector<double> q,
-                    Interpolation interpolation = Interpolation::kCubic, std::int64_t client = kAlice,
-                    CommandType type = CommandType::kJointSetPoint) {
-  QueuedItem item;
-  item.client_id = client;
-  item.command.id = id;
-  item.command.type = type;
-  item.command.target = joint;
-  item.command.num_values = static_cast<int>(q.size());
-  std::copy(q.begin(), q.end(), item.command.values.begin());
-  item.has_start_time = true;
-  item.start = at;
-  item.interpolation = interpolation;
-  return item;
-}
+using testing::Waypoint;  // kItemClient is kAlice
 
 RobotState Rest(const RobotModel& m) {
   RobotState s;
