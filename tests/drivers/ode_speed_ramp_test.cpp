@@ -8,6 +8,7 @@
 // periods; the figures are printed for docs/performance.md.
 #include "ode_driver.h"
 #include "robot_daemon.h"
+#include "support/test_clients.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
@@ -23,7 +24,7 @@ namespace {
 using std::chrono::milliseconds;
 using testing::ProjectModel;
 
-const TimePoint kT0 = TimePoint(std::chrono::seconds(1000));
+using testing::kT0;
 constexpr double kLinear = 3.0;  // the server's default, m/s²
 
 struct StreamRun {
@@ -56,7 +57,7 @@ StreamRun Stream(Interpolation interpolation) {
   for (TimePoint now = kT0; now <= end; now += milliseconds(10)) {
     if ((now - kT0) % milliseconds(100) == Duration(0) && k < kFrames) {
       QueuedItem f;
-      f.client_id = 0xA11CE;
+      f.client_id = testing::kAlice;
       f.command.id = ++k;
       f.command.type = CommandType::kSetSpeed;
       f.command.num_values = 2;

@@ -8,6 +8,7 @@
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "session_test_util.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -20,7 +21,7 @@ using ::testing::HasSubstr;
 using testing::PanRobot;
 using testing::SayHello;
 
-constexpr std::int64_t kAlice = 0xA11CE;
+using testing::kAlice;
 
 std::vector<std::uint8_t> ForgedAnnounce(std::int64_t server_id, const std::string& robot) {
   Announcement a;

@@ -6,6 +6,7 @@
 #include "fake_driver.h"
 #include "queued_items.h"
 #include "robot_daemon.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -26,7 +27,7 @@ using testing::JointStateQuery;
 using testing::Motion;
 using testing::PanRobot;
 
-constexpr std::int64_t kAlice = testing::kItemClient;
+using testing::kAlice;
 
 // A FakeDriver that throws from the one call named `throw_in` while armed.
 class ThrowingDriver : public FakeDriver {

@@ -8,6 +8,7 @@
 #include "queued_items.h"
 #include "robotalk/request.h"
 #include "state_encoding.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -23,7 +24,7 @@ namespace {
 using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 
-constexpr std::int64_t kAlice = 0xA11CE;
+using testing::kAlice;
 
 // A broken encoder: the pan joint's position (or the base's x) is NaN.
 class BrokenSensorDriver final : public testing::FakeDriver {

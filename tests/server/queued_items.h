@@ -4,6 +4,7 @@
 #pragma once
 
 #include "scheduler.h"
+#include "support/test_clients.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -12,7 +13,7 @@
 
 namespace robotalk::testing {
 
-inline constexpr std::int64_t kItemClient = 0xA11CE;  ///< the client of Motion() and JointStateQuery()
+inline constexpr std::int64_t kItemClient = kAlice;  ///< the client of Motion() and JointStateQuery()
 
 inline QueuedItem Motion(CommandId id, CommandType type, std::vector<double> values, int target = -1) {
   QueuedItem item;

@@ -2,6 +2,7 @@
 
 #include "fake_driver.h"
 #include "queued_items.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -40,7 +41,7 @@ using testing::JointStateQuery;
 using testing::Motion;
 using testing::PanRobot;
 
-constexpr std::int64_t kAlice = testing::kItemClient;
+using testing::kAlice;
 
 class RobotDaemonTest : public ::testing::Test {
  protected:

@@ -1,5 +1,7 @@
 #include "scheduler.h"
 
+#include "support/test_clients.h"
+
 #include <gtest/gtest.h>
 
 namespace robotalk {
@@ -8,7 +10,7 @@ namespace {
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
-const TimePoint kT0 = TimePoint(seconds(1000));
+using testing::kT0;
 
 QueuedItem Item(std::int64_t client, CommandId id, std::optional<TimePoint> start = std::nullopt,
                 CommandType type = CommandType::kJointSetPoint) {

@@ -7,6 +7,7 @@
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "session_test_util.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -26,7 +27,7 @@ using ::testing::HasSubstr;
 using testing::PanRobot;
 using testing::SayHello;
 
-constexpr std::int64_t kAlice = 0xA11CE;
+using testing::kAlice;
 
 class ServerDaemonTest : public ::testing::Test {
  protected:

@@ -8,6 +8,7 @@
 #include "robotalk/request.h"
 #include "server_daemon.h"
 #include "session_test_util.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -22,7 +23,7 @@ using ::testing::HasSubstr;
 using testing::PanRobot;
 using testing::SayHello;
 
-constexpr std::int64_t kAlice = 0xA11CE;
+using testing::kAlice;
 constexpr std::int64_t kMallory = 0xBAD;
 
 // One server (replaceable: Restart) with robot "bot" on a bus, and a client's

@@ -8,6 +8,7 @@
 #include "robotalk/config_message.h"
 #include "robotalk/request.h"
 #include "state_encoding.h"
+#include "support/test_clients.h"
 
 #include <gtest/gtest.h>
 
@@ -17,8 +18,6 @@
 #include <vector>
 
 namespace robotalk::testing {
-
-inline constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
 
 inline Command Cmd(CommandId id, CommandType type, std::vector<double> values = {}, std::string target = "",
                    StartTime start = StartTime::Now()) {

@@ -7,6 +7,7 @@
 // printed by RandomFramesRampWithinTheLimitWhereAStepPackageJumps.
 #include "kinematic_driver.h"
 #include "robot_daemon.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -22,8 +23,9 @@ namespace {
 using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 
-constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
-const TimePoint kT0 = TimePoint(std::chrono::seconds(1000));
+using testing::kAlice;
+using testing::kBob;
+using testing::kT0;
 constexpr double kLinear = 3.0, kAngular = 6.0;  // the server's defaults (m/s², rad/s²)
 
 // A differential rover with a pan joint; `base` overrides its base type.

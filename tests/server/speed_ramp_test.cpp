@@ -3,6 +3,7 @@
 // continuous and never changes faster than the base's limit, MODIFIED when
 // the limit bites, splices, late frames, and End().
 #include "speed_ramp.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,8 +17,9 @@ namespace {
 using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 
-constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
-const TimePoint kT0 = TimePoint(std::chrono::seconds(1000));
+using testing::kAlice;
+using testing::kBob;
+using testing::kT0;
 constexpr Duration kPeriod = milliseconds(10);
 
 QueuedItem Frame(CommandId id, TimePoint at, std::vector<double> values, std::int64_t client = kAlice) {

@@ -15,6 +15,7 @@
 #include <numbers>
 
 #include "support/allocation_counter.h"  // g_mallocs
+#include "support/test_clients.h"
 
 namespace robotalk {
 namespace {
@@ -22,8 +23,9 @@ namespace {
 using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 
-constexpr std::int64_t kAlice = 0xA11CE, kBob = 0xB0B;
-const TimePoint kT0 = TimePoint(std::chrono::seconds(1000));
+using testing::kAlice;
+using testing::kBob;
+using testing::kT0;
 
 // A base and an arm joint "elbow" (revolute, ±2 rad, 2 rad/s) and a 2-dof "wrist".
 RobotModel Arm() {
