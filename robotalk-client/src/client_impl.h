@@ -176,6 +176,10 @@ class RobotClient::Impl {
   void Tick(TimePoint now);
   void Publish(const std::string& channel, const std::vector<std::uint8_t>& bytes);
   void OnReplyPackage(std::span<const std::uint8_t> bytes);
+  // When the message being dispatched arrived, on clock_: the transport's
+  // stamp (the socket's, before this process handled it) when clock_ is the
+  // steady clock; else `now`.
+  TimePoint ArrivalTime(TimePoint now) const;
   void OnConfig(std::span<const std::uint8_t> bytes);
   /// Keyed mode: the bytes of a STATE or CONFIG message received on
   /// `channel` without their signature suffix when signed by the trusted

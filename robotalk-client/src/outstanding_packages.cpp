@@ -35,16 +35,26 @@ Duration OutstandingPackages::IntervalAt(int step) const {
   return std::max(base, Duration(static_cast<Duration::rep>(ns)));
 }
 
-std::optional<Duration> OutstandingPackages::recent_min_round_trip() const {
-  if (recent_count_ == 0) return std::nullopt;
-  return *std::min_element(recent_rtts_.begin(),
-                           recent_rtts_.begin() + static_cast<std::ptrdiff_t>(recent_count_));
+void OutstandingPackages::AddNetworkRoundTrip(Duration rtt, TimePoint now) {
+  network_rtts_.emplace_back(now, rtt);
+  while (network_rtts_.size() > kMaxRoundTrips ||
+         (network_rtts_.size() > 1 && now - network_rtts_.front().first > kRoundTripWindow)) {
+    network_rtts_.pop_front();
+  }
+  // A median over a large window moves slowly: past 64 samples, every 8th
+  // sample recomputes it (the cost stays a few microseconds per 8 acks).
+  if (network_rtts_.size() >= 64 && ++since_median_ < 8) return;
+  since_median_ = 0;
+  scratch_.clear();
+  for (const auto& [at, sample] : network_rtts_) scratch_.push_back(sample);
+  const std::size_t n = scratch_.size();
+  const auto upper = scratch_.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(scratch_.begin(), upper, scratch_.end());
+  reported_rtt_ = *upper;
+  if (n % 2 == 0) reported_rtt_ = (*upper + *std::max_element(scratch_.begin(), upper)) / 2;
 }
 
 void OutstandingPackages::AddRoundTrip(Duration rtt) {
-  recent_rtts_[recent_next_] = rtt;
-  recent_next_ = (recent_next_ + 1) % kRecentRoundTrips;
-  recent_count_ = std::min(recent_count_ + 1, kRecentRoundTrips);
   timer_backoff_ = 0;
   if (!srtt_) {
     srtt_ = rtt;
@@ -130,7 +140,8 @@ void OutstandingPackages::Add(std::int64_t sequence, std::vector<std::uint8_t> b
   packages_.emplace(sequence, std::move(p));
 }
 
-OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, TimePoint now) {
+OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, TimePoint now,
+                                                        std::optional<AckTiming> timing) {
   AckInfo info;
   auto it = packages_.find(sequence);
   if (it == packages_.end()) return info;
@@ -143,7 +154,12 @@ OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, T
   if (!p.acked) {
     p.acked = true;
     // Karn's rule: only a package sent once gives an unambiguous round trip.
-    if (p.sends == 1) AddRoundTrip(now - p.first_send);
+    if (p.sends == 1) {
+      AddRoundTrip(now - p.first_send);
+      const AckTiming t = timing.value_or(AckTiming{.received = now});
+      const Duration network = t.received - p.first_send - t.server_hold;
+      if (network > Duration::zero()) AddNetworkRoundTrip(network, now);
+    }
     // Replies are not due before the items' start times: ask again only after.
     p.backoff_step = 0;
     Reschedule(sequence, p, std::max(now, EarliestStart(p, now)) + IntervalAt(0));

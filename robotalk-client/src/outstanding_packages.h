@@ -34,8 +34,8 @@
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 
-#include <array>
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <set>
 #include <unordered_map>
@@ -80,8 +80,17 @@ class OutstandingPackages {
   /// Registers a package just sent at `now` (its encoded bytes for resending).
   /// REQUIRES: `sequence` not already outstanding.
   void Add(std::int64_t sequence, std::vector<std::uint8_t> bytes, std::vector<Item> items, TimePoint now);
-  /// The server acknowledged `sequence`.
-  AckInfo OnAck(std::int64_t sequence, TimePoint now);
+  /// When an acknowledgement arrived (the socket's stamp on this process's
+  /// clock, before this process got round to it) and how long the server held
+  /// the package before the ack left (reply_package_t's server_send_us −
+  /// server_receive_us).
+  struct AckTiming {
+    TimePoint received{};
+    Duration server_hold{0};
+  };
+  /// The server acknowledged `sequence`, handled at `now`; `timing` when known
+  /// (else the ack arrived at `now` and the server held it for no time).
+  AckInfo OnAck(std::int64_t sequence, TimePoint now, std::optional<AckTiming> timing = std::nullopt);
   /// A final reply for `id` arrived; returns the package it completed, if any.
   std::optional<std::int64_t> OnReply(CommandId id, TimePoint now);
 
@@ -105,11 +114,19 @@ class OutstandingPackages {
   Duration retransmit_timeout() const;
   /// The smoothed round trip (RFC 6298 SRTT; nullopt before the first sample).
   std::optional<Duration> smoothed_round_trip() const { return srtt_; }
-  /// The least round trip of the last kRecentRoundTrips samples (nullopt
-  /// before the first): the path without queueing and without this
-  /// process's own scheduling delays (the header's round_trip_us).
-  std::optional<Duration> recent_min_round_trip() const;
-  static constexpr std::size_t kRecentRoundTrips = 32;
+  /// The round trip every package reports (the header's round_trip_us;
+  /// nullopt before the first sample): the median of the network round trips
+  /// of the packages acknowledged in the last kRoundTripWindow (at most
+  /// kMaxRoundTrips; the mean of the middle two of an even count). A
+  /// network round trip is the ack's arrival (AckTiming::received) − the
+  /// package's send − the server's hold: neither side's processing counts,
+  /// and the median ignores what the stamps miss (a spike in the server's
+  /// receiving thread). Half of it is the mean one-way delay of a link whose
+  /// jitter is symmetric (issue 23; docs/server.md, Link health). Not the
+  /// RTO's samples: those run to when this process handled the ack.
+  std::optional<Duration> reported_round_trip() const { return reported_rtt_; }
+  static constexpr Duration kRoundTripWindow = std::chrono::seconds(10);
+  static constexpr std::size_t kMaxRoundTrips = 2048;
   /// Total resends so far.
   std::uint64_t retransmissions() const { return retransmissions_; }
 
@@ -138,9 +155,12 @@ class OutstandingPackages {
   static constexpr Duration kPacingStep = std::chrono::milliseconds(1);
   Duration BaseTimeout() const;
   void AddRoundTrip(Duration rtt);
+  void AddNetworkRoundTrip(Duration rtt, TimePoint now);
   std::optional<Duration> srtt_;
-  std::array<Duration, kRecentRoundTrips> recent_rtts_{};
-  std::size_t recent_next_ = 0, recent_count_ = 0;
+  std::deque<std::pair<TimePoint, Duration>> network_rtts_;  // (acked at, round trip), oldest first
+  std::vector<Duration> scratch_;
+  std::optional<Duration> reported_rtt_;
+  std::size_t since_median_ = 0;
   Duration rttvar_{0};
   static constexpr int kMaxTimerBackoff = 6;  // at most 64 × the RTO
   int timer_backoff_ = 0;

@@ -369,7 +369,17 @@ Request RobotClient::Impl::NextRequest(TimePoint now) const {
                  .session_id = session_id_,
                  .sequence = next_sequence_,
                  .send_time = now,
-                 .round_trip = outstanding_.recent_min_round_trip().value_or(Duration(0))};
+                 .round_trip = outstanding_.reported_round_trip().value_or(Duration(0))};
+}
+
+TimePoint RobotClient::Impl::ArrivalTime(TimePoint now) const {
+  // The transport's stamp is wall-clock time: it maps onto the steady clock
+  // as "this long ago". A test's own clock does not run with the wall clock;
+  // an age outside [0, 1 s] is a wall-clock step, not a wait.
+  if (&clock_ != &steady_clock_) return now;
+  const auto age = std::chrono::system_clock::now() - transport_->ReceiveTime();
+  if (age < Duration::zero() || age > std::chrono::seconds(1)) return now;
+  return now - std::chrono::duration_cast<Duration>(age);
 }
 
 void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
@@ -385,6 +395,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
       return;
     }
     const TimePoint now = clock_.Now();
+    const TimePoint arrived = ArrivalTime(now);
     bool notify = false;
     std::vector<CommandId> lost;
     const auto fail_lost = [&] {
@@ -415,7 +426,11 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     {
       std::lock_guard lock(mu_);
       if (batch.ack_sequence > 0) {
-        const auto info = outstanding_.OnAck(batch.ack_sequence, now);
+        const auto info = outstanding_.OnAck(
+            batch.ack_sequence, now,
+            client::OutstandingPackages::AckTiming{
+                .received = arrived,
+                .server_hold = std::max(Duration::zero(), batch.server_send - batch.server_receive)});
         if (info.known && info.first && clock_packages_.erase(batch.ack_sequence) != 0 &&
             !info.retransmitted) {
           // Only a never-resent package gives an unambiguous t1.

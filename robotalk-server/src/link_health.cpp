@@ -6,14 +6,15 @@
 
 namespace robotalk {
 
-std::pair<Duration, Duration> LinkHealth::TransitRange() const {
+Duration LinkHealth::SlowTransit() const {
   // The 90th percentile, not the greatest: one package its sender or this
   // server was slow to handle (a loaded machine) must not widen the range
   // past a retransmission's wait.
   std::array<Duration, 64> sorted = transits_;
   const auto end = sorted.begin() + static_cast<std::ptrdiff_t>(transit_count_);
-  std::sort(sorted.begin(), end);
-  return {sorted[0], sorted[(transit_count_ - 1) * 9 / 10]};
+  const auto at = sorted.begin() + static_cast<std::ptrdiff_t>((transit_count_ - 1) * 9 / 10);
+  std::nth_element(sorted.begin(), at, end);
+  return *at;
 }
 
 void LinkHealth::Decide(bool lost) {
@@ -74,7 +75,7 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     // includes the client's resend wait): told apart by how much slower it
     // travelled than the slowest recent first copies (their 90th percentile).
     const bool retransmission =
-        transit && transit_count_ > 0 && *transit - TransitRange().second > options_.reorder_tolerance;
+        transit && transit_count_ > 0 && *transit - SlowTransit() > options_.reorder_tolerance;
     resent = retransmission;
     if (retransmission) {
       ++f_.retransmitted;
@@ -138,13 +139,6 @@ void LinkHealth::Tick(TimePoint now) {
 LinkFigures LinkHealth::Figures() const {
   LinkFigures f = f_;
   f.jitter = Duration(static_cast<Duration::rep>(jitter_us_ * 1000));
-  if (transit_count_ > 0) {
-    // How much longer than the fastest recent package the recent ones took on average.
-    const Duration floor = TransitRange().first;
-    Duration::rep excess = 0;
-    for (std::size_t i = 0; i < transit_count_; ++i) excess += (transits_[i] - floor).count();
-    f.queueing = Duration(excess / static_cast<Duration::rep>(transit_count_));
-  }
   f.loss = f.expected == 0 ? 0.0 : static_cast<double>(f.lost) / static_cast<double>(f.expected);
   const std::uint64_t expected = current_.expected + previous_.expected;
   f.recent_loss = expected == 0

@@ -5,19 +5,21 @@
 //
 // Inputs, per package of the session (OnPackage): its sequence number, whether
 // the session's SequenceWindow saw it before, the client's send time (its own
-// clock) and the client's round trip (header round_trip_us: the least of its
-// recent acknowledged packages'); per final reply (OnReply): its lateness,
-// and whether it expired (expiry.h).
+// clock) and the client's round trip (header round_trip_us: the median of
+// its recent network round trips, outstanding_packages.h); per final reply
+// (OnReply): its lateness, and whether it expired (expiry.h).
 //
 // Figures (Figures()):
-//   - round trip: the latest the client reported, its least round trip over
-//     its recent acknowledged packages (the path without queueing, and
-//     without its own scheduling delays when it is loaded);
-//   - delay (one-way, client -> server): half that round trip (the clock
-//     sync's symmetric assumption, docs/protocol.md) plus the queueing: how
-//     much longer than the fastest the recent packages took on average
-//     (their transits, arrival − send time, compared among themselves: the
-//     clocks' offset cancels);
+//   - round trip: the latest the client reported: the median of its network
+//     round trips (an ack's arrival, as its socket stamped it, − the
+//     package's send − the server's hold: neither side's processing counts);
+//   - delay (one-way, client -> server): half that round trip. Without
+//     synchronised clocks nothing tells the two ways of a round trip apart
+//     (this server's transits, arrival − the client's send time, carry the
+//     clocks' unknown offset), so this is the mean of the two directions'
+//     mean delays when each direction's jitter is symmetric about its mean
+//     (the median of a sum of two such is its mean); the client's median
+//     makes it robust to processing spikes;
 //   - jitter: RFC 3550's inter-arrival jitter of the transit (arrival − send
 //     time: the clocks' offset cancels in its differences), J += (|D| − J)/16,
 //     over the packages that arrive in order (a retransmission carries its
@@ -78,7 +80,6 @@ struct LinkHealthOptions {
 /// What the server knows of one session's link.
 struct LinkFigures {
   std::optional<Duration> round_trip;  ///< as the client reported it; nullopt: not yet
-  Duration queueing{0};                ///< mean transit over the least, recent packages
   Duration jitter{0};
   std::uint64_t packages = 0;       ///< distinct packages received
   std::uint64_t expected = 0;       ///< sequence numbers whose fate is known
@@ -92,9 +93,9 @@ struct LinkFigures {
   double loss = 0;         ///< lost / expected, cumulative
   double recent_loss = 0;  ///< over the recent window
   std::uint64_t recent_expired = 0;
-  /// One-way: half the round trip plus the queueing; nullopt before a round trip is known.
+  /// One-way: half the round trip (see above); nullopt before a round trip is known.
   std::optional<Duration> delay() const {
-    return round_trip ? std::optional<Duration>(*round_trip / 2 + queueing) : std::nullopt;
+    return round_trip ? std::optional<Duration>(*round_trip / 2) : std::nullopt;
   }
 };
 
@@ -129,9 +130,9 @@ class LinkHealth {
     std::uint64_t expected = 0, lost = 0, expired = 0;
   };
   void Decide(bool lost);
-  // The least and the 90th percentile of the recent first copies' transits.
+  // The 90th percentile of the recent first copies' transits.
   // REQUIRES: transit_count_ > 0.
-  std::pair<Duration, Duration> TransitRange() const;
+  Duration SlowTransit() const;
 
   LinkHealthOptions options_;
   LinkFigures f_;

@@ -136,15 +136,37 @@ TEST(LinkHealth, HeavyJitterReordersWithoutLookingLikeLoss) {
   }
   std::sort(arrivals.begin(), arrivals.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
   LinkHealth health;
-  // The client's least recent round trip: 2 x (100 - 50) ms.
-  for (const Arrival& a : arrivals) health.OnPackage(a.seq, false, a.sent, a.at, milliseconds(100));
+  // The client's median round trip: 2 x 100 ms.
+  for (const Arrival& a : arrivals) health.OnPackage(a.seq, false, a.sent, a.at, milliseconds(200));
   health.Tick(arrivals.back().at + std::chrono::seconds(10));
   const LinkFigures f = health.Figures();
   EXPECT_GT(f.reordered, 500u);
   EXPECT_EQ(f.lost, dropped);
   EXPECT_EQ(f.retransmitted, dropped);
-  // Half the least round trip plus the mean queueing over the fastest: the mean delay.
-  EXPECT_NEAR(ToSeconds(*f.delay()), 0.100, 0.010);
+  // Half the client's median round trip: the mean delay (the spread of the
+  // transits the server sees adds nothing: it is in the round trip already).
+  EXPECT_EQ(f.delay(), milliseconds(100));
+}
+
+// The one-way delay is half the round trip the client reports (the median of
+// its network round trips, outstanding_packages.h), on any link: the
+// server's own transits (arrival - the client's send time) carry the clocks'
+// unknown offset, so they can say how much the delay varies, never how long
+// it is. Jittered (20 ms +- 15 ms) and asymmetric (the client measured 40 ms:
+// 30 ms up and 10 ms down): half the round trip, the mean of the two ways.
+TEST(LinkHealth, TheDelayIsHalfTheReportedRoundTripWhateverTheTransitsSpread) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> jitter_us(-15000, 15000);
+  Link symmetric, asymmetric;
+  for (int i = 1; i <= 500; ++i) {
+    symmetric.Send(i, milliseconds(10 * i), milliseconds(20) + std::chrono::microseconds(jitter_us(rng)),
+                   false, milliseconds(40));
+    asymmetric.Send(i, milliseconds(10 * i), milliseconds(30) + std::chrono::microseconds(jitter_us(rng) / 3),
+                    false, milliseconds(40));
+  }
+  EXPECT_EQ(symmetric.health.Figures().delay(), milliseconds(20));
+  EXPECT_EQ(asymmetric.health.Figures().delay(), milliseconds(20));
+  EXPECT_GT(symmetric.health.Figures().jitter, milliseconds(5)) << "the spread shows as jitter";
 }
 
 TEST(LinkHealth, LateAndExpiredRepliesAreCountedAndExpiredOnesWarn) {

@@ -59,9 +59,9 @@ struct Request {
   /// How late after its start time a command may still begin:
   /// kMaxLateServerDefault, kMaxLateNever, or a limit (> 0).
   Duration max_late = kMaxLateServerDefault;
-  /// The client's round trip to the server, the least of its recent
+  /// The client's network round trip to the server, the median of its recent
   /// acknowledged packages' (0 = not measured yet); the server's link health
-  /// reports it.
+  /// reports it, and half of it as the one-way delay.
   Duration round_trip{0};
   std::vector<Query> queries;
   std::vector<Command> commands;  ///< kPlayback: start_time holds the offset (see command.h)
