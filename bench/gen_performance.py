@@ -311,15 +311,17 @@ def playback_estimators_section(res):
     r = res.get("playback_estimators")
     if not r:
         return None
-    head = measured_head(r, f"; {r.get('frames')} frames at 10 Hz per run, {r.get('wall_s')} s in all "
-                            "(`scripts/bench.sh --only playback_estimators`).")
+    end = (r.get("loadavg") or [None])[0]
+    head = measured_head(r, (f", at the end {end:.1f}" if end is not None else "") +
+                         f"; {r.get('frames')} frames at 10 Hz per run, {r.get('wall_s')} s in all "
+                         f"({len(r.get('runs', []))} runs; `scripts/bench.sh --only playback_estimators`).")
     if r.get("error"):
         return head + "\n\nNot measured: " + str(r["error"])
-    names = {"paper": "paper's estimator", "quick": "quick start (issue 11)",
-             "adaptive": "adaptive (the default; before: the same)",
-             "adaptive_copies": "adaptive, client sends 2 copies",
-             "adaptive_queue": "adaptive + queue start (option)",
-             "adaptive_m05": "adaptive, 0.5 ms hand-over margin"}
+    names = {"paper": "paper's estimator",
+             "adaptive_lead0": "adaptive, previous default (`--playback-start-lead 0`)",
+             "adaptive": "adaptive, start lead 1 (the default now)",
+             "adaptive_copies": "adaptive (default) + client sends 2 copies",
+             "adaptive_queue": "adaptive (default) + queue start (option)"}
     lines = [head, "", "| relay profile (client → server) | estimator | start latency (per run) | hindsight minimum "
              "| ratio (per run) | hindsight + hand-over | ratio to it | late frames | pauses past the bound "
              "| largest gap stretch | whole-sequence stretch |",

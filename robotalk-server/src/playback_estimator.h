@@ -109,6 +109,12 @@ struct PlaybackEstimatorOptions {
   /// With the adaptive start, each gap between frames may play up to this
   /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
   double max_stretch = 0.10;
+  /// The adaptive start lies this many gaps' stretch (max_stretch × the mean
+  /// frame interval each) below the delay it covers, never before the
+  /// decision + adaptive_margin: the schedule's stretch of the first gaps
+  /// reaches that delay by the frame after them (see above). 0: the start
+  /// covers it itself (issue 23's first adaptive start).
+  double start_lead = 1.0;
   /// Beyond adaptive_max_spread: the queue start (see above) instead of the
   /// paper's estimate. Off by default: it misses the drift of a channel
   /// slower than the sequence in a fifth of the runs (Fig. 11's injector).
@@ -204,7 +210,8 @@ class PlaybackEstimator {
     std::optional<Duration> delay;  // arrival − send time
   };
   // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
-  TimePoint StartCovering(Duration worst, Duration margin) const;
+  // `lead`: that much earlier, but never before the decision + margin.
+  TimePoint StartCovering(Duration worst, Duration margin, Duration lead = Duration(0)) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
   Duration QueueWorst() const;                    // REQUIRES: queued()
   std::vector<double> Services() const;           // s, of the packages seen; REQUIRES: delay_spread()
