@@ -36,8 +36,11 @@
 // history's and the frames' max) + spread / n (n delays seen: the max of n samples falls short of the
 // channel's by about that) + `adaptive_margin`. The schedule then grows that buffer to the worst delay + 4 ×
 // spread / n by stretching the first gaps (at most max_stretch each), and further for any frame slower than
-// it. Where the spread exceeds one frame interval a queue can build that the history (sparse packages, no
-// queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
+// it. The start itself lies one gap's stretch below that worst delay (start_lead, never before the
+// decision + adaptive_margin): frame 0's own delay is unknown against the frames to come (the hindsight
+// minimum is the sequence's worst delay less frame 0's), and the first gap's stretch reaches the worst
+// delay by frame 1. Where the spread exceeds one frame interval a queue can build that the history (sparse
+// packages, no queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
 // adaptive_max_spread intervals: the paper's estimate, then the stretch.
 //
 // Queue start (issue 23 item 3; `queue_start`, off by default): beyond
