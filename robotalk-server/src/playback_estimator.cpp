@@ -236,6 +236,10 @@ std::optional<Duration> PlaybackEstimator::playout_delay() const {
   return AdaptiveWorst(options_.adaptive_headroom) + options_.adaptive_margin;
 }
 
+Duration PlaybackEstimator::start_lead() const {
+  return FromSeconds(std::max(0.0, options_.start_lead) * std::max(0.0, options_.max_stretch) * interval());
+}
+
 TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin, Duration lead) const {
   // Offset 0 plays when the latest frame seen (arrival − offset) would plus
   // the worst delay's excess over the frame's own; never before the decision
@@ -313,9 +317,7 @@ TimePoint PlaybackEstimator::StartTime() const {
     // length each) until the buffer covers the worst delay, so the frames
     // after them find it; frame 0 itself has arrived. StartCovering's floor
     // (the decision + margin) stays.
-    const Duration lead =
-        FromSeconds(std::max(0.0, options_.start_lead) * std::max(0.0, options_.max_stretch) * interval());
-    return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, lead);
+    return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, start_lead());
   }
   if (quick()) {
     // The worst delay a later frame may have is predicted as the least seen

@@ -193,6 +193,9 @@ class PlaybackEstimator {
   /// With the adaptive start, the worst delay it covers + its margin (the
   /// schedule's playout delay, PlaybackSchedule); else nullopt.
   std::optional<Duration> playout_delay() const;
+  /// How far below the worst delay it covers the adaptive start lies
+  /// (start_lead × max_stretch × the mean frame interval).
+  Duration start_lead() const;
   /// Max − min of the recent one-way delays and the frames' (nullopt: too
   /// few, or a frame without a send time).
   std::optional<Duration> delay_spread() const;

@@ -467,6 +467,7 @@ TEST_F(RobotSessionsTest, PlaybackStartsAtTheFirstFrameFromTheSessionsSendTimesW
   EXPECT_EQ(r.signal, Signal::kSuccess);
   EXPECT_THAT(r.message, HasSubstr("adaptive start"));
   EXPECT_THAT(r.message, HasSubstr("up to 10 % longer"));
+  EXPECT_THAT(r.message, HasSubstr("starts 0.01 s below the worst delay"));
   // The worst delay (500 us) + the 200 us spread / 7 delays, less this
   // frame's 400 us, + the 2 ms margin: 2.13 ms (the quick start: 10.1 ms);
   // less one gap's stretch (10 ms, the start lead), but never before the
