@@ -304,6 +304,27 @@ def measured_head(r, tail):
             f"mode, load average at start {r.get('loadavg_start', [0])[0]:.1f} on {m.get('nproc')} CPUs" + tail)
 
 
+def pool_playback(latest_path, other_path):
+    """Appends another playback_estimators run's runs to latest's; each run's date, commit and load
+    stay in "parts" (one "Measured" line each)."""
+    with open(latest_path) as fh:
+        a = json.load(fh)
+    with open(other_path) as fh:
+        b = json.load(fh)
+
+    def part(r):
+        return {"meta": r.get("meta", {}), "loadavg_start": r.get("loadavg_start"), "loadavg": r.get("loadavg"),
+                "wall_s": r.get("wall_s"), "frames": r.get("frames"), "runs_n": len(r.get("runs", [])),
+                "seeds": sorted({x["seed"] for x in r.get("runs", [])})}
+
+    parts = a.get("parts") or [part(a)]
+    parts.append(part(b))
+    a["parts"] = parts
+    a["runs"] = a.get("runs", []) + b.get("runs", [])
+    with open(latest_path, "w") as fh:
+        json.dump(a, fh, indent=1)
+
+
 def playback_estimators_section(res):
     """Issue 23 item 3's table: per relay profile, the paper's estimator, the quick start and the
     adaptive start (same relay seeds, interleaved): start latency / hindsight minimum per run, late
@@ -311,15 +332,22 @@ def playback_estimators_section(res):
     r = res.get("playback_estimators")
     if not r:
         return None
-    head = measured_head(r, f"; {r.get('frames')} frames at 10 Hz per run, {r.get('wall_s')} s in all "
-                            "(`scripts/bench.sh --only playback_estimators`).")
+    heads = []
+    for p in r.get("parts") or [dict(r, runs_n=len(r.get("runs", [])))]:
+        end = (p.get("loadavg") or [None])[0]
+        seeds = p.get("seeds") or sorted({x["seed"] for x in r.get("runs", [])})
+        heads.append(measured_head(p, (f", at the end {end:.1f}" if end is not None else "") +
+                                   f"; {p.get('frames')} frames at 10 Hz per run, {p.get('wall_s')} s for "
+                                   f"{p.get('runs_n')} runs, relay seeds {seeds[0]}–{seeds[-1]} "
+                                   "(`scripts/bench.sh --only playback_estimators`)."))
+    head = "  \n".join(heads)
     if r.get("error"):
         return head + "\n\nNot measured: " + str(r["error"])
-    names = {"paper": "paper's estimator", "quick": "quick start (issue 11)",
-             "adaptive": "adaptive (the default; before: the same)",
-             "adaptive_copies": "adaptive, client sends 2 copies",
-             "adaptive_queue": "adaptive + queue start (option)",
-             "adaptive_m05": "adaptive, 0.5 ms hand-over margin"}
+    names = {"paper": "paper's estimator",
+             "adaptive_lead0": "adaptive, previous default (`--playback-start-lead 0`)",
+             "adaptive": "adaptive, start lead 1 (the default now)",
+             "adaptive_copies": "adaptive (default) + client sends 2 copies",
+             "adaptive_queue": "adaptive (default) + queue start (option)"}
     lines = [head, "", "| relay profile (client → server) | estimator | start latency (per run) | hindsight minimum "
              "| ratio (per run) | hindsight + hand-over | ratio to it | late frames | pauses past the bound "
              "| largest gap stretch | whole-sequence stretch |",
@@ -408,7 +436,12 @@ def main():
     ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "performance.md"))
     ap.add_argument("--figdir", default=os.path.join(ROOT, "docs", "figures"))
     ap.add_argument("--freeze-before", action="store_true")
+    ap.add_argument("--pool-playback", metavar="JSON",
+                    help="pool a second playback_estimators run (other relay seeds: ROBOTALK_BENCH_SEED) "
+                         "into latest's playback_estimators.json before writing the tables")
     args = ap.parse_args()
+    if args.pool_playback:
+        pool_playback(os.path.join(args.latest, "playback_estimators.json"), args.pool_playback)
     if args.freeze_before:
         shutil.rmtree(args.before, ignore_errors=True)
         shutil.copytree(args.latest, args.before)

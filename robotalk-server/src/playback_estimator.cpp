@@ -236,7 +236,11 @@ std::optional<Duration> PlaybackEstimator::playout_delay() const {
   return AdaptiveWorst(options_.adaptive_headroom) + options_.adaptive_margin;
 }
 
-TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin) const {
+Duration PlaybackEstimator::start_lead() const {
+  return FromSeconds(std::max(0.0, options_.start_lead) * std::max(0.0, options_.max_stretch) * interval());
+}
+
+TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin, Duration lead) const {
   // Offset 0 plays when the latest frame seen (arrival − offset) would plus
   // the worst delay's excess over the frame's own; never before the decision
   // (as StartTime).
@@ -249,7 +253,7 @@ TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin) cons
     decided = std::max(decided, f.arrival);
   }
   const Duration excess = std::max(Duration(0), worst - *anchor->delay);
-  return std::max(anchor->arrival - anchor->offset + excess, decided - first_offset) + margin;
+  return std::max(anchor->arrival - anchor->offset + excess - lead, decided - first_offset) + margin;
 }
 
 Duration PlaybackEstimator::mean_command_interval() const {
@@ -308,7 +312,13 @@ TimePoint PlaybackEstimator::StartTime() const {
     const TimePoint start = StartCovering(QueueWorst(), options_.adaptive_margin);
     return frames_.size() >= needed_ ? std::max(start, PaperStart()) : start;
   }
-  if (adaptive()) return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin);
+  if (adaptive()) {
+    // Less the lead: the first gaps stretch (at most max_stretch × their
+    // length each) until the buffer covers the worst delay, so the frames
+    // after them find it; frame 0 itself has arrived. StartCovering's floor
+    // (the decision + margin) stays.
+    return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, start_lead());
+  }
   if (quick()) {
     // The worst delay a later frame may have is predicted as the least seen
     // plus quick_jitter_factor times the spread (the history is a sample:

@@ -36,8 +36,11 @@
 // history's and the frames' max) + spread / n (n delays seen: the max of n samples falls short of the
 // channel's by about that) + `adaptive_margin`. The schedule then grows that buffer to the worst delay + 4 ×
 // spread / n by stretching the first gaps (at most max_stretch each), and further for any frame slower than
-// it. Where the spread exceeds one frame interval a queue can build that the history (sparse packages, no
-// queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
+// it. The start itself lies one gap's stretch below that worst delay (start_lead, never before the
+// decision + adaptive_margin): frame 0's own delay is unknown against the frames to come (the hindsight
+// minimum is the sequence's worst delay less frame 0's), and the first gap's stretch reaches the worst
+// delay by frame 1. Where the spread exceeds one frame interval a queue can build that the history (sparse
+// packages, no queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
 // adaptive_max_spread intervals: the paper's estimate, then the stretch.
 //
 // Queue start (issue 23 item 3; `queue_start`, off by default): beyond
@@ -109,6 +112,12 @@ struct PlaybackEstimatorOptions {
   /// With the adaptive start, each gap between frames may play up to this
   /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
   double max_stretch = 0.10;
+  /// The adaptive start lies this many gaps' stretch (max_stretch × the mean
+  /// frame interval each) below the delay it covers, never before the
+  /// decision + adaptive_margin: the schedule's stretch of the first gaps
+  /// reaches that delay by the frame after them (see above). 0: the start
+  /// covers it itself (issue 23's first adaptive start).
+  double start_lead = 1.0;
   /// Beyond adaptive_max_spread: the queue start (see above) instead of the
   /// paper's estimate. Off by default: it misses the drift of a channel
   /// slower than the sequence in a fifth of the runs (Fig. 11's injector).
@@ -184,6 +193,9 @@ class PlaybackEstimator {
   /// With the adaptive start, the worst delay it covers + its margin (the
   /// schedule's playout delay, PlaybackSchedule); else nullopt.
   std::optional<Duration> playout_delay() const;
+  /// How far below the worst delay it covers the adaptive start lies
+  /// (start_lead × max_stretch × the mean frame interval).
+  Duration start_lead() const;
   /// Max − min of the recent one-way delays and the frames' (nullopt: too
   /// few, or a frame without a send time).
   std::optional<Duration> delay_spread() const;
@@ -204,7 +216,8 @@ class PlaybackEstimator {
     std::optional<Duration> delay;  // arrival − send time
   };
   // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
-  TimePoint StartCovering(Duration worst, Duration margin) const;
+  // `lead`: that much earlier, but never before the decision + margin.
+  TimePoint StartCovering(Duration worst, Duration margin, Duration lead = Duration(0)) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
   Duration QueueWorst() const;                    // REQUIRES: queued()
   std::vector<double> Services() const;           // s, of the packages seen; REQUIRES: delay_spread()

@@ -199,9 +199,12 @@ TEST(AdaptivePlayback, OnAJitteryChannelStartsNearTheHindsightMinimumAndFramesAr
       Many(1000, [](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, 40); });
   std::printf("U[0, 40] ms: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio,
               s.late_runs, s.worst_stretch);
-  // 10 connect-time delays are a small sample of the channel: in 2 runs of
-  // 1000 a frame came later than the buffer had grown by then.
-  EXPECT_LE(s.late_runs, 5);
+  // 10 connect-time delays are a small sample of the channel: in 35 runs of
+  // 1000 a frame came later than the buffer had grown by then, mostly frame
+  // 1, which the start lead covers only to the worst seen + spread / n (2 of
+  // 1000 without the lead, whose start exceeds 1.25x four times as often:
+  // TheStartLeadMeetsTheGoalInMoreRunsOnEveryChannel).
+  EXPECT_LE(s.late_runs, 50);
   EXPECT_LE(s.median_ratio, 1.25);
   EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
 }
@@ -215,9 +218,10 @@ TEST(AdaptivePlayback, OnAWanProfileStartsNearTheHindsightMinimumAndFramesAreRar
   });
   std::printf("WAN: median ratio %.2f, late runs %d, worst gap stretch %.3f\n", s.median_ratio, s.late_runs,
               s.worst_stretch);
-  // 16 of 1000 runs: the same small sample of a 100 ms spread, a frame
-  // slower than the start covered before two gaps could stretch for it.
-  EXPECT_LE(s.late_runs, 25);
+  // 43 of 1000 runs (16 without the start lead): the same small sample of a
+  // 100 ms spread, a frame slower than the start covered before the first
+  // gaps could stretch for it.
+  EXPECT_LE(s.late_runs, 60);
   EXPECT_LE(s.median_ratio, 1.25);
   EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
 }
@@ -261,7 +265,8 @@ TEST(AdaptivePlayback, OnACongestedLinkAQueueBuildsAndTheStartCoversIt) {
     EXPECT_LE(s.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
     EXPECT_LE(q.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
     if (x < 120) {  // a frame's service fits in its interval
-      EXPECT_LE(s.late_runs, 3) << "X = " << x;
+      // 9 and 12 of 300 (2 and 3 without the start lead): frame 1 slower than the worst seen.
+      EXPECT_LE(s.late_runs, 20) << "X = " << x;
       EXPECT_LE(s.median_ratio, 1.25) << "X = " << x;
       EXPECT_LE(q.median_ratio, 1.25) << "X = " << x;
       continue;
@@ -298,6 +303,96 @@ TEST(AdaptivePlayback, ThePapersCongestionGetsThePapersEstimateBecauseNeitherSta
   EXPECT_EQ(paper.late_runs, 0);
 }
 
+Channel Jitter(double hi_ms) {
+  return [hi_ms](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, hi_ms); };
+}
+
+// A WAN path: 100-300 ms (fixed per run), +-50 ms uniform jitter.
+Channel Wan() {
+  auto base = std::make_shared<Duration>();
+  return [base](std::mt19937_64& rng, std::size_t k, TimePoint) {
+    if (k == 0) *base = Uniform(rng, 100, 300);
+    return *base + Uniform(rng, -50, 50);
+  };
+}
+
+TEST(AdaptivePlayback, TheStartLiesOneGapsStretchBelowTheWorstDelayAndTheFirstGapReachesIt) {
+  // Ten recent delays 1, 4, ..., 28 ms; frame 0 took 1 ms. The start covers
+  // the worst, 28 ms, + spread / n (27 ms / 11) + the 2 ms margin, less frame
+  // 0's own 1 ms: 30.45 ms after its arrival with no lead; one gap's stretch
+  // (10 % of 100 ms) earlier with the lead (the default).
+  std::vector<Duration> history;
+  for (int i = 0; i < 10; ++i) history.push_back(milliseconds(1 + 3 * i));
+  const double covered_s = 0.028 + 0.027 / 11 + 0.002 - 0.001;
+  const auto start_of = [&](double lead, Duration first_delay) {
+    PlaybackEstimator est(40, milliseconds(3900), {.start_lead = lead});
+    est.SetDelayHistory(history);
+    est.Add(Duration(0), kT0, kT0 - first_delay);
+    EXPECT_TRUE(est.adaptive());
+    return std::make_pair(est.StartTime(), *est.playout_delay());
+  };
+  const auto [before, playout] = start_of(0, milliseconds(1));
+  EXPECT_NEAR(ToSeconds(before - kT0), covered_s, 1e-6);
+  const auto [start, playout_now] = start_of(1, milliseconds(1));
+  EXPECT_NEAR(ToSeconds(start - kT0), covered_s - 0.010, 1e-6);
+  EXPECT_EQ(playout_now, playout) << "the buffer the schedule grows to is the same";
+  // Frame 1, sent 100 ms after frame 0 and as slow as the worst seen (28
+  // ms): its gap stretches by 10 ms at most, which reaches it.
+  const auto place_frame1 = [&, start = start, playout = playout](Duration delay) {
+    PlaybackSchedule s(start, playout, {.max_stretch = 0.10, .margin = kMargin});
+    EXPECT_FALSE(s.Place(Duration(0), kT0, milliseconds(1)).late);
+    const TimePoint sent = kT0 - milliseconds(1) + milliseconds(100);
+    const auto p = s.Place(milliseconds(100), sent + delay, delay);
+    if (!p.late) {
+      EXPECT_LE(p.at, start + milliseconds(110)) << "within the bound";
+    }
+    return std::make_pair(p, s.max_gap_stretch());
+  };
+  const auto [on_time, stretch] = place_frame1(milliseconds(28));
+  EXPECT_FALSE(on_time.late);
+  EXPECT_NEAR(stretch, 0.10, 1e-6) << "the first gap takes the whole lead";
+  // The trade: a frame 1 slower than the worst seen + spread / n - the
+  // margin is late now; without the lead it had 10 ms more.
+  EXPECT_TRUE(place_frame1(milliseconds(31)).first.late);
+  EXPECT_GE(before + milliseconds(110), kT0 + milliseconds(99 + 31 + 2));
+  // Frame 0 as slow as the worst seen: the start is its arrival + the
+  // margin, never before (the decision, and frame 0's hand-over).
+  EXPECT_EQ(start_of(1, milliseconds(28)).first, kT0 + kMargin);
+}
+
+TEST(AdaptivePlayback, TheStartLeadMeetsTheGoalInMoreRunsOnEveryChannel) {
+  // The goal of issue 23 item 3 for a run: start / (hindsight minimum + the
+  // margin) <= 1.25 and no frame late. Without the lead the start covers the
+  // worst delay itself: the ratio exceeds 1.25 whenever frame 0 was slow
+  // (its own delay is the hindsight's floor), which the lead halves at the
+  // cost of a frame 1 slower than the worst seen being late (late runs 2 ->
+  // 35 of 1000 at U[0, 40]).
+  const std::vector<std::pair<const char*, Channel>> channels = {{"U[0, 40] ms", Jitter(40)},
+                                                                 {"FIFO U[0, 50] ms", Fifo(50)},
+                                                                 {"FIFO U[0, 100] ms", Fifo(100)},
+                                                                 {"WAN", Wan()}};
+  constexpr int kRuns = 300;
+  for (const auto& [name, channel] : channels) {
+    int met[2] = {0, 0}, late_runs[2] = {0, 0};
+    for (int lead = 0; lead <= 1; ++lead) {
+      for (int seed = 1; seed <= kRuns; ++seed) {
+        std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+        const SimRun r = Simulate(40, milliseconds(100), 10,
+                                  [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); },
+                                  {.start_lead = static_cast<double>(lead)});
+        late_runs[lead] += r.late > 0;
+        met[lead] += r.late == 0 && ToSeconds(r.start_delay) <= 1.25 * ToSeconds(r.hindsight + kMargin);
+        EXPECT_LE(r.max_gap_stretch, 0.10 + 1e-9);
+      }
+    }
+    std::printf("%s: goal met in %d of %d runs without the lead (%d late), %d with it (%d late)\n", name,
+                met[0], kRuns, late_runs[0], met[1], late_runs[1]);
+    EXPECT_GT(met[1], met[0]) << name;
+    EXPECT_GE(met[1], kRuns * 9 / 10) << name;
+    EXPECT_LE(late_runs[1], kRuns / 15) << name;
+  }
+}
+
 TEST(AdaptivePlayback, TheOldEstimatorsRemainOptions) {
   auto jitter = [](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, 40); };
   const Summary quick = Many(200, jitter, {.adaptive = false});
@@ -314,7 +409,9 @@ TEST(AdaptivePlayback, ARetransmittedPackageInTheHistoryDoesNotInflateTheStart) 
   std::vector<Duration> history;
   for (int i = 0; i < 10; ++i) history.push_back(std::chrono::microseconds(1000 + 100 * i));
   history.push_back(milliseconds(101));
-  PlaybackEstimator est(40, milliseconds(3900));
+  // No start lead (it would put the start at the floor, the arrival + 2 ms,
+  // and hide what this test checks).
+  PlaybackEstimator est(40, milliseconds(3900), {.start_lead = 0});
   est.SetDelayHistory(history);
   est.Add(Duration(0), kT0, kT0 - milliseconds(1));
   ASSERT_TRUE(est.adaptive());

@@ -30,7 +30,8 @@ for bad in "0|'0' is not a number in [0.001, 1000]" "1,x|'x' is not a number" "=
 done
 # The playback options' bad values too (issue 23 item 3).
 for bad in "--playback-queue-start|maybe|--playback-queue-start 'maybe': expected on or off" \
-           "--playback-margin|-1|--playback-margin: '-1' is not a number in [0, 1000]"; do
+           "--playback-margin|-1|--playback-margin: '-1' is not a number in [0, 1000]" \
+           "--playback-start-lead|x|--playback-start-lead: 'x' is not a number in [0, 100]"; do
   IFS='|' read -r flag value why <<<"$bad"
   "$server" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" "$flag" "$value" \
     --simulate "$examples/speed_ramp.txt" >/dev/null 2>"$tmp/bad.err"

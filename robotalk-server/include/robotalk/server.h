@@ -132,6 +132,11 @@ struct ServerOptions {
   /// start (a simulated queue of the sequence's frames) when on; off (the
   /// default): the paper's estimate.
   bool playback_queue_start = false;
+  /// Adaptive: the start lies this many gaps' stretch (playback_stretch ×
+  /// the frame interval each) below the worst delay it covers; the first
+  /// gaps' stretch reaches it (PlaybackEstimatorOptions::start_lead). 0: the
+  /// start covers it itself.
+  double playback_start_lead = 1.0;
   /// Test fault injection on outgoing reply packages (seeded): probability
   /// that one is dropped, and that one is sent twice.
   double reply_drop_probability = 0.0;
