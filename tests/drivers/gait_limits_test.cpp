@@ -72,7 +72,7 @@ TEST(GaitLimits, TheDerivedGaitMeetsTheSpeedFloorWithinEveryBound) {
   EXPECT_LE(g.step_forward, std::min(b.reach_step, b.speed_step) + 1e-9);
   EXPECT_LE(g.step_yaw, std::min(b.hip_yaw_turn, b.sole_turn) + 1e-9);
   EXPECT_LE(g.step_yaw_in, b.sole_turn_in + 1e-9);
-  EXPECT_LE(g.step_side, std::min(b.roll_side, b.reach_side) + 1e-9);
+  EXPECT_LE(g.step_side, std::min({b.roll_side, b.reach_side, b.sole_side}) + 1e-9);
   EXPECT_GE(g.single_support, 1.5 * b.tc);
   // The geometry is the base's.
   EXPECT_EQ(g.foot_separation, h.base.foot_separation);
@@ -114,6 +114,46 @@ TEST(GaitLimits, FastJointsOnLongLegsStepAtMostAMeasuredShareOfTheLeg) {
   GaitBounds own;
   EXPECT_DOUBLE_EQ(DeriveGait(h.leg, h.base, 9.81, &own).step_forward, 0.22);
   EXPECT_LT(own.speed_step, own.leg_step);
+}
+
+// The sideways step is bounded by the sole's lateral support as well as by
+// the hip roll and the reach: a sideways swing pushes the stance sole's
+// centre of pressure to its edge. Atlas (a 0.8 m leg whose hip roll allows
+// 0.23 m, on a 12.5 cm sole) rocked on its sole's edge after such steps and
+// fell in the turning steps that followed (docs/ode_sim.md); its side step is
+// now at most 1.34 sole widths: 0.16 m. The simple humanoid's stays 0.16 m.
+TEST(GaitLimits, SideStepsStayWithinWhatTheSolesWidthSupports) {
+  const Humanoid h;
+  GaitBounds own;
+  const GaitParams simple = DeriveGait(h.leg, h.base, 9.81, &own);
+  EXPECT_DOUBLE_EQ(simple.step_side, 0.16);
+  EXPECT_NEAR(own.sole_side, 1.34 * 0.12, 1e-12);
+  // Atlas's leg and sole, as its driver measures them.
+  LegGeometry atlas;
+  atlas.thigh = 0.377;
+  atlas.shank = 0.422;
+  atlas.hip_height = 0.72;
+  atlas.hip_width = 0.223;
+  atlas.hip_yaw = 0.174;
+  atlas.hip_roll_out = 0.5236;
+  atlas.joint_speed = 12;
+  GaitParams base = h.base;
+  base.foot_front = 0.1728;
+  base.foot_back = 0.0876;
+  base.foot_half_width = 0.0626;
+  base.zmp_x = (base.foot_front - base.foot_back) / 2;
+  base.foot_separation = 0.223;
+  base.com_height = 1.17;
+  GaitBounds b;
+  const GaitParams g = DeriveGait(atlas, base, 9.81, &b);
+  EXPECT_GT(std::min(b.roll_side, b.reach_side), 0.23) << "the hip roll and reach allow more";
+  EXPECT_NEAR(b.sole_side, 1.34 * 2 * 0.0626, 1e-12);
+  EXPECT_DOUBLE_EQ(g.step_side, 0.16);
+  EXPECT_DOUBLE_EQ(g.step_forward, 0.29) << "the other bounds are unchanged";
+  // A narrower sole under the simple humanoid's leg: a shorter side step.
+  GaitParams narrow = h.base;
+  narrow.foot_half_width = 0.04;
+  EXPECT_DOUBLE_EQ(DeriveGait(h.leg, narrow, 9.81).step_side, 0.10);
 }
 
 TEST(GaitLimits, TurningStepsKeepTheSolesApart) {
