@@ -22,17 +22,25 @@ namespace {
 // The simple humanoid's walking geometry, as the ode driver fills it (the
 // sole 24 x 12 cm, 3 cm ahead of the ankle; ankles 18 cm apart; pelvis
 // 0.7254 m above the soles: 7 % knee drop of 0.78 m).
+// A walking geometry as the ode driver fills it from the model: the sole
+// (front and back of the ankle, half-width; the ZMP point in its middle), the
+// ankles' separation and the CoM height.
+GaitParams Geometry(double front, double back, double half_width, double separation, double com_height) {
+  GaitParams g;
+  g.foot_front = front;
+  g.foot_back = back;
+  g.foot_half_width = half_width;
+  g.zmp_x = (front - back) / 2;
+  g.foot_separation = separation;
+  g.com_height = com_height;
+  return g;
+}
+
 struct Humanoid {
   RobotModel model = LoadUrdfFile(testing::ProjectModel("simple_humanoid.urdf")).model;
-  GaitParams base;
+  GaitParams base = Geometry(0.15, 0.09, 0.06, 0.18, 0.70);
   LegGeometry leg;
   Humanoid() {
-    base.foot_front = 0.15;
-    base.foot_back = 0.09;
-    base.foot_half_width = 0.06;
-    base.zmp_x = 0.03;
-    base.foot_separation = 0.18;
-    base.com_height = 0.70;
     std::string why;
     leg = MeasureLeg(model, model.LinkIndex("left_foot"), -0.07, 0.78 * 0.93, &why);
     EXPECT_EQ(why, "");
@@ -129,21 +137,14 @@ TEST(GaitLimits, SideStepsStayWithinWhatTheSolesWidthSupports) {
   EXPECT_DOUBLE_EQ(simple.step_side, 0.16);
   EXPECT_NEAR(own.sole_side, 1.34 * 0.12, 1e-12);
   // Atlas's leg and sole, as its driver measures them.
-  LegGeometry atlas;
-  atlas.thigh = 0.377;
-  atlas.shank = 0.422;
-  atlas.hip_height = 0.72;
-  atlas.hip_width = 0.223;
-  atlas.hip_yaw = 0.174;
-  atlas.hip_roll_out = 0.5236;
-  atlas.joint_speed = 12;
-  GaitParams base = h.base;
-  base.foot_front = 0.1728;
-  base.foot_back = 0.0876;
-  base.foot_half_width = 0.0626;
-  base.zmp_x = (base.foot_front - base.foot_back) / 2;
-  base.foot_separation = 0.223;
-  base.com_height = 1.17;
+  const LegGeometry atlas{.thigh = 0.377,
+                          .shank = 0.422,
+                          .hip_height = 0.72,
+                          .hip_width = 0.223,
+                          .hip_yaw = 0.174,
+                          .hip_roll_out = 0.5236,
+                          .joint_speed = 12};
+  const GaitParams base = Geometry(0.1728, 0.0876, 0.0626, 0.223, 1.17);
   GaitBounds b;
   const GaitParams g = DeriveGait(atlas, base, 9.81, &b);
   EXPECT_GT(std::min(b.roll_side, b.reach_side), 0.23) << "the hip roll and reach allow more";
