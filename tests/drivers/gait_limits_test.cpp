@@ -139,7 +139,7 @@ TEST(GaitLimits, SideStepsStayWithinWhatTheSolesWidthSupports) {
   // Atlas's leg and sole, as its driver measures them.
   const LegGeometry atlas{.thigh = 0.377,
                           .shank = 0.422,
-                          .hip_height = 0.72,
+                          .hip_height = 0.73,
                           .hip_width = 0.223,
                           .hip_yaw = 0.174,
                           .hip_roll_out = 0.5236,
