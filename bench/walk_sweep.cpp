@@ -7,7 +7,8 @@
 // transition the runs, falls and the worst tilt, and the instants that fell.
 // models/simple_humanoid.urdf on the ode driver (walk=true) at 1 kHz.
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
-//                       [--after S] [--option key=value]...
+//                       [--after S] [--model URDF] [--option key=value]...
+// (--model: another humanoid, e.g. ../shared/robots/atlas.urdf --option base=floating.)
 //   robotalk-walk-sweep --push standing|walking|all [--stabilizer on|off|both]
 //     [--resolution N_S] [--seed S]: per direction (8, every 45 degrees, 0 = a
 //     push forward, counter-clockwise) the largest impulse on the pelvis
@@ -71,6 +72,8 @@ Args Parse(int argc, char** argv) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--transition") {
       a.transition = v;
+    } else if (k == "--model") {
+      a.model = v;
     } else if (k == "--from") {
       a.from = std::atof(v.c_str());
     } else if (k == "--span") {

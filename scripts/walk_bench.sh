@@ -14,8 +14,11 @@
 # the push survival standing and walking with and without the stabilizer
 # (WALK_PUSH_RESOLUTION N·s, default 5), the arm swing, and the CPU per
 # physics step with and without the stabilizer (issue 26; an hour or more of
-# CPU at 20 ms). Exit status 0 only for N/N successes, no
-# fall (and, with WALK_SWEEP=1, no fall in the sweep).
+# CPU at 20 ms). WALK_ATLAS=1 also walks Atlas (WALK_ATLAS_URDF, default
+# ../shared/robots/atlas.urdf, base=floating) through the same seeded goals on
+# its derived gait (docs/ode_sim.md, "Published humanoids"; ~10 min of CPU).
+# Exit status 0 only for N/N successes, no fall (and, with WALK_SWEEP=1, no
+# fall in the sweep; with WALK_ATLAS=1, Atlas's too).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${ROBOTALK_BUILD_DIR:-build}
@@ -34,6 +37,10 @@ if "$PY" -c 'import matplotlib' 2>/dev/null; then
   "$PY" scripts/plot_walk.py "$TRACE" "$PLOT" && echo "top view: $PLOT"
 else
   echo "python3-matplotlib not installed: no plot (scripts/setup.sh installs it)"
+fi
+if [ "${WALK_ATLAS:-0}" = 1 ]; then
+  "$BUILD_DIR/bench/robotalk-walk-bench" --model "${WALK_ATLAS_URDF:-../shared/robots/atlas.urdf}" \
+    --option base=floating --goals 20 --seed 1 || status=$?
 fi
 if [ "${WALK_SWEEP:-0}" = 1 ]; then
   "$BUILD_DIR/bench/robotalk-walk-sweep" --every "${WALK_SWEEP_EVERY:-20}" --after 3 || status=$?

@@ -22,17 +22,25 @@ namespace {
 // The simple humanoid's walking geometry, as the ode driver fills it (the
 // sole 24 x 12 cm, 3 cm ahead of the ankle; ankles 18 cm apart; pelvis
 // 0.7254 m above the soles: 7 % knee drop of 0.78 m).
+// A walking geometry as the ode driver fills it from the model: the sole
+// (front and back of the ankle, half-width; the ZMP point in its middle), the
+// ankles' separation and the CoM height.
+GaitParams Geometry(double front, double back, double half_width, double separation, double com_height) {
+  GaitParams g;
+  g.foot_front = front;
+  g.foot_back = back;
+  g.foot_half_width = half_width;
+  g.zmp_x = (front - back) / 2;
+  g.foot_separation = separation;
+  g.com_height = com_height;
+  return g;
+}
+
 struct Humanoid {
   RobotModel model = LoadUrdfFile(testing::ProjectModel("simple_humanoid.urdf")).model;
-  GaitParams base;
+  GaitParams base = Geometry(0.15, 0.09, 0.06, 0.18, 0.70);
   LegGeometry leg;
   Humanoid() {
-    base.foot_front = 0.15;
-    base.foot_back = 0.09;
-    base.foot_half_width = 0.06;
-    base.zmp_x = 0.03;
-    base.foot_separation = 0.18;
-    base.com_height = 0.70;
     std::string why;
     leg = MeasureLeg(model, model.LinkIndex("left_foot"), -0.07, 0.78 * 0.93, &why);
     EXPECT_EQ(why, "");
@@ -72,7 +80,7 @@ TEST(GaitLimits, TheDerivedGaitMeetsTheSpeedFloorWithinEveryBound) {
   EXPECT_LE(g.step_forward, std::min(b.reach_step, b.speed_step) + 1e-9);
   EXPECT_LE(g.step_yaw, std::min(b.hip_yaw_turn, b.sole_turn) + 1e-9);
   EXPECT_LE(g.step_yaw_in, b.sole_turn_in + 1e-9);
-  EXPECT_LE(g.step_side, std::min(b.roll_side, b.reach_side) + 1e-9);
+  EXPECT_LE(g.step_side, std::min({b.roll_side, b.reach_side, b.sole_side}) + 1e-9);
   EXPECT_GE(g.single_support, 1.5 * b.tc);
   // The geometry is the base's.
   EXPECT_EQ(g.foot_separation, h.base.foot_separation);
@@ -114,6 +122,39 @@ TEST(GaitLimits, FastJointsOnLongLegsStepAtMostAMeasuredShareOfTheLeg) {
   GaitBounds own;
   EXPECT_DOUBLE_EQ(DeriveGait(h.leg, h.base, 9.81, &own).step_forward, 0.22);
   EXPECT_LT(own.speed_step, own.leg_step);
+}
+
+// The sideways step is bounded by the sole's lateral support as well as by
+// the hip roll and the reach: a sideways swing pushes the stance sole's
+// centre of pressure to its edge. Atlas (a 0.8 m leg whose hip roll allows
+// 0.23 m, on a 12.5 cm sole) rocked on its sole's edge after such steps and
+// fell in the turning steps that followed (docs/ode_sim.md); its side step is
+// now at most 1.34 sole widths: 0.16 m. The simple humanoid's stays 0.16 m.
+TEST(GaitLimits, SideStepsStayWithinWhatTheSolesWidthSupports) {
+  const Humanoid h;
+  GaitBounds own;
+  const GaitParams simple = DeriveGait(h.leg, h.base, 9.81, &own);
+  EXPECT_DOUBLE_EQ(simple.step_side, 0.16);
+  EXPECT_NEAR(own.sole_side, 1.34 * 0.12, 1e-12);
+  // Atlas's leg and sole, as its driver measures them.
+  const LegGeometry atlas{.thigh = 0.377,
+                          .shank = 0.422,
+                          .hip_height = 0.73,
+                          .hip_width = 0.223,
+                          .hip_yaw = 0.174,
+                          .hip_roll_out = 0.5236,
+                          .joint_speed = 12};
+  const GaitParams base = Geometry(0.1728, 0.0876, 0.0626, 0.223, 1.17);
+  GaitBounds b;
+  const GaitParams g = DeriveGait(atlas, base, 9.81, &b);
+  EXPECT_GT(std::min(b.roll_side, b.reach_side), 0.23) << "the hip roll and reach allow more";
+  EXPECT_NEAR(b.sole_side, 1.34 * 2 * 0.0626, 1e-12);
+  EXPECT_DOUBLE_EQ(g.step_side, 0.16);
+  EXPECT_DOUBLE_EQ(g.step_forward, 0.29) << "the other bounds are unchanged";
+  // A narrower sole under the simple humanoid's leg: a shorter side step.
+  GaitParams narrow = h.base;
+  narrow.foot_half_width = 0.04;
+  EXPECT_DOUBLE_EQ(DeriveGait(h.leg, narrow, 9.81).step_side, 0.10);
 }
 
 TEST(GaitLimits, TurningStepsKeepTheSolesApart) {

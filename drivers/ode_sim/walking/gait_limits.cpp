@@ -28,6 +28,14 @@ constexpr double kJointSpeedUse = 0.8;     // of the slowest pitch joint's veloc
 // (0.8 m leg, 12 rad/s joints: only the reach bounds it) fell in its first
 // goal on its reach-limited step and walks 20 goals at 0.29 m (docs/ode_sim.md).
 constexpr double kMaxStepOfLeg = 0.37;
+// The widest sideways step, of the sole's width (2 x foot_half_width).
+// Measured, not derived: a sideways swing pushes the stance sole's centre of
+// pressure to its edge (ODE traces: 5.9 of 6.0 cm on the simple humanoid at
+// its 0.16 m step on a 0.12 m sole; both edges on Atlas at 0.23 m on its
+// 0.125 m sole, which then rocked on its edge through the turning steps after
+// it and fell; docs/ode_sim.md). The hip roll's step grows with the leg, the
+// support with the sole: this is the simple humanoid's own ratio (0.16 / 0.12).
+constexpr double kSideOfSole = 1.34;
 constexpr double kSwingWindow = 0.8;        // of single support: the foot moves (walk_pattern.h)
 constexpr double kBackFraction = 0.5;       // backward step, of the forward one
 constexpr double kHipRollUse = 0.6;         // of the outward hip roll range
@@ -205,7 +213,9 @@ GaitParams DeriveGait(const LegGeometry& leg, const GaitParams& base, double gra
   b.roll_side = std::max(0.0, leg.hip_height * std::tan(kHipRollUse * leg.hip_roll_out) - out0);
   b.reach_side =
       std::max(0.0, std::sqrt(std::max(0.0, stretched * stretched - leg.hip_height * leg.hip_height)) - out0);
-  g.step_side = RoundDown(std::min(b.roll_side, b.reach_side));
+  // And the sole's lateral support (kSideOfSole).
+  b.sole_side = kSideOfSole * 2 * base.foot_half_width;
+  g.step_side = RoundDown(std::min({b.roll_side, b.reach_side, b.sole_side}));
   // Turning: the pelvis turns midway between the feet, so a hip yaws half a
   // step's turn; and the soles keep kSoleClearance apart with one foot turned
   // about the stance centre (outward: toes apart; inward: toes together).

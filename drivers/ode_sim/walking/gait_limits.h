@@ -21,7 +21,11 @@
 //   only the reach, fell on its reach-limited step). Backwards: kBackFraction of forward (the
 //   heel edge is shorter and the swing foot cannot see).
 // - Sideways: the outward hip roll and the reach (the swing foot lands
-//   `step_side` beyond its place while the hip is still over the stance foot).
+//   `step_side` beyond its place while the hip is still over the stance foot);
+//   and at most kSideOfSole of the sole's width (a measured bound, not
+//   derived: the swing pushes the stance sole's centre of pressure to its
+//   edge; Atlas, whose hip roll allows a step wider for its sole, fell rocking
+//   on its sole's edge after such steps).
 // - Turning: half a step's turn per hip yaw (the pelvis turns midway between
 //   the feet) within kHipYawUse of the range, and the soles at least
 //   kSoleClearance apart with one foot turned about the stance centre:
@@ -69,6 +73,7 @@ struct GaitBounds {
   double reach_step = 0, speed_step = 0;   ///< m, forward step by the knee's reach / the swing rate
   double leg_step = 0;                     ///< m, forward step by the leg's length (measured bound)
   double roll_side = 0, reach_side = 0;    ///< m, sideways step by the hip roll / the reach
+  double sole_side = 0;                    ///< m, sideways step by the sole's width (measured bound)
   double hip_yaw_turn = 0, sole_turn = 0;  ///< rad per step by the hip yaw / the soles' clearance
   double sole_turn_in = 0;                 ///< rad per step toward the stance foot (toes together)
 };
