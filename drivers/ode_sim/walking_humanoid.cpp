@@ -556,7 +556,13 @@ void WalkingHumanoid::Balance() {
   const Eigen::Vector2d v(c * com_velocity_.x() + s * com_velocity_.y(),
                           -s * com_velocity_.x() + c * com_velocity_.y());
   const Eigen::Vector2d at = ToPlan({xy.x(), xy.y(), 0}).xy();
-  if (recovery_ && recovery_->Update(pattern_, at, v)) com_offset_->Reset();
+  if (recovery_) {  // measured from the support foot (the feet slip and turn), put on its plan
+    const Side sup = pattern_.support_side();
+    const Pose2 to = pattern_.foot(sup), from = MeasuredFoot(sup);
+    if (recovery_->Update(pattern_, walking::Relocate(from, to, xy),
+                          walking::Relocate(from, to, com_velocity_, true)))
+      com_offset_->Reset();
+  }
   if (!stabilize_) return;
   const Eigen::Vector2d cop = ToPlan({zmp_measured_.x(), zmp_measured_.y(), 0}).xy();
   std::array<Eigen::Vector2d, 16> support;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <numbers>
 #include <span>
+#include <stdexcept>
 #include <string>
 
 namespace robotalk::walking {
@@ -137,6 +138,18 @@ TEST(PushRecovery, PushesOfTheGoalsSizeForwardAndBackOfHalfOfItMidSwingAreSurviv
       EXPECT_LT(r.worst_ref_jump, 9e-3) << what << ": the reference ZMP is continuous";
     }
   }
+}
+
+TEST(PushRecovery, TheMeasuredCoMIsReadFromTheSupportFootWhereverItSlipped) {
+  // The foot slipped 5 cm and turned 0.3 rad: the CoM 10 cm ahead of it is
+  // 10 cm ahead of the planned foot (its velocity turned alike).
+  const Pose2 measured{0.05, 0.02, 0.3}, planned{0, 0, 0};
+  const Eigen::Vector2d com = measured.Apply(0.1, 0.0);
+  EXPECT_TRUE(Relocate(measured, planned, com).isApprox(Eigen::Vector2d(0.1, 0.0)));
+  const Eigen::Vector2d v(std::cos(0.3), std::sin(0.3));
+  EXPECT_TRUE(Relocate(measured, planned, v, true).isApprox(Eigen::Vector2d(1.0, 0.0)));
+  EXPECT_THROW(PushRecovery(0, 0.001), std::invalid_argument);
+  EXPECT_THROW(PushRecovery(3.7, 0), std::invalid_argument);
 }
 
 TEST(PushRecovery, WithoutAPushNothingIsRegeneratedAndTheWalkIsThePlan) {

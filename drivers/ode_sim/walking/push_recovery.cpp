@@ -18,6 +18,15 @@ Eigen::Vector2d CaptureShift(const Eigen::Vector2d& e0, double omega, double T, 
   return (et * ed - u * (ed - 1 - f)) / (1 + f);
 }
 
+Eigen::Vector2d Relocate(const Pose2& from, const Pose2& to, const Eigen::Vector2d& p, bool vector) {
+  const double a = from.theta, c = std::cos(a), s = std::sin(a);
+  const Eigen::Vector2d d = vector ? p : Eigen::Vector2d(p - from.xy());
+  const Eigen::Vector2d local(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+  const double b = to.theta, cb = std::cos(b), sb = std::sin(b);
+  const Eigen::Vector2d r(cb * local.x() - sb * local.y(), sb * local.x() + cb * local.y());
+  return vector ? r : Eigen::Vector2d(to.xy() + r);
+}
+
 // WalkPattern's part of the recovery, here beside its maths (walk_pattern.h
 // declares it).
 
@@ -123,6 +132,7 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
   };
   while (k < steps_.size() && (steps_[k].land <= tick_ || too_late(steps_[k]))) ++k;
   if (k == steps_.size() || !steps_[k].swing) return false;
+  if (!rp.in_double_support && steps_[k].start > tick_) return false;
   const bool in_air = steps_[k].start <= tick_;
   const Eigen::Vector2d xi = com + com_vel / omega;
   const Eigen::Vector2d p_now = ZmpAt(tick_);

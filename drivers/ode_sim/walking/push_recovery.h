@@ -46,6 +46,11 @@ namespace robotalk::walking {
 Eigen::Vector2d CaptureShift(const Eigen::Vector2d& e0, double omega, double T, double D,
                              const Eigen::Vector2d& u = Eigen::Vector2d::Zero());
 
+/// A point (or with `vector`, a direction) given relative to the pose
+/// `from`, placed the same way relative to `to`: the measured CoM relative
+/// to the measured support foot, put on the planned one.
+Eigen::Vector2d Relocate(const Pose2& from, const Pose2& to, const Eigen::Vector2d& p, bool vector = false);
+
 struct RecoveryParams {
   double threshold = 0.07;  ///< m (per axis): beyond this DCM error the pattern regenerates (on ODE, walking
                             ///< unpushed, the measured error reaches 4 cm)
@@ -60,10 +65,11 @@ struct RecoveryParams {
   double max_width = 0.40;     ///< m: at most this far sideways
   double ankle_margin = 0.03;  ///< m: the stance foot's ZMP moves toward the error, this far inside its sole
   double ankle_ramp = 0.05;    ///< s: ... over this long (the reference stays continuous)
-  bool early_lift = true;      ///< in double support, the next step lifts within fast_double
-  int fast_steps = 2;          ///< the steps after the moved one taken at the fast timing below
-  double fast_single = 0.4;    ///< s: their single support
-  double fast_double = 0.1;    ///< s: their double support
+  bool in_double_support = true;  ///< false: only a foot in the air moves (no regeneration in double support)
+  bool early_lift = true;         ///< in double support, the next step lifts within fast_double
+  int fast_steps = 2;             ///< the steps after the moved one taken at the fast timing below
+  double fast_single = 0.4;       ///< s: their single support
+  double fast_double = 0.1;       ///< s: their double support
 };
 
 class PushRecovery {
