@@ -190,6 +190,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->adjust_steps_ = options.stabilizer && options.step_adjustment;
   w->dcm_.emplace(w->g_.com_height, gravity);
   w->com_offset_.emplace(w->dcm_->omega());
+  if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step);
   return w;
 }
 
@@ -550,11 +551,19 @@ void WalkingHumanoid::Balance() {
   if (tick_ <= 1) com_world_prev_ = xy;
   com_velocity_ += ((xy - com_world_prev_) / step_ - com_velocity_) * std::min(1.0, step_ / kComFilter);
   com_world_prev_ = xy;
-  if (!stabilize_ || tick_ < settle_ticks_) return;
+  if (tick_ < settle_ticks_) return;
   const double c = std::cos(plan_to_world_.theta), s = std::sin(plan_to_world_.theta);
   const Eigen::Vector2d v(c * com_velocity_.x() + s * com_velocity_.y(),
                           -s * com_velocity_.x() + c * com_velocity_.y());
   const Eigen::Vector2d at = ToPlan({xy.x(), xy.y(), 0}).xy();
+  if (recovery_) {  // measured from the support foot (the feet slip and turn), put on its plan
+    const Side sup = pattern_.support_side();
+    const Pose2 to = pattern_.foot(sup), from = MeasuredFoot(sup);
+    if (recovery_->Update(pattern_, walking::Relocate(from, to, xy),
+                          walking::Relocate(from, to, com_velocity_, true)))
+      com_offset_->Reset();
+  }
+  if (!stabilize_) return;
   const Eigen::Vector2d cop = ToPlan({zmp_measured_.x(), zmp_measured_.y(), 0}).xy();
   std::array<Eigen::Vector2d, 16> support;
   const int n = pattern_.SupportPolygon(support);
@@ -591,6 +600,7 @@ walking::WalkStatus WalkingHumanoid::status() const {
   s.fallen = fallen_;
   s.tilt = tilt_;
   s.steps_taken = pattern_.started_steps();
+  s.recoveries = recovery_ ? recovery_->regenerations() : 0;
   const Pose2 com = ToWorld({pattern_.com().x(), pattern_.com().y(), 0});
   s.com_plan = com.xy();
   const Eigen::Vector2d z = pattern_.zmp_ref();

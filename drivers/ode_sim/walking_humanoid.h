@@ -30,6 +30,7 @@
 #include "robotalk/driver.h"
 #include "walking/dcm_stabilizer.h"
 #include "walking/leg_ik.h"
+#include "walking/push_recovery.h"
 #include "walking/walk_pattern.h"
 
 #include <cstdint>
@@ -197,6 +198,7 @@ class WalkingHumanoid final : public BaseController {
   bool adjust_steps_ = false;  // options.step_adjustment
   std::optional<walking::DcmStabilizer> dcm_;
   std::optional<walking::ComOffset> com_offset_;
+  std::optional<walking::PushRecovery> recovery_;  // options.push_recovery
   walking::DcmStabilizer::Output balance_;
   Eigen::Vector2d com_world_prev_ = Eigen::Vector2d::Zero(), com_velocity_ = Eigen::Vector2d::Zero();
   bool zmp_valid_ = false;

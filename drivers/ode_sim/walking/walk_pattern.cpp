@@ -17,11 +17,6 @@ double Cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Ve
   return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
 }
 
-std::array<Eigen::Vector2d, 4> Corners(const Pose2& f, const GaitParams& g) {
-  return {f.Apply(g.foot_front, g.foot_half_width), f.Apply(-g.foot_back, g.foot_half_width),
-          f.Apply(-g.foot_back, -g.foot_half_width), f.Apply(g.foot_front, -g.foot_half_width)};
-}
-
 // R of the preview's cost (Qe = 1): 1e-5 tracks a 0.8 s weight shift seen
 // 1 s ahead within 6 mm; Kajita's 1e-6 swings the ZMP harder for little gain.
 constexpr double kJerkWeight = 1e-5;
@@ -31,6 +26,11 @@ bool SamePose(const Pose2& a, const Pose2& b) {
 }
 
 }  // namespace
+
+std::array<Eigen::Vector2d, 4> Corners(const Pose2& f, const GaitParams& g) {
+  return {f.Apply(g.foot_front, g.foot_half_width), f.Apply(-g.foot_back, g.foot_half_width),
+          f.Apply(-g.foot_back, -g.foot_half_width), f.Apply(g.foot_front, -g.foot_half_width)};
+}
 
 bool InFoot(const Pose2& foot, const GaitParams& g, const Eigen::Vector2d& p, double margin) {
   const double c = std::cos(foot.theta), s = std::sin(foot.theta);
@@ -44,6 +44,7 @@ WalkPattern::WalkPattern(const GaitParams& g, double tick, int preview_every, do
     : g_(g),
       tick_s_(tick),
       every_(preview_every),
+      gravity_(gravity),
       ss_ticks_(std::llround(g.single_support / tick)),
       ds_ticks_(std::llround(g.double_support / tick)),
       start_ticks_(std::llround(g.start_shift / tick)),
@@ -178,7 +179,8 @@ void WalkPattern::Append(const std::vector<Footstep>& steps, const std::vector<P
 }
 
 void WalkPattern::AppendAt(std::int64_t t, const std::vector<Footstep>& steps,
-                           const std::vector<Pose2>& centres) {
+                           const std::vector<Pose2>& centres, int fast, std::int64_t ss, std::int64_t ds,
+                           const Eigen::Vector2d& first_offset) {
   Cut(t);
   const bool from_stance = phases_.back().kind == Kind::kSingle;  // the weight on a foot, about to shift
   Pose2 last[2] = {rest_[0], rest_[1]};
@@ -192,13 +194,14 @@ void WalkPattern::AppendAt(std::int64_t t, const std::vector<Footstep>& steps,
     const int sw = static_cast<int>(s.step.side);
     s.from = last[sw];
     s.stance = last[1 - sw];
-    const Eigen::Vector2d p = ZmpPoint(s.stance);
+    const Eigen::Vector2d p = ZmpPoint(s.stance) + (i == 0 ? first_offset : Eigen::Vector2d::Zero());
+    const bool quick = static_cast<int>(i) < fast;
     if ((p - z).norm() > 1e-9) {
-      AddPhase(i > 0 || from_stance ? ds_ticks_ : start_ticks_, p, Kind::kShift, sw);
+      AddPhase(i > 0 || from_stance ? (quick ? ds : ds_ticks_) : start_ticks_, p, Kind::kShift, sw);
     }
     s.start = phases_.back().end;
-    s.land = s.start + ss_ticks_;
-    AddPhase(ss_ticks_, p, Kind::kSingle, 1 - sw);
+    s.land = s.start + (quick ? ss : ss_ticks_);
+    AddPhase(s.land - s.start, p, Kind::kSingle, 1 - sw);
     steps_.push_back(s);
     last[sw] = s.step.pose;
     z = p;
@@ -323,7 +326,7 @@ void WalkPattern::UpdateFeet() {
     }
     if (!st.swing) continue;  // a stand on the stance foot (StopSoon)
     if (st.start == tick_) ++started_;
-    const double s = static_cast<double>(tick_ - st.start) / static_cast<double>(ss_ticks_);
+    const double s = SwingProgress(st);
     const double m = std::clamp((s - 0.1) / 0.8, 0.0, 1.0);
     foot_[sw] = Lerp(st.from, st.step.pose, 0.5 * (1 - std::cos(std::numbers::pi * m)));
     height_[sw] = g_.step_height * 0.5 * (1 - std::cos(2 * std::numbers::pi * s));
@@ -351,6 +354,31 @@ void WalkPattern::Tick() {
   cx_ = ZmpPreview::Propagate(sample_x_, ux_, t);
   cy_ = ZmpPreview::Propagate(sample_y_, uy_, t);
   UpdateFeet();
+}
+
+double WalkPattern::SwingProgress(const Scheduled& s) const {
+  if (s.retimed < 0) return static_cast<double>(tick_ - s.start) / static_cast<double>(s.land - s.start);
+  return s.s_retimed + (1 - s.s_retimed) * static_cast<double>(tick_ - s.retimed) /
+                           static_cast<double>(std::max<std::int64_t>(1, s.land - s.retimed));
+}
+
+void WalkPattern::SetComState(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) {
+  // The acceleration that puts the model's ZMP at the reference now; the
+  // preview sample in progress restarted so that the state is the CoM's now.
+  const double w2 = gravity_ / g_.com_height;
+  const Eigen::Vector2d p = ZmpAt(tick_);
+  const Eigen::Vector3d sx(com.x(), com_vel.x(), w2 * (com.x() - p.x()));
+  const Eigen::Vector3d sy(com.y(), com_vel.y(), w2 * (com.y() - p.y()));
+  const std::int64_t phase = tick_ % every_ == 0 ? every_ : tick_ % every_;
+  const double back = -static_cast<double>(phase) * tick_s_,
+               ahead = static_cast<double>(every_ - phase) * tick_s_;
+  sample_x_ = ZmpPreview::Propagate(sx, 0, back);
+  sample_y_ = ZmpPreview::Propagate(sy, 0, back);
+  px_.SetState(ZmpPreview::Propagate(sx, 0, ahead));
+  py_.SetState(ZmpPreview::Propagate(sy, 0, ahead));
+  ux_ = uy_ = 0;
+  cx_ = sx;
+  cy_ = sy;
 }
 
 double WalkPattern::time_to_landing() const {

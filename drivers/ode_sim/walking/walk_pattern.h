@@ -45,6 +45,8 @@
 
 namespace robotalk::walking {
 
+struct RecoveryParams;  // push_recovery.h
+
 class WalkPattern {
  public:
   WalkPattern(const GaitParams& g, double tick, int preview_every, double gravity, double horizon = 1.6);
@@ -84,6 +86,17 @@ class WalkPattern {
   /// shift); the next steps start from it. Returns the offset applied; zero
   /// in double support.
   Eigen::Vector2d AdjustLanding(const Eigen::Vector2d& offset, double reach);
+  /// Push recovery (push_recovery.h): the plan regenerated from the measured
+  /// CoM and velocity (plan frame). The CoM state becomes the measured one;
+  /// the next foot to land (the one in the air unless within `late` of its
+  /// landing, else the next to lift) lands shifted by the CaptureShift of
+  /// the DCM error, sooner when that is beyond reach (not sooner than
+  /// `min_swing` after its lift-off), clamped beside its stance foot and
+  /// within reach; every later step and stance centre moves by the full
+  /// shift, re-planned from the landing on (the reference is cut there:
+  /// continuous). False (nothing changed) when no step can move: standing,
+  /// the end shift, a stop's stand without a swing.
+  bool Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p);
 
   /// True when no step is scheduled or running and the end shift is over.
   bool standing() const;
@@ -137,6 +150,8 @@ class WalkPattern {
     std::int64_t start = 0, land = 0;  // single support [start, land)
     bool swing = true;                 // false: the foot stays (a stop with the feet side by side)
     Pose2 planned;                     // step.pose before AdjustLanding
+    std::int64_t retimed = -1;         // Regenerate landed it sooner at this tick (-1: never)
+    double s_retimed = 0;              // the swing's progress (0..1) then
   };
   Eigen::Vector2d ZmpPoint(const Pose2& foot) const;
   Eigen::Vector2d ZmpAt(std::int64_t tick) const;
@@ -147,13 +162,23 @@ class WalkPattern {
   void Cut(std::int64_t t);
   void Prune();
   void AddPhase(std::int64_t ticks, const Eigen::Vector2d& to, Kind kind, int next);
-  void AppendAt(std::int64_t t, const std::vector<Footstep>& steps, const std::vector<Pose2>& centres);
+  // The first `fast` steps with single and double support of ss and ds
+  // ticks; the first step's stance ZMP `first_offset` from its point.
+  void AppendAt(std::int64_t t, const std::vector<Footstep>& steps, const std::vector<Pose2>& centres,
+                int fast = 0, std::int64_t ss = 0, std::int64_t ds = 0,
+                const Eigen::Vector2d& first_offset = Eigen::Vector2d::Zero());
   void UpdateFeet();
+  double SwingProgress(const Scheduled& s) const;  // 0 at lift-off .. 1 at landing
+  void SetComState(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel);
+  Eigen::Vector2d NominalDcm() const;
+  void Rebuild(size_t k, std::int64_t land, std::int64_t lift, const Eigen::Vector2d& u,
+               const std::vector<Eigen::Vector2d>& shift, const RecoveryParams& rp);
   const Scheduled* Swinging() const;  // the step in single support now, or null
 
   GaitParams g_;
   double tick_s_;
   int every_;
+  double gravity_;
   std::int64_t ss_ticks_, ds_ticks_, start_ticks_, end_ticks_, lead_ticks_;
   ZmpPreview px_, py_;
   std::vector<double> future_x_, future_y_;
@@ -170,6 +195,8 @@ class WalkPattern {
   int started_ = 0;
 };
 
+/// A foot's sole rectangle, counter-clockwise from the front left corner.
+std::array<Eigen::Vector2d, 4> Corners(const Pose2& foot, const GaitParams& g);
 /// Point-in-convex-polygon test helper: the sole rectangle of a foot.
 bool InFoot(const Pose2& foot, const GaitParams& g, const Eigen::Vector2d& p, double margin);
 

@@ -61,6 +61,11 @@ void ZmpPreview::Reset(double c) {
   sum_e_ = 0;
 }
 
+void ZmpPreview::SetState(const Eigen::Vector3d& x) {
+  x_ = x;
+  sum_e_ = 0;
+}
+
 double ZmpPreview::Step(double now, std::span<const double> future) {
   sum_e_ += zmp() - now;
   double u = -gi_ * sum_e_ - gx_.dot(x_);

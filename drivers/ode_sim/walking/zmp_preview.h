@@ -33,6 +33,9 @@ class ZmpPreview {
 
   /// Resets the state to rest at position c (ZMP = c, no error integral).
   void Reset(double c);
+  /// Sets the state [c, c', c''] (a measured one: the walking pattern
+  /// regenerated after a push), with no error integral.
+  void SetState(const Eigen::Vector3d& x);
   /// One sample: `future` holds p_ref(k+1) .. p_ref(k+N) (size N), `now` p_ref(k).
   /// Returns the jerk applied; the state moves on by dt.
   double Step(double now, std::span<const double> future);

@@ -1,0 +1,96 @@
+// Push recovery by regenerating the walking pattern from the measured state
+// (issue 26, item 4; docs/ode_sim.md, "Pushes and disturbances"). Pure
+// maths, no ODE; tests/drivers/walking_test.cpp pushes a linear inverted
+// pendulum that walks on the pattern's ZMP.
+//
+// Why not a correction of the plan: the legs are stiff position servos, so
+// a plan that goes on open loop after a push pulls the CoM back to where the
+// plan has moved on (docs/ode_sim.md, "Balance feedback"). Instead, when the
+// measured DCM (xi = c + c'/w) departs from the plan's by more than the
+// ankles absorb (`threshold`), the plan is regenerated from the measured
+// state (in the spirit of Nishiwaki & Kagami's online pattern regeneration
+// and Urata et al.'s online foot placement):
+//  - the preview's CoM state becomes the measured CoM and velocity (its
+//    acceleration such that its ZMP is the reference's now: no jump);
+//  - both the plan and the robot walk on the same ZMP from now on, so the
+//    DCM error e0 grows as e0 e^{w t}; the foot that lands next (the one in
+//    the air, or the next to lift) lands shifted by CaptureShift(e0, ...),
+//    which leaves no error once the weight has shifted onto it, and every
+//    later footstep (and stance centre) moves with it: the walk goes on
+//    from the new landing, re-planned from it (WalkPattern::Regenerate);
+//  - the moved landing stays beside its stance foot (never across it) and
+//    within reach; what that clamp leaves of the shift is caught by the
+//    next regeneration, on the next step (a push toward the stance leg is
+//    caught by the other foot: a two-step recovery).
+//  - step timing: when the shift is beyond reach, a foot in the air lands
+//    sooner (down to `min_swing` s of swing): e^{w T} is smaller.
+// The reference ZMP stays at the feet's ZMP points (inside the support) and
+// continuous: the cut is at the moved foot's landing.
+//
+// Threading: one thread. Allocation: Regenerate re-plans the schedule.
+#pragma once
+
+#include "walking/walk_pattern.h"
+
+#include <Eigen/Core>
+
+namespace robotalk::walking {
+
+/// The foothold shift that captures a DCM error e0 (m) which grows on the
+/// plan's ZMP for T s until the foot lands, then while the weight shifts
+/// onto it linearly over D s: the error at the end of that shift equals
+/// the shift (the DCM stands where the plan has it, relative to the moved
+/// foot). With the ZMP held `u` (m) from the plan's until the landing (the
+/// ankles), e_T = u + (e0 - u) e^{wT} and
+/// d = (e_T e^{wD} - u (e^{wD} - 1 - f)) / (1 + f), f = (e^{wD} - 1 - wD) / (wD).
+Eigen::Vector2d CaptureShift(const Eigen::Vector2d& e0, double omega, double T, double D,
+                             const Eigen::Vector2d& u = Eigen::Vector2d::Zero());
+
+/// A point (or with `vector`, a direction) given relative to the pose
+/// `from`, placed the same way relative to `to`: the measured CoM relative
+/// to the measured support foot, put on the planned one.
+Eigen::Vector2d Relocate(const Pose2& from, const Pose2& to, const Eigen::Vector2d& p, bool vector = false);
+
+struct RecoveryParams {
+  double threshold = 0.07;  ///< m (per axis): beyond this DCM error the pattern regenerates (on ODE, walking
+                            ///< unpushed, the measured error reaches 4 cm)
+  double interval = 0.05;   ///< s: at most one regeneration per interval
+  double min_swing = 0.35;  ///< s: a step in the air may land this soon after its lift-off, at the soonest
+  double late = 0.03;  ///< s: a foot in the air this close to landing keeps its landing; the next one moves
+  double swing_speed = 2.0;  ///< m/s: a foot in the air moves its landing at most this much per second left
+  // A moved landing's ankle from its stance foot's ankle, in that foot's frame:
+  double reach = 0.45;         ///< m: at most this far ahead
+  double reach_back = 0.30;    ///< m: at most this far behind
+  double min_width = 0.14;     ///< m: at least this far sideways (the soles never overlap nor cross)
+  double max_width = 0.40;     ///< m: at most this far sideways
+  double ankle_margin = 0.03;  ///< m: the stance foot's ZMP moves toward the error, this far inside its sole
+  double ankle_ramp = 0.05;    ///< s: ... over this long (the reference stays continuous)
+  bool in_double_support = true;  ///< false: only a foot in the air moves (no regeneration in double support)
+  bool early_lift = true;         ///< in double support, the next step lifts within fast_double
+  int fast_steps = 2;             ///< the steps after the moved one taken at the fast timing below
+  double fast_single = 0.4;       ///< s: their single support
+  double fast_double = 0.1;       ///< s: their double support
+};
+
+class PushRecovery {
+ public:
+  /// omega = sqrt(g / z_c) > 0, tick > 0 (s), else std::invalid_argument.
+  PushRecovery(double omega, double tick, RecoveryParams params = {});
+  /// One control tick with the measured CoM and velocity (plan frame).
+  /// Regenerates `pattern` when the DCM error passes the threshold and a
+  /// step can still take it; returns true when it did.
+  bool Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel);
+  /// The last measured DCM error (m), and how many regenerations so far.
+  const Eigen::Vector2d& error() const { return error_; }
+  int regenerations() const { return count_; }
+  const RecoveryParams& params() const { return p_; }
+
+ private:
+  double omega_, tick_;
+  RecoveryParams p_;
+  double since_ = 1e9;
+  Eigen::Vector2d error_ = Eigen::Vector2d::Zero();
+  int count_ = 0;
+};
+
+}  // namespace robotalk::walking

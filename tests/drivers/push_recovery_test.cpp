@@ -1,0 +1,165 @@
+// Push recovery by regenerating the walking pattern (issue 26, item 4;
+// drivers/ode_sim/walking/push_recovery.h), tested without ODE: a linear
+// inverted pendulum walks on the pattern's ZMP (a robot whose servos track
+// the plan), that ZMP limited to the support polygon of the feet (its
+// soles), and is pushed: a change of its CoM velocity.
+#include "walking/push_recovery.h"
+#include "walking/dcm_stabilizer.h"
+#include "walking/footstep_planner.h"
+#include "walking/walk_pattern.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+namespace robotalk::walking {
+namespace {
+
+// The derived gait of models/simple_humanoid.urdf (docs/ode_sim.md, "The
+// gait from the model"), its CoM 0.70 m up: w = 3.74/s.
+GaitParams FastGait() {
+  GaitParams g;
+  g.step_forward = 0.22;
+  g.step_back = 0.11;
+  g.step_side = 0.16;
+  g.single_support = 0.55;
+  g.double_support = 0.21;
+  g.com_height = 0.70;
+  return g;
+}
+
+struct Result {
+  bool fell = false;
+  int regenerations = 0;
+  double worst_ref_jump = 0;  // m per tick
+  double worst_clamp = 0;     // m the pattern's ZMP lay outside the support
+  double end_error = 0;       // m, the pendulum's CoM from the plan's at the end
+  double end_x = 0;           // m, the final stance centre
+};
+
+// Walks at full speed (SETSPEED's queue, as the driver keeps it) and is
+// pushed by `dv` (m/s) at `at` s; the pendulum's ZMP is the pattern's,
+// clamped into the support polygon. Fell: its CoM 0.3 m from the plan's.
+Result WalkAndPush(const Eigen::Vector2d& dv, double at, bool recover, double walk_for = 6.0,
+                   const RecoveryParams& params = {}) {
+  const GaitParams g = FastGait();
+  constexpr double kTick = 0.001, kG = 9.81;
+  WalkPattern w(g, kTick, 5, kG);
+  PushRecovery rec(std::sqrt(kG / g.com_height), kTick, params);
+  // The pendulum as its departure (d, d') from the plan's CoM: exact while
+  // it walks on the plan's ZMP, whatever the plan's own integration.
+  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero();
+  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+  Eigen::Vector2d ref = w.zmp_ref();
+  Result r;
+  const int ticks = static_cast<int>((walk_for + 4.0) / kTick);
+  for (int i = 0; i < ticks; ++i) {
+    if (w.time() < walk_for) {
+      while (w.planned_ahead() < g.start_lead + 2 * g.step_period()) {
+        const WalkPattern::Splice sp = w.AppendPoint();
+        const Side next = sp.side_free ? Side::kLeft : sp.next;
+        const Pose2 ce = StepBy(sp.centre, g.step_forward, 0, 0, next, g);
+        w.Append({Footstep{next, FootAt(ce, next, g)}}, {ce});
+      }
+    } else if (w.time() < walk_for + kTick) {
+      w.StopSoon();
+    }
+    w.Tick();
+    if (std::abs(w.time() - at) < 0.5 * kTick) dd += dv;
+    if (recover && rec.Update(w, w.com() + d, w.com_velocity() + dd)) {
+      ++r.regenerations;
+      d.setZero();  // the plan starts from the pendulum's state
+      dd.setZero();
+    }
+    r.worst_ref_jump = std::max(r.worst_ref_jump, (w.zmp_ref() - ref).norm());
+    ref = w.zmp_ref();
+    std::array<Eigen::Vector2d, 16> poly;
+    const int n = w.SupportPolygon(poly);
+    const Eigen::Vector2d p = ClampToPolygon(w.zmp(), std::span(poly.data(), static_cast<size_t>(n)), 0);
+    r.worst_clamp = std::max(r.worst_clamp, (p - w.zmp()).norm());
+    dd += kG / g.com_height * (d - (p - w.zmp())) * kTick;
+    d += dd * kTick;
+    if (d.norm() > 0.3) {
+      r.fell = true;
+      break;
+    }
+  }
+  r.end_error = d.norm();
+  r.end_x = w.final_centre().x;
+  return r;
+}
+
+TEST(PushRecovery, CaptureShiftLeavesNoErrorAfterTheShiftOfWeight) {
+  // A pendulum on a ZMP that stays for T, then moves by d linearly over D:
+  // the DCM error at the end of the shift equals d.
+  const double w = 3.74, T = 0.3, D = 0.21, dt = 1e-5;
+  const Eigen::Vector2d e0(0.05, -0.02);
+  const Eigen::Vector2d d = CaptureShift(e0, w, T, D);
+  Eigen::Vector2d e = e0;
+  for (double t = 0; t < T + D; t += dt) {
+    const Eigen::Vector2d p = t < T ? Eigen::Vector2d::Zero() : Eigen::Vector2d(d * (t - T) / D);
+    e += w * (e - p) * dt;
+  }
+  EXPECT_NEAR((e - d).norm(), 0, 1e-4);
+}
+
+// A noise-free pendulum: the threshold can be the ankles' (the driver's
+// default allows for the measured DCM's noise on ODE, ~4 cm).
+RecoveryParams Pendulum() {
+  RecoveryParams p;
+  p.threshold = 0.02;
+  return p;
+}
+
+TEST(PushRecovery, PushesOfTheGoalsSizeForwardAndBackOfHalfOfItMidSwingAreSurvived) {
+  // 35 N s forward (0.67 m/s: a capture point 0.18 m off) and 20 N s
+  // backward (0.38 m/s) at 11 instants over the middle of a swing; the open
+  // loop falls from each. Measured (docs/ode_sim.md, "Pushes"): nearer the
+  // landing or in double support the step comes too late for these, and
+  // sideways toward the stance leg it would have to cross (no crossover step).
+  const GaitParams g = FastGait();
+  for (const Eigen::Vector2d& dv : {Eigen::Vector2d(35 / 52.5, 0), Eigen::Vector2d(-20 / 52.5, 0)}) {
+    for (int k = 5; k <= 15; ++k) {
+      const double at = 3.0 + k * g.step_period() / 20;
+      const std::string what = "push (" + std::to_string(dv.x()) + ", " + std::to_string(dv.y()) +
+                               ") m/s at " + std::to_string(at) + " s";
+      EXPECT_TRUE(WalkAndPush(dv, at, false).fell) << what << ": the open loop";
+      const Result r = WalkAndPush(dv, at, true, 6.0, Pendulum());
+      EXPECT_FALSE(r.fell) << what;
+      EXPECT_GE(r.regenerations, 1) << what;
+      EXPECT_LT(r.end_error, 0.01) << what << ": the pendulum stands where the plan does";
+      // Continuous: the steepest move is a recovery's shift of weight (up
+      // to 0.5 m over fast_double, 0.1 s); the issue's jump was 5.5 cm.
+      EXPECT_LT(r.worst_ref_jump, 9e-3) << what << ": the reference ZMP is continuous";
+    }
+  }
+}
+
+TEST(PushRecovery, TheMeasuredCoMIsReadFromTheSupportFootWhereverItSlipped) {
+  // The foot slipped 5 cm and turned 0.3 rad: the CoM 10 cm ahead of it is
+  // 10 cm ahead of the planned foot (its velocity turned alike).
+  const Pose2 measured{0.05, 0.02, 0.3}, planned{0, 0, 0};
+  const Eigen::Vector2d com = measured.Apply(0.1, 0.0);
+  EXPECT_TRUE(Relocate(measured, planned, com).isApprox(Eigen::Vector2d(0.1, 0.0)));
+  const Eigen::Vector2d v(std::cos(0.3), std::sin(0.3));
+  EXPECT_TRUE(Relocate(measured, planned, v, true).isApprox(Eigen::Vector2d(1.0, 0.0)));
+  EXPECT_THROW(PushRecovery(0, 0.001), std::invalid_argument);
+  EXPECT_THROW(PushRecovery(3.7, 0), std::invalid_argument);
+}
+
+TEST(PushRecovery, WithoutAPushNothingIsRegeneratedAndTheWalkIsThePlan) {
+  const Result r = WalkAndPush(Eigen::Vector2d::Zero(), 3.0, true, 6.0, Pendulum());
+  EXPECT_FALSE(r.fell);
+  EXPECT_EQ(r.regenerations, 0);
+  const Result open = WalkAndPush(Eigen::Vector2d::Zero(), 3.0, false);
+  EXPECT_DOUBLE_EQ(r.end_x, open.end_x);
+  EXPECT_LT(r.worst_clamp, 1e-9);
+}
+
+}  // namespace
+}  // namespace robotalk::walking
