@@ -191,6 +191,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->dcm_.emplace(w->g_.com_height, gravity);
   w->com_offset_.emplace(w->dcm_->omega());
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step);
+  if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
   return w;
 }
 
@@ -551,16 +552,18 @@ void WalkingHumanoid::Balance() {
   if (tick_ <= 1) com_world_prev_ = xy;
   com_velocity_ += ((xy - com_world_prev_) / step_ - com_velocity_) * std::min(1.0, step_ / kComFilter);
   com_world_prev_ = xy;
+  if (com_estimate_) com_estimate_->Update(xy, zmp_valid_ ? &zmp_measured_ : nullptr);
   if (tick_ < settle_ticks_) return;
   const double c = std::cos(plan_to_world_.theta), s = std::sin(plan_to_world_.theta);
   const Eigen::Vector2d v(c * com_velocity_.x() + s * com_velocity_.y(),
                           -s * com_velocity_.x() + c * com_velocity_.y());
   const Eigen::Vector2d at = ToPlan({xy.x(), xy.y(), 0}).xy();
-  if (recovery_) {  // measured from the support foot (the feet slip and turn), put on its plan
+  if (recovery_) {  // estimated (DcmEstimator), read from the support foot (the feet slip and turn), put on
+                    // its plan
     const Side sup = pattern_.support_side();
     const Pose2 to = pattern_.foot(sup), from = MeasuredFoot(sup);
-    if (recovery_->Update(pattern_, walking::Relocate(from, to, xy),
-                          walking::Relocate(from, to, com_velocity_, true)))
+    if (recovery_->Update(pattern_, walking::Relocate(from, to, com_estimate_->com()),
+                          walking::Relocate(from, to, com_estimate_->com_velocity(), true)))
       com_offset_->Reset();
   }
   if (!stabilize_) return;

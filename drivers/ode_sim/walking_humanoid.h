@@ -28,6 +28,7 @@
 #include "ode_walk_status.h"
 #include "ode_world.h"
 #include "robotalk/driver.h"
+#include "walking/dcm_estimator.h"
 #include "walking/dcm_stabilizer.h"
 #include "walking/leg_ik.h"
 #include "walking/push_recovery.h"
@@ -198,7 +199,8 @@ class WalkingHumanoid final : public BaseController {
   bool adjust_steps_ = false;  // options.step_adjustment
   std::optional<walking::DcmStabilizer> dcm_;
   std::optional<walking::ComOffset> com_offset_;
-  std::optional<walking::PushRecovery> recovery_;  // options.push_recovery
+  std::optional<walking::PushRecovery> recovery_;      // options.push_recovery
+  std::optional<walking::DcmEstimator> com_estimate_;  // with recovery_: the CoM state it reads
   walking::DcmStabilizer::Output balance_;
   Eigen::Vector2d com_world_prev_ = Eigen::Vector2d::Zero(), com_velocity_ = Eigen::Vector2d::Zero();
   bool zmp_valid_ = false;
