@@ -384,7 +384,13 @@ class Bench:
                     ("adaptive", adaptive, [], 2.0, None),  # the server's default, a client without redundancy
                     # a lost frame's retransmission comes a round trip late: the client's redundancy
                     ("adaptive_copies", adaptive, ["--copies", "2"], 2.0, ("WAN",)),
-                    ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested))
+                    ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested),
+                    # before the connect burst's own queue was left out of the delay spread
+                    ("adaptive_burst_off", adaptive + ["--playback-burst-discount", "off"], [], 2.0, congested))
+        # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
+        only_variants = [v for v in os.environ.get("ROBOTALK_BENCH_VARIANTS", "").split(",") if v]
+        if only_variants:
+            variants = tuple(v for v in variants if v[0] in only_variants)
         runs = []
         # Another first seed (ROBOTALK_BENCH_SEED) gives a second set of relay draws to pool with the first.
         seed = int(os.environ.get("ROBOTALK_BENCH_SEED", "101"))

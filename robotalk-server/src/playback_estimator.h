@@ -127,6 +127,11 @@ struct PlaybackEstimatorOptions {
   double queue_quantile = 1.0;
   /// Resampled queues (each as long as the sequence, at most kQueueHorizon frames).
   std::size_t queue_resamples = 200;
+  /// A package sent within half a frame interval after the one before it (the
+  /// connect-time burst: hello, clock, heartbeat) that waited behind it on a
+  /// FIFO link: that wait is left out of its delay for the spread and the
+  /// worst delay (see ChannelDelays). Off: every delay as measured.
+  bool burst_wait_discount = true;
 };
 
 /// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
@@ -199,6 +204,11 @@ class PlaybackEstimator {
   /// Max − min of the recent one-way delays and the frames' (nullopt: too
   /// few, or a frame without a send time).
   std::optional<Duration> delay_spread() const;
+  /// Whether that spread (and the worst delay) leaves out the wait of a
+  /// connect-time burst's packages behind each other (burst_wait_discount):
+  /// only where the delays as measured exceed adaptive_max_spread and the
+  /// discounted ones do not.
+  bool burst_discounted() const;
 
   /// The server time at which offset 0 plays. REQUIRES: ready().
   TimePoint StartTime() const;
@@ -229,6 +239,18 @@ class PlaybackEstimator {
     std::size_t kept;      // delays within the fence
   };
   std::optional<Spread> FencedSpread() const;
+  // The delays seen (the history's, then the frames', both in arrival order),
+  // with their arrivals where known; empty: too few, or a frame without a send time.
+  struct Seen {
+    TimePoint arrival;
+    Duration delay;
+    bool known_arrival;
+  };
+  std::vector<Seen> SeenPackages() const;
+  // Their delays; with `discount`, each less its wait behind the package
+  // before it where it was sent within half a frame interval after it.
+  std::vector<Duration> ChannelDelays(bool discount) const;
+
   double interval() const;  // the declared mean frame interval, s
   std::size_t total_;
   Duration duration_;
