@@ -86,12 +86,13 @@ std::vector<Duration> PlaybackEstimator::ChannelDelays(bool discount) const {
   // (s_j its send time) behind an empty queue; it could not get through
   // before a_{j-1}, so it waited w_j = max(0, a_{j-1} - u_j) behind its
   // predecessor (Lindley's recursion, as in Services). That wait is left
-  // out for a package sent within half a frame interval after the one before
-  // it (paced frames, one interval apart, keep theirs: a queue of frames is
-  // what the gate is for).
+  // out for a package sent less than a frame interval after the one before
+  // it (a burst denser than the sequence), the first frame's included (sent
+  // right after the connect-time packages). A later frame keeps its wait: a
+  // queue of frames is what the gate is for.
   const Duration least = *std::min_element(delays.begin(), delays.end());
-  const Duration burst = FromSeconds(interval() / 2);
-  for (std::size_t j = 1; j < seen.size(); ++j) {
+  const Duration burst = FromSeconds(interval());
+  for (std::size_t j = 1; j < seen.size() && j <= history_.size(); ++j) {
     if (!seen[j].known_arrival || !seen[j - 1].known_arrival) continue;
     const TimePoint sent = seen[j].arrival - seen[j].delay,
                     sent_before = seen[j - 1].arrival - seen[j - 1].delay;

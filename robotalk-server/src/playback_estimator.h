@@ -127,10 +127,11 @@ struct PlaybackEstimatorOptions {
   double queue_quantile = 1.0;
   /// Resampled queues (each as long as the sequence, at most kQueueHorizon frames).
   std::size_t queue_resamples = 200;
-  /// A package sent within half a frame interval after the one before it (the
-  /// connect-time burst: hello, clock, heartbeat) that waited behind it on a
-  /// FIFO link: that wait is left out of its delay for the spread and the
-  /// worst delay (see ChannelDelays). Off: every delay as measured.
+  /// A package sent less than a frame interval after the one before it (the
+  /// connect-time burst: hello, clock, heartbeat; the first frame too) that
+  /// waited behind it on a FIFO link: that wait is left out of its delay for
+  /// the spread and the worst delay where the delays as measured exceed
+  /// adaptive_max_spread (see ChannelDelays). Off: every delay as measured.
   bool burst_wait_discount = true;
 };
 
@@ -248,7 +249,8 @@ class PlaybackEstimator {
   };
   std::vector<Seen> SeenPackages() const;
   // Their delays; with `discount`, each less its wait behind the package
-  // before it where it was sent within half a frame interval after it.
+  // before it where it was sent less than a frame interval after it (not
+  // a frame after the first).
   std::vector<Duration> ChannelDelays(bool discount) const;
 
   double interval() const;  // the declared mean frame interval, s

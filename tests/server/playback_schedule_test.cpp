@@ -516,11 +516,11 @@ TEST(AdaptivePlayback, AConnectBurstThatQueuedBehindItselfOnAFifoLinkGetsTheAdap
   EXPECT_EQ(est.StartTime(), kT0 + milliseconds(22) + FromSeconds(0.030 / 7));
   // The schedule grows the buffer to the worst + 4 x 30 ms / 7, + 2 ms.
   EXPECT_EQ(est.playout_delay(), milliseconds(33) + FromSeconds(0.120 / 7));
-  // Sent 60 ms apart (more than half a frame interval) they are no burst:
+  // Sent a frame interval apart they are no burst:
   // their delays are the channel's as frames meet it: the paper's estimate.
   std::vector<DelayHistory::Sample> paced{{burst + milliseconds(1), milliseconds(1)}};
   for (int j = 1; j <= 5; ++j)
-    paced.push_back({burst + milliseconds(60 * j + 1 + 30 * j), milliseconds(1 + 30 * j)});
+    paced.push_back({burst + milliseconds(100 * j + 1 + 30 * j), milliseconds(1 + 30 * j)});
   PlaybackEstimator sparse(40, milliseconds(3900));
   sparse.SetDelayHistory(paced);
   sparse.Add(Duration(0), kT0, kT0 - milliseconds(1));
