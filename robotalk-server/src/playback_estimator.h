@@ -42,6 +42,12 @@
 // delay by frame 1. Where the spread exceeds one frame interval a queue can build that the history (sparse
 // packages, no queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
 // adaptive_max_spread intervals: the paper's estimate, then the stretch.
+// The connect burst (burst_wait_discount, on): a client's hello, clock and
+// heartbeat leave together and, on a congested FIFO link, wait behind each
+// other, a spread its frames (one interval apart) do not meet. Where the
+// delays as measured exceed the gate, each package sent less than a frame
+// interval after the one before it counts without that wait (ChannelDelays);
+// if the gate then passes, the adaptive start decides from those delays.
 //
 // Queue start (issue 23 item 3; `queue_start`, off by default): beyond
 // `adaptive_max_spread` intervals the delays are a queue's (a congested link),
