@@ -371,8 +371,8 @@ class Bench:
                     ("WAN 300 ms +-50 ms, 1 % loss", ["--profile", "wan-300"])]
         if self.quick:
             profiles = [profiles[0], profiles[2], profiles[4]]
-        # ROBOTALK_BENCH_PROFILES="U[0, 100],WAN 100" runs only the profiles whose names start so.
-        only_profiles = [p for p in os.environ.get("ROBOTALK_BENCH_PROFILES", "").split(",") if p]
+        # ROBOTALK_BENCH_PROFILES="U[0, 100];WAN 100" runs only the profiles whose names start so.
+        only_profiles = [p for p in os.environ.get("ROBOTALK_BENCH_PROFILES", "").split(";") if p]
         if only_profiles:
             profiles = [p for p in profiles if any(p[0].startswith(o) for o in only_profiles)]
         reps = self.runs  # relay seeds per profile: 5 (quick: 3)
