@@ -347,7 +347,8 @@ def playback_estimators_section(res):
              "adaptive_lead0": "adaptive, previous default (`--playback-start-lead 0`)",
              "adaptive": "adaptive, start lead 1 (the default now)",
              "adaptive_copies": "adaptive (default) + client sends 2 copies",
-             "adaptive_queue": "adaptive (default) + queue start (option)"}
+             "adaptive_queue": "adaptive (default) + queue start (option)",
+             "adaptive_burst_off": "adaptive (default), burst discount off (`--playback-burst-discount off`)"}
     lines = [head, "", "| relay profile (client → server) | estimator | start latency (per run) | hindsight minimum "
              "| ratio (per run) | hindsight + hand-over | ratio to it | late frames | pauses past the bound "
              "| largest gap stretch | whole-sequence stretch |",

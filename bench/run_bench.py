@@ -371,6 +371,10 @@ class Bench:
                     ("WAN 300 ms +-50 ms, 1 % loss", ["--profile", "wan-300"])]
         if self.quick:
             profiles = [profiles[0], profiles[2], profiles[4]]
+        # ROBOTALK_BENCH_PROFILES="U[0, 100];WAN 100" runs only the profiles whose names start so.
+        only_profiles = [p for p in os.environ.get("ROBOTALK_BENCH_PROFILES", "").split(";") if p]
+        if only_profiles:
+            profiles = [p for p in profiles if any(p[0].startswith(o) for o in only_profiles)]
         reps = self.runs  # relay seeds per profile: 5 (quick: 3)
         # (name, server arguments, client arguments, the server's hand-over margin in ms: a frame of
         # the adaptive schedule must have arrived that long before it plays; the fixed schedule of
@@ -384,7 +388,13 @@ class Bench:
                     ("adaptive", adaptive, [], 2.0, None),  # the server's default, a client without redundancy
                     # a lost frame's retransmission comes a round trip late: the client's redundancy
                     ("adaptive_copies", adaptive, ["--copies", "2"], 2.0, ("WAN",)),
-                    ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested))
+                    ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested),
+                    # before the connect burst's own queue was left out of the delay spread
+                    ("adaptive_burst_off", adaptive + ["--playback-burst-discount", "off"], [], 2.0, congested + ("WAN",)))
+        # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
+        only_variants = [v for v in os.environ.get("ROBOTALK_BENCH_VARIANTS", "").split(",") if v]
+        if only_variants:
+            variants = tuple(v for v in variants if v[0] in only_variants)
         runs = []
         # Another first seed (ROBOTALK_BENCH_SEED) gives a second set of relay draws to pool with the first.
         seed = int(os.environ.get("ROBOTALK_BENCH_SEED", "101"))

@@ -60,13 +60,64 @@ void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<Ti
   frames_.push_back({offset, arrival, sent ? OneWayDelay(*sent, arrival) : std::nullopt});
 }
 
-std::optional<Duration> PlaybackEstimator::delay_spread() const {
-  std::vector<Duration> delays = history_;
+std::vector<PlaybackEstimator::Seen> PlaybackEstimator::SeenPackages() const {
+  std::vector<Seen> seen;
+  if (frames_.empty() || history_.size() + frames_.size() < options_.quick_min_delays) return seen;
+  const bool known = history_received_.size() == history_.size();
+  for (std::size_t k = 0; k < history_.size(); ++k)
+    seen.push_back({known ? history_received_[k] : TimePoint{}, history_[k], known});
   for (const Frame& f : frames_) {
-    if (!f.delay) return std::nullopt;  // a client that sends no send times
-    delays.push_back(*f.delay);
+    if (!f.delay) return {};  // a client that sends no send times
+    seen.push_back({f.arrival, *f.delay, true});
   }
-  if (frames_.empty() || delays.size() < options_.quick_min_delays) return std::nullopt;
+  return seen;
+}
+
+std::vector<Duration> PlaybackEstimator::ChannelDelays(bool discount) const {
+  const std::vector<Seen> seen = SeenPackages();
+  std::vector<Duration> delays;
+  for (const Seen& p : seen) delays.push_back(p.delay);
+  if (!discount || delays.empty()) return delays;
+  // A client's connect-time packages (hello, clock, heartbeat) leave within a
+  // millisecond; on a congested FIFO link each waits for the one before it to
+  // get through, so their delays add up the services before them: a spread
+  // that a frame, one interval after the one before it, does not meet. With
+  // d_min the least delay, package j would have arrived at u_j = s_j + d_min
+  // (s_j its send time) behind an empty queue; it could not get through
+  // before a_{j-1}, so it waited w_j = max(0, a_{j-1} - u_j) behind its
+  // predecessor (Lindley's recursion, as in Services). That wait is left
+  // out for a package sent less than a frame interval after the one before
+  // it (a burst denser than the sequence), the first frame's included (sent
+  // right after the connect-time packages). A later frame keeps its wait: a
+  // queue of frames is what the gate is for.
+  const Duration least = *std::min_element(delays.begin(), delays.end());
+  const Duration burst = FromSeconds(interval());
+  for (std::size_t j = 1; j < seen.size() && j <= history_.size(); ++j) {
+    if (!seen[j].known_arrival || !seen[j - 1].known_arrival) continue;
+    const TimePoint sent = seen[j].arrival - seen[j].delay,
+                    sent_before = seen[j - 1].arrival - seen[j - 1].delay;
+    if (sent - sent_before >= burst || sent < sent_before) continue;
+    const Duration wait = seen[j - 1].arrival - (sent + least);
+    delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
+  }
+  return delays;
+}
+
+bool PlaybackEstimator::burst_discounted() const {
+  if (!options_.burst_wait_discount) return false;
+  const auto spread = [](const std::vector<Duration>& d) {
+    const auto [lo, hi] = std::minmax_element(d.begin(), d.end());
+    return ToSeconds(*hi - *lo);
+  };
+  const std::vector<Duration> measured = ChannelDelays(false);
+  if (measured.empty()) return false;
+  const double gate = options_.adaptive_max_spread * interval();
+  return spread(measured) > gate && spread(ChannelDelays(true)) <= gate;
+}
+
+std::optional<Duration> PlaybackEstimator::delay_spread() const {
+  const std::vector<Duration> delays = ChannelDelays(burst_discounted());
+  if (delays.empty()) return std::nullopt;
   const auto [lo, hi] = std::minmax_element(delays.begin(), delays.end());
   return *hi - *lo;
 }
@@ -76,9 +127,8 @@ double PlaybackEstimator::interval() const {
 }
 
 std::optional<PlaybackEstimator::Spread> PlaybackEstimator::FencedSpread() const {
-  if (!delay_spread()) return std::nullopt;  // too few, or a frame without a send time
-  std::vector<Duration> delays = history_;
-  for (const Frame& f : frames_) delays.push_back(*f.delay);
+  std::vector<Duration> delays = ChannelDelays(burst_discounted());
+  if (delays.empty()) return std::nullopt;  // too few, or a frame without a send time
   std::sort(delays.begin(), delays.end());
   // A package whose first copy was lost arrives as its retransmission, which
   // carries its first send time: its delay includes the client's resend wait
@@ -142,27 +192,19 @@ std::vector<double> PlaybackEstimator::Services() const {
   // before it until max(a_{j-1}, u_j), so its own service took
   // s_j = a_j - max(a_{j-1}, u_j) (Lindley's recursion read backwards). A
   // delay beyond the fence (a retransmission: its resend wait) is no service.
-  struct Seen {
-    TimePoint arrival;
-    Duration delay;
-    bool known_arrival;
-  };
-  std::vector<Seen> seen;
-  for (std::size_t k = 0; k < history_.size(); ++k) {
-    const bool known = history_received_.size() == history_.size();
-    seen.push_back({known ? history_received_[k] : TimePoint{}, history_[k], known});
-  }
-  for (const Frame& f : frames_) seen.push_back({f.arrival, *f.delay, true});  // both in arrival order
+  const std::vector<Seen> seen = SeenPackages();  // both in arrival order
+  const std::vector<Duration> channel = ChannelDelays(burst_discounted());
   const Spread fenced = *FencedSpread();
   std::vector<double> service;  // s
   std::optional<TimePoint> previous;
-  for (const Seen& p : seen) {
+  for (std::size_t k = 0; k < seen.size(); ++k) {
+    const Seen& p = seen[k];
     const Duration excess = p.delay - fenced.least;
     Duration s = excess;  // arrival unknown: as if it had not queued (the larger service)
     if (p.known_arrival && previous)
       s = std::min(excess, p.arrival - std::max(*previous, p.arrival - excess));
     if (p.known_arrival) previous = p.arrival;
-    if (p.delay <= fenced.most) service.push_back(ToSeconds(s));
+    if (channel[k] <= fenced.most) service.push_back(ToSeconds(s));
   }
   return service;  // not empty: the fence keeps the least
 }

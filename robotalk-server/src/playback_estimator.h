@@ -42,6 +42,12 @@
 // delay by frame 1. Where the spread exceeds one frame interval a queue can build that the history (sparse
 // packages, no queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
 // adaptive_max_spread intervals: the paper's estimate, then the stretch.
+// The connect burst (burst_wait_discount, on): a client's hello, clock and
+// heartbeat leave together and, on a congested FIFO link, wait behind each
+// other, a spread its frames (one interval apart) do not meet. Where the
+// delays as measured exceed the gate, each package sent less than a frame
+// interval after the one before it counts without that wait (ChannelDelays);
+// if the gate then passes, the adaptive start decides from those delays.
 //
 // Queue start (issue 23 item 3; `queue_start`, off by default): beyond
 // `adaptive_max_spread` intervals the delays are a queue's (a congested link),
@@ -127,6 +133,12 @@ struct PlaybackEstimatorOptions {
   double queue_quantile = 1.0;
   /// Resampled queues (each as long as the sequence, at most kQueueHorizon frames).
   std::size_t queue_resamples = 200;
+  /// A package sent less than a frame interval after the one before it (the
+  /// connect-time burst: hello, clock, heartbeat; the first frame too) that
+  /// waited behind it on a FIFO link: that wait is left out of its delay for
+  /// the spread and the worst delay where the delays as measured exceed
+  /// adaptive_max_spread (see ChannelDelays). Off: every delay as measured.
+  bool burst_wait_discount = true;
 };
 
 /// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
@@ -199,6 +211,11 @@ class PlaybackEstimator {
   /// Max − min of the recent one-way delays and the frames' (nullopt: too
   /// few, or a frame without a send time).
   std::optional<Duration> delay_spread() const;
+  /// Whether that spread (and the worst delay) leaves out the wait of a
+  /// connect-time burst's packages behind each other (burst_wait_discount):
+  /// only where the delays as measured exceed adaptive_max_spread and the
+  /// discounted ones do not.
+  bool burst_discounted() const;
 
   /// The server time at which offset 0 plays. REQUIRES: ready().
   TimePoint StartTime() const;
@@ -229,6 +246,19 @@ class PlaybackEstimator {
     std::size_t kept;      // delays within the fence
   };
   std::optional<Spread> FencedSpread() const;
+  // The delays seen (the history's, then the frames', both in arrival order),
+  // with their arrivals where known; empty: too few, or a frame without a send time.
+  struct Seen {
+    TimePoint arrival;
+    Duration delay;
+    bool known_arrival;
+  };
+  std::vector<Seen> SeenPackages() const;
+  // Their delays; with `discount`, each less its wait behind the package
+  // before it where it was sent less than a frame interval after it (not
+  // a frame after the first).
+  std::vector<Duration> ChannelDelays(bool discount) const;
+
   double interval() const;  // the declared mean frame interval, s
   std::size_t total_;
   Duration duration_;

@@ -139,6 +139,7 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
           ", more than a frame interval; covers the queue its frames will build";
   } else if (estimator.adaptive()) {
     why = "adaptive start: this client's recent one-way delays vary by " + Seconds(*estimator.delay_spread());
+    if (estimator.burst_discounted()) why += " (less the wait of packages sent together behind each other)";
     if (estimator.start_lead() > Duration(0)) {
       why += "; starts " + Seconds(estimator.start_lead()) +
              " below the worst delay, which the first gap's stretch reaches";

@@ -52,6 +52,9 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals
                                   start from a simulated queue of the sequence's frames (on)
                                   or wait for frames (off, default: the paper's estimate)
+  --playback-burst-discount on|off
+                                  adaptive: leave a connect-time package's wait behind the
+                                  one sent just before it out of the delay spread (default on)
   --playback-start-lead G         adaptive: start G gaps' stretch below the worst delay, which
                                   the first gaps' stretch then reaches (default 1; 0: the
                                   start covers it)
@@ -228,6 +231,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-queue-start '" + v + "': expected on or off");
         options.playback_queue_start = v == "on";
+      } else if (arg == "--playback-burst-discount") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-burst-discount '" + v + "': expected on or off");
+        options.playback_burst_discount = v == "on";
       } else if (arg == "--playback-start-lead") {
         options.playback_start_lead = ParseNumber(arg, value(), 0, 100);
       } else if (arg == "--duration") {

@@ -102,11 +102,12 @@ struct SimRun {
 
 // A paced client (frame i sent at offset i), `history` connect-time packages
 // before it (each a round trip: sent once the one before it arrived, and at
-// least 20 ms after it), one-way delay delay(k, sent) for the k-th package;
+// least 20 ms after it; with `burst`, all sent 1 ms apart, as a client's
+// hello, clock and heartbeat), one-way delay delay(k, sent) for the k-th package;
 // its clock reads 5000 s ahead. `options` decides how the start is estimated.
 SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
                 const std::function<Duration(std::size_t, TimePoint)>& delay,
-                PlaybackEstimatorOptions options = {}) {
+                PlaybackEstimatorOptions options = {}, bool burst = false) {
   const Duration skew = std::chrono::seconds(5000);
   PlaybackEstimator est(frames, period * static_cast<int>(frames - 1), options);
   DelayHistory h;
@@ -114,7 +115,7 @@ SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
   for (TimePoint next = kT0 - std::chrono::seconds(4); k < history; ++k) {
     const TimePoint sent = next, arrival = sent + delay(k, sent);
     h.Add(sent + skew, arrival);
-    next = std::max(sent + milliseconds(20), arrival + milliseconds(1));
+    next = burst ? sent + milliseconds(1) : std::max(sent + milliseconds(20), arrival + milliseconds(1));
   }
   struct Frame {
     Duration offset;
@@ -168,15 +169,15 @@ struct Summary {
 // minimum, both + the 2 ms margin every start needs (a frame must be in the
 // RobotDaemon's queue before it is due).
 using Channel = std::function<Duration(std::mt19937_64&, std::size_t, TimePoint)>;
-Summary Many(int runs, const Channel& channel, PlaybackEstimatorOptions options = {},
-             std::size_t frames = 40) {
+Summary Many(int runs, const Channel& channel, PlaybackEstimatorOptions options = {}, std::size_t frames = 40,
+             std::size_t burst = 0) {
   Summary s;
   std::vector<double> ratios;
   for (int seed = 1; seed <= runs; ++seed) {
     std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
     const SimRun r = Simulate(
-        frames, milliseconds(100), 10, [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); },
-        options);
+        frames, milliseconds(100), burst > 0 ? burst : 10,
+        [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); }, options, burst > 0);
     s.late_frames += r.late;
     if (r.late > 0) ++s.late_runs;
     s.worst_stretch = std::max(s.worst_stretch, r.max_gap_stretch);
@@ -278,6 +279,43 @@ TEST(AdaptivePlayback, OnACongestedLinkAQueueBuildsAndTheStartCoversIt) {
     EXPECT_LE(q.median_ratio, 1.6);
     EXPECT_LE(q.late_runs, 70);
   }
+}
+
+TEST(AdaptivePlayback, OnACongestedLinkTheConnectBurstsOwnQueueDoesNotTripTheGate) {
+  // The relay's U[0, X] FIFO link with the client's connect-time packages
+  // sent as a burst (1 ms apart) 4 s before the sequence: each waits behind
+  // the one before it, so their delays add up (the paper's estimate decided
+  // in 5 of 10 relay runs at X = 100, 9 of 10 at X = 150). Less that wait,
+  // the delays spread as the services, which frames 100 ms apart meet.
+  for (double x : {100.0, 150.0}) {
+    const Summary before = Many(300, Fifo(x), {.burst_wait_discount = false}, 40, 4);
+    const Summary now = Many(300, Fifo(x), {}, 40, 4);
+    std::printf(
+        "X = %.0f, a burst of 4: median ratio %.2f -> %.2f, late runs %d -> %d of 300 (%d -> %d frames)\n", x,
+        before.median_ratio, now.median_ratio, before.late_runs, now.late_runs, before.late_frames,
+        now.late_frames);
+    EXPECT_LE(now.worst_stretch, PlaybackEstimatorOptions{}.max_stretch + 1e-9);
+    EXPECT_LT(now.median_ratio, before.median_ratio) << "X = " << x;
+    if (x < 120) {  // a frame's service fits in its interval
+      // Measured 29.7 -> 1.60, 2 -> 8 late runs: four services are a small
+      // sample, and a waiting package's delay is the least seen (the first
+      // package's, a service itself) + its service, an overestimate by the
+      // least service (never an underestimate: see ChannelDelays).
+      EXPECT_GT(before.median_ratio, 5.0) << "the cause, reproduced: the paper's estimate";
+      EXPECT_LE(now.median_ratio, 2.0);
+      EXPECT_LE(now.late_runs, 20);
+    }
+  }
+  // Fig. 11's server pauses with the same burst: the burst's services are
+  // the pauses (U[0, 250] ms), so the gate mostly still gives the paper's
+  // estimate; where all four pauses were under 1.2 intervals (0.48^4, 5 %)
+  // the adaptive start decides and the 25 % drift outruns the stretch:
+  // measured 2 -> 6 runs late of 100.
+  const Summary fig11 = Many(100, ServerPauses(250), {}, 129, 4);
+  const Summary fig11_before = Many(100, ServerPauses(250), {.burst_wait_discount = false}, 129, 4);
+  std::printf("Fig. 11 injector, a burst of 4: runs late %d -> %d of 100\n", fig11_before.late_runs,
+              fig11.late_runs);
+  EXPECT_LE(fig11.late_runs, 10);
 }
 
 TEST(AdaptivePlayback, ThePapersCongestionGetsThePapersEstimateBecauseNeitherStartCanSeeItsDrift) {
@@ -439,18 +477,55 @@ TEST(QueueStart, ReadsEachServiceFromABurstAndCoversTheWorstWhereNoQueueCanBuild
   std::vector<DelayHistory::Sample> history{{burst + milliseconds(1), milliseconds(1)}};
   for (int j = 1; j <= 5; ++j)
     history.push_back({burst + milliseconds(1 + 30 * j), milliseconds(1 + 30 * j)});
-  PlaybackEstimator est(40, milliseconds(3900), {.queue_start = true});
+  // (Without the burst's discount, AConnectBurstThatQueuedBehindItself... below.)
+  PlaybackEstimator est(40, milliseconds(3900), {.queue_start = true, .burst_wait_discount = false});
   est.SetDelayHistory(history);
   est.Add(Duration(0), kT0, kT0 - milliseconds(1));
   ASSERT_TRUE(est.ready());
   EXPECT_TRUE(est.queued());
   EXPECT_EQ(est.StartTime(), kT0 + milliseconds(32));
   EXPECT_EQ(est.playout_delay(), milliseconds(33));
-  // Without the queue start (the default): the paper's estimate, which waits for frames.
-  PlaybackEstimator paper(40, milliseconds(3900));
+  // Without the queue start: the paper's estimate, which waits for frames.
+  PlaybackEstimator paper(40, milliseconds(3900), {.burst_wait_discount = false});
   paper.SetDelayHistory(history);
   paper.Add(Duration(0), kT0, kT0 - milliseconds(1));
   EXPECT_FALSE(paper.ready());
+}
+
+TEST(AdaptivePlayback, AConnectBurstThatQueuedBehindItselfOnAFifoLinkGetsTheAdaptiveStart) {
+  // The same burst (issue 23 item 3's U[0, 100] and U[0, 150] relay runs):
+  // six packages sent at once through a FIFO link, delays 1, 31, ..., 151
+  // ms. Package j waited 30 (j - 1) ms behind package j - 1, sent with it;
+  // a frame, 100 ms after the one before it, does not. Less that wait each
+  // took 31 ms: a spread of 30 ms, within the gate, so the adaptive start
+  // decides at the first frame: the worst, 31 ms, + 30 ms / 7 delays, less
+  // this frame's 1 ms and the 10 ms start lead, + 2 ms (with the discount
+  // off: the paper's estimate, ReadsEachServiceFromABurst... above).
+  const TimePoint burst = kT0 - std::chrono::seconds(2);
+  std::vector<DelayHistory::Sample> history{{burst + milliseconds(1), milliseconds(1)}};
+  for (int j = 1; j <= 5; ++j)
+    history.push_back({burst + milliseconds(1 + 30 * j), milliseconds(1 + 30 * j)});
+  PlaybackEstimator est(40, milliseconds(3900));
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  ASSERT_TRUE(est.adaptive());
+  EXPECT_FALSE(est.queued());
+  ASSERT_TRUE(est.ready());
+  EXPECT_EQ(est.delay_spread(), milliseconds(30));
+  EXPECT_TRUE(est.burst_discounted());
+  EXPECT_EQ(est.StartTime(), kT0 + milliseconds(22) + FromSeconds(0.030 / 7));
+  // The schedule grows the buffer to the worst + 4 x 30 ms / 7, + 2 ms.
+  EXPECT_EQ(est.playout_delay(), milliseconds(33) + FromSeconds(0.120 / 7));
+  // Sent a frame interval apart they are no burst:
+  // their delays are the channel's as frames meet it: the paper's estimate.
+  std::vector<DelayHistory::Sample> paced{{burst + milliseconds(1), milliseconds(1)}};
+  for (int j = 1; j <= 5; ++j)
+    paced.push_back({burst + milliseconds(100 * j + 1 + 30 * j), milliseconds(1 + 30 * j)});
+  PlaybackEstimator sparse(40, milliseconds(3900));
+  sparse.SetDelayHistory(paced);
+  sparse.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  EXPECT_FALSE(sparse.adaptive());
+  EXPECT_FALSE(sparse.ready());
 }
 
 TEST(QueueStart, WaitsWhileTheNextFrameMayComeFirstAndLearnsFromEachFrame) {

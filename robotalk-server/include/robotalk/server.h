@@ -132,6 +132,10 @@ struct ServerOptions {
   /// start (a simulated queue of the sequence's frames) when on; off (the
   /// default): the paper's estimate.
   bool playback_queue_start = false;
+  /// Adaptive: a connect-time package's wait behind the client's package
+  /// sent just before it is left out of its delay where that brings the
+  /// spread within the gate (PlaybackEstimatorOptions::burst_wait_discount).
+  bool playback_burst_discount = true;
   /// Adaptive: the start lies this many gaps' stretch (playback_stretch ×
   /// the frame interval each) below the worst delay it covers; the first
   /// gaps' stretch reaches it (PlaybackEstimatorOptions::start_lead). 0: the
