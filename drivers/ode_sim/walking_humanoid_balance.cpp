@@ -1,0 +1,131 @@
+// The walking controller's balance feedback: the measured centre of
+// pressure and centre of mass, the DCM stabilizer and step adjustment
+// (stabilizer=true), the push recovery's hook (push_recovery=true), and the
+// walk status that reports them. See walking_humanoid.h.
+#include "walking_humanoid.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
+
+namespace robotalk::ode_detail {
+
+using walking::Pose2;
+using walking::Side;
+
+void WalkingHumanoid::MeasureContacts() {
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  double fz = 0;
+  foot_force_[0] = foot_force_[1] = 0;
+  foot_contacts_[0] = foot_contacts_[1] = 0;
+  for (const ContactPoint& c : world_->contacts()) {
+    for (int s = 0; s < 2; ++s) {
+      if (c.link != feet_[static_cast<size_t>(s)]) continue;
+      foot_force_[s] += c.force.z();
+      ++foot_contacts_[s];
+    }
+    fz += c.force.z();
+    moment += c.force.z() * c.position;
+  }
+  zmp_valid_ = fz > 1e-6;
+  if (zmp_valid_) zmp_measured_ = moment.head<2>() / fz;
+}
+
+// The measured CoM (the model's kinematics at the measured joints and root)
+// and its velocity (differenced, low-passed over kComFilter), the measured
+// CoP, into the plan frame; the stabilizer's ZMP command becomes the CoM
+// reference's offset (walking/dcm_stabilizer.h). Off during the start-up.
+void WalkingHumanoid::Balance() {
+  constexpr double kComFilter = 0.01;  // s
+  const Eigen::Vector3d com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
+  const Eigen::Vector2d xy = com.head<2>();
+  if (tick_ <= 1) com_world_prev_ = xy;
+  com_velocity_ += ((xy - com_world_prev_) / step_ - com_velocity_) * std::min(1.0, step_ / kComFilter);
+  com_world_prev_ = xy;
+  if (com_estimate_) com_estimate_->Update(xy, zmp_valid_ ? &zmp_measured_ : nullptr);
+  if (tick_ < settle_ticks_) return;
+  const double c = std::cos(plan_to_world_.theta), s = std::sin(plan_to_world_.theta);
+  const Eigen::Vector2d v(c * com_velocity_.x() + s * com_velocity_.y(),
+                          -s * com_velocity_.x() + c * com_velocity_.y());
+  const Eigen::Vector2d at = ToPlan({xy.x(), xy.y(), 0}).xy();
+  if (recovery_) {
+    // Estimated (DcmEstimator), read from the support foot (the feet slip
+    // and turn), put on its plan.
+    const Side sup = pattern_.support_side();
+    const Pose2 to = pattern_.foot(sup), from = MeasuredFoot(sup);
+    if (recovery_->Update(pattern_, walking::Relocate(from, to, com_estimate_->com()),
+                          walking::Relocate(from, to, com_estimate_->com_velocity(), true)))
+      com_offset_->Reset();
+  }
+  if (!stabilize_) return;
+  const Eigen::Vector2d cop = ToPlan({zmp_measured_.x(), zmp_measured_.y(), 0}).xy();
+  std::array<Eigen::Vector2d, 16> support;
+  const int n = pattern_.SupportPolygon(support);
+  balance_ = dcm_->Update(at, v, pattern_.com(), pattern_.com_velocity(), pattern_.zmp_ref(),
+                          std::span(support.data(), static_cast<size_t>(n)), pattern_.time_to_landing());
+  com_offset_->Update(balance_, at, pattern_.com(), pattern_.zmp_ref(), zmp_valid_ ? &cop : nullptr, step_);
+}
+
+// Step adjustment: while the ankles cannot hold the DCM (the stabilizer's
+// ZMP saturated) the foot in the air is moved toward where the DCM will be
+// at its touch-down, at most kAdjustRate fast (its swing stays smooth) and
+// not in the last kLateAdjust s of its swing; the last target is kept.
+void WalkingHumanoid::AdjustStep() {
+  constexpr double kAdjustRate = 1.0;   // m/s
+  constexpr double kLateAdjust = 0.15;  // s
+  if (!adjust_steps_ || tick_ < settle_ticks_) return;
+  if (pattern_.started_steps() != adjusted_step_) {
+    adjusted_step_ = pattern_.started_steps();
+    step_target_.setZero();
+    step_applied_.setZero();
+  }
+  if (pattern_.time_to_landing() <= kLateAdjust) return;
+  if (balance_.saturated && balance_.step_offset.norm() > 0) step_target_ = balance_.step_offset;
+  const double r = kAdjustRate * step_;
+  const Eigen::Vector2d next = step_applied_ + (step_target_ - step_applied_).cwiseMax(-r).cwiseMin(r);
+  if ((next - step_applied_).norm() > 1e-12) {
+    step_applied_ = pattern_.AdjustLanding(next, g_.foot_separation + 2 * g_.step_forward + 0.05);
+  }
+}
+
+walking::WalkStatus WalkingHumanoid::status() const {
+  walking::WalkStatus s;
+  s.stepping = !pattern_.standing();
+  s.fallen = fallen_;
+  s.tilt = tilt_;
+  s.steps_taken = pattern_.started_steps();
+  s.recoveries = recovery_ ? recovery_->regenerations() : 0;
+  const Pose2 com = ToWorld({pattern_.com().x(), pattern_.com().y(), 0});
+  s.com_plan = com.xy();
+  const Eigen::Vector2d z = pattern_.zmp_ref();
+  s.zmp_ref = ToWorld({z.x(), z.y(), 0}).xy();
+  for (int i = 0; i < 2; ++i) {
+    s.foot[i] = ToWorld(pattern_.foot(static_cast<Side>(i)));
+    s.foot_height[i] = pattern_.foot_height(static_cast<Side>(i));
+  }
+  s.pelvis = MeasuredPelvis();
+  s.zmp = zmp_measured_;
+  s.tracking_error = tracking_error_;
+  for (int i = 0; i < 2; ++i) {
+    s.foot_force[i] = foot_force_[i];
+    s.foot_contacts[i] = foot_contacts_[i];
+  }
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Isometry3d f = world_->LinkPose(feet_[static_cast<size_t>(i)]);
+    s.foot_measured[i] = MeasuredFoot(static_cast<Side>(i));
+    s.foot_tilt[i] = std::acos(std::clamp(f.linear()(2, 2), -1.0, 1.0));
+  }
+  s.com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
+  if (stabilize_ && tick_ >= settle_ticks_) {
+    s.dcm = ToWorld({balance_.dcm.x(), balance_.dcm.y(), 0}).xy();
+    s.dcm_ref = ToWorld({balance_.dcm_ref.x(), balance_.dcm_ref.y(), 0}).xy();
+    s.zmp_command = ToWorld({balance_.zmp.x(), balance_.zmp.y(), 0}).xy();
+    s.com_offset =
+        Pose2{0, 0, plan_to_world_.theta}.Apply(com_offset_->offset().x(), com_offset_->offset().y());
+    s.saturated = balance_.saturated;
+  }
+  return s;
+}
+
+}  // namespace robotalk::ode_detail
