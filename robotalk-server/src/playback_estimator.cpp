@@ -73,11 +73,17 @@ std::vector<PlaybackEstimator::Seen> PlaybackEstimator::SeenPackages() const {
   return seen;
 }
 
-std::vector<Duration> PlaybackEstimator::ChannelDelays(bool discount) const {
+PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
   const std::vector<Seen> seen = SeenPackages();
-  std::vector<Duration> delays;
-  for (const Seen& p : seen) delays.push_back(p.delay);
-  if (!discount || delays.empty()) return delays;
+  Channel measured;
+  for (const Seen& p : seen) measured.delays.push_back(p.delay);
+  if (!options_.burst_wait_discount || measured.delays.empty()) return measured;
+  const auto spread = [](const std::vector<Duration>& d) {
+    const auto [lo, hi] = std::minmax_element(d.begin(), d.end());
+    return ToSeconds(*hi - *lo);
+  };
+  const double gate = options_.adaptive_max_spread * interval();
+  if (spread(measured.delays) <= gate) return measured;
   // A client's connect-time packages (hello, clock, heartbeat) leave within a
   // millisecond; on a congested FIFO link each waits for the one before it to
   // get through, so their delays add up the services before them: a spread
@@ -90,7 +96,8 @@ std::vector<Duration> PlaybackEstimator::ChannelDelays(bool discount) const {
   // it (a burst denser than the sequence), the first frame's included (sent
   // right after the connect-time packages). A later frame keeps its wait: a
   // queue of frames is what the gate is for.
-  const Duration least = *std::min_element(delays.begin(), delays.end());
+  Channel discounted{measured.delays, true};
+  const Duration least = *std::min_element(measured.delays.begin(), measured.delays.end());
   const Duration burst = FromSeconds(interval());
   for (std::size_t j = 1; j < seen.size() && j <= history_.size(); ++j) {
     if (!seen[j].known_arrival || !seen[j - 1].known_arrival) continue;
@@ -98,25 +105,16 @@ std::vector<Duration> PlaybackEstimator::ChannelDelays(bool discount) const {
                     sent_before = seen[j - 1].arrival - seen[j - 1].delay;
     if (sent - sent_before >= burst || sent < sent_before) continue;
     const Duration wait = seen[j - 1].arrival - (sent + least);
-    delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
+    discounted.delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
   }
-  return delays;
+  // Only where that brings the spread within the gate; else as measured.
+  return spread(discounted.delays) <= gate ? discounted : measured;
 }
 
-bool PlaybackEstimator::burst_discounted() const {
-  if (!options_.burst_wait_discount) return false;
-  const auto spread = [](const std::vector<Duration>& d) {
-    const auto [lo, hi] = std::minmax_element(d.begin(), d.end());
-    return ToSeconds(*hi - *lo);
-  };
-  const std::vector<Duration> measured = ChannelDelays(false);
-  if (measured.empty()) return false;
-  const double gate = options_.adaptive_max_spread * interval();
-  return spread(measured) > gate && spread(ChannelDelays(true)) <= gate;
-}
+bool PlaybackEstimator::burst_discounted() const { return ChannelDelays().discounted; }
 
 std::optional<Duration> PlaybackEstimator::delay_spread() const {
-  const std::vector<Duration> delays = ChannelDelays(burst_discounted());
+  const std::vector<Duration> delays = ChannelDelays().delays;
   if (delays.empty()) return std::nullopt;
   const auto [lo, hi] = std::minmax_element(delays.begin(), delays.end());
   return *hi - *lo;
@@ -127,7 +125,7 @@ double PlaybackEstimator::interval() const {
 }
 
 std::optional<PlaybackEstimator::Spread> PlaybackEstimator::FencedSpread() const {
-  std::vector<Duration> delays = ChannelDelays(burst_discounted());
+  std::vector<Duration> delays = ChannelDelays().delays;
   if (delays.empty()) return std::nullopt;  // too few, or a frame without a send time
   std::sort(delays.begin(), delays.end());
   // A package whose first copy was lost arrives as its retransmission, which
@@ -193,7 +191,7 @@ std::vector<double> PlaybackEstimator::Services() const {
   // s_j = a_j - max(a_{j-1}, u_j) (Lindley's recursion read backwards). A
   // delay beyond the fence (a retransmission: its resend wait) is no service.
   const std::vector<Seen> seen = SeenPackages();  // both in arrival order
-  const std::vector<Duration> channel = ChannelDelays(burst_discounted());
+  const std::vector<Duration> channel = ChannelDelays().delays;
   const Spread fenced = *FencedSpread();
   std::vector<double> service;  // s
   std::optional<TimePoint> previous;

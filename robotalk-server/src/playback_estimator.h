@@ -254,10 +254,16 @@ class PlaybackEstimator {
     bool known_arrival;
   };
   std::vector<Seen> SeenPackages() const;
-  // Their delays; with `discount`, each less its wait behind the package
-  // before it where it was sent less than a frame interval after it (not
-  // a frame after the first).
-  std::vector<Duration> ChannelDelays(bool discount) const;
+  // Their delays (empty: too few, or a frame without a send time). With
+  // burst_wait_discount, where the measured spread exceeds the gate and
+  // discounting brings it within, each less its wait behind the package
+  // before it where it was sent less than a frame interval after it (not a
+  // frame after the first): `discounted`.
+  struct Channel {
+    std::vector<Duration> delays;
+    bool discounted = false;
+  };
+  Channel ChannelDelays() const;
 
   double interval() const;  // the declared mean frame interval, s
   std::size_t total_;

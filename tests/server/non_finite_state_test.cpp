@@ -55,6 +55,14 @@ QueuedItem Query(CommandId id, QueryType type) {
   return item;
 }
 
+// A finite state that fits PanRobot: one dof, one root, all zeros.
+RobotState FittingState() {
+  RobotState s;
+  s.position = s.velocity = s.effort = Eigen::VectorXd::Zero(1);
+  s.root_poses.resize(1);
+  return s;
+}
+
 class NonFiniteStateTest : public ::testing::Test {
  protected:
   NonFiniteStateTest() {
@@ -77,9 +85,7 @@ class NonFiniteStateTest : public ::testing::Test {
 
 TEST(NonFiniteState, NamesTheJointAndDofOrTheBaseField) {
   const RobotModel model = testing::PanRobot();
-  RobotState s;
-  s.position = s.velocity = s.effort = Eigen::VectorXd::Zero(1);
-  s.root_poses.resize(1);
+  RobotState s = FittingState();
   EXPECT_EQ(NonFiniteState(model, s), std::nullopt);
   s.velocity[0] = -std::numeric_limits<double>::infinity();
   EXPECT_EQ(NonFiniteState(model, s), "joint 'pan' dof 0 velocity is -inf");
@@ -188,9 +194,7 @@ TEST_F(NonFiniteStateTest, WaypointsArrivingWhenTheDriverCannotReadItsStateAreIn
 
 TEST(NonFiniteState, AStateOfTheWrongShapeIsNamed) {
   const RobotModel model = testing::PanRobot();
-  RobotState s;
-  s.position = s.velocity = s.effort = Eigen::VectorXd::Zero(1);
-  s.root_poses.resize(1);
+  RobotState s = FittingState();
   EXPECT_EQ(MisfitState(model, s), std::nullopt);
   s.velocity.resize(0);
   EXPECT_EQ(MisfitState(model, s), "velocity has 0 values, the model has 1 dofs");
