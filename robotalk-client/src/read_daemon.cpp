@@ -433,8 +433,9 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
                 .server_hold = std::max(Duration::zero(), batch.server_send - batch.server_receive)});
         if (info.known && info.first && clock_packages_.erase(batch.ack_sequence) != 0 &&
             !info.retransmitted) {
-          // Only a never-resent package gives an unambiguous t1.
-          clock_sync_.AddSample(info.first_send, batch.server_receive, batch.server_send, now);
+          // Only a never-resent package gives an unambiguous t1; t4 is the
+          // socket's stamp, so a starved read thread does not skew the offset.
+          clock_sync_.AddSample(info.first_send, batch.server_receive, batch.server_send, arrived);
         }
         notify = NotePanicAnswer(batch);
       }
