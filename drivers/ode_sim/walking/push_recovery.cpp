@@ -229,4 +229,19 @@ bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, cons
   return true;
 }
 
+PushRecovery::Walk PushRecovery::Watch(WalkPattern& pattern, const Eigen::Vector2d& impulse) {
+  if (p_.stop_impulse > 0 && impulse.norm() > p_.stop_impulse) {
+    if (hold_ <= 0 && !pattern.standing()) {
+      pattern.StopSoon();
+      ++stops_;
+      hold_ = p_.stop_hold;
+    } else if (hold_ > 0) {
+      hold_ = p_.stop_hold;
+    }
+  }
+  if (hold_ <= 0) return Walk::kOn;
+  hold_ -= tick_;
+  return hold_ > 0 ? Walk::kHold : Walk::kResume;
+}
+
 }  // namespace robotalk::walking

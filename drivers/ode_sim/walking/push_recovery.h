@@ -34,6 +34,8 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
+
 namespace robotalk::walking {
 
 /// The foothold shift that captures a DCM error e0 (m) which grows on the
@@ -70,6 +72,13 @@ struct RecoveryParams {
   int fast_steps = 2;             ///< the steps after the moved one taken at the fast timing below
   double fast_single = 0.4;       ///< s: their single support
   double fast_double = 0.1;       ///< s: their double support
+  // Stop and stand (Watch): walking, a push of more than stop_impulse (the
+  // DcmEstimator's impulse(), m/s per unit mass: walking unpushed on ODE it
+  // stays under 0.084; 10 N s on the 52.5 kg humanoid is 0.19) stops the
+  // walk (WalkPattern::StopSoon) and the robot stands stop_hold s before the
+  // walk goes on. 0: off.
+  double stop_impulse = 0.1;  ///< m/s
+  double stop_hold = 3.0;     ///< s
 };
 
 class PushRecovery {
@@ -85,12 +94,29 @@ class PushRecovery {
   int regenerations() const { return count_; }
   const RecoveryParams& params() const { return p_; }
 
+  /// What the walk does after Watch().
+  enum class Walk : std::uint8_t {
+    kOn,      ///< walks on (no push, or the hold is over)
+    kHold,    ///< stopped by a push: stands; queue no steps
+    kResume,  ///< this tick the hold ended: re-plan (a GOTO) and walk on
+  };
+  /// One control tick with the estimated push impulse (m/s): when it passes
+  /// stop_impulse while the pattern walks, stops it (the step in the air
+  /// lands, the next brings the other foot alongside, the weight shifts to
+  /// the middle: WalkPattern::StopSoon, continuous at any phase) and holds
+  /// stop_hold s; a push while holding holds on.
+  Walk Watch(WalkPattern& pattern, const Eigen::Vector2d& impulse);
+  /// Walks stopped by a push so far.
+  int stops() const { return stops_; }
+
  private:
   double omega_, tick_;
   RecoveryParams p_;
   double since_ = 1e9;
   Eigen::Vector2d error_ = Eigen::Vector2d::Zero();
   int count_ = 0;
+  double hold_ = 0;  // s of standing left
+  int stops_ = 0;
 };
 
 }  // namespace robotalk::walking
