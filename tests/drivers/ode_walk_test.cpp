@@ -523,6 +523,32 @@ TEST(OdeWalk, PushRecoveryRegeneratesThePlanOnlyWhenPushed) {
   }
 }
 
+// Push recovery's stop (walking/push_recovery.h, PushRecovery::Watch):
+// walking at full speed, 10 N s toward the robot's left (the probe of
+// robotalk-walk-sweep's table, docs/ode_sim.md "Pushes"); the open loop falls
+// 4-5 s later, over its stance foot's toe; with push_recovery the walk
+// stops, the robot stands and walks on after the hold.
+TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
+  for (const char* on : {"false", "true"}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_recovery", on}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(5.14);
+    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    w.Run(2.5, [&] { return w.driver->walk_status()->fallen; });
+    const int held = w.driver->walk_status()->steps_taken;  // stopped, standing (with push_recovery)
+    w.Run(3.5, [&] { return w.driver->walk_status()->fallen; });
+    const walking::WalkStatus s = *w.driver->walk_status();
+    if (std::string(on) == "false") {
+      EXPECT_TRUE(s.fallen) << "the open loop fell to this push before (tilt " << w.max_tilt << ")";
+    } else {
+      EXPECT_FALSE(s.fallen) << "tilt " << w.max_tilt;
+      EXPECT_LT(w.max_tilt, 0.1);
+      EXPECT_GT(s.steps_taken, held + 1) << "walks on after the hold (3 s from the push)";
+    }
+  }
+}
+
 TEST(OdeWalk, TheSameCommandsGiveTheSameWalk) {
   auto run = [] {
     Walker w;
