@@ -503,8 +503,9 @@ TEST(OdeWalk, TheStabilizerKeepsAWalkerUpThroughTheArmSwingThatToppledTheOpenLoo
 
 // Push recovery (option push_recovery, walking/push_recovery.h): walking at
 // full speed unpushed it regenerates nothing; a 30 N s push from behind
-// makes it regenerate the plan (it does not raise the impulse survived on
-// ODE, docs/ode_sim.md, so survival is not asserted); off, the count stays 0.
+// makes it regenerate the plan (the regeneration alone did not raise the
+// impulse survived on ODE, docs/ode_sim.md, so survival is not asserted
+// here; the stop is, in the next test); off, the count stays 0.
 TEST(OdeWalk, PushRecoveryRegeneratesThePlanOnlyWhenPushed) {
   for (const double impulse : {0.0, 30.0}) {
     for (const char* on : {"true", "false"}) {
