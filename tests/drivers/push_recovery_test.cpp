@@ -272,7 +272,7 @@ TEST(PushRecovery, WalkingUnpushedNeverStops) {
   EXPECT_LT(r.stood_at, 9.0) << "stood only once the walk ended";
 }
 
-TEST(PushRecovery, APushWhileStandingStopsNothing) {
+TEST(PushRecovery, APushWhileStandingStopsNothingAndBadSettingsAreRefused) {
   // Standing there is no walk to stop; nothing is held (a SETSPEED walks at once).
   const GaitParams g = FastGait();
   WalkPattern w(g, 0.001, 5, 9.81);
@@ -284,6 +284,12 @@ TEST(PushRecovery, APushWhileStandingStopsNothing) {
   off.stop_impulse = 0;  // off
   PushRecovery none(std::sqrt(9.81 / g.com_height), 0.001, off);
   EXPECT_EQ(none.Watch(w, Eigen::Vector2d(5, 0)), PushRecovery::Walk::kOn);
+  RecoveryParams bad;
+  bad.stop_hold = 0;
+  EXPECT_THROW(PushRecovery(3.7, 0.001, bad), std::invalid_argument);
+  bad.stop_hold = 1;
+  bad.stop_impulse = std::nan("");
+  EXPECT_THROW(PushRecovery(3.7, 0.001, bad), std::invalid_argument);
 }
 
 }  // namespace

@@ -212,6 +212,9 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
   if (!(omega > 0) || !(tick > 0) || !(p_.threshold >= 0) || !(p_.reach > 0)) {
     throw std::invalid_argument("PushRecovery: omega, tick and reach must be > 0, threshold >= 0");
   }
+  if (!(p_.stop_impulse >= 0) || (p_.stop_impulse > 0 && !(p_.stop_hold > 0))) {
+    throw std::invalid_argument("PushRecovery: stop_impulse must be >= 0 (0: off) and stop_hold > 0");
+  }
 }
 
 bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) {
