@@ -153,7 +153,13 @@ struct Run {
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.5f,%.5f,%.5f,%.5f,%.2f", s.foot[i].x, s.foot[i].y, s.foot[i].theta,
                    s.foot_height[i], s.foot_force[i]);
-    std::fprintf(trace, ",%.5f,%.5f\n", s.com_offset.x(), s.com_offset.y());
+    std::fprintf(trace, ",%.5f,%.5f", s.com_offset.x(), s.com_offset.y());
+    // Appended (after the columns plot_walk_push.py reads): the measured
+    // feet (x, y, yaw, sole tilt, contact points), steps started, recoveries.
+    for (int i = 0; i < 2; ++i)
+      std::fprintf(trace, ",%.5f,%.5f,%.5f,%.4f,%d", s.foot_measured[i].x, s.foot_measured[i].y,
+                   s.foot_measured[i].theta, s.foot_tilt[i], s.foot_contacts[i]);
+    std::fprintf(trace, ",%d,%d\n", s.steps_taken, s.recoveries);
   }
   void Panic() {
     d->Halt(done);
@@ -353,7 +359,9 @@ int Probe(const Args& args) {
           trace,
           "t,com_x,com_y,com_plan_x,com_plan_y,dcm_x,dcm_y,dcm_ref_x,dcm_ref_y,cop_x,cop_y,zmp_ref_x,"
           "zmp_ref_y,zmp_cmd_x,zmp_cmd_y,saturated,tilt,lfoot_x,lfoot_y,lfoot_th,lfoot_h,lfoot_f,"
-          "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y\n");
+          "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y,lmeas_x,lmeas_y,lmeas_th,ltilt,"
+          "lcontacts,"
+          "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries\n");
     }
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);

@@ -492,7 +492,12 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
     return;
   }
   MeasureContacts();
-  if (mode_ == Mode::kSpeed) KeepSpeedStepsQueued();
+  // push_recovery: a push stops the walk and the robot stands a while (walking/push_recovery.h).
+  using Walk = walking::PushRecovery::Walk;
+  const Walk walk =
+      recovery_ && tick_ >= settle_ticks_ ? recovery_->Watch(pattern_, com_estimate_->impulse()) : Walk::kOn;
+  if (mode_ == Mode::kGoto && walk == Walk::kResume) PlanGoto();
+  if (mode_ == Mode::kSpeed && walk != Walk::kHold) KeepSpeedStepsQueued();
   pattern_.Tick();
   Balance();
   AdjustStep();
@@ -515,7 +520,7 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
     world_->SetMotor(static_cast<int>(i), v, fmax_[i]);
     q_prev_[i] = target;
   }
-  if (mode_ == Mode::kGoto && pattern_.settled(kSettled)) {
+  if (mode_ == Mode::kGoto && walk != Walk::kHold && pattern_.settled(kSettled)) {
     FinishGoto(completed);
   } else if (mode_ == Mode::kGoto && pattern_.started_steps() - replanned_at_ >= kReplanSteps &&
              pattern_.unstarted_steps() > 2) {

@@ -503,8 +503,9 @@ TEST(OdeWalk, TheStabilizerKeepsAWalkerUpThroughTheArmSwingThatToppledTheOpenLoo
 
 // Push recovery (option push_recovery, walking/push_recovery.h): walking at
 // full speed unpushed it regenerates nothing; a 30 N s push from behind
-// makes it regenerate the plan (it does not raise the impulse survived on
-// ODE, docs/ode_sim.md, so survival is not asserted); off, the count stays 0.
+// makes it regenerate the plan (the regeneration alone did not raise the
+// impulse survived on ODE, docs/ode_sim.md, so survival is not asserted
+// here; the stop is, in the next test); off, the count stays 0.
 TEST(OdeWalk, PushRecoveryRegeneratesThePlanOnlyWhenPushed) {
   for (const double impulse : {0.0, 30.0}) {
     for (const char* on : {"true", "false"}) {
@@ -519,6 +520,32 @@ TEST(OdeWalk, PushRecoveryRegeneratesThePlanOnlyWhenPushed) {
         EXPECT_FALSE(s.fallen) << on;
       }
       EXPECT_EQ(s.recoveries > 0, impulse > 0 && std::string(on) == "true") << impulse << " N s, " << on;
+    }
+  }
+}
+
+// Push recovery's stop (walking/push_recovery.h, PushRecovery::Watch):
+// walking at full speed, 10 N s toward the robot's left (the probe of
+// robotalk-walk-sweep's table, docs/ode_sim.md "Pushes"); the open loop falls
+// 4-5 s later, over its stance foot's toe; with push_recovery the walk
+// stops, the robot stands and walks on after the hold.
+TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
+  for (const char* on : {"false", "true"}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_recovery", on}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(5.14);
+    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    w.Run(2.5, [&] { return w.driver->walk_status()->fallen; });
+    const int held = w.driver->walk_status()->steps_taken;  // stopped, standing (with push_recovery)
+    w.Run(3.5, [&] { return w.driver->walk_status()->fallen; });
+    const walking::WalkStatus s = *w.driver->walk_status();
+    if (std::string(on) == "false") {
+      EXPECT_TRUE(s.fallen) << "the open loop fell to this push before (tilt " << w.max_tilt << ")";
+    } else {
+      EXPECT_FALSE(s.fallen) << "tilt " << w.max_tilt;
+      EXPECT_LT(w.max_tilt, 0.1);
+      EXPECT_GT(s.steps_taken, held + 1) << "walks on after the hold (3 s from the push)";
     }
   }
 }

@@ -4,6 +4,7 @@
 // the plan), that ZMP limited to the support polygon of the feet (its
 // soles), and is pushed: a change of its CoM velocity.
 #include "walking/push_recovery.h"
+#include "walking/dcm_estimator.h"
 #include "walking/dcm_stabilizer.h"
 #include "walking/footstep_planner.h"
 #include "walking/walk_pattern.h"
@@ -159,6 +160,136 @@ TEST(PushRecovery, WithoutAPushNothingIsRegeneratedAndTheWalkIsThePlan) {
   const Result open = WalkAndPush(Eigen::Vector2d::Zero(), 3.0, false);
   EXPECT_DOUBLE_EQ(r.end_x, open.end_x);
   EXPECT_LT(r.worst_clamp, 1e-9);
+}
+
+// Stop and stand (PushRecovery::Watch). On ODE the stiff servos pull the
+// CoM back to the plan's while the ground can push where that needs; here a
+// pendulum whose ZMP is the plan's plus the DCM feedback (1 + k/w) e (the
+// DcmStabilizer's law, k = 3/s), limited to the support polygon of the
+// feet. The push is seen as on the robot: a DcmEstimator fed with the
+// pendulum's CoM and centre of pressure; pushed as on ODE, 0.1 s long.
+// (Survival itself is measured on ODE, where this recovery raises the
+// impulse survived: docs/ode_sim.md, "Pushes"; this ideal pendulum's ankles
+// hold these pushes either way.)
+struct StopResult {
+  bool fell = false;
+  int stops = 0;
+  double stood_at = -1;       // s: the pattern stood (standing()) after the push; -1: never
+  bool walked_again = false;  // a step started after the hold
+  double worst_jump = 0;      // m per tick of the reference ZMP
+  double worst_impulse = 0;   // m/s, the estimator's, after the first second
+  double worst_outside = 0;   // m the reference ZMP lay outside the support
+};
+
+StopResult WalkPushAndWatch(const Eigen::Vector2d& impulse_ns, double at, bool watch, double walk_for = 9.0) {
+  const GaitParams g = FastGait();
+  constexpr double kTick = 0.001, kG = 9.81, kGain = 3.0, kPushTime = 0.1, kMass = 52.5;
+  const double omega = std::sqrt(kG / g.com_height);
+  WalkPattern w(g, kTick, 5, kG);
+  RecoveryParams rp;
+  rp.stop_hold = 2.0;
+  PushRecovery rec(omega, kTick, rp);
+  DcmEstimator est(omega, kTick);
+  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero(), ref = w.zmp_ref();
+  StopResult r;
+  bool held = false;
+  for (int i = 0; i < static_cast<int>((walk_for + 3.0) / kTick); ++i) {
+    const PushRecovery::Walk walk = watch ? rec.Watch(w, est.impulse()) : PushRecovery::Walk::kOn;
+    held = held || walk == PushRecovery::Walk::kHold;
+    if (w.time() < walk_for && walk != PushRecovery::Walk::kHold) {
+      while (w.planned_ahead() < g.start_lead + 2 * g.step_period()) {  // SETSPEED's queue
+        const WalkPattern::Splice sp = w.AppendPoint();
+        const Side next = sp.side_free ? Side::kLeft : sp.next;
+        const Pose2 ce = StepBy(sp.centre, g.step_forward, 0, 0, next, g);
+        w.Append({Footstep{next, FootAt(ce, next, g)}}, {ce});
+      }
+    }
+    const int started = w.started_steps();
+    w.Tick();
+    if (held && walk == PushRecovery::Walk::kOn && w.started_steps() > started) r.walked_again = true;
+    if (w.time() > at - 0.5 * kTick && w.time() < at + kPushTime - 0.5 * kTick) {
+      dd += impulse_ns / kMass * (kTick / kPushTime);
+    }
+    if (r.stood_at < 0 && w.time() > at && w.standing()) r.stood_at = w.time();
+    r.worst_jump = std::max(r.worst_jump, (w.zmp_ref() - ref).norm());
+    ref = w.zmp_ref();
+    std::array<Eigen::Vector2d, 16> poly;
+    const std::span<const Eigen::Vector2d> support(poly.data(), static_cast<size_t>(w.SupportPolygon(poly)));
+    r.worst_outside =
+        std::max(r.worst_outside, (ClampToPolygon(w.zmp_ref(), support, 0) - w.zmp_ref()).norm());
+    const Eigen::Vector2d p = ClampToPolygon(w.zmp() + (1 + kGain / omega) * (d + dd / omega), support, 0);
+    dd += kG / g.com_height * (d - (p - w.zmp())) * kTick;
+    d += dd * kTick;
+    est.Update(w.com() + d, &p);
+    if (w.time() > 1.0) r.worst_impulse = std::max(r.worst_impulse, est.impulse().norm());
+    if (d.norm() > 0.3) {
+      r.fell = true;
+      break;
+    }
+  }
+  r.stops = rec.stops();
+  return r;
+}
+
+TEST(PushRecovery, APushSeenByTheEstimatorStopsTheWalkWhichGoesOnAfterTheHold) {
+  // 10 N s (the impulse the open loop falls to on ODE sideways and
+  // backward) from either side and from the front, at 8 instants over one
+  // step: the walk stops within the step in the air plus one bringing the
+  // feet together (2 step periods), the reference ZMP continuous and inside
+  // the support, and walks again after the hold. Unwatched it walks on.
+  const GaitParams g = FastGait();
+  for (const Eigen::Vector2d& j :
+       {Eigen::Vector2d(0, 10), Eigen::Vector2d(0, -10), Eigen::Vector2d(-10, 0)}) {
+    for (int k = 0; k < 8; ++k) {
+      const double at = 3.0 + k * g.step_period() / 8;
+      const std::string what =
+          "push (" + std::to_string(j.x()) + ", " + std::to_string(j.y()) + ") N s at " + std::to_string(at);
+      const StopResult r = WalkPushAndWatch(j, at, true);
+      EXPECT_FALSE(r.fell) << what;
+      EXPECT_EQ(r.stops, 1) << what;
+      EXPECT_GT(r.stood_at, at) << what << ": stood";
+      EXPECT_LT(r.stood_at, at + 2 * g.step_period() + g.end_shift + 0.1)
+          << what << ": stood within two steps";
+      EXPECT_TRUE(r.walked_again) << what;
+      EXPECT_LT(r.worst_jump, 2e-3) << what << ": the reference ZMP is continuous";
+      EXPECT_LT(r.worst_outside, 1e-9) << what << ": ... and inside the support";
+      const StopResult open = WalkPushAndWatch(j, at, false);
+      EXPECT_EQ(open.stops, 0) << what;
+      EXPECT_LT(open.stood_at, 0) << what << ": unwatched, the walk goes on";
+    }
+  }
+}
+
+TEST(PushRecovery, WalkingUnpushedNeverStops) {
+  // The threshold's margin: unpushed, the estimated impulse of this
+  // pendulum's walk stays far under it (on ODE under 0.084 m/s: the robot's
+  // own wobble).
+  const StopResult r = WalkPushAndWatch(Eigen::Vector2d::Zero(), 3.0, true);
+  EXPECT_FALSE(r.fell);
+  EXPECT_EQ(r.stops, 0);
+  EXPECT_LT(r.worst_impulse, 0.5 * RecoveryParams{}.stop_impulse);
+  EXPECT_LT(r.stood_at, 9.0) << "stood only once the walk ended";
+}
+
+TEST(PushRecovery, APushWhileStandingStopsNothingAndBadSettingsAreRefused) {
+  // Standing there is no walk to stop; nothing is held (a SETSPEED walks at once).
+  const GaitParams g = FastGait();
+  WalkPattern w(g, 0.001, 5, 9.81);
+  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+  PushRecovery rec(std::sqrt(9.81 / g.com_height), 0.001);
+  EXPECT_EQ(rec.Watch(w, Eigen::Vector2d(0.5, 0)), PushRecovery::Walk::kOn);
+  EXPECT_EQ(rec.stops(), 0);
+  RecoveryParams off;
+  off.stop_impulse = 0;  // off
+  PushRecovery none(std::sqrt(9.81 / g.com_height), 0.001, off);
+  EXPECT_EQ(none.Watch(w, Eigen::Vector2d(5, 0)), PushRecovery::Walk::kOn);
+  RecoveryParams bad;
+  bad.stop_hold = 0;
+  EXPECT_THROW(PushRecovery(3.7, 0.001, bad), std::invalid_argument);
+  bad.stop_hold = 1;
+  bad.stop_impulse = std::nan("");
+  EXPECT_THROW(PushRecovery(3.7, 0.001, bad), std::invalid_argument);
 }
 
 }  // namespace

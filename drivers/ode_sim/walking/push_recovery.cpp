@@ -212,6 +212,9 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
   if (!(omega > 0) || !(tick > 0) || !(p_.threshold >= 0) || !(p_.reach > 0)) {
     throw std::invalid_argument("PushRecovery: omega, tick and reach must be > 0, threshold >= 0");
   }
+  if (!(p_.stop_impulse >= 0) || (p_.stop_impulse > 0 && !(p_.stop_hold > 0))) {
+    throw std::invalid_argument("PushRecovery: stop_impulse must be >= 0 (0: off) and stop_hold > 0");
+  }
 }
 
 bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) {
@@ -227,6 +230,21 @@ bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, cons
   since_ = 0;
   ++count_;
   return true;
+}
+
+PushRecovery::Walk PushRecovery::Watch(WalkPattern& pattern, const Eigen::Vector2d& impulse) {
+  if (p_.stop_impulse > 0 && impulse.norm() > p_.stop_impulse) {
+    if (hold_ <= 0 && !pattern.standing()) {
+      pattern.StopSoon();
+      ++stops_;
+      hold_ = p_.stop_hold;
+    } else if (hold_ > 0) {
+      hold_ = p_.stop_hold;
+    }
+  }
+  if (hold_ <= 0) return Walk::kOn;
+  hold_ -= tick_;
+  return hold_ > 0 ? Walk::kHold : Walk::kResume;
 }
 
 }  // namespace robotalk::walking
