@@ -105,8 +105,11 @@ struct PlaybackEstimatorOptions {
   bool adaptive = true;
   /// Above this spread (in frame intervals) the delays may be a queue's
   /// (the paper's congestion): the adaptive start gives way to the paper's
-  /// estimate, which waits for frames and projects their drift.
+  /// estimate, which waits for frames and projects their drift. Set for a
+  /// stretch of kGateStretch; a wider max_stretch raises it (and the
+  /// adaptive start's quick_max_spread) by max_stretch − kGateStretch.
   double adaptive_max_spread = 1.2;
+  static constexpr double kGateStretch = 0.10;
   /// Added to the worst recent delay; also the schedule's margin.
   Duration adaptive_margin = std::chrono::milliseconds(2);
   /// And the spread × this / the delays seen: the max of n samples falls
@@ -241,6 +244,8 @@ class PlaybackEstimator {
   TimePoint PaperStart() const;                   // the paper's estimate
   bool QueueFollowable() const;                   // REQUIRES: delay_spread()
   bool SpreadWithinGate() const;
+  double WiderStretch() const;  // max(0, max_stretch − kGateStretch), intervals
+  double Gate() const;          // the spread beyond which the adaptive start gives way, s
   struct Spread {
     Duration least, most;  // of the recent delays, retransmissions left out
     std::size_t kept;      // delays within the fence
