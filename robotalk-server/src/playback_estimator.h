@@ -41,7 +41,10 @@
 // minimum is the sequence's worst delay less frame 0's), and the first gap's stretch reaches the worst
 // delay by frame 1. Where the spread exceeds one frame interval a queue can build that the history (sparse
 // packages, no queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
-// adaptive_max_spread intervals: the paper's estimate, then the stretch.
+// adaptive_max_spread intervals: the paper's estimate, then the stretch. Both thresholds are set for a
+// stretch of kGateStretch (10 %: a service of up to 1.1 intervals adds at most one gap's stretch to the
+// next frame's delay); a wider max_stretch follows services as much longer and moves both up by
+// max_stretch − kGateStretch intervals (Gate()); at kGateStretch and below nothing changes.
 // The connect burst (burst_wait_discount, on): a client's hello, clock and
 // heartbeat leave together and, on a congested FIFO link, wait behind each
 // other, a spread its frames (one interval apart) do not meet. Where the

@@ -46,7 +46,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   delay, then gaps stretch when a frame is slower), quick
                                   (issue 11's start, fixed timing) or paper (wait for frames)
   --playback-stretch F            adaptive: how much longer than recorded a gap between two
-                                  frames may play (default 0.1: 10 %; 0: never)
+                                  frames may play (default 0.1: 10 %; 0: never); above 0.1 the
+                                  adaptive start's gate (1.2 frame intervals) moves up by F - 0.1
   --playback-margin MS            adaptive: a frame plays no sooner than MS milliseconds after
                                   it arrived (its hand-over to the robot's thread; default 2)
   --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals
