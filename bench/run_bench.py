@@ -394,6 +394,8 @@ class Bench:
                     # a wider timing tolerance (an option): each gap up to 50 % longer; the gate moves with it
                     ("adaptive_stretch50", adaptive + ["--playback-stretch", "0.5"], ["--stretch-bound", "0.5"], 2.0,
                      None),
+                    # the client's copies chosen from its round trips (ClientOptions::playback_copies = 0)
+                    ("adaptive_autocopies", adaptive, ["--copies", "0"], 2.0, None),
                     ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],
                      ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)))
         # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
