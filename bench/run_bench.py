@@ -394,6 +394,10 @@ class Bench:
                     # a wider timing tolerance (an option): each gap up to 50 % longer; the gate moves with it
                     ("adaptive_stretch50", adaptive + ["--playback-stretch", "0.5"], ["--stretch-bound", "0.5"], 2.0,
                      None),
+                    # the default before a retransmitted package's delay was left out of the history
+                    ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, None),
+                    ("adaptive_stretch50_autocopies", adaptive + ["--playback-stretch", "0.5"],
+                     ["--stretch-bound", "0.5", "--copies", "0"], 2.0, None),
                     # the client's copies chosen from its round trips (ClientOptions::playback_copies = 0)
                     ("adaptive_autocopies", adaptive, ["--copies", "0"], 2.0, None),
                     ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],

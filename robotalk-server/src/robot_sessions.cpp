@@ -189,7 +189,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   // Playback's start reads the channel's one-way delays: a retransmission's
   // arrival − send time is the client's resend wait + a delay (issue 23: one
   // lost connect-time package on a WAN tripped the adaptive start's gate).
-  if (r.send_time != TimePoint{} && !resent) session.delays.Add(r.send_time, received);
+  if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
+    session.delays.Add(r.send_time, received);
   std::vector<CommandId> ids = r.item_ids();
   // The playback delay reply (id = playback id) may come with any of its packages.
   const bool playback = r.mode == RequestMode::kPlayback;

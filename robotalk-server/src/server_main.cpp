@@ -56,6 +56,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-burst-discount on|off
                                   adaptive: leave a connect-time package's wait behind the
                                   one sent just before it out of the delay spread (default on)
+  --playback-resent-delays on|off adaptive: count a retransmitted package's delay (its resend
+                                  wait included) in the client's delay history (default off)
   --playback-start-lead G         adaptive: start G gaps' stretch below the worst delay, which
                                   the first gaps' stretch then reaches (default 1; 0: the
                                   start covers it)
@@ -236,6 +238,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-burst-discount '" + v + "': expected on or off");
         options.playback_burst_discount = v == "on";
+      } else if (arg == "--playback-resent-delays") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-resent-delays '" + v + "': expected on or off");
+        options.playback_resent_delays = v == "on";
       } else if (arg == "--playback-start-lead") {
         options.playback_start_lead = ParseNumber(arg, value(), 0, 100);
       } else if (arg == "--duration") {

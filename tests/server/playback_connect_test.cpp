@@ -24,6 +24,8 @@ using ::testing::HasSubstr;
 
 class PlaybackConnectTest : public RobotSessionsTest {
  protected:
+  explicit PlaybackConnectTest(SessionOptions options = {})
+      : RobotSessionsTest(BaseType::kDifferential, options) {}
   struct Arrival {
     TimePoint at;
     Request request;
@@ -83,6 +85,31 @@ TEST_F(PlaybackConnectTest, ARetransmittedConnectTimePackageDoesNotTripTheAdapti
   // less this frame's 115 ms and one gap's 10 ms stretch: 10.2 ms.
   EXPECT_NEAR(r.values.at(0), 0.130 + 0.029 / 9 + 0.002 - 0.115 - 0.010, 1e-4);
   EXPECT_EQ(sessions_->link(kAlice)->retransmitted, 1u) << "link health counts it too";
+}
+
+// --playback-resent-delays on: every package counts, as before (the paper's estimate here).
+class PlaybackConnectResentTest : public PlaybackConnectTest {
+ protected:
+  PlaybackConnectResentTest() : PlaybackConnectTest(SessionOptions{.playback_resent_delays = true}) {}
+};
+
+TEST_F(PlaybackConnectResentTest, WithResentDelaysOnTheRetransmissionTripsTheGateAsBefore) {
+  const TimePoint t0 = clock_.Now() + milliseconds(10);
+  const std::vector<int> delay_ms = {112, 127, 105, 118, 130, 101, 123, 109};
+  std::vector<Arrival> connect;
+  for (int i = 0; i < 8; ++i) {
+    connect.push_back(Clock(i + 1, t0 + milliseconds(40 * i),
+                            milliseconds(delay_ms[static_cast<std::size_t>(i)]),
+                            i == 2 ? milliseconds(300) : Duration(0)));
+  }
+  Deliver(connect);
+  const TimePoint frame_sent = t0 + std::chrono::seconds(1);
+  Request frame0 =
+      Playback(kAlice, 9, 9202, 40, milliseconds(3900),
+               {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))});
+  frame0.send_time = frame_sent + std::chrono::seconds(3);
+  EXPECT_FALSE(Deliver({{frame_sent + milliseconds(115), frame0}}).count(9202))
+      << "the paper's: waits for frames";
 }
 
 TEST_F(PlaybackConnectTest, ASlowFirstCopyStillCountsAndSoDoesAReorderedOne) {
