@@ -11,7 +11,7 @@
 //   robotalk-bench-client stream   --url U --robot R --seconds T [--rate 100 --delay-ms 100 --start-at NS]
 //                                  delay-mode stream (the scale client): timeouts, lateness, own CPU
 //   robotalk-bench-client watch    --url U --robot R --count N [--period-us 1000]  STATE inter-arrival (us)
-//   robotalk-bench-client playback --url U --robot R --frames N [--period-ms 100] [--copies 0|1|2]  the
+//   robotalk-bench-client playback --url U --robot R --frames N [--period-ms 100] [--copies 1|2]  the
 //   server's chosen delay
 // Each prints one JSON line on stdout. Every loop is bounded in count and time.
 #include "bench_util.h"
@@ -328,7 +328,7 @@ int Playback(const Args& a) {
   ClientOptions o = Options(a);
   o.timeout = std::chrono::seconds(30);
   o.connect_timeout = std::chrono::seconds(20);
-  o.playback_copies = static_cast<int>(a.Int("copies", 1));  // playback redundancy (1: off; 0: auto)
+  o.playback_copies = static_cast<int>(a.Int("copies", 1));  // playback redundancy (1: off)
   RobotClient c(o);
   c.Connect(a.Str("robot", "pioneer"));
   const long frames = a.Int("frames", 40);

@@ -396,10 +396,6 @@ class Bench:
                      None),
                     # the default before a retransmitted package's delay was left out of the history
                     ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, None),
-                    ("adaptive_stretch50_autocopies", adaptive + ["--playback-stretch", "0.5"],
-                     ["--stretch-bound", "0.5", "--copies", "0"], 2.0, None),
-                    # the client's copies chosen from its round trips (ClientOptions::playback_copies = 0)
-                    ("adaptive_autocopies", adaptive, ["--copies", "0"], 2.0, None),
                     ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],
                      ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)))
         # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).

@@ -261,16 +261,4 @@ bool OutstandingPackages::IsAcked(std::int64_t sequence) const {
   return it != packages_.end() && it->second.acked;
 }
 
-std::optional<Duration> OutstandingPackages::least_round_trip() const {
-  if (network_rtts_.empty()) return std::nullopt;
-  Duration least = Duration::max();
-  for (const auto& [at, rtt] : network_rtts_) least = std::min(least, rtt);
-  return least;
-}
-
-int AutoPlaybackCopies(std::optional<Duration> least_round_trip, std::optional<Duration> median_round_trip) {
-  if (!least_round_trip || !median_round_trip) return 1;
-  return *median_round_trip - *least_round_trip <= *least_round_trip ? 2 : 1;
-}
-
 }  // namespace robotalk::client

@@ -125,9 +125,6 @@ class OutstandingPackages {
   /// jitter is symmetric (issue 23; docs/server.md, Link health). Not the
   /// RTO's samples: those run to when this process handled the ack.
   std::optional<Duration> reported_round_trip() const { return reported_rtt_; }
-  /// The least network round trip of the same window (nullopt before the
-  /// first sample): the path's floor, what its queues and jitter add to.
-  std::optional<Duration> least_round_trip() const;
   static constexpr Duration kRoundTripWindow = std::chrono::seconds(10);
   static constexpr std::size_t kMaxRoundTrips = 2048;
   /// Total resends so far.
@@ -177,17 +174,5 @@ class OutstandingPackages {
   std::set<Key> by_silence_;                           // every package, by silent_since
   std::uint64_t retransmissions_ = 0;
 };
-
-/// ClientOptions::playback_copies = 0 (auto; issue 23): how many times a
-/// playback package leaves, from the network round trips measured so far.
-/// A lost frame is late whatever the link (its retransmission comes one
-/// retransmission timeout, 100 ms or more, after it left, and the adaptive
-/// start's buffer covers the delay's jitter, a few to tens of ms), so a copy
-/// is worth its bandwidth wherever it costs no queue: 2 where the round
-/// trips vary by no more than their floor (median − least <= least: the
-/// path's own delay dominates, as on a WAN or an idle LAN), 1 where they
-/// vary by more (what varies is a queue: a congested link, where each copy
-/// costs every later package a service time) and before the first sample.
-int AutoPlaybackCopies(std::optional<Duration> least_round_trip, std::optional<Duration> median_round_trip);
 
 }  // namespace robotalk::client

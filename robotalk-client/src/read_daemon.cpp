@@ -56,11 +56,10 @@ RobotClient::Impl::Impl(ClientOptions options)
     }
     transport_ = own_transport_.get();
   }
-  if (options_.playback_copies < 0 || options_.playback_copies > 2) {
+  if (options_.playback_copies < 1 || options_.playback_copies > 2) {
     throw ClientError("RobotClient: ClientOptions::playback_copies is " +
                       std::to_string(options_.playback_copies) +
-                      "; expected 1 (each playback package once), 2 (twice) or 0 (auto: twice unless the "
-                      "link's round trips show a queue)");
+                      "; expected 1 (each playback package once) or 2 (twice)");
   }
   LoadKeys();
   if (identity_) {
@@ -142,7 +141,6 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
                                                        std::vector<robotalk::Query> queries,
                                                        const PackageOptions& options) {
   Sent sent;
-  int copies = 1;  // playback redundancy (ClientOptions::playback_copies)
   std::vector<std::uint8_t> bytes;
   std::string channel;
   {
@@ -198,18 +196,13 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     if (options.panic) ack_waited_.insert(sent.sequence);
     last_send_ = now;
     ++stats_.packages_sent;
-    if (options.mode == RequestMode::kPlayback) {
-      copies = options_.playback_copies;
-      if (copies == 0)  // auto: from the round trips measured so far (outstanding_packages.h)
-        copies =
-            client::AutoPlaybackCopies(outstanding_.least_round_trip(), outstanding_.reported_round_trip());
-    }
   }
   // No wake-up of the ReadDaemon (a context switch per command): it never
   // sleeps longer than retransmit_interval (IdleWait), and a new package's
   // first resend is at least that far away.
   // Playback redundancy: the copy is a duplicate by sequence number, which
   // the server drops (it re-acknowledges it; the frames run once).
+  const int copies = options.mode == RequestMode::kPlayback ? options_.playback_copies : 1;
   for (int k = 0; k < copies; ++k) Publish(channel, bytes);
   return sent;
 }

@@ -352,37 +352,5 @@ TEST(OutstandingPackages, ClearReturnsEveryUnansweredItem) {
   EXPECT_EQ(o.size(), 0u);
 }
 
-// ClientOptions::playback_copies = 0 (auto, issue 23 item 3): a playback
-// package leaves twice where the round trips show no queue (they vary by no
-// more than their least: the relay's WAN profiles), once where they do (its
-// congested U[0, X] links) or before any was measured.
-TEST(OutstandingPackages, AutoPlaybackCopiesAreTwoWhereTheRoundTripsShowNoQueue) {
-  const auto copies_after = [](std::initializer_list<int> rtts_ms) {
-    OutstandingPackages o(Policy());
-    std::int64_t seq = 0;
-    for (int ms : rtts_ms) {
-      const TimePoint sent = kT0 + milliseconds(500 * ++seq);
-      o.Add(seq, Bytes(1), {}, sent);
-      o.OnAck(seq, sent + milliseconds(ms));
-    }
-    return std::make_pair(o.least_round_trip(),
-                          AutoPlaybackCopies(o.least_round_trip(), o.reported_round_trip()));
-  };
-  EXPECT_EQ(copies_after({}), std::make_pair(std::optional<Duration>{}, 1)) << "nothing measured: once";
-  // WAN 100 ms +- 50 ms each way: round trips 100-300 ms, median 200.
-  EXPECT_EQ(copies_after({190, 131, 250, 205, 164, 280, 199, 226, 172}),
-            std::make_pair(std::optional<Duration>{milliseconds(131)}, 2));
-  // WAN 300 ms: 530-700 ms.
-  EXPECT_EQ(copies_after({600, 541, 655, 580, 612}).second, 2);
-  // An idle LAN: 0.4-0.7 ms (what varies is less than the floor).
-  EXPECT_EQ(copies_after({1, 1, 1, 1}).second, 2);
-  // A congested FIFO link (U[0, 50] ms per message and its queue): 2-60 ms.
-  EXPECT_EQ(copies_after({2, 31, 45, 18, 60, 27, 9}).second, 1);
-  // The bound: median - least == least still leaves twice; just above, once.
-  EXPECT_EQ(AutoPlaybackCopies(milliseconds(100), milliseconds(200)), 2);
-  EXPECT_EQ(AutoPlaybackCopies(milliseconds(100), milliseconds(201)), 1);
-  EXPECT_EQ(AutoPlaybackCopies(milliseconds(100), std::nullopt), 1);
-}
-
 }  // namespace
 }  // namespace robotalk::client

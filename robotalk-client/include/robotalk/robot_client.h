@@ -89,10 +89,6 @@ struct ClientOptions {
   /// sequence number); a frame whose first copy the network loses still
   /// arrives in time, instead of one retransmission timeout (>= 100 ms)
   /// later. Costs one more copy of every playback package (and of its ack).
-  /// 0: auto, per package from the round trips measured so far: twice where
-  /// they vary by no more than their least (a WAN, an idle LAN), once where
-  /// they vary by more (a queue: a congested link, where a copy costs every
-  /// later package a service time) or before any was measured.
   int playback_copies = 1;
   /// An idle client sends an empty package this often (server session watchdog).
   Duration heartbeat_interval = std::chrono::milliseconds(250);
