@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 namespace robotalk {
@@ -42,42 +43,45 @@ class PlaybackConnectTest : public RobotSessionsTest {
     }
     return last;
   }
-  // A package of CLOCK query `seq` sent at `sent` (the client's clock reads 3 s
-  // ahead) that took `delay` (+ `resend_wait`: its first copy was lost and the
-  // client resent it that much later, with the first copy's send time).
-  Arrival Clock(std::int64_t seq, TimePoint sent, Duration delay, Duration resend_wait = Duration(0)) {
-    Request r = Queries(kAlice, seq, {Query{.id = 100 + seq, .type = QueryType::kClock}});
-    r.send_time = sent + std::chrono::seconds(3);
-    return {sent + resend_wait + delay, r};
+  // Eight CLOCK rounds 40 ms apart from t0 (the client's clock reads 3 s
+  // ahead) taking `delay_ms`; the one at `lost` (if any) lost and resent
+  // 300 ms later with its first copy's send time. Then frame 0 of a 40-frame
+  // sequence at 10 Hz, sent 1 s after the first round and 115 ms on the way:
+  // its immediate replies.
+  std::map<CommandId, Reply> ConnectThenFrame0(const std::vector<int>& delay_ms, std::int64_t playback_id,
+                                               std::optional<std::size_t> lost = std::nullopt) {
+    const TimePoint t0 = clock_.Now() + milliseconds(10);
+    std::vector<Arrival> connect;
+    for (std::size_t i = 0; i < delay_ms.size(); ++i) {
+      const auto seq = static_cast<std::int64_t>(i + 1);
+      Request r = Queries(kAlice, seq, {Query{.id = 100 + seq, .type = QueryType::kClock}});
+      const TimePoint sent = t0 + milliseconds(40) * static_cast<int>(i);
+      r.send_time = sent + kSkew;
+      connect.push_back(
+          {sent + (lost == i ? milliseconds(300) : Duration(0)) + milliseconds(delay_ms[i]), r});
+    }
+    Deliver(connect);
+    const TimePoint frame_sent = t0 + std::chrono::seconds(1);
+    Request frame0 =
+        Playback(kAlice, 9, playback_id, 40, milliseconds(3900),
+                 {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))});
+    frame0.send_time = frame_sent + kSkew;
+    return Deliver({{frame_sent + milliseconds(115), frame0}});
   }
+  static constexpr Duration kSkew = std::chrono::seconds(3);
 };
 
+// A WAN: 100-130 ms one way; the 3rd round is lost and resent 300 ms later
+// (after the 4th and later ones arrived).
+const std::vector<int> kWanRounds = {112, 127, 105, 118, 130, 101, 123, 109};
+
 TEST_F(PlaybackConnectTest, ARetransmittedConnectTimePackageDoesNotTripTheAdaptiveStartsGate) {
-  // A WAN: 100-130 ms one way. Eight clock rounds 40 ms apart; the 3rd is
-  // lost and resent 300 ms later (after the 4th and later ones arrived).
-  const TimePoint t0 = clock_.Now() + milliseconds(10);
-  const std::vector<int> delay_ms = {112, 127, 105, 118, 130, 101, 123, 109};
-  std::vector<Arrival> connect;
-  for (int i = 0; i < 8; ++i) {
-    connect.push_back(Clock(i + 1, t0 + milliseconds(40 * i),
-                            milliseconds(delay_ms[static_cast<std::size_t>(i)]),
-                            i == 2 ? milliseconds(300) : Duration(0)));
-  }
-  Deliver(connect);
-  // Frame 0, sent 1 s after the first round, 115 ms on the way.
-  constexpr std::int64_t kPlayback = 9200;
-  const Duration period = milliseconds(100);
-  const TimePoint frame_sent = t0 + std::chrono::seconds(1);
-  Request frame0 =
-      Playback(kAlice, 9, kPlayback, 40, period * 39,
-               {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))});
-  frame0.send_time = frame_sent + std::chrono::seconds(3);
-  const auto immediate = Deliver({{frame_sent + milliseconds(115), frame0}});
+  const auto immediate = ConnectThenFrame0(kWanRounds, 9200, 2);
   // Before: the retransmission's 405 ms among 101-130 ms spread the delays
   // by 304 ms, past 1.2 frame intervals: the paper's estimate, which waits
   // for 5 frames (no reply yet).
-  ASSERT_TRUE(immediate.count(kPlayback)) << "decided at the first frame";
-  const Reply& r = immediate.at(kPlayback);
+  ASSERT_TRUE(immediate.count(9200)) << "decided at the first frame";
+  const Reply& r = immediate.at(9200);
   EXPECT_EQ(r.signal, Signal::kSuccess);
   EXPECT_THAT(r.message, HasSubstr("adaptive start"));
   // It covers the worst first copy, 130 ms, + the spread / n (29 ms / 9:
@@ -94,44 +98,16 @@ class PlaybackConnectResentTest : public PlaybackConnectTest {
 };
 
 TEST_F(PlaybackConnectResentTest, WithResentDelaysOnTheRetransmissionTripsTheGateAsBefore) {
-  const TimePoint t0 = clock_.Now() + milliseconds(10);
-  const std::vector<int> delay_ms = {112, 127, 105, 118, 130, 101, 123, 109};
-  std::vector<Arrival> connect;
-  for (int i = 0; i < 8; ++i) {
-    connect.push_back(Clock(i + 1, t0 + milliseconds(40 * i),
-                            milliseconds(delay_ms[static_cast<std::size_t>(i)]),
-                            i == 2 ? milliseconds(300) : Duration(0)));
-  }
-  Deliver(connect);
-  const TimePoint frame_sent = t0 + std::chrono::seconds(1);
-  Request frame0 =
-      Playback(kAlice, 9, 9202, 40, milliseconds(3900),
-               {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))});
-  frame0.send_time = frame_sent + std::chrono::seconds(3);
-  EXPECT_FALSE(Deliver({{frame_sent + milliseconds(115), frame0}}).count(9202))
-      << "the paper's: waits for frames";
+  EXPECT_FALSE(ConnectThenFrame0(kWanRounds, 9202, 2).count(9202)) << "the paper's: waits for frames";
 }
 
 TEST_F(PlaybackConnectTest, ASlowFirstCopyStillCountsAndSoDoesAReorderedOne) {
   // The same rounds, none lost: the 3rd only slow (160 ms) and overtaken by
   // the 4th (reordered, not resent: within the reorder tolerance). Its delay
   // is the channel's and counts: the worst is 160 ms.
-  const TimePoint t0 = clock_.Now() + milliseconds(10);
-  const std::vector<int> delay_ms = {112, 127, 160, 118, 130, 101, 123, 109};
-  std::vector<Arrival> connect;
-  for (int i = 0; i < 8; ++i)
-    connect.push_back(
-        Clock(i + 1, t0 + milliseconds(40 * i), milliseconds(delay_ms[static_cast<std::size_t>(i)])));
-  Deliver(connect);
-  constexpr std::int64_t kPlayback = 9201;
-  const TimePoint frame_sent = t0 + std::chrono::seconds(1);
-  Request frame0 =
-      Playback(kAlice, 9, kPlayback, 40, milliseconds(3900),
-               {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))});
-  frame0.send_time = frame_sent + std::chrono::seconds(3);
-  const auto immediate = Deliver({{frame_sent + milliseconds(115), frame0}});
-  ASSERT_TRUE(immediate.count(kPlayback));
-  EXPECT_NEAR(immediate.at(kPlayback).values.at(0), 0.160 + 0.059 / 10 + 0.002 - 0.115 - 0.010, 1e-4);
+  const auto immediate = ConnectThenFrame0({112, 127, 160, 118, 130, 101, 123, 109}, 9201);
+  ASSERT_TRUE(immediate.count(9201));
+  EXPECT_NEAR(immediate.at(9201).values.at(0), 0.160 + 0.059 / 10 + 0.002 - 0.115 - 0.010, 1e-4);
   EXPECT_EQ(sessions_->link(kAlice)->retransmitted, 0u);
 }
 
