@@ -395,7 +395,7 @@ class Bench:
                     ("adaptive_stretch50", adaptive + ["--playback-stretch", "0.5"], ["--stretch-bound", "0.5"], 2.0,
                      None),
                     # the default before a retransmitted package's delay was left out of the history
-                    ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, None),
+                    ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, ("WAN",)),
                     ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],
                      ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)))
         # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
