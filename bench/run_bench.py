@@ -390,7 +390,14 @@ class Bench:
                     ("adaptive_copies", adaptive, ["--copies", "2"], 2.0, ("WAN",)),
                     ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested),
                     # before the connect burst's own queue was left out of the delay spread
-                    ("adaptive_burst_off", adaptive + ["--playback-burst-discount", "off"], [], 2.0, congested + ("WAN",)))
+                    ("adaptive_burst_off", adaptive + ["--playback-burst-discount", "off"], [], 2.0, congested + ("WAN",)),
+                    # a wider timing tolerance (an option): each gap up to 50 % longer; the gate moves with it
+                    ("adaptive_stretch50", adaptive + ["--playback-stretch", "0.5"], ["--stretch-bound", "0.5"], 2.0,
+                     None),
+                    # the default before a retransmitted package's delay was left out of the history
+                    ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, ("WAN",)),
+                    ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],
+                     ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)))
         # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
         only_variants = [v for v in os.environ.get("ROBOTALK_BENCH_VARIANTS", "").split(",") if v]
         if only_variants:

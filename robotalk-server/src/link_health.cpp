@@ -26,13 +26,13 @@ void LinkHealth::Decide(bool lost) {
   }
 }
 
-void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
+bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
                            Duration round_trip) {
   Tick(received);
   if (round_trip > Duration::zero()) f_.round_trip = round_trip;
   if (duplicate) {
     ++f_.duplicates;
-    return;
+    return false;
   }
   ++f_.packages;
   // The transit on the client's clock: only its differences mean anything.
@@ -50,12 +50,17 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     Decide(false);
   } else if (sequence < lowest_) {
     // Sent before the first that came (reordered at the start): not lost;
-    // the numbers between it and that first one are missing now.
+    // the numbers between it and that first one are missing now. Counted
+    // as reordered (its loss cannot be judged), but a copy this much slower
+    // than the first that came is a retransmission all the same: its
+    // transit carries the resend wait (kept out of the transits, and
+    // returned: playback's delay history leaves it out).
     for (std::int64_t s = sequence + 1; s < lowest_ && missing_.size() < kMaxMissing; ++s)
       missing_.emplace(s, received);
     lowest_ = sequence;
     ++f_.reordered;
     Decide(false);
+    resent = transit && transit_count_ > 0 && *transit - SlowTransit() > options_.reorder_tolerance;
   } else if (sequence > highest_) {
     // Numbers skipped are missing until they come or the horizon passes; a
     // jump past the bound (the SequenceWindow refuses such) decides them lost.
@@ -97,6 +102,7 @@ void LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     transit_next_ = (transit_next_ + 1) % transits_.size();
     transit_count_ = std::min(transit_count_ + 1, transits_.size());
   }
+  return resent;
 }
 
 void LinkHealth::OnReply(Duration lateness, bool expired, TimePoint now) {

@@ -113,8 +113,12 @@ class LinkHealth {
 
   /// One package. `duplicate`: the session saw its sequence before. `sent`:
   /// the client's clock when sent (TimePoint{} = unknown). `round_trip`: the
-  /// client's report (0 = none).
-  void OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
+  /// client's report (0 = none). Returns whether it came as a retransmission
+  /// (after a later-numbered package, and slower than the slowest recent
+  /// first copies by more than reorder_tolerance, or decided lost before):
+  /// its send time is its first copy's, so arrival − send time includes the
+  /// client's resend wait, not only the network's delay.
+  bool OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
                  Duration round_trip);
   /// One final reply to the client (late, expired).
   void OnReply(Duration lateness, bool expired, TimePoint now);

@@ -82,7 +82,7 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     const auto [lo, hi] = std::minmax_element(d.begin(), d.end());
     return ToSeconds(*hi - *lo);
   };
-  const double gate = options_.adaptive_max_spread * interval();
+  const double gate = Gate();
   if (spread(measured.delays) <= gate) return measured;
   // A client's connect-time packages (hello, clock, heartbeat) leave within a
   // millisecond; on a congested FIFO link each waits for the one before it to
@@ -145,7 +145,20 @@ bool PlaybackEstimator::SpreadWithinGate() const {
   // The whole spread, outliers included: the paper's congestion (a server
   // pausing after each package) shows as a few slow packages among fast ones.
   const std::optional<Duration> spread = delay_spread();
-  return spread && ToSeconds(*spread) <= options_.adaptive_max_spread * interval();
+  return spread && ToSeconds(*spread) <= Gate();
+}
+
+double PlaybackEstimator::WiderStretch() const {
+  return std::max(0.0, options_.max_stretch - PlaybackEstimatorOptions::kGateStretch);
+}
+
+double PlaybackEstimator::Gate() const {
+  // The gate was set for the default stretch (kGateStretch): frames whose
+  // services exceed the interval by up to that much are followed gap by gap.
+  // A wider stretch follows services as much longer, so the gate moves up by
+  // the difference (a service of at most (1 + max_stretch) intervals adds at
+  // most max_stretch intervals to the next frame's delay: one gap's stretch).
+  return (options_.adaptive_max_spread + WiderStretch()) * interval();
 }
 
 bool PlaybackEstimator::adaptive() const {
@@ -266,7 +279,10 @@ Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
   // frames: the worst recent delay, and the schedule's stretch for a slower
   // frame. The spread beyond one interval may accumulate in a queue that
   // sparse packages never met: it is covered quick_jitter_factor times.
-  const double excess = std::max(0.0, ToSeconds(spread) - options_.quick_max_spread * interval());
+  // With a wider stretch than the default, the threshold moves up with the
+  // gate (see Gate()): the stretch follows what lies below it.
+  const double excess =
+      std::max(0.0, ToSeconds(spread) - (options_.quick_max_spread + WiderStretch()) * interval());
   return s.most + FromSeconds(excess * options_.quick_jitter_factor +
                               ToSeconds(spread) * headroom / static_cast<double>(s.kept));
 }

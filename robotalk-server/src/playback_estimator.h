@@ -41,7 +41,10 @@
 // minimum is the sequence's worst delay less frame 0's), and the first gap's stretch reaches the worst
 // delay by frame 1. Where the spread exceeds one frame interval a queue can build that the history (sparse
 // packages, no queue) cannot show: the spread beyond one interval is added quick_jitter_factor times. Beyond
-// adaptive_max_spread intervals: the paper's estimate, then the stretch.
+// adaptive_max_spread intervals: the paper's estimate, then the stretch. Both thresholds are set for a
+// stretch of kGateStretch (10 %: a service of up to 1.1 intervals adds at most one gap's stretch to the
+// next frame's delay); a wider max_stretch follows services as much longer and moves both up by
+// max_stretch − kGateStretch intervals (Gate()); at kGateStretch and below nothing changes.
 // The connect burst (burst_wait_discount, on): a client's hello, clock and
 // heartbeat leave together and, on a congested FIFO link, wait behind each
 // other, a spread its frames (one interval apart) do not meet. Where the
@@ -105,8 +108,11 @@ struct PlaybackEstimatorOptions {
   bool adaptive = true;
   /// Above this spread (in frame intervals) the delays may be a queue's
   /// (the paper's congestion): the adaptive start gives way to the paper's
-  /// estimate, which waits for frames and projects their drift.
+  /// estimate, which waits for frames and projects their drift. Set for a
+  /// stretch of kGateStretch; a wider max_stretch raises it (and the
+  /// adaptive start's quick_max_spread) by max_stretch − kGateStretch.
   double adaptive_max_spread = 1.2;
+  static constexpr double kGateStretch = 0.10;
   /// Added to the worst recent delay; also the schedule's margin.
   Duration adaptive_margin = std::chrono::milliseconds(2);
   /// And the spread × this / the delays seen: the max of n samples falls
@@ -241,6 +247,8 @@ class PlaybackEstimator {
   TimePoint PaperStart() const;                   // the paper's estimate
   bool QueueFollowable() const;                   // REQUIRES: delay_spread()
   bool SpreadWithinGate() const;
+  double WiderStretch() const;  // max(0, max_stretch − kGateStretch), intervals
+  double Gate() const;          // the spread beyond which the adaptive start gives way, s
   struct Spread {
     Duration least, most;  // of the recent delays, retransmissions left out
     std::size_t kept;      // delays within the fence

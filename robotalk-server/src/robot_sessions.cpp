@@ -166,9 +166,10 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   session.active = true;
   session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
   const SequenceWindow::Verdict seen = session.seen.Observe(r.sequence);
+  bool resent = false;  // a retransmission whose first copy was lost (link_health.h)
   if (seen != SequenceWindow::Verdict::kTooManyGaps) {
-    session.link.OnPackage(r.sequence, seen == SequenceWindow::Verdict::kDuplicate, r.send_time, received,
-                           r.round_trip);
+    resent = session.link.OnPackage(r.sequence, seen == SequenceWindow::Verdict::kDuplicate, r.send_time,
+                                    received, r.round_trip);
   }
   if (seen == SequenceWindow::Verdict::kTooManyGaps) {
     // A client numbers its packages 1, 2, 3...: a jump that leaves this many
@@ -185,7 +186,11 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     return answer;
   }
   session.last_heard = received;  // only a new, well-formed package refreshes the session
-  if (r.send_time != TimePoint{}) session.delays.Add(r.send_time, received);  // playback's quick start
+  // Playback's start reads the channel's one-way delays: a retransmission's
+  // arrival − send time is the client's resend wait + a delay (issue 23: one
+  // lost connect-time package on a WAN tripped the adaptive start's gate).
+  if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
+    session.delays.Add(r.send_time, received);
   std::vector<CommandId> ids = r.item_ids();
   // The playback delay reply (id = playback id) may come with any of its packages.
   const bool playback = r.mode == RequestMode::kPlayback;

@@ -39,6 +39,10 @@ struct SessionOptions {
   CommandLimits limits;
   /// When playback mode has seen enough frames to estimate its delay.
   PlaybackEstimatorOptions playback;
+  /// A package link health calls a retransmission (its send time is its first
+  /// copy's) stays out of the session's delay history (--playback-resent-delays
+  /// off, the default); on: every package counts, as before issue 23's fifth session.
+  bool playback_resent_delays = false;
   /// Most client sessions this robot serves at once (--max-sessions-per-robot);
   /// a new client beyond is refused.
   std::size_t max_sessions_per_robot = kDefaultMaxSessionsPerRobot;

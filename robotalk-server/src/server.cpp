@@ -121,6 +121,7 @@ class Server::Impl {
     sessions.playback.adaptive_margin = options_.playback_margin;
     sessions.playback.queue_start = options_.playback_queue_start;
     sessions.playback.burst_wait_discount = options_.playback_burst_discount;
+    sessions.playback_resent_delays = options_.playback_resent_delays;
     sessions.playback.start_lead = options_.playback_start_lead;
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);

@@ -46,7 +46,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
                                   delay, then gaps stretch when a frame is slower), quick
                                   (issue 11's start, fixed timing) or paper (wait for frames)
   --playback-stretch F            adaptive: how much longer than recorded a gap between two
-                                  frames may play (default 0.1: 10 %; 0: never)
+                                  frames may play (default 0.1: 10 %; 0: never); above 0.1 the
+                                  adaptive start's gate (1.2 frame intervals) moves up by F - 0.1
   --playback-margin MS            adaptive: a frame plays no sooner than MS milliseconds after
                                   it arrived (its hand-over to the robot's thread; default 2)
   --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals
@@ -55,6 +56,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-burst-discount on|off
                                   adaptive: leave a connect-time package's wait behind the
                                   one sent just before it out of the delay spread (default on)
+  --playback-resent-delays on|off adaptive: count a retransmitted package's delay (its resend
+                                  wait included) in the client's delay history (default off)
   --playback-start-lead G         adaptive: start G gaps' stretch below the worst delay, which
                                   the first gaps' stretch then reaches (default 1; 0: the
                                   start covers it)
@@ -235,6 +238,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-burst-discount '" + v + "': expected on or off");
         options.playback_burst_discount = v == "on";
+      } else if (arg == "--playback-resent-delays") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-resent-delays '" + v + "': expected on or off");
+        options.playback_resent_delays = v == "on";
       } else if (arg == "--playback-start-lead") {
         options.playback_start_lead = ParseNumber(arg, value(), 0, 100);
       } else if (arg == "--duration") {

@@ -201,5 +201,30 @@ TEST(LinkHealth, HeavyLossAndALongRoundTripAreBad) {
   EXPECT_EQ(v.why, "loss 49.5 % > 25.0 %, delay 750 ms > 500 ms");
 }
 
+// OnPackage says which packages came as retransmissions (playback's delay
+// history leaves them out, issue 23): one after a later-numbered package and
+// slower than the slowest recent first copies by more than the reorder
+// tolerance, the very first numbers included (they are counted as reordered:
+// their loss cannot be judged); not a reordered copy within the tolerance,
+// not one in order, not a duplicate.
+TEST(LinkHealth, SaysWhichPackagesCameAsRetransmissions) {
+  LinkHealth h;
+  const auto send = [&](std::int64_t seq, int sent_ms, int transit_ms) {
+    return h.OnPackage(seq, false, At(milliseconds(sent_ms)), At(milliseconds(sent_ms + transit_ms)),
+                       Duration(0));
+  };
+  EXPECT_FALSE(send(2, 10, 20)) << "the first that came";
+  EXPECT_TRUE(send(1, 0, 120)) << "sent before it, 100 ms slower: its first copy was lost";
+  EXPECT_FALSE(send(3, 20, 20));
+  EXPECT_FALSE(send(5, 40, 20));
+  EXPECT_FALSE(send(4, 30, 45)) << "reordered, 25 ms slower: within the 50 ms tolerance";
+  EXPECT_FALSE(send(7, 60, 20));
+  EXPECT_TRUE(send(6, 50, 150)) << "a retransmission 130 ms slower";
+  EXPECT_FALSE(send(8, 70, 300)) << "in order: slow, not resent";
+  EXPECT_FALSE(h.OnPackage(8, true, At(milliseconds(70)), At(milliseconds(400)), Duration(0)))
+      << "a duplicate";
+  EXPECT_EQ(h.Figures().retransmitted, 1u) << "the first number's copy counts as reordered";
+}
+
 }  // namespace
 }  // namespace robotalk

@@ -31,6 +31,7 @@ done
 # The playback options' bad values too (issue 23 item 3).
 for bad in "--playback-queue-start|maybe|--playback-queue-start 'maybe': expected on or off" \
            "--playback-burst-discount|yes|--playback-burst-discount 'yes': expected on or off" \
+           "--playback-resent-delays|1|--playback-resent-delays '1': expected on or off" \
            "--playback-margin|-1|--playback-margin: '-1' is not a number in [0, 1000]" \
            "--playback-start-lead|x|--playback-start-lead: 'x' is not a number in [0, 100]"; do
   IFS='|' read -r flag value why <<<"$bad"

@@ -136,6 +136,10 @@ struct ServerOptions {
   /// sent just before it is left out of its delay where that brings the
   /// spread within the gate (PlaybackEstimatorOptions::burst_wait_discount).
   bool playback_burst_discount = true;
+  /// Adaptive: a retransmitted package's one-way delay (its resend wait
+  /// included) counts in the delay history too (SessionOptions::playback_resent_delays;
+  /// off, the default: left out).
+  bool playback_resent_delays = false;
   /// Adaptive: the start lies this many gaps' stretch (playback_stretch ×
   /// the frame interval each) below the worst delay it covers; the first
   /// gaps' stretch reaches it (PlaybackEstimatorOptions::start_lead). 0: the
