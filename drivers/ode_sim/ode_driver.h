@@ -116,6 +116,12 @@ struct OdeDriverOptions {
   /// from, but on ODE it did not raise the impulse survived (measured in
   /// the docs). Key "push_recovery".
   bool push_recovery = false;
+  /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
+  /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
+  /// yield to the error between its measured and desired centre of pressure
+  /// (the plan's ZMP, or the stabilizer's command, split between the feet),
+  /// and a landing foot is compliant until loaded. Key "foot_damping".
+  bool foot_damping = false;
   /// With walk=true, the gait (docs/ode_sim.md, "Walking"): "fast" (default)
   /// derives step length, duration and turn from the model's legs
   /// (walking/gait_limits.h); "slow" is the earlier 0.10 m / 1.1 s gait

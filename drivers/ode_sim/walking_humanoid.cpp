@@ -192,6 +192,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->com_offset_.emplace(w->dcm_->omega());
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
+  if (options.foot_damping) w->foot_damping_.emplace(model.total_mass() * gravity, step);
   return w;
 }
 
@@ -499,6 +500,7 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   Eigen::Isometry3d pelvis;
   std::array<Eigen::Isometry3d, 2> soles;
   DesiredPelvis(&pelvis, &soles);
+  DampFeet(&soles);
   ik_.Solve(pelvis, soles, q_ref_);
   com_in_pelvis_ = ik_.ComInPelvis(q_ref_);
   // The servos' targets: the IK's, faded in from the joints at start-up
