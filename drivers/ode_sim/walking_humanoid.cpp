@@ -192,7 +192,11 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->com_offset_.emplace(w->dcm_->omega());
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
-  if (options.foot_damping) w->foot_damping_.emplace(model.total_mass() * gravity, step);
+  if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)
+    walking::FootDampingGains fg;
+    fg.admittance = walking::AdmittanceFor(w->sole_spring_.stiffness, w->g_.foot_front + w->g_.foot_back);
+    w->foot_damping_.emplace(model.total_mass() * gravity, step, fg);
+  }
   return w;
 }
 

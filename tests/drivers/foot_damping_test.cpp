@@ -143,6 +143,18 @@ TEST(FootDamping, ASoleLeveredOntoItsToeIsBroughtBackToItsDesiredCop) {
   EXPECT_NEAR(SteadyCop(true, -0.06), 0.01, 0.02);
 }
 
+TEST(FootDamping, TheAdmittanceKeepsTheTunedSolesLoopRateOnOtherSoles) {
+  EXPECT_EQ(AdmittanceFor(kTunedSoleStiffness, kTunedSoleLength), kTunedAdmittance);
+  EXPECT_EQ(AdmittanceFor(kTunedSoleStiffness * 1.0005, kTunedSoleLength), kTunedAdmittance);
+  // Admittance x rolling stiffness (stiffness x length^2) stays the tuned one's.
+  const double tuned = kTunedAdmittance * kTunedSoleStiffness * kTunedSoleLength * kTunedSoleLength;
+  EXPECT_NEAR(AdmittanceFor(8 * kTunedSoleStiffness, 0.25) * 8 * kTunedSoleStiffness * 0.25 * 0.25, tuned,
+              1e-12);
+  EXPECT_LT(AdmittanceFor(8 * kTunedSoleStiffness, kTunedSoleLength), kTunedAdmittance);
+  EXPECT_THROW(AdmittanceFor(0, 0.2), std::invalid_argument);
+  EXPECT_THROW(AdmittanceFor(1e5, -1), std::invalid_argument);
+}
+
 TEST(FootDamping, BadParametersAndFeetAreRefusedByName) {
   EXPECT_THROW(FootDamping(0, kTick), std::invalid_argument);
   EXPECT_THROW(FootDamping(kWeight, -1), std::invalid_argument);

@@ -53,6 +53,14 @@ FootTargets DistributeZmp(const Eigen::Vector2d& zmp, const std::array<Pose2, 2>
   return t;
 }
 
+double AdmittanceFor(double stiffness, double length) {
+  if (!(std::isfinite(stiffness) && stiffness > 0) || !(std::isfinite(length) && length > 0))
+    throw std::invalid_argument("AdmittanceFor: stiffness and length must be > 0");
+  const double scale =
+      kTunedSoleStiffness * kTunedSoleLength * kTunedSoleLength / (stiffness * length * length);
+  return std::abs(scale - 1) < 1e-3 ? kTunedAdmittance : kTunedAdmittance * scale;
+}
+
 FootDamping::FootDamping(double weight, double dt, FootDampingGains gains)
     : weight_(weight), dt_(dt), gains_(gains) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0; };

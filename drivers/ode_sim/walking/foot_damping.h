@@ -83,6 +83,17 @@ struct FootTargets {
 FootTargets DistributeZmp(const Eigen::Vector2d& zmp, const std::array<Pose2, 2>& feet,
                           const std::array<bool, 2>& on_ground, const SoleRect& sole, double margin);
 
+/// The admittance (rad/s per N·m) for a sole resting on four corner springs
+/// of `stiffness` (N/m each) `length` (m) long: the closed loop's rate is the
+/// admittance times the sole's rolling stiffness (stiffness · length²), so it
+/// keeps the rate measured stable on the simple humanoid (0.001 on its 0.24 m
+/// sole of 2e5 N/m corners: 11.5/s; kTunedAdmittance); a stiffer or longer
+/// sole gets less (atlas.urdf: the tuned 0.001 shook its feet and it fell
+/// in its first goal, docs/ode_sim.md). Within 0.1 % of the tuned sole it is
+/// the tuned value exactly. stiffness, length > 0, else std::invalid_argument.
+double AdmittanceFor(double stiffness, double length);
+inline constexpr double kTunedAdmittance = 0.001, kTunedSoleStiffness = 2e5, kTunedSoleLength = 0.24;
+
 class FootDamping {
  public:
   /// weight (N, the robot's m g) > 0, dt (s) > 0, gains positive (leak and
