@@ -40,11 +40,15 @@
 
 namespace robotalk::walking {
 
+/// The simple humanoid's tuned admittance (rad/s per N·m) and its sole (N/m per corner, m long).
+inline constexpr double kTunedAdmittance = 0.001, kTunedSoleStiffness = 2e5, kTunedSoleLength = 0.24;
+
 struct FootDampingGains {
   /// rad/s per N·m of ankle torque error. Measured on the simple humanoid's
   /// rubber soles: 0.004 and 0.01 shake the feet heel to toe (the sole
-  /// springs' and servos' lag) and it falls; 0.001 is stable.
-  double admittance = 0.001;
+  /// springs' and servos' lag) and it falls; 0.001 is stable. The driver
+  /// sets it from the model's sole (AdmittanceFor).
+  double admittance = kTunedAdmittance;
   double loaded = 0.3;        ///< fraction of the weight that ends a foot's landing
   double contact_force = 20;  ///< N: below it the foot is in the air
   double leak = 1.0;          ///< s: the offset's leak toward flat while in contact
@@ -92,7 +96,6 @@ FootTargets DistributeZmp(const Eigen::Vector2d& zmp, const std::array<Pose2, 2>
 /// in its first goal, docs/ode_sim.md). Within 0.1 % of the tuned sole it is
 /// the tuned value exactly. stiffness, length > 0, else std::invalid_argument.
 double AdmittanceFor(double stiffness, double length);
-inline constexpr double kTunedAdmittance = 0.001, kTunedSoleStiffness = 2e5, kTunedSoleLength = 0.24;
 
 class FootDamping {
  public:
