@@ -5,7 +5,8 @@
 // hinge motors at every physics step, optional balance feedback (walking/
 // dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
 // reference and the swing foot's landing; options stabilizer,
-// step_adjustment), and fall
+// step_adjustment; walking/foot_damping.h: the ankles yield to each sole's
+// centre-of-pressure error, option foot_damping), and fall
 // detection. The root is a free ODE body: the robot stands on its contacts
 // and can fall.
 //
