@@ -143,26 +143,37 @@ struct Outcome {
 // --timeout is stopped and reported TIMEOUT (a failure), whatever it answers then.
 // The measured centre of pressure against the plan's ZMP and the
 // stabilizer's ZMP command, every 10 ms while stepping (m).
+// Per foot carrying more than kLoaded N: its CoP from where it should press
+// (walking/foot_damping.h's split of the ZMP) and its roll and pitch.
 struct CopErrors {
-  std::vector<double> to_plan, to_command;
+  static constexpr double kLoaded = 50;  // N
+  std::vector<double> to_plan, to_command, foot_cop, foot_roll, foot_pitch;
   void Add(const walking::WalkStatus& s) {
     if (!s.stepping) return;
     to_plan.push_back((s.zmp - s.zmp_ref).norm());
     if (s.zmp_command.norm() > 0) to_command.push_back((s.zmp - s.zmp_command).norm());
+    for (int i = 0; i < 2; ++i) {
+      if (s.foot_force[i] < kLoaded) continue;
+      foot_cop.push_back((s.foot_cop[i] - s.foot_cop_ref[i]).norm());
+      foot_roll.push_back(std::abs(s.foot_roll[i]));
+      foot_pitch.push_back(std::abs(s.foot_pitch[i]));
+    }
   }
 };
 CopErrors cop_errors;
 
 // "median a / 95th b / max c cm" of v.
-std::string Percentiles(std::vector<double> v) {
+// (scale, unit: "cm" of metres by default; 1 and "rad" for angles.)
+std::string Percentiles(std::vector<double> v, double scale = 100, const char* unit = "cm") {
   if (v.empty()) return "none";
   std::sort(v.begin(), v.end());
   const auto at = [&](double p) {
-    return 100 * v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
+    return scale * v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
   };
-  char out[96];
-  std::snprintf(out, sizeof out, "median %.2f / 95th %.2f / max %.2f cm (%zu samples)", at(0.5), at(0.95),
-                at(1.0), v.size());
+  char out[112];
+  const int digits = scale >= 100 ? 2 : 3;
+  std::snprintf(out, sizeof out, "median %.*f / 95th %.*f / max %.*f %s (%zu samples)", digits, at(0.5),
+                digits, at(0.95), digits, at(1.0), unit, v.size());
   return out;
 }
 
@@ -345,5 +356,9 @@ int main(int argc, char** argv) {
               Percentiles(cop_errors.to_plan).c_str());
   std::printf("centre of pressure from the stabilizer's ZMP command while stepping: %s\n",
               Percentiles(cop_errors.to_command).c_str());
+  std::printf("each loaded sole's centre of pressure from its share of the ZMP while stepping: %s\n",
+              Percentiles(cop_errors.foot_cop).c_str());
+  std::printf("each loaded sole's |roll|: %s\n", Percentiles(cop_errors.foot_roll, 1, "rad").c_str());
+  std::printf("each loaded sole's |pitch|: %s\n", Percentiles(cop_errors.foot_pitch, 1, "rad").c_str());
   return successes == args.goals && falls == 0 ? 0 : 1;
 }

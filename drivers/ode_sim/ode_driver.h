@@ -116,6 +116,16 @@ struct OdeDriverOptions {
   /// measured better or equal in all 8 push directions, with the 20-goal
   /// benchmark and the phase sweep unchanged. Key "push_recovery".
   bool push_recovery = true;
+  /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
+  /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
+  /// yield to the error between its measured and desired centre of pressure
+  /// (the plan's ZMP, or the stabilizer's command, split between the feet),
+  /// and a landing foot is compliant until loaded. Off by default:
+  /// measured, it halves the centre of pressure's median error from the
+  /// plan and survives larger walking pushes in four of eight directions,
+  /// but one direction fell at a smaller push and the walking arm swing
+  /// still topples it without the stabilizer. Key "foot_damping".
+  bool foot_damping = false;
   /// With walk=true, the gait (docs/ode_sim.md, "Walking"): "fast" (default)
   /// derives step length, duration and turn from the model's legs
   /// (walking/gait_limits.h); "slow" is the earlier 0.10 m / 1.1 s gait

@@ -46,6 +46,13 @@ struct WalkStatus {
   double foot_tilt[2] = {0, 0};                   ///< the soles' tilt from level, rad
   double foot_force[2] = {0, 0};                  ///< vertical ground force on each foot, N
   int foot_contacts[2] = {0, 0};                  ///< contact points of each sole
+  Eigen::Vector2d foot_cop[2] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  ///< each sole's CoP, m
+  /// Where each sole should press (the plan's ZMP, or the stabilizer's
+  /// command, split between the feet on the ground; walking/foot_damping.h), m
+  Eigen::Vector2d foot_cop_ref[2] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  double foot_roll[2] = {0, 0}, foot_pitch[2] = {0, 0};  ///< each foot's roll and pitch in its yaw frame, rad
+  /// foot_damping=true: the ankle offsets (roll, pitch) foot damping adds, rad
+  Eigen::Vector2d ankle_offset[2] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   Eigen::Vector2d zmp =
       Eigen::Vector2d::Zero();  ///< centre of pressure of the ground forces (plan frame mapped to the world)
   double tracking_error = 0;    ///< largest |q_ref - q| over the leg joints, rad

@@ -192,6 +192,11 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->com_offset_.emplace(w->dcm_->omega());
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
+  if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)
+    walking::FootDampingGains fg;
+    fg.admittance = walking::AdmittanceFor(w->sole_spring_.stiffness, w->g_.foot_front + w->g_.foot_back);
+    w->foot_damping_.emplace(model.total_mass() * gravity, step, fg);
+  }
   return w;
 }
 
@@ -504,6 +509,7 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   Eigen::Isometry3d pelvis;
   std::array<Eigen::Isometry3d, 2> soles;
   DesiredPelvis(&pelvis, &soles);
+  DampFeet(&soles);
   ik_.Solve(pelvis, soles, q_ref_);
   com_in_pelvis_ = ik_.ComInPelvis(q_ref_);
   // The servos' targets: the IK's, faded in from the joints at start-up

@@ -5,7 +5,8 @@
 // hinge motors at every physics step, optional balance feedback (walking/
 // dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
 // reference and the swing foot's landing; options stabilizer,
-// step_adjustment), and fall
+// step_adjustment; walking/foot_damping.h: the ankles yield to each sole's
+// centre-of-pressure error, option foot_damping), and fall
 // detection. The root is a free ODE body: the robot stands on its contacts
 // and can fall.
 //
@@ -30,6 +31,7 @@
 #include "robotalk/driver.h"
 #include "walking/dcm_estimator.h"
 #include "walking/dcm_stabilizer.h"
+#include "walking/foot_damping.h"
 #include "walking/leg_ik.h"
 #include "walking/push_recovery.h"
 #include "walking/walk_pattern.h"
@@ -209,6 +211,13 @@ class WalkingHumanoid final : public BaseController {
   Eigen::Vector2d step_target_ = Eigen::Vector2d::Zero(), step_applied_ = Eigen::Vector2d::Zero();
   double foot_force_[2] = {0, 0};
   int foot_contacts_[2] = {0, 0};
+  // The feet in the loop (options.foot_damping): each foot's measured
+  // contact (its frame), its CoP in the world, and where it should press.
+  void DampFeet(std::array<Eigen::Isometry3d, 2>* soles);
+  std::optional<walking::FootDamping> foot_damping_;
+  std::array<walking::FootWrench, 2> foot_wrench_;
+  std::array<Eigen::Vector2d, 2> foot_cop_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  // world
+  walking::FootTargets foot_targets_;                       // plan frame's feet
   Eigen::Vector2d zmp_measured_ = Eigen::Vector2d::Zero();  // world
   double tracking_error_ = 0;
   SoleSpring sole_spring_;

@@ -16,6 +16,7 @@ using walking::Side;
 
 void WalkingHumanoid::MeasureContacts() {
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  std::array<Eigen::Vector2d, 2> foot_moment{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   double fz = 0;
   foot_force_[0] = foot_force_[1] = 0;
   foot_contacts_[0] = foot_contacts_[1] = 0;
@@ -23,6 +24,7 @@ void WalkingHumanoid::MeasureContacts() {
     for (int s = 0; s < 2; ++s) {
       if (c.link != feet_[static_cast<size_t>(s)]) continue;
       foot_force_[s] += c.force.z();
+      foot_moment[static_cast<size_t>(s)] += c.force.z() * c.position.head<2>();
       ++foot_contacts_[s];
     }
     fz += c.force.z();
@@ -30,6 +32,45 @@ void WalkingHumanoid::MeasureContacts() {
   }
   zmp_valid_ = fz > 1e-6;
   if (zmp_valid_) zmp_measured_ = moment.head<2>() / fz;
+  // Each sole's centre of pressure, in the world and in the foot's frame
+  // (its ankle point on the ground, its yaw: walking/foot_damping.h).
+  for (size_t s = 0; s < 2; ++s) {
+    walking::FootWrench& w = foot_wrench_[s];
+    w.force = foot_force_[s];
+    if (w.force <= 1e-6) continue;
+    foot_cop_[s] = foot_moment[s] / w.force;
+    const Pose2 f = MeasuredFoot(static_cast<Side>(s));
+    const Eigen::Vector2d d = foot_cop_[s] - f.xy();
+    const double c = std::cos(f.theta), sn = std::sin(f.theta);
+    w.cop = {c * d.x() + sn * d.y(), -sn * d.x() + c * d.y()};
+  }
+}
+
+// Foot damping (options.foot_damping; walking/foot_damping.h): the ZMP the
+// walker wants (the stabilizer's command when it runs, else the plan's) is
+// split between the feet the plan has on the ground; each foot's ankle roll
+// and pitch yield to its CoP error: the sole's target turns about the ankle
+// (soles are the IK's targets). The split is kept for the status also
+// without the option.
+void WalkingHumanoid::DampFeet(std::array<Eigen::Isometry3d, 2>* soles) {
+  constexpr double kMargin = 0.01;  // m inside the sole, as the stabilizer's
+  const std::array<Pose2, 2> feet{pattern_.foot(Side::kLeft), pattern_.foot(Side::kRight)};
+  const std::array<bool, 2> down{pattern_.foot_height(Side::kLeft) <= 0,
+                                 pattern_.foot_height(Side::kRight) <= 0};
+  const bool command = stabilize_ && tick_ >= settle_ticks_;
+  const walking::SoleRect sole{g_.foot_front, g_.foot_back, g_.foot_half_width};
+  foot_targets_ =
+      walking::DistributeZmp(command ? balance_.zmp : pattern_.zmp_ref(), feet, down, sole, kMargin);
+  if (!foot_damping_ || tick_ < settle_ticks_) return;
+  for (size_t s = 0; s < 2; ++s) {
+    const Eigen::Vector2d a =
+        foot_damping_->Update(static_cast<int>(s), foot_targets_.cop[s], foot_wrench_[s]);
+    // Turn about the ankle (the sole target sits -z below it in the foot's frame).
+    const double up = -soles_[s].z;
+    Eigen::Isometry3d& t = (*soles)[s];
+    t = t * Eigen::Translation3d(0, 0, up) * Eigen::AngleAxisd(a.x(), Eigen::Vector3d::UnitX()) *
+        Eigen::AngleAxisd(a.y(), Eigen::Vector3d::UnitY()) * Eigen::Translation3d(0, 0, -up);
+  }
 }
 
 // The measured CoM (the model's kinematics at the measured joints and root)
@@ -115,6 +156,16 @@ walking::WalkStatus WalkingHumanoid::status() const {
     const Eigen::Isometry3d f = world_->LinkPose(feet_[static_cast<size_t>(i)]);
     s.foot_measured[i] = MeasuredFoot(static_cast<Side>(i));
     s.foot_tilt[i] = std::acos(std::clamp(f.linear()(2, 2), -1.0, 1.0));
+    // Roll and pitch in the foot's yaw frame.
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(-s.foot_measured[i].theta, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+        f.linear();
+    s.foot_roll[i] = std::atan2(r(2, 1), r(2, 2));
+    s.foot_pitch[i] = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
+    s.foot_cop[i] = foot_cop_[static_cast<size_t>(i)];
+    s.foot_cop_ref[i] = s.foot_measured[i].Apply(foot_targets_.cop[static_cast<size_t>(i)].x(),
+                                                 foot_targets_.cop[static_cast<size_t>(i)].y());
+    if (foot_damping_) s.ankle_offset[i] = foot_damping_->offset(i);
   }
   s.com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
   if (stabilize_ && tick_ >= settle_ticks_) {

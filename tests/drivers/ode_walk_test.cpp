@@ -16,6 +16,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -547,6 +548,53 @@ TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
       EXPECT_LT(w.max_tilt, 0.1);
       EXPECT_GT(s.steps_taken, held + 1) << "walks on after the hold (3 s from the push)";
     }
+  }
+}
+
+// Foot damping (option foot_damping, walking/foot_damping.h): walking at
+// full speed, each loaded sole's centre of pressure stays nearer the share
+// of the ZMP it was given than with stiff ankles, and the soles roll less
+// onto their edges; a bad value is refused naming the key.
+TEST(OdeWalk, FootDampingKeepsEachSolesCopNearItsShareOfTheZmp) {
+  std::map<std::string, double> cop95, roll95;
+  for (const char* on : {"false", "true"}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"foot_damping", on}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(10.0, [&] { return w.driver->walk_status()->steps_taken >= 2; });
+    std::vector<double> cop, roll;
+    for (int i = 0; i < 400 && !w.driver->walk_status()->fallen; ++i) {
+      w.Run(0.01);
+      const walking::WalkStatus s = *w.driver->walk_status();
+      for (int f = 0; f < 2; ++f) {
+        if (s.foot_force[f] < 50) continue;
+        cop.push_back((s.foot_cop[f] - s.foot_cop_ref[f]).norm());
+        roll.push_back(std::abs(s.foot_roll[f]));
+      }
+    }
+    ASSERT_FALSE(w.driver->walk_status()->fallen) << on;
+    ASSERT_GT(cop.size(), 300u);
+    const auto p95 = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() * 95 / 100];
+    };
+    cop95[on] = p95(cop);
+    roll95[on] = p95(roll);
+    std::printf(
+        "foot_damping=%s: loaded soles' CoP from their share, 95th pct %.2f cm; |roll| 95th %.4f rad\n", on,
+        100 * cop95[on], roll95[on]);
+  }
+  EXPECT_LT(cop95["true"], 0.85 * cop95["false"]);  // measured 8.78 against 11.99 cm
+  EXPECT_LT(roll95["true"], roll95["false"]);
+  DriverRegistry registry;
+  RegisterOdeDriver(registry);
+  try {
+    registry.Create("ode", DriverConfig{.robot_name = "",
+                                        .urdf_path = ProjectModel("simple_humanoid.urdf"),
+                                        .options = {{"walk", "true"}, {"foot_damping", "maybe"}}});
+    FAIL() << "foot_damping=maybe accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("foot_damping"), std::string::npos) << e.what();
   }
 }
 
