@@ -62,6 +62,7 @@ struct WalkStatus {
   Eigen::Vector2d zmp_command = Eigen::Vector2d::Zero();  ///< the stabilizer's ZMP, inside the support, m
   Eigen::Vector2d com_offset = Eigen::Vector2d::Zero();   ///< CoM reference minus the plan's (world axes), m
   int recoveries = 0;      ///< push recoveries so far (walking/push_recovery.h: the pattern regenerated)
+  int push_stops = 0;      ///< walks stopped by a push so far (push_recovery's stop and stand)
   bool saturated = false;  ///< the ZMP the stabilizer wanted lay outside the support
 };
 

@@ -543,7 +543,9 @@ TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
     const walking::WalkStatus s = *w.driver->walk_status();
     if (std::string(on) == "false") {
       EXPECT_TRUE(s.fallen) << "the open loop fell to this push before (tilt " << w.max_tilt << ")";
+      EXPECT_EQ(s.push_stops, 0);
     } else {
+      EXPECT_EQ(s.push_stops, 1) << "the status says the push stopped the walk";
       EXPECT_FALSE(s.fallen) << "tilt " << w.max_tilt;
       EXPECT_LT(w.max_tilt, 0.1);
       EXPECT_GT(s.steps_taken, held + 1) << "walks on after the hold (3 s from the push)";
