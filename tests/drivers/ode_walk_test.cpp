@@ -553,6 +553,30 @@ TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
   }
 }
 
+// Push recovery's stop during a GOTO (on by default): the walk stops, the
+// robot stands through the hold, then the GOTO re-plans from where the push
+// left it and still ends at its goal with SUCCESS (no reply before the hold
+// is over).
+TEST(OdeWalk, APushedGotoStopsStandsThenReplansAndStillArrives) {
+  Walker w;  // the defaults: push_recovery on
+  w.Run(1.0);
+  ASSERT_TRUE(w.Exec(CommandType::kGoto, {1.5, 0, 0}).in_progress);
+  w.Run(3.0);
+  ASSERT_TRUE(w.driver->walk_status()->stepping);
+  const TimePoint pushed_at = w.driver->sim_time();
+  w.driver->PushForTesting(Eigen::Vector3d(0, 8 / 0.1, 0), FromSeconds(0.1));  // 8 N s toward the left
+  w.Run(60.0, [&] { return !w.done.empty() || w.driver->walk_status()->fallen; });
+  const walking::WalkStatus s = *w.driver->walk_status();
+  ASSERT_FALSE(s.fallen) << "tilt " << w.max_tilt;
+  EXPECT_EQ(s.push_stops, 1) << "the push stopped the walk";
+  ASSERT_EQ(w.done.size(), 1u);
+  EXPECT_EQ(w.done[0].signal, Signal::kSuccess) << w.done[0].message;
+  EXPECT_GT(w.driver->sim_time() - pushed_at, FromSeconds(3.0)) << "no answer before the 3 s hold was over";
+  const walking::Pose2 p = w.Pelvis();
+  EXPECT_LT(std::hypot(p.x - 1.5, p.y), 0.05);
+  EXPECT_LT(std::abs(walking::Wrap(p.theta)), 0.05);
+}
+
 // Foot damping (option foot_damping, walking/foot_damping.h): walking at
 // full speed, each loaded sole's centre of pressure stays nearer the share
 // of the ZMP it was given than with stiff ankles, and the soles roll less
