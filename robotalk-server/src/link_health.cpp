@@ -44,6 +44,11 @@ bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
   // A retransmission's transit is the client's resend wait, not the network's:
   // it counts in neither the jitter nor the transit range.
   bool resent = false;
+  // Slower than the slowest recent first copies (their 90th percentile) by
+  // more than reordering explains: a copy sent again.
+  const auto came_resent = [&] {
+    return transit && transit_count_ > 0 && *transit - SlowTransit() > options_.reorder_tolerance;
+  };
   if (!started_) {
     started_ = true;
     highest_ = lowest_ = sequence;
@@ -60,7 +65,7 @@ bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     lowest_ = sequence;
     ++f_.reordered;
     Decide(false);
-    resent = transit && transit_count_ > 0 && *transit - SlowTransit() > options_.reorder_tolerance;
+    resent = came_resent();
   } else if (sequence > highest_) {
     // Numbers skipped are missing until they come or the horizon passes; a
     // jump past the bound (the SequenceWindow refuses such) decides them lost.
@@ -78,16 +83,14 @@ bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
     // Reordered (came a little late) or a retransmission (its first copy was
     // lost, and this copy carries the first one's send time, so its transit
     // includes the client's resend wait): told apart by how much slower it
-    // travelled than the slowest recent first copies (their 90th percentile).
-    const bool retransmission =
-        transit && transit_count_ > 0 && *transit - SlowTransit() > options_.reorder_tolerance;
-    resent = retransmission;
-    if (retransmission) {
+    // travelled than the slowest recent first copies (came_resent).
+    resent = came_resent();
+    if (resent) {
       ++f_.retransmitted;
     } else {
       ++f_.reordered;
     }
-    Decide(retransmission);
+    Decide(resent);
   } else {
     resent = true;
     ++f_.retransmitted;  // a number already decided lost: its retransmission came at last
