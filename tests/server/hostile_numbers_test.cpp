@@ -24,6 +24,7 @@ namespace robotalk {
 namespace {
 
 using std::chrono::milliseconds;
+using std::chrono::seconds;
 using ::testing::HasSubstr;
 using testing::kAlice;
 using testing::kT0;
@@ -42,6 +43,13 @@ RobotModel Arm() {
   b.AddControlFrame(ControlFrame{.name = "tool", .servo_types = ServoType::kSetPoint}, "hand");
   b.SetRoot("base", Pose{}, BaseType::kDifferential);
   return b.Build();
+}
+
+Command Waypoint(CommandId id, const std::string& joint, TimePoint at, std::vector<double> values,
+                 std::vector<double> velocities = {}) {
+  Command c{id, CommandType::kJointSetPoint, StartTime::At(at), joint, std::move(values)};
+  c.velocities = std::move(velocities);
+  return c;
 }
 
 class HostileNumbersTest : public ::testing::Test {
@@ -80,6 +88,18 @@ class HostileNumbersTest : public ::testing::Test {
     driver_->ReadState(s);
     return s.position[dof];
   }
+  // Nothing of the refused package ran: the robot is not in panic, and a
+  // well-formed waypoint sent next still reaches the elbow.
+  void ExpectServingOn() {
+    RunTo(clock_.Now() + milliseconds(300));
+    EXPECT_FALSE(daemon_.in_panic()) << "one client's package halted the robot: " << daemon_.fault();
+    const TimePoint at = clock_.Now() + seconds(1);  // within the elbow's limits
+    EXPECT_TRUE(Send({Waypoint(99, "elbow", at, {0.25})}, Interpolation::kCubic).empty());
+    RunTo(at + milliseconds(20));
+    ASSERT_TRUE(replies_.contains(99));
+    EXPECT_EQ(replies_[99].signal, Signal::kSuccess) << replies_[99].message;
+    EXPECT_NEAR(Position(0), 0.25, 1e-9);
+  }
   std::unique_ptr<Driver> MakeDriver() {
     auto driver = std::make_unique<KinematicDriver>(Arm());
     driver_ = driver.get();
@@ -95,72 +115,159 @@ class HostileNumbersTest : public ::testing::Test {
   std::map<CommandId, Reply> replies_;
 };
 
-Command Waypoint(CommandId id, const std::string& joint, TimePoint at, std::vector<double> values,
-                 std::vector<double> velocities = {}) {
-  Command c{id, CommandType::kJointSetPoint, StartTime::At(at), joint, std::move(values)};
-  c.velocities = std::move(velocities);
-  return c;
+// Each test below halted the robot in panic before CheckCommand bounded every
+// number by kMaxCommandMagnitude (1e9): a finite but huge number overflowed
+// the plan's arithmetic to NaN, which reached the driver.
+//
+// A waypoint's velocity: 1e308 rad/s 0.1 s ahead overflowed the cubic's
+// coefficients (trajectory.cpp, Rebuild: -inf and +inf), the plan's sample
+// was NaN, TrajectoryTracker::Limit passed NaN on (std::clamp of NaN is NaN),
+// the kinematic driver's joint became NaN and the RobotDaemon halted the
+// robot ("non-finite state") for every client.
+TEST_F(HostileNumbersTest, AWaypointWhoseVelocityOverflowsThePlanIsRefusedAndTheRobotServesOn) {
+  const std::map<CommandId, Reply> immediate =
+      Send({Waypoint(1, "elbow", kT0 + milliseconds(100), {0.5}, {1e308})}, Interpolation::kCubic);
+  ASSERT_TRUE(immediate.contains(1));
+  EXPECT_EQ(immediate.at(1).signal, Signal::kError) << immediate.at(1).message;
+  EXPECT_EQ(immediate.at(1).message, "JOINT_SETPOINT 'elbow': velocity 0 is 1e+308, beyond ±1e+09");
+  ExpectServingOn();
 }
 
-// DEFECT: a waypoint's velocity is only checked finite. 1e308 rad/s 0.1 s
-// ahead overflows the cubic's coefficients (trajectory.cpp, Rebuild: -inf and
-// +inf), the plan's sample is NaN, TrajectoryTracker::Limit passes NaN on
-// (std::clamp of NaN is NaN) and the kinematic driver's joint becomes NaN:
-// the RobotDaemon halts the robot in panic for every client ("non-finite
-// state"), where the promise is a clear error naming the field to the sender.
-TEST_F(HostileNumbersTest, DISABLED_AWaypointWhoseVelocityOverflowsThePlanIsRefusedAndTheRobotServesOn) {
-  const Command w = Waypoint(1, "elbow", kT0 + milliseconds(100), {0.5}, {1e308});
-  ASSERT_FALSE(CheckCommand(daemon_.model(), w)) << "CheckCommand accepts it: it is finite";
-  const std::map<CommandId, Reply> immediate = Send({w}, Interpolation::kCubic);
-  RunTo(kT0 + milliseconds(500));
-  EXPECT_FALSE(daemon_.in_panic()) << "one client's waypoint halted the robot: " << daemon_.fault();
-  EXPECT_TRUE(std::isfinite(Position(0))) << "a non-finite reference reached the driver";
-  const Reply& answer = immediate.contains(1) ? immediate.at(1) : replies_[1];
-  EXPECT_EQ(answer.signal, Signal::kError) << answer.message;
-  EXPECT_THAT(answer.message, HasSubstr("velocit"));
+// A frame waypoint's position (a pose's x, y, z were only checked finite):
+// 1e308 m made the cubic's sample NaN, the inverse kinematics threw on it and
+// the RobotDaemon reported a SERVER FAULT and halted the robot.
+TEST_F(HostileNumbersTest, AFrameWaypointAHugeDistanceAwayIsRefusedAndTheRobotServesOn) {
+  const std::map<CommandId, Reply> immediate =
+      Send({Command{1, CommandType::kFrameSetPoint, StartTime::At(kT0 + milliseconds(100)), "tool",
+                    std::vector<double>{1e308, 0, 0, 1, 0, 0, 0}}},
+           Interpolation::kCubic);
+  ASSERT_TRUE(immediate.contains(1));
+  EXPECT_EQ(immediate.at(1).signal, Signal::kError) << immediate.at(1).message;
+  EXPECT_THAT(immediate.at(1).message, HasSubstr("FRAME_SETPOINT 'tool': value 0 is 1e+308, beyond ±1e+09"));
+  ExpectServingOn();
 }
 
-// DEFECT: the same through a frame waypoint's position (a pose's x, y, z are
-// only checked finite): 1e308 m ahead makes the cubic's sample NaN, the
-// tracker hands NaN to the inverse kinematics, which throws, and the
-// RobotDaemon reports a SERVER FAULT and halts the robot in panic.
-TEST_F(HostileNumbersTest, DISABLED_AFrameWaypointAHugeDistanceAwayIsRefusedAndTheRobotServesOn) {
-  Command w{1, CommandType::kFrameSetPoint, StartTime::At(kT0 + milliseconds(100)), "tool",
-            std::vector<double>{1e308, 0, 0, 1, 0, 0, 0}};
-  ASSERT_FALSE(CheckCommand(daemon_.model(), w)) << "CheckCommand accepts it: it is finite";
-  const std::map<CommandId, Reply> immediate = Send({w}, Interpolation::kCubic);
-  RunTo(kT0 + milliseconds(500));
-  EXPECT_FALSE(daemon_.in_panic()) << "one client's waypoint halted the robot: " << daemon_.fault();
-  const Reply& answer = immediate.contains(1) ? immediate.at(1) : replies_[1];
-  EXPECT_NE(answer.signal, Signal::kSuccess) << answer.message;
-}
-
-// DEFECT: a continuous joint with no <limit> has no position or velocity
-// bound; two finite waypoints ±1.7e308 rad make their difference overflow and
-// the plan NaN: the robot halts in panic as above.
-TEST_F(HostileNumbersTest, DISABLED_WaypointsWhoseDifferenceOverflowsAreRefusedAndTheRobotServesOn) {
+// A continuous joint with no <limit> has no position or velocity bound: two
+// waypoints ±1.7e308 rad made their difference overflow and the plan NaN.
+TEST_F(HostileNumbersTest, WaypointsWhoseDifferenceOverflowsAreRefusedAndTheRobotServesOn) {
   const std::map<CommandId, Reply> immediate =
       Send({Waypoint(1, "wheel", kT0 + milliseconds(100), {1.7e308}),
             Waypoint(2, "wheel", kT0 + milliseconds(200), {-1.7e308})},
            Interpolation::kLinear);
-  RunTo(kT0 + milliseconds(500));
-  EXPECT_FALSE(daemon_.in_panic()) << "one client's waypoints halted the robot: " << daemon_.fault();
-  EXPECT_TRUE(std::isfinite(Position(1)));
+  for (CommandId id : {1, 2}) {
+    ASSERT_TRUE(immediate.contains(id));
+    EXPECT_EQ(immediate.at(id).signal, Signal::kError) << immediate.at(id).message;
+    EXPECT_THAT(immediate.at(id).message, HasSubstr("JOINT_SETPOINT 'wheel': value 0 is"));
+  }
+  ExpectServingOn();
 }
 
-// DEFECT: the same in the base speed ramp (speed_ramp.cpp, Approach): two
-// SETSPEED frames of a linear package, +1.7e308 and -1.7e308 m/s, make the
-// plan's segment -inf; the clipped reference is ref + 0 * -inf = NaN, and
-// driver_support::ShapeBaseSpeed passes NaN on (NaN > max_v is false): the
-// base pose becomes NaN and the robot halts in panic.
-TEST_F(HostileNumbersTest, DISABLED_SpeedFramesWhoseDifferenceOverflowsAreRefusedAndTheRobotServesOn) {
+// The base speed ramp (speed_ramp.cpp, Approach): SETSPEED frames +1.7e308
+// and -1.7e308 m/s made the plan's segment -inf, the clipped reference
+// ref + 0 * -inf = NaN, and driver_support::ShapeBaseSpeed passed NaN on
+// (NaN > max_v is false): the base pose became NaN.
+TEST_F(HostileNumbersTest, SpeedFramesWhoseDifferenceOverflowsAreRefusedAndTheRobotServesOn) {
   const auto speed = [](CommandId id, TimePoint at, double v) {
     return Command{id, CommandType::kSetSpeed, StartTime::At(at), "", std::vector<double>{v, 0}};
   };
-  Send({speed(1, kT0 + milliseconds(100), 1.7e308), speed(2, kT0 + milliseconds(200), -1.7e308)},
-       Interpolation::kLinear);
+  const std::map<CommandId, Reply> immediate =
+      Send({speed(1, kT0 + milliseconds(100), 1.7e308), speed(2, kT0 + milliseconds(200), -1.7e308)},
+           Interpolation::kLinear);
+  for (CommandId id : {1, 2}) {
+    ASSERT_TRUE(immediate.contains(id));
+    EXPECT_EQ(immediate.at(id).signal, Signal::kError) << immediate.at(id).message;
+    EXPECT_THAT(immediate.at(id).message, HasSubstr("SETSPEED: value 0 is"));
+  }
+  ExpectServingOn();
+}
+
+// The bound is what keeps the arithmetic finite: the worst a client may send
+// within it (quintic waypoints ±1e9 rad on the unlimited wheel, 1 µs apart,
+// every rate ±1e9, and SETSPEED frames ±1e9 m/s) is accepted and runs
+// without a non-finite reference reaching the driver.
+TEST_F(HostileNumbersTest, TheWorstNumbersWithinTheBoundRunWithoutANonFiniteReference) {
+  constexpr double kMax = kMaxCommandMagnitude;
+  Command a = Waypoint(1, "wheel", kT0 + milliseconds(100), {kMax}, {-kMax});
+  a.accelerations = {kMax};
+  Command b = Waypoint(2, "wheel", kT0 + milliseconds(100) + std::chrono::microseconds(1), {-kMax}, {kMax});
+  b.accelerations = {-kMax};
+  std::map<CommandId, Reply> immediate = Send({a, b}, Interpolation::kQuintic);
+  EXPECT_TRUE(immediate.empty()) << immediate.begin()->second.message;
+  immediate = Send({Command{3, CommandType::kSetSpeed, StartTime::At(kT0 + milliseconds(150)), "",
+                            std::vector<double>{kMax, -kMax}},
+                    Command{4, CommandType::kSetSpeed, StartTime::At(kT0 + milliseconds(160)), "",
+                            std::vector<double>{-kMax, kMax}}},
+                   Interpolation::kLinear);
+  EXPECT_TRUE(immediate.empty()) << immediate.begin()->second.message;
+  RunTo(kT0 + milliseconds(300));
+  EXPECT_FALSE(daemon_.in_panic()) << daemon_.fault();
+  EXPECT_TRUE(std::isfinite(Position(1)));
+}
+
+// Issue 23's expiry (expiry.h): a speed that arrives past its deadline "was
+// meant to end the previous motion at its start time, so that actuator is
+// stopped and holds ... the previous speed does not run on past its time".
+// The base's ramp is ended for an expired SETSPEED; a joint's trajectory was
+// not ended for an expired JOINT_SPEED: the driver's StopOnly held the joint
+// for one period and the tracker's next reference moved it on along the
+// trajectory the expired command was meant to replace.
+using ExpiredSpeedTest = HostileNumbersTest;
+
+TEST_F(ExpiredSpeedTest, DISABLED_AnExpiredJointSpeedEndsTheJointsTrajectoryAndTheJointHolds) {
+  EXPECT_TRUE(Send({Waypoint(1, "wheel", kT0 + milliseconds(1000), {1.0}),
+                    Waypoint(2, "wheel", kT0 + milliseconds(2000), {2.0})},
+                   Interpolation::kCubic)
+                  .empty());
   RunTo(kT0 + milliseconds(500));
-  EXPECT_FALSE(daemon_.in_panic()) << "one client's frames halted the robot: " << daemon_.fault();
+  ASSERT_GT(Position(1), 0.1) << "the trajectory moves the wheel";
+  // Due 0.3 s ago: past the robot's 0.1 s default deadline for servo commands.
+  const std::map<CommandId, Reply> immediate =
+      Send({Command{3, CommandType::kJointSpeed, StartTime::At(clock_.Now() - milliseconds(300)), "wheel",
+                    std::vector<double>{0.5}}},
+           Interpolation::kStep);
+  EXPECT_TRUE(immediate.empty());
+  RunTo(kT0 + milliseconds(520));
+  ASSERT_TRUE(replies_.contains(3));
+  EXPECT_EQ(replies_[3].signal, Signal::kInterrupted) << replies_[3].message;
+  EXPECT_THAT(replies_[3].message, HasSubstr("expired"));
+  const double held = Position(1);
+  RunTo(kT0 + milliseconds(900));
+  EXPECT_DOUBLE_EQ(Position(1), held) << "the trajectory the expired speed replaced ran on";
+  for (CommandId id : {1, 2}) {
+    ASSERT_TRUE(replies_.contains(id)) << "waypoint " << id << " unanswered";
+    EXPECT_EQ(replies_[id].signal, Signal::kInterrupted) << replies_[id].message;
+  }
+}
+
+// The watchdog on trajectories: no test named in docs/safety.md covered a
+// vanished client's joint or frame trajectory (the watchdog matrix sends step
+// commands; only the base's ramp has a test). Both must end, the joints hold
+// where the stop found them. (Their waypoints' answers go nowhere: a vanished
+// session's replies are dropped.)
+using WatchdogTrajectoryTest = HostileNumbersTest;
+
+TEST_F(WatchdogTrajectoryTest, AVanishedClientsJointAndFrameTrajectoriesEndAndTheJointsHold) {
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+  const std::vector<double> pose{0, 0, 0, turned.w(), turned.x(), turned.y(), turned.z()};
+  for (const bool frame : {false, true}) {
+    SCOPED_TRACE(frame ? "a frame trajectory" : "a joint trajectory");
+    const TimePoint t0 = clock_.Now();
+    const std::vector<Command> waypoints =
+        frame ? std::vector<Command>{Command{11, CommandType::kFrameSetPoint, StartTime::At(t0 + seconds(6)),
+                                             "tool", pose}}
+              : std::vector<Command>{Waypoint(1, "wheel", t0 + seconds(3), {3.0}),
+                                     Waypoint(2, "wheel", t0 + seconds(6), {6.0})};
+    EXPECT_TRUE(Send(waypoints, Interpolation::kCubic).empty());
+    RunTo(t0 + milliseconds(2500));  // the session has been silent for 2.5 s: past the 2 s timeout
+    const int dof = frame ? 0 : 1;
+    const double before = Position(dof);
+    ASSERT_GT(std::abs(before), 0.01) << "the trajectory moves the joint";
+    ASSERT_EQ(sessions_.Expire(clock_.Now()).size(), 1u);
+    RunTo(t0 + milliseconds(2520));
+    const double held = Position(dof);
+    RunTo(t0 + milliseconds(4000));
+    EXPECT_DOUBLE_EQ(Position(dof), held) << "the vanished client's trajectory ran on";
+  }
 }
 
 }  // namespace
