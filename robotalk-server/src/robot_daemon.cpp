@@ -510,6 +510,13 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     const int joint = hold.joint;
     const StopScope scope{.joints = std::span<const int>(&joint, hold.joint >= 0 ? 1 : 0), .base = hold.base};
     if (hold.base) EndRamp(now, "stopped: SETSPEED " + std::to_string(item.command.id) + " expired");
+    if (hold.joint >= 0) {  // the joint's trajectory ends too, or its next reference would move it on
+      tracker_.End(hold.joint, now,
+                   std::string("stopped: ") + ToString(item.command.type) + " " +
+                       std::to_string(item.command.id) + " expired",
+                   tracked_);
+      EmitTracked();
+    }
     if (hold.any() && !driver_call("StopOnly", [&] { driver_->StopOnly(scope, now, completions_); })) return;
     r.signal = Signal::kInterrupted;
     r.message = *ExpiryRefusal(r.lateness, item.max_late, item.received - item.start);

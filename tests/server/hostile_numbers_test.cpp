@@ -213,7 +213,7 @@ TEST_F(HostileNumbersTest, TheWorstNumbersWithinTheBoundRunWithoutANonFiniteRefe
 // trajectory the expired command was meant to replace.
 using ExpiredSpeedTest = HostileNumbersTest;
 
-TEST_F(ExpiredSpeedTest, DISABLED_AnExpiredJointSpeedEndsTheJointsTrajectoryAndTheJointHolds) {
+TEST_F(ExpiredSpeedTest, AnExpiredJointSpeedEndsTheJointsTrajectoryAndTheJointHolds) {
   EXPECT_TRUE(Send({Waypoint(1, "wheel", kT0 + milliseconds(1000), {1.0}),
                     Waypoint(2, "wheel", kT0 + milliseconds(2000), {2.0})},
                    Interpolation::kCubic)
@@ -236,6 +236,7 @@ TEST_F(ExpiredSpeedTest, DISABLED_AnExpiredJointSpeedEndsTheJointsTrajectoryAndT
   for (CommandId id : {1, 2}) {
     ASSERT_TRUE(replies_.contains(id)) << "waypoint " << id << " unanswered";
     EXPECT_EQ(replies_[id].signal, Signal::kInterrupted) << replies_[id].message;
+    EXPECT_THAT(replies_[id].message, HasSubstr("stopped: JOINT_SPEED 3 expired"));
   }
 }
 
