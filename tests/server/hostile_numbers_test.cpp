@@ -54,13 +54,13 @@ Command Waypoint(CommandId id, const std::string& joint, TimePoint at, std::vect
 
 class HostileNumbersTest : public ::testing::Test {
  protected:
-  HostileNumbersTest()
+  explicit HostileNumbersTest(SessionOptions options = {})
       : daemon_("arm", "kinematic", MakeDriver(), clock_, RobotDaemonOptions{.precise_timing = false}),
-        sessions_(daemon_, ConfigHash(daemon_.model()), SessionOptions{}) {
+        sessions_(daemon_, ConfigHash(daemon_.model()), options) {
     daemon_.Preallocate(out_);
   }
 
-  // One interpolated package of `commands`, all due at kT0 + `ahead`.
+  // One interpolated package of `commands`; the immediate replies by id.
   std::map<CommandId, Reply> Send(std::vector<Command> commands, Interpolation interpolation) {
     Request r{.client_id = kAlice, .sequence = ++sequence_};
     r.interpolation = interpolation;
@@ -269,6 +269,33 @@ TEST_F(WatchdogTrajectoryTest, AVanishedClientsJointAndFrameTrajectoriesEndAndTh
     RunTo(t0 + milliseconds(4000));
     EXPECT_DOUBLE_EQ(Position(dof), held) << "the vanished client's trajectory ran on";
   }
+}
+
+// Bounds (docs/safety.md): "the robot's queue is bounded", a client may keep
+// at most --max-queue items waiting. A waypoint is counted only until the
+// RobotDaemon hands it to its TrajectoryTracker (RobotDaemon::queued counts
+// the scheduler and arrived_waypoints_): the tracker's pending waypoints
+// (TrajectoryTracker::Track::pending, and the Trajectory's knots) are counted
+// nowhere. A client sending waypoints ever further ahead (up to --max-future,
+// 1 h) between two control periods grows the server's memory without bound.
+class SmallQueueTest : public HostileNumbersTest {
+ protected:
+  SmallQueueTest() : HostileNumbersTest(SessionOptions{.max_queue = 50}) {}
+};
+
+TEST_F(SmallQueueTest, DISABLED_WaypointsWaitingInTheTrackerCountAgainstTheClientsQueueBound) {
+  std::size_t accepted = 0;
+  CommandId id = 0;
+  for (int package = 0; package < 40; ++package) {
+    std::vector<Command> waypoints;
+    for (int k = 0; k < 50; ++k, ++id) {
+      waypoints.push_back(
+          Waypoint(id + 1, "elbow", kT0 + seconds(10) + milliseconds(id), {0.001 * (id % 100)}));
+    }
+    accepted += waypoints.size() - Send(waypoints, Interpolation::kLinear).size();
+    RunTo(clock_.Now() + milliseconds(10));  // one control period: the tracker takes them
+  }
+  EXPECT_LE(accepted, 50u) << "waypoints of one client waiting on the robot, beyond --max-queue 50";
 }
 
 }  // namespace
