@@ -298,5 +298,23 @@ TEST_F(SmallQueueTest, DISABLED_WaypointsWaitingInTheTrackerCountAgainstTheClien
   EXPECT_LE(accepted, 50u) << "waypoints of one client waiting on the robot, beyond --max-queue 50";
 }
 
+// The same for the base's speed ramp: SETSPEED frames of interpolated
+// packages wait in SpeedRamp::pending_, counted nowhere.
+TEST_F(SmallQueueTest, DISABLED_SpeedFramesWaitingInTheRampCountAgainstTheClientsQueueBound) {
+  std::size_t accepted = 0;
+  CommandId id = 0;
+  for (int package = 0; package < 40; ++package) {
+    std::vector<Command> frames;
+    for (int k = 0; k < 50; ++k, ++id) {
+      frames.push_back(Command{id + 1, CommandType::kSetSpeed,
+                               StartTime::At(kT0 + seconds(10) + milliseconds(id)), "",
+                               std::vector<double>{0.001 * (id % 100), 0}});
+    }
+    accepted += frames.size() - Send(frames, Interpolation::kLinear).size();
+    RunTo(clock_.Now() + milliseconds(10));
+  }
+  EXPECT_LE(accepted, 50u) << "SETSPEED frames of one client waiting on the robot, beyond --max-queue 50";
+}
+
 }  // namespace
 }  // namespace robotalk
