@@ -316,5 +316,27 @@ TEST_F(SmallQueueTest, DISABLED_SpeedFramesWaitingInTheRampCountAgainstTheClient
   EXPECT_LE(accepted, 50u) << "SETSPEED frames of one client waiting on the robot, beyond --max-queue 50";
 }
 
+// "A STOP always runs, however late" (docs/safety.md, Deadlines). Admission
+// refuses any start time more than --max-future (1 h) in the past with ERROR
+// ("is the client's clock synchronised?"), a STOP's too, before the deadline
+// rule that exempts it is reached: a STOP from a client whose clock is wrong
+// by more than an hour is refused and the robot moves on.
+TEST_F(HostileNumbersTest, DISABLED_AStopDueLongAgoStillRuns) {
+  EXPECT_TRUE(
+      Send({Command{1, CommandType::kJointSpeed, StartTime::Now(), "wheel", std::vector<double>{0.5}}},
+           Interpolation::kStep)
+          .empty());
+  RunTo(kT0 + milliseconds(200));
+  ASSERT_GT(Position(1), 0.05) << "the wheel turns";
+  const std::map<CommandId, Reply> immediate =
+      Send({Command{2, CommandType::kStop, StartTime::At(clock_.Now() - std::chrono::hours(2)), "", {}}},
+           Interpolation::kStep);
+  EXPECT_FALSE(immediate.contains(2)) << immediate.at(2).message;
+  RunTo(kT0 + milliseconds(220));
+  const double stopped = Position(1);
+  RunTo(kT0 + milliseconds(500));
+  EXPECT_DOUBLE_EQ(Position(1), stopped) << "the wheel still turns after the STOP";
+}
+
 }  // namespace
 }  // namespace robotalk
