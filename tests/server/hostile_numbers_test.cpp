@@ -272,18 +272,18 @@ TEST_F(WatchdogTrajectoryTest, AVanishedClientsJointAndFrameTrajectoriesEndAndTh
 }
 
 // Bounds (docs/safety.md): "the robot's queue is bounded", a client may keep
-// at most --max-queue items waiting. A waypoint is counted only until the
-// RobotDaemon hands it to its TrajectoryTracker (RobotDaemon::queued counts
-// the scheduler and arrived_waypoints_): the tracker's pending waypoints
-// (TrajectoryTracker::Track::pending, and the Trajectory's knots) are counted
-// nowhere. A client sending waypoints ever further ahead (up to --max-future,
-// 1 h) between two control periods grows the server's memory without bound.
+// at most --max-queue items waiting. A waypoint was counted only until the
+// RobotDaemon handed it to its TrajectoryTracker (RobotDaemon::queued counted
+// the scheduler and arrived_waypoints_): the tracker's pending waypoints (and
+// the Trajectory's knots) were counted nowhere, so a client sending waypoints
+// ever further ahead (up to --max-future, 1 h) between two control periods
+// grew the server's memory without bound (200k waypoints: +64 MiB of RSS).
 class SmallQueueTest : public HostileNumbersTest {
  protected:
   SmallQueueTest() : HostileNumbersTest(SessionOptions{.max_queue = 50}) {}
 };
 
-TEST_F(SmallQueueTest, DISABLED_WaypointsWaitingInTheTrackerCountAgainstTheClientsQueueBound) {
+TEST_F(SmallQueueTest, WaypointsWaitingInTheTrackerCountAgainstTheClientsQueueBound) {
   std::size_t accepted = 0;
   CommandId id = 0;
   for (int package = 0; package < 40; ++package) {
@@ -299,8 +299,8 @@ TEST_F(SmallQueueTest, DISABLED_WaypointsWaitingInTheTrackerCountAgainstTheClien
 }
 
 // The same for the base's speed ramp: SETSPEED frames of interpolated
-// packages wait in SpeedRamp::pending_, counted nowhere.
-TEST_F(SmallQueueTest, DISABLED_SpeedFramesWaitingInTheRampCountAgainstTheClientsQueueBound) {
+// packages waited in SpeedRamp::pending_, counted nowhere.
+TEST_F(SmallQueueTest, SpeedFramesWaitingInTheRampCountAgainstTheClientsQueueBound) {
   std::size_t accepted = 0;
   CommandId id = 0;
   for (int package = 0; package < 40; ++package) {
