@@ -171,23 +171,21 @@ void RobotDaemon::Submit(QueuedItem item) {
 }
 
 // What waits: in the scheduler, arrived for the planners, and held by them
-// (waypoints and SETSPEED frames not yet passed; they were counted nowhere,
-// so a client streaming them far ahead grew the server without bound).
+// (waypoints and SETSPEED frames not yet passed, once counted nowhere:
+// streamed far ahead, they grew the server without bound).
 std::size_t RobotDaemon::queued(std::int64_t client_id) const {
   std::lock_guard lock(mutex_);
-  std::size_t held = 0;
-  for (const auto& [id, n] : held_) held += id == client_id ? n : 0;
-  return scheduler_.queued(client_id) + held +
-         static_cast<std::size_t>(
-             std::count_if(arrived_waypoints_.begin(), arrived_waypoints_.end(),
-                           [&](const QueuedItem& i) { return i.client_id == client_id; }));
+  std::size_t n = scheduler_.queued(client_id);
+  for (const auto& [id, held] : held_) n += id == client_id ? held : 0;
+  for (const QueuedItem& i : arrived_waypoints_) n += i.client_id == client_id ? 1 : 0;
+  return n;
 }
 
 std::size_t RobotDaemon::queued_total() const {
   std::lock_guard lock(mutex_);
-  std::size_t held = 0;
-  for (const auto& entry : held_) held += entry.second;
-  return scheduler_.size() + arrived_waypoints_.size() + held;
+  std::size_t n = scheduler_.size() + arrived_waypoints_.size();
+  for (const auto& entry : held_) n += entry.second;
+  return n;
 }
 
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
