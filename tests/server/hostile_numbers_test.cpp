@@ -14,6 +14,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <vector>
@@ -88,6 +90,15 @@ class HostileNumbersTest : public ::testing::Test {
     driver_->ReadState(s);
     return s.position[dof];
   }
+  // Each of `ids` was answered ERROR at once, naming `text`.
+  static void ExpectRefused(const std::map<CommandId, Reply>& immediate, std::initializer_list<CommandId> ids,
+                            const std::string& text) {
+    for (CommandId id : ids) {
+      ASSERT_TRUE(immediate.contains(id)) << "command " << id << " not refused";
+      EXPECT_EQ(immediate.at(id).signal, Signal::kError) << immediate.at(id).message;
+      EXPECT_THAT(immediate.at(id).message, HasSubstr(text));
+    }
+  }
   // Nothing of the refused package ran: the robot is not in panic, and a
   // well-formed waypoint sent next still reaches the elbow.
   void ExpectServingOn() {
@@ -127,9 +138,7 @@ class HostileNumbersTest : public ::testing::Test {
 TEST_F(HostileNumbersTest, AWaypointWhoseVelocityOverflowsThePlanIsRefusedAndTheRobotServesOn) {
   const std::map<CommandId, Reply> immediate =
       Send({Waypoint(1, "elbow", kT0 + milliseconds(100), {0.5}, {1e308})}, Interpolation::kCubic);
-  ASSERT_TRUE(immediate.contains(1));
-  EXPECT_EQ(immediate.at(1).signal, Signal::kError) << immediate.at(1).message;
-  EXPECT_EQ(immediate.at(1).message, "JOINT_SETPOINT 'elbow': velocity 0 is 1e+308, beyond ±1e+09");
+  ExpectRefused(immediate, {1}, "JOINT_SETPOINT 'elbow': velocity 0 is 1e+308, beyond ±1e+09");
   ExpectServingOn();
 }
 
@@ -141,9 +150,7 @@ TEST_F(HostileNumbersTest, AFrameWaypointAHugeDistanceAwayIsRefusedAndTheRobotSe
       Send({Command{1, CommandType::kFrameSetPoint, StartTime::At(kT0 + milliseconds(100)), "tool",
                     std::vector<double>{1e308, 0, 0, 1, 0, 0, 0}}},
            Interpolation::kCubic);
-  ASSERT_TRUE(immediate.contains(1));
-  EXPECT_EQ(immediate.at(1).signal, Signal::kError) << immediate.at(1).message;
-  EXPECT_THAT(immediate.at(1).message, HasSubstr("FRAME_SETPOINT 'tool': value 0 is 1e+308, beyond ±1e+09"));
+  ExpectRefused(immediate, {1}, "FRAME_SETPOINT 'tool': value 0 is 1e+308, beyond ±1e+09");
   ExpectServingOn();
 }
 
@@ -154,11 +161,7 @@ TEST_F(HostileNumbersTest, WaypointsWhoseDifferenceOverflowsAreRefusedAndTheRobo
       Send({Waypoint(1, "wheel", kT0 + milliseconds(100), {1.7e308}),
             Waypoint(2, "wheel", kT0 + milliseconds(200), {-1.7e308})},
            Interpolation::kLinear);
-  for (CommandId id : {1, 2}) {
-    ASSERT_TRUE(immediate.contains(id));
-    EXPECT_EQ(immediate.at(id).signal, Signal::kError) << immediate.at(id).message;
-    EXPECT_THAT(immediate.at(id).message, HasSubstr("JOINT_SETPOINT 'wheel': value 0 is"));
-  }
+  ExpectRefused(immediate, {1, 2}, "JOINT_SETPOINT 'wheel': value 0 is");
   ExpectServingOn();
 }
 
@@ -173,11 +176,7 @@ TEST_F(HostileNumbersTest, SpeedFramesWhoseDifferenceOverflowsAreRefusedAndTheRo
   const std::map<CommandId, Reply> immediate =
       Send({speed(1, kT0 + milliseconds(100), 1.7e308), speed(2, kT0 + milliseconds(200), -1.7e308)},
            Interpolation::kLinear);
-  for (CommandId id : {1, 2}) {
-    ASSERT_TRUE(immediate.contains(id));
-    EXPECT_EQ(immediate.at(id).signal, Signal::kError) << immediate.at(id).message;
-    EXPECT_THAT(immediate.at(id).message, HasSubstr("SETSPEED: value 0 is"));
-  }
+  ExpectRefused(immediate, {1, 2}, "SETSPEED: value 0 is");
   ExpectServingOn();
 }
 
@@ -281,38 +280,35 @@ TEST_F(WatchdogTrajectoryTest, AVanishedClientsJointAndFrameTrajectoriesEndAndTh
 class SmallQueueTest : public HostileNumbersTest {
  protected:
   SmallQueueTest() : HostileNumbersTest(SessionOptions{.max_queue = 50}) {}
+  // 40 packages of 50 timed commands, each ever further ahead, one control
+  // period apart (the planners take them in between); how many were accepted.
+  std::size_t Flood(const std::function<Command(CommandId, TimePoint)>& make) {
+    std::size_t accepted = 0;
+    CommandId id = 0;
+    for (int package = 0; package < 40; ++package) {
+      std::vector<Command> commands;
+      for (int k = 0; k < 50; ++k, ++id)
+        commands.push_back(make(id + 1, kT0 + seconds(10) + milliseconds(id)));
+      accepted += commands.size() - Send(commands, Interpolation::kLinear).size();
+      RunTo(clock_.Now() + milliseconds(10));
+    }
+    return accepted;
+  }
 };
 
 TEST_F(SmallQueueTest, WaypointsWaitingInTheTrackerCountAgainstTheClientsQueueBound) {
-  std::size_t accepted = 0;
-  CommandId id = 0;
-  for (int package = 0; package < 40; ++package) {
-    std::vector<Command> waypoints;
-    for (int k = 0; k < 50; ++k, ++id) {
-      waypoints.push_back(
-          Waypoint(id + 1, "elbow", kT0 + seconds(10) + milliseconds(id), {0.001 * (id % 100)}));
-    }
-    accepted += waypoints.size() - Send(waypoints, Interpolation::kLinear).size();
-    RunTo(clock_.Now() + milliseconds(10));  // one control period: the tracker takes them
-  }
+  const std::size_t accepted =
+      Flood([](CommandId id, TimePoint at) { return Waypoint(id, "elbow", at, {0.001 * (id % 100)}); });
   EXPECT_LE(accepted, 50u) << "waypoints of one client waiting on the robot, beyond --max-queue 50";
 }
 
 // The same for the base's speed ramp: SETSPEED frames of interpolated
 // packages waited in SpeedRamp::pending_, counted nowhere.
 TEST_F(SmallQueueTest, SpeedFramesWaitingInTheRampCountAgainstTheClientsQueueBound) {
-  std::size_t accepted = 0;
-  CommandId id = 0;
-  for (int package = 0; package < 40; ++package) {
-    std::vector<Command> frames;
-    for (int k = 0; k < 50; ++k, ++id) {
-      frames.push_back(Command{id + 1, CommandType::kSetSpeed,
-                               StartTime::At(kT0 + seconds(10) + milliseconds(id)), "",
-                               std::vector<double>{0.001 * (id % 100), 0}});
-    }
-    accepted += frames.size() - Send(frames, Interpolation::kLinear).size();
-    RunTo(clock_.Now() + milliseconds(10));
-  }
+  const std::size_t accepted = Flood([](CommandId id, TimePoint at) {
+    return Command{id, CommandType::kSetSpeed, StartTime::At(at), "",
+                   std::vector<double>{0.001 * (id % 100), 0}};
+  });
   EXPECT_LE(accepted, 50u) << "SETSPEED frames of one client waiting on the robot, beyond --max-queue 50";
 }
 
