@@ -98,7 +98,8 @@ DriverResult OdeDriver::Impl::JointCommand(const DriverCommand& c) {
       what = want > got ? "the upper limit" : "the lower limit";
       servos_.SetPoint(i, got);
     } else if (servo == ServoType::kSpeed) {
-      got = std::clamp(want, -dof.limits.velocity, dof.limits.velocity);
+      // The servo's limit: the model's, or default_velocity where that is infinite.
+      got = std::clamp(want, -servos_.vmax()[i], servos_.vmax()[i]);
       unit += "/s";
       what = "the velocity limit";
       servos_.Speed(i, got);

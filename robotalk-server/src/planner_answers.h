@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace robotalk::planner_answers {
 
@@ -27,6 +28,21 @@ inline Reply MakeAnswer(CommandId id, Signal signal, std::string message, TimePo
   r.exec_time = exec;
   r.lateness = lateness;
   return r;
+}
+
+/// Commands a planner holds per client (client id, count): what a client has
+/// waiting on the robot beside its queue (RobotDaemon::queued, --max-queue).
+using HeldCounts = std::vector<std::pair<std::int64_t, std::size_t>>;
+
+/// One more held for `client` (a linear search: few clients hold any).
+inline void CountHeld(HeldCounts& counts, std::int64_t client) {
+  for (auto& [id, n] : counts) {
+    if (id == client) {
+      ++n;
+      return;
+    }
+  }
+  counts.emplace_back(client, 1);
 }
 
 /// `note` and `more`, joined with "; ".

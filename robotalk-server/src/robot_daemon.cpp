@@ -63,6 +63,8 @@ RobotDaemon::RobotDaemon(std::string robot_name, std::string driver_name, std::u
   tracked_.reserve(256);
   speed_frames_.reserve(256);
   ramped_.reserve(256);
+  held_.reserve(64);
+  held_now_.reserve(64);
   completions_.reserve(64);
   produced_.replies.reserve(256);
   produced_.executed.reserve(256);
@@ -168,16 +170,22 @@ void RobotDaemon::Submit(QueuedItem item) {
   if (wake) wake_.notify_one();
 }
 
+// What waits: in the scheduler, arrived for the planners, and held by them
+// (waypoints and SETSPEED frames not yet passed, once counted nowhere:
+// streamed far ahead, they grew the server without bound).
 std::size_t RobotDaemon::queued(std::int64_t client_id) const {
   std::lock_guard lock(mutex_);
-  return scheduler_.queued(client_id) + static_cast<std::size_t>(std::count_if(
-                                            arrived_waypoints_.begin(), arrived_waypoints_.end(),
-                                            [&](const QueuedItem& i) { return i.client_id == client_id; }));
+  std::size_t n = scheduler_.queued(client_id);
+  for (const auto& [id, held] : held_) n += id == client_id ? held : 0;
+  for (const QueuedItem& i : arrived_waypoints_) n += i.client_id == client_id ? 1 : 0;
+  return n;
 }
 
 std::size_t RobotDaemon::queued_total() const {
   std::lock_guard lock(mutex_);
-  return scheduler_.size() + arrived_waypoints_.size();
+  std::size_t n = scheduler_.size() + arrived_waypoints_.size();
+  for (const auto& entry : held_) n += entry.second;
+  return n;
 }
 
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
@@ -366,6 +374,8 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     scheduler_.TakeDue(now, due_);
     waypoints_.clear();
     std::swap(waypoints_, arrived_waypoints_);
+    // Held from now on (the planners take them below); recounted at the end.
+    for (const QueuedItem& w : waypoints_) planner_answers::CountHeld(held_, w.client_id);
     pushes_taken_ = pushes_;
     period = scheduler_.stream_period();
     sample_due = scheduler_.TakeSampleDue(now) || (last_iteration_ && period.count() > 0);
@@ -418,8 +428,12 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   TimePoint next = next_update_;
   TimePoint next_due = TimePoint::max();
   bool ready = false;
+  held_now_.clear();
+  tracker_.CountPending(held_now_);
+  ramp_.CountPending(held_now_);
   {
     std::lock_guard lock(mutex_);
+    held_.swap(held_now_);
     for (auto& a : produced_.replies) outbox_.replies.push_back(std::move(a));
     for (const auto& e : produced_.executed) outbox_.executed.push_back(e);
     for (auto& line : produced_.log) outbox_.log.push_back(std::move(line));
@@ -510,6 +524,13 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
     const int joint = hold.joint;
     const StopScope scope{.joints = std::span<const int>(&joint, hold.joint >= 0 ? 1 : 0), .base = hold.base};
     if (hold.base) EndRamp(now, "stopped: SETSPEED " + std::to_string(item.command.id) + " expired");
+    if (hold.joint >= 0) {  // the joint's trajectory ends too, or its next reference would move it on
+      tracker_.End(hold.joint, now,
+                   std::string("stopped: ") + ToString(item.command.type) + " " +
+                       std::to_string(item.command.id) + " expired",
+                   tracked_);
+      EmitTracked();
+    }
     if (hold.any() && !driver_call("StopOnly", [&] { driver_->StopOnly(scope, now, completions_); })) return;
     r.signal = Signal::kInterrupted;
     r.message = *ExpiryRefusal(r.lateness, item.max_late, item.received - item.start);

@@ -315,7 +315,10 @@ class RobotDaemon {
   Scheduler scheduler_;                        // GUARDED_BY(mutex_)
   std::vector<QueuedItem> arrived_waypoints_;  // GUARDED_BY(mutex_): QueuedItem::is_waypoint(), not yet taken
   DaemonOutput outbox_;                        // GUARDED_BY(mutex_)
-  bool wake_flag_ = false;                     // GUARDED_BY(mutex_)
+  /// Waypoints and SETSPEED frames the planners hold, per client: what a
+  /// client has waiting beside the scheduler's queue (queued()).
+  planner_answers::HeldCounts held_;  // GUARDED_BY(mutex_)
+  bool wake_flag_ = false;            // GUARDED_BY(mutex_)
   /// The deadline the thread waits for; nullopt while it runs (Submit wakes it
   /// only for an item due before this).
   std::optional<TimePoint> sleeping_until_;  // GUARDED_BY(mutex_)
@@ -341,6 +344,7 @@ class RobotDaemon {
   std::vector<QueuedItem> speed_frames_;  // this iteration's SETSPEED frames (QueuedItem::is_speed_frame())
   SpeedRamp ramp_;
   std::vector<SpeedRamp::Answer> ramped_;  // the ramp's answers of this iteration
+  planner_answers::HeldCounts held_now_;   // held_ as this iteration leaves it (swapped in)
   std::vector<Completion> completions_;
   std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
   DaemonOutput produced_;

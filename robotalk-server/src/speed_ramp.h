@@ -41,6 +41,7 @@
 #pragma once
 
 #include "command_queue.h"
+#include "planner_answers.h"
 #include "robotalk/command.h"
 #include "robotalk/driver.h"
 
@@ -104,6 +105,10 @@ class SpeedRamp {
   bool active() const { return active_; }
   /// Frames waiting to be passed.
   std::size_t pending() const { return pending_.size(); }
+  /// Adds each client's frames waiting to be passed to `counts`.
+  void CountPending(planner_answers::HeldCounts& counts) const {
+    for (const Frame& f : pending_) planner_answers::CountHeld(counts, f.client_id);
+  }
 
  private:
   struct Twist {

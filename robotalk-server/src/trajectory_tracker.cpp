@@ -117,6 +117,15 @@ std::size_t TrajectoryTracker::pending() const {
   return n;
 }
 
+void TrajectoryTracker::CountPending(planner_answers::HeldCounts& counts) const {
+  for (const std::vector<Track>* tracks : {&tracks_, &frame_tracks_}) {
+    for (const Track& t : *tracks) {
+      for (std::size_t i = 0; i < t.pending.size(); ++i)
+        planner_answers::CountHeld(counts, t.pending[i].client_id);
+    }
+  }
+}
+
 void TrajectoryTracker::Add(std::span<const QueuedItem> waypoints, TimePoint now, const RobotState& state,
                             std::vector<Answer>& answers, std::vector<Started>& started) {
   // Waypoints in time order per joint (ties in arrival order), so a package's

@@ -44,6 +44,7 @@
 #pragma once
 
 #include "command_queue.h"
+#include "planner_answers.h"
 #include "robotalk/command.h"
 #include "robotalk/driver.h"
 #include "robotalk/inverse_kinematics.h"
@@ -119,6 +120,8 @@ class TrajectoryTracker {
   double max_reference_acceleration() const { return max_reference_acceleration_; }
   /// Waypoints waiting to be passed, over every joint (for tests and bounds).
   std::size_t pending() const;
+  /// Adds each client's waypoints waiting to be passed to `counts`.
+  void CountPending(planner_answers::HeldCounts& counts) const;
 
  private:
   struct Pending {  // a waypoint not yet passed: the trajectory's last knots, in order

@@ -60,6 +60,24 @@ std::optional<std::string> CheckFinite(const Command& c) {
   return CheckFinite(c, c.accelerations, "acceleration");
 }
 
+// Every number within ±kMaxCommandMagnitude (checked after CheckFinite and the
+// target's own checks, so a GOTO far away still names its workspace bound).
+std::optional<std::string> CheckMagnitude(const Command& c) {
+  const auto check = [&c](const std::vector<double>& values, const char* noun) -> std::optional<std::string> {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (std::abs(values[i]) <= kMaxCommandMagnitude) continue;
+      char text[96];
+      std::snprintf(text, sizeof text, ": %s %zu is %.4g, beyond ±%.0e", noun, i, values[i],
+                    kMaxCommandMagnitude);
+      return Label(c) + text;
+    }
+    return std::nullopt;
+  };
+  if (auto bad = check(c.values, "value")) return bad;
+  if (auto bad = check(c.velocities, "velocity")) return bad;
+  return check(c.accelerations, "acceleration");
+}
+
 // A waypoint's velocities and accelerations: none, or WaypointRateCount each.
 std::optional<std::string> CheckRateCount(const Command& c, std::size_t dofs = 0) {
   const std::size_t expected = WaypointRateCount(c.type, dofs);
@@ -239,6 +257,7 @@ std::optional<std::string> QueryProblem(const RobotModel& model, const Query& q)
 std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& c, const CommandLimits& limits) {
   Signal signal = Signal::kError;
   if (auto problem = CommandProblem(model, c, limits, &signal)) return Refusal{signal, std::move(*problem)};
+  if (auto problem = CheckMagnitude(c)) return Refusal{Signal::kError, std::move(*problem)};
   return std::nullopt;
 }
 

@@ -253,6 +253,13 @@ constexpr bool IsMotionCommand(CommandType t) {
 /// The default of CommandLimits::max_goto_distance (m).
 inline constexpr double kDefaultMaxGotoDistance = 100.0;
 
+/// The largest magnitude of any number a command carries (a value, a
+/// waypoint's velocity or acceleration): no robot's joint range, speed,
+/// effort or pose coordinate comes near it, and within it a trajectory's or
+/// a speed ramp's arithmetic cannot overflow (a finite 1e308 rad/s made the
+/// plan NaN and halted the robot in panic). Beyond it CheckCommand refuses.
+inline constexpr double kMaxCommandMagnitude = 1e9;
+
 /// What a server allows beyond the model (robotalk-server's options).
 struct CommandLimits {
   /// A GOTO target (x, y) farther than this from the world origin is refused
@@ -265,7 +272,8 @@ struct CommandLimits {
 /// malformed request ("JOINT_SETPOINT: robot 'pioneer' has no joint named
 /// 'nek'", "JOINT_SETPOINT 'pan_tilt': expected 2 values (one per dof), got
 /// 3", "JOINT_SETPOINT 'pan_tilt': value 1 is NaN", "GOTO: target (1e+308,
-/// 0) m is 1e+308 m from the world origin; the bound is 100 m"), kNa for a
+/// 0) m is 1e+308 m from the world origin; the bound is 100 m",
+/// "JOINT_SETPOINT 'elbow': velocity 0 is 1e+308, beyond ±1e+09"), kNa for a
 /// servo type or base command the robot does not support. The one check for
 /// every driver.
 std::optional<Refusal> CheckCommand(const RobotModel& model, const Command& command,
