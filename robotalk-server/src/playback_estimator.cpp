@@ -56,10 +56,8 @@ void PlaybackEstimator::SetDelayHistory(const std::vector<DelayHistory::Sample>&
   }
 }
 
-void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent,
-                            std::optional<TimePoint> handled) {
-  frames_.push_back({offset, arrival, sent ? OneWayDelay(*sent, arrival) : std::nullopt,
-                     std::max(arrival, handled.value_or(arrival))});
+void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent) {
+  frames_.push_back({offset, arrival, sent ? OneWayDelay(*sent, arrival) : std::nullopt});
 }
 
 std::vector<PlaybackEstimator::Seen> PlaybackEstimator::SeenPackages() const {
@@ -301,14 +299,14 @@ Duration PlaybackEstimator::start_lead() const {
 TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin, Duration lead) const {
   // Offset 0 plays when the latest frame seen (arrival − offset) would plus
   // the worst delay's excess over the frame's own; never before the decision
-  // (the latest frame's handling, as StartTime).
+  // (as StartTime).
   const Frame* anchor = &frames_.front();  // quick(): every frame has a delay
   Duration first_offset = Duration::max();
   TimePoint decided = TimePoint::min();
   for (const Frame& f : frames_) {
     if (f.arrival - f.offset > anchor->arrival - anchor->offset) anchor = &f;
     first_offset = std::min(first_offset, f.offset);
-    decided = std::max(decided, f.handled);
+    decided = std::max(decided, f.arrival);
   }
   const Duration excess = std::max(Duration(0), worst - *anchor->delay);
   return std::max(anchor->arrival - anchor->offset + excess - lead, decided - first_offset) + margin;
@@ -396,10 +394,10 @@ TimePoint PlaybackEstimator::PaperStart() const {
   Duration first_offset = Duration::max(), last_offset = Duration::min();
   TimePoint decided = TimePoint::min();  // the estimate is made when the last frame seen arrived
   for (const Frame& f : frames_) {
-    lag = std::max(lag, f.handled - f.offset);
+    lag = std::max(lag, f.arrival - f.offset);
     first_offset = std::min(first_offset, f.offset);
     last_offset = std::max(last_offset, f.offset);
-    decided = std::max(decided, f.handled);
+    decided = std::max(decided, f.arrival);
   }
   // Frames still to come lag more if the channel is slower than the sequence.
   const TimePoint projected = lag + ExtraLagBound(duration_ - std::min(duration_, last_offset));

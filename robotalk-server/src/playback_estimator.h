@@ -187,13 +187,9 @@ class PlaybackEstimator {
   }
   /// The same with their arrival times (DelayHistory::RecentSamples), oldest first.
   void SetDelayHistory(const std::vector<DelayHistory::Sample>& samples);
-  /// Records one frame: its offset from the sequence start, its arrival (the
-  /// socket's stamp: the delays are the link's) and the client's send time
-  /// of its package (nullopt: unknown). `handled`: when the server handled
-  /// it, if later (nullopt: at its arrival); nothing is started before the
-  /// latest frame was handled, and no frame before it was.
-  void Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent = std::nullopt,
-           std::optional<TimePoint> handled = std::nullopt);
+  /// Records one frame: its offset from the sequence start, its arrival and
+  /// the client's send time of its package (nullopt: unknown).
+  void Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent = std::nullopt);
   std::size_t frames_seen() const { return frames_.size(); }
   std::size_t frames_needed() const { return needed_; }
   /// Heap memory it holds (its frames and delay history), for the session's accounting.
@@ -241,7 +237,6 @@ class PlaybackEstimator {
     Duration offset;
     TimePoint arrival;
     std::optional<Duration> delay;  // arrival − send time
-    TimePoint handled;              // >= arrival: from then on it can play
   };
   // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
   // `lead`: that much earlier, but never before the decision + margin.

@@ -10,18 +10,14 @@ PlaybackSchedule::PlaybackSchedule(TimePoint start, std::optional<Duration> play
     : start_(start), playout_delay_(playout_delay), options_(options), knot_at_(start) {}
 
 PlaybackSchedule::Placement PlaybackSchedule::Place(Duration offset, TimePoint arrival,
-                                                    std::optional<Duration> delay,
-                                                    std::optional<TimePoint> handled) {
+                                                    std::optional<Duration> delay) {
   const bool fixed = options_.max_stretch <= 0;
-  // Here (in the RobotDaemon's reach) once handled; `arrival` stays the
-  // link's (its send time is arrival − delay).
-  const TimePoint in = std::max(arrival, handled.value_or(arrival));
-  const TimePoint ready = in + options_.margin;  // the earliest it can play
+  const TimePoint ready = arrival + options_.margin;  // the earliest it can play
   if (offset <= knot_offset_) {
     // Reordered, or another command at an instant already placed: slope 1
     // back from the knot keeps both gaps around it within the bound.
     const TimePoint at = knot_at_ - (knot_offset_ - offset);
-    const bool late = (fixed ? in : ready) > at;
+    const bool late = (fixed ? arrival : ready) > at;
     if (late) ++late_;
     return {at, late};
   }
@@ -30,7 +26,7 @@ PlaybackSchedule::Placement PlaybackSchedule::Place(Duration offset, TimePoint a
   const TimePoint latest = earliest + FromSeconds(ToSeconds(gap) * std::max(0.0, options_.max_stretch));
   Placement p{earliest, false};
   if (fixed) {
-    p.late = in > earliest;
+    p.late = arrival > earliest;
   } else {
     TimePoint want = ready;
     if (delay && playout_delay_) {

@@ -11,8 +11,7 @@
 //   - frame i (offset o_i) arriving at a_i, the last frame placed (o_c, T_c):
 //     its time is T_c + (o_i − o_c) × [1, 1 + max_stretch], as early as
 //     possible but no earlier than a_i + margin (it must be in the
-//     RobotDaemon's queue before it is due: reactive stretch; a_i is when it
-//     was handled where that was later than the socket's stamp) and, when the
+//     RobotDaemon's queue before it is due: reactive stretch) and, when the
 //     client stamps its send times, no earlier than its send time + the
 //     playout delay (the worst delay seen in this sequence + margin:
 //     proactive stretch, so the frames after a slow one get its headroom);
@@ -58,11 +57,8 @@ class PlaybackSchedule {
     bool late = false;  ///< it arrived after the bound allowed it to play
   };
   /// Places one frame: its offset, its arrival and its one-way delay
-  /// (arrival − client send time, OneWayDelay; nullopt: unknown). `handled`:
-  /// when the server handled it, if later than its arrival (the socket's
-  /// stamp): it plays no sooner than that + margin (nullopt: at its arrival).
-  Placement Place(Duration offset, TimePoint arrival, std::optional<Duration> delay = std::nullopt,
-                  std::optional<TimePoint> handled = std::nullopt);
+  /// (arrival − client send time, OneWayDelay; nullopt: unknown).
+  Placement Place(Duration offset, TimePoint arrival, std::optional<Duration> delay = std::nullopt);
 
   /// How much later than start + offset the last frame placed plays.
   Duration stretch() const { return knot_at_ - (start_ + knot_offset_); }

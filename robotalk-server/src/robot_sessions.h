@@ -101,9 +101,10 @@ class RobotSessions {
   /// Handles one decoded request, handled at `now` (the server clock) after
   /// it reached the socket at `arrived` (the transport's receive stamp on the
   /// server clock; ServerDaemon::ArrivalTime): `arrived` measures the link
-  /// (playback's one-way delays, link health, the reply's server_receive for
-  /// the client's clock), `now` judges what runs (start times, expiry, the
-  /// session's liveness, the playback start's floor). docs/protocol.md "Clocks".
+  /// (link health's transits, the reply's server_receive for the client's
+  /// clock); `now` judges what runs (start times, expiry, the session's
+  /// liveness) and playback's delays (a frame can play only once handled).
+  /// docs/protocol.md "Clocks".
   ImmediateAnswer Handle(const Request& request, TimePoint now, TimePoint arrived);
   /// The same handled when it arrived (a simulation, a test).
   ImmediateAnswer Handle(const Request& request, TimePoint now) { return Handle(request, now, now); }
@@ -166,9 +167,7 @@ class RobotSessions {
   std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
                                   bool playback, Duration max_late,
                                   Interpolation interpolation = Interpolation::kStep);
-  // `now`: handled; `arrived`: reached the socket (as Handle).
-  void AdmitPlayback(Session& s, const Request& request, TimePoint now, TimePoint arrived,
-                     std::vector<Reply>& immediate);
+  void AdmitPlayback(Session& s, const Request& request, TimePoint now, std::vector<Reply>& immediate);
   void Panic(std::int64_t client_id, TimePoint now, const std::string& sender = "");
   void Deliver(std::int64_t client_id, Reply reply);
   std::size_t Waiting(const Session& s) const;

@@ -11,7 +11,7 @@ namespace robotalk {
 
 using namespace sessions_text;
 
-void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, TimePoint arrived,
+void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
                                   std::vector<Reply>& immediate) {
   const PlaybackDeclaration& d = r.playback;
   const std::string label = "PLAYBACK " + std::to_string(d.id);
@@ -75,17 +75,15 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, T
            false);
     return;
   }
-  // The delays (and the start latency the client is told) from when each
-  // frame reached the socket; when it can play, from when it was handled.
   if (!seq.first_arrival) {
-    seq.first_arrival = arrived;
+    seq.first_arrival = now;
     // This package's delay is not in it yet (Handle records it after its
     // items): frame 0 counts once, as a frame.
     seq.estimator->SetDelayHistory(s.delays.RecentSamples(now));
   }
   const std::optional<TimePoint> sent =
       r.send_time != TimePoint{} ? std::optional<TimePoint>(r.send_time) : std::nullopt;
-  const std::optional<Duration> delay = sent ? OneWayDelay(*sent, arrived) : std::nullopt;
+  const std::optional<Duration> delay = sent ? OneWayDelay(*sent, now) : std::nullopt;
   for (const Command& c : r.commands) {
     std::optional<QueuedItem> item =
         Admit(s, c, now, immediate, /*playback=*/true, r.max_late, r.interpolation);
@@ -103,11 +101,11 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, T
     }
     item->has_start_time = true;
     if (seq.start) {  // already playing: straight to the RobotDaemon
-      item->start = seq.schedule->Place(offset, arrived, delay, now).at;
+      item->start = seq.schedule->Place(offset, now, delay).at;
       if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
     } else {
-      seq.estimator->Add(offset, arrived, sent, now);
-      seq.frames.push_back({offset, std::move(*item), arrived, delay, now});
+      seq.estimator->Add(offset, now, sent);
+      seq.frames.push_back({offset, std::move(*item), now, delay});
     }
   }
   if (!seq.start && seq.estimator->ready()) Start(s, d.id, seq, now, immediate);
@@ -132,7 +130,7 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
   std::stable_sort(seq.frames.begin(), seq.frames.end(),
                    [](const auto& a, const auto& b) { return a.offset < b.offset; });
   for (PlaybackSequence::Frame& frame : seq.frames) {
-    frame.item.start = seq.schedule->Place(frame.offset, frame.arrival, frame.delay, frame.handled).at;
+    frame.item.start = seq.schedule->Place(frame.offset, frame.arrival, frame.delay).at;
     if (!Superseded(s, frame.item, now, immediate)) daemon_.Submit(std::move(frame.item));
   }
   std::vector<PlaybackSequence::Frame>().swap(seq.frames);

@@ -294,8 +294,6 @@ void ServerDaemon::Flush() {
   WriteLog();
 }
 
-// A transport handler: never throws for bad input (the transport would
-// rethrow it out of RunOnce and end the loop's iteration).
 TimePoint ServerDaemon::ArrivalTime(TimePoint now) const {
   // The stamp is wall-clock time: it maps onto the server's steady clock as
   // "this long ago" (as the client's RobotClient::Impl::ArrivalTime).
@@ -305,12 +303,15 @@ TimePoint ServerDaemon::ArrivalTime(TimePoint now) const {
   return now - std::chrono::duration_cast<Duration>(age);
 }
 
+// A transport handler: never throws for bad input (the transport would
+// rethrow it out of RunOnce and end the loop's iteration).
 void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes) {
   // Two times (issue 23): `received`, when it is handled, judges what runs
   // and what expires (start times, --max-late, the session table's and the
-  // sessions' liveness); `arrived`, when it reached the socket, measures the
-  // link (playback's one-way delays, link health, the clock sample's t2), so
-  // that this thread's own lag under load is not the network's.
+  // sessions' liveness, playback's delays: a frame plays only once handled);
+  // `arrived`, when it reached the socket, measures the link (link health's
+  // transits, the clock sample's t2), so that this thread's own lag under
+  // load is not the network's.
   const TimePoint received = clock_.Now();
   const TimePoint arrived = ArrivalTime(received);
   const std::optional<std::string> robot_name = RobotOfRequestChannel(channel);

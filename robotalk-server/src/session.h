@@ -100,11 +100,10 @@ struct PlaybackSequence {
 
   std::optional<PlaybackEstimator> estimator;  ///< until the start is known
   struct Frame {
-    Duration offset;                ///< from the sequence start
-    QueuedItem item;                ///< its start is set once the sequence's start is known
-    TimePoint arrival;              ///< reached the socket (RobotSessions::Handle's `arrived`)
+    Duration offset;  ///< from the sequence start
+    QueuedItem item;  ///< its start is set once the sequence's start is known
+    TimePoint arrival;
     std::optional<Duration> delay;  ///< arrival − client send time (OneWayDelay)
-    TimePoint handled;              ///< the ServerDaemon handled it: it can play from then on
   };
   std::vector<Frame> frames;                 ///< the playback queue
   std::optional<TimePoint> start;            ///< when offset 0 plays, once estimated

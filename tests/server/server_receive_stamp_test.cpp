@@ -1,11 +1,14 @@
 // What measures the link comes from when a package reached the socket, not
 // from when the ServerDaemon got round to handling it (issue 23 item 3): a
 // loaded server that handles each package 20 ms after the one before it must
-// not record those 20 ms in playback's one-way delays (PlaybackEstimator's
-// history), in link health's transits (its jitter) or in the receive time it
-// answers for the client's clock (t2, which the round trip leaves out).
-// Playback's start is still judged against when a frame can really run: its
-// handling time.
+// not put those 20 ms into link health's transits (its jitter) or into the
+// receive time it answers for the client's clock (t2, which the round trip
+// and the offset leave out). Playback's one-way delays keep them: a frame can
+// play only once it was handled, so this server's own lag is part of what
+// the start must cover (the paper's Fig. 11 congestion is a server pausing
+// after each package; with the socket's stamp the adaptive start's gate missed
+// it and ServerClientTest.PlaybackKeepsTheInterFrameTimingUnderCongestion
+// played its frames 0.4 s late).
 //
 // The ServerDaemon on the in-memory transport (whose receive stamp is the
 // publish time), with the client's packages stamped on the same steady clock:
@@ -22,7 +25,6 @@
 #include <gtest/gtest.h>
 
 #include <map>
-#include <string>
 #include <thread>
 
 namespace robotalk {
@@ -100,7 +102,7 @@ class ServerReceiveStampTest : public ::testing::Test {
   std::map<CommandId, Reply> replies_;
 };
 
-TEST_F(ServerReceiveStampTest, DelaysTransitsAndTheClockReplysReceiveTimeLeaveOutTheServersHandlingLag) {
+TEST_F(ServerReceiveStampTest, TheClockSampleAndLinkHealthLeaveOutTheServersHandlingLagPlaybackKeepsIt) {
   // A burst of four clock rounds: handled 20, 40, 60 and 80 ms after they came.
   std::map<std::int64_t, TimePoint> sent;
   for (std::int64_t seq = 1; seq <= 4; ++seq)
@@ -110,27 +112,12 @@ TEST_F(ServerReceiveStampTest, DelaysTransitsAndTheClockReplysReceiveTimeLeaveOu
   // Before: the handling time, 20-80 ms after each was sent.
   for (const auto& [seq, at] : receive_)
     EXPECT_LT(at - sent.at(seq), milliseconds(10)) << "package " << seq << "'s server_receive (t2)";
+  // Before: transits 20 ms apart, a jitter of 3.6 ms.
+  EXPECT_LT(session().link.Figures().jitter, milliseconds(1)) << "link health's jitter";
+  // Playback's delays: from when each could act (at least its 20 ms wait).
   const std::vector<Duration> delays = session().delays.Recent(clock_.Now());
   ASSERT_EQ(delays.size(), 4u);
-  for (Duration d : delays) EXPECT_LT(d, milliseconds(10)) << "a one-way delay in playback's history";
-  // Before: transits 20 ms apart, a jitter of 3.5 ms.
-  EXPECT_LT(session().link.Figures().jitter, milliseconds(1)) << "link health's jitter";
-
-  // Frame 0 of a playback sequence, handled 20 ms after it came: its start
-  // is decided from the delays above (a spread of well under a millisecond,
-  // not 60 ms), and not before it could run (its handling + the margin).
-  Send(Playback(kAlice, 5, 900, 40, milliseconds(3900),
-                {Cmd(1, CommandType::kJointSetPoint, {0.1}, "pan", StartTime::After(Duration(0)))}));
-  Step();
-  ASSERT_TRUE(replies_.count(900)) << "the start is decided at the first frame";
-  const Reply& start = replies_.at(900);
-  EXPECT_EQ(start.signal, Signal::kSuccess) << start.message;
-  const std::string vary = "adaptive start: this client's recent one-way delays vary by ";
-  const std::size_t at = start.message.find(vary);
-  ASSERT_NE(at, std::string::npos) << start.message;
-  EXPECT_LT(std::stod(start.message.substr(at + vary.size())), 0.005) << start.message;
-  // After its arrival (the socket's stamp): at least the 20 ms it waited.
-  EXPECT_GE(start.values.at(0), 0.020) << start.message;
+  for (Duration d : delays) EXPECT_GE(d, milliseconds(20)) << "a one-way delay in playback's history";
 }
 
 }  // namespace
