@@ -351,7 +351,8 @@ def playback_estimators_section(res):
              "adaptive_burst_off": "adaptive (default), burst discount off (`--playback-burst-discount off`)",
              "adaptive_stretch50": "adaptive, stretch 50 % (`--playback-stretch 0.5`, option)",
              "adaptive_stretch50_copies": "adaptive, stretch 50 % (option) + client sends 2 copies",
-             "adaptive_resent": "adaptive, previous default (`--playback-resent-delays on`)"}
+             "adaptive_resent": "adaptive, previous default (`--playback-resent-delays on`)",
+             "adaptive_before_build": "adaptive (default) on the build before (`ROBOTALK_BENCH_BEFORE_SERVER`)"}
     lines = [head, "", "| relay profile (client → server) | estimator | start latency (per run) | hindsight minimum "
              "| ratio (per run) | hindsight + hand-over | ratio to it | late frames | pauses past the bound "
              "| largest gap stretch | whole-sequence stretch |",

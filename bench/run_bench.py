@@ -398,6 +398,12 @@ class Bench:
                     ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, ("WAN",)),
                     ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],
                      ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)))
+        # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
+        # robotalk-server ("adaptive_before_build"): a code change's before and after on the same
+        # relay seeds and under the same load, interleaved.
+        before_server = os.environ.get("ROBOTALK_BENCH_BEFORE_SERVER")
+        if before_server:
+            variants += (("adaptive_before_build", adaptive, [], 2.0, None),)
         # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
         only_variants = [v for v in os.environ.get("ROBOTALK_BENCH_VARIANTS", "").split(",") if v]
         if only_variants:
@@ -410,7 +416,13 @@ class Bench:
                 for est, server_args, client_args, margin_ms, only in variants:  # interleaved on one relay seed
                     if only and not name.startswith(only):
                         continue
-                    self.start_server(url=URL_B, extra=server_args)
+                    own_server = self.server_bin
+                    if est == "adaptive_before_build":
+                        self.server_bin = before_server
+                    try:
+                        self.start_server(url=URL_B, extra=server_args)
+                    finally:
+                        self.server_bin = own_server
                     relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, *impair, "--seed", str(seed),
                                         "--duration", "120"])
                     time.sleep(0.3)

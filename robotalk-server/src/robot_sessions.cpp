@@ -113,20 +113,24 @@ std::vector<Reply> RobotSessions::Retransmitted(const Session& s, const Request&
   return out;
 }
 
-ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
+ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint arrived) {
+  // What measures the link reads `arrived`; what decides whether and when
+  // something runs, or whether the session lives, reads `now`: a package
+  // that waited in the socket's buffer must not be judged earlier than it
+  // could act (an expiry, a start time, a session's silence).
   // A session the robot has not served (all its packages refused: rights,
   // the robot full) holds nothing on it: any new package keeps it. A served
   // one is kept only by packages it admits (below): a client that moved the
   // robot and then sends only refused packages is stopped when it expires.
   if (Session* s = table_.Find(robot_id_, r.client_id);
       s != nullptr && !s->active && s->seen.Check(r.sequence) == SequenceWindow::Verdict::kNew) {
-    s->last_heard = received;
+    s->last_heard = now;
   }
-  if (!r.header_error.empty()) return Refuse(r, received);
+  if (!r.header_error.empty()) return Refuse(r, now, arrived);
   ImmediateAnswer answer;
   answer.batch.client_id = r.client_id;
   answer.batch.ack_sequence = r.sequence;
-  answer.batch.server_receive = received;
+  answer.batch.server_receive = arrived;  // the client's clock sample (t2): the link's, not our lag
   std::vector<Reply>& immediate = answer.batch.replies;
   count_.known = false;
   // The panic flag is acted on for every admitted package with a sound
@@ -136,8 +140,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
 
   const auto refuse_all = [&](const std::string& why) {
     ++refused_packages_;
-    if (r.panic) Panic(r.client_id, received, r.sender);
-    for (CommandId id : r.item_ids()) immediate.push_back(MakeReply(id, Signal::kError, why, received));
+    if (r.panic) Panic(r.client_id, now, r.sender);
+    for (CommandId id : r.item_ids()) immediate.push_back(MakeReply(id, Signal::kError, why, now));
     return answer;
   };
   if (Session* known = table_.Find(robot_id_, r.client_id);
@@ -148,7 +152,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     if (known != nullptr) {
       const SequenceWindow::Verdict seen = known->seen.Observe(r.sequence);
       if (seen == SequenceWindow::Verdict::kDuplicate) {
-        immediate = Retransmitted(*known, r, received);
+        immediate = Retransmitted(*known, r, now);
         return answer;
       }
       if (seen == SequenceWindow::Verdict::kNew) known->replies.RecordPackage(r.sequence, r.item_ids());
@@ -161,7 +165,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
     }
     return answer;
   }
-  Session& session = SessionFor(r.client_id, received);
+  Session& session = SessionFor(r.client_id, now);
   if (!session.active) session.link = LinkHealth(options_.link);
   session.active = true;
   session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
@@ -169,7 +173,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   bool resent = false;  // a retransmission whose first copy was lost (link_health.h)
   if (seen != SequenceWindow::Verdict::kTooManyGaps) {
     resent = session.link.OnPackage(r.sequence, seen == SequenceWindow::Verdict::kDuplicate, r.send_time,
-                                    received, r.round_trip);
+                                    arrived, r.round_trip);
   }
   if (seen == SequenceWindow::Verdict::kTooManyGaps) {
     // A client numbers its packages 1, 2, 3...: a jump that leaves this many
@@ -182,15 +186,10 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   if (seen == SequenceWindow::Verdict::kDuplicate) {
     // A retransmission or a duplicate: never execute again; re-send what is
     // known. It does not refresh the session (a replay must not keep it alive).
-    immediate = Retransmitted(session, r, received);
+    immediate = Retransmitted(session, r, now);
     return answer;
   }
-  session.last_heard = received;  // only a new, well-formed package refreshes the session
-  // Playback's start reads the channel's one-way delays: a retransmission's
-  // arrival − send time is the client's resend wait + a delay (issue 23: one
-  // lost connect-time package on a WAN tripped the adaptive start's gate).
-  if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
-    session.delays.Add(r.send_time, received);
+  session.last_heard = now;  // only a new, well-formed package refreshes the session
   std::vector<CommandId> ids = r.item_ids();
   // The playback delay reply (id = playback id) may come with any of its packages.
   const bool playback = r.mode == RequestMode::kPlayback;
@@ -198,22 +197,34 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint received) {
   session.replies.RecordPackage(r.sequence, ids);
 
   for (const MalformedItem& m : r.malformed)
-    immediate.push_back(MakeReply(m.id, Signal::kError, m.reason, received));
+    immediate.push_back(MakeReply(m.id, Signal::kError, m.reason, now));
   if (r.panic) {
-    Panic(r.client_id, received, r.sender);
+    Panic(r.client_id, now, r.sender);
     for (CommandId id : r.item_ids()) {
       immediate.push_back(
-          MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", received));
+          MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", now));
     }
   } else if (playback) {
-    AdmitPlayback(session, r, received, immediate);
+    AdmitPlayback(session, r, now, immediate);
   } else {
-    for (const Query& q : r.queries) AdmitQuery(session, q, received, immediate, answer.publish_config);
+    for (const Query& q : r.queries) AdmitQuery(session, q, now, immediate, answer.publish_config);
     for (const Command& c : r.commands) {
-      auto item = Admit(session, c, received, immediate, /*playback=*/false, r.max_late, r.interpolation);
-      if (item && !Superseded(session, *item, received, immediate)) daemon_.Submit(std::move(*item));
+      auto item = Admit(session, c, now, immediate, /*playback=*/false, r.max_late, r.interpolation);
+      if (item && !Superseded(session, *item, now, immediate)) daemon_.Submit(std::move(*item));
     }
   }
+  // Playback's start reads the one-way delays: a retransmission's arrival −
+  // send time is the client's resend wait + a delay (issue 23: one lost
+  // connect-time package on a WAN tripped the adaptive start's gate).
+  // Recorded after its items: a sequence's first frame reads the history of
+  // the packages before it and counts its own delay once, as a frame. On
+  // `now`, not `arrived`: a frame can play only once handled, so this
+  // server's own lag (a pause after each package, the paper's Fig. 11
+  // congestion) is part of the delay the start must cover (with `arrived`
+  // the gate missed it: ServerClientTest.PlaybackKeepsTheInterFrameTiming-
+  // UnderCongestion, frames 0.4 s late).
+  if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
+    session.delays.Add(r.send_time, now);
   for (Reply& reply : immediate) {
     Bound(reply);
     session.replies.RecordReply(reply);
@@ -227,23 +238,23 @@ void RobotSessions::Bound(Reply& reply) const {
   reply.message += "... (truncated)";
 }
 
-ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint received) const {
+ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint now, TimePoint arrived) const {
   ImmediateAnswer answer;
   answer.batch.client_id = r.client_id;
   answer.batch.ack_sequence = r.sequence;
-  answer.batch.server_receive = received;
+  answer.batch.server_receive = arrived;
   if (const Session* s = table_.Find(robot_id_, r.client_id)) {
-    answer.batch.replies = Retransmitted(*s, r, received);
+    answer.batch.replies = Retransmitted(*s, r, now);
   }
   return answer;
 }
 
-ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
+ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint now, TimePoint arrived) {
   ImmediateAnswer answer;
   answer.send = r.client_id != 0;
   answer.batch.client_id = r.client_id;
   answer.batch.ack_sequence = r.sequence > 0 ? r.sequence : 0;
-  answer.batch.server_receive = received;
+  answer.batch.server_receive = arrived;
   const std::vector<CommandId> ids = r.item_ids();
   ++refused_packages_;
   if (r.panic) {
@@ -251,7 +262,7 @@ ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
     answer.batch.panic_refusal = r.header_error;
   }
   for (CommandId id : ids) {
-    answer.batch.replies.push_back(MakeReply(id, Signal::kError, r.header_error, received));
+    answer.batch.replies.push_back(MakeReply(id, Signal::kError, r.header_error, now));
     Bound(answer.batch.replies.back());
   }
   // Remember it in an existing session, so a retransmission of the same bad
@@ -265,107 +276,6 @@ ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint received) {
     }
   }
   return answer;
-}
-
-void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::vector<Reply>& immediate,
-                               bool& publish_config) {
-  const RobotModel& model = daemon_.model();
-  if (auto bad = CheckQuery(model, q)) {
-    immediate.push_back(MakeReply(q.id, bad->signal, bad->message, now));
-    return;
-  }
-  switch (q.type) {
-    case QueryType::kClock:
-      immediate.push_back(MakeReply(q.id, Signal::kSuccess, "", now));
-      return;
-    case QueryType::kStateStream:
-    case QueryType::kStateStreamCancel: {
-      const Duration period =
-          daemon_.SetStream(s.client_id, q.type == QueryType::kStateStream ? q.period : Duration(0));
-      Reply r =
-          MakeReply(q.id, Signal::kSuccess,
-                    period.count() == 0 ? "no state stream"
-                                        : "state every " + Seconds(period) + " on " + StateChannel(robot_),
-                    now);
-      r.values = {ToSeconds(period)};
-      immediate.push_back(std::move(r));
-      return;
-    }
-    case QueryType::kCommandStatus:
-      immediate.push_back(CommandStatus(s, q, now));
-      return;
-    case QueryType::kServerCounters: {
-      Reply r = MakeReply(q.id, Signal::kSuccess, "", now);
-      if (options_.counters) {
-        for (const auto& [name, value] : options_.counters()) {
-          r.message += (r.message.empty() ? "" : " ") + std::string(name);
-          r.values.push_back(value);
-        }
-      }
-      r.message += (r.message.empty() ? "" : " ") +
-                   std::string("refused_packages expired_commands reference_max_acceleration");
-      r.values.push_back(static_cast<double>(refused_packages_));
-      r.values.push_back(static_cast<double>(expired_commands_));
-      r.values.push_back(daemon_.max_reference_acceleration());
-      AppendLinkCounters(s, r);
-      immediate.push_back(std::move(r));
-      return;
-    }
-    case QueryType::kConfig:
-      publish_config = true;
-      immediate.push_back(MakeReply(q.id, Signal::kSuccess, Hex64(config_hash_), now));
-      return;
-    default:
-      break;
-  }
-  if (std::string full = QueueRefusal(s); !full.empty()) {
-    immediate.push_back(MakeReply(q.id, Signal::kError, std::move(full) + "; query not queued", now));
-    return;
-  }
-  QueuedItem item;
-  item.client_id = s.client_id;
-  item.is_query = true;
-  item.query = q.type;
-  item.command.id = q.id;
-  if (!q.target.empty()) {
-    switch (q.type) {
-      case QueryType::kJointState:
-        item.query_target = *model.FindJoint(q.target);
-        break;
-      case QueryType::kLinkPoses:
-        item.query_target = *model.FindLink(q.target);
-        break;
-      case QueryType::kFramePoses:
-        item.query_target = *model.FindFrame(q.target);
-        break;
-      default:
-        break;
-    }
-  }
-  // On receipt, from the state the RobotDaemon published, when that is what
-  // the driver would report now (query_snapshot.h); else in order, queued.
-  if (Reply reply; daemon_.snapshot().Answer(item, reply)) {
-    immediate.push_back(std::move(reply));
-    return;
-  }
-  daemon_.Submit(std::move(item));
-}
-
-// What became of a command of this session: its own final reply once it
-// ended, BUSY while it waits or runs, NA when this session never got it.
-Reply RobotSessions::CommandStatus(const Session& s, const Query& q, TimePoint now) const {
-  const std::optional<std::optional<Reply>> known = s.replies.Lookup(q.about);
-  if (!known) {
-    return MakeReply(q.id, Signal::kNa,
-                     "command " + std::to_string(q.about) +
-                         " was never received in this session (or is older than its reply cache)",
-                     now);
-  }
-  if (!*known)
-    return MakeReply(q.id, Signal::kBusy, "command " + std::to_string(q.about) + " has not ended", now);
-  Reply r = **known;
-  r.id = q.id;
-  return r;
 }
 
 std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, TimePoint now,

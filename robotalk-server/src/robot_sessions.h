@@ -98,12 +98,20 @@ class RobotSessions {
   /// package of a client without a session opens one.
   RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options = {});
 
-  /// Handles one decoded request received at `received`.
-  ImmediateAnswer Handle(const Request& request, TimePoint received);
+  /// Handles one decoded request, handled at `now` (the server clock) after
+  /// it reached the socket at `arrived` (the transport's receive stamp on the
+  /// server clock; ServerDaemon::ArrivalTime): `arrived` measures the link
+  /// (link health's transits, the reply's server_receive for the client's
+  /// clock); `now` judges what runs (start times, expiry, the session's
+  /// liveness) and playback's delays (a frame can play only once handled).
+  /// docs/protocol.md "Clocks".
+  ImmediateAnswer Handle(const Request& request, TimePoint now, TimePoint arrived);
+  /// The same handled when it arrived (a simulation, a test).
+  ImmediateAnswer Handle(const Request& request, TimePoint now) { return Handle(request, now, now); }
   /// A retransmission the session table's window saw (open or keyed mode):
   /// acknowledges it with what is known of its items; runs nothing, opens
-  /// and refreshes no session.
-  ImmediateAnswer Resend(const Request& request, TimePoint received) const;
+  /// and refreshes no session. `now`, `arrived`: as Handle.
+  ImmediateAnswer Resend(const Request& request, TimePoint now, TimePoint arrived) const;
   /// Raises a panic on behalf of `client_id` (outside any session: open
   /// mode honours a panic from anyone).
   void RaisePanic(std::int64_t client_id, TimePoint now) { Panic(client_id, now); }
@@ -150,7 +158,7 @@ class RobotSessions {
   RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options,
                 std::unique_ptr<SessionTable> own, SessionTable* table);
   Session& SessionFor(std::int64_t client_id, TimePoint now);
-  ImmediateAnswer Refuse(const Request& request, TimePoint received);
+  ImmediateAnswer Refuse(const Request& request, TimePoint now, TimePoint arrived);
   void AdmitQuery(Session& s, const Query& q, TimePoint now, std::vector<Reply>& immediate,
                   bool& publish_config);
   Reply CommandStatus(const Session& s, const Query& q, TimePoint now) const;

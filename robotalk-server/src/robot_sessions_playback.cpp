@@ -77,6 +77,8 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
   }
   if (!seq.first_arrival) {
     seq.first_arrival = now;
+    // This package's delay is not in it yet (Handle records it after its
+    // items): frame 0 counts once, as a frame.
     seq.estimator->SetDelayHistory(s.delays.RecentSamples(now));
   }
   const std::optional<TimePoint> sent =

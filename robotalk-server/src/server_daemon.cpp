@@ -294,10 +294,26 @@ void ServerDaemon::Flush() {
   WriteLog();
 }
 
+TimePoint ServerDaemon::ArrivalTime(TimePoint now) const {
+  // The stamp is wall-clock time: it maps onto the server's steady clock as
+  // "this long ago" (as the client's RobotClient::Impl::ArrivalTime).
+  if (dynamic_cast<const SteadyClock*>(&clock_) == nullptr) return now;
+  const auto age = std::chrono::system_clock::now() - transport_.ReceiveTime();
+  if (age < Duration::zero() || age > std::chrono::seconds(1)) return now;
+  return now - std::chrono::duration_cast<Duration>(age);
+}
+
 // A transport handler: never throws for bad input (the transport would
 // rethrow it out of RunOnce and end the loop's iteration).
 void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes) {
+  // Two times (issue 23): `received`, when it is handled, judges what runs
+  // and what expires (start times, --max-late, the session table's and the
+  // sessions' liveness, playback's delays: a frame plays only once handled);
+  // `arrived`, when it reached the socket, measures the link (link health's
+  // transits, the clock sample's t2), so that this thread's own lag under
+  // load is not the network's.
   const TimePoint received = clock_.Now();
+  const TimePoint arrived = ArrivalTime(received);
   const std::optional<std::string> robot_name = RobotOfRequestChannel(channel);
   if (!robot_name) return;
   auto it = robots_.find(*robot_name);
@@ -313,8 +329,8 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
     Log("robot '" + *robot_name + "': dropped a malformed package on " + channel + ": " + e.what());
     return;
   }
-  if (!Gate(robot, *robot_name, request, bytes, received)) return;
-  ImmediateAnswer answer = robot.sessions->Handle(request, received);
+  if (!Gate(robot, *robot_name, request, bytes, received, arrived)) return;
+  ImmediateAnswer answer = robot.sessions->Handle(request, received, arrived);
   if (!request.header_error.empty()) {
     Log("robot '" + *robot_name + "': refused package from client " +
         Hex64(static_cast<std::uint64_t>(request.client_id)) + ": " + request.header_error);
@@ -333,7 +349,7 @@ void ServerDaemon::OnRequest(const std::string& channel, std::span<const std::ui
 }
 
 bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
-                        std::span<const std::uint8_t> bytes, TimePoint received) {
+                        std::span<const std::uint8_t> bytes, TimePoint received, TimePoint arrived) {
   const SessionTable::Admission admission =
       table_->Admit(robot.sessions->robot_id(), request, bytes, received);
   if (table_->keyed()) request.sender = admission.who;
@@ -345,7 +361,7 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
       Log("robot '" + name + "': refused " + admission.who + ": " + admission.why);
       return true;
     case SessionTable::Verdict::kDuplicate: {
-      ImmediateAnswer answer = robot.sessions->Resend(request, received);
+      ImmediateAnswer answer = robot.sessions->Resend(request, received, arrived);
       if (request.panic) {
         // As the first copy was answered: its header and the key's rights are unchanged.
         answer.batch.panic_refusal = request.header_error.empty() ? admission.why : request.header_error;
@@ -381,7 +397,7 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
   unknown.session_id = request.session_id;
   unknown.session_status = SessionStatus::kUnknown;
   unknown.ack_sequence = request.sequence > 0 ? request.sequence : 0;
-  unknown.server_receive = received;
+  unknown.server_receive = arrived;
   if (raised) {
     Drain(robot, /*wait=*/true, answer ? &unknown : nullptr);  // on disk before TAKEN is sent
   } else if (answer) {

@@ -148,8 +148,15 @@ class ServerDaemon {
   void OnRequest(const std::string& channel, std::span<const std::uint8_t> bytes);
   void OnHello(const std::string& channel, std::span<const std::uint8_t> bytes);
   // The session table's verdict on a decoded request; false when Handle must not run.
+  // `now`: handled; `arrived`: reached the socket (ArrivalTime).
   bool Gate(Robot& robot, const std::string& name, Request& request, std::span<const std::uint8_t> bytes,
-            TimePoint received);
+            TimePoint now, TimePoint arrived);
+  // When the message being handled reached the socket (the transport's
+  // receive stamp), on clock_: `now` less its age. `now` itself where that
+  // cannot be told: a clock that does not run with the wall clock's seconds
+  // (a ManualClock), a transport without a stamp, an age outside [0, 1 s]
+  // (a wall-clock step).
+  TimePoint ArrivalTime(TimePoint now) const;
   void OnAnnounce(std::span<const std::uint8_t> bytes);
   void Refuse(Robot& robot, const std::string& why);
   void LogConflict(Robot& robot, const std::string& other, Duration served);

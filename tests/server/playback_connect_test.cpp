@@ -84,10 +84,11 @@ TEST_F(PlaybackConnectTest, ARetransmittedConnectTimePackageDoesNotTripTheAdapti
   const Reply& r = immediate.at(9200);
   EXPECT_EQ(r.signal, Signal::kSuccess);
   EXPECT_THAT(r.message, HasSubstr("adaptive start"));
-  // It covers the worst first copy, 130 ms, + the spread / n (29 ms / 9:
-  // the 7 first copies and frame 0, which the history holds too) + 2 ms,
-  // less this frame's 115 ms and one gap's 10 ms stretch: 10.2 ms.
-  EXPECT_NEAR(r.values.at(0), 0.130 + 0.029 / 9 + 0.002 - 0.115 - 0.010, 1e-4);
+  // It covers the worst first copy, 130 ms, + the spread / n (29 ms / 8:
+  // the 7 first copies and frame 0, counted once) + 2 ms, less this frame's
+  // 115 ms and one gap's 10 ms stretch: 10.6 ms (10.2 ms while frame 0's
+  // delay was in the history too: n = 9).
+  EXPECT_NEAR(r.values.at(0), 0.130 + 0.029 / 8 + 0.002 - 0.115 - 0.010, 1e-4);
   EXPECT_EQ(sessions_->link(kAlice)->retransmitted, 1u) << "link health counts it too";
 }
 
@@ -107,8 +108,24 @@ TEST_F(PlaybackConnectTest, ASlowFirstCopyStillCountsAndSoDoesAReorderedOne) {
   // is the channel's and counts: the worst is 160 ms.
   const auto immediate = ConnectThenFrame0({112, 127, 160, 118, 130, 101, 123, 109}, 9201);
   ASSERT_TRUE(immediate.count(9201));
-  EXPECT_NEAR(immediate.at(9201).values.at(0), 0.160 + 0.059 / 10 + 0.002 - 0.115 - 0.010, 1e-4);
+  // n = 9: 8 rounds and frame 0, once.
+  EXPECT_NEAR(immediate.at(9201).values.at(0), 0.160 + 0.059 / 9 + 0.002 - 0.115 - 0.010, 1e-4);
   EXPECT_EQ(sessions_->link(kAlice)->retransmitted, 0u);
+}
+
+// Frame 0's delay is one sample, not two: the session records a package's
+// delay after its items, so the history the first frame reads holds only the
+// packages before it (it held frame 0 too, which then counted again as a
+// frame: n + 1 samples for n packages). quick_min_delays (4) delays are 4
+// packages: 2 clock rounds and frame 0 are too few for a start at the first
+// frame (the paper's estimate waits for frames: no reply yet); 3 rounds and
+// frame 0 are enough.
+TEST_F(PlaybackConnectTest, FrameZerosDelayCountsOnceAmongTheDelaysTheStartNeeds) {
+  EXPECT_FALSE(ConnectThenFrame0({112, 127}, 9203).count(9203)) << "3 delays, not 4";
+}
+
+TEST_F(PlaybackConnectTest, FourPackagesDelaysAreEnoughForAStartAtTheFirstFrame) {
+  EXPECT_TRUE(ConnectThenFrame0({112, 127, 105}, 9204).count(9204));
 }
 
 }  // namespace
