@@ -234,7 +234,7 @@ bool WalkPattern::CaptureStop(const Eigen::Vector2d& com, const Eigen::Vector2d&
   const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
   size_t k = 0;  // the first step whose landing may move
   while (k < steps_.size() && TooLate(steps_[k], ticks(rp.late))) ++k;
-  if (k == steps_.size() || !steps_[k].swing) return false;
+  if (k == steps_.size() || !steps_[k].swing || steps_[k].tidy) return false;
   // It becomes the stop's last step; where it cannot catch the DCM (reach,
   // swing speed), it lands as it would and the other foot, brought
   // alongside it after (as StopSoon has it), catches the DCM.
@@ -251,6 +251,8 @@ bool WalkPattern::CaptureStop(const Eigen::Vector2d& com, const Eigen::Vector2d&
   along.step.pose.x = at.x();
   along.step.pose.y = at.y();
   along.planned = along.step.pose;
+  along.uncaptured = along.step.pose;
+  along.captured = true;
   along.from = st.stance;
   along.stance = st.step.pose;
   along.centre = st.centre;
@@ -269,6 +271,8 @@ bool WalkPattern::CaptureWith(size_t k, const Eigen::Vector2d& com, const Eigen:
   const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
   steps_.resize(k + 1);
   Scheduled& st = steps_[k];
+  if (!st.captured) st.uncaptured = st.step.pose;
+  st.captured = true;
   const bool in_air = st.start <= tick_;
   const int j = PhaseAt(tick_);
   const double omega = std::sqrt(gravity_ / g_.com_height);
@@ -311,19 +315,22 @@ bool WalkPattern::CaptureWith(size_t k, const Eigen::Vector2d& com, const Eigen:
   for (;; land = std::max(soonest, land - ticks(0.025))) {
     until_landing(land);
     const Eigen::Vector2d xi_land = DcmAt(land, xi0), p_land = phases_.back().to;
-    // The foot alongside the stance foot, moved (in its frame) only as far
-    // as q needs, within reach and width, and (in the air) swing speed.
-    Eigen::Vector2d f(0, g_.foot_separation);
+    // The landing as planned before the capture (the stop's: alongside),
+    // moved only as far as q needs to be inside the soles' hull, within
+    // reach and width of the stance foot, and (in the air) swing speed.
+    const Eigen::Vector2d n0 = to_local(st.uncaptured.xy());
+    Eigen::Vector2d f(n0.x(), side * n0.y());
     for (int it = 0; it < 4; ++it) {
       foot = {stance.Apply(f.x(), side * f.y()).x(), stance.Apply(f.x(), side * f.y()).y(), stance.theta};
       m = 0.5 * (ZmpPoint(stance) + ZmpPoint(foot));
       q = (xi_land - p_land * (1 - g1) - m * e * ge) / (g1 - e * ge);
-      const Eigen::Vector2d lq = to_local(q);
-      const double out = side * lq.y() - g_.foot_half_width + rp.capture_margin;
-      double fx = 0;
-      if (lq.x() > g_.foot_front - rp.capture_margin) fx = lq.x() - g_.foot_front + rp.capture_margin;
-      if (lq.x() < -g_.foot_back + rp.capture_margin) fx = lq.x() + g_.foot_back - rp.capture_margin;
-      const Eigen::Vector2d want(fx, std::max(g_.foot_separation, out));
+      std::array<Eigen::Vector2d, 16> h;
+      const Eigen::Vector2d out =
+          q - ClampToPolygon(q, std::span(h.data(), static_cast<size_t>(HullOfSoles(stance, foot, g_, h))),
+                             rp.capture_margin);
+      // (sideways only outward: a foot moved inward narrows the support)
+      const Eigen::Vector2d d(c * out.x() + s * out.y(), std::max(0.0, side * (-s * out.x() + c * out.y())));
+      const Eigen::Vector2d want = f + d;
       f = {std::clamp(want.x(), -rp.reach_back, rp.reach), std::clamp(want.y(), rp.min_width, rp.max_width)};
       fits = (f - want).norm() < 1e-9;
     }
@@ -358,6 +365,7 @@ bool WalkPattern::CaptureWith(size_t k, const Eigen::Vector2d& com, const Eigen:
   AddPhase(ticks(rp.capture_hold), q, Kind::kHold, -1);
   if (tidy) {
     Scheduled t;
+    t.tidy = true;
     t.step = {Other(st.step.side), {beside.x(), beside.y(), st.step.pose.theta}};
     t.planned = t.step.pose;
     t.from = stance;
@@ -375,7 +383,7 @@ bool WalkPattern::CaptureWith(size_t k, const Eigen::Vector2d& com, const Eigen:
   } else {
     AddPhase(end_ticks_, after, Kind::kEnd, -1);
   }
-  SetComState(com, com_vel);
+  if (rp.capture_reanchor) SetComState(com, com_vel);
   return fits;
 }
 

@@ -96,6 +96,7 @@ struct RecoveryParams {
   double capture_margin = 0.05;  ///< m: the caught ZMP this far inside the final support
   double capture_shift = 0.1;    ///< s: after the landing the ZMP goes to the DCM this fast ...
   double capture_hold = 0.3;     ///< s: ... holds there this long, then shifts back to the middle (end_shift)
+  bool capture_reanchor = true;  ///< the plan's CoM state becomes the measured one at each re-plan
   bool capture_tidy = true;      ///< a landing moved off alongside: then the other foot steps alongside it
   double capture_tidy_beyond = 0.03;  ///< m: ... when moved more than this
 };

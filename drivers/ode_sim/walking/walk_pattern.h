@@ -104,9 +104,9 @@ class WalkPattern {
   /// nearest the DCM, `ankle_margin` inside), the DCM at the landing must be
   /// the reference's own from then on: the ZMP goes to a point q within
   /// `capture_shift` s, holds `capture_hold` s, then shifts to the middle of
-  /// the feet over end_shift. The foot lands alongside, moved only as far as
-  /// q needs to be `capture_margin` inside the two soles' hull (within reach
-  /// and width of the stance foot: beyond them q is clamped into the hull);
+  /// the feet over end_shift. The foot lands where it was to, moved only as
+  /// far as q needs to be `capture_margin` inside the two soles' hull (within
+  /// reach and width of the stance foot: beyond them q is clamped into the hull);
   /// while that does not fit, a foot in the air lands sooner (not sooner than
   /// `min_swing` after its lift-off). The plan's CoM state becomes the
   /// measured one. False (nothing changed) when no step can still move.
@@ -166,6 +166,9 @@ class WalkPattern {
     Pose2 planned;                     // step.pose before AdjustLanding
     std::int64_t retimed = -1;         // Regenerate landed it sooner at this tick (-1: never)
     double s_retimed = 0;              // the swing's progress (0..1) then
+    bool captured = false;             // CaptureStop moved it from `uncaptured`
+    bool tidy = false;                 // CaptureStop's step bringing the other foot alongside after
+    Pose2 uncaptured;
   };
   Eigen::Vector2d ZmpPoint(const Pose2& foot) const;
   Eigen::Vector2d ZmpAt(std::int64_t tick) const;
