@@ -433,7 +433,7 @@ PushRecovery::Walk PushRecovery::Watch(WalkPattern& pattern, const Eigen::Vector
       ++stops_;
       hold_ = p_.stop_hold;
       capturing_ = p_.capture_stop;
-      since_ = 1e9;  // the capture's first re-plan at the next Update
+      if (capturing_) since_ = 1e9;  // the capture's first re-plan at the next Update
     } else if (hold_ > 0) {
       hold_ = p_.stop_hold;
     }
