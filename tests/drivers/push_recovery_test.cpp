@@ -163,6 +163,22 @@ TEST(PushRecovery, WithoutAPushNothingIsRegeneratedAndTheWalkIsThePlan) {
   EXPECT_LT(r.worst_clamp, 1e-9);
 }
 
+// The reference ZMP watched tick by tick: its largest step between ticks and
+// its largest distance outside the support polygon; Tick() returns that polygon.
+struct ReferenceWatch {
+  explicit ReferenceWatch(const WalkPattern& w) : last(w.zmp_ref()) {}
+  std::span<const Eigen::Vector2d> Tick(const WalkPattern& w) {
+    worst_jump = std::max(worst_jump, (w.zmp_ref() - last).norm());
+    last = w.zmp_ref();
+    const std::span<const Eigen::Vector2d> support(poly.data(), static_cast<size_t>(w.SupportPolygon(poly)));
+    worst_outside = std::max(worst_outside, (ClampToPolygon(w.zmp_ref(), support, 0) - w.zmp_ref()).norm());
+    return support;
+  }
+  Eigen::Vector2d last;
+  double worst_jump = 0, worst_outside = 0;
+  std::array<Eigen::Vector2d, 16> poly;
+};
+
 // Stop and stand (PushRecovery::Watch). On ODE the stiff servos pull the
 // CoM back to the plan's while the ground can push where that needs; here a
 // pendulum whose ZMP is the plan's plus the DCM feedback (1 + k/w) e (the
@@ -192,7 +208,8 @@ StopResult WalkPushAndWatch(const Eigen::Vector2d& impulse_ns, double at, bool w
   PushRecovery rec(omega, kTick, rp);
   DcmEstimator est(omega, kTick);
   w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
-  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero(), ref = w.zmp_ref();
+  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero();
+  ReferenceWatch reference(w);
   StopResult r;
   bool held = false;
   for (int i = 0; i < static_cast<int>((walk_for + 3.0) / kTick); ++i) {
@@ -213,12 +230,7 @@ StopResult WalkPushAndWatch(const Eigen::Vector2d& impulse_ns, double at, bool w
       dd += impulse_ns / kMass * (kTick / kPushTime);
     }
     if (r.stood_at < 0 && w.time() > at && w.standing()) r.stood_at = w.time();
-    r.worst_jump = std::max(r.worst_jump, (w.zmp_ref() - ref).norm());
-    ref = w.zmp_ref();
-    std::array<Eigen::Vector2d, 16> poly;
-    const std::span<const Eigen::Vector2d> support(poly.data(), static_cast<size_t>(w.SupportPolygon(poly)));
-    r.worst_outside =
-        std::max(r.worst_outside, (ClampToPolygon(w.zmp_ref(), support, 0) - w.zmp_ref()).norm());
+    const std::span<const Eigen::Vector2d> support = reference.Tick(w);
     const Eigen::Vector2d p = ClampToPolygon(w.zmp() + (1 + kGain / omega) * (d + dd / omega), support, 0);
     dd += kG / g.com_height * (d - (p - w.zmp())) * kTick;
     d += dd * kTick;
@@ -230,6 +242,8 @@ StopResult WalkPushAndWatch(const Eigen::Vector2d& impulse_ns, double at, bool w
     }
   }
   r.stops = rec.stops();
+  r.worst_jump = reference.worst_jump;
+  r.worst_outside = reference.worst_outside;
   return r;
 }
 
@@ -302,7 +316,8 @@ CaptureResult WalkPushAndCapture(const Eigen::Vector2d& impulse_ns, double at, b
   PushRecovery rec(omega, kTick, rp);
   DcmEstimator est(omega, kTick);
   w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
-  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero(), ref = w.zmp_ref();
+  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero();
+  ReferenceWatch reference(w);
   CaptureResult r;
   for (int i = 0; i < static_cast<int>((at + 6.0) / kTick); ++i) {
     const PushRecovery::Walk walk = rec.Watch(w, est.impulse());
@@ -322,12 +337,7 @@ CaptureResult WalkPushAndCapture(const Eigen::Vector2d& impulse_ns, double at, b
       d.setZero();  // the plan is the pendulum's state
       dd.setZero();
     }
-    r.worst_jump = std::max(r.worst_jump, (w.zmp_ref() - ref).norm());
-    ref = w.zmp_ref();
-    std::array<Eigen::Vector2d, 16> poly;
-    const std::span<const Eigen::Vector2d> support(poly.data(), static_cast<size_t>(w.SupportPolygon(poly)));
-    r.worst_outside =
-        std::max(r.worst_outside, (ClampToPolygon(w.zmp_ref(), support, 0) - w.zmp_ref()).norm());
+    const std::span<const Eigen::Vector2d> support = reference.Tick(w);
     const Eigen::Vector2d p = ClampToPolygon(w.zmp(), support, 0);
     dd += kG / g.com_height * (d - (p - w.zmp())) * kTick;
     d += dd * kTick;
@@ -339,6 +349,8 @@ CaptureResult WalkPushAndCapture(const Eigen::Vector2d& impulse_ns, double at, b
   }
   r.stops = rec.stops();
   r.captures = rec.captures();
+  r.worst_jump = reference.worst_jump;
+  r.worst_outside = reference.worst_outside;
   const Eigen::Vector2d l = w.foot(Side::kLeft).xy(), rt = w.foot(Side::kRight).xy();
   r.end_offset = (w.com() + d - 0.5 * (l + rt) - Eigen::Vector2d(g.zmp_x, 0)).norm();
   r.end_speed = (w.com_velocity() + dd).norm();
