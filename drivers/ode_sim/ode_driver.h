@@ -116,6 +116,12 @@ struct OdeDriverOptions {
   /// measured better or equal in all 8 push directions, with the 20-goal
   /// benchmark and the phase sweep unchanged. Key "push_recovery".
   bool push_recovery = true;
+  /// With push_recovery: the capture stop (walking/push_recovery.h,
+  /// RecoveryParams::capture_stop; docs/ode_sim.md, "Pushes and
+  /// disturbances"): the stop's last step lands where the measured DCM is
+  /// caught, the plan re-anchored on the measured CoM state, in place of the
+  /// regeneration until that step lands. Key "push_capture".
+  bool push_capture = false;
   /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
   /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
   /// yield to the error between its measured and desired centre of pressure

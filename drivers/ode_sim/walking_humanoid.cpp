@@ -190,7 +190,12 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   w->adjust_steps_ = options.stabilizer && options.step_adjustment;
   w->dcm_.emplace(w->g_.com_height, gravity);
   w->com_offset_.emplace(w->dcm_->omega());
-  if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step);
+  if (options.push_capture && !options.push_recovery) {
+    throw Error("OdeDriver: push_capture=true needs push_recovery=true (the capture is how its stop steps)");
+  }
+  walking::RecoveryParams recovery;
+  recovery.capture_stop = options.push_capture;
+  if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step, recovery);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
   if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)
     walking::FootDampingGains fg;

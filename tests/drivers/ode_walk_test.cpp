@@ -566,6 +566,35 @@ TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
   }
 }
 
+// push_capture=true (off by default: measured on ODE it survives smaller
+// pushes than the stop alone, docs/ode_sim.md, "Pushes"): the wiring — a
+// push stops the walk and the stop is re-planned as a capture from the
+// measured state; without the option never. Bad settings are refused.
+TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
+  for (const char* on : {"false", "true"}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_capture", on}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(5.14);
+    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    w.Run(1.5, [&] { return w.driver->walk_status()->fallen; });
+    const walking::WalkStatus s = *w.driver->walk_status();
+    EXPECT_EQ(s.push_stops, 1) << "push_capture=" << on;
+    if (std::string(on) == "true") {
+      EXPECT_GE(s.push_captures, 1) << "the stop re-planned as a capture";
+    } else {
+      EXPECT_EQ(s.push_captures, 0);
+    }
+  }
+  const std::optional<std::string> alone =
+      RefusalOfWalker({{"push_capture", "true"}, {"push_recovery", "false"}});
+  ASSERT_TRUE(alone) << "push_capture without push_recovery accepted";
+  EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
+  const std::optional<std::string> maybe = RefusalOfWalker({{"push_capture", "maybe"}});
+  ASSERT_TRUE(maybe) << "push_capture=maybe accepted";
+  EXPECT_NE(maybe->find("push_capture"), std::string::npos) << *maybe;
+}
+
 // Push recovery's stop during a GOTO (on by default): the walk stops, the
 // robot stands through the hold, then the GOTO re-plans from where the push
 // left it and still ends at its goal with SUCCESS (no reply before the hold

@@ -4,8 +4,10 @@
 #include "walking/dcm_stabilizer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 
 namespace robotalk::walking {
@@ -68,34 +70,15 @@ void WalkPattern::Rebuild(size_t k, std::int64_t land, std::int64_t lift, const 
     later.push_back(f);
     centres.push_back(ce);
   }
-  const auto truncate_now = [&] {  // the phase holding now ends now
-    phases_.resize(static_cast<size_t>(j) + 1);
-    Phase& ph = phases_.back();
-    ph.end = tick_;
-    ph.to = p_now;
-    if (ph.end <= ph.start && phases_.size() > 1) phases_.pop_back();
-  };
   std::int64_t cut = in_air ? land : steps_[k].start;
   if (in_air) {
     Scheduled& st = steps_[k];
-    const Eigen::Vector2d& dk = shift[0];
-    const double s0 = SwingProgress(st);
-    const double m = std::clamp((s0 - 0.1) / 0.8, 0.0, 1.0), b = 0.5 * (1 - std::cos(std::numbers::pi * m));
-    st.from.x -= b / (1 - b) * dk.x();  // the foot where it is now, then to the new landing
-    st.from.y -= b / (1 - b) * dk.y();
-    st.step.pose.x += dk.x();
-    st.step.pose.y += dk.y();
-    st.planned = st.step.pose;
-    st.centre.x += dk.x();
-    st.centre.y += dk.y();
-    if (land != st.land) {
-      st.s_retimed = s0;
-      st.retimed = tick_;
-      st.land = land;
-    }
+    MoveLanding(st, shift[0], land);
+    st.centre.x += shift[0].x();
+    st.centre.y += shift[0].y();
     if (in_phase) {  // the single support: the ankles' ZMP from now to the landing
       const int next = phases_[static_cast<size_t>(j)].next;
-      truncate_now();
+      TruncateNow(j, p_now);
       const std::int64_t ramp = std::min(land - tick_, ticks(rp.ankle_ramp));
       if (ramp > 0) AddPhase(ramp, p_now + u, Kind::kSingle, next);
       if (land - tick_ - ramp > 0) AddPhase(land - tick_ - ramp, p_now + u, Kind::kSingle, next);
@@ -104,7 +87,7 @@ void WalkPattern::Rebuild(size_t k, std::int64_t land, std::int64_t lift, const 
     const Eigen::Vector2d to = ZmpPoint(steps_[k].stance);
     const int side = static_cast<int>(steps_[k].step.side);
     while (!steps_.empty() && steps_.back().start >= tick_) steps_.pop_back();
-    truncate_now();
+    TruncateNow(j, p_now);
     if (lift > 0) AddPhase(lift, to + u, Kind::kShift, side);
     cut = phases_.back().end;
   }
@@ -118,19 +101,45 @@ void WalkPattern::Rebuild(size_t k, std::int64_t land, std::int64_t lift, const 
   }
 }
 
+bool WalkPattern::TooLate(const Scheduled& st, std::int64_t late) const {
+  if (st.start > tick_) return false;
+  const double m = std::clamp((SwingProgress(st) - 0.1) / 0.8, 0.0, 1.0);
+  return st.land - tick_ < late || 0.5 * (1 - std::cos(std::numbers::pi * m)) > 0.9;
+}
+
+void WalkPattern::TruncateNow(int j, const Eigen::Vector2d& p_now) {
+  phases_.resize(static_cast<size_t>(j) + 1);
+  Phase& ph = phases_.back();
+  ph.end = tick_;
+  ph.to = p_now;
+  if (ph.end <= ph.start && phases_.size() > 1) phases_.pop_back();
+}
+
+void WalkPattern::MoveLanding(Scheduled& st, const Eigen::Vector2d& by, std::int64_t land) {
+  if (st.start <= tick_) {
+    const double s0 = SwingProgress(st);
+    const double m = std::clamp((s0 - 0.1) / 0.8, 0.0, 1.0), b = 0.5 * (1 - std::cos(std::numbers::pi * m));
+    st.from.x -= b / (1 - b) * by.x();  // the foot where it is now, then to the new landing
+    st.from.y -= b / (1 - b) * by.y();
+    if (land != st.land) {
+      st.s_retimed = s0;
+      st.retimed = tick_;
+      st.land = land;
+    }
+  }
+  st.step.pose.x += by.x();
+  st.step.pose.y += by.y();
+  st.planned = st.step.pose;
+}
+
 bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
                              const RecoveryParams& rp) {
   Prune();
   const double omega = std::sqrt(gravity_ / g_.com_height);
   const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
   const std::int64_t late = ticks(rp.late);
-  size_t k = 0;                                     // the first step whose landing may move
-  const auto too_late = [&](const Scheduled& st) {  // in the air, about to land
-    if (st.start > tick_) return false;
-    const double m = std::clamp((SwingProgress(st) - 0.1) / 0.8, 0.0, 1.0);
-    return st.land - tick_ < late || 0.5 * (1 - std::cos(std::numbers::pi * m)) > 0.9;
-  };
-  while (k < steps_.size() && (steps_[k].land <= tick_ || too_late(steps_[k]))) ++k;
+  size_t k = 0;  // the first step whose landing may move
+  while (k < steps_.size() && (steps_[k].land <= tick_ || TooLate(steps_[k], late))) ++k;
   if (k == steps_.size() || !steps_[k].swing) return false;
   if (!rp.in_double_support && steps_[k].start > tick_) return false;
   const bool in_air = steps_[k].start <= tick_;
@@ -207,6 +216,177 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
   return true;
 }
 
+Eigen::Vector2d WalkPattern::DcmAt(std::int64_t at, const Eigen::Vector2d& xi0) const {
+  // xi(T) = e^{wT} (xi0 - w int_0^T e^{-wt} p(now + t) dt), midpoint rule over 5 ticks.
+  const double omega = std::sqrt(gravity_ / g_.com_height);
+  Eigen::Vector2d pulled = Eigen::Vector2d::Zero();
+  for (std::int64_t i = 0; i < at - tick_; i += 5) {
+    const std::int64_t n = std::min<std::int64_t>(5, at - tick_ - i);
+    const double t0 = static_cast<double>(i) * tick_s_, t1 = static_cast<double>(i + n) * tick_s_;
+    pulled += (std::exp(-omega * t0) - std::exp(-omega * t1)) * ZmpAt(tick_ + i + n / 2);
+  }
+  return std::exp(omega * static_cast<double>(at - tick_) * tick_s_) * (xi0 - pulled);
+}
+
+bool WalkPattern::CaptureStop(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
+                              const RecoveryParams& rp) {
+  Prune();
+  const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
+  size_t k = 0;  // the first step whose landing may move
+  while (k < steps_.size() && TooLate(steps_[k], ticks(rp.late))) ++k;
+  if (k == steps_.size() || !steps_[k].swing || steps_[k].tidy) return false;
+  // It becomes the stop's last step; where it cannot catch the DCM (reach,
+  // swing speed), it lands as it would and the other foot, brought
+  // alongside it after (as StopSoon has it), catches the DCM.
+  const std::vector<Scheduled> steps = steps_;
+  const std::vector<Phase> phases = phases_;
+  if (CaptureWith(k, com, com_vel, rp)) return true;
+  steps_ = steps;
+  phases_ = phases;
+  steps_.resize(k + 1);
+  Scheduled along;  // the other foot brought alongside step k's landing, as StopSoon has it
+  const Scheduled& st = steps_[k];
+  along.step = {Other(st.step.side), st.step.pose};
+  const Eigen::Vector2d at = st.step.pose.Apply(0, -SideSign(st.step.side) * g_.foot_separation);
+  along.step.pose.x = at.x();
+  along.step.pose.y = at.y();
+  along.planned = along.step.pose;
+  along.uncaptured = along.step.pose;
+  along.captured = true;
+  along.from = st.stance;
+  along.stance = st.step.pose;
+  along.centre = st.centre;
+  while (phases_.size() > 1 && phases_.back().start >= st.land) phases_.pop_back();
+  AddPhase(ds_ticks_, ZmpPoint(st.step.pose), Kind::kShift, static_cast<int>(along.step.side));
+  along.start = phases_.back().end;
+  along.land = along.start + ss_ticks_;
+  AddPhase(ss_ticks_, ZmpPoint(st.step.pose), Kind::kSingle, -1);
+  steps_.push_back(along);
+  CaptureWith(k + 1, com, com_vel, rp);
+  return true;
+}
+
+bool WalkPattern::CaptureWith(size_t k, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
+                              const RecoveryParams& rp) {
+  const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
+  steps_.resize(k + 1);
+  Scheduled& st = steps_[k];
+  if (!st.captured) st.uncaptured = st.step.pose;
+  st.captured = true;
+  const bool in_air = st.start <= tick_;
+  const int j = PhaseAt(tick_);
+  const double omega = std::sqrt(gravity_ / g_.com_height);
+  const Eigen::Vector2d xi0 = com + com_vel / omega, p_now = ZmpAt(tick_);
+  const Pose2 stance = st.stance;
+  const double side = SideSign(st.step.side), c = std::cos(stance.theta), s = std::sin(stance.theta);
+  const auto to_local = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d d = p - stance.xy();
+    return Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+  };
+  // The ankles: in the air, the stance ZMP at the sole's point nearest the DCM.
+  const Eigen::Vector2d ankle = ClampToPolygon(xi0, Corners(stance, g_), rp.ankle_margin);
+  // After the landing the ZMP ramps from p_land to q over d1, holds it h,
+  // ramps to the middle m over de: the reference's DCM at the landing is
+  // p_land + (q - p_land) g1 + (m - q) e ge (xi = p(0) + int e^{-wt} p'(t) dt).
+  const double d1 = static_cast<double>(ticks(rp.capture_shift)) * tick_s_;
+  const double de = static_cast<double>(end_ticks_) * tick_s_;
+  const double g1 = (1 - std::exp(-omega * d1)) / (omega * d1),
+               ge = (1 - std::exp(-omega * de)) / (omega * de);
+  const double e = std::exp(-omega * (d1 + static_cast<double>(ticks(rp.capture_hold)) * tick_s_));
+  const std::vector<Phase> saved = phases_;
+  const auto until_landing = [&](std::int64_t land) {  // the reference from now to the landing
+    phases_ = saved;
+    if (in_air) {
+      const int next = phases_[static_cast<size_t>(j)].next;
+      TruncateNow(j, p_now);
+      const std::int64_t ramp = std::min(land - tick_, ticks(rp.ankle_ramp));
+      if (ramp > 0) AddPhase(ramp, ankle, Kind::kSingle, next);
+      if (land - tick_ - ramp > 0) AddPhase(land - tick_ - ramp, ankle, Kind::kSingle, next);
+    } else {
+      while (phases_.size() > 1 && phases_.back().start >= land) phases_.pop_back();
+    }
+  };
+  const std::int64_t soonest =
+      in_air ? std::max(tick_ + ticks(rp.late), st.start + ticks(rp.min_swing)) : st.land;
+  std::int64_t land = st.land;
+  Pose2 foot;
+  Eigen::Vector2d q, m;
+  bool fits = true;
+  for (;; land = std::max(soonest, land - ticks(0.025))) {
+    until_landing(land);
+    const Eigen::Vector2d xi_land = DcmAt(land, xi0), p_land = phases_.back().to;
+    // The landing as planned before the capture (the stop's: alongside),
+    // moved only as far as q needs to be inside the soles' hull, within
+    // reach and width of the stance foot, and (in the air) swing speed.
+    const Eigen::Vector2d n0 = to_local(st.uncaptured.xy());
+    Eigen::Vector2d f(n0.x(), side * n0.y());
+    for (int it = 0; it < 4; ++it) {
+      foot = {stance.Apply(f.x(), side * f.y()).x(), stance.Apply(f.x(), side * f.y()).y(), stance.theta};
+      m = 0.5 * (ZmpPoint(stance) + ZmpPoint(foot));
+      q = (xi_land - p_land * (1 - g1) - m * e * ge) / (g1 - e * ge);
+      std::array<Eigen::Vector2d, 16> h;
+      const Eigen::Vector2d out =
+          q - ClampToPolygon(q, std::span(h.data(), static_cast<size_t>(HullOfSoles(stance, foot, g_, h))),
+                             rp.capture_margin);
+      // (sideways only outward: a foot moved inward narrows the support)
+      const Eigen::Vector2d d(c * out.x() + s * out.y(), std::max(0.0, side * (-s * out.x() + c * out.y())));
+      const Eigen::Vector2d want = f + d;
+      f = {std::clamp(want.x(), -rp.reach_back, rp.reach), std::clamp(want.y(), rp.min_width, rp.max_width)};
+      fits = (f - want).norm() < 1e-9;
+    }
+    foot = {stance.Apply(f.x(), side * f.y()).x(), stance.Apply(f.x(), side * f.y()).y(), stance.theta};
+    const double most = rp.swing_speed * static_cast<double>(land - tick_) * tick_s_;
+    fits = fits && (!in_air || (foot.xy() - st.step.pose.xy()).norm() <= most);
+    if (fits || land <= soonest) break;
+  }
+  Eigen::Vector2d by = foot.xy() - st.step.pose.xy();
+  if (in_air) {  // the swing foot's speed
+    const double most = rp.swing_speed * static_cast<double>(land - tick_) * tick_s_;
+    if (by.norm() > most) by *= most / by.norm();
+  }
+  MoveLanding(st, by, land);
+  st.step.pose.theta = stance.theta;
+  st.planned = st.step.pose;
+  const Pose2 mid{0.5 * (stance.x + st.step.pose.x), 0.5 * (stance.y + st.step.pose.y), stance.theta};
+  const Eigen::Vector2d centre = mid.Apply(-g_.ankle_x, 0);
+  st.centre = {centre.x(), centre.y(), stance.theta};
+  // Moved off alongside: after the hold the weight goes onto the moved foot
+  // (as a start's first shift) and the other foot steps alongside it, so
+  // that the walk resumes from its usual stance; else to the middle.
+  const Eigen::Vector2d beside = st.step.pose.Apply(0, -side * g_.foot_separation);
+  const bool tidy = rp.capture_tidy && (beside - stance.xy()).norm() > rp.capture_tidy_beyond;
+  const Eigen::Vector2d after =
+      tidy ? ZmpPoint(st.step.pose) : Eigen::Vector2d(0.5 * (ZmpPoint(stance) + ZmpPoint(st.step.pose)));
+  q = (DcmAt(land, xi0) - phases_.back().to * (1 - g1) - after * e * ge) / (g1 - e * ge);
+  std::array<Eigen::Vector2d, 16> hull;
+  const int n = HullOfSoles(stance, st.step.pose, g_, hull);
+  q = ClampToPolygon(q, std::span(hull.data(), static_cast<size_t>(n)), rp.capture_margin);
+  AddPhase(ticks(rp.capture_shift), q, Kind::kShift, -1);
+  AddPhase(ticks(rp.capture_hold), q, Kind::kHold, -1);
+  if (tidy) {
+    Scheduled t;
+    t.tidy = true;
+    t.step = {Other(st.step.side), {beside.x(), beside.y(), st.step.pose.theta}};
+    t.planned = t.step.pose;
+    t.from = stance;
+    t.stance = st.step.pose;
+    const Eigen::Vector2d c2 =
+        Pose2{0.5 * (beside.x() + st.step.pose.x), 0.5 * (beside.y() + st.step.pose.y), st.step.pose.theta}
+            .Apply(-g_.ankle_x, 0);
+    t.centre = {c2.x(), c2.y(), st.step.pose.theta};
+    AddPhase(end_ticks_, after, Kind::kShift, static_cast<int>(t.step.side));
+    t.start = phases_.back().end;
+    t.land = t.start + ss_ticks_;
+    AddPhase(ss_ticks_, after, Kind::kSingle, -1);
+    steps_.push_back(t);
+    AddPhase(end_ticks_, 0.5 * (ZmpPoint(t.step.pose) + after), Kind::kEnd, -1);
+  } else {
+    AddPhase(end_ticks_, after, Kind::kEnd, -1);
+  }
+  if (rp.capture_reanchor) SetComState(com, com_vel);
+  return fits;
+}
+
 PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
     : omega_(omega), tick_(tick), p_(params) {
   if (!(omega > 0) || !(tick > 0) || !(p_.threshold >= 0) || !(p_.reach > 0)) {
@@ -215,11 +395,25 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
   if (!(p_.stop_impulse >= 0) || (p_.stop_impulse > 0 && !(p_.stop_hold > 0))) {
     throw std::invalid_argument("PushRecovery: stop_impulse must be >= 0 (0: off) and stop_hold > 0");
   }
+  if (!(p_.capture_margin >= 0) || !(p_.capture_shift > 0) || !(p_.capture_hold >= 0) ||
+      !(p_.capture_tidy_beyond >= 0)) {
+    throw std::invalid_argument(
+        "PushRecovery: capture_margin, capture_hold and capture_tidy_beyond must be >= 0 and capture_shift > "
+        "0");
+  }
 }
 
 bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) {
   since_ += tick_;
   error_ = (com + com_vel / omega_) - (pattern.com() + pattern.com_velocity() / omega_);
+  if (capturing_) {  // the capture stop re-plans until its last step lands; no regeneration meanwhile
+    if (since_ < p_.interval) return false;
+    capturing_ = pattern.CaptureStop(com, com_vel, p_);
+    if (!capturing_) return false;
+    since_ = 0;
+    ++captures_;
+    return true;
+  }
   // Per axis: an axis within the threshold keeps the plan's state (the
   // measured one's noise, amplified by e^{w T}, would move the feet).
   const Eigen::Array2d over = (error_.array().abs() > p_.threshold).cast<double>();
@@ -238,6 +432,8 @@ PushRecovery::Walk PushRecovery::Watch(WalkPattern& pattern, const Eigen::Vector
       pattern.StopSoon();
       ++stops_;
       hold_ = p_.stop_hold;
+      capturing_ = p_.capture_stop;
+      if (capturing_) since_ = 1e9;  // the capture's first re-plan at the next Update
     } else if (hold_ > 0) {
       hold_ = p_.stop_hold;
     }

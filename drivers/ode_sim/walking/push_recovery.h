@@ -89,6 +89,16 @@ struct RecoveryParams {
   // walk goes on. 0: off.
   double stop_impulse = 0.1;  ///< m/s
   double stop_hold = 3.0;     ///< s
+  // The capture stop (CaptureStop below; option push_capture): the stop's
+  // last step lands where the measured DCM is caught, the plan re-anchored
+  // on the measured CoM state, re-planned every `interval` until it lands.
+  bool capture_stop = false;
+  double capture_margin = 0.05;  ///< m: the caught ZMP this far inside the final support
+  double capture_shift = 0.1;    ///< s: after the landing the ZMP goes to the DCM this fast ...
+  double capture_hold = 0.3;     ///< s: ... holds there this long, then shifts back to the middle (end_shift)
+  bool capture_reanchor = true;  ///< the plan's CoM state becomes the measured one at each re-plan
+  bool capture_tidy = true;      ///< a landing moved off alongside: then the other foot steps alongside it
+  double capture_tidy_beyond = 0.03;  ///< m: ... when moved more than this
 };
 
 class PushRecovery {
@@ -97,7 +107,10 @@ class PushRecovery {
   PushRecovery(double omega, double tick, RecoveryParams params = {});
   /// One control tick with the measured CoM and velocity (plan frame).
   /// Regenerates `pattern` when the DCM error passes the threshold and a
-  /// step can still take it; returns true when it did.
+  /// step can still take it; during a capture stop (capture_stop, after
+  /// Watch stopped the walk) re-plans the stop from the measured state
+  /// instead (WalkPattern::CaptureStop). Returns true when it did either:
+  /// the plan's CoM state is then the measured one.
   bool Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel);
   /// The last measured DCM error (m), and how many regenerations so far.
   const Eigen::Vector2d& error() const { return error_; }
@@ -118,6 +131,9 @@ class PushRecovery {
   Walk Watch(WalkPattern& pattern, const Eigen::Vector2d& impulse);
   /// Walks stopped by a push so far.
   int stops() const { return stops_; }
+  /// With capture_stop: the capture stop's re-plans so far (Update returns
+  /// true for each; every `interval` from the stop until its last step lands).
+  int captures() const { return captures_; }
 
  private:
   double omega_, tick_;
@@ -127,6 +143,8 @@ class PushRecovery {
   int count_ = 0;
   double hold_ = 0;  // s of standing left
   int stops_ = 0;
+  bool capturing_ = false;  // a capture stop whose last step has not landed
+  int captures_ = 0;
 };
 
 }  // namespace robotalk::walking

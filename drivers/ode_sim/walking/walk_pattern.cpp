@@ -392,9 +392,14 @@ int WalkPattern::SupportPolygon(std::array<Eigen::Vector2d, 16>& hull) const {
     std::copy(c.begin(), c.end(), hull.begin());
     return 4;
   }
-  // Convex hull of both soles (monotone chain, counter-clockwise).
+  return HullOfSoles(foot_[0], foot_[1], g_, hull);
+}
+
+int HullOfSoles(const Pose2& fa, const Pose2& fb, const GaitParams& g,
+                std::array<Eigen::Vector2d, 16>& hull) {
+  // Monotone chain, counter-clockwise.
   std::array<Eigen::Vector2d, 8> pts;
-  const auto a = Corners(foot_[0], g_), b = Corners(foot_[1], g_);
+  const auto a = Corners(fa, g), b = Corners(fb, g);
   std::copy(a.begin(), a.end(), pts.begin());
   std::copy(b.begin(), b.end(), pts.begin() + 4);
   std::sort(pts.begin(), pts.end(),

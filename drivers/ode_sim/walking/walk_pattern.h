@@ -97,6 +97,20 @@ class WalkPattern {
   /// continuous). False (nothing changed) when no step can move: standing,
   /// the end shift, a stop's stand without a swing.
   bool Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p);
+  /// The capture stop (push_recovery.h), after StopSoon: the stop's last
+  /// step (the foot brought alongside) lands where the measured DCM (from
+  /// `com`, `com_vel`, plan frame) is caught. Predicted on the reference's
+  /// ZMP until that landing (in the air: the stance ZMP at the sole's point
+  /// nearest the DCM, `ankle_margin` inside), the DCM at the landing must be
+  /// the reference's own from then on: the ZMP goes to a point q within
+  /// `capture_shift` s, holds `capture_hold` s, then shifts to the middle of
+  /// the feet over end_shift. The foot lands where it was to, moved only as
+  /// far as q needs to be `capture_margin` inside the two soles' hull (within
+  /// reach and width of the stance foot: beyond them q is clamped into the hull);
+  /// while that does not fit, a foot in the air lands sooner (not sooner than
+  /// `min_swing` after its lift-off). The plan's CoM state becomes the
+  /// measured one. False (nothing changed) when no step can still move.
+  bool CaptureStop(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p);
 
   /// True when no step is scheduled or running and the end shift is over.
   bool standing() const;
@@ -152,6 +166,9 @@ class WalkPattern {
     Pose2 planned;                     // step.pose before AdjustLanding
     std::int64_t retimed = -1;         // Regenerate landed it sooner at this tick (-1: never)
     double s_retimed = 0;              // the swing's progress (0..1) then
+    bool captured = false;             // CaptureStop moved it from `uncaptured`
+    bool tidy = false;                 // CaptureStop's step bringing the other foot alongside after
+    Pose2 uncaptured;
   };
   Eigen::Vector2d ZmpPoint(const Pose2& foot) const;
   Eigen::Vector2d ZmpAt(std::int64_t tick) const;
@@ -171,6 +188,17 @@ class WalkPattern {
   double SwingProgress(const Scheduled& s) const;  // 0 at lift-off .. 1 at landing
   void SetComState(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel);
   Eigen::Vector2d NominalDcm() const;
+  // CaptureStop with step k as the stop's last (the later ones dropped); false: q did not fit.
+  bool CaptureWith(size_t k, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
+                   const RecoveryParams& rp);
+  // The DCM at tick `at` of a pendulum whose DCM is xi0 now and whose ZMP is the reference's.
+  Eigen::Vector2d DcmAt(std::int64_t at, const Eigen::Vector2d& xi0) const;
+  // A step in the air within `late` ticks (or the last tenth of its move) of its landing.
+  bool TooLate(const Scheduled& st, std::int64_t late) const;
+  // The phase j (holding now) ends now at `p_now`; the later ones are dropped.
+  void TruncateNow(int j, const Eigen::Vector2d& p_now);
+  // Moves the landing of `st` by `by` (m) at tick `land`; in the air, the foot goes on from where it is.
+  void MoveLanding(Scheduled& st, const Eigen::Vector2d& by, std::int64_t land);
   void Rebuild(size_t k, std::int64_t land, std::int64_t lift, const Eigen::Vector2d& u,
                const std::vector<Eigen::Vector2d>& shift, const RecoveryParams& rp);
   const Scheduled* Swinging() const;  // the step in single support now, or null
@@ -197,6 +225,8 @@ class WalkPattern {
 
 /// A foot's sole rectangle, counter-clockwise from the front left corner.
 std::array<Eigen::Vector2d, 4> Corners(const Pose2& foot, const GaitParams& g);
+/// The convex hull of two feet's soles, counter-clockwise, into `hull`; returns how many corners.
+int HullOfSoles(const Pose2& a, const Pose2& b, const GaitParams& g, std::array<Eigen::Vector2d, 16>& hull);
 /// Point-in-convex-polygon test helper: the sole rectangle of a foot.
 bool InFoot(const Pose2& foot, const GaitParams& g, const Eigen::Vector2d& p, double margin);
 
