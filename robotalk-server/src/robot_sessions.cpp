@@ -313,9 +313,20 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
   const Duration ahead = c.start_time.is_after() ? *c.start_time.offset()
                          : c.start_time.is_at()  ? SaturatingSub(*c.start_time.time(), now)
                                                  : Duration(0);
+  // A STOP due now or in the past runs at once, whatever its clock or the
+  // client's queue: "a STOP always runs, however late" (it empties what it
+  // stops, so it cannot grow the queue).
+  const bool stop_now = Traits(c.type).kind == CommandKind::kStop && ahead <= Duration(0);
+  bool run_now = false;
   // As far behind as the limit ahead: a clock that wrong is a bug to report,
-  // not a command to run late (and its lateness must stay in range).
-  if (c.start_time.is_at() && ahead < -options_.max_future) {
+  // not a command to run late (and its lateness must stay in range); a STOP
+  // runs now, and the server's log says the clock was wrong.
+  if (c.start_time.is_at() && ahead < -options_.max_future && stop_now) {
+    log_.push_back("robot '" + robot_ + "': " + s.who + "'s STOP " + std::to_string(c.id) + " was due " +
+                   Seconds(SaturatingSub(now, *c.start_time.time())) +
+                   " in the past of the server clock (is the client's clock synchronised?); run now");
+    run_now = true;
+  } else if (c.start_time.is_at() && ahead < -options_.max_future) {
     immediate.push_back(MakeReply(c.id, Signal::kError,
                                   std::string(ToString(c.type)) + ": start time is " +
                                       Seconds(SaturatingSub(now, *c.start_time.time())) +
@@ -333,14 +344,14 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                   now));
     return std::nullopt;
   }
-  if (std::string full = QueueRefusal(s); !full.empty()) {
+  if (std::string full = stop_now ? std::string() : QueueRefusal(s); !full.empty()) {
     immediate.push_back(MakeReply(c.id, Signal::kError, std::move(full) + "; command not queued", now));
     return std::nullopt;
   }
   QueuedItem item;
   item.client_id = s.client_id;
-  item.has_start_time = !c.start_time.is_now();
-  if (c.start_time.is_at()) item.start = *c.start_time.time();
+  item.has_start_time = !c.start_time.is_now() && !run_now;
+  if (c.start_time.is_at() && !run_now) item.start = *c.start_time.time();
   item.received = now;
   item.max_late = EffectiveMaxLate(c.type, item.has_start_time, max_late, options_.max_late);
   item.command.id = c.id;
