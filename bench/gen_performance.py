@@ -350,6 +350,7 @@ def playback_estimators_section(res):
              "adaptive_queue": "adaptive (default) + queue start (option)",
              "adaptive_burst_off": "adaptive (default), burst discount off (`--playback-burst-discount off`)",
              "adaptive_stretch50": "adaptive, stretch 50 % (`--playback-stretch 0.5`, option)",
+             "adaptive_stretch50_queue": "adaptive, stretch 50 % and queue start (both options)",
              "adaptive_stretch50_copies": "adaptive, stretch 50 % (option) + client sends 2 copies",
              "adaptive_resent": "adaptive, previous default (`--playback-resent-delays on`)",
              "adaptive_before_build": "adaptive (default) on the build before (`ROBOTALK_BENCH_BEFORE_SERVER`)"}

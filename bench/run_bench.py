@@ -397,7 +397,10 @@ class Bench:
                     # the default before a retransmitted package's delay was left out of the history
                     ("adaptive_resent", adaptive + ["--playback-resent-delays", "on"], [], 2.0, ("WAN",)),
                     ("adaptive_stretch50_copies", adaptive + ["--playback-stretch", "0.5"],
-                     ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)))
+                     ["--stretch-bound", "0.5", "--copies", "2"], 2.0, ("WAN",)),
+                    # both options: the queue start decides where the 50 % stretch can follow the queue
+                    ("adaptive_stretch50_queue", adaptive + ["--playback-stretch", "0.5", "--playback-queue-start", "on"],
+                     ["--stretch-bound", "0.5"], 2.0, None))
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
         # robotalk-server ("adaptive_before_build"): a code change's before and after on the same
         # relay seeds and under the same load, interleaved.
