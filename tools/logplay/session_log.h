@@ -133,6 +133,11 @@ class SessionLog {
   std::int64_t first_us() const { return first_us_; }
   std::int64_t last_us() const { return last_us_; }
   std::uint64_t events() const { return events_; }
+  /// Why entries were not used (each names the event, its channel and the
+  /// field): the first kKeptRejections of them; rejections() counts all.
+  const std::vector<std::string>& rejected() const { return rejected_; }
+  std::uint64_t rejections() const { return rejections_; }
+  static constexpr std::size_t kKeptRejections = 20;
 
   /// The selected commands on one clock (see the file comment). Throws
   /// LogError when nothing matches or the clocks cannot be joined.
@@ -159,6 +164,8 @@ class SessionLog {
   std::vector<StateSample> states_;
   std::int64_t first_us_ = 0, last_us_ = 0;
   std::uint64_t events_ = 0;
+  std::vector<std::string> rejected_;
+  std::uint64_t rejections_ = 0;
 };
 
 /// Parses a client id as printed (16 hex digits) or in decimal; throws LogError.
