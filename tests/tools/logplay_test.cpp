@@ -327,7 +327,8 @@ TEST_F(HostileLog, RefusesLogTimestampsOutOfRangeAndNamesThem) {
   const auto p = Package(kClient, 1, 100, kDelay, {{1, CommandType::kGoto, 5'000'000, "", {1, 0, 0}}});
   Write(kRequest, std::numeric_limits<std::int64_t>::min(), p);
   Write("OTHER", std::numeric_limits<std::int64_t>::max(), {1, 2, 3});
-  Write(kRequest, 1'700'000'000'000'000, Package(kClient, 2, 200, kDelay, {{2, CommandType::kStop, 6'000'000, "", {}}}));
+  Write(kRequest, 1'700'000'000'000'000,
+        Package(kClient, 2, 200, kDelay, {{2, CommandType::kStop, 6'000'000, "", {}}}));
   const SessionLog log = Read();
   EXPECT_TRUE(Names(log, {"event 0", kRequest, "log timestamp"}));
   EXPECT_TRUE(Names(log, {"event 1", "OTHER", "log timestamp"}));
@@ -337,7 +338,7 @@ TEST_F(HostileLog, RefusesLogTimestampsOutOfRangeAndNamesThem) {
   ASSERT_EQ(log.commands().size(), 1u);
   std::ostringstream info;
   PrintInfo(log, "hostile.lcmlog", info);
-  EXPECT_NE(info.str().find("2 entries rejected"), std::string::npos) << info.str();
+  EXPECT_NE(info.str().find("2 log entries rejected"), std::string::npos) << info.str();
   EXPECT_NE(info.str().find("log timestamp"), std::string::npos) << info.str();
 }
 
