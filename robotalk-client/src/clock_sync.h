@@ -15,8 +15,11 @@ class ClockSync {
  public:
   /// One round trip: t1 client send, t2 server receive, t3 server send,
   /// t4 client receive (t1, t4 on the client's clock; t2, t3 on the server's).
-  /// A sample with a negative round trip (t4 < t1 or t3 < t2 beyond the
-  /// client's interval) is inconsistent and ignored; returns whether it was used.
+  /// A sample with a negative round trip (t4 < t1, t3 < t2, or a server
+  /// interval t3 - t2 longer than the client's t4 - t1) is inconsistent and
+  /// ignored, as is one whose arithmetic would overflow int64 nanoseconds
+  /// (forged server times at the ends of the range) or whose offset would map
+  /// t4 past the end of the range; returns whether it was used.
   bool AddSample(TimePoint t1, TimePoint t2, TimePoint t3, TimePoint t4);
 
   /// True once at least one sample was accepted.

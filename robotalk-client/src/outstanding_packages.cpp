@@ -157,8 +157,11 @@ OutstandingPackages::AckInfo OutstandingPackages::OnAck(std::int64_t sequence, T
     if (p.sends == 1) {
       AddRoundTrip(now - p.first_send);
       const AckTiming t = timing.value_or(AckTiming{.received = now});
-      const Duration network = t.received - p.first_send - t.server_hold;
-      if (network > Duration::zero()) AddNetworkRoundTrip(network, now);
+      // server_hold comes from the reply (forgeable, saturated): compared, never
+      // subtracted beyond the round trip, so no overflow.
+      const Duration total = t.received - p.first_send;
+      if (t.server_hold >= Duration::zero() && t.server_hold < total)
+        AddNetworkRoundTrip(total - t.server_hold, now);
     }
     // Replies are not due before the items' start times: ask again only after.
     p.backoff_step = 0;

@@ -430,7 +430,8 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
             batch.ack_sequence, now,
             client::OutstandingPackages::AckTiming{
                 .received = arrived,
-                .server_hold = std::max(Duration::zero(), batch.server_send - batch.server_receive)});
+                .server_hold =
+                    std::max(Duration::zero(), SaturatingSub(batch.server_send, batch.server_receive))});
         if (info.known && info.first && clock_packages_.erase(batch.ack_sequence) != 0 &&
             !info.retransmitted) {
           // Only a never-resent package gives an unambiguous t1; t4 is the

@@ -62,5 +62,35 @@ TEST(ClockSync, IgnoresInconsistentSamples) {
   EXPECT_FALSE(s.synced());
 }
 
+// A forged (or corrupt) reply may carry server times anywhere in the wire's
+// range: a sample whose arithmetic would overflow is rejected, not added
+// (it was undefined behaviour, in practice a wrapped difference that passed
+// the checks and set an absurd offset).
+TEST(ClockSync, RejectsForgedTimesAtTheEndsOfTheRange) {
+  const TimePoint lo = TimePoint::min(), hi = TimePoint::max();
+  const TimePoint t1 = kT0, t4 = kT0 + milliseconds(2);
+  ClockSync s;
+  EXPECT_FALSE(s.AddSample(t1, lo, hi, t4)) << "server interval t3 - t2 overflows";
+  EXPECT_FALSE(s.AddSample(t1, hi, lo, t4)) << "t3 < t2";
+  EXPECT_FALSE(s.AddSample(lo, kT0, kT0, hi)) << "client interval t4 - t1 overflows";
+  EXPECT_FALSE(s.AddSample(hi, kT0, kT0, lo)) << "t4 < t1";
+  EXPECT_FALSE(s.AddSample(t1, lo, lo, t4)) << "t2 - t1 overflows";
+  EXPECT_FALSE(s.AddSample(t1, hi, hi, t4)) << "t3 - t4 overflows";
+  // Each difference fits, their sum does not: an offset of more than 146 years.
+  const TimePoint far = lo + std::chrono::seconds(200);
+  EXPECT_FALSE(s.AddSample(t1, far, far, t4)) << "(t2 - t1) + (t3 - t4) overflows";
+  // The offset fits but maps the client's receive time past the end of the range.
+  const Duration off = hi.time_since_epoch() / 4;
+  const TimePoint t(hi.time_since_epoch() - off - std::chrono::microseconds(1500));
+  const TimePoint server = t + milliseconds(1) + off;  // hi - 0.5 ms
+  EXPECT_FALSE(s.AddSample(t, server, server, t + milliseconds(2))) << "ServerTime(t4) overflows";
+  EXPECT_FALSE(s.synced());
+  EXPECT_EQ(s.num_samples(), 0);
+  EXPECT_EQ(s.offset(), Duration::zero());
+  // A sane sample after them is used as usual.
+  EXPECT_TRUE(s.AddSample(t1, t1 + milliseconds(1) + kTrueOffset, t1 + milliseconds(1) + kTrueOffset, t4));
+  EXPECT_EQ(s.offset(), kTrueOffset);
+}
+
 }  // namespace
 }  // namespace robotalk::client

@@ -1,5 +1,6 @@
 // SessionLog and the frame/sequence helpers of robotalk-logplay, fed with
-// packages encoded by the message layer in memory (no LCM, no files).
+// packages encoded by the message layer in memory (no LCM), and hostile logs
+// written with LCM's log API in a temp dir.
 #include "logplay.h"
 #include "receipt_order.h"
 #include "robotalk/channels.h"
@@ -8,6 +9,13 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+#include <limits>
+#include <memory>
 #include <sstream>
 
 namespace robotalk::logplay {
@@ -238,6 +246,100 @@ TEST(SessionLog, RecognisesLoggedHellosAndTheirRefusals) {
   std::ostringstream info;
   PrintInfo(log, "x.lcmlog", info);
   EXPECT_NE(info.str().find("hellos 1 (1 refused)"), std::string::npos) << info.str();
+}
+
+// A hostile (or corrupt) log: numbers that are not finite or out of range
+// are refused entry by entry, with a message naming the event, its channel
+// and the field; never undefined behaviour (a NaN cast to an integer), never
+// an overflow of `time - t0` that silently drops valid frames from a replay.
+// The log is written with LCM's own log API, as lcm-logger would.
+class HostileLog : public ::testing::Test {
+ protected:
+  void Write(const std::string& channel, std::int64_t timestamp, const std::vector<std::uint8_t>& bytes) {
+    lcm::LogEvent e{};
+    e.eventnum = next_++;
+    e.timestamp = timestamp;
+    e.channel = channel;
+    e.datalen = static_cast<std::int32_t>(bytes.size());
+    e.data = const_cast<std::uint8_t*>(bytes.data());
+    ASSERT_EQ(file_->writeEvent(&e), 0);
+  }
+  SessionLog Read() {
+    file_.reset();  // closed: flushed
+    return ReadLog(path_);
+  }
+  void Restart() {
+    file_ = std::make_unique<lcm::LogFile>(path_, "w");
+    next_ = 0;
+  }
+  static bool Names(const SessionLog& log, const std::vector<std::string>& words) {
+    for (const std::string& r : log.rejected()) {
+      bool all = true;
+      for (const std::string& w : words) all = all && r.find(w) != std::string::npos;
+      if (all) return true;
+    }
+    return false;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  const std::string dir_ = testing::TempDir() + "/logplay_hostile_" + std::to_string(::getpid());
+  const std::string path_ = (std::filesystem::create_directories(dir_), dir_ + "/hostile.lcmlog");
+  std::unique_ptr<lcm::LogFile> file_ = std::make_unique<lcm::LogFile>(path_, "w");
+  std::int64_t next_ = 0;
+};
+
+TEST_F(HostileLog, RefusesAPlaybackStartThatIsNotAFiniteTimeAndKeepsEveryValidFrame) {
+  const std::int64_t kOther = kClient + 1;
+  const double starts[] = {std::nan(""), std::numeric_limits<double>::infinity(), -1e300, -9.2e18};
+  for (std::size_t i = 0; i < std::size(starts); ++i) {
+    SCOPED_TRACE(starts[i]);
+    Restart();
+    // Client A plays back two frames (offsets 0 and 2 s); its PLAYBACK reply's start is hostile.
+    Write(kRequest, 10,
+          Package(kClient, 1, 0, kPlayback,
+                  {{2, CommandType::kSetSpeed, 0, "", {0.2, 0}}, {3, CommandType::kStop, 2'000'000, "", {}}},
+                  /*playback_id=*/1));
+    Write(kReply, 11, ReplyPackage(kClient, 1, 49'750'000, {Reply{.id = 1, .values = {0.25, starts[i]}}}));
+    // Client B sends two delay-mode commands at real server-clock times.
+    Write(kRequest, 12,
+          Package(kOther, 1, 5, kDelay,
+                  {{1, CommandType::kSetSpeed, 1'700'000'000'000'000, "", {0.1, 0}},
+                   {2, CommandType::kStop, 1'700'000'001'000'000, "", {}}}));
+    const SessionLog log = Read();
+    EXPECT_TRUE(Names(log, {"event 1", kReply, "values[1]", "playback 1"}))
+        << (log.rejected().empty() ? "nothing rejected" : log.rejected()[0]);
+    EXPECT_EQ(log.channels().at(kReply).undecodable, 1u);
+    EXPECT_TRUE(log.clients().at(kClient).playback_start_us.empty());
+    // A's frames keep their own clock (the playback offsets), both of them.
+    const Timeline a = log.MakeTimeline({.client_id = kClient});
+    EXPECT_EQ(a.clock, "playback offsets");
+    ASSERT_EQ(a.frames.size(), 2u);
+    EXPECT_DOUBLE_EQ(a.frames[1].offset_s, 2.0);
+    // Both clients together cannot be put on one clock: said, not B's frames dropped.
+    EXPECT_THROW(log.MakeTimeline({.robot = "pioneer"}), LogError);
+    const Timeline b = log.MakeTimeline({.client_id = kOther});
+    ASSERT_EQ(b.frames.size(), 2u);
+    EXPECT_DOUBLE_EQ(b.frames[1].offset_s, 1.0);
+  }
+}
+
+TEST_F(HostileLog, RefusesLogTimestampsOutOfRangeAndNamesThem) {
+  const auto p = Package(kClient, 1, 100, kDelay, {{1, CommandType::kGoto, 5'000'000, "", {1, 0, 0}}});
+  Write(kRequest, std::numeric_limits<std::int64_t>::min(), p);
+  Write("OTHER", std::numeric_limits<std::int64_t>::max(), {1, 2, 3});
+  Write(kRequest, 1'700'000'000'000'000,
+        Package(kClient, 2, 200, kDelay, {{2, CommandType::kStop, 6'000'000, "", {}}}));
+  const SessionLog log = Read();
+  EXPECT_TRUE(Names(log, {"event 0", kRequest, "log timestamp"}));
+  EXPECT_TRUE(Names(log, {"event 1", "OTHER", "log timestamp"}));
+  EXPECT_EQ(log.first_us(), 1'700'000'000'000'000);
+  EXPECT_EQ(log.last_us(), 1'700'000'000'000'000);
+  EXPECT_EQ(log.events(), 3u);
+  ASSERT_EQ(log.commands().size(), 1u);
+  std::ostringstream info;
+  PrintInfo(log, "hostile.lcmlog", info);
+  EXPECT_NE(info.str().find("2 log entries rejected"), std::string::npos) << info.str();
+  EXPECT_NE(info.str().find("log timestamp"), std::string::npos) << info.str();
 }
 
 // Issue 19: the recorder dispatches the 66 lanes one after the other, so a

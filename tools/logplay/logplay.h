@@ -19,6 +19,11 @@ namespace robotalk::logplay {
 /// LogError when the file cannot be opened.
 SessionLog ReadLog(const std::string& path);
 
+/// The log's rejected entries (SessionLog::rejected(): each names the event,
+/// its channel and what was wrong), one line each after `prefix`; nothing
+/// when every entry was used.
+void PrintRejected(const SessionLog& log, const std::string& prefix, std::ostream& out);
+
 /// How recorded commands become frames again.
 struct FrameOptions {
   std::map<std::string, std::string> rename;  ///< --map old=new: joint / frame names

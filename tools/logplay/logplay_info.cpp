@@ -130,6 +130,14 @@ SessionLog ReadLog(const std::string& path) {
   return log;
 }
 
+void PrintRejected(const SessionLog& log, const std::string& prefix, std::ostream& out) {
+  const std::uint64_t n = log.rejections();
+  if (n == 0) return;
+  out << prefix << n << (n == 1 ? " log entry" : " log entries") << " rejected (not used):\n";
+  for (const std::string& r : log.rejected()) out << prefix << "  " << r << "\n";
+  if (n > log.rejected().size()) out << prefix << "  ... and " << n - log.rejected().size() << " more\n";
+}
+
 std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions& options) {
   if (!(options.speed > 0)) throw cli::UsageError("--speed must be positive");
   std::vector<TimedCommand> frames;
@@ -197,6 +205,7 @@ void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out
                   s.messages, s.bytes);
     out << line << (s.undecodable ? "  (" + std::to_string(s.undecodable) + " undecodable)" : "") << "\n";
   }
+  PrintRejected(log, "", out);
   const auto servers = log.servers();
   out << "servers: " << servers.size();
   for (std::int64_t s : servers) out << ' ' << Hex64(static_cast<std::uint64_t>(s));

@@ -151,6 +151,7 @@ int RunExtract(Args& a) {
   if (!sel.client_id && sel.robot.empty()) throw UsageError("extract needs --client ID or --robot NAME");
   if (!out) throw UsageError("extract needs -o SEQ.txt");
   const lp::SessionLog log = lp::ReadLog(path);
+  lp::PrintRejected(log, "robotalk-logplay: ", std::cerr);
   const lp::Timeline t = log.MakeTimeline(sel);
   for (const auto& s : t.skipped) std::cerr << "robotalk-logplay: not extracted: " << s << "\n";
   const auto f = lp::ToFrames(t, frames);
@@ -251,6 +252,7 @@ int RunExport(Args& a) {
   const bool plot = !a.Flag("--no-plot");
   const std::string path = a.Log();
   const lp::SessionLog log = lp::ReadLog(path);
+  lp::PrintRejected(log, "robotalk-logplay: ", std::cerr);
   for (const auto& f : lp::ExportCsv(log, lp::ReadConfigs(path), dir, std::cerr)) std::cout << f << "\n";
   if (!plot) return 0;
   const std::string png = dir + "/session.png";

@@ -86,8 +86,11 @@ class Exporter {
   void Event(const std::string& channel, std::int64_t log_us, std::span<const std::uint8_t> bytes) {
     const std::optional<ChannelParts> parts = ParseChannel(channel);
     if (!parts) return;
-    const std::uint64_t log_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(0, log_us)) * 1000;
+    const std::uint64_t log_ns =
+        static_cast<std::uint64_t>(std::clamp<std::int64_t>(log_us, 0, kMaxWireMicros)) * 1000;
     try {
+      if (log_us > kMaxWireMicros)  // would wrap around as nanoseconds
+        throw ProtocolError("log timestamp " + std::to_string(log_us) + " us is out of range");
       switch (parts->kind) {
         case ChannelKind::kConfig:
           Config(parts->robot, log_ns, bytes);

@@ -43,6 +43,7 @@ std::string Describe(const Selection& s) {
 int Replay(const SessionLog& log, const ReplayOptions& o, std::ostream& out) {
   Selection selection = o.selection;
   if (!selection.client_id && selection.robot.empty()) selection.robot = o.robot;
+  PrintRejected(log, "robotalk-logplay: ", std::cerr);
   const Timeline timeline = log.MakeTimeline(selection);
   for (const std::string& s : timeline.skipped) std::cerr << "robotalk-logplay: not replayed: " << s << "\n";
   const std::vector<TimedCommand> frames = ToFrames(timeline, o.frames);

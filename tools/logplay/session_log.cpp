@@ -4,6 +4,7 @@
 #include "robotalk/request.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace robotalk::logplay {
@@ -14,6 +15,33 @@ namespace {
 std::int64_t StartMicros(const StartTime& s) {
   if (s.is_now()) return 0;
   return s.is_at() ? ToWireMicros(*s.time()) : ToWireMicros(*s.offset());
+}
+
+// Every time kept from a log is a wire time, |t| <= kMaxWireMicros (the
+// decoders refuse larger ones; Add() and AddReply() refuse the rest), so the
+// timeline's sums and differences of at most six of them cannot overflow.
+static_assert(kMaxWireMicros <= std::numeric_limits<std::int64_t>::max() / 6);
+
+// A log entry that is refused whole, with what was wrong in it.
+class BadEntry : public LogError {
+ public:
+  using LogError::LogError;
+};
+
+std::string OutOfRange(const std::string& field, const std::string& value) {
+  return field + " = " + value + " is not a time in us (finite, |t| <= " + std::to_string(kMaxWireMicros) +
+         ")";
+}
+
+// A time carried as a double (a reply's values): the integer micros, or
+// BadEntry naming `field` for NaN, an infinity or a value out of range.
+std::int64_t MicrosFromDouble(double v, const std::string& field) {
+  if (!std::isfinite(v) || std::abs(v) >= static_cast<double>(kMaxWireMicros)) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    throw BadEntry(OutOfRange(field, text));
+  }
+  return static_cast<std::int64_t>(v);
 }
 
 }  // namespace
@@ -31,13 +59,23 @@ std::int64_t ParseClientId(const std::string& text) {
 
 void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
                      std::span<const std::uint8_t> bytes) {
-  ++events_;
-  if (events_ == 1 || log_time_us < first_us_) first_us_ = log_time_us;
-  last_us_ = std::max(last_us_, log_time_us);
+  const std::uint64_t event = events_++;  // LCM's numbering: from 0
   ChannelStats& s = channels_[channel];
-  if (s.messages++ == 0) s.first_us = log_time_us;
-  s.last_us = log_time_us;
+  ++s.messages;
   s.bytes += bytes.size();
+  const auto reject = [&](const std::string& why) {
+    ++s.undecodable;
+    if (rejections_++ < kKeptRejections)
+      rejected_.push_back("event " + std::to_string(event) + " on " + channel + ": " + why);
+  };
+  if (log_time_us > kMaxWireMicros || log_time_us < -kMaxWireMicros) {
+    reject(OutOfRange("log timestamp", std::to_string(log_time_us)));
+    return;
+  }
+  if (timed_events_++ == 0 || log_time_us < first_us_) first_us_ = log_time_us;
+  last_us_ = timed_events_ == 1 ? log_time_us : std::max(last_us_, log_time_us);
+  if (s.timed++ == 0) s.first_us = log_time_us;
+  s.last_us = log_time_us;
   const std::optional<ChannelParts> name = ParseChannel(channel);
   if (!name) return;
   try {
@@ -64,8 +102,8 @@ void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
       case ChannelKind::kConfig:
         break;  // the robot's description: nothing a session's timeline needs
     }
-  } catch (const std::exception&) {
-    ++s.undecodable;  // a log holds whatever was on the bus; count it, go on
+  } catch (const std::exception& e) {
+    reject(e.what());  // a log holds whatever was on the bus; count it, name it, go on
   }
 }
 
@@ -83,7 +121,11 @@ LoggedClient& SessionLog::Client(std::int64_t id, const std::string& robot, std:
 void SessionLog::AddRequest(const std::string& robot, std::int64_t log_time_us,
                             std::span<const std::uint8_t> bytes) {
   const Request r = DecodeRequest(bytes);
-  if (!r.header_error.empty() || !r.malformed.empty()) throw LogError("inconsistent package");
+  if (!r.header_error.empty())
+    throw BadEntry("package " + std::to_string(r.sequence) + ": " + r.header_error);
+  if (!r.malformed.empty())
+    throw BadEntry("package " + std::to_string(r.sequence) + ", item " + std::to_string(r.malformed[0].id) +
+                   ": " + r.malformed[0].reason);
   LoggedClient& c = Client(r.client_id, robot, log_time_us);
   const auto key = std::make_pair(r.client_id, r.sequence);
   if (package_send_us_.count(key)) {
@@ -130,8 +172,17 @@ void SessionLog::AddRequest(const std::string& robot, std::int64_t log_time_us,
 
 void SessionLog::AddReply(std::span<const std::uint8_t> bytes) {
   ReplyBatch b = DecodeReplyBatch(bytes);
-  if (!b.malformed.empty()) throw LogError("undecodable reply");
+  if (!b.malformed.empty())
+    throw BadEntry("reply " + std::to_string(b.malformed[0].id) + ": " + b.malformed[0].reason);
   auto client = clients_.find(b.client_id);
+  // A playback sequence's delay reply (its id is the playback id): values[1]
+  // = the start, on the server clock. Checked before anything is kept.
+  std::map<std::int64_t, std::int64_t> starts;
+  for (const Reply& r : b.replies) {
+    if (client != clients_.end() && r.values.size() >= 2 && playback_ids_.count({b.client_id, r.id}))
+      starts[r.id] = MicrosFromDouble(r.values[1], "reply " + std::to_string(r.id) + " (playback " +
+                                                       std::to_string(r.id) + "'s start) values[1]");
+  }
   if (b.ack_sequence > 0 && client != clients_.end()) {
     auto sent = package_send_us_.find({b.client_id, b.ack_sequence});
     if (sent != package_send_us_.end() && sent->second != 0) {
@@ -141,11 +192,8 @@ void SessionLog::AddReply(std::span<const std::uint8_t> bytes) {
       if (!o || offset < *o) o = offset;
     }
   }
+  for (const auto& [id, start] : starts) client->second.playback_start_us[id] = start;
   for (Reply& r : b.replies) {
-    if (client != clients_.end() && r.values.size() >= 2 && playback_ids_.count({b.client_id, r.id})) {
-      // A playback sequence's delay reply (its id is the playback id): values[1] = the start.
-      client->second.playback_start_us[r.id] = static_cast<std::int64_t>(r.values[1]);
-    }
     auto it = command_index_.find({b.client_id, r.id});
     if (it != command_index_.end() && !commands_[it->second].reply)
       commands_[it->second].reply = std::move(r);

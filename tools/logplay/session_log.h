@@ -10,7 +10,11 @@
 // lcm::LogFile), so tests build logs in memory. Undecodable messages on
 // RoboTalk channels are counted, never thrown; a package or reply package
 // with an item that does not decode, or an inconsistent header, is
-// undecodable as a whole (nothing of it is kept).
+// undecodable as a whole (nothing of it is kept). So is a hostile entry:
+// a log timestamp, or a PLAYBACK reply's start, that is not a finite wire
+// time (|t| <= kMaxWireMicros). rejected() names each such entry (event,
+// channel, field); with every kept time a wire time, the timeline's
+// arithmetic cannot overflow.
 //
 // Recovering a client's timing (Timeline): every command is placed on the
 // SERVER clock, whatever mode it was sent in:
@@ -51,7 +55,8 @@ struct ChannelStats {
   std::uint64_t messages = 0;
   std::uint64_t bytes = 0;
   std::int64_t first_us = 0, last_us = 0;  ///< logger clock (µs since the UNIX epoch)
-  std::uint64_t undecodable = 0;
+  std::uint64_t undecodable = 0;           ///< not decoded or rejected (SessionLog::rejected() says why)
+  std::uint64_t timed = 0;                 ///< with a usable log timestamp (first_us, last_us are theirs)
 };
 
 struct LoggedRobot {
@@ -133,6 +138,11 @@ class SessionLog {
   std::int64_t first_us() const { return first_us_; }
   std::int64_t last_us() const { return last_us_; }
   std::uint64_t events() const { return events_; }
+  /// Why entries were not used (each names the event, its channel and the
+  /// field): the first kKeptRejections of them; rejections() counts all.
+  const std::vector<std::string>& rejected() const { return rejected_; }
+  std::uint64_t rejections() const { return rejections_; }
+  static constexpr std::size_t kKeptRejections = 20;
 
   /// The selected commands on one clock (see the file comment). Throws
   /// LogError when nothing matches or the clocks cannot be joined.
@@ -157,8 +167,10 @@ class SessionLog {
   std::map<std::pair<std::int64_t, std::int64_t>, std::int64_t> package_send_us_;  // (client, seq)
   std::set<std::pair<std::int64_t, std::int64_t>> playback_ids_;                   // (client, playback id)
   std::vector<StateSample> states_;
-  std::int64_t first_us_ = 0, last_us_ = 0;
-  std::uint64_t events_ = 0;
+  std::int64_t first_us_ = 0, last_us_ = 0;  // over the events with a usable log timestamp
+  std::uint64_t events_ = 0, timed_events_ = 0;
+  std::vector<std::string> rejected_;
+  std::uint64_t rejections_ = 0;
 };
 
 /// Parses a client id as printed (16 hex digits) or in decimal; throws LogError.
