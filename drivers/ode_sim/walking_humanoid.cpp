@@ -199,8 +199,10 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   }
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
-  recovery.stop_feet = options.push_stop_feet == "keep" ? walking::RecoveryParams::StopFeet::kKeep
-                                                        : walking::RecoveryParams::StopFeet::kMove;
+  using StopFeet = walking::RecoveryParams::StopFeet;
+  recovery.stop_feet = options.push_stop_feet == "keep"    ? StopFeet::kKeep
+                       : options.push_stop_feet == "still" ? StopFeet::kStill
+                                                           : StopFeet::kMove;
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step, recovery);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
   if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)

@@ -593,7 +593,7 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   const std::optional<std::string> maybe = RefusalOfWalker({{"push_capture", "maybe"}});
   ASSERT_TRUE(maybe) << "push_capture=maybe accepted";
   EXPECT_NE(maybe->find("push_capture"), std::string::npos) << *maybe;
-  // push_stop_feet (move or keep: the regeneration's footholds during the stop)
+  // push_stop_feet (move, keep or still: the regeneration during the stop)
   const std::optional<std::string> sideways = RefusalOfWalker({{"push_stop_feet", "sideways"}});
   ASSERT_TRUE(sideways) << "push_stop_feet=sideways accepted";
   EXPECT_NE(sideways->find("push_stop_feet"), std::string::npos) << *sideways;

@@ -408,12 +408,13 @@ TEST(PushRecovery, TheCaptureStopLandsItsLastStepWhereTheDcmIsCaughtAndStands) {
   EXPECT_EQ(plain_survived, 0);
 }
 
-TEST(PushRecovery, DuringThePushsStopTheRegenerationKeepsTheStopsLandingsWithStopFeetKeep) {
+TEST(PushRecovery, DuringThePushsStopTheRegenerationKeepsTheStopsLandingsWithStopFeetKeepOrStill) {
   // 8 and 15 N s from either side and from behind at 4 instants over a
   // step, the regeneration on (its 7 cm threshold): it fires during the
   // stop (the plan's CoM state re-anchored on the pendulum's) in every
   // case. Walking's rule (kMove) moves the stop's landings (the final
-  // stance centre) in most; kKeep leaves them where StopSoon put them.
+  // stance centre) in most; kKeep leaves them where StopSoon put them;
+  // kStill does not regenerate (here the push is seen before the 7 cm).
   // (This pendulum, on the plan's ZMP without feedback, falls either way:
   // survival is measured on ODE, docs/ode_sim.md, "Pushes".)
   const GaitParams g = FastGait();
@@ -431,6 +432,10 @@ TEST(PushRecovery, DuringThePushsStopTheRegenerationKeepsTheStopsLandingsWithSto
         const CaptureResult move = WalkPushAndRecover(j, at, rp);
         rp.stop_feet = RecoveryParams::StopFeet::kKeep;
         const CaptureResult keep = WalkPushAndRecover(j, at, rp);
+        rp.stop_feet = RecoveryParams::StopFeet::kStill;
+        const CaptureResult still = WalkPushAndRecover(j, at, rp);
+        EXPECT_EQ(still.regenerations, 0) << what << ": kStill: no regeneration in the stop";
+        EXPECT_LT(moved(still), 1e-9) << what << ": kStill: the stop lands where it was to";
         for (const CaptureResult* r : {&move, &keep}) {
           EXPECT_EQ(r->stops, 1) << what;
           EXPECT_GE(r->regenerations, 1) << what << ": the regeneration fired";

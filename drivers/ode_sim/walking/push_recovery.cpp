@@ -424,6 +424,7 @@ bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, cons
   // measured one's noise, amplified by e^{w T}, would move the feet).
   const Eigen::Array2d over = (error_.array().abs() > p_.threshold).cast<double>();
   if (!over.any() || since_ < p_.interval) return false;
+  if (hold_ > 0 && p_.stop_feet == RecoveryParams::StopFeet::kStill) return false;
   const Eigen::Vector2d c = over * com.array() + (1 - over) * pattern.com().array();
   const Eigen::Vector2d v = over * com_vel.array() + (1 - over) * pattern.com_velocity().array();
   if (!pattern.Regenerate(c, v, p_, hold_ > 0)) return false;

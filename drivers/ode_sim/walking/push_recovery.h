@@ -103,8 +103,9 @@ struct RecoveryParams {
   // until the stop's steps have landed; driver option push_stop_feet):
   // kMove as walking; kKeep: the stop's landings stay where and when
   // StopSoon put them (the CoM state, the ankles, the early lift and the
-  // fast timing of the steps after the first as walking).
-  enum class StopFeet : std::uint8_t { kMove, kKeep };
+  // fast timing of the steps after the first as walking); kStill: no
+  // regeneration at all until the walk resumes (nothing re-anchored).
+  enum class StopFeet : std::uint8_t { kMove, kKeep, kStill };
   StopFeet stop_feet = StopFeet::kMove;
 };
 
