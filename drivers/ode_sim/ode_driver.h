@@ -122,6 +122,12 @@ struct OdeDriverOptions {
   /// caught, the plan re-anchored on the measured CoM state, in place of the
   /// regeneration until that step lands. Key "push_capture".
   bool push_capture = false;
+  /// With push_recovery: the regeneration's footholds during the push's
+  /// stop (RecoveryParams::stop_feet; docs/ode_sim.md, "Pushes and
+  /// disturbances"): "move" as walking, "keep" the stop's landings stay
+  /// where and when the stop put them, "still" no regeneration during the
+  /// stop. Key "push_stop_feet".
+  std::string push_stop_feet = "move";
   /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
   /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
   /// yield to the error between its measured and desired centre of pressure

@@ -69,6 +69,10 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
   r.Bool("step_adjustment", &o.step_adjustment);
   r.Bool("push_recovery", &o.push_recovery);
   r.Bool("push_capture", &o.push_capture);
+  if (r.Text("push_stop_feet", &o.push_stop_feet) && o.push_stop_feet != "move" &&
+      o.push_stop_feet != "keep" && o.push_stop_feet != "still") {
+    r.Fail("push_stop_feet", "move, keep or still");
+  }
   r.Bool("foot_damping", &o.foot_damping);
   if (r.Text("gait", &o.gait) && o.gait != "fast" && o.gait != "slow") r.Fail("gait", "fast or slow");
   auto& go = o.gait_overrides;

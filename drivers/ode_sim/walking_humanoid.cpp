@@ -193,8 +193,16 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   if (options.push_capture && !options.push_recovery) {
     throw Error("OdeDriver: push_capture=true needs push_recovery=true (the capture is how its stop steps)");
   }
+  if (options.push_stop_feet != "move" && !options.push_recovery) {
+    throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
+                " needs push_recovery=true (it changes the push recovery's regeneration)");
+  }
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
+  using StopFeet = walking::RecoveryParams::StopFeet;
+  recovery.stop_feet = options.push_stop_feet == "keep"    ? StopFeet::kKeep
+                       : options.push_stop_feet == "still" ? StopFeet::kStill
+                                                           : StopFeet::kMove;
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step, recovery);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
   if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)

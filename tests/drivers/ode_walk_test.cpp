@@ -593,6 +593,15 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   const std::optional<std::string> maybe = RefusalOfWalker({{"push_capture", "maybe"}});
   ASSERT_TRUE(maybe) << "push_capture=maybe accepted";
   EXPECT_NE(maybe->find("push_capture"), std::string::npos) << *maybe;
+  // push_stop_feet (move, keep or still: the regeneration during the stop)
+  const std::optional<std::string> sideways = RefusalOfWalker({{"push_stop_feet", "sideways"}});
+  ASSERT_TRUE(sideways) << "push_stop_feet=sideways accepted";
+  EXPECT_NE(sideways->find("push_stop_feet"), std::string::npos) << *sideways;
+  const std::optional<std::string> keep_alone =
+      RefusalOfWalker({{"push_stop_feet", "keep"}, {"push_recovery", "false"}});
+  ASSERT_TRUE(keep_alone) << "push_stop_feet=keep without push_recovery accepted";
+  EXPECT_NE(keep_alone->find("push_recovery"), std::string::npos) << *keep_alone;
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_feet", "keep"}}));
 }
 
 // Push recovery's stop during a GOTO (on by default): the walk stops, the

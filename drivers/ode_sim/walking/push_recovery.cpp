@@ -133,7 +133,7 @@ void WalkPattern::MoveLanding(Scheduled& st, const Eigen::Vector2d& by, std::int
 }
 
 bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
-                             const RecoveryParams& rp) {
+                             const RecoveryParams& rp, bool stopping) {
   Prune();
   const double omega = std::sqrt(gravity_ / g_.com_height);
   const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
@@ -172,6 +172,12 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
   const double g_ramp =
       wd > 1e-9 ? (1 - std::exp(-wd)) / wd : 1.0;  // a shift's effect on the DCM, per e^{-wT}
   std::vector<Eigen::Vector2d> shift;
+  if (stopping &&
+      rp.stop_feet == RecoveryParams::StopFeet::kKeep) {  // the stop lands where and when it was to
+    Rebuild(k, land, lift, u, {Eigen::Vector2d::Zero()}, rp);
+    SetComState(com, com_vel);
+    return true;
+  }
   bool fits = false;
   for (;; land = std::max(soonest, land - ticks(0.025))) {
     phases_ = phases;
@@ -418,9 +424,10 @@ bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, cons
   // measured one's noise, amplified by e^{w T}, would move the feet).
   const Eigen::Array2d over = (error_.array().abs() > p_.threshold).cast<double>();
   if (!over.any() || since_ < p_.interval) return false;
+  if (hold_ > 0 && p_.stop_feet == RecoveryParams::StopFeet::kStill) return false;
   const Eigen::Vector2d c = over * com.array() + (1 - over) * pattern.com().array();
   const Eigen::Vector2d v = over * com_vel.array() + (1 - over) * pattern.com_velocity().array();
-  if (!pattern.Regenerate(c, v, p_)) return false;
+  if (!pattern.Regenerate(c, v, p_, hold_ > 0)) return false;
   since_ = 0;
   ++count_;
   return true;

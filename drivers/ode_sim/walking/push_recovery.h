@@ -99,6 +99,14 @@ struct RecoveryParams {
   bool capture_reanchor = true;  ///< the plan's CoM state becomes the measured one at each re-plan
   bool capture_tidy = true;      ///< a landing moved off alongside: then the other foot steps alongside it
   double capture_tidy_beyond = 0.03;  ///< m: ... when moved more than this
+  // The regeneration's footholds during the push's stop (from Watch's stop
+  // until the stop's steps have landed; driver option push_stop_feet):
+  // kMove as walking; kKeep: the stop's landings stay where and when
+  // StopSoon put them (the CoM state, the ankles, the early lift and the
+  // fast timing of the steps after the first as walking); kStill: no
+  // regeneration at all until the walk resumes (nothing re-anchored).
+  enum class StopFeet : std::uint8_t { kMove, kKeep, kStill };
+  StopFeet stop_feet = StopFeet::kMove;
 };
 
 class PushRecovery {
@@ -107,7 +115,8 @@ class PushRecovery {
   PushRecovery(double omega, double tick, RecoveryParams params = {});
   /// One control tick with the measured CoM and velocity (plan frame).
   /// Regenerates `pattern` when the DCM error passes the threshold and a
-  /// step can still take it; during a capture stop (capture_stop, after
+  /// step can still take it (during Watch's stop, its footholds as
+  /// stop_feet says); during a capture stop (capture_stop, after
   /// Watch stopped the walk) re-plans the stop from the measured state
   /// instead (WalkPattern::CaptureStop). Returns true when it did either:
   /// the plan's CoM state is then the measured one.

@@ -95,8 +95,10 @@ class WalkPattern {
   /// within reach; every later step and stance centre moves by the full
   /// shift, re-planned from the landing on (the reference is cut there:
   /// continuous). False (nothing changed) when no step can move: standing,
-  /// the end shift, a stop's stand without a swing.
-  bool Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p);
+  /// the end shift, a stop's stand without a swing. `stopping` (a push's
+  /// stop, PushRecovery::Watch): the landings as RecoveryParams::stop_feet says.
+  bool Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p,
+                  bool stopping = false);
   /// The capture stop (push_recovery.h), after StopSoon: the stop's last
   /// step (the foot brought alongside) lands where the measured DCM (from
   /// `com`, `com_vel`, plan frame) is caught. Predicted on the reference's
