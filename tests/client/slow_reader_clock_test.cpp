@@ -8,6 +8,7 @@
 #include "robotalk/memory_transport.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/server.h"
+#include "support/forwarding_transport.h"
 
 #include <gtest/gtest.h>
 
@@ -22,25 +23,15 @@ using std::chrono::seconds;
 
 // Reads every message `lag` after it was ready (a client whose read thread
 // is starved); the socket's stamp, ReceiveTime(), still says when it came.
-class SlowReaderTransport final : public Transport {
+class SlowReaderTransport final : public testing::ForwardingTransport {
  public:
-  SlowReaderTransport(Transport& inner, Duration lag) : inner_(inner), lag_(lag) {}
-  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
-    inner_.Publish(channel, bytes);
-  }
-  std::unique_ptr<Subscription> Subscribe(const std::string& channel_regex, Handler handler) override {
-    return inner_.Subscribe(channel_regex, std::move(handler));
-  }
+  SlowReaderTransport(Transport& inner, Duration lag) : ForwardingTransport(inner), lag_(lag) {}
   int HandleFor(Duration timeout) override {
     std::this_thread::sleep_for(lag_);
-    return inner_.HandleFor(timeout);
+    return inner().HandleFor(timeout);
   }
-  int fileno() const override { return inner_.fileno(); }
-  std::string url() const override { return inner_.url(); }
-  WallTime ReceiveTime() const override { return inner_.ReceiveTime(); }
 
  private:
-  Transport& inner_;
   Duration lag_;
 };
 

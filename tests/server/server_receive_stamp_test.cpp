@@ -20,6 +20,7 @@
 #include "server_daemon.h"
 #include "session_test_util.h"
 #include "sessions_fixture.h"
+#include "support/forwarding_transport.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -36,27 +37,19 @@ using namespace robotalk::testing;  // NOLINT: the sessions fixture's helpers
 // Every handler runs `lag` after the one before it could have (a ServerDaemon
 // whose thread is starved): a burst of packages queues, each handled later
 // than it arrived. ReceiveTime() still says when each came.
-class LateHandlerTransport final : public Transport {
+class LateHandlerTransport final : public testing::ForwardingTransport {
  public:
-  LateHandlerTransport(Transport& inner, Duration lag) : inner_(inner), lag_(lag) {}
-  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
-    inner_.Publish(channel, bytes);
-  }
+  LateHandlerTransport(Transport& inner, Duration lag) : ForwardingTransport(inner), lag_(lag) {}
   std::unique_ptr<Subscription> Subscribe(const std::string& channel_regex, Handler handler) override {
-    return inner_.Subscribe(channel_regex,
-                            [this, handler = std::move(handler)](const std::string& channel,
-                                                                 std::span<const std::uint8_t> bytes) {
-                              std::this_thread::sleep_for(lag_);
-                              handler(channel, bytes);
-                            });
+    return inner().Subscribe(channel_regex,
+                             [this, handler = std::move(handler)](const std::string& channel,
+                                                                  std::span<const std::uint8_t> bytes) {
+                               std::this_thread::sleep_for(lag_);
+                               handler(channel, bytes);
+                             });
   }
-  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
-  int fileno() const override { return inner_.fileno(); }
-  std::string url() const override { return inner_.url(); }
-  WallTime ReceiveTime() const override { return inner_.ReceiveTime(); }
 
  private:
-  Transport& inner_;
   Duration lag_;
 };
 
