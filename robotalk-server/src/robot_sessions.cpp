@@ -315,8 +315,9 @@ std::optional<QueuedItem> RobotSessions::Admit(Session& s, const Command& c, Tim
                                                  : Duration(0);
   // A STOP due now or in the past runs at once, whatever its clock or the
   // client's queue: "a STOP always runs, however late" (it empties what it
-  // stops, so it cannot grow the queue).
-  const bool stop_now = Traits(c.type).kind == CommandKind::kStop && ahead <= Duration(0);
+  // stops, so it cannot grow the queue). Not a playback frame: its offset
+  // counts from a start not yet decided, and its buffer has its own bound.
+  const bool stop_now = !playback && Traits(c.type).kind == CommandKind::kStop && ahead <= Duration(0);
   bool run_now = false;
   // As far behind as the limit ahead: a clock that wrong is a bug to report,
   // not a command to run late (and its lateness must stay in range); a STOP
