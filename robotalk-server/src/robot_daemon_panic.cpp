@@ -4,6 +4,7 @@
 // watchdog (CheckOverrun) that raises one when a driver call outlives its
 // bound, and, on the RobotDaemon's side, Fault(): the robot halted and
 // latched in panic when its driver or a planner fails.
+#include "planner_answers.h"
 #include "robot_daemon.h"
 
 #include "robotalk/signal.h"
@@ -13,15 +14,7 @@
 #include <utility>
 
 namespace robotalk {
-namespace {
-
-std::string Seconds(Duration d) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g s", ToSeconds(d));
-  return buf;
-}
-
-}  // namespace
+using planner_answers::Seconds;
 
 void RobotDaemon::Panic(std::vector<QueuedItem>& flushed, const std::string& reason) {
   panic_.Raise(reason);  // from here on only a STOP runs (Execute checks it)
