@@ -345,6 +345,7 @@ class RobotDaemon {
   SpeedRamp ramp_;
   std::vector<SpeedRamp::Answer> ramped_;  // the ramp's answers of this iteration
   planner_answers::HeldCounts held_now_;   // held_ as this iteration leaves it (swapped in)
+  std::size_t held_total_ = 0;             // the planners' total when held_ was last recounted
   std::vector<Completion> completions_;
   std::uint64_t pushes_taken_ = 0;  // pushes_ when this iteration took its due items
   DaemonOutput produced_;
