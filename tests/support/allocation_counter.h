@@ -14,3 +14,10 @@ extern long g_mallocs;
 /// throws std::bad_alloc (counting down; 0: never). What the code under test
 /// does when an allocation fails where it may (a throw it must contain).
 extern long g_fail_allocation;
+
+/// Heap bytes the malloc family holds (usable sizes, so glibc's rounding is
+/// counted; its per-block header is not), and the most it held since the
+/// last ResetHeapBytesPeak(). Blocks from memalign/posix_memalign are not seen.
+long HeapBytesInUse();
+long HeapBytesPeak();
+void ResetHeapBytesPeak();
