@@ -3,19 +3,24 @@
 #include "robot_sessions_text.h"
 #include "robotalk/channels.h"
 #include "robotalk/request.h"
+#include "speed_ramp.h"
+#include "trajectory_tracker.h"
+
+#include <algorithm>
 
 namespace robotalk {
 
 using namespace sessions_text;
 
 std::size_t QueuedItemBytes() {
-  // The item in its client's heap or in a playback buffer (a vector: up to
+  // Waiting: the item in its client's heap or in a playback buffer (a vector: up to
   // twice its size in capacity), a buffered frame's estimator entry (offset,
   // arrival, delay), and its timed-servo entry (a hash-map node).
   constexpr std::size_t kEstimatorFrame = 4 * sizeof(Duration);
   constexpr std::size_t kTimedServo =
       sizeof(std::pair<const CommandId, std::pair<TimePoint, int>>) + 3 * sizeof(void*);
-  return 2 * sizeof(PlaybackSequence::Frame) + kEstimatorFrame + kTimedServo;
+  constexpr std::size_t kWaiting = 2 * sizeof(PlaybackSequence::Frame) + kEstimatorFrame + kTimedServo;
+  return std::max({kWaiting, TrajectoryTracker::kHeldWaypointBytes, SpeedRamp::kHeldFrameBytes});
 }
 
 RobotSessions::RobotSessions(RobotDaemon& daemon, std::uint64_t config_hash, SessionOptions options,

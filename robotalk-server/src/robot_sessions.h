@@ -71,9 +71,11 @@ struct SessionOptions {
   bool link_stop = false;
 };
 
-/// What one waiting item (a queued command or query, a buffered playback
-/// frame with its estimator entry and its timed-servo entry) costs at most,
-/// the queue's spare capacity included: the byte bound behind the item bounds.
+/// What one waiting item costs at most wherever it waits -- a queued command
+/// or query, a buffered playback frame with its estimator entry and its
+/// timed-servo entry, a waypoint the trajectory tracker holds, a SETSPEED
+/// frame the speed ramp holds (all count against the same item bounds) --
+/// the containers' spare capacity included: the byte bound behind the item bounds.
 std::size_t QueuedItemBytes();
 
 /// What the ServerDaemon sends back at once for a received package.

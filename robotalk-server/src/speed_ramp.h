@@ -72,6 +72,10 @@ struct SpeedRampOptions {
 
 class SpeedRamp {
  public:
+  /// The most heap one held SETSPEED frame costs, for the server's memory
+  /// bound (QueuedItemBytes). Measured 100 B (HeldWaypointMemory).
+  static constexpr std::size_t kHeldFrameBytes = 128;
+
   struct Answer {
     std::int64_t client_id = 0;
     Reply reply;

@@ -73,6 +73,13 @@ struct TrackerOptions {
 
 class TrajectoryTracker {
  public:
+  /// The most heap one held waypoint costs (its pending slot, its MODIFIED
+  /// note, its knot in the trajectory; the containers' doubling and the moment
+  /// a growing one holds its old and new storage included), for the server's
+  /// memory bound (QueuedItemBytes). Measured at most 1,059 B (a 6-dof
+  /// joint's clamped quintic waypoints with rates; HeldWaypointMemory).
+  static constexpr std::size_t kHeldWaypointBytes = 1152;
+
   struct Answer {
     std::int64_t client_id = 0;
     Reply reply;

@@ -122,23 +122,27 @@ Cost HoldSpeedFrames(int n) {
 // The tracker's containers double: just past a doubling (2^k + 1 items) a
 // waypoint costs the most; the peak includes the moment the old and the new
 // buffer both exist.
-TEST(HeldWaypointMemory, AHeldWaypointCostsNoMoreThanTheServersBoundPricesIt) {
-  double worst = 0;
+TEST(HeldWaypointMemory, AHeldWaypointOrSpeedFrameCostsNoMoreThanTheServersBoundPricesIt) {
+  double waypoint = 0, speed = 0;
   for (bool frame : {false, true}) {
     for (int n : {1024, 2048, 4096}) {
       const Cost c = Hold(n, frame);
       std::printf("%s quintic waypoints with rates, %d held: %.0f B each in use, %.0f B at the peak\n",
                   frame ? "frame (6-dof)" : "joint (6-dof, clamped)", n + 1, c.held, c.peak);
-      worst = std::max({worst, c.held, c.peak});
+      waypoint = std::max({waypoint, c.held, c.peak});
       EXPECT_GT(c.held, 0) << "the counter sees the tracker's heap";
     }
   }
   for (int n : {1024, 4096}) {
     const Cost c = HoldSpeedFrames(n);
     std::printf("SETSPEED frames, %d held: %.0f B each in use, %.0f B at the peak\n", n + 1, c.held, c.peak);
-    worst = std::max({worst, c.held, c.peak});
+    speed = std::max({speed, c.held, c.peak});
   }
-  EXPECT_LE(worst, static_cast<double>(QueuedItemBytes()));
+  EXPECT_LE(waypoint, static_cast<double>(TrajectoryTracker::kHeldWaypointBytes));
+  EXPECT_LE(speed, static_cast<double>(SpeedRamp::kHeldFrameBytes));
+  // The server's sum prices every waiting item at the most any of them costs.
+  EXPECT_GE(QueuedItemBytes(), TrajectoryTracker::kHeldWaypointBytes);
+  EXPECT_GE(QueuedItemBytes(), SpeedRamp::kHeldFrameBytes);
 }
 
 }  // namespace

@@ -216,7 +216,6 @@ void Trajectory::AddKnot(TimePoint time, const Eigen::VectorXd& position, const 
 void Trajectory::AddKnots(std::span<const Waypoint> waypoints, std::size_t first) {
   for (const Waypoint& w : waypoints) AddKnot(w.time, w.position, w.velocity, w.acceleration);
   Resolve(first);
-  Rebuild(first);
 }
 
 void Trajectory::Append(std::span<const Waypoint> waypoints) {
@@ -237,7 +236,6 @@ void Trajectory::Splice(TimePoint t, std::span<const Waypoint> waypoints) {
   times_.resize(keep);
   given_v_.resize(keep);
   given_a_.resize(keep);
-  coeffs_.resize((keep - 1) * static_cast<std::size_t>(num_dofs()) * kCoeffs);
   if (!at_knot) {
     // The sampled state becomes a knot: Hermite interpolation of a polynomial's
     // own end values reproduces it, so the segment before t keeps its shape
@@ -251,7 +249,6 @@ void Trajectory::Forget(TimePoint t) {
   const auto next = std::upper_bound(times_.begin(), times_.end(), t);
   const auto drop = static_cast<std::size_t>(next - times_.begin()) - (next == times_.begin() ? 0 : 1);
   if (drop == 0) return;
-  const auto n = static_cast<std::size_t>(num_dofs());
   const auto kept = static_cast<Eigen::Index>(times_.size() - drop), first = static_cast<Eigen::Index>(drop);
   times_.erase(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(drop));
   given_v_.erase(given_v_.begin(), given_v_.begin() + static_cast<std::ptrdiff_t>(drop));
@@ -259,7 +256,6 @@ void Trajectory::Forget(TimePoint t) {
   for (Eigen::MatrixXd* m : {&p_, &v_, &a_}) {  // in place (columns are contiguous): no allocation
     std::copy(m->data() + first * m->rows(), m->data() + (first + kept) * m->rows(), m->data());
   }
-  coeffs_.erase(coeffs_.begin(), coeffs_.begin() + static_cast<std::ptrdiff_t>(drop * n * kCoeffs));
 }
 
 void Trajectory::Resolve(std::size_t first) {
@@ -285,40 +281,35 @@ void Trajectory::Resolve(std::size_t first) {
   }
 }
 
-void Trajectory::Rebuild(std::size_t first) {
-  const std::size_t segments = times_.size() - 1, n = static_cast<std::size_t>(num_dofs());
-  coeffs_.resize(segments * n * kCoeffs);
-  for (std::size_t k = first == 0 ? 0 : first - 1; k < segments; ++k) {
-    const double h = Seconds(times_[k + 1] - times_[k]);
-    const auto k0 = static_cast<Eigen::Index>(k), k1 = k0 + 1;
-    for (std::size_t i = 0; i < n; ++i) {
-      double* c = &coeffs_[(k * n + i) * kCoeffs];
-      std::fill(c, c + kCoeffs, 0.0);
-      const auto r = static_cast<Eigen::Index>(i);
-      const double p0 = p_(r, k0), p1 = p_(r, k1), v0 = v_(r, k0), v1 = v_(r, k1);
-      const double a0 = a_(r, k0), a1 = a_(r, k1), dp = p1 - p0;
-      c[0] = p0;
-      switch (interpolation_) {
-        case Interpolation::kStep:
-          break;
-        case Interpolation::kLinear:
-          c[1] = dp / h;
-          break;
-        case Interpolation::kCubic:
-          c[1] = v0;
-          c[2] = (3 * dp / h - 2 * v0 - v1) / h;
-          c[3] = (-2 * dp / h + v0 + v1) / (h * h);
-          break;
-        case Interpolation::kQuintic: {
-          const double h2 = h * h, h3 = h2 * h;
-          c[1] = v0;
-          c[2] = a0 / 2;
-          c[3] = (20 * dp - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h2) / (2 * h3);
-          c[4] = (-30 * dp + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h2) / (2 * h3 * h);
-          c[5] = (12 * dp - 6 * (v1 + v0) * h + (a1 - a0) * h2) / (2 * h3 * h2);
-          break;
-        }
-      }
+void Trajectory::Coefficients(std::size_t segment, int dof, double* c) const {
+  // Computed when needed rather than kept: 6 per dof per knot would be most
+  // of what a held waypoint costs the server (docs/server.md, memory bounds).
+  const double h = Seconds(times_[segment + 1] - times_[segment]);
+  const auto k0 = static_cast<Eigen::Index>(segment), k1 = k0 + 1;
+  const auto r = static_cast<Eigen::Index>(dof);
+  std::fill(c, c + kCoeffs, 0.0);
+  const double p0 = p_(r, k0), p1 = p_(r, k1), v0 = v_(r, k0), v1 = v_(r, k1);
+  const double a0 = a_(r, k0), a1 = a_(r, k1), dp = p1 - p0;
+  c[0] = p0;
+  switch (interpolation_) {
+    case Interpolation::kStep:
+      break;
+    case Interpolation::kLinear:
+      c[1] = dp / h;
+      break;
+    case Interpolation::kCubic:
+      c[1] = v0;
+      c[2] = (3 * dp / h - 2 * v0 - v1) / h;
+      c[3] = (-2 * dp / h + v0 + v1) / (h * h);
+      break;
+    case Interpolation::kQuintic: {
+      const double h2 = h * h, h3 = h2 * h;
+      c[1] = v0;
+      c[2] = a0 / 2;
+      c[3] = (20 * dp - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h2) / (2 * h3);
+      c[4] = (-30 * dp + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h2) / (2 * h3 * h);
+      c[5] = (12 * dp - 6 * (v1 + v0) * h + (a1 - a0) * h2) / (2 * h3 * h2);
+      break;
     }
   }
 }
@@ -332,8 +323,8 @@ TrajectorySample Trajectory::MakeSample() const {
 }
 
 void Trajectory::Evaluate(std::size_t segment, double tau, int dof, double* p, double* v, double* a) const {
-  const double* c =
-      &coeffs_[(segment * static_cast<std::size_t>(num_dofs()) + static_cast<std::size_t>(dof)) * kCoeffs];
+  double c[kCoeffs];
+  Coefficients(segment, dof, c);
   *p = Poly(c, tau);
   *v = Deriv1(c, tau);
   *a = Deriv2(c, tau);
@@ -396,14 +387,15 @@ LimitCheck Trajectory::CheckLimits(const TrajectoryLimits& limits, TimePoint fro
     if (times_[k + 1] <= from) continue;
     const double lo = std::max(0.0, Seconds(from - times_[k])), hi = Seconds(times_[k + 1] - times_[k]);
     for (int i = 0; i < n; ++i) {
-      const double* c = &coeffs_[(k * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)) * kCoeffs];
+      double c[kCoeffs];
+      Coefficients(k, i, c);
       double vmin = kInf, vmax = -kInf, amin = kInf, amax = -kInf;
-      Extremes([c](double x) { return Poly(c, x); }, [c](double x) { return Deriv1(c, x); }, lo, hi,
+      Extremes([&c](double x) { return Poly(c, x); }, [&c](double x) { return Deriv1(c, x); }, lo, hi,
                &r.min_position[i], &r.max_position[i]);
-      Extremes([c](double x) { return Deriv1(c, x); }, [c](double x) { return Deriv2(c, x); }, lo, hi, &vmin,
-               &vmax);
-      Extremes([c](double x) { return Deriv2(c, x); }, [c](double x) { return Deriv3(c, x); }, lo, hi, &amin,
-               &amax);
+      Extremes([&c](double x) { return Deriv1(c, x); }, [&c](double x) { return Deriv2(c, x); }, lo, hi,
+               &vmin, &vmax);
+      Extremes([&c](double x) { return Deriv2(c, x); }, [&c](double x) { return Deriv3(c, x); }, lo, hi,
+               &amin, &amax);
       r.max_velocity[i] = std::max({r.max_velocity[i], -vmin, vmax});
       r.max_acceleration[i] = std::max({r.max_acceleration[i], -amin, amax});
     }
@@ -464,12 +456,13 @@ TimeScaling Trajectory::ScaleToLimits(const TrajectoryLimits& limits, TimePoint 
       if (times_[k] < from) continue;
       const double h = Seconds(times_[k + 1] - times_[k]);
       for (int i = 0; i < n; ++i) {
-        const double* c = &coeffs_[(k * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)) * kCoeffs];
+        double c[kCoeffs];
+        Coefficients(k, i, c);
         double vmin = 0, vmax = 0, amin = 0, amax = 0;
-        Extremes([c](double x) { return Deriv1(c, x); }, [c](double x) { return Deriv2(c, x); }, 0, h, &vmin,
-                 &vmax);
-        Extremes([c](double x) { return Deriv2(c, x); }, [c](double x) { return Deriv3(c, x); }, 0, h, &amin,
-                 &amax);
+        Extremes([&c](double x) { return Deriv1(c, x); }, [&c](double x) { return Deriv2(c, x); }, 0, h,
+                 &vmin, &vmax);
+        Extremes([&c](double x) { return Deriv2(c, x); }, [&c](double x) { return Deriv3(c, x); }, 0, h,
+                 &amin, &amax);
         // A fixed start knot's own velocity (acceleration, quintic) cannot be
         // scaled: stretch only towards it, never forever.
         const auto c0 = static_cast<Eigen::Index>(k);
@@ -505,7 +498,6 @@ TimeScaling Trajectory::ScaleToLimits(const TrajectoryLimits& limits, TimePoint 
       a_.col(c) /= f * f;
     }
     times_ = std::move(times);
-    Rebuild(0);
   }
   double largest = 1;
   for (std::size_t k = 0; k < segments; ++k) {

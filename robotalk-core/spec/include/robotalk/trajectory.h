@@ -179,14 +179,15 @@ class Trajectory {
 
  private:
   void Resolve(std::size_t first);  // choose missing v/a for knots >= first
-  void Rebuild(std::size_t first);  // coefficients of segments >= first-1
+  // A segment's polynomial coefficients for one dof, c[0..5]: value = sum c[i] tau^i.
+  void Coefficients(std::size_t segment, int dof, double* c) const;
   void Evaluate(std::size_t segment, double tau, int dof, double* p, double* v, double* a) const;
   void EvaluateHold(double tau, int dof, double* p, double* v, double* a) const;
   void CheckWaypoints(TimePoint after, std::span<const Waypoint> waypoints) const;
   // Appends one knot (empty velocity / acceleration: not given, chosen by Resolve).
   void AddKnot(TimePoint time, const Eigen::VectorXd& position, const Eigen::VectorXd& velocity,
                const Eigen::VectorXd& acceleration);
-  // Appends `waypoints`, then chooses rates and coefficients from knot `first` on.
+  // Appends `waypoints`, then chooses the missing rates from knot `first` on.
   void AddKnots(std::span<const Waypoint> waypoints, std::size_t first);
 
   Interpolation interpolation_;
@@ -197,8 +198,6 @@ class Trajectory {
   Eigen::MatrixXd p_, v_, a_;
   TrajectorySample splice_sample_;  // Splice()'s state at the splice time (sized once)
   std::vector<bool> given_v_, given_a_;
-  // Segment coefficients, 6 per dof per segment: value = sum c[i] tau^i.
-  std::vector<double> coeffs_;
 };
 
 }  // namespace robotalk
