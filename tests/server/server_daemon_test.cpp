@@ -7,6 +7,7 @@
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "session_test_util.h"
+#include "support/forwarding_transport.h"
 #include "support/test_clients.h"
 
 #include <gmock/gmock.h>
@@ -256,10 +257,12 @@ TEST_F(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
 
 // Reads the latch file whenever the server publishes a reply that answers
 // ERROR: what was on disk at the moment it left.
-class LatchAtErrorTransport final : public Transport {
+class LatchAtErrorTransport final : public testing::ForwardingTransport {
  public:
+  // The base keeps a reference to bus_transport_, constructed after it (it is
+  // not used before).
   LatchAtErrorTransport(std::shared_ptr<MemoryBus> bus, std::string latch)
-      : inner_(std::move(bus)), latch_(std::move(latch)) {}
+      : ForwardingTransport(bus_transport_), bus_transport_(std::move(bus)), latch_(std::move(latch)) {}
   void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
     if (ParseReplyChannel(channel)) {
       for (const Reply& r : DecodeReplyBatch(bytes).replies) {
@@ -268,19 +271,13 @@ class LatchAtErrorTransport final : public Transport {
         on_disk_at_error.assign(std::istreambuf_iterator<char>(file), {});
       }
     }
-    inner_.Publish(channel, bytes);
+    ForwardingTransport::Publish(channel, bytes);
   }
-  std::unique_ptr<Subscription> Subscribe(const std::string& regex, Handler handler) override {
-    return inner_.Subscribe(regex, std::move(handler));
-  }
-  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
-  int fileno() const override { return inner_.fileno(); }
-  std::string url() const override { return inner_.url(); }
 
   std::string on_disk_at_error;
 
  private:
-  MemoryTransport inner_;
+  MemoryTransport bus_transport_;
   std::string latch_;
 };
 
