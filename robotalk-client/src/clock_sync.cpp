@@ -3,13 +3,7 @@
 namespace robotalk::client {
 namespace {
 
-// a - b and a + b on nanosecond counts; nullopt where int64 would overflow.
-std::optional<Duration> CheckedSub(TimePoint a, TimePoint b) {
-  Duration::rep d = 0;
-  if (__builtin_sub_overflow(a.time_since_epoch().count(), b.time_since_epoch().count(), &d))
-    return std::nullopt;
-  return Duration(d);
-}
+// a + b on nanosecond counts; nullopt where int64 would overflow.
 std::optional<Duration> CheckedAdd(Duration a, Duration b) {
   Duration::rep d = 0;
   if (__builtin_add_overflow(a.count(), b.count(), &d)) return std::nullopt;

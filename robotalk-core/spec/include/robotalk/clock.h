@@ -107,6 +107,15 @@ inline Duration SaturatingSub(TimePoint a, TimePoint b) {
   return Duration(d);
 }
 
+/// a - b, or nullopt where it would overflow (for times from the wire that
+/// must be refused rather than saturated: a clock sample, a delay).
+inline std::optional<Duration> CheckedSub(TimePoint a, TimePoint b) {
+  Duration::rep d = 0;
+  if (__builtin_sub_overflow(a.time_since_epoch().count(), b.time_since_epoch().count(), &d))
+    return std::nullopt;
+  return Duration(d);
+}
+
 /// Seconds as a double, for printing and for maths on rates.
 inline double ToSeconds(Duration d) { return std::chrono::duration<double>(d).count(); }
 /// The largest |seconds| FromSeconds() accepts: a Duration (int64
