@@ -63,5 +63,22 @@ check "the bridge exits 0 on SIGINT (status $status)" test "$status" -eq 0
 check "and sends STOP to the robot it set moving: $(tail -1 "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$tmp/bridge.log"
 
+# A bridge whose queue on the server is full (its own trajectory, seconds
+# ahead, past --max-queue): the cmd_vel timeout's SETSPEED 0 is refused
+# ("command not queued"), so the bridge escalates to STOP and says so.
+url2="udpm://239.255.76.67:7626?ttl=0"
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url2" --max-queue 8 \
+  --key "$tmp/server" --clients "$tmp/clients" --duration 30 2>"$tmp/server2.log" &
+pids+=("$!")
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server2.log" 2>/dev/null && break; sleep 0.1; done
+"$bridge" --robot pioneer --url "$url2" --key "$tmp/bridge" --duration 20 >"$tmp/bridge2.out" 2>"$tmp/bridge2.log" &
+pids+=("$!")
+for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge2.log" 2>/dev/null && break; sleep 0.1; done
+url_saved=$url url=$url2
+peer_checks cmd_vel_full_queue "with its queue full, the bridge still stops a base whose cmd_vel fell silent"
+url=$url_saved
+check "the bridge says the SETSPEED 0 was refused and it sent STOP: $(grep -e cmd_vel -e STOP "$tmp/bridge2.log")" \
+  grep -q "robot 'pioneer': SETSPEED 0 (cmd_vel timeout) was not executed.*: STOP" "$tmp/bridge2.log"
+
 echo "passed $pass, failed $failures"
 [ "$failures" -eq 0 ]
