@@ -72,13 +72,21 @@ url2="udpm://239.255.76.67:7626?ttl=0"
 pids+=("$!")
 for _ in $(seq 50); do grep -q "serving robot" "$tmp/server2.log" 2>/dev/null && break; sleep 0.1; done
 "$bridge" --robot pioneer --url "$url2" --key "$tmp/bridge" --duration 20 >"$tmp/bridge2.out" 2>"$tmp/bridge2.log" &
-pids+=("$!")
+bridge2_pid=$!
+pids+=("$bridge2_pid")
 for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge2.log" 2>/dev/null && break; sleep 0.1; done
 url_saved=$url url=$url2
 peer_checks cmd_vel_full_queue "with its queue full, the bridge still stops a base whose cmd_vel fell silent"
 url=$url_saved
 check "the bridge says the SETSPEED 0 was refused and it sent STOP: $(grep -e cmd_vel -e STOP "$tmp/bridge2.log")" \
   grep -q "robot 'pioneer': SETSPEED 0 (cmd_vel timeout) was not executed.*: STOP" "$tmp/bridge2.log"
+# SIGTERM too: STOP to the robot the bridge set moving, exit 0.
+kill -TERM "$bridge2_pid"
+wait "$bridge2_pid"
+status=$?
+check "the bridge exits 0 on SIGTERM (status $status)" test "$status" -eq 0
+check "and sends STOP to the robot it set moving: $(tail -1 "$tmp/bridge2.log")" \
+  grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$tmp/bridge2.log"
 
 echo "passed $pass, failed $failures"
 [ "$failures" -eq 0 ]
