@@ -123,6 +123,25 @@ void Percentiles(const char* what, std::vector<double> v) {
               v.back());
 }
 
+// The cmd_vel checks: the base drove at 0.2 m/s, stopped within `bound` of
+// the teleop's last Twist (sent at `last_sent`, server time) and stayed
+// stopped. REQUIRES: h.mu held.
+void CheckTheBaseStops(const Heard& h, TimePoint last_sent, Duration bound, const std::string& what) {
+  bool drove = false;
+  const LcmSample* stopped = nullptr;
+  for (const LcmSample& l : h.lcm) {
+    drove = drove || std::abs(l.base.v - 0.2) < 1e-9;
+    if (!stopped && drove && l.server_time > last_sent && l.base.v == 0 && l.base.omega == 0) stopped = &l;
+  }
+  Check(drove, "cmd_vel drives the base (v 0.2 m/s in the STATE stream)");
+  Check(
+      stopped && stopped->server_time < last_sent + bound,
+      what + " (" +
+          (stopped ? std::to_string(Ms(stopped->server_time - last_sent)) + " ms after the last" : "never") +
+          ")");
+  Check(!h.lcm.empty() && h.lcm.back().base.v == 0, "and stays stopped");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -251,19 +270,7 @@ int main(int argc, char** argv) {
     const TimePoint last_sent = client.ServerNow();
     std::this_thread::sleep_for(1500ms);
     std::lock_guard lock(heard.mu);
-    bool drove = false;
-    const LcmSample* stopped = nullptr;
-    for (const LcmSample& l : heard.lcm) {
-      drove = drove || std::abs(l.base.v - 0.2) < 1e-9;
-      if (!stopped && drove && l.server_time > last_sent && l.base.v == 0 && l.base.omega == 0) stopped = &l;
-    }
-    Check(drove, "cmd_vel drives the base (v 0.2 m/s in the STATE stream)");
-    Check(stopped && stopped->server_time < last_sent + 800ms,
-          "the base stops by itself once cmd_vel falls silent (" +
-              (stopped ? std::to_string(Ms(stopped->server_time - last_sent)) + " ms after the last"
-                       : "never") +
-              ")");
-    Check(!heard.lcm.empty() && heard.lcm.back().base.v == 0, "and stays stopped");
+    CheckTheBaseStops(heard, last_sent, 800ms, "the base stops by itself once cmd_vel falls silent");
     return failures ? 1 : 0;
   }
   if (mode == "cmd_vel_full_queue") {
@@ -306,19 +313,8 @@ int main(int argc, char** argv) {
     const TimePoint last_sent = client.ServerNow();
     std::this_thread::sleep_for(2000ms);
     std::lock_guard lock(heard.mu);
-    bool drove = false;
-    const LcmSample* stopped = nullptr;
-    for (const LcmSample& l : heard.lcm) {
-      drove = drove || std::abs(l.base.v - 0.2) < 1e-9;
-      if (!stopped && drove && l.server_time > last_sent && l.base.v == 0 && l.base.omega == 0) stopped = &l;
-    }
-    Check(drove, "cmd_vel drives the base (v 0.2 m/s in the STATE stream)");
-    Check(stopped && stopped->server_time < last_sent + 1000ms,
-          "with the bridge's queue full, the base still stops once cmd_vel falls silent (" +
-              (stopped ? std::to_string(Ms(stopped->server_time - last_sent)) + " ms after the last"
-                       : "never: the base drives on") +
-              ")");
-    Check(!heard.lcm.empty() && heard.lcm.back().base.v == 0, "and stays stopped");
+    CheckTheBaseStops(heard, last_sent, 1000ms,
+                      "with the bridge's queue full, the base still stops once cmd_vel falls silent");
     return failures ? 1 : 0;
   }
   if (mode == "bad_trajectory") {
