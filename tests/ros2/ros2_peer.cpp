@@ -311,9 +311,9 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(200ms);
     twist_writer.Write(&twist);  // the teleop's last message
     const TimePoint last_sent = client.ServerNow();
-    std::this_thread::sleep_for(2000ms);
+    std::this_thread::sleep_for(2500ms);
     std::lock_guard lock(heard.mu);
-    CheckTheBaseStops(heard, last_sent, 1000ms,
+    CheckTheBaseStops(heard, last_sent, 1500ms,
                       "with the bridge's queue full, the base still stops once cmd_vel falls silent");
     return failures ? 1 : 0;
   }

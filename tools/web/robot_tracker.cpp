@@ -62,16 +62,20 @@ struct Robot {
 
 enum class Task { kConnect, kStream };
 
-// A robot's panic in flight: one thread sends it; requests meanwhile (a page
-// or Foxglove client may send them as fast as its socket carries them) wait
-// for its answer instead of each taking a thread of its own.
+// A robot's panics in flight: one thread sends them, one at a time. Requests
+// that come while one is sent (a page or Foxglove client may send them as
+// fast as its socket carries them) are answered together by the next, so
+// each request is answered by a panic sent after it came (a reset in between
+// is not hidden), without a thread of its own.
+using PanicDone = std::function<void(const std::string&)>;
 struct PanicInFlight {
   std::thread thread;
-  std::vector<std::function<void(const std::string&)>> waiting;
-  bool finished = false;  // answered: the thread is ending and may be joined
+  std::vector<PanicDone> sending;  // answered by the panic being sent
+  std::vector<PanicDone> next;     // came after it was sent: answered by the next one
+  bool finished = false;           // all answered: the thread is ending and may be joined
 };
-// Requests that may wait for one robot's panic in flight; later ones are
-// answered at once, saying so.
+// Requests that may wait for one robot's next panic; later ones are answered
+// at once, saying so.
 constexpr std::size_t kMaxPanicWaiters = 65536;
 
 // Anyone on the bus can announce a robot: the tracker holds at most this
@@ -394,8 +398,8 @@ void RobotTracker::Impl::Panic(const std::string& robot, std::function<void(cons
       it = panics_.erase(it);
     }
     if (auto in_flight = panics_.find(robot); in_flight != panics_.end()) {
-      if (in_flight->second.waiting.size() < kMaxPanicWaiters)
-        in_flight->second.waiting.push_back(std::move(done));
+      if (in_flight->second.next.size() < kMaxPanicWaiters)
+        in_flight->second.next.push_back(std::move(done));
       else
         refused = "a panic of robot '" + robot + "' is already being sent and " +
                   std::to_string(kMaxPanicWaiters) + " requests wait for its answer; this one is not queued";
@@ -406,22 +410,26 @@ void RobotTracker::Impl::Panic(const std::string& robot, std::function<void(cons
         refused = "robot '" + robot + "' is not connected";
       } else {
         PanicInFlight& p = panics_[robot];
-        p.waiting.push_back(std::move(done));
+        p.sending.push_back(std::move(done));
         p.thread = std::thread([this, client, robot] {
-          std::string error;
-          try {
-            client->Panic();
-          } catch (const std::exception& e) {
-            error = e.what();
+          for (bool again = true; again;) {
+            std::string error;
+            try {
+              client->Panic();
+            } catch (const std::exception& e) {
+              error = e.what();
+            }
+            std::vector<PanicDone> answered;
+            {
+              std::lock_guard l(mutex_);
+              PanicInFlight& mine = panics_.at(robot);
+              answered.swap(mine.sending);
+              mine.sending.swap(mine.next);
+              again = !mine.sending.empty();
+              mine.finished = !again;
+            }
+            for (PanicDone& w : answered) w(error);
           }
-          std::vector<std::function<void(const std::string&)>> waiting;
-          {
-            std::lock_guard l(mutex_);
-            PanicInFlight& mine = panics_.at(robot);
-            waiting.swap(mine.waiting);
-            mine.finished = true;
-          }
-          for (auto& w : waiting) w(error);
         });
       }
     }
