@@ -191,7 +191,9 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     throw UsageError("watch: --period must be >= 0.001 s, --duration and --count positive");
   }
   const auto client = ConnectClient(g, args[0]);
-  AnnounceWatch announces(g.url);  // with the STATE samples: is the server still there?
+  // With the STATE samples: is the server still there? Keyed: only its signed
+  // announcements count (as only its signed STATE does).
+  AnnounceWatch announces(g.url, client->trusted_server().key);
   std::cerr << "robotalk: watching ROBOTALK/" << args[0] << "/STATE (asked every " << FormatSeconds(period_s)
             << "; Ctrl-C ends)\n";
   std::mutex mu;

@@ -1,6 +1,7 @@
 #include "cli_support.h"
 
 #include "describe_format.h"
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
@@ -27,20 +28,30 @@ constexpr Duration kAnnounceWait = std::chrono::milliseconds(1200);  // > one an
 // The watch listens from here to kAnnounceWait: still more than one period.
 constexpr std::chrono::milliseconds kWatchAfter(100);
 
+// Robot names an AnnounceWatch keeps (anyone can announce any name).
+constexpr std::size_t kMaxHeardRobots = 1024;
+
 struct AnnounceWatch::Impl {
   std::string url;
+  std::optional<PublicKey> trusted_key;  // keyed: only announcements this key signed count
   int wake[2] = {-1, -1};
   mutable std::mutex mu;
   std::map<std::string, TimePoint> heard;  // GUARDED_BY(mu): robot -> last announce (steady clock)
   std::thread thread;
 
   void On(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
+    // Keyed: an unsigned one, or one of another key, is not its server's (the
+    // key is compared before the signature is verified).
+    if (trusted_key &&
+        VerifyBroadcast(kAnnounceChannel, bytes, *trusted_key, nullptr) != BroadcastVerdict::kAuthentic)
+      return;
     try {  // the checked decoder; a hostile ANNOUNCE is dropped, never thrown through LCM
-      const Announcement a =
-          DecodeAnnouncement({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
+      const Announcement a = DecodeAnnouncement(bytes);
       const TimePoint now = SteadyClock().Now();
       std::lock_guard lock(mu);
-      for (const auto& r : a.robots) heard[r.name] = now;
+      for (const auto& r : a.robots)
+        if (heard.size() < kMaxHeardRobots || heard.count(r.name)) heard[r.name] = now;
     } catch (const ProtocolError&) {
     }
   }
@@ -69,8 +80,10 @@ struct AnnounceWatch::Impl {
   }
 };
 
-AnnounceWatch::AnnounceWatch(const std::string& url) : impl_(std::make_unique<Impl>()) {
+AnnounceWatch::AnnounceWatch(const std::string& url, std::string trusted_key)
+    : impl_(std::make_unique<Impl>()) {
   impl_->url = url;
+  if (!trusted_key.empty()) impl_->trusted_key = PublicKey::Parse(trusted_key);
   if (pipe(impl_->wake) != 0) return;
   impl_->thread = std::thread([this] { impl_->Run(); });
 }

@@ -14,11 +14,14 @@
 namespace robotalk::cli {
 
 /// Listens to ROBOTALK/ANNOUNCE on its own LCM instance and thread from
-/// construction to destruction (which wakes and joins it at once).
+/// construction to destruction (which wakes and joins it at once). With a
+/// `trusted_key` ("ed25519:<hex>", a keyed client's server) it counts only
+/// announcements signed by that key: anyone can send an unsigned one, or
+/// sign with a key of their own. It keeps at most 1024 robot names.
 /// Thread safety: Heard() may be called from any thread.
 class AnnounceWatch {
  public:
-  explicit AnnounceWatch(const std::string& url);
+  explicit AnnounceWatch(const std::string& url, std::string trusted_key = "");
   ~AnnounceWatch();
   AnnounceWatch(const AnnounceWatch&) = delete;
   AnnounceWatch& operator=(const AnnounceWatch&) = delete;

@@ -44,6 +44,10 @@ std::string ReadFile(const std::string& path) {
 struct Pending {
   PendingReply reply;
   std::string what;  // "JOINT_SETPOINT 'pan' at +0.300 s"
+  // The bridge's own stop of the base (the cmd_vel timeout): if it is not
+  // executed (refused, e.g. "command not queued" behind the bridge's own
+  // trajectory, or its outcome unknown), a STOP follows, which always runs.
+  bool stop_if_not_executed = false;
 };
 
 }  // namespace
@@ -354,10 +358,11 @@ class Ros2Bridge::Impl {
     Track(r, r.client->Send(std::move(c)), "SETSPEED (cmd_vel)", moving);
   }
 
-  void Track(RobotLink& r, PendingReply reply, std::string what, bool moves) {
+  void Track(RobotLink& r, PendingReply reply, std::string what, bool moves,
+             bool stop_if_not_executed = false) {
     std::lock_guard lock(r.mu);
     r.set_moving = r.set_moving || moves;
-    r.pending.push_back({std::move(reply), std::move(what)});
+    r.pending.push_back({std::move(reply), std::move(what), stop_if_not_executed});
   }
 
   void Housekeep(RobotLink& r) {
@@ -369,7 +374,7 @@ class Ros2Bridge::Impl {
           " s: SETSPEED 0");
       Command stop{.type = CommandType::kSetSpeed};
       stop.values.assign(r.base == BaseType::kHolonomic ? 3 : 2, 0.0);
-      Track(r, r.client->Send(std::move(stop)), "SETSPEED 0 (cmd_vel timeout)", false);
+      Track(r, r.client->Send(std::move(stop)), "SETSPEED 0 (cmd_vel timeout)", false, true);
     }
     std::vector<Pending> pending;
     {
@@ -377,18 +382,26 @@ class Ros2Bridge::Impl {
       pending.swap(r.pending);
     }
     std::vector<Pending> keep;
+    std::string not_executed;  // why the bridge's own stop of the base did not run
     for (Pending& p : pending) {
+      std::string failure;
       try {
         auto reply = p.reply.Poll();
         if (!reply) {
           keep.push_back(std::move(p));
         } else if (reply->signal != Signal::kSuccess && reply->signal != Signal::kModified) {
-          Log("robot '" + r.name + "': " + p.what + ": " + std::string(ToString(reply->signal)) + " " +
-              reply->message);
+          failure = std::string(ToString(reply->signal)) + " " + reply->message;
         }
       } catch (const std::exception& e) {
-        Log("robot '" + r.name + "': " + p.what + ": " + e.what());
+        failure = e.what();
       }
+      if (failure.empty()) continue;
+      Log("robot '" + r.name + "': " + p.what + ": " + failure);
+      if (p.stop_if_not_executed) not_executed = p.what + " was not executed (" + failure + ")";
+    }
+    if (!not_executed.empty()) {  // the base may still be moving: STOP always runs
+      Log("robot '" + r.name + "': " + not_executed + ": STOP (every actuator of the robot)");
+      Track(r, r.client->Send(Command{.type = CommandType::kStop}), "STOP (cmd_vel timeout)", false);
     }
     std::lock_guard lock(r.mu);
     for (Pending& p : keep) r.pending.push_back(std::move(p));

@@ -58,6 +58,25 @@ check "watch printed no forged sample: $(grep -c ' 42.0000 42.0000' "$tmp/watch"
   bash -c "! grep -q ' 42.0000 42.0000' '$tmp/watch'"
 check "watch says how many it dropped: $(cat "$tmp/watch.err")" grep -q "dropped [0-9]* STATE/CONFIG messages" "$tmp/watch.err"
 
+# A keyed watch counts only announcements its server signed: forged ones
+# (unsigned, another server) do not keep it watching a server that is gone
+# (here stopped with SIGSTOP, a hung host).
+rt watch pioneer --period 0.05 --duration 30 >"$tmp/watch_gone" 2>"$tmp/watch_gone.err" &
+watch_pid=$!
+sleep 1
+"$forge" "$url" announce pioneer 600 &  # 6 s of forged ANNOUNCEs naming pioneer
+forge_pid=$!
+kill -STOP "$server_pid"
+for _ in $(seq 50); do kill -0 "$watch_pid" 2>/dev/null || break; sleep 0.1; done
+kill -KILL "$watch_pid" 2>/dev/null  # still watching after 5 s: the forger kept it
+wait "$watch_pid"
+status=$?
+wait "$forge_pid"
+kill -CONT "$server_pid"
+check "a keyed watch ends with 1 when its server is gone, forged announcements or not (got $status)" \
+  test "$status" -eq 1
+check "and says so: $(tail -2 "$tmp/watch_gone.err")" grep -q "pioneer: no STATE sample and no announcement for 3 s: its server is gone" "$tmp/watch_gone.err"
+
 # Item 12: a second server for pioneer (its only robot) refuses it and exits 1.
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 20 \
   >"$tmp/second_server.log" 2>&1

@@ -54,14 +54,36 @@ unexpected=$(grep "^robotalk-ros2:" "$tmp/bridge.log" |
   grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel")
 check "no command was refused: $unexpected" test -z "$unexpected"
 
-# SIGINT stops the bridge: it sends STOP to the
-# robot the bridge set moving, and the bridge exits 0.
-kill -INT "$bridge_pid"
-wait "$bridge_pid"
-status=$?
-check "the bridge exits 0 on SIGINT (status $status)" test "$status" -eq 0
-check "and sends STOP to the robot it set moving: $(tail -1 "$tmp/bridge.log")" \
-  grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$tmp/bridge.log"
+# stop_bridge SIGNAL PID LOG: the signal stops the bridge: it sends STOP to
+# the robot the bridge set moving, and the bridge exits 0.
+stop_bridge() {
+  kill -"$1" "$2"
+  wait "$2"
+  local status=$?
+  check "the bridge exits 0 on SIG$1 (status $status)" test "$status" -eq 0
+  check "and sends STOP to the robot it set moving: $(tail -1 "$3")" \
+    grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$3"
+}
+stop_bridge INT "$bridge_pid" "$tmp/bridge.log"
+
+# A bridge whose queue on the server is full (its own trajectory, seconds
+# ahead, past --max-queue): the cmd_vel timeout's SETSPEED 0 is refused
+# ("command not queued"), so the bridge escalates to STOP and says so.
+url2="udpm://239.255.76.67:7626?ttl=0"
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url2" --max-queue 8 \
+  --key "$tmp/server" --clients "$tmp/clients" --duration 30 2>"$tmp/server2.log" &
+pids+=("$!")
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server2.log" 2>/dev/null && break; sleep 0.1; done
+"$bridge" --robot pioneer --url "$url2" --key "$tmp/bridge" --duration 20 >"$tmp/bridge2.out" 2>"$tmp/bridge2.log" &
+bridge2_pid=$!
+pids+=("$bridge2_pid")
+for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge2.log" 2>/dev/null && break; sleep 0.1; done
+url_saved=$url url=$url2
+peer_checks cmd_vel_full_queue "with its queue full, the bridge still stops a base whose cmd_vel fell silent"
+url=$url_saved
+check "the bridge says the SETSPEED 0 was refused and it sent STOP: $(grep -e cmd_vel -e STOP "$tmp/bridge2.log")" \
+  grep -q "robot 'pioneer': SETSPEED 0 (cmd_vel timeout) was not executed.*: STOP" "$tmp/bridge2.log"
+stop_bridge TERM "$bridge2_pid" "$tmp/bridge2.log"  # SIGTERM too
 
 echo "passed $pass, failed $failures"
 [ "$failures" -eq 0 ]

@@ -12,6 +12,9 @@
 //   ros2_peer cmd_vel ROBOT --url URL [--key FILE]
 //     Twists at 10 Hz for 0.5 s drive the base; once they stop, the base
 //     stops within 0.8 s (the bridge's cmd_vel timeout) and stays stopped.
+//   ros2_peer cmd_vel_full_queue ROBOT --url URL [--key FILE]
+//     As cmd_vel, with a JointTrajectory seconds ahead filling the bridge's
+//     queue on a server run with a small --max-queue: the base still stops.
 //   ros2_peer measure ROBOT --url URL [--key FILE] --seconds S
 //     per sample, LCM latency (server sample time -> STATE received here) and
 //     DDS latency (the same sample time, as JointState's stamp -> JointState
@@ -118,6 +121,25 @@ void Percentiles(const char* what, std::vector<double> v) {
   };
   std::printf("%s: n %zu p50 %.3f p90 %.3f p99 %.3f max %.3f ms\n", what, v.size(), p(0.5), p(0.9), p(0.99),
               v.back());
+}
+
+// The cmd_vel checks: the base drove at 0.2 m/s, stopped within `bound` of
+// the teleop's last Twist (sent at `last_sent`, server time) and stayed
+// stopped. REQUIRES: h.mu held.
+void CheckTheBaseStops(const Heard& h, TimePoint last_sent, Duration bound, const std::string& what) {
+  bool drove = false;
+  const LcmSample* stopped = nullptr;
+  for (const LcmSample& l : h.lcm) {
+    drove = drove || std::abs(l.base.v - 0.2) < 1e-9;
+    if (!stopped && drove && l.server_time > last_sent && l.base.v == 0 && l.base.omega == 0) stopped = &l;
+  }
+  Check(drove, "cmd_vel drives the base (v 0.2 m/s in the STATE stream)");
+  Check(
+      stopped && stopped->server_time < last_sent + bound,
+      what + " (" +
+          (stopped ? std::to_string(Ms(stopped->server_time - last_sent)) + " ms after the last" : "never") +
+          ")");
+  Check(!h.lcm.empty() && h.lcm.back().base.v == 0, "and stays stopped");
 }
 
 }  // namespace
@@ -248,19 +270,51 @@ int main(int argc, char** argv) {
     const TimePoint last_sent = client.ServerNow();
     std::this_thread::sleep_for(1500ms);
     std::lock_guard lock(heard.mu);
-    bool drove = false;
-    const LcmSample* stopped = nullptr;
-    for (const LcmSample& l : heard.lcm) {
-      drove = drove || std::abs(l.base.v - 0.2) < 1e-9;
-      if (!stopped && drove && l.server_time > last_sent && l.base.v == 0 && l.base.omega == 0) stopped = &l;
+    CheckTheBaseStops(heard, last_sent, 800ms, "the base stops by itself once cmd_vel falls silent");
+    return failures ? 1 : 0;
+  }
+  if (mode == "cmd_vel_full_queue") {
+    // The server runs with a small --max-queue. The base is driven by
+    // cmd_vel; then a JointTrajectory whose points lie seconds ahead fills
+    // the bridge's queue on the server, and cmd_vel falls silent: the
+    // timeout's SETSPEED 0 is refused ("command not queued"), and the base
+    // must still stop.
+    DdsWriter twist_writer(participant, geometry_msgs_msg_dds__Twist__desc, ns + "/cmd_vel", kDefaultQos);
+    Check(WaitFor(
+              heard, 5s,
+              [&] { return twist_writer.matched_readers() > 0 && trajectory_writer.matched_readers() > 0; }),
+          "the bridge subscribes to cmd_vel and joint_trajectory");
+    geometry_msgs_msg_dds__Twist_ twist{{0.2, 0, 0}, {0, 0, 0.1}};
+    for (int i = 0; i < 3; ++i) {
+      twist_writer.Write(&twist);
+      std::this_thread::sleep_for(100ms);
     }
-    Check(drove, "cmd_vel drives the base (v 0.2 m/s in the STATE stream)");
-    Check(stopped && stopped->server_time < last_sent + 800ms,
-          "the base stops by itself once cmd_vel falls silent (" +
-              (stopped ? std::to_string(Ms(stopped->server_time - last_sent)) + " ms after the last"
-                       : "never") +
-              ")");
-    Check(!heard.lcm.empty() && heard.lcm.back().base.v == 0, "and stays stopped");
+    // Stamped 5 s ahead (none passes during the check), at +1 .. +12 s from
+    // the stamp: more than the server's --max-queue.
+    constexpr int kPoints = 12;
+    const RosTime ahead = ToRosTime(SystemNow() + 5s);
+    std::vector<char*> jn = {const_cast<char*>("pan")};
+    std::vector<double> values(kPoints);
+    std::vector<trajectory_msgs_msg_dds__JointTrajectoryPoint_> pts(kPoints);
+    for (int k = 0; k < kPoints; ++k) {
+      values[k] = 0.01 * (k + 1);
+      pts[k] = {};
+      pts[k].positions = {1, 1, &values[k], false};
+      pts[k].time_from_start = {k + 1, 0};
+    }
+    trajectory_msgs_msg_dds__JointTrajectory_ msg{};
+    msg.header.stamp = {ahead.sec, ahead.nanosec};
+    msg.header.frame_id = const_cast<char*>("");
+    msg.joint_names = {1, 1, jn.data(), false};
+    msg.points = {kPoints, kPoints, pts.data(), false};
+    trajectory_writer.Write(&msg);
+    std::this_thread::sleep_for(200ms);
+    twist_writer.Write(&twist);  // the teleop's last message
+    const TimePoint last_sent = client.ServerNow();
+    std::this_thread::sleep_for(2500ms);
+    std::lock_guard lock(heard.mu);
+    CheckTheBaseStops(heard, last_sent, 1500ms,
+                      "with the bridge's queue full, the base still stops once cmd_vel falls silent");
     return failures ? 1 : 0;
   }
   if (mode == "bad_trajectory") {

@@ -62,6 +62,28 @@ struct Robot {
 
 enum class Task { kConnect, kStream };
 
+// A robot's panics in flight: one thread sends them, one at a time. Requests
+// that come while one is sent (a page or Foxglove client may send them as
+// fast as its socket carries them) are answered together by the next, so
+// each request is answered by a panic sent after it came (a reset in between
+// is not hidden), without a thread of its own.
+using PanicDone = std::function<void(const std::string&)>;
+struct PanicInFlight {
+  std::thread thread;
+  std::vector<PanicDone> sending;  // answered by the panic being sent
+  std::vector<PanicDone> next;     // came after it was sent: answered by the next one
+  bool finished = false;           // all answered: the thread is ending and may be joined
+};
+// Requests that may wait for one robot's next panic; later ones are answered
+// at once, saying so.
+constexpr std::size_t kMaxPanicWaiters = 65536;
+
+// Anyone on the bus can announce a robot: the tracker holds at most this
+// many (a new name beyond it is ignored until one is forgotten), and forgets
+// a robot not announced for kForgetGone beyond its timeout.
+constexpr std::size_t kMaxRobots = 256;
+constexpr std::chrono::seconds kForgetGone(60);
+
 }  // namespace
 
 class RobotTracker::Impl {
@@ -78,7 +100,12 @@ class RobotTracker::Impl {
     wake_.notify_all();
     listener_.join();
     worker_.join();
-    for (std::thread& t : panics_) t.join();
+    std::vector<std::thread> threads;
+    {
+      std::lock_guard lock(mutex_);
+      for (auto& [robot, p] : panics_) threads.push_back(std::move(p.thread));
+    }
+    for (std::thread& t : threads) t.join();  // each takes mutex_ to answer its waiters
     std::lock_guard lock(mutex_);
     robots_.clear();  // each RobotClient joins its ReadDaemon
   }
@@ -106,7 +133,12 @@ class RobotTracker::Impl {
     std::lock_guard lock(mutex_);
     const auto now = Steady::now();
     for (const RobotAnnouncement& r : announcement.robots) {
-      Robot& robot = robots_[r.name];
+      auto it = robots_.find(r.name);
+      if (it == robots_.end()) {
+        if (robots_.size() >= kMaxRobots) continue;
+        it = robots_.emplace(r.name, Robot{}).first;
+      }
+      Robot& robot = it->second;
       robot.name = r.name;
       robot.server_id = announcement.server_id;
       robot.announced_hash = r.config_hash;
@@ -233,11 +265,11 @@ class RobotTracker::Impl {
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::map<std::string, Robot> robots_;             // GUARDED_BY(mutex_)
+  std::map<std::string, Robot> robots_;             // GUARDED_BY(mutex_), at most kMaxRobots
   std::deque<std::pair<std::string, Task>> queue_;  // GUARDED_BY(mutex_)
   std::atomic<bool> watching_{false};
-  std::function<void()> on_sample_;  // GUARDED_BY(mutex_)
-  std::vector<std::thread> panics_;  // GUARDED_BY(mutex_)
+  std::function<void()> on_sample_;              // GUARDED_BY(mutex_)
+  std::map<std::string, PanicInFlight> panics_;  // GUARDED_BY(mutex_): at most one per robot
   std::thread listener_, worker_;
 };
 
@@ -321,6 +353,12 @@ TrackerFrame RobotTracker::Impl::Poll() {
     std::lock_guard lock(mutex_);
     const auto now = Steady::now();
     nlohmann::json list = nlohmann::json::array();
+    const auto forget = std::chrono::duration_cast<Steady::duration>(
+        std::chrono::duration<double>(options_.robot_timeout_s) + kForgetGone);
+    std::erase_if(robots_, [&](const auto& entry) {
+      const Robot& r = entry.second;
+      return !r.client && !r.connecting && now - r.last_announce > forget;
+    });
     for (auto& [name, r] : robots_) {
       Housekeep(r, now, drop);
       list.push_back(RobotJson(r));
@@ -347,18 +385,57 @@ TrackerFrame RobotTracker::Impl::Poll() {
 }
 
 void RobotTracker::Impl::Panic(const std::string& robot, std::function<void(const std::string&)> done) {
-  std::lock_guard lock(mutex_);
-  std::shared_ptr<RobotClient> client;
-  if (auto it = robots_.find(robot); it != robots_.end()) client = it->second.client;
-  panics_.emplace_back([client, robot, done = std::move(done)] {
-    if (!client) return done("robot '" + robot + "' is not connected");
-    try {
-      client->Panic();
-      done("");
-    } catch (const std::exception& e) {
-      done(e.what());
+  std::vector<std::thread> ended;  // joined outside the lock
+  std::string refused;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto it = panics_.begin(); it != panics_.end();) {
+      if (!it->second.finished) {
+        ++it;
+        continue;
+      }
+      ended.push_back(std::move(it->second.thread));
+      it = panics_.erase(it);
     }
-  });
+    if (auto in_flight = panics_.find(robot); in_flight != panics_.end()) {
+      if (in_flight->second.next.size() < kMaxPanicWaiters)
+        in_flight->second.next.push_back(std::move(done));
+      else
+        refused = "a panic of robot '" + robot + "' is already being sent and " +
+                  std::to_string(kMaxPanicWaiters) + " requests wait for its answer; this one is not queued";
+    } else {
+      std::shared_ptr<RobotClient> client;
+      if (auto it = robots_.find(robot); it != robots_.end()) client = it->second.client;
+      if (!client) {
+        refused = "robot '" + robot + "' is not connected";
+      } else {
+        PanicInFlight& p = panics_[robot];
+        p.sending.push_back(std::move(done));
+        p.thread = std::thread([this, client, robot] {
+          for (bool again = true; again;) {
+            std::string error;
+            try {
+              client->Panic();
+            } catch (const std::exception& e) {
+              error = e.what();
+            }
+            std::vector<PanicDone> answered;
+            {
+              std::lock_guard l(mutex_);
+              PanicInFlight& mine = panics_.at(robot);
+              answered.swap(mine.sending);
+              mine.sending.swap(mine.next);
+              again = !mine.sending.empty();
+              mine.finished = !again;
+            }
+            for (PanicDone& w : answered) w(error);
+          }
+        });
+      }
+    }
+  }
+  for (std::thread& t : ended) t.join();
+  if (!refused.empty()) done(refused);
 }
 
 RobotTracker::RobotTracker(const WebOptions& options) : impl_(std::make_unique<Impl>(options)) {}

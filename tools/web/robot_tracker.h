@@ -77,7 +77,11 @@ class RobotTracker {
 
   /// Sends a panic package to `robot` on a thread of its own and calls `done`
   /// there with an empty string on success or the reason it failed (not
-  /// connected, no acknowledgement).
+  /// connected, no acknowledgement). A robot has at most one panic in flight,
+  /// on one thread: requests meanwhile are answered together by the next
+  /// panic, sent when that one is answered (at most 65,536 wait; later ones are
+  /// answered at once saying so). A robot that is not connected is answered
+  /// at once, on the caller's thread.
   void Panic(const std::string& robot, std::function<void(const std::string& error)> done);
 
  private:

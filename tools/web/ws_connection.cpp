@@ -2,7 +2,18 @@
 
 #include <boost/asio.hpp>
 
+#include <iostream>
+
 namespace robotalk::web {
+namespace {
+
+// What a client may be behind on among the messages it must receive (not
+// droppable): beyond it, the client does not read what it asked for, and is
+// closed rather than queued for without bound.
+constexpr std::size_t kMaxBacklogBytes = 64u << 20;
+constexpr std::size_t kMaxBacklogMessages = 4096;
+
+}  // namespace
 
 namespace asio = boost::asio;
 namespace beast = boost::beast;
@@ -39,8 +50,27 @@ void WsConnection::Send(const Message& m, bool binary, bool droppable) {
     ++dropped_;
     return;
   }
+  if (!droppable && (queue_.size() >= kMaxBacklogMessages || queued_bytes_ + m->size() > kMaxBacklogBytes)) {
+    Close("it has not read " + std::to_string(queue_.size()) + " messages (" +
+          std::to_string(queued_bytes_ >> 20) + " MiB) it must receive; the limit is " +
+          std::to_string(kMaxBacklogMessages) + " messages or " + std::to_string(kMaxBacklogBytes >> 20) +
+          " MiB");
+    return;
+  }
   queue_.emplace_back(m, binary);
+  queued_bytes_ += m->size();
   if (queue_.size() == 1) Write();
+}
+
+void WsConnection::Close(const std::string& why) {
+  open_ = false;
+  beast::error_code ec;
+  auto& socket = beast::get_lowest_layer(ws_).socket();
+  const auto peer = socket.remote_endpoint(ec);
+  std::cerr << "robotalk-web: closing the WebSocket of "
+            << (ec ? std::string("a client") : peer.address().to_string() + ":" + std::to_string(peer.port()))
+            << ": " << why << '\n';
+  socket.close(ec);  // the write and read in flight end with an error; the owner drops it
 }
 
 void WsConnection::Write() {
@@ -51,6 +81,7 @@ void WsConnection::Write() {
                       self->open_ = false;
                       return;
                     }
+                    self->queued_bytes_ -= self->queue_.front().first->size();
                     self->queue_.pop_front();
                     if (!self->queue_.empty()) self->Write();
                   });

@@ -3,7 +3,9 @@
 // (foxglove_endpoint.cpp). It accepts the upgrade (answering with a
 // subprotocol when given), sends a greeting, keeps a write queue and hands
 // every message it reads to a callback. A client that cannot keep up loses
-// droppable messages once `max_droppable` are queued, never the others.
+// droppable messages once `max_droppable` are queued, never the others; a
+// client more than 64 MiB or 4096 messages behind on the others (it asks
+// and does not read the answers) is closed, the reason on stderr.
 //
 // Thread safety: everything on the io_context's thread.
 // Errors: none thrown; a failed accept, read or write closes the connection
@@ -48,12 +50,14 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
  private:
   void Write();
   void Read();
+  void Close(const std::string& why);
 
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
   std::size_t max_message_, max_droppable_;
   OnMessage on_message_;
   boost::beast::flat_buffer in_;
   std::deque<std::pair<Message, bool>> queue_;  // message, binary
+  std::size_t queued_bytes_ = 0;                // of queue_'s messages
   bool open_ = false;
   std::uint64_t dropped_ = 0;
 };

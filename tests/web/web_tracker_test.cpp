@@ -1,0 +1,176 @@
+// robotalk-web's RobotTracker against a live in-process server, over real
+// LCM multicast on the loopback of a private network namespace (this binary
+// runs under scripts/netns_run.sh): what a hostile page or bus can make the
+// bridge hold.
+#include "kinematic_driver.h"
+#include "robot_tracker.h"
+#include "robotalk/channels.h"
+#include "robotalk/request.h"
+#include "robotalk/robot_client.h"
+#include "robotalk/server.h"
+#include "test_paths.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace robotalk::web {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+
+constexpr const char* kUrl = "udpm://239.255.76.67:7743?ttl=0";
+
+// This process's virtual size (/proc/self/status VmSize), in KiB: a thread
+// that ended but was never joined keeps its stack mapped (8 MiB).
+long VmSizeKiB() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  while (status >> key) {
+    if (key == "VmSize:") {
+      long kib = 0;
+      status >> kib;
+      return kib;
+    }
+    status.ignore(1 << 16, '\n');
+  }
+  return -1;
+}
+
+class WebTrackerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    RegisterKinematicDriver(registry_);
+    ServerOptions options;
+    options.lcm_url = kUrl;
+    RobotSpec spec{"pioneer", "kinematic", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
+    server_ = std::make_unique<Server>(options, std::vector<RobotSpec>{spec}, registry_, clock_);
+    server_->Start();
+  }
+  void TearDown() override {
+    if (server_) server_->Stop();
+  }
+  // Polls until the tracker shows `robot` live (connected), at most 15 s.
+  static bool WaitLive(RobotTracker& tracker, const std::string& robot) {
+    for (int i = 0; i < 150; ++i) {
+      const TrackerFrame f = tracker.Poll();
+      for (const auto& r : f.robots["robots"])
+        if (r["name"] == robot && r["status"] == "live") return true;
+      std::this_thread::sleep_for(milliseconds(100));
+    }
+    return false;
+  }
+
+  SteadyClock clock_;
+  DriverRegistry registry_;
+  std::unique_ptr<Server> server_;
+};
+
+// A page (or a Foxglove client) may send PANIC requests as fast as its
+// socket carries them. Each request took a thread of its own that was never
+// joined until the bridge exited: 4,000 requests held 4,000 stacks (32 GiB of
+// address space) and as many concurrent panics of one client. Now a robot
+// has at most one panic in flight; requests meanwhile share its answer, and
+// a robot the bridge is not connected to is answered at once, without a
+// thread.
+TEST_F(WebTrackerTest, AFloodOfPanicRequestsHoldsAtMostOnePanicPerRobotAndAnswersEveryRequest) {
+  WebOptions o;
+  o.lcm_url = kUrl;
+  RobotTracker tracker(o);
+  ASSERT_TRUE(WaitLive(tracker, "pioneer")) << "the tracker never connected to the server's robot";
+
+  constexpr int kRequests = 2000;
+  std::mutex mu;
+  int answered_ok = 0, answered_ghost = 0;
+  std::string unexpected;
+  const long vm_before = VmSizeKiB();
+  for (int i = 0; i < kRequests; ++i) {
+    tracker.Panic("pioneer", [&](const std::string& error) {
+      std::lock_guard lock(mu);
+      if (error.empty())
+        ++answered_ok;
+      else if (unexpected.empty())
+        unexpected = error;
+    });
+    tracker.Panic("ghost", [&](const std::string& error) {
+      std::lock_guard lock(mu);
+      if (error.find("not connected") != std::string::npos)
+        ++answered_ghost;
+      else if (unexpected.empty())
+        unexpected = "ghost: '" + error + "'";
+    });
+  }
+  for (int i = 0; i < 300; ++i) {
+    {
+      std::lock_guard lock(mu);
+      if (answered_ok + answered_ghost == 2 * kRequests || !unexpected.empty()) break;
+    }
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  const long vm_after = VmSizeKiB();
+  std::lock_guard lock(mu);
+  EXPECT_EQ(unexpected, "");
+  EXPECT_EQ(answered_ok, kRequests) << "every PANIC request of a connected robot is acknowledged";
+  EXPECT_EQ(answered_ghost, kRequests) << "a robot that is not connected is answered so";
+  EXPECT_LT(vm_after - vm_before, 256L * 1024)
+      << "the requests' threads stayed mapped: " << (vm_after - vm_before) / 1024
+      << " MiB more address space";
+
+  // The robot really is in panic.
+  ClientOptions co;
+  co.lcm_url = kUrl;
+  RobotClient client(co);
+  client.Connect("pioneer");
+  EXPECT_EQ(client.SetJoint("pan", {0.1}).signal, Signal::kPanic);
+}
+
+// Anyone on the bus can send an ANNOUNCE (a keyed server signs with its own
+// key, and anyone can make a key). Every name ever announced was tracked for
+// good, shown to every page in each robots message, and queued for a
+// connect: 5,000 forged names made 5,000 entries. Now the tracker holds at
+// most 256 robots; a robot it already serves stays live and connected.
+TEST_F(WebTrackerTest, ThousandsOfForgedRobotNamesKeepTheTrackedRobotsBoundedAndTheRealOneLive) {
+  WebOptions o;
+  o.lcm_url = kUrl;
+  RobotTracker tracker(o);
+  ASSERT_TRUE(WaitLive(tracker, "pioneer")) << "the tracker never connected to the server's robot";
+
+  lcm::LCM bus(kUrl);
+  ASSERT_TRUE(bus.good());
+  constexpr int kAnnouncements = 100, kRobotsEach = 50;
+  for (int i = 0; i < kAnnouncements; ++i) {
+    Announcement a;
+    a.server_id = 7000 + i;
+    a.server_time = TimePoint(seconds(1));
+    a.uptime = seconds(100);
+    for (int j = 0; j < kRobotsEach; ++j)
+      a.robots.push_back(
+          {.name = "forged-" + std::to_string(i) + "-" + std::to_string(j), .driver = "kinematic"});
+    const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+    bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    std::this_thread::sleep_for(milliseconds(5));  // within the tracker's LCM queue
+  }
+  std::this_thread::sleep_for(milliseconds(500));
+  TrackerFrame f = tracker.Poll();
+  std::size_t forged = 0;
+  bool live = false;
+  for (const auto& r : f.robots["robots"]) {
+    if (r["name"].get<std::string>().rfind("forged-", 0) == 0) ++forged;
+    if (r["name"] == "pioneer") live = r["status"] == "live";
+  }
+  EXPECT_GT(forged, 0u) << "the forged announcements reached the tracker";
+  EXPECT_LE(f.robots["robots"].size(), 256u) << forged << " forged robots tracked";
+  EXPECT_TRUE(live) << "the served robot stays live";
+}
+
+}  // namespace
+}  // namespace robotalk::web

@@ -1,0 +1,125 @@
+// WsConnection (robotalk-web's page and Foxglove sockets) against a client
+// on the loopback that reads nothing: what it may make the bridge hold.
+#include "ws_connection.h"
+
+#include <gtest/gtest.h>
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <sys/socket.h>
+
+namespace robotalk::web {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+// A server-side WsConnection for one client, and the client: a WebSocket
+// that does the handshake and then reads only when `reading` is set.
+struct Pair {
+  asio::io_context ioc;
+  tcp::acceptor acceptor{ioc, {asio::ip::make_address("127.0.0.1"), 0}};
+  std::shared_ptr<WsConnection> server;
+  std::atomic<bool> reading{false}, done{false};
+  std::atomic<std::size_t> received{0};
+  std::atomic<int> client_fd{-1};  // shut down at the end: a blocking read returns
+  std::thread client;
+
+  explicit Pair(bool read) {
+    reading = read;
+    auto stream = std::make_shared<beast::tcp_stream>(ioc);
+    auto buffer = std::make_shared<beast::flat_buffer>();
+    auto req = std::make_shared<http::request<http::string_body>>();
+    acceptor.async_accept([this, stream, buffer, req](beast::error_code ec, tcp::socket s) {
+      if (ec) return;
+      stream->socket() = std::move(s);
+      http::async_read(*stream, *buffer, *req, [this, stream, buffer, req](beast::error_code e, std::size_t) {
+        if (e) return;
+        server = std::make_shared<WsConnection>(
+            stream->release_socket(), 4096, 8,
+            [](const std::shared_ptr<WsConnection>&, const std::string&, bool) {});
+        server->Start(std::move(*req), {});
+      });
+    });
+    const tcp::endpoint at = acceptor.local_endpoint();
+    client = std::thread([this, at] {
+      asio::io_context cio;
+      websocket::stream<tcp::socket> ws(cio);
+      ws.next_layer().open(tcp::v4());
+      if (!reading) ws.next_layer().set_option(asio::socket_base::receive_buffer_size(4096));
+      ws.next_layer().connect(at);
+      ws.handshake("127.0.0.1", "/ws");
+      client_fd = ws.next_layer().native_handle();
+      beast::flat_buffer in;
+      while (!done) {
+        if (!reading) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          continue;
+        }
+        beast::error_code ec;
+        ws.read(in, ec);
+        if (ec) return;
+        received += in.size();
+        in.consume(in.size());
+      }
+    });
+  }
+  ~Pair() {
+    done = true;
+    if (client_fd >= 0) ::shutdown(client_fd, SHUT_RDWR);
+    ioc.stop();
+    if (client.joinable()) client.join();
+  }
+  // Runs the io_context until `until` holds or 20 s pass.
+  template <class F>
+  bool RunUntil(F until) {
+    for (int i = 0; i < 2000; ++i) {
+      ioc.run_for(std::chrono::milliseconds(10));
+      if (until()) return true;
+    }
+    return false;
+  }
+};
+
+// A page or Foxglove client controls both what it asks for and whether it
+// reads the answers: one that sent requests (bad ops, scene subscriptions,
+// PANICs) and read nothing had every answer queued for it, without a bound.
+// Now a client more than 64 MiB or 4096 messages behind on what it must
+// receive is closed.
+TEST(WsBacklog, AClientThatReadsNothingOfWhatItMustReceiveIsClosedNotQueuedForWithoutBound) {
+  Pair p(false);
+  ASSERT_TRUE(p.RunUntil([&] { return p.server && p.server->open(); })) << "no WebSocket opened";
+  const auto mib = std::make_shared<const std::string>(1 << 20, 'x');
+  for (int i = 0; i < 200 && p.server->open(); ++i) {
+    p.server->Send(mib, true, false);
+    p.ioc.run_for(std::chrono::milliseconds(1));
+  }
+  const auto small = std::make_shared<const std::string>("{\"op\":\"status\"}");
+  for (int i = 0; i < 10000 && p.server->open(); ++i) p.server->Send(small, false, false);
+  EXPECT_TRUE(p.RunUntil([&] { return !p.server->open(); }))
+      << "a client that read none of 200 MiB and 10,000 answers is still served";
+}
+
+TEST(WsBacklog, AClientThatReadsGetsEveryMessageOfALargeBurst) {
+  Pair p(true);
+  ASSERT_TRUE(p.RunUntil([&] { return p.server && p.server->open(); })) << "no WebSocket opened";
+  const auto mib = std::make_shared<const std::string>(1 << 20, 'x');
+  for (int i = 0; i < 48; ++i) p.server->Send(mib, true, false);
+  EXPECT_TRUE(p.RunUntil([&] { return p.received == 48u << 20; })) << p.received << " bytes received";
+  EXPECT_TRUE(p.server->open());
+}
+
+}  // namespace
+}  // namespace robotalk::web
