@@ -73,6 +73,10 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       o.push_stop_feet != "keep" && o.push_stop_feet != "still") {
     r.Fail("push_stop_feet", "move, keep or still");
   }
+  if (r.Text("push_balance", &o.push_balance) && o.push_balance != "off" && o.push_balance != "damping" &&
+      o.push_balance != "stabilizer" && o.push_balance != "both") {
+    r.Fail("push_balance", "off, damping, stabilizer or both");
+  }
   r.Bool("foot_damping", &o.foot_damping);
   if (r.Text("gait", &o.gait) && o.gait != "fast" && o.gait != "slow") r.Fail("gait", "fast or slow");
   auto& go = o.gait_overrides;

@@ -197,6 +197,12 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
   }
+  if (options.push_balance != "off" && !options.push_recovery) {
+    throw Error("OdeDriver: push_balance=" + options.push_balance +
+                " needs push_recovery=true (it acts while the push recovery's stop holds)");
+  }
+  w->push_damping_ = options.push_balance == "damping" || options.push_balance == "both";
+  w->push_stabilizer_ = options.push_balance == "stabilizer" || options.push_balance == "both";
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
   using StopFeet = walking::RecoveryParams::StopFeet;
@@ -205,7 +211,9 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
                                                            : StopFeet::kMove;
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step, recovery);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
-  if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)
+  w->damp_feet_ = options.foot_damping;
+  if (options.foot_damping ||
+      w->push_damping_) {  // the admittance from the sole's springs (walking/foot_damping.h)
     walking::FootDampingGains fg;
     fg.admittance = walking::AdmittanceFor(w->sole_spring_.stiffness, w->g_.foot_front + w->g_.foot_back);
     w->foot_damping_.emplace(model.total_mass() * gravity, step, fg);

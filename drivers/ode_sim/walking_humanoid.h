@@ -199,6 +199,10 @@ class WalkingHumanoid final : public BaseController {
   // as an offset of the planned CoM (plan frame), from the measured CoM.
   bool stabilize_ = true;
   bool adjust_steps_ = false;  // options.step_adjustment
+  // options.push_balance: foot damping / the stabilizer while a push's stop
+  // holds (PushRecovery::holding); stabilizing_ is whether it ran this tick.
+  bool push_damping_ = false, push_stabilizer_ = false, stabilizing_ = false;
+  bool PushHolding() const { return recovery_ && recovery_->holding(); }
   std::optional<walking::DcmStabilizer> dcm_;
   std::optional<walking::ComOffset> com_offset_;
   std::optional<walking::PushRecovery> recovery_;      // options.push_recovery
@@ -214,7 +218,8 @@ class WalkingHumanoid final : public BaseController {
   // The feet in the loop (options.foot_damping): each foot's measured
   // contact (its frame), its CoP in the world, and where it should press.
   void DampFeet(std::array<Eigen::Isometry3d, 2>* soles);
-  std::optional<walking::FootDamping> foot_damping_;
+  std::optional<walking::FootDamping> foot_damping_;  // options.foot_damping or push_balance's damping
+  bool damp_feet_ = false;                            // options.foot_damping
   std::array<walking::FootWrench, 2> foot_wrench_;
   std::array<Eigen::Vector2d, 2> foot_cop_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  // world
   walking::FootTargets foot_targets_;                       // plan frame's feet

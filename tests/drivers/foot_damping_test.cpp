@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -93,6 +94,33 @@ TEST(FootDamping, OffsetsAndTheirRatesAreBoundedAndAFootInTheAirTurnsFlat) {
   // Non-finite measurements count as no contact.
   u.Update(1, {0, 0}, {std::numeric_limits<double>::quiet_NaN(), {0, 0}});
   EXPECT_TRUE(u.offset(1).allFinite());
+}
+
+TEST(FootDamping, SwitchedOffTheOffsetReturnsToFlatOverTheLeakAndTheFootIsNotLanding) {
+  // push_balance=damping: the loop runs only while a push's stop holds;
+  // then Relax brings the ankle back to the IK's angle, smoothly.
+  const FootDampingGains g;
+  FootDamping d(kWeight, kTick, g);
+  for (int i = 0; i < 2000; ++i) d.Update(0, {0, 0}, {kWeight, {0.05, -0.03}});
+  const Eigen::Vector2d held = d.offset(0);
+  ASSERT_GT(held.cwiseAbs().minCoeff(), 0.01);
+  double worst_step = 0;
+  Eigen::Vector2d last = held;
+  for (int i = 0; i < static_cast<int>(g.leak / kTick); ++i) {
+    const Eigen::Vector2d now = d.Relax(0);
+    worst_step = std::max(worst_step, (now - last).cwiseAbs().maxCoeff());
+    last = now;
+  }
+  // exp(-1) after one leak time, each component toward 0 without crossing it.
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(last[k] / held[k], std::exp(-1.0), 0.01) << k;
+  EXPECT_LE(worst_step, g.max_rate * kTick + 1e-15);
+  for (int i = 0; i < 5000; ++i) d.Relax(0);
+  EXPECT_LT(d.offset(0).norm(), 1e-3);
+  EXPECT_FALSE(d.landing(0));
+  // Back on with the foot loaded on the ground: not a landing (no extra compliance).
+  d.Update(0, {0, 0}, {0.1 * kWeight, {0, 0}});
+  EXPECT_FALSE(d.landing(0));
+  EXPECT_THROW(d.Relax(2), std::invalid_argument);
 }
 
 TEST(FootDamping, ALandingFootIsCompliantUntilLoaded) {

@@ -170,6 +170,57 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   EXPECT_FALSE(RefusalOfWalker({{"push_stop_feet", "keep"}}));
 }
 
+// push_balance (off by default; docs/ode_sim.md, "Pushes"): the wiring —
+// walking unpushed nothing runs (no DCM reported, the ankles and the CoM
+// reference the plan's); pushed, the named feedback runs while the push's
+// stop holds (both: the stabilizer's DCM reported, ankle and CoM offsets)
+// and afterwards returns to the plan. Bad settings are refused.
+TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
+  for (const char* which : {"off", "both"}) {
+    const bool on = std::string(which) == "both";
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    double unpushed = 0, held = 0, dcm_held = 0;
+    const auto feedback = [&] {
+      const walking::WalkStatus s = *w.driver->walk_status();
+      return std::max({s.ankle_offset[0].norm(), s.ankle_offset[1].norm(), s.com_offset.norm()});
+    };
+    w.Run(5.14, [&] {
+      unpushed = std::max({unpushed, feedback(), w.driver->walk_status()->dcm.norm()});
+      return false;
+    });
+    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    w.Run(2.5, [&] {  // the hold: 3 s from the push
+      held = std::max(held, feedback());
+      dcm_held = std::max(dcm_held, w.driver->walk_status()->dcm.norm());
+      return w.driver->walk_status()->fallen;
+    });
+    w.Run(3.5, [&] { return w.driver->walk_status()->fallen; });  // walking on, the offsets relaxed
+    const walking::WalkStatus s = *w.driver->walk_status();
+    EXPECT_FALSE(s.fallen) << which << ", tilt " << w.max_tilt;
+    EXPECT_EQ(s.push_stops, 1) << which;
+    EXPECT_EQ(unpushed, 0) << which << ": nothing runs before the push";
+    if (on) {
+      EXPECT_GT(held, 1e-3) << "the feedback ran during the hold";
+      EXPECT_GT(dcm_held, 0) << "the stabilizer ran during the hold";
+      EXPECT_LT(feedback(), 0.2 * held) << "back to the plan after the hold";
+      EXPECT_EQ(s.dcm.norm(), 0) << "the stabilizer is off again";
+    } else {
+      EXPECT_EQ(held, 0);
+      EXPECT_EQ(dcm_held, 0);
+    }
+  }
+  const std::optional<std::string> bad = RefusalOfWalker({{"push_balance", "hips"}});
+  ASSERT_TRUE(bad) << "push_balance=hips accepted";
+  EXPECT_NE(bad->find("push_balance"), std::string::npos) << *bad;
+  const std::optional<std::string> alone =
+      RefusalOfWalker({{"push_balance", "damping"}, {"push_recovery", "false"}});
+  ASSERT_TRUE(alone) << "push_balance without push_recovery accepted";
+  EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}}));
+}
+
 // Push recovery's stop during a GOTO (on by default): the walk stops, the
 // robot stands through the hold, then the GOTO re-plans from where the push
 // left it and still ends at its goal with SUCCESS (no reply before the hold

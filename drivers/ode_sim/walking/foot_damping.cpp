@@ -115,4 +115,13 @@ const Eigen::Vector2d& FootDamping::Update(int foot, const Eigen::Vector2d& desi
   return off;
 }
 
+const Eigen::Vector2d& FootDamping::Relax(int foot) {
+  const size_t i = Index(foot);
+  const double r = gains_.max_rate;
+  offset_[i] += dt_ * (-offset_[i] / gains_.leak).cwiseMax(-r).cwiseMin(r);
+  landing_[i] = false;
+  in_contact_[i] = true;  // a foot on the ground when the loop comes back is not landing
+  return offset_[i];
+}
+
 }  // namespace robotalk::walking

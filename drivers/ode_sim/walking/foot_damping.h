@@ -105,6 +105,10 @@ class FootDamping {
   /// One control step of foot `foot` (0 left, 1 right) from its desired CoP
   /// (foot frame) and its measured contact; returns its (roll, pitch) offset.
   const Eigen::Vector2d& Update(int foot, const Eigen::Vector2d& desired_cop, const FootWrench& measured);
+  /// One control step of foot `foot` without damping (the loop switched
+  /// off): its offset returns to flat over `leak` (no faster than max_rate);
+  /// returns it.
+  const Eigen::Vector2d& Relax(int foot);
   const Eigen::Vector2d& offset(int foot) const { return offset_[Index(foot)]; }
   /// Touched down and not yet carrying `loaded` of the weight.
   bool landing(int foot) const { return landing_[Index(foot)]; }
