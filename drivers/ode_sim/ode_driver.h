@@ -130,10 +130,12 @@ struct OdeDriverOptions {
   std::string push_stop_feet = "move";
   /// With push_recovery: balance feedback only while a push's stop holds
   /// (from the stop until the walk goes on; docs/ode_sim.md, "Pushes and
-  /// disturbances"): "off" none, "damping" foot damping, "stabilizer" the
-  /// DCM stabilizer, "both"; afterwards their offsets return to the plan
-  /// (1 s, 0.5 s). An option that is on anyway (foot_damping, stabilizer)
-  /// stays on. Key "push_balance".
+  /// disturbances"): "off" none, or any of "damping" (foot damping),
+  /// "stabilizer" (the DCM stabilizer) and "forces" (foot force difference
+  /// control in double support, walking/foot_damping.h) joined by '+';
+  /// "both" is damping+stabilizer. Afterwards their offsets return to the
+  /// plan (1 s, 0.5 s, 1 s). An option that is on anyway (foot_damping,
+  /// stabilizer) stays on. Key "push_balance".
   std::string push_balance = "off";
   /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
   /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch

@@ -201,8 +201,15 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error("OdeDriver: push_balance=" + options.push_balance +
                 " needs push_recovery=true (it acts while the push recovery's stop holds)");
   }
-  w->push_damping_ = options.push_balance == "damping" || options.push_balance == "both";
-  w->push_stabilizer_ = options.push_balance == "stabilizer" || options.push_balance == "both";
+  {  // parts checked by the option parser: off, both, or damping/stabilizer/forces joined by '+'
+    const std::string& b = options.push_balance;
+    const auto has = [&](const char* part) { return b.find(part) != std::string::npos; };
+    w->push_damping_ = b == "both" || has("damping");
+    w->push_stabilizer_ = b == "both" || has("stabilizer");
+    if (has("forces")) {  // the loop's rate on the feet's sole springs (4 corners each)
+      w->push_forces_.emplace(step, walking::ForceDifferenceFor(4 * w->sole_spring_.stiffness, kForceRate));
+    }
+  }
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
   using StopFeet = walking::RecoveryParams::StopFeet;

@@ -203,6 +203,10 @@ class WalkingHumanoid final : public BaseController {
   // holds (PushRecovery::holding); stabilizing_ is whether it ran this tick.
   bool push_damping_ = false, push_stabilizer_ = false, stabilizing_ = false;
   bool PushHolding() const { return recovery_ && recovery_->holding(); }
+  // push_balance's forces: foot force difference control (walking/foot_damping.h).
+  std::optional<walking::ForceDifference> push_forces_;
+  /// Its loop rate (1/s) on the sole springs: the leg servos' 100/s is ten times faster.
+  static constexpr double kForceRate = 10.0;
   std::optional<walking::DcmStabilizer> dcm_;
   std::optional<walking::ComOffset> com_offset_;
   std::optional<walking::PushRecovery> recovery_;      // options.push_recovery

@@ -61,6 +61,14 @@ void WalkingHumanoid::DampFeet(std::array<Eigen::Isometry3d, 2>* soles) {
   const walking::SoleRect sole{g_.foot_front, g_.foot_back, g_.foot_half_width};
   foot_targets_ =
       walking::DistributeZmp(command ? balance_.zmp : pattern_.zmp_ref(), feet, down, sole, kMargin);
+  if (push_forces_ && tick_ >= settle_ticks_) {  // push_balance's forces: the soles' heights
+    const double h =
+        PushHolding()
+            ? push_forces_->Update(foot_targets_.share, {foot_force_[0], foot_force_[1]}, down[0] && down[1])
+            : push_forces_->Relax();
+    (*soles)[0].translation().z() += 0.5 * h;
+    (*soles)[1].translation().z() -= 0.5 * h;
+  }
   if (!foot_damping_ || tick_ < settle_ticks_) return;
   // push_balance's damping: only while a push's stop holds, then back to flat.
   const bool damp = damp_feet_ || (push_damping_ && PushHolding());
@@ -187,6 +195,7 @@ walking::WalkStatus WalkingHumanoid::status() const {
     s.zmp_command = ToWorld({balance_.zmp.x(), balance_.zmp.y(), 0}).xy();
     s.saturated = balance_.saturated;
   }
+  if (push_forces_) s.force_difference = push_forces_->height();
   // push_balance's stabilizer returns it to the plan after the hold.
   s.com_offset =
       Pose2{0, 0, plan_to_world_.theta}.Apply(com_offset_->offset().x(), com_offset_->offset().y());

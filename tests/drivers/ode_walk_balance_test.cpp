@@ -173,18 +173,19 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
 // push_balance (off by default; docs/ode_sim.md, "Pushes"): the wiring —
 // walking unpushed nothing runs (no DCM reported, the ankles and the CoM
 // reference the plan's); pushed, the named feedback runs while the push's
-// stop holds (both: the stabilizer's DCM reported, ankle and CoM offsets)
+// stop holds (all three: the stabilizer's DCM reported, ankle, CoM and sole height offsets)
 // and afterwards returns to the plan. Bad settings are refused.
 TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
-  for (const char* which : {"off", "both"}) {
-    const bool on = std::string(which) == "both";
+  for (const char* which : {"off", "damping+stabilizer+forces"}) {
+    const bool on = std::string(which) != "off";
     Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}});
     w.Run(1.0);
     ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
     double unpushed = 0, held = 0, dcm_held = 0;
     const auto feedback = [&] {
       const walking::WalkStatus s = *w.driver->walk_status();
-      return std::max({s.ankle_offset[0].norm(), s.ankle_offset[1].norm(), s.com_offset.norm()});
+      return std::max({s.ankle_offset[0].norm(), s.ankle_offset[1].norm(), s.com_offset.norm(),
+                       std::abs(s.force_difference)});
     };
     w.Run(5.14, [&] {
       unpushed = std::max({unpushed, feedback(), w.driver->walk_status()->dcm.norm()});
@@ -211,9 +212,12 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
       EXPECT_EQ(dcm_held, 0);
     }
   }
-  const std::optional<std::string> bad = RefusalOfWalker({{"push_balance", "hips"}});
-  ASSERT_TRUE(bad) << "push_balance=hips accepted";
-  EXPECT_NE(bad->find("push_balance"), std::string::npos) << *bad;
+  for (const char* wrong : {"hips", "damping+hips", "on"}) {
+    const std::optional<std::string> bad = RefusalOfWalker({{"push_balance", wrong}});
+    ASSERT_TRUE(bad) << "push_balance=" << wrong << " accepted";
+    EXPECT_NE(bad->find("push_balance"), std::string::npos) << *bad;
+  }
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "both"}}));
   const std::optional<std::string> alone =
       RefusalOfWalker({{"push_balance", "damping"}, {"push_recovery", "false"}});
   ASSERT_TRUE(alone) << "push_balance without push_recovery accepted";
