@@ -74,7 +74,9 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
     r.Fail("push_stop_feet", "move, keep or still");
   }
   if (r.Text("push_balance", &o.push_balance) && o.push_balance != "off" && o.push_balance != "both") {
-    for (const std::string& part : SplitPlus(o.push_balance)) {
+    const std::vector<std::string> parts = SplitPlus(o.push_balance);
+    if (parts.empty()) r.Fail("push_balance", "off, both, or damping, stabilizer and forces joined by '+'");
+    for (const std::string& part : parts) {
       if (part != "damping" && part != "stabilizer" && part != "forces") {
         r.Fail("push_balance", "off, both, or damping, stabilizer and forces joined by '+'");
         break;
