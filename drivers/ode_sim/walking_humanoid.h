@@ -6,7 +6,8 @@
 // dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
 // reference and the swing foot's landing; options stabilizer,
 // step_adjustment; walking/foot_damping.h: the ankles yield to each sole's
-// centre-of-pressure error, option foot_damping), and fall
+// centre-of-pressure error, option foot_damping; push_balance: these and
+// foot force difference control only while a push's stop holds), and fall
 // detection. The root is a free ODE body: the robot stands on its contacts
 // and can fall.
 //
