@@ -197,14 +197,12 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
   }
-  if (!options.push_balance.empty() && options.push_balance != "off" && !options.push_recovery) {
+  if (options.push_balance != "off" && !options.push_recovery) {
     throw Error("OdeDriver: push_balance=" + options.push_balance +
                 " needs push_recovery=true (it acts while the push recovery's stop holds)");
   }
   {  // parts checked by the option parser: off, both, or damping/stabilizer/forces joined by '+'
-    const std::string b = !options.push_balance.empty() ? options.push_balance
-                          : options.push_recovery       ? std::string("forces")
-                                                        : std::string("off");
+    const std::string& b = options.push_balance;
     const auto has = [&](const char* part) { return b.find(part) != std::string::npos; };
     w->push_damping_ = b == "both" || has("damping");
     w->push_stabilizer_ = b == "both" || has("stabilizer");

@@ -170,17 +170,16 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   EXPECT_FALSE(RefusalOfWalker({{"push_stop_feet", "keep"}}));
 }
 
-// push_balance (default "forces" with push_recovery; docs/ode_sim.md,
-// "Pushes"): the wiring — walking unpushed nothing runs (no DCM reported,
-// the ankles, the CoM reference and the soles' heights the plan's); pushed,
-// the named feedback runs while the push's stop holds (the default: only the
-// soles' force difference height; all three: also the stabilizer's DCM,
-// ankle and CoM offsets) and afterwards returns to the plan. Bad settings
-// are refused.
+// push_balance (off by default; docs/ode_sim.md, "Pushes"): the wiring —
+// walking unpushed nothing runs (no DCM reported, the ankles, the CoM
+// reference and the soles' heights the plan's); pushed, the named feedback
+// runs while the push's stop holds (forces: only the soles' force
+// difference height; all three: also the stabilizer's DCM, ankle and CoM
+// offsets) and afterwards returns to the plan. Bad settings are refused.
 TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
-  for (const char* which : {"", "damping+stabilizer+forces"}) {
-    const bool all = std::string(which) != "";
-    Walker w = all ? Walker(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}}) : Walker();
+  for (const char* which : {"forces", "damping+stabilizer+forces"}) {
+    const bool all = std::string(which) != "forces";
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}});
     w.Run(1.0);
     ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
     double unpushed = 0, held = 0, dcm_held = 0, offsets_held = 0;
@@ -214,7 +213,7 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
       EXPECT_GT(offsets_held, 1e-3) << "the ankles' and CoM's offsets moved during the hold";
       EXPECT_GT(dcm_held, 0) << "the stabilizer ran during the hold";
     } else {
-      EXPECT_EQ(offsets_held, 0) << "the default moves only the soles' heights";
+      EXPECT_EQ(offsets_held, 0) << "forces moves only the soles' heights";
       EXPECT_EQ(dcm_held, 0);
     }
   }
@@ -225,7 +224,7 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
   }
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "both"}}));
   EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}}))
-      << "the default push_balance needs no push_recovery";
+      << "the default push_balance (off) needs no push_recovery";
   EXPECT_TRUE(RefusalOfWalker({{"push_balance", ""}})) << "an empty push_balance";
   const std::optional<std::string> alone =
       RefusalOfWalker({{"push_balance", "damping"}, {"push_recovery", "false"}});
