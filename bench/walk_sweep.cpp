@@ -159,7 +159,13 @@ struct Run {
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.5f,%.5f,%.5f,%.4f,%d", s.foot_measured[i].x, s.foot_measured[i].y,
                    s.foot_measured[i].theta, s.foot_tilt[i], s.foot_contacts[i]);
-    std::fprintf(trace, ",%d,%d\n", s.steps_taken, s.recoveries);
+    std::fprintf(trace, ",%d,%d", s.steps_taken, s.recoveries);
+    // Then the push stop's count, each sole's roll and ankle offsets (roll,
+    // pitch), the force difference control's height (push_balance).
+    std::fprintf(trace, ",%d", s.push_stops);
+    for (int i = 0; i < 2; ++i)
+      std::fprintf(trace, ",%.4f,%.4f,%.4f", s.foot_roll[i], s.ankle_offset[i].x(), s.ankle_offset[i].y());
+    std::fprintf(trace, ",%.5f\n", s.force_difference);
   }
   void Panic() {
     d->Halt(done);
@@ -361,7 +367,8 @@ int Probe(const Args& args) {
           "zmp_ref_y,zmp_cmd_x,zmp_cmd_y,saturated,tilt,lfoot_x,lfoot_y,lfoot_th,lfoot_h,lfoot_f,"
           "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y,lmeas_x,lmeas_y,lmeas_th,ltilt,"
           "lcontacts,"
-          "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries\n");
+          "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
+          "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference\n");
     }
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);

@@ -73,6 +73,16 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       o.push_stop_feet != "keep" && o.push_stop_feet != "still") {
     r.Fail("push_stop_feet", "move, keep or still");
   }
+  if (r.Text("push_balance", &o.push_balance) && o.push_balance != "off" && o.push_balance != "both") {
+    const std::vector<std::string> parts = SplitPlus(o.push_balance);
+    if (parts.empty()) r.Fail("push_balance", "off, both, or damping, stabilizer and forces joined by '+'");
+    for (const std::string& part : parts) {
+      if (part != "damping" && part != "stabilizer" && part != "forces") {
+        r.Fail("push_balance", "off, both, or damping, stabilizer and forces joined by '+'");
+        break;
+      }
+    }
+  }
   r.Bool("foot_damping", &o.foot_damping);
   if (r.Text("gait", &o.gait) && o.gait != "fast" && o.gait != "slow") r.Fail("gait", "fast or slow");
   auto& go = o.gait_overrides;

@@ -61,6 +61,8 @@ struct WalkStatus {
   Eigen::Vector2d dcm_ref = Eigen::Vector2d::Zero();      ///< planned DCM, m
   Eigen::Vector2d zmp_command = Eigen::Vector2d::Zero();  ///< the stabilizer's ZMP, inside the support, m
   Eigen::Vector2d com_offset = Eigen::Vector2d::Zero();   ///< CoM reference minus the plan's (world axes), m
+  /// push_balance's forces: the left sole's target raised by half of it and the right's lowered, m
+  double force_difference = 0;
   int recoveries = 0;      ///< push recoveries so far (walking/push_recovery.h: the pattern regenerated)
   int push_stops = 0;      ///< walks stopped by a push so far (push_recovery's stop and stand)
   int push_captures = 0;   ///< push_capture=true: the capture stop's re-plans so far

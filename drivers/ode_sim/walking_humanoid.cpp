@@ -197,6 +197,19 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
   }
+  if (options.push_balance != "off" && !options.push_recovery) {
+    throw Error("OdeDriver: push_balance=" + options.push_balance +
+                " needs push_recovery=true (it acts while the push recovery's stop holds)");
+  }
+  {  // parts checked by the option parser: off, both, or damping/stabilizer/forces joined by '+'
+    const std::string& b = options.push_balance;
+    const auto has = [&](const char* part) { return b.find(part) != std::string::npos; };
+    w->push_damping_ = b == "both" || has("damping");
+    w->push_stabilizer_ = b == "both" || has("stabilizer");
+    if (has("forces")) {  // the loop's rate on the feet's sole springs (4 corners each)
+      w->push_forces_.emplace(step, walking::ForceDifferenceFor(4 * w->sole_spring_.stiffness, kForceRate));
+    }
+  }
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
   using StopFeet = walking::RecoveryParams::StopFeet;
@@ -205,7 +218,9 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
                                                            : StopFeet::kMove;
   if (options.push_recovery) w->recovery_.emplace(w->dcm_->omega(), step, recovery);
   if (options.push_recovery) w->com_estimate_.emplace(w->dcm_->omega(), step);
-  if (options.foot_damping) {  // the admittance from the sole's springs (walking/foot_damping.h)
+  w->damp_feet_ = options.foot_damping;
+  if (options.foot_damping ||
+      w->push_damping_) {  // the admittance from the sole's springs (walking/foot_damping.h)
     walking::FootDampingGains fg;
     fg.admittance = walking::AdmittanceFor(w->sole_spring_.stiffness, w->g_.foot_front + w->g_.foot_back);
     w->foot_damping_.emplace(model.total_mass() * gravity, step, fg);

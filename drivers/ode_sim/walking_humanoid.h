@@ -6,7 +6,8 @@
 // dcm_stabilizer.h: the measured CoM and centre of pressure move the CoM
 // reference and the swing foot's landing; options stabilizer,
 // step_adjustment; walking/foot_damping.h: the ankles yield to each sole's
-// centre-of-pressure error, option foot_damping), and fall
+// centre-of-pressure error, option foot_damping; push_balance: these and
+// foot force difference control only while a push's stop holds), and fall
 // detection. The root is a free ODE body: the robot stands on its contacts
 // and can fall.
 //
@@ -199,6 +200,14 @@ class WalkingHumanoid final : public BaseController {
   // as an offset of the planned CoM (plan frame), from the measured CoM.
   bool stabilize_ = true;
   bool adjust_steps_ = false;  // options.step_adjustment
+  // options.push_balance: foot damping / the stabilizer while a push's stop
+  // holds (PushRecovery::holding); stabilizing_ is whether it ran this tick.
+  bool push_damping_ = false, push_stabilizer_ = false, stabilizing_ = false;
+  bool PushHolding() const { return recovery_ && recovery_->holding(); }
+  // push_balance's forces: foot force difference control (walking/foot_damping.h).
+  std::optional<walking::ForceDifference> push_forces_;
+  /// Its loop rate (1/s) on the sole springs: the leg servos' 100/s is ten times faster.
+  static constexpr double kForceRate = 10.0;
   std::optional<walking::DcmStabilizer> dcm_;
   std::optional<walking::ComOffset> com_offset_;
   std::optional<walking::PushRecovery> recovery_;      // options.push_recovery
@@ -214,7 +223,8 @@ class WalkingHumanoid final : public BaseController {
   // The feet in the loop (options.foot_damping): each foot's measured
   // contact (its frame), its CoP in the world, and where it should press.
   void DampFeet(std::array<Eigen::Isometry3d, 2>* soles);
-  std::optional<walking::FootDamping> foot_damping_;
+  std::optional<walking::FootDamping> foot_damping_;  // options.foot_damping or push_balance's damping
+  bool damp_feet_ = false;                            // options.foot_damping
   std::array<walking::FootWrench, 2> foot_wrench_;
   std::array<Eigen::Vector2d, 2> foot_cop_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  // world
   walking::FootTargets foot_targets_;                       // plan frame's feet

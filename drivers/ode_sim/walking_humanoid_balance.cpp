@@ -57,14 +57,25 @@ void WalkingHumanoid::DampFeet(std::array<Eigen::Isometry3d, 2>* soles) {
   const std::array<Pose2, 2> feet{pattern_.foot(Side::kLeft), pattern_.foot(Side::kRight)};
   const std::array<bool, 2> down{pattern_.foot_height(Side::kLeft) <= 0,
                                  pattern_.foot_height(Side::kRight) <= 0};
-  const bool command = stabilize_ && tick_ >= settle_ticks_;
+  const bool command = stabilizing_;
   const walking::SoleRect sole{g_.foot_front, g_.foot_back, g_.foot_half_width};
   foot_targets_ =
       walking::DistributeZmp(command ? balance_.zmp : pattern_.zmp_ref(), feet, down, sole, kMargin);
+  if (push_forces_ && tick_ >= settle_ticks_) {  // push_balance's forces: the soles' heights
+    const double h =
+        PushHolding()
+            ? push_forces_->Update(foot_targets_.share, {foot_force_[0], foot_force_[1]}, down[0] && down[1])
+            : push_forces_->Relax();
+    (*soles)[0].translation().z() += 0.5 * h;
+    (*soles)[1].translation().z() -= 0.5 * h;
+  }
   if (!foot_damping_ || tick_ < settle_ticks_) return;
+  // push_balance's damping: only while a push's stop holds, then back to flat.
+  const bool damp = damp_feet_ || (push_damping_ && PushHolding());
   for (size_t s = 0; s < 2; ++s) {
+    const int i = static_cast<int>(s);
     const Eigen::Vector2d a =
-        foot_damping_->Update(static_cast<int>(s), foot_targets_.cop[s], foot_wrench_[s]);
+        damp ? foot_damping_->Update(i, foot_targets_.cop[s], foot_wrench_[s]) : foot_damping_->Relax(i);
     // Turn about the ankle (the sole target sits -z below it in the foot's frame).
     const double up = -soles_[s].z;
     Eigen::Isometry3d& t = (*soles)[s];
@@ -85,6 +96,7 @@ void WalkingHumanoid::Balance() {
   com_velocity_ += ((xy - com_world_prev_) / step_ - com_velocity_) * std::min(1.0, step_ / kComFilter);
   com_world_prev_ = xy;
   if (com_estimate_) com_estimate_->Update(xy, zmp_valid_ ? &zmp_measured_ : nullptr);
+  stabilizing_ = false;
   if (tick_ < settle_ticks_) return;
   const double c = std::cos(plan_to_world_.theta), s = std::sin(plan_to_world_.theta);
   const Eigen::Vector2d v(c * com_velocity_.x() + s * com_velocity_.y(),
@@ -99,7 +111,14 @@ void WalkingHumanoid::Balance() {
                           walking::Relocate(from, to, com_estimate_->com_velocity(), true)))
       com_offset_->Reset();
   }
-  if (!stabilize_) return;
+  // push_balance's stabilizer: only while a push's stop holds, then the
+  // CoM offset returns to the plan over kRelax.
+  constexpr double kRelax = 0.5;  // s
+  if (!stabilize_ && !(push_stabilizer_ && PushHolding())) {
+    if (push_stabilizer_) com_offset_->Relax(step_, kRelax);
+    return;
+  }
+  stabilizing_ = true;
   const Eigen::Vector2d cop = ToPlan({zmp_measured_.x(), zmp_measured_.y(), 0}).xy();
   std::array<Eigen::Vector2d, 16> support;
   const int n = pattern_.SupportPolygon(support);
@@ -170,14 +189,16 @@ walking::WalkStatus WalkingHumanoid::status() const {
     if (foot_damping_) s.ankle_offset[i] = foot_damping_->offset(i);
   }
   s.com = world_->LinkPose(model_.roots().front().link) * ik_.ComInPelvis(world_->q());
-  if (stabilize_ && tick_ >= settle_ticks_) {
+  if (stabilizing_) {
     s.dcm = ToWorld({balance_.dcm.x(), balance_.dcm.y(), 0}).xy();
     s.dcm_ref = ToWorld({balance_.dcm_ref.x(), balance_.dcm_ref.y(), 0}).xy();
     s.zmp_command = ToWorld({balance_.zmp.x(), balance_.zmp.y(), 0}).xy();
-    s.com_offset =
-        Pose2{0, 0, plan_to_world_.theta}.Apply(com_offset_->offset().x(), com_offset_->offset().y());
     s.saturated = balance_.saturated;
   }
+  if (push_forces_) s.force_difference = push_forces_->height();
+  // push_balance's stabilizer returns it to the plan after the hold.
+  s.com_offset =
+      Pose2{0, 0, plan_to_world_.theta}.Apply(com_offset_->offset().x(), com_offset_->offset().y());
   return s;
 }
 

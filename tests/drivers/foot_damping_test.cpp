@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -93,6 +94,80 @@ TEST(FootDamping, OffsetsAndTheirRatesAreBoundedAndAFootInTheAirTurnsFlat) {
   // Non-finite measurements count as no contact.
   u.Update(1, {0, 0}, {std::numeric_limits<double>::quiet_NaN(), {0, 0}});
   EXPECT_TRUE(u.offset(1).allFinite());
+}
+
+TEST(FootDamping, SwitchedOffTheOffsetReturnsToFlatOverTheLeakAndTheFootIsNotLanding) {
+  // push_balance=damping: the loop runs only while a push's stop holds;
+  // then Relax brings the ankle back to the IK's angle, smoothly.
+  const FootDampingGains g;
+  FootDamping d(kWeight, kTick, g);
+  for (int i = 0; i < 2000; ++i) d.Update(0, {0, 0}, {kWeight, {0.05, -0.03}});
+  const Eigen::Vector2d held = d.offset(0);
+  ASSERT_GT(held.cwiseAbs().minCoeff(), 0.01);
+  double worst_step = 0;
+  Eigen::Vector2d last = held;
+  for (int i = 0; i < static_cast<int>(g.leak / kTick); ++i) {
+    const Eigen::Vector2d now = d.Relax(0);
+    worst_step = std::max(worst_step, (now - last).cwiseAbs().maxCoeff());
+    last = now;
+  }
+  // exp(-1) after one leak time, each component toward 0 without crossing it.
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(last[k] / held[k], std::exp(-1.0), 0.01) << k;
+  EXPECT_LE(worst_step, g.max_rate * kTick + 1e-15);
+  for (int i = 0; i < 5000; ++i) d.Relax(0);
+  EXPECT_LT(d.offset(0).norm(), 1e-3);
+  EXPECT_FALSE(d.landing(0));
+  // Back on with the foot loaded on the ground: not a landing (no extra compliance).
+  d.Update(0, {0, 0}, {0.1 * kWeight, {0, 0}});
+  EXPECT_FALSE(d.landing(0));
+  EXPECT_THROW(d.Relax(2), std::invalid_argument);
+}
+
+// Foot force difference control on two feet standing on springs (k each,
+// a rigid body on them: the forces change by k times each sole's move):
+// the overloaded foot rises and the other presses down until the forces'
+// difference is the desired one; out of double support and switched off
+// it returns to 0.
+TEST(ForceDifference, TheFeetsHeightsBringTheForcesDifferenceToTheDesiredOne) {
+  constexpr double kStiff = 8e5, kRate = 10;
+  const ForceDifferenceGains g = ForceDifferenceFor(kStiff, kRate);
+  EXPECT_DOUBLE_EQ(g.admittance, kRate / kStiff);
+  ForceDifference f(kTick, g);
+  // Rolled onto the left foot: 400 N left, 115 N right, wanted half each.
+  const double left0 = 400, right0 = kWeight - left0;
+  std::array<double, 2> force{left0, right0};
+  for (int i = 0; i < 1000; ++i) {
+    const double h = f.Update({0.5, 0.5}, force, true);
+    force = {left0 - 0.5 * kStiff * h, right0 + 0.5 * kStiff * h};  // the left sole raised by h/2
+  }
+  EXPECT_GT(f.height(), 0) << "the overloaded left foot rises";
+  EXPECT_LE(f.height(), g.max_height);
+  // The leak leaves a small steady error: |e| = h / (A T_leak), under 20 % of the first.
+  EXPECT_LT(std::abs(force[0] - force[1]), 0.2 * (left0 - right0));
+  // The other way round: the right foot overloaded, the left lowered (h < 0).
+  ForceDifference r(kTick, g);
+  for (int i = 0; i < 100; ++i) r.Update({0.5, 0.5}, {100, 415}, true);
+  EXPECT_LT(r.height(), 0);
+  // Rates and bounds (a gain high enough to reach them).
+  ForceDifferenceGains high = g;
+  high.admittance = 1e-3;
+  ForceDifference b(kTick, high);
+  EXPECT_LE(std::abs(b.Update({0.5, 0.5}, {kWeight, 0}, true)), g.max_rate * kTick + 1e-15);
+  for (int i = 0; i < 2000; ++i) b.Update({0.5, 0.5}, {kWeight, 0}, true);
+  EXPECT_NEAR(b.height(), g.max_height, 1e-12);
+  // Single support: back to 0 over air_return.
+  for (int i = 0; i < 1000; ++i) b.Update({1, 0}, {kWeight, 0}, false);
+  EXPECT_LT(std::abs(b.height()), 1e-4);
+  // Switched off: back to 0 over the leak.
+  for (int i = 0; i < 2000; ++i) b.Update({0.5, 0.5}, {kWeight, 0}, true);
+  for (int i = 0; i < static_cast<int>(g.leak / kTick); ++i) b.Relax();
+  EXPECT_NEAR(b.height() / g.max_height, std::exp(-1.0), 0.01);
+  // Non-finite measurements count as out of double support; bad gains are refused.
+  EXPECT_TRUE(std::isfinite(b.Update({0.5, 0.5}, {std::numeric_limits<double>::quiet_NaN(), 0}, true)));
+  EXPECT_THROW(ForceDifference(0), std::invalid_argument);
+  EXPECT_THROW(ForceDifference(kTick, ForceDifferenceGains{.max_height = 0}), std::invalid_argument);
+  EXPECT_THROW(ForceDifferenceFor(-1, kRate), std::invalid_argument);
+  EXPECT_THROW(ForceDifferenceFor(kStiff, 0), std::invalid_argument);
 }
 
 TEST(FootDamping, ALandingFootIsCompliantUntilLoaded) {

@@ -170,6 +170,69 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   EXPECT_FALSE(RefusalOfWalker({{"push_stop_feet", "keep"}}));
 }
 
+// push_balance (off by default; docs/ode_sim.md, "Pushes"): the wiring —
+// walking unpushed nothing runs (no DCM reported, the ankles, the CoM
+// reference and the soles' heights the plan's); pushed, the named feedback
+// runs while the push's stop holds (forces: only the soles' force
+// difference height; all three: also the stabilizer's DCM, ankle and CoM
+// offsets) and afterwards returns to the plan. Bad settings are refused.
+TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
+  for (const char* which : {"forces", "damping+stabilizer+forces"}) {
+    const bool all = std::string(which) != "forces";
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    double unpushed = 0, held = 0, dcm_held = 0, offsets_held = 0;
+    const auto offsets = [&] {
+      const walking::WalkStatus s = *w.driver->walk_status();
+      return std::max({s.ankle_offset[0].norm(), s.ankle_offset[1].norm(), s.com_offset.norm()});
+    };
+    const auto feedback = [&] {
+      return std::max(offsets(), std::abs(w.driver->walk_status()->force_difference));
+    };
+    w.Run(5.14, [&] {
+      unpushed = std::max({unpushed, feedback(), w.driver->walk_status()->dcm.norm()});
+      return false;
+    });
+    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    w.Run(2.5, [&] {  // the hold: 3 s from the push
+      held = std::max(held, feedback());
+      offsets_held = std::max(offsets_held, offsets());
+      dcm_held = std::max(dcm_held, w.driver->walk_status()->dcm.norm());
+      return w.driver->walk_status()->fallen;
+    });
+    w.Run(3.5, [&] { return w.driver->walk_status()->fallen; });  // walking on, the offsets relaxed
+    const walking::WalkStatus s = *w.driver->walk_status();
+    EXPECT_FALSE(s.fallen) << which << ", tilt " << w.max_tilt;
+    EXPECT_EQ(s.push_stops, 1) << which;
+    EXPECT_EQ(unpushed, 0) << which << ": nothing runs before the push";
+    EXPECT_GT(held, 1e-4) << which << ": the feedback ran during the hold";
+    EXPECT_LT(feedback(), 0.2 * held) << which << ": back to the plan after the hold";
+    EXPECT_EQ(s.dcm.norm(), 0) << which << ": no stabilizer after the hold";
+    if (all) {
+      EXPECT_GT(offsets_held, 1e-3) << "the ankles' and CoM's offsets moved during the hold";
+      EXPECT_GT(dcm_held, 0) << "the stabilizer ran during the hold";
+    } else {
+      EXPECT_EQ(offsets_held, 0) << "forces moves only the soles' heights";
+      EXPECT_EQ(dcm_held, 0);
+    }
+  }
+  for (const char* wrong : {"hips", "damping+hips", "on"}) {
+    const std::optional<std::string> bad = RefusalOfWalker({{"push_balance", wrong}});
+    ASSERT_TRUE(bad) << "push_balance=" << wrong << " accepted";
+    EXPECT_NE(bad->find("push_balance"), std::string::npos) << *bad;
+  }
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "both"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}}))
+      << "the default push_balance (off) needs no push_recovery";
+  EXPECT_TRUE(RefusalOfWalker({{"push_balance", ""}})) << "an empty push_balance";
+  const std::optional<std::string> alone =
+      RefusalOfWalker({{"push_balance", "damping"}, {"push_recovery", "false"}});
+  ASSERT_TRUE(alone) << "push_balance without push_recovery accepted";
+  EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}}));
+}
+
 // Push recovery's stop during a GOTO (on by default): the walk stops, the
 // robot stands through the hold, then the GOTO re-plans from where the push
 // left it and still ends at its goal with SUCCESS (no reply before the hold

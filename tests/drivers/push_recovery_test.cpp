@@ -196,6 +196,7 @@ struct StopResult {
   double worst_jump = 0;      // m per tick of the reference ZMP
   double worst_impulse = 0;   // m/s, the estimator's, after the first second
   double worst_outside = 0;   // m the reference ZMP lay outside the support
+  int holding_wrong = 0;      // ticks holding() disagreed with Watch's kHold
 };
 
 StopResult WalkPushAndWatch(const Eigen::Vector2d& impulse_ns, double at, bool watch, double walk_for = 9.0) {
@@ -215,6 +216,7 @@ StopResult WalkPushAndWatch(const Eigen::Vector2d& impulse_ns, double at, bool w
   for (int i = 0; i < static_cast<int>((walk_for + 3.0) / kTick); ++i) {
     const PushRecovery::Walk walk = watch ? rec.Watch(w, est.impulse()) : PushRecovery::Walk::kOn;
     held = held || walk == PushRecovery::Walk::kHold;
+    if (rec.holding() != (walk == PushRecovery::Walk::kHold)) ++r.holding_wrong;
     if (w.time() < walk_for && walk != PushRecovery::Walk::kHold) {
       while (w.planned_ahead() < g.start_lead + 2 * g.step_period()) {  // SETSPEED's queue
         const WalkPattern::Splice sp = w.AppendPoint();
@@ -267,6 +269,7 @@ TEST(PushRecovery, APushSeenByTheEstimatorStopsTheWalkWhichGoesOnAfterTheHold) {
       EXPECT_LT(r.stood_at, at + 2 * g.step_period() + g.end_shift + 0.1)
           << what << ": stood within two steps";
       EXPECT_TRUE(r.walked_again) << what;
+      EXPECT_EQ(r.holding_wrong, 0) << what << ": holding() is the stop's hold";
       EXPECT_LT(r.worst_jump, 2e-3) << what << ": the reference ZMP is continuous";
       EXPECT_LT(r.worst_outside, 1e-9) << what << ": ... and inside the support";
       const StopResult open = WalkPushAndWatch(j, at, false);

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -538,6 +539,34 @@ TEST(ComOffset, WithThePlanTrackedTheOffsetReturnsToZeroAndMeasuredCopCorrectsAL
   EXPECT_LT(offset.velocity().x(), 0);
   EXPECT_THROW(ComOffset(0.0), std::invalid_argument);
   EXPECT_THROW(ComOffset(3.0, ComOffsetGains{.max_offset = -1}), std::invalid_argument);
+}
+
+TEST(ComOffset, SwitchedOffTheOffsetReturnsToThePlanSmoothly) {
+  // push_balance=stabilizer: the stabilizer runs only while a push's stop
+  // holds; then Relax takes its offset back to the plan over tau.
+  const DcmStabilizer s(0.6, 9.81);
+  ComOffset offset(s.omega());
+  DcmStabilizer::Output o;
+  o.zmp = Eigen::Vector2d(-0.05, 0.04);  // the command behind and left of the CoM: the reference moves
+  const Eigen::Vector2d zero = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 300; ++i) offset.Update(o, zero, zero, zero, nullptr, 1e-3);
+  const Eigen::Vector2d held = offset.offset();
+  ASSERT_GT(held.cwiseAbs().minCoeff(), 0.005);
+  constexpr double kTau = 0.5;
+  Eigen::Vector2d last = held;
+  double worst_step = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector2d now = offset.Relax(1e-3, kTau);
+    worst_step = std::max(worst_step, (now - last).cwiseAbs().maxCoeff());
+    last = now;
+  }
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(last[k] / held[k], std::exp(-1.0), 0.01) << k;
+  EXPECT_LE(worst_step, ComOffsetGains{}.max_speed * 1e-3 + 1e-15);
+  EXPECT_NEAR(offset.velocity().x(), -last.x() / kTau, 0.01 * std::abs(last.x() / kTau));
+  for (int i = 0; i < 5000; ++i) offset.Relax(1e-3, kTau);
+  EXPECT_LT(offset.offset().norm(), 1e-6);
+  EXPECT_THROW(offset.Relax(1e-3, 0), std::invalid_argument);
+  EXPECT_THROW(offset.Relax(-1e-3, kTau), std::invalid_argument);
 }
 
 TEST(LegIk, TheSimpleHumanoidsSolesReachTheirTargetsAndTheCoMIsAboveTheFeet) {

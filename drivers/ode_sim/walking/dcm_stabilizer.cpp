@@ -128,4 +128,12 @@ const Eigen::Vector2d& ComOffset::Update(const DcmStabilizer::Output& o, const E
   return offset_;
 }
 
+const Eigen::Vector2d& ComOffset::Relax(double dt, double tau) {
+  if (!(tau > 0) || !(dt >= 0))
+    throw std::invalid_argument("ComOffset::Relax: tau must be > 0 s and dt >= 0 s");
+  velocity_ = (-offset_ / tau).cwiseMax(-gains_.max_speed).cwiseMin(gains_.max_speed);
+  offset_ += velocity_ * dt;
+  return offset_;
+}
+
 }  // namespace robotalk::walking

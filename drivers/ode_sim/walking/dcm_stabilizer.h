@@ -96,6 +96,10 @@ class ComOffset {
   const Eigen::Vector2d& Update(const DcmStabilizer::Output& o, const Eigen::Vector2d& com,
                                 const Eigen::Vector2d& com_ref, const Eigen::Vector2d& zmp_ref,
                                 const Eigen::Vector2d* cop, double dt);
+  /// One control step of `dt` s without the stabilizer (switched off): the
+  /// offset returns to the plan exponentially over `tau` s (> 0), its
+  /// velocity that return's (no faster than max_speed). Returns the offset.
+  const Eigen::Vector2d& Relax(double dt, double tau);
   const Eigen::Vector2d& offset() const { return offset_; }
   const Eigen::Vector2d& velocity() const { return velocity_; }
 

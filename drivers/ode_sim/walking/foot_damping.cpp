@@ -115,4 +115,50 @@ const Eigen::Vector2d& FootDamping::Update(int foot, const Eigen::Vector2d& desi
   return off;
 }
 
+const Eigen::Vector2d& FootDamping::Relax(int foot) {
+  const size_t i = Index(foot);
+  const double r = gains_.max_rate;
+  offset_[i] += dt_ * (-offset_[i] / gains_.leak).cwiseMax(-r).cwiseMin(r);
+  landing_[i] = false;
+  in_contact_[i] = true;  // a foot on the ground when the loop comes back is not landing
+  return offset_[i];
+}
+
+ForceDifferenceGains ForceDifferenceFor(double stiffness, double rate) {
+  if (!(std::isfinite(stiffness) && stiffness > 0) || !(std::isfinite(rate) && rate > 0))
+    throw std::invalid_argument("ForceDifferenceFor: stiffness and rate must be > 0");
+  ForceDifferenceGains g;
+  // h moves each foot by h/2: the difference of forces changes by stiffness * h.
+  g.admittance = rate / stiffness;
+  return g;
+}
+
+ForceDifference::ForceDifference(double dt, ForceDifferenceGains gains) : dt_(dt), gains_(gains) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(dt)) throw std::invalid_argument("ForceDifference: dt must be > 0 s");
+  if (!positive(gains.admittance) || !positive(gains.leak) || !positive(gains.air_return) ||
+      !positive(gains.max_height) || !positive(gains.max_rate)) {
+    throw std::invalid_argument(
+        "ForceDifference: admittance, leak, air_return, max_height and max_rate must be > 0");
+  }
+}
+
+double ForceDifference::Move(double rate) {
+  h_ += dt_ * std::clamp(rate, -gains_.max_rate, gains_.max_rate);
+  h_ = std::clamp(h_, -gains_.max_height, gains_.max_height);
+  return h_;
+}
+
+double ForceDifference::Update(const std::array<double, 2>& share, const std::array<double, 2>& force,
+                               bool double_support) {
+  const bool valid = std::isfinite(share[0]) && std::isfinite(share[1]) && std::isfinite(force[0]) &&
+                     std::isfinite(force[1]);
+  if (!double_support || !valid) return Move(-h_ / gains_.air_return);
+  const double total = force[0] + force[1];
+  const double error = (force[0] - force[1]) - (share[0] - share[1]) * total;
+  return Move(gains_.admittance * error - h_ / gains_.leak);
+}
+
+double ForceDifference::Relax() { return Move(-h_ / gains_.leak); }
+
 }  // namespace robotalk::walking

@@ -105,6 +105,10 @@ class FootDamping {
   /// One control step of foot `foot` (0 left, 1 right) from its desired CoP
   /// (foot frame) and its measured contact; returns its (roll, pitch) offset.
   const Eigen::Vector2d& Update(int foot, const Eigen::Vector2d& desired_cop, const FootWrench& measured);
+  /// One control step of foot `foot` without damping (the loop switched
+  /// off): its offset returns to flat over `leak` (no faster than max_rate);
+  /// returns it.
+  const Eigen::Vector2d& Relax(int foot);
   const Eigen::Vector2d& offset(int foot) const { return offset_[Index(foot)]; }
   /// Touched down and not yet carrying `loaded` of the weight.
   bool landing(int foot) const { return landing_[Index(foot)]; }
@@ -118,6 +122,52 @@ class FootDamping {
   FootDampingGains gains_;
   std::array<Eigen::Vector2d, 2> offset_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   std::array<bool, 2> landing_{false, false}, in_contact_{true, true};
+};
+
+/// Foot force difference control (Kajita et al. 2010, section III.E; the
+/// LIPM walking controller's "dfz" loop): in double support the feet's
+/// heights move apart so that the difference of their normal forces follows
+/// the desired one (the shares of DistributeZmp times the measured total):
+///   d(h)/dt = A ((f_l - f_r) - (f_l,d - f_r,d)) - h / T_leak,
+/// the left sole raised by h/2 and the right lowered by h/2: an overloaded
+/// foot yields and an unloaded one presses down, so the stance cannot roll
+/// onto one foot's edge with the other foot lifted (the ODE walker's fall
+/// after a push's stop: docs/ode_sim.md, "Pushes"). Out of double support h
+/// returns to 0 over `air_return`.
+struct ForceDifferenceGains {
+  /// m/s per N of force difference error. The loop's rate is A times the
+  /// feet's vertical stiffness (the sole springs): ForceDifferenceFor.
+  double admittance = 1.25e-5;
+  double leak = 1.0;         ///< s: h's leak toward 0 in double support
+  double air_return = 0.1;   ///< s: h's return to 0 out of double support
+  double max_height = 0.02;  ///< m: bound of |h|
+  double max_rate = 0.1;     ///< m/s: bound of |dh/dt|
+};
+
+/// The force difference gains for feet on `stiffness` (N/m, each foot's
+/// vertical stiffness: its contact springs together), the loop's rate
+/// `rate` (1/s, > 0). stiffness, rate > 0, else std::invalid_argument.
+ForceDifferenceGains ForceDifferenceFor(double stiffness, double rate);
+
+class ForceDifference {
+ public:
+  /// dt (s) > 0 and gains positive, else std::invalid_argument.
+  explicit ForceDifference(double dt, ForceDifferenceGains gains = {});
+  /// One control step: `share` the desired fractions of the weight of the
+  /// left and right foot (DistributeZmp), `force` their measured normal
+  /// forces (N), `double_support` both feet planned on the ground. Returns h
+  /// (m): the left sole's target raised by h/2, the right's lowered by h/2.
+  double Update(const std::array<double, 2>& share, const std::array<double, 2>& force, bool double_support);
+  /// One step with the loop switched off: h returns to 0 over `leak`.
+  double Relax();
+  double height() const { return h_; }
+  const ForceDifferenceGains& gains() const { return gains_; }
+
+ private:
+  double Move(double rate);
+  double dt_;
+  ForceDifferenceGains gains_;
+  double h_ = 0;
 };
 
 }  // namespace robotalk::walking

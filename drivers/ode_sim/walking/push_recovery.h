@@ -140,6 +140,9 @@ class PushRecovery {
   Walk Watch(WalkPattern& pattern, const Eigen::Vector2d& impulse);
   /// Walks stopped by a push so far.
   int stops() const { return stops_; }
+  /// Watch's stop holds: from a push's stop until the walk goes on (the
+  /// stop's steps and the stance after them).
+  bool holding() const { return hold_ > 0; }
   /// With capture_stop: the capture stop's re-plans so far (Update returns
   /// true for each; every `interval` from the stop until its last step lands).
   int captures() const { return captures_; }
