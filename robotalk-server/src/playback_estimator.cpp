@@ -76,6 +76,20 @@ std::vector<PlaybackEstimator::Seen> PlaybackEstimator::SeenPackages() const {
   return seen;
 }
 
+bool PlaybackEstimator::ArrivedInSendOrder(const std::vector<Seen>& seen) {
+  // Each package's send time is its arrival − its delay (both on the server
+  // clock, less the constant offset); in arrival order they must not go back.
+  std::vector<std::pair<TimePoint, TimePoint>> order;  // arrival, send time
+  for (const Seen& p : seen) {
+    if (!p.known_arrival) return false;
+    order.push_back({p.arrival, p.arrival - p.delay});
+  }
+  std::sort(order.begin(), order.end());
+  for (std::size_t j = 1; j < order.size(); ++j)
+    if (order[j].second < order[j - 1].second) return false;
+  return !order.empty();
+}
+
 PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
   const std::vector<Seen> seen = SeenPackages();
   Channel measured;
@@ -86,7 +100,13 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     return ToSeconds(*hi - *lo);
   };
   const double gate = Gate();
-  if (spread(measured.delays) <= gate) return measured;
+  // Within the gate too where the link is FIFO: the burst's own queue then
+  // overstates the worst delay a frame meets (issue 23, seventh session: at
+  // U[0, 50] starts of 1.4 to 2 times the hindsight minimum). A jittery
+  // link reorders a burst sent a millisecond apart, and its spread is the
+  // jitter frames meet too: there only where the gate needs it.
+  const bool fifo = options_.burst_wait_discount_fifo && ArrivedInSendOrder(seen);
+  if (!fifo && spread(measured.delays) <= gate) return measured;
   // A client's connect-time packages (hello, clock, heartbeat) leave within a
   // millisecond; on a congested FIFO link each waits for the one before it to
   // get through, so their delays add up the services before them: a spread
@@ -110,11 +130,11 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     const Duration wait = seen[j - 1].arrival - (sent + least);
     discounted.delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
   }
-  // Only where that brings the spread within the gate, or where a queue
-  // beyond it may be followed (follow_queue: its start covers the channel's
-  // delays, not the burst's own queue); else as measured.
+  // Only on a FIFO link, where that brings the spread within the gate, or
+  // where a queue beyond it may be followed (follow_queue: its start covers
+  // the channel's delays, not the burst's own queue); else as measured.
   const bool follows = options_.follow_queue && !options_.queue_start;
-  return spread(discounted.delays) <= gate || follows ? discounted : measured;
+  return fifo || spread(discounted.delays) <= gate || follows ? discounted : measured;
 }
 
 bool PlaybackEstimator::burst_discounted() const { return ChannelDelays().discounted; }

@@ -48,9 +48,20 @@
 // The connect burst (burst_wait_discount, on): a client's hello, clock and
 // heartbeat leave together and, on a congested FIFO link, wait behind each
 // other, a spread its frames (one interval apart) do not meet. Where the
-// delays as measured exceed the gate, each package sent less than a frame
-// interval after the one before it counts without that wait (ChannelDelays);
-// if the gate then passes, the adaptive start decides from those delays.
+// delays as measured exceed the gate, or every package seen arrived in the
+// order it was sent (a FIFO link; burst_wait_discount_fifo), each package
+// sent less than a frame interval after the one before it counts without
+// that wait (ChannelDelays); if the gate then passes, the adaptive start
+// decides from those delays.
+//
+// Queue follow (issue 23 item 3, seventh session; follow_queue, on): beyond
+// the gate, where the server handled every package seen within one gap's
+// stretch of its arrival at the socket (the queue is the link's, not the
+// server's own, as in the paper's Fig. 11) and the services read off them
+// (Services) average at most (1 + max_stretch) intervals, the adaptive start
+// decides at the first frame without the 2.5 × excess, and the playout delay
+// is QueueWorst: the schedule stretches each gap (within max_stretch) until
+// the buffer covers the simulated queue.
 //
 // Queue start (issue 23 item 3; `queue_start`, off by default): beyond
 // `adaptive_max_spread` intervals the delays are a queue's (a congested link),
@@ -145,6 +156,11 @@ struct PlaybackEstimatorOptions {
   /// the spread and the worst delay where the delays as measured exceed
   /// adaptive_max_spread (see ChannelDelays). Off: every delay as measured.
   bool burst_wait_discount = true;
+  /// And within the gate too where every package seen arrived in the order
+  /// it was sent (a FIFO link: the burst's own queue is no delay a frame
+  /// meets; a jittery link reorders a burst, and there its spread is
+  /// jitter). Off: only where the delays as measured exceed the gate.
+  bool burst_wait_discount_fifo = true;
   /// Beyond adaptive_max_spread, a queue the stretch can follow (see above,
   /// "Queue follow"): the adaptive start (without the spread's 2.5 × excess)
   /// and a playout delay that covers the simulated queue, which the schedule
@@ -270,7 +286,7 @@ class PlaybackEstimator {
   // `lead`: that much earlier, but never before the decision + margin.
   TimePoint StartCovering(Duration worst, Duration margin, Duration lead = Duration(0)) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
-  Duration QueueWorst() const;                    // REQUIRES: queued()
+  Duration QueueWorst() const;                    // REQUIRES: queued() or followed()
   std::vector<double> Services() const;           // s, of the packages seen; REQUIRES: delay_spread()
   TimePoint PaperStart() const;                   // the paper's estimate
   bool QueueFollowable(double z) const;           // REQUIRES: delay_spread()
@@ -301,6 +317,7 @@ class PlaybackEstimator {
     bool discounted = false;
   };
   Channel ChannelDelays() const;
+  static bool ArrivedInSendOrder(const std::vector<Seen>& seen);
 
   double interval() const;  // the declared mean frame interval, s
   std::size_t total_;

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <vector>
 
@@ -151,6 +152,48 @@ TEST(FollowQueue, OnTheRelaysHeaviestCongestionMostRunsMeetTheGoalAndNoOtherChan
                 on.late_runs);
     EXPECT_EQ(on.late_runs, off.late_runs) << "burst " << burst;
   }
+}
+
+// Four connect-time packages sent at one instant through a link: delays 1,
+// 21, 41, 61 ms, arriving `sends` ms after that instant + their delay (all
+// 0: each waited 20 ms behind the one before it, a FIFO link's burst).
+PlaybackEstimator AfterABurst(const std::vector<int>& sends, PlaybackEstimatorOptions options = {}) {
+  const TimePoint burst = kT0 - std::chrono::seconds(2);
+  std::vector<DelayHistory::Sample> history;
+  for (int j = 0; j < 4; ++j) {
+    const Duration delay = milliseconds(1 + 20 * j);
+    history.push_back({burst + milliseconds(sends[static_cast<std::size_t>(j)]) + delay, delay});
+  }
+  std::sort(history.begin(), history.end(),
+            [](const auto& a, const auto& b) { return a.received < b.received; });  // as handled
+  PlaybackEstimator est(40, milliseconds(3900), options);
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  return est;
+}
+
+TEST(BurstOnAFifoLink, ItsOwnQueueIsLeftOutWithinTheGateToo) {
+  // The delays spread by 60 ms, within the gate: before, the start covered
+  // the burst's last package, 61 ms + 60 ms / 5, less frame 0's 1 ms and the
+  // 10 ms lead, + 2 ms: 64 ms, where frames 100 ms apart meet no such queue
+  // (U[0, 50] relay runs: starts 1.4 to 2 times the hindsight minimum).
+  const PlaybackEstimator before = AfterABurst({0, 0, 0, 0}, {.burst_wait_discount_fifo = false});
+  ASSERT_TRUE(before.adaptive());
+  EXPECT_NEAR(ToSeconds(before.StartTime() - kT0), 0.061 + 0.060 / 5 - 0.001 - 0.010 + 0.002, 1e-6);
+  // Now: each package less its wait behind the one before it (20, 40 ms):
+  // delays 1, 21, 21, 21 and frame 0's 1 ms: the worst 21 ms + 20 ms / 5.
+  const PlaybackEstimator est = AfterABurst({0, 0, 0, 0});
+  ASSERT_TRUE(est.adaptive());
+  EXPECT_TRUE(est.burst_discounted());
+  EXPECT_EQ(est.delay_spread(), milliseconds(20));
+  EXPECT_NEAR(ToSeconds(est.StartTime() - kT0), 0.021 + 0.020 / 5 - 0.001 - 0.010 + 0.002, 1e-6);
+  // The same delays where the packages overtook each other (sent 3, 2, 1, 0
+  // ms after the instant, arriving in the other order): no FIFO link, the
+  // spread is jitter a frame may meet too: as measured.
+  const PlaybackEstimator jitter = AfterABurst({3, 2, 1, 0});
+  EXPECT_FALSE(jitter.burst_discounted());
+  EXPECT_EQ(jitter.delay_spread(), milliseconds(60));
+  EXPECT_NEAR(ToSeconds(jitter.StartTime() - kT0), 0.061 + 0.060 / 5 - 0.001 - 0.010 + 0.002, 1e-6);
 }
 
 }  // namespace
