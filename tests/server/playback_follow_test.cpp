@@ -27,18 +27,13 @@ Goal Runs(const Channel& channel, PlaybackEstimatorOptions options, std::size_t 
           std::size_t frames = 40) {
   Goal g;
   std::vector<double> ratios;
-  for (int seed = 1; seed <= runs; ++seed) {
-    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-    const SimRun r = Simulate(
-        frames, milliseconds(100), burst > 0 ? burst : 10,
-        [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); }, options, burst > 0,
-        channel.server_lag.get());
+  ForEachRun(runs, channel, options, frames, burst, [&](const SimRun& r) {
     g.late_runs += r.late > 0;
     const double ratio = ToSeconds(r.start_delay) / ToSeconds(r.hindsight + kMargin);
     ratios.push_back(ratio);
     g.met += r.late == 0 && ratio <= 1.25;
     g.worst_stretch = std::max(g.worst_stretch, r.stretch);
-  }
+  });
   std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
   g.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
   return g;
@@ -54,10 +49,7 @@ PlaybackEstimator OnAQueue(Duration server_lag, PlaybackEstimatorOptions options
     const Duration delay = FromSeconds((1 + 150.0 * j / 9) / 1000.0);
     history.push_back({kT0 - milliseconds(2000 - 200 * j) + delay, delay, server_lag});
   }
-  PlaybackEstimator est(40, milliseconds(3900), options);
-  est.SetDelayHistory(history);
-  est.Add(Duration(0), kT0, kT0 - milliseconds(1), server_lag);
-  return est;
+  return AtFirstFrame(history, options, server_lag);
 }
 
 TEST(FollowQueue, AQueueOnTheLinkBeyondTheGateStartsAtTheFirstFrameAndTheStretchGrowsTheBufferToIt) {
@@ -108,9 +100,7 @@ TEST(FollowQueue, TheServersOwnLagIsNotFollowedAndNeitherIsAChannelSlowerThanThe
   // 10 % stretch cannot follow: the paper's estimate.
   std::vector<Duration> history;
   for (int j = 0; j < 10; ++j) history.push_back(milliseconds(1 + 250 * j / 9));
-  PlaybackEstimator slow(40, milliseconds(3900));
-  slow.SetDelayHistory(history);
-  slow.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  const PlaybackEstimator slow = AtFirstFrame(history);
   EXPECT_FALSE(slow.adaptive());
   EXPECT_FALSE(slow.ready());
 }
@@ -166,10 +156,7 @@ PlaybackEstimator AfterABurst(const std::vector<int>& sends, PlaybackEstimatorOp
   }
   std::sort(history.begin(), history.end(),
             [](const auto& a, const auto& b) { return a.received < b.received; });  // as handled
-  PlaybackEstimator est(40, milliseconds(3900), options);
-  est.SetDelayHistory(history);
-  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
-  return est;
+  return AtFirstFrame(history, options);
 }
 
 TEST(BurstOnAFifoLink, ItsOwnQueueIsLeftOutWithinTheGateToo) {

@@ -119,24 +119,50 @@ struct Channel {
     return delay(rng, k, sent);
   }
 };
+// Seeds 1 to `runs` of `channel`: `frames` at 10 Hz after 10 connect-time
+// round trips, or a burst of `burst` packages; each run to `each`.
+inline void ForEachRun(int runs, const Channel& channel, PlaybackEstimatorOptions options, std::size_t frames,
+                       std::size_t burst, const std::function<void(const SimRun&)>& each) {
+  for (int seed = 1; seed <= runs; ++seed) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    each(Simulate(
+        frames, milliseconds(100), burst > 0 ? burst : 10,
+        [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); }, options, burst > 0,
+        channel.server_lag.get()));
+  }
+}
+
 inline Summary Many(int runs, const Channel& channel, PlaybackEstimatorOptions options = {},
                     std::size_t frames = 40, std::size_t burst = 0) {
   Summary s;
   std::vector<double> ratios;
-  for (int seed = 1; seed <= runs; ++seed) {
-    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-    const SimRun r = Simulate(
-        frames, milliseconds(100), burst > 0 ? burst : 10,
-        [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); }, options, burst > 0,
-        channel.server_lag.get());
+  ForEachRun(runs, channel, options, frames, burst, [&](const SimRun& r) {
     s.late_frames += r.late;
     if (r.late > 0) ++s.late_runs;
     s.worst_stretch = std::max(s.worst_stretch, r.max_gap_stretch);
     ratios.push_back(ToSeconds(r.start_delay) / ToSeconds(r.hindsight + kMargin));
-  }
+  });
   std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
   s.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
   return s;
+}
+
+// A 40-frame sequence at 10 Hz whose frame 0 took 1 ms, arrived at kT0 and
+// was handled `server_lag` after it reached the socket, after `history`.
+inline PlaybackEstimator AtFirstFrame(const std::vector<DelayHistory::Sample>& history,
+                                      PlaybackEstimatorOptions options = {},
+                                      Duration server_lag = Duration(0)) {
+  PlaybackEstimator est(40, milliseconds(3900), options);
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1), server_lag);
+  return est;
+}
+inline PlaybackEstimator AtFirstFrame(const std::vector<Duration>& history,
+                                      PlaybackEstimatorOptions options = {}) {
+  PlaybackEstimator est(40, milliseconds(3900), options);
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  return est;
 }
 
 inline Duration Uniform(std::mt19937_64& rng, double lo_ms, double hi_ms) {

@@ -396,9 +396,7 @@ TEST(AdaptivePlayback, AConnectBurstThatQueuedBehindItselfOnAFifoLinkGetsTheAdap
   sparse.Add(Duration(0), kT0, kT0 - milliseconds(1));
   EXPECT_FALSE(sparse.adaptive());
   EXPECT_FALSE(sparse.ready());
-  PlaybackEstimator followed(40, milliseconds(3900));
-  followed.SetDelayHistory(paced);
-  followed.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  const PlaybackEstimator followed = AtFirstFrame(paced);
   EXPECT_TRUE(followed.followed());
   EXPECT_TRUE(followed.ready());
 }
