@@ -401,6 +401,8 @@ class Bench:
                     # both options: the queue start decides where the 50 % stretch can follow the queue
                     ("adaptive_stretch50_queue", adaptive + ["--playback-stretch", "0.5", "--playback-queue-start", "on"],
                      ["--stretch-bound", "0.5"], 2.0, None))
+        # the default before a queue beyond the gate was followed (issue 23, seventh session)
+        variants += (("adaptive_follow_off", adaptive + ["--playback-follow-queue", "off"], [], 2.0, None),)
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
         # robotalk-server ("adaptive_before_build"): a code change's before and after on the same
         # relay seeds and under the same load, interleaved.

@@ -23,10 +23,11 @@ std::optional<Duration> OneWayDelay(TimePoint sent, TimePoint arrival) {
   return Duration(d);
 }
 
-void DelayHistory::Add(TimePoint sent, TimePoint received) {
+void DelayHistory::Add(TimePoint sent, TimePoint received, std::optional<TimePoint> arrived) {
   const std::optional<Duration> d = OneWayDelay(sent, received);
   if (!d) return;
-  ring_[next_] = {received, *d};
+  const Duration lag = arrived && *arrived < received ? received - *arrived : Duration(0);
+  ring_[next_] = {received, *d, lag};
   next_ = (next_ + 1) % kCapacity;
   size_ = std::min(size_ + 1, kCapacity);
 }
@@ -50,14 +51,16 @@ std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const
 void PlaybackEstimator::SetDelayHistory(const std::vector<DelayHistory::Sample>& samples) {
   history_.clear();
   history_received_.clear();
+  history_lag_.clear();
   for (const DelayHistory::Sample& s : samples) {
     history_.push_back(s.delay);
     history_received_.push_back(s.received);
+    history_lag_.push_back(s.lag);
   }
 }
 
-void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent) {
-  frames_.push_back({offset, arrival, sent ? OneWayDelay(*sent, arrival) : std::nullopt});
+void PlaybackEstimator::Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent, Duration lag) {
+  frames_.push_back({offset, arrival, sent ? OneWayDelay(*sent, arrival) : std::nullopt, lag});
 }
 
 std::vector<PlaybackEstimator::Seen> PlaybackEstimator::SeenPackages() const {
@@ -73,6 +76,20 @@ std::vector<PlaybackEstimator::Seen> PlaybackEstimator::SeenPackages() const {
   return seen;
 }
 
+bool PlaybackEstimator::ArrivedInSendOrder(const std::vector<Seen>& seen) {
+  // Each package's send time is its arrival − its delay (both on the server
+  // clock, less the constant offset); in arrival order they must not go back.
+  std::vector<std::pair<TimePoint, TimePoint>> order;  // arrival, send time
+  for (const Seen& p : seen) {
+    if (!p.known_arrival) return false;
+    order.push_back({p.arrival, p.arrival - p.delay});
+  }
+  std::sort(order.begin(), order.end());
+  for (std::size_t j = 1; j < order.size(); ++j)
+    if (order[j].second < order[j - 1].second) return false;
+  return !order.empty();
+}
+
 PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
   const std::vector<Seen> seen = SeenPackages();
   Channel measured;
@@ -83,7 +100,13 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     return ToSeconds(*hi - *lo);
   };
   const double gate = Gate();
-  if (spread(measured.delays) <= gate) return measured;
+  // Within the gate too where the link is FIFO: the burst's own queue then
+  // overstates the worst delay a frame meets (issue 23, seventh session: at
+  // U[0, 50] starts of 1.4 to 2 times the hindsight minimum). A jittery
+  // link reorders a burst sent a millisecond apart, and its spread is the
+  // jitter frames meet too: there only where the gate needs it.
+  const bool fifo = options_.burst_wait_discount_fifo && ArrivedInSendOrder(seen);
+  if (!fifo && spread(measured.delays) <= gate) return measured;
   // A client's connect-time packages (hello, clock, heartbeat) leave within a
   // millisecond; on a congested FIFO link each waits for the one before it to
   // get through, so their delays add up the services before them: a spread
@@ -107,8 +130,11 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     const Duration wait = seen[j - 1].arrival - (sent + least);
     discounted.delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
   }
-  // Only where that brings the spread within the gate; else as measured.
-  return spread(discounted.delays) <= gate ? discounted : measured;
+  // Only on a FIFO link, where that brings the spread within the gate, or
+  // where a queue beyond it may be followed (follow_queue: its start covers
+  // the channel's delays, not the burst's own queue); else as measured.
+  const bool follows = options_.follow_queue && !options_.queue_start;
+  return fifo || spread(discounted.delays) <= gate || follows ? discounted : measured;
 }
 
 bool PlaybackEstimator::burst_discounted() const { return ChannelDelays().discounted; }
@@ -163,10 +189,34 @@ double PlaybackEstimator::Gate() const {
 
 bool PlaybackEstimator::adaptive() const {
   if (!options_.adaptive || !delay_spread()) return false;
-  return SpreadWithinGate() || (options_.queue_start && QueueFollowable());
+  if (SpreadWithinGate()) return true;
+  if (options_.queue_start) return QueueFollowable(options_.confidence_z);
+  return options_.follow_queue && ServerKeptUp() && QueueFollowable(options_.follow_z);
 }
 
-bool PlaybackEstimator::QueueFollowable() const {
+bool PlaybackEstimator::followed() const {
+  return !options_.queue_start && adaptive() && !SpreadWithinGate();
+}
+
+Duration PlaybackEstimator::followed_queue() const {
+  return *playout_delay() - options_.adaptive_margin - FencedSpread()->least;
+}
+
+bool PlaybackEstimator::ServerKeptUp() const {
+  // The server's own lag handling a package (handled − reached the socket)
+  // is a queue in front of the playback that the link's services do not
+  // show: the paper's Fig. 11 pauses the server after each package, 8
+  // packages a second against 10 frames, a drift the stretch cannot follow.
+  const Duration bound =
+      FromSeconds(std::max(0.0, options_.follow_max_lag) * std::max(0.0, options_.max_stretch) * interval());
+  for (Duration lag : history_lag_)
+    if (lag > bound) return false;
+  for (const Frame& f : frames_)
+    if (f.lag > bound) return false;
+  return true;
+}
+
+bool PlaybackEstimator::QueueFollowable(double z) const {
   // The frames' queue drifts by (mean service - T) a frame, which the
   // stretch follows up to max_stretch × T. A channel that may be slower than
   // that (the mean's upper confidence bound, of the few services seen) gets
@@ -179,7 +229,7 @@ bool PlaybackEstimator::QueueFollowable() const {
   for (double x : s) mean += x / n;
   for (double x : s) var += (x - mean) * (x - mean);
   const double sd = s.size() > 1 ? std::sqrt(var / (n - 1)) : mean;
-  return mean + options_.confidence_z * sd / std::sqrt(n) <= interval() * (1.0 + options_.max_stretch);
+  return mean + z * sd / std::sqrt(n) <= interval() * (1.0 + options_.max_stretch);
 }
 
 bool PlaybackEstimator::ready() const {
@@ -194,7 +244,7 @@ bool PlaybackEstimator::ready() const {
   return StartTime() - latest < FromSeconds(interval());
 }
 
-bool PlaybackEstimator::queued() const { return adaptive() && !SpreadWithinGate(); }
+bool PlaybackEstimator::queued() const { return options_.queue_start && adaptive() && !SpreadWithinGate(); }
 
 std::vector<double> PlaybackEstimator::Services() const {
   // The packages seen (the history's and the frames'), in arrival order. On a
@@ -281,15 +331,22 @@ Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
   // sparse packages never met: it is covered quick_jitter_factor times.
   // With a wider stretch than the default, the threshold moves up with the
   // gate (see Gate()): the stretch follows what lies below it.
+  // A followed queue (beyond the gate) is covered by the playout delay the
+  // stretch grows to (playout_delay), not by the start.
   const double excess =
-      std::max(0.0, ToSeconds(spread) - (options_.quick_max_spread + WiderStretch()) * interval());
+      followed()
+          ? 0.0
+          : std::max(0.0, ToSeconds(spread) - (options_.quick_max_spread + WiderStretch()) * interval());
   return s.most + FromSeconds(excess * options_.quick_jitter_factor +
                               ToSeconds(spread) * headroom / static_cast<double>(s.kept));
 }
 
 std::optional<Duration> PlaybackEstimator::playout_delay() const {
   if (!adaptive()) return std::nullopt;
-  return AdaptiveWorst(options_.adaptive_headroom) + options_.adaptive_margin;
+  const Duration worst = AdaptiveWorst(options_.adaptive_headroom);
+  // A followed queue: the worst delay of its simulated sequences, which the
+  // schedule reaches by stretching each gap (at most max_stretch of it).
+  return (followed() ? std::max(worst, QueueWorst()) : worst) + options_.adaptive_margin;
 }
 
 Duration PlaybackEstimator::start_lead() const {

@@ -48,9 +48,20 @@
 // The connect burst (burst_wait_discount, on): a client's hello, clock and
 // heartbeat leave together and, on a congested FIFO link, wait behind each
 // other, a spread its frames (one interval apart) do not meet. Where the
-// delays as measured exceed the gate, each package sent less than a frame
-// interval after the one before it counts without that wait (ChannelDelays);
-// if the gate then passes, the adaptive start decides from those delays.
+// delays as measured exceed the gate, or every package seen arrived in the
+// order it was sent (a FIFO link; burst_wait_discount_fifo), each package
+// sent less than a frame interval after the one before it counts without
+// that wait (ChannelDelays); if the gate then passes, the adaptive start
+// decides from those delays.
+//
+// Queue follow (issue 23 item 3, seventh session; follow_queue, on): beyond
+// the gate, where the server handled every package seen within one gap's
+// stretch of its arrival at the socket (the queue is the link's, not the
+// server's own, as in the paper's Fig. 11) and the services read off them
+// (Services) average at most (1 + max_stretch) intervals, the adaptive start
+// decides at the first frame without the 2.5 × excess, and the playout delay
+// is QueueWorst: the schedule stretches each gap (within max_stretch) until
+// the buffer covers the simulated queue.
 //
 // Queue start (issue 23 item 3; `queue_start`, off by default): beyond
 // `adaptive_max_spread` intervals the delays are a queue's (a congested link),
@@ -145,6 +156,26 @@ struct PlaybackEstimatorOptions {
   /// the spread and the worst delay where the delays as measured exceed
   /// adaptive_max_spread (see ChannelDelays). Off: every delay as measured.
   bool burst_wait_discount = true;
+  /// And within the gate too where every package seen arrived in the order
+  /// it was sent (a FIFO link: the burst's own queue is no delay a frame
+  /// meets; a jittery link reorders a burst, and there its spread is
+  /// jitter). Off: only where the delays as measured exceed the gate.
+  bool burst_wait_discount_fifo = true;
+  /// Beyond adaptive_max_spread, a queue the stretch can follow (see above,
+  /// "Queue follow"): the adaptive start (without the spread's 2.5 × excess)
+  /// and a playout delay that covers the simulated queue, which the schedule
+  /// reaches by stretching the gaps. Off: the paper's estimate there (or the
+  /// queue start, with queue_start).
+  bool follow_queue = true;
+  /// The queue is followed only where the server handled every package seen
+  /// within this many gaps' stretch (max_stretch × the mean frame interval
+  /// each) of its arrival at the socket: a server that lags behind its own
+  /// input (the paper's Fig. 11 pauses after each package) is a queue whose
+  /// drift its sparse packages do not show.
+  double follow_max_lag = 1.0;
+  /// The queue's mean service may be at most (1 + max_stretch) intervals at
+  /// mean + follow_z × its standard error (the queue start uses confidence_z).
+  double follow_z = 0.0;
 };
 
 /// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
@@ -160,10 +191,13 @@ class DelayHistory {
   struct Sample {
     TimePoint received;
     Duration delay;
+    Duration lag{0};  ///< handled − reached the socket (the server's own lag)
   };
-  /// Records one package; a send time whose difference to `received` does
-  /// not fit is ignored (a hostile header must not overflow anything).
-  void Add(TimePoint sent, TimePoint received);
+  /// Records one package, handled at `received` after it reached the socket
+  /// at `arrived` (both on the server clock; `arrived` later than `received`
+  /// counts as no lag); a send time whose difference to `received` does not
+  /// fit is ignored (a hostile header must not overflow anything).
+  void Add(TimePoint sent, TimePoint received, std::optional<TimePoint> arrived = std::nullopt);
   /// The delays recorded within `window` before `now`, oldest first.
   std::vector<Duration> Recent(TimePoint now, Duration window = std::chrono::seconds(30)) const;
   /// The same with their arrival times (the queue start reads the queue from them).
@@ -184,18 +218,21 @@ class PlaybackEstimator {
   void SetDelayHistory(std::vector<Duration> delays) {
     history_ = std::move(delays);
     history_received_.clear();
+    history_lag_.clear();
   }
   /// The same with their arrival times (DelayHistory::RecentSamples), oldest first.
   void SetDelayHistory(const std::vector<DelayHistory::Sample>& samples);
-  /// Records one frame: its offset from the sequence start, its arrival and
-  /// the client's send time of its package (nullopt: unknown).
-  void Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent = std::nullopt);
+  /// Records one frame: its offset from the sequence start, its arrival
+  /// (handled), the client's send time of its package (nullopt: unknown) and
+  /// how long after it reached the socket the server handled it.
+  void Add(Duration offset, TimePoint arrival, std::optional<TimePoint> sent = std::nullopt,
+           Duration lag = Duration(0));
   std::size_t frames_seen() const { return frames_.size(); }
   std::size_t frames_needed() const { return needed_; }
   /// Heap memory it holds (its frames and delay history), for the session's accounting.
   std::size_t heap_bytes() const {
     return frames_.capacity() * sizeof(Frame) + history_.capacity() * sizeof(Duration) +
-           history_received_.capacity() * sizeof(TimePoint);
+           history_received_.capacity() * sizeof(TimePoint) + history_lag_.capacity() * sizeof(Duration);
   }
   bool ready() const;
   /// Whether the start is decided at the first frames from send times (the
@@ -205,6 +242,12 @@ class PlaybackEstimator {
   /// its queue start (the delays spread by more than adaptive_max_spread).
   bool adaptive() const;
   bool queued() const;
+  /// Whether it is the adaptive start beyond the gate on a queue the stretch
+  /// can follow (follow_queue, see above): its playout delay covers the queue.
+  bool followed() const;
+  /// With followed(): how far above the least delay seen its playout delay lies (the simulated
+  /// queue's worst). REQUIRES: followed().
+  Duration followed_queue() const;
   /// Frames the queue start simulates at most (a longer sequence's queue is
   /// extrapolated at its drift).
   static constexpr std::size_t kQueueHorizon = 2000;
@@ -237,15 +280,17 @@ class PlaybackEstimator {
     Duration offset;
     TimePoint arrival;
     std::optional<Duration> delay;  // arrival − send time
+    Duration lag;                   // handled − reached the socket
   };
   // Offset 0's time covering a worst delay `worst`. REQUIRES: quick().
   // `lead`: that much earlier, but never before the decision + margin.
   TimePoint StartCovering(Duration worst, Duration margin, Duration lead = Duration(0)) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
-  Duration QueueWorst() const;                    // REQUIRES: queued()
+  Duration QueueWorst() const;                    // REQUIRES: queued() or followed()
   std::vector<double> Services() const;           // s, of the packages seen; REQUIRES: delay_spread()
   TimePoint PaperStart() const;                   // the paper's estimate
-  bool QueueFollowable() const;                   // REQUIRES: delay_spread()
+  bool QueueFollowable(double z) const;           // REQUIRES: delay_spread()
+  bool ServerKeptUp() const;  // every package seen handled within follow_max_lag of its arrival
   bool SpreadWithinGate() const;
   double WiderStretch() const;  // max(0, max_stretch − kGateStretch), intervals
   double Gate() const;          // the spread beyond which the adaptive start gives way, s
@@ -272,6 +317,7 @@ class PlaybackEstimator {
     bool discounted = false;
   };
   Channel ChannelDelays() const;
+  static bool ArrivedInSendOrder(const std::vector<Seen>& seen);
 
   double interval() const;  // the declared mean frame interval, s
   std::size_t total_;
@@ -281,6 +327,7 @@ class PlaybackEstimator {
   std::vector<Frame> frames_;
   std::vector<Duration> history_;
   std::vector<TimePoint> history_received_;  // empty, or history_'s arrivals
+  std::vector<Duration> history_lag_;        // empty, or the server's lag handling each
 };
 
 }  // namespace robotalk

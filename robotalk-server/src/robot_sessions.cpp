@@ -210,7 +210,7 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
           MakeReply(id, Signal::kPanic, "the package carried the panic flag; not executed", now));
     }
   } else if (playback) {
-    AdmitPlayback(session, r, now, immediate);
+    AdmitPlayback(session, r, now, arrived, immediate);
   } else {
     for (const Query& q : r.queries) AdmitQuery(session, q, now, immediate, answer.publish_config);
     for (const Command& c : r.commands) {
@@ -227,9 +227,11 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
   // server's own lag (a pause after each package, the paper's Fig. 11
   // congestion) is part of the delay the start must cover (with `arrived`
   // the gate missed it: ServerClientTest.PlaybackKeepsTheInterFrameTiming-
-  // UnderCongestion, frames 0.4 s late).
+  // UnderCongestion, frames 0.4 s late). The lag (now − arrived) is kept
+  // beside it: a queue beyond the adaptive start's gate is followed only
+  // where it was the link's, not this server's (follow_queue).
   if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
-    session.delays.Add(r.send_time, now);
+    session.delays.Add(r.send_time, now, arrived);
   for (Reply& reply : immediate) {
     Bound(reply);
     session.replies.RecordReply(reply);

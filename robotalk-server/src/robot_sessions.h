@@ -169,7 +169,10 @@ class RobotSessions {
   std::optional<QueuedItem> Admit(Session& s, const Command& c, TimePoint now, std::vector<Reply>& immediate,
                                   bool playback, Duration max_late,
                                   Interpolation interpolation = Interpolation::kStep);
-  void AdmitPlayback(Session& s, const Request& request, TimePoint now, std::vector<Reply>& immediate);
+  /// `arrived`: when it reached the socket (the server's own lag, now − arrived, tells the
+  /// estimator whether a queue beyond its gate is the server's: PlaybackEstimatorOptions::follow_queue).
+  void AdmitPlayback(Session& s, const Request& request, TimePoint now, TimePoint arrived,
+                     std::vector<Reply>& immediate);
   void Panic(std::int64_t client_id, TimePoint now, const std::string& sender = "");
   void Deliver(std::int64_t client_id, Reply reply);
   std::size_t Waiting(const Session& s) const;

@@ -11,7 +11,7 @@ namespace robotalk {
 
 using namespace sessions_text;
 
-void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
+void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, TimePoint arrived,
                                   std::vector<Reply>& immediate) {
   const PlaybackDeclaration& d = r.playback;
   const std::string label = "PLAYBACK " + std::to_string(d.id);
@@ -104,7 +104,7 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now,
       item->start = seq.schedule->Place(offset, now, delay).at;
       if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
     } else {
-      seq.estimator->Add(offset, now, sent);
+      seq.estimator->Add(offset, now, sent, arrived < now ? now - arrived : Duration(0));
       seq.frames.push_back({offset, std::move(*item), now, delay});
     }
   }
@@ -136,7 +136,14 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
   std::vector<PlaybackSequence::Frame>().swap(seq.frames);
   const Duration delay = *seq.start - *seq.first_arrival;
   std::string why;
-  if (estimator.queued()) {
+  if (estimator.followed()) {
+    why =
+        "adaptive start on a queue: this client's recent one-way delays vary by " +
+        Seconds(*estimator.delay_spread()) +
+        ", more than a frame interval, on the link (this server kept up); the gaps stretch until the buffer "
+        "covers the queue its frames may build (" +
+        Seconds(estimator.followed_queue()) + " above the least delay)";
+  } else if (estimator.queued()) {
     why = "queue start: this client's recent one-way delays vary by " + Seconds(*estimator.delay_spread()) +
           ", more than a frame interval; covers the queue its frames will build";
   } else if (estimator.adaptive()) {

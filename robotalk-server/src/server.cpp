@@ -120,6 +120,7 @@ class Server::Impl {
     sessions.playback.max_stretch = options_.playback_stretch;
     sessions.playback.adaptive_margin = options_.playback_margin;
     sessions.playback.queue_start = options_.playback_queue_start;
+    sessions.playback.follow_queue = options_.playback_follow_queue;
     sessions.playback.burst_wait_discount = options_.playback_burst_discount;
     sessions.playback_resent_delays = options_.playback_resent_delays;
     sessions.playback.start_lead = options_.playback_start_lead;

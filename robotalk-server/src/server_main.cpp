@@ -53,6 +53,10 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals
                                   start from a simulated queue of the sequence's frames (on)
                                   or wait for frames (off, default: the paper's estimate)
+  --playback-follow-queue on|off  adaptive: delays spread by more than 1.2 frame intervals on
+                                  the link (this server kept up) start at the first frame and
+                                  the gaps stretch until the buffer covers the queue (default
+                                  on; off: the paper's estimate there)
   --playback-burst-discount on|off
                                   adaptive: leave a connect-time package's wait behind the
                                   one sent just before it out of the delay spread (default on)
@@ -234,6 +238,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-queue-start '" + v + "': expected on or off");
         options.playback_queue_start = v == "on";
+      } else if (arg == "--playback-follow-queue") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-follow-queue '" + v + "': expected on or off");
+        options.playback_follow_queue = v == "on";
       } else if (arg == "--playback-burst-discount") {
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-burst-discount '" + v + "': expected on or off");

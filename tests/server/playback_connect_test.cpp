@@ -92,10 +92,15 @@ TEST_F(PlaybackConnectTest, ARetransmittedConnectTimePackageDoesNotTripTheAdapti
   EXPECT_EQ(sessions_->link(kAlice)->retransmitted, 1u) << "link health counts it too";
 }
 
-// --playback-resent-delays on: every package counts, as before (the paper's estimate here).
+// --playback-resent-delays on: every package counts, as before (the paper's
+// estimate here). With the queue follow (on by default) the spread beyond
+// the gate is followed instead, the retransmission left out by the fence:
+// off here, to show the gate as the option restores it.
 class PlaybackConnectResentTest : public PlaybackConnectTest {
  protected:
-  PlaybackConnectResentTest() : PlaybackConnectTest(SessionOptions{.playback_resent_delays = true}) {}
+  PlaybackConnectResentTest()
+      : PlaybackConnectTest(
+            SessionOptions{.playback = {.follow_queue = false}, .playback_resent_delays = true}) {}
 };
 
 TEST_F(PlaybackConnectResentTest, WithResentDelaysOnTheRetransmissionTripsTheGateAsBefore) {

@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 namespace robotalk::playback_model {
@@ -34,26 +35,32 @@ struct SimRun {
 // least 20 ms after it; with `burst`, all sent 1 ms apart, as a client's
 // hello, clock and heartbeat), one-way delay delay(k, sent) for the k-th package;
 // its clock reads 5000 s ahead. `options` decides how the start is estimated.
+// `server_lag`, where given, holds how long after it reached the server's
+// socket the last package delay() gave was handled (the server's own lag).
 inline SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
                        const std::function<Duration(std::size_t, TimePoint)>& delay,
-                       PlaybackEstimatorOptions options = {}, bool burst = false) {
+                       PlaybackEstimatorOptions options = {}, bool burst = false,
+                       const Duration* server_lag = nullptr) {
+  const auto lag = [server_lag] { return server_lag ? *server_lag : Duration(0); };
   const Duration skew = std::chrono::seconds(5000);
   PlaybackEstimator est(frames, period * static_cast<int>(frames - 1), options);
   DelayHistory h;
   std::size_t k = 0;
   for (TimePoint next = kT0 - std::chrono::seconds(4); k < history; ++k) {
     const TimePoint sent = next, arrival = sent + delay(k, sent);
-    h.Add(sent + skew, arrival);
+    h.Add(sent + skew, arrival, arrival - lag());
     next = burst ? sent + milliseconds(1) : std::max(sent + milliseconds(20), arrival + milliseconds(1));
   }
   struct Frame {
     Duration offset;
     TimePoint arrival, sent;
+    Duration lag;
   };
   std::vector<Frame> all;
   for (std::size_t i = 0; i < frames; ++i, ++k) {
     const TimePoint sent = kT0 + period * static_cast<int>(i);
-    all.push_back({period * static_cast<int>(i), sent + delay(k, sent), sent + skew});
+    const TimePoint arrival = sent + delay(k, sent);
+    all.push_back({period * static_cast<int>(i), arrival, sent + skew, lag()});
   }
   std::stable_sort(all.begin(), all.end(),
                    [](const Frame& a, const Frame& b) { return a.arrival < b.arrival; });
@@ -65,7 +72,7 @@ inline SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
   std::vector<const Frame*> buffered;
   for (const Frame& f : all) {
     if (!schedule) {
-      est.Add(f.offset, f.arrival, f.sent);
+      est.Add(f.offset, f.arrival, f.sent, f.lag);
       buffered.push_back(&f);
       if (!est.ready()) continue;
       const TimePoint start = est.StartTime();
@@ -97,24 +104,65 @@ struct Summary {
 // `runs` seeded channels; the ratio is the start delay over the hindsight
 // minimum, both + the 2 ms margin every start needs (a frame must be in the
 // RobotDaemon's queue before it is due).
-using Channel = std::function<Duration(std::mt19937_64&, std::size_t, TimePoint)>;
+// A channel: the k-th package's delay (sent at `sent`), and where the server
+// itself is the queue, its lag handling that package (handled − reached the
+// socket), written into `server_lag` as each delay is drawn.
+struct Channel {
+  template <class F>
+  requires(!std::is_same_v<std::decay_t<F>, Channel>)
+      Channel(F f,
+              std::shared_ptr<Duration> lag = std::make_shared<Duration>(0))  // NOLINT: a lambda is a channel
+      : delay(std::move(f)), server_lag(std::move(lag)) {}
+  std::function<Duration(std::mt19937_64&, std::size_t, TimePoint)> delay;
+  std::shared_ptr<Duration> server_lag;
+  Duration operator()(std::mt19937_64& rng, std::size_t k, TimePoint sent) const {
+    return delay(rng, k, sent);
+  }
+};
+// Seeds 1 to `runs` of `channel`: `frames` at 10 Hz after 10 connect-time
+// round trips, or a burst of `burst` packages; each run to `each`.
+inline void ForEachRun(int runs, const Channel& channel, PlaybackEstimatorOptions options, std::size_t frames,
+                       std::size_t burst, const std::function<void(const SimRun&)>& each) {
+  for (int seed = 1; seed <= runs; ++seed) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    each(Simulate(
+        frames, milliseconds(100), burst > 0 ? burst : 10,
+        [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); }, options, burst > 0,
+        channel.server_lag.get()));
+  }
+}
+
 inline Summary Many(int runs, const Channel& channel, PlaybackEstimatorOptions options = {},
                     std::size_t frames = 40, std::size_t burst = 0) {
   Summary s;
   std::vector<double> ratios;
-  for (int seed = 1; seed <= runs; ++seed) {
-    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-    const SimRun r = Simulate(
-        frames, milliseconds(100), burst > 0 ? burst : 10,
-        [&](std::size_t k, TimePoint sent) { return channel(rng, k, sent); }, options, burst > 0);
+  ForEachRun(runs, channel, options, frames, burst, [&](const SimRun& r) {
     s.late_frames += r.late;
     if (r.late > 0) ++s.late_runs;
     s.worst_stretch = std::max(s.worst_stretch, r.max_gap_stretch);
     ratios.push_back(ToSeconds(r.start_delay) / ToSeconds(r.hindsight + kMargin));
-  }
+  });
   std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
   s.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
   return s;
+}
+
+// A 40-frame sequence at 10 Hz whose frame 0 took 1 ms, arrived at kT0 and
+// was handled `server_lag` after it reached the socket, after `history`.
+inline PlaybackEstimator AtFirstFrame(const std::vector<DelayHistory::Sample>& history,
+                                      PlaybackEstimatorOptions options = {},
+                                      Duration server_lag = Duration(0)) {
+  PlaybackEstimator est(40, milliseconds(3900), options);
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1), server_lag);
+  return est;
+}
+inline PlaybackEstimator AtFirstFrame(const std::vector<Duration>& history,
+                                      PlaybackEstimatorOptions options = {}) {
+  PlaybackEstimator est(40, milliseconds(3900), options);
+  est.SetDelayHistory(history);
+  est.Add(Duration(0), kT0, kT0 - milliseconds(1));
+  return est;
 }
 
 inline Duration Uniform(std::mt19937_64& rng, double lo_ms, double hi_ms) {
@@ -124,36 +172,42 @@ inline Duration Uniform(std::mt19937_64& rng, double lo_ms, double hi_ms) {
 // The relay's congestion: a FIFO link whose service is U[0, X] ms per message.
 inline Channel Fifo(double x_ms) {
   auto busy = std::make_shared<TimePoint>();
-  return [busy, x_ms](std::mt19937_64& rng, std::size_t k, TimePoint sent) {
+  return {[busy, x_ms](std::mt19937_64& rng, std::size_t k, TimePoint sent) {
     if (k == 0) *busy = TimePoint{};
     *busy = std::max(*busy, sent) + Uniform(rng, 0, x_ms);
     return *busy - sent;
-  };
+  }};
 }
 
 // Fig. 11's injector: the server pauses U[0, P] ms after each package it
 // reads, so it reads the next one no sooner than that pause's end.
 inline Channel ServerPauses(double p_ms) {
+  // It reads a package no sooner than its pause ends: the package waited at
+  // the socket that long (the server's own lag).
   auto free_at = std::make_shared<TimePoint>();
-  return [free_at, p_ms](std::mt19937_64& rng, std::size_t k, TimePoint sent) {
-    if (k == 0) *free_at = TimePoint{};
-    const TimePoint read = std::max(sent + milliseconds(1), *free_at);
-    *free_at = read + Uniform(rng, 0, p_ms);
-    return read - sent;
-  };
+  auto lag = std::make_shared<Duration>(0);
+  return {[free_at, lag, p_ms](std::mt19937_64& rng, std::size_t k, TimePoint sent) {
+            if (k == 0) *free_at = TimePoint{};
+            const TimePoint at_socket = sent + milliseconds(1);
+            const TimePoint read = std::max(at_socket, *free_at);
+            *lag = read - at_socket;
+            *free_at = read + Uniform(rng, 0, p_ms);
+            return read - sent;
+          },
+          lag};
 }
 
 inline Channel Jitter(double hi_ms) {
-  return [hi_ms](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, hi_ms); };
+  return {[hi_ms](std::mt19937_64& rng, std::size_t, TimePoint) { return Uniform(rng, 0, hi_ms); }};
 }
 
 // A WAN path: 100-300 ms (fixed per run), +-50 ms uniform jitter.
 inline Channel Wan() {
   auto base = std::make_shared<Duration>();
-  return [base](std::mt19937_64& rng, std::size_t k, TimePoint) {
+  return {[base](std::mt19937_64& rng, std::size_t k, TimePoint) {
     if (k == 0) *base = Uniform(rng, 100, 300);
     return *base + Uniform(rng, -50, 50);
-  };
+  }};
 }
 
 }  // namespace robotalk::playback_model

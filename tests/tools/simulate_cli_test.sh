@@ -30,6 +30,7 @@ for bad in "0|'0' is not a number in [0.001, 1000]" "1,x|'x' is not a number" "=
 done
 # The playback options' bad values too (issue 23 item 3).
 for bad in "--playback-queue-start|maybe|--playback-queue-start 'maybe': expected on or off" \
+           "--playback-follow-queue|maybe|--playback-follow-queue 'maybe': expected on or off" \
            "--playback-burst-discount|yes|--playback-burst-discount 'yes': expected on or off" \
            "--playback-resent-delays|1|--playback-resent-delays '1': expected on or off" \
            "--playback-margin|-1|--playback-margin: '-1' is not a number in [0, 1000]" \

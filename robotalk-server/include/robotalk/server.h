@@ -132,6 +132,13 @@ struct ServerOptions {
   /// start (a simulated queue of the sequence's frames) when on; off (the
   /// default): the paper's estimate.
   bool playback_queue_start = false;
+  /// Adaptive: delays spread by more than 1.2 frame intervals on the link
+  /// (the server kept up with its input) whose mean service the 10 %
+  /// stretch can follow get the adaptive start at the first frame, and the
+  /// gaps stretch until the buffer covers a simulated queue of the
+  /// sequence's frames (PlaybackEstimatorOptions::follow_queue); off: the
+  /// paper's estimate there. Under --playback-queue-start on, the queue start.
+  bool playback_follow_queue = true;
   /// Adaptive: a connect-time package's wait behind the client's package
   /// sent just before it is left out of its delay where that brings the
   /// spread within the gate (PlaybackEstimatorOptions::burst_wait_discount).
