@@ -311,8 +311,9 @@ TEST(ServerMemoryBound, TheDefaultBoundsKeepTheWholeServerUnder512MiB) {
   std::printf(
       "a session at most %zu B (%zu KiB; an unfinished playback %zu B; the table's part %zu B); %zu sessions "
       "%zu MiB; remembered nonces %zu KiB; a waiting item %zu B, queued %zu MiB; total %zu MiB\n",
-      per_session, per_session / 1024, playback, table, server.max_sessions, server.max_sessions * per_session >> 20,
-      remembered >> 10, QueuedItemBytes(), queued >> 20, total >> 20);
+      per_session, per_session / 1024, playback, table, server.max_sessions,
+      server.max_sessions * per_session >> 20, remembered >> 10, QueuedItemBytes(), queued >> 20,
+      total >> 20);
   EXPECT_LT(per_session, 1u << 20);
   EXPECT_LT(total, 512u << 20) << "sessions " << server.max_sessions * per_session << " + queued " << queued;
   EXPECT_EQ(SessionTableOptions{}.max_sessions, server.max_sessions) << "one default";
