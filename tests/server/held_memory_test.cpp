@@ -21,6 +21,7 @@ namespace {
 
 using std::chrono::milliseconds;
 using testing::kT0;
+using testing::Rest;
 using testing::Waypoint;
 
 // A base, a 6-dof joint "free" (±1, clamps the test's ±5), a 1-dof "elbow"
@@ -41,14 +42,6 @@ RobotModel SixDofArm() {
   b.AddControlFrame(ControlFrame{.name = "tool", .servo_types = ServoType::kSetPoint}, "hand");
   b.SetRoot("base", Pose{}, BaseType::kFixed);
   return b.Build();
-}
-
-RobotState Rest(const RobotModel& m) {
-  RobotState s;
-  s.position = Eigen::VectorXd::Zero(m.num_dofs());
-  s.velocity = Eigen::VectorXd::Zero(m.num_dofs());
-  s.effort = Eigen::VectorXd::Zero(m.num_dofs());
-  return s;
 }
 
 struct Cost {

@@ -1,8 +1,10 @@
 // Items as the ServerDaemon hands them to a RobotDaemon, for RobotDaemon
 // tests: a motion command, a trajectory waypoint and a joint-state query of
-// one client.
+// one client; and a robot's state at rest (what a planner starts from).
 #pragma once
 
+#include "robotalk/driver.h"
+#include "robotalk/robot_model.h"
 #include "scheduler.h"
 #include "support/test_clients.h"
 
@@ -47,6 +49,15 @@ inline QueuedItem JointStateQuery(CommandId id) {
   item.query = QueryType::kJointState;
   item.command.id = id;
   return item;
+}
+
+/// Every dof at 0, at rest.
+inline RobotState Rest(const RobotModel& m) {
+  RobotState s;
+  s.position = Eigen::VectorXd::Zero(m.num_dofs());
+  s.velocity = Eigen::VectorXd::Zero(m.num_dofs());
+  s.effort = Eigen::VectorXd::Zero(m.num_dofs());
+  return s;
 }
 
 }  // namespace robotalk::testing

@@ -43,15 +43,8 @@ RobotModel Arm() {
   return b.Build();
 }
 
+using testing::Rest;
 using testing::Waypoint;  // kItemClient is kAlice
-
-RobotState Rest(const RobotModel& m) {
-  RobotState s;
-  s.position = Eigen::VectorXd::Zero(m.num_dofs());
-  s.velocity = Eigen::VectorXd::Zero(m.num_dofs());
-  s.effort = Eigen::VectorXd::Zero(m.num_dofs());
-  return s;
-}
 
 class TrackerTest : public ::testing::Test {
  protected:
