@@ -15,8 +15,9 @@ using namespace sessions_text;
 std::size_t QueuedItemBytes() {
   // Waiting: the item in its client's heap or in a playback buffer (a vector: up to
   // twice its size in capacity), a buffered frame's estimator entry (offset,
-  // arrival, delay), and its timed-servo entry (a hash-map node).
-  constexpr std::size_t kEstimatorFrame = 4 * sizeof(Duration);
+  // arrival, optional delay, the server's lag: 5 durations; a vector, twice
+  // in capacity), and its timed-servo entry (a hash-map node).
+  constexpr std::size_t kEstimatorFrame = 2 * 5 * sizeof(Duration);
   constexpr std::size_t kTimedServo =
       sizeof(std::pair<const CommandId, std::pair<TimePoint, int>>) + 3 * sizeof(void*);
   constexpr std::size_t kWaiting = 2 * sizeof(PlaybackSequence::Frame) + kEstimatorFrame + kTimedServo;
