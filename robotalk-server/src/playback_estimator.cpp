@@ -15,12 +15,10 @@ PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration
 }
 
 std::optional<Duration> OneWayDelay(TimePoint sent, TimePoint arrival) {
-  Duration::rep d = 0;
-  if (__builtin_sub_overflow(arrival.time_since_epoch().count(), sent.time_since_epoch().count(), &d))
-    return std::nullopt;
-  constexpr Duration::rep kBound = Duration::rep{1} << 61;
-  if (d > kBound || d < -kBound) return std::nullopt;
-  return Duration(d);
+  const std::optional<Duration> d = CheckedSub(arrival, sent);
+  constexpr Duration kBound(Duration::rep{1} << 61);
+  if (!d || *d > kBound || *d < -kBound) return std::nullopt;
+  return d;
 }
 
 void DelayHistory::Add(TimePoint sent, TimePoint received, std::optional<TimePoint> arrived) {
