@@ -5,10 +5,10 @@
 // Real server core (kinematic driver) and client in one process on a
 // MemoryBus, both on the steady clock, so the true offset is zero.
 #include "kinematic_driver.h"
+#include "robotalk/forwarding_transport.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/server.h"
-#include "support/forwarding_transport.h"
 
 #include <gtest/gtest.h>
 
@@ -23,7 +23,7 @@ using std::chrono::seconds;
 
 // Reads every message `lag` after it was ready (a client whose read thread
 // is starved); the socket's stamp, ReceiveTime(), still says when it came.
-class SlowReaderTransport final : public testing::ForwardingTransport {
+class SlowReaderTransport final : public ForwardingTransport {
  public:
   SlowReaderTransport(Transport& inner, Duration lag) : ForwardingTransport(inner), lag_(lag) {}
   int HandleFor(Duration timeout) override {

@@ -4,10 +4,10 @@
 
 #include "fake_driver.h"
 #include "robotalk/channels.h"
+#include "robotalk/forwarding_transport.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "session_test_util.h"
-#include "support/forwarding_transport.h"
 #include "support/test_clients.h"
 
 #include <gmock/gmock.h>
@@ -257,7 +257,7 @@ TEST_F(ServerDaemonPanicLatch, APanicSurvivesARestartUntilReset) {
 
 // Reads the latch file whenever the server publishes a reply that answers
 // ERROR: what was on disk at the moment it left.
-class LatchAtErrorTransport final : public testing::ForwardingTransport {
+class LatchAtErrorTransport final : public ForwardingTransport {
  public:
   // The base keeps a reference to bus_transport_, constructed after it (it is
   // not used before).

@@ -15,12 +15,12 @@
 // every true one-way delay is well under a millisecond.
 #include "fake_driver.h"
 #include "robotalk/channels.h"
+#include "robotalk/forwarding_transport.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "server_daemon.h"
 #include "session_test_util.h"
 #include "sessions_fixture.h"
-#include "support/forwarding_transport.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -37,7 +37,7 @@ using namespace robotalk::testing;  // NOLINT: the sessions fixture's helpers
 // Every handler runs `lag` after the one before it could have (a ServerDaemon
 // whose thread is starved): a burst of packages queues, each handled later
 // than it arrived. ReceiveTime() still says when each came.
-class LateHandlerTransport final : public testing::ForwardingTransport {
+class LateHandlerTransport final : public ForwardingTransport {
  public:
   LateHandlerTransport(Transport& inner, Duration lag) : ForwardingTransport(inner), lag_(lag) {}
   std::unique_ptr<Subscription> Subscribe(const std::string& channel_regex, Handler handler) override {

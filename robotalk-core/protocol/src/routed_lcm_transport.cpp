@@ -1,5 +1,7 @@
 #include "robotalk/routed_lcm_transport.h"
 
+#include "robotalk/forwarding_transport.h"
+
 #include <sys/epoll.h>
 #include <unistd.h>
 
@@ -26,25 +28,22 @@ class MultiLaneSubscription final : public Subscription {
   std::vector<std::unique_ptr<Subscription>> parts_;
 };
 
+// The LcmTransport a SingleUdpmTransport owns, a base so that it is
+// constructed before the ForwardingTransport that refers to it.
+struct OwnedLcmTransport {
+  explicit OwnedLcmTransport(LcmTransportOptions options) : lcm(std::move(options)) {}
+  LcmTransport lcm;
+};
+
 // A udpm LcmTransport of the single layout that says so in its url(), so that
 // what a server prints and announces is a URL its clients can use as is.
-class SingleUdpmTransport final : public Transport {
+class SingleUdpmTransport final : private OwnedLcmTransport, public ForwardingTransport {
  public:
   SingleUdpmTransport(LcmTransportOptions options, std::string url)
-      : inner_(std::move(options)), url_(std::move(url)) {}
-  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
-    inner_.Publish(channel, bytes);
-  }
-  std::unique_ptr<Subscription> Subscribe(const std::string& channel_regex, Handler handler) override {
-    return inner_.Subscribe(channel_regex, std::move(handler));
-  }
-  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
-  int fileno() const override { return inner_.fileno(); }
+      : OwnedLcmTransport(std::move(options)), ForwardingTransport(lcm), url_(std::move(url)) {}
   std::string url() const override { return url_; }
-  WallTime ReceiveTime() const override { return inner_.ReceiveTime(); }
 
  private:
-  LcmTransport inner_;
   const std::string url_;
 };
 

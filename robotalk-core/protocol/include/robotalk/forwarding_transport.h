@@ -1,6 +1,8 @@
-// A Transport that passes every call to another one: a test derives from it
-// and overrides only the call it delays or alters (a starved read thread, a
-// late handler), so the socket's stamp (ReceiveTime) stays the inner one's.
+// ForwardingTransport: a Transport that passes every call to another one. A
+// wrapper derives from it and overrides only what it changes — a URL it
+// names differently (OpenLcmTransport's single layout), a read thread a test
+// starves, a handler it delays — so everything else, the socket's receive
+// stamp (ReceiveTime) above all, stays the inner transport's.
 #pragma once
 
 #include "robotalk/transport.h"
@@ -9,10 +11,12 @@
 #include <string>
 #include <utility>
 
-namespace robotalk::testing {
+namespace robotalk {
 
 class ForwardingTransport : public Transport {
  public:
+  /// `inner` must outlive this transport. It may be a member of a derived
+  /// class not yet constructed: the reference is only kept here, never used.
   explicit ForwardingTransport(Transport& inner) : inner_(inner) {}
   void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
     inner_.Publish(channel, bytes);
@@ -32,4 +36,4 @@ class ForwardingTransport : public Transport {
   Transport& inner_;
 };
 
-}  // namespace robotalk::testing
+}  // namespace robotalk
