@@ -204,6 +204,15 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
       if (i == k && in_air) {  // the swing foot's speed
         const double left = static_cast<double>(land - tick_) * tick_s_, most = rp.swing_speed * left;
         if ((now - total).norm() > most) now = total + (now - total) * (most / (now - total).norm());
+        if (rp.swing_reach > 0) {  // the landing within what the foot can reach from where it is
+          // The foot moves horizontally until 0.9 of its swing (UpdateFeet), its
+          // progress linear to 1 at the landing from now.
+          const double s0 = SwingProgress(steps_[i]), moving = s0 < 0.9 ? left * (0.9 - s0) / (1 - s0) : 0.0;
+          const Eigen::Vector2d at = foot_[static_cast<int>(steps_[i].step.side)].xy();
+          const Eigen::Vector2d to = plan.xy() + now - at;
+          const double far = std::max((plan.xy() - at).norm(), rp.swing_reach * moving);
+          if (to.norm() > far) now = at + to * (far / to.norm()) - plan.xy();
+        }
       }
       if (i == k) fits = (now - want).norm() < 1e-6;
       rest -= (now - total) / grow;
