@@ -175,8 +175,8 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
 // push toward the left while the left foot swings (30 N s at 5.14 s into a
 // walk at full speed, the sweep's seed-1 instant) moves that foot's landing
 // outward in the air. Without the option the regenerations' moves add up to
-// more than the legs follow: the foot lands ~10 cm from its planned landing
-// (and the robot falls); with 1 m/s the landing is reached within a few cm.
+// more than the legs follow: the foot lands ~10 cm inside its planned
+// landing (and the robot falls); with 1 m/s within a few cm, and it stands.
 TEST(OdeWalk, PushSwingReachKeepsAMovedLandingWithinWhatTheSwingFootReaches) {
   for (const char* reach : {"0", "1.0"}) {
     Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_swing_reach", reach}});
@@ -188,11 +188,13 @@ TEST(OdeWalk, PushSwingReachKeepsAMovedLandingWithinWhatTheSwingFootReaches) {
     w.Run(1.0, [&] { return w.driver->walk_status()->foot_height[0] <= 0; });
     w.Run(0.05);
     const walking::WalkStatus s = *w.driver->walk_status();
-    const double miss = (s.foot[0].xy() - s.foot_measured[0].xy()).norm();
-    std::printf("push_swing_reach=%s: the left foot lands %.3f m from its planned landing\n", reach, miss);
+    // Outward (the walk heads along x): the move the push asked for.
+    const double miss = std::abs(s.foot[0].y - s.foot_measured[0].y);
+    std::printf("push_swing_reach=%s: the left foot lands %.3f m (%.3f m outward) from its planned landing\n",
+                reach, (s.foot[0].xy() - s.foot_measured[0].xy()).norm(), miss);
     w.Run(2.0, [&] { return w.driver->walk_status()->fallen; });
     if (std::string(reach) == "0") {
-      EXPECT_GT(miss, 0.08);
+      EXPECT_GT(miss, 0.10);
     } else {
       EXPECT_LT(miss, 0.06);
       EXPECT_FALSE(w.driver->walk_status()->fallen) << "tilt " << w.max_tilt;
