@@ -193,7 +193,8 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   if (options.push_capture && !options.push_recovery) {
     throw Error("OdeDriver: push_capture=true needs push_recovery=true (the capture is how its stop steps)");
   }
-  if (options.push_swing_reach > 0 && !options.push_recovery) {
+  if (options.push_swing_reach > 0 && options.push_swing_reach != OdeDriverOptions{}.push_swing_reach &&
+      !options.push_recovery) {  // (the default is accepted without it)
     throw Error(
         "OdeDriver: push_swing_reach needs push_recovery=true (it bounds the regeneration's landings)");
   }

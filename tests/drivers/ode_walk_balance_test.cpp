@@ -171,7 +171,7 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   EXPECT_FALSE(RefusalOfWalker({{"push_stop_feet", "keep"}}));
 }
 
-// push_swing_reach (off by default; docs/ode_sim.md, "eighth session"): a
+// push_swing_reach (1 m/s by default; docs/ode_sim.md, "eighth session"): a
 // push toward the left while the left foot swings (30 N s at 5.14 s into a
 // walk at full speed, the sweep's seed-1 instant) moves that foot's landing
 // outward in the air. Without the option the regenerations' moves add up to
@@ -201,12 +201,13 @@ TEST(OdeWalk, PushSwingReachKeepsAMovedLandingWithinWhatTheSwingFootReaches) {
     }
   }
   const std::optional<std::string> alone =
-      RefusalOfWalker({{"push_swing_reach", "1"}, {"push_recovery", "false"}});
+      RefusalOfWalker({{"push_swing_reach", "2"}, {"push_recovery", "false"}});
   ASSERT_TRUE(alone) << "push_swing_reach without push_recovery accepted";
   EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
   const std::optional<std::string> negative = RefusalOfWalker({{"push_swing_reach", "-1"}});
   ASSERT_TRUE(negative) << "push_swing_reach=-1 accepted";
   EXPECT_NE(negative->find("push_swing_reach"), std::string::npos) << *negative;
+  EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}})) << "the default needs no push_recovery";
 }
 
 // push_balance (off by default; docs/ode_sim.md, "Pushes"): the wiring —

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numbers>
 #include <span>
 #include <stdexcept>
@@ -47,8 +48,11 @@ struct Result {
 // Walks at full speed (SETSPEED's queue, as the driver keeps it) and is
 // pushed by `dv` (m/s) at `at` s; the pendulum's ZMP is the pattern's,
 // clamped into the support polygon. Fell: its CoM 0.3 m from the plan's.
+// `watch`, when given, sees the pattern before (false) and after (true)
+// every regeneration.
 Result WalkAndPush(const Eigen::Vector2d& dv, double at, bool recover, double walk_for = 6.0,
-                   const RecoveryParams& params = {}) {
+                   const RecoveryParams& params = {},
+                   const std::function<void(const WalkPattern&, bool)>& watch = {}) {
   const GaitParams g = FastGait();
   constexpr double kTick = 0.001, kG = 9.81;
   WalkPattern w(g, kTick, 5, kG);
@@ -73,7 +77,9 @@ Result WalkAndPush(const Eigen::Vector2d& dv, double at, bool recover, double wa
     }
     w.Tick();
     if (std::abs(w.time() - at) < 0.5 * kTick) dd += dv;
+    if (watch) watch(w, false);
     if (recover && rec.Update(w, w.com() + d, w.com_velocity() + dd)) {
+      if (watch) watch(w, true);
       ++r.regenerations;
       d.setZero();  // the plan starts from the pendulum's state
       dd.setZero();
@@ -142,44 +148,27 @@ TEST(PushRecovery, PushesOfTheGoalsSizeForwardAndBackOfHalfOfItMidSwingAreSurviv
   }
 }
 
-// The regenerations of a pushed walk (as WalkAndPush, noise-free): the
-// worst excess, over all regenerations made while a foot is in the air, of
-// its landing's distance from the foot now beyond max(the distance before,
-// `speed` times the time to the landing), m.
+// The regenerations of a pushed walk (WalkAndPush): the worst excess, over
+// all regenerations made while a foot is in the air, of its landing's
+// distance from the foot now beyond max(the distance before, `speed` times
+// the time to the landing), m.
 double WorstReachExcess(const Eigen::Vector2d& dv, double at, const RecoveryParams& params, double speed) {
-  const GaitParams g = FastGait();
-  constexpr double kTick = 0.001, kG = 9.81;
-  WalkPattern w(g, kTick, 5, kG);
-  PushRecovery rec(std::sqrt(kG / g.com_height), kTick, params);
-  Eigen::Vector2d d = Eigen::Vector2d::Zero(), dd = Eigen::Vector2d::Zero();
-  w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
-  double worst = 0;
-  while (w.time() < at + 2.0) {
-    while (w.planned_ahead() < g.start_lead + 2 * g.step_period()) {
-      const WalkPattern::Splice sp = w.AppendPoint();
-      const Side next = sp.side_free ? Side::kLeft : sp.next;
-      const Pose2 ce = StepBy(sp.centre, g.step_forward, 0, 0, next, g);
-      w.Append({Footstep{next, FootAt(ce, next, g)}}, {ce});
+  double worst = 0, allowed = 0;
+  Side side = Side::kLeft;
+  Eigen::Vector2d foot = Eigen::Vector2d::Zero();
+  bool in_air = false;
+  WalkAndPush(dv, at, true, 6.0, params, [&](const WalkPattern& w, bool after) {
+    const Footstep* step = w.swing_step();
+    if (!after) {
+      in_air = step != nullptr;
+      if (!in_air) return;
+      side = step->side;
+      foot = w.foot(side).xy();
+      allowed = std::max((step->pose.xy() - foot).norm(), speed * w.time_to_landing());
+    } else if (in_air && step && step->side == side) {
+      worst = std::max(worst, (step->pose.xy() - foot).norm() - allowed);
     }
-    w.Tick();
-    if (std::abs(w.time() - at) < 0.5 * kTick) dd += dv;
-    const Footstep* before = w.swing_step();
-    const Side side = before ? before->side : Side::kLeft;
-    const Eigen::Vector2d foot = w.foot(side).xy(), was = before ? before->pose.xy() : foot;
-    const double left = w.time_to_landing();
-    if (rec.Update(w, w.com() + d, w.com_velocity() + dd)) {
-      d.setZero();
-      dd.setZero();
-      const Footstep* after = w.swing_step();
-      if (before && after && after->side == side) {
-        const double allowed = std::max((was - foot).norm(), speed * left);
-        worst = std::max(worst, (after->pose.xy() - foot).norm() - allowed);
-      }
-    }
-    const double k = kG / g.com_height;
-    dd += k * d * kTick;  // on the plan's ZMP (unclamped: only the plan's landings are looked at)
-    d += dd * kTick;
-  }
+  });
   return worst;
 }
 
