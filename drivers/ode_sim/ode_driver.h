@@ -122,6 +122,14 @@ struct OdeDriverOptions {
   /// caught, the plan re-anchored on the measured CoM state, in place of the
   /// regeneration until that step lands. Key "push_capture".
   bool push_capture = false;
+  /// With push_recovery: a foot in the air moved by the regeneration lands
+  /// at most this far per second of its swing's move left from where its
+  /// swing has it now (RecoveryParams::swing_reach; docs/ode_sim.md, "Pushes
+  /// and disturbances"), m/s; 0: off (the regenerations' moves then add up
+  /// beyond what the legs follow). 1 m/s by default: measured better or
+  /// equal in all 16 cells of the push sweep (seeds 1 and 2), the traces
+  /// showing the moved landing reached. Key "push_swing_reach".
+  double push_swing_reach = 1.0;
   /// With push_recovery: the regeneration's footholds during the push's
   /// stop (RecoveryParams::stop_feet; docs/ode_sim.md, "Pushes and
   /// disturbances"): "move" as walking, "keep" the stop's landings stay

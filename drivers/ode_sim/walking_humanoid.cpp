@@ -193,6 +193,11 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   if (options.push_capture && !options.push_recovery) {
     throw Error("OdeDriver: push_capture=true needs push_recovery=true (the capture is how its stop steps)");
   }
+  if (options.push_swing_reach > 0 && options.push_swing_reach != OdeDriverOptions{}.push_swing_reach &&
+      !options.push_recovery) {  // (the default is accepted without it)
+    throw Error(
+        "OdeDriver: push_swing_reach needs push_recovery=true (it bounds the regeneration's landings)");
+  }
   if (options.push_stop_feet != "move" && !options.push_recovery) {
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
@@ -212,6 +217,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   }
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
+  recovery.swing_reach = options.push_swing_reach;
   using StopFeet = walking::RecoveryParams::StopFeet;
   recovery.stop_feet = options.push_stop_feet == "keep"    ? StopFeet::kKeep
                        : options.push_stop_feet == "still" ? StopFeet::kStill

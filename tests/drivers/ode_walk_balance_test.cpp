@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <string>
@@ -168,6 +169,45 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   ASSERT_TRUE(keep_alone) << "push_stop_feet=keep without push_recovery accepted";
   EXPECT_NE(keep_alone->find("push_recovery"), std::string::npos) << *keep_alone;
   EXPECT_FALSE(RefusalOfWalker({{"push_stop_feet", "keep"}}));
+}
+
+// push_swing_reach (1 m/s by default; docs/ode_sim.md, "eighth session"): a
+// push toward the left while the left foot swings (30 N s at 5.14 s into a
+// walk at full speed, the sweep's seed-1 instant) moves that foot's landing
+// outward in the air. Without the option the regenerations' moves add up to
+// more than the legs follow: the foot lands ~10 cm inside its planned
+// landing (and the robot falls); with 1 m/s within a few cm, and it stands.
+TEST(OdeWalk, PushSwingReachKeepsAMovedLandingWithinWhatTheSwingFootReaches) {
+  for (const char* reach : {"0", "1.0"}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_swing_reach", reach}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(5.14);
+    w.driver->PushForTesting(Eigen::Vector3d(0, 30 / 0.1, 0), FromSeconds(0.1));
+    // The left foot in the air: its first touchdown after the push (planned height 0), 50 ms on.
+    w.Run(1.0, [&] { return w.driver->walk_status()->foot_height[0] <= 0; });
+    w.Run(0.05);
+    const walking::WalkStatus s = *w.driver->walk_status();
+    // Outward (the walk heads along x): the move the push asked for.
+    const double miss = std::abs(s.foot[0].y - s.foot_measured[0].y);
+    std::printf("push_swing_reach=%s: the left foot lands %.3f m (%.3f m outward) from its planned landing\n",
+                reach, (s.foot[0].xy() - s.foot_measured[0].xy()).norm(), miss);
+    w.Run(2.0, [&] { return w.driver->walk_status()->fallen; });
+    if (std::string(reach) == "0") {
+      EXPECT_GT(miss, 0.10);
+    } else {
+      EXPECT_LT(miss, 0.06);
+      EXPECT_FALSE(w.driver->walk_status()->fallen) << "tilt " << w.max_tilt;
+    }
+  }
+  const std::optional<std::string> alone =
+      RefusalOfWalker({{"push_swing_reach", "2"}, {"push_recovery", "false"}});
+  ASSERT_TRUE(alone) << "push_swing_reach without push_recovery accepted";
+  EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
+  const std::optional<std::string> negative = RefusalOfWalker({{"push_swing_reach", "-1"}});
+  ASSERT_TRUE(negative) << "push_swing_reach=-1 accepted";
+  EXPECT_NE(negative->find("push_swing_reach"), std::string::npos) << *negative;
+  EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}})) << "the default needs no push_recovery";
 }
 
 // push_balance (off by default; docs/ode_sim.md, "Pushes"): the wiring —

@@ -202,8 +202,17 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
       Eigen::Vector2d now =
           on.xy() + Eigen::Vector2d(c * got.x() - s * got.y(), s * got.x() + c * got.y()) - plan.xy();
       if (i == k && in_air) {  // the swing foot's speed
-        const double most = rp.swing_speed * static_cast<double>(land - tick_) * tick_s_;
+        const double left = static_cast<double>(land - tick_) * tick_s_, most = rp.swing_speed * left;
         if ((now - total).norm() > most) now = total + (now - total) * (most / (now - total).norm());
+        if (rp.swing_reach > 0) {  // the landing within what the foot can reach from where it is
+          // The foot moves horizontally until 0.9 of its swing (UpdateFeet), its
+          // progress linear to 1 at the landing from now.
+          const double s0 = SwingProgress(steps_[i]), moving = s0 < 0.9 ? left * (0.9 - s0) / (1 - s0) : 0.0;
+          const Eigen::Vector2d at = foot_[static_cast<int>(steps_[i].step.side)].xy();
+          const Eigen::Vector2d to = plan.xy() + now - at;
+          const double far = std::max((plan.xy() - at).norm(), rp.swing_reach * moving);
+          if (to.norm() > far) now = at + to * (far / to.norm()) - plan.xy();
+        }
       }
       if (i == k) fits = (now - want).norm() < 1e-6;
       rest -= (now - total) / grow;
@@ -398,6 +407,7 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
   if (!(omega > 0) || !(tick > 0) || !(p_.threshold >= 0) || !(p_.reach > 0)) {
     throw std::invalid_argument("PushRecovery: omega, tick and reach must be > 0, threshold >= 0");
   }
+  if (!(p_.swing_reach >= 0)) throw std::invalid_argument("PushRecovery: swing_reach must be >= 0 (0: off)");
   if (!(p_.stop_impulse >= 0) || (p_.stop_impulse > 0 && !(p_.stop_hold > 0))) {
     throw std::invalid_argument("PushRecovery: stop_impulse must be >= 0 (0: off) and stop_hold > 0");
   }

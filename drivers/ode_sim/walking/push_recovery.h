@@ -70,6 +70,12 @@ struct RecoveryParams {
   double min_swing = 0.35;  ///< s: a step in the air may land this soon after its lift-off, at the soonest
   double late = 0.03;  ///< s: a foot in the air this close to landing keeps its landing; the next one moves
   double swing_speed = 2.0;  ///< m/s: a foot in the air moves its landing at most this much per second left
+  /// m/s, 0: off (option push_swing_reach). A foot in the air lands at most
+  /// this far per second of its swing's move left (to 0.9 of the swing) from
+  /// where the swing has it now (or as far as its landing already was): each
+  /// regeneration's swing_speed bounds only its own move, and moves 50 ms
+  /// apart add up beyond what the legs follow.
+  double swing_reach = 0;
   // A moved landing's ankle from its stance foot's ankle, in that foot's frame:
   double reach = 0.45;         ///< m: at most this far ahead
   double reach_back = 0.30;    ///< m: at most this far behind

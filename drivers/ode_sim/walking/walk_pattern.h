@@ -147,6 +147,11 @@ class WalkPattern {
   int SupportPolygon(std::array<Eigen::Vector2d, 16>& out) const;
   /// Time until the foot in the air lands, s; 0 in double support.
   double time_to_landing() const;
+  /// The step of the foot in the air (its landing), or null in double support.
+  const Footstep* swing_step() const {
+    const Scheduled* s = Swinging();
+    return s && s->swing ? &s->step : nullptr;
+  }
   const GaitParams& gait() const { return g_; }
   double time() const { return static_cast<double>(tick_) * tick_s_; }
 
