@@ -65,10 +65,17 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-start-lead G         adaptive: start G gaps' stretch below the worst delay, which
                                   the first gaps' stretch then reaches (default 1; 0: the
                                   start covers it)
+  --playback-copy-discount on|off adaptive, on a FIFO link: leave a package's wait behind a
+                                  copy of an earlier one (a retransmission) out of its delay
+                                  (default on)
+  --playback-fifo-start on|off    adaptive, on a FIFO link: the start from frame 0's own queue
+                                  (simulated sequences from the services seen; default off)
   --inject-reply-drop P           test only: drop each reply package with probability P
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
   --log-executions                print one line per executed command (diagnostics)
+  --log-playback                  print one line per playback start: the delays its estimator
+                                  saw and what it decided (diagnostics)
   --max-acceleration A            acceleration limit of every dof's trajectory, rad/s^2 or m/s^2
                                   (interpolated waypoints; default 20)
   --max-base-acceleration LIN[,ANG]|NAME=LIN[,ANG]
@@ -175,6 +182,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.max_acceleration = ParseNumber(arg, value(), 1e-3, 1e6);
       } else if (arg == "--log-executions") {
         options.log_executions = true;
+      } else if (arg == "--log-playback") {
+        options.log_playback = true;
       } else if (arg == "--robot") {
         robots.push_back(RobotSpec::Parse(value()));
       } else if (arg == "--url") {
@@ -250,6 +259,14 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-resent-delays '" + v + "': expected on or off");
         options.playback_resent_delays = v == "on";
+      } else if (arg == "--playback-copy-discount") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-copy-discount '" + v + "': expected on or off");
+        options.playback_copy_discount = v == "on";
+      } else if (arg == "--playback-fifo-start") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-fifo-start '" + v + "': expected on or off");
+        options.playback_fifo_start = v == "on";
       } else if (arg == "--playback-start-lead") {
         options.playback_start_lead = ParseNumber(arg, value(), 0, 100);
       } else if (arg == "--duration") {
