@@ -412,10 +412,6 @@ class Bench:
                      ["--stretch-bound", "0.5"], 2.0, None))
         # the default before a queue beyond the gate was followed (issue 23, seventh session)
         variants += (("adaptive_follow_off", adaptive + ["--playback-follow-queue", "off"], [], 2.0, None),)
-        # the start from frame 0's own queue on a FIFO link (issue 23, eighth session)
-        variants += (("adaptive_fifo", adaptive + ["--playback-fifo-start", "on"], [], 2.0, None),)
-        # before a package's wait behind a copy (a retransmission) was left out (eighth session)
-        variants += (("adaptive_copy_discount_off", adaptive + ["--playback-copy-discount", "off"], [], 2.0, None),)
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
         # robotalk-server ("adaptive_before_build"): a code change's before and after on the same
         # relay seeds and under the same load, interleaved.

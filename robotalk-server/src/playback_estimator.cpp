@@ -5,18 +5,6 @@
 #include <cstdio>
 
 namespace robotalk {
-namespace {
-
-// One of `pool` drawn by splitmix64 from `state` (a fixed seed: the estimate
-// is a pure function of its inputs). REQUIRES: pool not empty.
-double Resample(std::uint64_t& state, const std::vector<double>& pool) {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return pool[(z ^ (z >> 31)) % pool.size()];
-}
-
-}  // namespace
 
 PlaybackEstimator::PlaybackEstimator(std::size_t total_frames, Duration duration,
                                      PlaybackEstimatorOptions options)
@@ -43,12 +31,6 @@ void DelayHistory::Add(TimePoint sent, TimePoint received, std::optional<TimePoi
   size_ = std::min(size_ + 1, kCapacity);
 }
 
-void DelayHistory::AddCopy(TimePoint received) {
-  ring_[next_] = {received, Duration(0), Sample::kCopy};
-  next_ = (next_ + 1) % kCapacity;
-  size_ = std::min(size_ + 1, kCapacity);
-}
-
 std::vector<DelayHistory::Sample> DelayHistory::RecentSamples(TimePoint now, Duration window) const {
   std::vector<Sample> out;
   out.reserve(size_);
@@ -61,8 +43,7 @@ std::vector<DelayHistory::Sample> DelayHistory::RecentSamples(TimePoint now, Dur
 
 std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const {
   std::vector<Duration> out;
-  for (const Sample& s : RecentSamples(now, window))
-    if (!s.copy()) out.push_back(s.delay);
+  for (const Sample& s : RecentSamples(now, window)) out.push_back(s.delay);
   return out;
 }
 
@@ -70,12 +51,7 @@ void PlaybackEstimator::SetDelayHistory(const std::vector<DelayHistory::Sample>&
   history_.clear();
   history_received_.clear();
   history_lag_.clear();
-  copies_.clear();
   for (const DelayHistory::Sample& s : samples) {
-    if (s.copy()) {
-      if (options_.copy_wait_discount) copies_.push_back(s.received);
-      continue;
-    }
     history_.push_back(s.delay);
     history_received_.push_back(s.received);
     history_lag_.push_back(s.lag);
@@ -149,11 +125,8 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     if (!seen[j].known_arrival || !seen[j - 1].known_arrival) continue;
     const TimePoint sent = seen[j].arrival - seen[j].delay,
                     sent_before = seen[j - 1].arrival - seen[j - 1].delay;
-    // A copy of an earlier package between the two (copy_wait_discount): the
-    // package waited behind it, a queue the client's own retransmission made.
-    const TimePoint before = BehindCopy(seen[j - 1].arrival, seen[j].arrival);
-    if (before == seen[j - 1].arrival && (sent - sent_before >= burst || sent < sent_before)) continue;
-    const Duration wait = before - (sent + least);
+    if (sent - sent_before >= burst || sent < sent_before) continue;
+    const Duration wait = seen[j - 1].arrival - (sent + least);
     discounted.delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
   }
   // Only on a FIFO link, where that brings the spread within the gate, or
@@ -161,13 +134,6 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
   // the channel's delays, not the burst's own queue); else as measured.
   const bool follows = options_.follow_queue && !options_.queue_start;
   return fifo || spread(discounted.delays) <= gate || follows ? discounted : measured;
-}
-
-TimePoint PlaybackEstimator::BehindCopy(TimePoint after, TimePoint before) const {
-  TimePoint latest = after;
-  for (TimePoint c : copies_)
-    if (c > latest && c < before) latest = c;
-  return latest;
 }
 
 bool PlaybackEstimator::burst_discounted() const { return ChannelDelays().discounted; }
@@ -296,7 +262,7 @@ std::vector<double> PlaybackEstimator::Services() const {
     const Duration excess = p.delay - fenced.least;
     Duration s = excess;  // arrival unknown: as if it had not queued (the larger service)
     if (p.known_arrival && previous)
-      s = std::min(excess, p.arrival - std::max(BehindCopy(*previous, p.arrival), p.arrival - excess));
+      s = std::min(excess, p.arrival - std::max(*previous, p.arrival - excess));
     if (p.known_arrival) previous = p.arrival;
     if (channel[k] <= fenced.most) service.push_back(ToSeconds(s));
   }
@@ -317,7 +283,12 @@ Duration PlaybackEstimator::QueueWorst() const {
   const std::size_t frames = std::min(total_, kQueueHorizon);
   const std::size_t runs = std::max<std::size_t>(options_.queue_resamples, 1);
   std::uint64_t state = 0x9E3779B97F4A7C15ull;
-  const auto draw = [&] { return Resample(state, service); };
+  const auto draw = [&] {  // splitmix64
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return service[(z ^ (z >> 31)) % service.size()];
+  };
   std::vector<double> worst(runs);
   for (double& w_max : worst) {
     double wait = 0, previous_s = 0, total = 0;
@@ -335,64 +306,6 @@ Duration PlaybackEstimator::QueueWorst() const {
       std::clamp(options_.queue_quantile, 0.0, 1.0) * static_cast<double>(runs - 1) + 0.5);
   std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(q), worst.end());
   return least + FromSeconds(worst[q]);
-}
-
-std::optional<Duration> PlaybackEstimator::FifoStartBuffer() const {
-  if (!options_.fifo_start || frames_.size() != 1) return std::nullopt;
-  const std::vector<Seen> seen = SeenPackages();
-  if (seen.empty() || !ArrivedInSendOrder(seen)) return std::nullopt;
-  // On a FIFO link frame 0's delay says how long the queue in front of the
-  // frames after it is: with d_min the least delay, frame 0 left e_0 = d_0 -
-  // d_min of queue and service behind it, so frame 1 waits max(0, e_0 - T)
-  // and arrives e_1 = that + its service above d_min, frame 2 waits
-  // max(0, e_1 - T), ... (Lindley, as QueueWorst, but from frame 0's state
-  // instead of an empty queue). Each simulated sequence (services resampled
-  // from those seen) needs a start buffer b_r = max_i (e_i - e_0 + margin -
-  // i × the stretch of one gap): frame i may play that much later than
-  // recorded once the gaps before it stretched (the playout delay makes them
-  // stretch), and its hindsight minimum is h_r = max(0, max_i (e_i - e_0)).
-  // A buffer b meets both in a sequence where b_r <= b <= goal × (h_r + margin).
-  // The start is the b that does so in the most simulated sequences (the least
-  // such b): frame 0 slow against the services seen gives a small buffer, a
-  // fast one a larger, and an outlier service (a connect-time package that waited
-  // behind copies this server did not record) weighs as often as it is drawn
-  // instead of setting the start.
-  const std::vector<double> service = Services();
-  const double least = ToSeconds(FencedSpread()->least);
-  const double t = interval(), gap_stretch = std::max(0.0, options_.max_stretch) * t;
-  const double margin = ToSeconds(options_.adaptive_margin), goal = options_.start_ratio_goal;
-  const double e0 = ToSeconds(*frames_.front().delay) - least;
-  // The most of n services seen falls short of the channel's by about spread / n (as
-  // AdaptiveWorst's headroom): each simulated frame's need counts that much more.
-  const Spread fenced = *FencedSpread();
-  const double headroom =
-      options_.start_headroom * ToSeconds(fenced.most - fenced.least) / static_cast<double>(fenced.kept);
-  const std::size_t frames = std::min(total_, kQueueHorizon);
-  const std::size_t runs = std::max<std::size_t>(options_.queue_resamples, 1);
-  std::uint64_t state = 0xD1B54A32D192ED03ull;
-  const auto draw = [&] { return Resample(state, service); };
-  std::vector<std::pair<double, double>> need(runs);  // (b_r, h_r)
-  for (auto& [b, h] : need) {
-    double e = e0;
-    b = margin;
-    h = 0;
-    for (std::size_t i = 1; i < frames; ++i) {
-      e = std::max(0.0, e - t) + draw();
-      b = std::max(b, e + headroom - e0 + margin - static_cast<double>(i) * gap_stretch);
-      h = std::max(h, e - e0);
-    }
-  }
-  double best = margin;
-  std::size_t best_met = 0;
-  for (const auto& [candidate, unused] : need) {
-    std::size_t met = 0;
-    for (const auto& [b, h] : need) met += b <= candidate && candidate <= goal * (h + margin);
-    if (met > best_met || (met == best_met && candidate < best)) {
-      best_met = met;
-      best = candidate;
-    }
-  }
-  return FromSeconds(best);
 }
 
 bool PlaybackEstimator::quick() const {
@@ -516,10 +429,6 @@ TimePoint PlaybackEstimator::StartTime() const {
     // length each) until the buffer covers the worst delay, so the frames
     // after them find it; frame 0 itself has arrived. StartCovering's floor
     // (the decision + margin) stays.
-    if (const std::optional<Duration> buffer = FifoStartBuffer()) {
-      const Frame& f = frames_.front();
-      return f.arrival - f.offset + *buffer;  // at least frame 0's arrival + margin
-    }
     return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, start_lead());
   }
   if (quick()) {

@@ -174,24 +174,9 @@ struct PlaybackEstimatorOptions {
   /// input (the paper's Fig. 11 pauses after each package) is a queue whose
   /// drift its sparse packages do not show.
   double follow_max_lag = 1.0;
-  /// A package that arrived right after a copy of an earlier one (a client's
-  /// retransmission: at connect, its hello's) on a FIFO link waited behind that
-  /// copy: that wait is left out of its delay like a burst package's, whenever it
-  /// was sent, and out of its service (Services). Off: copies are not seen.
-  bool copy_wait_discount = true;
   /// The queue's mean service may be at most (1 + max_stretch) intervals at
   /// mean + follow_z × its standard error (the queue start uses confidence_z).
   double follow_z = 0.0;
-  /// On a FIFO link (every package seen arrived in the order it was sent), the
-  /// adaptive start from frame 0's own queue (see "Start from frame 0's queue"):
-  /// the sequences that frame 0's wait and the services seen may give, and of
-  /// the starts that cover their frames within the stretch, the one that also lies
-  /// within start_ratio_goal of each sequence's hindsight minimum in the most of them.
-  /// Off: the worst recent delay less the lead, as before.
-  bool fifo_start = false;
-  /// The ratio to a simulated sequence's hindsight minimum (+ adaptive_margin) a
-  /// start aims within (issue 23's goal).
-  double start_ratio_goal = 1.25;
 };
 
 /// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
@@ -207,25 +192,16 @@ class DelayHistory {
   struct Sample {
     TimePoint received;
     Duration delay;
-    Duration lag{0};  ///< handled − reached the socket (the server's own lag); kCopy: a copy
-    /// A copy (AddCopy): its arrival only, no delay (marked in `lag`, never negative
-    /// otherwise, so a session's history keeps its size).
-    static constexpr Duration kCopy = Duration::min();
-    bool copy() const { return lag == kCopy; }
+    Duration lag{0};  ///< handled − reached the socket (the server's own lag)
   };
   /// Records one package, handled at `received` after it reached the socket
   /// at `arrived` (both on the server clock; `arrived` later than `received`
   /// counts as no lag); a send time whose difference to `received` does not
   /// fit is ignored (a hostile header must not overflow anything).
   void Add(TimePoint sent, TimePoint received, std::optional<TimePoint> arrived = std::nullopt);
-  /// Records that a copy of an earlier package (a duplicate, or a retransmission
-  /// whose first copy was lost: its send time is the first copy's) was handled at
-  /// `received`: no delay of the channel, but on a FIFO link the package after it
-  /// waited behind it (the copy wait, PlaybackEstimatorOptions::copy_wait_discount).
-  void AddCopy(TimePoint received);
-  /// The delays recorded within `window` before `now`, oldest first (copies left out).
+  /// The delays recorded within `window` before `now`, oldest first.
   std::vector<Duration> Recent(TimePoint now, Duration window = std::chrono::seconds(30)) const;
-  /// The same with their arrival times (the queue start reads the queue from them), copies included.
+  /// The same with their arrival times (the queue start reads the queue from them).
   std::vector<Sample> RecentSamples(TimePoint now, Duration window = std::chrono::seconds(30)) const;
 
  private:
@@ -244,7 +220,6 @@ class PlaybackEstimator {
     history_ = std::move(delays);
     history_received_.clear();
     history_lag_.clear();
-    copies_.clear();
   }
   /// The same with their arrival times (DelayHistory::RecentSamples), oldest first.
   void SetDelayHistory(const std::vector<DelayHistory::Sample>& samples);
@@ -258,8 +233,7 @@ class PlaybackEstimator {
   /// Heap memory it holds (its frames and delay history), for the session's accounting.
   std::size_t heap_bytes() const {
     return frames_.capacity() * sizeof(Frame) + history_.capacity() * sizeof(Duration) +
-           history_received_.capacity() * sizeof(TimePoint) + history_lag_.capacity() * sizeof(Duration) +
-           copies_.capacity() * sizeof(TimePoint);
+           history_received_.capacity() * sizeof(TimePoint) + history_lag_.capacity() * sizeof(Duration);
   }
   bool ready() const;
   /// Whether the start is decided at the first frames from send times (the
@@ -319,13 +293,10 @@ class PlaybackEstimator {
   TimePoint StartCovering(Duration worst, Duration margin, Duration lead = Duration(0)) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
   Duration QueueWorst() const;                    // REQUIRES: queued() or followed()
-  // fifo_start: how long after frame 0's arrival offset 0 plays (see above), or nullopt
-  // where it does not apply (not a FIFO link, a frame without a send time).
-  std::optional<Duration> FifoStartBuffer() const;
-  std::vector<double> Services() const;  // s, of the packages seen; REQUIRES: delay_spread()
-  TimePoint PaperStart() const;          // the paper's estimate
-  bool QueueFollowable(double z) const;  // REQUIRES: delay_spread()
-  bool ServerKeptUp() const;             // every package seen handled within follow_max_lag of its arrival
+  std::vector<double> Services() const;           // s, of the packages seen; REQUIRES: delay_spread()
+  TimePoint PaperStart() const;                   // the paper's estimate
+  bool QueueFollowable(double z) const;           // REQUIRES: delay_spread()
+  bool ServerKeptUp() const;  // every package seen handled within follow_max_lag of its arrival
   bool SpreadWithinGate() const;
   double WiderStretch() const;  // max(0, max_stretch − kGateStretch), intervals
   double Gate() const;          // the spread beyond which the adaptive start gives way, s
@@ -363,9 +334,6 @@ class PlaybackEstimator {
   std::vector<Duration> history_;
   std::vector<TimePoint> history_received_;  // empty, or history_'s arrivals
   std::vector<Duration> history_lag_;        // empty, or the server's lag handling each
-  std::vector<TimePoint> copies_;            // when copies of earlier packages were handled
-  // The latest copy handled after `after` and before `before` (copy_wait_discount), else `after`.
-  TimePoint BehindCopy(TimePoint after, TimePoint before) const;
 };
 
 }  // namespace robotalk

@@ -192,8 +192,6 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
   if (seen == SequenceWindow::Verdict::kDuplicate) {
     // A retransmission or a duplicate: never execute again; re-send what is
     // known. It does not refresh the session (a replay must not keep it alive).
-    // On a FIFO link the package after it waited behind it (playback's start).
-    if (r.send_time != TimePoint{}) session.delays.AddCopy(now);
     immediate = Retransmitted(session, r, now);
     return answer;
   }
@@ -235,8 +233,6 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
   // where it was the link's, not this server's (follow_queue).
   if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
     session.delays.Add(r.send_time, now, arrived);
-  else if (r.send_time != TimePoint{})
-    session.delays.AddCopy(now);  // a retransmission: its arrival only
   for (Reply& reply : immediate) {
     Bound(reply);
     session.replies.RecordReply(reply);

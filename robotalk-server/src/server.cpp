@@ -125,8 +125,6 @@ class Server::Impl {
     sessions.playback_resent_delays = options_.playback_resent_delays;
     sessions.log_playback = options_.log_playback;
     sessions.playback.start_lead = options_.playback_start_lead;
-    sessions.playback.fifo_start = options_.playback_fifo_start;
-    sessions.playback.copy_wait_discount = options_.playback_copy_discount;
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);
     sessions.max_sessions_per_robot = options_.max_sessions_per_robot;

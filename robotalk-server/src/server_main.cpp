@@ -65,11 +65,6 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-start-lead G         adaptive: start G gaps' stretch below the worst delay, which
                                   the first gaps' stretch then reaches (default 1; 0: the
                                   start covers it)
-  --playback-copy-discount on|off adaptive, on a FIFO link: leave a package's wait behind a
-                                  copy of an earlier one (a retransmission) out of its delay
-                                  (default on)
-  --playback-fifo-start on|off    adaptive, on a FIFO link: the start from frame 0's own queue
-                                  (simulated sequences from the services seen; default off)
   --inject-reply-drop P           test only: drop each reply package with probability P
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
@@ -259,14 +254,6 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-resent-delays '" + v + "': expected on or off");
         options.playback_resent_delays = v == "on";
-      } else if (arg == "--playback-copy-discount") {
-        const std::string v = value();
-        if (v != "on" && v != "off") throw Error("--playback-copy-discount '" + v + "': expected on or off");
-        options.playback_copy_discount = v == "on";
-      } else if (arg == "--playback-fifo-start") {
-        const std::string v = value();
-        if (v != "on" && v != "off") throw Error("--playback-fifo-start '" + v + "': expected on or off");
-        options.playback_fifo_start = v == "on";
       } else if (arg == "--playback-start-lead") {
         options.playback_start_lead = ParseNumber(arg, value(), 0, 100);
       } else if (arg == "--duration") {

@@ -155,13 +155,6 @@ struct ServerOptions {
   /// gaps' stretch reaches it (PlaybackEstimatorOptions::start_lead). 0: the
   /// start covers it itself.
   double playback_start_lead = 1.0;
-  /// Adaptive, on a FIFO link: the start from frame 0's own queue
-  /// (PlaybackEstimatorOptions::fifo_start; --playback-fifo-start).
-  bool playback_fifo_start = false;
-  /// Adaptive: a package's wait behind a copy of an earlier one left out of its
-  /// delay on a FIFO link (PlaybackEstimatorOptions::copy_wait_discount;
-  /// --playback-copy-discount).
-  bool playback_copy_discount = true;
   /// Test fault injection on outgoing reply packages (seeded): probability
   /// that one is dropped, and that one is sent twice.
   double reply_drop_probability = 0.0;
