@@ -273,9 +273,10 @@ class ArrivalLog {
       seen_[c.id] = true;
       arrival_ns.push_back(now);
       offset_us.push_back(c.start_time_us);
+      send_us.push_back(p->header.send_time_us);
     }
   }
-  std::vector<std::int64_t> arrival_ns, offset_us;
+  std::vector<std::int64_t> arrival_ns, offset_us, send_us;
 
  private:
   std::map<std::int64_t, bool> seen_;
@@ -292,16 +293,21 @@ int Arrivals(const Args& a) {
   while (static_cast<long>(log.arrival_ns.size()) < frames && MonoNs() < end) lcm.handleTimeout(100);
   std::int64_t first = log.arrival_ns.empty() ? 0 : log.arrival_ns.front();
   for (std::int64_t t : log.arrival_ns) first = std::min(first, t);
-  std::vector<double> lags;
+  std::vector<double> lags, transits, offsets;
   double worst = 0;
   for (std::size_t i = 0; i < log.arrival_ns.size(); ++i) {
     const double lag =
         static_cast<double>(log.arrival_ns[i] - first) / 1e6 - static_cast<double>(log.offset_us[i]) / 1e3;
     worst = std::max(worst, lag);
     lags.push_back(std::round(lag * 1e3) / 1e3);
+    // arrival - the client's send time (ms, the clocks' offset included): a retransmission
+    // carries its first copy's send time, so its resend wait shows here.
+    transits.push_back(std::round(static_cast<double>(log.arrival_ns[i] / 1000 - log.send_us[i])) / 1e3);
+    offsets.push_back(static_cast<double>(log.offset_us[i]) / 1e3);
   }
   PrintJson({Field("frames", static_cast<double>(log.arrival_ns.size())),
-             Field("hindsight_min_s", worst / 1e3), Field("lag_ms", lags)});
+             Field("hindsight_min_s", worst / 1e3), Field("lag_ms", lags), Field("transit_ms", transits),
+             Field("offset_ms", offsets)});
   return 0;
 }
 

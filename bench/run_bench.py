@@ -51,6 +51,14 @@ class Bench:
         self.children.append(p)
         return p
 
+    def playback_decision(self):
+        """The last --log-playback line of the server's log (a JSON object), or None (an older build)."""
+        try:
+            lines = [x for x in open(f"{self.tmp}/server.log") if " start {" in x and "PLAYBACK" in x]
+            return json.loads(lines[-1][lines[-1].index(" start {") + 7:]) if lines else None
+        except (OSError, ValueError):
+            return None
+
     @staticmethod
     def parse(out, what):
         for line in reversed((out or "").strip().splitlines()):
@@ -375,7 +383,8 @@ class Bench:
         only_profiles = [p for p in os.environ.get("ROBOTALK_BENCH_PROFILES", "").split(";") if p]
         if only_profiles:
             profiles = [p for p in profiles if any(p[0].startswith(o) for o in only_profiles)]
-        reps = self.runs  # relay seeds per profile: 5 (quick: 3)
+        # relay seeds per profile: 5 (quick: 3); ROBOTALK_BENCH_RUNS=N another count
+        reps = int(os.environ.get("ROBOTALK_BENCH_RUNS", self.runs))
         # (name, server arguments, client arguments, the server's hand-over margin in ms: a frame of
         # the adaptive schedule must have arrived that long before it plays; the fixed schedule of
         # the paper calls a frame late only once it arrives after its time; the profiles it runs on,
@@ -424,8 +433,8 @@ class Bench:
                     own_server = self.server_bin
                     if est == "adaptive_before_build":
                         self.server_bin = before_server
-                    try:
-                        self.start_server(url=URL_B, extra=server_args)
+                    try:  # --log-playback: the estimator's inputs and decision in the server's log
+                        self.start_server(url=URL_B, extra=server_args + ["--log-playback"])
                     finally:
                         self.server_bin = own_server
                     relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, *impair, "--seed", str(seed),
@@ -441,7 +450,8 @@ class Bench:
                     self.stop_server()
                     runs.append({"profile": name, "relay_args": impair, "seed": seed, "estimator": est,
                                  "margin_ms": margin_ms, "server_args": server_args,
-                                 "client_args": client_args, "robotalk": a, "arrivals": arr})
+                                 "client_args": client_args, "robotalk": a, "arrivals": arr,
+                                 "decision": self.playback_decision()})
                     time.sleep(0.5)
                 seed += 1
         return {"figure": "playback_estimators", "frames": frames, "period_ms": 100, "stretch_bound": 0.1,

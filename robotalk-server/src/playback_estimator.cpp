@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace robotalk {
 
@@ -459,6 +460,51 @@ TimePoint PlaybackEstimator::PaperStart() const {
   // Nothing may be scheduled before the decision: the waiting for enough
   // frames is playback's start latency (paper Table I).
   return std::max(projected, decided - first_offset) + options_.margin;
+}
+
+std::string PlaybackEstimator::Describe() const {
+  // Milliseconds above the least delay seen (the clocks' offset cancels), to one decimal.
+  const std::vector<Seen> seen = SeenPackages();
+  const Channel channel = ChannelDelays();
+  Duration least = Duration::max();
+  for (const Seen& p : seen) least = std::min(least, p.delay);
+  const auto ms = [](Duration d) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.1f", ToSeconds(d) * 1e3);
+    return std::string(b);
+  };
+  const auto list = [&](auto begin, auto end, auto f) {
+    std::string out = "[";
+    for (auto it = begin; it != end; ++it) out += (it == begin ? "" : ",") + f(*it);
+    return out + "]";
+  };
+  std::string out = "{\"history\":" + std::to_string(history_.size()) + ",\"delays\":" +
+                    list(seen.begin(), seen.end(), [&](const Seen& p) { return ms(p.delay - least); });
+  out += ",\"channel\":" +
+         list(channel.delays.begin(), channel.delays.end(), [&](Duration d) { return ms(d - least); });
+  const TimePoint sent0 =
+      seen.empty() ? TimePoint{} : seen[history_.size()].arrival - seen[history_.size()].delay;
+  out += ",\"sent\":" + list(seen.begin(), seen.end(), [&](const Seen& p) {
+           return p.known_arrival ? ms(p.arrival - p.delay - sent0) : std::string("null");
+         });
+  out += ",\"lags\":" + list(history_lag_.begin(), history_lag_.end(), ms);
+  out += ",\"frame_lags\":" + list(frames_.begin(), frames_.end(), [&](const Frame& f) { return ms(f.lag); });
+  const TimePoint first = frames_.front().arrival;
+  out += ",\"frame_arrivals\":" +
+         list(frames_.begin(), frames_.end(), [&](const Frame& f) { return ms(f.arrival - first); });
+  out += std::string(",\"adaptive\":") + (adaptive() ? "true" : "false") +
+         ",\"followed\":" + (followed() ? "true" : "false") + ",\"queued\":" + (queued() ? "true" : "false") +
+         ",\"discounted\":" + (channel.discounted ? "true" : "false");
+  if (const std::optional<Spread> s = FencedSpread()) {
+    out += ",\"fenced_most\":" + ms(s->most - least) + ",\"kept\":" + std::to_string(s->kept);
+  }
+  if (adaptive()) {
+    out += ",\"worst\":" + ms(AdaptiveWorst(options_.start_headroom) - least) +
+           ",\"playout\":" + ms(*playout_delay() - least) + ",\"lead\":" + ms(start_lead());
+  }
+  if (!seen.empty()) out += ",\"frame0\":" + ms(seen[history_.size()].delay - least);
+  out += ",\"start\":" + ms(StartTime() - first) + "}";
+  return out;
 }
 
 }  // namespace robotalk

@@ -91,6 +91,7 @@
 #include <array>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace robotalk {
@@ -268,6 +269,11 @@ class PlaybackEstimator {
 
   /// The server time at which offset 0 plays. REQUIRES: ready().
   TimePoint StartTime() const;
+  /// What the start was decided from, one JSON object (diagnostics, --log-playback): the
+  /// delays seen in ms above the least (history and frames, as measured and as the channel's),
+  /// the server's lag, the spread, the worst delay covered, frame 0's delay, the lead, the start
+  /// after the first frame and the playout delay. REQUIRES: ready().
+  std::string Describe() const;
   /// Average time between commands and between arrivals over the frames seen.
   Duration mean_command_interval() const;
   Duration mean_arrival_interval() const;

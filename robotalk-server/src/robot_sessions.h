@@ -43,6 +43,8 @@ struct SessionOptions {
   /// copy's) stays out of the session's delay history (--playback-resent-delays
   /// off, the default); on: every package counts, as before issue 23's fifth session.
   bool playback_resent_delays = false;
+  /// A log line per playback start: what the estimator decided it from (--log-playback).
+  bool log_playback = false;
   /// Most client sessions this robot serves at once (--max-sessions-per-robot);
   /// a new client beyond is refused.
   std::size_t max_sessions_per_robot = kDefaultMaxSessionsPerRobot;

@@ -121,6 +121,9 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
   const PlaybackEstimator& estimator = *seq.estimator;
   const PlaybackEstimatorOptions& o = options_.playback;
   seq.start = estimator.StartTime();
+  if (options_.log_playback)
+    log_.push_back("robot '" + robot_ + "': PLAYBACK " + std::to_string(id) + " start " +
+                   estimator.Describe());
   // The adaptive start's schedule may stretch the gaps between frames; the
   // quick and the paper's starts keep every frame at start + its offset.
   const double stretch = o.adaptive ? o.max_stretch : 0.0;

@@ -123,6 +123,7 @@ class Server::Impl {
     sessions.playback.follow_queue = options_.playback_follow_queue;
     sessions.playback.burst_wait_discount = options_.playback_burst_discount;
     sessions.playback_resent_delays = options_.playback_resent_delays;
+    sessions.log_playback = options_.log_playback;
     sessions.playback.start_lead = options_.playback_start_lead;
     // The server-wide bound of queued items, an equal part per robot.
     sessions.max_robot_queue = std::max<std::size_t>(options_.max_queued_total / specs.size(), 1);

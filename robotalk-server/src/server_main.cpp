@@ -69,6 +69,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --inject-reply-dup P            test only: send each reply package twice with probability P
   --seed N                        seed of the fault injection (default 1)
   --log-executions                print one line per executed command (diagnostics)
+  --log-playback                  print one line per playback start: the delays its estimator
+                                  saw and what it decided (diagnostics)
   --max-acceleration A            acceleration limit of every dof's trajectory, rad/s^2 or m/s^2
                                   (interpolated waypoints; default 20)
   --max-base-acceleration LIN[,ANG]|NAME=LIN[,ANG]
@@ -175,6 +177,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         options.max_acceleration = ParseNumber(arg, value(), 1e-3, 1e6);
       } else if (arg == "--log-executions") {
         options.log_executions = true;
+      } else if (arg == "--log-playback") {
+        options.log_playback = true;
       } else if (arg == "--robot") {
         robots.push_back(RobotSpec::Parse(value()));
       } else if (arg == "--url") {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 namespace robotalk {
@@ -142,6 +143,23 @@ TEST(FollowQueue, OnTheRelaysHeaviestCongestionMostRunsMeetTheGoalAndNoOtherChan
                 on.late_runs);
     EXPECT_EQ(on.late_runs, off.late_runs) << "burst " << burst;
   }
+}
+
+TEST(PlaybackDecision, DescribeSaysWhatTheStartWasDecidedFrom) {
+  // --log-playback's line (diagnostics): the delays above the least, the
+  // worst delay covered, frame 0's delay and the start after frame 0, in ms.
+  // History 11, 21, 31 ms (sparse, no send times of their own: unknown
+  // arrivals); frame 0 took 1 ms: spread 30 ms / 4 delays, worst 31 + 7.5 =
+  // 38.5 ms, 37.5 above the least; start 38.5 - 1 - 10 + 2 = 29.5 ms.
+  const PlaybackEstimator est =
+      AtFirstFrame(std::vector<Duration>{milliseconds(11), milliseconds(21), milliseconds(31)});
+  ASSERT_TRUE(est.ready());
+  const std::string line = est.Describe();
+  EXPECT_NE(line.find("\"history\":3,\"delays\":[10.0,20.0,30.0,0.0]"), std::string::npos) << line;
+  EXPECT_NE(line.find("\"worst\":37.5"), std::string::npos) << line;
+  EXPECT_NE(line.find("\"frame0\":0.0"), std::string::npos) << line;
+  EXPECT_NE(line.find("\"start\":29.5}"), std::string::npos) << line;
+  EXPECT_NEAR(ToSeconds(est.StartTime() - kT0), 0.0295, 1e-6);
 }
 
 // Four connect-time packages sent at one instant through a link: delays 1,

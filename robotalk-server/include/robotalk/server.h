@@ -147,6 +147,9 @@ struct ServerOptions {
   /// included) counts in the delay history too (SessionOptions::playback_resent_delays;
   /// off, the default: left out).
   bool playback_resent_delays = false;
+  /// One log line per playback start with what the estimator decided it from
+  /// (PlaybackEstimator::Describe; --log-playback, diagnostics).
+  bool log_playback = false;
   /// Adaptive: the start lies this many gaps' stretch (playback_stretch ×
   /// the frame interval each) below the worst delay it covers; the first
   /// gaps' stretch reaches it (PlaybackEstimatorOptions::start_lead). 0: the
