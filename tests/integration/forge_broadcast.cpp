@@ -4,12 +4,17 @@
 //       unsigned, and signed by a key of the forger's own; 10 ms apart.
 //   forge_broadcast URL announce ROBOT N
 //       N ANNOUNCEs naming ROBOT, by server 0000000000000001 "serving it for a year".
+//   forge_broadcast URL replay-announce ROBOT RECORD_S REPLAY_S
+//       records the ANNOUNCEs naming ROBOT for RECORD_S seconds (a keyed
+//       server's, signed), then sends them again, every 10 ms, for REPLAY_S.
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
 #include "robotalk/request.h"
 #include "robotalk/routed_lcm_transport.h"
 
 #include <chrono>
+#include <cstdint>
+#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -53,6 +58,28 @@ int main(int argc, char** argv) {
       a.url_hint = "forged";
       a.robots.push_back({robot, "kinematic", 1, 1, BaseType::kFixed, false, 0});
       lan->Publish(kAnnounceChannel, EncodeAnnouncement(a));
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return 0;
+  }
+  if (what == "replay-announce" && argc == 6) {
+    using Seconds = std::chrono::duration<double>;
+    const auto record = std::chrono::steady_clock::now() + Seconds(std::atof(argv[4]));
+    std::vector<std::vector<std::uint8_t>> recorded;
+    auto sub = lan->Subscribe(kAnnounceChannel, [&](const std::string&, std::span<const std::uint8_t> bytes) {
+      try {
+        for (const RobotAnnouncement& r : DecodeAnnouncement(bytes).robots)
+          if (r.name == robot) recorded.emplace_back(bytes.begin(), bytes.end());
+      } catch (const ProtocolError&) {
+      }
+    });
+    while (std::chrono::steady_clock::now() < record) lan->HandleFor(std::chrono::milliseconds(20));
+    sub.reset();
+    std::fprintf(stderr, "forge_broadcast: recorded %zu announcements of %s\n", recorded.size(), robot.c_str());
+    if (recorded.empty()) return 1;
+    const auto replay = std::chrono::steady_clock::now() + Seconds(std::atof(argv[5]));
+    for (std::size_t i = 0; std::chrono::steady_clock::now() < replay; ++i) {
+      lan->Publish(kAnnounceChannel, recorded[i % recorded.size()]);
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     return 0;

@@ -77,6 +77,27 @@ check "a keyed watch ends with 1 when its server is gone, forged announcements o
   test "$status" -eq 1
 check "and says so: $(tail -2 "$tmp/watch_gone.err")" grep -q "pioneer: no STATE sample and no announcement for 3 s: its server is gone" "$tmp/watch_gone.err"
 
+# A keyed watch counts its server's signed announcements as of their signed
+# server time: a recording of them, replayed once the server is gone (here
+# stopped with SIGSTOP), is stale and keeps nothing alive (review8: it did).
+rt watch pioneer --period 0.05 --duration 30 >"$tmp/watch_replay" 2>"$tmp/watch_replay.err" &
+watch_pid=$!
+"$forge" "$url" replay-announce pioneer 1.5 8 2>"$tmp/replay.err" &  # 1.5 s recorded, 8 s replayed
+forge_pid=$!
+sleep 1.7
+kill -STOP "$server_pid"
+for _ in $(seq 60); do kill -0 "$watch_pid" 2>/dev/null || break; sleep 0.1; done
+kill -KILL "$watch_pid" 2>/dev/null  # still watching after 6 s: the replay kept it
+wait "$watch_pid"
+status=$?
+wait "$forge_pid"
+kill -CONT "$server_pid"
+check "the forger recorded the server's announcements: $(cat "$tmp/replay.err")" grep -q "recorded [1-9]" "$tmp/replay.err"
+check "a keyed watch ends with 1 when its server is gone, its announcements replayed or not (got $status)" \
+  test "$status" -eq 1
+check "and says the replayed ones were stale: $(grep stale "$tmp/watch_replay.err")" \
+  grep -q "refused [0-9]* announcements signed by the server but stale" "$tmp/watch_replay.err"
+
 # Item 12: a second server for pioneer (its only robot) refuses it and exits 1.
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 20 \
   >"$tmp/second_server.log" 2>&1
