@@ -49,9 +49,15 @@ peer_checks cmd_vel "cmd_vel drives the base, and a silent cmd_vel stops it"
 check "the bridge says it stopped the base: $(grep cmd_vel "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': no cmd_vel for 0.5.* s: SETSPEED 0" "$tmp/bridge.log"
 
+# A flood of cmd_vel the bridge refuses (not finite): each refusal was a line
+# of its own (review8: 2,000 lines); now the bridge's log is rate-limited as
+# the server's (robotalk/log_limiter.h), counted below once the bridge stops.
+peer_checks cmd_vel_flood "2,000 refused cmd_vel move nothing"
+
 # The bridge's own lines only (Cyclone DDS may log on the same stderr).
 unexpected=$(grep "^robotalk-ros2:" "$tmp/bridge.log" |
-  grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel")
+  grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel" -e "cmd_vel refused" \
+    -e "log lines suppressed")
 check "no command was refused: $unexpected" test -z "$unexpected"
 
 # stop_bridge SIGNAL PID LOG: the signal stops the bridge: it sends STOP to
@@ -65,6 +71,10 @@ stop_bridge() {
     grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$3"
 }
 stop_bridge INT "$bridge_pid" "$tmp/bridge.log"
+refused_lines=$(grep -c "cmd_vel refused" "$tmp/bridge.log")
+check "a flood of 2,000 refused cmd_vel logs at most 100 lines ($refused_lines)" test "$refused_lines" -le 100
+check "and counts what it did not print: $(grep -e "suppressed" -e "cmd_vel refused.*repeated" "$tmp/bridge.log" | head -3)" \
+  grep -q -e "log lines suppressed" -e "cmd_vel refused.*(repeated [0-9]* times" "$tmp/bridge.log"
 
 # A bridge whose queue on the server is full (its own trajectory, seconds
 # ahead, past --max-queue): the cmd_vel timeout's SETSPEED 0 is refused
