@@ -4,9 +4,9 @@
 # IDL) as the ROS 2 side. Runs inside a private network namespace (CTest wraps
 # it with scripts/netns_run.sh); Cyclone DDS is bound to lo there by an
 # explicit configuration (CYCLONEDDS_URI), so no DDS or LCM traffic leaves it.
-#   ros2_bridge_test.sh SERVER KEYGEN BRIDGE PEER MODELS_DIR
+#   ros2_bridge_test.sh SERVER KEYGEN BRIDGE PEER MODELS_DIR FORGE
 set -u
-server_bin=$1 keygen=$2 bridge=$3 peer=$4 models=$5
+server_bin=$1 keygen=$2 bridge=$3 peer=$4 models=$5 forge=$6
 url="udpm://239.255.76.67:7625?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, pids, check
 export CYCLONEDDS_URI="file://$(cd "$(dirname "$0")" && pwd)/cyclonedds_loopback.xml"
@@ -94,6 +94,27 @@ url=$url_saved
 check "the bridge says the SETSPEED 0 was refused and it sent STOP: $(grep -e cmd_vel -e STOP "$tmp/bridge2.log")" \
   grep -q "robot 'pioneer': SETSPEED 0 (cmd_vel timeout) was not executed.*: STOP" "$tmp/bridge2.log"
 stop_bridge TERM "$bridge2_pid" "$tmp/bridge2.log"  # SIGTERM too
+
+# A bridge of every announced robot (no --robot): 255 forged names no server
+# answers for (one ANNOUNCE datagram each), heard before the real server
+# starts, do not delay its robot's bridging (review8: the bridge connected one
+# robot at a time, 5 s each: 255 forged names held pioneer back 21 minutes).
+url3="udpm://239.255.76.67:7627?ttl=0"
+"$forge" "$url3" announce-names ghost 255 70 &  # 35 s of forged names
+pids+=("$!")
+"$bridge" --url "$url3" --key "$tmp/bridge" --duration 45 >"$tmp/bridge3.out" 2>"$tmp/bridge3.log" &
+bridge3_pid=$!
+pids+=("$bridge3_pid")
+sleep 2.5  # the bridge has heard the forged names and connects them
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url3" \
+  --key "$tmp/server" --clients "$tmp/clients" --duration 45 2>"$tmp/server3.log" &
+pids+=("$!")
+started=$SECONDS
+for _ in $(seq 300); do grep -q "robot 'pioneer' bridged" "$tmp/bridge3.log" 2>/dev/null && break; sleep 0.1; done
+check "with 255 forged robots announced first, the real one is bridged within 30 s ($((SECONDS - started)) s)" \
+  grep -q "robot 'pioneer' bridged" "$tmp/bridge3.log"
+kill -INT "$bridge3_pid"
+wait "$bridge3_pid"
 
 echo "passed $pass, failed $failures"
 [ "$failures" -eq 0 ]
