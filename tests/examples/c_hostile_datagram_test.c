@@ -7,7 +7,7 @@
  *   c_hostile_datagram_test URL
  * While rtc_connect() looks for a robot nobody serves, a second thread sends
  * such ANNOUNCEs; the process's address space must not grow by more than
- * 64 MiB. Exit 0 pass, 1 fail. */
+ * 1 GiB (four of them). Exit 0 pass, 1 fail. */
 #define _POSIX_C_SOURCE 200809L
 #include <lcm/lcm.h>
 #include <pthread.h>
@@ -79,7 +79,10 @@ int main(int argc, char** argv) {
   const long grown = vm_size_kib() - before;
   printf("%d hostile ANNOUNCEs (each declaring 256 MiB of robots): address space grew %ld MiB (%s)\n",
          kDatagrams, grown / 1024, err);
-  if (grown > 64 * 1024) {
+  /* glibc reserves a 64 MiB arena for each thread that allocates (the
+   * sender's, LCM's receive thread) besides their stacks: 144 MiB with the
+   * check; without it, 10,384 MiB. */
+  if (grown > 1024 * 1024) {
     printf("FAIL: the decoder allocated what the datagrams declared, not what they carried\n");
     return 1;
   }
