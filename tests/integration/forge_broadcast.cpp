@@ -17,11 +17,11 @@
 
 #include <chrono>
 #include <cstdint>
-#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <thread>
+#include <vector>
 
 int main(int argc, char** argv) {
   using namespace robotalk;
@@ -73,7 +73,8 @@ int main(int argc, char** argv) {
         a.server_id = 1000 + i;
         a.server_time = TimePoint(std::chrono::hours(1000));
         a.uptime = std::chrono::hours(1);
-        a.robots.push_back({robot + "-" + std::to_string(i), "kinematic", 1, 1, BaseType::kDifferential, false, 0});
+        a.robots.push_back(
+            {robot + "-" + std::to_string(i), "kinematic", 1, 1, BaseType::kDifferential, false, 0});
         lan->Publish(kAnnounceChannel, EncodeAnnouncement(a));
         if (i % 50 == 49) std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
@@ -94,7 +95,8 @@ int main(int argc, char** argv) {
     });
     while (std::chrono::steady_clock::now() < record) lan->HandleFor(std::chrono::milliseconds(20));
     sub.reset();
-    std::fprintf(stderr, "forge_broadcast: recorded %zu announcements of %s\n", recorded.size(), robot.c_str());
+    std::fprintf(stderr, "forge_broadcast: recorded %zu announcements of %s\n", recorded.size(),
+                 robot.c_str());
     if (recorded.empty()) return 1;
     const auto replay = std::chrono::steady_clock::now() + Seconds(std::atof(argv[5]));
     for (std::size_t i = 0; std::chrono::steady_clock::now() < replay; ++i) {

@@ -111,6 +111,7 @@ sleep 2.5  # the bridge has heard the forged names and connects them
 pids+=("$!")
 started=$SECONDS
 for _ in $(seq 300); do grep -q "robot 'pioneer' bridged" "$tmp/bridge3.log" 2>/dev/null && break; sleep 0.1; done
+echo "pioneer bridged $((SECONDS - started)) s after its server started, 255 forged robots announced first"
 check "with 255 forged robots announced first, the real one is bridged within 30 s ($((SECONDS - started)) s)" \
   grep -q "robot 'pioneer' bridged" "$tmp/bridge3.log"
 kill -INT "$bridge3_pid"
