@@ -72,6 +72,7 @@ stop_bridge() {
 }
 stop_bridge INT "$bridge_pid" "$tmp/bridge.log"
 refused_lines=$(grep -c "cmd_vel refused" "$tmp/bridge.log")
+echo "2,000 refused cmd_vel: $refused_lines lines name them; $(grep -c "suppressed" "$tmp/bridge.log") per-second summaries"
 check "a flood of 2,000 refused cmd_vel logs at most 100 lines ($refused_lines)" test "$refused_lines" -le 100
 check "and counts what it did not print: $(grep -e "suppressed" -e "cmd_vel refused.*repeated" "$tmp/bridge.log" | head -3)" \
   grep -q -e "log lines suppressed" -e "cmd_vel refused.*(repeated [0-9]* times" "$tmp/bridge.log"
