@@ -436,8 +436,7 @@ int rtc_sync_clock(rtc_client* c, int samples, int64_t* offset_us, int64_t* roun
 robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
   char channel[192];
   snprintf(channel, sizeof channel, "ROBOTALK/%s/CONFIG", c->robot);
-  robotalk_msgs_robot_config_t_subscription_t* sub =
-      robotalk_msgs_robot_config_t_subscribe(c->main_lcm, channel, on_config, c); /* before asking */
+  rtci_checked_sub* sub = rtci_subscribe_robot_config(c->main_lcm, channel, on_config, c); /* before asking */
   robotalk_msgs_query_t q;
   memset(&q, 0, sizeof q);
   q.type = ROBOTALK_MSGS_QUERY_T_CONFIG;
@@ -465,6 +464,6 @@ robotalk_msgs_robot_config_t* rtc_load_config(rtc_client* c, double timeout_s) {
       }
     }
   }
-  robotalk_msgs_robot_config_t_unsubscribe(c->main_lcm, sub);
+  rtci_unsubscribe_checked(c->main_lcm, sub);
   return result;
 }

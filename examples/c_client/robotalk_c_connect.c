@@ -51,11 +51,10 @@ static int open_layout(rtc_client* c, const char* url) {
 }
 
 static int find_robot(rtc_client* c, double timeout_s) {
-  robotalk_msgs_announce_t_subscription_t* sub =
-      robotalk_msgs_announce_t_subscribe(c->main_lcm, "ROBOTALK/ANNOUNCE", on_announce, c);
+  rtci_checked_sub* sub = rtci_subscribe_announce(c->main_lcm, "ROBOTALK/ANNOUNCE", on_announce, c);
   const int64_t deadline = rtc_now_us() + (int64_t)(timeout_s * 1e6);
   while (!c->found && rtc_now_us() < deadline) rtci_handle_for(c, 50000);
-  robotalk_msgs_announce_t_unsubscribe(c->main_lcm, sub);
+  rtci_unsubscribe_checked(c->main_lcm, sub);
   if (!c->found)
     return rtci_set_error(c, "no robot '%s' announced within %.1f s (heard: %s)", c->robot, timeout_s,
                           c->heard[0] ? c->heard : "nothing"),
@@ -126,10 +125,10 @@ rtc_client* rtc_connect_keyed(const char* url, const char* robot, const char* ke
              hex);
     snprintf(c->request_channel, sizeof c->request_channel, "ROBOTALK/%s/REQUEST", robot);
     snprintf(c->reply_channel, sizeof c->reply_channel, "ROBOTALK/%s/REPLY/%016" PRIx64, robot, hex);
-    c->hello_sub = robotalk_msgs_hello_answer_t_subscribe(c->reply_lcm, c->hello_answer_channel,
-                                                          rtci_on_hello_answer, c);
-    c->reply_sub = robotalk_msgs_reply_package_t_subscribe(c->reply_lcm, c->reply_channel, rtci_on_reply, c);
-    robotalk_msgs_reply_package_t_subscription_set_queue_capacity(c->reply_sub, 1000);
+    c->hello_sub =
+        rtci_subscribe_hello_answer(c->reply_lcm, c->hello_answer_channel, rtci_on_hello_answer, c);
+    c->reply_sub = rtci_subscribe_reply_package(c->reply_lcm, c->reply_channel, rtci_on_reply, c);
+    rtci_checked_set_queue_capacity(c->reply_sub, 1000);
     ok = rtci_say_hello(c, timeout_s) == 0;
   }
   if (!ok) {
@@ -144,8 +143,8 @@ void rtc_close(rtc_client* c) {
   if (!c) return;
   for (int i = 0; i < kMaxPackages; ++i) free(c->packages[i].bytes);
   if (c->config) robotalk_msgs_robot_config_t_destroy(c->config);
-  if (c->hello_sub) robotalk_msgs_hello_answer_t_unsubscribe(c->reply_lcm, c->hello_sub);
-  if (c->reply_sub) robotalk_msgs_reply_package_t_unsubscribe(c->reply_lcm, c->reply_sub);
+  rtci_unsubscribe_checked(c->reply_lcm, c->hello_sub);
+  rtci_unsubscribe_checked(c->reply_lcm, c->reply_sub);
   if (c->reply_lcm && c->reply_lcm != c->main_lcm) lcm_destroy(c->reply_lcm);
   if (c->request_lcm && c->request_lcm != c->main_lcm) lcm_destroy(c->request_lcm);
   if (c->main_lcm) lcm_destroy(c->main_lcm);

@@ -5,6 +5,7 @@
 
 #include <lcm/lcm.h>
 
+#include "robotalk_c_check.h"
 #include "robotalk_c_client.h"
 #include "robotalk_c_keyed.h"
 #include "robotalk_msgs_hello_answer_t.h"
@@ -58,8 +59,8 @@ struct rtc_client {
   rtc_reply replies[kMaxReplies];
   int reply_count, reply_next;
   robotalk_msgs_robot_config_t* config; /* the last CONFIG message heard */
-  robotalk_msgs_hello_answer_t_subscription_t* hello_sub;
-  robotalk_msgs_reply_package_t_subscription_t* reply_sub;
+  rtci_checked_sub* hello_sub;          /* checked before decoding (robotalk_c_check.h) */
+  rtci_checked_sub* reply_sub;
   char error[512];
   /* rtc_connect: the ANNOUNCE search */
   int found;

@@ -192,8 +192,10 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   }
   const auto client = ConnectClient(g, args[0]);
   // With the STATE samples: is the server still there? Keyed: only its signed
-  // announcements count (as only its signed STATE does).
-  AnnounceWatch announces(g.url, client->trusted_server().key);
+  // announcements count (as only its signed STATE does), as of their signed
+  // server time (a replayed recording is stale).
+  AnnounceWatch announces(g.url, client->trusted_server().key,
+                          [&client](TimePoint server_time) { return client->ClientTime(server_time); });
   std::cerr << "robotalk: watching ROBOTALK/" << args[0] << "/STATE (asked every " << FormatSeconds(period_s)
             << "; Ctrl-C ends)\n";
   std::mutex mu;
@@ -269,6 +271,10 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
       client->SendQuery({.type = QueryType::kStateStreamCancel}).Wait(kStreamCancelWait);
     } catch (const std::exception&) {
     }
+  }
+  if (const std::uint64_t stale = announces.Stale(); stale > 0) {
+    std::cerr << "robotalk: refused " << stale
+              << " announcements signed by the server but stale (replayed or delayed)\n";
   }
   if (const std::uint64_t refused = client->stats().broadcasts_refused; refused > 0) {
     std::cerr << "robotalk: dropped " << refused

@@ -33,10 +33,12 @@ constexpr std::size_t kMaxHeardRobots = 1024;
 
 struct AnnounceWatch::Impl {
   std::string url;
-  std::optional<PublicKey> trusted_key;  // keyed: only announcements this key signed count
+  std::optional<PublicKey> trusted_key;             // keyed: only announcements this key signed count
+  std::function<TimePoint(TimePoint)> client_time;  // keyed: freshness by the signed server time
   int wake[2] = {-1, -1};
   mutable std::mutex mu;
   std::map<std::string, TimePoint> heard;  // GUARDED_BY(mu): robot -> last announce (steady clock)
+  std::uint64_t stale = 0;                 // GUARDED_BY(mu)
   std::thread thread;
 
   void On(const lcm::ReceiveBuffer* rbuf, const std::string&) {
@@ -49,9 +51,24 @@ struct AnnounceWatch::Impl {
     try {  // the checked decoder; a hostile ANNOUNCE is dropped, never thrown through LCM
       const Announcement a = DecodeAnnouncement(bytes);
       const TimePoint now = SteadyClock().Now();
+      TimePoint at = now;
+      if (trusted_key && client_time) {
+        // Signed, so the server time is the server's: it was alive then. A
+        // recording replayed after the server stopped is that old.
+        at = std::min(now, client_time(a.server_time));
+        if (now - at > kAnnounceMaxAge) {
+          std::lock_guard lock(mu);
+          if (stale++ == 0)
+            std::cerr << "robotalk: refused an announcement signed by the server but "
+                      << FormatDuration(now - at) << " old (more than " << FormatDuration(kAnnounceMaxAge)
+                      << "): replayed or delayed; it does not show the server is there\n";
+          return;
+        }
+      }
       std::lock_guard lock(mu);
       for (const auto& r : a.robots)
-        if (heard.size() < kMaxHeardRobots || heard.count(r.name)) heard[r.name] = now;
+        if (heard.size() < kMaxHeardRobots || heard.count(r.name))
+          heard[r.name] = std::max(heard[r.name], at);
     } catch (const ProtocolError&) {
     }
   }
@@ -80,9 +97,11 @@ struct AnnounceWatch::Impl {
   }
 };
 
-AnnounceWatch::AnnounceWatch(const std::string& url, std::string trusted_key)
+AnnounceWatch::AnnounceWatch(const std::string& url, std::string trusted_key,
+                             std::function<TimePoint(TimePoint)> client_time)
     : impl_(std::make_unique<Impl>()) {
   impl_->url = url;
+  impl_->client_time = std::move(client_time);
   if (!trusted_key.empty()) impl_->trusted_key = PublicKey::Parse(trusted_key);
   if (pipe(impl_->wake) != 0) return;
   impl_->thread = std::thread([this] { impl_->Run(); });
@@ -103,6 +122,11 @@ std::set<std::string> AnnounceWatch::Heard() const {
   std::set<std::string> names;
   for (const auto& entry : impl_->heard) names.insert(entry.first);
   return names;
+}
+
+std::uint64_t AnnounceWatch::Stale() const {
+  std::lock_guard lock(impl_->mu);
+  return impl_->stale;
 }
 
 std::optional<TimePoint> AnnounceWatch::LastHeard(const std::string& robot) const {

@@ -5,6 +5,8 @@
 #include "cli_commands.h"
 #include "robotalk/robot_client.h"
 
+#include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <optional>
@@ -18,10 +20,22 @@ namespace robotalk::cli {
 /// `trusted_key` ("ed25519:<hex>", a keyed client's server) it counts only
 /// announcements signed by that key: anyone can send an unsigned one, or
 /// sign with a key of their own. It keeps at most 1024 robot names.
-/// Thread safety: Heard() may be called from any thread.
+///
+/// Freshness (keyed, with `client_time`: the server time -> client time
+/// conversion of a synchronised client): a signed announcement proves the
+/// server was alive at its signed `server_time`, not when it arrives (a
+/// captured one can be replayed later). It counts as heard at that time, and
+/// one older than kAnnounceMaxAge on arrival is refused as stale, counted
+/// (Stale()) and said once on stderr.
+/// Thread safety: Heard(), LastHeard() and Stale() may be called from any thread.
 class AnnounceWatch {
  public:
-  explicit AnnounceWatch(const std::string& url, std::string trusted_key = "");
+  /// How old (by its signed server time) a keyed announcement may arrive:
+  /// one announce period (1 s) and slack for the network and the clock sync.
+  static constexpr Duration kAnnounceMaxAge = std::chrono::milliseconds(1500);
+
+  explicit AnnounceWatch(const std::string& url, std::string trusted_key = "",
+                         std::function<TimePoint(TimePoint server_time)> client_time = {});
   ~AnnounceWatch();
   AnnounceWatch(const AnnounceWatch&) = delete;
   AnnounceWatch& operator=(const AnnounceWatch&) = delete;
@@ -29,6 +43,8 @@ class AnnounceWatch {
   std::set<std::string> Heard() const;
   /// When `robot` was last announced (steady clock), or nullopt.
   std::optional<TimePoint> LastHeard(const std::string& robot) const;
+  /// Signed announcements refused as stale (replayed or delayed).
+  std::uint64_t Stale() const;
 
  private:
   struct Impl;

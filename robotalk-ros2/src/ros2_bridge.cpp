@@ -1,6 +1,7 @@
 #include "ros2_bridge.h"
 
 #include "dds_entities.h"
+#include "robotalk/log_limiter.h"
 #include "robotalk/robot_client.h"
 #include "ros_wire.h"
 
@@ -10,6 +11,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -22,9 +24,68 @@ namespace {
 
 using SteadyTime = std::chrono::steady_clock::time_point;
 
-void Log(const std::string& line) { std::cerr << "robotalk-ros2: " << line << std::endl; }
+// The bridge's log. A ROS 2 peer can send a cmd_vel or trajectory the bridge
+// refuses as fast as DDS carries them, and anyone on the LAN can announce
+// robot names no server answers for: each refusal or failed connect was a
+// line of its own (2,000 refused cmd_vel, 2,000 lines). Such lines (LogLimited)
+// pass one LogLimiter, as the server's: a line repeated is printed once and
+// summarised every 10 s; at most 20 lines a second, the rest counted. The
+// bridge's own actions (a robot bridged, the cmd_vel timeout's stop, STOP on
+// shutdown) come at its own pace and are always printed (Log), so a flood
+// cannot hide them. Lines come from DDS listener threads, the connector and
+// Run(): one mutex, held while printing too, so lines never interleave.
+class LimitedLog {
+ public:
+  void Limited(const std::string& line) {
+    std::lock_guard lock(mu_);
+    limiter_.Add(line, SteadyClock().Now(), out_);
+    Print();
+  }
+  void Always(const std::string& line) {
+    std::lock_guard lock(mu_);
+    out_.push_back(line);
+    Print();
+  }
+  /// Summaries that fell due (Run() calls it every iteration).
+  void Tick() {
+    std::lock_guard lock(mu_);
+    limiter_.Tick(SteadyClock().Now(), out_);
+    Print();
+  }
+  /// Every pending summary (at shutdown).
+  void Flush() {
+    std::lock_guard lock(mu_);
+    limiter_.Flush(SteadyClock().Now(), out_);
+    Print();
+  }
+
+ private:
+  void Print() {  // REQUIRES: mu_
+    for (const std::string& line : out_) std::cerr << "robotalk-ros2: " << line << '\n';
+    if (!out_.empty()) std::cerr << std::flush;
+    out_.clear();
+  }
+  std::mutex mu_;
+  LogLimiter limiter_;            // GUARDED_BY(mu_)
+  std::vector<std::string> out_;  // GUARDED_BY(mu_)
+};
+
+LimitedLog& TheLog() {
+  static LimitedLog log;
+  return log;
+}
+
+void Log(const std::string& line) { TheLog().Always(line); }
+void LogLimited(const std::string& line) { TheLog().Limited(line); }
 
 double Seconds(Duration d) { return std::chrono::duration<double>(d).count(); }
+
+// Robots connecting at once (each RobotClient holds LCM sockets, and LCM's
+// select() aborts past fd 1024), names announced and kept (anyone can
+// announce any name), and how long an announced name not heard is kept.
+constexpr std::size_t kMaxConnecting = 32;
+constexpr std::size_t kMaxAnnounced = 256;
+constexpr std::chrono::seconds kForgetAnnounced(60);
 
 // The system-clock (ROS time) instant of a steady-clock instant, read now.
 SystemTime ToSystem(TimePoint steady) {
@@ -95,7 +156,6 @@ class Ros2Bridge::Impl {
         tf_static_(participant_, tf2_msgs_msg_dds__TFMessage__desc, "/tf_static", kLatchedQos) {
     getrusage(RUSAGE_SELF, &usage_start_);
     start_ = std::chrono::steady_clock::now();
-    for (const std::string& r : options.robots) wanted_.insert(r);
     connector_ = std::jthread([this](std::stop_token st) { ConnectLoop(st); });
   }
 
@@ -109,6 +169,7 @@ class Ros2Bridge::Impl {
       robots = robots_;
     }
     for (auto& [name, r] : robots) Close(*r);
+    TheLog().Flush();  // what repeated since its last summary
   }
 
   void Run() {
@@ -119,6 +180,7 @@ class Ros2Bridge::Impl {
       auto robots = robots_;
       lock.unlock();
       for (auto& [name, r] : robots) Housekeep(*r);
+      TheLog().Tick();
       lock.lock();
     }
     end_ = std::chrono::steady_clock::now();
@@ -142,54 +204,103 @@ class Ros2Bridge::Impl {
     return c;
   }
 
+  // Connects every robot wanted (--robot, or every one announced) that is not
+  // bridged yet. Each connect waits up to the client's connect timeout (5 s)
+  // and anyone can announce a name no server answers for, so each runs on a
+  // thread of its own with a bounded slot: at most kMaxConnecting at once, the
+  // first attempt waiting 1 s for an answer (a server on the LAN answers in
+  // milliseconds), each failure doubling that up to 5 s; one that never
+  // answers delays no other (they ran one at a time, 5 s each: 255 forged
+  // names held a real robot back 21 minutes). A failed connect is tried
+  // again 2 s later, the wait doubling up to 64 s. Announced names are bounded too
+  // (kMaxAnnounced; one not heard for kForgetAnnounced is forgotten).
   void ConnectLoop(std::stop_token st) {
-    std::map<std::string, SteadyTime> next_try;
+    struct Retry {
+      SteadyTime next{};
+      int failures = 0;
+    };
+    std::map<std::string, Retry> retry;
+    std::map<std::string, SteadyTime> announced;  // name -> last heard (not bridged yet)
+    std::map<std::string, std::future<void>> connecting;
     while (!st.stop_requested()) {
       if (options_.robots.empty()) {
         try {
+          const auto now = std::chrono::steady_clock::now();
           for (const AnnouncedRobot& a : ListRobots(MakeClientOptions(), std::chrono::milliseconds(1200))) {
-            std::lock_guard lock(mu_);
-            if (wanted_.insert(a.name).second) Log("robot '" + a.name + "' announced");
+            if (!announced.contains(a.name) && announced.size() >= kMaxAnnounced) continue;
+            if (!announced.contains(a.name)) LogLimited("robot '" + a.name + "' announced");
+            announced[a.name] = now;
           }
         } catch (const std::exception& e) {
-          Log(std::string("listening for robots: ") + e.what());
+          LogLimited(std::string("listening for robots: ") + e.what());
         }
       }
-      std::set<std::string> todo;
-      {
-        std::lock_guard lock(mu_);
-        for (const std::string& w : wanted_) {
-          if (!robots_.contains(w)) todo.insert(w);
-        }
-      }
-      for (const std::string& name : todo) {
-        if (st.stop_requested()) return;
-        if (auto it = next_try.find(name);
-            it != next_try.end() && std::chrono::steady_clock::now() < it->second) {
+      const auto now = std::chrono::steady_clock::now();
+      for (auto it = connecting.begin(); it != connecting.end();) {  // connects that ended
+        if (it->second.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+          ++it;
           continue;
         }
         try {
-          auto link = Connect(name);
-          std::lock_guard lock(mu_);
-          robots_[name] = std::move(link);
+          it->second.get();  // bridged: in robots_
+          retry.erase(it->first);
+          announced.erase(it->first);
         } catch (const std::exception& e) {
-          Log("robot '" + name + "': " + e.what() + " (trying again in 2 s)");
-          next_try[name] = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+          Retry& r = retry[it->first];
+          const auto wait = std::min<Duration>(std::chrono::seconds(2) * (1 << std::min(r.failures, 5)),
+                                               std::chrono::seconds(64));
+          ++r.failures;
+          r.next = now + wait;
+          LogLimited("robot '" + it->first + "': " + e.what() + " (trying again in " +
+                     std::to_string(static_cast<int>(Seconds(wait))) + " s)");
         }
+        it = connecting.erase(it);
+      }
+      std::erase_if(announced, [&](const auto& entry) {
+        const bool forget = !connecting.contains(entry.first) && now - entry.second > kForgetAnnounced;
+        if (forget) retry.erase(entry.first);
+        return forget;
+      });
+      std::vector<std::string> todo;  // robots never tried first, then the retries
+      {
+        std::lock_guard lock(mu_);
+        for (const std::string& w : options_.robots)
+          if (!robots_.contains(w)) todo.push_back(w);
+        for (const auto& [name, heard] : announced)
+          if (!robots_.contains(name)) todo.push_back(name);
+      }
+      std::stable_partition(todo.begin(), todo.end(),
+                            [&](const std::string& n) { return !retry.contains(n); });
+      for (const std::string& name : todo) {
+        if (connecting.size() >= kMaxConnecting) break;
+        if (connecting.contains(name)) continue;
+        if (auto it = retry.find(name); it != retry.end() && now < it->second.next) continue;
+        const int failures = retry.contains(name) ? retry[name].failures : 0;
+        const Duration timeout = std::min<Duration>(std::chrono::seconds(1) * (1 << std::min(failures, 3)),
+                                                    std::chrono::seconds(5));
+        connecting[name] = std::async(std::launch::async, [this, name, timeout] {
+          std::shared_ptr<RobotLink> link = Connect(name, timeout);
+          std::lock_guard lock(mu_);  // at once: Run() watches its cmd_vel from now on
+          robots_[name] = std::move(link);
+        });
       }
       std::unique_lock lock(mu_);
       cv_.wait_for(lock, std::chrono::milliseconds(options_.robots.empty() ? 500 : 200),
                    [&] { return st.stop_requested(); });
     }
+    // Each connect still running is waited for (up to its timeout) as its
+    // future goes; one that succeeds is in robots_, so shutdown stops it.
   }
 
-  std::shared_ptr<RobotLink> Connect(const std::string& name) {
+  std::shared_ptr<RobotLink> Connect(const std::string& name, Duration connect_timeout) {
     auto r = std::make_shared<RobotLink>();
     r->name = name;
     r->token = RosNameToken(name);
-    if (r->token != name) Log("robot '" + name + "': its ROS 2 topics are under /" + r->token);
+    if (r->token != name) LogLimited("robot '" + name + "': its ROS 2 topics are under /" + r->token);
     r->prefix = FramePrefixFor(options_.frame_prefix, r->token);
-    r->client = std::make_unique<RobotClient>(MakeClientOptions());
+    ClientOptions options = MakeClientOptions();
+    options.connect_timeout = connect_timeout;
+    r->client = std::make_unique<RobotClient>(options);
     r->client->Connect(name);
     r->model = std::make_unique<RobotModel>(r->client->model());
     r->base = r->model->roots().empty() ? BaseType::kFixed : r->model->roots()[0].base;
@@ -272,7 +383,7 @@ class Ros2Bridge::Impl {
 
   void OnTrajectory(RobotLink& r, const TrajectoryMessage& msg) {
     if (msg.points.empty()) {
-      Log("robot '" + r.name + "': an empty JointTrajectory: STOP");
+      LogLimited("robot '" + r.name + "': an empty JointTrajectory: STOP");
       Track(r, r.client->Send(Command{.type = CommandType::kStop}), "STOP (empty JointTrajectory)", false);
       return;
     }
@@ -285,14 +396,14 @@ class Ros2Bridge::Impl {
     try {
       plan = TrajectoryToCommands(*r.model, msg, start, now);
     } catch (const std::exception& e) {
-      Log("robot '" + r.name + "': trajectory refused: " + e.what());
+      LogLimited("robot '" + r.name + "': trajectory refused: " + e.what());
       return;
     }
     std::ostringstream what;
     what << "trajectory of " << msg.points.size() << " points";
     if (plan.points_skipped) what << " (" << plan.points_skipped << " already past, skipped)";
     what << " starts in " << Seconds(start - now) << " s, " << plan.commands.size() << " JOINT_SETPOINTs";
-    Log("robot '" + r.name + "': " + what.str());
+    LogLimited("robot '" + r.name + "': " + what.str());
     SendTrajectory(r, std::move(plan.commands), start);
   }
 
@@ -335,7 +446,7 @@ class Ros2Bridge::Impl {
           Track(r, std::move(replies[k]), w.str(), true);
         }
       } catch (const std::exception& e) {
-        Log("robot '" + r.name + "': sending the trajectory of joint '" + j.joint + "': " + e.what());
+        LogLimited("robot '" + r.name + "': sending the trajectory of joint '" + j.joint + "': " + e.what());
         return;
       }
     }
@@ -348,7 +459,7 @@ class Ros2Bridge::Impl {
       c = TwistToCommand(r.base, {t.linear.x, t.linear.y, t.linear.z},
                          {t.angular.x, t.angular.y, t.angular.z}, &note);
     } catch (const std::exception& e) {
-      Log("robot '" + r.name + "': cmd_vel refused: " + e.what());
+      LogLimited("robot '" + r.name + "': cmd_vel refused: " + e.what());
       return;
     }
     if (!note.empty() && !r.twist_note_told.exchange(true)) Log("robot '" + r.name + "': cmd_vel: " + note);
@@ -396,7 +507,7 @@ class Ros2Bridge::Impl {
         failure = e.what();
       }
       if (failure.empty()) continue;
-      Log("robot '" + r.name + "': " + p.what + ": " + failure);
+      LogLimited("robot '" + r.name + "': " + p.what + ": " + failure);
       if (p.stop_if_not_executed) not_executed = p.what + " was not executed (" + failure + ")";
     }
     if (!not_executed.empty()) {  // the base may still be moving: STOP always runs
@@ -440,7 +551,6 @@ class Ros2Bridge::Impl {
   mutable std::mutex mu_;
   std::condition_variable cv_;
   bool stopping_ = false;                                     // GUARDED_BY(mu_)
-  std::set<std::string> wanted_;                              // GUARDED_BY(mu_)
   std::map<std::string, std::shared_ptr<RobotLink>> robots_;  // GUARDED_BY(mu_)
   std::jthread connector_;
 

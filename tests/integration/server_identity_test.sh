@@ -61,21 +61,43 @@ check "watch says how many it dropped: $(cat "$tmp/watch.err")" grep -q "dropped
 # A keyed watch counts only announcements its server signed: forged ones
 # (unsigned, another server) do not keep it watching a server that is gone
 # (here stopped with SIGSTOP, a hung host).
-rt watch pioneer --period 0.05 --duration 30 >"$tmp/watch_gone" 2>"$tmp/watch_gone.err" &
-watch_pid=$!
-sleep 1
-"$forge" "$url" announce pioneer 600 &  # 6 s of forged ANNOUNCEs naming pioneer
-forge_pid=$!
-kill -STOP "$server_pid"
-for _ in $(seq 50); do kill -0 "$watch_pid" 2>/dev/null || break; sleep 0.1; done
-kill -KILL "$watch_pid" 2>/dev/null  # still watching after 5 s: the forger kept it
-wait "$watch_pid"
-status=$?
-wait "$forge_pid"
-kill -CONT "$server_pid"
+# watch_a_stopped_server NAME FORGE_AFTER STOP_AFTER FORGE_ARGS...: a keyed
+# `watch` of pioneer (out and err in $tmp/NAME, $tmp/NAME.err); FORGE_AFTER s
+# later the forger runs FORGE_ARGS, STOP_AFTER s after that the server is
+# stopped (SIGSTOP, a hung host). The watch's exit status, or 137 when it was
+# still watching 6 s later, is in $status.
+watch_a_stopped_server() {
+  local name=$1 forge_after=$2 stop_after=$3
+  shift 3
+  rt watch pioneer --period 0.05 --duration 30 >"$tmp/$name" 2>"$tmp/$name.err" &
+  watch_pid=$!
+  sleep "$forge_after"
+  "$forge" "$url" "$@" 2>"$tmp/$name.forge" &
+  forge_pid=$!
+  sleep "$stop_after"
+  kill -STOP "$server_pid"
+  for _ in $(seq 60); do kill -0 "$watch_pid" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$watch_pid" 2>/dev/null  # still watching after 6 s: the forger kept it
+  wait "$watch_pid"
+  status=$?
+  wait "$forge_pid"
+  kill -CONT "$server_pid"
+}
+watch_a_stopped_server watch_gone 1 0 announce pioneer 600  # 6 s of forged ANNOUNCEs naming pioneer
 check "a keyed watch ends with 1 when its server is gone, forged announcements or not (got $status)" \
   test "$status" -eq 1
 check "and says so: $(tail -2 "$tmp/watch_gone.err")" grep -q "pioneer: no STATE sample and no announcement for 3 s: its server is gone" "$tmp/watch_gone.err"
+
+# A keyed watch counts its server's signed announcements as of their signed
+# server time: a recording of them, replayed once the server is gone (here
+# stopped with SIGSTOP), is stale and keeps nothing alive (review8: it did).
+watch_a_stopped_server watch_replay 0 1.7 replay-announce pioneer 1.5 8  # 1.5 s recorded, 8 s replayed
+check "the forger recorded the server's announcements: $(cat "$tmp/watch_replay.forge")" \
+  grep -q "recorded [1-9]" "$tmp/watch_replay.forge"
+check "a keyed watch ends with 1 when its server is gone, its announcements replayed or not (got $status)" \
+  test "$status" -eq 1
+check "and says the replayed ones were stale: $(grep stale "$tmp/watch_replay.err")" \
+  grep -q "refused [0-9]* announcements signed by the server but stale" "$tmp/watch_replay.err"
 
 # Item 12: a second server for pioneer (its only robot) refuses it and exits 1.
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 20 \

@@ -4,9 +4,9 @@
 # IDL) as the ROS 2 side. Runs inside a private network namespace (CTest wraps
 # it with scripts/netns_run.sh); Cyclone DDS is bound to lo there by an
 # explicit configuration (CYCLONEDDS_URI), so no DDS or LCM traffic leaves it.
-#   ros2_bridge_test.sh SERVER KEYGEN BRIDGE PEER MODELS_DIR
+#   ros2_bridge_test.sh SERVER KEYGEN BRIDGE PEER MODELS_DIR FORGE
 set -u
-server_bin=$1 keygen=$2 bridge=$3 peer=$4 models=$5
+server_bin=$1 keygen=$2 bridge=$3 peer=$4 models=$5 forge=$6
 url="udpm://239.255.76.67:7625?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, pids, check
 export CYCLONEDDS_URI="file://$(cd "$(dirname "$0")" && pwd)/cyclonedds_loopback.xml"
@@ -49,9 +49,15 @@ peer_checks cmd_vel "cmd_vel drives the base, and a silent cmd_vel stops it"
 check "the bridge says it stopped the base: $(grep cmd_vel "$tmp/bridge.log")" \
   grep -q "robot 'pioneer': no cmd_vel for 0.5.* s: SETSPEED 0" "$tmp/bridge.log"
 
+# A flood of cmd_vel the bridge refuses (not finite): each refusal was a line
+# of its own (review8: 2,000 lines); now the bridge's log is rate-limited as
+# the server's (robotalk/log_limiter.h), counted below once the bridge stops.
+peer_checks cmd_vel_flood "2,000 refused cmd_vel move nothing"
+
 # The bridge's own lines only (Cyclone DDS may log on the same stderr).
 unexpected=$(grep "^robotalk-ros2:" "$tmp/bridge.log" |
-  grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel")
+  grep -v -e bridged -e "trajectory of" -e "trajectory refused" -e "no cmd_vel" -e "cmd_vel refused" \
+    -e "log lines suppressed")
 check "no command was refused: $unexpected" test -z "$unexpected"
 
 # stop_bridge SIGNAL PID LOG: the signal stops the bridge: it sends STOP to
@@ -65,6 +71,11 @@ stop_bridge() {
     grep -q "robot 'pioneer': STOP on shutdown: SUCCESS" "$3"
 }
 stop_bridge INT "$bridge_pid" "$tmp/bridge.log"
+refused_lines=$(grep -c "cmd_vel refused" "$tmp/bridge.log")
+echo "2,000 refused cmd_vel: $refused_lines lines name them; $(grep -c "suppressed" "$tmp/bridge.log") per-second summaries"
+check "a flood of 2,000 refused cmd_vel logs at most 100 lines ($refused_lines)" test "$refused_lines" -le 100
+check "and counts what it did not print: $(grep -e "suppressed" -e "cmd_vel refused.*repeated" "$tmp/bridge.log" | head -3)" \
+  grep -q -e "log lines suppressed" -e "cmd_vel refused.*(repeated [0-9]* times" "$tmp/bridge.log"
 
 # A bridge whose queue on the server is full (its own trajectory, seconds
 # ahead, past --max-queue): the cmd_vel timeout's SETSPEED 0 is refused
@@ -84,6 +95,28 @@ url=$url_saved
 check "the bridge says the SETSPEED 0 was refused and it sent STOP: $(grep -e cmd_vel -e STOP "$tmp/bridge2.log")" \
   grep -q "robot 'pioneer': SETSPEED 0 (cmd_vel timeout) was not executed.*: STOP" "$tmp/bridge2.log"
 stop_bridge TERM "$bridge2_pid" "$tmp/bridge2.log"  # SIGTERM too
+
+# A bridge of every announced robot (no --robot): 255 forged names no server
+# answers for (one ANNOUNCE datagram each), heard before the real server
+# starts, do not delay its robot's bridging (review8: the bridge connected one
+# robot at a time, 5 s each: 255 forged names held pioneer back 21 minutes).
+url3="udpm://239.255.76.67:7627?ttl=0"
+"$forge" "$url3" announce-names ghost 255 70 &  # 35 s of forged names
+pids+=("$!")
+"$bridge" --url "$url3" --key "$tmp/bridge" --duration 45 >"$tmp/bridge3.out" 2>"$tmp/bridge3.log" &
+bridge3_pid=$!
+pids+=("$bridge3_pid")
+sleep 2.5  # the bridge has heard the forged names and connects them
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url3" \
+  --key "$tmp/server" --clients "$tmp/clients" --duration 45 2>"$tmp/server3.log" &
+pids+=("$!")
+started=$SECONDS
+for _ in $(seq 300); do grep -q "robot 'pioneer' bridged" "$tmp/bridge3.log" 2>/dev/null && break; sleep 0.1; done
+echo "pioneer bridged $((SECONDS - started)) s after its server started, 255 forged robots announced first"
+check "with 255 forged robots announced first, the real one is bridged within 30 s ($((SECONDS - started)) s)" \
+  grep -q "robot 'pioneer' bridged" "$tmp/bridge3.log"
+kill -INT "$bridge3_pid"
+wait "$bridge3_pid"
 
 echo "passed $pass, failed $failures"
 [ "$failures" -eq 0 ]

@@ -15,6 +15,10 @@
 //   ros2_peer cmd_vel_full_queue ROBOT --url URL [--key FILE]
 //     As cmd_vel, with a JointTrajectory seconds ahead filling the bridge's
 //     queue on a server run with a small --max-queue: the base still stops.
+//   ros2_peer cmd_vel_flood ROBOT --url URL [--key FILE]
+//     2,000 Twists the bridge refuses (linear.x not finite), half of them
+//     alike, as fast as DDS takes them: nothing moves (the bridge's log of
+//     them is checked by ros2_bridge_test.sh).
 //   ros2_peer measure ROBOT --url URL [--key FILE] --seconds S
 //     per sample, LCM latency (server sample time -> STATE received here) and
 //     DDS latency (the same sample time, as JointState's stamp -> JointState
@@ -271,6 +275,20 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(1500ms);
     std::lock_guard lock(heard.mu);
     CheckTheBaseStops(heard, last_sent, 800ms, "the base stops by itself once cmd_vel falls silent");
+    return failures ? 1 : 0;
+  }
+  if (mode == "cmd_vel_flood") {
+    DdsWriter twist_writer(participant, geometry_msgs_msg_dds__Twist__desc, ns + "/cmd_vel", kDefaultQos);
+    Check(WaitFor(heard, 5s, [&] { return twist_writer.matched_readers() > 0; }),
+          "the bridge subscribes to cmd_vel");
+    constexpr int kTwists = 2000;
+    for (int i = 0; i < kTwists; ++i) {  // every other one alike; the others each say another angular.z
+      geometry_msgs_msg_dds__Twist_ twist{{std::nan(""), 0, 0}, {0, 0, i % 2 ? 0.0 : 0.001 * i}};
+      twist_writer.Write(&twist);
+      if (i % 100 == 99) std::this_thread::sleep_for(10ms);
+    }
+    std::this_thread::sleep_for(1500ms);
+    std::cout << "sent " << kTwists << " refused cmd_vel\n";
     return failures ? 1 : 0;
   }
   if (mode == "cmd_vel_full_queue") {

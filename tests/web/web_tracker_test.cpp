@@ -172,5 +172,59 @@ TEST_F(WebTrackerTest, ThousandsOfForgedRobotNamesKeepTheTrackedRobotsBoundedAnd
   EXPECT_TRUE(live) << "the served robot stays live";
 }
 
+// The tracker connected robots one at a time on one worker thread, each
+// connect waiting up to its 4 s timeout: a forged name (one ANNOUNCE datagram,
+// no server behind it) held the worker for 4 s, so 255 of them queued before
+// a real robot delayed its connection by 255 x 4 s = 17 minutes. Now
+// connects do not wait on each other and one that is not answered has a
+// bounded slot: the real robot is live while forged ones still wait.
+TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConnection) {
+  WebOptions o;
+  o.lcm_url = kUrl;
+  RobotTracker tracker(o);
+  lcm::LCM bus(kUrl);
+  ASSERT_TRUE(bus.good());
+  constexpr int kForged = 255;  // the tracker holds 256: room for the real one
+  for (int i = 0; i < kForged; ++i) {
+    Announcement a;
+    a.server_id = 9000 + i;
+    a.server_time = TimePoint(seconds(1));
+    a.uptime = seconds(100);
+    a.robots.push_back({.name = "ghost-" + std::to_string(i), .driver = "kinematic"});
+    const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+    bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    if (i % 50 == 49) std::this_thread::sleep_for(milliseconds(20));  // within the tracker's LCM queue
+  }
+  std::this_thread::sleep_for(milliseconds(300));
+  std::size_t connecting = 0;
+  const nlohmann::json heard = tracker.Poll().robots["robots"];
+  for (const auto& r : heard) connecting += r["status"] == "connecting";
+  EXPECT_EQ(connecting, static_cast<std::size_t>(kForged)) << "every forged name was queued for a connect";
+
+  // Only now does the real robot's server start.
+  SteadyClock clock;
+  DriverRegistry registry;
+  RegisterKinematicDriver(registry);
+  ServerOptions options;
+  options.lcm_url = kUrl;
+  RobotSpec spec{"pioneer", "kinematic", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
+  Server server(options, std::vector<RobotSpec>{spec}, registry, clock);
+  server.Start();
+  bool live = false;
+  int forged_waiting = 0;
+  for (int i = 0; i < 300 && !live; ++i) {  // 30 s: one connect's timeout many times over
+    std::this_thread::sleep_for(milliseconds(100));
+    forged_waiting = 0;
+    const nlohmann::json list = tracker.Poll().robots["robots"];
+    for (const auto& r : list) {
+      if (r["name"] == "pioneer") live = r["status"] == "live";
+      forged_waiting += r["name"] != "pioneer" && r["status"] != "live";
+    }
+  }
+  server.Stop();
+  EXPECT_TRUE(live) << "the real robot is still not live 30 s after its server started, behind "
+                    << forged_waiting << " forged robots that never answer";
+}
+
 }  // namespace
 }  // namespace robotalk::web

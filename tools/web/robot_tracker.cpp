@@ -10,6 +10,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -41,8 +42,9 @@ struct Robot {
   Steady::time_point last_announce{};
   std::string status = "connecting";
   std::string message;
-  bool connecting = false;
+  bool connecting = false;  // waiting for a connect slot or connecting
   Steady::time_point last_attempt{};
+  int failures = 0;  // connects that failed in a row: the next waits longer (ConnectBackoff)
   std::shared_ptr<RobotClient> client;
   std::int64_t client_server_id = 0;
   std::uint64_t client_hash = 0;
@@ -60,7 +62,27 @@ struct Robot {
   bool stream_task = false;  // a start/stop of the stream is queued
 };
 
-enum class Task { kConnect, kStream };
+// Anyone can announce a name no server answers for (one datagram), and a
+// connect waits for an answer up to its timeout: connects ran one at a time,
+// so 255 forged names held a real robot back 255 x 4 s. Now each connect runs
+// on a thread of its own and gets a bounded slot: at most kMaxConnecting at
+// once (each RobotClient holds LCM sockets, and LCM's select() aborts past
+// fd 1024: 255 at once did), the first attempt waits 1 s for an answer (a
+// server on the LAN answers in milliseconds), each failure doubles it up to
+// 4 s and waits 2 s, doubled up to kMaxBackoff, before the next try; a robot
+// never tried goes before the retries.
+constexpr std::size_t kMaxConnecting = 32;
+constexpr std::chrono::seconds kMaxBackoff(64);
+Steady::duration ConnectBackoff(int failures) {
+  return std::min<Steady::duration>(std::chrono::seconds(2) * (1 << std::min(failures, 5)), kMaxBackoff);
+}
+Duration ConnectTimeout(int failures) {
+  return std::min<Duration>(std::chrono::seconds(1) * (1 << std::min(failures, 2)), std::chrono::seconds(4));
+}
+struct ConnectThread {
+  std::thread thread;
+  bool finished = false;  // Connect() returned: the thread may be joined
+};
 
 // A robot's panics in flight: one thread sends them, one at a time. Requests
 // that come while one is sent (a page or Foxglove client may send them as
@@ -104,6 +126,8 @@ class RobotTracker::Impl {
     {
       std::lock_guard lock(mutex_);
       for (auto& [robot, p] : panics_) threads.push_back(std::move(p.thread));
+      for (auto& [robot, c] : connects_) threads.push_back(std::move(c.thread));
+      connect_wait_.clear();
     }
     for (std::thread& t : threads) t.join();  // each takes mutex_ to answer its waiters
     std::lock_guard lock(mutex_);
@@ -149,8 +173,8 @@ class RobotTracker::Impl {
     }
   }
 
-  // Worker: connects one robot at a time and starts / stops state streams
-  // (blocking calls, up to the client's timeout).
+  // Worker: starts / stops state streams (blocking calls, up to the client's
+  // timeout) of connected robots. Connects run on threads of their own.
   void Work() {
     std::unique_lock lock(mutex_);
     while (!stop_) {
@@ -158,22 +182,19 @@ class RobotTracker::Impl {
         wake_.wait_for(lock, std::chrono::milliseconds(200));
         continue;
       }
-      const auto [name, task] = queue_.front();
+      const std::string name = queue_.front();
       queue_.pop_front();
       lock.unlock();
-      if (task == Task::kConnect)
-        Connect(name);
-      else
-        SetStream(name);
+      SetStream(name);
       lock.lock();
     }
   }
 
-  void Connect(const std::string& name) {
+  void Connect(const std::string& name, Duration connect_timeout) {
     ClientOptions co;
     co.lcm_url = options_.lcm_url;
     co.timeout = std::chrono::seconds(2);
-    co.connect_timeout = std::chrono::seconds(4);
+    co.connect_timeout = connect_timeout;
     std::shared_ptr<RobotClient> client;
     auto slot = std::make_shared<SampleSlot>();
     std::string error;
@@ -189,11 +210,14 @@ class RobotTracker::Impl {
     if (it == robots_.end()) return;
     Robot& r = it->second;
     r.connecting = false;
+    r.last_attempt = Steady::now();  // the backoff counts from the end of this attempt
     if (!client) {
       r.status = "error";
       r.message = "cannot connect: " + error;
+      ++r.failures;
       return;
     }
+    r.failures = 0;
     r.root_query.reset();
     r.streaming = false;
     r.client = std::move(client);
@@ -257,6 +281,7 @@ class RobotTracker::Impl {
   }
 
   void Housekeep(Robot& r, Steady::time_point now, std::vector<std::shared_ptr<RobotClient>>& drop);
+  void StartConnects(std::vector<std::thread>& ended);
   static void MeasureRoot(Robot& r);
   nlohmann::json RobotJson(const Robot& r) const;
 
@@ -265,8 +290,10 @@ class RobotTracker::Impl {
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::map<std::string, Robot> robots_;             // GUARDED_BY(mutex_), at most kMaxRobots
-  std::deque<std::pair<std::string, Task>> queue_;  // GUARDED_BY(mutex_)
+  std::map<std::string, Robot> robots_;            // GUARDED_BY(mutex_), at most kMaxRobots
+  std::deque<std::string> queue_;                  // GUARDED_BY(mutex_): state stream tasks
+  std::deque<std::string> connect_wait_;           // GUARDED_BY(mutex_): robots waiting for a connect slot
+  std::map<std::string, ConnectThread> connects_;  // GUARDED_BY(mutex_): at most kMaxConnecting running
   std::atomic<bool> watching_{false};
   std::function<void()> on_sample_;              // GUARDED_BY(mutex_)
   std::map<std::string, PanicInFlight> panics_;  // GUARDED_BY(mutex_): at most one per robot
@@ -292,19 +319,55 @@ void RobotTracker::Impl::Housekeep(Robot& r, Steady::time_point now,
     r.client.reset();
     r.root_query.reset();
   }
-  if (!r.client && !r.connecting && now - r.last_attempt > std::chrono::seconds(2)) {
+  if (!r.client && !r.connecting && now - r.last_attempt > ConnectBackoff(r.failures)) {
     r.connecting = true;
-    r.last_attempt = now;
     r.status = "connecting";
     r.message.clear();
-    queue_.push_back({r.name, Task::kConnect});
-    wake_.notify_all();
+    if (r.failures == 0)
+      connect_wait_.push_front(r.name);  // never tried (or served before): ahead of the retries
+    else
+      connect_wait_.push_back(r.name);
   }
   if (r.client && !r.stream_task && r.streaming != watching_) {
     r.stream_task = true;
-    queue_.push_back({r.name, Task::kStream});
+    queue_.push_back(r.name);
     wake_.notify_all();
   }
+}
+
+// REQUIRES: mutex_ held. Threads of connects that ended go to `ended`, to be
+// joined outside the lock.
+void RobotTracker::Impl::StartConnects(std::vector<std::thread>& ended) {
+  for (auto it = connects_.begin(); it != connects_.end();) {
+    if (!it->second.finished) {
+      ++it;
+      continue;
+    }
+    ended.push_back(std::move(it->second.thread));
+    it = connects_.erase(it);
+  }
+  std::vector<std::string> later;  // its previous connect's thread is still ending
+  while (connects_.size() < kMaxConnecting && !connect_wait_.empty()) {
+    const std::string name = connect_wait_.front();
+    connect_wait_.pop_front();
+    auto robot = robots_.find(name);
+    if (robot == robots_.end() || !robot->second.connecting) continue;
+    if (auto previous = connects_.find(name); previous != connects_.end()) {
+      if (!previous->second.finished) {
+        later.push_back(name);
+        continue;
+      }
+      ended.push_back(std::move(previous->second.thread));
+      connects_.erase(previous);
+    }
+    const Duration timeout = ConnectTimeout(robot->second.failures);
+    connects_[name].thread = std::thread([this, name, timeout] {
+      Connect(name, timeout);
+      std::lock_guard lock(mutex_);
+      connects_.at(name).finished = true;
+    });
+  }
+  connect_wait_.insert(connect_wait_.begin(), later.begin(), later.end());
 }
 
 // One LINK_POSES query for the root in flight at a time; a new one goes out
@@ -349,6 +412,7 @@ nlohmann::json RobotTracker::Impl::RobotJson(const Robot& r) const {
 TrackerFrame RobotTracker::Impl::Poll() {
   TrackerFrame frame;
   std::vector<std::shared_ptr<RobotClient>> drop;  // destroyed outside the lock (joins threads)
+  std::vector<std::thread> ended;                  // joined outside the lock
   {
     std::lock_guard lock(mutex_);
     const auto now = Steady::now();
@@ -379,7 +443,9 @@ TrackerFrame RobotTracker::Impl::Poll() {
       }
     }
     frame.robots = {{"type", "robots"}, {"robots", list}};
+    StartConnects(ended);
   }
+  for (std::thread& t : ended) t.join();
   drop.clear();
   return frame;
 }

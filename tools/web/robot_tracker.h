@@ -13,8 +13,10 @@
 //
 // Thread safety: Poll() must be called from one thread at a time (it owns the
 // kinematics buffers); Panic() from any thread. Internally: one LCM thread for
-// announces, one worker thread for (blocking) connects, each client's own
-// ReadDaemon delivering samples into a single-slot buffer.
+// announces, a thread per connect in progress (at most 32; one that is not
+// answered delays no other), one worker thread for (blocking) state stream
+// requests, each client's own ReadDaemon delivering samples into a
+// single-slot buffer.
 // Errors: the constructor throws robotalk::Error when LCM cannot be opened.
 // Connection failures are reported in the robot's status, not thrown.
 #pragma once

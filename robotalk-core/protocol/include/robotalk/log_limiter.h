@@ -1,6 +1,7 @@
-// The server log's limiter (issue 19: a driver failing in Update logged 231
-// fault lines in 12 s). Two rules, applied to every line the ServerDaemon
-// logs:
+// A log's limiter, shared by the server (issue 19: a driver failing in
+// Update logged 231 fault lines in 12 s) and robotalk-ros2 (review8: a flood
+// of refused cmd_vel logged a line each). Two rules, applied to every line
+// offered:
 //   - per line: a line seen again within `repeat_window` of its first
 //     printing is counted, not printed; when the window ends one summary
 //     says how often it came ("<line> (repeated 230 times in 10 s)") and, if
@@ -13,7 +14,8 @@
 // remembered (bounded memory); beyond that lines are only rate-limited.
 //
 // Pure: times come from the caller (a ManualClock in tests).
-// Thread safety: none (the ServerDaemon thread).
+// Thread safety: none (the server: the ServerDaemon thread; robotalk-ros2
+// holds a mutex around it).
 #pragma once
 
 #include "robotalk/clock.h"

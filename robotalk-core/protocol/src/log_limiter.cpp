@@ -1,4 +1,4 @@
-#include "log_limiter.h"
+#include "robotalk/log_limiter.h"
 
 #include <algorithm>
 #include <cstdio>
