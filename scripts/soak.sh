@@ -219,17 +219,20 @@ for c, info in clients.items():
             out = st["outcome"]
             if "never received in this session" in st["msg"]:
                 bump(unknown, label + ", status: not in this session (not run)")
-            elif out == "BUSY":
+            elif out == "BUSY" and "has not ended" in st["msg"]:
+                # BUSY "command N has not ended": still waiting or running. A
+                # frame that ended BUSY (refused, e.g. "GOTO in progress")
+                # keeps its own message: refused, below.
                 count["lost"] += 1
                 violations.append("LOST: client %s playback frame %d was accepted, never ran and was never answered "
                                   "(COMMAND_STATUS: %s)" % (c, cid, st["msg"]))
-            elif out in ("PANIC", "INTERRUPTED", "ERROR", "NA"):
+            elif out in ("PANIC", "INTERRUPTED", "ERROR", "NA", "BUSY"):
                 bump(refused, "%s (playback frame, learnt by COMMAND_STATUS)" % out)
             else:
                 bump(unknown, label + ", status %s (not run)" % out)
         bump(unknown, label + " (not run)", g[2] - g[3] - known)
         pst = info["status"].get(g[0] + 1)
-        if pst is not None and pst["outcome"] == "BUSY":
+        if pst is not None and pst["outcome"] == "BUSY" and "has not ended" in pst["msg"]:
             count["playback_unanswered"] += 1
 
     # Start-time order per client and actuator, over the servo commands whose

@@ -135,8 +135,12 @@ TEST_F(RobotClientTest, AServerRestartAnswersOutstandingCommandsAsUnknownOutcome
                                            .target = "pan",
                                            .values = {0.1 * i}}));
   }
-  for (const auto& p : pending)
-    ASSERT_EQ(client->CommandStatus(p.id()).signal, Signal::kBusy);  // queued there
+  for (const auto& p : pending) {
+    const Reply status = client->CommandStatus(p.id());
+    ASSERT_EQ(status.signal, Signal::kBusy);  // queued there
+    // What tells it from a command that ended BUSY (docs/protocol.md): the message.
+    EXPECT_EQ(status.message, "command " + std::to_string(p.id()) + " has not ended");
+  }
   server_.reset();
   StartServer();
   for (auto& p : pending) {
