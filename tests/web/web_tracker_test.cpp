@@ -226,5 +226,66 @@ TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConn
                     << forged_waiting << " forged robots that never answer";
 }
 
+// A forger who keeps re-announcing 256 names no server answers for kept the
+// tracker's table (at most 256 robots) full: a real robot announced later
+// was never tracked at all. A name whose connect failed now gives its place
+// to a new one when the table is full.
+TEST(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
+  WebOptions o;
+  o.lcm_url = kUrl;
+  RobotTracker tracker(o);
+  lcm::LCM bus(kUrl);
+  ASSERT_TRUE(bus.good());
+  constexpr int kForged = 256;  // the tracker's whole table
+  const auto announce_forged = [&bus] {
+    for (int i = 0; i < kForged; ++i) {
+      Announcement a;
+      a.server_id = 9000 + i;
+      a.server_time = TimePoint(seconds(1));
+      a.uptime = seconds(100);
+      a.robots.push_back({.name = "ghost-" + std::to_string(i), .driver = "kinematic"});
+      const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+      bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+      if (i % 50 == 49) std::this_thread::sleep_for(milliseconds(20));  // within the tracker's LCM queue
+    }
+  };
+  // Until the table is full and forged names have been tried and refused
+  // (32 connects at once, 1 s each, then a back-off: they cycle).
+  std::size_t tracked = 0;
+  int failed = 0;
+  for (int i = 0; i < 60 && (tracked < kForged || failed < 32); ++i) {
+    announce_forged();
+    std::this_thread::sleep_for(milliseconds(500));
+    const nlohmann::json list = tracker.Poll().robots["robots"];  // a copy: the frame is a temporary
+    tracked = list.size();
+    failed = 0;
+    for (const auto& r : list) failed += r["status"] == "error";
+  }
+  ASSERT_EQ(tracked, static_cast<std::size_t>(kForged)) << "the forged names fill the table";
+  ASSERT_GE(failed, 32) << "and their connects fail";
+
+  SteadyClock clock;
+  DriverRegistry registry;
+  RegisterKinematicDriver(registry);
+  ServerOptions options;
+  options.lcm_url = kUrl;
+  RobotSpec spec{"pioneer", "kinematic", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
+  Server server(options, std::vector<RobotSpec>{spec}, registry, clock);
+  server.Start();
+  bool live = false;
+  for (int i = 0; i < 60 && !live; ++i) {  // 30 s, the forger re-announcing all the while
+    announce_forged();
+    std::this_thread::sleep_for(milliseconds(500));
+    const nlohmann::json list = tracker.Poll().robots["robots"];
+    tracked = list.size();
+    for (const auto& r : list)
+      if (r["name"] == "pioneer") live = r["status"] == "live";
+  }
+  server.Stop();
+  EXPECT_TRUE(live) << "the real robot is not live 30 s after its server started (the table kept full by "
+                    << kForged << " forged names)";
+  EXPECT_LE(tracked, 256u) << "still bounded";
+}
+
 }  // namespace
 }  // namespace robotalk::web
