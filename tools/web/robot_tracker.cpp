@@ -159,7 +159,7 @@ class RobotTracker::Impl {
     for (const RobotAnnouncement& r : announcement.robots) {
       auto it = robots_.find(r.name);
       if (it == robots_.end()) {
-        if (robots_.size() >= kMaxRobots) continue;
+        if (robots_.size() >= kMaxRobots && !EvictUnanswered()) continue;
         it = robots_.emplace(r.name, Robot{}).first;
       }
       Robot& robot = it->second;
@@ -280,6 +280,7 @@ class RobotTracker::Impl {
       it->second.message = std::string("state stream: ") + error;
   }
 
+  bool EvictUnanswered();
   void Housekeep(Robot& r, Steady::time_point now, std::vector<std::shared_ptr<RobotClient>>& drop);
   void StartConnects(std::vector<std::thread>& ended);
   static void MeasureRoot(Robot& r);
@@ -333,6 +334,27 @@ void RobotTracker::Impl::Housekeep(Robot& r, Steady::time_point now,
     queue_.push_back(r.name);
     wake_.notify_all();
   }
+}
+
+// REQUIRES: mutex_ held. The table is full (kMaxRobots) and a new name is
+// announced: a forger re-announcing 256 names kept it full, so a real robot
+// announced later was never tracked. The robot whose connects failed most
+// (then the one announced longest ago) that is neither connected nor
+// connecting gives its place; a robot never tried or served keeps it.
+// Returns false when there is none.
+bool RobotTracker::Impl::EvictUnanswered() {
+  auto worst = robots_.end();
+  for (auto it = robots_.begin(); it != robots_.end(); ++it) {
+    const Robot& r = it->second;
+    if (r.client || r.connecting || r.failures == 0) continue;
+    if (worst == robots_.end() || r.failures > worst->second.failures ||
+        (r.failures == worst->second.failures && r.last_announce < worst->second.last_announce)) {
+      worst = it;
+    }
+  }
+  if (worst == robots_.end()) return false;
+  robots_.erase(worst);
+  return true;
 }
 
 // REQUIRES: mutex_ held. Threads of connects that ended go to `ended`, to be
