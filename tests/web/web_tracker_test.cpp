@@ -46,9 +46,11 @@ long VmSizeKiB() {
   return -1;
 }
 
-class WebTrackerTest : public ::testing::Test {
- protected:
-  void SetUp() override {
+// A server of the project's Pioneer (kinematic driver) on kUrl, serving from
+// its construction to its destruction.
+class PioneerServer {
+ public:
+  PioneerServer() {
     RegisterKinematicDriver(registry_);
     ServerOptions options;
     options.lcm_url = kUrl;
@@ -56,9 +58,16 @@ class WebTrackerTest : public ::testing::Test {
     server_ = std::make_unique<Server>(options, std::vector<RobotSpec>{spec}, registry_, clock_);
     server_->Start();
   }
-  void TearDown() override {
-    if (server_) server_->Stop();
-  }
+  ~PioneerServer() { server_->Stop(); }
+
+ private:
+  SteadyClock clock_;
+  DriverRegistry registry_;
+  std::unique_ptr<Server> server_;
+};
+
+class WebTrackerTest : public ::testing::Test {
+ protected:
   // Polls until the tracker shows `robot` live (connected), at most 15 s.
   static bool WaitLive(RobotTracker& tracker, const std::string& robot) {
     for (int i = 0; i < 150; ++i) {
@@ -70,9 +79,7 @@ class WebTrackerTest : public ::testing::Test {
     return false;
   }
 
-  SteadyClock clock_;
-  DriverRegistry registry_;
-  std::unique_ptr<Server> server_;
+  PioneerServer server_;
 };
 
 // A page (or a Foxglove client) may send PANIC requests as fast as its
@@ -172,6 +179,21 @@ TEST_F(WebTrackerTest, ThousandsOfForgedRobotNamesKeepTheTrackedRobotsBoundedAnd
   EXPECT_TRUE(live) << "the served robot stays live";
 }
 
+// Announces `n` robots "ghost-0" ... no server answers for (one forged
+// ANNOUNCE datagram each), paced within the tracker's LCM queue.
+void AnnounceGhosts(lcm::LCM& bus, int n) {
+  for (int i = 0; i < n; ++i) {
+    Announcement a;
+    a.server_id = 9000 + i;
+    a.server_time = TimePoint(seconds(1));
+    a.uptime = seconds(100);
+    a.robots.push_back({.name = "ghost-" + std::to_string(i), .driver = "kinematic"});
+    const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+    bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    if (i % 50 == 49) std::this_thread::sleep_for(milliseconds(20));
+  }
+}
+
 // The tracker connected robots one at a time on one worker thread, each
 // connect waiting up to its 4 s timeout: a forged name (one ANNOUNCE datagram,
 // no server behind it) held the worker for 4 s, so 255 of them queued before
@@ -185,16 +207,7 @@ TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConn
   lcm::LCM bus(kUrl);
   ASSERT_TRUE(bus.good());
   constexpr int kForged = 255;  // the tracker holds 256: room for the real one
-  for (int i = 0; i < kForged; ++i) {
-    Announcement a;
-    a.server_id = 9000 + i;
-    a.server_time = TimePoint(seconds(1));
-    a.uptime = seconds(100);
-    a.robots.push_back({.name = "ghost-" + std::to_string(i), .driver = "kinematic"});
-    const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
-    bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
-    if (i % 50 == 49) std::this_thread::sleep_for(milliseconds(20));  // within the tracker's LCM queue
-  }
+  AnnounceGhosts(bus, kForged);
   std::this_thread::sleep_for(milliseconds(300));
   std::size_t connecting = 0;
   const nlohmann::json heard = tracker.Poll().robots["robots"];
@@ -202,14 +215,7 @@ TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConn
   EXPECT_EQ(connecting, static_cast<std::size_t>(kForged)) << "every forged name was queued for a connect";
 
   // Only now does the real robot's server start.
-  SteadyClock clock;
-  DriverRegistry registry;
-  RegisterKinematicDriver(registry);
-  ServerOptions options;
-  options.lcm_url = kUrl;
-  RobotSpec spec{"pioneer", "kinematic", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
-  Server server(options, std::vector<RobotSpec>{spec}, registry, clock);
-  server.Start();
+  auto server = std::make_unique<PioneerServer>();
   bool live = false;
   int forged_waiting = 0;
   for (int i = 0; i < 300 && !live; ++i) {  // 30 s: one connect's timeout many times over
@@ -221,7 +227,7 @@ TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConn
       forged_waiting += r["name"] != "pioneer" && r["status"] != "live";
     }
   }
-  server.Stop();
+  server.reset();
   EXPECT_TRUE(live) << "the real robot is still not live 30 s after its server started, behind "
                     << forged_waiting << " forged robots that never answer";
 }
@@ -237,24 +243,12 @@ TEST(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
   lcm::LCM bus(kUrl);
   ASSERT_TRUE(bus.good());
   constexpr int kForged = 256;  // the tracker's whole table
-  const auto announce_forged = [&bus] {
-    for (int i = 0; i < kForged; ++i) {
-      Announcement a;
-      a.server_id = 9000 + i;
-      a.server_time = TimePoint(seconds(1));
-      a.uptime = seconds(100);
-      a.robots.push_back({.name = "ghost-" + std::to_string(i), .driver = "kinematic"});
-      const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
-      bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
-      if (i % 50 == 49) std::this_thread::sleep_for(milliseconds(20));  // within the tracker's LCM queue
-    }
-  };
   // Until the table is full and forged names have been tried and refused
   // (32 connects at once, 1 s each, then a back-off: they cycle).
   std::size_t tracked = 0;
   int failed = 0;
   for (int i = 0; i < 60 && (tracked < kForged || failed < 32); ++i) {
-    announce_forged();
+    AnnounceGhosts(bus, kForged);
     std::this_thread::sleep_for(milliseconds(500));
     const nlohmann::json list = tracker.Poll().robots["robots"];  // a copy: the frame is a temporary
     tracked = list.size();
@@ -264,24 +258,17 @@ TEST(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
   ASSERT_EQ(tracked, static_cast<std::size_t>(kForged)) << "the forged names fill the table";
   ASSERT_GE(failed, 32) << "and their connects fail";
 
-  SteadyClock clock;
-  DriverRegistry registry;
-  RegisterKinematicDriver(registry);
-  ServerOptions options;
-  options.lcm_url = kUrl;
-  RobotSpec spec{"pioneer", "kinematic", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
-  Server server(options, std::vector<RobotSpec>{spec}, registry, clock);
-  server.Start();
+  auto server = std::make_unique<PioneerServer>();
   bool live = false;
   for (int i = 0; i < 60 && !live; ++i) {  // 30 s, the forger re-announcing all the while
-    announce_forged();
+    AnnounceGhosts(bus, kForged);
     std::this_thread::sleep_for(milliseconds(500));
     const nlohmann::json list = tracker.Poll().robots["robots"];
     tracked = list.size();
     for (const auto& r : list)
       if (r["name"] == "pioneer") live = r["status"] == "live";
   }
-  server.Stop();
+  server.reset();
   EXPECT_TRUE(live) << "the real robot is not live 30 s after its server started (the table kept full by "
                     << kForged << " forged names)";
   EXPECT_LE(tracked, 256u) << "still bounded";
