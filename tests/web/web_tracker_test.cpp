@@ -194,18 +194,26 @@ void AnnounceGhosts(lcm::LCM& bus, int n) {
   }
 }
 
+// A tracker and a bus on kUrl to forge announcements on; no server.
+class WebTrackerForgedNames : public ::testing::Test {
+ protected:
+  void SetUp() override { ASSERT_TRUE(bus.good()); }
+  static WebOptions Options() {
+    WebOptions o;
+    o.lcm_url = kUrl;
+    return o;
+  }
+  RobotTracker tracker{Options()};
+  lcm::LCM bus{kUrl};
+};
+
 // The tracker connected robots one at a time on one worker thread, each
 // connect waiting up to its 4 s timeout: a forged name (one ANNOUNCE datagram,
 // no server behind it) held the worker for 4 s, so 255 of them queued before
 // a real robot delayed its connection by 255 x 4 s = 17 minutes. Now
 // connects do not wait on each other and one that is not answered has a
 // bounded slot: the real robot is live while forged ones still wait.
-TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConnection) {
-  WebOptions o;
-  o.lcm_url = kUrl;
-  RobotTracker tracker(o);
-  lcm::LCM bus(kUrl);
-  ASSERT_TRUE(bus.good());
+TEST_F(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConnection) {
   constexpr int kForged = 255;  // the tracker holds 256: room for the real one
   AnnounceGhosts(bus, kForged);
   std::this_thread::sleep_for(milliseconds(300));
@@ -236,12 +244,7 @@ TEST(WebTrackerForgedNames, ForgedRobotsThatNeverAnswerDoNotDelayARealRobotsConn
 // tracker's table (at most 256 robots) full: a real robot announced later
 // was never tracked at all. A name whose connect failed now gives its place
 // to a new one when the table is full.
-TEST(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
-  WebOptions o;
-  o.lcm_url = kUrl;
-  RobotTracker tracker(o);
-  lcm::LCM bus(kUrl);
-  ASSERT_TRUE(bus.good());
+TEST_F(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
   constexpr int kForged = 256;  // the tracker's whole table
   // Until the table is full and forged names have been tried and refused
   // (32 connects at once, 1 s each, then a back-off: they cycle).
