@@ -103,7 +103,8 @@ std::optional<Reply> PendingReply::WaitFor(Duration most, std::stop_token stop) 
 
 // --- ListRobots --------------------------------------------------------------
 
-std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen) {
+std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen, std::size_t* unlisted) {
+  if (unlisted) *unlisted = 0;
   std::unique_ptr<Transport> own;
   Transport* transport = options.transport;
   if (!transport) {

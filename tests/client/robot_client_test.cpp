@@ -555,6 +555,36 @@ TEST_F(RobotClientTest, ListRobotsDedupesAnnouncements) {
   EXPECT_NE(robots[0].server_id, robots[1].server_id);
 }
 
+// A forger floods ANNOUNCE with distinct names (1000 per datagram, the most a
+// decoder takes is 1024): the list keeps at most kMaxListedRobots and counts
+// the rest, instead of growing with the flood (and comparing every new name
+// with every one kept).
+TEST_F(RobotClientTest, AFloodOfAnnouncedNamesIsListedUpToTheBoundAndCounted) {
+  MemoryTransport forger(bus_);
+  std::atomic<bool> listed{false};
+  std::atomic<int> sent_names{0};
+  std::thread flood([&] {
+    for (int round = 0; round < 30 && !listed; ++round) {
+      Announcement a;
+      a.server_id = 7000 + round;
+      for (int i = 0; i < 1000; ++i)
+        a.robots.push_back(
+            {"forged-" + std::to_string(i), "kinematic", 1, 1, BaseType::kDifferential, false, 0});
+      forger.Publish(kAnnounceChannel, EncodeAnnouncement(a));
+      sent_names += 1000;
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+  });
+  std::size_t unlisted = 0;
+  const auto robots = ListRobots(Options(), milliseconds(1500), &unlisted);
+  listed = true;
+  flood.join();
+  ASSERT_GT(sent_names.load(), static_cast<int>(kMaxListedRobots));  // the flood outgrew the list
+  EXPECT_EQ(robots.size(), kMaxListedRobots);
+  EXPECT_GT(unlisted, 0u);
+  EXPECT_LE(robots.size() + unlisted, static_cast<std::size_t>(sent_names.load()));
+}
+
 // Issue 22: SETSPEED frames of a linear sequence ramp within the robot's own
 // base acceleration limit (ServerOptions::robot_base_acceleration, the
 // server's --max-base-acceleration NAME=LIN,ANG), end to end through a client.

@@ -30,6 +30,7 @@
 #include "robotalk/trajectory.h"
 #include "robotalk/transport.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -320,10 +321,18 @@ struct AnnouncedRobot {
   std::string server_key;
 };
 
+/// The most robots ListRobots returns: a LAN's robots fit many times over,
+/// while anyone on the bus can announce a thousand names per datagram.
+inline constexpr std::size_t kMaxListedRobots = 1024;
+
 /// Listens to ROBOTALK/ANNOUNCE for `listen` and returns every robot heard,
 /// once per (server id, name), sorted by name. Servers announce once a second.
 /// An announcement whose signature suffix does not verify is dropped.
-std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen);
+/// At most kMaxListedRobots, the first heard; each further (server id, name)
+/// heard is counted in `*unlisted` (if given; a name heard twice counts twice)
+/// so a caller can say the bus carries more names than it lists — a flood.
+std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen,
+                                       std::size_t* unlisted = nullptr);
 
 /// Client counters, for diagnostics and tests.
 struct ClientStats {
