@@ -92,7 +92,12 @@ int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
   RejectOptions(args);
   if (!args.empty()) throw UsageError("robots takes no arguments");
   const double seconds = ParseNumber(listen, "--listen");
-  const auto robots = ListRobots(MakeOptions(g), FromSeconds(seconds));
+  std::size_t unlisted = 0;
+  const auto robots = ListRobots(MakeOptions(g), FromSeconds(seconds), &unlisted);
+  if (unlisted > 0)
+    std::cerr << "robotalk: listing the first " << kMaxListedRobots << " robots heard; " << unlisted
+              << " announcements named others: more names than a LAN has robots, someone may be flooding "
+              << "ROBOTALK/ANNOUNCE\n";
   if (robots.empty())
     std::cerr << "robotalk: no robot announced itself within " << FormatSeconds(seconds) << "\n";
   if (json) {

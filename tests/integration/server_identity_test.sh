@@ -46,6 +46,16 @@ check "the server logged the conflict and kept the robot" grep -q "keeps serving
 check "the server refused nothing" bash -c "! grep -q 'refuses it' '$tmp/real.log'"
 rt robots --listen 1.2 >"$tmp/robots" 2>&1
 check "robots shows the pinned key: $(cat "$tmp/robots")" grep -q "$(fp server) (pinned)" "$tmp/robots"
+# A flood of forged names (1,100 of them, four times): the list stops at 1,024
+# robots and says so.
+"$forge" "$url" announce-names flood 1100 4 &
+flood_pid=$!
+rt robots --listen 1.5 >"$tmp/flood_robots" 2>"$tmp/flood_robots.err"
+wait "$flood_pid"
+check "a flood of names is listed up to 1,024 robots: $(($(wc -l <"$tmp/flood_robots") - 1)) listed" \
+  test "$(($(wc -l <"$tmp/flood_robots") - 1))" -le 1024
+check "and robots warns of the names it did not list: $(cat "$tmp/flood_robots.err")" \
+  grep -q "listing the first 1024 robots heard; [1-9][0-9]* announcements named others" "$tmp/flood_robots.err"
 
 # Item 7: forged STATE (unsigned, and signed by another key) is not printed by a keyed watch.
 rt watch pioneer --period 0.05 --duration 3 >"$tmp/watch" 2>"$tmp/watch.err" &
