@@ -130,8 +130,15 @@ def parse_urdf(
 
 def robots(url: Optional[str] = None, listen: Seconds = 1.5) -> List[AnnouncedRobot]:
     """The robots the servers on ``url`` announce, heard for ``listen`` s (servers
-    announce once a second), sorted by name."""
-    return _robots(url, listen)
+    announce once a second), sorted by name: at most 1024, the first heard. A
+    RobotalkWarning says how many announcements named robots beyond those (more
+    names than a LAN has robots: someone may be flooding ROBOTALK/ANNOUNCE)."""
+    listed, unlisted = _robots(url, listen)
+    if unlisted:
+        warnings.warn(f"listing the first {len(listed)} robots heard; {unlisted} announcements named others: "
+                      "more names than a LAN has robots, someone may be flooding ROBOTALK/ANNOUNCE",
+                      RobotalkWarning, stacklevel=2)
+    return listed
 
 
 class RobotClient(_RobotClient, ClosesOnExit):

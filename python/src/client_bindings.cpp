@@ -620,7 +620,9 @@ void BindClient(py::module_& m) {
         o.lcm_url = url.value_or("");
         const Duration d = ToNonNegativeDuration(listen, "robots listen");
         py::gil_scoped_release release;
-        return ListRobots(o, d);
+        std::size_t unlisted = 0;
+        std::vector<AnnouncedRobot> robots = ListRobots(o, d, &unlisted);
+        return std::make_pair(std::move(robots), unlisted);
       },
       py::arg("url") = py::none(), py::arg("listen") = 1.5);
 }

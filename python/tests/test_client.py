@@ -4,13 +4,14 @@ signals, blocking and non-blocking calls, queries, errors."""
 
 from __future__ import annotations
 
+import subprocess
 import time
 
 import numpy as np
 import pytest
 
 import robotalk
-from conftest import MODELS, SHARED, Server
+from conftest import MODELS, SHARED, Server, program
 
 
 @pytest.fixture()
@@ -26,6 +27,16 @@ def test_robots_lists_what_the_server_announces(server: Server) -> None:
     assert found["pioneer"].driver == "kinematic"
     assert found["pioneer"].base_type == "differential"
     assert "'pioneer'" in repr(found["pioneer"])
+
+
+def test_robots_warns_of_a_flood_of_names_it_does_not_list(server: Server) -> None:
+    forger = subprocess.Popen([program("ROBOTALK_FORGE"), server.url, "announce-names", "flood", "1100", "4"])
+    try:
+        with pytest.warns(robotalk.RobotalkWarning, match=r"listing the first 1024 robots heard; [1-9]"):
+            listed = robotalk.robots(server.url, listen=1.5)
+    finally:
+        forger.wait(timeout=10)
+    assert len(listed) == 1024
 
 
 def test_connects_and_describes_the_robot(robot: robotalk.RobotClient) -> None:
