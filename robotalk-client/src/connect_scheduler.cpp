@@ -199,14 +199,9 @@ std::optional<ConnectScheduler::State> ConnectScheduler::Find(const std::string&
                .failures = n.failures};
 }
 
-std::size_t ConnectScheduler::size() const {
+ConnectScheduler::Counts ConnectScheduler::counts() const {
   std::lock_guard lock(mu_);
-  return names_.size();
-}
-
-std::size_t ConnectScheduler::connecting() const {
-  std::lock_guard lock(mu_);
-  return in_flight_;
+  return {.names = names_.size(), .connecting = in_flight_};
 }
 
 }  // namespace robotalk

@@ -130,7 +130,7 @@ TEST_F(ConnectSchedulerTest, NeverMoreThanMaxConnectingAtOnceAndNamesNotTriedYet
   for (int i = 39; i >= 0; --i) order.push_back(Name(i));
   for (const std::string& n : order) EXPECT_EQ(s.Announce(n), ConnectScheduler::Heard::kAdded);
   s.Poll();
-  EXPECT_EQ(s.connecting(), 32u) << "the bound (max_connecting)";
+  EXPECT_EQ(s.counts().connecting, 32u) << "the bound (max_connecting)";
   const auto started = connects_.Started(32);
   ASSERT_EQ(started.size(), 32u);
   for (std::size_t i = 0; i < 32; ++i) {
@@ -138,19 +138,19 @@ TEST_F(ConnectSchedulerTest, NeverMoreThanMaxConnectingAtOnceAndNamesNotTriedYet
     EXPECT_EQ(started[i].time, seconds(1)) << "a first attempt waits 1 s";
   }
   s.Poll();
-  EXPECT_EQ(s.connecting(), 32u) << "polling again starts no more";
+  EXPECT_EQ(s.counts().connecting, 32u) << "polling again starts no more";
   EXPECT_FALSE(s.Find(order[32])->connecting);
 
   connects_.Answer(s, order[0], false);
   connects_.Answer(s, order[1], true);
-  EXPECT_EQ(s.connecting(), 32u) << "two slots freed, two more started at once, without a Poll()";
+  EXPECT_EQ(s.counts().connecting, 32u) << "two slots freed, two more started at once, without a Poll()";
   EXPECT_TRUE(s.Find(order[32])->connecting);
   EXPECT_TRUE(s.Find(order[33])->connecting);
   EXPECT_FALSE(s.Find(order[34])->connecting);
   EXPECT_TRUE(s.Find(order[1])->served);
   EXPECT_FALSE(s.Find(order[0])->connecting) << "failed: it waits its back-off";
   s.Poll();
-  EXPECT_EQ(s.connecting(), 32u);
+  EXPECT_EQ(s.counts().connecting, 32u);
 }
 
 TEST_F(ConnectSchedulerTest, FailedConnectsWaitLongerEachTimeAndGiveLaterAttemptsMoreTime) {
@@ -231,7 +231,7 @@ TEST_F(ConnectSchedulerTest,
   EXPECT_EQ(s.Announce("real", &evicted), ConnectScheduler::Heard::kAdded) << "a full table takes a new name";
   EXPECT_EQ(evicted, "failed-twice") << "the one that failed most, then announced longest ago, goes";
   EXPECT_FALSE(s.Find("failed-twice"));
-  EXPECT_EQ(s.size(), 4u);
+  EXPECT_EQ(s.counts().names, 4u);
   EXPECT_EQ(s.Announce("another", &evicted), ConnectScheduler::Heard::kAdded);
   EXPECT_EQ(evicted, "failed-once");
   // Left: served, connecting, and two never tried: none gives its place.
@@ -277,7 +277,7 @@ TEST_F(ConnectSchedulerTest, ANameSilentLongIsForgottenUnlessServedOrConnecting)
   EXPECT_TRUE(s.Find("connecting"));
   connects_.Answer(s, "connecting", false);
   EXPECT_EQ(s.Poll(), std::vector<std::string>{"connecting"}) << "forgotten once its connect ended";
-  EXPECT_EQ(s.size(), 1u);
+  EXPECT_EQ(s.counts().names, 1u);
 }
 
 TEST_F(ConnectSchedulerTest, ALostNameIsTriedAgainAtOnceAndALossDuringItsConnectCounts) {

@@ -113,8 +113,11 @@ class ConnectScheduler {
   /// nullopt when `name` is not in the table.
   std::optional<State> Find(const std::string& name) const;
 
-  std::size_t size() const;        ///< names in the table
-  std::size_t connecting() const;  ///< connects in flight
+  struct Counts {
+    std::size_t names = 0;       ///< in the table
+    std::size_t connecting = 0;  ///< connects in flight
+  };
+  Counts counts() const;
 
  private:
   struct Name {
