@@ -1,6 +1,7 @@
 #include "ros2_bridge.h"
 
 #include "dds_entities.h"
+#include "robotalk/connect_scheduler.h"
 #include "robotalk/log_limiter.h"
 #include "robotalk/robot_client.h"
 #include "ros_wire.h"
@@ -11,7 +12,6 @@
 #include <atomic>
 #include <condition_variable>
 #include <fstream>
-#include <future>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -79,13 +79,6 @@ void Log(const std::string& line) { TheLog().Always(line); }
 void LogLimited(const std::string& line) { TheLog().Limited(line); }
 
 double Seconds(Duration d) { return std::chrono::duration<double>(d).count(); }
-
-// Robots connecting at once (each RobotClient holds LCM sockets, and LCM's
-// select() aborts past fd 1024), names announced and kept (anyone can
-// announce any name), and how long an announced name not heard is kept.
-constexpr std::size_t kMaxConnecting = 32;
-constexpr std::size_t kMaxAnnounced = 256;
-constexpr std::chrono::seconds kForgetAnnounced(60);
 
 // The system-clock (ROS time) instant of a steady-clock instant, read now.
 SystemTime ToSystem(TimePoint steady) {
@@ -205,91 +198,47 @@ class Ros2Bridge::Impl {
   }
 
   // Connects every robot wanted (--robot, or every one announced) that is not
-  // bridged yet. Each connect waits up to the client's connect timeout (5 s)
-  // and anyone can announce a name no server answers for, so each runs on a
-  // thread of its own with a bounded slot: at most kMaxConnecting at once, the
-  // first attempt waiting 1 s for an answer (a server on the LAN answers in
-  // milliseconds), each failure doubling that up to 5 s; one that never
-  // answers delays no other (they ran one at a time, 5 s each: 255 forged
-  // names held a real robot back 21 minutes). A failed connect is tried
-  // again 2 s later, the wait doubling up to 64 s. Announced names are bounded too
-  // (kMaxAnnounced; one not heard for kForgetAnnounced is forgotten).
+  // bridged yet. Anyone can announce a name no server answers for, and a
+  // connect waits for an answer up to its timeout: the names kept, the
+  // connects at once, their timeouts and retries are a ConnectScheduler's
+  // (robotalk/connect_scheduler.h, as robotalk-web's), so a name that never
+  // answers delays no other and a forger cannot keep a real robot out (they
+  // connected one at a time, 5 s each: 255 forged names held a real robot
+  // back 21 minutes; 256 re-announced kept the table full for good). A robot
+  // bridged stays bridged until the bridge exits.
   void ConnectLoop(std::stop_token st) {
-    struct Retry {
-      SteadyTime next{};
-      int failures = 0;
-    };
-    std::map<std::string, Retry> retry;
-    std::map<std::string, SteadyTime> announced;  // name -> last heard (not bridged yet)
-    std::map<std::string, std::future<void>> connecting;
-    while (!st.stop_requested()) {
-      if (options_.robots.empty()) {
-        try {
-          const auto now = std::chrono::steady_clock::now();
-          for (const AnnouncedRobot& a : ListRobots(MakeClientOptions(), std::chrono::milliseconds(1200))) {
-            if (!announced.contains(a.name) && announced.size() >= kMaxAnnounced) continue;
-            if (!announced.contains(a.name)) LogLimited("robot '" + a.name + "' announced");
-            announced[a.name] = now;
-          }
-        } catch (const std::exception& e) {
-          LogLimited(std::string("listening for robots: ") + e.what());
-        }
-      }
-      const auto now = std::chrono::steady_clock::now();
-      for (auto it = connecting.begin(); it != connecting.end();) {  // connects that ended
-        if (it->second.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
-          ++it;
-          continue;
-        }
-        try {
-          it->second.get();  // bridged: in robots_
-          retry.erase(it->first);
-          announced.erase(it->first);
-        } catch (const std::exception& e) {
-          Retry& r = retry[it->first];
-          const auto wait = std::min<Duration>(std::chrono::seconds(2) * (1 << std::min(r.failures, 5)),
-                                               std::chrono::seconds(64));
-          ++r.failures;
-          r.next = now + wait;
-          LogLimited("robot '" + it->first + "': " + e.what() + " (trying again in " +
-                     std::to_string(static_cast<int>(Seconds(wait))) + " s)");
-        }
-        it = connecting.erase(it);
-      }
-      std::erase_if(announced, [&](const auto& entry) {
-        const bool forget = !connecting.contains(entry.first) && now - entry.second > kForgetAnnounced;
-        if (forget) retry.erase(entry.first);
-        return forget;
-      });
-      std::vector<std::string> todo;  // robots never tried first, then the retries
-      {
-        std::lock_guard lock(mu_);
-        for (const std::string& w : options_.robots)
-          if (!robots_.contains(w)) todo.push_back(w);
-        for (const auto& [name, heard] : announced)
-          if (!robots_.contains(name)) todo.push_back(name);
-      }
-      std::stable_partition(todo.begin(), todo.end(),
-                            [&](const std::string& n) { return !retry.contains(n); });
-      for (const std::string& name : todo) {
-        if (connecting.size() >= kMaxConnecting) break;
-        if (connecting.contains(name)) continue;
-        if (auto it = retry.find(name); it != retry.end() && now < it->second.next) continue;
-        const int failures = retry.contains(name) ? retry[name].failures : 0;
-        const Duration timeout = std::min<Duration>(std::chrono::seconds(1) * (1 << std::min(failures, 3)),
-                                                    std::chrono::seconds(5));
-        connecting[name] = std::async(std::launch::async, [this, name, timeout] {
+    ConnectSchedulerOptions options;
+    options.max_names = std::max(options.max_names, options_.robots.size());  // --robot: every one
+    ConnectScheduler scheduler(
+        [this](const std::string& name, Duration timeout) {
           std::shared_ptr<RobotLink> link = Connect(name, timeout);
           std::lock_guard lock(mu_);  // at once: Run() watches its cmd_vel from now on
           robots_[name] = std::move(link);
-        });
+        },
+        [](const std::string& name, const std::string& error, Duration retry_in) {
+          LogLimited("robot '" + name + "': " + error + " (trying again in " +
+                     std::to_string(static_cast<int>(Seconds(retry_in))) + " s)");
+        },
+        options);
+    while (!st.stop_requested()) {
+      if (options_.robots.empty()) {
+        try {
+          for (const AnnouncedRobot& a : ListRobots(MakeClientOptions(), std::chrono::milliseconds(1200)))
+            if (scheduler.Announce(a.name) == ConnectScheduler::Heard::kAdded)
+              LogLimited("robot '" + a.name + "' announced");
+        } catch (const std::exception& e) {
+          LogLimited(std::string("listening for robots: ") + e.what());
+        }
+      } else {
+        for (const std::string& name : options_.robots) scheduler.Announce(name);  // wanted: never silent
       }
+      scheduler.Poll();
       std::unique_lock lock(mu_);
       cv_.wait_for(lock, std::chrono::milliseconds(options_.robots.empty() ? 500 : 200),
                    [&] { return st.stop_requested(); });
     }
-    // Each connect still running is waited for (up to its timeout) as its
-    // future goes; one that succeeds is in robots_, so shutdown stops it.
+    // The scheduler waits for each connect still running (up to its timeout);
+    // one that succeeds is in robots_, so shutdown stops it.
   }
 
   std::shared_ptr<RobotLink> Connect(const std::string& name, Duration connect_timeout) {

@@ -2,6 +2,7 @@
 
 #include "json_text.h"
 #include "robotalk/channels.h"
+#include "robotalk/connect_scheduler.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
@@ -23,8 +24,6 @@
 namespace robotalk::web {
 namespace {
 
-using Steady = std::chrono::steady_clock;
-
 // The newest sample of one robot, written by its client's ReadDaemon.
 struct SampleSlot {
   std::mutex mutex;
@@ -39,12 +38,7 @@ struct Robot {
   std::string driver;
   bool panic = false;
   int num_clients = 0;
-  Steady::time_point last_announce{};
-  std::string status = "connecting";
   std::string message;
-  bool connecting = false;  // waiting for a connect slot or connecting
-  Steady::time_point last_attempt{};
-  int failures = 0;  // connects that failed in a row: the next waits longer (ConnectBackoff)
   std::shared_ptr<RobotClient> client;
   std::int64_t client_server_id = 0;
   std::uint64_t client_hash = 0;
@@ -60,28 +54,6 @@ struct Robot {
   std::optional<PendingReply> root_query;
   bool streaming = false;    // the current client asked for the state stream
   bool stream_task = false;  // a start/stop of the stream is queued
-};
-
-// Anyone can announce a name no server answers for (one datagram), and a
-// connect waits for an answer up to its timeout: connects ran one at a time,
-// so 255 forged names held a real robot back 255 x 4 s. Now each connect runs
-// on a thread of its own and gets a bounded slot: at most kMaxConnecting at
-// once (each RobotClient holds LCM sockets, and LCM's select() aborts past
-// fd 1024: 255 at once did), the first attempt waits 1 s for an answer (a
-// server on the LAN answers in milliseconds), each failure doubles it up to
-// 4 s and waits 2 s, doubled up to kMaxBackoff, before the next try; a robot
-// never tried goes before the retries.
-constexpr std::size_t kMaxConnecting = 32;
-constexpr std::chrono::seconds kMaxBackoff(64);
-Steady::duration ConnectBackoff(int failures) {
-  return std::min<Steady::duration>(std::chrono::seconds(2) * (1 << std::min(failures, 5)), kMaxBackoff);
-}
-Duration ConnectTimeout(int failures) {
-  return std::min<Duration>(std::chrono::seconds(1) * (1 << std::min(failures, 2)), std::chrono::seconds(4));
-}
-struct ConnectThread {
-  std::thread thread;
-  bool finished = false;  // Connect() returned: the thread may be joined
 };
 
 // A robot's panics in flight: one thread sends them, one at a time. Requests
@@ -100,17 +72,19 @@ struct PanicInFlight {
 // at once, saying so.
 constexpr std::size_t kMaxPanicWaiters = 65536;
 
-// Anyone on the bus can announce a robot: the tracker holds at most this
-// many (a new name beyond it is ignored until one is forgotten), and forgets
-// a robot not announced for kForgetGone beyond its timeout.
-constexpr std::size_t kMaxRobots = 256;
-constexpr std::chrono::seconds kForgetGone(60);
-
 }  // namespace
 
 class RobotTracker::Impl {
  public:
-  explicit Impl(const WebOptions& o) : options_(o), lcm_(MainLcmUrl(o.lcm_url)) {  // ANNOUNCE: main lane
+  explicit Impl(const WebOptions& o)
+      : options_(o),
+        lcm_(MainLcmUrl(o.lcm_url)),  // ANNOUNCE: main lane
+        connects_(std::make_unique<ConnectScheduler>(
+            [this](const std::string& name, Duration timeout) { Connect(name, timeout); },
+            [this](const std::string& name, const std::string& error, Duration) {
+              ConnectFailed(name, error);
+            },
+            ConnectSchedulerOptions{.silent_after = FromSeconds(o.robot_timeout_s)})) {
     if (!lcm_.good()) throw Error("robotalk-web: cannot open LCM '" + o.lcm_url + "'");
     lcm_.subscribe(kAnnounceChannel, &Impl::OnAnnounce, this)->setQueueCapacity(100);
     listener_ = std::thread([this] { Listen(); });
@@ -122,12 +96,11 @@ class RobotTracker::Impl {
     wake_.notify_all();
     listener_.join();
     worker_.join();
+    connects_.reset();  // waits for the connects in flight, which take mutex_
     std::vector<std::thread> threads;
     {
       std::lock_guard lock(mutex_);
       for (auto& [robot, p] : panics_) threads.push_back(std::move(p.thread));
-      for (auto& [robot, c] : connects_) threads.push_back(std::move(c.thread));
-      connect_wait_.clear();
     }
     for (std::thread& t : threads) t.join();  // each takes mutex_ to answer its waiters
     std::lock_guard lock(mutex_);
@@ -155,21 +128,17 @@ class RobotTracker::Impl {
       return;
     }
     std::lock_guard lock(mutex_);
-    const auto now = Steady::now();
     for (const RobotAnnouncement& r : announcement.robots) {
-      auto it = robots_.find(r.name);
-      if (it == robots_.end()) {
-        if (robots_.size() >= kMaxRobots && !EvictUnanswered()) continue;
-        it = robots_.emplace(r.name, Robot{}).first;
-      }
-      Robot& robot = it->second;
+      std::string evicted;  // the scheduler's table and robots_ hold the same names
+      if (connects_->Announce(r.name, &evicted) == ConnectScheduler::Heard::kRefused) continue;
+      if (!evicted.empty()) robots_.erase(evicted);
+      Robot& robot = robots_[r.name];
       robot.name = r.name;
       robot.server_id = announcement.server_id;
       robot.announced_hash = r.config_hash;
       robot.driver = r.driver;
       robot.panic = r.panic;
       robot.num_clients = r.num_clients;
-      robot.last_announce = now;
     }
   }
 
@@ -190,34 +159,19 @@ class RobotTracker::Impl {
     }
   }
 
+  // The scheduler's connect (on a thread of its own): throws when it fails.
   void Connect(const std::string& name, Duration connect_timeout) {
     ClientOptions co;
     co.lcm_url = options_.lcm_url;
     co.timeout = std::chrono::seconds(2);
     co.connect_timeout = connect_timeout;
-    std::shared_ptr<RobotClient> client;
+    auto client = std::make_shared<RobotClient>(co);
+    client->Connect(name);
     auto slot = std::make_shared<SampleSlot>();
-    std::string error;
-    try {
-      client = std::make_shared<RobotClient>(co);
-      client->Connect(name);
-    } catch (const std::exception& e) {
-      error = e.what();
-      client.reset();
-    }
     std::lock_guard lock(mutex_);
-    auto it = robots_.find(name);
-    if (it == robots_.end()) return;
+    auto it = robots_.find(name);  // always found: a name connecting is never forgotten or pushed out
+    if (it == robots_.end()) throw Error("robot '" + name + "' is no longer tracked");
     Robot& r = it->second;
-    r.connecting = false;
-    r.last_attempt = Steady::now();  // the backoff counts from the end of this attempt
-    if (!client) {
-      r.status = "error";
-      r.message = "cannot connect: " + error;
-      ++r.failures;
-      return;
-    }
-    r.failures = 0;
     r.root_query.reset();
     r.streaming = false;
     r.client = std::move(client);
@@ -227,12 +181,16 @@ class RobotTracker::Impl {
     r.slot_seen = 0;
     r.model = std::make_shared<const RobotModel>(r.client->model());
     r.poser = std::make_unique<StatePoser>(*r.model);
-    r.status = "live";
     r.message.clear();
     ++r.generation;
     nlohmann::json m = {
         {"type", "model"}, {"robot", name}, {"generation", r.generation}, {"model", ModelToJson(*r.model)}};
     r.model_message = std::make_shared<const std::string>(JsonText(m));
+  }
+
+  void ConnectFailed(const std::string& name, const std::string& error) {
+    std::lock_guard lock(mutex_);
+    if (auto it = robots_.find(name); it != robots_.end()) it->second.message = "cannot connect: " + error;
   }
 
   // Asks for the state stream while a page is open, cancels it when none is:
@@ -280,116 +238,43 @@ class RobotTracker::Impl {
       it->second.message = std::string("state stream: ") + error;
   }
 
-  bool EvictUnanswered();
-  void Housekeep(Robot& r, Steady::time_point now, std::vector<std::shared_ptr<RobotClient>>& drop);
-  void StartConnects(std::vector<std::thread>& ended);
+  void Housekeep(Robot& r, const ConnectScheduler::State& s, std::vector<std::shared_ptr<RobotClient>>& drop);
   static void MeasureRoot(Robot& r);
-  nlohmann::json RobotJson(const Robot& r) const;
+  nlohmann::json RobotJson(const Robot& r, const ConnectScheduler::State& s) const;
 
   const WebOptions options_;
   lcm::LCM lcm_;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::map<std::string, Robot> robots_;            // GUARDED_BY(mutex_), at most kMaxRobots
-  std::deque<std::string> queue_;                  // GUARDED_BY(mutex_): state stream tasks
-  std::deque<std::string> connect_wait_;           // GUARDED_BY(mutex_): robots waiting for a connect slot
-  std::map<std::string, ConnectThread> connects_;  // GUARDED_BY(mutex_): at most kMaxConnecting running
+  std::map<std::string, Robot> robots_;  // GUARDED_BY(mutex_): the names of connects_'s table
+  std::deque<std::string> queue_;        // GUARDED_BY(mutex_): state stream tasks
   std::atomic<bool> watching_{false};
   std::function<void()> on_sample_;              // GUARDED_BY(mutex_)
   std::map<std::string, PanicInFlight> panics_;  // GUARDED_BY(mutex_): at most one per robot
+  // The robots announced, their connects (at most 32 at once), back-off and
+  // table (at most 256); it calls Connect() and ConnectFailed().
+  std::unique_ptr<ConnectScheduler> connects_;
   std::thread listener_, worker_;
 };
 
-void RobotTracker::Impl::Housekeep(Robot& r, Steady::time_point now,
+// REQUIRES: mutex_ held. A robot not announced for robot_timeout_s is gone:
+// its client is dropped; so is a stale one (the server restarted or the robot
+// changed), and the scheduler tries it again.
+void RobotTracker::Impl::Housekeep(Robot& r, const ConnectScheduler::State& s,
                                    std::vector<std::shared_ptr<RobotClient>>& drop) {
-  const auto timeout = std::chrono::duration<double>(options_.robot_timeout_s);
-  if (now - r.last_announce > timeout) {
-    if (r.status != "gone") {
-      r.status = "gone";
-      r.message = "not announced for " + std::to_string(static_cast<int>(options_.robot_timeout_s)) + " s";
-    }
-    if (r.client) drop.push_back(std::move(r.client));
-    r.client.reset();
-    r.root_query.reset();
-    return;
-  }
   const bool stale = r.client && (r.client_server_id != r.server_id || r.client_hash != r.announced_hash);
-  if (stale) {  // the server restarted or the robot changed: load it again
+  if (r.client && (s.silent || stale)) {
     drop.push_back(std::move(r.client));
     r.client.reset();
     r.root_query.reset();
-  }
-  if (!r.client && !r.connecting && now - r.last_attempt > ConnectBackoff(r.failures)) {
-    r.connecting = true;
-    r.status = "connecting";
-    r.message.clear();
-    if (r.failures == 0)
-      connect_wait_.push_front(r.name);  // never tried (or served before): ahead of the retries
-    else
-      connect_wait_.push_back(r.name);
+    connects_->Lost(r.name);
   }
   if (r.client && !r.stream_task && r.streaming != watching_) {
     r.stream_task = true;
     queue_.push_back(r.name);
     wake_.notify_all();
   }
-}
-
-// REQUIRES: mutex_ held. The table is full (kMaxRobots) and a new name is
-// announced: a forger re-announcing 256 names kept it full, so a real robot
-// announced later was never tracked. The robot whose connects failed most
-// (then the one announced longest ago) that is neither connected nor
-// connecting gives its place; a robot never tried or served keeps it.
-// Returns false when there is none.
-bool RobotTracker::Impl::EvictUnanswered() {
-  auto worst = robots_.end();
-  for (auto it = robots_.begin(); it != robots_.end(); ++it) {
-    const Robot& r = it->second;
-    if (r.client || r.connecting || r.failures == 0) continue;
-    if (worst == robots_.end() || r.failures > worst->second.failures ||
-        (r.failures == worst->second.failures && r.last_announce < worst->second.last_announce)) {
-      worst = it;
-    }
-  }
-  if (worst == robots_.end()) return false;
-  robots_.erase(worst);
-  return true;
-}
-
-// REQUIRES: mutex_ held. Threads of connects that ended go to `ended`, to be
-// joined outside the lock.
-void RobotTracker::Impl::StartConnects(std::vector<std::thread>& ended) {
-  for (auto it = connects_.begin(); it != connects_.end();) {
-    if (!it->second.finished) {
-      ++it;
-      continue;
-    }
-    ended.push_back(std::move(it->second.thread));
-    it = connects_.erase(it);
-  }
-  std::vector<std::string> later;  // its previous connect's thread is still ending
-  while (connects_.size() < kMaxConnecting && !connect_wait_.empty()) {
-    const std::string name = connect_wait_.front();
-    connect_wait_.pop_front();
-    auto robot = robots_.find(name);
-    if (robot == robots_.end() || !robot->second.connecting) continue;
-    if (auto previous = connects_.find(name); previous != connects_.end()) {
-      if (!previous->second.finished) {
-        later.push_back(name);
-        continue;
-      }
-      ended.push_back(std::move(previous->second.thread));
-      connects_.erase(previous);
-    }
-    const Duration timeout = ConnectTimeout(robot->second.failures);
-    connects_[name].thread = std::thread([this, name, timeout] {
-      Connect(name, timeout);
-      std::lock_guard lock(mutex_);
-      connects_.at(name).finished = true;
-    });
-  }
-  connect_wait_.insert(connect_wait_.begin(), later.begin(), later.end());
 }
 
 // One LINK_POSES query for the root in flight at a time; a new one goes out
@@ -416,13 +301,23 @@ void RobotTracker::Impl::MeasureRoot(Robot& r) {
   }
 }
 
-nlohmann::json RobotTracker::Impl::RobotJson(const Robot& r) const {
+nlohmann::json RobotTracker::Impl::RobotJson(const Robot& r, const ConnectScheduler::State& s) const {
   nlohmann::json urdf = nullptr;
   if (auto it = options_.urdf.find(r.name); it != options_.urdf.end())
     urdf = "/urdf/" + r.name + "/" + std::filesystem::path(it->second).filename().string();
+  std::string status = "live", message = r.message;
+  if (!r.client && s.silent) {
+    status = "gone";
+    message = "not announced for " + std::to_string(static_cast<int>(options_.robot_timeout_s)) + " s";
+  } else if (!r.client && s.failures > 0 && !s.connecting) {
+    status = "error";  // message: why its last connect failed
+  } else if (!r.client) {
+    status = "connecting";
+    message.clear();
+  }
   return {{"name", r.name},
-          {"status", r.status},
-          {"message", r.message},
+          {"status", status},
+          {"message", message},
           {"driver", r.driver},
           {"panic", r.panic},
           {"num_clients", r.num_clients},
@@ -434,20 +329,16 @@ nlohmann::json RobotTracker::Impl::RobotJson(const Robot& r) const {
 TrackerFrame RobotTracker::Impl::Poll() {
   TrackerFrame frame;
   std::vector<std::shared_ptr<RobotClient>> drop;  // destroyed outside the lock (joins threads)
-  std::vector<std::thread> ended;                  // joined outside the lock
   {
     std::lock_guard lock(mutex_);
-    const auto now = Steady::now();
     nlohmann::json list = nlohmann::json::array();
-    const auto forget = std::chrono::duration_cast<Steady::duration>(
-        std::chrono::duration<double>(options_.robot_timeout_s) + kForgetGone);
-    std::erase_if(robots_, [&](const auto& entry) {
-      const Robot& r = entry.second;
-      return !r.client && !r.connecting && now - r.last_announce > forget;
-    });
+    for (auto& [name, r] : robots_)
+      if (const auto s = connects_->Find(name)) Housekeep(r, *s, drop);
+    for (const std::string& name : connects_->Poll()) robots_.erase(name);  // forgotten
     for (auto& [name, r] : robots_) {
-      Housekeep(r, now, drop);
-      list.push_back(RobotJson(r));
+      const auto s = connects_->Find(name);
+      if (!s) continue;
+      list.push_back(RobotJson(r, *s));
       if (r.model_message) frame.models.push_back({name, r.generation, r.model_message, r.model});
       if (!r.client || !r.slot || !r.poser) continue;
       if (watching_ && r.poser->needs_measured_root()) MeasureRoot(r);
@@ -465,9 +356,7 @@ TrackerFrame RobotTracker::Impl::Poll() {
       }
     }
     frame.robots = {{"type", "robots"}, {"robots", list}};
-    StartConnects(ended);
   }
-  for (std::thread& t : ended) t.join();
   drop.clear();
   return frame;
 }

@@ -11,12 +11,15 @@
 // It sends queries and heartbeats, and a panic package on Panic(); never a
 // command.
 //
+// Which robots it tracks and when it connects them (at most 256 names, 32
+// connects at once, back-off, forgetting) is robotalk::ConnectScheduler's
+// (robotalk/connect_scheduler.h), shared with robotalk-ros2.
+//
 // Thread safety: Poll() must be called from one thread at a time (it owns the
 // kinematics buffers); Panic() from any thread. Internally: one LCM thread for
-// announces, a thread per connect in progress (at most 32; one that is not
-// answered delays no other), one worker thread for (blocking) state stream
-// requests, each client's own ReadDaemon delivering samples into a
-// single-slot buffer.
+// announces, the scheduler's thread per connect in progress, one worker
+// thread for (blocking) state stream requests, each client's own ReadDaemon
+// delivering samples into a single-slot buffer.
 // Errors: the constructor throws robotalk::Error when LCM cannot be opened.
 // Connection failures are reported in the robot's status, not thrown.
 #pragma once
