@@ -22,28 +22,48 @@ std::optional<Duration> OneWayDelay(TimePoint sent, TimePoint arrival) {
   return d;
 }
 
+void DelayHistory::Ring::Push(const Sample& s) {
+  samples[next] = s;
+  next = (next + 1) % kCapacity;
+  size = std::min(size + 1, kCapacity);
+}
+
+void DelayHistory::Ring::AppendRecent(TimePoint now, Duration window, std::vector<Sample>& out) const {
+  for (std::size_t k = 0; k < size; ++k) {
+    const Sample& s = samples[(next + kCapacity - size + k) % kCapacity];
+    if (now - s.received <= window) out.push_back(s);
+  }
+}
+
 void DelayHistory::Add(TimePoint sent, TimePoint received, std::optional<TimePoint> arrived) {
   const std::optional<Duration> d = OneWayDelay(sent, received);
   if (!d) return;
   const Duration lag = arrived && *arrived < received ? received - *arrived : Duration(0);
-  ring_[next_] = {received, *d, lag};
-  next_ = (next_ + 1) % kCapacity;
-  size_ = std::min(size_ + 1, kCapacity);
+  delays_.Push({received, *d, lag});
+}
+
+void DelayHistory::AddCopy(TimePoint sent, TimePoint received) {
+  copies_.Push({received, OneWayDelay(sent, received).value_or(Duration(0)), Sample::kCopy});
 }
 
 std::vector<DelayHistory::Sample> DelayHistory::RecentSamples(TimePoint now, Duration window) const {
   std::vector<Sample> out;
-  out.reserve(size_);
-  for (std::size_t k = 0; k < size_; ++k) {
-    const Sample& s = ring_[(next_ + kCapacity - size_ + k) % kCapacity];
-    if (now - s.received <= window) out.push_back(s);
-  }
+  out.reserve(delays_.size + copies_.size);
+  delays_.AppendRecent(now, window, out);
+  const auto first_copy = static_cast<std::ptrdiff_t>(out.size());
+  copies_.AppendRecent(now, window, out);
+  // Both rings are in the order handled: one list in that order, a delay before a copy handled at the same
+  // time.
+  std::inplace_merge(out.begin(), out.begin() + first_copy, out.end(),
+                     [](const Sample& a, const Sample& b) { return a.received < b.received; });
   return out;
 }
 
 std::vector<Duration> DelayHistory::Recent(TimePoint now, Duration window) const {
+  std::vector<Sample> samples;
+  delays_.AppendRecent(now, window, samples);
   std::vector<Duration> out;
-  for (const Sample& s : RecentSamples(now, window)) out.push_back(s.delay);
+  for (const Sample& s : samples) out.push_back(s.delay);
   return out;
 }
 
@@ -51,7 +71,12 @@ void PlaybackEstimator::SetDelayHistory(const std::vector<DelayHistory::Sample>&
   history_.clear();
   history_received_.clear();
   history_lag_.clear();
+  copies_.clear();
   for (const DelayHistory::Sample& s : samples) {
+    if (s.copy()) {
+      copies_.push_back({s.received, s.delay});
+      continue;
+    }
     history_.push_back(s.delay);
     history_received_.push_back(s.received);
     history_lag_.push_back(s.lag);
@@ -125,8 +150,12 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
     if (!seen[j].known_arrival || !seen[j - 1].known_arrival) continue;
     const TimePoint sent = seen[j].arrival - seen[j].delay,
                     sent_before = seen[j - 1].arrival - seen[j - 1].delay;
-    if (sent - sent_before >= burst || sent < sent_before) continue;
-    const Duration wait = seen[j - 1].arrival - (sent + least);
+    // A copy of an earlier package handled between the two (the client's
+    // retransmission): on a FIFO link the package waited behind it, whenever
+    // it was sent, a queue the client's own copy made.
+    const TimePoint before = BehindCopy(seen[j - 1].arrival, seen[j].arrival);
+    if (before == seen[j - 1].arrival && (sent - sent_before >= burst || sent < sent_before)) continue;
+    const Duration wait = before - (sent + least);
     discounted.delays[j] -= std::clamp(wait, Duration(0), seen[j].delay - least);
   }
   // Only on a FIFO link, where that brings the spread within the gate, or
@@ -134,6 +163,13 @@ PlaybackEstimator::Channel PlaybackEstimator::ChannelDelays() const {
   // the channel's delays, not the burst's own queue); else as measured.
   const bool follows = options_.follow_queue && !options_.queue_start;
   return fifo || spread(discounted.delays) <= gate || follows ? discounted : measured;
+}
+
+TimePoint PlaybackEstimator::BehindCopy(TimePoint after, TimePoint before) const {
+  TimePoint latest = after;
+  for (const Copy& c : copies_)
+    if (c.received > latest && c.received < before) latest = c.received;
+  return latest;
 }
 
 bool PlaybackEstimator::burst_discounted() const { return ChannelDelays().discounted; }
@@ -262,7 +298,7 @@ std::vector<double> PlaybackEstimator::Services() const {
     const Duration excess = p.delay - fenced.least;
     Duration s = excess;  // arrival unknown: as if it had not queued (the larger service)
     if (p.known_arrival && previous)
-      s = std::min(excess, p.arrival - std::max(*previous, p.arrival - excess));
+      s = std::min(excess, p.arrival - std::max(BehindCopy(*previous, p.arrival), p.arrival - excess));
     if (p.known_arrival) previous = p.arrival;
     if (channel[k] <= fenced.most) service.push_back(ToSeconds(s));
   }
@@ -486,6 +522,11 @@ std::string PlaybackEstimator::Describe() const {
       seen.empty() ? TimePoint{} : seen[history_.size()].arrival - seen[history_.size()].delay;
   out += ",\"sent\":" + list(seen.begin(), seen.end(), [&](const Seen& p) {
            return p.known_arrival ? ms(p.arrival - p.delay - sent0) : std::string("null");
+         });
+  // Copies of earlier packages: when handled (ms after the first frame) and the send time they carry.
+  out += ",\"copies\":" + list(copies_.begin(), copies_.end(), [&](const Copy& c) {
+           return "[" + ms(c.received - frames_.front().arrival) + "," +
+                  (seen.empty() ? std::string("null") : ms(c.received - c.delay - sent0)) + "]";
          });
   out += ",\"lags\":" + list(history_lag_.begin(), history_lag_.end(), ms);
   out += ",\"frame_lags\":" + list(frames_.begin(), frames_.end(), [&](const Frame& f) { return ms(f.lag); });

@@ -53,6 +53,15 @@
 // sent less than a frame interval after the one before it counts without
 // that wait (ChannelDelays); if the gate then passes, the adaptive start
 // decides from those delays.
+// The copies (issue 23, ninth session): a package the client resent because
+// its acknowledgement was late (the relay's U[0, 100] ms link holds a
+// package up to 100 ms, the client's first resend is after 100 ms) reaches
+// the server as a duplicate, and the package sent after it waits behind it
+// on a FIFO link: its delay then includes a queue the client's own copy made
+// (in 46 of 55 relay misses it set the start's worst delay). The session
+// records when each copy was handled (DelayHistory::AddCopy), and the burst
+// discount leaves a package's wait behind a copy out of its delay whenever it
+// was sent; Services reads its service behind the copy.
 //
 // Queue follow (issue 23 item 3, seventh session; follow_queue, on): beyond
 // the gate, where the server handled every package seen within one gap's
@@ -192,21 +201,38 @@ class DelayHistory {
   struct Sample {
     TimePoint received;
     Duration delay;
-    Duration lag{0};  ///< handled − reached the socket (the server's own lag)
+    Duration lag{0};  ///< handled − reached the socket (the server's own lag); kCopy: a copy
+    /// A copy (AddCopy): no delay of the channel (`delay` is its arrival − its
+    /// first copy's send time, for diagnostics); marked in `lag`, never
+    /// negative otherwise.
+    static constexpr Duration kCopy = Duration::min();
+    bool copy() const { return lag == kCopy; }
   };
   /// Records one package, handled at `received` after it reached the socket
   /// at `arrived` (both on the server clock; `arrived` later than `received`
   /// counts as no lag); a send time whose difference to `received` does not
   /// fit is ignored (a hostile header must not overflow anything).
   void Add(TimePoint sent, TimePoint received, std::optional<TimePoint> arrived = std::nullopt);
-  /// The delays recorded within `window` before `now`, oldest first.
+  /// Records that a copy of an earlier package (a duplicate, or a
+  /// retransmission whose first copy was lost), stamped `sent` by the client,
+  /// was handled at `received`: no delay of the channel, but on a FIFO link
+  /// the package after it waited behind it (see "The copies" above). Kept in
+  /// a ring of its own: a WAN's resends (every package whose round trip
+  /// exceeds the client's resend interval) never push delays out.
+  void AddCopy(TimePoint sent, TimePoint received);
+  /// The delays recorded within `window` before `now`, oldest first (copies left out).
   std::vector<Duration> Recent(TimePoint now, Duration window = std::chrono::seconds(30)) const;
-  /// The same with their arrival times (the queue start reads the queue from them).
+  /// The same with their arrival times (the queue start reads the queue from them), copies included.
   std::vector<Sample> RecentSamples(TimePoint now, Duration window = std::chrono::seconds(30)) const;
 
  private:
-  std::array<Sample, kCapacity> ring_{};
-  std::size_t next_ = 0, size_ = 0;
+  struct Ring {
+    std::array<Sample, kCapacity> samples{};
+    std::size_t next = 0, size = 0;
+    void Push(const Sample& s);
+    void AppendRecent(TimePoint now, Duration window, std::vector<Sample>& out) const;
+  };
+  Ring delays_, copies_;
 };
 
 class PlaybackEstimator {
@@ -220,6 +246,7 @@ class PlaybackEstimator {
     history_ = std::move(delays);
     history_received_.clear();
     history_lag_.clear();
+    copies_.clear();
   }
   /// The same with their arrival times (DelayHistory::RecentSamples), oldest first.
   void SetDelayHistory(const std::vector<DelayHistory::Sample>& samples);
@@ -233,7 +260,8 @@ class PlaybackEstimator {
   /// Heap memory it holds (its frames and delay history), for the session's accounting.
   std::size_t heap_bytes() const {
     return frames_.capacity() * sizeof(Frame) + history_.capacity() * sizeof(Duration) +
-           history_received_.capacity() * sizeof(TimePoint) + history_lag_.capacity() * sizeof(Duration);
+           history_received_.capacity() * sizeof(TimePoint) + history_lag_.capacity() * sizeof(Duration) +
+           copies_.capacity() * sizeof(Copy);
   }
   bool ready() const;
   /// Whether the start is decided at the first frames from send times (the
@@ -334,6 +362,13 @@ class PlaybackEstimator {
   std::vector<Duration> history_;
   std::vector<TimePoint> history_received_;  // empty, or history_'s arrivals
   std::vector<Duration> history_lag_;        // empty, or the server's lag handling each
+  struct Copy {
+    TimePoint received;
+    Duration delay;  // its arrival − its first copy's send time (diagnostics)
+  };
+  std::vector<Copy> copies_;  // copies of earlier packages the history saw handled, oldest first
+  // The latest copy handled after `after` and before `before`, else `after`.
+  TimePoint BehindCopy(TimePoint after, TimePoint before) const;
 };
 
 }  // namespace robotalk

@@ -192,6 +192,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
   if (seen == SequenceWindow::Verdict::kDuplicate) {
     // A retransmission or a duplicate: never execute again; re-send what is
     // known. It does not refresh the session (a replay must not keep it alive).
+    // On a FIFO link the package after it waited behind it (playback's start).
+    if (r.send_time != TimePoint{}) session.delays.AddCopy(r.send_time, now);
     immediate = Retransmitted(session, r, now);
     return answer;
   }
@@ -233,6 +235,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
   // where it was the link's, not this server's (follow_queue).
   if (r.send_time != TimePoint{} && (!resent || options_.playback_resent_delays))
     session.delays.Add(r.send_time, now, arrived);
+  else if (r.send_time != TimePoint{})
+    session.delays.AddCopy(r.send_time, now);  // a retransmission: only that the next package met it
   for (Reply& reply : immediate) {
     Bound(reply);
     session.replies.RecordReply(reply);
@@ -246,13 +250,16 @@ void RobotSessions::Bound(Reply& reply) const {
   reply.message += "... (truncated)";
 }
 
-ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint now, TimePoint arrived) const {
+ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint now, TimePoint arrived) {
   ImmediateAnswer answer;
   answer.batch.client_id = r.client_id;
   answer.batch.ack_sequence = r.sequence;
   answer.batch.server_receive = arrived;
-  if (const Session* s = table_.Find(robot_id_, r.client_id)) {
+  if (Session* s = table_.Find(robot_id_, r.client_id)) {
     answer.batch.replies = Retransmitted(*s, r, now);
+    // On a FIFO link the package after this copy waited behind it (playback's
+    // start, "The copies" in playback_estimator.h).
+    if (r.send_time != TimePoint{}) s->delays.AddCopy(r.send_time, now);
   }
   return answer;
 }

@@ -114,8 +114,9 @@ class RobotSessions {
   ImmediateAnswer Handle(const Request& request, TimePoint now) { return Handle(request, now, now); }
   /// A retransmission the session table's window saw (open or keyed mode):
   /// acknowledges it with what is known of its items; runs nothing, opens
-  /// and refreshes no session. `now`, `arrived`: as Handle.
-  ImmediateAnswer Resend(const Request& request, TimePoint now, TimePoint arrived) const;
+  /// and refreshes no session; records when the copy was handled in the
+  /// session's delay history (playback's start). `now`, `arrived`: as Handle.
+  ImmediateAnswer Resend(const Request& request, TimePoint now, TimePoint arrived);
   /// Raises a panic on behalf of `client_id` (outside any session: open
   /// mode honours a panic from anyone).
   void RaisePanic(std::int64_t client_id, TimePoint now) { Panic(client_id, now); }
