@@ -85,6 +85,7 @@ public final class RobotalkClient implements AutoCloseable {
   private boolean helloAnswered, clockStale;
   private String refusal = "";
   private robot_config_t config;
+  private long refusedMessages;
 
   /** The client's monotonic clock, microseconds. */
   public static long nowUs() { return System.nanoTime() / 1000; }
@@ -172,7 +173,8 @@ public final class RobotalkClient implements AutoCloseable {
     while (found == null && problem == null && nowUs() < deadline) {
       Object[] m = take(deadline - nowUs());
       if (m == null || !m[0].equals("ROBOTALK/ANNOUNCE")) continue;
-      announce_t a = new announce_t((byte[]) m[1]);
+      announce_t a = checked((String) m[0], (byte[]) m[1], MessageCheck.ANNOUNCE, announce_t::new);
+      if (a == null) continue;
       for (robotalk_msgs.robot_info_t r : a.robots) {
         if (!r.name.equals(robot)) {
           if (!heard.contains(r.name)) heard.add(r.name);
@@ -219,10 +221,46 @@ public final class RobotalkClient implements AutoCloseable {
   }
 
   private void dispatch(String channel, byte[] bytes) throws IOException {
-    if (channel.equals(replyChannel)) onReply(new reply_package_t(bytes));
-    else if (channel.equals(helloAnswerChannel)) onHelloAnswer(new hello_answer_t(bytes));
-    else if (channel.equals("ROBOTALK/" + robot + "/CONFIG")) config = new robot_config_t(bytes);
+    if (channel.equals(replyChannel)) {
+      reply_package_t m = checked(channel, bytes, MessageCheck.REPLY_PACKAGE, reply_package_t::new);
+      if (m != null) onReply(m);
+    } else if (channel.equals(helloAnswerChannel)) {
+      hello_answer_t m = checked(channel, bytes, MessageCheck.HELLO_ANSWER, hello_answer_t::new);
+      if (m != null) onHelloAnswer(m);
+    } else if (channel.equals("ROBOTALK/" + robot + "/CONFIG")) {
+      robot_config_t m = checked(channel, bytes, MessageCheck.ROBOT_CONFIG, robot_config_t::new);
+      if (m != null) config = m;
+    }
   }
+
+  private interface Decoder<T> {
+    T decode(byte[] bytes) throws IOException;
+  }
+
+  /**
+   * The decoded message, or null when it is refused: a declared count or length past its bytes
+   * (MessageCheck, before lcm-gen's decoder allocates it) or a message that does not decode (another
+   * type, corrupt). Anyone on the network can send one: it is dropped, counted and said once.
+   */
+  private <T> T checked(String channel, byte[] bytes, MessageCheck.Field[] schema, Decoder<T> decoder) {
+    String why;
+    if (!MessageCheck.fits(bytes, schema)) {
+      why = "a declared count or length goes past its " + bytes.length + " bytes";
+    } else {
+      try {
+        return decoder.decode(bytes);
+      } catch (IOException e) {
+        why = "it does not decode (" + e.getMessage() + ")";
+      }
+    }
+    if (refusedMessages++ == 0)
+      System.err.println("robotalk-java: dropped a message on " + channel + ": " + why
+          + " (hostile or corrupt; counted, said once)");
+    return null;
+  }
+
+  /** Messages dropped because they did not decode or declared more than they carried. */
+  public long refusedMessages() { return refusedMessages; }
 
   private void onHelloAnswer(hello_answer_t m) {
     if (m.client_id != clientId || !Arrays.equals(m.client_nonce, nonce)) return;  // not our hello
