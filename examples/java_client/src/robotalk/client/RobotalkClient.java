@@ -76,7 +76,13 @@ public final class RobotalkClient implements AutoCloseable {
   private final boolean split;
   private final long clientId;
   private final SecureRandom random = new SecureRandom();
-  private final LinkedBlockingQueue<Object[]> inbox = new LinkedBlockingQueue<>();
+  // Bounded: LCM's thread fills it, only a client call drains it, and anyone can send to our
+  // channels. A message that finds it full is dropped and counted (droppedMessages()); a lost
+  // reply comes again: the package is sent again until acknowledged, and every second until each
+  // of its items has its final reply.
+  static final int INBOX_CAPACITY = 256;
+  private final LinkedBlockingQueue<Object[]> inbox = new LinkedBlockingQueue<>(INBOX_CAPACITY);
+  private final java.util.concurrent.atomic.AtomicLong droppedMessages = new java.util.concurrent.atomic.AtomicLong();
   private final Map<Long, Pending> pending = new HashMap<>();
   private final Map<Long, reply_t> replies = new HashMap<>();
   private final String helloChannel, requestChannel, replyChannel, helloAnswerChannel;
@@ -157,7 +163,9 @@ public final class RobotalkClient implements AutoCloseable {
     try {
       byte[] b = new byte[ins.available()];
       ins.readFully(b);
-      inbox.add(new Object[] {channel, b});
+      if (!inbox.offer(new Object[] {channel, b}) && droppedMessages.getAndIncrement() == 0)
+        System.err.println("robotalk-java: the inbox is full (" + INBOX_CAPACITY + " messages not yet handled): "
+            + "dropped a message on " + channel + " (counted, said once; a flood, or no client call for long)");
     } catch (IOException e) {
       // a truncated message: dropped, as LCM would
     }
@@ -261,6 +269,9 @@ public final class RobotalkClient implements AutoCloseable {
 
   /** Messages dropped because they did not decode or declared more than they carried. */
   public long refusedMessages() { return refusedMessages; }
+
+  /** Messages dropped because the inbox was full (INBOX_CAPACITY not yet handled). */
+  public long droppedMessages() { return droppedMessages.get(); }
 
   private void onHelloAnswer(hello_answer_t m) {
     if (m.client_id != clientId || !Arrays.equals(m.client_nonce, nonce)) return;  // not our hello
