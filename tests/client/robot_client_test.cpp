@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <thread>
 
@@ -553,6 +554,35 @@ TEST_F(RobotClientTest, ListRobotsDedupesAnnouncements) {
     EXPECT_EQ(robot.config_hash, ConfigHash(model_));
   }
   EXPECT_NE(robots[0].server_id, robots[1].server_id);
+}
+
+// Review9: ListRobots kept every (server, name) it heard and de-duplicated
+// with a linear scan, so a forger announcing thousands of names grew the list
+// without bound (robotalk list, Python's robotalk.robots(), the ROS 2 bridge's
+// discovery: all call it), each new name costing a scan of every name before it.
+TEST(ListRobotsFlood, AFloodOfForgedNamesIsBounded) {
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport forger(bus), listener(bus);
+  std::atomic<bool> done{false};
+  std::thread flood([&] {
+    for (int d = 0; d < 60 && !done; ++d) {  // 60 datagrams of 500 names each: 30,000 names
+      Announcement a{.server_id = 1000 + d};
+      for (int k = 0; k < 500; ++k)
+        a.robots.push_back({.name = "ghost-" + std::to_string(d) + "-" + std::to_string(k), .driver = "x"});
+      forger.Publish(kAnnounceChannel, EncodeAnnouncement(a));
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+  });
+  ClientOptions o;
+  o.transport = &listener;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto robots = ListRobots(o, milliseconds(1500));
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  done = true;
+  flood.join();
+  std::printf("ListRobots under a flood of forged names: %zu listed, %.2f s for a 1.5 s window\n",
+              robots.size(), took);
+  EXPECT_LE(robots.size(), 1024u);
 }
 
 // Issue 22: SETSPEED frames of a linear sequence ramp within the robot's own
