@@ -619,8 +619,19 @@ void BindClient(py::module_& m) {
         ClientOptions o;
         o.lcm_url = url.value_or("");
         const Duration d = ToNonNegativeDuration(listen, "robots listen");
-        py::gil_scoped_release release;
-        return ListRobots(o, d);
+        std::uint64_t unlisted = 0;
+        std::vector<AnnouncedRobot> robots;
+        {
+          py::gil_scoped_release release;
+          robots = ListRobots(o, d, &unlisted);
+        }
+        if (unlisted > 0) {
+          const std::string text = "robotalk.robots(): listed the first " + std::to_string(kMaxListedRobots) +
+                                   " robots heard; " + std::to_string(unlisted) +
+                                   " more announced names not listed (a flood of forged names?)";
+          if (PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+        }
+        return robots;
       },
       py::arg("url") = py::none(), py::arg("listen") = 1.5);
 }

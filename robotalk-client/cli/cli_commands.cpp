@@ -92,9 +92,13 @@ int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
   RejectOptions(args);
   if (!args.empty()) throw UsageError("robots takes no arguments");
   const double seconds = ParseNumber(listen, "--listen");
-  const auto robots = ListRobots(MakeOptions(g), FromSeconds(seconds));
+  std::uint64_t unlisted = 0;
+  const auto robots = ListRobots(MakeOptions(g), FromSeconds(seconds), &unlisted);
   if (robots.empty())
     std::cerr << "robotalk: no robot announced itself within " << FormatSeconds(seconds) << "\n";
+  if (unlisted > 0)
+    std::cerr << "robotalk: listed the first " << kMaxListedRobots << " robots heard; " << unlisted
+              << " more announced names not listed (a flood of forged names?)\n";
   if (json) {
     std::cout << RobotsJson(robots) << "\n";
     return 0;

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <set>
+#include <utility>
 
 namespace robotalk {
 namespace {
@@ -103,7 +105,8 @@ std::optional<Reply> PendingReply::WaitFor(Duration most, std::stop_token stop) 
 
 // --- ListRobots --------------------------------------------------------------
 
-std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen) {
+std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen,
+                                       std::uint64_t* unlisted) {
   std::unique_ptr<Transport> own;
   Transport* transport = options.transport;
   if (!transport) {
@@ -116,6 +119,8 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
   }
   struct Collector {
     std::vector<AnnouncedRobot> robots;
+    std::set<std::pair<std::int64_t, std::string>> seen;  // (server id, name): each listed once
+    std::uint64_t unlisted = 0;
     void On(std::span<const std::uint8_t> bytes) {
       std::string key;
       if (SignatureSuffix(bytes)) {
@@ -125,10 +130,12 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
       }
       const Announcement msg = DecodeAnnouncement(bytes);
       for (const auto& r : msg.robots) {
-        const bool seen = std::any_of(robots.begin(), robots.end(), [&](const AnnouncedRobot& a) {
-          return a.server_id == msg.server_id && a.name == r.name;
-        });
-        if (seen) continue;
+        if (seen.count({msg.server_id, r.name})) continue;
+        if (robots.size() >= kMaxListedRobots) {
+          ++unlisted;
+          continue;
+        }
+        seen.insert({msg.server_id, r.name});
         robots.push_back({.name = r.name,
                           .driver = r.driver,
                           .config_hash = r.config_hash,
@@ -158,6 +165,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
     }
   }
   sub.reset();
+  if (unlisted) *unlisted = collector.unlisted;
   std::sort(collector.robots.begin(), collector.robots.end(),
             [](const AnnouncedRobot& a, const AnnouncedRobot& b) {
               return a.name != b.name ? a.name < b.name : a.server_id < b.server_id;

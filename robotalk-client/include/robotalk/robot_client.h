@@ -320,10 +320,18 @@ struct AnnouncedRobot {
   std::string server_key;
 };
 
+/// The most robots ListRobots lists: anyone on the network can announce
+/// names (in open mode, or signed with a key of their own), so the list is
+/// bounded like every other table a sender fills.
+inline constexpr std::size_t kMaxListedRobots = 1024;
+
 /// Listens to ROBOTALK/ANNOUNCE for `listen` and returns every robot heard,
-/// once per (server id, name), sorted by name. Servers announce once a second.
-/// An announcement whose signature suffix does not verify is dropped.
-std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen);
+/// once per (server id, name), sorted by name, at most kMaxListedRobots (the
+/// first heard). Servers announce once a second. An announcement whose
+/// signature suffix does not verify is dropped. `unlisted` (when given) counts
+/// the (server id, name) pairs heard once the list was full (a repeat counts again).
+std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen,
+                                       std::uint64_t* unlisted = nullptr);
 
 /// Client counters, for diagnostics and tests.
 struct ClientStats {
