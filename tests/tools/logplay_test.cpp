@@ -131,11 +131,21 @@ TEST(SessionLog, RefusesToMixClientsWhoseClocksCannotBeJoined) {
 TEST(SessionLog, NeverReplaysAPanicOrAPanicReset) {
   SessionLog log;
   log.Add(kRequest, 10, Package(kClient, 1, 5, kDelay, {{1, CommandType::kGoto, 100, "", {1, 0, 0}}}));
-  log.Add(kRequest, 11, Package(kClient, 2, 6, kDelay, {{2, CommandType::kPanicReset, 200, "", {}}}));
+  // A panic package (review9: the test checked only the reset, not the panic its name promises).
+  Request panic{.client_id = kClient, .sequence = 2, .send_time = AtMicros(6), .mode = kDirect};
+  panic.panic = true;
+  log.Add(kRequest, 11, EncodeRequest(panic));
+  log.Add(kRequest, 12, Package(kClient, 3, 7, kDelay, {{2, CommandType::kPanicReset, 200, "", {}}}));
+  EXPECT_EQ(log.clients().at(kClient).panics, 1u);
   const Timeline t = log.MakeTimeline({.client_id = kClient});
   ASSERT_EQ(t.frames.size(), 1u);
-  ASSERT_EQ(t.skipped.size(), 1u);
-  EXPECT_NE(t.skipped[0].find("PANIC_RESET"), std::string::npos);
+  EXPECT_EQ(t.frames[0].source->command.type, CommandType::kGoto);
+  ASSERT_EQ(t.skipped.size(), 2u);
+  EXPECT_NE(t.skipped[0].find("a panic from client"), std::string::npos) << t.skipped[0];
+  EXPECT_NE(t.skipped[1].find("PANIC_RESET"), std::string::npos) << t.skipped[1];
+  const std::vector<TimedCommand> frames = ToFrames(t, {});
+  ASSERT_EQ(frames.size(), 1u);  // what replay and extract send
+  EXPECT_EQ(frames[0].command.type, CommandType::kGoto);
 }
 
 TEST(SessionLog, CountsUndecodableMessagesInsteadOfThrowing) {
