@@ -112,6 +112,24 @@ M.hex_of_raw = hex
 local Client = {}
 Client.__index = Client
 
+-- An LCM handler for what anyone on the network can send: `handle(data)` runs
+-- under pcall, so a message that does not decode (a declared count or length
+-- past its bytes, a torn datagram, another type's bytes) is dropped, counted in
+-- self.refused and said once on stderr. Raised out of the handler it would end
+-- whatever call was waiting, and leave LCM's C module "in handle": its next
+-- handle() aborts the process on an assertion.
+function Client:guarded(channel, handle)
+  return function(_, data)
+    local ok, err = pcall(handle, data)
+    if ok then return end
+    self.refused = (self.refused or 0) + 1
+    if self.refused == 1 then
+      io.stderr:write(string.format('robotalk-lua: dropped a message on %s: %s (hostile or corrupt; counted, said once)\n',
+        channel, tostring(err)))
+    end
+  end
+end
+
 -- url without RoboTalk's own option traffic=single|split (LCM does not know
 -- it; the layout is taken from ANNOUNCE).
 local function lcm_url_of(url)
@@ -383,10 +401,11 @@ end
 function Client:load_config(timeout_s)
   local channel = 'ROBOTALK/' .. self.robot .. '/CONFIG'
   local heard = {}
-  local sub = self.main:subscribe(channel, function(_, data)  -- before asking
+  local sub = self.main:subscribe(channel, self:guarded(channel, function(data)  -- before asking
+    local config = msgs.robot_config_t.decode(zeroed(data, 13))  -- header.hash: returned as hex
     -- config_header_t.hash: bytes 13..20 (fingerprint 8, format_version 4).
-    heard.hash, heard.data = hex(raw8(data, 13)), data
-  end)
+    heard.hash, heard.config = hex(raw8(data, 13)), config
+  end))
   local r, err = self:query(msgs.query_t.CONFIG, '', timeout_s)
   local result
   if r and r.signal ~= msgs.reply_t.SUCCESS then
@@ -399,7 +418,7 @@ function Client:load_config(timeout_s)
       self:handle_for(0.02)
     end
     if heard.hash == r.message then
-      result = msgs.robot_config_t.decode(zeroed(heard.data, 13))  -- header.hash: returned as hex
+      result = heard.config
     else
       err = err or ('no robot_config_t with hash ' .. r.message .. ' on ' .. channel)
     end
@@ -423,7 +442,7 @@ function M.connect(url, robot, timeout_s)
   url = lcm_url_of(url)
   self.main = lcm.lcm.new(url)
   local found, problem, heard = nil, nil, {}
-  local sub = self.main:subscribe('ROBOTALK/ANNOUNCE', function(_, data)
+  local sub = self.main:subscribe('ROBOTALK/ANNOUNCE', self:guarded('ROBOTALK/ANNOUNCE', function(data)
     local a = msgs.announce_t.decode(zeroed(data, OFF.announce_server))  -- robots[].config_hash still warns
     for _, r in ipairs(a.robots) do
       if r.name ~= robot then
@@ -438,7 +457,7 @@ function M.connect(url, robot, timeout_s)
         found = a
       end
     end
-  end)
+  end))
   local deadline = M.now() + timeout_s
   while not found and not problem and M.now() < deadline do
     self.main:handle_timeout(math.max(1, math.floor((deadline - M.now()) * 1000)))
@@ -466,8 +485,9 @@ function M.connect(url, robot, timeout_s)
   local hexid = string.format('%016x', self.client_id)
   self.hello_channel = 'ROBOTALK/' .. robot .. '/HELLO'
   self.request_channel = 'ROBOTALK/' .. robot .. '/REQUEST'
-  self.reply:subscribe(self.hello_channel .. '/' .. hexid, function(_, data) self:on_hello_answer(data) end)
-  self.reply:subscribe('ROBOTALK/' .. robot .. '/REPLY/' .. hexid, function(_, data) self:on_reply(data) end)
+  local answers, replies = self.hello_channel .. '/' .. hexid, 'ROBOTALK/' .. robot .. '/REPLY/' .. hexid
+  self.reply:subscribe(answers, self:guarded(answers, function(data) self:on_hello_answer(data) end))
+  self.reply:subscribe(replies, self:guarded(replies, function(data) self:on_reply(data) end))
   local ok, err = self:say_hello(timeout_s)
   if not ok then return nil, err end
   return self

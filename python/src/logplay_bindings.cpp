@@ -33,6 +33,9 @@ py::dict Info(const std::string& path) {
   out["events"] = log.events();
   out["first_time"] = UnixSeconds(log.first_us());
   out["last_time"] = UnixSeconds(log.last_us());
+  // What was not used (an entry that does not decode, a damaged stretch of the file), as `info` says it.
+  out["rejected"] = log.rejected();
+  out["rejections"] = log.rejections();
   py::dict channels;
   for (const auto& [name, s] : log.channels()) {
     py::dict c;
@@ -202,7 +205,9 @@ void BindLogs(py::module_& m) {
   m.def("log_info", &Info, py::arg("path"),
         "What `robotalk-logplay info` reports, as plain data: events, time span (UNIX seconds),\n"
         "channels, servers, robots, clients (their packages, retransmissions, modes, clock\n"
-        "offset) and every recorded command (client, mode, Command, its logged Reply or None).\n"
+        "offset) and every recorded command (client, mode, Command, its logged Reply or None);\n"
+        "rejected: what was not used (undecodable entries, damaged stretches of the file, each\n"
+        "naming where), the first 20 of `rejections`.\n"
         "Raises LogError when the file cannot be opened.");
   m.def("log_states", &States, py::arg("path"), py::arg("robot") = py::none(),
         "The recorded state stream of one robot as numpy arrays: log_time and server_time (n,),\n"

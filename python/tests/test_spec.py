@@ -155,3 +155,19 @@ def test_help_is_readable() -> None:
     for words in ("goto(", "GOTO: drive the base", "state_stream(", "KeyboardInterrupt", "wait=True"):
         assert words in text, words
     assert robotalk.Kinematics.__doc__ and "Jacobian" in robotalk.Kinematics.__doc__
+
+
+def test_a_damaged_log_is_read_with_its_damage_named(tmp_path: Path) -> None:
+    """Review9: an event header declaring 2^31 - 1 data bytes crashed the
+    interpreter in log_info (LCM's reader); now the damage is named and every
+    intact event is read."""
+    import struct
+    events = [struct.pack(">IqqII", 0xEDA1DA01, n, 1000 * n, 2, 100) + b"CH" + bytes([n]) * 100 for n in range(4)]
+    damaged = bytearray(b"".join(events))
+    at = 2 * len(events[0]) + 24  # event 2's data length
+    damaged[at:at + 4] = b"\x7f\xff\xff\xff"
+    log = tmp_path / "damaged.lcmlog"
+    log.write_bytes(bytes(damaged))
+    info = robotalk.log_info(str(log))
+    assert info["events"] == 3 and info["rejections"] == 1
+    assert "2147483647 data bytes" in info["rejected"][0] and f"byte {2 * len(events[0])}" in info["rejected"][0]

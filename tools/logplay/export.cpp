@@ -5,8 +5,6 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_message.h"
 
-#include <lcm/lcm-cpp.hpp>
-
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -75,13 +73,9 @@ const std::vector<DofColumn>* LoggedConfigs::Find(const std::string& robot, std:
 }
 
 LoggedConfigs ReadConfigs(const std::string& path) {
-  lcm::LogFile file(path, "r");
-  if (!file.good()) throw LogError("cannot open LCM log '" + path + "'");
+  LcmLogReader file = OpenLog(path);  // its damage is said by ReadLog, which export runs too
   LoggedConfigs configs;
-  while (const lcm::LogEvent* e = file.readNextEvent()) {
-    configs.Add(e->channel, {static_cast<const std::uint8_t*>(e->data),
-                             static_cast<std::size_t>(std::max(e->datalen, 0))});
-  }
+  while (const LcmLogEvent* e = file.Next()) configs.Add(e->channel, e->data);
   return configs;
 }
 

@@ -47,7 +47,7 @@ class LoggedConfigs {
   std::uint64_t undecodable_ = 0;
 };
 
-/// Reads the CONFIG messages of an LCM log (lcm::LogFile). Throws LogError
+/// Reads the CONFIG messages of an LCM log (LcmLogReader). Throws LogError
 /// when the file cannot be opened.
 LoggedConfigs ReadConfigs(const std::string& path);
 

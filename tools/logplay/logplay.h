@@ -4,6 +4,7 @@
 // selection), robotalk::cli::UsageError (bad options), client errors on replay.
 #pragma once
 
+#include "robotalk/lcm_log.h"
 #include "robotalk/robot_client.h"
 #include "session_log.h"
 
@@ -15,9 +16,13 @@
 
 namespace robotalk::logplay {
 
-/// Reads every event of an LCM log (lcm::LogFile) into a SessionLog. Throws
-/// LogError when the file cannot be opened.
+/// Reads every intact event of an LCM log (LcmLogReader) into a SessionLog;
+/// a damaged stretch of the file is one of its rejected entries, naming the
+/// byte. Throws LogError when the file cannot be opened.
 SessionLog ReadLog(const std::string& path);
+/// The checked reader of every robotalk-logplay command (robotalk/lcm_log.h);
+/// LogError when the file cannot be opened.
+LcmLogReader OpenLog(const std::string& path);
 
 /// The log's rejected entries (SessionLog::rejected(): each names the event,
 /// its channel and what was wrong), one line each after `prefix`; nothing

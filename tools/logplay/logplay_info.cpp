@@ -4,8 +4,6 @@
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
-#include <lcm/lcm-cpp.hpp>
-
 #include <algorithm>
 #include <cctype>
 #include <cinttypes>
@@ -120,14 +118,22 @@ const char* ModeName(RequestMode mode) {
 }
 
 SessionLog ReadLog(const std::string& path) {
-  lcm::LogFile file(path, "r");
-  if (!file.good()) throw LogError("cannot open LCM log '" + path + "'");
+  LcmLogReader file = OpenLog(path);
   SessionLog log;
-  while (const lcm::LogEvent* e = file.readNextEvent()) {
-    log.Add(e->channel, e->timestamp,
-            {static_cast<const std::uint8_t*>(e->data), static_cast<std::size_t>(std::max(e->datalen, 0))});
-  }
+  while (const LcmLogEvent* e = file.Next()) log.Add(e->channel, e->timestamp_us, e->data);
+  for (const std::string& d : file.damage()) log.AddDamage(d);
+  if (file.damaged_stretches() > file.damage().size())
+    log.AddDamage(std::to_string(file.damaged_stretches() - file.damage().size()) +
+                  " more damaged stretches of '" + path + "'");
   return log;
+}
+
+LcmLogReader OpenLog(const std::string& path) {
+  try {
+    return LcmLogReader(path);
+  } catch (const Error& e) {
+    throw LogError(e.what());
+  }
 }
 
 void PrintRejected(const SessionLog& log, const std::string& prefix, std::ostream& out) {

@@ -11,8 +11,6 @@
 #include "scene_json.h"
 #include "web_options.h"
 
-#include <lcm/lcm-cpp.hpp>
-
 #include <algorithm>
 #include <filesystem>
 #include <map>
@@ -197,8 +195,7 @@ McapGeometry ParseGeometryOptions(const std::vector<std::string>& urdf,
 
 McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap_path, std::ostream& warnings,
                             const McapGeometry& geometry) {
-  lcm::LogFile file(log_path, "r");
-  if (!file.good()) throw LogError("cannot open LCM log '" + log_path + "'");
+  LcmLogReader file = OpenLog(log_path);
   std::map<std::string, web::MeshCatalog> catalogs;
   for (const auto& [robot, path] : geometry.urdf) {
     web::MeshCatalog& c = catalogs[robot] = web::ResolveMeshes(robot, path, geometry.package_paths);
@@ -220,12 +217,12 @@ McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap
   } catch (const Error& e) {
     throw LogError(std::string("export --mcap: ") + e.what());
   }
-  while (const lcm::LogEvent* e = file.readNextEvent()) {
-    const auto size = static_cast<std::size_t>(std::max(e->datalen, 0));
+  while (const LcmLogEvent* e = file.Next()) {
     ++exporter->result.events;
-    exporter->result.log_bytes += size;
-    exporter->Event(e->channel, e->timestamp, {static_cast<const std::uint8_t*>(e->data), size});
+    exporter->result.log_bytes += e->data.size();
+    exporter->Event(e->channel, e->timestamp_us, e->data);
   }
+  for (const std::string& d : file.damage()) warnings << "robotalk-logplay: damaged log: " << d << "\n";
   try {
     exporter->Close();
   } catch (const Error& e) {

@@ -107,6 +107,10 @@ void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
   }
 }
 
+void SessionLog::AddDamage(const std::string& what) {
+  if (rejections_++ < kKeptRejections) rejected_.push_back(what);
+}
+
 LoggedClient& SessionLog::Client(std::int64_t id, const std::string& robot, std::int64_t log_time_us) {
   LoggedClient& c = clients_[id];
   if (c.id == 0) {

@@ -7,7 +7,7 @@
 // broadcast state (STATE).
 //
 // It is pure: events go in through Add() (ReadLog feeds it from
-// lcm::LogFile), so tests build logs in memory. Undecodable messages on
+// LcmLogReader), so tests build logs in memory. Undecodable messages on
 // RoboTalk channels are counted, never thrown; a package or reply package
 // with an item that does not decode, or an inconsistent header, is
 // undecodable as a whole (nothing of it is kept). So is a hostile entry:
@@ -126,6 +126,9 @@ class SessionLog {
  public:
   /// One log event. `bytes` is the message; `log_time_us` the logger's timestamp.
   void Add(const std::string& channel, std::int64_t log_time_us, std::span<const std::uint8_t> bytes);
+  /// A damaged stretch of the log file (LcmLogReader::damage()): counted and
+  /// kept with the rejected entries, so every command that reads the log says it.
+  void AddDamage(const std::string& what);
 
   const std::map<std::string, ChannelStats>& channels() const { return channels_; }
   /// Robots heard in ANNOUNCE, one per (server, name), sorted by name.

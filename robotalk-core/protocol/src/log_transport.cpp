@@ -2,9 +2,11 @@
 
 #include "subscription_table.h"
 
-#include <lcm/lcm-cpp.hpp>
+#include "robotalk/error.h"
+#include "robotalk/lcm_log.h"
 
 #include <algorithm>
+#include <memory>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -26,9 +28,8 @@ class LogCore {
  public:
   explicit LogCore(LogTransportOptions options)
       : options_(std::move(options)),
-        log_(options_.path, "r"),
+        log_(Open(options_.path)),
         clock_(options_.clock ? *options_.clock : steady_) {
-    if (!log_.good()) throw TransportError("LogTransport: cannot read the LCM log '" + options_.path + "'");
     if (!(options_.speed > 0)) {
       throw TransportError("LogTransport '" + options_.path + "': speed " + std::to_string(options_.speed) +
                            " is not positive");
@@ -36,15 +37,23 @@ class LogCore {
     ReadNext();
   }
 
+  static std::unique_ptr<LcmLogReader> Open(const std::string& path) {
+    try {
+      return std::make_unique<LcmLogReader>(path);
+    } catch (const Error& e) {
+      throw TransportError("LogTransport: cannot read the LCM log '" + path + "' (" + e.what() + ")");
+    }
+  }
+
+  // A damaged stretch of the file is skipped by the reader (LcmLogReader::damage()).
   void ReadNext() {
-    const lcm::LogEvent* e = log_.readNextEvent();
+    const LcmLogEvent* e = log_->Next();
     if (e == nullptr) {
       next_.reset();
       return;
     }
     ++read_;
-    const auto* data = static_cast<const std::uint8_t*>(e->data);
-    next_ = Event{e->timestamp, e->channel, std::vector<std::uint8_t>(data, data + std::max(e->datalen, 0))};
+    next_ = Event{e->timestamp_us, e->channel, e->data};
   }
 
   // When the pending event is due on the clock (paced mode).
@@ -58,7 +67,7 @@ class LogCore {
   }
 
   const LogTransportOptions options_;
-  lcm::LogFile log_;
+  std::unique_ptr<LcmLogReader> log_;
   SteadyClock steady_;
   const Clock& clock_;
   std::optional<Event> next_;  // the first event not yet dispatched

@@ -1,5 +1,6 @@
 // LogTransport: a read-only Transport over an LCM log file (as written by
-// lcm-logger), read through LCM's own log API. Each HandleFor() dispatches
+// lcm-logger), read through LcmLogReader (lcm_log.h: a damaged event is
+// skipped, never allocated as declared). Each HandleFor() dispatches
 // the log's events in file order to the matching subscriptions, either as
 // fast as possible or paced by their timestamps on a robotalk::Clock, so a
 // recorded session can be replayed into the same code that served it live.

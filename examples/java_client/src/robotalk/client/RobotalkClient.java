@@ -76,7 +76,13 @@ public final class RobotalkClient implements AutoCloseable {
   private final boolean split;
   private final long clientId;
   private final SecureRandom random = new SecureRandom();
-  private final LinkedBlockingQueue<Object[]> inbox = new LinkedBlockingQueue<>();
+  // Bounded: LCM's thread fills it, only a client call drains it, and anyone can send to our
+  // channels. A message that finds it full is dropped and counted (droppedMessages()); a lost
+  // reply comes again: the package is sent again until acknowledged, and every second until each
+  // of its items has its final reply.
+  static final int INBOX_CAPACITY = 256;
+  private final LinkedBlockingQueue<Object[]> inbox = new LinkedBlockingQueue<>(INBOX_CAPACITY);
+  private final java.util.concurrent.atomic.AtomicLong droppedMessages = new java.util.concurrent.atomic.AtomicLong();
   private final Map<Long, Pending> pending = new HashMap<>();
   private final Map<Long, reply_t> replies = new HashMap<>();
   private final String helloChannel, requestChannel, replyChannel, helloAnswerChannel;
@@ -85,6 +91,7 @@ public final class RobotalkClient implements AutoCloseable {
   private boolean helloAnswered, clockStale;
   private String refusal = "";
   private robot_config_t config;
+  private long refusedMessages;
 
   /** The client's monotonic clock, microseconds. */
   public static long nowUs() { return System.nanoTime() / 1000; }
@@ -156,7 +163,9 @@ public final class RobotalkClient implements AutoCloseable {
     try {
       byte[] b = new byte[ins.available()];
       ins.readFully(b);
-      inbox.add(new Object[] {channel, b});
+      if (!inbox.offer(new Object[] {channel, b}) && droppedMessages.getAndIncrement() == 0)
+        System.err.println("robotalk-java: the inbox is full (" + INBOX_CAPACITY + " messages not yet handled): "
+            + "dropped a message on " + channel + " (counted, said once; a flood, or no client call for long)");
     } catch (IOException e) {
       // a truncated message: dropped, as LCM would
     }
@@ -172,7 +181,8 @@ public final class RobotalkClient implements AutoCloseable {
     while (found == null && problem == null && nowUs() < deadline) {
       Object[] m = take(deadline - nowUs());
       if (m == null || !m[0].equals("ROBOTALK/ANNOUNCE")) continue;
-      announce_t a = new announce_t((byte[]) m[1]);
+      announce_t a = checked((String) m[0], (byte[]) m[1], MessageCheck.ANNOUNCE, announce_t::new);
+      if (a == null) continue;
       for (robotalk_msgs.robot_info_t r : a.robots) {
         if (!r.name.equals(robot)) {
           if (!heard.contains(r.name)) heard.add(r.name);
@@ -219,10 +229,49 @@ public final class RobotalkClient implements AutoCloseable {
   }
 
   private void dispatch(String channel, byte[] bytes) throws IOException {
-    if (channel.equals(replyChannel)) onReply(new reply_package_t(bytes));
-    else if (channel.equals(helloAnswerChannel)) onHelloAnswer(new hello_answer_t(bytes));
-    else if (channel.equals("ROBOTALK/" + robot + "/CONFIG")) config = new robot_config_t(bytes);
+    if (channel.equals(replyChannel)) {
+      reply_package_t m = checked(channel, bytes, MessageCheck.REPLY_PACKAGE, reply_package_t::new);
+      if (m != null) onReply(m);
+    } else if (channel.equals(helloAnswerChannel)) {
+      hello_answer_t m = checked(channel, bytes, MessageCheck.HELLO_ANSWER, hello_answer_t::new);
+      if (m != null) onHelloAnswer(m);
+    } else if (channel.equals("ROBOTALK/" + robot + "/CONFIG")) {
+      robot_config_t m = checked(channel, bytes, MessageCheck.ROBOT_CONFIG, robot_config_t::new);
+      if (m != null) config = m;
+    }
   }
+
+  private interface Decoder<T> {
+    T decode(byte[] bytes) throws IOException;
+  }
+
+  /**
+   * The decoded message, or null when it is refused: a declared count or length past its bytes
+   * (MessageCheck, before lcm-gen's decoder allocates it) or a message that does not decode (another
+   * type, corrupt). Anyone on the network can send one: it is dropped, counted and said once.
+   */
+  private <T> T checked(String channel, byte[] bytes, MessageCheck.Field[] schema, Decoder<T> decoder) {
+    String why;
+    if (!MessageCheck.fits(bytes, schema)) {
+      why = "a declared count or length goes past its " + bytes.length + " bytes";
+    } else {
+      try {
+        return decoder.decode(bytes);
+      } catch (IOException e) {
+        why = "it does not decode (" + e.getMessage() + ")";
+      }
+    }
+    if (refusedMessages++ == 0)
+      System.err.println("robotalk-java: dropped a message on " + channel + ": " + why
+          + " (hostile or corrupt; counted, said once)");
+    return null;
+  }
+
+  /** Messages dropped because they did not decode or declared more than they carried. */
+  public long refusedMessages() { return refusedMessages; }
+
+  /** Messages dropped because the inbox was full (INBOX_CAPACITY not yet handled). */
+  public long droppedMessages() { return droppedMessages.get(); }
 
   private void onHelloAnswer(hello_answer_t m) {
     if (m.client_id != clientId || !Arrays.equals(m.client_nonce, nonce)) return;  // not our hello
