@@ -20,7 +20,8 @@
 //     table, then the arm swing below for the same stabilizer settings.
 //   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
 //     after the start of the walk, default 5.5; standing 2); survived or not; --trace
-//     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them).
+//     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them), a row every
+//     10 ms (--trace-ms MS: every MS ms).
 //   robotalk-walk-sweep --rtf S [--stabilizer ...]: CPU per physics step walking S s.
 //   robotalk-walk-sweep --arms 1 [--stabilizer ...]: both shoulders swung
 //     together +-1 rad every 0.5 s for 6 s, standing and walking: fell or not.
@@ -58,6 +59,7 @@ struct Args {
   std::string push;   // --push standing|walking|all: the largest impulse survived per direction instead
   std::string probe;  // --probe standing|walking,DEG,N_S: one push
   std::string trace;  // --trace FILE: the probe's walk status every 10 ms as CSV (tools: plot_walk_push.py)
+  int trace_ms = 10;  // --trace-ms MS: ... every MS ms instead
   std::string stabilizer = "both";  // --stabilizer on|off|both (the push table and the arm swing)
   double resolution = 2.5;          // N s, of the push bisection
   double rtf = 0;     // --rtf S: S simulated seconds of walking per stabilizer setting, CPU per physics step
@@ -86,6 +88,8 @@ Args Parse(int argc, char** argv) {
       a.probe = v;
     } else if (k == "--trace") {
       a.trace = v;
+    } else if (k == "--trace-ms") {
+      a.trace_ms = std::atoi(v.c_str());
     } else if (k == "--stabilizer") {
       a.stabilizer = v;
     } else if (k == "--resolution") {
@@ -106,7 +110,7 @@ Args Parse(int argc, char** argv) {
       std::exit(2);
     }
   }
-  if (a.every_ms <= 0 || a.span < 0 || a.after <= 0 || !(a.resolution > 0)) {
+  if (a.every_ms <= 0 || a.trace_ms <= 0 || a.span < 0 || a.after <= 0 || !(a.resolution > 0)) {
     std::fprintf(stderr, "--every must be > 0 ms, --span >= 0, --after > 0, --resolution > 0\n");
     std::exit(2);
   }
@@ -123,7 +127,8 @@ struct Run {
   std::vector<Completion> done;
   CommandId id = 0;
   double max_tilt = 0;
-  std::FILE* trace = nullptr;  // --trace: one CSV row per 10 ms
+  std::FILE* trace = nullptr;  // --trace: one CSV row per trace_ms
+  int trace_ms = 10;
   void Exec(CommandType type, std::vector<double> values) {
     DriverCommand c;
     c.id = ++id;
@@ -165,7 +170,11 @@ struct Run {
     std::fprintf(trace, ",%d", s.push_stops);
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.4f,%.4f,%.4f", s.foot_roll[i], s.ankle_offset[i].x(), s.ankle_offset[i].y());
-    std::fprintf(trace, ",%.5f\n", s.force_difference);
+    std::fprintf(trace, ",%.5f", s.force_difference);
+    // Then each sole's lowest corner's height, largest one-contact force and pitch.
+    for (int i = 0; i < 2; ++i)
+      std::fprintf(trace, ",%.5f,%.1f,%.4f", s.foot_low[i], s.foot_peak_force[i], s.foot_pitch[i]);
+    std::fprintf(trace, "\n");
   }
   void Panic() {
     d->Halt(done);
@@ -174,7 +183,7 @@ struct Run {
   // Steps to `t` s after t0; false once fallen.
   bool Until(TimePoint t0, double t) {
     while (ToSeconds(ode->sim_time() - t0) < t - 1e-9) {
-      ode->Step(10, done);
+      ode->Step(trace ? trace_ms : 10, done);
       const walking::WalkStatus s = *ode->walk_status();
       max_tilt = std::max(max_tilt, s.tilt);
       if (trace) Trace(s);
@@ -258,7 +267,7 @@ std::unique_ptr<Driver> NewDriver(const Args& args) {
 bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at,
                   std::FILE* trace = nullptr) {
   std::unique_ptr<Driver> d = NewDriver(args);
-  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get(), .trace = trace};
+  Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get(), .trace = trace, .trace_ms = args.trace_ms};
   r.ode->Step(1000, r.done);
   const TimePoint t0 = r.ode->sim_time();
   if (walking) r.Speed(kFullSpeed);
@@ -368,7 +377,8 @@ int Probe(const Args& args) {
           "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y,lmeas_x,lmeas_y,lmeas_th,ltilt,"
           "lcontacts,"
           "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
-          "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference\n");
+          "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
+          "rpitch\n");
     }
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);

@@ -46,6 +46,9 @@ struct WalkStatus {
   double foot_tilt[2] = {0, 0};                   ///< the soles' tilt from level, rad
   double foot_force[2] = {0, 0};                  ///< vertical ground force on each foot, N
   int foot_contacts[2] = {0, 0};                  ///< contact points of each sole
+  double foot_peak_force[2] = {0, 0};  ///< the largest vertical force on one contact of each sole, N
+  double foot_low[2] = {
+      0, 0};  ///< the height of each sole's lowest corner above the ground, m (< 0: pressed in)
   Eigen::Vector2d foot_cop[2] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};  ///< each sole's CoP, m
   /// Where each sole should press (the plan's ZMP, or the stabilizer's
   /// command, split between the feet on the ground; walking/foot_damping.h), m

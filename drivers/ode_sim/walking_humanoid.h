@@ -220,6 +220,7 @@ class WalkingHumanoid final : public BaseController {
   Eigen::Vector2d step_target_ = Eigen::Vector2d::Zero(), step_applied_ = Eigen::Vector2d::Zero();
   double foot_force_[2] = {0, 0};
   int foot_contacts_[2] = {0, 0};
+  double foot_peak_force_[2] = {0, 0};
   // The feet in the loop (options.foot_damping): each foot's measured
   // contact (its frame), its CoP in the world, and where it should press.
   void DampFeet(std::array<Eigen::Isometry3d, 2>* soles);

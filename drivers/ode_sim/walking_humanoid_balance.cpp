@@ -20,10 +20,12 @@ void WalkingHumanoid::MeasureContacts() {
   double fz = 0;
   foot_force_[0] = foot_force_[1] = 0;
   foot_contacts_[0] = foot_contacts_[1] = 0;
+  foot_peak_force_[0] = foot_peak_force_[1] = 0;
   for (const ContactPoint& c : world_->contacts()) {
     for (int s = 0; s < 2; ++s) {
       if (c.link != feet_[static_cast<size_t>(s)]) continue;
       foot_force_[s] += c.force.z();
+      foot_peak_force_[s] = std::max(foot_peak_force_[s], c.force.z());
       foot_moment[static_cast<size_t>(s)] += c.force.z() * c.position.head<2>();
       ++foot_contacts_[s];
     }
@@ -172,11 +174,18 @@ walking::WalkStatus WalkingHumanoid::status() const {
   for (int i = 0; i < 2; ++i) {
     s.foot_force[i] = foot_force_[i];
     s.foot_contacts[i] = foot_contacts_[i];
+    s.foot_peak_force[i] = foot_peak_force_[i];
   }
   for (int i = 0; i < 2; ++i) {
     const Eigen::Isometry3d f = world_->LinkPose(feet_[static_cast<size_t>(i)]);
     s.foot_measured[i] = MeasuredFoot(static_cast<Side>(i));
     s.foot_tilt[i] = std::acos(std::clamp(f.linear()(2, 2), -1.0, 1.0));
+    const Sole& sole = soles_[static_cast<size_t>(i)];
+    s.foot_low[i] = 1e9;
+    for (const double x : {sole.front, -sole.back}) {
+      for (const double y : {sole.left, -sole.right})
+        s.foot_low[i] = std::min(s.foot_low[i], (f * Eigen::Vector3d(x, y, sole.z)).z());
+    }
     // Roll and pitch in the foot's yaw frame.
     const Eigen::Matrix3d r =
         Eigen::AngleAxisd(-s.foot_measured[i].theta, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
