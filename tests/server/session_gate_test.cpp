@@ -13,6 +13,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <sstream>
 
 namespace robotalk {
@@ -179,6 +180,30 @@ TEST_F(GateTest, ServerCountersNameAndCountRefusals) {
       EXPECT_EQ(r.values[i], 1.0) << name;
     }
   }
+}
+
+// Issue 23 item 2: a copy of a package (a retransmission whose answer was
+// lost, a duplicated datagram) is answered by the gate from the session
+// table and never reaches RobotSessions::Handle; the session's link health
+// counts it all the same.
+TEST_F(GateTest, TheLinkHealthCountsTheCopiesTheGateAnswers) {
+  const std::int64_t session = OpenSession(kAlice);
+  const auto move = Publish(EncodeRequest(Move(kAlice, session, 1, 1)));
+  Publish(move);
+  Publish(move);
+  EXPECT_EQ(Executed(), 1u);
+  Request ask{.client_id = kAlice, .session_id = session, .sequence = 2};
+  ask.queries.push_back(Query{.id = 5, .type = QueryType::kServerCounters});
+  Publish(EncodeRequest(ask));
+  const Reply& r = replies_.at(5);
+  ASSERT_EQ(r.signal, Signal::kSuccess);
+  std::istringstream names(r.message);
+  std::string name;
+  std::optional<double> duplicates;
+  for (std::size_t i = 0; names >> name && i < r.values.size(); ++i)
+    if (name == "link_duplicates") duplicates = r.values[i];
+  ASSERT_TRUE(duplicates) << r.message;
+  EXPECT_EQ(*duplicates, 2.0);
 }
 
 TEST_F(GateTest, InOpenModeAPanicOutsideAnySessionStillStopsTheRobot) {
