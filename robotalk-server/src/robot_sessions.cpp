@@ -177,10 +177,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
   session.who = r.sender.empty() ? Client(r.client_id) : r.sender;
   const SequenceWindow::Verdict seen = session.seen.Observe(r.sequence);
   bool resent = false;  // a retransmission whose first copy was lost (link_health.h)
-  if (seen != SequenceWindow::Verdict::kTooManyGaps) {
-    resent = session.link.OnPackage(r.sequence, seen == SequenceWindow::Verdict::kDuplicate, r.send_time,
-                                    arrived, r.round_trip);
-  }
+  if (seen == SequenceWindow::Verdict::kNew)
+    resent = session.link.OnPackage(r.sequence, /*duplicate=*/false, r.send_time, arrived, r.round_trip);
   if (seen == SequenceWindow::Verdict::kTooManyGaps) {
     // A client numbers its packages 1, 2, 3...: a jump that leaves this many
     // numbers unreceived is not one of its packages (sequence_window.h).
@@ -190,11 +188,8 @@ ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint
                       " sequence numbers of this client never received; refused");
   }
   if (seen == SequenceWindow::Verdict::kDuplicate) {
-    // A retransmission or a duplicate: never execute again; re-send what is
-    // known. It does not refresh the session (a replay must not keep it alive).
-    // On a FIFO link the package after it waited behind it (playback's start).
-    if (r.send_time != TimePoint{}) session.delays.AddCopy(r.send_time, now);
-    immediate = Retransmitted(session, r, now);
+    // It does not refresh the session (a replay must not keep it alive).
+    immediate = AnswerCopy(session, r, now, arrived);
     return answer;
   }
   session.last_heard = now;  // only a new, well-formed package refreshes the session
@@ -255,13 +250,17 @@ ImmediateAnswer RobotSessions::Resend(const Request& r, TimePoint now, TimePoint
   answer.batch.client_id = r.client_id;
   answer.batch.ack_sequence = r.sequence;
   answer.batch.server_receive = arrived;
-  if (Session* s = table_.Find(robot_id_, r.client_id)) {
-    answer.batch.replies = Retransmitted(*s, r, now);
-    // On a FIFO link the package after this copy waited behind it (playback's
-    // start, "The copies" in playback_estimator.h).
-    if (r.send_time != TimePoint{}) s->delays.AddCopy(r.send_time, now);
-  }
+  if (Session* s = table_.Find(robot_id_, r.client_id))
+    answer.batch.replies = AnswerCopy(*s, r, now, arrived);
   return answer;
+}
+
+std::vector<Reply> RobotSessions::AnswerCopy(Session& s, const Request& r, TimePoint now, TimePoint arrived) {
+  s.link.OnPackage(r.sequence, /*duplicate=*/true, r.send_time, arrived, r.round_trip);
+  // On a FIFO link the package after this copy waited behind it (playback's
+  // start, "The copies" in playback_estimator.h).
+  if (r.send_time != TimePoint{}) s.delays.AddCopy(r.send_time, now);
+  return Retransmitted(s, r, now);
 }
 
 ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint now, TimePoint arrived) {

@@ -114,8 +114,9 @@ class RobotSessions {
   ImmediateAnswer Handle(const Request& request, TimePoint now) { return Handle(request, now, now); }
   /// A retransmission the session table's window saw (open or keyed mode):
   /// acknowledges it with what is known of its items; runs nothing, opens
-  /// and refreshes no session; records when the copy was handled in the
-  /// session's delay history (playback's start). `now`, `arrived`: as Handle.
+  /// and refreshes no session; counts it in the session's link health and
+  /// records when it was handled in its delay history (AnswerCopy). `now`,
+  /// `arrived`: as Handle.
   ImmediateAnswer Resend(const Request& request, TimePoint now, TimePoint arrived);
   /// Raises a panic on behalf of `client_id` (outside any session: open
   /// mode honours a panic from anyone).
@@ -183,6 +184,11 @@ class RobotSessions {
   std::string QueueRefusal(const Session& s);
   // The answer to a retransmission of a package already seen.
   std::vector<Reply> Retransmitted(const Session& s, const Request& request, TimePoint now) const;
+  // A copy of a package `s` saw (a retransmission, a duplicated datagram),
+  // whether the session table's gate (Resend) or Handle caught it: never
+  // executed again, answered with what is known (Retransmitted), counted by
+  // the link's health and kept for playback's start (DelayHistory::AddCopy).
+  std::vector<Reply> AnswerCopy(Session& s, const Request& request, TimePoint now, TimePoint arrived);
   void Start(Session& s, std::int64_t id, PlaybackSequence& seq, TimePoint now,
              std::vector<Reply>& immediate);
   void Own(const DaemonOutput::Executed& e);
