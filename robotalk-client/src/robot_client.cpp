@@ -4,6 +4,7 @@
 
 #include "client_impl.h"
 #include "robotalk/broadcast_signature.h"
+#include "robotalk/keys.h"
 #include "robotalk/request.h"
 #include "robotalk/routed_lcm_transport.h"
 
@@ -117,9 +118,21 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
     }
     transport = own.get();
   }
+  // An explicit server key: only what it signed (server_trust.h: that key and
+  // nothing else), dropped before the list's bound so others' names cannot
+  // crowd its robots out.
+  std::string only_key;
+  if (!options.server_key_file.empty()) {
+    try {
+      only_key = ReadPublicKeyFile(options.server_key_file).key.ToString();
+    } catch (const KeyError& e) {
+      throw ClientError(std::string("ListRobots: ") + e.what());
+    }
+  }
   // Keyed by (server id, name): a flood of names costs a lookup each, and
   // past kMaxListedRobots only a count.
   struct Collector {
+    std::string only_key;
     std::vector<AnnouncedRobot> robots;
     std::set<std::pair<std::int64_t, std::string>> seen;
     std::size_t unlisted = 0;
@@ -130,6 +143,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
         if (!by) return;  // a suffix that does not verify: forged
         key = by->server_key.ToString();
       }
+      if (!only_key.empty() && key != only_key) return;
       const Announcement msg = DecodeAnnouncement(bytes);
       for (const auto& r : msg.robots) {
         if (seen.contains({msg.server_id, r.name})) continue;
@@ -150,7 +164,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
                           .server_key = key});
       }
     }
-  } collector;
+  } collector{.only_key = only_key};
   // The checked decoder: LCM's typed one throws through its C callback on a
   // zero-length string (tests/fuzz/regressions/announce).
   auto sub = transport->Subscribe(

@@ -113,8 +113,8 @@ struct ClientOptions {
   /// $ROBOTALK_KEY if set, else open mode.
   std::string key_file;
   /// Keyed mode: the server's public key file (.pub); when set, a server
-  /// answering with another key is refused, and the known-servers file is
-  /// not used.
+  /// answering with another key is refused, the known-servers file is not
+  /// used, and ListRobots lists only the robots this key announced.
   std::string server_key_file;
   /// Keyed mode without `server_key_file`: the known-servers file that pins
   /// each robot's server key on first use (docs/security.md, "Which server?").
@@ -327,7 +327,9 @@ inline constexpr std::size_t kMaxListedRobots = 1024;
 
 /// Listens to ROBOTALK/ANNOUNCE for `listen` and returns every robot heard,
 /// once per (server id, name), sorted by name. Servers announce once a second.
-/// An announcement whose signature suffix does not verify is dropped.
+/// An announcement whose signature suffix does not verify is dropped; with
+/// `options.server_key_file` set, so is every announcement that key did not
+/// sign (before the bound below: others' names cannot crowd its robots out).
 /// At most kMaxListedRobots, the first heard; each further (server id, name)
 /// heard is counted in `*unlisted` (if given; a name heard twice counts twice)
 /// so a caller can say the bus carries more names than it lists — a flood.
