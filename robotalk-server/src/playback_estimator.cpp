@@ -305,11 +305,7 @@ std::vector<double> PlaybackEstimator::Services() const {
   return service;  // not empty: the fence keeps the least
 }
 
-Duration PlaybackEstimator::QueueWorst() const { return SimulateQueue().worst; }
-
-Duration PlaybackEstimator::QueueReach() const { return SimulateQueue().reach; }
-
-PlaybackEstimator::SimulatedQueue PlaybackEstimator::SimulateQueue() const {
+Duration PlaybackEstimator::QueueWorst() const {
   const std::vector<double> service = Services();
   const Duration least = FencedSpread()->least;
   // The sequence's frames, one every interval T, queue behind each other:
@@ -329,34 +325,23 @@ PlaybackEstimator::SimulatedQueue PlaybackEstimator::SimulateQueue() const {
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return service[(z ^ (z >> 31)) % service.size()];
   };
-  // The reach (a followed queue's start): frame i may play up to i gaps'
-  // stretch (max_stretch × T each) after start + o_i, so the start covers
-  // max over i >= 1 of its simulated delay less that; frame 0 has arrived,
-  // and frame 1 queues behind its measured delay (Lindley from there).
-  const double stretch = std::max(0.0, options_.max_stretch) * t;
-  const double first = std::max(0.0, ToSeconds(*frames_.front().delay - least));
-  std::vector<double> worst(runs), reach(runs);
-  for (std::size_t r = 0; r < runs; ++r) {
-    double wait = 0, previous_s = 0, total = 0, queued = 0, previous_q = first;
+  std::vector<double> worst(runs);
+  for (double& w_max : worst) {
+    double wait = 0, previous_s = 0, total = 0;
     for (std::size_t i = 0; i < frames; ++i) {
       wait = std::max(0.0, wait + previous_s - t);
       previous_s = draw();
       total += previous_s;
-      worst[r] = std::max(worst[r], wait + previous_s);
-      if (i == 0) continue;
-      queued = std::max(0.0, queued + previous_q - t);
-      previous_q = previous_s;
-      reach[r] = std::max(reach[r], queued + previous_s - static_cast<double>(i) * stretch);
+      w_max = std::max(w_max, wait + previous_s);
     }
     // Beyond the horizon, a drifting queue keeps growing at its drift.
     const double drift = total / static_cast<double>(frames) - t;
-    if (drift > 0) worst[r] += drift * static_cast<double>(total_ - frames);
+    if (drift > 0) w_max += drift * static_cast<double>(total_ - frames);
   }
   const auto q = static_cast<std::size_t>(
       std::clamp(options_.queue_quantile, 0.0, 1.0) * static_cast<double>(runs - 1) + 0.5);
   std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(q), worst.end());
-  std::nth_element(reach.begin(), reach.begin() + static_cast<std::ptrdiff_t>(q), reach.end());
-  return {least + FromSeconds(worst[q]), least + FromSeconds(reach[q])};
+  return least + FromSeconds(worst[q]);
 }
 
 bool PlaybackEstimator::quick() const {
@@ -480,12 +465,7 @@ TimePoint PlaybackEstimator::StartTime() const {
     // length each) until the buffer covers the worst delay, so the frames
     // after them find it; frame 0 itself has arrived. StartCovering's floor
     // (the decision + margin) stays.
-    const TimePoint start =
-        StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, start_lead());
-    // A followed queue: the frames to come queue behind each other, which
-    // the gaps' stretch reaches only by so much a frame (QueueReach).
-    if (!followed() || !options_.follow_reach) return start;
-    return std::max(start, StartCovering(QueueReach(), options_.adaptive_margin));
+    return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, start_lead());
   }
   if (quick()) {
     // The worst delay a later frame may have is predicted as the least seen

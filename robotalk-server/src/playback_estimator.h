@@ -186,14 +186,6 @@ struct PlaybackEstimatorOptions {
   /// The queue's mean service may be at most (1 + max_stretch) intervals at
   /// mean + follow_z × its standard error (the queue start uses confidence_z).
   double follow_z = 0.0;
-  /// A followed queue's start covers, besides the worst delay seen (less the
-  /// lead), each simulated frame's delay less the stretch the gaps before it
-  /// may add (frame i: i × max_stretch × the mean frame interval), at
-  /// queue_quantile of the resampled sequences, frame 1 queued behind frame
-  /// 0's measured delay: frames queued behind each other early in the
-  /// sequence, which the stretch cannot reach in time (issue 23, tenth
-  /// session). Off: the worst delay seen alone.
-  bool follow_reach = true;
 };
 
 /// arrival − send time, or nullopt when it does not fit or exceeds 2^61 ns
@@ -329,16 +321,10 @@ class PlaybackEstimator {
   TimePoint StartCovering(Duration worst, Duration margin, Duration lead = Duration(0)) const;
   Duration AdaptiveWorst(double headroom) const;  // REQUIRES: adaptive()
   Duration QueueWorst() const;                    // REQUIRES: queued() or followed()
-  Duration QueueReach() const;                    // REQUIRES: followed()
-  struct SimulatedQueue {
-    Duration worst;  // the simulated sequences' worst delay (their queue_quantile)
-    Duration reach;  // the same of max over frames i >= 1 of its delay − i gaps' stretch
-  };
-  SimulatedQueue SimulateQueue() const;  // REQUIRES: queued() or followed()
-  std::vector<double> Services() const;  // s, of the packages seen; REQUIRES: delay_spread()
-  TimePoint PaperStart() const;          // the paper's estimate
-  bool QueueFollowable(double z) const;  // REQUIRES: delay_spread()
-  bool ServerKeptUp() const;             // every package seen handled within follow_max_lag of its arrival
+  std::vector<double> Services() const;           // s, of the packages seen; REQUIRES: delay_spread()
+  TimePoint PaperStart() const;                   // the paper's estimate
+  bool QueueFollowable(double z) const;           // REQUIRES: delay_spread()
+  bool ServerKeptUp() const;  // every package seen handled within follow_max_lag of its arrival
   bool SpreadWithinGate() const;
   double WiderStretch() const;  // max(0, max_stretch − kGateStretch), intervals
   double Gate() const;          // the spread beyond which the adaptive start gives way, s

@@ -87,35 +87,6 @@ TEST(FollowQueue, AQueueOnTheLinkBeyondTheGateStartsAtTheFirstFrameAndTheStretch
   }
 }
 
-TEST(FollowQueue, TheStartCoversTheEarlyFramesQueueLessTheStretchTheGapsBeforeThemMayAdd) {
-  // The relay's U[0, 150] ms runs 1331 and 1342 (ninth session): a followed
-  // queue whose start covered only the services seen (here 155.6 ms after
-  // frame 0) while frames 1 and 2 queued behind each other: frame 1 took
-  // 150 ms of service (151 ms), frame 2 waited 50 ms behind it and took
-  // 140 ms (191 ms), due 220 ms after the start at most (two gaps' stretch
-  // of 10 ms): late by the base start. The start covers each simulated
-  // frame's delay less the stretch the gaps before it may add (frame i: i x
-  // 10 ms): the frames of this sequence are not late, and the gaps stretch
-  // within the bound.
-  PlaybackEstimator est = OnAQueue(Duration(0));
-  ASSERT_TRUE(est.followed());
-  const TimePoint start = est.StartTime();
-  PlaybackSchedule schedule(start, est.playout_delay(), {.max_stretch = 0.1});
-  const TimePoint sent0 = kT0 - milliseconds(1);
-  const std::vector<int> delays_ms = {1, 151, 191, 141, 91, 41, 1, 1};
-  for (std::size_t i = 0; i < delays_ms.size(); ++i) {
-    const TimePoint sent = sent0 + milliseconds(100) * static_cast<int>(i);
-    const auto p = schedule.Place(milliseconds(100) * static_cast<int>(i), sent + milliseconds(delays_ms[i]),
-                                  milliseconds(delays_ms[i]));
-    EXPECT_FALSE(p.late) << "frame " << i << ", start " << ToSeconds(start - kT0) * 1e3
-                         << " ms after frame 0";
-  }
-  EXPECT_EQ(schedule.late_frames(), 0u);
-  EXPECT_LE(schedule.max_gap_stretch(), 0.1 + 1e-9);
-  // Not above what the queue needs: below the playout delay the stretch grows to.
-  EXPECT_LT(start - sent0, *est.playout_delay());
-}
-
 TEST(FollowQueue, TheServersOwnLagIsNotFollowedAndNeitherIsAChannelSlowerThanTheStretch) {
   // The same delays where the server handled each package 50 ms after it
   // reached the socket (the paper's Fig. 11 pauses the server after each
