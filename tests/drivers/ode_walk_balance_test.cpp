@@ -24,6 +24,16 @@ using testing::ProjectModel;
 using testing::RefusalOfWalker;
 using testing::Walker;
 
+// Walks `w` at full speed (SETSPEED 1 after 1 s standing) for 5.14 s, the
+// seed-1 instant of robotalk-walk-sweep's table, then pushes its pelvis
+// toward the left with `impulse` N s over 0.1 s.
+void WalkAtFullSpeedThenPushLeft(Walker& w, double impulse) {
+  w.Run(1.0);
+  ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+  w.Run(5.14);
+  w.driver->PushForTesting(Eigen::Vector3d(0, impulse / 0.1, 0), FromSeconds(0.1));
+}
+
 // Pushes as a test input (issue 26, item 4): OdeDriver::PushForTesting, a
 // 0.1 s push on the pelvis. Standing, the walker takes 15 N s from behind
 // (robotalk-walk-sweep --push standing measured 20 N s survived and 25 fell,
@@ -113,10 +123,7 @@ TEST(OdeWalk, PushRecoveryRegeneratesThePlanOnlyWhenPushed) {
 TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
   for (const char* on : {"false", "true"}) {
     Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_recovery", on}});
-    w.Run(1.0);
-    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
-    w.Run(5.14);
-    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    ASSERT_NO_FATAL_FAILURE(WalkAtFullSpeedThenPushLeft(w, 10));
     w.Run(2.5, [&] { return w.driver->walk_status()->fallen; });
     const int held = w.driver->walk_status()->steps_taken;  // stopped, standing (with push_recovery)
     w.Run(3.5, [&] { return w.driver->walk_status()->fallen; });
@@ -140,10 +147,7 @@ TEST(OdeWalk, PushRecoveryStopsAndStandsThroughAPushTheOpenLoopFallsTo) {
 TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
   for (const char* on : {"false", "true"}) {
     Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_capture", on}});
-    w.Run(1.0);
-    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
-    w.Run(5.14);
-    w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
+    ASSERT_NO_FATAL_FAILURE(WalkAtFullSpeedThenPushLeft(w, 10));
     w.Run(1.5, [&] { return w.driver->walk_status()->fallen; });
     const walking::WalkStatus s = *w.driver->walk_status();
     EXPECT_EQ(s.push_stops, 1) << "push_capture=" << on;
@@ -180,10 +184,7 @@ TEST(OdeWalk, PushCaptureReplansThePushsStopOnlyWithTheOption) {
 TEST(OdeWalk, PushSwingReachKeepsAMovedLandingWithinWhatTheSwingFootReaches) {
   for (const char* reach : {"0", "1.0"}) {
     Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_swing_reach", reach}});
-    w.Run(1.0);
-    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
-    w.Run(5.14);
-    w.driver->PushForTesting(Eigen::Vector3d(0, 30 / 0.1, 0), FromSeconds(0.1));
+    ASSERT_NO_FATAL_FAILURE(WalkAtFullSpeedThenPushLeft(w, 30));
     // The left foot in the air: its first touchdown after the push (planned height 0), 50 ms on.
     w.Run(1.0, [&] { return w.driver->walk_status()->foot_height[0] <= 0; });
     w.Run(0.05);
