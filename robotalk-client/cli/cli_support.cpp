@@ -43,34 +43,30 @@ struct AnnounceWatch::Impl {
 
   void On(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
-    // Keyed: an unsigned one, or one of another key, is not its server's (the
-    // key is compared before the signature is verified).
-    if (trusted_key &&
-        VerifyBroadcast(kAnnounceChannel, bytes, *trusted_key, nullptr) != BroadcastVerdict::kAuthentic)
-      return;
-    try {  // the checked decoder; a hostile ANNOUNCE is dropped, never thrown through LCM
-      const Announcement a = DecodeAnnouncement(bytes);
-      const TimePoint now = SteadyClock().Now();
-      TimePoint at = now;
-      if (trusted_key && client_time) {
-        // Signed, so the server time is the server's: it was alive then. A
-        // recording replayed after the server stopped is that old.
-        at = std::min(now, client_time(a.server_time));
-        if (now - at > kAnnounceMaxAge) {
-          std::lock_guard lock(mu);
-          if (stale++ == 0)
-            std::cerr << "robotalk: refused an announcement signed by the server but "
-                      << FormatDuration(now - at) << " old (more than " << FormatDuration(kAnnounceMaxAge)
-                      << "): replayed or delayed; it does not show the server is there\n";
-          return;
-        }
+    // Keyed: an unsigned one, or one of another key, is not its server's; a
+    // hostile one is dropped, never thrown through LCM.
+    const std::optional<HeardAnnouncement> got =
+        HearAnnouncement(bytes, trusted_key ? &*trusted_key : nullptr);
+    if (!got) return;
+    const Announcement& a = got->announcement;
+    const TimePoint now = SteadyClock().Now();
+    TimePoint at = now;
+    if (trusted_key && client_time) {
+      // Signed, so the server time is the server's: it was alive then. A
+      // recording replayed after the server stopped is that old.
+      at = std::min(now, client_time(a.server_time));
+      if (now - at > kAnnounceMaxAge) {
+        std::lock_guard lock(mu);
+        if (stale++ == 0)
+          std::cerr << "robotalk: refused an announcement signed by the server but "
+                    << FormatDuration(now - at) << " old (more than " << FormatDuration(kAnnounceMaxAge)
+                    << "): replayed or delayed; it does not show the server is there\n";
+        return;
       }
-      std::lock_guard lock(mu);
-      for (const auto& r : a.robots)
-        if (heard.size() < kMaxHeardRobots || heard.count(r.name))
-          heard[r.name] = std::max(heard[r.name], at);
-    } catch (const ProtocolError&) {
     }
+    std::lock_guard lock(mu);
+    for (const auto& r : a.robots)
+      if (heard.size() < kMaxHeardRobots || heard.count(r.name)) heard[r.name] = std::max(heard[r.name], at);
   }
   // LCM is opened on this thread, and only after kWatchAfter, so a Connect
   // that succeeds at once neither waits for it nor shares the CPU with a

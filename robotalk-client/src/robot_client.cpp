@@ -106,6 +106,35 @@ std::optional<Reply> PendingReply::WaitFor(Duration most, std::stop_token stop) 
 
 // --- ListRobots --------------------------------------------------------------
 
+std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> bytes,
+                                                  const PublicKey* only) {
+  HeardAnnouncement heard;
+  if (only) {
+    if (VerifyBroadcast(kAnnounceChannel, bytes, *only, nullptr) != BroadcastVerdict::kAuthentic)
+      return std::nullopt;
+    heard.server_key = only->ToString();
+  } else if (SignatureSuffix(bytes)) {
+    const std::optional<SignedBy> by = VerifySelfSigned(kAnnounceChannel, bytes);
+    if (!by) return std::nullopt;  // a suffix that does not verify: forged
+    heard.server_key = by->server_key.ToString();
+  }
+  try {  // the checked decoder: hostile counts never reach an allocation (request.h)
+    heard.announcement = DecodeAnnouncement(bytes);
+  } catch (const ProtocolError&) {
+    return std::nullopt;
+  }
+  return heard;
+}
+
+std::optional<PublicKey> ExplicitServerKey(const ClientOptions& options) {
+  if (options.server_key_file.empty()) return std::nullopt;
+  try {
+    return ReadPublicKeyFile(options.server_key_file).key;
+  } catch (const KeyError& e) {
+    throw ClientError(std::string("server key: ") + e.what());
+  }
+}
+
 std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration listen, std::size_t* unlisted) {
   if (unlisted) *unlisted = 0;
   std::unique_ptr<Transport> own;
@@ -121,30 +150,18 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
   // An explicit server key: only what it signed (server_trust.h: that key and
   // nothing else), dropped before the list's bound so others' names cannot
   // crowd its robots out.
-  std::string only_key;
-  if (!options.server_key_file.empty()) {
-    try {
-      only_key = ReadPublicKeyFile(options.server_key_file).key.ToString();
-    } catch (const KeyError& e) {
-      throw ClientError(std::string("ListRobots: ") + e.what());
-    }
-  }
+  const std::optional<PublicKey> only_key = ExplicitServerKey(options);
   // Keyed by (server id, name): a flood of names costs a lookup each, and
   // past kMaxListedRobots only a count.
   struct Collector {
-    std::string only_key;
+    const PublicKey* only_key;
     std::vector<AnnouncedRobot> robots;
     std::set<std::pair<std::int64_t, std::string>> seen;
     std::size_t unlisted = 0;
     void On(std::span<const std::uint8_t> bytes) {
-      std::string key;
-      if (SignatureSuffix(bytes)) {
-        const std::optional<SignedBy> by = VerifySelfSigned(kAnnounceChannel, bytes);
-        if (!by) return;  // a suffix that does not verify: forged
-        key = by->server_key.ToString();
-      }
-      if (!only_key.empty() && key != only_key) return;
-      const Announcement msg = DecodeAnnouncement(bytes);
+      const std::optional<HeardAnnouncement> heard = HearAnnouncement(bytes, only_key);
+      if (!heard) return;
+      const Announcement& msg = heard->announcement;
       for (const auto& r : msg.robots) {
         if (seen.contains({msg.server_id, r.name})) continue;
         if (robots.size() >= kMaxListedRobots) {
@@ -161,10 +178,10 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
                           .num_clients = r.num_clients,
                           .server_id = msg.server_id,
                           .url_hint = msg.url_hint,
-                          .server_key = key});
+                          .server_key = heard->server_key});
       }
     }
-  } collector{.only_key = only_key};
+  } collector{.only_key = only_key ? &*only_key : nullptr};
   // The checked decoder: LCM's typed one throws through its C callback on a
   // zero-length string (tests/fuzz/regressions/announce).
   auto sub = transport->Subscribe(

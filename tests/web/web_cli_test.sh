@@ -20,5 +20,7 @@ expect "a bad port is named" 2 "--port: 'x' is not a number" -- --port x
 expect "a missing URDF file is named" 2 "--urdf arm=/nonexistent.urdf: no such file" -- --urdf arm=/nonexistent.urdf
 expect "--help offers --package-path and ROS_PACKAGE_PATH" 0 "package-path DIRS.*" -- --help
 expect "an empty --package-path is named" 2 "--package-path: ':' names no folder" -- --package-path :
+expect "--help offers keyed mode's --key and --server-key" 0 "server-key FILE" -- --help
+expect "a missing --server-key file is named" 1 "public key file /nonexistent.pub: cannot open" -- --port 0 --server-key /nonexistent.pub
 expect "missing npm modules say how to install them" 1 "run scripts/setup.sh" -- --node-modules /nonexistent
 exit $fail

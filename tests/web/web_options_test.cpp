@@ -39,6 +39,8 @@ TEST(WebOptions, ParsesEveryOption) {
                               "--robot-timeout", "5",
                               "--www",           "w",
                               "--node-modules",  "n",
+                              "--key",           "k",
+                              "--server-key",    "s.pub",
                               "--version",       "-h"});
   EXPECT_EQ(o.bind, "0.0.0.0");
   EXPECT_EQ(o.port, 0);
@@ -49,6 +51,8 @@ TEST(WebOptions, ParsesEveryOption) {
   EXPECT_DOUBLE_EQ(o.robot_timeout_s, 5.0);
   EXPECT_EQ(o.www_dir, "w");
   EXPECT_EQ(o.node_modules_dir, "n");
+  EXPECT_EQ(o.key_file, "k");
+  EXPECT_EQ(o.server_key_file, "s.pub");
   EXPECT_TRUE(o.version);
   EXPECT_TRUE(o.help);
 }
@@ -61,12 +65,14 @@ TEST(WebOptions, NamesTheBadArgument) {
   EXPECT_EQ(ErrorOf({"--urdf", "pioneer"}), "--urdf: 'pioneer' is not NAME=PATH");
   EXPECT_EQ(ErrorOf({"--rate", "0"}), "--rate: 0 Hz is outside 1-240");
   EXPECT_NE(ErrorOf({"--robot-timeout", "1"}).find("shorter than 1.5 s"), std::string::npos);
+  EXPECT_EQ(ErrorOf({"--server-key", ""}), "--server-key: the file name is empty");
+  EXPECT_EQ(ErrorOf({"--key"}), "--key: needs a value");
 }
 
 TEST(WebOptions, HelpMentionsEveryOption) {
   const std::string usage = WebUsage();
   for (const char* opt : {"--bind", "--port", "--lcm-url", "--rate", "--urdf", "--robot-timeout", "--www",
-                          "--node-modules", "--version", "--help"})
+                          "--node-modules", "--key", "--server-key", "--version", "--help"})
     EXPECT_NE(usage.find(opt), std::string::npos) << opt;
 }
 

@@ -4,11 +4,17 @@
 // bridge hold.
 #include "kinematic_driver.h"
 #include "robot_tracker.h"
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
+#include "robotalk/keys.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/server.h"
+#include "robotalk/session_auth.h"
 #include "test_paths.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -18,8 +24,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <random>
 #include <string>
 #include <thread>
 
@@ -51,10 +59,13 @@ long VmSizeKiB() {
 // its construction to its destruction.
 class PioneerServer {
  public:
-  PioneerServer() {
+  // Keyed mode when both files are given (ServerOptions::key_file, clients_file).
+  explicit PioneerServer(const std::string& key_file = "", const std::string& clients_file = "") {
     RegisterKinematicDriver(registry_);
     ServerOptions options;
     options.lcm_url = kUrl;
+    options.key_file = key_file;
+    options.clients_file = clients_file;
     RobotSpec spec{"pioneer", "kinematic", testing::ProjectModel("pioneer2dx_pantilt.urdf"), {}};
     server_ = std::make_unique<Server>(options, std::vector<RobotSpec>{spec}, registry_, clock_);
     server_->Start();
@@ -287,6 +298,76 @@ TEST_F(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
   EXPECT_TRUE(live) << "the real robot is not live 30 s after its server started (the table kept full by "
                     << kForged << " forged names)";
   EXPECT_LE(tracked, 256u) << "still bounded";
+}
+
+// Keyed mode's answer to what open mode cannot stop (docs/web.md): a forger
+// announcing fresh names faster than connects can try them keeps every slot
+// of the table taken by names never tried, so a real robot announced once a
+// second finds no room. With its server's key (--server-key) the tracker
+// takes only what that key signed: neither the forger's unsigned names nor
+// names it signs with a key of its own reach the table, and the real robot
+// is live as soon as its server announces it.
+TEST(WebTrackerKeyed, WithItsServersKeyAFloodOfFreshForgedNamesNeverReachesTheTableAndTheRealRobotIsLive) {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("robotalk_web_keyed_" + std::to_string(::getpid()) + "_" +
+                                   std::to_string(std::mt19937_64(std::random_device{}())()));
+  fs::create_directories(dir);
+  const KeyPair mallory = KeyPair::Generate();
+  for (const char* name : {"server", "web"}) WriteKeyFiles(dir / name, KeyPair::Generate(), name);
+  {
+    std::ifstream pub(dir / "web.pub");
+    std::string line;
+    std::getline(pub, line);
+    std::ofstream(dir / "clients") << line << " *=all\n";
+  }
+  ::chmod((dir / "clients").c_str(), 0600);
+
+  WebOptions o;
+  o.lcm_url = kUrl;
+  o.key_file = (dir / "web").string();
+  o.server_key_file = (dir / "server.pub").string();
+  RobotTracker tracker(o);
+  lcm::LCM bus(kUrl);
+  ASSERT_TRUE(bus.good());
+  const BroadcastSigner forger(mallory, RandomNonce());
+  int next_name = 0;
+  // 500 fresh unsigned names and 50 fresh names signed by the forger's own key.
+  auto flood = [&] {
+    for (int i = 0; i < 550; ++i, ++next_name) {
+      Announcement a;
+      a.server_id = 100000 + next_name;
+      a.server_time = TimePoint(seconds(1));
+      a.uptime = seconds(100);
+      a.robots.push_back({.name = "fresh-" + std::to_string(next_name), .driver = "kinematic"});
+      std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+      if (i >= 500) forger.Sign(kAnnounceChannel, bytes);
+      bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+      if (i % 50 == 49) std::this_thread::sleep_for(milliseconds(20));
+    }
+  };
+  for (int i = 0; i < 4; ++i) flood();  // the flood is on before the real server starts
+
+  auto server = std::make_unique<PioneerServer>((dir / "server").string(), (dir / "clients").string());
+  const auto started = std::chrono::steady_clock::now();
+  bool live = false;
+  std::size_t others = 0;
+  for (int i = 0; i < 300 && !live && std::chrono::steady_clock::now() - started < seconds(30); ++i) {
+    flood();  // the forger flooding all the while
+    const nlohmann::json list = tracker.Poll().robots["robots"];
+    for (const auto& r : list) {
+      if (r["name"] == "pioneer")
+        live = r["status"] == "live";
+      else
+        ++others;
+    }
+  }
+  PrintLiveAfter(started, live, "keyed, a flood of fresh forged names all the while");
+  std::printf("forged names sent: %d\n", next_name);
+  server.reset();
+  fs::remove_all(dir);
+  EXPECT_TRUE(live) << "the keyed server's robot is not live 30 s after its server started";
+  EXPECT_EQ(others, 0u) << "forged names (unsigned, or signed by another key) reached the tracker";
 }
 
 }  // namespace

@@ -68,6 +68,15 @@ struct PanicInFlight {
   std::vector<PanicDone> next;     // came after it was sent: answered by the next one
   bool finished = false;           // all answered: the thread is ending and may be joined
 };
+// The options of every client the tracker makes (connects, ListRobots' key).
+ClientOptions ClientOptionsFor(const WebOptions& o) {
+  ClientOptions co;
+  co.lcm_url = o.lcm_url;
+  co.key_file = o.key_file;
+  co.server_key_file = o.server_key_file;
+  return co;
+}
+
 // Requests that may wait for one robot's next panic; later ones are answered
 // at once, saying so.
 constexpr std::size_t kMaxPanicWaiters = 65536;
@@ -78,6 +87,7 @@ class RobotTracker::Impl {
  public:
   explicit Impl(const WebOptions& o)
       : options_(o),
+        only_key_(ExplicitServerKey(ClientOptionsFor(o))),
         lcm_(MainLcmUrl(o.lcm_url)),  // ANNOUNCE: main lane
         connects_(std::make_unique<ConnectScheduler>(
             [this](const std::string& name, Duration timeout) { Connect(name, timeout); },
@@ -86,6 +96,10 @@ class RobotTracker::Impl {
             },
             ConnectSchedulerOptions{.silent_after = FromSeconds(o.robot_timeout_s)})) {
     if (!lcm_.good()) throw Error("robotalk-web: cannot open LCM '" + o.lcm_url + "'");
+    if (!o.key_file.empty() || !o.server_key_file.empty()) {
+      RobotClient check(
+          ClientOptionsFor(o));  // the keys every connect will use, read now: a bad file is said at start-up
+    }
     lcm_.subscribe(kAnnounceChannel, &Impl::OnAnnounce, this)->setQueueCapacity(100);
     listener_ = std::thread([this] { Listen(); });
     worker_ = std::thread([this] { Work(); });
@@ -121,12 +135,11 @@ class RobotTracker::Impl {
   }
 
   void OnAnnounce(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    Announcement announcement;
-    try {  // the checked decoder: hostile counts never reach an allocation (request.h)
-      announcement = DecodeAnnouncement({static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size});
-    } catch (const ProtocolError&) {
-      return;
-    }
+    // Keyed with --server-key: only what that key signed; a hostile one is dropped.
+    const std::optional<HeardAnnouncement> heard = HearAnnouncement(
+        {static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size}, only_key_ ? &*only_key_ : nullptr);
+    if (!heard) return;
+    const Announcement& announcement = heard->announcement;
     std::lock_guard lock(mutex_);
     for (const RobotAnnouncement& r : announcement.robots) {
       std::string evicted;  // the scheduler's table and robots_ hold the same names
@@ -161,8 +174,7 @@ class RobotTracker::Impl {
 
   // The scheduler's connect (on a thread of its own): throws when it fails.
   void Connect(const std::string& name, Duration connect_timeout) {
-    ClientOptions co;
-    co.lcm_url = options_.lcm_url;
+    ClientOptions co = ClientOptionsFor(options_);
     co.timeout = std::chrono::seconds(2);
     co.connect_timeout = connect_timeout;
     auto client = std::make_shared<RobotClient>(co);
@@ -243,6 +255,7 @@ class RobotTracker::Impl {
   nlohmann::json RobotJson(const Robot& r, const ConnectScheduler::State& s) const;
 
   const WebOptions options_;
+  const std::optional<PublicKey> only_key_;  // --server-key: only its robots are tracked
   lcm::LCM lcm_;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;

@@ -53,6 +53,8 @@ std::string WebUsage() {
          "  --urdf NAME=PATH   draw robot NAME from this URDF with urdf-loader (repeatable)\n"
          "  --package-path DIRS folders holding the packages of package:// meshes\n"
          "                     (colon-separated, repeatable; then $ROS_PACKAGE_PATH)\n"
+         "  --key FILE         keyed mode: this bridge's secret key (default: $ROBOTALK_KEY)\n"
+         "  --server-key FILE  keyed mode: track only robots this server key announced\n"
          "  --robot-timeout S  a robot not announced for S seconds is shown as gone (default 3)\n"
          "  --www DIR          the page's files (default: share/robotalk/web/www of this\n"
          "                     installation, else tools/web/www of the sources)\n"
@@ -97,6 +99,12 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       if (o.robot_timeout_s < 1.5)
         throw Error("--robot-timeout: " + args[i] +
                     " s is shorter than 1.5 s (servers announce every second)");
+    } else if (a == "--key") {
+      o.key_file = value();
+      if (o.key_file.empty()) throw Error("--key: the file name is empty");
+    } else if (a == "--server-key") {
+      o.server_key_file = value();
+      if (o.server_key_file.empty()) throw Error("--server-key: the file name is empty");
     } else if (a == "--urdf") {
       auto [name, path] = ParseUrdfOption(value());
       o.urdf[name] = path;

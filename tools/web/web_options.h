@@ -32,6 +32,12 @@ struct WebOptions {
   /// colon-separated and repeatable, then $ROS_PACKAGE_PATH); meshes are served
   /// only from below these and the URDF's own folder (mesh_catalog.h).
   std::vector<std::string> package_paths;
+  /// Keyed mode (docs/security.md): the bridge's own secret key (--key;
+  /// empty: $ROBOTALK_KEY if set, else open mode) and the servers' public key
+  /// (--server-key): with it, only robots that key announced are tracked and
+  /// connected (others' names, forged or not, never reach the table).
+  std::string key_file;
+  std::string server_key_file;
   /// A robot is shown as gone when no announce named it for this long (s).
   double robot_timeout_s = 3.0;
   bool help = false;
