@@ -4,6 +4,7 @@
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
+#include "robotalk/heard_announcement.h"
 #include "robotalk/request.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "sequence_runner.h"

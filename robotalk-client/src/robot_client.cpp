@@ -4,6 +4,7 @@
 
 #include "client_impl.h"
 #include "robotalk/broadcast_signature.h"
+#include "robotalk/heard_announcement.h"
 #include "robotalk/keys.h"
 #include "robotalk/request.h"
 #include "robotalk/routed_lcm_transport.h"
@@ -105,26 +106,6 @@ std::optional<Reply> PendingReply::WaitFor(Duration most, std::stop_token stop) 
 }
 
 // --- ListRobots --------------------------------------------------------------
-
-std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> bytes,
-                                                  const PublicKey* only) {
-  HeardAnnouncement heard;
-  if (only) {
-    if (VerifyBroadcast(kAnnounceChannel, bytes, *only, nullptr) != BroadcastVerdict::kAuthentic)
-      return std::nullopt;
-    heard.server_key = only->ToString();
-  } else if (SignatureSuffix(bytes)) {
-    const std::optional<SignedBy> by = VerifySelfSigned(kAnnounceChannel, bytes);
-    if (!by) return std::nullopt;  // a suffix that does not verify: forged
-    heard.server_key = by->server_key.ToString();
-  }
-  try {  // the checked decoder: hostile counts never reach an allocation (request.h)
-    heard.announcement = DecodeAnnouncement(bytes);
-  } catch (const ProtocolError&) {
-    return std::nullopt;
-  }
-  return heard;
-}
 
 std::optional<PublicKey> ExplicitServerKey(const ClientOptions& options) {
   if (options.server_key_file.empty()) return std::nullopt;

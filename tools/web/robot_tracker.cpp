@@ -4,6 +4,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/connect_scheduler.h"
 #include "robotalk/error.h"
+#include "robotalk/heard_announcement.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/routed_lcm_transport.h"

@@ -26,7 +26,6 @@
 #include "robotalk/command.h"
 #include "robotalk/keys.h"
 #include "robotalk/max_late.h"
-#include "robotalk/request.h"
 #include "robotalk/robot_model.h"
 #include "robotalk/state_sample.h"
 #include "robotalk/trajectory.h"
@@ -37,7 +36,6 @@
 #include <functional>
 #include <memory>
 #include <optional>
-#include <span>
 #include <stop_token>
 #include <string>
 #include <utility>
@@ -323,18 +321,6 @@ struct AnnouncedRobot {
   /// with a pin (known_servers.h): anyone can sign with a key of their own.
   std::string server_key;
 };
-
-/// One ROBOTALK/ANNOUNCE datagram as every client-side reader takes it
-/// (ListRobots, `robotalk watch`, robotalk-web): nullopt when it does not
-/// decode, when its signature suffix does not verify, or, with `only` given,
-/// when `only` did not sign it. With `only`, the key is compared before the
-/// signature is verified, so others' announcements cost no verification.
-struct HeardAnnouncement {
-  Announcement announcement;
-  std::string server_key;  ///< the key that signed it ("ed25519:<64 hex>"), "" unsigned
-};
-std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> bytes,
-                                                  const PublicKey* only = nullptr);
 
 /// The key of `options.server_key_file` (nullopt when none is set); throws
 /// ClientError naming the file when it cannot be read.

@@ -1,0 +1,29 @@
+#include "robotalk/heard_announcement.h"
+
+#include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
+#include "robotalk/error.h"
+
+namespace robotalk {
+
+std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> bytes,
+                                                  const PublicKey* only) {
+  HeardAnnouncement heard;
+  if (only) {
+    if (VerifyBroadcast(kAnnounceChannel, bytes, *only, nullptr) != BroadcastVerdict::kAuthentic)
+      return std::nullopt;
+    heard.server_key = only->ToString();
+  } else if (SignatureSuffix(bytes)) {
+    const std::optional<SignedBy> by = VerifySelfSigned(kAnnounceChannel, bytes);
+    if (!by) return std::nullopt;  // a suffix that does not verify: forged
+    heard.server_key = by->server_key.ToString();
+  }
+  try {
+    heard.announcement = DecodeAnnouncement(bytes);
+  } catch (const ProtocolError&) {
+    return std::nullopt;
+  }
+  return heard;
+}
+
+}  // namespace robotalk
