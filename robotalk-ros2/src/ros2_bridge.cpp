@@ -1,9 +1,11 @@
 #include "ros2_bridge.h"
 
 #include "dds_entities.h"
+#include "robotalk/announce_listener.h"
 #include "robotalk/connect_scheduler.h"
 #include "robotalk/log_limiter.h"
 #include "robotalk/robot_client.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "ros_wire.h"
 
 #include <sys/resource.h>
@@ -220,22 +222,30 @@ class Ros2Bridge::Impl {
                      std::to_string(static_cast<int>(Seconds(retry_in))) + " s)");
         },
         options);
+    // Every robot announced: heard as it is announced (with --server-key,
+    // only what that key signed), on the listener's thread.
+    std::unique_ptr<AnnounceListener> announcements;  // destroyed before the scheduler
     while (!st.stop_requested()) {
       if (options_.robots.empty()) {
-        try {
-          for (const AnnouncedRobot& a : ListRobots(MakeClientOptions(), std::chrono::milliseconds(1200)))
-            if (scheduler.Announce(a.name) == ConnectScheduler::Heard::kAdded)
-              LogLimited("robot '" + a.name + "' announced");
-        } catch (const std::exception& e) {
-          LogLimited(std::string("listening for robots: ") + e.what());
+        if (!announcements) {
+          try {
+            announcements = std::make_unique<AnnounceListener>(
+                OpenLcmTransport(options_.lcm_url), ExplicitServerKey(MakeClientOptions()),
+                [&scheduler](const HeardAnnouncement& heard) {
+                  for (const RobotAnnouncement& r : heard.announcement.robots)
+                    if (scheduler.Announce(r.name) == ConnectScheduler::Heard::kAdded)
+                      LogLimited("robot '" + r.name + "' announced");
+                });
+          } catch (const std::exception& e) {
+            LogLimited(std::string("listening for robots: ") + e.what());
+          }
         }
       } else {
         for (const std::string& name : options_.robots) scheduler.Announce(name);  // wanted: never silent
       }
       scheduler.Poll();
       std::unique_lock lock(mu_);
-      cv_.wait_for(lock, std::chrono::milliseconds(options_.robots.empty() ? 500 : 200),
-                   [&] { return st.stop_requested(); });
+      cv_.wait_for(lock, std::chrono::milliseconds(200), [&] { return st.stop_requested(); });
     }
     // The scheduler waits for each connect still running (up to its timeout);
     // one that succeeds is in robots_, so shutdown stops it.

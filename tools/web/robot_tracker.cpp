@@ -1,16 +1,14 @@
 #include "robot_tracker.h"
 
 #include "json_text.h"
+#include "robotalk/announce_listener.h"
 #include "robotalk/channels.h"
 #include "robotalk/connect_scheduler.h"
 #include "robotalk/error.h"
-#include "robotalk/heard_announcement.h"
 #include "robotalk/request.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "scene_json.h"
-
-#include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -89,27 +87,25 @@ class RobotTracker::Impl {
   explicit Impl(const WebOptions& o)
       : options_(o),
         only_key_(ExplicitServerKey(ClientOptionsFor(o))),
-        lcm_(MainLcmUrl(o.lcm_url)),  // ANNOUNCE: main lane
         connects_(std::make_unique<ConnectScheduler>(
             [this](const std::string& name, Duration timeout) { Connect(name, timeout); },
             [this](const std::string& name, const std::string& error, Duration) {
               ConnectFailed(name, error);
             },
             ConnectSchedulerOptions{.silent_after = FromSeconds(o.robot_timeout_s)})) {
-    if (!lcm_.good()) throw Error("robotalk-web: cannot open LCM '" + o.lcm_url + "'");
     if (!o.key_file.empty() || !o.server_key_file.empty()) {
       RobotClient check(
           ClientOptionsFor(o));  // the keys every connect will use, read now: a bad file is said at start-up
     }
-    lcm_.subscribe(kAnnounceChannel, &Impl::OnAnnounce, this)->setQueueCapacity(100);
-    listener_ = std::thread([this] { Listen(); });
+    announcements_ = std::make_unique<AnnounceListener>(
+        OpenLcmTransport(o.lcm_url), only_key_, [this](const HeardAnnouncement& a) { OnAnnounce(a); });
     worker_ = std::thread([this] { Work(); });
   }
 
   ~Impl() {
+    announcements_.reset();  // its thread takes mutex_
     stop_ = true;
     wake_.notify_all();
-    listener_.join();
     worker_.join();
     connects_.reset();  // waits for the connects in flight, which take mutex_
     std::vector<std::thread> threads;
@@ -131,16 +127,9 @@ class RobotTracker::Impl {
   void Panic(const std::string& robot, std::function<void(const std::string&)> done);
 
  private:
-  void Listen() {
-    while (!stop_) lcm_.handleTimeout(100);
-  }
-
-  void OnAnnounce(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    // Keyed with --server-key: only what that key signed; a hostile one is dropped.
-    const std::optional<HeardAnnouncement> heard = HearAnnouncement(
-        {static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size}, only_key_ ? &*only_key_ : nullptr);
-    if (!heard) return;
-    const Announcement& announcement = heard->announcement;
+  // Keyed with --server-key, only what that key signed reaches here.
+  void OnAnnounce(const HeardAnnouncement& heard) {
+    const Announcement& announcement = heard.announcement;
     std::lock_guard lock(mutex_);
     for (const RobotAnnouncement& r : announcement.robots) {
       std::string evicted;  // the scheduler's table and robots_ hold the same names
@@ -257,7 +246,6 @@ class RobotTracker::Impl {
 
   const WebOptions options_;
   const std::optional<PublicKey> only_key_;  // --server-key: only its robots are tracked
-  lcm::LCM lcm_;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable wake_;
@@ -269,7 +257,8 @@ class RobotTracker::Impl {
   // The robots announced, their connects (at most 32 at once), back-off and
   // table (at most 256); it calls Connect() and ConnectFailed().
   std::unique_ptr<ConnectScheduler> connects_;
-  std::thread listener_, worker_;
+  std::thread worker_;
+  std::unique_ptr<AnnounceListener> announcements_;  // calls OnAnnounce(); started last, stopped first
 };
 
 // REQUIRES: mutex_ held. A robot not announced for robot_timeout_s is gone:
