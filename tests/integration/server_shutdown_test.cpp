@@ -300,6 +300,7 @@ TEST(HungDriverShutdown, AHungCallKeepsNoOtherRobotFromItsStopIsAFaultAndTheShut
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   std::printf("Server::Stop returned after %.2f s with the rover's Execute hung (bound 1.5 s)\n", took);
   EXPECT_TRUE(hang->Hanging()) << "the shutdown waited for the hung call (" << took << " s)";
+  EXPECT_EQ(server.not_stopped(), std::vector<std::string>{"rover"});
   const auto pioneer_calls = log->Of("pioneer");
   ASSERT_FALSE(pioneer_calls.empty());
   EXPECT_EQ(pioneer_calls.back(), "Stop") << "the other robot got its STOP while the rover's call hung";
