@@ -458,8 +458,12 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
   const auto publish = [&](ReplyBatch& part) {
     part.server_send = clock_.Now();
     std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
-    if (part.session_status == SessionStatus::kOk && !table_->Seal(part.session_id, bytes)) {
-      return;  // its session closed: the client said hello again and failed these
+    if (part.session_status == SessionStatus::kOk) {
+      if (!table_->Seal(part.session_id, bytes)) return;  // its session closed: the client said hello again
+    } else if (signer_) {
+      // Keyed: no session key to seal with, so the server key signs it; a
+      // keyed client believes no other (a fake server's would end its sessions).
+      signer_->Sign(channel, bytes);
     }
     for (int copies = faults_.Copies(); copies > 0; --copies) transport_.Publish(channel, bytes);
   };
