@@ -434,6 +434,12 @@ void ServerDaemon::OnHello(const std::string& channel, std::span<const std::uint
 void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
   PumpOutput(*robot.daemon, *robot.sessions, robot.output, to_send_, wait);
   Persist(robot);  // a driver fault latched by the RobotDaemon; a panic or reset just handled
+  if (!robot.output.audit.empty()) {
+    // soak.md: an audit line is on stderr before its reply leaves, so a
+    // reply never exists without its line (a server killed in between).
+    for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
+    WriteLog();
+  }
   const std::string& name = robot.daemon->robot_name();
   if (ack) Send(name, *ack);
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
@@ -444,7 +450,6 @@ void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
     if (signer_) signer_->Sign(channel, bytes);  // keyed: readers verify the server key (issue 19)
     transport_.Publish(channel, bytes);
   }
-  for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
   for (ReplyBatch& batch : to_send_) Send(name, batch);
   for (const std::string& line : robot.sessions->TakeLog()) Log(line);
 }
