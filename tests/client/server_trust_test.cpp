@@ -184,7 +184,8 @@ TEST_F(ServerTrustTest, AFakeServerThatAnswersFirstCannotKeepAKeyedClientFromIts
   connect.join();
   const double after = std::chrono::duration<double>(std::chrono::steady_clock::now() - real_from).count();
   std::printf(
-      "connected %.2f s after the real server started; %llu answers of the fake server refused; %llu sessions "
+      "connected %.2f s after the real server started; %llu answers of the fake server refused; %llu "
+      "sessions "
       "lost\n",
       after, static_cast<unsigned long long>(client.stats().servers_refused),
       static_cast<unsigned long long>(client.stats().sessions_lost));
@@ -193,6 +194,33 @@ TEST_F(ServerTrustTest, AFakeServerThatAnswersFirstCannotKeepAKeyedClientFromIts
   EXPECT_EQ(client.trusted_server().fingerprint, ReadPublicKeyFile(dir_ / "server.pub").key.Fingerprint());
   EXPECT_EQ(client.Goto(0.1, 0, 0).signal, Signal::kSuccess);
   EXPECT_GE(client.stats().servers_refused, 1u);
+}
+
+// security.md, Binding: a keyed client's id is one of its key's; given
+// another key's id (or a made-up one) it is refused at construction, naming
+// the id and its key, before it sends anything.
+using KeyedClientIdTest = ServerTrustTest;
+TEST_F(KeyedClientIdTest, AKeyedClientGivenAnIdNotOfItsKeyIsRefusedAtConstruction) {
+  const PublicKey alice = ReadPublicKeyFile(dir_ / "alice.pub").key;
+  const PublicKey mallory = ReadPublicKeyFile(dir_ / "mallory.pub").key;
+  const std::size_t published = bus_->published();
+  for (const std::int64_t id : {KeyedClientId(mallory, 7), std::int64_t{0x1234}}) {
+    ClientOptions o = Options();
+    o.client_id = id;
+    try {
+      RobotClient client(o);
+      ADD_FAILURE() << "client id " << id << " was taken by alice's key";
+    } catch (const ClientError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("client id " + std::to_string(id) + " is not one of key " +
+                                      alice.Fingerprint() + "'s"));
+    }
+  }
+  EXPECT_EQ(bus_->published(), published) << "a refused client sends nothing";
+  ClientOptions own = Options();
+  own.client_id = KeyedClientId(alice, 7);
+  EXPECT_EQ(RobotClient(own).client_id(), own.client_id);
+  EXPECT_TRUE(ClientIdBelongsTo(RobotClient(Options()).client_id(), alice))
+      << "id 0: one of the key's is made";
 }
 
 TEST_F(ServerTrustTest, ACorruptOrGroupWritableKnownServersFileIsAClearError) {
