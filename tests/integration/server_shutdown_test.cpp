@@ -7,6 +7,7 @@
 #include "ode_driver.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/server.h"
+#include "support/observed_driver.h"
 #include "test_paths.h"
 
 #include <gmock/gmock.h>
@@ -193,62 +194,40 @@ TEST_F(ServerShutdownTest, NothingThatWaitedRunsOnAnyRobotOnceTheShutdownHasBegu
   EXPECT_FALSE(later.Poll().has_value()) << "it never ran, and nobody says it did";
 }
 
-// A driver whose Execute, once armed, hangs (at most 20 s, or until
-// released): a driver call that never returns while the server shuts down.
-class HangingDriver final : public Driver {
- public:
-  struct Hang {
-    void Arm() { armed = true; }
-    // Waits until a call hangs, at most `timeout`.
-    bool WaitHung(Duration timeout) {
-      std::unique_lock lock(mutex);
-      return changed.wait_for(lock, timeout, [&] { return hung; });
-    }
-    void Release() {
-      {
-        std::lock_guard lock(mutex);
-        released = true;
-      }
-      changed.notify_all();
-    }
-    bool Hanging() {
+// Once armed, the next Execute of the driver it observes hangs (at most
+// 20 s, or until released): a driver call that never returns while the
+// server shuts down.
+struct Hang final : testing::DriverObserver {
+  void Executed(const DriverCommand&, TimePoint) override {
+    if (!armed.exchange(false)) return;
+    std::unique_lock lock(mutex);
+    hung = true;
+    changed.notify_all();
+    changed.wait_for(lock, seconds(20), [&] { return released; });
+    returned = true;
+  }
+  // Waits until a call hangs, at most `timeout`.
+  bool WaitHung(Duration timeout) {
+    std::unique_lock lock(mutex);
+    return changed.wait_for(lock, timeout, [&] { return hung; });
+  }
+  void Release() {
+    {
       std::lock_guard lock(mutex);
-      return hung && !returned;
+      released = true;
     }
-    std::atomic<bool> armed{false};
-    std::mutex mutex;
-    std::condition_variable changed;
-    bool hung = false;
-    bool released = false;
-    bool returned = false;
-  };
-  HangingDriver(std::unique_ptr<Driver> inner, std::shared_ptr<Hang> hang)
-      : inner_(std::move(inner)), hang_(std::move(hang)) {}
-  const RobotModel& model() const override { return inner_->model(); }
-  Duration period() const override { return inner_->period(); }
-  DriverResult Execute(const DriverCommand& c, TimePoint now, std::vector<Completion>& done) override {
-    if (hang_->armed.exchange(false)) {
-      std::unique_lock lock(hang_->mutex);
-      hang_->hung = true;
-      hang_->changed.notify_all();
-      hang_->changed.wait_for(lock, seconds(20), [&] { return hang_->released; });
-      hang_->returned = true;
-    }
-    return inner_->Execute(c, now, done);
+    changed.notify_all();
   }
-  void Update(TimePoint now, std::vector<Completion>& done) override { inner_->Update(now, done); }
-  void ReadState(RobotState& s) const override { inner_->ReadState(s); }
-  void Stop(TimePoint now, std::vector<Completion>& done) override { inner_->Stop(now, done); }
-  void StopOnly(const StopScope& scope, TimePoint now, std::vector<Completion>& done) override {
-    inner_->StopOnly(scope, now, done);
+  bool Hanging() {
+    std::lock_guard lock(mutex);
+    return hung && !returned;
   }
-  void Halt(std::vector<Completion>& done) override { inner_->Halt(done); }
-  void Resume() override { inner_->Resume(); }
-  std::string_view Fault() const override { return inner_->Fault(); }
-
- private:
-  std::unique_ptr<Driver> inner_;
-  std::shared_ptr<Hang> hang_;
+  std::atomic<bool> armed{false};
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool hung = false;
+  bool released = false;
+  bool returned = false;
 };
 
 // A driver call that hangs while the server shuts down (the ServerDaemon
@@ -261,11 +240,11 @@ TEST(HungDriverShutdown, AHungCallKeepsNoOtherRobotFromItsStopIsAFaultAndTheShut
   DriverRegistry registry;
   RegisterKinematicDriver(registry);
   auto log = std::make_shared<CallLog>();
-  auto hang = std::make_shared<HangingDriver::Hang>();
+  auto hang = std::make_shared<Hang>();
   registry.Register("hanging-kinematic", [&](const DriverConfig& config) {
     return std::make_unique<RecordingDriver>(
-        config.robot_name, std::make_unique<HangingDriver>(registry.Create("kinematic", config), hang), log,
-        nullptr);
+        config.robot_name,
+        std::make_unique<testing::ObservedDriver>(registry.Create("kinematic", config), hang), log, nullptr);
   });
   registry.Register("recorded-kinematic", [&](const DriverConfig& config) {
     return std::make_unique<RecordingDriver>(config.robot_name, registry.Create("kinematic", config), log,
@@ -291,7 +270,7 @@ TEST(HungDriverShutdown, AHungCallKeepsNoOtherRobotFromItsStopIsAFaultAndTheShut
   RobotClient rover(client_options);
   rover.Connect("rover");
   ASSERT_EQ(pioneer.SetSpeed(0.3, 0.1).signal, Signal::kSuccess);
-  hang->Arm();
+  hang->armed = true;
   PendingReply drive = rover.Send(Command{.type = CommandType::kGoto, .values = {5.0, 0.0, 0.0}});
   ASSERT_TRUE(hang->WaitHung(seconds(5))) << "the rover's Execute never started";
 

@@ -6,6 +6,7 @@
 #include "fake_driver.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
+#include "robotalk/forwarding_transport.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "server_daemon.h"
@@ -64,24 +65,17 @@ TEST(ServerDaemonLog, ADriverFailingInEveryUpdateLogsItsFaultOnceAndThenASummary
 }
 
 // Publishes through `inner`; `before` sees every message just before it leaves.
-class WatchedTransport final : public Transport {
+class WatchedTransport final : public ForwardingTransport {
  public:
   using Before = std::function<void(const std::string&, std::span<const std::uint8_t>)>;
-  WatchedTransport(Transport& inner, Before before) : inner_(inner), before_(std::move(before)) {}
+  WatchedTransport(Transport& inner, Before before)
+      : ForwardingTransport(inner), before_(std::move(before)) {}
   void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
     before_(channel, bytes);
-    inner_.Publish(channel, bytes);
+    inner().Publish(channel, bytes);
   }
-  std::unique_ptr<Subscription> Subscribe(const std::string& channel_regex, Handler handler) override {
-    return inner_.Subscribe(channel_regex, std::move(handler));
-  }
-  int HandleFor(Duration timeout) override { return inner_.HandleFor(timeout); }
-  int fileno() const override { return inner_.fileno(); }
-  std::string url() const override { return inner_.url(); }
-  WallTime ReceiveTime() const override { return inner_.ReceiveTime(); }
 
  private:
-  Transport& inner_;
   Before before_;
 };
 
