@@ -95,14 +95,17 @@ static void server_changed(rtc_client* c, int64_t new_server_id) {
 
 void rtci_on_reply(const lcm_recv_buf_t* rbuf, const char* channel, const robotalk_msgs_reply_package_t* m,
                    void* user) {
-  (void)channel;
   rtc_client* c = user;
   int64_t t4 = rtc_now_us();
   if (m->protocol_version != kProtocolVersion || m->client_id != c->client_id) return;
-  /* Keyed: a reply of our session must carry its MAC (SESSION_UNKNOWN has none). */
+  /* Keyed: a reply of our session must carry its MAC; SESSION_UNKNOWN has none but the
+   * server key's signature, of any instance (a fake server's would end our sessions). */
   if (c->keyed && m->session_status != ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN &&
       (m->session_id != c->keys.session_id ||
        !rtc_mac_verifies(c->keys.s2c, c->keys.session_id, rbuf->data, rbuf->data_size)))
+    return;
+  if (c->keyed && m->session_status == ROBOTALK_MSGS_REPLY_PACKAGE_T_SESSION_UNKNOWN &&
+      !rtc_broadcast_verifies(channel, rbuf->data, rbuf->data_size, c->server_key, NULL))
     return;
   if (m->server_id != c->server_id && c->server_id != 0) server_changed(c, m->server_id);
   pending_package* p = m->ack_sequence > 0 ? find_package(c, m->ack_sequence) : NULL;

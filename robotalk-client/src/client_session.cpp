@@ -2,6 +2,8 @@
 // answer, sealing packages and checking replies in keyed mode, and what
 // happens when the server no longer knows the session (a restart, an expiry).
 #include "client_impl.h"
+#include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
 #include "robotalk/config_message.h"
 #include "robotalk/known_servers.h"
 #include "robotalk/request.h"
@@ -195,12 +197,24 @@ std::vector<CommandId> RobotClient::Impl::LoseSession(TimePoint now) {
 bool RobotClient::Impl::AcceptReplyPackage(const ReplyBatch& batch, std::span<const std::uint8_t> bytes,
                                            TimePoint now, std::vector<CommandId>& lost) {
   if (batch.session_status == SessionStatus::kUnknown) {
-    // Unsealed by nature (the server has no key for it): believed only for
-    // the live session. A forger can make the client say hello again; it
-    // could as well drop every package (docs/security.md, availability).
+    // Unsealed by nature (the server has no key for it): keyed, it must
+    // carry the trusted server key's signature, of any instance (a restarted
+    // server's is what it is for); else it is another server's (a fake one
+    // that answered first would end every session the real one opens) or
+    // a forger's, refused and counted. Open mode believes it for the live
+    // session: there a forger can make the client say hello again; it could
+    // as well drop every package (docs/security.md, availability).
     // Its panic answer counts in open mode, where nothing is sealed; in keyed
     // mode only as a refusal for want of a session (RobotClient::Panic then
     // says hello and sends the panic again), never as a panic taken.
+    if (identity_) {
+      const std::optional<PublicKey> key = trust_ ? trust_->trusted() : std::nullopt;
+      if (!key || VerifyBroadcast(ReplyChannel(robot_, client_id_), bytes, *key, nullptr) !=
+                      BroadcastVerdict::kAuthentic) {
+        ++stats_.replies_refused;
+        return false;
+      }
+    }
     if (!identity_ || batch.panic == PanicStatus::kRefused) NotePanicAnswer(batch);
     if (session_id_ == 0 || batch.session_id != session_id_) return false;
     lost = LoseSession(now);  // each lost item's failure says why

@@ -388,7 +388,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
   try {
     ReplyBatch batch;
     try {
-      batch = DecodeReplyBatch(bytes);
+      batch = DecodeReplyBatch(bytes);  // a SESSION_UNKNOWN's signature: AcceptReplyPackage verifies it
     } catch (const ProtocolError&) {
       std::lock_guard lock(mu_);
       ++stats_.malformed_packages;

@@ -1,6 +1,7 @@
 #include "robot_daemon.h"
 
 #include "expiry.h"
+#include "planner_answers.h"
 
 #include "robotalk/signal.h"
 
@@ -99,18 +100,31 @@ void RobotDaemon::EndSoon() {
   {
     std::lock_guard lock(mutex_);
     running_ = false;
+    shutting_down_ = true;
   }
   wake_.notify_all();
 }
 
+bool RobotDaemon::WaitEnded(Duration timeout) {
+  std::unique_lock lock(mutex_);
+  if (!thread_.joinable()) return true;
+  return ended_changed_.wait_for(lock, timeout, [this] { return ended_; });
+}
+
 void RobotDaemon::Shutdown() {
   EndSoon();
-  if (thread_.joinable()) thread_.join();
-  // The thread is gone: this one acts as it, once. What waits never runs
-  // (issue 19: a command due during the shutdown ran after its STOP); it is
-  // not answered either: to its client it is an outcome the server took
-  // away, as after a crash (an UnknownOutcomeError once it meets the next
-  // server instance).
+  if (thread_.joinable()) {
+    thread_.join();  // it did the last STOP itself
+  } else {
+    LastStop();  // never started: this thread acts as it, once
+  }
+}
+
+void RobotDaemon::LastStop() {
+  // What waits never runs (issue 19: a command due during the shutdown ran
+  // after its STOP); it is not answered either: to its client it is an
+  // outcome the server took away, as after a crash (an UnknownOutcomeError
+  // once it meets the next server instance).
   std::vector<QueuedItem> waiting;
   {
     std::lock_guard lock(mutex_);
@@ -120,6 +134,31 @@ void RobotDaemon::Shutdown() {
   QueueStop(/*only_if_moving=*/false);
   last_iteration_ = true;
   RunOnce(clock_.Now());
+}
+
+Duration RobotDaemon::CallRunning(TimePoint now) const {
+  std::lock_guard lock(call_mutex_);
+  return call_.name ? now - call_.started : Duration(0);
+}
+
+bool RobotDaemon::Abandon(TimePoint now) {
+  std::string why;
+  {
+    std::lock_guard call_lock(call_mutex_);
+    why = "robot '" + robot_name_ + "': NOT STOPPED: driver '" + driver_name_ + "' " +
+          (call_.name ? call_.name : "call") + " has not returned after " +
+          planner_answers::Seconds(call_.name ? now - call_.started : Duration(0)) +
+          " (twice --driver-call-bound); the server shuts down without this robot's STOP: the robot may "
+          "still move (it is in panic)";
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (ended_ || !thread_.joinable()) return false;
+    output_ready_ = nullptr;  // the ServerDaemon it wakes is going away
+    outbox_.log.push_back(std::move(why));
+  }
+  thread_.detach();
+  return true;
 }
 
 void RobotDaemon::DaemonLoop() {
@@ -136,6 +175,12 @@ void RobotDaemon::DaemonLoop() {
     waiter_.WaitUntil(lock, wake_, next, spin_, woken_);
     wake_flag_ = false;
   }
+  const bool last_stop = shutting_down_;
+  lock.unlock();
+  if (last_stop) LastStop();
+  lock.lock();
+  ended_ = true;
+  ended_changed_.notify_all();
 }
 
 // --- ServerDaemon side -------------------------------------------------------
@@ -343,7 +388,11 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
   }
   snapshot_.Publish(state_read ? &state_ : nullptr, now, driver_->period(), pushes_taken_, next_due,
                     panic_.driver_halted());
-  if (ready && output_ready_) output_ready_();
+  if (ready) {
+    // Under the lock: Abandon() clears it when the ServerDaemon goes away.
+    std::lock_guard lock(mutex_);
+    if (output_ready_) output_ready_();
+  }
   return next;
 }
 

@@ -162,14 +162,30 @@ class RobotDaemon {
   /// so a STOP queued just before (QueueStop) still executes.
   void Start();
   void Stop();
-  /// The server's shutdown, in two halves so that every robot's thread ends
-  /// at once: EndSoon() asks the thread to end after its current iteration
-  /// (returns at once); Shutdown() ends and joins it, drops every waiting
-  /// item without running it (unanswered, as after a crash), and STOPs the
-  /// robot: that STOP is the last command the driver gets, and the broadcast
-  /// stream gets a last sample after it.
+  /// The server's shutdown. EndSoon() (returns at once) asks the thread to
+  /// end after its current iteration, dropping every waiting item without
+  /// running it (unanswered, as after a crash), and to STOP the robot as its
+  /// last act: that STOP is the last command the driver gets, and the
+  /// broadcast stream gets a last sample after it. The thread does this
+  /// itself, so a robot whose driver call hangs keeps no other robot from
+  /// its STOP (the Server calls EndSoon() on every robot first).
+  /// WaitEnded() waits at most `timeout` for that to be done (true when it
+  /// is, or when the thread was never started). Shutdown() is EndSoon() and
+  /// an unbounded wait (joined); without a thread it does the STOP itself.
   void EndSoon();
+  bool WaitEnded(Duration timeout);
   void Shutdown();
+  /// How long the driver call now running has run at `now` (0 when none).
+  Duration CallRunning(TimePoint now) const;
+  /// The server gives up waiting for a thread whose driver call hangs
+  /// during the shutdown (robotalk::Server, after twice the call bound):
+  /// says so in the outbox (naming the call and how long it has run at
+  /// `now`), detaches the thread and stops waking the ServerDaemon. Should
+  /// the call ever return, the thread still drops what waits and STOPs the
+  /// robot. REQUIRES: EndSoon(); the daemon is never destroyed afterwards
+  /// (its thread may still use it). Returns false (nothing done) when the
+  /// thread ended meanwhile.
+  bool Abandon(TimePoint now);
 
   // --- ServerDaemon side (thread-safe) ------------------------------------
   /// Queues a checked item. REQUIRES: admission checks passed. A state query
@@ -249,6 +265,8 @@ class RobotDaemon {
   };
 
   void DaemonLoop();
+  // The shutdown's last iteration (EndSoon): drops what waits, STOPs the robot.
+  void LastStop();
   void FlushForPanicLocked();  // REQUIRES: mutex_ held
   void Execute(const QueuedItem& item, TimePoint now);
   void AnswerQuery(const QueuedItem& item, Reply& reply);
@@ -323,6 +341,9 @@ class RobotDaemon {
   /// only for an item due before this).
   std::optional<TimePoint> sleeping_until_;  // GUARDED_BY(mutex_)
   bool running_ = false;                     // GUARDED_BY(mutex_)
+  bool shutting_down_ = false;               // GUARDED_BY(mutex_): EndSoon() was called
+  bool ended_ = false;                       // GUARDED_BY(mutex_): the thread has done its last STOP
+  std::condition_variable ended_changed_;
   std::uint64_t pushes_ = 0;                 // GUARDED_BY(mutex_): items submitted so far
   std::string timing_;                       // GUARDED_BY(mutex_)
   std::atomic<bool> flush_deferred_{false};  // Panic() could not take mutex_ to flush

@@ -19,6 +19,13 @@
 namespace robotalk {
 namespace {
 
+// RobotDaemons whose thread the shutdown gave up waiting for (a driver call
+// that hangs): that thread may still use them, so they are never destroyed.
+std::vector<std::unique_ptr<RobotDaemon>>& AbandonedRobots() {
+  static auto* abandoned = new std::vector<std::unique_ptr<RobotDaemon>>;
+  return *abandoned;
+}
+
 bool ValidRobotName(const std::string& name) {
   return !name.empty() && std::regex_match(name, std::regex("[A-Za-z0-9_-]+"));
 }
@@ -194,12 +201,48 @@ class Server::Impl {
     // while another robot stopped ran after its STOP).
     server_daemon_->Stop();
     for (auto& robot : robots_) robot->EndSoon();
-    for (auto& robot : robots_) robot->Shutdown();
+    // Each robot's thread drops what waits and STOPs its robot itself, all
+    // at once: a driver call that hangs keeps no other robot from its STOP.
+    // While the server waits, the call bound is watched as while it served
+    // (the ServerDaemon that watched it has stopped): a call past it is a
+    // driver fault, its command answered ERROR and the robot latched in
+    // panic on disk. A call still running at twice the bound is given up on:
+    // the server says so and shuts down without that robot's STOP (its
+    // thread still STOPs it should the call ever return).
+    const Duration bound = options_.driver_call_bound;
+    std::vector<std::unique_ptr<RobotDaemon>*> left;
+    for (auto& robot : robots_) left.push_back(&robot);
+    while (!left.empty()) {
+      std::erase_if(left, [](std::unique_ptr<RobotDaemon>* robot) {
+        if (!(*robot)->WaitEnded(Duration(0))) return false;
+        (*robot)->Shutdown();  // joins: it has ended
+        return true;
+      });
+      const TimePoint now = clock_.Now();
+      bool flush = false;  // a fault or a NOT STOPPED line to write now
+      for (auto* robot : left) flush = (*robot)->CheckOverrun(now) || flush;
+      std::erase_if(left, [&](std::unique_ptr<RobotDaemon>* robot) {
+        RobotDaemon& daemon = **robot;
+        const Duration running = daemon.CallRunning(now);
+        if (bound.count() <= 0 || running <= 2 * bound) return false;
+        if (!daemon.Abandon(now)) {
+          return false;  // it ended meanwhile: Shutdown() at the next turn
+        }
+        flush = true;
+        not_stopped_.push_back(daemon.robot_name());
+        AbandonedRobots().push_back(std::move(*robot));  // its thread may still use it: never destroyed
+        return true;
+      });
+      if (flush) server_daemon_->Flush();  // the latch, the ERROR, the log lines now
+      if (!left.empty()) (*left.front())->WaitEnded(std::chrono::milliseconds(20));
+    }
+    std::erase(robots_, nullptr);
     server_daemon_->Flush();  // the STOPs' log lines, the last replies and samples
   }
 
   std::vector<std::string> names() const { return server_daemon_->robot_names(); }
   const ServerDaemon& daemon() const { return *server_daemon_; }
+  std::vector<std::string> not_stopped() const { return not_stopped_; }
 
  private:
   ServerOptions options_;
@@ -209,6 +252,7 @@ class Server::Impl {
   std::unique_ptr<ServerDaemon> server_daemon_;  // destroyed before the robots it refers to
   std::string url_;
   std::atomic<bool> running_{false};
+  std::vector<std::string> not_stopped_;
 };
 
 Server::Server(ServerOptions options, const std::vector<RobotSpec>& robots, const DriverRegistry& registry,
@@ -223,5 +267,6 @@ void Server::Stop() { impl_->Stop(); }
 std::vector<std::string> Server::robot_names() const { return impl_->names(); }
 std::size_t Server::serving() const { return impl_->daemon().serving(); }
 std::vector<std::string> Server::refusals() const { return impl_->daemon().refusals(); }
+std::vector<std::string> Server::not_stopped() const { return impl_->not_stopped(); }
 
 }  // namespace robotalk

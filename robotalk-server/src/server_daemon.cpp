@@ -434,6 +434,12 @@ void ServerDaemon::OnHello(const std::string& channel, std::span<const std::uint
 void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
   PumpOutput(*robot.daemon, *robot.sessions, robot.output, to_send_, wait);
   Persist(robot);  // a driver fault latched by the RobotDaemon; a panic or reset just handled
+  if (!robot.output.audit.empty()) {
+    // soak.md: an audit line is on stderr before its reply leaves, so a
+    // reply never exists without its line (a server killed in between).
+    for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
+    WriteLog();
+  }
   const std::string& name = robot.daemon->robot_name();
   if (ack) Send(name, *ack);
   for (std::size_t i = 0; i < robot.output.num_samples; ++i) {
@@ -444,7 +450,6 @@ void ServerDaemon::Drain(Robot& robot, bool wait, ReplyBatch* ack) {
     if (signer_) signer_->Sign(channel, bytes);  // keyed: readers verify the server key (issue 19)
     transport_.Publish(channel, bytes);
   }
-  for (std::string& line : robot.output.audit) log_pending_.push_back(std::move(line));  // never limited
   for (ReplyBatch& batch : to_send_) Send(name, batch);
   for (const std::string& line : robot.sessions->TakeLog()) Log(line);
 }
@@ -458,8 +463,12 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
   const auto publish = [&](ReplyBatch& part) {
     part.server_send = clock_.Now();
     std::vector<std::uint8_t> bytes = EncodeReplyBatch(part);
-    if (part.session_status == SessionStatus::kOk && !table_->Seal(part.session_id, bytes)) {
-      return;  // its session closed: the client said hello again and failed these
+    if (part.session_status == SessionStatus::kOk) {
+      if (!table_->Seal(part.session_id, bytes)) return;  // its session closed: the client said hello again
+    } else if (signer_) {
+      // Keyed: no session key to seal with, so the server key signs it; a
+      // keyed client believes no other (a fake server's would end its sessions).
+      signer_->Sign(channel, bytes);
     }
     for (int copies = faults_.Copies(); copies > 0; --copies) transport_.Publish(channel, bytes);
   };

@@ -162,7 +162,8 @@ class ServerDaemon {
   void LogConflict(Robot& robot, const std::string& other, Duration served);
   void Send(const std::string& robot, ReplyBatch& batch);
   // Takes and files the RobotDaemon's output (PumpOutput), writes the panic
-  // latch (Persist), then sends `ack` (if any), the state samples and the replies.
+  // latch (Persist) and the audit lines (--log-executions), then sends `ack`
+  // (if any), the state samples and the replies.
   void Drain(Robot& robot, bool wait = true, ReplyBatch* ack = nullptr);
   void WriteLog();
   void ApplyPriority();
@@ -195,7 +196,7 @@ class ServerDaemon {
   std::vector<std::string> refusals_;  // GUARDED_BY(refusals_mu_)
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
-  std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes
+  std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes (audit lines before)
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

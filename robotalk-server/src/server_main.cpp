@@ -309,7 +309,9 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   try {
-    SteadyClock clock;
+    // Outlives the server: a robot thread the shutdown gave up on (a driver
+    // call that hangs) may still read it until the process exits.
+    static const SteadyClock clock;
     Server server(options, robots, registry, clock);
     server.Start();
     // Waits for a signal or --duration, and looks every 100 ms whether the
@@ -336,6 +338,12 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
     }
     if (received > 0) std::cerr << "robotalk-server: " << strsignal(received) << ", stopping every robot\n";
     server.Stop();
+    if (!server.not_stopped().empty()) {
+      std::cerr << "robotalk-server: error: not stopped (a driver call hung):";
+      for (const std::string& robot : server.not_stopped()) std::cerr << " '" << robot << "'";
+      std::cerr << "\n";
+      return 1;
+    }
   } catch (const std::exception& e) {
     std::cerr << "robotalk-server: error: " << e.what() << "\n";
     return 1;

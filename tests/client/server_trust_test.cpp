@@ -24,9 +24,11 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <thread>
 
 namespace robotalk {
 namespace {
@@ -64,16 +66,22 @@ class ServerTrustTest : public ::testing::Test {
   }
   // A keyed server of kRobot with the secret key `key` ("server", or
   // "mallory": an impersonator who copied the access list, which is public).
-  void StartServer(const std::string& key) {
+  void StartServer(const std::string& key, bool allow_duplicate_robots = false) {
     server_.reset();
+    server_ = KeyedServer(server_end_, key, allow_duplicate_robots);
+  }
+  // The same on its own endpoint `end`, started.
+  std::unique_ptr<Server> KeyedServer(Transport& end, const std::string& key, bool allow_duplicate_robots) {
     ServerOptions o;
     o.precise_timing = false;
     o.key_file = (dir_ / key).string();
     o.clients_file = (dir_ / "clients").string();
+    o.allow_duplicate_robots = allow_duplicate_robots;
     const RobotSpec spec{
         kRobot, "kinematic", std::string(ROBOTALK_MODELS_DIR) + "/pioneer2dx_pantilt.urdf", {}};
-    server_ = std::make_unique<Server>(server_end_, o, std::vector<RobotSpec>{spec}, registry_, clock_);
-    server_->Start();
+    auto server = std::make_unique<Server>(end, o, std::vector<RobotSpec>{spec}, registry_, clock_);
+    server->Start();
+    return server;
   }
   ClientOptions Options() {
     ClientOptions o;
@@ -148,6 +156,71 @@ TEST_F(ServerTrustTest, AnExplicitServerKeyOverridesThePinAndLeavesTheFileAlone)
   EXPECT_EQ(Slurp(Options().known_servers_file), pins);
   o.server_key_file = (dir_ / "server.pub").string();
   EXPECT_THAT(ConnectError(o), HasSubstr("given with --server-key; refused"));
+}
+
+// security.md ("Which server?"): a keyed client waits, up to its connect
+// timeout, for an answer of the server it trusts, so a fake server that
+// answers its hello first cannot keep it from its real one. Here the fake
+// one answers every hello before the real one even runs.
+TEST_F(ServerTrustTest, AFakeServerThatAnswersFirstCannotKeepAKeyedClientFromItsRealOne) {
+  MemoryTransport mallory_end(bus_);
+  const std::unique_ptr<Server> mallory = KeyedServer(mallory_end, "mallory", false);
+  ClientOptions o = Options();
+  o.server_key_file = (dir_ / "server.pub").string();
+  o.connect_timeout = seconds(10);
+  RobotClient client(o);
+  std::string error = "Connect has not returned";
+  std::thread connect([&] {
+    try {
+      client.Connect(kRobot);
+      error.clear();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  const bool refused = WaitUntil([&] { return client.stats().servers_refused >= 1; });
+  const auto real_from = std::chrono::steady_clock::now();
+  StartServer("server", /*allow_duplicate_robots=*/true);  // it starts second, beside the fake one
+  connect.join();
+  const double after = std::chrono::duration<double>(std::chrono::steady_clock::now() - real_from).count();
+  std::printf(
+      "connected %.2f s after the real server started; %llu answers of the fake server refused; %llu "
+      "sessions "
+      "lost\n",
+      after, static_cast<unsigned long long>(client.stats().servers_refused),
+      static_cast<unsigned long long>(client.stats().sessions_lost));
+  ASSERT_TRUE(refused) << "the fake server answered first";
+  ASSERT_EQ(error, "");
+  EXPECT_EQ(client.trusted_server().fingerprint, ReadPublicKeyFile(dir_ / "server.pub").key.Fingerprint());
+  EXPECT_EQ(client.Goto(0.1, 0, 0).signal, Signal::kSuccess);
+  EXPECT_GE(client.stats().servers_refused, 1u);
+}
+
+// security.md, Binding: a keyed client's id is one of its key's; given
+// another key's id (or a made-up one) it is refused at construction, naming
+// the id and its key, before it sends anything.
+using KeyedClientIdTest = ServerTrustTest;
+TEST_F(KeyedClientIdTest, AKeyedClientGivenAnIdNotOfItsKeyIsRefusedAtConstruction) {
+  const PublicKey alice = ReadPublicKeyFile(dir_ / "alice.pub").key;
+  const PublicKey mallory = ReadPublicKeyFile(dir_ / "mallory.pub").key;
+  const std::size_t published = bus_->published();
+  for (const std::int64_t id : {KeyedClientId(mallory, 7), std::int64_t{0x1234}}) {
+    ClientOptions o = Options();
+    o.client_id = id;
+    try {
+      RobotClient client(o);
+      ADD_FAILURE() << "client id " << id << " was taken by alice's key";
+    } catch (const ClientError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("client id " + std::to_string(id) + " is not one of key " +
+                                      alice.Fingerprint() + "'s"));
+    }
+  }
+  EXPECT_EQ(bus_->published(), published) << "a refused client sends nothing";
+  ClientOptions own = Options();
+  own.client_id = KeyedClientId(alice, 7);
+  EXPECT_EQ(RobotClient(own).client_id(), own.client_id);
+  EXPECT_TRUE(ClientIdBelongsTo(RobotClient(Options()).client_id(), alice))
+      << "id 0: one of the key's is made";
 }
 
 TEST_F(ServerTrustTest, ACorruptOrGroupWritableKnownServersFileIsAClearError) {

@@ -7,6 +7,7 @@
 #include "ode_driver.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/server.h"
+#include "support/observed_driver.h"
 #include "test_paths.h"
 
 #include <gmock/gmock.h>
@@ -14,6 +15,9 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -188,6 +192,114 @@ TEST_F(ServerShutdownTest, NothingThatWaitedRunsOnAnyRobotOnceTheShutdownHasBegu
   EXPECT_EQ(log_->Of("pioneer").back(), "Stop");
   std::this_thread::sleep_for(milliseconds(200));  // time for a reply, were there one
   EXPECT_FALSE(later.Poll().has_value()) << "it never ran, and nobody says it did";
+}
+
+// Once armed, the next Execute of the driver it observes hangs (at most
+// 20 s, or until released): a driver call that never returns while the
+// server shuts down.
+struct Hang final : testing::DriverObserver {
+  void Executed(const DriverCommand&, TimePoint) override {
+    if (!armed.exchange(false)) return;
+    std::unique_lock lock(mutex);
+    hung = true;
+    changed.notify_all();
+    changed.wait_for(lock, seconds(20), [&] { return released; });
+    returned = true;
+  }
+  // Waits until a call hangs, at most `timeout`.
+  bool WaitHung(Duration timeout) {
+    std::unique_lock lock(mutex);
+    return changed.wait_for(lock, timeout, [&] { return hung; });
+  }
+  void Release() {
+    {
+      std::lock_guard lock(mutex);
+      released = true;
+    }
+    changed.notify_all();
+  }
+  bool Hanging() {
+    std::lock_guard lock(mutex);
+    return hung && !returned;
+  }
+  std::atomic<bool> armed{false};
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool hung = false;
+  bool released = false;
+  bool returned = false;
+};
+
+// A driver call that hangs while the server shuts down (the ServerDaemon
+// that watched the call bound has stopped): the other robot still gets its
+// STOP at once, the call is still a fault (its command answered ERROR, the
+// robot latched in panic) and the shutdown ends; it once waited for the call
+// however long it hung, every robot after it in the list left moving.
+TEST(HungDriverShutdown, AHungCallKeepsNoOtherRobotFromItsStopIsAFaultAndTheShutdownEnds) {
+  static const SteadyClock clock;  // the thread the shutdown gave up on may read it later
+  DriverRegistry registry;
+  RegisterKinematicDriver(registry);
+  auto log = std::make_shared<CallLog>();
+  auto hang = std::make_shared<Hang>();
+  registry.Register("hanging-kinematic", [&](const DriverConfig& config) {
+    return std::make_unique<RecordingDriver>(
+        config.robot_name,
+        std::make_unique<testing::ObservedDriver>(registry.Create("kinematic", config), hang), log, nullptr);
+  });
+  registry.Register("recorded-kinematic", [&](const DriverConfig& config) {
+    return std::make_unique<RecordingDriver>(config.robot_name, registry.Create("kinematic", config), log,
+                                             nullptr);
+  });
+  const std::string latch = ::testing::TempDir() + "/hung_driver_shutdown_latch";
+  std::remove(latch.c_str());
+  ServerOptions options;
+  options.lcm_url = kUrl;
+  options.driver_call_bound = milliseconds(1500);
+  options.panic_latch_path = latch;
+  const std::string urdf = testing::ProjectModel("pioneer2dx_pantilt.urdf");
+  // The hanging robot first: the shutdown once took the robots in this order.
+  Server server(options,
+                std::vector<RobotSpec>{{"rover", "hanging-kinematic", urdf, {}},
+                                       {"pioneer", "recorded-kinematic", urdf, {}}},
+                registry, clock);
+  server.Start();
+  ClientOptions client_options;
+  client_options.lcm_url = kUrl;
+  RobotClient pioneer(client_options);
+  pioneer.Connect("pioneer");
+  RobotClient rover(client_options);
+  rover.Connect("rover");
+  ASSERT_EQ(pioneer.SetSpeed(0.3, 0.1).signal, Signal::kSuccess);
+  hang->armed = true;
+  PendingReply drive = rover.Send(Command{.type = CommandType::kGoto, .values = {5.0, 0.0, 0.0}});
+  ASSERT_TRUE(hang->WaitHung(seconds(5))) << "the rover's Execute never started";
+
+  const auto begin = std::chrono::steady_clock::now();
+  server.Stop();
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  std::printf("Server::Stop returned after %.2f s with the rover's Execute hung (bound 1.5 s)\n", took);
+  EXPECT_TRUE(hang->Hanging()) << "the shutdown waited for the hung call (" << took << " s)";
+  EXPECT_EQ(server.not_stopped(), std::vector<std::string>{"rover"});
+  const auto pioneer_calls = log->Of("pioneer");
+  ASSERT_FALSE(pioneer_calls.empty());
+  EXPECT_EQ(pioneer_calls.back(), "Stop") << "the other robot got its STOP while the rover's call hung";
+  const Reply goto_reply = drive.Wait(seconds(5));
+  EXPECT_EQ(goto_reply.signal, Signal::kError) << goto_reply.message;
+  EXPECT_THAT(goto_reply.message, HasSubstr("has run for"));
+  std::ifstream latched(latch);
+  const std::string latch_text((std::istreambuf_iterator<char>(latched)), std::istreambuf_iterator<char>());
+  EXPECT_THAT(latch_text, HasSubstr("rover")) << "the fault is on the panic latch";
+
+  // Should the call ever return, the rover's own thread still STOPs it.
+  hang->Release();
+  const auto until = std::chrono::steady_clock::now() + seconds(5);
+  auto rover_calls = log->Of("rover");
+  while ((rover_calls.empty() || rover_calls.back() != "Stop") && std::chrono::steady_clock::now() < until) {
+    log->WaitForMoreThan("rover", rover_calls.size(), milliseconds(100));
+    rover_calls = log->Of("rover");
+  }
+  ASSERT_FALSE(rover_calls.empty());
+  EXPECT_EQ(rover_calls.back(), "Stop");
 }
 
 }  // namespace

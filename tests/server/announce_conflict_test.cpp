@@ -13,6 +13,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <sstream>
+
 namespace robotalk {
 namespace {
 
@@ -119,6 +122,63 @@ TEST_F(AnnounceConflictTest, AConflictDuringTheStartUpWindowRefusesTheRobotAndTh
   EXPECT_EQ(server_->refused("arm"), "");
   EXPECT_EQ(server_->serving(), 1u) << "still serves 'arm'";
   EXPECT_THAT(server_->refusals(), ::testing::ElementsAre(HasSubstr("robot 'bot' is served by")));
+}
+
+// server.md: a robot given up in the start-up window is stopped if it
+// moved (a client of this server may have moved it in those 2 s); one at
+// rest gets no STOP.
+TEST_F(AnnounceConflictTest, ARobotGivenUpInTheStartUpWindowIsStoppedIfItMovedAndOnlyThen) {
+  Step();  // starts; its window is open
+  ASSERT_TRUE(BotStillServes(1));
+  ASSERT_TRUE(fakes_["bot"]->moving);
+  const std::size_t bot_calls = fakes_["bot"]->calls.size();
+  lan_.Publish(kAnnounceChannel, ForgedAnnounce(7, "bot"));
+  lan_.Publish(kAnnounceChannel, ForgedAnnounce(8, "arm"));
+  Step();
+  ASSERT_THAT(server_->refused("bot"), HasSubstr("is served by server 0000000000000007"));
+  ASSERT_THAT(server_->refused("arm"), HasSubstr("is served by server 0000000000000008"));
+  ASSERT_EQ(fakes_["bot"]->calls.size(), bot_calls + 1);
+  EXPECT_EQ(fakes_["bot"]->calls.back().type, CommandType::kStop) << "the robot it moved is stopped";
+  EXPECT_FALSE(fakes_["bot"]->moving);
+  EXPECT_TRUE(fakes_["arm"]->calls.empty()) << "a robot at rest gets no STOP";
+}
+
+// A conflict after the start-up window is logged at most once per robot per
+// 10 s, the ANNOUNCEs between counted in the next line (the burst above is
+// one line; this is the period).
+TEST_F(AnnounceConflictTest, AConflictIsLoggedAtMostOncePerRobotPerTenSeconds) {
+  Step();
+  clock_.Advance(std::chrono::seconds(10));  // past the start-up window
+  Step();
+  const auto lines = [this](const std::function<void()>& burst, const std::string& robot) {
+    ::testing::internal::CaptureStderr();
+    burst();
+    Step();
+    std::istringstream log(::testing::internal::GetCapturedStderr());
+    std::vector<std::string> found;
+    for (std::string line; std::getline(log, line);) {
+      if (line.find("robot '" + robot + "': ") != std::string::npos &&
+          line.find("also announces it") != std::string::npos)
+        found.push_back(line);
+    }
+    return found;
+  };
+  const auto forge = [this](const std::string& robot, int n) {
+    return [this, robot, n] {
+      for (int i = 0; i < n; ++i) lan_.Publish(kAnnounceChannel, ForgedAnnounce(100 + i, robot));
+    };
+  };
+  EXPECT_EQ(lines(forge("bot", 1), "bot").size(), 1u) << "the first is logged";
+  clock_.Advance(std::chrono::seconds(5));
+  EXPECT_TRUE(lines(forge("bot", 50), "bot").empty()) << "5 s later: counted, not logged";
+  EXPECT_EQ(lines(forge("arm", 1), "arm").size(), 1u) << "another robot's conflict has its own period";
+  clock_.Advance(std::chrono::milliseconds(4990));
+  EXPECT_TRUE(lines(forge("bot", 1), "bot").empty()) << "9.99 s after the first line";
+  clock_.Advance(std::chrono::milliseconds(10));
+  const auto line = lines(forge("bot", 1), "bot");
+  ASSERT_EQ(line.size(), 1u) << "10 s after the first line, the next";
+  EXPECT_THAT(line.front(), HasSubstr("; 51 more such ANNOUNCEs since the last line"));
+  EXPECT_EQ(server_->refused("bot"), "");
 }
 
 TEST_F(AnnounceConflictTest, AServerThatRefusesEveryRobotServesNothingAndSaysSo) {

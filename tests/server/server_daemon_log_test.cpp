@@ -5,13 +5,21 @@
 
 #include "fake_driver.h"
 #include "robot_daemon.h"
+#include "robotalk/channels.h"
+#include "robotalk/forwarding_transport.h"
 #include "robotalk/memory_transport.h"
+#include "robotalk/request.h"
 #include "server_daemon.h"
+#include "session_test_util.h"
+#include "support/test_clients.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <functional>
+#include <iterator>
 #include <sstream>
 
 namespace robotalk {
@@ -54,6 +62,67 @@ TEST(ServerDaemonLog, ADriverFailingInEveryUpdateLogsItsFaultOnceAndThenASummary
   EXPECT_THAT(faults[0], HasSubstr("driver 'fake' threw in Update: CAN bus timeout"));
   EXPECT_THAT(faults[1], HasSubstr("(repeated "));
   EXPECT_TRUE(robot.in_panic());
+}
+
+// Publishes through `inner`; `before` sees every message just before it leaves.
+class WatchedTransport final : public ForwardingTransport {
+ public:
+  using Before = std::function<void(const std::string&, std::span<const std::uint8_t>)>;
+  WatchedTransport(Transport& inner, Before before)
+      : ForwardingTransport(inner), before_(std::move(before)) {}
+  void Publish(const std::string& channel, std::span<const std::uint8_t> bytes) override {
+    before_(channel, bytes);
+    inner().Publish(channel, bytes);
+  }
+
+ private:
+  Before before_;
+};
+
+// soak.md: the audit line (--log-executions) of a command is on stderr
+// before its reply leaves, so a reply never exists without its line (a
+// server killed in between would leave the soak's checker a reply it cannot
+// explain). Stderr is captured to a file; at each reply package's publish
+// the file must already hold the line of every reply in it.
+TEST(ServerDaemonLog, AnAuditLineIsWrittenBeforeItsReplyLeaves) {
+  ManualClock clock;
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport server_end(bus);
+  MemoryTransport client(bus);
+  std::vector<std::string> without_line;
+  std::size_t replies = 0;
+  WatchedTransport watched(server_end, [&](const std::string& channel, std::span<const std::uint8_t> bytes) {
+    if (channel.find("/REPLY/") == std::string::npos) return;
+    std::ifstream captured("/proc/self/fd/2");  // what stderr holds now
+    const std::string written((std::istreambuf_iterator<char>(captured)), std::istreambuf_iterator<char>());
+    for (const Reply& r : DecodeReplyBatch(bytes).replies) {
+      ++replies;
+      if (written.find("command " + std::to_string(r.id) + " ") == std::string::npos)
+        without_line.push_back(std::to_string(r.id) + " " + std::string(ToString(r.signal)));
+    }
+  });
+  RobotDaemon robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
+                    RobotDaemonOptions{.log_executions = true});
+  ::testing::internal::CaptureStderr();
+  {
+    ServerDaemon server(watched, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0});
+    server.AddRobot(robot, SessionOptions{});
+    const auto step = [&] {
+      server.RunOnce(Duration(0));
+      robot.RunOnce(clock.Now());
+      server.RunOnce(Duration(0));
+      clock.Advance(milliseconds(10));
+    };
+    const std::int64_t session = testing::SayHello(client, "bot", testing::kAlice, step).session_id;
+    Request r{.client_id = testing::kAlice, .session_id = session, .sequence = 1};
+    r.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
+    r.commands.push_back(Command{2, CommandType::kJointSetPoint, std::nullopt, "pan", {2.0}});  // MODIFIED
+    client.Publish(RequestChannel("bot"), EncodeRequest(r));
+    for (int i = 0; i < 5; ++i) step();
+  }
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(replies, 2u) << log;
+  EXPECT_THAT(without_line, ::testing::IsEmpty()) << "replies that left before their audit line\n" << log;
 }
 
 }  // namespace

@@ -240,6 +240,55 @@ TEST_F(GateTest, APanicInAPackageWithABadHeaderIsAnsweredRefusedWithTheReason) {
   EXPECT_FALSE(batches_.back().panic_refusal.empty());
 }
 
+// protocol.md, Protocol versions: the server refuses a package or hello of
+// another version naming both versions. `bytes`' version (an int16 after the
+// 8-byte fingerprint, the first field of hello_t and of package_header_t)
+// becomes `version`; returns the version it had.
+int SetProtocolVersion(std::vector<std::uint8_t>& bytes, int version) {
+  const int had = bytes.at(8) << 8 | bytes.at(9);
+  bytes[8] = static_cast<std::uint8_t>(version >> 8);
+  bytes[9] = static_cast<std::uint8_t>(version & 0xff);
+  return had;
+}
+
+TEST_F(GateTest, AHelloOfAnotherProtocolVersionIsRefusedNamingBothVersions) {
+  Hello hello;
+  hello.body.client_id = kAlice;
+  hello.body.client_nonce = RandomNonce();
+  std::vector<std::uint8_t> bytes = EncodeHello(hello);
+  const int ours = SetProtocolVersion(bytes, 3);
+  ASSERT_NE(ours, 3);
+  bool answered = false;
+  auto sub = client_.Subscribe(HelloAnswerChannel("bot", kAlice),
+                               [&](const std::string&, std::span<const std::uint8_t>) { answered = true; });
+  ::testing::internal::CaptureStderr();
+  client_.Publish(HelloChannel("bot"), bytes);
+  Step();
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(answered) << "no session for a hello of another version";
+  EXPECT_EQ(server_->malformed(), 1u);
+  EXPECT_THAT(log, HasSubstr("protocol version 3 is not supported"));
+  EXPECT_THAT(log, HasSubstr("speaks " + std::to_string(ours))) << log;
+  EXPECT_NE(OpenSession(kAlice), 0) << "a hello of this version is answered";
+}
+
+TEST_F(GateTest, APackageOfAnotherProtocolVersionIsRefusedNamingBothVersions) {
+  const std::int64_t session = OpenSession(kAlice);
+  std::vector<std::uint8_t> bytes = EncodeRequest(Move(kAlice, session, 1, 1));
+  const int ours = SetProtocolVersion(bytes, 3);
+  ::testing::internal::CaptureStderr();
+  Publish(bytes);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(Executed(), 0u);
+  ASSERT_EQ(replies_.count(1), 1u);
+  EXPECT_EQ(replies_.at(1).signal, Signal::kError);
+  for (const std::string& text : {replies_.at(1).message, log}) {
+    EXPECT_THAT(text, HasSubstr("protocol version 3 is not supported"));
+    EXPECT_THAT(text, HasSubstr("speaks " + std::to_string(ours))) << text;
+  }
+  EXPECT_THAT(log, HasSubstr("refused package from client"));
+}
+
 // --- keyed mode ------------------------------------------------------------
 
 KeyPair Key(std::uint8_t seed) {

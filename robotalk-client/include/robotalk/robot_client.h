@@ -352,7 +352,7 @@ struct ClientStats {
   std::uint64_t gave_up = 0;             ///< packages abandoned
   std::uint64_t sessions_opened = 0;     ///< hellos answered with a session
   std::uint64_t sessions_lost = 0;       ///< the server no longer knew the session (restart, expiry)
-  std::uint64_t replies_refused = 0;     ///< keyed: reply packages whose MAC did not verify
+  std::uint64_t replies_refused = 0;     ///< keyed: replies whose MAC or (SESSION_UNKNOWN) signature failed
   /// Keyed: STATE and CONFIG messages dropped: unsigned, signed by another
   /// key or server instance, forged, or (STATE) not newer than the last one.
   std::uint64_t broadcasts_refused = 0;

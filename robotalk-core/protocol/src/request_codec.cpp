@@ -146,8 +146,27 @@ std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& b) {
   return EncodeMessage(p);
 }
 
+namespace {
+
+// A keyed server signs a SESSION_UNKNOWN answer (it has no session key to
+// seal it with): the message, then the signature suffix (broadcast_signature.h).
+robotalk_msgs::reply_package_t DecodeReplyPackageOrSigned(std::span<const std::uint8_t> bytes) {
+  try {
+    return DecodeReplyPackage(bytes);
+  } catch (const ProtocolError&) {
+    if (!SignatureSuffix(bytes)) throw;
+  }
+  const robotalk_msgs::reply_package_t p = DecodeReplyPackage(WithoutSignature(bytes));
+  if (p.session_status != robotalk_msgs::reply_package_t::SESSION_UNKNOWN) {
+    throw ProtocolError("DecodeReplyBatch: a signature suffix after a reply package of a session");
+  }
+  return p;
+}
+
+}  // namespace
+
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes) {
-  const robotalk_msgs::reply_package_t p = DecodeReplyPackage(bytes);
+  const robotalk_msgs::reply_package_t p = DecodeReplyPackageOrSigned(bytes);
   if (p.protocol_version != kProtocolVersion) {
     throw ProtocolError("DecodeReplyBatch: protocol version " + std::to_string(p.protocol_version) +
                         " is not supported (this side speaks " + std::to_string(kProtocolVersion) + ")");

@@ -178,8 +178,13 @@ class Server {
   Server& operator=(const Server&) = delete;
 
   void Start();
-  /// Stops every robot (STOP), then the threads. Idempotent.
+  /// Stops every robot (STOP), then the threads. Idempotent. A driver call
+  /// that hangs is watched against `driver_call_bound` meanwhile (a fault,
+  /// latched) and waited for until it has run twice the bound; its robot is
+  /// then left without its STOP and named by not_stopped().
   void Stop();
+  /// The robots Stop() could not STOP (their driver call hung); empty before.
+  std::vector<std::string> not_stopped() const;
 
   std::vector<std::string> robot_names() const;
   /// How many robots this server serves: fewer than robot_names() when

@@ -126,7 +126,9 @@ struct ReplyBatch {
 };
 std::vector<std::uint8_t> EncodeReplyBatch(const ReplyBatch& batch);
 /// Throws ProtocolError on truncated, hostile or foreign bytes, another
-/// protocol version, or an unknown session or panic status.
+/// protocol version, or an unknown session or panic status. A SESSION_UNKNOWN
+/// package may carry a keyed server's signature suffix (broadcast_signature.h;
+/// not verified here).
 ReplyBatch DecodeReplyBatch(std::span<const std::uint8_t> bytes);
 
 /// One served robot in an ANNOUNCE.
