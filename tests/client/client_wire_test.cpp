@@ -18,6 +18,7 @@
 #include <future>
 #include <map>
 #include <set>
+#include <thread>
 
 namespace robotalk {
 namespace {
@@ -177,6 +178,62 @@ TEST_F(RobotClientWireTest, WhenAPlaybackPackagesFirstCopyIsLostTheSecondKeepsIt
       EXPECT_GT(client.stats().retransmissions, 0u);
     }
   }
+}
+
+// Issue 23 item 3 on a lossy WAN: a link that has shown loss (the first copy
+// of the client's second package, at Connect) goes on losing: the first copy
+// of the 4th playback package too. With the default options the client sends
+// that frame's second copy at once (the link lost a message, and its
+// retransmission could not arrive before the frame is due), so every frame
+// runs on time; before, the default sent each playback package once and the
+// frame came as its retransmission, 100 ms late.
+TEST_F(RobotClientWireTest, OnALinkThatHasShownLossTheDefaultSendsAPlaybackFramesSecondCopyInTime) {
+  const std::int64_t fixture_client = client_->client_id();
+  struct Seen {
+    std::vector<std::int64_t> packages, playback;
+  };
+  auto seen = std::make_shared<std::map<std::int64_t, Seen>>();  // client -> first copies, in order
+  server_net_.Add({.channel_regex = RequestChannel(kRobot),
+                   .direction = Direction::kIncoming,
+                   .when =
+                       [seen, fixture_client](const std::string&, std::span<const std::uint8_t> bytes) {
+                         const Request r = DecodeRequest(bytes);
+                         if (r.client_id == fixture_client || r.sequence <= 0) return false;
+                         Seen& s = (*seen)[r.client_id];
+                         if (std::find(s.packages.begin(), s.packages.end(), r.sequence) != s.packages.end())
+                           return false;  // a later copy passes
+                         s.packages.push_back(r.sequence);
+                         if (r.mode == RequestMode::kPlayback) s.playback.push_back(r.sequence);
+                         return s.packages.size() == 2 ||
+                                (r.mode == RequestMode::kPlayback && s.playback.size() == 4);
+                       },
+                   .mute = true});
+  std::vector<TimedCommand> frames;
+  for (int i = 0; i < 6; ++i)
+    frames.push_back({milliseconds(50 * i), Command{.type = CommandType::kSetSpeed, .values = {0.0, 0.0}}});
+  ClientOptions o;  // the default playback redundancy
+  o.transport = &client_end_;
+  o.timeout = seconds(5);
+  o.connect_timeout = seconds(5);
+  RobotClient client(o);
+  client.Connect(kRobot);
+  // The client counts a message lost once every copy's acknowledgement had
+  // time to come (twice the retransmission timeout after its last copy).
+  std::this_thread::sleep_for(seconds(1));
+  const SequenceResult result = client.RunSequence(frames, {.mode = CommandMode::kPlayback});
+  int ran = 0;
+  Duration longest_gap{0};
+  for (std::size_t i = 0; i < result.replies.size(); ++i) {
+    const Reply& r = result.replies[i];
+    ran += r.signal == Signal::kSuccess;
+    if (i > 0) longest_gap = std::max(longest_gap, r.exec_time - result.replies[i - 1].exec_time);
+  }
+  EXPECT_EQ((*seen)[client.client_id()].playback.size(), 6u);
+  EXPECT_EQ(ran, 6);
+  // The lost frame's retransmission comes 100 ms after its first copy: a
+  // gap of 80 ms or more is the pause for it (every gap is 50 ms, at most
+  // 10 % longer).
+  EXPECT_LT(longest_gap, milliseconds(80)) << "the 4th frame came as its retransmission";
 }
 
 TEST_F(RobotClientWireTest, APanicAndQueriesAreEmptyOrQueryPackagesTheServerReadsWithoutError) {
