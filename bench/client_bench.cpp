@@ -11,8 +11,8 @@
 //   robotalk-bench-client stream   --url U --robot R --seconds T [--rate 100 --delay-ms 100 --start-at NS]
 //                                  delay-mode stream (the scale client): timeouts, lateness, own CPU
 //   robotalk-bench-client watch    --url U --robot R --count N [--period-us 1000]  STATE inter-arrival (us)
-//   robotalk-bench-client playback --url U --robot R --frames N [--period-ms 100] [--copies 1|2]  the
-//   server's chosen delay
+//   robotalk-bench-client playback --url U --robot R --frames N [--period-ms 100] [--copies 0|1|2]  the
+//   server's chosen delay (copies 0, the default: decided from the link)
 // Each prints one JSON line on stdout. Every loop is bounded in count and time.
 #include "bench_util.h"
 #include "robotalk/robot_client.h"
@@ -328,7 +328,8 @@ int Playback(const Args& a) {
   ClientOptions o = Options(a);
   o.timeout = std::chrono::seconds(30);
   o.connect_timeout = std::chrono::seconds(20);
-  o.playback_copies = static_cast<int>(a.Int("copies", 1));  // playback redundancy (1: off)
+  // playback redundancy: 1 off, 2 always, 0 (the library's default) decided from the link
+  o.playback_copies = static_cast<int>(a.Int("copies", ClientOptions{}.playback_copies));
   RobotClient c(o);
   c.Connect(a.Str("robot", "pioneer"));
   const long frames = a.Int("frames", 40);
@@ -368,7 +369,11 @@ int Playback(const Args& a) {
                                          ToSeconds(period) * static_cast<double>(r.replies.size() - 1)
                                    : 0;
   auto f = StatsFields(c);
+  const ClientStats stats = c.stats();
   f.insert(f.begin(), {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
+                       Field("copies_option", static_cast<double>(o.playback_copies)),
+                       Field("playback_copies", static_cast<double>(stats.playback_copies)),
+                       Field("messages_lost", static_cast<double>(stats.messages_lost)),
                        Summary("lateness_us", late), Field("late_frames", static_cast<double>(late_frames)),
                        Field("not_run", static_cast<double>(not_run)),
                        Field("gaps_over_bound", static_cast<double>(over_bound)),

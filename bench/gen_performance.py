@@ -347,6 +347,7 @@ def playback_estimators_section(res):
              "adaptive_lead0": "adaptive, previous default (`--playback-start-lead 0`)",
              "adaptive": "adaptive, start lead 1 (the default now)",
              "adaptive_copies": "adaptive (default) + client sends 2 copies",
+             "adaptive_one_copy": "adaptive (default) + client sends 1 copy (the client's default before)",
              "adaptive_queue": "adaptive (default) + queue start (option)",
              "adaptive_burst_off": "adaptive (default), burst discount off (`--playback-burst-discount off`)",
              "adaptive_stretch50": "adaptive, stretch 50 % (`--playback-stretch 0.5`, option)",

@@ -394,9 +394,12 @@ class Bench:
         variants = (("paper", ["--playback-estimator", "paper"], [], 0.0, None),
                     # the default before the start lead (issue 23's first adaptive start)
                     ("adaptive_lead0", adaptive + ["--playback-start-lead", "0"], [], 2.0, None),
-                    ("adaptive", adaptive, [], 2.0, None),  # the server's default, a client without redundancy
+                    # the server's default and the client's: redundancy decided from the link
+                    ("adaptive", adaptive, [], 2.0, None),
                     # a lost frame's retransmission comes a round trip late: the client's redundancy
                     ("adaptive_copies", adaptive, ["--copies", "2"], 2.0, ("WAN",)),
+                    # the client's default before (issue 23, tenth session): each playback package once
+                    ("adaptive_one_copy", adaptive, ["--copies", "1"], 2.0, None),
                     ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested),
                     # before the connect burst's own queue was left out of the delay spread
                     ("adaptive_burst_off", adaptive + ["--playback-burst-discount", "off"], [], 2.0, congested + ("WAN",)),
