@@ -234,6 +234,38 @@ TEST_F(RobotClientWireTest, OnALinkThatHasShownLossTheDefaultSendsAPlaybackFrame
   // gap of 80 ms or more is the pause for it (every gap is 50 ms, at most
   // 10 % longer).
   EXPECT_LT(longest_gap, milliseconds(80)) << "the 4th frame came as its retransmission";
+  EXPECT_GE(client.stats().messages_lost, 1u) << "the Connect-time loss, counted";
+  EXPECT_GE(client.stats().playback_copies, 1u);
+}
+
+// The other half of the automatic redundancy: a link that loses nothing (a
+// congested one among them: the relay's U[0, X] profiles) never gets a
+// second copy, heartbeats and all, so a queue-bound link's queue is not
+// doubled.
+TEST_F(RobotClientWireTest, OnALossFreeLinkTheDefaultSendsEachPlaybackPackageOnce) {
+  ClientOptions o;  // the default playback redundancy
+  o.transport = &client_end_;
+  o.timeout = seconds(5);
+  o.connect_timeout = seconds(5);
+  RobotClient client(o);
+  client.Connect(kRobot);
+  // Idle: heartbeats, each acknowledged; every package settles.
+  std::this_thread::sleep_for(seconds(1));
+  const std::size_t before = Heard().size();
+  const SequenceResult result = client.RunSequence(Frames(6), {.mode = CommandMode::kPlayback});
+  for (const Reply& r : result.replies) EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+  std::map<std::int64_t, int> copies;  // this client's packages: sequence -> times heard
+  const auto heard = Heard();
+  for (std::size_t k = before; k < heard.size(); ++k) {
+    if (heard[k].first != RequestChannel(kRobot)) continue;
+    const Request r = DecodeRequest(heard[k].second);
+    if (r.client_id == client.client_id() && r.mode == RequestMode::kPlayback) ++copies[r.sequence];
+  }
+  EXPECT_EQ(copies.size(), 6u);
+  for (const auto& [sequence, n] : copies) EXPECT_EQ(n, 1) << "package " << sequence;
+  EXPECT_EQ(client.stats().messages_lost, 0u);
+  EXPECT_EQ(client.stats().playback_copies, 0u);
+  EXPECT_GT(client.stats().heartbeats, 0u) << "the heartbeats' acks were counted too";
 }
 
 TEST_F(RobotClientWireTest, APanicAndQueriesAreEmptyOrQueryPackagesTheServerReadsWithoutError) {
