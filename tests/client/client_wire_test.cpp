@@ -180,6 +180,22 @@ TEST_F(RobotClientWireTest, WhenAPlaybackPackagesFirstCopyIsLostTheSecondKeepsIt
   }
 }
 
+// A client with the default playback redundancy, connected and then idle for
+// a second (heartbeats, each acknowledged): the client counts a message lost
+// once every copy's acknowledgement had time to come (twice the
+// retransmission timeout after its last copy), so every Connect-time
+// package has settled.
+std::unique_ptr<RobotClient> ConnectWithTheDefaultCopies(Transport& transport) {
+  ClientOptions o;
+  o.transport = &transport;
+  o.timeout = seconds(5);
+  o.connect_timeout = seconds(5);
+  auto client = std::make_unique<RobotClient>(o);
+  client->Connect(kRobot);
+  std::this_thread::sleep_for(seconds(1));
+  return client;
+}
+
 // Issue 23 item 3 on a lossy WAN: a link that has shown loss (the first copy
 // of the client's second package, at Connect) goes on losing: the first copy
 // of the 4th playback package too. With the default options the client sends
@@ -211,15 +227,8 @@ TEST_F(RobotClientWireTest, OnALinkThatHasShownLossTheDefaultSendsAPlaybackFrame
   std::vector<TimedCommand> frames;
   for (int i = 0; i < 6; ++i)
     frames.push_back({milliseconds(50 * i), Command{.type = CommandType::kSetSpeed, .values = {0.0, 0.0}}});
-  ClientOptions o;  // the default playback redundancy
-  o.transport = &client_end_;
-  o.timeout = seconds(5);
-  o.connect_timeout = seconds(5);
-  RobotClient client(o);
-  client.Connect(kRobot);
-  // The client counts a message lost once every copy's acknowledgement had
-  // time to come (twice the retransmission timeout after its last copy).
-  std::this_thread::sleep_for(seconds(1));
+  const std::unique_ptr<RobotClient> connected = ConnectWithTheDefaultCopies(client_end_);
+  RobotClient& client = *connected;
   const SequenceResult result = client.RunSequence(frames, {.mode = CommandMode::kPlayback});
   int ran = 0;
   Duration longest_gap{0};
@@ -243,14 +252,8 @@ TEST_F(RobotClientWireTest, OnALinkThatHasShownLossTheDefaultSendsAPlaybackFrame
 // second copy, heartbeats and all, so a queue-bound link's queue is not
 // doubled.
 TEST_F(RobotClientWireTest, OnALossFreeLinkTheDefaultSendsEachPlaybackPackageOnce) {
-  ClientOptions o;  // the default playback redundancy
-  o.transport = &client_end_;
-  o.timeout = seconds(5);
-  o.connect_timeout = seconds(5);
-  RobotClient client(o);
-  client.Connect(kRobot);
-  // Idle: heartbeats, each acknowledged; every package settles.
-  std::this_thread::sleep_for(seconds(1));
+  const std::unique_ptr<RobotClient> connected = ConnectWithTheDefaultCopies(client_end_);
+  RobotClient& client = *connected;
   const std::size_t before = Heard().size();
   const SequenceResult result = client.RunSequence(Frames(6), {.mode = CommandMode::kPlayback});
   for (const Reply& r : result.replies) EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;

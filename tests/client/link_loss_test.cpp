@@ -61,10 +61,16 @@ TEST(LinkLoss, AHeartbeatWithoutAckAndALostAckAreLossesToo) {
   EXPECT_EQ(l.settled(), 3u);
 }
 
-TEST(LinkLoss, AnAckAfterThePackageSettledChangesNothing) {
+// A heartbeat never acknowledged, found lost at 1 s.
+LinkLoss OneLossFoundAtOneSecond() {
   LinkLoss l;
   l.OnSend(1, kT0);
   l.Settle(kT0 + seconds(1), kSettle);
+  return l;
+}
+
+TEST(LinkLoss, AnAckAfterThePackageSettledChangesNothing) {
+  LinkLoss l = OneLossFoundAtOneSecond();
   l.OnAck(1);
   l.Settle(kT0 + seconds(2), kSettle);
   EXPECT_EQ(l.lost(), 1u);
@@ -72,9 +78,7 @@ TEST(LinkLoss, AnAckAfterThePackageSettledChangesNothing) {
 }
 
 TEST(LinkLoss, ALossIsForgottenAfterTheMemory) {
-  LinkLoss l;
-  l.OnSend(1, kT0);
-  l.Settle(kT0 + seconds(1), kSettle);  // found at 1 s
+  const LinkLoss l = OneLossFoundAtOneSecond();
   ASSERT_EQ(l.last_loss(), kT0 + seconds(1));
   EXPECT_TRUE(l.LostRecently(kT0 + seconds(1) + LinkLoss::kMemory - milliseconds(1)));
   EXPECT_FALSE(l.LostRecently(kT0 + seconds(1) + LinkLoss::kMemory));
@@ -83,12 +87,11 @@ TEST(LinkLoss, ALossIsForgottenAfterTheMemory) {
 // The rule: a second copy only on a link that lost a message and only where
 // the retransmission would come after the frame is due.
 TEST(LinkLoss, ASecondCopyOnlyAfterALossAndWhenARetransmissionWouldComeTooLate) {
-  LinkLoss l;
   const TimePoint now = kT0 + seconds(2);
   const Duration rto = milliseconds(150);
-  EXPECT_FALSE(l.WantsSecondCopy(now, rto, std::nullopt)) << "no loss yet: a congested link keeps one copy";
-  l.OnSend(1, kT0);
-  l.Settle(kT0 + seconds(1), kSettle);
+  EXPECT_FALSE(LinkLoss().WantsSecondCopy(now, rto, std::nullopt))
+      << "no loss yet: a congested link keeps one copy";
+  const LinkLoss l = OneLossFoundAtOneSecond();
   EXPECT_TRUE(l.WantsSecondCopy(now, rto, std::nullopt)) << "before the delay reply: no headroom known";
   EXPECT_TRUE(l.WantsSecondCopy(now, rto, milliseconds(40))) << "a 40 ms buffer: the resend is late";
   EXPECT_FALSE(l.WantsSecondCopy(now, rto, milliseconds(150))) << "the resend arrives in time";
