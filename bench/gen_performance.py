@@ -348,6 +348,8 @@ def playback_estimators_section(res):
              "adaptive": "adaptive, start lead 1 (the default now)",
              "adaptive_copies": "adaptive (default) + client sends 2 copies",
              "adaptive_one_copy": "adaptive (default) + client sends 1 copy (the client's default before)",
+             "adaptive_warm": "adaptive (default), the client's second sequence in its session",
+             "adaptive_one_copy_warm": "adaptive (default) + 1 copy, the client's second sequence in its session",
              "adaptive_queue": "adaptive (default) + queue start (option)",
              "adaptive_burst_off": "adaptive (default), burst discount off (`--playback-burst-discount off`)",
              "adaptive_stretch50": "adaptive, stretch 50 % (`--playback-stretch 0.5`, option)",

@@ -46,7 +46,7 @@ def main():
     for run in runs:
         table[(run["profile"], run["estimator"])].append(run)
     print("\n| profile | variant | goal met | median ratio to hindsight + hand-over | paper's estimate "
-          "| runs with second copies | runs whose client counted a loss |")
+          "| runs with second copies | runs whose client counted a loss (before the sequence) |")
     print("|---|---|---|---|---|---|---|")
     misses = []
     for (prof, est), rs in table.items():
@@ -57,7 +57,9 @@ def main():
         stat = lambda x, k: (x.get("robotalk") or {}).get(k) or 0  # noqa: E731
         copied = sum(1 for x in rs if stat(x, "playback_copies") > 0)
         lossy = sum(1 for x in rs if stat(x, "messages_lost") > 0)
-        print(f"| {prof} | {est} | {sum(v[0] for v in vs)} of {len(rs)} | {med:.2f} | {paper} | {copied} | {lossy} |")
+        before = sum(1 for x in rs if stat(x, "messages_lost_before") > 0)
+        print(f"| {prof} | {est} | {sum(v[0] for v in vs)} of {len(rs)} | {med:.2f} | {paper} | {copied} "
+              f"| {lossy} ({before}) |")
         misses += [(prof, est, x["seed"], v[1] + [f"second copies {stat(x, 'playback_copies'):.0f}, client "
                                                    f"counted {stat(x, 'messages_lost'):.0f} lost"])
                    for x, v in zip(rs, vs) if not v[0]]
