@@ -52,10 +52,9 @@ struct PackageOptions {
   /// The package's deadline (Request::max_late); nullopt: ClientOptions::max_late.
   std::optional<Duration> max_late;
   /// kPlayback: how long after its arrival the package's earliest frame is
-  /// due (the server's chosen delay + the frame's offset ahead of the
-  /// sequence's clock); nullopt before the delay reply. The automatic
-  /// redundancy (kPlaybackCopiesAuto) compares it with the retransmission
-  /// timeout.
+  /// due (the server's chosen delay, 0 before the delay reply, + the frame's
+  /// offset ahead of the sequence's clock). The automatic redundancy
+  /// (kPlaybackCopiesAuto) compares it with the retransmission timeout.
   std::optional<Duration> playback_headroom;
 };
 

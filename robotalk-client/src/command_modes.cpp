@@ -107,11 +107,12 @@ std::vector<PendingReply> RobotClient::Impl::SendPlanned(std::vector<TimedComman
     commands.push_back(std::move(c));
   }
   sequence.package.interpolation = send.interpolation;
-  if (sequence.chosen_delay && earliest) {
-    // Its earliest frame is due this long after the package arrives (its
-    // offset ahead of the sequence's clock on top of the server's buffer).
+  if (sequence.mode == CommandMode::kPlayback && earliest) {
+    // Its earliest frame is due this long after the package arrives: its
+    // offset ahead of the sequence's clock on top of the server's buffer
+    // (before the delay reply, at least the offset ahead).
     const Duration ahead = std::max(Duration(0), *earliest - (clock_.Now() - sequence.t0));
-    sequence.package.playback_headroom = *sequence.chosen_delay + ahead;
+    sequence.package.playback_headroom = sequence.chosen_delay.value_or(Duration(0)) + ahead;
   }
   const Sent sent = SendPackage(std::move(commands), {}, sequence.package);
   sequence.package.ask_for_delay = false;  // only the first package asks

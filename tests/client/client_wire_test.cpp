@@ -247,6 +247,50 @@ TEST_F(RobotClientWireTest, OnALinkThatHasShownLossTheDefaultSendsAPlaybackFrame
   EXPECT_GE(client.stats().playback_copies, 1u);
 }
 
+// The headroom half of the rule: a sequence sent ahead of its time (not
+// paced, a frame a package) on a link that has shown loss copies only the
+// frames a retransmission could not reach in time: the first (due at once)
+// goes twice, the last (500 ms ahead, against a 100 ms retransmission
+// timeout) once.
+TEST_F(RobotClientWireTest, AFrameSentFarAheadOfItsTimeGoesOnceEvenOnALinkThatHasShownLoss) {
+  const std::int64_t fixture_client = client_->client_id();
+  auto packages = std::make_shared<std::map<std::int64_t, std::set<std::int64_t>>>();  // client -> sequences
+  server_net_.Add({.channel_regex = RequestChannel(kRobot),
+                   .direction = Direction::kIncoming,
+                   .when =
+                       [packages, fixture_client](const std::string&, std::span<const std::uint8_t> bytes) {
+                         const Request r = DecodeRequest(bytes);
+                         if (r.client_id == fixture_client || r.sequence <= 0) return false;
+                         std::set<std::int64_t>& seen = (*packages)[r.client_id];
+                         return seen.insert(r.sequence).second && seen.size() == 2;  // one Connect-time copy
+                       },
+                   .mute = true});
+  const std::unique_ptr<RobotClient> client = ConnectWithTheDefaultCopies(client_end_);
+  ASSERT_GE(client->stats().messages_lost, 1u);
+  std::vector<TimedCommand> frames;
+  for (int i = 0; i < 6; ++i)
+    frames.push_back({milliseconds(100 * i), Command{.type = CommandType::kSetSpeed, .values = {0.0, 0.0}}});
+  const std::size_t before = Heard().size();
+  const SequenceResult result =
+      client->RunSequence(frames, {.mode = CommandMode::kPlayback, .paced = false, .batch = 1});
+  for (const Reply& r : result.replies) EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+  std::map<std::int64_t, int> copies;  // the frame's offset (ms) -> copies heard
+  const auto heard = Heard();
+  for (std::size_t k = before; k < heard.size(); ++k) {
+    if (heard[k].first != RequestChannel(kRobot)) continue;
+    const Request r = DecodeRequest(heard[k].second);
+    if (r.client_id != client->client_id() || r.mode != RequestMode::kPlayback || r.commands.size() != 1)
+      continue;
+    const auto offset =
+        std::chrono::duration_cast<milliseconds>(r.commands[0].start_time.offset().value_or(Duration(-1)))
+            .count();
+    ++copies[offset];
+  }
+  ASSERT_EQ(copies.size(), 6u);
+  EXPECT_EQ(copies[0], 2) << "due at once: its retransmission would be late";
+  EXPECT_EQ(copies[500], 1) << "500 ms ahead: a retransmission arrives in time";
+}
+
 // The other half of the automatic redundancy: a link that loses nothing (a
 // congested one among them: the relay's U[0, X] profiles) never gets a
 // second copy, heartbeats and all, so a queue-bound link's queue is not
