@@ -10,6 +10,12 @@ void LinkLoss::OnSend(std::int64_t sequence, TimePoint now, int copies) {
   e.sent += copies;
   e.last_send = std::max(e.last_send, now);
   by_last_send_.insert({e.last_send, sequence});
+  // Beyond kMaxPending the oldest are forgotten, neither lost nor settled:
+  // a flood of packages is no evidence of loss.
+  while (by_last_send_.size() > kMaxPending) {
+    entries_.erase(by_last_send_.begin()->second);
+    by_last_send_.erase(by_last_send_.begin());
+  }
 }
 
 void LinkLoss::OnAck(std::int64_t sequence) {

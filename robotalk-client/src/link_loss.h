@@ -21,6 +21,7 @@
 
 #include "robotalk/clock.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <set>
@@ -34,6 +35,10 @@ class LinkLoss {
   /// How long a loss keeps the second copy on (the loss-free time after
   /// which a link is trusted again).
   static constexpr Duration kMemory = std::chrono::seconds(60);
+  /// Packages awaiting their acks at most; beyond, the oldest are forgotten
+  /// uncounted (a server that never answers, or a flood of packages, must
+  /// not grow the bookkeeping, and is no evidence of loss).
+  static constexpr std::size_t kMaxPending = 4096;
 
   /// `copies` copies of package `sequence` left at `now` (a first send with
   /// its redundancy copies, or a retransmission: 1).
@@ -41,8 +46,8 @@ class LinkLoss {
   /// An acknowledgement of `sequence` arrived (one per copy the server got).
   void OnAck(std::int64_t sequence);
   /// Settles the packages whose last copy left `settle_after` or more before
-  /// `now`: a package with fewer acks than copies counts its missing acks as
-  /// lost messages.
+  /// `now`: a package with fewer acks than copies counts its missing acks
+  /// as lost messages.
   void Settle(TimePoint now, Duration settle_after);
 
   /// Messages lost so far (either direction), and packages settled.

@@ -84,6 +84,14 @@ TEST(LinkLoss, ALossIsForgottenAfterTheMemory) {
   EXPECT_FALSE(l.LostRecently(kT0 + seconds(1) + LinkLoss::kMemory));
 }
 
+TEST(LinkLoss, AServerThatNeverAnswersDoesNotGrowTheBookkeeping) {
+  LinkLoss l;
+  for (std::int64_t k = 1; k <= static_cast<std::int64_t>(LinkLoss::kMaxPending) + 10; ++k) l.OnSend(k, kT0);
+  l.Settle(kT0 + seconds(1), kSettle);
+  EXPECT_EQ(l.settled(), LinkLoss::kMaxPending) << "the 10 oldest forgotten";
+  EXPECT_EQ(l.lost(), LinkLoss::kMaxPending);
+}
+
 // The rule: a second copy only on a link that lost a message and only where
 // the retransmission would come after the frame is due.
 TEST(LinkLoss, ASecondCopyOnlyAfterALossAndWhenARetransmissionWouldComeTooLate) {
