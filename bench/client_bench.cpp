@@ -11,8 +11,9 @@
 //   robotalk-bench-client stream   --url U --robot R --seconds T [--rate 100 --delay-ms 100 --start-at NS]
 //                                  delay-mode stream (the scale client): timeouts, lateness, own CPU
 //   robotalk-bench-client watch    --url U --robot R --count N [--period-us 1000]  STATE inter-arrival (us)
-//   robotalk-bench-client playback --url U --robot R --frames N [--period-ms 100] [--copies 1|2]  the
-//   server's chosen delay
+//   robotalk-bench-client playback --url U --robot R --frames N [--period-ms 100] [--copies 0|1|2] [--warmup
+//   K]  the server's chosen delay (copies 0, the default: decided from the link; K sequences before,
+//   unmeasured)
 // Each prints one JSON line on stdout. Every loop is bounded in count and time.
 #include "bench_util.h"
 #include "robotalk/robot_client.h"
@@ -328,7 +329,8 @@ int Playback(const Args& a) {
   ClientOptions o = Options(a);
   o.timeout = std::chrono::seconds(30);
   o.connect_timeout = std::chrono::seconds(20);
-  o.playback_copies = static_cast<int>(a.Int("copies", 1));  // playback redundancy (1: off)
+  // playback redundancy: 1 off, 2 always, 0 (the library's default) decided from the link
+  o.playback_copies = static_cast<int>(a.Int("copies", ClientOptions{}.playback_copies));
   RobotClient c(o);
   c.Connect(a.Str("robot", "pioneer"));
   const long frames = a.Int("frames", 40);
@@ -338,6 +340,10 @@ int Playback(const Args& a) {
   SequenceOptions so;
   so.mode = CommandMode::kPlayback;
   so.paced = true;
+  // --warmup K: K unmeasured sequences first, in the same session (a
+  // long-lived client, whose link figures have had time to form).
+  for (long k = a.Int("warmup", 0); k > 0; --k) c.RunSequence(seq, so);
+  const ClientStats before = c.stats();
   const SequenceResult r = c.RunSequence(std::move(seq), so);
   std::vector<double> late;
   long late_frames = 0, not_run = 0, over_bound = 0;
@@ -368,11 +374,17 @@ int Playback(const Args& a) {
                                          ToSeconds(period) * static_cast<double>(r.replies.size() - 1)
                                    : 0;
   auto f = StatsFields(c);
-  f.insert(f.begin(), {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
-                       Summary("lateness_us", late), Field("late_frames", static_cast<double>(late_frames)),
-                       Field("not_run", static_cast<double>(not_run)),
-                       Field("gaps_over_bound", static_cast<double>(over_bound)),
-                       Field("max_gap_stretch", max_stretch), Field("total_stretch_s", total_stretch)});
+  const ClientStats stats = c.stats();
+  f.insert(
+      f.begin(),
+      {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
+       Field("copies_option", static_cast<double>(o.playback_copies)),
+       Field("playback_copies", static_cast<double>(stats.playback_copies - before.playback_copies)),
+       Field("messages_lost", static_cast<double>(stats.messages_lost)),
+       Field("messages_lost_before", static_cast<double>(before.messages_lost)), Summary("lateness_us", late),
+       Field("late_frames", static_cast<double>(late_frames)), Field("not_run", static_cast<double>(not_run)),
+       Field("gaps_over_bound", static_cast<double>(over_bound)), Field("max_gap_stretch", max_stretch),
+       Field("total_stretch_s", total_stretch)});
   PrintJson(f);
   return 0;
 }

@@ -45,16 +45,24 @@ def main():
     table = defaultdict(list)
     for run in runs:
         table[(run["profile"], run["estimator"])].append(run)
-    print("\n| profile | variant | goal met | median ratio to hindsight + hand-over | paper's estimate |")
-    print("|---|---|---|---|---|")
+    print("\n| profile | variant | goal met | median ratio to hindsight + hand-over | paper's estimate "
+          "| runs with second copies | runs whose client counted a loss (before the sequence) |")
+    print("|---|---|---|---|---|---|---|")
     misses = []
     for (prof, est), rs in table.items():
         vs = [verdict(x) for x in rs]
         ratios = sorted(v[2] for v in vs if v[2] is not None)
         med = ratios[len(ratios) // 2] if ratios else float("nan")
         paper = sum(1 for x in rs if ((x.get("robotalk") or {}).get("chosen_delay_s") or 0) >= 0.45)
-        print(f"| {prof} | {est} | {sum(v[0] for v in vs)} of {len(rs)} | {med:.2f} | {paper} |")
-        misses += [(prof, est, x["seed"], v[1]) for x, v in zip(rs, vs) if not v[0]]
+        stat = lambda x, k: (x.get("robotalk") or {}).get(k) or 0  # noqa: E731
+        copied = sum(1 for x in rs if stat(x, "playback_copies") > 0)
+        lossy = sum(1 for x in rs if stat(x, "messages_lost") > 0)
+        before = sum(1 for x in rs if stat(x, "messages_lost_before") > 0)
+        print(f"| {prof} | {est} | {sum(v[0] for v in vs)} of {len(rs)} | {med:.2f} | {paper} | {copied} "
+              f"| {lossy} ({before}) |")
+        misses += [(prof, est, x["seed"], v[1] + [f"second copies {stat(x, 'playback_copies'):.0f}, client "
+                                                   f"counted {stat(x, 'messages_lost'):.0f} lost"])
+                   for x, v in zip(rs, vs) if not v[0]]
     print("\nMisses:")
     for prof, est, seed, why in misses:
         print(f"- {prof}, {est}, seed {seed}: " + "; ".join(why))

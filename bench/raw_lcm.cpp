@@ -11,7 +11,7 @@
 //   robotalk-bench-raw watch    --url U --channel C --count N [--period-us P --timeout S]
 //   robotalk-bench-raw sessions --url U --robot R --count K --seconds S [--load L ...]
 //       K sessions, idle or under an exhaustion load (sessions_bench.cpp)
-//   robotalk-bench-raw arrivals --url U --robot R --frames N [--timeout S]
+//   robotalk-bench-raw arrivals --url U --robot R --frames N [--timeout S] [--skip K]
 //       the arrival log of a playback sequence at the server's side: each frame's
 //       lag (arrival - first arrival - offset) and the hindsight minimum delay
 //   robotalk-bench-raw sizes    encoded sizes of a BASE_POSE request and its reply
@@ -271,12 +271,14 @@ class ArrivalLog {
     for (const auto& c : p->commands) {
       if (seen_.count(c.id)) continue;
       seen_[c.id] = true;
+      if (static_cast<long>(seen_.size()) <= skip) continue;  // a warm-up sequence's frame
       arrival_ns.push_back(now);
       offset_us.push_back(c.start_time_us);
       send_us.push_back(p->header.send_time_us);
     }
   }
   std::vector<std::int64_t> arrival_ns, offset_us, send_us;
+  long skip = 0;  ///< the first `skip` frames are not logged
 
  private:
   std::map<std::int64_t, bool> seen_;
@@ -287,6 +289,7 @@ int Arrivals(const Args& a) {
   lcm::LCM lcm(UrlOfChannel(a.Str("url", ""), channel));
   CheckGood(lcm, a);
   ArrivalLog log;
+  log.skip = a.Int("skip", 0);
   lcm.subscribe(channel, &ArrivalLog::On, &log)->setQueueCapacity(10000);
   const long frames = a.Int("frames", 40);
   const std::int64_t end = MonoNs() + static_cast<std::int64_t>(a.Num("timeout", 60) * 1e9);

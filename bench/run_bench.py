@@ -394,9 +394,15 @@ class Bench:
         variants = (("paper", ["--playback-estimator", "paper"], [], 0.0, None),
                     # the default before the start lead (issue 23's first adaptive start)
                     ("adaptive_lead0", adaptive + ["--playback-start-lead", "0"], [], 2.0, None),
-                    ("adaptive", adaptive, [], 2.0, None),  # the server's default, a client without redundancy
+                    # the server's default and the client's: redundancy decided from the link
+                    ("adaptive", adaptive, [], 2.0, None),
                     # a lost frame's retransmission comes a round trip late: the client's redundancy
                     ("adaptive_copies", adaptive, ["--copies", "2"], 2.0, ("WAN",)),
+                    # the client's default before (issue 23, tenth session): each playback package once
+                    ("adaptive_one_copy", adaptive, ["--copies", "1"], 2.0, None),
+                    # the same two after one unmeasured sequence in the same session (a long-lived client)
+                    ("adaptive_warm", adaptive, ["--warmup", "1"], 2.0, ("WAN",)),
+                    ("adaptive_one_copy_warm", adaptive, ["--copies", "1", "--warmup", "1"], 2.0, ("WAN",)),
                     ("adaptive_queue", adaptive + ["--playback-queue-start", "on"], [], 2.0, congested),
                     # before the connect burst's own queue was left out of the delay spread
                     ("adaptive_burst_off", adaptive + ["--playback-burst-discount", "off"], [], 2.0, congested + ("WAN",)),
@@ -440,12 +446,14 @@ class Bench:
                     relay = self.start([self.relay, "--a", URL_A, "--b", URL_B, *impair, "--seed", str(seed),
                                         "--duration", "120"])
                     time.sleep(0.3)
+                    warmups = int(client_args[client_args.index("--warmup") + 1]) if "--warmup" in client_args else 0
                     log = self.start([self.raw, "arrivals", "--url", URL_B, "--robot", ROBOT, "--frames",
-                                      str(frames), "--timeout", "50"])
+                                      str(frames), "--timeout", "50", "--skip", str(frames * warmups)])
                     time.sleep(0.2)  # the arrival log subscribed before the first frame
                     a = self.run([self.client, "playback", "--url", URL_A, "--frames", str(frames),
-                                  "--period-ms", "100", "--stretch-bound", "0.1", *client_args], timeout=60)
-                    arr = self.collect(log, 50, "arrivals")
+                                  "--period-ms", "100", "--stretch-bound", "0.1", *client_args],
+                                 timeout=60 * (1 + warmups))
+                    arr = self.collect(log, 50 * (1 + warmups), "arrivals")
                     self.stop(relay)
                     self.stop_server()
                     runs.append({"profile": name, "relay_args": impair, "seed": seed, "estimator": est,

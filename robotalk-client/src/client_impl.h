@@ -8,6 +8,7 @@
 
 #include "clock_sync.h"
 #include "config_store.h"
+#include "link_loss.h"
 #include "outstanding_packages.h"
 #include "return_cache.h"
 #include "robotalk/channels.h"
@@ -50,6 +51,11 @@ struct PackageOptions {
   Interpolation interpolation = Interpolation::kStep;
   /// The package's deadline (Request::max_late); nullopt: ClientOptions::max_late.
   std::optional<Duration> max_late;
+  /// kPlayback: how long after its arrival the package's earliest frame is
+  /// due (the server's chosen delay, 0 before the delay reply, + the frame's
+  /// offset ahead of the sequence's clock). The automatic redundancy
+  /// (kPlaybackCopiesAuto) compares it with the retransmission timeout.
+  std::optional<Duration> playback_headroom;
 };
 
 namespace client {
@@ -63,6 +69,8 @@ struct SequenceSend {
   PackageOptions package;
   TimePoint server_start{};  ///< delay: from the start; playback: once the delay reply is in
   bool start_known = false;
+  TimePoint t0{};                        ///< offset 0 on the client's clock (the first send)
+  std::optional<Duration> chosen_delay;  ///< playback: the server's delay after the first frame arrived
 };
 
 class RobotClient::Impl {
@@ -81,6 +89,10 @@ class RobotClient::Impl {
   /// start time EncodeRequest refuses); nothing is consumed when it throws.
   Sent SendPackage(std::vector<Command> commands, std::vector<robotalk::Query> queries,
                    const PackageOptions& options = {});
+  /// How many copies of a playback package leave at `now`
+  /// (ClientOptions::playback_copies; kPlaybackCopiesAuto: LinkLoss's rule).
+  /// REQUIRES: mu_ held.
+  int PlaybackCopies(TimePoint now, std::optional<Duration> headroom) const;
   /// A fresh id from the client's command-id space (for a playback sequence).
   CommandId NewId();
   /// Opens a sequence of `frames` frames whose last offset is `duration`,
@@ -128,6 +140,7 @@ class RobotClient::Impl {
   mutable std::mutex mu_;
   std::condition_variable cv_;                                   // panic answers, sessions, configurations
   client::OutstandingPackages outstanding_;                      // GUARDED_BY(mu_)
+  client::LinkLoss link_loss_;                                   // GUARDED_BY(mu_)
   client::ClockSync clock_sync_;                                 // GUARDED_BY(mu_)
   std::int64_t next_sequence_ = 1;                               // GUARDED_BY(mu_)
   CommandId next_id_ = 1;                                        // GUARDED_BY(mu_)

@@ -72,6 +72,7 @@ SequenceSend RobotClient::Impl::BeginSequence(const SequenceOptions& options, st
                                               std::optional<PendingReply>* delay_reply) {
   SequenceSend sequence;
   sequence.mode = options.mode;
+  sequence.t0 = t0;
   sequence.package.mode = RequestMode::kDirect;
   sequence.package.max_late = options.max_late;
   if (options.mode == CommandMode::kPlayback) {
@@ -98,12 +99,21 @@ std::vector<PendingReply> RobotClient::Impl::SendPlanned(std::vector<TimedComman
                                                          const client::PlannedSend& send,
                                                          SequenceSend& sequence) {
   std::vector<Command> commands;
+  std::optional<Duration> earliest;
   for (std::size_t i : send.frames) {
+    earliest = std::min(earliest.value_or(frames[i].offset), frames[i].offset);
     Command c = std::move(frames[i].command);
     c.start_time = client::FrameStart(sequence.mode, frames[i].offset, sequence.server_start);
     commands.push_back(std::move(c));
   }
   sequence.package.interpolation = send.interpolation;
+  if (sequence.mode == CommandMode::kPlayback && earliest) {
+    // Its earliest frame is due this long after the package arrives: its
+    // offset ahead of the sequence's clock on top of the server's buffer
+    // (before the delay reply, at least the offset ahead).
+    const Duration ahead = std::max(Duration(0), *earliest - (clock_.Now() - sequence.t0));
+    sequence.package.playback_headroom = sequence.chosen_delay.value_or(Duration(0)) + ahead;
+  }
   const Sent sent = SendPackage(std::move(commands), {}, sequence.package);
   sequence.package.ask_for_delay = false;  // only the first package asks
   std::vector<PendingReply> pending;
@@ -247,6 +257,7 @@ SequenceResult RobotClient::RunSequence(std::vector<TimedCommand> frames, const 
       start_known = true;
       if (r->values.size() >= 2) {
         result.playback_delay = FromSeconds(r->values[0]);
+        sequence.chosen_delay = result.playback_delay;
         result.server_start = FromWireMicros(static_cast<std::int64_t>(r->values[1]));
         server_start = *result.server_start;
         std::vector<std::pair<CommandId, TimePoint>> starts;

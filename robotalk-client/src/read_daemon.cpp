@@ -56,10 +56,11 @@ RobotClient::Impl::Impl(ClientOptions options)
     }
     transport_ = own_transport_.get();
   }
-  if (options_.playback_copies < 1 || options_.playback_copies > 2) {
+  if (options_.playback_copies < kPlaybackCopiesAuto || options_.playback_copies > 2) {
     throw ClientError("RobotClient: ClientOptions::playback_copies is " +
                       std::to_string(options_.playback_copies) +
-                      "; expected 1 (each playback package once) or 2 (twice)");
+                      "; expected 0 (kPlaybackCopiesAuto: twice once the link has lost a message), 1 "
+                      "(each playback package once) or 2 (twice)");
   }
   LoadKeys();
   if (identity_) {
@@ -143,6 +144,7 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
   Sent sent;
   std::vector<std::uint8_t> bytes;
   std::string channel;
+  int copies = 1;
   {
     std::unique_lock lock(mu_);
     if (daemon_error_) std::rethrow_exception(std::exchange(daemon_error_, nullptr));
@@ -190,6 +192,9 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     bytes = EncodeSealed(request);
     next_id_ = id;
     sent.sequence = next_sequence_++;
+    if (options.mode == RequestMode::kPlayback) copies = PlaybackCopies(now, options.playback_headroom);
+    link_loss_.OnSend(sent.sequence, now, copies);
+    stats_.playback_copies += static_cast<std::uint64_t>(copies - 1);
     for (CommandId i : sent.ids) cache_->Expect(i);
     outstanding_.Add(sent.sequence, bytes, std::move(items), now);
     if (options.clock_query) clock_packages_.insert(sent.sequence);
@@ -202,9 +207,13 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
   // first resend is at least that far away.
   // Playback redundancy: the copy is a duplicate by sequence number, which
   // the server drops (it re-acknowledges it; the frames run once).
-  const int copies = options.mode == RequestMode::kPlayback ? options_.playback_copies : 1;
   for (int k = 0; k < copies; ++k) Publish(channel, bytes);
   return sent;
+}
+
+int RobotClient::Impl::PlaybackCopies(TimePoint now, std::optional<Duration> headroom) const {
+  if (options_.playback_copies != kPlaybackCopiesAuto) return options_.playback_copies;
+  return link_loss_.WantsSecondCopy(now, outstanding_.retransmit_timeout(), headroom) ? 2 : 1;
 }
 
 PendingReply RobotClient::Impl::MakePending(CommandId id, std::string what) {
@@ -338,6 +347,11 @@ void RobotClient::Impl::Tick(TimePoint now) {
       resync_ = false;
     }
     resends = outstanding_.TakeDue(now);
+    for (const auto& r : resends) link_loss_.OnSend(r.sequence, now);
+    // Every copy's ack has had time to come twice the retransmission
+    // timeout after it left (never before a round trip was measured).
+    if (outstanding_.smoothed_round_trip()) link_loss_.Settle(now, 2 * outstanding_.retransmit_timeout());
+    stats_.messages_lost = link_loss_.lost();
     expired = outstanding_.TakeExpired(now);
     stats_.retransmissions += resends.size();
     stats_.gave_up += expired.size();
@@ -346,6 +360,7 @@ void RobotClient::Impl::Tick(TimePoint now) {
     // packages, so heartbeats go on while a long GOTO is re-asked about.
     if (session_id_ != 0 && now - last_send_ >= options_.heartbeat_interval) {
       heartbeat = EncodeSealed(NextRequest(now));  // no items: PAYLOAD_QUERIES, size 0
+      link_loss_.OnSend(next_sequence_, now);      // acknowledged like any package
       ++next_sequence_;
       last_send_ = now;
       ++stats_.heartbeats;
@@ -426,6 +441,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     {
       std::lock_guard lock(mu_);
       if (batch.ack_sequence > 0) {
+        link_loss_.OnAck(batch.ack_sequence);  // one per copy the server received
         const auto info = outstanding_.OnAck(
             batch.ack_sequence, now,
             client::OutstandingPackages::AckTiming{

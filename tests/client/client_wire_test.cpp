@@ -18,6 +18,7 @@
 #include <future>
 #include <map>
 #include <set>
+#include <thread>
 
 namespace robotalk {
 namespace {
@@ -177,6 +178,141 @@ TEST_F(RobotClientWireTest, WhenAPlaybackPackagesFirstCopyIsLostTheSecondKeepsIt
       EXPECT_GT(client.stats().retransmissions, 0u);
     }
   }
+}
+
+// A client with the default playback redundancy, connected and then idle for
+// a second (heartbeats, each acknowledged): the client counts a message lost
+// once every copy's acknowledgement had time to come (twice the
+// retransmission timeout after its last copy), so every Connect-time
+// package has settled.
+std::unique_ptr<RobotClient> ConnectWithTheDefaultCopies(Transport& transport) {
+  ClientOptions o;
+  o.transport = &transport;
+  o.timeout = seconds(5);
+  o.connect_timeout = seconds(5);
+  auto client = std::make_unique<RobotClient>(o);
+  client->Connect(kRobot);
+  std::this_thread::sleep_for(seconds(1));
+  return client;
+}
+
+// Issue 23 item 3 on a lossy WAN: a link that has shown loss (the first copy
+// of the client's second package, at Connect) goes on losing: the first copy
+// of the 4th playback package too. With the default options the client sends
+// that frame's second copy at once (the link lost a message, and its
+// retransmission could not arrive before the frame is due), so every frame
+// runs on time; before, the default sent each playback package once and the
+// frame came as its retransmission, 100 ms late.
+TEST_F(RobotClientWireTest, OnALinkThatHasShownLossTheDefaultSendsAPlaybackFramesSecondCopyInTime) {
+  const std::int64_t fixture_client = client_->client_id();
+  struct Seen {
+    std::vector<std::int64_t> packages, playback;
+  };
+  auto seen = std::make_shared<std::map<std::int64_t, Seen>>();  // client -> first copies, in order
+  server_net_.Add({.channel_regex = RequestChannel(kRobot),
+                   .direction = Direction::kIncoming,
+                   .when =
+                       [seen, fixture_client](const std::string&, std::span<const std::uint8_t> bytes) {
+                         const Request r = DecodeRequest(bytes);
+                         if (r.client_id == fixture_client || r.sequence <= 0) return false;
+                         Seen& s = (*seen)[r.client_id];
+                         if (std::find(s.packages.begin(), s.packages.end(), r.sequence) != s.packages.end())
+                           return false;  // a later copy passes
+                         s.packages.push_back(r.sequence);
+                         if (r.mode == RequestMode::kPlayback) s.playback.push_back(r.sequence);
+                         return s.packages.size() == 2 ||
+                                (r.mode == RequestMode::kPlayback && s.playback.size() == 4);
+                       },
+                   .mute = true});
+  std::vector<TimedCommand> frames;
+  for (int i = 0; i < 6; ++i)
+    frames.push_back({milliseconds(50 * i), Command{.type = CommandType::kSetSpeed, .values = {0.0, 0.0}}});
+  const std::unique_ptr<RobotClient> connected = ConnectWithTheDefaultCopies(client_end_);
+  RobotClient& client = *connected;
+  const SequenceResult result = client.RunSequence(frames, {.mode = CommandMode::kPlayback});
+  int ran = 0;
+  Duration longest_gap{0};
+  for (std::size_t i = 0; i < result.replies.size(); ++i) {
+    const Reply& r = result.replies[i];
+    ran += r.signal == Signal::kSuccess;
+    if (i > 0) longest_gap = std::max(longest_gap, r.exec_time - result.replies[i - 1].exec_time);
+  }
+  EXPECT_EQ((*seen)[client.client_id()].playback.size(), 6u);
+  EXPECT_EQ(ran, 6);
+  // The lost frame's retransmission comes 100 ms after its first copy: a
+  // gap of 80 ms or more is the pause for it (every gap is 50 ms, at most
+  // 10 % longer).
+  EXPECT_LT(longest_gap, milliseconds(80)) << "the 4th frame came as its retransmission";
+  EXPECT_GE(client.stats().messages_lost, 1u) << "the Connect-time loss, counted";
+  EXPECT_GE(client.stats().playback_copies, 1u);
+}
+
+// The headroom half of the rule: a sequence sent ahead of its time (not
+// paced, a frame a package) on a link that has shown loss copies only the
+// frames a retransmission could not reach in time: the first (due at once)
+// goes twice, the last (500 ms ahead, against a 100 ms retransmission
+// timeout) once.
+TEST_F(RobotClientWireTest, AFrameSentFarAheadOfItsTimeGoesOnceEvenOnALinkThatHasShownLoss) {
+  const std::int64_t fixture_client = client_->client_id();
+  auto packages = std::make_shared<std::map<std::int64_t, std::set<std::int64_t>>>();  // client -> sequences
+  server_net_.Add({.channel_regex = RequestChannel(kRobot),
+                   .direction = Direction::kIncoming,
+                   .when =
+                       [packages, fixture_client](const std::string&, std::span<const std::uint8_t> bytes) {
+                         const Request r = DecodeRequest(bytes);
+                         if (r.client_id == fixture_client || r.sequence <= 0) return false;
+                         std::set<std::int64_t>& seen = (*packages)[r.client_id];
+                         return seen.insert(r.sequence).second && seen.size() == 2;  // one Connect-time copy
+                       },
+                   .mute = true});
+  const std::unique_ptr<RobotClient> client = ConnectWithTheDefaultCopies(client_end_);
+  ASSERT_GE(client->stats().messages_lost, 1u);
+  std::vector<TimedCommand> frames;
+  for (int i = 0; i < 6; ++i)
+    frames.push_back({milliseconds(100 * i), Command{.type = CommandType::kSetSpeed, .values = {0.0, 0.0}}});
+  const std::size_t before = Heard().size();
+  const SequenceResult result =
+      client->RunSequence(frames, {.mode = CommandMode::kPlayback, .paced = false, .batch = 1});
+  for (const Reply& r : result.replies) EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+  std::map<std::int64_t, int> copies;  // the frame's offset (ms) -> copies heard
+  const auto heard = Heard();
+  for (std::size_t k = before; k < heard.size(); ++k) {
+    if (heard[k].first != RequestChannel(kRobot)) continue;
+    const Request r = DecodeRequest(heard[k].second);
+    if (r.client_id != client->client_id() || r.mode != RequestMode::kPlayback || r.commands.size() != 1)
+      continue;
+    const auto offset =
+        std::chrono::duration_cast<milliseconds>(r.commands[0].start_time.offset().value_or(Duration(-1)))
+            .count();
+    ++copies[offset];
+  }
+  ASSERT_EQ(copies.size(), 6u);
+  EXPECT_EQ(copies[0], 2) << "due at once: its retransmission would be late";
+  EXPECT_EQ(copies[500], 1) << "500 ms ahead: a retransmission arrives in time";
+}
+
+// The other half of the automatic redundancy: a link that loses nothing (a
+// congested one among them: the relay's U[0, X] profiles) never gets a
+// second copy, heartbeats and all, so a queue-bound link's queue is not
+// doubled.
+TEST_F(RobotClientWireTest, OnALossFreeLinkTheDefaultSendsEachPlaybackPackageOnce) {
+  const std::unique_ptr<RobotClient> connected = ConnectWithTheDefaultCopies(client_end_);
+  RobotClient& client = *connected;
+  const std::size_t before = Heard().size();
+  const SequenceResult result = client.RunSequence(Frames(6), {.mode = CommandMode::kPlayback});
+  for (const Reply& r : result.replies) EXPECT_EQ(r.signal, Signal::kSuccess) << r.message;
+  std::map<std::int64_t, int> copies;  // this client's packages: sequence -> times heard
+  const auto heard = Heard();
+  for (std::size_t k = before; k < heard.size(); ++k) {
+    if (heard[k].first != RequestChannel(kRobot)) continue;
+    const Request r = DecodeRequest(heard[k].second);
+    if (r.client_id == client.client_id() && r.mode == RequestMode::kPlayback) ++copies[r.sequence];
+  }
+  EXPECT_EQ(copies.size(), 6u);
+  for (const auto& [sequence, n] : copies) EXPECT_EQ(n, 1) << "package " << sequence;
+  EXPECT_EQ(client.stats().messages_lost, 0u);
+  EXPECT_EQ(client.stats().playback_copies, 0u);
+  EXPECT_GT(client.stats().heartbeats, 0u) << "the heartbeats' acks were counted too";
 }
 
 TEST_F(RobotClientWireTest, APanicAndQueriesAreEmptyOrQueryPackagesTheServerReadsWithoutError) {

@@ -47,6 +47,10 @@ namespace client {
 class ReturnCache;
 }
 
+/// ClientOptions::playback_copies: the copies decided from the link (twice
+/// once it has lost a message and a retransmission would come too late).
+inline constexpr int kPlaybackCopiesAuto = 0;
+
 struct ClientOptions {
   /// LCM URL; "" = LCM's default (the LCM_DEFAULT_URL environment variable, or
   /// udpm://239.255.76.67:7667?ttl=0).
@@ -91,7 +95,11 @@ struct ClientOptions {
   /// sequence number); a frame whose first copy the network loses still
   /// arrives in time, instead of one retransmission timeout (>= 100 ms)
   /// later. Costs one more copy of every playback package (and of its ack).
-  int playback_copies = 1;
+  /// kPlaybackCopiesAuto (0): twice only while the link has lost a message
+  /// in the last 60 s (the client's own count: fewer acks than copies sent;
+  /// a spurious retransmission is not a loss) and the retransmission timeout
+  /// exceeds the frame's headroom; once otherwise (docs/client.md).
+  int playback_copies = kPlaybackCopiesAuto;
   /// An idle client sends an empty package this often (server session watchdog).
   Duration heartbeat_interval = std::chrono::milliseconds(250);
   /// CLOCK round trips at Connect(); the one with the smallest round trip wins.
@@ -350,9 +358,14 @@ struct ClientStats {
   std::uint64_t replies_ignored = 0;     ///< duplicates, unknown ids
   std::uint64_t malformed_packages = 0;  ///< undecodable reply packages dropped
   std::uint64_t gave_up = 0;             ///< packages abandoned
-  std::uint64_t sessions_opened = 0;     ///< hellos answered with a session
-  std::uint64_t sessions_lost = 0;       ///< the server no longer knew the session (restart, expiry)
-  std::uint64_t replies_refused = 0;     ///< keyed: replies whose MAC or (SESSION_UNKNOWN) signature failed
+  /// Playback redundancy: second copies of playback packages sent.
+  std::uint64_t playback_copies = 0;
+  /// Messages the link lost (either way), as the client counts them: a
+  /// package's copies minus its acks, once every ack had time to come.
+  std::uint64_t messages_lost = 0;
+  std::uint64_t sessions_opened = 0;  ///< hellos answered with a session
+  std::uint64_t sessions_lost = 0;    ///< the server no longer knew the session (restart, expiry)
+  std::uint64_t replies_refused = 0;  ///< keyed: replies whose MAC or (SESSION_UNKNOWN) signature failed
   /// Keyed: STATE and CONFIG messages dropped: unsigned, signed by another
   /// key or server instance, forged, or (STATE) not newer than the last one.
   std::uint64_t broadcasts_refused = 0;
