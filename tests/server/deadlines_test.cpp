@@ -246,5 +246,44 @@ TEST_F(LinkStopTest, StopsWhatTheSessionOwnsAndDropsItsQueueOncePerBadSpell) {
   EXPECT_EQ(fake_->partial_stops.size(), 1u) << "once per bad spell";
 }
 
+// A copy of one of Alice's packages, recorded and replayed by someone who
+// cannot forge one (keyed mode: the copy is hers, MAC and all; the session
+// table answers it as a duplicate), carries the round trip she reported
+// when she sent it. Her link's figure is her latest report: a replay from a
+// bad spell neither makes her good link bad (--link-stop stopped her base)
+// nor, from a good spell, hides her bad link (no stop).
+TEST_F(LinkStopTest, AReplayedPackagesOldRoundTripNeitherStopsAGoodLinkNorHidesABadOne) {
+  Handle(Heartbeat(kAlice, 1, clock_.Now(), milliseconds(1200)));  // a bad spell, recorded
+  clock_.Advance(milliseconds(20));
+  Handle(Package(kAlice, 2, {Cmd(1, CommandType::kSetSpeed, {0.3, 0})}));
+  Run();
+  for (std::int64_t i = 3; i <= 12; ++i) {
+    clock_.Advance(milliseconds(20));
+    Handle(Heartbeat(kAlice, i, clock_.Now(), milliseconds(20)));
+  }
+  sessions_->Expire(clock_.Now());
+  Run();
+  ASSERT_TRUE(fake_->partial_stops.empty());
+  clock_.Advance(milliseconds(20));
+  Handle(Heartbeat(kAlice, 1, clock_.Now() - milliseconds(220), milliseconds(1200)));  // the replay
+  sessions_->Expire(clock_.Now());
+  Run();
+  EXPECT_TRUE(fake_->partial_stops.empty()) << "a replayed old report stopped a good link's base";
+  EXPECT_EQ(sessions_->MotionLink().level, LinkState::Level::kGood);
+  EXPECT_EQ(sessions_->MotionLink().round_trip, milliseconds(20));
+
+  // Now her link is bad (she reports 1.2 s); a replay of a good spell's package hides nothing.
+  for (std::int64_t i = 13; i <= 16; ++i) {
+    clock_.Advance(milliseconds(20));
+    Handle(Heartbeat(kAlice, i, clock_.Now(), milliseconds(1200)));
+  }
+  clock_.Advance(milliseconds(20));
+  Handle(Heartbeat(kAlice, 3, clock_.Now() - milliseconds(300), milliseconds(20)));  // the replay
+  sessions_->Expire(clock_.Now());
+  Run();
+  EXPECT_EQ(sessions_->MotionLink().round_trip, milliseconds(1200));
+  EXPECT_EQ(fake_->partial_stops.size(), 1u) << "a replayed good report hid a bad link";
+}
+
 }  // namespace
 }  // namespace robotalk

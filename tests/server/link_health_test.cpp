@@ -201,6 +201,40 @@ TEST(LinkHealth, HeavyLossAndALongRoundTripAreBad) {
   EXPECT_EQ(v.why, "loss 49.5 % > 25.0 %, delay 750 ms > 500 ms");
 }
 
+// The round trip is the latest the client reported: the report of its
+// highest-numbered package. A copy of a package seen before (a duplicated
+// datagram, a retransmission whose answer was lost, or a recording replayed
+// by someone who cannot forge a package: keyed mode) and a package
+// overtaken by a later-numbered one carry an older report, which must not
+// replace it: a replay of a package from a bad spell made a good link bad
+// (--link-stop stopped the robot), one from a good spell hid a bad link.
+TEST(LinkHealth, OnlyTheHighestNumberedPackagesRoundTripCountsNotACopyOrAnOvertakenOne) {
+  Link bad_then_good;
+  bad_then_good.Send(1, milliseconds(0), milliseconds(20), false, milliseconds(1200));
+  for (int i = 2; i <= 30; ++i)
+    bad_then_good.Send(i, milliseconds(10 * i), milliseconds(20), false, milliseconds(20));
+  ASSERT_EQ(bad_then_good.health.Evaluate().level, LinkHealth::Level::kGood);
+  bad_then_good.Send(1, milliseconds(0), milliseconds(400), /*duplicate=*/true, milliseconds(1200));
+  EXPECT_EQ(bad_then_good.health.Figures().round_trip, milliseconds(20)) << "a copy's older report";
+  EXPECT_EQ(bad_then_good.health.Evaluate().level, LinkHealth::Level::kGood);
+
+  Link good_then_bad;
+  good_then_bad.Send(1, milliseconds(0), milliseconds(20), false, milliseconds(20));
+  for (int i = 2; i <= 30; ++i)
+    good_then_bad.Send(i, milliseconds(10 * i), milliseconds(20), false, milliseconds(1200));
+  ASSERT_EQ(good_then_bad.health.Evaluate().level, LinkHealth::Level::kBad);
+  good_then_bad.Send(1, milliseconds(0), milliseconds(400), /*duplicate=*/true, milliseconds(20));
+  EXPECT_EQ(good_then_bad.health.Figures().round_trip, milliseconds(1200)) << "a copy's older report";
+  EXPECT_EQ(good_then_bad.health.Evaluate().level, LinkHealth::Level::kBad);
+
+  Link overtaken;
+  overtaken.Send(2, milliseconds(10), milliseconds(20), false, milliseconds(30));
+  overtaken.Send(1, milliseconds(0), milliseconds(35), false, milliseconds(900));
+  EXPECT_EQ(overtaken.health.Figures().round_trip, milliseconds(30)) << "package 2's report is the later";
+  overtaken.Send(3, milliseconds(20), milliseconds(20), false, milliseconds(50));
+  EXPECT_EQ(overtaken.health.Figures().round_trip, milliseconds(50));
+}
+
 // OnPackage says which packages came as retransmissions (playback's delay
 // history leaves them out, issue 23): one after a later-numbered package and
 // slower than the slowest recent first copies by more than the reorder
