@@ -29,7 +29,13 @@ void LinkHealth::Decide(bool lost) {
 bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
                            Duration round_trip) {
   Tick(received);
-  if (round_trip > Duration::zero()) f_.round_trip = round_trip;
+  // The round trip is the client's latest report: that of its highest-numbered
+  // package. A copy (a duplicated datagram, a recording replayed: keyed mode
+  // answers it from the session table) or a package a later-numbered one
+  // overtook carries an older report; taking it let a replay from a bad spell
+  // make a good link bad (--link-stop stopped the robot) or hide a bad one.
+  if (round_trip > Duration::zero() && !duplicate && (!started_ || sequence > highest_))
+    f_.round_trip = round_trip;
   if (duplicate) {
     ++f_.duplicates;
     return false;
