@@ -235,6 +235,26 @@ TEST(LinkHealth, OnlyTheHighestNumberedPackagesRoundTripCountsNotACopyOrAnOverta
   EXPECT_EQ(overtaken.health.Figures().round_trip, milliseconds(50));
 }
 
+// A send time no client's clock has (the wire's extremes, ±292 years) is no
+// transit: arrival − send time overflowed (undefined behaviour), and the
+// wrapped values made the jitter 6.9e8 s and the link bad (review 10). Such a
+// package counts as received, its transit unknown (OneWayDelay, as
+// playback's delays).
+TEST(LinkHealth, ASendTimeAtTheWiresExtremesIsNoTransitAndLeavesTheJitterAlone) {
+  Link l;
+  for (int i = 1; i <= 20; ++i) l.Send(i, milliseconds(10 * i), milliseconds(20));
+  for (const std::int64_t extreme : {-kMaxWireMicros, kMaxWireMicros}) {
+    l.health.OnPackage(l.health.Figures().packages + 1, false, FromWireMicros(extreme), At(milliseconds(300)),
+                       milliseconds(40));
+  }
+  for (int i = 23; i <= 30; ++i) l.Send(i, milliseconds(10 * i), milliseconds(20));
+  const LinkFigures f = l.health.Figures();
+  EXPECT_EQ(f.packages, 30u);
+  EXPECT_EQ(f.lost, 0u);
+  EXPECT_EQ(f.jitter, Duration(0));
+  EXPECT_EQ(l.health.Evaluate().level, LinkHealth::Level::kGood) << l.health.Evaluate().why;
+}
+
 // OnPackage says which packages came as retransmissions (playback's delay
 // history leaves them out, issue 23): one after a later-numbered package and
 // slower than the slowest recent first copies by more than the reorder
