@@ -1,5 +1,7 @@
 #include "link_health.h"
 
+#include "playback_estimator.h"  // OneWayDelay
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -42,11 +44,9 @@ bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent
   }
   ++f_.packages;
   // The transit on the client's clock: only its differences mean anything.
-  std::optional<Duration> transit;
-  if (sent != TimePoint{}) {
-    const auto d = received.time_since_epoch().count() - sent.time_since_epoch().count();
-    transit = Duration(d);
-  }
+  // Unknown for a send time no clock has (OneWayDelay: within 2^61 ns, so
+  // two transits always subtract; the wire's extremes overflowed here).
+  const std::optional<Duration> transit = sent != TimePoint{} ? OneWayDelay(sent, received) : std::nullopt;
   // A retransmission's transit is the client's resend wait, not the network's:
   // it counts in neither the jitter nor the transit range.
   bool resent = false;
