@@ -209,23 +209,18 @@ TEST(LinkHealth, HeavyLossAndALongRoundTripAreBad) {
 // replace it: a replay of a package from a bad spell made a good link bad
 // (--link-stop stopped the robot), one from a good spell hid a bad link.
 TEST(LinkHealth, OnlyTheHighestNumberedPackagesRoundTripCountsNotACopyOrAnOvertakenOne) {
-  Link bad_then_good;
-  bad_then_good.Send(1, milliseconds(0), milliseconds(20), false, milliseconds(1200));
-  for (int i = 2; i <= 30; ++i)
-    bad_then_good.Send(i, milliseconds(10 * i), milliseconds(20), false, milliseconds(20));
-  ASSERT_EQ(bad_then_good.health.Evaluate().level, LinkHealth::Level::kGood);
-  bad_then_good.Send(1, milliseconds(0), milliseconds(400), /*duplicate=*/true, milliseconds(1200));
-  EXPECT_EQ(bad_then_good.health.Figures().round_trip, milliseconds(20)) << "a copy's older report";
-  EXPECT_EQ(bad_then_good.health.Evaluate().level, LinkHealth::Level::kGood);
-
-  Link good_then_bad;
-  good_then_bad.Send(1, milliseconds(0), milliseconds(20), false, milliseconds(20));
-  for (int i = 2; i <= 30; ++i)
-    good_then_bad.Send(i, milliseconds(10 * i), milliseconds(20), false, milliseconds(1200));
-  ASSERT_EQ(good_then_bad.health.Evaluate().level, LinkHealth::Level::kBad);
-  good_then_bad.Send(1, milliseconds(0), milliseconds(400), /*duplicate=*/true, milliseconds(20));
-  EXPECT_EQ(good_then_bad.health.Figures().round_trip, milliseconds(1200)) << "a copy's older report";
-  EXPECT_EQ(good_then_bad.health.Evaluate().level, LinkHealth::Level::kBad);
+  // Package 1 reports `first`, 2 .. 30 `then`; then a copy of package 1 comes.
+  const auto replay_first = [](Duration first, Duration then, LinkHealth::Level level) {
+    Link l;
+    l.Send(1, milliseconds(0), milliseconds(20), false, first);
+    for (int i = 2; i <= 30; ++i) l.Send(i, milliseconds(10 * i), milliseconds(20), false, then);
+    ASSERT_EQ(l.health.Evaluate().level, level);
+    l.Send(1, milliseconds(0), milliseconds(400), /*duplicate=*/true, first);
+    EXPECT_EQ(l.health.Figures().round_trip, then) << "a copy's older report";
+    EXPECT_EQ(l.health.Evaluate().level, level);
+  };
+  replay_first(milliseconds(1200), milliseconds(20), LinkHealth::Level::kGood);  // stays good
+  replay_first(milliseconds(20), milliseconds(1200), LinkHealth::Level::kBad);   // stays bad
 
   Link overtaken;
   overtaken.Send(2, milliseconds(10), milliseconds(20), false, milliseconds(30));
