@@ -438,7 +438,8 @@ void BindClient(py::module_& m) {
             std::vector<TrajectoryPoint> points;
             for (std::size_t i = 0; i < times.size(); ++i) {
               points.push_back(TrajectoryPoint{
-                  .time_from_start = FromSeconds(times[i]),
+                  .time_from_start = ToDuration(
+                      py::float_(times[i]), ("send_trajectory: times[" + std::to_string(i) + "]").c_str()),
                   .positions = positions[i],
                   .velocities = velocities ? (*velocities)[i] : std::vector<double>{},
                   .accelerations = accelerations ? (*accelerations)[i] : std::vector<double>{}});

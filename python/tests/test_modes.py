@@ -61,6 +61,10 @@ def test_a_cubic_trajectory_passes_through_its_points_on_time(server: Server) ->
         assert np.allclose(spacing, 0.2, atol=1e-3), spacing
         with pytest.raises(robotalk.UsageError, match="unknown interpolation 'spline'"):
             robot.send_trajectory("pan", [0.1], [[0.0]], interpolation="spline")
+        # A time that is no time is named by its place (review 10: "FromSeconds: nan s is not a finite time").
+        for bad in (float("nan"), float("inf"), 1e12):
+            with pytest.raises(robotalk.RobotalkError, match=r"send_trajectory: times\[1\]"):
+                robot.send_trajectory("pan", [0.1, bad], [[0.0], [0.1]], interpolation="cubic")
 
 
 def test_direct_sequence_waits_for_each_reply(server: Server) -> None:

@@ -91,7 +91,7 @@ int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
   const bool json = TakeOption(args, "--json", nullptr);
   RejectOptions(args);
   if (!args.empty()) throw UsageError("robots takes no arguments");
-  const double seconds = ParseNumber(listen, "--listen");
+  const double seconds = ParseSeconds(listen, "--listen");
   std::size_t unlisted = 0;
   const auto robots = ListRobots(MakeOptions(g), FromSeconds(seconds), &unlisted);
   if (unlisted > 0)
@@ -189,8 +189,8 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   RejectOptions(args);
   if (args.size() != 1)
     throw UsageError("usage: robotalk watch ROBOT [--period S] [--duration S] [--count N] [--json]");
-  const double period_s = ParseNumber(period, "--period");
-  const double duration_s = has_duration ? ParseNumber(duration, "--duration") : 1e9;
+  const double period_s = ParseSeconds(period, "--period");
+  const double duration_s = has_duration ? ParseSeconds(duration, "--duration") : kMaxTextSeconds;
   const double max_samples = has_count ? ParseNumber(count, "--count") : 1e18;
   if (period_s < 0.001 || duration_s <= 0 || max_samples < 1) {
     throw UsageError("watch: --period must be >= 0.001 s, --duration and --count positive");
@@ -245,7 +245,7 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   // gone quiet: no STATE sample and no announcement for kServerSilence (exit 1).
   Interrupter::Defer(true);
   const TimePoint start = SteadyClock().Now();
-  const TimePoint end = start + FromSeconds(std::min(duration_s, 1e9));
+  const TimePoint end = start + FromSeconds(duration_s);
   bool gone = false;
   while (SteadyClock().Now() < end && !Interrupter::Signal()) {
     TimePoint heard = announces.LastHeard(args[0]).value_or(start);

@@ -43,8 +43,7 @@ SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
     f.any = true;
   }
   if (TakeOption(args, "--delay", &delay)) {
-    const double d = ParseNumber(delay, "--delay");
-    if (d < 0) throw UsageError("--delay " + delay + " is negative");
+    const double d = ParseSeconds(delay, "--delay");
     if (f.options.mode != CommandMode::kDelay) throw UsageError("--delay goes with --mode delay");
     f.options.delay = FromSeconds(d);
     f.delay_given = true;
@@ -219,8 +218,7 @@ int RunSend(const GlobalOptions& g, const std::vector<std::string>& in) {
     throw UsageError("--hold goes with setspeed, joint_speed or joint_force");
   std::optional<double> delay;
   if (has_at) {
-    delay = ParseNumber(at, "--at");
-    if (*delay < 0) throw UsageError("--at " + at + " is negative");
+    delay = ParseSeconds(at, "--at");
   }
   return SendOne(g, args[0], std::move(c), delay, hold, json);
 }

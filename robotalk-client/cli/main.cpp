@@ -106,12 +106,12 @@ int main(int argc, char** argv) {
           g.known_servers = args[++i];
         } else if (args[i] == "--max-late") {
           const std::string& v = args[++i];
-          const double s = v == "never" ? 0 : ParseNumber(v, "--max-late");
+          const double s = v == "never" ? 0 : ParseSeconds(v, "--max-late");
           if (v != "never" && !(s > 0))
             throw UsageError("--max-late " + v + ": expected seconds > 0 or never");
           g.max_late = v == "never" ? robotalk::kMaxLateNever : robotalk::FromSeconds(s);
         } else {
-          g.timeout_s = ParseNumber(args[++i], "--timeout");
+          g.timeout_s = ParseSeconds(args[++i], "--timeout");
           if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");
         }
       } else if (rest.empty() && args[i].size() > 1 && args[i][0] == '-') {

@@ -1,5 +1,7 @@
 #include "link_health.h"
 
+#include "playback_estimator.h"  // OneWayDelay
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,18 +31,22 @@ void LinkHealth::Decide(bool lost) {
 bool LinkHealth::OnPackage(std::int64_t sequence, bool duplicate, TimePoint sent, TimePoint received,
                            Duration round_trip) {
   Tick(received);
-  if (round_trip > Duration::zero()) f_.round_trip = round_trip;
+  // The round trip is the client's latest report: that of its highest-numbered
+  // package. A copy (a duplicated datagram, a recording replayed: keyed mode
+  // answers it from the session table) or a package a later-numbered one
+  // overtook carries an older report; taking it let a replay from a bad spell
+  // make a good link bad (--link-stop stopped the robot) or hide a bad one.
+  if (round_trip > Duration::zero() && !duplicate && (!started_ || sequence > highest_))
+    f_.round_trip = round_trip;
   if (duplicate) {
     ++f_.duplicates;
     return false;
   }
   ++f_.packages;
   // The transit on the client's clock: only its differences mean anything.
-  std::optional<Duration> transit;
-  if (sent != TimePoint{}) {
-    const auto d = received.time_since_epoch().count() - sent.time_since_epoch().count();
-    transit = Duration(d);
-  }
+  // Unknown for a send time no clock has (OneWayDelay: within 2^61 ns, so
+  // two transits always subtract; the wire's extremes overflowed here).
+  const std::optional<Duration> transit = sent != TimePoint{} ? OneWayDelay(sent, received) : std::nullopt;
   // A retransmission's transit is the client's resend wait, not the network's:
   // it counts in neither the jitter nor the transit range.
   bool resent = false;

@@ -10,7 +10,9 @@
 // (OnReply): its lateness, and whether it expired (expiry.h).
 //
 // Figures (Figures()):
-//   - round trip: the latest the client reported: the median of its network
+//   - round trip: the latest the client reported (the report of its
+//     highest-numbered package; never a copy's or an overtaken package's,
+//     whose report is older): the median of its network
 //     round trips (an ack's arrival, as its socket stamped it, − the
 //     package's send − the server's hold: neither side's processing counts);
 //   - delay (one-way, client -> server): half that round trip. Without

@@ -401,26 +401,27 @@ void RobotSessions::Panic(std::int64_t client_id, TimePoint now, const std::stri
   log_.push_back("robot '" + robot_ + "': PANIC from " + who + (first ? "" : " (already in panic)"));
   flushed_.clear();
   daemon_.Panic(flushed_);
-  for (const auto& [id, s] : table_.live(robot_id_)) {
-    Session& session = *s;
-    std::vector<std::int64_t> ended;
-    for (auto& [pid, seq] : session.playbacks) {
-      for (PlaybackSequence::Frame& frame : seq.frames) flushed_.push_back(std::move(frame.item));
-      if (!seq.start) {  // its delay reply was never sent: it never will be
-        Deliver(session.client_id, MakeReply(pid, Signal::kInterrupted,
-                                             "PLAYBACK " + std::to_string(pid) + ": ended by panic from " +
-                                                 who + " before it started",
-                                             now));
-      }
-      ended.push_back(pid);
-    }
-    for (std::int64_t pid : ended) session.EndPlayback(pid, Session::Ended::kPanic);
-  }
+  for (const auto& [id, s] : table_.live(robot_id_))
+    EndPlaybacks(*s, Session::Ended::kPanic, "panic from " + who, now);
   for (const QueuedItem& item : flushed_) {
     if (item.client_id == 0) continue;
     Deliver(item.client_id,
             MakeReply(item.command.id, Signal::kInterrupted, "flushed by panic from " + who, now));
   }
+}
+
+void RobotSessions::EndPlaybacks(Session& s, Session::Ended ended, const std::string& why, TimePoint now) {
+  std::vector<std::int64_t> ids;
+  for (auto& [pid, seq] : s.playbacks) {
+    for (PlaybackSequence::Frame& frame : seq.frames) flushed_.push_back(std::move(frame.item));
+    if (!seq.start) {  // its delay reply was never sent: it never will be
+      Deliver(s.client_id,
+              MakeReply(pid, Signal::kInterrupted,
+                        "PLAYBACK " + std::to_string(pid) + ": ended by " + why + " before it started", now));
+    }
+    ids.push_back(pid);
+  }
+  for (std::int64_t pid : ids) s.EndPlayback(pid, ended);
 }
 
 void RobotSessions::Deliver(std::int64_t client_id, Reply reply) {

@@ -203,6 +203,11 @@ class RobotSessions {
   void CheckLinks(TimePoint now);
   // Stops what `client` owns (Driver::StopOnly); returns whether it owned anything.
   bool StopOwned(std::int64_t client, const std::string& why);
+  // Ends every unfinished playback sequence of `s` (a panic, --link-stop):
+  // its buffered frames go to flushed_ (the caller answers them), a sequence
+  // not started answers its delay reply INTERRUPTED "PLAYBACK n: ended by
+  // <why> before it started", and its later frames are answered, never run.
+  void EndPlaybacks(Session& s, Session::Ended ended, const std::string& why, TimePoint now);
 
   RobotDaemon& daemon_;
   const std::string robot_;

@@ -88,6 +88,12 @@ void RobotSessions::CheckLinks(TimePoint now) {
   for (auto& [client, why] : to_stop) {
     flushed_.clear();
     daemon_.FlushClient(client, flushed_);
+    // Its playback sequences are queued commands too: the frames buffered
+    // for a start not yet decided are dropped with the rest, and a sequence
+    // does not go on without the frames it had (review 10: they ran after
+    // the stop once the sequence started).
+    if (Session* s = table_.Find(robot_id_, client))
+      EndPlaybacks(*s, Session::Ended::kLinkStop, "--link-stop", now);
     for (const QueuedItem& item : flushed_) {
       Deliver(client, MakeReply(item.command.id, Signal::kInterrupted, "not executed: " + why, now));
     }

@@ -27,9 +27,10 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, T
       refuse(label + ": all its declared frames were received already; this frame is beyond them", false);
       return;
     }
+    const char* by = *ended == Session::Ended::kPanic ? "a panic" : "--link-stop (its client's link was bad)";
     for (const Command& c : r.commands) {
       immediate.push_back(MakeReply(c.id, Signal::kInterrupted,
-                                    label + " was ended by a panic; its later frames do not run", now));
+                                    label + " was ended by " + by + "; its later frames do not run", now));
     }
     return;
   }

@@ -162,7 +162,7 @@ struct Session {
   /// Per actuator, the latest start time of this client's servo commands that ran.
   std::map<int, TimePoint> latest_servo_start;
   /// Why a playback sequence is no longer in `playbacks`.
-  enum class Ended { kPanic, kComplete };
+  enum class Ended { kPanic, kLinkStop, kComplete };
   /// Playback sequences that ended (the most recent kMaxEnded): their late
   /// frames are answered at once instead of starting a new sequence.
   std::deque<std::pair<std::int64_t, Ended>> ended_playbacks;

@@ -485,7 +485,12 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
   if (now <= t.last_sample && !t.fresh) return;  // sampled at this time already: the same reference
   const bool first = t.fresh;
   t.fresh = false;
-  const double dt = std::clamp(ToSeconds(now - t.last_sample), 1e-4, 1.0);
+  // A fresh trajectory's first reference is at its start, where the joint is:
+  // the plan's position there is the start's, but its velocity need not be (a
+  // linear plan's first slope, unlimited before review 10): it may step by
+  // one period's worth of the limit, as after a reference a period before.
+  const double dt =
+      first ? ToSeconds(options_.period) : std::clamp(ToSeconds(now - t.last_sample), 1e-4, 1.0);
   t.last_sample = now;
   bool on_plan = true;
   velocity_before_.head(t.dofs) = t.ref_velocity;
@@ -501,8 +506,8 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
     // the trapezoid's).
     const bool within =
         std::abs(v) <= vmax * (1 + kRound) && std::abs(a) <= amax * (1 + kRound) && p >= lo && p <= hi;
-    const bool reachable = first || (std::abs(v - v0) <= amax * dt * (1 + kRound) + kRound &&
-                                     std::abs((p - p0) / dt - 0.5 * (v0 + v)) <= amax * dt / 4 + kRound);
+    const bool reachable = std::abs(v - v0) <= amax * dt * (1 + kRound) + kRound &&
+                           (first || std::abs((p - p0) / dt - 0.5 * (v0 + v)) <= amax * dt / 4 + kRound);
     if (within && reachable) {
       t.ref_position[k] = p;
       t.ref_velocity[k] = v;
@@ -528,6 +533,13 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
       }
       t.limited = what;
     }
+    if (first) {  // at the start: the plan's position, the velocity toward the plan's within the limits
+      const double a1 = std::clamp((v - v0) / dt, -amax, amax);
+      t.ref_position[k] = std::clamp(p, lo, hi);
+      t.ref_velocity[k] = std::clamp(v0 + a1 * dt, -vmax, vmax);
+      t.ref_acceleration[k] = a1;
+      continue;
+    }
     const double e = p - (p0 + v0 * dt);  // the plan against where the reference would coast to
     const double close = std::min(std::abs(e) / (4 * dt), std::sqrt(2 * amax * std::abs(e)));
     const double v_want = std::clamp(v + std::copysign(close, e), -vmax, vmax);
@@ -543,11 +555,9 @@ void TrajectoryTracker::Limit(Track& t, TimePoint now) {
     t.ref_acceleration[k] = a1;
   }
   t.on_plan = on_plan;
-  if (!first) {
-    for (int k = 0; k < t.dofs; ++k) {
-      max_reference_acceleration_ =
-          std::max(max_reference_acceleration_, std::abs(t.ref_velocity[k] - velocity_before_[k]) / dt);
-    }
+  for (int k = 0; k < t.dofs; ++k) {
+    max_reference_acceleration_ =
+        std::max(max_reference_acceleration_, std::abs(t.ref_velocity[k] - velocity_before_[k]) / dt);
   }
 }
 

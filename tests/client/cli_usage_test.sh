@@ -51,6 +51,23 @@ printf 'interpolation smooth\n0 stop\n' > "$seq"
 expect_msg 2 "$seq:1: interpolation: 'smooth' is not an interpolation (step, linear, cubic, quintic)" \
   send pioneer --file "$seq"
 rm -f "$seq"
+# Times out of range are usage errors naming the option (review 10: --timeout 1e12, --max-late 1e12 and
+# --listen 1e12 ended with "FromSeconds: ... out of range" and status 1, naming no option; --listen -1
+# listened "within -1 s"; --period, --at, --delay and a file's start time 1e12 failed only after connecting).
+# memq:// keeps what is not refused off the network.
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--timeout" --timeout 1e12 robots
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--max-late" --max-late 1e12 robots
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--listen" robots --listen 1e12
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--listen" robots --listen -1
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--period" watch pioneer --period 1e12
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--duration" watch pioneer --duration 1e12
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--at" send pioneer stop --at 1e12
+seq=$(mktemp)
+printf '0 stop\n1e12 stop\n' > "$seq"
+LCM_DEFAULT_URL=memq:// expect_msg 2 "$seq:2: start time" send pioneer --file "$seq"
+printf '0 stop\n' > "$seq"
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--delay" send pioneer --file "$seq" --delay 1e12
+rm -f "$seq"
 expect_msg 0 "robotalk " --version
 "$cli" --version | grep -Eq '^robotalk [0-9]+\.[0-9]+\.[0-9]+$' || { echo "FAIL: --version format"; fail=1; }
 [ $fail = 0 ] && echo "cli usage: all passed"

@@ -274,6 +274,18 @@ TEST(RequestCodec, CarriesTheInterpolationTheMaxLateAndAWaypointsRates) {
   EXPECT_THROW(EncodeRequest(r), ProtocolError);
 }
 
+// A positive max_late below the wire's resolution (1 µs) travels as 1 µs:
+// 0 on the wire is "the robot's default" (0.1 s unless --max-late), so a
+// limit of 400 ns, truncated to 0, became a limit 250,000 times looser
+// (review 10; the CLI's --max-late 1e-7 did the same).
+TEST(RequestCodec, APositiveMaxLateBelowAMicrosecondIsNeverTheRobotsDefault) {
+  Request r{.client_id = 42, .sequence = 7, .mode = RequestMode::kDelay};
+  r.max_late = std::chrono::nanoseconds(400);
+  EXPECT_EQ(DecodeRequest(EncodeRequest(r)).max_late, std::chrono::microseconds(1));
+  r.max_late = std::chrono::nanoseconds(1500);
+  EXPECT_EQ(DecodeRequest(EncodeRequest(r)).max_late, std::chrono::microseconds(1)) << "truncated as before";
+}
+
 TEST(RequestCodec, AnUnknownInterpolationOrANegativeMaxLateIsAHeaderError) {
   robotalk_msgs::package_t p{};
   p.header.protocol_version = kProtocolVersion;

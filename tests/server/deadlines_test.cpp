@@ -192,8 +192,8 @@ SessionOptions ShortHorizon(bool link_stop) {
 
 class LinkTest : public RobotSessionsTest {
  protected:
-  explicit LinkTest(bool link_stop = false)
-      : RobotSessionsTest(BaseType::kDifferential, ShortHorizon(link_stop)) {}
+  explicit LinkTest(bool link_stop = false) : LinkTest(ShortHorizon(link_stop)) {}
+  explicit LinkTest(SessionOptions options) : RobotSessionsTest(BaseType::kDifferential, options) {}
   // Alice's packages first .. first+39 every 20 ms, every other one lost,
   // then 0.3 s of silence (past the horizon).
   void LoseHalf(std::int64_t first) {
@@ -244,6 +244,100 @@ TEST_F(LinkStopTest, StopsWhatTheSessionOwnsAndDropsItsQueueOncePerBadSpell) {
   sessions_->Expire(clock_.Now());
   Run();
   EXPECT_EQ(fake_->partial_stops.size(), 1u) << "once per bad spell";
+}
+
+// A copy of one of Alice's packages, recorded and replayed by someone who
+// cannot forge one (keyed mode: the copy is hers, MAC and all; the session
+// table answers it as a duplicate), carries the round trip she reported
+// when she sent it. Her link's figure is her latest report: a replay from a
+// bad spell neither makes her good link bad (--link-stop stopped her base)
+// nor, from a good spell, hides her bad link (no stop).
+TEST_F(LinkStopTest, AReplayedPackagesOldRoundTripNeitherStopsAGoodLinkNorHidesABadOne) {
+  Handle(Heartbeat(kAlice, 1, clock_.Now(), milliseconds(1200)));  // a bad spell, recorded
+  clock_.Advance(milliseconds(20));
+  Handle(Package(kAlice, 2, {Cmd(1, CommandType::kSetSpeed, {0.3, 0})}));
+  Run();
+  for (std::int64_t i = 3; i <= 12; ++i) {
+    clock_.Advance(milliseconds(20));
+    Handle(Heartbeat(kAlice, i, clock_.Now(), milliseconds(20)));
+  }
+  sessions_->Expire(clock_.Now());
+  Run();
+  ASSERT_TRUE(fake_->partial_stops.empty());
+  clock_.Advance(milliseconds(20));
+  Handle(Heartbeat(kAlice, 1, clock_.Now() - milliseconds(220), milliseconds(1200)));  // the replay
+  sessions_->Expire(clock_.Now());
+  Run();
+  EXPECT_TRUE(fake_->partial_stops.empty()) << "a replayed old report stopped a good link's base";
+  EXPECT_EQ(sessions_->MotionLink().level, LinkState::Level::kGood);
+  EXPECT_EQ(sessions_->MotionLink().round_trip, milliseconds(20));
+
+  // Now her link is bad (she reports 1.2 s); a replay of a good spell's package hides nothing.
+  for (std::int64_t i = 13; i <= 16; ++i) {
+    clock_.Advance(milliseconds(20));
+    Handle(Heartbeat(kAlice, i, clock_.Now(), milliseconds(1200)));
+  }
+  clock_.Advance(milliseconds(20));
+  Handle(Heartbeat(kAlice, 3, clock_.Now() - milliseconds(300), milliseconds(20)));  // the replay
+  sessions_->Expire(clock_.Now());
+  Run();
+  EXPECT_EQ(sessions_->MotionLink().round_trip, milliseconds(1200));
+  EXPECT_EQ(fake_->partial_stops.size(), 1u) << "a replayed good report hid a bad link";
+}
+
+// A playback sequence waiting for its start (the paper's estimate, which a
+// jittery link also gets: frames buffered in the session until enough came)
+// is queued commands of the session: --link-stop drops them and ends the
+// sequence, so frames that arrived before the stop never run after it, and
+// its later frames are answered, never a sequence started without its first
+// frames (review 10: the buffered frames ran once the sequence started).
+SessionOptions PaperPlayback() {
+  SessionOptions o = ShortHorizon(/*link_stop=*/true);
+  o.playback.quick_start = false;
+  o.playback.adaptive = false;
+  return o;
+}
+class LinkStopPlaybackTest : public LinkTest {
+ protected:
+  LinkStopPlaybackTest() : LinkTest(PaperPlayback()) {}
+};
+
+TEST_F(LinkStopPlaybackTest, DropsTheFramesOfASequenceWaitingForItsStartAndEndsIt) {
+  Handle(Package(kAlice, 1, {Cmd(1, CommandType::kSetSpeed, {0.3, 0})}));
+  Run();
+  Handle(Playback(kAlice, 2, 50, 10, seconds(1),
+                  {Cmd(3, CommandType::kSetSpeed, {0.5, 0}, "", StartTime::After(Duration(0))),
+                   Cmd(4, CommandType::kSetSpeed, {0.6, 0}, "", StartTime::After(milliseconds(100)))}));
+  LoseHalf(3);
+  sessions_->Expire(clock_.Now());
+  Run();
+  ASSERT_EQ(fake_->partial_stops.size(), 1u);
+  const std::map<CommandId, Reply> replies = Replies(kAlice);
+  for (CommandId id : {3, 4, 50}) {
+    EXPECT_TRUE(replies.count(id)) << "buffered frame or delay reply " << id << " not answered at the stop";
+    if (!replies.count(id)) continue;
+    EXPECT_EQ(replies.at(id).signal, Signal::kInterrupted) << id;
+    EXPECT_THAT(replies.at(id).message, HasSubstr("--link-stop")) << id;
+  }
+  // The client sends the rest of the sequence: answered, never run.
+  std::vector<Command> rest;
+  for (int k = 2; k < 10; ++k)
+    rest.push_back(
+        Cmd(3 + k, CommandType::kSetSpeed, {0.1 * k, 0}, "", StartTime::After(milliseconds(100 * k))));
+  const std::map<CommandId, Reply> later = Handle(Playback(kAlice, 43, 50, 10, seconds(1), rest));
+  for (int k = 2; k < 10; ++k) {
+    EXPECT_TRUE(later.count(3 + k)) << "later frame " << 3 + k << " not answered at once";
+    if (!later.count(3 + k)) continue;
+    EXPECT_EQ(later.at(3 + k).signal, Signal::kInterrupted);
+    EXPECT_THAT(later.at(3 + k).message, HasSubstr("--link-stop"));
+  }
+  for (int i = 0; i < 200; ++i) {
+    clock_.Advance(milliseconds(10));
+    Run();
+  }
+  for (const FakeDriver::Call& c : fake_->calls)
+    EXPECT_FALSE(c.type == CommandType::kSetSpeed && c.values.at(0) > 0.35)
+        << "a frame of the stopped sequence ran";
 }
 
 }  // namespace

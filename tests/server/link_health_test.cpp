@@ -201,6 +201,55 @@ TEST(LinkHealth, HeavyLossAndALongRoundTripAreBad) {
   EXPECT_EQ(v.why, "loss 49.5 % > 25.0 %, delay 750 ms > 500 ms");
 }
 
+// The round trip is the latest the client reported: the report of its
+// highest-numbered package. A copy of a package seen before (a duplicated
+// datagram, a retransmission whose answer was lost, or a recording replayed
+// by someone who cannot forge a package: keyed mode) and a package
+// overtaken by a later-numbered one carry an older report, which must not
+// replace it: a replay of a package from a bad spell made a good link bad
+// (--link-stop stopped the robot), one from a good spell hid a bad link.
+TEST(LinkHealth, OnlyTheHighestNumberedPackagesRoundTripCountsNotACopyOrAnOvertakenOne) {
+  // Package 1 reports `first`, 2 .. 30 `then`; then a copy of package 1 comes.
+  const auto replay_first = [](Duration first, Duration then, LinkHealth::Level level) {
+    Link l;
+    l.Send(1, milliseconds(0), milliseconds(20), false, first);
+    for (int i = 2; i <= 30; ++i) l.Send(i, milliseconds(10 * i), milliseconds(20), false, then);
+    ASSERT_EQ(l.health.Evaluate().level, level);
+    l.Send(1, milliseconds(0), milliseconds(400), /*duplicate=*/true, first);
+    EXPECT_EQ(l.health.Figures().round_trip, then) << "a copy's older report";
+    EXPECT_EQ(l.health.Evaluate().level, level);
+  };
+  replay_first(milliseconds(1200), milliseconds(20), LinkHealth::Level::kGood);  // stays good
+  replay_first(milliseconds(20), milliseconds(1200), LinkHealth::Level::kBad);   // stays bad
+
+  Link overtaken;
+  overtaken.Send(2, milliseconds(10), milliseconds(20), false, milliseconds(30));
+  overtaken.Send(1, milliseconds(0), milliseconds(35), false, milliseconds(900));
+  EXPECT_EQ(overtaken.health.Figures().round_trip, milliseconds(30)) << "package 2's report is the later";
+  overtaken.Send(3, milliseconds(20), milliseconds(20), false, milliseconds(50));
+  EXPECT_EQ(overtaken.health.Figures().round_trip, milliseconds(50));
+}
+
+// A send time no client's clock has (the wire's extremes, ±292 years) is no
+// transit: arrival − send time overflowed (undefined behaviour), and the
+// wrapped values made the jitter 6.9e8 s and the link bad (review 10). Such a
+// package counts as received, its transit unknown (OneWayDelay, as
+// playback's delays).
+TEST(LinkHealth, ASendTimeAtTheWiresExtremesIsNoTransitAndLeavesTheJitterAlone) {
+  Link l;
+  for (int i = 1; i <= 20; ++i) l.Send(i, milliseconds(10 * i), milliseconds(20));
+  for (const std::int64_t extreme : {-kMaxWireMicros, kMaxWireMicros}) {
+    l.health.OnPackage(l.health.Figures().packages + 1, false, FromWireMicros(extreme), At(milliseconds(300)),
+                       milliseconds(40));
+  }
+  for (int i = 23; i <= 30; ++i) l.Send(i, milliseconds(10 * i), milliseconds(20));
+  const LinkFigures f = l.health.Figures();
+  EXPECT_EQ(f.packages, 30u);
+  EXPECT_EQ(f.lost, 0u);
+  EXPECT_EQ(f.jitter, Duration(0));
+  EXPECT_EQ(l.health.Evaluate().level, LinkHealth::Level::kGood) << l.health.Evaluate().why;
+}
+
 // OnPackage says which packages came as retransmissions (playback's delay
 // history leaves them out, issue 23): one after a later-numbered package and
 // slower than the slowest recent first copies by more than the reorder

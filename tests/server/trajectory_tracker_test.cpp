@@ -262,6 +262,57 @@ TEST_F(TrackerTest, ATooFastPlanIsFollowedWithinTheLimitsAndAnswersModifiedNamin
   EXPECT_EQ(AnswerTo(1)->reply.exec_time, kT0 + milliseconds(100)) << "the client's timing is kept";
 }
 
+// A linear plan's velocity steps at its knots, its first one included: the
+// start knot is where the joint is, moving or not, and the first segment's
+// slope is whatever the waypoint asks. That first step is limited like any
+// other (review 10: from rest, the first reference of a 2 rad/s slope was
+// 2 rad/s, 200 rad/s² in one period, and reference_max_acceleration did not
+// count it; a cubic moving at 1.6 rad/s replaced by a linear waypoint the
+// other way stepped 3.2 rad/s at once).
+TEST_F(TrackerTest, ALinearPlansFirstVelocityStepIsWithinTheAccelerationLimitToo) {
+  double amax = 0, last_v = 0;
+  const auto run = [&](TimePoint from, TimePoint to) {
+    for (TimePoint t = from; t <= to; t += milliseconds(10)) {
+      tracker_.Sample(t, answers_);
+      if (tracker_.references().empty()) {
+        last_v = 0;
+        continue;
+      }
+      const double v = tracker_.references()[0].velocity[0];
+      amax = std::max(amax, std::abs(v - last_v) / 0.01);
+      last_v = v;
+    }
+  };
+  // From rest: 1 rad in 0.5 s, the elbow's 2 rad/s.
+  Add({Waypoint(1, 0, kT0 + milliseconds(500), {1.0}, Interpolation::kLinear)}, kT0);
+  run(kT0, kT0 + std::chrono::seconds(2));
+  EXPECT_LE(amax, 20 * (1 + 1e-6)) << "from rest";
+  EXPECT_LE(tracker_.max_reference_acceleration(), 20 * (1 + 1e-6));
+  ASSERT_NE(AnswerTo(1), nullptr);
+  EXPECT_EQ(AnswerTo(1)->reply.signal, Signal::kModified) << "the reference was limited on the way";
+
+  // Moving (a cubic at speed), then a linear waypoint back the other way.
+  const TimePoint t1 = kT0 + std::chrono::seconds(3);
+  RobotState at_one = Rest(model_);
+  at_one.position[0] = 1.0;  // where the first plan ended
+  tracker_.Add(std::vector<QueuedItem>{Waypoint(2, 0, t1 + milliseconds(500), {0.0}),
+                                       Waypoint(3, 0, t1 + milliseconds(1000), {-1.0})},
+               t1, at_one, answers_, started_);
+  run(t1, t1 + milliseconds(500));
+  ASSERT_FALSE(tracker_.references().empty());
+  ASSERT_LT(last_v, -1.0) << "moving";
+  const TimePoint t2 = t1 + milliseconds(510);
+  RobotState moving = Rest(model_);
+  moving.position[0] = tracker_.references()[0].position[0];
+  moving.velocity[0] = last_v;
+  tracker_.Add(std::vector<QueuedItem>{Waypoint(4, 0, t2 + milliseconds(400), {0.5}, Interpolation::kLinear)},
+               t2, moving, answers_, started_);
+  amax = 0;
+  run(t2, t2 + std::chrono::seconds(2));
+  EXPECT_LE(amax, 20 * (1 + 1e-6)) << "switching a moving cubic to linear";
+  EXPECT_LE(tracker_.max_reference_acceleration(), 20 * (1 + 1e-6));
+}
+
 TEST_F(TrackerTest, AWaypointBeyondAPositionLimitIsClampedAndSaysSo) {
   Add({Waypoint(1, 0, kT0 + std::chrono::seconds(3), {2.5})}, kT0);
   const std::vector<double> q = Run(kT0, kT0 + std::chrono::seconds(3));

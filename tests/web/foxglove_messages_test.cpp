@@ -235,6 +235,25 @@ TEST(RobotMessages, AMeshOverTheEmbeddingLimitIsDrawnAsItsInertiaBoxSayingWhy) {
   EXPECT_NE(Meta(arm, "mesh").find("over the 16-byte limit of an embedded mesh"), std::string::npos) << arm;
 }
 
+// A STATE sample's time at the wire's extremes (a forged sample, a damaged
+// log exported to MCAP) is stamped at those extremes: its seconds, back in
+// microseconds, round up past them, and the nanoseconds overflowed an int64
+// (review 10: undefined behaviour; it wrapped to the far side of the range).
+TEST(RobotMessages, AStateAtTheWiresExtremeTimesIsStampedThereWithoutOverflow) {
+  const auto model = Pioneer();
+  const RobotMessages m(model);
+  StatePoser poser(*model);
+  for (const std::int64_t us : {kMaxWireMicros, -kMaxWireMicros}) {
+    StateSample s;
+    s.robot = model->name();
+    s.server_time = FromWireMicros(us);
+    s.period = std::chrono::microseconds(10'000);
+    s.positions.assign(static_cast<std::size_t>(model->num_dofs()), 0.0);
+    s.velocities = s.efforts = s.positions;
+    EXPECT_EQ(m.FromPose(poser.Pose(s)).time_ns, us * 1000) << us;
+  }
+}
+
 TEST(RobotMessages, FromPoseOfAnotherModelThrowsNamingTheRobot) {
   const auto model = Pioneer();
   const RobotMessages m(model);

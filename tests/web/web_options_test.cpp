@@ -67,6 +67,10 @@ TEST(WebOptions, NamesTheBadArgument) {
   EXPECT_NE(ErrorOf({"--robot-timeout", "1"}).find("shorter than 1.5 s"), std::string::npos);
   EXPECT_EQ(ErrorOf({"--server-key", ""}), "--server-key: the file name is empty");
   EXPECT_EQ(ErrorOf({"--key"}), "--key: needs a value");
+  // Review 10: a timeout past what a time holds was accepted here and failed later naming no
+  // option ("FromSeconds: 1e+12 s is out of range"); 5e9 s overflowed an int in the robot card's text.
+  EXPECT_EQ(ErrorOf({"--robot-timeout", "1e12"}), "--robot-timeout 1e12 is out of range (at most 1e+09 s)");
+  EXPECT_EQ(ErrorOf({"--robot-timeout", "5e9"}), "--robot-timeout 5e9 is out of range (at most 1e+09 s)");
 }
 
 TEST(WebOptions, HelpMentionsEveryOption) {

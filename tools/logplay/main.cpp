@@ -181,14 +181,13 @@ int RunReplay(Args& a) {
     o.sequence.mode = *mode;
   }
   if (auto d = a.One("--delay")) {
-    const double s = robotalk::cli::ParseNumber(*d, "--delay");
-    if (s < 0) throw UsageError("--delay must be >= 0");
+    const double s = robotalk::cli::ParseSeconds(*d, "--delay");
     o.sequence.delay = robotalk::FromSeconds(s);
   }
   if (const char* env = std::getenv("LCM_DEFAULT_URL")) o.url = env;
   if (auto u = a.One("--url")) o.url = *u;
   if (auto t = a.One("--timeout")) {
-    o.timeout_s = robotalk::cli::ParseNumber(*t, "--timeout");
+    o.timeout_s = robotalk::cli::ParseSeconds(*t, "--timeout");
     if (o.timeout_s <= 0) throw UsageError("--timeout must be positive");
   }
   o.progress = !a.Flag("--no-progress") && isatty(STDERR_FILENO);
@@ -205,7 +204,7 @@ int RunRecord(Args& a) {
   if (auto u = a.One("--url")) o.url = *u;
   if (auto c = a.One("-c")) o.channels = *c;
   if (auto d = a.One("--duration")) {
-    const double s = robotalk::cli::ParseNumber(*d, "--duration");
+    const double s = robotalk::cli::ParseSeconds(*d, "--duration");
     if (s <= 0) throw UsageError("--duration must be positive");
     o.duration = robotalk::FromSeconds(s);
   }

@@ -406,7 +406,11 @@ json RobotMessages::Scene(std::int64_t time_ns, const MeshLinks& links) const {
 RobotMessages::State RobotMessages::FromPose(const json& pose) const {
   State s;
   const double t = Field(pose, "t").get<double>();
-  s.time_ns = static_cast<std::int64_t>(std::llround(t * 1e6)) * 1000;
+  // In the wire's range (seconds back to microseconds may round past it, and
+  // nanoseconds beyond it overflow an int64).
+  s.time_ns = std::clamp<std::int64_t>(std::llround(std::clamp(t * 1e6, -9.3e15, 9.3e15)), -kMaxWireMicros,
+                                       kMaxWireMicros) *
+              1000;
   const json& links = Field(pose, "links");
   if (!links.is_array() || links.size() != model_->links().size()) {
     throw Error("foxglove: state pose of robot '" + model_->name() + "' has " + std::to_string(links.size()) +

@@ -1,6 +1,7 @@
 #include "web_options.h"
 
 #include "robotalk/error.h"
+#include "robotalk/sequence_file.h"  // ParseSeconds
 
 #include <algorithm>
 #include <cmath>
@@ -95,7 +96,7 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       o.rate_hz = ParseNumber(a, value());
       if (o.rate_hz < 1 || o.rate_hz > 240) throw Error("--rate: " + args[i] + " Hz is outside 1-240");
     } else if (a == "--robot-timeout") {
-      o.robot_timeout_s = ParseNumber(a, value());
+      o.robot_timeout_s = ParseSeconds(value(), a);  // within what every time given as text may be
       if (o.robot_timeout_s < 1.5)
         throw Error("--robot-timeout: " + args[i] +
                     " s is shorter than 1.5 s (servers announce every second)");

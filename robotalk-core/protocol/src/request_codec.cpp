@@ -11,6 +11,7 @@
 #include "robotalk_msgs/root_link_t.hpp"
 #include "wire_scanner.h"
 
+#include <algorithm>
 #include <cstring>
 #include <utility>
 
@@ -112,7 +113,9 @@ std::vector<std::uint8_t> EncodeRequest(const Request& r) {
   } else if (r.max_late < Duration::zero()) {
     throw ProtocolError("package: negative max_late " + std::to_string(ToSeconds(r.max_late)) + " s");
   } else {
-    h.max_late_us = ToWireMicros(r.max_late);
+    // 0 on the wire is the robot's default: a positive limit below the wire's
+    // microsecond travels as 1 µs, never as that (looser) default.
+    h.max_late_us = r.max_late > Duration::zero() ? std::max<std::int64_t>(1, ToWireMicros(r.max_late)) : 0;
   }
   h.round_trip_us = r.round_trip > Duration::zero() ? ToWireMicros(r.round_trip) : 0;
   for (const Query& q : r.queries) p.queries.push_back(ToWire(q));

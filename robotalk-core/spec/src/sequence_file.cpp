@@ -27,6 +27,17 @@ double ParseNumber(const std::string& word, const std::string& what) {
   return v;
 }
 
+double ParseSeconds(const std::string& word, const std::string& what) {
+  const double s = ParseNumber(word, what);
+  if (s < 0) throw UsageError(what + " " + word + " is negative");
+  if (s > kMaxTextSeconds) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", kMaxTextSeconds);
+    throw UsageError(what + " " + word + " is out of range (at most " + limit + " s)");
+  }
+  return s;
+}
+
 namespace {
 
 bool NeedsTarget(CommandType t) {
@@ -194,8 +205,7 @@ SequenceFile ParseSequenceFile(const std::string& text, const std::string& sourc
       }
       SequenceEntry e;
       e.line = number;
-      e.offset_s = ParseNumber(words[0], "start time");
-      if (e.offset_s < 0) throw UsageError("start time " + words[0] + " is negative");
+      e.offset_s = ParseSeconds(words[0], "start time");
       if (words.size() < 2) throw UsageError("missing command after the start time");
       e.command = ParseCommandWords({words.begin() + 1, words.end()});
       file.entries.push_back(std::move(e));

@@ -50,6 +50,17 @@ Interpolation ParseInterpolationWord(const std::string& word, const std::string&
 /// Parses a number (the whole word); throws UsageError naming `what`.
 double ParseNumber(const std::string& word, const std::string& what);
 
+/// The most seconds a time given as text may be (a sequence file's start
+/// times; the command lines' --timeout, --at, --delay, --listen ...): 1e9 s,
+/// 31 years, well inside what a Duration holds (FromSeconds: 9.2e9 s), so
+/// that one added to a clock cannot overflow it.
+inline constexpr double kMaxTextSeconds = 1e9;
+/// Parses a time in seconds (the whole word) in [0, kMaxTextSeconds]; throws
+/// UsageError naming `what`: "--timeout 1e12 is out of range (at most 1e+09
+/// s)", "start time -1 is negative" (before: a time past FromSeconds' range
+/// failed later, naming neither option nor line).
+double ParseSeconds(const std::string& word, const std::string& what);
+
 struct SequenceEntry {
   int line = 0;         ///< 1-based line number in the file
   double offset_s = 0;  ///< seconds after the sequence's send time
@@ -78,6 +89,7 @@ namespace robotalk::cli {
 using robotalk::ParseCommandWords;
 using robotalk::ParseInterpolationWord;
 using robotalk::ParseNumber;
+using robotalk::ParseSeconds;
 using robotalk::ParseSequence;
 using robotalk::ParseSequenceFile;
 using robotalk::SequenceEntry;
