@@ -1,0 +1,37 @@
+// robotalk-ros2's command line (ros2_options.h): values out of range are
+// named, never cast past what a Duration holds.
+#include "ros2_options.h"
+
+#include "robotalk/error.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+
+namespace robotalk::ros2 {
+namespace {
+
+std::string ErrorOf(std::vector<std::string> args) {
+  try {
+    ParseRos2Options(args);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Ros2Options, ADurationIsParsedInSeconds) {
+  EXPECT_EQ(ParseRos2Options({"--duration", "2.5"}).duration, std::chrono::milliseconds(2500));
+}
+
+// Review 10: --duration 1e300 went through an unchecked double-to-int64 cast
+// (undefined behaviour); a time past what a time holds is now named.
+TEST(Ros2Options, ADurationOutOfRangeOrNotPositiveIsNamed) {
+  EXPECT_EQ(ErrorOf({"--duration", "1e300"}), "--duration 1e300 is out of range (at most 1e+09 s)");
+  EXPECT_EQ(ErrorOf({"--duration", "0"}), "--duration: 0 s is not positive");
+  EXPECT_NE(ErrorOf({"--duration", "nan"}), "(no error)");
+  EXPECT_NE(ErrorOf({"--duration", "-1"}), "(no error)");
+}
+
+}  // namespace
+}  // namespace robotalk::ros2
