@@ -1,6 +1,7 @@
 #include "ros2_options.h"
 
 #include "robotalk/error.h"
+#include "robotalk/sequence_file.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -17,7 +18,6 @@ double ParseNumber(const std::string& option, const std::string& text) {
   return v;
 }
 
-Duration Seconds(double s) { return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s)); }
 
 std::uint32_t ParseDomain(const std::string& option, const std::string& text) {
   // DDS's port mapping leaves room for domain ids 0..232 (ROS 2's
@@ -88,7 +88,7 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
       const double hz = ParseNumber(a, value());
       if (hz < 1 || hz > 1000)
         throw Error("--rate: " + args[i] + " Hz is outside 1..1000 (the STATE stream's range)");
-      o.period = Seconds(1.0 / hz);
+      o.period = FromSeconds(1.0 / hz);
     } else if (a == "--frame-prefix") {
       o.frame_prefix = value();
     } else if (a == "--world-frame") {
@@ -104,13 +104,13 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
     } else if (a == "--cmd-vel-timeout") {
       const double s = ParseNumber(a, value());
       if (s <= 0 || s > 60) throw Error("--cmd-vel-timeout: " + args[i] + " s is outside (0, 60]");
-      o.cmd_vel_timeout = Seconds(s);
+      o.cmd_vel_timeout = FromSeconds(s);
     } else if (a == "--read-only") {
       o.read_only = true;
     } else if (a == "--duration") {
-      const double s = ParseNumber(a, value());
+      const double s = ParseSeconds(value(), a);  // at most kMaxTextSeconds: FromSeconds cannot overflow
       if (s <= 0) throw Error("--duration: " + args[i] + " s is not positive");
-      o.duration = Seconds(s);
+      o.duration = FromSeconds(s);
     } else if (a == "--stats") {
       o.stats = true;
     } else {
