@@ -18,7 +18,6 @@ double ParseNumber(const std::string& option, const std::string& text) {
   return v;
 }
 
-
 std::uint32_t ParseDomain(const std::string& option, const std::string& text) {
   // DDS's port mapping leaves room for domain ids 0..232 (ROS 2's
   // "The ROS_DOMAIN_ID" concept page).
