@@ -24,8 +24,9 @@ inline const Duration kMargin = milliseconds(2);
 
 struct SimRun {
   int late = 0;
-  Duration start_delay{};  // offset 0's time − the first arrival
-  Duration hindsight{};    // the least delay after the first arrival with no frame late
+  std::size_t thin_gaps = 0;  // gaps stretched past max_stretch (a thin buffer's)
+  Duration start_delay{};     // offset 0's time − the first arrival
+  Duration hindsight{};       // the least delay after the first arrival with no frame late
   double max_gap_stretch = 0;
   Duration stretch{};  // of the last frame
 };
@@ -77,9 +78,7 @@ inline SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
       if (!est.ready()) continue;
       const TimePoint start = est.StartTime();
       run.start_delay = start - first;
-      schedule.emplace(start, est.playout_delay(),
-                       PlaybackScheduleOptions{.max_stretch = options.adaptive ? options.max_stretch : 0,
-                                               .margin = options.adaptive_margin});
+      schedule.emplace(start, est.playout_delay(), est.schedule_options());
       std::stable_sort(buffered.begin(), buffered.end(),
                        [](const Frame* a, const Frame* b) { return a->offset < b->offset; });
       for (const Frame* b : buffered) {
@@ -92,6 +91,7 @@ inline SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
     if (p.late || p.at < f.arrival) ++run.late;
   }
   run.max_gap_stretch = schedule->max_gap_stretch();
+  run.thin_gaps = schedule->thin_gaps();
   run.stretch = schedule->stretch();
   return run;
 }
