@@ -104,30 +104,6 @@ TEST(ThinBuffer, OffAtOrBelowTheNormalBoundAndWithTheFixedSchedule) {
       << AtFirstFrame(history).Describe();
 }
 
-struct Goal {
-  int met = 0, late_runs = 0, thin_runs = 0;
-  double median_ratio = 0, worst_gap = 0;
-  Duration worst_stretch{};
-};
-
-Goal Runs(const Channel& channel, PlaybackEstimatorOptions options, std::size_t burst, int runs = 300,
-          std::size_t frames = 40) {
-  Goal g;
-  std::vector<double> ratios;
-  ForEachRun(runs, channel, options, frames, burst, [&](const SimRun& r) {
-    g.late_runs += r.late > 0;
-    const double ratio = ToSeconds(r.start_delay) / ToSeconds(r.hindsight + kMargin);
-    ratios.push_back(ratio);
-    g.met += r.late == 0 && ratio <= 1.25;
-    g.thin_runs += r.thin_gaps > 0;
-    g.worst_gap = std::max(g.worst_gap, r.max_gap_stretch);
-    g.worst_stretch = std::max(g.worst_stretch, r.stretch);
-  });
-  std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
-  g.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
-  return g;
-}
-
 TEST(ThinBuffer, OnEveryModelChannelMoreRunsMeetTheGoalTheStartUnchangedAndNoGapPastItsBound) {
   // 300 seeded runs per channel, connect-time packages as round trips (burst
   // 0) or sent together (burst 4); thin buffer off (the base) against on.
