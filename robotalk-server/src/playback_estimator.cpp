@@ -391,13 +391,17 @@ PlaybackScheduleOptions PlaybackEstimator::schedule_options() const {
   if (!options_.adaptive) return {.max_stretch = 0.0, .margin = options_.adaptive_margin};
   // The thin buffer's lead scales with the channel: a quarter of the delay
   // spread (on an unimpaired link a fraction of a millisecond, so its
-  // sequences keep the normal bound); no spread known: off.
+  // sequences keep the normal bound), on a FIFO link only (every package
+  // seen arrived in the order it was sent): there the frames after a thin
+  // one queue behind it. On a jittery link a frame's delay says little of
+  // the next one's: only a frame past the normal bound takes the wider one.
   const std::optional<Duration> spread = delay_spread();
-  return {.max_stretch = options_.max_stretch,
-          .margin = options_.adaptive_margin,
-          .thin_max_stretch = spread ? options_.thin_stretch : 0.0,
-          .thin_lead =
-              spread ? FromSeconds(std::max(0.0, options_.thin_lead) * ToSeconds(*spread)) : Duration(0)};
+  const bool fifo = spread && ArrivedInSendOrder(SeenPackages());
+  return {
+      .max_stretch = options_.max_stretch,
+      .margin = options_.adaptive_margin,
+      .thin_max_stretch = options_.thin_stretch,
+      .thin_lead = fifo ? FromSeconds(std::max(0.0, options_.thin_lead) * ToSeconds(*spread)) : Duration(0)};
 }
 
 Duration PlaybackEstimator::start_lead() const {

@@ -147,10 +147,10 @@ struct PlaybackEstimatorOptions {
   /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
   double max_stretch = 0.10;
   /// A thin buffer (issue 23, tenth session; PlaybackScheduleOptions): a
-  /// frame that arrives less than thin_lead × the delay spread before the
-  /// latest time max_stretch allows may take up to thin_stretch of its gap
-  /// (and plays that lead after its arrival). At or below max_stretch: off.
-  /// It moves neither the gate nor the start.
+  /// frame that arrives after the latest time max_stretch allows, or on a
+  /// FIFO link less than thin_lead × the delay spread before it, may take up
+  /// to thin_stretch of its gap (and plays that lead after its arrival). At
+  /// or below max_stretch: off. It moves neither the gate nor the start.
   double thin_stretch = 0.25;
   double thin_lead = 0.25;
   /// The adaptive start lies this many gaps' stretch (max_stretch × the mean

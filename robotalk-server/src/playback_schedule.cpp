@@ -32,12 +32,12 @@ PlaybackSchedule::Placement PlaybackSchedule::Place(Duration offset, TimePoint a
     p.late = arrival > earliest;
   } else {
     TimePoint want = ready;
-    // A thin buffer: this frame came less than thin_lead before the latest
-    // time the normal bound allows. On a FIFO link the frames after it
-    // queue behind it; this gap may take up to thin_max_stretch, and the
-    // frame plays no sooner than thin_lead after it arrived.
-    const bool thin = options_.thin_max_stretch > options_.max_stretch && options_.thin_lead > Duration(0) &&
-                      latest - arrival < options_.thin_lead;
+    // A thin buffer: this frame came after the latest time the normal bound
+    // allows, or less than thin_lead before it. On a FIFO link the frames
+    // after it queue behind it; this gap may take up to thin_max_stretch,
+    // and the frame plays no sooner than thin_lead after it arrived.
+    const bool thin = options_.thin_max_stretch > options_.max_stretch &&
+                      arrival + std::max(options_.thin_lead, options_.margin) > latest;
     if (thin) {
       latest = stretched(options_.thin_max_stretch);
       want = std::max(want, arrival + options_.thin_lead);

@@ -164,9 +164,12 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
   if (stretch > 0) {
     const auto percent = [](double f) { return std::to_string(static_cast<int>(std::lround(f * 100))); };
     why += "; a gap between frames plays up to " + percent(stretch) + " % longer when the next frame is slow";
-    if (schedule.thin_max_stretch > stretch && schedule.thin_lead > Duration(0))
-      why += " (up to " + percent(schedule.thin_max_stretch) + " % while a frame comes less than " +
-             Seconds(schedule.thin_lead) + " before its time)";
+    if (schedule.thin_max_stretch > stretch) {
+      why += " (up to " + percent(schedule.thin_max_stretch) + " % after a frame that came past that" +
+             (schedule.thin_lead > Duration(0) ? " or less than " + Seconds(schedule.thin_lead) + " before it"
+                                               : std::string()) +
+             ")";
+    }
   }
   Reply reply = MakeReply(id, Signal::kSuccess,
                           "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +

@@ -79,29 +79,62 @@ TEST(ThinBuffer, AFrameThatComesWithLessThanTheThinLeadMayTakeUpToTheThinBoundAn
   EXPECT_NEAR(s.max_gap_stretch(), 0.25, 1e-9) << "the pause is counted as late instead";
 }
 
-TEST(ThinBuffer, OffAtOrBelowTheNormalBoundAndWithTheFixedSchedule) {
-  for (const PlaybackScheduleOptions& o :
-       {PlaybackScheduleOptions{.max_stretch = 0.10, .thin_max_stretch = 0.10, .thin_lead = milliseconds(20)},
-        PlaybackScheduleOptions{.max_stretch = 0.10, .thin_max_stretch = 0.25, .thin_lead = Duration(0)}}) {
-    PlaybackSchedule s(kT0, milliseconds(10), o);  // the frames' own delay: no proactive stretch
+TEST(ThinBuffer, OffAtOrBelowTheNormalBoundWithoutALeadOnlyAFramePastItTakesTheWiderBound) {
+  // At or below max_stretch: off; a frame past 10 % is late (a pause).
+  {
+    PlaybackSchedule s(kT0, milliseconds(10),  // the frames' own delay: no proactive stretch
+                       {.max_stretch = 0.10, .thin_max_stretch = 0.10, .thin_lead = milliseconds(20)});
     s.Place(Duration(0), kT0 - milliseconds(40), milliseconds(10));
-    const auto p = s.Place(milliseconds(100), kT0 + milliseconds(105), milliseconds(10));
-    EXPECT_EQ(p.at, kT0 + milliseconds(107)) << "the 10 % bound only";
+    EXPECT_EQ(s.Place(milliseconds(100), kT0 + milliseconds(105), milliseconds(10)).at,
+              kT0 + milliseconds(107))
+        << "the 10 % bound only";
     EXPECT_TRUE(s.Place(milliseconds(200), kT0 + milliseconds(220), milliseconds(10)).late);
     EXPECT_EQ(s.thin_gaps(), 0u);
   }
-  // The estimator's schedule: the thin lead is a quarter of the delay spread
-  // with the adaptive estimator (10, 20, 30 ms and frame 0's 1 ms: 29 ms),
-  // nothing with the quick or the paper's (fixed timing).
-  const std::vector<Duration> history = {milliseconds(10), milliseconds(20), milliseconds(30)};
-  const PlaybackScheduleOptions adaptive = AtFirstFrame(history).schedule_options();
-  EXPECT_EQ(adaptive.max_stretch, 0.10);
-  EXPECT_EQ(adaptive.thin_max_stretch, 0.25);
-  EXPECT_EQ(adaptive.thin_lead, FromSeconds(0.029 / 4));
-  EXPECT_EQ(AtFirstFrame(history, {.thin_stretch = 0}).schedule_options().thin_max_stretch, 0.0);
-  EXPECT_EQ(AtFirstFrame(history, {.adaptive = false}).schedule_options().max_stretch, 0.0);
-  EXPECT_NE(AtFirstFrame(history).Describe().find("\"thin_lead\":7.2"), std::string::npos)
-      << AtFirstFrame(history).Describe();
+  // Without a lead (a jittery link): a frame that came in time keeps the
+  // 10 % bound; one past it may take up to 25 % and plays at its arrival + 2 ms.
+  PlaybackSchedule s(kT0, milliseconds(10), {.max_stretch = 0.10, .thin_max_stretch = 0.25});
+  s.Place(Duration(0), kT0 - milliseconds(40), milliseconds(10));
+  EXPECT_EQ(s.Place(milliseconds(100), kT0 + milliseconds(105), milliseconds(10)).at,
+            kT0 + milliseconds(107));
+  const auto past = s.Place(milliseconds(200), kT0 + milliseconds(220), milliseconds(10));
+  EXPECT_FALSE(past.late);
+  EXPECT_EQ(past.at, kT0 + milliseconds(222));
+  EXPECT_EQ(s.thin_gaps(), 1u);
+}
+
+// Connect-time packages sent 0, 200 and 400 ms into the second before frame
+// 0 with delays `delays` ms (frame 0 took 1 ms), arriving in the order
+// `handled` (a FIFO link: the order they were sent).
+PlaybackEstimator AfterThree(const std::vector<int>& delays, PlaybackEstimatorOptions options = {}) {
+  std::vector<DelayHistory::Sample> history;
+  for (std::size_t j = 0; j < delays.size(); ++j) {
+    const TimePoint sent = kT0 - milliseconds(1000) + milliseconds(200) * static_cast<int>(j);
+    history.push_back({sent + milliseconds(delays[j]), milliseconds(delays[j])});
+  }
+  std::sort(history.begin(), history.end(),
+            [](const auto& a, const auto& b) { return a.received < b.received; });  // as handled
+  return AtFirstFrame(history, options);
+}
+
+TEST(ThinBuffer, TheEstimatorsScheduleTakesAQuarterOfTheSpreadAsTheLeadOnAFifoLinkOnly) {
+  // Delays 10, 20, 30 ms and frame 0's 1 ms, in the order sent: the spread
+  // 29 ms, the lead a quarter of it.
+  const PlaybackScheduleOptions fifo = AfterThree({10, 20, 30}).schedule_options();
+  EXPECT_EQ(fifo.max_stretch, 0.10);
+  EXPECT_EQ(fifo.thin_max_stretch, 0.25);
+  EXPECT_EQ(fifo.thin_lead, FromSeconds(0.029 / 4));
+  EXPECT_NE(AfterThree({10, 20, 30}).Describe().find("\"thin_lead\":7.2"), std::string::npos)
+      << AfterThree({10, 20, 30}).Describe();
+  // 10, 250, 30 ms: the second arrived after the third (sent 200 ms later):
+  // a jittery link, no lead (only a frame past 10 % takes the wider bound).
+  const PlaybackScheduleOptions jitter = AfterThree({10, 250, 30}).schedule_options();
+  EXPECT_EQ(jitter.thin_max_stretch, 0.25);
+  EXPECT_EQ(jitter.thin_lead, Duration(0));
+  // Off: --playback-thin-stretch at or below the stretch; the quick or the
+  // paper's estimator keeps the timing exact.
+  EXPECT_EQ(AfterThree({10, 20, 30}, {.thin_stretch = 0}).schedule_options().thin_max_stretch, 0.0);
+  EXPECT_EQ(AfterThree({10, 20, 30}, {.adaptive = false}).schedule_options().max_stretch, 0.0);
 }
 
 TEST(ThinBuffer, OnEveryModelChannelMoreRunsMeetTheGoalTheStartUnchangedAndNoGapPastItsBound) {

@@ -125,10 +125,10 @@ struct ServerOptions {
   /// "paper" (the paper's estimate only, fixed timing).
   std::string playback_estimator = "adaptive";
   double playback_stretch = 0.10;
-  /// Adaptive: while a frame comes less than a quarter of the delay spread
-  /// before the latest time playback_stretch allows, its gap may play up to
-  /// this much longer (a thin buffer; PlaybackEstimatorOptions::thin_stretch).
-  /// At or below playback_stretch: off.
+  /// Adaptive: a frame that comes after the latest time playback_stretch
+  /// allows, or on a FIFO link less than a quarter of the delay spread before
+  /// it, may have its gap play up to this much longer (a thin buffer;
+  /// PlaybackEstimatorOptions::thin_stretch). At or below playback_stretch: off.
   double playback_thin_stretch = 0.25;
   /// Adaptive: a frame plays no sooner than this after it arrived (its
   /// hand-over to the RobotDaemon; PlaybackScheduleOptions::margin).
