@@ -348,9 +348,14 @@ int Playback(const Args& a) {
   const double bound = a.Num("stretch-bound", 0.10);
   double max_stretch = 0;
   std::optional<TimePoint> previous;
+  Json late_detail = Json::array();  // each late frame: [its index, lateness ms, the gap before it ms]
   for (const Reply& rep : r.replies) {
     late.push_back(Us(rep.lateness));
-    if (rep.lateness > std::chrono::milliseconds(1)) ++late_frames;
+    if (rep.lateness > std::chrono::milliseconds(1)) {
+      ++late_frames;
+      late_detail.push_back({static_cast<double>(late.size() - 1), ToSeconds(rep.lateness) * 1e3,
+                             previous ? ToSeconds(rep.exec_time - *previous) * 1e3 : 0.0});
+    }
     if (rep.signal != Signal::kSuccess && rep.signal != Signal::kModified) {
       ++not_run;
       previous.reset();
@@ -370,12 +375,13 @@ int Playback(const Args& a) {
                                          ToSeconds(period) * static_cast<double>(r.replies.size() - 1)
                                    : 0;
   auto f = StatsFields(c);
-  f.insert(f.begin(), {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
-                       Summary("lateness_us", late), Field("late_frames", static_cast<double>(late_frames)),
-                       Field("not_run", static_cast<double>(not_run)),
-                       Field("gaps_over_bound", static_cast<double>(over_bound)),
-                       Field("gaps_over_10pct", static_cast<double>(over_default)),
-                       Field("max_gap_stretch", max_stretch), Field("total_stretch_s", total_stretch)});
+  f.insert(f.begin(),
+           {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
+            Summary("lateness_us", late), Field("late_frames", static_cast<double>(late_frames)),
+            Field("not_run", static_cast<double>(not_run)),
+            Field("gaps_over_bound", static_cast<double>(over_bound)),
+            Field("gaps_over_10pct", static_cast<double>(over_default)), Field("late_detail", late_detail),
+            Field("max_gap_stretch", max_stretch), Field("total_stretch_s", total_stretch)});
   PrintJson(f);
   return 0;
 }

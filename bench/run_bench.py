@@ -414,6 +414,8 @@ class Bench:
                      ["--stretch-bound", "0.5"], 2.0, None))
         # the default before a queue beyond the gate was followed (issue 23, seventh session)
         variants += (("adaptive_follow_off", adaptive + ["--playback-follow-queue", "off"], [], 2.0, None),)
+        # the default before the thin buffer (issue 23, tenth session): every gap within 10 %
+        variants += (("adaptive_thin_off", adaptive + ["--playback-thin-stretch", "0.1"], [], 2.0, None),)
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
         # robotalk-server ("adaptive_before_build"): a code change's before and after on the same
         # relay seeds and under the same load, interleaved.
