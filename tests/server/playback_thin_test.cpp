@@ -19,6 +19,9 @@ namespace {
 
 using namespace playback_model;
 
+// The thin buffer on (`--playback-thin-stretch 0.25`; off by default).
+const PlaybackEstimatorOptions kThin{.thin_stretch = 0.25};
+
 // Relay U[0, 150] ms, seed 1521 (bench/results/session9/reach1521.json, the
 // base server): nine connect-time round trips and the 40 frames, each one-way
 // delay in ms (the relay's least + 5 ms, so that none is below zero). The
@@ -30,7 +33,7 @@ const std::vector<int> kFrames = {71, 104, 155, 200, 208, 246, 240, 140, 50, 65,
                                   41, 71,  34,  37,  104, 82,  42,  131, 31, 16, 46, 92, 39, 56,
                                   60, 19,  117, 134, 55,  61,  35,  57,  24, 64, 9,  5};
 
-SimRun Seed1521(PlaybackEstimatorOptions options = {}) {
+SimRun Seed1521(PlaybackEstimatorOptions options) {
   return Simulate(
       kFrames.size(), milliseconds(100), kConnect.size(),
       [](std::size_t k, TimePoint) {
@@ -42,7 +45,8 @@ SimRun Seed1521(PlaybackEstimatorOptions options = {}) {
 TEST(ThinBuffer, AQueueWithinTheGateThatOutgrowsTheTenPercentStretchPlaysEveryFrameInTime) {
   // Before (the base, 5b1c8a9): frames 3 and 5 arrived after the 10 %
   // stretch could reach them: two pauses past the bound (as on the relay).
-  const SimRun run = Seed1521();
+  EXPECT_GT(Seed1521({}).late, 0) << "the default (the thin buffer is an option): as on the relay";
+  const SimRun run = Seed1521(kThin);
   EXPECT_EQ(run.late, 0) << "frames past the bound";
   EXPECT_LE(ToSeconds(run.start_delay), 0.100) << "the start itself is unchanged (91 ms on the relay)";
 }
@@ -106,7 +110,7 @@ TEST(ThinBuffer, OffAtOrBelowTheNormalBoundWithoutALeadOnlyAFramePastItTakesTheW
 // Connect-time packages sent 0, 200 and 400 ms into the second before frame
 // 0 with delays `delays` ms (frame 0 took 1 ms), arriving in the order
 // `handled` (a FIFO link: the order they were sent).
-PlaybackEstimator AfterThree(const std::vector<int>& delays, PlaybackEstimatorOptions options = {}) {
+PlaybackEstimator AfterThree(const std::vector<int>& delays, PlaybackEstimatorOptions options = kThin) {
   std::vector<DelayHistory::Sample> history;
   for (std::size_t j = 0; j < delays.size(); ++j) {
     const TimePoint sent = kT0 - milliseconds(1000) + milliseconds(200) * static_cast<int>(j);
@@ -134,7 +138,10 @@ TEST(ThinBuffer, TheEstimatorsScheduleTakesAQuarterOfTheSpreadAsTheLeadOnAFifoLi
   // Off: --playback-thin-stretch at or below the stretch; the quick or the
   // paper's estimator keeps the timing exact.
   EXPECT_EQ(AfterThree({10, 20, 30}, {.thin_stretch = 0}).schedule_options().thin_max_stretch, 0.0);
-  EXPECT_EQ(AfterThree({10, 20, 30}, {.adaptive = false}).schedule_options().max_stretch, 0.0);
+  EXPECT_EQ(AfterThree({10, 20, 30}, {}).schedule_options().thin_max_stretch, 0.10) << "off by default";
+  EXPECT_EQ(
+      AfterThree({10, 20, 30}, {.adaptive = false, .thin_stretch = 0.25}).schedule_options().max_stretch,
+      0.0);
 }
 
 TEST(ThinBuffer, OnEveryModelChannelMoreRunsMeetTheGoalTheStartUnchangedAndNoGapPastItsBound) {
@@ -150,7 +157,7 @@ TEST(ThinBuffer, OnEveryModelChannelMoreRunsMeetTheGoalTheStartUnchangedAndNoGap
                                                                  {"U[0, 40] ms jitter", Jitter(40)},
                                                                  {"WAN", Wan()},
                                                                  {"U[0, 0.5] ms", Jitter(0.5)}};
-  const PlaybackEstimatorOptions on{};
+  const PlaybackEstimatorOptions on = kThin;
   for (std::size_t burst : {std::size_t{0}, std::size_t{4}}) {
     for (const auto& [name, channel] : channels) {
       const Goal off = Runs(channel, {.thin_stretch = 0}, burst), thin = Runs(channel, on, burst);
