@@ -418,6 +418,12 @@ class Bench:
                      ["--stretch-bound", "0.5"], 2.0, None))
         # the default before a queue beyond the gate was followed (issue 23, seventh session)
         variants += (("adaptive_follow_off", adaptive + ["--playback-follow-queue", "off"], [], 2.0, None),)
+        # the thin buffer (issue 23, tenth session; an option): a gap up to 25 % while the buffer is
+        # thin, judged at that bound; "adaptive_thin_off" (the default since, every gap within 10 %)
+        # is the name its relay runs in bench/results/session10/ gave the default
+        thin = ["--playback-thin-stretch", "0.25"]
+        variants += (("adaptive_thin", adaptive + thin, ["--stretch-bound", "0.25"], 2.0, None),
+                     ("adaptive_thin_off", adaptive + ["--playback-thin-stretch", "0.1"], [], 2.0, None))
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
         # robotalk-server ("adaptive_before_build"): a code change's before and after on the same
         # relay seeds and under the same load, interleaved.

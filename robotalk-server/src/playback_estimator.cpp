@@ -384,6 +384,26 @@ std::optional<Duration> PlaybackEstimator::playout_delay() const {
   return (followed() ? std::max(worst, QueueWorst()) : worst) + options_.adaptive_margin;
 }
 
+PlaybackScheduleOptions PlaybackEstimator::schedule_options() const {
+  // With the adaptive estimator the gaps stretch whichever start decided
+  // (its fallback, the paper's estimate, too); the quick and the paper's
+  // estimators keep the fixed schedule.
+  if (!options_.adaptive) return {.max_stretch = 0.0, .margin = options_.adaptive_margin};
+  // The thin buffer's lead scales with the channel: a quarter of the delay
+  // spread (on an unimpaired link a fraction of a millisecond, so its
+  // sequences keep the normal bound), on a FIFO link only (every package
+  // seen arrived in the order it was sent): there the frames after a thin
+  // one queue behind it. On a jittery link a frame's delay says little of
+  // the next one's: only a frame past the normal bound takes the wider one.
+  const std::optional<Duration> spread = delay_spread();
+  const bool fifo = spread && ArrivedInSendOrder(SeenPackages());
+  return {
+      .max_stretch = options_.max_stretch,
+      .margin = options_.adaptive_margin,
+      .thin_max_stretch = options_.thin_stretch,
+      .thin_lead = fifo ? FromSeconds(std::max(0.0, options_.thin_lead) * ToSeconds(*spread)) : Duration(0)};
+}
+
 Duration PlaybackEstimator::start_lead() const {
   return FromSeconds(std::max(0.0, options_.start_lead) * std::max(0.0, options_.max_stretch) * interval());
 }
@@ -542,6 +562,7 @@ std::string PlaybackEstimator::Describe() const {
   if (adaptive()) {
     out += ",\"worst\":" + ms(AdaptiveWorst(options_.start_headroom) - least) +
            ",\"playout\":" + ms(*playout_delay() - least) + ",\"lead\":" + ms(start_lead());
+    out += ",\"thin_lead\":" + ms(schedule_options().thin_lead);
   }
   if (!seen.empty()) out += ",\"frame0\":" + ms(seen[history_.size()].delay - least);
   out += ",\"start\":" + ms(StartTime() - first) + "}";

@@ -95,6 +95,7 @@
 // the paper's estimate waits for 13 frames, which show it.
 #pragma once
 
+#include "playback_schedule.h"
 #include "robotalk/clock.h"
 
 #include <array>
@@ -145,6 +146,14 @@ struct PlaybackEstimatorOptions {
   /// With the adaptive start, each gap between frames may play up to this
   /// fraction longer than recorded (PlaybackScheduleOptions::max_stretch).
   double max_stretch = 0.10;
+  /// A thin buffer (issue 23, tenth session; PlaybackScheduleOptions): a
+  /// frame that arrives after the latest time max_stretch allows, or on a
+  /// FIFO link less than thin_lead × the delay spread before it, may take up
+  /// to thin_stretch of its gap (and plays that lead after its arrival). At
+  /// or below max_stretch (the default: an option, 0.25 measured): off. It
+  /// moves neither the gate nor the start.
+  double thin_stretch = 0.10;
+  double thin_lead = 0.25;
   /// The adaptive start lies this many gaps' stretch (max_stretch × the mean
   /// frame interval each) below the delay it covers, never before the
   /// decision + adaptive_margin: the schedule's stretch of the first gaps
@@ -283,6 +292,10 @@ class PlaybackEstimator {
   /// With the adaptive start, the worst delay it covers + its margin (the
   /// schedule's playout delay, PlaybackSchedule); else nullopt.
   std::optional<Duration> playout_delay() const;
+  /// The schedule's options: with the adaptive estimator its stretch, margin
+  /// and thin buffer (its lead from the delay spread), else the fixed
+  /// schedule (the quick and the paper's estimators).
+  PlaybackScheduleOptions schedule_options() const;
   /// How far below the worst delay it covers the adaptive start lies
   /// (start_lead × max_stretch × the mean frame interval).
   Duration start_lead() const;

@@ -23,12 +23,25 @@ PlaybackSchedule::Placement PlaybackSchedule::Place(Duration offset, TimePoint a
   }
   const Duration gap = offset - knot_offset_;
   const TimePoint earliest = knot_at_ + gap;
-  const TimePoint latest = earliest + FromSeconds(ToSeconds(gap) * std::max(0.0, options_.max_stretch));
+  const auto stretched = [&](double fraction) {
+    return earliest + FromSeconds(ToSeconds(gap) * std::max(0.0, fraction));
+  };
+  TimePoint latest = stretched(options_.max_stretch);
   Placement p{earliest, false};
   if (fixed) {
     p.late = arrival > earliest;
   } else {
     TimePoint want = ready;
+    // A thin buffer: this frame came after the latest time the normal bound
+    // allows, or less than thin_lead before it. On a FIFO link the frames
+    // after it queue behind it; this gap may take up to thin_max_stretch,
+    // and the frame plays no sooner than thin_lead after it arrived.
+    const bool thin = options_.thin_max_stretch > options_.max_stretch &&
+                      arrival + std::max(options_.thin_lead, options_.margin) > latest;
+    if (thin) {
+      latest = stretched(options_.thin_max_stretch);
+      want = std::max(want, arrival + options_.thin_lead);
+    }
     if (delay && playout_delay_) {
       // The playout delay grows to the worst delay this sequence has shown
       // (+ margin), so the frames after a slow one get its headroom. (Both
@@ -42,6 +55,7 @@ PlaybackSchedule::Placement PlaybackSchedule::Place(Duration offset, TimePoint a
       p.at = ready;
     } else if (p.at > earliest) {
       max_gap_stretch_ = std::max(max_gap_stretch_, ToSeconds(p.at - knot_at_) / ToSeconds(gap) - 1.0);
+      if (p.at > stretched(options_.max_stretch)) ++thin_;
     }
   }
   if (p.late) ++late_;

@@ -26,6 +26,16 @@
 //     around it stay within the bound; if that time is before its arrival it
 //     is late (it plays late or is superseded, as in the fixed schedule).
 //
+//   - a thin buffer (issue 23, tenth session; thin_max_stretch, thin_lead):
+//     a frame that arrives after the latest time max_stretch allows it, or
+//     less than thin_lead before it (its buffer thin: on a FIFO link the
+//     frames after it queue behind it), may take up to thin_max_stretch of
+//     its gap, and plays no sooner than thin_lead after its arrival: the
+//     buffer grows faster while it is thin, so a queue that outgrows
+//     max_stretch a gap is followed. Such gaps are counted (thin_gaps); the
+//     stated tolerance is then thin_max_stretch per gap, max_stretch after
+//     every frame that came in time.
+//
 // max_stretch = 0 is the fixed schedule of the paper: frame i at start + o_i.
 #pragma once
 
@@ -43,6 +53,13 @@ struct PlaybackScheduleOptions {
   /// A frame plays no sooner than this after it arrived (the hand-over to
   /// the RobotDaemon and its wake-up).
   Duration margin = std::chrono::milliseconds(2);
+  /// A thin buffer's bound (see above): a frame arriving after the time
+  /// max_stretch allows its gap at most, or less than `thin_lead` before it,
+  /// may take up to this fraction of it and plays at least `thin_lead` after
+  /// its arrival (a zero lead: only a frame past the normal bound). At or
+  /// below max_stretch: off.
+  double thin_max_stretch = 0;
+  Duration thin_lead{0};
 };
 
 class PlaybackSchedule {
@@ -66,6 +83,8 @@ class PlaybackSchedule {
   /// bound (late frames' pauses are counted in late_frames instead).
   double max_gap_stretch() const { return max_gap_stretch_; }
   std::size_t late_frames() const { return late_; }
+  /// Gaps that played longer than max_stretch allows (a thin buffer's, within thin_max_stretch).
+  std::size_t thin_gaps() const { return thin_; }
   std::optional<Duration> playout_delay() const { return playout_delay_; }
 
  private:
@@ -75,7 +94,7 @@ class PlaybackSchedule {
   Duration knot_offset_{0};  // the last frame placed in offset order
   TimePoint knot_at_;
   double max_gap_stretch_ = 0;
-  std::size_t late_ = 0;
+  std::size_t late_ = 0, thin_ = 0;
 };
 
 }  // namespace robotalk

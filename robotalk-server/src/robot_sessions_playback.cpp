@@ -120,16 +120,15 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, T
 void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, TimePoint now,
                           std::vector<Reply>& immediate) {
   const PlaybackEstimator& estimator = *seq.estimator;
-  const PlaybackEstimatorOptions& o = options_.playback;
   seq.start = estimator.StartTime();
   if (options_.log_playback)
     log_.push_back("robot '" + robot_ + "': PLAYBACK " + std::to_string(id) + " start " +
                    estimator.Describe());
-  // The adaptive start's schedule may stretch the gaps between frames; the
-  // quick and the paper's starts keep every frame at start + its offset.
-  const double stretch = o.adaptive ? o.max_stretch : 0.0;
-  seq.schedule.emplace(*seq.start, estimator.playout_delay(),
-                       PlaybackScheduleOptions{.max_stretch = stretch, .margin = o.adaptive_margin});
+  // The adaptive estimator's schedule may stretch the gaps between frames;
+  // the quick and the paper's estimators keep every frame at start + its offset.
+  const PlaybackScheduleOptions schedule = estimator.schedule_options();
+  const double stretch = schedule.max_stretch;
+  seq.schedule.emplace(*seq.start, estimator.playout_delay(), schedule);
   // The buffered frames, in offset order (the schedule stretches forward).
   std::stable_sort(seq.frames.begin(), seq.frames.end(),
                    [](const auto& a, const auto& b) { return a.offset < b.offset; });
@@ -164,9 +163,14 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
           Seconds(estimator.mean_arrival_interval()) + " between arrivals";
   }
   if (stretch > 0) {
-    why += "; a gap between frames plays up to " +
-           std::to_string(static_cast<int>(std::lround(stretch * 100))) +
-           " % longer when the next frame is slow";
+    const auto percent = [](double f) { return std::to_string(static_cast<int>(std::lround(f * 100))); };
+    why += "; a gap between frames plays up to " + percent(stretch) + " % longer when the next frame is slow";
+    if (schedule.thin_max_stretch > stretch) {
+      why += " (up to " + percent(schedule.thin_max_stretch) + " % after a frame that came past that" +
+             (schedule.thin_lead > Duration(0) ? " or less than " + Seconds(schedule.thin_lead) + " before it"
+                                               : std::string()) +
+             ")";
+    }
   }
   Reply reply = MakeReply(id, Signal::kSuccess,
                           "playback of " + std::to_string(seq.total) + " frames starts " + Seconds(delay) +

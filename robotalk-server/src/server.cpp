@@ -125,6 +125,7 @@ class Server::Impl {
     sessions.playback.quick_start = options_.playback_estimator != "paper";
     sessions.playback.adaptive = options_.playback_estimator == "adaptive";
     sessions.playback.max_stretch = options_.playback_stretch;
+    sessions.playback.thin_stretch = options_.playback_thin_stretch;
     sessions.playback.adaptive_margin = options_.playback_margin;
     sessions.playback.queue_start = options_.playback_queue_start;
     sessions.playback.follow_queue = options_.playback_follow_queue;

@@ -48,6 +48,11 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-stretch F            adaptive: how much longer than recorded a gap between two
                                   frames may play (default 0.1: 10 %; 0: never); above 0.1 the
                                   adaptive start's gate (1.2 frame intervals) moves up by F - 0.1
+  --playback-thin-stretch F       adaptive: a frame that comes after the latest time
+                                  --playback-stretch allows, or on a FIFO link less than a
+                                  quarter of the delay spread before it, may have its gap play
+                                  up to F longer (a thin buffer, e.g. 0.25; default 0.1: at or below
+                                  --playback-stretch: off)
   --playback-margin MS            adaptive: a frame plays no sooner than MS milliseconds after
                                   it arrived (its hand-over to the robot's thread; default 2)
   --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals
@@ -236,6 +241,8 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         }
       } else if (arg == "--playback-stretch") {
         options.playback_stretch = ParseNumber(arg, value(), 0, 1);
+      } else if (arg == "--playback-thin-stretch") {
+        options.playback_thin_stretch = ParseNumber(arg, value(), 0, 1);
       } else if (arg == "--playback-margin") {
         options.playback_margin = FromSeconds(ParseNumber(arg, value(), 0, 1000) / 1000);
       } else if (arg == "--playback-queue-start") {

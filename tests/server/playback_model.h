@@ -24,8 +24,9 @@ inline const Duration kMargin = milliseconds(2);
 
 struct SimRun {
   int late = 0;
-  Duration start_delay{};  // offset 0's time − the first arrival
-  Duration hindsight{};    // the least delay after the first arrival with no frame late
+  std::size_t thin_gaps = 0;  // gaps stretched past max_stretch (a thin buffer's)
+  Duration start_delay{};     // offset 0's time − the first arrival
+  Duration hindsight{};       // the least delay after the first arrival with no frame late
   double max_gap_stretch = 0;
   Duration stretch{};  // of the last frame
 };
@@ -77,9 +78,7 @@ inline SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
       if (!est.ready()) continue;
       const TimePoint start = est.StartTime();
       run.start_delay = start - first;
-      schedule.emplace(start, est.playout_delay(),
-                       PlaybackScheduleOptions{.max_stretch = options.adaptive ? options.max_stretch : 0,
-                                               .margin = options.adaptive_margin});
+      schedule.emplace(start, est.playout_delay(), est.schedule_options());
       std::stable_sort(buffered.begin(), buffered.end(),
                        [](const Frame* a, const Frame* b) { return a->offset < b->offset; });
       for (const Frame* b : buffered) {
@@ -92,6 +91,7 @@ inline SimRun Simulate(std::size_t frames, Duration period, std::size_t history,
     if (p.late || p.at < f.arrival) ++run.late;
   }
   run.max_gap_stretch = schedule->max_gap_stretch();
+  run.thin_gaps = schedule->thin_gaps();
   run.stretch = schedule->stretch();
   return run;
 }
@@ -145,6 +145,33 @@ inline Summary Many(int runs, const Channel& channel, PlaybackEstimatorOptions o
   std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
   s.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
   return s;
+}
+
+// Issue 23 item 3's goal over `runs` seeded runs of `channel`: runs with no
+// frame late and start / (hindsight + 2 ms) <= 1.25, runs with a late frame,
+// runs with a gap stretched past max_stretch (a thin buffer's), the median
+// ratio, the largest gap stretch and the longest whole-sequence stretch.
+struct Goal {
+  int met = 0, late_runs = 0, thin_runs = 0;
+  double median_ratio = 0, worst_gap = 0;
+  Duration worst_stretch{};
+};
+inline Goal Runs(const Channel& channel, PlaybackEstimatorOptions options, std::size_t burst, int runs = 300,
+                 std::size_t frames = 40) {
+  Goal g;
+  std::vector<double> ratios;
+  ForEachRun(runs, channel, options, frames, burst, [&](const SimRun& r) {
+    g.late_runs += r.late > 0;
+    const double ratio = ToSeconds(r.start_delay) / ToSeconds(r.hindsight + kMargin);
+    ratios.push_back(ratio);
+    g.met += r.late == 0 && ratio <= 1.25;
+    g.thin_runs += r.thin_gaps > 0;
+    g.worst_gap = std::max(g.worst_gap, r.max_gap_stretch);
+    g.worst_stretch = std::max(g.worst_stretch, r.stretch);
+  });
+  std::nth_element(ratios.begin(), ratios.begin() + runs / 2, ratios.end());
+  g.median_ratio = ratios[static_cast<std::size_t>(runs / 2)];
+  return g;
 }
 
 // A 40-frame sequence at 10 Hz whose frame 0 took 1 ms, arrived at kT0 and
