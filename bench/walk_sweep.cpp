@@ -30,6 +30,8 @@
 //     forked per (direction, level): the child is that run continued (the
 //     driver is deterministic and single-threaded), so 8 x K x levels pushes
 //     cost K walks of ~6.5 s plus 8 x K x levels x <= --after s simulated.
+//     --nudge 1: every push direction one ulp larger: the same sweep but for a
+//     difference no controller makes, i.e. how far chaos alone moves the figures.
 //   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
 //     after the start of the walk, default 5.5; standing 2); survived or not; --trace
 //     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them), a row every
@@ -85,6 +87,7 @@ struct Args {
   int instants = 0;  // --instants K: the multi-instant push sweep (walking)
   std::vector<double> levels = {10, 15, 20, 25, 30, 40};  // --levels: its impulses, N s
   double cycle = 1.52;                                    // --cycle S: the span its instants cover
+  bool nudge = false;  // --nudge 1: every push direction one ulp larger (how chaotic a figure is)
   std::map<std::string, std::string> options = {{"walk", "true"}};
 };
 
@@ -122,6 +125,8 @@ Args Parse(int argc, char** argv) {
       a.seed = static_cast<unsigned>(std::atoi(v.c_str()));
     } else if (k == "--instants") {
       a.instants = std::atoi(v.c_str());
+    } else if (k == "--nudge") {
+      a.nudge = v == "1";
     } else if (k == "--cycle") {
       a.cycle = std::atof(v.c_str());
     } else if (k == "--levels") {
@@ -210,6 +215,8 @@ struct Run {
     // Then each sole's lowest corner's height, largest one-contact force and pitch.
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.5f,%.1f,%.4f", s.foot_low[i], s.foot_peak_force[i], s.foot_pitch[i]);
+    // Then push_hip's lean (world axes, rad) and the torso's roll and pitch.
+    std::fprintf(trace, ",%.4f,%.4f,%.4f,%.4f", s.lean.x(), s.lean.y(), s.pelvis_roll, s.pelvis_pitch);
     std::fprintf(trace, "\n");
   }
   void Panic() {
@@ -411,7 +418,8 @@ int MultiInstantPushes(const Args& args) {
       r.Speed(kFullSpeed);
       if (!r.Until(t0, at[i])) continue;  // fell unpushed: every cell of this instant counts as a fall
       for (int k = 0; k < 8; ++k) {
-        const double angle = k * 45.0 * std::numbers::pi / 180;  // as --probe computes it
+        double angle = k * 45.0 * std::numbers::pi / 180;  // as --probe computes it
+        if (args.nudge) angle = std::nextafter(angle, 10.0);
         for (int l = 0; l < n_levels; ++l) {
           std::fflush(stdout);
           const pid_t pid = fork();
@@ -465,8 +473,19 @@ int MultiInstantPushes(const Args& args) {
       sum_median += median;
       std::printf("  %14.1f  %12.1f\n", median, mean);
     }
-    std::printf("survived %d of %d pushes; sum of the medians %.1f N s\n\n", total, 8 * n_levels * k_instants,
+    std::printf("survived %d of %d pushes; sum of the medians %.1f N s\n", total, 8 * n_levels * k_instants,
                 sum_median);
+    // Every push's outcome (S survived, F fell; the instants in order), for
+    // comparing two settings push by push (the same instants, another binary).
+    std::printf("cells (direction_deg N_s outcomes):\n");
+    for (int k = 0; k < 8; ++k) {
+      for (int l = 0; l < n_levels; ++l) {
+        std::printf("cell %d %.0f ", k * 45, args.levels[l]);
+        for (int i = 0; i < k_instants; ++i) std::printf("%c", survived[k][l][i] ? 'S' : 'F');
+        std::printf("\n");
+      }
+    }
+    std::printf("\n");
   }
   rusage ru{};
   getrusage(RUSAGE_CHILDREN, &ru);
@@ -515,7 +534,7 @@ int Probe(const Args& args) {
           "lcontacts,"
           "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
           "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
-          "rpitch\n");
+          "rpitch,lean_x,lean_y,pelvis_roll,pelvis_pitch\n");
     }
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);
