@@ -221,8 +221,6 @@ struct Run {
     // Then each sole's lowest corner's height, largest one-contact force and pitch.
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.5f,%.1f,%.4f", s.foot_low[i], s.foot_peak_force[i], s.foot_pitch[i]);
-    // Then push_hip's lean (world axes, rad) and the torso's roll and pitch.
-    std::fprintf(trace, ",%.4f,%.4f,%.4f,%.4f", s.lean.x(), s.lean.y(), s.pelvis_roll, s.pelvis_pitch);
     std::fprintf(trace, "\n");
   }
   void Panic() {
@@ -540,7 +538,7 @@ int Probe(const Args& args) {
           "lcontacts,"
           "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
           "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
-          "rpitch,lean_x,lean_y,pelvis_roll,pelvis_pitch\n");
+          "rpitch\n");
     }
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);

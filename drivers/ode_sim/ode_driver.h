@@ -149,12 +149,6 @@ struct OdeDriverOptions {
   /// to be the cause (its height stays under 1 mm; the runs diverge
   /// chaotically), so it stays an option. Key "push_balance".
   std::string push_balance = "off";
-  /// With push_recovery: the hip strategy (walking/hip_strategy.h;
-  /// docs/ode_sim.md, "Pushes and disturbances"): a push the DCM estimator
-  /// reads as more than 0.1 m/s leans the upper body toward it, at most this
-  /// far (rad), fast, then back upright slowly, the whole-body CoM kept on
-  /// the plan; 0: off. Key "push_hip".
-  double push_hip = 0;
   /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
   /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
   /// yield to the error between its measured and desired centre of pressure

@@ -84,7 +84,6 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       }
     }
   }
-  r.Number("push_hip", &o.push_hip, {.min = 0, .max = 0.5}, "a lean in [0, 0.5] (rad; 0: off)");
   r.Bool("foot_damping", &o.foot_damping);
   if (r.Text("gait", &o.gait) && o.gait != "fast" && o.gait != "slow") r.Fail("gait", "fast or slow");
   auto& go = o.gait_overrides;

@@ -42,7 +42,6 @@ struct WalkStatus {
   // Measured.
   Eigen::Vector3d com = Eigen::Vector3d::Zero();  ///< whole-body CoM from the physics, m
   Pose2 pelvis;                                   ///< the root's planar pose
-  double pelvis_roll = 0, pelvis_pitch = 0;       ///< the root's roll and pitch in its yaw frame, rad
   Pose2 foot_measured[2];                         ///< the feet's planar poses (ankle point, yaw)
   double foot_tilt[2] = {0, 0};                   ///< the soles' tilt from level, rad
   double foot_force[2] = {0, 0};                  ///< vertical ground force on each foot, N
@@ -67,9 +66,6 @@ struct WalkStatus {
   Eigen::Vector2d com_offset = Eigen::Vector2d::Zero();   ///< CoM reference minus the plan's (world axes), m
   /// push_balance's forces: the left sole's target raised by half of it and the right's lowered, m
   double force_difference = 0;
-  /// push_hip: the upper body's lean (world axes: the direction it leans toward times the angle), rad
-  Eigen::Vector2d lean = Eigen::Vector2d::Zero();
-  int leans = 0;           ///< push_hip: pushes that leaned the upper body so far
   int recoveries = 0;      ///< push recoveries so far (walking/push_recovery.h: the pattern regenerated)
   int push_stops = 0;      ///< walks stopped by a push so far (push_recovery's stop and stand)
   int push_captures = 0;   ///< push_capture=true: the capture stop's re-plans so far

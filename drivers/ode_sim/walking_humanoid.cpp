@@ -215,14 +215,6 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
       w->push_forces_.emplace(step, walking::ForceDifferenceFor(4 * w->sole_spring_.stiffness, kForceRate));
     }
   }
-  if (options.push_hip > 0 && !options.push_recovery) {
-    throw Error("OdeDriver: push_hip needs push_recovery=true (its DCM estimator reads the push)");
-  }
-  if (options.push_hip > 0) {
-    walking::HipStrategyParams hp;
-    hp.max_lean = options.push_hip;
-    w->hip_.emplace(step, hp);
-  }
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
   recovery.swing_reach = options.push_swing_reach;
@@ -349,20 +341,7 @@ void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
   const Eigen::Vector2d com =
       pattern_.com() + (com_offset_ ? com_offset_->offset() : Eigen::Vector2d::Zero());
   Pose2 p{0, 0, yaw};
-  // push_hip: the pelvis leans (the top toward lean_) about the horizontal
-  // axis z x lean_, and moves so that the whole-body CoM stays on the plan's.
-  // (Upright, the same arithmetic as without the option.)
-  const bool leaning = lean_.norm() > 0;
-  Eigen::Matrix3d tilt = Eigen::Matrix3d::Identity();
-  if (leaning) {
-    tilt = Eigen::AngleAxisd(lean_.norm(), Eigen::Vector3d(-lean_.y(), lean_.x(), 0).normalized())
-               .toRotationMatrix();
-  }
-  const Eigen::Vector2d off =
-      leaning ? Eigen::Vector2d((tilt * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                                 com_in_pelvis_)
-                                    .head<2>())
-              : p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y());
+  const Eigen::Vector2d off = p.Apply(com_in_pelvis_.x(), com_in_pelvis_.y());
   p.x = com.x() - off.x();
   p.y = com.y() - off.y();
   double z = pelvis_z_;
@@ -375,7 +354,6 @@ void WalkingHumanoid::DesiredPelvis(Eigen::Isometry3d* pelvis,
     p.y = pelvis_start_.y() + (p.y - pelvis_start_.y()) * blend;
   }
   *pelvis = Planar(p, z);
-  if (leaning) pelvis->linear() = tilt * pelvis->linear();
   (*soles)[0] = Planar(l, pattern_.foot_height(Side::kLeft));
   (*soles)[1] = Planar(r, pattern_.foot_height(Side::kRight));
 }
@@ -561,11 +539,6 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
   if (mode_ == Mode::kSpeed && walk != Walk::kHold) KeepSpeedStepsQueued();
   pattern_.Tick();
   Balance();
-  if (hip_ && tick_ >= settle_ticks_) {  // the push's impulse (world) in the plan frame
-    const Eigen::Vector2d j = com_estimate_->impulse();
-    const double c = std::cos(plan_to_world_.theta), s = std::sin(plan_to_world_.theta);
-    lean_ = hip_->Update({c * j.x() + s * j.y(), -s * j.x() + c * j.y()});
-  }
   AdjustStep();
   Eigen::Isometry3d pelvis;
   std::array<Eigen::Isometry3d, 2> soles;

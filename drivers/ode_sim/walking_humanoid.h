@@ -33,7 +33,6 @@
 #include "walking/dcm_estimator.h"
 #include "walking/dcm_stabilizer.h"
 #include "walking/foot_damping.h"
-#include "walking/hip_strategy.h"
 #include "walking/leg_ik.h"
 #include "walking/push_recovery.h"
 #include "walking/walk_pattern.h"
@@ -213,9 +212,6 @@ class WalkingHumanoid final : public BaseController {
   std::optional<walking::ComOffset> com_offset_;
   std::optional<walking::PushRecovery> recovery_;      // options.push_recovery
   std::optional<walking::DcmEstimator> com_estimate_;  // with recovery_: the CoM state it reads
-  // options.push_hip: the upper body leans toward a push (walking/hip_strategy.h); the lean (plan frame).
-  std::optional<walking::HipStrategy> hip_;
-  Eigen::Vector2d lean_ = Eigen::Vector2d::Zero();
   walking::DcmStabilizer::Output balance_;
   Eigen::Vector2d com_world_prev_ = Eigen::Vector2d::Zero(), com_velocity_ = Eigen::Vector2d::Zero();
   bool zmp_valid_ = false;

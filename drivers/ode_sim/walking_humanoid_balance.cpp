@@ -169,13 +169,6 @@ walking::WalkStatus WalkingHumanoid::status() const {
     s.foot_height[i] = pattern_.foot_height(static_cast<Side>(i));
   }
   s.pelvis = MeasuredPelvis();
-  {
-    const Eigen::Matrix3d r =
-        Eigen::AngleAxisd(-s.pelvis.theta, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-        world_->LinkPose(model_.roots().front().link).linear();
-    s.pelvis_roll = std::atan2(r(2, 1), r(2, 2));
-    s.pelvis_pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
-  }
   s.zmp = zmp_measured_;
   s.tracking_error = tracking_error_;
   for (int i = 0; i < 2; ++i) {
@@ -212,10 +205,6 @@ walking::WalkStatus WalkingHumanoid::status() const {
     s.saturated = balance_.saturated;
   }
   if (push_forces_) s.force_difference = push_forces_->height();
-  if (hip_) {
-    s.lean = Pose2{0, 0, plan_to_world_.theta}.Apply(lean_.x(), lean_.y());
-    s.leans = hip_->leans();
-  }
   // push_balance's stabilizer returns it to the plan after the hold.
   s.com_offset =
       Pose2{0, 0, plan_to_world_.theta}.Apply(com_offset_->offset().x(), com_offset_->offset().y());

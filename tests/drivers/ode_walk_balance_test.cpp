@@ -274,51 +274,6 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}}));
 }
 
-// push_hip (off by default; docs/ode_sim.md, "Pushes", tenth session): the
-// wiring — walking unpushed nothing leans; pushed 10 N s toward the left the
-// upper body leans toward the push (the status' lean, world axes), within
-// the option's bound, the torso's measured roll following it, then upright
-// again; bad values are refused naming the key.
-TEST(OdeWalk, PushHipLeansTheUpperBodyTowardAPushOnlyWhenPushed) {
-  Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_hip", "0.2"}});
-  w.Run(1.0);
-  ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
-  double unpushed = 0, lean_y = 0, lean_x = 0, roll = 0;
-  w.Run(5.14, [&] {
-    unpushed = std::max(unpushed, w.driver->walk_status()->lean.norm());
-    return false;
-  });
-  w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
-  w.Run(1.0, [&] {
-    const walking::WalkStatus s = *w.driver->walk_status();
-    lean_y = std::max(lean_y, s.lean.y());
-    lean_x = std::max(lean_x, std::abs(s.lean.x()));
-    roll = std::min(roll, s.pelvis_roll);  // leaning left: the pelvis' left side down (roll < 0)
-    return s.fallen;
-  });
-  w.Run(3.0, [&] { return w.driver->walk_status()->fallen; });
-  const walking::WalkStatus s = *w.driver->walk_status();
-  std::printf(
-      "push_hip=0.2, 10 N s to the left: lean up to %.3f rad left (%.3f across), torso roll %.3f rad\n",
-      lean_y, lean_x, roll);
-  EXPECT_EQ(unpushed, 0) << "nothing leans before the push";
-  EXPECT_EQ(s.leans, 1);
-  EXPECT_GT(lean_y, 0.1) << "leans toward the push";
-  EXPECT_LE(lean_y, 0.2 + 1e-9) << "within the option's bound";
-  EXPECT_LT(lean_x, 0.5 * lean_y) << "mostly along the push";
-  EXPECT_LT(roll, -0.05) << "the torso follows the lean";
-  EXPECT_EQ(s.lean.norm(), 0) << "upright again";
-  for (const char* wrong : {"-0.1", "0.6", "yes"}) {
-    const std::optional<std::string> bad = RefusalOfWalker({{"push_hip", wrong}});
-    ASSERT_TRUE(bad) << "push_hip=" << wrong << " accepted";
-    EXPECT_NE(bad->find("push_hip"), std::string::npos) << *bad;
-  }
-  const std::optional<std::string> alone = RefusalOfWalker({{"push_hip", "0.2"}, {"push_recovery", "false"}});
-  ASSERT_TRUE(alone) << "push_hip without push_recovery accepted";
-  EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
-  EXPECT_FALSE(RefusalOfWalker({{"push_hip", "0"}, {"push_recovery", "false"}}));
-}
-
 // Push recovery's stop during a GOTO (on by default): the walk stops, the
 // robot stands through the hold, then the GOTO re-plans from where the push
 // left it and still ends at its goal with SUCCESS (no reply before the hold
