@@ -405,7 +405,7 @@ int MultiInstantPushes(const Args& args) {
   std::vector<double> at(k_instants);
   for (int i = 0; i < k_instants; ++i) at[i] = 5.0 + args.shift + args.cycle * (i + jitter(rng)) / k_instants;
   std::printf("push instants (s into the walk):");
-  for (double t : at) std::printf(" %.3f", t);
+  for (double t : at) std::printf(" %.6f", t);  // (--probe ...,AT with these lands on the same 10 ms step)
   std::printf("\n");
   const auto wall0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
