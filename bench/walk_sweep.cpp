@@ -310,6 +310,13 @@ std::unique_ptr<Driver> NewDriver(const Args& args) {
                          DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
 }
 
+// Pushes the pelvis with `j` N s toward `angle` (rad from ahead) over 0.1 s from now.
+void PushNow(Run& r, double angle, double j) {
+  constexpr double kPushTime = 0.1;
+  r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
+                        FromSeconds(kPushTime));
+}
+
 // Survives an impulse of `j` N s toward `angle` (rad from ahead), pushed at `at` s?
 bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at,
                   std::FILE* trace = nullptr) {
@@ -319,9 +326,7 @@ bool SurvivesPush(const Args& args, bool walking, double angle, double j, double
   const TimePoint t0 = r.ode->sim_time();
   if (walking) r.Speed(kFullSpeed);
   if (!r.Until(t0, at)) return false;
-  constexpr double kPushTime = 0.1;
-  r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
-                        FromSeconds(kPushTime));
+  PushNow(r, angle, j);
   return r.Until(t0, at + args.after);
 }
 
@@ -432,10 +437,7 @@ int MultiInstantPushes(const Args& args) {
             return 1;
           }
           if (pid == 0) {
-            constexpr double kPushTime = 0.1;
-            r.ode->PushForTesting(
-                Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (args.levels[l] / kPushTime),
-                FromSeconds(kPushTime));
+            PushNow(r, angle, args.levels[l]);
             _exit(r.Until(t0, at[i] + args.after) ? 0 : 1);
           }
           int status = 0;
