@@ -18,6 +18,23 @@
 //     instant of the gait cycle, the same per direction for every column),
 //     with and/or without the balance feedback (option stabilizer), in one
 //     table, then the arm swing below for the same stabilizer settings.
+//   robotalk-walk-sweep --push walking --instants K [--levels 10,15,20,25,30,40]
+//     [--cycle S] [--seed S]: a steadier measure than one instant's bisection
+//     (survival is not monotonic in the impulse, and one ulp of direction or
+//     1 ms of instant flips a result there): K push instants stratified over
+//     --cycle s of the gait (default 1.52, two steps of the derived gait) from
+//     5 s into the walk, jittered by --seed, the same for every direction; per
+//     direction and impulse level, the fraction of the K instants survived,
+//     and the median over the instants of the largest level survived below the
+//     first level that fell. Each instant's walk is run once up to the push and
+//     forked per (direction, level): the child is that run continued (the
+//     driver is deterministic and single-threaded), so 8 x K x levels pushes
+//     cost K walks of ~6.5 s plus 8 x K x levels x <= --after s simulated.
+//     --nudge 1: every push direction one ulp larger: the same sweep but for a
+//     difference no controller makes, i.e. how far chaos alone moves the figures
+//     (measured: not at all, 0 of 384 pushes changed). --shift S: every instant
+//     S s later (the run steps in 10 ms, so 0.01 moves each push by one step of
+//     the loop): how far a small change of phase moves them.
 //   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
 //     after the start of the walk, default 5.5; standing 2); survived or not; --trace
 //     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them), a row every
@@ -35,6 +52,11 @@
 // docs/ode_sim.md ("Walking", "Replanning") has the table.
 #include "ode_driver.h"
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -65,6 +87,11 @@ struct Args {
   double rtf = 0;     // --rtf S: S simulated seconds of walking per stabilizer setting, CPU per physics step
   bool arms = false;  // --arms 1: both arms swung together +-1 rad every 0.5 s, standing and walking
   unsigned seed = 1;
+  int instants = 0;  // --instants K: the multi-instant push sweep (walking)
+  std::vector<double> levels = {10, 15, 20, 25, 30, 40};  // --levels: its impulses, N s
+  double cycle = 1.52;                                    // --cycle S: the span its instants cover
+  bool nudge = false;  // --nudge 1: every push direction one ulp larger (how chaotic a figure is)
+  double shift = 0;    // --shift S: every instant S s later (how steady a figure is)
   std::map<std::string, std::string> options = {{"walk", "true"}};
 };
 
@@ -100,6 +127,21 @@ Args Parse(int argc, char** argv) {
       a.arms = v == "1";
     } else if (k == "--seed") {
       a.seed = static_cast<unsigned>(std::atoi(v.c_str()));
+    } else if (k == "--instants") {
+      a.instants = std::atoi(v.c_str());
+    } else if (k == "--shift") {
+      a.shift = std::atof(v.c_str());
+    } else if (k == "--nudge") {
+      a.nudge = v == "1";
+    } else if (k == "--cycle") {
+      a.cycle = std::atof(v.c_str());
+    } else if (k == "--levels") {
+      a.levels.clear();
+      for (size_t at = 0; at < v.size();) {
+        const size_t comma = std::min(v.find(',', at), v.size());
+        a.levels.push_back(std::atof(v.substr(at, comma - at).c_str()));
+        at = comma + 1;
+      }
     } else if (k == "--after") {
       a.after = std::atof(v.c_str());
     } else if (k == "--option") {
@@ -112,6 +154,11 @@ Args Parse(int argc, char** argv) {
   }
   if (a.every_ms <= 0 || a.trace_ms <= 0 || a.span < 0 || a.after <= 0 || !(a.resolution > 0)) {
     std::fprintf(stderr, "--every must be > 0 ms, --span >= 0, --after > 0, --resolution > 0\n");
+    std::exit(2);
+  }
+  if (a.instants < 0 || a.instants > 50 || !(a.cycle > 0) || a.levels.empty() ||
+      std::any_of(a.levels.begin(), a.levels.end(), [](double l) { return !(l > 0); })) {
+    std::fprintf(stderr, "--instants in [0, 50], --cycle > 0, --levels N_S,... each > 0\n");
     std::exit(2);
   }
   if (a.stabilizer != "on" && a.stabilizer != "off" && a.stabilizer != "both") {
@@ -263,6 +310,13 @@ std::unique_ptr<Driver> NewDriver(const Args& args) {
                          DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
 }
 
+// Pushes the pelvis with `j` N s toward `angle` (rad from ahead) over 0.1 s from now.
+void PushNow(Run& r, double angle, double j) {
+  constexpr double kPushTime = 0.1;
+  r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
+                        FromSeconds(kPushTime));
+}
+
 // Survives an impulse of `j` N s toward `angle` (rad from ahead), pushed at `at` s?
 bool SurvivesPush(const Args& args, bool walking, double angle, double j, double at,
                   std::FILE* trace = nullptr) {
@@ -272,9 +326,7 @@ bool SurvivesPush(const Args& args, bool walking, double angle, double j, double
   const TimePoint t0 = r.ode->sim_time();
   if (walking) r.Speed(kFullSpeed);
   if (!r.Until(t0, at)) return false;
-  constexpr double kPushTime = 0.1;
-  r.ode->PushForTesting(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * (j / kPushTime),
-                        FromSeconds(kPushTime));
+  PushNow(r, angle, j);
   return r.Until(t0, at + args.after);
 }
 
@@ -342,6 +394,116 @@ int Pushes(const Args& args) {
   for (double w : worst) std::printf("  %*.2f", 16, w);
   std::printf("\n\n");
   return ArmSwing(args);
+}
+
+// --push walking --instants K: per direction and impulse level, the fraction
+// of K push instants survived (see the header). Each instant's walk is stepped
+// to the push once; every (direction, level) is a forked child of it.
+int MultiInstantPushes(const Args& args) {
+  if (args.push != "walking") {
+    std::fprintf(stderr, "--instants needs --push walking\n");
+    return 2;
+  }
+  const int k_instants = args.instants, n_levels = static_cast<int>(args.levels.size());
+  std::mt19937 rng(args.seed);
+  std::uniform_real_distribution<double> jitter(0, 1);
+  std::vector<double> at(k_instants);
+  for (int i = 0; i < k_instants; ++i) at[i] = 5.0 + args.shift + args.cycle * (i + jitter(rng)) / k_instants;
+  std::printf("push instants (s into the walk):");
+  for (double t : at) std::printf(" %.6f", t);  // (--probe ...,AT with these lands on the same 10 ms step)
+  std::printf("\n");
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  int children = 0;
+  for (const Args& s : Settings(args)) {
+    // survived[direction][level][instant]
+    std::vector<std::vector<std::vector<bool>>> survived(
+        8, std::vector<std::vector<bool>>(n_levels, std::vector<bool>(k_instants, false)));
+    for (int i = 0; i < k_instants; ++i) {
+      std::unique_ptr<Driver> d = NewDriver(s);
+      Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+      r.ode->Step(1000, r.done);
+      const TimePoint t0 = r.ode->sim_time();
+      r.Speed(kFullSpeed);
+      if (!r.Until(t0, at[i])) continue;  // fell unpushed: every cell of this instant counts as a fall
+      for (int k = 0; k < 8; ++k) {
+        double angle = k * 45.0 * std::numbers::pi / 180;  // as --probe computes it
+        if (args.nudge) angle = std::nextafter(angle, 10.0);
+        for (int l = 0; l < n_levels; ++l) {
+          std::fflush(stdout);
+          const pid_t pid = fork();
+          if (pid < 0) {
+            std::perror("fork");
+            return 1;
+          }
+          if (pid == 0) {
+            PushNow(r, angle, args.levels[l]);
+            _exit(r.Until(t0, at[i] + args.after) ? 0 : 1);
+          }
+          int status = 0;
+          if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) > 1) {
+            std::fprintf(stderr, "push child %d failed (status %d)\n", static_cast<int>(pid), status);
+            return 1;
+          }
+          survived[k][l][i] = WEXITSTATUS(status) == 0;
+          ++children;
+        }
+      }
+    }
+    std::printf(
+        "walking at full speed, stabilizer %s: instants survived of %d per impulse (N s), "
+        "--after %.1f s\n",
+        s.options.at("stabilizer") == "true" ? "on" : "off", k_instants, args.after);
+    std::printf("direction_deg");
+    for (double lv : args.levels) std::printf("  %5.0f", lv);
+    std::printf("  median_largest  mean_largest\n");
+    int total = 0;
+    double sum_median = 0;
+    for (int k = 0; k < 8; ++k) {
+      std::printf("%13d", k * 45);
+      for (int l = 0; l < n_levels; ++l) {
+        const int n = static_cast<int>(std::count(survived[k][l].begin(), survived[k][l].end(), true));
+        total += n;
+        std::printf("  %2d/%-2d", n, k_instants);
+      }
+      // Per instant, the largest level survived below its first fall (0: the first fell).
+      std::vector<double> largest(k_instants, 0);
+      for (int i = 0; i < k_instants; ++i)
+        for (int l = 0; l < n_levels && survived[k][l][i]; ++l) largest[i] = args.levels[l];
+      std::vector<double> sorted = largest;
+      std::sort(sorted.begin(), sorted.end());
+      const double median = k_instants % 2 == 1 ? sorted[k_instants / 2]
+                                                : 0.5 * (sorted[k_instants / 2 - 1] + sorted[k_instants / 2]);
+      double mean = 0;
+      for (double v : largest) mean += v / k_instants;
+      sum_median += median;
+      std::printf("  %14.1f  %12.1f\n", median, mean);
+    }
+    std::printf("survived %d of %d pushes; sum of the medians %.1f N s\n", total, 8 * n_levels * k_instants,
+                sum_median);
+    // Every push's outcome (S survived, F fell; the instants in order), for
+    // comparing two settings push by push (the same instants, another binary).
+    std::printf("cells (direction_deg N_s outcomes):\n");
+    for (int k = 0; k < 8; ++k) {
+      for (int l = 0; l < n_levels; ++l) {
+        std::printf("cell %d %.0f ", k * 45, args.levels[l]);
+        for (int i = 0; i < k_instants; ++i) std::printf("%c", survived[k][l][i] ? 'S' : 'F');
+        std::printf("\n");
+      }
+    }
+    std::printf("\n");
+  }
+  rusage ru{};
+  getrusage(RUSAGE_CHILDREN, &ru);
+  const double child_cpu =
+      ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  std::printf(
+      "%d pushes (each <= %.1f s simulated after its walk's prefix): %.0f CPU s (walks %.0f, pushes %.0f), "
+      "%.0f s wall\n",
+      children, args.after, static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC + child_cpu,
+      static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC, child_cpu,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
+  return 0;
 }
 
 // --probe standing|walking,DEG,N_S
@@ -439,7 +601,7 @@ int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   if (!args.probe.empty()) return Probe(args);
   if (args.rtf > 0) return Rtf(args);
-  if (!args.push.empty()) return Pushes(args);
+  if (!args.push.empty()) return args.instants > 0 ? MultiInstantPushes(args) : Pushes(args);
   if (args.arms) return ArmSwing(args);
   if (args.transition != "all" && !Transitions().count(args.transition)) {
     std::fprintf(stderr, "unknown transition %s\n", args.transition.c_str());
