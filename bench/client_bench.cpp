@@ -382,16 +382,17 @@ int Playback(const Args& a) {
                                    : 0;
   auto f = StatsFields(c);
   const ClientStats stats = c.stats();
-  f.insert(f.begin(),
-           {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
-            Field("copies_option", static_cast<double>(o.playback_copies)),
-            Field("playback_copies", static_cast<double>(stats.playback_copies - before.playback_copies)),
-            Field("messages_lost", static_cast<double>(stats.messages_lost)),
-            Field("messages_lost_before", static_cast<double>(before.messages_lost)), Summary("lateness_us", late),
-            Field("late_frames", static_cast<double>(late_frames)), Field("not_run", static_cast<double>(not_run)),
-            Field("gaps_over_bound", static_cast<double>(over_bound)),
-            Field("gaps_over_10pct", static_cast<double>(over_default)), Field("late_detail", late_detail),
-            Field("max_gap_stretch", max_stretch), Field("total_stretch_s", total_stretch)});
+  f.insert(
+      f.begin(),
+      {Field("chosen_delay_s", r.playback_delay ? ToSeconds(*r.playback_delay) : -1),
+       Field("copies_option", static_cast<double>(o.playback_copies)),
+       Field("playback_copies", static_cast<double>(stats.playback_copies - before.playback_copies)),
+       Field("messages_lost", static_cast<double>(stats.messages_lost)),
+       Field("messages_lost_before", static_cast<double>(before.messages_lost)), Summary("lateness_us", late),
+       Field("late_frames", static_cast<double>(late_frames)), Field("not_run", static_cast<double>(not_run)),
+       Field("gaps_over_bound", static_cast<double>(over_bound)),
+       Field("gaps_over_10pct", static_cast<double>(over_default)), Field("late_detail", late_detail),
+       Field("max_gap_stretch", max_stretch), Field("total_stretch_s", total_stretch)});
   PrintJson(f);
   return 0;
 }
