@@ -51,6 +51,16 @@ TEST(ThinBuffer, AQueueWithinTheGateThatOutgrowsTheTenPercentStretchPlaysEveryFr
   EXPECT_LE(ToSeconds(run.start_delay), 0.100) << "the start itself is unchanged (91 ms on the relay)";
 }
 
+// The final review's finding: the default was 0.10, so a server given
+// --playback-stretch 0.05 got gaps up to 10 % longer from a thin buffer the
+// user never asked for. Off by default means off at every --playback-stretch.
+TEST(ThinBuffer, OffByDefaultEvenBelowTheDefaultStretch) {
+  const SimRun run = Seed1521({.max_stretch = 0.05});
+  EXPECT_EQ(run.thin_gaps, 0u)
+      << "gaps stretched past --playback-stretch 0.05 by a thin buffer not asked for";
+  EXPECT_LE(run.max_gap_stretch, 0.05 + 1e-9);
+}
+
 TEST(ThinBuffer, AFrameThatComesWithLessThanTheThinLeadMayTakeUpToTheThinBoundAndIsCounted) {
   // 10 % normally, 25 % while a frame comes less than 20 ms before the latest
   // time 10 % allows; frames 100 ms apart, start at kT0, playout delay 50 ms
