@@ -149,10 +149,10 @@ struct PlaybackEstimatorOptions {
   /// A thin buffer (issue 23, tenth session; PlaybackScheduleOptions): a
   /// frame that arrives after the latest time max_stretch allows, or on a
   /// FIFO link less than thin_lead × the delay spread before it, may take up
-  /// to thin_stretch of its gap (and plays that lead after its arrival). At
-  /// or below max_stretch (the default: an option, 0.25 measured): off. It
+  /// to thin_stretch of its gap (and plays that lead after its arrival). 0
+  /// (the default: an option, 0.25 measured) or at or below max_stretch: off. It
   /// moves neither the gate nor the start.
-  double thin_stretch = 0.10;
+  double thin_stretch = 0;
   double thin_lead = 0.25;
   /// The adaptive start lies this many gaps' stretch (max_stretch × the mean
   /// frame interval each) below the delay it covers, never before the

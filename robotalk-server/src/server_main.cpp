@@ -51,8 +51,8 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-thin-stretch F       adaptive: a frame that comes after the latest time
                                   --playback-stretch allows, or on a FIFO link less than a
                                   quarter of the delay spread before it, may have its gap play
-                                  up to F longer (a thin buffer, e.g. 0.25; default 0.1: at or below
-                                  --playback-stretch: off)
+                                  up to F longer (a thin buffer, e.g. 0.25; default 0: off, as is
+                                  any F at or below --playback-stretch)
   --playback-margin MS            adaptive: a frame plays no sooner than MS milliseconds after
                                   it arrived (its hand-over to the robot's thread; default 2)
   --playback-queue-start on|off   adaptive: delays spread by more than 1.2 frame intervals

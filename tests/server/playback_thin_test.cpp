@@ -148,7 +148,7 @@ TEST(ThinBuffer, TheEstimatorsScheduleTakesAQuarterOfTheSpreadAsTheLeadOnAFifoLi
   // Off: --playback-thin-stretch at or below the stretch; the quick or the
   // paper's estimator keeps the timing exact.
   EXPECT_EQ(AfterThree({10, 20, 30}, {.thin_stretch = 0}).schedule_options().thin_max_stretch, 0.0);
-  EXPECT_EQ(AfterThree({10, 20, 30}, {}).schedule_options().thin_max_stretch, 0.10) << "off by default";
+  EXPECT_EQ(AfterThree({10, 20, 30}, {}).schedule_options().thin_max_stretch, 0.0) << "off by default";
   EXPECT_EQ(
       AfterThree({10, 20, 30}, {.adaptive = false, .thin_stretch = 0.25}).schedule_options().max_stretch,
       0.0);

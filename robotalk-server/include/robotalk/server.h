@@ -128,9 +128,9 @@ struct ServerOptions {
   /// Adaptive: a frame that comes after the latest time playback_stretch
   /// allows, or on a FIFO link less than a quarter of the delay spread before
   /// it, may have its gap play up to this much longer (a thin buffer;
-  /// PlaybackEstimatorOptions::thin_stretch). At or below playback_stretch
-  /// (the default: an option, docs/performance.md "Issue 23, tenth session"): off.
-  double playback_thin_stretch = 0.10;
+  /// PlaybackEstimatorOptions::thin_stretch). 0 (the default: an option,
+  /// docs/performance.md "Issue 23, tenth session") or at or below playback_stretch: off.
+  double playback_thin_stretch = 0;
   /// Adaptive: a frame plays no sooner than this after it arrived (its
   /// hand-over to the RobotDaemon; PlaybackScheduleOptions::margin).
   Duration playback_margin = std::chrono::milliseconds(2);
