@@ -230,7 +230,7 @@ class Ros2Bridge::Impl {
         if (!announcements) {
           try {
             announcements = std::make_unique<AnnounceListener>(
-                OpenLcmTransport(options_.lcm_url), ExplicitServerKey(MakeClientOptions()),
+                OpenLcmTransport(options_.lcm_url, kAnnounceQueue), ExplicitServerKey(MakeClientOptions()),
                 [&scheduler](const HeardAnnouncement& heard) {
                   for (const RobotAnnouncement& r : heard.announcement.robots)
                     if (scheduler.Announce(r.name) == ConnectScheduler::Heard::kAdded)

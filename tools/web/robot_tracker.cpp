@@ -97,8 +97,9 @@ class RobotTracker::Impl {
       RobotClient check(
           ClientOptionsFor(o));  // the keys every connect will use, read now: a bad file is said at start-up
     }
-    announcements_ = std::make_unique<AnnounceListener>(
-        OpenLcmTransport(o.lcm_url), only_key_, [this](const HeardAnnouncement& a) { OnAnnounce(a); });
+    announcements_ =
+        std::make_unique<AnnounceListener>(OpenLcmTransport(o.lcm_url, kAnnounceQueue), only_key_,
+                                           [this](const HeardAnnouncement& a) { OnAnnounce(a); });
     worker_ = std::thread([this] { Work(); });
   }
 

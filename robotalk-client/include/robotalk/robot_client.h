@@ -358,20 +358,21 @@ struct ClientStats {
   std::uint64_t replies_ignored = 0;     ///< duplicates, unknown ids
   std::uint64_t malformed_packages = 0;  ///< undecodable reply packages dropped
   std::uint64_t gave_up = 0;             ///< packages abandoned
-  /// Playback redundancy: second copies of playback packages sent.
-  std::uint64_t playback_copies = 0;
-  /// Messages the link lost (either way), as the client counts them: a
-  /// package's copies minus its acks, once every ack had time to come.
-  std::uint64_t messages_lost = 0;
-  std::uint64_t sessions_opened = 0;  ///< hellos answered with a session
-  std::uint64_t sessions_lost = 0;    ///< the server no longer knew the session (restart, expiry)
-  std::uint64_t replies_refused = 0;  ///< keyed: replies whose MAC or (SESSION_UNKNOWN) signature failed
+  std::uint64_t sessions_opened = 0;     ///< hellos answered with a session
+  std::uint64_t sessions_lost = 0;       ///< the server no longer knew the session (restart, expiry)
+  std::uint64_t replies_refused = 0;     ///< keyed: replies whose MAC or (SESSION_UNKNOWN) signature failed
   /// Keyed: STATE and CONFIG messages dropped: unsigned, signed by another
   /// key or server instance, forged, or (STATE) not newer than the last one.
   std::uint64_t broadcasts_refused = 0;
   std::uint64_t servers_refused = 0;    ///< keyed: hello answers of a server key this client does not trust
   std::size_t configs_cached = 0;       ///< robot descriptions held (bounded: docs/client.md)
   std::size_t config_bytes_cached = 0;  ///< their encoded size
+  // Added 2026-11-27, at the end so that the fields before keep their offsets.
+  /// Playback redundancy: second copies of playback packages sent.
+  std::uint64_t playback_copies = 0;
+  /// Messages the link lost (either way), as the client counts them: a
+  /// package's copies minus its acks, once every ack had time to come.
+  std::uint64_t messages_lost = 0;
 };
 
 class RobotClient {

@@ -187,7 +187,10 @@ class Server {
   /// Stops every robot (STOP), then the threads. Idempotent. A driver call
   /// that hangs is watched against `driver_call_bound` meanwhile (a fault,
   /// latched) and waited for until it has run twice the bound; its robot is
-  /// then left without its STOP and named by not_stopped().
+  /// then left without its STOP and named by not_stopped(). Its thread is
+  /// detached and may still run should the call return: with not_stopped()
+  /// not empty, the clock given to the constructor (and whatever the driver
+  /// uses) must live until the process exits (robotalk-server exits at once).
   void Stop();
   /// The robots Stop() could not STOP (their driver call hung); empty before.
   std::vector<std::string> not_stopped() const;

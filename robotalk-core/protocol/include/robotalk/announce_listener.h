@@ -13,6 +13,7 @@
 
 #include "robotalk/heard_announcement.h"
 #include "robotalk/keys.h"
+#include "robotalk/routed_lcm_transport.h"
 #include "robotalk/transport.h"
 
 #include <atomic>
@@ -23,6 +24,11 @@
 #include <thread>
 
 namespace robotalk {
+
+/// The LCM options for an AnnounceListener's transport: at most 100
+/// announcements queued (servers announce once a second; a flood beyond that
+/// is dropped by LCM, not held).
+inline const OpenLcmOptions kAnnounceQueue{.lane = {.queue_capacity = 100}};
 
 class AnnounceListener {
  public:
