@@ -15,7 +15,7 @@
 //   {"ev":"panic"|"reset"|"samples"|"end", ...}
 //
 //   robotalk-soak-client --mode direct|delay|playback|watch|chaos --url U --robot R
-//                        --seconds S --seed N --out FILE [--playback-copies 1|2]
+//                        --seconds S --seed N --out FILE [--playback-copies 0|1|2]
 //
 // Every loop is bounded by --seconds (and each wait by the client's timeouts).
 #include "bench_util.h"
@@ -331,7 +331,7 @@ int Main(int argc, char** argv) {
   Report report(a.Str("out", "/dev/stdout"));
   ClientOptions o;
   o.lcm_url = a.Str("url", "");
-  o.playback_copies = static_cast<int>(a.Int("playback-copies", 1));
+  o.playback_copies = static_cast<int>(a.Int("playback-copies", kPlaybackCopiesAuto));
   RobotClient client(o);
   const TimePoint deadline = Soak::SteadyNow() + FromSeconds(a.Num("seconds", 10));
   // A client started while the server restarts retries until its deadline.

@@ -2,7 +2,7 @@
 # The soak (issue 9, item 9; docs/soak.md). Its 60 s form runs in ctest (soak_60s, label soak).
 #
 #   scripts/soak.sh [--seconds N] [--seed S] [--per-mode K] [--kills K] [--build DIR] [--keep] [--keyed]
-#                   [--playback-copies 1|2]   (ClientOptions::playback_copies of every client)
+#                   [--playback-copies 0|1|2] (ClientOptions::playback_copies of every client; 0, the default: decided from the link)
 #   scripts/soak.sh --check-only DIR     the checks again on a kept run's files
 #
 # One robotalk-server (kinematic driver, models/pioneer2dx_pantilt.urdf,
@@ -29,7 +29,7 @@
 # answers before they are killed; the relay stops by itself after N + 120 s.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
-seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only="" keyed=0 copies=1
+seconds=60 seed=1 per_mode=4 kills=3 build="$root/build" keep=0 check_only="" keyed=0 copies=0
 while [ $# -gt 0 ]; do
   case $1 in
     --seconds) seconds=$2; shift 2 ;;
