@@ -94,8 +94,8 @@ class RobotTracker::Impl {
             },
             ConnectSchedulerOptions{.silent_after = FromSeconds(o.robot_timeout_s)})) {
     if (!o.key_file.empty() || !o.server_key_file.empty()) {
-      RobotClient check(
-          ClientOptionsFor(o));  // the keys every connect will use, read now: a bad file is said at start-up
+      // The keys every connect will use, read once now: a bad file is named at start-up.
+      RobotClient check(ClientOptionsFor(o));
     }
     announcements_ =
         std::make_unique<AnnounceListener>(OpenLcmTransport(o.lcm_url, kAnnounceQueue), only_key_,
