@@ -528,6 +528,47 @@ TEST_F(KeyedGateTest, APanicOutsideAnySessionIsAnsweredRefusedNotTaken) {
   EXPECT_THAT(batches_.back().panic_refusal, HasSubstr("say hello"));
 }
 
+// The tenth session's known gap: a keyed server signs every SESSION_UNKNOWN
+// it answers (a fake server's cannot end a keyed client's sessions), one
+// Ed25519 signature each (~25 µs, three times an unsigned answer's cost), so
+// a flood of packages naming made-up sessions bought that much of the
+// ServerDaemon thread per datagram. Now the signed answers have a budget per
+// second (panics their own); the rest are counted and not answered, and a
+// client's live session is served as before.
+TEST_F(KeyedGateTest,
+       AFloodNamingMadeUpSessionsIsAnsweredWithinTheSignedAnswerBudgetAndLiveSessionsAreServed) {
+  auto alice = Handshake(Key(2), Id(Key(2), kAlice));
+  ASSERT_TRUE(alice);
+  const std::size_t before = batches_.size();
+  constexpr int kFlood = 2000;
+  for (int i = 0; i < kFlood; ++i) {
+    Publish(EncodeRequest(Move(kMallory + i, 1'000'000 + i, 1, 1)));  // made-up clients and sessions
+  }
+  const auto unknown_answers = [&](std::size_t from) {
+    std::size_t n = 0;
+    for (std::size_t b = from; b < batches_.size(); ++b)
+      n += batches_[b].session_status == SessionStatus::kUnknown;
+    return n;
+  };
+  const std::size_t answered = unknown_answers(before);
+  EXPECT_EQ(answered, 256u) << "at most the budget of signed answers within one second";
+  EXPECT_EQ(server_->sessions().counters().unknown_session, static_cast<std::uint64_t>(kFlood));
+
+  // The live session is served during the flood.
+  Publish(Sealed(*alice, Commands(CommandType::kJointSetPoint, 1, {0.5})));
+  EXPECT_EQ(replies_.at(1).signal, Signal::kSuccess);
+  // A panic outside any session keeps its own budget: its refusal still comes.
+  Request panic{.client_id = kAlice, .session_id = 77, .sequence = 1, .panic = true};
+  Publish(EncodeRequest(panic));
+  EXPECT_EQ(batches_.back().panic, PanicStatus::kRefused);
+  EXPECT_THAT(batches_.back().panic_refusal, HasSubstr("say hello"));
+  // A second later the budget is back: a client whose server restarted learns it.
+  clock_.Advance(std::chrono::seconds(1));
+  const std::size_t later = batches_.size();
+  Publish(EncodeRequest(Move(kAlice + 1, 5, 9, 9)));
+  EXPECT_EQ(unknown_answers(later), 1u);
+}
+
 TEST_F(GateTest, ARepeatedHelloGetsTheSameSessionAndPendingSessionsAreBoundedPerClientId) {
   Hello hello;
   hello.body.client_id = kAlice;
