@@ -98,6 +98,7 @@ void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   options.counters = [this] {
     auto table = table_->counters().Table();
     table.emplace_back("malformed", static_cast<double>(malformed_));
+    table.emplace_back("unknown_unanswered", static_cast<double>(unknown_unanswered_));
     return table;
   };
   robot.sessions = std::make_unique<RobotSessions>(daemon, robot.config_hash, options, *table_);
@@ -392,7 +393,18 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
         std::to_string(request.session_id) + "; say hello and send it again";
     Log("robot '" + name + "': refused a panic of " + admission.who + " outside any session");
   }
-  const bool answer = request.client_id != 0;
+  bool answer = request.client_id != 0;
+  if (answer && signer_ && !raised) {
+    // Keyed: the answer costs a signature; within the budget only (see
+    // ServerDaemonOptions::unknown_answers_per_second).
+    AnswerBudget& budget = request.panic ? unknown_panic_budget_ : unknown_budget_;
+    if (!budget.Take(received, options_.unknown_answers_per_second)) {
+      ++unknown_unanswered_;
+      Log("keyed mode: packages naming no session of this server left unanswered past the budget of " +
+          std::to_string(options_.unknown_answers_per_second) + " signed answers a second (a flood?)");
+      return false;
+    }
+  }
   unknown.client_id = request.client_id;
   unknown.session_id = request.session_id;
   unknown.session_status = SessionStatus::kUnknown;

@@ -33,6 +33,7 @@
 #include "robotalk/transport.h"
 #include "session_table.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <map>
@@ -45,6 +46,28 @@
 #include <vector>
 
 namespace robotalk {
+
+/// A token bucket: Take() succeeds at most `per_second` times a second on
+/// average, in bursts of at most `per_second`. Pure (times from the caller).
+class AnswerBudget {
+ public:
+  bool Take(TimePoint now, int per_second) {
+    if (per_second <= 0) return false;
+    const double full = per_second;
+    if (last_ == TimePoint::min())
+      tokens_ = full;
+    else if (now > last_)
+      tokens_ = std::min(full, tokens_ + ToSeconds(now - last_) * full);
+    last_ = std::max(last_, now);
+    if (tokens_ < 1.0) return false;
+    tokens_ -= 1.0;
+    return true;
+  }
+
+ private:
+  double tokens_ = 0.0;
+  TimePoint last_ = TimePoint::min();
+};
 
 struct ServerDaemonOptions {
   /// Period of the ROBOTALK/ANNOUNCE message.
@@ -92,6 +115,16 @@ struct ServerDaemonOptions {
   /// ServerDaemon runs, one wake-up for many packages. 0 = off
   /// (robotalk::Server: with the RobotDaemons' timing option).
   int fifo_priority = 5;
+  /// Keyed mode: SESSION_UNKNOWN answers signed per second, at most (a burst
+  /// of as many; answers to packages carrying a panic have a budget of their
+  /// own of the same size). Each costs an Ed25519 signature (~25 µs), so a
+  /// flood of packages naming made-up sessions would otherwise buy that much
+  /// of this thread per datagram; beyond the budget a package is counted
+  /// (`unknown_unanswered`) and not answered. 256 answers the whole of a
+  /// restarted server's sessions of one robot (`--max-sessions-per-robot`)
+  /// within a second at ~0.5 % of a core (robotalk-flood-bench). Open mode's answers are unsigned
+  /// and unlimited.
+  int unknown_answers_per_second = 256;
 };
 
 class ServerDaemon {
@@ -130,6 +163,9 @@ class ServerDaemon {
   std::int64_t server_id() const { return server_id_; }
   /// Packages dropped because their bytes could not be decoded at all.
   std::uint64_t malformed() const { return malformed_; }
+  /// Keyed: packages naming no session left unanswered past the signed
+  /// answers' budget (ServerDaemonOptions::unknown_answers_per_second).
+  std::uint64_t unknown_unanswered() const { return unknown_unanswered_; }
   /// The server's session table (all robots' sessions).
   const SessionTable& sessions() const { return *table_; }
 
@@ -191,6 +227,10 @@ class ServerDaemon {
   int event_fd_ = -1;
   std::int64_t server_id_ = 0;
   std::uint64_t malformed_ = 0;
+  // Keyed: the signed SESSION_UNKNOWN answers' budgets (without and with a panic).
+  AnswerBudget unknown_budget_;
+  AnswerBudget unknown_panic_budget_;
+  std::uint64_t unknown_unanswered_ = 0;
   std::atomic<std::size_t> serving_{0};
   mutable std::mutex refusals_mu_;
   std::vector<std::string> refusals_;  // GUARDED_BY(refusals_mu_)

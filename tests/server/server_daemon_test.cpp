@@ -90,6 +90,24 @@ class RefusingTransport final : public Transport {
   std::string url() const override { return "refusing://"; }
 };
 
+// The signed SESSION_UNKNOWN answers' budget: a burst of `per_second`, then
+// one more each 1/per_second, never more than a burst however long the pause.
+TEST(AnswerBudget, AllowsABurstThenRefillsAtItsRateUpToOneBurst) {
+  const TimePoint t0 = TimePoint(std::chrono::seconds(100));
+  AnswerBudget budget;
+  int taken = 0;
+  for (int i = 0; i < 10; ++i) taken += budget.Take(t0, 4);
+  EXPECT_EQ(taken, 4);
+  EXPECT_FALSE(budget.Take(t0 + milliseconds(240), 4));
+  EXPECT_TRUE(budget.Take(t0 + milliseconds(250), 4)) << "one token a quarter second";
+  EXPECT_FALSE(budget.Take(t0 + milliseconds(260), 4));
+  taken = 0;
+  for (int i = 0; i < 10; ++i) taken += budget.Take(t0 + std::chrono::hours(1), 4);
+  EXPECT_EQ(taken, 4) << "an hour's pause buys one burst, not 14,400 answers";
+  EXPECT_FALSE(budget.Take(t0 - std::chrono::seconds(5), 4)) << "a clock stepped back refills nothing";
+  EXPECT_FALSE(AnswerBudget{}.Take(t0, 0)) << "a budget of 0 answers none";
+}
+
 TEST(ServerDaemon, ASubscriptionErrorReachesItsCreatorWithOrWithoutTheFifoSubscribingThread) {
   // With fifo_priority the subscriptions are made on a short-lived thread (so
   // LCM's receive threads inherit the priority); its error must still be the
