@@ -18,7 +18,7 @@ void LinkLoss::OnSend(std::int64_t sequence, TimePoint now, int copies) {
   }
 }
 
-void LinkLoss::OnAck(std::int64_t sequence, TimePoint /*server_receive*/) {
+void LinkLoss::OnAck(std::int64_t sequence) {
   // An ack of a package already settled (or never recorded) changes nothing.
   if (auto it = entries_.find(sequence); it != entries_.end()) ++it->second.acked;
 }

@@ -43,9 +43,8 @@ class LinkLoss {
   /// `copies` copies of package `sequence` left at `now` (a first send with
   /// its redundancy copies, or a retransmission: 1).
   void OnSend(std::int64_t sequence, TimePoint now, int copies = 1);
-  /// An acknowledgement of `sequence` arrived (one per copy the server got),
-  /// carrying the server's receive time of the copy it answers.
-  void OnAck(std::int64_t sequence, TimePoint server_receive);
+  /// An acknowledgement of `sequence` arrived (one per copy the server got).
+  void OnAck(std::int64_t sequence);
   /// Settles the packages whose last copy left `settle_after` or more before
   /// `now`: a package with fewer acks than copies counts its missing acks
   /// as lost messages.

@@ -441,7 +441,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     {
       std::lock_guard lock(mu_);
       if (batch.ack_sequence > 0) {
-        link_loss_.OnAck(batch.ack_sequence, batch.server_receive);  // one per copy the server received
+        link_loss_.OnAck(batch.ack_sequence);  // one per copy the server received
         const auto info = outstanding_.OnAck(
             batch.ack_sequence, now,
             client::OutstandingPackages::AckTiming{
