@@ -182,6 +182,31 @@ TEST_F(GateTest, ServerCountersNameAndCountRefusals) {
   }
 }
 
+// A long reply batch leaves in parts (each under LCM's 64 KB); the ack is
+// the copy's, so only the first part carries it: a client counting acks
+// against copies sent (LinkLoss) would otherwise take the parts for copies
+// and miss a lost one.
+TEST_F(GateTest, ALongReplyBatchSplitInPartsAcknowledgesItsPackageOnce) {
+  const std::int64_t session = OpenSession(kAlice);
+  Request r{.client_id = kAlice, .session_id = session, .sequence = 1};
+  for (CommandId id = 1; id <= 300; ++id) {  // each answered ERROR naming its 200-byte unknown joint
+    r.commands.push_back(
+        Command{id, CommandType::kJointSetPoint, std::nullopt, std::string(200, 'j'), {0.1}});
+  }
+  const std::size_t before = batches_.size();
+  Publish(EncodeRequest(r));
+  std::size_t parts = 0, acks = 0, replies = 0;
+  for (std::size_t b = before; b < batches_.size(); ++b) {
+    ++parts;
+    acks += batches_[b].ack_sequence == 1;
+    replies += batches_[b].replies.size();
+  }
+  EXPECT_GE(parts, 2u) << "the batch is long enough to be split";
+  EXPECT_EQ(replies, 300u) << "every reply sent";
+  EXPECT_EQ(acks, 1u) << "one ack for one copy received";
+  EXPECT_EQ(batches_[before].ack_sequence, 1) << "in the first part";
+}
+
 // Issue 23 item 2: a copy of a package (a retransmission whose answer was
 // lost, a duplicated datagram) is answered by the gate from the session
 // table and never reaches RobotSessions::Handle; the session's link health
