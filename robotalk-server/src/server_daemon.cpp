@@ -496,6 +496,12 @@ void ServerDaemon::Send(const std::string& robot, ReplyBatch& batch) {
       publish(part);
       part.replies.clear();
       bytes = 0;
+      // The ack (and the panic's answer) is the received copy's: in the
+      // first part only, so that a client counting acks against the copies
+      // it sent (LinkLoss) never takes a part for a copy.
+      part.ack_sequence = 0;
+      part.panic = PanicStatus::kNone;
+      part.panic_refusal.clear();
     }
   }
   if (!part.replies.empty() || part.ack_sequence != 0 || part.session_status != SessionStatus::kOk) {
