@@ -16,11 +16,17 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 namespace robotalk {
 namespace {
@@ -123,6 +129,102 @@ TEST(ServerDaemonLog, AnAuditLineIsWrittenBeforeItsReplyLeaves) {
   const std::string log = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(replies, 2u) << log;
   EXPECT_THAT(without_line, ::testing::IsEmpty()) << "replies that left before their audit line\n" << log;
+}
+
+}  // namespace
+}  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// Stderr as a pipe that is full and never read: a supervisor that keeps the
+// pipe but never drains it, or a terminal stopped with Ctrl-S. Restores the
+// old stderr (and drains the pipe, so whatever blocked on it ends) when done.
+class FullStderr {
+ public:
+  FullStderr() {
+    int fds[2];
+    if (pipe(fds) != 0) throw std::runtime_error("pipe");
+    read_end_ = fds[0];
+    const int flags = fcntl(fds[1], F_GETFL);
+    fcntl(fds[1], F_SETFL, flags | O_NONBLOCK);
+    const std::string chunk(4096, 'x');
+    while (write(fds[1], chunk.data(), chunk.size()) > 0) {
+    }
+    fcntl(fds[1], F_SETFL, flags);  // blocking again, as stderr is
+    saved_ = dup(2);
+    dup2(fds[1], 2);
+    close(fds[1]);
+  }
+  ~FullStderr() { Release(); }
+  /// Reads the pipe until `done()` (whatever blocked on it goes on), then
+  /// restores stderr.
+  void Release(const std::function<bool()>& done = [] { return true; }) {
+    if (saved_ < 0) return;
+    fcntl(read_end_, F_SETFL, fcntl(read_end_, F_GETFL) | O_NONBLOCK);
+    char buffer[4096];
+    do {
+      while (read(read_end_, buffer, sizeof buffer) > 0) {
+      }
+      std::this_thread::sleep_for(milliseconds(1));
+    } while (!done());
+    dup2(saved_, 2);
+    close(saved_);
+    saved_ = -1;
+    while (read(read_end_, buffer, sizeof buffer) > 0) {
+    }
+    close(read_end_);
+  }
+
+ private:
+  int read_end_ = -1;
+  int saved_ = -1;
+};
+
+// A stderr that takes nothing (full, never read) never stops the
+// ServerDaemon. With --log-executions every command's audit line waits for
+// stderr; before, the ServerDaemon waited with it, in fprintf, for as long as
+// stderr took nothing: no panic was taken, no watchdog ran, no reply left.
+// A panic sent while stderr takes nothing is taken.
+TEST(ServerDaemonLog, AStderrThatTakesNothingNeverKeepsAPanicFromBeingTaken) {
+  ManualClock clock;
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport server_end(bus);
+  MemoryTransport client(bus);
+  RobotDaemon robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
+                    RobotDaemonOptions{.log_executions = true});
+  ServerDaemon server(server_end, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0});
+  server.AddRobot(robot, SessionOptions{});
+  const auto step = [&] {
+    server.RunOnce(Duration(0));
+    robot.RunOnce(clock.Now());
+    server.RunOnce(Duration(0));
+    clock.Advance(milliseconds(10));
+  };
+  const std::int64_t session = testing::SayHello(client, "bot", testing::kAlice, step).session_id;
+  Request r{.client_id = testing::kAlice, .session_id = session, .sequence = 1};
+  for (int i = 0; i < 20; ++i) {  // 20 audit lines for a stderr that takes none
+    r.commands.push_back(Command{i + 1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.01 * i}});
+  }
+  client.Publish(RequestChannel("bot"), EncodeRequest(r));  // before the steps: its session is live
+  FullStderr full;
+  std::atomic<bool> stop{false};
+  std::atomic<bool> stepping_ended{false};
+  std::thread stepping([&] {
+    while (!stop) step();
+    stepping_ended = true;
+  });
+  std::this_thread::sleep_for(milliseconds(300));  // the ServerDaemon meets the full stderr
+  client.Publish(RequestChannel("bot"),
+                 EncodeRequest(Request{.client_id = testing::kBob, .sequence = 1, .panic = true}));
+  const auto deadline = std::chrono::steady_clock::now() + seconds(5);
+  while (!robot.in_panic() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(milliseconds(10));
+  const bool taken = robot.in_panic();
+  stop = true;
+  full.Release([&] { return stepping_ended.load(); });
+  stepping.join();
+  EXPECT_TRUE(taken) << "a panic sent while stderr took nothing was not taken within 5 s";
 }
 
 }  // namespace
