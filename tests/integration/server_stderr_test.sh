@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# A server whose stderr goes away (the pipe's reader exits: `robotalk-server
+# ... 2>&1 | head`, a log collector restarted) goes on serving: a log line
+# written to the closed pipe is lost, never the server (before: SIGPIPE
+# killed it at its next line, no STOP, the robot left moving). The robot
+# moves under `send setspeed --hold`, stderr's reader exits, the server logs
+# (--log-executions: every command a line), and still answers; SIGTERM then
+# stops the robot (an observer's last STATE sample at rest) and the server
+# exits 0. Runs inside a private network namespace (CTest wraps it with
+# scripts/netns_run.sh).
+#   server_stderr_test.sh SERVER CLI MODELS_DIR
+set -u
+server_bin=$1 cli=$2 models=$3
+. "$(dirname "$0")/../lib.sh" # $tmp, $server_pid, check
+urdf="$models/pioneer2dx_pantilt.urdf"
+url="udpm://239.255.76.67:7719?ttl=0"
+wait_for() { for _ in $(seq 50); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
+last_motion() {
+  python3 -c 'import json, sys
+lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
+s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
+print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
+}
+
+# stderr's reader copies lines to server.log until the server serves, then exits.
+mkfifo "$tmp/stderr"
+python3 -c 'import sys
+with open(sys.argv[1]) as f, open(sys.argv[2], "w") as out:
+    for line in f:
+        out.write(line); out.flush()
+        if "serving robot" in line: break' "$tmp/stderr" "$tmp/server.log" &
+reader=$!
+pids+=("$reader")
+"$server_bin" --robot "pioneer=kinematic:$urdf" --url "$url" --log-executions --duration 60 2>"$tmp/stderr" &
+server_pid=$!
+check "the server starts" wait_for "$tmp/server.log" "serving robot 'pioneer'"
+wait "$reader"  # stderr's reader is gone: the pipe has none
+
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch.json" 2>"$tmp/watch.err" &
+pids+=($!)
+"$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold.out" 2>&1 &
+pids+=($!)
+sleep 1.5  # the SETSPEED and its audit line: a write to a pipe without a reader
+check "the server lives on after a log line to a stderr without a reader" kill -0 "$server_pid"
+check "it still answers: $("$cli" --url "$url" --timeout 3 query pioneer base_pose 2>&1 | head -c 300)" \
+  "$cli" --url "$url" --timeout 3 query pioneer base_pose
+read -r v w moving < <(last_motion "$tmp/watch.json")
+check "pioneer moves before the signal (v=$v w=$w moving=$moving)" \
+  python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+
+kill -TERM "$server_pid" 2>/dev/null
+for _ in $(seq 100); do kill -0 "$server_pid" 2>/dev/null || break; sleep 0.1; done
+wait "$server_pid"
+status=$?
+server_pid=""
+check "the server exits 0 on SIGTERM (status $status)" test "$status" -eq 0
+sleep 0.3
+read -r v w moving < <(last_motion "$tmp/watch.json")
+check "the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
+  python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
