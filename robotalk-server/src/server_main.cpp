@@ -314,6 +314,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // A stderr whose reader went away (`robotalk-server ... | head`, a log
+  // collector restarted) loses the log lines written to it (EPIPE), never the
+  // server: SIGPIPE would end it at its next line without STOPping a robot.
+  std::signal(SIGPIPE, SIG_IGN);
 
   try {
     // Outlives the server: a robot thread the shutdown gave up on (a driver
