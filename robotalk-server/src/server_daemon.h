@@ -24,6 +24,7 @@
 #pragma once
 
 #include "fault_injector.h"
+#include "log_writer.h"
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robot_sessions.h"
@@ -197,6 +198,7 @@ class ServerDaemon {
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes (audit lines before)
+  LogWriter log_writer_{"robotalk-server: "};  // stderr; a stderr that takes nothing never stops this thread
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

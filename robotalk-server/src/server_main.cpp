@@ -1,6 +1,7 @@
 // robotalk-server's command line (server_main.h).
 #include "robotalk/server_main.h"
 
+#include "log_writer.h"
 #include "panic_latch.h"
 #include "robotalk/error.h"
 
@@ -12,6 +13,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 namespace robotalk {
 namespace {
@@ -347,7 +349,12 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
       const timespec timeout{0, static_cast<long>(wait.count())};
       received = sigtimedwait(&signals, nullptr, &timeout);
     }
-    if (received > 0) std::cerr << "robotalk-server: " << strsignal(received) << ", stopping every robot\n";
+    if (received > 0) {
+      // Through a LogWriter: a stderr that takes nothing must not keep the robots from their STOP.
+      LogWriter log("robotalk-server: ");
+      std::vector<std::string> line{std::string(strsignal(received)) + ", stopping every robot"};
+      log.Write(line);
+    }
     server.Stop();
     if (!server.not_stopped().empty()) {
       std::cerr << "robotalk-server: error: not stopped (a driver call hung):";

@@ -4,6 +4,7 @@
 #include "robotalk/log_limiter.h"
 
 #include "fake_driver.h"
+#include "log_writer.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
 #include "robotalk/forwarding_transport.h"
@@ -25,6 +26,7 @@
 #include <functional>
 #include <iterator>
 #include <mutex>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -159,21 +161,24 @@ class FullStderr {
   ~FullStderr() { Release(); }
   /// Reads the pipe until `done()` (whatever blocked on it goes on), then
   /// restores stderr.
-  void Release(const std::function<bool()>& done = [] { return true; }) {
-    if (saved_ < 0) return;
+  std::string Release(const std::function<bool()>& done = [] { return true; }) {
+    std::string text;
+    if (saved_ < 0) return text;
     fcntl(read_end_, F_SETFL, fcntl(read_end_, F_GETFL) | O_NONBLOCK);
     char buffer[4096];
+    const auto drain = [&] {
+      for (ssize_t n; (n = read(read_end_, buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+    };
     do {
-      while (read(read_end_, buffer, sizeof buffer) > 0) {
-      }
+      drain();
       std::this_thread::sleep_for(milliseconds(1));
     } while (!done());
     dup2(saved_, 2);
     close(saved_);
     saved_ = -1;
-    while (read(read_end_, buffer, sizeof buffer) > 0) {
-    }
+    drain();
     close(read_end_);
+    return text;
   }
 
  private:
@@ -225,6 +230,40 @@ TEST(ServerDaemonLog, AStderrThatTakesNothingNeverKeepsAPanicFromBeingTaken) {
   full.Release([&] { return stepping_ended.load(); });
   stepping.join();
   EXPECT_TRUE(taken) << "a panic sent while stderr took nothing was not taken within 5 s";
+}
+
+// The LogWriter under a stderr that takes nothing: a Write returns without
+// its lines written; what waits is bounded (kMaxQueuedBytes), the rest
+// dropped and counted; once stderr takes lines again, the first says how many
+// were lost, and the lines after are written.
+TEST(LogWriterTest, AStderrThatTakesNothingBoundsTheQueueAndSaysWhatWasLostOnceItTakesLinesAgain) {
+  FullStderr full;
+  LogWriter log("test: ");
+  std::vector<std::string> lines{"first"};
+  EXPECT_FALSE(log.Write(lines)) << "written to a full pipe nobody reads";
+  EXPECT_TRUE(lines.empty());
+  for (int i = 0; i < 6000; ++i) lines.push_back(std::string(1000, 'a'));  // 6 MB
+  EXPECT_FALSE(log.Write(lines));
+  const std::uint64_t dropped = log.dropped();
+  EXPECT_GT(dropped, 6000u - LogWriter::kMaxQueuedBytes / 1000) << "more than the bound waits";
+  EXPECT_LT(dropped, 6000u);
+  std::atomic<bool> after_written{false};
+  std::thread after([&] {
+    std::vector<std::string> line{"after"};
+    while (!log.Write(line)) {  // each "after" that found the queue full is dropped too
+      std::this_thread::sleep_for(milliseconds(10));
+      line = {"after"};
+    }
+    after_written = true;
+  });
+  const std::string text = full.Release([&] { return after_written.load(); });
+  after.join();
+  EXPECT_THAT(text, HasSubstr("test: first\n"));
+  std::smatch lost;
+  ASSERT_TRUE(std::regex_search(text, lost, std::regex("test: ([0-9]+) log lines lost")))
+      << text.substr(0, 300);
+  EXPECT_GE(std::stoull(lost[1]), dropped);
+  EXPECT_THAT(text, HasSubstr("test: after\n"));
 }
 
 }  // namespace
