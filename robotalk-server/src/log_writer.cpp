@@ -42,7 +42,7 @@ struct LogWriter::State {
       std::string text;
       if (dropped_unsaid > 0) {
         text = prefix + std::to_string(dropped_unsaid) +
-               " log lines lost: the log took nothing for too long and more than " +
+               " log lines lost: the log refused them, or took nothing while more than " +
                std::to_string(kMaxQueuedBytes >> 20) + " MiB waited\n";
         dropped_unsaid = 0;
       }
@@ -56,13 +56,18 @@ struct LogWriter::State {
       writing = true;
       write_began = std::chrono::steady_clock::now();
       lock.unlock();
+      bool failed = false;
       for (std::size_t at = 0; at < text.size();) {
         const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
         if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;  // closed, EPIPE, no space: these lines are lost, the next may not be
+        if (n <= 0) {  // closed, EPIPE, no space: these lines are lost, the next may not be
+          failed = true;
+          break;
+        }
         at += static_cast<std::size_t>(n);
       }
       lock.lock();
+      if (failed) dropped_unsaid += lines;  // said by the next write that succeeds
       writing = false;
       done += lines;
       written.notify_all();

@@ -10,7 +10,8 @@
 // leaves, soak.md); one that takes nothing costs a caller kMaxWait at most,
 // once per spell, and nothing after. Lines then wait in a queue of at most
 // kMaxQueuedBytes; beyond it they are dropped, and the first write after
-// says how many ("N log lines lost: ...").
+// says how many ("N log lines lost: ..."), as it does for lines whose write
+// failed (a full disk, a pipe without a reader: EPIPE, never SIGPIPE).
 //
 // Thread safety: Write() from any thread. The writer's state outlives the
 // object: a destructor that cannot write what waits within kMaxWait leaves
