@@ -227,7 +227,7 @@ class Server::Impl {
         const Duration running = daemon.CallRunning(now);
         if (bound.count() <= 0 || running <= 2 * bound) return false;
         if (!daemon.Abandon(now)) {
-          return false;  // it ended meanwhile: Shutdown() at the next turn
+          return false;  // its call returned meanwhile (its STOP runs) or it ended: the next turn
         }
         flush = true;
         not_stopped_.push_back(daemon.robot_name());
