@@ -26,3 +26,11 @@ check() {  # check NAME COMMAND...
   if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
 }
 value_of() { sed -n "s/^$2=//p" "$1" | head -1; }
+# start_pioneer_server SERVER URL MODELS_DIR SECONDS: a server of the Pioneer
+# (kinematic) in the background, its log in $tmp/server.log, $server_pid set;
+# returns once it serves (5 s at most).
+start_pioneer_server() {
+  "$1" --robot "pioneer=kinematic:$3/pioneer2dx_pantilt.urdf" --url "$2" --duration "$4" 2>"$tmp/server.log" &
+  server_pid=$!
+  for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+}

@@ -87,6 +87,27 @@ class WatchedTransport final : public ForwardingTransport {
   Before before_;
 };
 
+// A ServerDaemon serving one robot with audit lines (--log-executions),
+// stepped by hand: the server, the robot, the server again, then 10 ms on.
+struct AuditedBot {
+  AuditedBot(Transport& transport, ManualClock& clock)
+      : clock(clock),
+        robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
+              RobotDaemonOptions{.log_executions = true}),
+        server(transport, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0}) {
+    server.AddRobot(robot, SessionOptions{});
+  }
+  void Step() {
+    server.RunOnce(Duration(0));
+    robot.RunOnce(clock.Now());
+    server.RunOnce(Duration(0));
+    clock.Advance(milliseconds(10));
+  }
+  ManualClock& clock;
+  RobotDaemon robot;  // outlives the server
+  ServerDaemon server;
+};
+
 // soak.md: the audit line (--log-executions) of a command is on stderr
 // before its reply leaves, so a reply never exists without its line (a
 // server killed in between would leave the soak's checker a reply it cannot
@@ -109,18 +130,10 @@ TEST(ServerDaemonLog, AnAuditLineIsWrittenBeforeItsReplyLeaves) {
         without_line.push_back(std::to_string(r.id) + " " + std::string(ToString(r.signal)));
     }
   });
-  RobotDaemon robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
-                    RobotDaemonOptions{.log_executions = true});
   ::testing::internal::CaptureStderr();
   {
-    ServerDaemon server(watched, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0});
-    server.AddRobot(robot, SessionOptions{});
-    const auto step = [&] {
-      server.RunOnce(Duration(0));
-      robot.RunOnce(clock.Now());
-      server.RunOnce(Duration(0));
-      clock.Advance(milliseconds(10));
-    };
+    AuditedBot bot(watched, clock);
+    const auto step = [&] { bot.Step(); };
     const std::int64_t session = testing::SayHello(client, "bot", testing::kAlice, step).session_id;
     Request r{.client_id = testing::kAlice, .session_id = session, .sequence = 1};
     r.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
@@ -196,16 +209,8 @@ TEST(ServerDaemonLog, AStderrThatTakesNothingNeverKeepsAPanicFromBeingTaken) {
   auto bus = std::make_shared<MemoryBus>();
   MemoryTransport server_end(bus);
   MemoryTransport client(bus);
-  RobotDaemon robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
-                    RobotDaemonOptions{.log_executions = true});
-  ServerDaemon server(server_end, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0});
-  server.AddRobot(robot, SessionOptions{});
-  const auto step = [&] {
-    server.RunOnce(Duration(0));
-    robot.RunOnce(clock.Now());
-    server.RunOnce(Duration(0));
-    clock.Advance(milliseconds(10));
-  };
+  AuditedBot bot(server_end, clock);
+  const auto step = [&] { bot.Step(); };
   const std::int64_t session = testing::SayHello(client, "bot", testing::kAlice, step).session_id;
   Request r{.client_id = testing::kAlice, .session_id = session, .sequence = 1};
   for (int i = 0; i < 20; ++i) {  // 20 audit lines for a stderr that takes none
@@ -223,9 +228,9 @@ TEST(ServerDaemonLog, AStderrThatTakesNothingNeverKeepsAPanicFromBeingTaken) {
   client.Publish(RequestChannel("bot"),
                  EncodeRequest(Request{.client_id = testing::kBob, .sequence = 1, .panic = true}));
   const auto deadline = std::chrono::steady_clock::now() + seconds(5);
-  while (!robot.in_panic() && std::chrono::steady_clock::now() < deadline)
+  while (!bot.robot.in_panic() && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(milliseconds(10));
-  const bool taken = robot.in_panic();
+  const bool taken = bot.robot.in_panic();
   stop = true;
   full.Release([&] { return stepping_ended.load(); });
   stepping.join();

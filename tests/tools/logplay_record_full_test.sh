@@ -12,10 +12,7 @@ server_bin=$1 logplay=$2 models=$3
 url="udpm://239.255.76.67:7834?ttl=0"
 . "$(dirname "$0")/../lib.sh"
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-  2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+start_pioneer_server "$server_bin" "$url" "$models" 60
 
 "$logplay" record -o /dev/full --lcm-url "$url" --duration 2.5 2>"$tmp/record.log"
 status=$?
