@@ -59,5 +59,50 @@ read -r v w moving < <(last_motion "$tmp/watch.json")
 check "the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
   python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
 
+# A stderr that takes nothing from the start (a pipe that is full and never
+# read: a supervisor that never drains it, a terminal stopped with Ctrl-S):
+# the server serves all the same, and SIGTERM still STOPs the robot and ends
+# it (before: it hung in its first line, "open mode: ...", and never served;
+# SIGTERM, taken by the thread that writes its lines, did nothing).
+url="udpm://239.255.76.67:7720?ttl=0"
+mkfifo "$tmp/full"
+sleep 1000 <"$tmp/full" &  # holds the read end, reads nothing
+pids+=($!)
+exec 3>"$tmp/full"
+head -c 65536 /dev/zero >&3  # the pipe's capacity: full
+"$server_bin" --robot "pioneer=kinematic:$urdf" --url "$url" --log-executions --duration 60 2>&3 &
+server_pid=$!
+exec 3>&-
+served=1
+for _ in $(seq 20); do
+  "$cli" --url "$url" --timeout 1 query pioneer base_pose >/dev/null 2>&1 && served=0 && break
+  sleep 0.2
+done
+check "a server whose stderr takes nothing serves" test "$served" -eq 0
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch2.json" 2>/dev/null &
+pids+=($!)
+"$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold2.out" 2>&1 &
+pids+=($!)
+sleep 1.5
+read -r v w moving < <(last_motion "$tmp/watch2.json")
+check "full stderr: pioneer moves before the signal (v=$v w=$w moving=$moving)" \
+  python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+kill -TERM "$server_pid" 2>/dev/null
+waited=0
+for _ in $(seq 100); do kill -0 "$server_pid" 2>/dev/null || break; sleep 0.1; done
+if kill -0 "$server_pid" 2>/dev/null; then
+  waited=1
+  kill -9 "$server_pid"
+fi
+wait "$server_pid"
+status=$?
+server_pid=""
+check "full stderr: the server ends within 10 s of SIGTERM" test "$waited" -eq 0
+check "full stderr: it exits 0 (status $status)" test "$status" -eq 0
+sleep 0.3
+read -r v w moving < <(last_motion "$tmp/watch2.json")
+check "full stderr: the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
+  python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
