@@ -1,6 +1,6 @@
 #include "robotalk/server.h"
 
-#include "log_writer.h"
+#include "robotalk/log_writer.h"
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"

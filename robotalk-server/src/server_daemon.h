@@ -24,7 +24,7 @@
 #pragma once
 
 #include "fault_injector.h"
-#include "log_writer.h"
+#include "robotalk/log_writer.h"
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robot_sessions.h"

@@ -1,7 +1,7 @@
 // robotalk-server's command line (server_main.h).
 #include "robotalk/server_main.h"
 
-#include "log_writer.h"
+#include "robotalk/log_writer.h"
 #include "panic_latch.h"
 #include "robotalk/error.h"
 

@@ -4,7 +4,7 @@
 #include "robotalk/log_limiter.h"
 
 #include "fake_driver.h"
-#include "log_writer.h"
+#include "robotalk/log_writer.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
 #include "robotalk/forwarding_transport.h"

@@ -1,4 +1,4 @@
-#include "log_writer.h"
+#include "robotalk/log_writer.h"
 
 #include <unistd.h>
 
