@@ -34,3 +34,18 @@ start_pioneer_server() {
   server_pid=$!
   for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
 }
+# signal_server SIGNAL: sends SIGNAL to $server_pid and waits 10 s at most for
+# it to end (then kill -9); sets $server_status (its exit status) and
+# $server_ended (1 when it ended by itself) and clears $server_pid.
+signal_server() {
+  kill -s "$1" "$server_pid" 2>/dev/null
+  server_ended=0
+  for _ in $(seq 100); do
+    kill -0 "$server_pid" 2>/dev/null || { server_ended=1; break; }
+    sleep 0.1
+  done
+  [ "$server_ended" = 1 ] || kill -9 "$server_pid" 2>/dev/null
+  wait "$server_pid"
+  server_status=$?
+  server_pid=""
+}

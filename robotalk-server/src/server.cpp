@@ -1,12 +1,12 @@
 #include "robotalk/server.h"
 
-#include "robotalk/log_writer.h"
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_message.h"
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "server_daemon.h"
 

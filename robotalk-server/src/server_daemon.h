@@ -24,13 +24,13 @@
 #pragma once
 
 #include "fault_injector.h"
-#include "robotalk/log_writer.h"
 #include "panic_latch.h"
 #include "robot_daemon.h"
 #include "robot_sessions.h"
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/clock.h"
 #include "robotalk/log_limiter.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/transport.h"
 #include "session_table.h"
 

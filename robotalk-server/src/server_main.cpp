@@ -1,9 +1,9 @@
 // robotalk-server's command line (server_main.h).
 #include "robotalk/server_main.h"
 
-#include "robotalk/log_writer.h"
 #include "panic_latch.h"
 #include "robotalk/error.h"
+#include "robotalk/log_writer.h"
 
 #include <algorithm>
 #include <chrono>

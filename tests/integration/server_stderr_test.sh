@@ -48,12 +48,8 @@ read -r v w moving < <(last_motion "$tmp/watch.json")
 check "pioneer moves before the signal (v=$v w=$w moving=$moving)" \
   python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
 
-kill -TERM "$server_pid" 2>/dev/null
-for _ in $(seq 100); do kill -0 "$server_pid" 2>/dev/null || break; sleep 0.1; done
-wait "$server_pid"
-status=$?
-server_pid=""
-check "the server exits 0 on SIGTERM (status $status)" test "$status" -eq 0
+signal_server TERM
+check "the server exits 0 on SIGTERM (status $server_status)" test "$server_status" -eq 0
 sleep 0.3
 read -r v w moving < <(last_motion "$tmp/watch.json")
 check "the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
@@ -87,18 +83,9 @@ sleep 1.5
 read -r v w moving < <(last_motion "$tmp/watch2.json")
 check "full stderr: pioneer moves before the signal (v=$v w=$w moving=$moving)" \
   python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
-kill -TERM "$server_pid" 2>/dev/null
-waited=0
-for _ in $(seq 100); do kill -0 "$server_pid" 2>/dev/null || break; sleep 0.1; done
-if kill -0 "$server_pid" 2>/dev/null; then
-  waited=1
-  kill -9 "$server_pid"
-fi
-wait "$server_pid"
-status=$?
-server_pid=""
-check "full stderr: the server ends within 10 s of SIGTERM" test "$waited" -eq 0
-check "full stderr: it exits 0 (status $status)" test "$status" -eq 0
+signal_server TERM
+check "full stderr: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
+check "full stderr: it exits 0 (status $server_status)" test "$server_status" -eq 0
 sleep 0.3
 read -r v w moving < <(last_motion "$tmp/watch2.json")
 check "full stderr: the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \

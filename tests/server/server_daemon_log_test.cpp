@@ -4,10 +4,10 @@
 #include "robotalk/log_limiter.h"
 
 #include "fake_driver.h"
-#include "robotalk/log_writer.h"
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
 #include "robotalk/forwarding_transport.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "server_daemon.h"
