@@ -91,5 +91,36 @@ read -r v w moving < <(last_motion "$tmp/watch2.json")
 check "full stderr: the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
   python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
 
+# The CLI's `send ... --hold`: its stderr stops taking lines after "holding
+# ... until Ctrl-C" (a full pipe); Ctrl-C must still STOP the robot (before:
+# it wrote "robotalk: " before it sent the STOP, and waited there; its
+# heartbeats kept its session, so the server's watchdog never stopped it).
+url="udpm://239.255.76.67:7721?ttl=0"
+start_pioneer_server "$server_bin" "$url" "$(dirname "$urdf")" 60
+mkfifo "$tmp/cli_err"
+python3 -c 'import sys, time
+with open(sys.argv[1]) as f:
+    for line in f:
+        if "holding" in line:
+            open(sys.argv[2], "w").close()
+            break
+    time.sleep(1000)  # holds the read end, reads nothing more' "$tmp/cli_err" "$tmp/holding" &
+pids+=($!)
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch3.json" 2>/dev/null &
+pids+=($!)
+setsid "$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >/dev/null 2>"$tmp/cli_err" &
+hold_pid=$!
+pids+=("$hold_pid")
+for _ in $(seq 50); do [ -e "$tmp/holding" ] && break; sleep 0.1; done
+check "the CLI holds the SETSPEED" test -e "$tmp/holding"
+head -c 65536 /dev/zero >"$tmp/cli_err"  # the pipe's capacity: its stderr takes nothing now
+sleep 0.5
+kill -INT "$hold_pid"
+sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
+read -r v w moving < <(last_motion "$tmp/watch3.json")
+check "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer (v=$v w=$w moving=$moving)" \
+  python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+kill -9 "$hold_pid" 2>/dev/null
+
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
