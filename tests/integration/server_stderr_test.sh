@@ -21,6 +21,16 @@ lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
 s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
 print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
 }
+# moves NAME WATCH_JSON / at_rest NAME WATCH_JSON: the last STATE sample of
+# a `watch --json` output shows pioneer moving / at rest (a check named NAME).
+moves() {
+  read -r v w moving < <(last_motion "$2")
+  check "$1 (v=$v w=$w moving=$moving)" python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+}
+at_rest() {
+  read -r v w moving < <(last_motion "$2")
+  check "$1 (v=$v w=$w moving=$moving)" python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+}
 
 # stderr's reader copies lines to server.log until the server serves, then exits.
 mkfifo "$tmp/stderr"
@@ -44,16 +54,12 @@ sleep 1.5  # the SETSPEED and its audit line: a write to a pipe without a reader
 check "the server lives on after a log line to a stderr without a reader" kill -0 "$server_pid"
 check "it still answers: $("$cli" --url "$url" --timeout 3 query pioneer base_pose 2>&1 | head -c 300)" \
   "$cli" --url "$url" --timeout 3 query pioneer base_pose
-read -r v w moving < <(last_motion "$tmp/watch.json")
-check "pioneer moves before the signal (v=$v w=$w moving=$moving)" \
-  python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+moves "pioneer moves before the signal" "$tmp/watch.json"
 
 signal_server TERM
 check "the server exits 0 on SIGTERM (status $server_status)" test "$server_status" -eq 0
 sleep 0.3
-read -r v w moving < <(last_motion "$tmp/watch.json")
-check "the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
-  python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+at_rest "the last STATE sample shows pioneer at rest" "$tmp/watch.json"
 
 # A stderr that takes nothing from the start (a pipe that is full and never
 # read: a supervisor that never drains it, a terminal stopped with Ctrl-S):
@@ -80,16 +86,12 @@ pids+=($!)
 "$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold2.out" 2>&1 &
 pids+=($!)
 sleep 1.5
-read -r v w moving < <(last_motion "$tmp/watch2.json")
-check "full stderr: pioneer moves before the signal (v=$v w=$w moving=$moving)" \
-  python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+moves "full stderr: pioneer moves before the signal" "$tmp/watch2.json"
 signal_server TERM
 check "full stderr: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
 check "full stderr: it exits 0 (status $server_status)" test "$server_status" -eq 0
 sleep 0.3
-read -r v w moving < <(last_motion "$tmp/watch2.json")
-check "full stderr: the last STATE sample shows pioneer at rest (v=$v w=$w moving=$moving)" \
-  python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+at_rest "full stderr: the last STATE sample shows pioneer at rest" "$tmp/watch2.json"
 
 # The CLI's `send ... --hold`: its stderr stops taking lines after "holding
 # ... until Ctrl-C" (a full pipe); Ctrl-C must still STOP the robot (before:
@@ -117,9 +119,7 @@ head -c 65536 /dev/zero >"$tmp/cli_err"  # the pipe's capacity: its stderr takes
 sleep 0.5
 kill -INT "$hold_pid"
 sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
-read -r v w moving < <(last_motion "$tmp/watch3.json")
-check "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer (v=$v w=$w moving=$moving)" \
-  python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
 kill -9 "$hold_pid" 2>/dev/null
 
 echo "$pass passed, $failures failed"
