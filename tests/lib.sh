@@ -26,3 +26,26 @@ check() {  # check NAME COMMAND...
   if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
 }
 value_of() { sed -n "s/^$2=//p" "$1" | head -1; }
+# start_pioneer_server SERVER URL MODELS_DIR SECONDS: a server of the Pioneer
+# (kinematic) in the background, its log in $tmp/server.log, $server_pid set;
+# returns once it serves (5 s at most).
+start_pioneer_server() {
+  "$1" --robot "pioneer=kinematic:$3/pioneer2dx_pantilt.urdf" --url "$2" --duration "$4" 2>"$tmp/server.log" &
+  server_pid=$!
+  for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+}
+# signal_server SIGNAL: sends SIGNAL to $server_pid and waits 10 s at most for
+# it to end (then kill -9); sets $server_status (its exit status) and
+# $server_ended (1 when it ended by itself) and clears $server_pid.
+signal_server() {
+  kill -s "$1" "$server_pid" 2>/dev/null
+  server_ended=0
+  for _ in $(seq 100); do
+    kill -0 "$server_pid" 2>/dev/null || { server_ended=1; break; }
+    sleep 0.1
+  done
+  [ "$server_ended" = 1 ] || kill -9 "$server_pid" 2>/dev/null
+  wait "$server_pid"
+  server_status=$?
+  server_pid=""
+}

@@ -182,8 +182,11 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
   }
   std::cerr << "robotalk: holding " << ToString(type) << " on " << robot << " until Ctrl-C (then STOP)\n";
   while (!Interrupter::Signal()) Interrupter::WaitFor(std::chrono::seconds(1));
-  std::cerr << "robotalk: " << StopNow(*client) << " (hold ended by "
-            << Interrupter::Name(Interrupter::Signal()) << ")\n";
+  // The STOP first, then the line: a stderr that takes nothing must not keep
+  // the robot moving (the CLI's heartbeats keep its session alive meanwhile).
+  const std::string stopped = StopNow(*client);
+  std::cerr << "robotalk: " << stopped << " (hold ended by " << Interrupter::Name(Interrupter::Signal())
+            << ")\n";
   return 0;
 }
 

@@ -4,6 +4,7 @@
 #include "robotalk/announce_listener.h"
 #include "robotalk/connect_scheduler.h"
 #include "robotalk/log_limiter.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "ros_wire.h"
@@ -35,7 +36,8 @@ using SteadyTime = std::chrono::steady_clock::time_point;
 // bridge's own actions (a robot bridged, the cmd_vel timeout's stop, STOP on
 // shutdown) come at its own pace and are always printed (Log), so a flood
 // cannot hide them. Lines come from DDS listener threads, the connector and
-// Run(): one mutex, held while printing too, so lines never interleave.
+// Run(): one mutex, held while printing too, so lines never interleave;
+// printed through a LogWriter (robotalk/log_writer.h), never waiting long.
 class LimitedLog {
  public:
   void Limited(const std::string& line) {
@@ -63,10 +65,12 @@ class LimitedLog {
 
  private:
   void Print() {  // REQUIRES: mu_
-    for (const std::string& line : out_) std::cerr << "robotalk-ros2: " << line << '\n';
-    if (!out_.empty()) std::cerr << std::flush;
-    out_.clear();
+    // Waits for stderr at most LogWriter::kMaxWait: a stderr that takes
+    // nothing (a full pipe, a terminal stopped with Ctrl-S) must not hold the
+    // cmd_vel timeout's stop, which logs first (the base drove on).
+    if (!out_.empty()) writer_.Write(out_);
   }
+  LogWriter writer_{"robotalk-ros2: "};
   std::mutex mu_;
   LogLimiter limiter_;            // GUARDED_BY(mu_)
   std::vector<std::string> out_;  // GUARDED_BY(mu_)

@@ -142,20 +142,24 @@ Duration RobotDaemon::CallRunning(TimePoint now) const {
 }
 
 bool RobotDaemon::Abandon(TimePoint now) {
-  std::string why;
-  {
-    std::lock_guard call_lock(call_mutex_);
-    why = "robot '" + robot_name_ + "': NOT STOPPED: driver '" + driver_name_ + "' " +
-          (call_.name ? call_.name : "call") + " has not returned after " +
-          planner_answers::Seconds(call_.name ? now - call_.started : Duration(0)) +
-          " (twice --driver-call-bound); the server shuts down without this robot's STOP: the robot may "
-          "still move (it is in panic)";
-  }
+  // Under call_mutex_ throughout: the call cannot end (and the shutdown STOP
+  // begin) between the check and the detach.
+  std::lock_guard call_lock(call_mutex_);
+  // Only the call that has run twice the bound at `now` is given up on: one
+  // that returned meanwhile (its thread in the shutdown STOP, or done) is not.
+  if (!call_.name || options_.driver_call_bound.count() <= 0 ||
+      now - call_.started <= 2 * options_.driver_call_bound)
+    return false;
+  const std::string why =
+      "robot '" + robot_name_ + "': NOT STOPPED: driver '" + driver_name_ + "' " + call_.name +
+      " has not returned after " + planner_answers::Seconds(now - call_.started) +
+      " (twice --driver-call-bound); the server shuts down without this robot's STOP: the "
+      "robot may still move (it is in panic)";
   {
     std::lock_guard lock(mutex_);
     if (ended_ || !thread_.joinable()) return false;
     output_ready_ = nullptr;  // the ServerDaemon it wakes is going away
-    outbox_.log.push_back(std::move(why));
+    outbox_.log.push_back(why);
   }
   thread_.detach();
   return true;

@@ -184,7 +184,9 @@ class RobotDaemon {
   /// the call ever return, the thread still drops what waits and STOPs the
   /// robot. REQUIRES: EndSoon(); the daemon is never destroyed afterwards
   /// (its thread may still use it). Returns false (nothing done) when the
-  /// thread ended meanwhile.
+  /// call running has not run twice the call bound at `now` (the one
+  /// measured returned meanwhile, its thread perhaps in the shutdown STOP)
+  /// or the thread ended.
   bool Abandon(TimePoint now);
 
   // --- ServerDaemon side (thread-safe) ------------------------------------

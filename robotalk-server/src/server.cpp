@@ -6,6 +6,7 @@
 #include "robotalk/config_message.h"
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "server_daemon.h"
 
@@ -24,6 +25,16 @@ namespace {
 std::vector<std::unique_ptr<RobotDaemon>>& AbandonedRobots() {
   static auto* abandoned = new std::vector<std::unique_ptr<RobotDaemon>>;
   return *abandoned;
+}
+
+// The server's own lines (start-up) through a LogWriter of their own, never
+// destroyed: a stderr that takes nothing keeps neither the robots from being
+// served nor the server from its shutdown (robotalk-server takes SIGTERM on
+// the thread that writes these).
+void Say(std::string line) {
+  static LogWriter* const log = new LogWriter("robotalk-server: ");
+  std::vector<std::string> lines{std::move(line)};
+  log->Write(lines);
 }
 
 bool ValidRobotName(const std::string& name) {
@@ -74,16 +85,14 @@ SessionTableOptions TableOptions(const ServerOptions& options) {
     throw Error("keyed mode needs both --key (the server's secret key) and --clients (the access list)");
   }
   if (options.key_file.empty()) {
-    std::fprintf(stderr,
-                 "robotalk-server: open mode: any process on the LAN may command these robots "
-                 "(--key and --clients turn on authentication; docs/security.md)\n");
+    Say("open mode: any process on the LAN may command these robots "
+        "(--key and --clients turn on authentication; docs/security.md)");
     return table;
   }
   table.identity = std::make_shared<const KeyPair>(ReadSecretKeyFile(options.key_file));
   table.access = std::make_shared<const AccessList>(AccessList::ReadFile(options.clients_file));
-  std::fprintf(stderr, "robotalk-server: keyed mode: %zu client keys from %s; server key %s\n",
-               table.access->size(), options.clients_file.c_str(),
-               table.identity->public_key.Fingerprint().c_str());
+  Say("keyed mode: " + std::to_string(table.access->size()) + " client keys from " + options.clients_file +
+      "; server key " + table.identity->public_key.Fingerprint());
   return table;
 }
 
@@ -179,8 +188,7 @@ class Server::Impl {
 
   void Start() {
     if (!options_.panic_latch_path.empty()) {
-      std::fprintf(stderr, "robotalk-server: panic latch %s (a panic survives a restart)\n",
-                   options_.panic_latch_path.c_str());
+      Say("panic latch " + options_.panic_latch_path + " (a panic survives a restart)");
     }
     // The ServerDaemon writes a robot's "starts in PANIC" as it starts, so
     // that line comes before "serving robot" (tests and operators wait for it).
@@ -188,9 +196,9 @@ class Server::Impl {
     server_daemon_->Start();
     running_ = true;
     for (auto& robot : robots_) {
-      std::fprintf(stderr, "robotalk-server: serving robot '%s' (%zu links, %d dofs, config %s) on '%s'\n",
-                   robot->robot_name().c_str(), robot->model().links().size(), robot->model().num_dofs(),
-                   Hex64(ConfigHash(robot->model())).c_str(), url_.c_str());
+      Say("serving robot '" + robot->robot_name() + "' (" + std::to_string(robot->model().links().size()) +
+          " links, " + std::to_string(robot->model().num_dofs()) + " dofs, config " +
+          Hex64(ConfigHash(robot->model())) + ") on '" + url_ + "'");
     }
   }
 
@@ -227,7 +235,7 @@ class Server::Impl {
         const Duration running = daemon.CallRunning(now);
         if (bound.count() <= 0 || running <= 2 * bound) return false;
         if (!daemon.Abandon(now)) {
-          return false;  // it ended meanwhile: Shutdown() at the next turn
+          return false;  // its call returned meanwhile (its STOP runs) or it ended: the next turn
         }
         flush = true;
         not_stopped_.push_back(daemon.robot_name());

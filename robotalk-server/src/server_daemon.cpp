@@ -546,8 +546,9 @@ void ServerDaemon::Announce(TimePoint now) {
 void ServerDaemon::Log(const std::string& line) { log_limiter_.Add(line, clock_.Now(), log_pending_); }
 
 void ServerDaemon::WriteLog() {
-  for (const std::string& line : log_pending_) std::fprintf(stderr, "robotalk-server: %s\n", line.c_str());
-  log_pending_.clear();
+  // Waits for stderr, but never longer than LogWriter::kMaxWait (a stderr
+  // that takes nothing would stop the panics and the watchdogs).
+  if (!log_pending_.empty()) log_writer_.Write(log_pending_);
 }
 
 }  // namespace robotalk

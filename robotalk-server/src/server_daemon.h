@@ -30,6 +30,7 @@
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/clock.h"
 #include "robotalk/log_limiter.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/transport.h"
 #include "session_table.h"
 
@@ -238,6 +239,7 @@ class ServerDaemon {
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes (audit lines before)
+  LogWriter log_writer_{"robotalk-server: "};  // stderr; a stderr that takes nothing never stops this thread
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

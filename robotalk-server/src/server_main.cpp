@@ -3,6 +3,7 @@
 
 #include "panic_latch.h"
 #include "robotalk/error.h"
+#include "robotalk/log_writer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 namespace robotalk {
 namespace {
@@ -314,6 +316,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // A stderr whose reader went away (`robotalk-server ... | head`, a log
+  // collector restarted) loses the log lines written to it (EPIPE), never the
+  // server: SIGPIPE would end it at its next line without STOPping a robot.
+  std::signal(SIGPIPE, SIG_IGN);
 
   try {
     // Outlives the server: a robot thread the shutdown gave up on (a driver
@@ -343,7 +349,12 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
       const timespec timeout{0, static_cast<long>(wait.count())};
       received = sigtimedwait(&signals, nullptr, &timeout);
     }
-    if (received > 0) std::cerr << "robotalk-server: " << strsignal(received) << ", stopping every robot\n";
+    if (received > 0) {
+      // Through a LogWriter: a stderr that takes nothing must not keep the robots from their STOP.
+      LogWriter log("robotalk-server: ");
+      std::vector<std::string> line{std::string(strsignal(received)) + ", stopping every robot"};
+      log.Write(line);
+    }
     server.Stop();
     if (!server.not_stopped().empty()) {
       std::cerr << "robotalk-server: error: not stopped (a driver call hung):";

@@ -52,18 +52,9 @@ shutdown_case() {
   check "$sig: pioneer moves before the signal (v=$v w=$w moving=$moving)" \
     python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
 
-  kill -s "$sig" "$server_pid"
-  local status=0 waited=0
-  for _ in $(seq 100); do kill -0 "$server_pid" 2>/dev/null || break; sleep 0.1; done
-  if kill -0 "$server_pid" 2>/dev/null; then
-    waited=1
-    kill -9 "$server_pid"
-  fi
-  wait "$server_pid"
-  status=$?
-  server_pid=""
-  check "$sig: the server exits by itself within 10 s" test "$waited" -eq 0
-  check "$sig: the server exits 0 (status $status)" test "$status" -eq 0
+  signal_server "$sig"
+  check "$sig: the server exits by itself within 10 s" test "$server_ended" -eq 1
+  check "$sig: the server exits 0 (status $server_status)" test "$server_status" -eq 0
   local name
   case "$sig" in TERM) name=Terminated ;; INT) name=Interrupt ;; esac
   check "$sig: the server says why it stops: $(tail -n 4 "$dir/server.log" | tr '\n' '|')" \

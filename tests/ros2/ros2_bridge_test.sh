@@ -96,6 +96,34 @@ check "the bridge says the SETSPEED 0 was refused and it sent STOP: $(grep -e cm
   grep -q "robot 'pioneer': SETSPEED 0 (cmd_vel timeout) was not executed.*: STOP" "$tmp/bridge2.log"
 stop_bridge TERM "$bridge2_pid" "$tmp/bridge2.log"  # SIGTERM too
 
+# A bridge whose stderr takes nothing (a pipe that is full and never read, a
+# terminal stopped with Ctrl-S): the cmd_vel timeout's stop logs first ("no
+# cmd_vel ...: SETSPEED 0"); it waited for stderr and the base drove on, the
+# bridge's heartbeats keeping its session (and so the server's watchdog)
+# alive. Its lines wait for stderr at most 0.2 s now.
+url3="udpm://239.255.76.67:7630?ttl=0"
+"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url3" \
+  --key "$tmp/server" --clients "$tmp/clients" --duration 30 2>"$tmp/server3.log" &
+pids+=("$!")
+for _ in $(seq 50); do grep -q "serving robot" "$tmp/server3.log" 2>/dev/null && break; sleep 0.1; done
+mkfifo "$tmp/full"
+sleep 1000 <"$tmp/full" &  # holds the read end, reads nothing
+pids+=($!)
+exec 3>"$tmp/full"
+head -c 65536 /dev/zero >&3  # the pipe's capacity: full
+"$bridge" --robot pioneer --url "$url3" --key "$tmp/bridge" --duration 20 >"$tmp/bridge3.out" 2>&3 &
+bridge3_pid=$!
+pids+=("$bridge3_pid")
+exec 3>&-
+sleep 2  # it connects (its "bridged" line waits for a stderr that takes nothing)
+url_saved=$url url=$url3
+peer_checks cmd_vel "with a stderr that takes nothing, the bridge still stops a base whose cmd_vel fell silent"
+url=$url_saved
+kill -TERM "$bridge3_pid"
+for _ in $(seq 100); do kill -0 "$bridge3_pid" 2>/dev/null || break; sleep 0.1; done
+check "and it ends on SIGTERM within 10 s" sh -c "! kill -0 $bridge3_pid 2>/dev/null"
+kill -9 "$bridge3_pid" 2>/dev/null
+
 # forged_then_real PORT N ROUNDS: a bridge of every announced robot (no
 # --robot) hears N forged names no server answers for (one ANNOUNCE datagram
 # each, ROUNDS times 0.5 s apart) before the real server starts; the real robot

@@ -14,6 +14,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -247,6 +250,93 @@ TEST(DriverCallBound, AnExecutePastTheBoundAnswersErrorAtOnceAndItsLateResultIsD
   }
   EXPECT_TRUE(slow->halted) << "halted after the late return";
   EXPECT_FALSE(slow->goto_id.has_value()) << "the late GOTO was halted, not left running";
+}
+
+}  // namespace
+}  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// Gates for a driver call that hangs until released; shared with the driver,
+// so a thread given up on may still use them after the test.
+struct Gates {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::atomic<bool> hang_update{false};
+  bool update_released = false;
+  bool stop_entered = false;
+  bool stop_released = false;
+
+  void Wait(bool& released) {
+    std::unique_lock lock(mutex);
+    changed.wait_for(lock, std::chrono::seconds(20), [&] { return released; });
+  }
+  void Set(bool& flag) {
+    {
+      std::lock_guard lock(mutex);
+      flag = true;
+    }
+    changed.notify_all();
+  }
+  bool WaitFor(bool& flag) {
+    std::unique_lock lock(mutex);
+    return changed.wait_for(lock, std::chrono::seconds(5), [&] { return flag; });
+  }
+};
+
+// Its next Update, once armed, hangs until released; its Stop waits for its
+// own release.
+class GatedDriver final : public FakeDriver {
+ public:
+  GatedDriver(RobotModel model, std::shared_ptr<Gates> gates) : FakeDriver(std::move(model)), gates_(gates) {}
+  void Update(TimePoint now, std::vector<Completion>& done) override {
+    if (gates_->hang_update.exchange(false)) gates_->Wait(gates_->update_released);
+    FakeDriver::Update(now, done);
+  }
+  void Stop(TimePoint now, std::vector<Completion>& done) override {
+    gates_->Set(gates_->stop_entered);
+    gates_->Wait(gates_->stop_released);
+    FakeDriver::Stop(now, done);
+  }
+
+ private:
+  std::shared_ptr<Gates> gates_;
+};
+
+// The shutdown gives up on a driver call that has run twice the call bound
+// (robotalk::Server measures it, then calls Abandon). A call that returns
+// just then, its robot's thread already in the shutdown STOP, is not given
+// up on: the robot is being stopped (before: Abandon gave up on whatever call
+// ran, the STOP just begun; the server named the robot NOT STOPPED and
+// robotalk-server exited during its STOP).
+TEST(DriverCallBound, TheShutdownDoesNotGiveUpOnARobotWhoseHungCallReturnedAndWhoseStopRuns) {
+  static const SteadyClock clock;  // a thread given up on may read it later
+  auto gates = std::make_shared<Gates>();
+  // Never deleted when given up on: its thread may still use it.
+  auto* robot = new RobotDaemon("bot", "gated", std::make_unique<GatedDriver>(PanRobot(), gates), clock,
+                                RobotDaemonOptions{.driver_call_bound = milliseconds(100)});
+  gates->hang_update = true;
+  robot->Start();
+  // The Update hangs past twice the bound: measured as the shutdown does.
+  TimePoint measured = clock.Now();
+  for (int i = 0; i < 500 && robot->CallRunning(measured) <= milliseconds(200); ++i) {
+    std::this_thread::sleep_for(milliseconds(10));
+    measured = clock.Now();
+  }
+  ASSERT_GT(robot->CallRunning(measured), milliseconds(200));
+  robot->EndSoon();
+  // The hung call returns; the thread goes on to its shutdown STOP.
+  gates->Set(gates->update_released);
+  ASSERT_TRUE(gates->WaitFor(gates->stop_entered)) << "the shutdown STOP never began";
+  const bool abandoned = robot->Abandon(measured);
+  gates->Set(gates->stop_released);
+  EXPECT_FALSE(abandoned) << "gave up on a robot whose hung call had returned, its STOP running";
+  if (!abandoned) {
+    EXPECT_TRUE(robot->WaitEnded(std::chrono::seconds(5)));
+    robot->Shutdown();
+    delete robot;
+  }
 }
 
 }  // namespace

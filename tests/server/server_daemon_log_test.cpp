@@ -7,6 +7,7 @@
 #include "robot_daemon.h"
 #include "robotalk/channels.h"
 #include "robotalk/forwarding_transport.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 #include "server_daemon.h"
@@ -16,11 +17,18 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <mutex>
+#include <regex>
 #include <sstream>
+#include <thread>
 
 namespace robotalk {
 namespace {
@@ -79,6 +87,27 @@ class WatchedTransport final : public ForwardingTransport {
   Before before_;
 };
 
+// A ServerDaemon serving one robot with audit lines (--log-executions),
+// stepped by hand: the server, the robot, the server again, then 10 ms on.
+struct AuditedBot {
+  AuditedBot(Transport& transport, ManualClock& clock)
+      : clock(clock),
+        robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
+              RobotDaemonOptions{.log_executions = true}),
+        server(transport, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0}) {
+    server.AddRobot(robot, SessionOptions{});
+  }
+  void Step() {
+    server.RunOnce(Duration(0));
+    robot.RunOnce(clock.Now());
+    server.RunOnce(Duration(0));
+    clock.Advance(milliseconds(10));
+  }
+  ManualClock& clock;
+  RobotDaemon robot;  // outlives the server
+  ServerDaemon server;
+};
+
 // soak.md: the audit line (--log-executions) of a command is on stderr
 // before its reply leaves, so a reply never exists without its line (a
 // server killed in between would leave the soak's checker a reply it cannot
@@ -101,18 +130,10 @@ TEST(ServerDaemonLog, AnAuditLineIsWrittenBeforeItsReplyLeaves) {
         without_line.push_back(std::to_string(r.id) + " " + std::string(ToString(r.signal)));
     }
   });
-  RobotDaemon robot("bot", "fake", std::make_unique<testing::FakeDriver>(testing::PanRobot()), clock,
-                    RobotDaemonOptions{.log_executions = true});
   ::testing::internal::CaptureStderr();
   {
-    ServerDaemon server(watched, clock, ServerDaemonOptions{.server_id = 7, .fifo_priority = 0});
-    server.AddRobot(robot, SessionOptions{});
-    const auto step = [&] {
-      server.RunOnce(Duration(0));
-      robot.RunOnce(clock.Now());
-      server.RunOnce(Duration(0));
-      clock.Advance(milliseconds(10));
-    };
+    AuditedBot bot(watched, clock);
+    const auto step = [&] { bot.Step(); };
     const std::int64_t session = testing::SayHello(client, "bot", testing::kAlice, step).session_id;
     Request r{.client_id = testing::kAlice, .session_id = session, .sequence = 1};
     r.commands.push_back(Command{1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.5}});
@@ -123,6 +144,131 @@ TEST(ServerDaemonLog, AnAuditLineIsWrittenBeforeItsReplyLeaves) {
   const std::string log = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(replies, 2u) << log;
   EXPECT_THAT(without_line, ::testing::IsEmpty()) << "replies that left before their audit line\n" << log;
+}
+
+}  // namespace
+}  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// Stderr as a pipe that is full and never read: a supervisor that keeps the
+// pipe but never drains it, or a terminal stopped with Ctrl-S. Restores the
+// old stderr (and drains the pipe, so whatever blocked on it ends) when done.
+class FullStderr {
+ public:
+  FullStderr() {
+    int fds[2];
+    if (pipe(fds) != 0) throw std::runtime_error("pipe");
+    read_end_ = fds[0];
+    const int flags = fcntl(fds[1], F_GETFL);
+    fcntl(fds[1], F_SETFL, flags | O_NONBLOCK);
+    const std::string chunk(4096, 'x');
+    while (write(fds[1], chunk.data(), chunk.size()) > 0) {
+    }
+    fcntl(fds[1], F_SETFL, flags);  // blocking again, as stderr is
+    saved_ = dup(2);
+    dup2(fds[1], 2);
+    close(fds[1]);
+  }
+  ~FullStderr() { Release(); }
+  /// Reads the pipe until `done()` (whatever blocked on it goes on), then
+  /// restores stderr.
+  std::string Release(const std::function<bool()>& done = [] { return true; }) {
+    std::string text;
+    if (saved_ < 0) return text;
+    fcntl(read_end_, F_SETFL, fcntl(read_end_, F_GETFL) | O_NONBLOCK);
+    char buffer[4096];
+    const auto drain = [&] {
+      for (ssize_t n; (n = read(read_end_, buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+    };
+    do {
+      drain();
+      std::this_thread::sleep_for(milliseconds(1));
+    } while (!done());
+    dup2(saved_, 2);
+    close(saved_);
+    saved_ = -1;
+    drain();
+    close(read_end_);
+    return text;
+  }
+
+ private:
+  int read_end_ = -1;
+  int saved_ = -1;
+};
+
+// A stderr that takes nothing (full, never read) never stops the
+// ServerDaemon. With --log-executions every command's audit line waits for
+// stderr; before, the ServerDaemon waited with it, in fprintf, for as long as
+// stderr took nothing: no panic was taken, no watchdog ran, no reply left.
+// A panic sent while stderr takes nothing is taken.
+TEST(ServerDaemonLog, AStderrThatTakesNothingNeverKeepsAPanicFromBeingTaken) {
+  ManualClock clock;
+  auto bus = std::make_shared<MemoryBus>();
+  MemoryTransport server_end(bus);
+  MemoryTransport client(bus);
+  AuditedBot bot(server_end, clock);
+  const auto step = [&] { bot.Step(); };
+  const std::int64_t session = testing::SayHello(client, "bot", testing::kAlice, step).session_id;
+  Request r{.client_id = testing::kAlice, .session_id = session, .sequence = 1};
+  for (int i = 0; i < 20; ++i) {  // 20 audit lines for a stderr that takes none
+    r.commands.push_back(Command{i + 1, CommandType::kJointSetPoint, std::nullopt, "pan", {0.01 * i}});
+  }
+  client.Publish(RequestChannel("bot"), EncodeRequest(r));  // before the steps: its session is live
+  FullStderr full;
+  std::atomic<bool> stop{false};
+  std::atomic<bool> stepping_ended{false};
+  std::thread stepping([&] {
+    while (!stop) step();
+    stepping_ended = true;
+  });
+  std::this_thread::sleep_for(milliseconds(300));  // the ServerDaemon meets the full stderr
+  client.Publish(RequestChannel("bot"),
+                 EncodeRequest(Request{.client_id = testing::kBob, .sequence = 1, .panic = true}));
+  const auto deadline = std::chrono::steady_clock::now() + seconds(5);
+  while (!bot.robot.in_panic() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(milliseconds(10));
+  const bool taken = bot.robot.in_panic();
+  stop = true;
+  full.Release([&] { return stepping_ended.load(); });
+  stepping.join();
+  EXPECT_TRUE(taken) << "a panic sent while stderr took nothing was not taken within 5 s";
+}
+
+// The LogWriter under a stderr that takes nothing: a Write returns without
+// its lines written; what waits is bounded (kMaxQueuedBytes), the rest
+// dropped and counted; once stderr takes lines again, the first says how many
+// were lost, and the lines after are written.
+TEST(LogWriterTest, AStderrThatTakesNothingBoundsTheQueueAndSaysWhatWasLostOnceItTakesLinesAgain) {
+  FullStderr full;
+  LogWriter log("test: ");
+  std::vector<std::string> lines{"first"};
+  EXPECT_FALSE(log.Write(lines)) << "written to a full pipe nobody reads";
+  EXPECT_TRUE(lines.empty());
+  for (int i = 0; i < 6000; ++i) lines.push_back(std::string(1000, 'a'));  // 6 MB
+  EXPECT_FALSE(log.Write(lines));
+  const std::uint64_t dropped = log.dropped();
+  EXPECT_GT(dropped, 6000u - LogWriter::kMaxQueuedBytes / 1000) << "more than the bound waits";
+  EXPECT_LT(dropped, 6000u);
+  std::atomic<bool> after_written{false};
+  std::thread after([&] {
+    std::vector<std::string> line{"after"};
+    while (!log.Write(line)) {  // each "after" that found the queue full is dropped too
+      std::this_thread::sleep_for(milliseconds(10));
+      line = {"after"};
+    }
+    after_written = true;
+  });
+  const std::string text = full.Release([&] { return after_written.load(); });
+  after.join();
+  EXPECT_THAT(text, HasSubstr("test: first\n"));
+  std::smatch lost;
+  ASSERT_TRUE(std::regex_search(text, lost, std::regex("test: ([0-9]+) log lines lost")))
+      << text.substr(0, 300);
+  EXPECT_GE(std::stoull(lost[1]), dropped);
+  EXPECT_THAT(text, HasSubstr("test: after\n"));
 }
 
 }  // namespace

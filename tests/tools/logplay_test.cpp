@@ -455,5 +455,29 @@ TEST(ReceiptOrder, HoldsAtMostItsBoundWritingTheOldestFirst) {
   EXPECT_EQ(order.held(), 2u);
 }
 
+// The wall clock stepped back (an NTP step, a date set by hand) while
+// recording: what came before the step is written at once and first, not
+// held until the clock catches up (an hour here: a recorder killed meanwhile
+// lost it, against logplay.md's 1.25 s, and it was written after the events
+// that came after it), and nothing after the step counts as late.
+TEST(ReceiptOrder, AWallClockSteppedBackWritesWhatCameBeforeTheStepAtOnceAndFirst) {
+  ReceiptOrder order(/*hold_us=*/1000);
+  const std::vector<std::uint8_t> none;
+  std::vector<std::string> written;
+  const auto write = [&](const ReceiptOrder::Event& e) { written.push_back(e.channel); };
+  const std::int64_t t0 = 1'800'000'000'000'000, hour = 3'600'000'000;
+  order.Add(t0, "BEFORE", none);
+  order.Release(t0 + 500, write);
+  EXPECT_TRUE(written.empty()) << "held for `hold`";
+  order.Add(t0 - hour + 600, "AFTER", none);  // the clock stepped back an hour
+  order.Release(t0 - hour + 700, write);
+  EXPECT_EQ(written, std::vector<std::string>{"BEFORE"}) << "held until the clock caught up";
+  order.Release(t0 - hour + 1700, write);
+  EXPECT_EQ(written, (std::vector<std::string>{"BEFORE", "AFTER"}));
+  order.Add(t0 - hour + 2000, "LATER", none);
+  order.ReleaseAll(write);
+  EXPECT_EQ(order.late(), 0u) << "events after the step counted as dispatched late";
+}
+
 }  // namespace
 }  // namespace robotalk::logplay

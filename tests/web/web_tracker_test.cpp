@@ -307,13 +307,14 @@ TEST_F(WebTrackerForgedNames, ATableKeptFullByForgedNamesStillTakesARealRobot) {
 // takes only what that key signed: neither the forger's unsigned names nor
 // names it signs with a key of its own reach the table, and the real robot
 // is live as soon as its server announces it.
-TEST(WebTrackerKeyed, WithItsServersKeyAFloodOfFreshForgedNamesNeverReachesTheTableAndTheRealRobotIsLive) {
+// A fresh folder with a server key ("server", "server.pub"), the bridge's key
+// ("web") and an access list ("clients") giving the bridge every right.
+std::filesystem::path KeyedDir() {
   namespace fs = std::filesystem;
   const fs::path dir =
       fs::temp_directory_path() / ("robotalk_web_keyed_" + std::to_string(::getpid()) + "_" +
                                    std::to_string(std::mt19937_64(std::random_device{}())()));
   fs::create_directories(dir);
-  const KeyPair mallory = KeyPair::Generate();
   for (const char* name : {"server", "web"}) WriteKeyFiles(dir / name, KeyPair::Generate(), name);
   {
     std::ifstream pub(dir / "web.pub");
@@ -322,6 +323,13 @@ TEST(WebTrackerKeyed, WithItsServersKeyAFloodOfFreshForgedNamesNeverReachesTheTa
     std::ofstream(dir / "clients") << line << " *=all\n";
   }
   ::chmod((dir / "clients").c_str(), 0600);
+  return dir;
+}
+
+TEST(WebTrackerKeyed, WithItsServersKeyAFloodOfFreshForgedNamesNeverReachesTheTableAndTheRealRobotIsLive) {
+  namespace fs = std::filesystem;
+  const fs::path dir = KeyedDir();
+  const KeyPair mallory = KeyPair::Generate();
 
   WebOptions o;
   o.lcm_url = kUrl;
@@ -368,6 +376,69 @@ TEST(WebTrackerKeyed, WithItsServersKeyAFloodOfFreshForgedNamesNeverReachesTheTa
   fs::remove_all(dir);
   EXPECT_TRUE(live) << "the keyed server's robot is not live 30 s after its server started";
   EXPECT_EQ(others, 0u) << "forged names (unsigned, or signed by another key) reached the tracker";
+}
+
+// A recording of the keyed server's own signed announcements, from an
+// earlier instance (before a restart), replayed while the bridge is
+// connected to the robot's present server: it is signed by the trusted key,
+// so it passes --server-key. Its old server id made the bridge drop its
+// client of the robot as stale and connect again, over and over (the card
+// "connecting", the PANIC button answered "not connected"), and its panic
+// flag was shown as the robot's. A signed announcement more than 1.5 s older
+// than the connected client's clock says is stale and changes nothing.
+TEST(WebTrackerKeyed, AReplayOfTheServersEarlierAnnouncementsNeverDisconnectsTheRobot) {
+  namespace fs = std::filesystem;
+  const fs::path dir = KeyedDir();
+  lcm::LCM bus(kUrl);
+  ASSERT_TRUE(bus.good());
+  std::vector<std::uint8_t> recorded;
+  struct Recorder {
+    std::vector<std::uint8_t>* out;
+    void Take(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+      const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
+      if (out->empty()) out->assign(b, b + rbuf->data_size);
+    }
+  } recorder{&recorded};
+  lcm::Subscription* sub = bus.subscribe(kAnnounceChannel, &Recorder::Take, &recorder);
+  {
+    PioneerServer earlier((dir / "server").string(), (dir / "clients").string());
+    for (int i = 0; i < 30 && recorded.empty(); ++i) bus.handleTimeout(100);
+  }
+  bus.unsubscribe(sub);
+  ASSERT_FALSE(recorded.empty()) << "no announcement of the earlier instance recorded";
+
+  PioneerServer server((dir / "server").string(), (dir / "clients").string());
+  WebOptions o;
+  o.lcm_url = kUrl;
+  o.key_file = (dir / "web").string();
+  o.server_key_file = (dir / "server.pub").string();
+  RobotTracker tracker(o);
+  std::string server_id;
+  for (int i = 0; i < 150 && server_id.empty(); ++i) {
+    const nlohmann::json list = tracker.Poll().robots["robots"];
+    for (const auto& r : list)
+      if (r["name"] == "pioneer" && r["status"] == "live") server_id = r["server_id"].get<std::string>();
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  ASSERT_FALSE(server_id.empty()) << "pioneer not live";
+  int polls = 0, not_live = 0, other_server = 0;
+  for (int i = 0; i < 80; ++i) {  // 4 s of replays at 20 Hz
+    bus.publish(kAnnounceChannel, recorded.data(), static_cast<unsigned>(recorded.size()));
+    std::this_thread::sleep_for(milliseconds(50));
+    const nlohmann::json list = tracker.Poll().robots["robots"];
+    for (const auto& r : list) {
+      if (r["name"] != "pioneer") continue;
+      ++polls;
+      if (r["status"] != "live") ++not_live;
+      if (r["server_id"].get<std::string>() != server_id) ++other_server;
+    }
+  }
+  std::printf("%d polls: pioneer not live in %d, shown with the replayed server id in %d\n", polls, not_live,
+              other_server);
+  fs::remove_all(dir);
+  EXPECT_EQ(polls, 80);
+  EXPECT_EQ(not_live, 0) << "a replay of the earlier instance's announcements disconnected the robot";
+  EXPECT_EQ(other_server, 0) << "a replay of the earlier instance's announcements was taken as the robot's";
 }
 
 }  // namespace

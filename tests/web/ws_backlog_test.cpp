@@ -16,6 +16,7 @@
 #include <thread>
 
 #include <sys/socket.h>
+#include <unistd.h>
 
 namespace robotalk::web {
 namespace {
@@ -98,9 +99,11 @@ struct Pair {
 // PANICs) and read nothing had every answer queued for it, without a bound.
 // Now a client more than 64 MiB or 4096 messages behind on what it must
 // receive is closed.
-TEST(WsBacklog, AClientThatReadsNothingOfWhatItMustReceiveIsClosedNotQueuedForWithoutBound) {
+// Sends 200 MiB and 10,000 answers to a client that reads nothing; true when
+// the bridge closed its socket.
+bool ClosesAClientThatReadsNothing() {
   Pair p(false);
-  ASSERT_TRUE(p.RunUntil([&] { return p.server && p.server->open(); })) << "no WebSocket opened";
+  if (!p.RunUntil([&] { return p.server && p.server->open(); })) return false;
   const auto mib = std::make_shared<const std::string>(1 << 20, 'x');
   for (int i = 0; i < 200 && p.server->open(); ++i) {
     p.server->Send(mib, true, false);
@@ -108,8 +111,29 @@ TEST(WsBacklog, AClientThatReadsNothingOfWhatItMustReceiveIsClosedNotQueuedForWi
   }
   const auto small = std::make_shared<const std::string>("{\"op\":\"status\"}");
   for (int i = 0; i < 10000 && p.server->open(); ++i) p.server->Send(small, false, false);
-  EXPECT_TRUE(p.RunUntil([&] { return !p.server->open(); }))
+  return p.RunUntil([&] { return !p.server->open(); });
+}
+
+TEST(WsBacklog, AClientThatReadsNothingOfWhatItMustReceiveIsClosedNotQueuedForWithoutBound) {
+  EXPECT_TRUE(ClosesAClientThatReadsNothing())
       << "a client that read none of 200 MiB and 10,000 answers is still served";
+}
+
+// robotalk-web's stderr whose reader went away (its output piped into a
+// reader that exited): closing a client writes a line, and SIGPIPE ended
+// robotalk-web there (every page's PANIC button with it). The line is lost,
+// never the bridge.
+TEST(WsBacklog, ClosingAClientWithAStderrWithoutAReaderLosesTheLineNotTheBridge) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ::close(fds[0]);  // no reader
+  const int saved = ::dup(2);
+  ::dup2(fds[1], 2);
+  ::close(fds[1]);
+  const bool closed = ClosesAClientThatReadsNothing();
+  ::dup2(saved, 2);
+  ::close(saved);
+  EXPECT_TRUE(closed) << "the client was not closed";
 }
 
 TEST(WsBacklog, AClientThatReadsGetsEveryMessageOfALargeBurst) {

@@ -42,11 +42,22 @@ class ReceiptOrder {
 
   /// Calls `write(const Event&)` in receipt order for every event received
   /// at or before `now_us - hold`, and for the oldest ones beyond
-  /// `max_held`. An event received before one already written (it waited
+  /// `max_held`; first, after a wall-clock step back, every event stamped
+  /// more than `hold` after `now_us`. An event received before one already written (it waited
   /// longer than `hold` to be dispatched) is written at once and counted in
   /// late().
   template <typename Write>
   void Release(std::int64_t now_us, Write&& write) {
+    // The wall clock stepped back (NTP, a date set by hand): an event stamped
+    // more than `hold` after `now_us` came before the step. Those are written
+    // at once and first (held until the clock caught up, a kill meanwhile
+    // lost them), and the order starts again: nothing after the step is late.
+    if (!held_.empty() && held_.rbegin()->first.first > now_us + hold_us_) {
+      auto stepped = held_.upper_bound(Key{now_us + hold_us_, UINT64_MAX});
+      for (auto it = stepped; it != held_.end(); ++it) write(it->second);
+      held_.erase(stepped, held_.end());
+      last_written_us_ = INT64_MIN;
+    }
     while (!held_.empty() && (held_.begin()->first.first <= now_us - hold_us_ || held_.size() > max_held_)) {
       WriteFirst(write);
     }

@@ -14,8 +14,10 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ostream>
 
 namespace robotalk::logplay {
@@ -38,11 +40,19 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
     event.datalen = static_cast<std::int32_t>(e.bytes.size());
     event.data = const_cast<std::uint8_t*>(e.bytes.data());  // LCM's API is not const; it only reads
     if (file.writeEvent(&event) != 0) {
-      write_error = "record: writing '" + options.output + "' failed";
+      write_error = "record: writing '" + options.output + "' failed: " + std::strerror(errno ? errno : EIO);
       return;
     }
     ++result.events;
     result.bytes += e.bytes.size();
+  };
+  // The stdio buffer's writes fail here, not in writeEvent (a full disk:
+  // "wrote 2 events" and nothing on disk, before this was checked).
+  const auto flush = [&] {
+    if (!write_error.empty()) return;
+    errno = 0;
+    if (std::fflush(file.getFilePtr()) != 0 || std::ferror(file.getFilePtr()))
+      write_error = "record: writing '" + options.output + "' failed: " + std::strerror(errno ? errno : EIO);
   };
   auto sub = transport->Subscribe(
       options.channels, [&](const std::string& channel, std::span<const std::uint8_t> bytes) {
@@ -74,14 +84,14 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
                       .count(),
                   write);
     if (clock.Now() >= next_flush) {
-      std::fflush(file.getFilePtr());
+      flush();
       next_flush = clock.Now() + flush_period;
     }
   }
   sub.reset();
   order.ReleaseAll(write);
   result.late = order.late();
-  std::fflush(file.getFilePtr());
+  flush();
   if (!write_error.empty()) throw LogError(write_error);
   result.signal = cli::Interrupter::Signal();
   return result;

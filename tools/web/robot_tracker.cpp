@@ -3,6 +3,7 @@
 #include "json_text.h"
 #include "robotalk/announce_listener.h"
 #include "robotalk/channels.h"
+#include "robotalk/clock.h"
 #include "robotalk/connect_scheduler.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
@@ -37,6 +38,9 @@ struct Robot {
   std::string driver;
   bool panic = false;
   int num_clients = 0;
+  // The newest announcement taken: its server time, and when it came (steady).
+  TimePoint announced_server_time{};
+  TimePoint announced_at{};
   std::string message;
   std::shared_ptr<RobotClient> client;
   std::int64_t client_server_id = 0;
@@ -131,8 +135,21 @@ class RobotTracker::Impl {
   // Keyed with --server-key, only what that key signed reaches here.
   void OnAnnounce(const HeardAnnouncement& heard) {
     const Announcement& announcement = heard.announcement;
+    const TimePoint now = clock_.Now();
     std::lock_guard lock(mutex_);
     for (const RobotAnnouncement& r : announcement.robots) {
+      // A robot's announcements are taken in their server's time order: one
+      // no newer than the last taken is a replay (a recording, signed by the
+      // trusted key, of an earlier instance or of the present one) and
+      // changes nothing: neither the server id (its client would be dropped
+      // as stale, over and over) nor the panic flag shown, nor silence. Only
+      // a robot not heard for --robot-timeout takes any time again (a server
+      // host restarted with its clock).
+      if (auto known = robots_.find(r.name); known != robots_.end()) {
+        const Robot& k = known->second;
+        const bool heard_lately = now - k.announced_at < FromSeconds(options_.robot_timeout_s);
+        if (heard_lately && announcement.server_time <= k.announced_server_time) continue;
+      }
       std::string evicted;  // the scheduler's table and robots_ hold the same names
       if (connects_->Announce(r.name, &evicted) == ConnectScheduler::Heard::kRefused) continue;
       if (!evicted.empty()) robots_.erase(evicted);
@@ -143,6 +160,8 @@ class RobotTracker::Impl {
       robot.driver = r.driver;
       robot.panic = r.panic;
       robot.num_clients = r.num_clients;
+      robot.announced_server_time = announcement.server_time;
+      robot.announced_at = now;
     }
   }
 
@@ -247,6 +266,7 @@ class RobotTracker::Impl {
 
   const WebOptions options_;
   const std::optional<PublicKey> only_key_;  // --server-key: only its robots are tracked
+  const SteadyClock clock_;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable wake_;

@@ -1,0 +1,55 @@
+// LogWriter: log lines reach a file descriptor (stderr) on a thread of their
+// own, so a stderr that takes nothing (a full pipe nobody reads, a terminal
+// stopped with Ctrl-S, a stalled log collector) never stops the thread that
+// logs: the ServerDaemon takes panics, runs the watchdogs and answers on.
+//
+// Write() queues the lines and waits until they are written, as a direct
+// write did, but never longer than kMaxWait after the line being written
+// when it was called began: while the descriptor takes lines the order of
+// lines and replies is as before (an audit line on stderr before its reply
+// leaves, soak.md); one that takes nothing costs a caller kMaxWait at most,
+// once per spell, and nothing after. Lines then wait in a queue of at most
+// kMaxQueuedBytes; beyond it they are dropped, and the first write after
+// says how many ("N log lines lost: ..."), as it does for lines whose write
+// failed (a full disk, a pipe without a reader: EPIPE, never SIGPIPE).
+//
+// Thread safety: Write() from any thread. The writer's state outlives the
+// object: a destructor that cannot write what waits within kMaxWait leaves
+// the writer thread blocked, and returns.
+#pragma once
+
+#include "robotalk/clock.h"
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace robotalk {
+
+class LogWriter {
+ public:
+  static constexpr Duration kMaxWait = std::chrono::milliseconds(200);
+  static constexpr std::size_t kMaxQueuedBytes = std::size_t{4} << 20;
+
+  /// Each line is written as `prefix` + line + "\n" to `fd` (not owned).
+  explicit LogWriter(std::string prefix, int fd = 2);
+  ~LogWriter();
+  LogWriter(const LogWriter&) = delete;
+  LogWriter& operator=(const LogWriter&) = delete;
+
+  /// Queues `lines` (moved out; `lines` is left empty) and waits until they
+  /// are written, or until the write in progress has run kMaxWait. Returns
+  /// true when they were written.
+  bool Write(std::vector<std::string>& lines);
+  /// Lines dropped so far because the queue was full.
+  std::uint64_t dropped() const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+}  // namespace robotalk

@@ -1,0 +1,128 @@
+#include "robotalk/log_writer.h"
+
+#include <unistd.h>
+
+#include <pthread.h>
+#include <algorithm>
+#include <cerrno>
+#include <condition_variable>
+#include <csignal>
+#include <deque>
+#include <mutex>
+#include <thread>
+
+namespace robotalk {
+
+struct LogWriter::State {
+  std::string prefix;
+  int fd = 2;
+  std::mutex mu;
+  std::condition_variable work;                         // lines queued, or stop
+  std::condition_variable written;                      // a write ended
+  std::deque<std::string> queue;                        // GUARDED_BY(mu): prefixed lines, "\n" ended
+  std::size_t queued_bytes = 0;                         // GUARDED_BY(mu)
+  std::uint64_t queued = 0;                             // GUARDED_BY(mu): lines queued or dropped so far
+  std::uint64_t done = 0;                               // GUARDED_BY(mu): lines written or dropped so far
+  std::uint64_t dropped = 0;                            // GUARDED_BY(mu)
+  std::uint64_t dropped_unsaid = 0;                     // GUARDED_BY(mu): not yet said in a line
+  bool writing = false;                                 // GUARDED_BY(mu)
+  std::chrono::steady_clock::time_point write_began{};  // GUARDED_BY(mu)
+  bool stop = false;                                    // GUARDED_BY(mu)
+
+  void Run() {
+    // A descriptor whose reader went away answers EPIPE, never SIGPIPE.
+    sigset_t pipe_signal;
+    sigemptyset(&pipe_signal);
+    sigaddset(&pipe_signal, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &pipe_signal, nullptr);
+    std::unique_lock lock(mu);
+    for (;;) {
+      work.wait(lock, [&] { return stop || !queue.empty(); });
+      if (queue.empty()) return;  // stop, and everything written
+      std::string text;
+      if (dropped_unsaid > 0) {
+        text = prefix + std::to_string(dropped_unsaid) +
+               " log lines lost: the log refused them, or took nothing while more than " +
+               std::to_string(kMaxQueuedBytes >> 20) + " MiB waited\n";
+        dropped_unsaid = 0;
+      }
+      std::uint64_t lines = 0;
+      while (!queue.empty()) {
+        text += queue.front();
+        queue.pop_front();
+        ++lines;
+      }
+      queued_bytes = 0;
+      writing = true;
+      write_began = std::chrono::steady_clock::now();
+      lock.unlock();
+      bool failed = false;
+      for (std::size_t at = 0; at < text.size();) {
+        const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {  // closed, EPIPE, no space: these lines are lost, the next may not be
+          failed = true;
+          break;
+        }
+        at += static_cast<std::size_t>(n);
+      }
+      lock.lock();
+      if (failed) dropped_unsaid += lines;  // said by the next write that succeeds
+      writing = false;
+      done += lines;
+      written.notify_all();
+    }
+  }
+};
+
+LogWriter::LogWriter(std::string prefix, int fd) : state_(std::make_shared<State>()) {
+  state_->prefix = std::move(prefix);
+  state_->fd = fd;
+  std::thread([state = state_] { state->Run(); }).detach();
+}
+
+LogWriter::~LogWriter() {
+  std::vector<std::string> none;
+  Write(none);  // what waits, within kMaxWait of a write that hangs
+  std::lock_guard lock(state_->mu);
+  state_->stop = true;
+  state_->work.notify_all();
+}
+
+bool LogWriter::Write(std::vector<std::string>& lines) {
+  State& s = *state_;
+  std::unique_lock lock(s.mu);
+  for (std::string& line : lines) {
+    ++s.queued;
+    const std::size_t size = s.prefix.size() + line.size() + 1;
+    if (s.queued_bytes + size > kMaxQueuedBytes) {
+      ++s.dropped;
+      ++s.dropped_unsaid;
+      ++s.done;
+      continue;
+    }
+    s.queue.push_back(s.prefix + line + "\n");
+    s.queued_bytes += size;
+  }
+  lines.clear();
+  const std::uint64_t mine = s.queued;
+  s.work.notify_one();
+  // Waits at most kMaxWait, and not at all past kMaxWait of the write in
+  // progress: a descriptor that takes nothing costs kMaxWait once a spell.
+  const auto entry = std::chrono::steady_clock::now();
+  while (s.done < mine) {
+    const auto now = std::chrono::steady_clock::now();
+    auto until = entry + kMaxWait;
+    if (s.writing) until = std::min(until, s.write_began + kMaxWait);
+    if (now >= until) return false;
+    s.written.wait_until(lock, until);
+  }
+  return true;
+}
+
+std::uint64_t LogWriter::dropped() const {
+  std::lock_guard lock(state_->mu);
+  return state_->dropped;
+}
+
+}  // namespace robotalk

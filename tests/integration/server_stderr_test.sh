@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# A server whose stderr goes away (the pipe's reader exits: `robotalk-server
+# ... 2>&1 | head`, a log collector restarted) goes on serving: a log line
+# written to the closed pipe is lost, never the server (before: SIGPIPE
+# killed it at its next line, no STOP, the robot left moving). The robot
+# moves under `send setspeed --hold`, stderr's reader exits, the server logs
+# (--log-executions: every command a line), and still answers; SIGTERM then
+# stops the robot (an observer's last STATE sample at rest) and the server
+# exits 0. Runs inside a private network namespace (CTest wraps it with
+# scripts/netns_run.sh).
+#   server_stderr_test.sh SERVER CLI MODELS_DIR
+set -u
+server_bin=$1 cli=$2 models=$3
+. "$(dirname "$0")/../lib.sh" # $tmp, $server_pid, check
+urdf="$models/pioneer2dx_pantilt.urdf"
+url="udpm://239.255.76.67:7719?ttl=0"
+wait_for() { for _ in $(seq 50); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
+last_motion() {
+  python3 -c 'import json, sys
+lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
+s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
+print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
+}
+# moves NAME WATCH_JSON / at_rest NAME WATCH_JSON: the last STATE sample of
+# a `watch --json` output shows pioneer moving / at rest (a check named NAME).
+moves() {
+  read -r v w moving < <(last_motion "$2")
+  check "$1 (v=$v w=$w moving=$moving)" python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+}
+at_rest() {
+  read -r v w moving < <(last_motion "$2")
+  check "$1 (v=$v w=$w moving=$moving)" python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
+}
+
+# stderr's reader copies lines to server.log until the server serves, then exits.
+mkfifo "$tmp/stderr"
+python3 -c 'import sys
+with open(sys.argv[1]) as f, open(sys.argv[2], "w") as out:
+    for line in f:
+        out.write(line); out.flush()
+        if "serving robot" in line: break' "$tmp/stderr" "$tmp/server.log" &
+reader=$!
+pids+=("$reader")
+"$server_bin" --robot "pioneer=kinematic:$urdf" --url "$url" --log-executions --duration 60 2>"$tmp/stderr" &
+server_pid=$!
+check "the server starts" wait_for "$tmp/server.log" "serving robot 'pioneer'"
+wait "$reader"  # stderr's reader is gone: the pipe has none
+
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch.json" 2>"$tmp/watch.err" &
+pids+=($!)
+"$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold.out" 2>&1 &
+pids+=($!)
+sleep 1.5  # the SETSPEED and its audit line: a write to a pipe without a reader
+check "the server lives on after a log line to a stderr without a reader" kill -0 "$server_pid"
+check "it still answers: $("$cli" --url "$url" --timeout 3 query pioneer base_pose 2>&1 | head -c 300)" \
+  "$cli" --url "$url" --timeout 3 query pioneer base_pose
+moves "pioneer moves before the signal" "$tmp/watch.json"
+
+signal_server TERM
+check "the server exits 0 on SIGTERM (status $server_status)" test "$server_status" -eq 0
+sleep 0.3
+at_rest "the last STATE sample shows pioneer at rest" "$tmp/watch.json"
+
+# A stderr that takes nothing from the start (a pipe that is full and never
+# read: a supervisor that never drains it, a terminal stopped with Ctrl-S):
+# the server serves all the same, and SIGTERM still STOPs the robot and ends
+# it (before: it hung in its first line, "open mode: ...", and never served;
+# SIGTERM, taken by the thread that writes its lines, did nothing).
+url="udpm://239.255.76.67:7720?ttl=0"
+mkfifo "$tmp/full"
+sleep 1000 <"$tmp/full" &  # holds the read end, reads nothing
+pids+=($!)
+exec 3>"$tmp/full"
+head -c 65536 /dev/zero >&3  # the pipe's capacity: full
+"$server_bin" --robot "pioneer=kinematic:$urdf" --url "$url" --log-executions --duration 60 2>&3 &
+server_pid=$!
+exec 3>&-
+served=1
+for _ in $(seq 20); do
+  "$cli" --url "$url" --timeout 1 query pioneer base_pose >/dev/null 2>&1 && served=0 && break
+  sleep 0.2
+done
+check "a server whose stderr takes nothing serves" test "$served" -eq 0
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch2.json" 2>/dev/null &
+pids+=($!)
+"$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold2.out" 2>&1 &
+pids+=($!)
+sleep 1.5
+moves "full stderr: pioneer moves before the signal" "$tmp/watch2.json"
+signal_server TERM
+check "full stderr: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
+check "full stderr: it exits 0 (status $server_status)" test "$server_status" -eq 0
+sleep 0.3
+at_rest "full stderr: the last STATE sample shows pioneer at rest" "$tmp/watch2.json"
+
+# The CLI's `send ... --hold`: its stderr stops taking lines after "holding
+# ... until Ctrl-C" (a full pipe); Ctrl-C must still STOP the robot (before:
+# it wrote "robotalk: " before it sent the STOP, and waited there; its
+# heartbeats kept its session, so the server's watchdog never stopped it).
+url="udpm://239.255.76.67:7721?ttl=0"
+start_pioneer_server "$server_bin" "$url" "$(dirname "$urdf")" 60
+mkfifo "$tmp/cli_err"
+python3 -c 'import sys, time
+with open(sys.argv[1]) as f:
+    for line in f:
+        if "holding" in line:
+            open(sys.argv[2], "w").close()
+            break
+    time.sleep(1000)  # holds the read end, reads nothing more' "$tmp/cli_err" "$tmp/holding" &
+pids+=($!)
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch3.json" 2>/dev/null &
+pids+=($!)
+setsid "$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >/dev/null 2>"$tmp/cli_err" &
+hold_pid=$!
+pids+=("$hold_pid")
+for _ in $(seq 50); do [ -e "$tmp/holding" ] && break; sleep 0.1; done
+check "the CLI holds the SETSPEED" test -e "$tmp/holding"
+head -c 65536 /dev/zero >"$tmp/cli_err"  # the pipe's capacity: its stderr takes nothing now
+sleep 0.5
+kill -INT "$hold_pid"
+sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
+at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
+kill -9 "$hold_pid" 2>/dev/null
+
+echo "$pass passed, $failures failed"
+[ "$failures" -eq 0 ]
