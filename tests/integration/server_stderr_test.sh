@@ -122,5 +122,37 @@ sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anyt
 at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
 kill -9 "$hold_pid" 2>/dev/null
 
+# The CLI's progress line while it waits for a task (`send ... goto`) on a
+# terminal that takes nothing (a pty nobody reads, its buffer full; a
+# terminal stopped with Ctrl-S): Ctrl-C must still STOP the robot (before:
+# the line's write waited, so the Ctrl-C was never acted on, and the CLI's
+# heartbeats kept its session and the GOTO alive).
+url="udpm://239.255.76.67:7722?ttl=0"
+signal_server TERM
+start_pioneer_server "$server_bin" "$url" "$(dirname "$urdf")" 60
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch4.json" 2>/dev/null &
+pids+=($!)
+python3 -c 'import os, pty, signal, subprocess, sys, time
+cli, url, out = sys.argv[1:4]
+master, slave = pty.openpty()
+fill = os.open(os.ttyname(slave), os.O_WRONLY | os.O_NONBLOCK | os.O_NOCTTY)
+total, chunk = 0, 4096
+while chunk and total < 1 << 24:  # until it takes not one byte more (bounded)
+    try:
+        total += os.write(fill, b"x" * chunk)
+    except BlockingIOError:
+        chunk //= 2
+goto = subprocess.Popen([cli, "--url", url, "send", "pioneer", "goto", "6", "0", "0"], stdin=subprocess.DEVNULL,
+                        stdout=subprocess.DEVNULL, stderr=slave, start_new_session=True)
+time.sleep(2.0)  # moving, its progress line due every 50 ms after 0.3 s
+goto.send_signal(signal.SIGINT)
+time.sleep(2.5)  # past the session timeout (2 s): the STOP, not the watchdog, if anything
+with open(out, "w") as f:
+    f.write("filled %d bytes; the CLI %s\n" % (total, "ended" if goto.poll() is not None else "still runs"))
+goto.kill()
+goto.wait()' "$cli" "$url" "$tmp/pty.out"
+cat "$tmp/pty.out"
+at_rest "Ctrl-C on a goto whose terminal takes nothing still stops pioneer" "$tmp/watch4.json"
+
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
