@@ -154,5 +154,26 @@ goto.wait()' "$cli" "$url" "$tmp/pty.out"
 cat "$tmp/pty.out"
 at_rest "Ctrl-C on a goto whose terminal takes nothing still stops pioneer" "$tmp/watch4.json"
 
+# The same with a stdout that takes nothing (`robotalk send --file seq.txt |
+# a reader that stalls`): a frame's reply line waits in its write, so the
+# CLI's thread never sees the Ctrl-C; the signal's own thread sends the STOP
+# (before: the sequence played on to its end, 0.3 m/s 2.5 s after Ctrl-C).
+printf '0.0 setspeed 0.3 0.0\n0.5 joint_setpoint pan 0.3\n1.0 joint_setpoint pan -0.3\n9.0 stop\n' >"$tmp/seq.txt"
+mkfifo "$tmp/full_out"
+sleep 1000 <"$tmp/full_out" &  # holds the read end, reads nothing
+pids+=($!)
+exec 4>"$tmp/full_out"
+head -c 65536 /dev/zero >&4  # the pipe's capacity: full
+setsid "$cli" --url "$url" send pioneer --file "$tmp/seq.txt" --mode delay >&4 2>/dev/null &
+seq_pid=$!
+pids+=("$seq_pid")
+exec 4>&-
+sleep 2.0
+moves "a sequence whose stdout takes nothing: pioneer moves before Ctrl-C" "$tmp/watch4.json"
+kill -INT "$seq_pid"
+sleep 2.5
+at_rest "Ctrl-C on a sequence whose stdout takes nothing still stops pioneer" "$tmp/watch4.json"
+kill -9 "$seq_pid" 2>/dev/null
+
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
