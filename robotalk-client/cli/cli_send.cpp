@@ -6,6 +6,7 @@
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -62,7 +63,35 @@ SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
   return f;
 }
 
-bool ProgressOnTty() { return isatty(STDERR_FILENO) == 1; }
+// The progress line on a terminal, written through a description of its own
+// opened non-blocking: a terminal that takes nothing (stopped with Ctrl-S, a
+// pty nobody reads) loses progress lines, never the thread that must send
+// the STOP on Ctrl-C (before: it waited in the write, and its heartbeats kept
+// the session and so the motion alive). Other lines go to std::cerr as before.
+class TtyProgress {
+ public:
+  TtyProgress() {
+    if (isatty(STDERR_FILENO) != 1) return;
+    if (const char* name = ttyname(STDERR_FILENO))
+      fd_ = open(name, O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  }
+  ~TtyProgress() {
+    if (fd_ >= 0) close(fd_);
+  }
+  TtyProgress(const TtyProgress&) = delete;
+  TtyProgress& operator=(const TtyProgress&) = delete;
+
+  bool on() const { return fd_ >= 0; }
+  /// Writes what the terminal takes now, nothing more (a torn line at worst).
+  void Show(const std::string& text) const {
+    if (fd_ >= 0) [[maybe_unused]]
+      const ssize_t n = write(fd_, text.data(), text.size());
+  }
+  void Clear() const { Show("\r\033[K"); }
+
+ private:
+  int fd_ = -1;
+};
 
 void PrintOne(const Reply& r, bool json) {
   if (json) {
@@ -110,19 +139,18 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
 
   const auto client = ConnectClient(g, robot);
   Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
-  const bool bar = ProgressOnTty();
+  const StopOnInterrupt stop_at_once(*client);
+  const TtyProgress progress;
   int status = 0;
   const RunReport report = RunFrames(
       *client, std::move(frames), options,
       [&](std::size_t, const Reply& r) {
-        if (bar) std::cerr << "\r\033[K" << std::flush;
+        progress.Clear();
         PrintOne(r, json);
         status = std::max(status, ExitStatus(r));
       },
-      [&](const RunProgress& p) {
-        if (bar) std::cerr << "\r" << ProgressBar(p) << std::flush;
-      });
-  if (bar) std::cerr << "\r\033[K" << std::flush;
+      [&](const RunProgress& p) { progress.Show("\r" + ProgressBar(p)); });
+  progress.Clear();
   for (const auto& [index, why] : report.unknown_outcomes) {
     std::cerr << "robotalk: line " << entries[index].line << ": " << TidyDurations(why) << "\n";
   }
@@ -150,14 +178,18 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
   const CommandType type = c.type;
   const bool motion = IsMotionCommand(type);
   Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
+  std::optional<StopOnInterrupt> stop_at_once;
+  if (motion) stop_at_once.emplace(*client);
   PendingReply pending = client->Send(std::move(c));
-  const bool bar = ProgressOnTty() && (Traits(type).kind == CommandKind::kTask || at);
+  const TtyProgress progress;
+  const bool bar = progress.on() && (Traits(type).kind == CommandKind::kTask || at);
   const std::optional<Reply> r = AwaitReply(pending, [&](Duration waited) {
     if (bar && waited > std::chrono::milliseconds(300))
-      std::cerr << "\r" << ToString(type) << " " << pending.id() << ": waiting for its end, "
-                << FormatSeconds(std::round(ToSeconds(waited) * 10) / 10) << " \033[K" << std::flush;
+      progress.Show("\r" + std::string(ToString(type)) + " " + std::to_string(pending.id()) +
+                    ": waiting for its end, " + FormatSeconds(std::round(ToSeconds(waited) * 10) / 10) +
+                    " \033[K");
   });
-  if (bar) std::cerr << "\r\033[K" << std::flush;
+  if (bar) progress.Clear();
   if (!r) {
     const int sig = Interrupter::Signal();
     if (!motion) return Interrupted(sig, "nothing was moving");

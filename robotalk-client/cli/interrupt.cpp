@@ -46,8 +46,9 @@ void WaitForSignals() {
     int sig = 0;
     if (sigwait(&set, &sig) != 0) continue;
     if (g_signal.load() != 0 || !g_defer.load()) {
-      // Nothing to stop yet, or the second signal: the user does not want to wait.
-      std::fflush(stdout);
+      // Nothing to stop yet, or the second signal: the user does not want to
+      // wait. No flush: a stdout that takes nothing would hold the exit too
+      // (the tools flush each line as they write it).
       std::_Exit(128 + sig);
     }
     {

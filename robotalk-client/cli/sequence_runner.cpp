@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <mutex>
 #include <regex>
 #include <utility>
 
@@ -71,6 +73,26 @@ std::string ProgressBar(const RunProgress& p, int width) {
   std::snprintf(tail, sizeof tail, "] %zu/%zu  %.1f s / ", p.answered, p.total, elapsed_s);
   return "[" + std::string(filled, '#') + std::string(width - filled, '.') + tail + FormatSeconds(total_s);
 }
+
+StopOnInterrupt::StopOnInterrupt(RobotClient& client, std::stop_token interrupt)
+    : sender_([&client, interrupt](std::stop_token done) {
+        std::mutex mu;
+        std::condition_variable_any cv;
+        const std::stop_callback wake(interrupt, [&] {
+          std::lock_guard lock(mu);
+          cv.notify_all();
+        });
+        {
+          std::unique_lock lock(mu);
+          if (!cv.wait(lock, done, [&] { return interrupt.stop_requested(); }))
+            return;  // the tool ended first
+        }
+        try {
+          (void)client.Send(Command{.type = CommandType::kStop});  // not waited for: StopNow follows
+        } catch (const std::exception&) {
+          // StopNow, when the tool's thread gets there, says what failed.
+        }
+      }) {}
 
 std::string StopNow(RobotClient& client) {
   try {

@@ -26,6 +26,7 @@
 #include <optional>
 #include <stop_token>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace robotalk::cli {
@@ -64,6 +65,21 @@ std::optional<Reply> AwaitReply(PendingReply& pending, const std::function<void(
 /// Sends STOP now and waits for its reply (the client's timeout); returns a
 /// short account: "STOP sent to pioneer: SUCCESS". Never throws.
 std::string StopNow(RobotClient& client);
+
+/// While it lives, the first SIGINT/SIGTERM (`interrupt`) sends `client` a
+/// STOP at once from a thread of its own, whatever the tool's thread is doing:
+/// a write to a stdout or stderr that takes nothing (a full pipe, a terminal
+/// stopped with Ctrl-S) waits for ever, and the CLI's heartbeats would keep
+/// the motion alive meanwhile. The tool's own StopNow and its lines follow
+/// when it gets there (a second STOP changes nothing). Destruction waits for
+/// a STOP being sent (the client's timeouts bound it).
+class StopOnInterrupt {
+ public:
+  explicit StopOnInterrupt(RobotClient& client, std::stop_token interrupt = Interrupter::StopToken());
+
+ private:
+  std::jthread sender_;
+};
 
 /// "5 s", "0.25 s", "1.5 s": seconds without trailing zeros.
 std::string FormatSeconds(double seconds);

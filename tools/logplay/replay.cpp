@@ -69,6 +69,7 @@ int Replay(const SessionLog& log, const ReplayOptions& o, std::ostream& out) {
   std::map<std::string, int> signals;
   bool all_ok = true;
   cli::Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
+  const cli::StopOnInterrupt stop_at_once(client);
   const TimePoint t0 = SteadyClock().Now();
   const cli::RunReport report = cli::RunFrames(
       client, frames, o.sequence,
