@@ -14,7 +14,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <regex>
 
 namespace robotalk {
 namespace {
@@ -24,10 +23,6 @@ namespace {
 std::vector<std::unique_ptr<RobotDaemon>>& AbandonedRobots() {
   static auto* abandoned = new std::vector<std::unique_ptr<RobotDaemon>>;
   return *abandoned;
-}
-
-bool ValidRobotName(const std::string& name) {
-  return !name.empty() && std::regex_match(name, std::regex("[A-Za-z0-9_-]+"));
 }
 
 }  // namespace
@@ -40,7 +35,7 @@ RobotSpec RobotSpec::Parse(const std::string& text) {
   RobotSpec spec;
   spec.name = text.substr(0, eq);
   spec.driver = text.substr(eq + 1, colon - eq - 1);
-  if (!ValidRobotName(spec.name)) {
+  if (!IsValidRobotName(spec.name)) {
     throw Error("--robot '" + text + "': robot name '" + spec.name + "' must be letters, digits, '_' or '-'");
   }
   if (spec.driver.empty()) throw Error("--robot '" + text + "': no driver given");

@@ -47,6 +47,11 @@ inline std::string HelloAnswerChannel(const std::string& robot, std::int64_t cli
 inline std::string ConfigChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/CONFIG"; }
 inline std::string StateChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/STATE"; }
 
+/// True when `name` may name a served robot: non-empty, only [A-Za-z0-9_-]
+/// (the server's --robot, RobotClient::Connect, access lists and known-servers
+/// files all check this one rule; an access list also caps it at 64).
+bool IsValidRobotName(std::string_view name);
+
 /// The robot of "ROBOTALK/<robot>/REQUEST"; nullopt for any other channel.
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel);
 /// The robot of "ROBOTALK/<robot>/HELLO".
