@@ -6,6 +6,9 @@
 #   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
 #   $pass, $failures        the counts
 #   value_of FILE KEY       the value of the first "KEY=value" line of FILE
+#   wait_for FILE PATTERN [TRIES [PAUSE]]  until grep finds PATTERN in FILE (a log
+#                           line such as "serving robot"): TRIES looks (50), PAUSE s
+#                           apart (0.1); status 1 if it never did
 #   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
 tmp=$(mktemp -d)
 export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
@@ -26,3 +29,8 @@ check() {  # check NAME COMMAND...
   if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
 }
 value_of() { sed -n "s/^$2=//p" "$1" | head -1; }
+wait_for() {  # wait_for FILE PATTERN [TRIES [PAUSE]]
+  local _
+  for _ in $(seq "${3:-50}"); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep "${4:-0.1}"; done
+  return 1
+}

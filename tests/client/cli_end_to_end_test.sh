@@ -11,7 +11,7 @@ url="udpm://239.255.76.67:7671?ttl=0"
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
   2>"$tmp/server.log" &
 server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot"
 
 cli_says() {  # cli_says STATUS PATTERN ARGS...: robotalk ARGS exits STATUS and prints PATTERN
   local want=$1 pattern=$2 out got

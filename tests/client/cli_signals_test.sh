@@ -14,7 +14,7 @@ rt() { "$cli" --url "$url" "$@"; }
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 100 \
   2>"$tmp/server.log" &
 server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot"
 base() { rt query pioneer base_pose | awk '{print $(NF-4), $(NF-1)}'; }  # x v
 speed() { rt query pioneer base_pose | awk '{print $(NF-1)}'; }
 # Starts the CLI in its own session (a background job of a non-interactive

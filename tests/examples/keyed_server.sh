@@ -12,5 +12,5 @@ start_keyed_server() {
   "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration "$duration" \
     --key "$tmp/server" --clients "$tmp/clients" 2>"$tmp/server.log" &
   server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+  wait_for "$tmp/server.log" "serving robot"
 }

@@ -19,7 +19,7 @@ start_server() {  # start_server PORT LOG [extra server flags...]
   "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$(url "$p")" \
     --duration 60 "$@" 2>"$log" &
   server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$log" 2>/dev/null && return 0; sleep 0.1; done
+  wait_for "$log" "serving robot" && return 0
   echo "server did not start:"; cat "$log"; exit 1
 }
 kill9_server() { kill -9 "$server_pid" 2>/dev/null; wait "$server_pid" 2>/dev/null; server_pid=""; }

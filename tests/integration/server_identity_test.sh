@@ -17,7 +17,7 @@ serve() {  # serve KEY LOG: a keyed server of pioneer
   "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --log-executions \
     --key "$tmp/$1" --clients "$tmp/clients" --duration 60 2>"$tmp/$2" &
   server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$tmp/$2" 2>/dev/null && break; sleep 0.1; done
+  wait_for "$tmp/$2" "serving robot"
 }
 
 for who in server mallory alice; do "$keygen" --out "$tmp/$who" --name "$who" >/dev/null; done

@@ -19,7 +19,7 @@ url="udpm://239.255.76.67:7833?ttl=0"
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 90 \
   2>"$tmp/server.log" &
 server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot"
 "$cli" --url "$url" watch pioneer --period 1 >/dev/null 2>&1 &
 client_pid=$!
 sleep 0.5
@@ -27,7 +27,7 @@ sleep 0.5
 record() {  # record LOG NAME: a recorder in the background, once it listens
   "$logplay" record -o "$1" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/$2.log" &
   recorder=$!
-  for _ in $(seq 50); do grep -q "recording" "$tmp/$2.log" && break; sleep 0.05; done
+  wait_for "$tmp/$2.log" "recording" 50 0.05
 }
 record "$tmp/reference.lcmlog" reference
 reference=$recorder

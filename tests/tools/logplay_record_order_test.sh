@@ -16,11 +16,11 @@ rt() { "$cli" --url "$url" "$@"; }
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
   2>"$tmp/server.log" &
 server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot"
 
 "$logplay" record -o "$tmp/session.lcmlog" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
 logger=$!
-for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
+wait_for "$tmp/record.log" "recording"
 sleep 0.3
 
 n=40
