@@ -9,6 +9,7 @@
 #include "robotalk/request.h"
 #include "session_test_util.h"
 #include "support/test_clients.h"
+#include "two_robot_server.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -30,16 +31,9 @@ using testing::SayHello;
 
 using testing::kAlice;
 
-class ServerDaemonTest : public ::testing::Test {
+class ServerDaemonTest : public testing::TwoRobotServerTest {
  protected:
-  ServerDaemonTest() : server_transport_(bus_), client_(bus_) {
-    for (const char* name : {"bot", "arm"}) {
-      auto driver = std::make_unique<FakeDriver>(PanRobot());
-      fakes_[name] = driver.get();
-      robots_.push_back(std::make_unique<RobotDaemon>(name, "fake", std::move(driver), clock_));
-    }
-    server_ = std::make_unique<ServerDaemon>(server_transport_, clock_, ServerDaemonOptions{.server_id = 42});
-    for (auto& r : robots_) server_->AddRobot(*r, SessionOptions{});
+  ServerDaemonTest() {
     reply_sub_ =
         client_.Subscribe("ROBOTALK/.*", [this](const std::string& channel, std::span<const std::uint8_t> b) {
           channels_.push_back(channel);
@@ -56,22 +50,6 @@ class ServerDaemonTest : public ::testing::Test {
     r.session_id = session;
     client_.Publish(RequestChannel(robot), EncodeRequest(r));
   }
-  // One ServerDaemon iteration, every RobotDaemon once, another ServerDaemon
-  // iteration to send what they produced, then the client reads.
-  void Step() {
-    server_->RunOnce(Duration(0));
-    for (auto& r : robots_) r->RunOnce(clock_.Now());
-    server_->RunOnce(Duration(0));
-    client_.HandleFor(Duration(0));
-  }
-
-  ManualClock clock_;
-  std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
-  MemoryTransport server_transport_;
-  MemoryTransport client_;
-  std::map<std::string, FakeDriver*> fakes_;
-  std::vector<std::unique_ptr<RobotDaemon>> robots_;
-  std::unique_ptr<ServerDaemon> server_;
   std::unique_ptr<Subscription> reply_sub_;
   std::vector<std::string> channels_;
   std::map<std::string, std::map<CommandId, Reply>> replies_;
