@@ -8,6 +8,7 @@
 // destructor stops every robot's motion and joins them.
 #pragma once
 
+#include "robotalk/channels.h"
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 #include "robotalk/driver.h"
@@ -112,7 +113,7 @@ struct ServerOptions {
   /// ROBOTALK_PRECISE_TIMING=0 in the environment turns it off too.
   bool precise_timing = true;
   /// Period of the ROBOTALK/ANNOUNCE message.
-  Duration announce_period = std::chrono::seconds(1);
+  Duration announce_period = kAnnouncePeriod;
   /// The paper's congestion injector (§VI-B): after each received package the
   /// ServerDaemon pauses a random time uniform in [0, this]. 0 = off.
   Duration congestion_max_pause{0};
