@@ -9,6 +9,9 @@
 #   wait_for FILE PATTERN [TRIES [PAUSE]]  until grep finds PATTERN in FILE (a log
 #                           line such as "serving robot"): TRIES looks (50), PAUSE s
 #                           apart (0.1); status 1 if it never did
+#   start_pioneer LOG [ARGS...]  "$server_bin" serving the kinematic Pioneer of
+#                           "$models" with ARGS, stderr to LOG, in $server_pid;
+#                           returns once it serves (wait_for's status)
 #   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
 tmp=$(mktemp -d)
 export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
@@ -33,4 +36,11 @@ wait_for() {  # wait_for FILE PATTERN [TRIES [PAUSE]]
   local _
   for _ in $(seq "${3:-50}"); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep "${4:-0.1}"; done
   return 1
+}
+start_pioneer() {  # start_pioneer LOG [ARGS...]
+  local log=$1
+  shift
+  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" "$@" 2>"$log" &
+  server_pid=$!
+  wait_for "$log" "serving robot"
 }

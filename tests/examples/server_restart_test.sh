@@ -10,9 +10,7 @@ shift 3
 url="udpm://239.255.76.67:$port?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, $client_pid, check
 start_server() {  # start_server LOG
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 2>"$1" &
-  server_pid=$!
-  wait_for "$1" "serving robot" && return 0
+  start_pioneer "$1" --url "$url" --duration 60 && return 0
   echo "server did not start"; cat "$1"; exit 1
 }
 start_server "$tmp/first.log"

@@ -19,10 +19,7 @@ for who in server bridge peer; do "$keygen" --out "$tmp/$who" --name "$who" >/de
 } >"$tmp/clients"
 chmod 644 "$tmp/clients"
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
-  --key "$tmp/server" --clients "$tmp/clients" --duration 60 2>"$tmp/server.log" &
-server_pid=$!
-wait_for "$tmp/server.log" "serving robot"
+start_pioneer "$tmp/server.log" --url "$url" --key "$tmp/server" --clients "$tmp/clients" --duration 60
 
 "$bridge" --robot pioneer --url "$url" --key "$tmp/bridge" --duration 40 >"$tmp/bridge.out" 2>"$tmp/bridge.log" &
 bridge_pid=$!

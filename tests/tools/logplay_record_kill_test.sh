@@ -16,10 +16,7 @@ server_bin=$1 cli=$2 logplay=$3 models=$4
 url="udpm://239.255.76.67:7833?ttl=0"
 . "$(dirname "$0")/../lib.sh"
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 90 \
-  2>"$tmp/server.log" &
-server_pid=$!
-wait_for "$tmp/server.log" "serving robot"
+start_pioneer "$tmp/server.log" --url "$url" --duration 90
 "$cli" --url "$url" watch pioneer --period 1 >/dev/null 2>&1 &
 client_pid=$!
 sleep 0.5

@@ -13,10 +13,7 @@ url="udpm://239.255.76.67:7831?ttl=0"
 . "$(dirname "$0")/../lib.sh"
 rt() { "$cli" --url "$url" "$@"; }
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-  2>"$tmp/server.log" &
-server_pid=$!
-wait_for "$tmp/server.log" "serving robot"
+start_pioneer "$tmp/server.log" --url "$url" --duration 60
 
 "$logplay" record -o "$tmp/session.lcmlog" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
 logger=$!
