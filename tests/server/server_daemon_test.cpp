@@ -7,6 +7,7 @@
 #include "robotalk/forwarding_transport.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
+#include "robotalk/server.h"
 #include "session_test_util.h"
 #include "support/test_clients.h"
 #include "two_robot_server.h"
@@ -67,6 +68,13 @@ class RefusingTransport final : public Transport {
   int fileno() const override { return -1; }
   std::string url() const override { return "refusing://"; }
 };
+
+// server.h (installed) cannot name channels.h's kAnnouncePeriod, which the
+// clients' waits are counted in: the two defaults must stay one value.
+TEST(ServerDaemon, AnnouncesEveryKAnnouncePeriodByDefault) {
+  EXPECT_EQ(ServerOptions{}.announce_period, kAnnouncePeriod);
+  EXPECT_EQ(ServerDaemonOptions{}.announce_period, kAnnouncePeriod);
+}
 
 TEST(ServerDaemon, ASubscriptionErrorReachesItsCreatorWithOrWithoutTheFifoSubscribingThread) {
   // With fifo_priority the subscriptions are made on a short-lived thread (so
