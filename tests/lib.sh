@@ -6,6 +6,12 @@
 #   check NAME COMMAND...   runs COMMAND; counts a pass, or prints "FAIL: NAME"
 #   $pass, $failures        the counts
 #   value_of FILE KEY       the value of the first "KEY=value" line of FILE
+#   wait_for FILE PATTERN [TRIES [PAUSE]]  until grep finds PATTERN in FILE (a log
+#                           line such as "serving robot"): TRIES looks (50), PAUSE s
+#                           apart (0.1); status 1 if it never did
+#   start_pioneer LOG [ARGS...]  "$server_bin" serving the kinematic Pioneer of
+#                           "$models" with ARGS, stderr to LOG, in $server_pid;
+#                           returns once it serves (wait_for's status)
 #   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
 tmp=$(mktemp -d)
 export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
@@ -26,13 +32,17 @@ check() {  # check NAME COMMAND...
   if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
 }
 value_of() { sed -n "s/^$2=//p" "$1" | head -1; }
-# start_pioneer_server SERVER URL MODELS_DIR SECONDS: a server of the Pioneer
-# (kinematic) in the background, its log in $tmp/server.log, $server_pid set;
-# returns once it serves (5 s at most).
-start_pioneer_server() {
-  "$1" --robot "pioneer=kinematic:$3/pioneer2dx_pantilt.urdf" --url "$2" --duration "$4" 2>"$tmp/server.log" &
+wait_for() {  # wait_for FILE PATTERN [TRIES [PAUSE]]
+  local _
+  for _ in $(seq "${3:-50}"); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep "${4:-0.1}"; done
+  return 1
+}
+start_pioneer() {  # start_pioneer LOG [ARGS...]
+  local log=$1
+  shift
+  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" "$@" 2>"$log" &
   server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+  wait_for "$log" "serving robot"
 }
 # signal_server SIGNAL: sends SIGNAL to $server_pid and waits 10 s at most for
 # it to end (then kill -9); sets $server_status (its exit status) and

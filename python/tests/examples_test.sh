@@ -13,7 +13,7 @@ robots=(--robot "pioneer=kinematic:$src/models/pioneer2dx_pantilt.urdf")
 [ -f "$shared/iiwa14.urdf" ] && robots+=(--robot "iiwa=kinematic:$shared/iiwa14.urdf")
 "$server_bin" "${robots[@]}" --url "$url" --duration 60 --state-dir "$tmp/state" 2>"$tmp/server.log" &
 server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot"
 "$logplay" record -o "$tmp/session.lcmlog" --url "$url" -c 'ROBOTALK/.*' --duration 8 2>"$tmp/record.log" &
 recorder=$!
 pids+=("$recorder")

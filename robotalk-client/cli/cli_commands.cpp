@@ -3,6 +3,7 @@
 #include "cli_support.h"
 #include "describe_format.h"
 #include "interrupt.h"
+#include "robotalk/channels.h"
 #include "robotalk/known_servers.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "robotalk/sequence_file.h"
@@ -173,9 +174,9 @@ int RunReset(const GlobalOptions& g, const std::vector<std::string>& args) {
 }
 
 namespace {
-// Servers announce once a second: three periods without an announcement or a
-// STATE sample mean the server is gone.
-constexpr Duration kServerSilence = std::chrono::seconds(3);
+// Three announce periods without an announcement or a STATE sample mean the
+// server is gone.
+constexpr Duration kServerSilence = 3 * kAnnouncePeriod;
 constexpr Duration kStreamCancelWait = std::chrono::milliseconds(200);
 }  // namespace
 

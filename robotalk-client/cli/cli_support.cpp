@@ -25,7 +25,7 @@
 
 namespace robotalk::cli {
 
-constexpr Duration kAnnounceWait = std::chrono::milliseconds(1200);  // > one announce period
+constexpr Duration kAnnounceWait = kAnnouncePeriod + std::chrono::milliseconds(200);  // > one announce period
 // The watch listens from here to kAnnounceWait: still more than one period.
 constexpr std::chrono::milliseconds kWatchAfter(100);
 

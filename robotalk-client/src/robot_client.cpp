@@ -4,6 +4,7 @@
 
 #include "client_impl.h"
 #include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
 #include "robotalk/heard_announcement.h"
 #include "robotalk/keys.h"
 #include "robotalk/request.h"
@@ -193,9 +194,7 @@ RobotClient::RobotClient(ClientOptions options) : impl_(std::make_unique<Impl>(s
 RobotClient::~RobotClient() = default;
 
 void RobotClient::Connect(const std::string& robot) {
-  if (robot.empty() ||
-      robot.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
-          std::string::npos) {
+  if (!IsValidRobotName(robot)) {
     throw ClientError("RobotClient::Connect: invalid robot name '" + robot +
                       "' (letters, digits, _ and - only)");
   }

@@ -84,8 +84,6 @@ LimitedLog& TheLog() {
 void Log(const std::string& line) { TheLog().Always(line); }
 void LogLimited(const std::string& line) { TheLog().Limited(line); }
 
-double Seconds(Duration d) { return std::chrono::duration<double>(d).count(); }
-
 // The system-clock (ROS time) instant of a steady-clock instant, read now.
 SystemTime ToSystem(TimePoint steady) {
   const auto sys_now = std::chrono::time_point_cast<Duration>(std::chrono::system_clock::now());
@@ -223,7 +221,7 @@ class Ros2Bridge::Impl {
         },
         [](const std::string& name, const std::string& error, Duration retry_in) {
           LogLimited("robot '" + name + "': " + error + " (trying again in " +
-                     std::to_string(static_cast<int>(Seconds(retry_in))) + " s)");
+                     std::to_string(static_cast<int>(ToSeconds(retry_in))) + " s)");
         },
         options);
     // Every robot announced: heard as it is announced (with --server-key,
@@ -365,7 +363,7 @@ class Ros2Bridge::Impl {
     std::ostringstream what;
     what << "trajectory of " << msg.points.size() << " points";
     if (plan.points_skipped) what << " (" << plan.points_skipped << " already past, skipped)";
-    what << " starts in " << Seconds(start - now) << " s, " << plan.commands.size() << " JOINT_SETPOINTs";
+    what << " starts in " << ToSeconds(start - now) << " s, " << plan.commands.size() << " JOINT_SETPOINTs";
     LogLimited("robot '" + r.name + "': " + what.str());
     SendTrajectory(r, std::move(plan.commands), start);
   }
@@ -405,7 +403,7 @@ class Ros2Bridge::Impl {
         auto replies = r.client->SendTrajectory(j, options);
         for (std::size_t k = 0; k < replies.size(); ++k) {
           std::ostringstream w;
-          w << "JOINT_SETPOINT '" << j.joint << "' at +" << Seconds(j.points[k].time_from_start) << " s";
+          w << "JOINT_SETPOINT '" << j.joint << "' at +" << ToSeconds(j.points[k].time_from_start) << " s";
           Track(r, std::move(replies[k]), w.str(), true);
         }
       } catch (const std::exception& e) {
@@ -444,7 +442,7 @@ class Ros2Bridge::Impl {
     if (r.base_moving.load() &&
         now - SteadyTime(std::chrono::nanoseconds(r.last_cmd_vel_ns.load())) > options_.cmd_vel_timeout) {
       r.base_moving.store(false);
-      Log("robot '" + r.name + "': no cmd_vel for " + std::to_string(Seconds(options_.cmd_vel_timeout)) +
+      Log("robot '" + r.name + "': no cmd_vel for " + std::to_string(ToSeconds(options_.cmd_vel_timeout)) +
           " s: SETSPEED 0");
       Command stop{.type = CommandType::kSetSpeed};
       stop.values.assign(r.base == BaseType::kHolonomic ? 3 : 2, 0.0);

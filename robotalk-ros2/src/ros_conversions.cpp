@@ -184,8 +184,7 @@ TrajectoryCommands TrajectoryToCommands(const RobotModel& model, const Trajector
     if (point.time_from_start < Duration(0))
       throw Error("JointTrajectory: " + at + ".time_from_start is negative");
     if (p > 0 && point.time_from_start <= msg.points[p - 1].time_from_start) {
-      throw Error("JointTrajectory: " + at + ".time_from_start (" +
-                  Num(std::chrono::duration<double>(point.time_from_start).count()) +
+      throw Error("JointTrajectory: " + at + ".time_from_start (" + Num(ToSeconds(point.time_from_start)) +
                   " s) is not after the previous point's");
     }
   }

@@ -35,9 +35,6 @@
 
 namespace robotalk {
 
-/// The default of --max-late for servo commands: 0.1 s, drake-franka-driver's
-/// --expire_sec default (docs/server.md, Deadlines says why).
-inline constexpr Duration kDefaultServoMaxLate = std::chrono::milliseconds(100);
 /// A limit that never expires (QueuedItem::max_late's default).
 inline constexpr Duration kNeverExpires = Duration::max();
 

@@ -15,6 +15,7 @@
 #include "link_health.h"
 #include "robot_daemon.h"
 #include "robotalk/request.h"
+#include "robotalk/server.h"
 #include "robotalk/state_sample.h"
 #include "session.h"
 #include "session_table.h"
@@ -30,11 +31,11 @@ namespace robotalk {
 
 struct SessionOptions {
   /// A session that sends nothing for this long expires (watchdog).
-  Duration session_timeout = std::chrono::seconds(2);
+  Duration session_timeout = kDefaultSessionTimeout;
   /// Most items one client may have waiting (queued and buffered playback frames).
-  std::size_t max_queue = 10000;
+  std::size_t max_queue = kDefaultMaxQueue;
   /// Start times further ahead than this, or further in the past, are refused.
-  Duration max_future = std::chrono::hours(1);
+  Duration max_future = kDefaultMaxFuture;
   /// What CheckCommand allows beyond the model (the GOTO bound).
   CommandLimits limits;
   /// When playback mode has seen enough frames to estimate its delay.
@@ -66,7 +67,7 @@ struct SessionOptions {
   ReplyCache::Limits replies;
   /// Deadlines (expiry.h): the limit of a timed servo command whose package
   /// gives none (--max-late); Duration::max() = never.
-  Duration max_late = kDefaultServoMaxLate;
+  Duration max_late = kDefaultMaxLate;
   /// Each session's link health: its tolerances and thresholds.
   LinkHealthOptions link;
   /// Stop what a session owns when its link is past a stop threshold (--link-stop).

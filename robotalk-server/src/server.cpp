@@ -15,7 +15,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <regex>
 
 namespace robotalk {
 namespace {
@@ -37,10 +36,6 @@ void Say(std::string line) {
   log->Write(lines);
 }
 
-bool ValidRobotName(const std::string& name) {
-  return !name.empty() && std::regex_match(name, std::regex("[A-Za-z0-9_-]+"));
-}
-
 }  // namespace
 
 RobotSpec RobotSpec::Parse(const std::string& text) {
@@ -51,7 +46,7 @@ RobotSpec RobotSpec::Parse(const std::string& text) {
   RobotSpec spec;
   spec.name = text.substr(0, eq);
   spec.driver = text.substr(eq + 1, colon - eq - 1);
-  if (!ValidRobotName(spec.name)) {
+  if (!IsValidRobotName(spec.name)) {
     throw Error("--robot '" + text + "': robot name '" + spec.name + "' must be letters, digits, '_' or '-'");
   }
   if (spec.driver.empty()) throw Error("--robot '" + text + "': no driver given");

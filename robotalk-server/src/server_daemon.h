@@ -28,6 +28,7 @@
 #include "robot_daemon.h"
 #include "robot_sessions.h"
 #include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
 #include "robotalk/clock.h"
 #include "robotalk/log_limiter.h"
 #include "robotalk/log_writer.h"
@@ -72,7 +73,7 @@ class AnswerBudget {
 
 struct ServerDaemonOptions {
   /// Period of the ROBOTALK/ANNOUNCE message.
-  Duration announce_period = std::chrono::seconds(1);
+  Duration announce_period = kAnnouncePeriod;
   /// How often silent sessions and overrunning driver calls are looked for.
   Duration watchdog_period = std::chrono::milliseconds(100);
   /// The paper's congestion injector (§VI-B): after each received package the

@@ -8,10 +8,7 @@ set -u
 server_bin=$1 cli=$2 models=$3
 url="udpm://239.255.76.67:7671?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-  2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --duration 60
 
 cli_says() {  # cli_says STATUS PATTERN ARGS...: robotalk ARGS exits STATUS and prints PATTERN
   local want=$1 pattern=$2 out got

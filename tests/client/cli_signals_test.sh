@@ -11,10 +11,7 @@ server_bin=$1 cli=$2 models=$3
 url="udpm://239.255.76.67:7814?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, check
 rt() { "$cli" --url "$url" "$@"; }
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 100 \
-  2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --duration 100
 base() { rt query pioneer base_pose | awk '{print $(NF-4), $(NF-1)}'; }  # x v
 speed() { rt query pioneer base_pose | awk '{print $(NF-1)}'; }
 # Starts the CLI in its own session (a background job of a non-interactive

@@ -23,10 +23,7 @@ check "it gives the no-robot hint: $(cat "$tmp/query.out")" \
 check "not the HELLO message" sh -c "! grep -qi hello '$tmp/query.out'"
 
 start_server() {
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-    2>"$tmp/server.log" &
-  server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+  start_pioneer "$tmp/server.log" --url "$url" --duration 60
 }
 stop_server() { kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""; }
 # Starts watch in its own session (a background job of a non-interactive shell

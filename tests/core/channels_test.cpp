@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 namespace robotalk {
 namespace {
 
@@ -12,6 +14,16 @@ TEST(Channels, BuildsTheDocumentedNames) {
   EXPECT_EQ(ConfigChannel("pioneer"), "ROBOTALK/pioneer/CONFIG");
   EXPECT_EQ(StateChannel("pioneer"), "ROBOTALK/pioneer/STATE");
   EXPECT_STREQ(kAnnounceChannel, "ROBOTALK/ANNOUNCE");
+}
+
+TEST(Channels, ARobotNameIsLettersDigitsUnderscoreAndHyphen) {
+  for (const char* good : {"pioneer", "a", "asimo_2", "arm-left", "_", "-", "ABC09"}) {
+    EXPECT_TRUE(IsValidRobotName(good)) << good;
+  }
+  for (const char* bad : {"", "x.y", "a/b", "a b", "caf\xc3\xa9", "*", "a\n"}) {
+    EXPECT_FALSE(IsValidRobotName(bad)) << bad;
+  }
+  EXPECT_TRUE(IsValidRobotName(std::string(1000, 'r'))) << "no length limit of its own";
 }
 
 TEST(Channels, ParsesWhatItBuilds) {

@@ -26,10 +26,7 @@ esac
 value() { grep -o -m1 "$1=[-0-9.]*" "$2" | head -1 | cut -d= -f2; }
 within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v != "" && v >= lo && v <= hi) }'; }
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
-  --duration 90 "${server_flags[@]}" 2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --duration 90 "${server_flags[@]}"
 
 # --- the example: connect, configuration, GOTO, timed sequence, replies ------
 timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/out" 2>"$tmp/err"

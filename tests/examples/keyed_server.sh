@@ -9,8 +9,6 @@ start_keyed_server() {
   for k in server alice "$@"; do "$keygen" --out "$tmp/$k" >/dev/null || exit 1; done
   echo "$(cut -d' ' -f1 "$tmp/alice.pub") alice *=all" >"$tmp/clients"
   chmod 600 "$tmp/clients"
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration "$duration" \
-    --key "$tmp/server" --clients "$tmp/clients" 2>"$tmp/server.log" &
-  server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+  start_pioneer "$tmp/server.log" --url "$url" --duration "$duration" \
+    --key "$tmp/server" --clients "$tmp/clients"
 }

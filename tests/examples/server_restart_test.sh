@@ -10,15 +10,13 @@ shift 3
 url="udpm://239.255.76.67:$port?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, $client_pid, check
 start_server() {  # start_server LOG
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 2>"$1" &
-  server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$1" 2>/dev/null && return 0; sleep 0.1; done
+  start_pioneer "$1" --url "$url" --duration 60 && return 0
   echo "server did not start"; cat "$1"; exit 1
 }
 start_server "$tmp/first.log"
 timeout 60 "$@" --url "$url" --robot pioneer --pause 4 >"$tmp/out" 2>"$tmp/err" &
 client_pid=$!
-for _ in $(seq 300); do grep -q "^pausing" "$tmp/out" && break; sleep 0.1; done
+wait_for "$tmp/out" "^pausing" 300
 check "the example got to its pause" grep -q "^pausing" "$tmp/out"
 kill "$server_pid"; wait "$server_pid" 2>/dev/null
 start_server "$tmp/second.log"

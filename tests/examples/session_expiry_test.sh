@@ -12,15 +12,12 @@ server_bin=$1 models=$2 port=$3
 shift 3
 url="udpm://239.255.76.67:$port?ttl=0"
 . "$(dirname "$0")/../lib.sh"  # $tmp, $server_pid, $client_pid, check
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-  --session-timeout 0.5 --log-executions 2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --duration 60 --session-timeout 0.5 --log-executions
 
 # The frames start 3 s after they are sent; the client is frozen 0.1 s after sending them, for 4 s.
 "$@" --url "$url" --robot pioneer --delay 3 >"$tmp/out" 2>"$tmp/err" &
 client_pid=$!
-for _ in $(seq 600); do grep -q "^sequence sent" "$tmp/out" && break; sleep 0.05; done
+wait_for "$tmp/out" "^sequence sent" 600 0.05
 check "the example sent its sequence" grep -q "^sequence sent" "$tmp/out"
 sleep 0.1
 kill -STOP "$client_pid"

@@ -17,10 +17,7 @@ for who in server alice monitor viewer stranger; do "$keygen" --out "$tmp/$who" 
 } >"$tmp/clients"
 chmod 644 "$tmp/clients"
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
-  --key "$tmp/server" --clients "$tmp/clients" --duration 60 2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --key "$tmp/server" --clients "$tmp/clients" --duration 60
 check "the server says it runs keyed" grep -q "keyed mode: 3 client keys" "$tmp/server.log"
 
 rt --key "$tmp/alice" query pioneer base_pose >"$tmp/alice_query" 2>&1

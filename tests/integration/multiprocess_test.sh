@@ -12,10 +12,7 @@ rt() { "$cli" --url "$url" --timeout 5 "$@"; }
 start_server() {  # start_server LOG [extra server flags...]
   local log=$1; shift
   [ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
-    --session-timeout 0.5 --duration 60 "$@" 2>"$log" &
-  server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$log" 2>/dev/null && return 0; sleep 0.1; done
+  start_pioneer "$log" --url "$url" --session-timeout 0.5 --duration 60 "$@" && return 0
   echo "server did not start:"; cat "$log"; exit 1
 }
 

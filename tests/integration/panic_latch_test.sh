@@ -16,10 +16,7 @@ export ROBOTALK_STATE_DIR="$tmp/state"
 
 start_server() {  # start_server PORT LOG [extra server flags...]
   local p=$1 log=$2; shift 2
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$(url "$p")" \
-    --duration 60 "$@" 2>"$log" &
-  server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$log" 2>/dev/null && return 0; sleep 0.1; done
+  start_pioneer "$log" --url "$(url "$p")" --duration 60 "$@" && return 0
   echo "server did not start:"; cat "$log"; exit 1
 }
 kill9_server() { kill -9 "$server_pid" 2>/dev/null; wait "$server_pid" 2>/dev/null; server_pid=""; }

@@ -30,7 +30,7 @@ server_pid=$!
 "$relay" --a "$A" --b "$B" --a2b-latency-ms 5 --a2b-jitter-ms 3 --a2b-jitter-dist uniform --seed 22 \
   --duration 35 >"$tmp/relay.log" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot" 100
 sleep 0.3
 
 check "the client ran" timeout 30 "$client" --url "$A" --robot pioneer --joint pan --splices 400 \

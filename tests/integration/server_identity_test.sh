@@ -14,10 +14,7 @@ url="udpm://239.255.76.67:7610?ttl=0"
 pins=$ROBOTALK_KNOWN_SERVERS
 rt() { "$cli" --url "$url" --timeout 3 --key "$tmp/alice" "$@"; }
 serve() {  # serve KEY LOG: a keyed server of pioneer
-  "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --log-executions \
-    --key "$tmp/$1" --clients "$tmp/clients" --duration 60 2>"$tmp/$2" &
-  server_pid=$!
-  for _ in $(seq 50); do grep -q "serving robot" "$tmp/$2" 2>/dev/null && break; sleep 0.1; done
+  start_pioneer "$tmp/$2" --url "$url" --log-executions --key "$tmp/$1" --clients "$tmp/clients" --duration 60
 }
 
 for who in server mallory alice; do "$keygen" --out "$tmp/$who" --name "$who" >/dev/null; done

@@ -20,8 +20,6 @@ lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
 s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
 print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
 }
-# Waits (5 s at most) for a line matching PATTERN in FILE.
-wait_for() { for _ in $(seq 50); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
 
 # shutdown_case SIGNAL PORT SETSPEED_ROBOT GOTO_ROBOT
 shutdown_case() {

@@ -14,7 +14,6 @@ server_bin=$1 cli=$2 models=$3
 . "$(dirname "$0")/../lib.sh" # $tmp, $server_pid, check
 urdf="$models/pioneer2dx_pantilt.urdf"
 url="udpm://239.255.76.67:7719?ttl=0"
-wait_for() { for _ in $(seq 50); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
 last_motion() {
   python3 -c 'import json, sys
 lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
@@ -98,7 +97,7 @@ at_rest "full stderr: the last STATE sample shows pioneer at rest" "$tmp/watch2.
 # it wrote "robotalk: " before it sent the STOP, and waited there; its
 # heartbeats kept its session, so the server's watchdog never stopped it).
 url="udpm://239.255.76.67:7721?ttl=0"
-start_pioneer_server "$server_bin" "$url" "$(dirname "$urdf")" 60
+start_pioneer "$tmp/server.log" --url "$url" --duration 60
 mkfifo "$tmp/cli_err"
 python3 -c 'import sys, time
 with open(sys.argv[1]) as f:
@@ -129,7 +128,7 @@ kill -9 "$hold_pid" 2>/dev/null
 # heartbeats kept its session and the GOTO alive).
 url="udpm://239.255.76.67:7722?ttl=0"
 signal_server TERM
-start_pioneer_server "$server_bin" "$url" "$(dirname "$urdf")" 60
+start_pioneer "$tmp/server.log" --url "$url" --duration 60
 "$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch4.json" 2>/dev/null &
 pids+=($!)
 python3 -c 'import os, pty, signal, subprocess, sys, time

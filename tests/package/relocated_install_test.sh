@@ -42,7 +42,7 @@ check "robotalk-spy passes the URL to lcm-spy" grep -qxF -- "--lcm-url=$url" "$t
 echo '<!-- the moved installation -->' >>"$prefix/share/robotalk/web/www/index.html"
 "$bin/robotalk-web" --lcm-url "$url" --port 0 >"$tmp/web.out" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do grep -q "open http" "$tmp/web.out" && break; sleep 0.1; done
+wait_for "$tmp/web.out" "open http" 100
 port=$(grep -o 'open http://[^ ]*' "$tmp/web.out" | sed 's#.*:\([0-9]*\)/$#\1#')
 check "robotalk-web starts from the moved tree ($(head -1 "$tmp/web.out"))" test -n "$port"
 check "robotalk-web serves the installed page" \

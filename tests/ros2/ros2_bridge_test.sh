@@ -19,15 +19,12 @@ for who in server bridge peer; do "$keygen" --out "$tmp/$who" --name "$who" >/de
 } >"$tmp/clients"
 chmod 644 "$tmp/clients"
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" \
-  --key "$tmp/server" --clients "$tmp/clients" --duration 60 2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" 2>/dev/null && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --key "$tmp/server" --clients "$tmp/clients" --duration 60
 
 "$bridge" --robot pioneer --url "$url" --key "$tmp/bridge" --duration 40 >"$tmp/bridge.out" 2>"$tmp/bridge.log" &
 bridge_pid=$!
 pids+=("$bridge_pid")
-for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge.log" 2>/dev/null && break; sleep 0.1; done
+wait_for "$tmp/bridge.log" "bridged" 100
 check "the bridge connects with its key: $(cat "$tmp/bridge.log")" grep -q "robot 'pioneer' bridged (DDS domain 25)" "$tmp/bridge.log"
 
 peer_checks() {  # peer_checks MODE WHAT: ros2_peer MODE's own checks, printed, must all pass
@@ -84,11 +81,11 @@ url2="udpm://239.255.76.67:7626?ttl=0"
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url2" --max-queue 8 \
   --key "$tmp/server" --clients "$tmp/clients" --duration 30 2>"$tmp/server2.log" &
 pids+=("$!")
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server2.log" 2>/dev/null && break; sleep 0.1; done
+wait_for "$tmp/server2.log" "serving robot"
 "$bridge" --robot pioneer --url "$url2" --key "$tmp/bridge" --duration 20 >"$tmp/bridge2.out" 2>"$tmp/bridge2.log" &
 bridge2_pid=$!
 pids+=("$bridge2_pid")
-for _ in $(seq 100); do grep -q "bridged" "$tmp/bridge2.log" 2>/dev/null && break; sleep 0.1; done
+wait_for "$tmp/bridge2.log" "bridged" 100
 url_saved=$url url=$url2
 peer_checks cmd_vel_full_queue "with its queue full, the bridge still stops a base whose cmd_vel fell silent"
 url=$url_saved
@@ -142,7 +139,7 @@ forged_then_real() {
     --key "$tmp/server" --clients "$tmp/clients" --duration 60 2>"$tmp/server_forged_$2.log" &
   pids+=("$!")
   started=$SECONDS
-  for _ in $(seq 300); do grep -q "robot 'pioneer' bridged" "$log" 2>/dev/null && break; sleep 0.1; done
+  wait_for "$log" "robot 'pioneer' bridged" 300
   echo "pioneer bridged $((SECONDS - started)) s after its server started, $2 forged robots announced first"
   check "with $2 forged robots announced first ($3 rounds), the real one is bridged within 30 s ($((SECONDS - started)) s)" \
     grep -q "robot 'pioneer' bridged" "$log"

@@ -9,6 +9,7 @@
 #include "robotalk/request.h"
 #include "session_test_util.h"
 #include "support/test_clients.h"
+#include "two_robot_server.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -37,16 +38,9 @@ std::vector<std::uint8_t> ForgedAnnounce(std::int64_t server_id, const std::stri
 }
 
 // One ServerDaemon serving "bot" (and "arm") on the in-memory bus.
-class AnnounceConflictTest : public ::testing::Test {
+class AnnounceConflictTest : public testing::TwoRobotServerTest {
  protected:
-  AnnounceConflictTest() : server_transport_(bus_), lan_(bus_) {
-    for (const char* name : {"bot", "arm"}) {
-      auto driver = std::make_unique<FakeDriver>(PanRobot());
-      fakes_[name] = driver.get();
-      robots_.push_back(std::make_unique<RobotDaemon>(name, "fake", std::move(driver), clock_));
-    }
-    server_ = std::make_unique<ServerDaemon>(server_transport_, clock_, ServerDaemonOptions{.server_id = 42});
-    for (auto& r : robots_) server_->AddRobot(*r, SessionOptions{});
+  AnnounceConflictTest() {
     announce_sub_ =
         lan_.Subscribe(kAnnounceChannel, [this](const std::string&, std::span<const std::uint8_t> b) {
           const Announcement a = DecodeAnnouncement(b);
@@ -58,13 +52,6 @@ class AnnounceConflictTest : public ::testing::Test {
         lan_.Subscribe("ROBOTALK/bot/REPLY/.*", [this](const std::string&, std::span<const std::uint8_t> b) {
           for (Reply& r : DecodeReplyBatch(b).replies) replies_[r.id] = r;
         });
-  }
-
-  void Step() {
-    server_->RunOnce(Duration(0));
-    for (auto& r : robots_) r->RunOnce(clock_.Now());
-    server_->RunOnce(Duration(0));
-    lan_.HandleFor(Duration(0));
   }
 
   // Moves "bot"'s pan joint as a fresh client; true when it ran.
@@ -80,13 +67,7 @@ class AnnounceConflictTest : public ::testing::Test {
     return it != replies_.end() && it->second.signal == Signal::kSuccess;
   }
 
-  ManualClock clock_;
-  std::shared_ptr<MemoryBus> bus_ = std::make_shared<MemoryBus>();
-  MemoryTransport server_transport_;
-  MemoryTransport lan_;  // anyone on the LAN
-  std::map<std::string, FakeDriver*> fakes_;
-  std::vector<std::unique_ptr<RobotDaemon>> robots_;
-  std::unique_ptr<ServerDaemon> server_;
+  MemoryTransport& lan_ = client_;  // anyone on the LAN
   std::unique_ptr<Subscription> announce_sub_;
   std::unique_ptr<Subscription> reply_sub_;
   std::vector<std::string> announced_;

@@ -22,7 +22,7 @@ demo=$!
 set +m
 pids+=("$demo")
 exec 9<&-
-for _ in $(seq 1200); do grep -q "Running until Ctrl-C" "$tmp/demo.out" && break; sleep 0.1; done
+wait_for "$tmp/demo.out" "Running until Ctrl-C" 1200
 check "the walkthrough ends and the demo keeps running" grep -q "Running until Ctrl-C" "$tmp/demo.out"
 url=$(grep -o 'Watch it in a browser on this machine: http://127.0.0.1:[0-9]*/' "$tmp/demo.out" | grep -o 'http.*')
 check "it prints a URL on this machine's loopback ($url)" test -n "$url"

@@ -21,7 +21,7 @@ for _ in $(seq 50); do [ "$(grep -c "serving robot" "$tmp/server.log")" -ge 2 ] 
 record() {
   "$logplay" record -o "$1" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
   recorder=$!
-  for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
+  wait_for "$tmp/record.log" "recording"
 }
 stop_recording() { sleep 0.3; kill -INT "$recorder"; wait "$recorder"; }
 

@@ -12,7 +12,7 @@ server_bin=$1 logplay=$2 models=$3
 url="udpm://239.255.76.67:7834?ttl=0"
 . "$(dirname "$0")/../lib.sh"
 
-start_pioneer_server "$server_bin" "$url" "$models" 60
+start_pioneer "$tmp/server.log" --url "$url" --duration 60
 
 "$logplay" record -o /dev/full --lcm-url "$url" --duration 2.5 2>"$tmp/record.log"
 status=$?

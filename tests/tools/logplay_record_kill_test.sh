@@ -16,7 +16,7 @@ server_bin=$1 cli=$2 logplay=$3 models=$4
 url="udpm://239.255.76.67:7833?ttl=0"
 . "$(dirname "$0")/../lib.sh"
 
-start_pioneer_server "$server_bin" "$url" "$models" 90
+start_pioneer "$tmp/server.log" --url "$url" --duration 90
 "$cli" --url "$url" watch pioneer --period 1 >/dev/null 2>&1 &
 client_pid=$!
 sleep 0.5
@@ -24,7 +24,7 @@ sleep 0.5
 record() {  # record LOG NAME: a recorder in the background, once it listens
   "$logplay" record -o "$1" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/$2.log" &
   recorder=$!
-  for _ in $(seq 50); do grep -q "recording" "$tmp/$2.log" && break; sleep 0.05; done
+  wait_for "$tmp/$2.log" "recording" 50 0.05
 }
 record "$tmp/reference.lcmlog" reference
 reference=$recorder

@@ -13,14 +13,11 @@ url="udpm://239.255.76.67:7831?ttl=0"
 . "$(dirname "$0")/../lib.sh"
 rt() { "$cli" --url "$url" "$@"; }
 
-"$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
-  2>"$tmp/server.log" &
-server_pid=$!
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+start_pioneer "$tmp/server.log" --url "$url" --duration 60
 
 "$logplay" record -o "$tmp/session.lcmlog" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
 logger=$!
-for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
+wait_for "$tmp/record.log" "recording"
 sleep 0.3
 
 n=40

@@ -24,7 +24,7 @@ for _ in $(seq 50); do [ "$(grep -c "serving robot" "$tmp/server.log")" -ge 2 ] 
 # --- record: the state stream and a sequence in send's default mode ---------
 "$logplay" record -o "$tmp/session.lcmlog" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
 logger=$!
-for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
+wait_for "$tmp/record.log" "recording"
 # The binary itself in the background, not the rt function: $! must be
 # watch's own pid, or the kill below leaves it running.
 "$cli" --url "$url" watch pioneer --period 0.05 >"$tmp/watch.txt" 2>&1 &

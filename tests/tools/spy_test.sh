@@ -22,7 +22,7 @@ pids+=($!)
 "$server_bin" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" --url "$url" --duration 60 \
   2>"$tmp/server.log" &
 pids+=($!)
-for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && break; sleep 0.1; done
+wait_for "$tmp/server.log" "serving robot"
 
 DISPLAY=$display "$spy" --url "$url" >"$tmp/spy.out" 2>&1 &
 pids+=($!)

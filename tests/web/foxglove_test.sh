@@ -34,7 +34,7 @@ for _ in $(seq 50); do grep -q "serving robot" "$tmp/server.log" && grep -q "ser
 # Record before the bridge connects, so its CONFIG query's answer is logged.
 "$logplay" record -o "$tmp/session.lcmlog" --lcm-url "$url" -c 'ROBOTALK/.*' 2>"$tmp/record.log" &
 logger=$!
-for _ in $(seq 50); do grep -q "recording" "$tmp/record.log" && break; sleep 0.1; done
+wait_for "$tmp/record.log" "recording"
 
 # The robot's URDF as the bridge and the export get it: the shipped pioneer
 # with a material on base_link's visual and the caster's collision sphere

@@ -28,12 +28,26 @@ def read_csv(path):
         return list(csv.DictReader(f))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def parse_args(doc):
+    """--runs DIR --png FIG.png --table METRICS.csv, as every Fig. 11 plot takes them."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
     ap.add_argument("--runs", required=True)
     ap.add_argument("--png", required=True)
     ap.add_argument("--table", required=True)
-    args = ap.parse_args()
+    return ap.parse_args()
+
+
+def write_metrics(path, header, rows):
+    """The runs' metrics rows (dicts with the keys `header`) as one CSV."""
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=header, lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+
+
+def main():
+    args = parse_args(__doc__)
 
     ideal = read_csv(os.path.join(args.runs, "ideal.csv"))
     ix = [float(r["x"]) for r in ideal]
@@ -79,11 +93,7 @@ def main():
     if header is None:
         print("no runs found", file=sys.stderr)
         return 1
-    with open(args.table, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=header, lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow(r)
+    write_metrics(args.table, header, rows)
     print(f"wrote {args.table}", file=sys.stderr)
 
     cols = [("label", "run"), ("start_latency_s", "start latency (s)"), ("playback_delay_s", "playback delay (s)"),

@@ -9,8 +9,6 @@ was sent) against its offset in the profile: on schedule a frame sits on the
 diagonal; the stall's burst is the flat run of frames executed at once; an
 expired frame (not executed) is a red cross at its offset.
 """
-import argparse
-import csv
 import os
 import sys
 
@@ -19,17 +17,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from plot_fig11 import read_csv  # noqa: E402  (beside this script)
+from plot_fig11 import parse_args, read_csv, write_metrics  # noqa: E402  (beside this script)
 
 RUNS = [("stall_nodeadline", "no deadline (--max-late never)"), ("stall_deadline", "deadline 0.1 s (default)")]
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", required=True)
-    ap.add_argument("--png", required=True)
-    ap.add_argument("--table", required=True)
-    args = ap.parse_args()
+    args = parse_args(__doc__)
     ideal = read_csv(os.path.join(args.runs, "ideal.csv"))
     fig, axes = plt.subplots(2, len(RUNS), figsize=(5.5 * len(RUNS), 9.5), squeeze=False)
     rows, header = [], None
@@ -75,11 +69,7 @@ def main():
     print(f"wrote {args.png}", file=sys.stderr)
     if header is None:
         return 1
-    with open(args.table, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=header, lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow(r)
+    write_metrics(args.table, header, rows)
     for r in rows:
         print(f"| {r['label']} | {r['late_frames']} late (max {float(r['max_lateness_s']):.2f} s) | "
               f"{r['expired_frames']} expired | max dev {100 * float(r['max_dev_m']):.1f} cm |")

@@ -235,9 +235,7 @@ class RobotTracker::Impl {
     std::string error;
     try {
       if (want) {
-        const auto period =
-            std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / options_.rate_hz));
-        client->StartStateStream(period, [slot, on_sample](const StateSample& s) {
+        client->StartStateStream(options_.period(), [slot, on_sample](const StateSample& s) {
           {
             std::lock_guard l(slot->mutex);
             slot->sample = s;

@@ -4,6 +4,8 @@
 // naming the bad argument ("unknown option '--x'", "--port: 'abc' is not ...").
 #pragma once
 
+#include "robotalk/clock.h"
+
 #include <map>
 #include <string>
 #include <utility>
@@ -21,6 +23,9 @@ struct WebOptions {
   std::string lcm_url;
   /// Frames per second pushed to each browser (state samples are decimated to this).
   double rate_hz = 30.0;
+  /// 1 / rate_hz: the STATE stream's period and the page's frame period.
+  /// Throws Error (FromSeconds) when rate_hz is 0 or not finite.
+  Duration period() const { return FromSeconds(1.0 / rate_hz); }
   /// The page's files (index.html, app.js, ...).
   std::string www_dir;
   /// The npm modules folder holding three and urdf-loader.

@@ -71,8 +71,7 @@ class WebServer::Impl {
     if (ec)
       throw Error("robotalk-web: cannot listen on " + o.bind + ":" + std::to_string(o.port) + ": " +
                   ec.message());
-    period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(1.0 / o.rate_hz));
+    period_ = o.period();
     for (const auto& [robot, urdf] : o.urdf) meshes_[robot] = ResolveMeshes(robot, urdf, o.package_paths);
     // PANIC from Foxglove only when the bridge holds a key: a keyed server
     // then decides by the bridge's rights (docs/interop.md).

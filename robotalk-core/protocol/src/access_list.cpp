@@ -3,6 +3,7 @@
 #include "robotalk/access_list.h"
 
 #include "file_trust.h"
+#include "robotalk/channels.h"
 
 #include "robotalk/request.h"
 
@@ -21,15 +22,8 @@ namespace {
 // A list of a few thousand clients is a few hundred KB; cap it well above.
 constexpr std::size_t kMaxFileBytes = std::size_t{4} * 1024 * 1024;
 
-bool IsRobotName(std::string_view s) {
-  if (s.empty() || s.size() > 64) return false;
-  for (const char c : s) {
-    const bool ok =
-        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
-    if (!ok) return false;
-  }
-  return true;
-}
+// A robot name (channels.h) of at most 64 characters.
+bool IsListedRobotName(std::string_view s) { return s.size() <= 64 && IsValidRobotName(s); }
 
 std::vector<std::string_view> Fields(std::string_view line) {
   std::vector<std::string_view> out;
@@ -97,7 +91,7 @@ class LineParser {
         Fail("'" + std::string(f[i].substr(0, 80)) + "': expected <robot>=<rights>");
       }
       const std::string_view robot = f[i].substr(0, eq);
-      if (robot != "*" && !IsRobotName(robot)) {
+      if (robot != "*" && !IsListedRobotName(robot)) {
         Fail("robot '" + std::string(robot.substr(0, 80)) + "': not a robot name or '*'");
       }
       const Rights rights = ParseRights(robot, f[i].substr(eq + 1));

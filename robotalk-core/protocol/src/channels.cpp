@@ -36,6 +36,16 @@ std::optional<std::uint64_t> ParseHex64(std::string_view hex) {
 
 }  // namespace
 
+bool IsValidRobotName(std::string_view name) {
+  if (name.empty()) return false;
+  for (const char c : name) {
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel) {
   return RobotBefore(channel, "/REQUEST");
 }

@@ -2,6 +2,7 @@
 #include "robotalk/known_servers.h"
 
 #include "file_trust.h"
+#include "robotalk/channels.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -35,12 +36,6 @@ int OpenChecked(const std::filesystem::path& file, int flags, mode_t mode) {
   const int fd = ::open(file.c_str(), flags | O_NOFOLLOW | O_CLOEXEC, mode);
   if (fd < 0 && errno == ELOOP) throw KeyError(Where(file) + ": is a symlink; give the real file");
   return fd;
-}
-
-bool ValidRobot(std::string_view s) {
-  return !s.empty() &&
-         s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") ==
-             std::string_view::npos;
 }
 
 }  // namespace
@@ -80,7 +75,7 @@ KnownServers KnownServers::Read(const std::filesystem::path& file) {
     if (!(words >> pin.network >> key) || (words >> extra)) {
       throw KeyError(at + "expected '<robot> <network> ed25519:<64 hex>', got '" + line + "'");
     }
-    if (!ValidRobot(pin.robot)) throw KeyError(at + "'" + pin.robot + "' is not a robot name");
+    if (!IsValidRobotName(pin.robot)) throw KeyError(at + "'" + pin.robot + "' is not a robot name");
     try {
       pin.key = PublicKey::Parse(key);
     } catch (const KeyError& e) {

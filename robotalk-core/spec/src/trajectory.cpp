@@ -11,8 +11,6 @@ namespace {
 
 constexpr int kCoeffs = 6;
 
-double Seconds(Duration d) { return std::chrono::duration<double>(d).count(); }
-
 std::string Str(double x) {
   std::ostringstream out;
   out << x;
@@ -180,9 +178,9 @@ void Trajectory::CheckWaypoints(TimePoint after, std::span<const Waypoint> waypo
     const std::string name = "Trajectory: waypoint " + std::to_string(i);
     if (w.time <= previous) {
       throw Error(
-          name + ": time " + Str(Seconds(w.time - after)) + " s is not after " +
+          name + ": time " + Str(ToSeconds(w.time - after)) + " s is not after " +
           (i == 0 ? std::string("the trajectory's time ") + Str(0) + " s"
-                  : "waypoint " + std::to_string(i - 1) + "'s " + Str(Seconds(previous - after)) + " s") +
+                  : "waypoint " + std::to_string(i - 1) + "'s " + Str(ToSeconds(previous - after)) + " s") +
           " (times must strictly increase)");
     }
     CheckVector(name + ": position", w.position, n, false);
@@ -264,7 +262,7 @@ void Trajectory::Resolve(std::size_t first) {
   const bool smooth = interpolation_ == Interpolation::kCubic || interpolation_ == Interpolation::kQuintic;
   for (std::size_t k = first; k <= last && smooth; ++k) {
     if (given_v_[k] || k == last) continue;  // the last one stays zero unless given
-    const double h0 = Seconds(times_[k] - times_[k - 1]), h1 = Seconds(times_[k + 1] - times_[k]);
+    const double h0 = ToSeconds(times_[k] - times_[k - 1]), h1 = ToSeconds(times_[k + 1] - times_[k]);
     const auto c = static_cast<Eigen::Index>(k);
     for (int i = 0; i < n; ++i) {
       const double d0 = (p_(i, c) - p_(i, c - 1)) / h0, d1 = (p_(i, c + 1) - p_(i, c)) / h1;
@@ -277,14 +275,14 @@ void Trajectory::Resolve(std::size_t first) {
   for (std::size_t k = first; k <= last && interpolation_ == Interpolation::kQuintic; ++k) {
     if (given_a_[k] || k == last) continue;
     const auto c = static_cast<Eigen::Index>(k);
-    a_.col(c) = (v_.col(c + 1) - v_.col(c - 1)) / Seconds(times_[k + 1] - times_[k - 1]);
+    a_.col(c) = (v_.col(c + 1) - v_.col(c - 1)) / ToSeconds(times_[k + 1] - times_[k - 1]);
   }
 }
 
 void Trajectory::Coefficients(std::size_t segment, int dof, double* c) const {
   // Computed when needed rather than kept: 6 per dof per knot would be most
   // of what a held waypoint costs the server (docs/server.md, memory bounds).
-  const double h = Seconds(times_[segment + 1] - times_[segment]);
+  const double h = ToSeconds(times_[segment + 1] - times_[segment]);
   const auto k0 = static_cast<Eigen::Index>(segment), k1 = k0 + 1;
   const auto r = static_cast<Eigen::Index>(dof);
   std::fill(c, c + kCoeffs, 0.0);
@@ -356,7 +354,7 @@ void Trajectory::Sample(TimePoint t, TrajectorySample* out) const {
   const auto next = std::upper_bound(times_.begin(), times_.end(), t);
   const bool hold = next == times_.end();
   const auto segment = static_cast<std::size_t>(next - times_.begin()) - 1;
-  const double tau = Seconds(t - times_[segment]);
+  const double tau = ToSeconds(t - times_[segment]);
   out->holding = hold;
   for (int i = 0; i < num_dofs(); ++i) {
     double p, v, a;
@@ -385,7 +383,7 @@ LimitCheck Trajectory::CheckLimits(const TrajectoryLimits& limits, TimePoint fro
   from = std::max(from, times_.front());
   for (std::size_t k = 0; k + 1 < times_.size(); ++k) {
     if (times_[k + 1] <= from) continue;
-    const double lo = std::max(0.0, Seconds(from - times_[k])), hi = Seconds(times_[k + 1] - times_[k]);
+    const double lo = std::max(0.0, ToSeconds(from - times_[k])), hi = ToSeconds(times_[k + 1] - times_[k]);
     for (int i = 0; i < n; ++i) {
       double c[kCoeffs];
       Coefficients(k, i, c);
@@ -401,7 +399,7 @@ LimitCheck Trajectory::CheckLimits(const TrajectoryLimits& limits, TimePoint fro
     }
   }
   // The hold: from the last knot (or `from`) to rest.
-  const double hold_from = std::max(0.0, Seconds(from - times_.back()));
+  const double hold_from = std::max(0.0, ToSeconds(from - times_.back()));
   for (int i = 0; i < n; ++i) {
     double p0, v0, a0, p1, v1, a1;
     EvaluateHold(hold_from, i, &p0, &v0, &a0);
@@ -442,7 +440,7 @@ TimeScaling Trajectory::ScaleToLimits(const TrajectoryLimits& limits, TimePoint 
   const std::size_t segments = times_.size() - 1;
   const int n = num_dofs();
   std::vector<double> original(segments), factor(segments);
-  for (std::size_t k = 0; k < segments; ++k) original[k] = Seconds(times_[k + 1] - times_[k]);
+  for (std::size_t k = 0; k < segments; ++k) original[k] = ToSeconds(times_[k + 1] - times_[k]);
   // Stretch each offending segment by what it needs (velocity / limit, or the
   // square root of acceleration / limit); a knot between stretched segments
   // scales its velocity by 1/f and acceleration by 1/f² (f the larger
@@ -454,7 +452,7 @@ TimeScaling Trajectory::ScaleToLimits(const TrajectoryLimits& limits, TimePoint 
     bool stretched = false;
     for (std::size_t k = 0; k < segments; ++k) {
       if (times_[k] < from) continue;
-      const double h = Seconds(times_[k + 1] - times_[k]);
+      const double h = ToSeconds(times_[k + 1] - times_[k]);
       for (int i = 0; i < n; ++i) {
         double c[kCoeffs];
         Coefficients(k, i, c);
@@ -488,7 +486,7 @@ TimeScaling Trajectory::ScaleToLimits(const TrajectoryLimits& limits, TimePoint 
     result.changed = true;
     std::vector<TimePoint> times = times_;
     for (std::size_t k = 0; k < segments; ++k) {
-      times[k + 1] = times[k] + FromSeconds(Seconds(times_[k + 1] - times_[k]) * factor[k]);
+      times[k + 1] = times[k] + FromSeconds(ToSeconds(times_[k + 1] - times_[k]) * factor[k]);
     }
     for (std::size_t j = 1; j <= segments; ++j) {
       if (times_[j] <= from) continue;
@@ -501,7 +499,7 @@ TimeScaling Trajectory::ScaleToLimits(const TrajectoryLimits& limits, TimePoint 
   }
   double largest = 1;
   for (std::size_t k = 0; k < segments; ++k) {
-    largest = std::max(largest, Seconds(times_[k + 1] - times_[k]) / original[k]);
+    largest = std::max(largest, ToSeconds(times_[k + 1] - times_[k]) / original[k]);
   }
   result.largest_factor = largest;
   result.new_end = times_.back() - times_.front();

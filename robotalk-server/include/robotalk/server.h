@@ -35,6 +35,15 @@ struct RobotSpec {
 inline constexpr std::size_t kDefaultMaxSessions = 1024;
 /// The default of --max-sessions-per-robot (ServerOptions::max_sessions_per_robot).
 inline constexpr std::size_t kDefaultMaxSessionsPerRobot = 256;
+/// The defaults of --session-timeout, --max-queue, --max-future and
+/// --max-late (ServerOptions); the session layer's own options start from
+/// the same values.
+inline constexpr Duration kDefaultSessionTimeout = std::chrono::seconds(2);
+inline constexpr std::size_t kDefaultMaxQueue = 10000;
+inline constexpr Duration kDefaultMaxFuture = std::chrono::hours(1);
+/// --max-late for servo commands: 0.1 s, drake-franka-driver's --expire_sec
+/// default (docs/server.md, Deadlines says why).
+inline constexpr Duration kDefaultMaxLate = std::chrono::milliseconds(100);
 
 /// A mobile base's acceleration limit for SETSPEED ramps (the SETSPEED frames
 /// of interpolated packages; docs/server.md, "Base speed ramps"). The
@@ -48,21 +57,21 @@ struct ServerOptions {
   /// LCM provider URL; "" uses LCM's default (or $LCM_DEFAULT_URL).
   std::string lcm_url;
   /// A client session silent for this long expires; the robot is stopped if it moved it.
-  Duration session_timeout = std::chrono::seconds(2);
+  Duration session_timeout = kDefaultSessionTimeout;
   /// Most commands one client may have queued.
-  size_t max_queue = 10000;
+  size_t max_queue = kDefaultMaxQueue;
   /// Most commands all clients may have queued in the whole server; each
   /// robot gets an equal part, half of it as every client's guaranteed
   /// share (docs/protocol.md, Bounds).
   size_t max_queued_total = 65536;
   /// Start times further ahead than this, or further in the past, are
   /// refused with ERROR.
-  Duration max_future = std::chrono::hours(1);
+  Duration max_future = kDefaultMaxFuture;
   /// Deadlines (issue 23; docs/server.md, Deadlines): how late after its
   /// start time a timed servo command may still begin when its package gives
   /// no limit (`--max-late S`); Duration::max() = never. `robot_max_late`
   /// overrides it per robot name (`--max-late NAME=S`).
-  Duration max_late = std::chrono::milliseconds(100);
+  Duration max_late = kDefaultMaxLate;
   std::map<std::string, Duration> robot_max_late;
   /// Link health (docs/server.md): stop what a session owns when its link
   /// passes a stop threshold (`--link-stop`; off by default).
@@ -111,7 +120,9 @@ struct ServerOptions {
   /// for the server's threads where permitted (docs/server.md; costs CPU).
   /// ROBOTALK_PRECISE_TIMING=0 in the environment turns it off too.
   bool precise_timing = true;
-  /// Period of the ROBOTALK/ANNOUNCE message.
+  /// Period of the ROBOTALK/ANNOUNCE message. The default is the protocol's
+  /// kAnnouncePeriod (channels.h, not installed; server_daemon_test checks
+  /// they agree), which clients count their waits for an announcement in.
   Duration announce_period = std::chrono::seconds(1);
   /// The paper's congestion injector (§VI-B): after each received package the
   /// ServerDaemon pauses a random time uniform in [0, this]. 0 = off.

@@ -13,6 +13,9 @@
 // nullopt for any other channel (they never throw). Thread-safe (pure).
 #pragma once
 
+#include "robotalk/clock.h"
+
+#include <chrono>
 #include <cinttypes>
 #include <cstdint>
 #include <cstdio>
@@ -22,8 +25,11 @@
 
 namespace robotalk {
 
-/// Every server announces its robots here once a second.
+/// Every server announces its robots here once a second (kAnnouncePeriod).
 inline constexpr const char* kAnnounceChannel = "ROBOTALK/ANNOUNCE";
+/// How often a server announces (ServerOptions::announce_period's default);
+/// clients' waits for an announcement are counted in it.
+inline constexpr Duration kAnnouncePeriod = std::chrono::seconds(1);
 /// Subscription regex (LCM: whole-name match) for the REQUEST channel of every robot.
 inline constexpr const char* kAnyRequestChannelRegex = "ROBOTALK/[^/]+/REQUEST";
 /// Subscription regex for the HELLO channel of every robot.
@@ -46,6 +52,11 @@ inline std::string HelloAnswerChannel(const std::string& robot, std::int64_t cli
 }
 inline std::string ConfigChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/CONFIG"; }
 inline std::string StateChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/STATE"; }
+
+/// True when `name` may name a served robot: non-empty, only [A-Za-z0-9_-]
+/// (the server's --robot, RobotClient::Connect, access lists and known-servers
+/// files all check this one rule; an access list also caps it at 64).
+bool IsValidRobotName(std::string_view name);
 
 /// The robot of "ROBOTALK/<robot>/REQUEST"; nullopt for any other channel.
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel);
