@@ -154,8 +154,9 @@ struct OdeDriverOptions {
   /// "Earlier and faster capture steps"): "off"; "push": from the push's
   /// reading until the step in the air lands, that step lands where and
   /// when the DCM needs (sooner when its place alone cannot catch it), the
-  /// next steps at the fast timing; "always": also whenever the DCM error
-  /// passes the regeneration's threshold with a foot in the air. A value
+  /// next steps at the fast timing; "threshold": instead whenever the DCM
+  /// error passes the regeneration's threshold with a foot in the air (in
+  /// place of the regeneration's step); "always": both. A value
   /// other than "off" without push_recovery is refused. Key "push_step_timing".
   std::string push_step_timing = "off";
   /// With push_recovery: the soonest a foot in the air may land after its

@@ -224,9 +224,10 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   recovery.swing_reach = options.push_swing_reach;
   recovery.min_swing = options.push_min_swing;
   using TimingMode = walking::RecoveryParams::TimingMode;
-  recovery.step_timing = options.push_step_timing == "push"     ? TimingMode::kPush
-                         : options.push_step_timing == "always" ? TimingMode::kAlways
-                                                                : TimingMode::kOff;
+  recovery.step_timing = options.push_step_timing == "push"        ? TimingMode::kPush
+                         : options.push_step_timing == "threshold" ? TimingMode::kThreshold
+                         : options.push_step_timing == "always"    ? TimingMode::kAlways
+                                                                   : TimingMode::kOff;
   using StopFeet = walking::RecoveryParams::StopFeet;
   recovery.stop_feet = options.push_stop_feet == "keep"    ? StopFeet::kKeep
                        : options.push_stop_feet == "still" ? StopFeet::kStill

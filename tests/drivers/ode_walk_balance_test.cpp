@@ -276,38 +276,39 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
 
 // push_step_timing (off by default; docs/ode_sim.md, "Earlier and faster
 // capture steps"): the wiring — walking unpushed it never re-plans; pushed
-// (10 N s toward the left, read in double support), the next step is
-// re-planned from its lift-off until it lands, then no more. Bad settings
-// are refused.
+// toward the left (read in double support), 10 N s is left to the
+// regeneration (the step's place alone catches it: no sooner landing), 30
+// N s re-plans the next step from its lift-off until it lands, then no
+// more. Bad settings are refused.
 TEST(OdeWalk, PushStepTimingReplansOnlyTheStepInTheAirAfterAPush) {
-  Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_step_timing", "push"}});
-  w.Run(1.0);
-  ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
-  w.Run(5.14);
-  EXPECT_EQ(w.driver->walk_status()->push_timings, 0) << "unpushed, nothing re-planned";
-  EXPECT_EQ(w.driver->walk_status()->recoveries, 0);
-  const int steps = w.driver->walk_status()->steps_taken;
-  w.driver->PushForTesting(Eigen::Vector3d(0, 10 / 0.1, 0), FromSeconds(0.1));
-  int first_step = -1, last_step = -1;
-  w.Run(1.5, [&] {
-    const walking::WalkStatus s = *w.driver->walk_status();
-    if (s.push_timings > 0 && first_step < 0) first_step = s.steps_taken;
-    if (s.push_timings > 0) last_step = s.steps_taken;
-    return s.fallen;
-  });
-  const walking::WalkStatus s = *w.driver->walk_status();
-  EXPECT_EQ(s.push_stops, 1);
-  EXPECT_GE(s.push_timings, 1);
-  // The step in the air at the push's reading (in double support: the next one).
-  EXPECT_TRUE(first_step == steps || first_step == steps + 1) << first_step << " " << steps;
-  EXPECT_EQ(last_step, first_step) << "only that step";
-  EXPECT_FALSE(s.fallen);
-  int timings = s.push_timings;
-  w.Run(1.0, [&] {
-    timings = std::max(timings, w.driver->walk_status()->push_timings);
-    return w.driver->walk_status()->fallen;
-  });
-  EXPECT_EQ(timings, s.push_timings) << "none after that step landed";
+  for (const double impulse : {10.0, 30.0}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_step_timing", "push"}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(5.14);
+    EXPECT_EQ(w.driver->walk_status()->push_timings, 0) << "unpushed, nothing re-planned";
+    EXPECT_EQ(w.driver->walk_status()->recoveries, 0);
+    const int steps = w.driver->walk_status()->steps_taken;
+    w.driver->PushForTesting(Eigen::Vector3d(0, impulse / 0.1, 0), FromSeconds(0.1));
+    int first_step = -1, last_step = -1, timings = 0;
+    w.Run(2.5, [&] {
+      const walking::WalkStatus s = *w.driver->walk_status();
+      if (s.push_timings > timings && first_step < 0) first_step = s.steps_taken;
+      if (s.push_timings > timings) last_step = s.steps_taken;
+      timings = s.push_timings;
+      return s.fallen;
+    });
+    EXPECT_EQ(w.driver->walk_status()->push_stops, 1) << impulse;
+    if (impulse < 20) {
+      EXPECT_EQ(timings, 0) << "10 N s: the regeneration as ever";
+      EXPECT_FALSE(w.driver->walk_status()->fallen);
+      continue;
+    }
+    EXPECT_GE(timings, 1);
+    // The step in the air at the push's reading (in double support: the next one).
+    EXPECT_TRUE(first_step == steps || first_step == steps + 1) << first_step << " " << steps;
+    EXPECT_EQ(last_step, first_step) << "only that step";
+  }
   const std::optional<std::string> bad = RefusalOfWalker({{"push_step_timing", "soon"}});
   ASSERT_TRUE(bad) << "push_step_timing=soon accepted";
   EXPECT_NE(bad->find("push_step_timing"), std::string::npos) << *bad;

@@ -233,7 +233,7 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
 }
 
 bool WalkPattern::AdaptStep(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
-                            const StepTimingAdapter& adapter, const RecoveryParams& rp) {
+                            const StepTimingAdapter& adapter, const RecoveryParams& rp, bool only_sooner) {
   Prune();
   const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
   size_t k = 0;  // the step in the air
@@ -262,6 +262,7 @@ bool WalkPattern::AdaptStep(const Eigen::Vector2d& com, const Eigen::Vector2d& c
   s.foot = foot_[static_cast<int>(st.step.side)].xy();
   s.foot_speed = rp.swing_reach;
   const StepTiming r = adapter.Solve(s);
+  if (only_sooner && r.remaining > s.remaining - rp.timing_sooner) return false;
   const std::int64_t land = std::clamp(tick_ + ticks(r.remaining), std::min(soonest, st.land), st.land);
   Rebuild(k, land, -1, u, {r.landing - s.landing}, rp);
   SetComState(com, com_vel);
@@ -467,14 +468,18 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
 bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) {
   since_ += tick_;
   error_ = (com + com_vel / omega_) - (pattern.com() + pattern.com_velocity() / omega_);
-  if (timing_ && (pushed_ || p_.step_timing == RecoveryParams::TimingMode::kAlways) &&
-      since_ >= p_.interval) {
+  if (timing_ && since_ >= p_.interval) {
     // Step timing: from the push's reading until a step it re-planned lands
-    // (read in double support: the next step to lift; kAlways: also when
-    // the DCM error passes the threshold with a foot in the air).
-    const bool over = (error_.array().abs() > p_.threshold).any();
+    // (read in double support: the next step to lift; kPush, kAlways: only
+    // a step the adapter lands sooner than planned, else the regeneration
+    // below as ever), and
+    // whenever the DCM error passes the threshold with a foot in the air
+    // (kThreshold, kAlways: in place of the regeneration).
+    using Mode = RecoveryParams::TimingMode;
+    const bool over = (error_.array().abs() > p_.threshold).any() && p_.step_timing != Mode::kPush;
+    pushed_ = pushed_ && p_.step_timing != Mode::kThreshold;
     if (pushed_ || over) {
-      if (pattern.AdaptStep(com, com_vel, *timing_, p_)) {
+      if (pattern.AdaptStep(com, com_vel, *timing_, p_, !over)) {
         since_ = 0;
         ++timed_;
         adapted_ = true;

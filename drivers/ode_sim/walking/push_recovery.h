@@ -117,15 +117,19 @@ struct RecoveryParams {
   StopFeet stop_feet = StopFeet::kMove;
   // Step timing adaptation with step location (step_timing.h; driver option
   // push_step_timing, off): kPush: from Watch's stop (the push read) until
-  // the step in the air lands (read in double support: the next step, from
-  // its lift-off; before it the regeneration as ever), every `interval` that step lands where and
-  // when StepTimingAdapter says for the measured DCM (WalkPattern::AdaptStep,
-  // in place of the regeneration); kAlways: also whenever the DCM error
-  // passes `threshold` with a foot in the air. The soonest landing is
-  // min_swing after the lift-off; the next steps at the fast timing.
-  enum class TimingMode : std::uint8_t { kOff, kPush, kAlways };
+  // the step in the air lands, when the adapter lands it `timing_sooner` sooner than planned (read in double
+  // support: the next step, from its lift-off; before it the regeneration as ever), every `interval` that
+  // step lands where and when StepTimingAdapter says for the measured DCM (WalkPattern::AdaptStep, in place
+  // of the regeneration); kThreshold: instead whenever the DCM error passes `threshold` with a foot in the
+  // air (in place of the regeneration's step); kAlways: both. The soonest landing is min_swing after the
+  // lift-off; the next steps at the fast timing.
+  enum class TimingMode : std::uint8_t { kOff, kPush, kThreshold, kAlways };
   TimingMode step_timing = TimingMode::kOff;
   StepTimingParams timing;  ///< its weights; reach and widths are copied from above
+  /// s: after a push's reading a step is re-planned only when the adapter
+  /// lands it at least this much sooner than planned (its place alone cannot
+  /// catch the DCM); else the regeneration as ever.
+  double timing_sooner = 0.02;
 };
 
 class PushRecovery {

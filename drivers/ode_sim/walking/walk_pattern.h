@@ -110,8 +110,11 @@ class WalkPattern {
   /// moves with it, the next `fast_steps` at the fast timing (the next lifts
   /// within `fast_double`). The CoM state becomes the measured one. False
   /// (nothing changed) when no foot is in the air or it is too late.
+  /// `only_sooner`: changes nothing (false) unless the adapter lands the
+  /// step at least `sooner` s before the plan's time (its place alone
+  /// cannot catch the DCM).
   bool AdaptStep(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const StepTimingAdapter& adapter,
-                 const RecoveryParams& p);
+                 const RecoveryParams& p, bool only_sooner = false);
   /// The capture stop (push_recovery.h), after StopSoon: the stop's last
   /// step (the foot brought alongside) lands where the measured DCM (from
   /// `com`, `com_vel`, plan frame) is caught. Predicted on the reference's
