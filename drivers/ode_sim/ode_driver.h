@@ -152,12 +152,13 @@ struct OdeDriverOptions {
   /// With push_recovery: step timing adaptation with step location
   /// (walking/step_timing.h, RecoveryParams::step_timing; docs/ode_sim.md,
   /// "Earlier and faster capture steps"): "off"; "push": from the push's
-  /// reading until the step in the air lands, that step lands where and
-  /// when the DCM needs (sooner when its place alone cannot catch it), the
-  /// next steps at the fast timing; "threshold": instead whenever the DCM
-  /// error passes the regeneration's threshold with a foot in the air (in
-  /// place of the regeneration's step); "always": both. A value
-  /// other than "off" without push_recovery is refused. Key "push_step_timing".
+  /// reading until a re-planned step lands, a step in the air whose place
+  /// alone cannot catch the DCM lands sooner, where the DCM needs, the next
+  /// steps at the fast timing (otherwise the regeneration as ever);
+  /// "threshold": instead whenever the DCM error passes the regeneration's
+  /// threshold with a foot in the air (in place of the regeneration's
+  /// step); "always": both. Off: measured no better on ODE. A value other
+  /// than "off" without push_recovery is refused. Key "push_step_timing".
   std::string push_step_timing = "off";
   /// With push_recovery: the soonest a foot in the air may land after its
   /// lift-off when the regeneration or the step timing lands it sooner

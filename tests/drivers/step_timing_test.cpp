@@ -159,6 +159,8 @@ TEST(StepTiming, ALandingBeyondReachLandsSoonerWithinReachAndBesideTheStanceFoot
   const StepTiming slow = adapter.Solve(s);
   EXPECT_LE((slow.landing - s.foot).norm(),
             std::max((s.landing - s.foot).norm(), s.foot_speed * slow.remaining) + 1e-9);
+  EXPECT_GE(slow.remaining, s.soonest);
+  EXPECT_LE(slow.remaining, s.remaining);
 }
 
 // The reproducer: a pushed pendulum walking on, the step's location alone
