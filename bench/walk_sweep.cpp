@@ -221,7 +221,7 @@ struct Run {
     // Then each sole's lowest corner's height, largest one-contact force and pitch.
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.5f,%.1f,%.4f", s.foot_low[i], s.foot_peak_force[i], s.foot_pitch[i]);
-    std::fprintf(trace, "\n");
+    std::fprintf(trace, ",%d\n", s.push_timings);  // then push_step_timing's re-plans
   }
   void Panic() {
     d->Halt(done);
@@ -540,7 +540,7 @@ int Probe(const Args& args) {
           "lcontacts,"
           "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
           "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
-          "rpitch\n");
+          "rpitch,timings\n");
     }
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);

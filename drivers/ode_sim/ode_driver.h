@@ -149,6 +149,21 @@ struct OdeDriverOptions {
   /// to be the cause (its height stays under 1 mm; the runs diverge
   /// chaotically), so it stays an option. Key "push_balance".
   std::string push_balance = "off";
+  /// With push_recovery: step timing adaptation with step location
+  /// (walking/step_timing.h, RecoveryParams::step_timing; docs/ode_sim.md,
+  /// "Earlier and faster capture steps"): "off"; "push": from the push's
+  /// reading until a re-planned step lands, a step in the air whose place
+  /// alone cannot catch the DCM lands sooner, where the DCM needs, the next
+  /// steps at the fast timing (otherwise the regeneration as ever);
+  /// "threshold": instead whenever the DCM error passes the regeneration's
+  /// threshold with a foot in the air (in place of the regeneration's
+  /// step); "always": both. Off: measured no better on ODE. A value other
+  /// than "off" without push_recovery is refused. Key "push_step_timing".
+  std::string push_step_timing = "off";
+  /// With push_recovery: the soonest a foot in the air may land after its
+  /// lift-off when the regeneration or the step timing lands it sooner
+  /// (RecoveryParams::min_swing), s. Key "push_min_swing".
+  double push_min_swing = 0.35;
   /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
   /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
   /// yield to the error between its measured and desired centre of pressure

@@ -74,6 +74,11 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       o.push_stop_feet != "keep" && o.push_stop_feet != "still") {
     r.Fail("push_stop_feet", "move, keep or still");
   }
+  if (r.Text("push_step_timing", &o.push_step_timing) && o.push_step_timing != "off" &&
+      o.push_step_timing != "push" && o.push_step_timing != "threshold" && o.push_step_timing != "always") {
+    r.Fail("push_step_timing", "off, push, threshold or always");
+  }
+  r.Number("push_min_swing", &o.push_min_swing, kNonNegative, "a time >= 0 (s)");
   if (r.Text("push_balance", &o.push_balance) && o.push_balance != "off" && o.push_balance != "both") {
     const std::vector<std::string> parts = SplitPlus(o.push_balance);
     if (parts.empty()) r.Fail("push_balance", "off, both, or damping, stabilizer and forces joined by '+'");

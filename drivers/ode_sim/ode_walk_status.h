@@ -69,6 +69,7 @@ struct WalkStatus {
   int recoveries = 0;      ///< push recoveries so far (walking/push_recovery.h: the pattern regenerated)
   int push_stops = 0;      ///< walks stopped by a push so far (push_recovery's stop and stand)
   int push_captures = 0;   ///< push_capture=true: the capture stop's re-plans so far
+  int push_timings = 0;    ///< push_step_timing: the step timing's re-plans so far
   bool saturated = false;  ///< the ZMP the stabilizer wanted lay outside the support
 };
 

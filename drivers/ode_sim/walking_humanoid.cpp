@@ -202,6 +202,10 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
   }
+  if (options.push_step_timing != "off" && !options.push_recovery) {
+    throw Error("OdeDriver: push_step_timing=" + options.push_step_timing +
+                " needs push_recovery=true (it re-plans the push recovery's steps)");
+  }
   if (options.push_balance != "off" && !options.push_recovery) {
     throw Error("OdeDriver: push_balance=" + options.push_balance +
                 " needs push_recovery=true (it acts while the push recovery's stop holds)");
@@ -218,6 +222,12 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
   recovery.swing_reach = options.push_swing_reach;
+  recovery.min_swing = options.push_min_swing;
+  using TimingMode = walking::RecoveryParams::TimingMode;
+  recovery.step_timing = options.push_step_timing == "push"        ? TimingMode::kPush
+                         : options.push_step_timing == "threshold" ? TimingMode::kThreshold
+                         : options.push_step_timing == "always"    ? TimingMode::kAlways
+                                                                   : TimingMode::kOff;
   using StopFeet = walking::RecoveryParams::StopFeet;
   recovery.stop_feet = options.push_stop_feet == "keep"    ? StopFeet::kKeep
                        : options.push_stop_feet == "still" ? StopFeet::kStill

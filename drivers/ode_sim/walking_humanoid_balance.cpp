@@ -160,6 +160,7 @@ walking::WalkStatus WalkingHumanoid::status() const {
   s.recoveries = recovery_ ? recovery_->regenerations() : 0;
   s.push_stops = recovery_ ? recovery_->stops() : 0;
   s.push_captures = recovery_ ? recovery_->captures() : 0;
+  s.push_timings = recovery_ ? recovery_->timings() : 0;
   const Pose2 com = ToWorld({pattern_.com().x(), pattern_.com().y(), 0});
   s.com_plan = com.xy();
   const Eigen::Vector2d z = pattern_.zmp_ref();

@@ -274,6 +274,52 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}}));
 }
 
+// push_step_timing (off by default; docs/ode_sim.md, "Earlier and faster
+// capture steps"): the wiring — walking unpushed it never re-plans; pushed
+// toward the left (read in double support), 10 N s is left to the
+// regeneration (the step's place alone catches it: no sooner landing), 30
+// N s re-plans the next step from its lift-off until it lands, then no
+// more. Bad settings are refused.
+TEST(OdeWalk, PushStepTimingReplansOnlyTheStepInTheAirAfterAPush) {
+  for (const double impulse : {10.0, 30.0}) {
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_step_timing", "push"}});
+    w.Run(1.0);
+    ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
+    w.Run(5.14);
+    EXPECT_EQ(w.driver->walk_status()->push_timings, 0) << "unpushed, nothing re-planned";
+    EXPECT_EQ(w.driver->walk_status()->recoveries, 0);
+    const int steps = w.driver->walk_status()->steps_taken;
+    w.driver->PushForTesting(Eigen::Vector3d(0, impulse / 0.1, 0), FromSeconds(0.1));
+    int first_step = -1, last_step = -1, timings = 0;
+    w.Run(2.5, [&] {
+      const walking::WalkStatus s = *w.driver->walk_status();
+      if (s.push_timings > timings && first_step < 0) first_step = s.steps_taken;
+      if (s.push_timings > timings) last_step = s.steps_taken;
+      timings = s.push_timings;
+      return s.fallen;
+    });
+    EXPECT_EQ(w.driver->walk_status()->push_stops, 1) << impulse;
+    if (impulse < 20) {
+      EXPECT_EQ(timings, 0) << "10 N s: the regeneration as ever";
+      EXPECT_FALSE(w.driver->walk_status()->fallen);
+      continue;
+    }
+    EXPECT_GE(timings, 1);
+    // The step in the air at the push's reading (in double support: the next one).
+    EXPECT_TRUE(first_step == steps || first_step == steps + 1) << first_step << " " << steps;
+    EXPECT_EQ(last_step, first_step) << "only that step";
+  }
+  const std::optional<std::string> bad = RefusalOfWalker({{"push_step_timing", "soon"}});
+  ASSERT_TRUE(bad) << "push_step_timing=soon accepted";
+  EXPECT_NE(bad->find("push_step_timing"), std::string::npos) << *bad;
+  const std::optional<std::string> alone =
+      RefusalOfWalker({{"push_step_timing", "push"}, {"push_recovery", "false"}});
+  ASSERT_TRUE(alone) << "push_step_timing without push_recovery accepted";
+  EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
+  EXPECT_FALSE(RefusalOfWalker({{"push_step_timing", "always"}}));
+  EXPECT_TRUE(RefusalOfWalker({{"push_min_swing", "-0.1"}}));
+}
+
 // Push recovery's stop during a GOTO (on by default): the walk stops, the
 // robot stands through the hold, then the GOTO re-plans from where the push
 // left it and still ends at its goal with SUCCESS (no reply before the hold

@@ -2,6 +2,7 @@
 #include "walking/push_recovery.h"
 
 #include "walking/dcm_stabilizer.h"
+#include "walking/step_timing.h"
 
 #include <algorithm>
 #include <array>
@@ -231,6 +232,43 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
   return true;
 }
 
+bool WalkPattern::AdaptStep(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel,
+                            const StepTimingAdapter& adapter, const RecoveryParams& rp, bool only_sooner) {
+  Prune();
+  const auto ticks = [&](double s) { return static_cast<std::int64_t>(std::llround(s / tick_s_)); };
+  size_t k = 0;  // the step in the air
+  while (k < steps_.size() && steps_[k].land <= tick_) ++k;
+  if (k == steps_.size() || !steps_[k].swing || steps_[k].start > tick_ ||
+      TooLate(steps_[k], ticks(rp.late))) {
+    return false;
+  }
+  const double omega = std::sqrt(gravity_ / g_.com_height);
+  const Scheduled& st = steps_[k];
+  const Eigen::Vector2d xi = com + com_vel / omega, xi_plan = this->com() + com_velocity() / omega;
+  const Eigen::Vector2d p_now = ZmpAt(tick_);
+  // The ankles as the regeneration's: the stance ZMP toward the error, inside the sole.
+  const Eigen::Vector2d u =
+      ClampToPolygon(p_now + xi - xi_plan, Corners(st.stance, g_), rp.ankle_margin) - p_now;
+  StepSituation s;
+  s.dcm = xi;
+  s.cop = p_now + u;
+  s.stance = st.stance;
+  s.swing = st.step.side;
+  s.landing = st.step.pose.xy();
+  s.offset = DcmAt(st.land, xi_plan) - s.landing;  // the plan's own DCM at its landing
+  s.remaining = static_cast<double>(st.land - tick_) * tick_s_;
+  const std::int64_t soonest = std::max(tick_ + ticks(rp.late), st.start + ticks(rp.min_swing));
+  s.soonest = static_cast<double>(std::max<std::int64_t>(0, soonest - tick_)) * tick_s_;
+  s.foot = foot_[static_cast<int>(st.step.side)].xy();
+  s.foot_speed = rp.swing_reach;
+  const StepTiming r = adapter.Solve(s);
+  if (only_sooner && r.remaining > s.remaining - rp.timing_sooner) return false;
+  const std::int64_t land = std::clamp(tick_ + ticks(r.remaining), std::min(soonest, st.land), st.land);
+  Rebuild(k, land, -1, u, {r.landing - s.landing}, rp);
+  SetComState(com, com_vel);
+  return true;
+}
+
 Eigen::Vector2d WalkPattern::DcmAt(std::int64_t at, const Eigen::Vector2d& xi0) const {
   // xi(T) = e^{wT} (xi0 - w int_0^T e^{-wt} p(now + t) dt), midpoint rule over 5 ticks.
   const double omega = std::sqrt(gravity_ / g_.com_height);
@@ -411,6 +449,14 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
   if (!(p_.stop_impulse >= 0) || (p_.stop_impulse > 0 && !(p_.stop_hold > 0))) {
     throw std::invalid_argument("PushRecovery: stop_impulse must be >= 0 (0: off) and stop_hold > 0");
   }
+  if (p_.step_timing != RecoveryParams::TimingMode::kOff) {
+    StepTimingParams t = p_.timing;
+    t.reach = p_.reach;
+    t.reach_back = p_.reach_back;
+    t.min_width = p_.min_width;
+    t.max_width = p_.max_width;
+    timing_.emplace(omega, t);
+  }
   if (!(p_.capture_margin >= 0) || !(p_.capture_shift > 0) || !(p_.capture_hold >= 0) ||
       !(p_.capture_tidy_beyond >= 0)) {
     throw std::invalid_argument(
@@ -422,6 +468,27 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
 bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) {
   since_ += tick_;
   error_ = (com + com_vel / omega_) - (pattern.com() + pattern.com_velocity() / omega_);
+  if (timing_ && since_ >= p_.interval) {
+    // Step timing: from the push's reading until a step it re-planned lands
+    // (read in double support: the next step to lift; kPush, kAlways: only
+    // a step the adapter lands sooner than planned, else the regeneration
+    // below as ever), and
+    // whenever the DCM error passes the threshold with a foot in the air
+    // (kThreshold, kAlways: in place of the regeneration).
+    using Mode = RecoveryParams::TimingMode;
+    const bool over = (error_.array().abs() > p_.threshold).any() && p_.step_timing != Mode::kPush;
+    pushed_ = pushed_ && p_.step_timing != Mode::kThreshold;
+    if (pushed_ || over) {
+      if (pattern.AdaptStep(com, com_vel, *timing_, p_, !over)) {
+        since_ = 0;
+        ++timed_;
+        adapted_ = true;
+        return true;
+      }
+      // No foot in the air (or too late): the regeneration below as ever.
+      if (adapted_ || pattern.standing()) pushed_ = adapted_ = false;
+    }
+  }
   if (capturing_) {  // the capture stop re-plans until its last step lands; no regeneration meanwhile
     if (since_ < p_.interval) return false;
     capturing_ = pattern.CaptureStop(com, com_vel, p_);
@@ -447,6 +514,9 @@ PushRecovery::Walk PushRecovery::Watch(WalkPattern& pattern, const Eigen::Vector
   if (p_.stop_impulse > 0 && impulse.norm() > p_.stop_impulse) {
     if (hold_ <= 0 && !pattern.standing()) {
       pattern.StopSoon();
+      pushed_ = timing_.has_value();
+      adapted_ = false;
+      if (pushed_) since_ = 1e9;  // the step timing's first re-plan at the next Update
       ++stops_;
       hold_ = p_.stop_hold;
       capturing_ = p_.capture_stop;

@@ -40,11 +40,13 @@
 // Threading: one thread. Allocation: Regenerate re-plans the schedule.
 #pragma once
 
+#include "walking/step_timing.h"
 #include "walking/walk_pattern.h"
 
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <optional>
 
 namespace robotalk::walking {
 
@@ -113,6 +115,21 @@ struct RecoveryParams {
   // regeneration at all until the walk resumes (nothing re-anchored).
   enum class StopFeet : std::uint8_t { kMove, kKeep, kStill };
   StopFeet stop_feet = StopFeet::kMove;
+  // Step timing adaptation with step location (step_timing.h; driver option
+  // push_step_timing, off): kPush: from Watch's stop (the push read) until
+  // the step in the air lands, when the adapter lands it `timing_sooner` sooner than planned (read in double
+  // support: the next step, from its lift-off; before it the regeneration as ever), every `interval` that
+  // step lands where and when StepTimingAdapter says for the measured DCM (WalkPattern::AdaptStep, in place
+  // of the regeneration); kThreshold: instead whenever the DCM error passes `threshold` with a foot in the
+  // air (in place of the regeneration's step); kAlways: both. The soonest landing is min_swing after the
+  // lift-off; the next steps at the fast timing.
+  enum class TimingMode : std::uint8_t { kOff, kPush, kThreshold, kAlways };
+  TimingMode step_timing = TimingMode::kOff;
+  StepTimingParams timing;  ///< its weights; reach and widths are copied from above
+  /// s: after a push's reading a step is re-planned only when the adapter
+  /// lands it at least this much sooner than planned (its place alone cannot
+  /// catch the DCM); else the regeneration as ever.
+  double timing_sooner = 0.02;
 };
 
 class PushRecovery {
@@ -152,6 +169,8 @@ class PushRecovery {
   /// With capture_stop: the capture stop's re-plans so far (Update returns
   /// true for each; every `interval` from the stop until its last step lands).
   int captures() const { return captures_; }
+  /// With step_timing: the step timing's re-plans so far (Update returns true for each).
+  int timings() const { return timed_; }
 
  private:
   double omega_, tick_;
@@ -163,6 +182,10 @@ class PushRecovery {
   int stops_ = 0;
   bool capturing_ = false;  // a capture stop whose last step has not landed
   int captures_ = 0;
+  std::optional<StepTimingAdapter> timing_;  // step_timing != kOff
+  bool pushed_ = false;                      // a push read; no step it re-planned has landed yet
+  bool adapted_ = false;                     // ... and one was re-planned
+  int timed_ = 0;
 };
 
 }  // namespace robotalk::walking

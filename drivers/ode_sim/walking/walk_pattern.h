@@ -45,7 +45,8 @@
 
 namespace robotalk::walking {
 
-struct RecoveryParams;  // push_recovery.h
+struct RecoveryParams;    // push_recovery.h
+class StepTimingAdapter;  // step_timing.h
 
 class WalkPattern {
  public:
@@ -99,6 +100,21 @@ class WalkPattern {
   /// stop, PushRecovery::Watch): the landings as RecoveryParams::stop_feet says.
   bool Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p,
                   bool stopping = false);
+  /// Step timing adaptation (step_timing.h; push_recovery.h's step_timing):
+  /// the foot in the air (unless within `late` of its landing) lands where
+  /// and when `adapter` says for the measured CoM and velocity (plan frame):
+  /// the stance ZMP until then moved toward the DCM error as the
+  /// regeneration's ankles do (`ankle_margin` inside the sole), not sooner
+  /// than `min_swing` after its lift-off, within reach and width of its
+  /// stance foot and `swing_reach` from where the foot is; every later step
+  /// moves with it, the next `fast_steps` at the fast timing (the next lifts
+  /// within `fast_double`). The CoM state becomes the measured one. False
+  /// (nothing changed) when no foot is in the air or it is too late.
+  /// `only_sooner`: changes nothing (false) unless the adapter lands the
+  /// step at least `sooner` s before the plan's time (its place alone
+  /// cannot catch the DCM).
+  bool AdaptStep(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const StepTimingAdapter& adapter,
+                 const RecoveryParams& p, bool only_sooner = false);
   /// The capture stop (push_recovery.h), after StopSoon: the stop's last
   /// step (the foot brought alongside) lands where the measured DCM (from
   /// `com`, `com_vel`, plan frame) is caught. Predicted on the reference's
