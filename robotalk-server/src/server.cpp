@@ -170,6 +170,7 @@ class Server::Impl {
           spec.name, spec.driver, registry.Create(spec.driver, config), clock_, daemon_options));
       const auto own_limit = options_.robot_max_late.find(spec.name);
       sessions.max_late = own_limit != options_.robot_max_late.end() ? own_limit->second : options_.max_late;
+      robots_.back()->LogLateStarts(options_.log_playback);  // its late starts explained (issue 23)
       server_daemon_->AddRobot(*robots_.back(), sessions);
     }
     url_ = transport->url();
