@@ -380,7 +380,7 @@ void PlaybackEstimator::AddFrameCopy(TimePoint sent, TimePoint received) {
   const std::optional<Duration> d = OneWayDelay(sent, received);
   if (!d) return;
   frame_copies_.push_back(*d);
-  copy_decided_ = std::max(copy_decided_, received);
+  DecideAt(received);
 }
 
 Duration PlaybackEstimator::CopiesWorst() const {
@@ -471,7 +471,7 @@ TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin, Dura
     first_offset = std::min(first_offset, f.offset);
     decided = std::max(decided, f.arrival);
   }
-  decided = std::max(decided, copy_decided_);  // a frame's second copy seen: decided then
+  decided = std::max(decided, decided_at_);  // a wait for a frame's second copy ended: decided then
   const Duration excess = std::max(Duration(0), worst - *anchor->delay);
   return std::max(anchor->arrival - anchor->offset + excess - lead, decided - first_offset) + margin;
 }
@@ -616,7 +616,7 @@ std::string PlaybackEstimator::Describe() const {
     if (frames_copied()) {
       out += ",\"frame_copies\":" +
              list(frame_copies_.begin(), frame_copies_.end(), [&](Duration d) { return ms(d - least); });
-      out += ",\"copies_worst\":" + ms(CopiesWorst() - least) + ",\"decided\":" + ms(copy_decided_ - first);
+      out += ",\"copies_worst\":" + ms(CopiesWorst() - least) + ",\"decided\":" + ms(decided_at_ - first);
     }
     out += ",\"worst\":" + ms(AdaptiveWorst(options_.start_headroom) - least) +
            ",\"playout\":" + ms(*playout_delay() - least) + ",\"lead\":" + ms(start_lead());

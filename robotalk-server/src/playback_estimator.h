@@ -330,6 +330,9 @@ class PlaybackEstimator {
   /// its frames come twice (copies_start). The decision is then no earlier
   /// than `received`.
   void AddFrameCopy(TimePoint sent, TimePoint received);
+  /// The start is decided at `now` (later than the latest frame: a wait for a
+  /// second copy ended): it is never before `now` + the margin.
+  void DecideAt(TimePoint now) { decided_at_ = std::max(decided_at_, now); }
   /// Whether a frame of this sequence came twice (AddFrameCopy).
   bool frames_copied() const { return !frame_copies_.empty(); }
   /// The schedule's options: with the adaptive estimator its stretch, margin
@@ -425,7 +428,7 @@ class PlaybackEstimator {
   };
   std::vector<Copy> copies_;            // copies of earlier packages the history saw handled, oldest first
   std::vector<Duration> frame_copies_;  // the delays of this sequence's frames' second copies
-  TimePoint copy_decided_ = TimePoint::min();  // the latest AddFrameCopy
+  TimePoint decided_at_ = TimePoint::min();  // the latest AddFrameCopy or DecideAt
   // The latest copy handled after `after` and before `before`, else `after`.
   TimePoint BehindCopy(TimePoint after, TimePoint before) const;
 };

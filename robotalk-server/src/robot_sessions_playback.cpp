@@ -173,6 +173,8 @@ bool RobotSessions::DecidePlaybacks(TimePoint now) {
     }
     copy_waits_.erase(copy_waits_.begin() + static_cast<std::ptrdiff_t>(k));
     if (!live) continue;
+    // Decided now: a thread that woke late starts later, never with a frame past its time.
+    it->second.estimator->DecideAt(now);
     std::vector<Reply> started;
     Start(*s, w.playback_id, it->second, now, started);
     for (Reply& reply : started) {

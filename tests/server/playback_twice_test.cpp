@@ -24,6 +24,8 @@ using std::chrono::milliseconds;
 
 class PlaybackTwiceTest : public RobotSessionsTest {
  protected:
+  explicit PlaybackTwiceTest(SessionOptions options = {})
+      : RobotSessionsTest(BaseType::kDifferential, options) {}
   static constexpr Duration kSkew = std::chrono::seconds(3);
   static constexpr std::int64_t kId = 9300;
   static constexpr int kFrames = 40;
@@ -33,7 +35,7 @@ class PlaybackTwiceTest : public RobotSessionsTest {
     double worst_gap_s = 0;  // between successive frames' executions
     std::size_t ran = 0;
   };
-  Outcome Run(std::uint64_t seed) {
+  Outcome Run(std::uint64_t seed, int copies = 2) {
     std::mt19937_64 rng(seed);
     const auto draw = [&] {
       return milliseconds(100) + FromSeconds(std::uniform_real_distribution<double>(0, 100)(rng) / 1000.0);
@@ -62,9 +64,9 @@ class PlaybackTwiceTest : public RobotSessionsTest {
       const TimePoint s = frame_sent + milliseconds(100) * i;
       r.send_time = s + kSkew;
       const TimePoint a = s + draw(), b = s + draw();
-      first[static_cast<std::size_t>(i)] = std::min(a, b);
+      first[static_cast<std::size_t>(i)] = copies > 1 ? std::min(a, b) : a;
       events.push_back({a, r});
-      events.push_back({b, r});  // the second copy: same sequence, a duplicate
+      if (copies > 1) events.push_back({b, r});  // the second copy: same sequence, a duplicate
     }
     std::stable_sort(events.begin(), events.end(),
                      [](const Event& a, const Event& b) { return a.at < b.at; });
@@ -85,6 +87,7 @@ class PlaybackTwiceTest : public RobotSessionsTest {
         ++next;
       }
       clock_.Set(t);
+      sessions_->DecidePlaybacks(t);  // as the ServerDaemon does at a wait's end
       RobotSessionsTest::Run();
     }
     note(Replies(kAlice));
@@ -109,6 +112,31 @@ TEST_F(PlaybackTwiceTest, FramesSentTwiceStartWithinAQuarterOfTheHindsightMinimu
   EXPECT_EQ(o.ran, static_cast<std::size_t>(kFrames));
   EXPECT_LE(o.start_s, 1.25 * (o.hindsight_s + 0.002));
   EXPECT_LE(o.worst_gap_s, 0.110 + 0.001) << "no pause: every gap within the 10 % stretch";
+}
+
+// A client that sends each package once: the server waits for a second copy
+// that never comes and starts, when its wait ends, with the start it would
+// have taken at frame 0 (copies_start off: the same start, the same gaps).
+TEST_F(PlaybackTwiceTest, FramesSentOnceStartAsWithoutTheWait) {
+  const Outcome o = Run(21, 1);
+  std::printf("one copy: start %.6f ms, worst gap %.6f ms\n", o.start_s * 1e3, o.worst_gap_s * 1e3);
+  EXPECT_EQ(o.ran, static_cast<std::size_t>(kFrames));
+  EXPECT_NEAR(o.start_s, 0.0286592, 1e-6) << "as with copies_start off";
+  EXPECT_NEAR(o.worst_gap_s, 0.110, 1e-6);
+}
+
+class PlaybackTwiceOffTest : public PlaybackTwiceTest {
+ protected:
+  PlaybackTwiceOffTest() : PlaybackTwiceTest(SessionOptions{.playback = {.copies_start = false}}) {}
+};
+
+TEST_F(PlaybackTwiceOffTest, FramesSentOnceStartAtTheFirstFrameWithoutTheWait) {
+  const Outcome o = Run(21, 1);
+  std::printf("one copy, copies_start off: start %.6f ms, worst gap %.6f ms\n", o.start_s * 1e3,
+              o.worst_gap_s * 1e3);
+  EXPECT_EQ(o.ran, static_cast<std::size_t>(kFrames));
+  EXPECT_NEAR(o.start_s, 0.0286592, 1e-6);
+  EXPECT_NEAR(o.worst_gap_s, 0.110, 1e-6);
 }
 
 }  // namespace
