@@ -130,6 +130,7 @@ class Server::Impl {
     sessions.playback.queue_start = options_.playback_queue_start;
     sessions.playback.follow_queue = options_.playback_follow_queue;
     sessions.playback.burst_wait_discount = options_.playback_burst_discount;
+    sessions.playback.copies_start = options_.playback_copies_start;
     sessions.playback_resent_delays = options_.playback_resent_delays;
     sessions.log_playback = options_.log_playback;
     sessions.playback.start_lead = options_.playback_start_lead;

@@ -24,7 +24,8 @@ using std::chrono::milliseconds;
 
 class PlaybackTwiceTest : public RobotSessionsTest {
  protected:
-  explicit PlaybackTwiceTest(SessionOptions options = {})
+  // --playback-copies-start on (an option, off by default).
+  explicit PlaybackTwiceTest(SessionOptions options = SessionOptions{.playback = {.copies_start = true}})
       : RobotSessionsTest(BaseType::kDifferential, options) {}
   static constexpr Duration kSkew = std::chrono::seconds(3);
   static constexpr std::int64_t kId = 9300;
