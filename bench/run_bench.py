@@ -430,6 +430,11 @@ class Bench:
         # thin, judged at that bound; "adaptive_thin_off" (the default since, every gap within 10 %)
         # is the name its relay runs in bench/results/session10/ gave the default
         thin = ["--playback-thin-stretch", "0.25"]
+        # frames that come twice (issue 23, eleventh session; an option): the server waits for frame 0's
+        # second copy and covers the earlier of two delays; the client sends two copies always.
+        # In bench/results/session11/ this build was the branch's "adaptive_copies" (then its default).
+        variants += (("adaptive_copies_start", adaptive + ["--playback-copies-start", "on"], ["--copies", "2"], 2.0,
+                      ("WAN",)),)
         variants += (("adaptive_thin", adaptive + thin, ["--stretch-bound", "0.25"], 2.0, None),
                      ("adaptive_thin_off", adaptive + ["--playback-thin-stretch", "0.1"], [], 2.0, None))
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
