@@ -59,6 +59,14 @@ class Bench:
         except (OSError, ValueError):
             return None
 
+    def late_starts(self):
+        """The server log's "late start:" lines (the RobotDaemon's own account of each command it began more
+        than 1 ms after its start time, and of each timed item handed over after its start; --log-playback)."""
+        try:
+            return [x.strip() for x in open(f"{self.tmp}/server.log") if "late start:" in x][:50]
+        except OSError:
+            return []
+
     @staticmethod
     def parse(out, what):
         for line in reversed((out or "").strip().splitlines()):
@@ -422,6 +430,11 @@ class Bench:
         # thin, judged at that bound; "adaptive_thin_off" (the default since, every gap within 10 %)
         # is the name its relay runs in bench/results/session10/ gave the default
         thin = ["--playback-thin-stretch", "0.25"]
+        # frames that come twice (issue 23, eleventh session; an option): the server waits for frame 0's
+        # second copy and covers the earlier of two delays; the client sends two copies always.
+        # In bench/results/session11/ this build was the branch's "adaptive_copies" (then its default).
+        variants += (("adaptive_copies_start", adaptive + ["--playback-copies-start", "on"], ["--copies", "2"], 2.0,
+                      ("WAN",)),)
         variants += (("adaptive_thin", adaptive + thin, ["--stretch-bound", "0.25"], 2.0, None),
                      ("adaptive_thin_off", adaptive + ["--playback-thin-stretch", "0.1"], [], 2.0, None))
         # ROBOTALK_BENCH_BEFORE_SERVER=PATH adds the default's arguments on another build's
@@ -429,7 +442,9 @@ class Bench:
         # relay seeds and under the same load, interleaved.
         before_server = os.environ.get("ROBOTALK_BENCH_BEFORE_SERVER")
         if before_server:
-            variants += (("adaptive_before_build", adaptive, [], 2.0, None),)
+            variants += (("adaptive_before_build", adaptive, [], 2.0, None),
+                         # the same with the client's two copies always (issue 23, eleventh session)
+                         ("adaptive_copies_before_build", adaptive, ["--copies", "2"], 2.0, ("WAN",)))
         # ROBOTALK_BENCH_VARIANTS=a,b runs only those variants (a shorter run).
         only_variants = [v for v in os.environ.get("ROBOTALK_BENCH_VARIANTS", "").split(",") if v]
         if only_variants:
@@ -443,7 +458,7 @@ class Bench:
                     if only and not name.startswith(only):
                         continue
                     own_server = self.server_bin
-                    if est == "adaptive_before_build":
+                    if est in ("adaptive_before_build", "adaptive_copies_before_build"):
                         self.server_bin = before_server
                     try:  # --log-playback: the estimator's inputs and decision in the server's log
                         self.start_server(url=URL_B, extra=server_args + ["--log-playback"])
@@ -465,7 +480,7 @@ class Bench:
                     runs.append({"profile": name, "relay_args": impair, "seed": seed, "estimator": est,
                                  "margin_ms": margin_ms, "server_args": server_args,
                                  "client_args": client_args, "robotalk": a, "arrivals": arr,
-                                 "decision": self.playback_decision()})
+                                 "decision": self.playback_decision(), "late_starts": self.late_starts()})
                     time.sleep(0.5)
                 seed += 1
         return {"figure": "playback_estimators", "frames": frames, "period_ms": 100, "stretch_bound": 0.1,

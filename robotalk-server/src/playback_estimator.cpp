@@ -376,6 +376,57 @@ Duration PlaybackEstimator::AdaptiveWorst(double headroom) const {
                               ToSeconds(spread) * headroom / static_cast<double>(s.kept));
 }
 
+void PlaybackEstimator::AddFrameCopy(TimePoint sent, TimePoint received) {
+  const std::optional<Duration> d = OneWayDelay(sent, received);
+  if (!d) return;
+  frame_copies_.push_back(*d);
+  DecideAt(received);
+}
+
+Duration PlaybackEstimator::CopiesWorst() const {
+  const Duration single = AdaptiveWorst(options_.start_headroom);
+  if (followed() || queued()) return single;
+  // The single-copy delays: the channel's (history and frames; a frame's
+  // first copy is the earlier of its two, its second the later: two draws)
+  // and the frames' second copies, within the fence (a retransmission's
+  // resend wait is no draw of the channel).
+  std::vector<Duration> x = ChannelDelays().delays;
+  x.insert(x.end(), frame_copies_.begin(), frame_copies_.end());
+  std::sort(x.begin(), x.end());
+  const Duration least = x.front(), median = x[x.size() / 2];
+  const Duration fence = median + std::max(8 * (median - least), Duration(std::chrono::milliseconds(50)));
+  while (x.size() > 1 && x.back() > fence) x.pop_back();
+  const auto n = static_cast<double>(x.size());
+  const Duration spread = x.back() - least;
+  // M frames to come, each the earlier of two independent draws: the
+  // quantile whose tail is sqrt(copies_tail / M) (P(min > x) = P(X > x)²),
+  // at the plotting position rank u (n + 1); past the largest, spread / n a rank.
+  const double to_come =
+      static_cast<double>(std::max<std::size_t>(1, total_ - std::min(total_, frames_.size())));
+  const double u = 1.0 - std::sqrt(std::clamp(options_.copies_tail, 0.0, to_come) / to_come);
+  const double rank = u * (n + 1.0);  // 1-based
+  Duration q;
+  if (rank <= 1.0) {
+    q = least;
+  } else if (rank >= n) {
+    q = x.back() + FromSeconds((rank - n) * ToSeconds(spread) / n);
+  } else {
+    const auto lo = static_cast<std::size_t>(std::floor(rank)) - 1;
+    const double f = rank - std::floor(rank);
+    q = x[lo] + FromSeconds(f * ToSeconds(x[lo + 1] - x[lo]));
+  }
+  // The spread beyond one interval (a queue sparse packages never met) as the single-copy start adds it.
+  const Spread s = *FencedSpread();
+  const Duration excess =
+      single - s.most -
+      FromSeconds(ToSeconds(s.most - s.least) * options_.start_headroom / static_cast<double>(s.kept));
+  return std::min(single, q + std::max(Duration(0), excess));
+}
+
+Duration PlaybackEstimator::StartWorst() const {
+  return options_.copies_start && frames_copied() ? CopiesWorst() : AdaptiveWorst(options_.start_headroom);
+}
+
 std::optional<Duration> PlaybackEstimator::playout_delay() const {
   if (!adaptive()) return std::nullopt;
   const Duration worst = AdaptiveWorst(options_.adaptive_headroom);
@@ -420,6 +471,7 @@ TimePoint PlaybackEstimator::StartCovering(Duration worst, Duration margin, Dura
     first_offset = std::min(first_offset, f.offset);
     decided = std::max(decided, f.arrival);
   }
+  decided = std::max(decided, decided_at_);  // a wait for a frame's second copy ended: decided then
   const Duration excess = std::max(Duration(0), worst - *anchor->delay);
   return std::max(anchor->arrival - anchor->offset + excess - lead, decided - first_offset) + margin;
 }
@@ -485,7 +537,8 @@ TimePoint PlaybackEstimator::StartTime() const {
     // length each) until the buffer covers the worst delay, so the frames
     // after them find it; frame 0 itself has arrived. StartCovering's floor
     // (the decision + margin) stays.
-    return StartCovering(AdaptiveWorst(options_.start_headroom), options_.adaptive_margin, start_lead());
+    // Frames that come twice: the earlier of two delays (copies_start).
+    return StartCovering(StartWorst(), options_.adaptive_margin, start_lead());
   }
   if (quick()) {
     // The worst delay a later frame may have is predicted as the least seen
@@ -560,6 +613,11 @@ std::string PlaybackEstimator::Describe() const {
     out += ",\"fenced_most\":" + ms(s->most - least) + ",\"kept\":" + std::to_string(s->kept);
   }
   if (adaptive()) {
+    if (frames_copied()) {
+      out += ",\"frame_copies\":" +
+             list(frame_copies_.begin(), frame_copies_.end(), [&](Duration d) { return ms(d - least); });
+      out += ",\"copies_worst\":" + ms(CopiesWorst() - least) + ",\"decided\":" + ms(decided_at_ - first);
+    }
     out += ",\"worst\":" + ms(AdaptiveWorst(options_.start_headroom) - least) +
            ",\"playout\":" + ms(*playout_delay() - least) + ",\"lead\":" + ms(start_lead());
     out += ",\"thin_lead\":" + ms(schedule_options().thin_lead);

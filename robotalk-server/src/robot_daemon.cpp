@@ -165,6 +165,14 @@ bool RobotDaemon::Abandon(TimePoint now) {
   return true;
 }
 
+namespace {
+std::string LateMs(Duration d) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", std::chrono::duration<double, std::milli>(d).count());
+  return b;
+}
+}  // namespace
+
 void RobotDaemon::DaemonLoop() {
   const std::string timing = waiter_.Apply();
   std::unique_lock lock(mutex_);
@@ -176,7 +184,13 @@ void RobotDaemon::DaemonLoop() {
     const TimePoint next = RunOnce(clock_.Now());
     lock.lock();
     sleeping_until_ = next;
+    diag_.waited_for = next;
+    diag_.spin = spin_;
     waiter_.WaitUntil(lock, wake_, next, spin_, woken_);
+    if (log_late_) {
+      diag_.woke = clock_.Now();
+      diag_.by_submit = wake_flag_;
+    }
     wake_flag_ = false;
   }
   const bool last_stop = shutting_down_;
@@ -199,6 +213,12 @@ void RobotDaemon::Submit(QueuedItem item) {
     // wake-up per delayed command (issue 11: 64 clients x 100 Hz are CPU-bound
     // on thread switches). While it runs (no deadline yet) it is always told.
     wake = due || !sleeping_until_ || item.start < *sleeping_until_;
+    if (log_late_ && item.has_start_time && now - item.start > std::chrono::milliseconds(1)) {
+      outbox_.log.push_back("robot '" + robot_name_ + "': late start: command " +
+                            std::to_string(item.command.id) + " handed over " + LateMs(now - item.start) +
+                            " ms after its start (handled " + LateMs(item.start - item.received) +
+                            " ms before it)");
+    }
     if (item.is_waypoint() || item.is_speed_frame()) {
       // Planned toward before its time: the thread takes it at its next iteration.
       wake = true;
@@ -293,6 +313,10 @@ void RobotDaemon::Emit(std::int64_t client_id, Reply reply) {
 }
 
 TimePoint RobotDaemon::RunOnce(TimePoint now) {
+  if (log_late_) {
+    diag_.previous_began = diag_.began;
+    diag_.began = now;
+  }
   bool sample_due = false;
   bool took_waypoints = false;
   Duration period{0};
@@ -397,6 +421,7 @@ TimePoint RobotDaemon::RunOnce(TimePoint now) {
     std::lock_guard lock(mutex_);
     if (output_ready_) output_ready_();
   }
+  if (log_late_) diag_.previous_ended = clock_.Now();
   return next;
 }
 
@@ -405,6 +430,17 @@ void RobotDaemon::Execute(const QueuedItem& item, TimePoint now) {
   r.id = item.command.id;
   r.exec_time = now;
   if (item.has_start_time && now > item.start) r.lateness = now - item.start;
+  if (log_late_ && item.has_start_time && now - item.start > std::chrono::milliseconds(1)) {
+    // Times in ms after the command's start: what the thread did before it ran it.
+    const auto at = [&](TimePoint t) { return LateMs(t - item.start); };
+    produced_.log.push_back(
+        "robot '" + robot_name_ + "': late start: command " + std::to_string(item.command.id) + " ran " +
+        at(now) + " ms after its start; handled at " + at(item.received) + "; the thread waited for " +
+        at(diag_.waited_for) + (diag_.spin ? " (spin)" : "") + ", woke at " + at(diag_.woke) +
+        (diag_.by_submit ? " (a submit)" : "") + "; the iteration before ran " + at(diag_.previous_began) +
+        " to " + at(diag_.previous_ended) + "; this one began at " + at(diag_.began) + "; now " +
+        at(clock_.Now()));
+  }
   if (item.is_query) {
     AnswerQuery(item, r);
     Emit(item.client_id, std::move(r));

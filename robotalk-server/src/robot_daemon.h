@@ -193,6 +193,11 @@ class RobotDaemon {
   /// Queues a checked item. REQUIRES: admission checks passed. A state query
   /// due now is answered from snapshot() first when it can be (RobotSessions).
   void Submit(QueuedItem item);
+  /// Diagnostics (issue 23, eleventh session; the server's --log-playback):
+  /// a log line for each command that begins more than 1 ms after its start
+  /// time (what the thread waited for, when it woke, the iteration before)
+  /// and for each timed item handed over after its start. Set before Start().
+  void LogLateStarts(bool on) { log_late_ = on; }
   /// The state queries are answered from on receipt (the session side's).
   QuerySnapshot& snapshot() { return snapshot_; }
   /// The robot's panic, halt and driver-fault state.
@@ -359,6 +364,12 @@ class RobotDaemon {
   DeadlineWaiter waiter_;
   std::function<bool()> woken_;  // the waiter's wake-up condition (under mutex_)
   bool spin_ = false;            // the next deadline is a start time or sample
+  bool log_late_ = false;        // LogLateStarts
+  // LogLateStarts' record of the thread's last wait and iterations (its thread only).
+  struct LateDiag {
+    TimePoint waited_for{}, woke{}, began{}, previous_began{}, previous_ended{};
+    bool spin = false, by_submit = false;
+  } diag_;
   std::vector<QueuedItem> due_;
   std::vector<QueuedItem> waypoints_;  // taken from arrived_waypoints_ this iteration
   TrajectoryTracker tracker_;

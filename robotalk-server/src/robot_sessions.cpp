@@ -120,6 +120,7 @@ std::vector<Reply> RobotSessions::Retransmitted(const Session& s, const Request&
 }
 
 ImmediateAnswer RobotSessions::Handle(const Request& r, TimePoint now, TimePoint arrived) {
+  DecidePlaybacks(now);  // a sequence whose wait for a second copy ended starts first
   // What measures the link reads `arrived`; what decides whether and when
   // something runs, or whether the session lives, reads `now`: a package
   // that waited in the socket's buffer must not be judged earlier than it
@@ -260,7 +261,9 @@ std::vector<Reply> RobotSessions::AnswerCopy(Session& s, const Request& r, TimeP
   // On a FIFO link the package after this copy waited behind it (playback's
   // start, "The copies" in playback_estimator.h).
   if (r.send_time != TimePoint{}) s.delays.AddCopy(r.send_time, now);
-  return Retransmitted(s, r, now);
+  std::vector<Reply> replies = Retransmitted(s, r, now);
+  OnPlaybackCopy(s, r, now, replies);  // frame 0's second copy: a waiting sequence starts
+  return replies;
 }
 
 ImmediateAnswer RobotSessions::Refuse(const Request& r, TimePoint now, TimePoint arrived) {

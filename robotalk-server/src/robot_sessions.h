@@ -129,6 +129,12 @@ class RobotSessions {
   /// Expires this robot's silent and never-used sessions (SessionTable::Expire);
   /// a STOP follows if one had moved the robot.
   std::vector<ExpiredSession> Expire(TimePoint now);
+  /// Starts the playback sequences whose wait for frame 0's second copy ended
+  /// by `now` (PlaybackSequence::decide_by); their delay replies are sent
+  /// with the next File. Returns whether it started one.
+  bool DecidePlaybacks(TimePoint now);
+  /// When DecidePlaybacks has one to start next (nullopt: none waits).
+  std::optional<TimePoint> NextPlaybackDecision() const;
   /// Lines for the server log (panic, reset), taken once.
   std::vector<std::string> TakeLog();
 
@@ -219,6 +225,16 @@ class RobotSessions {
   const int robot_id_;
   std::map<std::int64_t, std::vector<Reply>> pending_;  // replies made outside Handle, by client
   std::vector<std::string> log_;
+  // Playback sequences waiting for frame 0's second copy: client, playback id, until when.
+  struct CopyWait {
+    std::int64_t client_id, playback_id;
+    TimePoint until;
+  };
+  std::vector<CopyWait> copy_waits_;
+  // Whether `seq`, ready at its first frame, waits for that frame's second copy (copies_start).
+  bool WaitForFrameCopy(const PlaybackSequence& seq, TimePoint now) const;
+  // A second copy of a playback package: a waiting sequence's frame came twice (AnswerCopy).
+  void OnPlaybackCopy(Session& s, const Request& r, TimePoint now, std::vector<Reply>& replies);
   std::vector<QueuedItem> flushed_;
   std::vector<std::int64_t> joint_owner_;  // per joint: the client that last commanded it
   std::int64_t base_owner_ = 0;

@@ -104,14 +104,94 @@ void RobotSessions::AdmitPlayback(Session& s, const Request& r, TimePoint now, T
     if (seq.start) {  // already playing: straight to the RobotDaemon
       item->start = seq.schedule->Place(offset, now, delay).at;
       if (!Superseded(s, *item, now, immediate)) daemon_.Submit(std::move(*item));
+    } else if (seq.decide_by) {
+      // Waiting for frame 0's second copy: decided from frame 0 (as without
+      // the wait); this frame is placed when it starts.
+      seq.frames.push_back({offset, std::move(*item), now, delay});
     } else {
       seq.estimator->Add(offset, now, sent, arrived < now ? now - arrived : Duration(0));
       seq.frames.push_back({offset, std::move(*item), now, delay});
     }
   }
-  if (!seq.start && seq.estimator->ready()) Start(s, d.id, seq, now, immediate);
+  if (!seq.start && !seq.decide_by && seq.estimator->ready()) {
+    if (WaitForFrameCopy(seq, now)) {
+      seq.decide_by = seq.estimator->StartTime() - options_.playback.copies_hold;
+      copy_waits_.push_back({s.client_id, d.id, *seq.decide_by});
+    } else {
+      Start(s, d.id, seq, now, immediate);
+    }
+  }
   // Every declared frame is in the command queue: nothing of it is left here.
   if (seq.start && seq.received >= seq.total) s.EndPlayback(d.id, Session::Ended::kComplete);
+}
+
+// Frames that come twice ("Frames that come twice" in playback_estimator.h):
+// an adaptive start decided at frame 0 from send times waits for frame 0's
+// second copy until copies_hold before the start it would take without one,
+// so a client that sends once starts as before, and one that sends twice
+// starts no later. The wait changes neither the start's inputs (later frames
+// are buffered, not added) nor, without a copy, the start.
+bool RobotSessions::WaitForFrameCopy(const PlaybackSequence& seq, TimePoint now) const {
+  const PlaybackEstimator& e = *seq.estimator;
+  if (!options_.playback.copies_start || e.frames_seen() != 1 || e.frames_copied() || !e.adaptive() ||
+      e.followed() || e.queued())
+    return false;
+  return e.StartTime() - options_.playback.copies_hold > now;
+}
+
+void RobotSessions::OnPlaybackCopy(Session& s, const Request& r, TimePoint now, std::vector<Reply>& replies) {
+  if (r.mode != RequestMode::kPlayback || r.send_time == TimePoint{}) return;
+  auto it = s.playbacks.find(r.playback.id);
+  if (it == s.playbacks.end() || it->second.start || !it->second.decide_by || !it->second.estimator) return;
+  PlaybackSequence& seq = it->second;
+  // A redundancy copy comes within the delays' spread of the first (a
+  // retransmission a timeout later, which the wait, shorter than the spread, does not reach).
+  const std::optional<Duration> spread = seq.estimator->delay_spread();
+  if (!seq.first_arrival || !spread || now - *seq.first_arrival > *spread) return;
+  seq.estimator->AddFrameCopy(r.send_time, now);
+  std::vector<Reply> started;
+  Start(s, r.playback.id, seq, now, started);
+  for (Reply& reply : started) {
+    Bound(reply);
+    s.replies.RecordReply(reply);
+    replies.push_back(std::move(reply));
+  }
+  if (seq.received >= seq.total) s.EndPlayback(r.playback.id, Session::Ended::kComplete);
+}
+
+bool RobotSessions::DecidePlaybacks(TimePoint now) {
+  bool any = false;
+  for (std::size_t k = 0; k < copy_waits_.size();) {
+    const CopyWait w = copy_waits_[k];
+    Session* s = table_.Find(robot_id_, w.client_id);
+    auto it = s != nullptr ? s->playbacks.find(w.playback_id) : decltype(s->playbacks.end()){};
+    const bool live = s != nullptr && it != s->playbacks.end() && !it->second.start && it->second.decide_by &&
+                      it->second.estimator;
+    if (live && w.until > now) {
+      ++k;
+      continue;
+    }
+    copy_waits_.erase(copy_waits_.begin() + static_cast<std::ptrdiff_t>(k));
+    if (!live) continue;
+    // Decided now: a thread that woke late starts later, never with a frame past its time.
+    it->second.estimator->DecideAt(now);
+    std::vector<Reply> started;
+    Start(*s, w.playback_id, it->second, now, started);
+    for (Reply& reply : started) {
+      Bound(reply);
+      Deliver(w.client_id, std::move(reply));
+    }
+    if (it->second.received >= it->second.total) s->EndPlayback(w.playback_id, Session::Ended::kComplete);
+    any = true;
+  }
+  return any;
+}
+
+std::optional<TimePoint> RobotSessions::NextPlaybackDecision() const {
+  std::optional<TimePoint> next;
+  for (const CopyWait& w : copy_waits_)
+    if (!next || w.until < *next) next = w.until;
+  return next;
 }
 
 // The delay is estimated: every buffered frame moves to the command queue,
@@ -121,6 +201,7 @@ void RobotSessions::Start(Session& s, std::int64_t id, PlaybackSequence& seq, Ti
                           std::vector<Reply>& immediate) {
   const PlaybackEstimator& estimator = *seq.estimator;
   seq.start = estimator.StartTime();
+  seq.decide_by.reset();
   if (options_.log_playback)
     log_.push_back("robot '" + robot_ + "': PLAYBACK " + std::to_string(id) + " start " +
                    estimator.Describe());

@@ -134,6 +134,7 @@ class Server::Impl {
     sessions.playback.queue_start = options_.playback_queue_start;
     sessions.playback.follow_queue = options_.playback_follow_queue;
     sessions.playback.burst_wait_discount = options_.playback_burst_discount;
+    sessions.playback.copies_start = options_.playback_copies_start;
     sessions.playback_resent_delays = options_.playback_resent_delays;
     sessions.log_playback = options_.log_playback;
     sessions.playback.start_lead = options_.playback_start_lead;
@@ -174,6 +175,7 @@ class Server::Impl {
           spec.name, spec.driver, registry.Create(spec.driver, config), clock_, daemon_options));
       const auto own_limit = options_.robot_max_late.find(spec.name);
       sessions.max_late = own_limit != options_.robot_max_late.end() ? own_limit->second : options_.max_late;
+      robots_.back()->LogLateStarts(options_.log_playback);  // its late starts explained (issue 23)
       server_daemon_->AddRobot(*robots_.back(), sessions);
     }
     url_ = transport->url();

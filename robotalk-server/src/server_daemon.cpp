@@ -260,8 +260,14 @@ void ServerDaemon::Wake() {
 
 void ServerDaemon::RunOnce(Duration timeout) {
   pollfd fds[2] = {{transport_.fileno(), POLLIN, 0}, {event_fd_, POLLIN, 0}};
-  const int timeout_ms =
-      static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count());
+  // A playback sequence waiting for its frame 0's second copy starts when its wait ends.
+  for (auto& [name, robot] : robots_) {
+    if (const std::optional<TimePoint> next = robot.sessions->NextPlaybackDecision())
+      timeout = std::clamp(*next - clock_.Now(), Duration(0), timeout);
+  }
+  const int timeout_ms = static_cast<int>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(timeout + std::chrono::microseconds(999))
+          .count());
   const int ready = fds[0].fd >= 0 ? poll(fds, 2, timeout_ms) : poll(fds + 1, 1, timeout_ms);
   if (ready > 0 && (fds[1].revents & POLLIN)) {
     std::uint64_t count;
@@ -274,6 +280,8 @@ void ServerDaemon::RunOnce(Duration timeout) {
   }
   Flush();
   const TimePoint now = clock_.Now();
+  for (auto& [name, robot] : robots_)
+    if (robot.sessions->DecidePlaybacks(now)) Drain(robot);
   if (started_ == TimePoint::min()) started_ = now;
   if (now >= next_watchdog_) {
     Watchdogs(now);

@@ -67,6 +67,9 @@ Serves one or more robots over LCM (see docs/protocol.md).
   --playback-burst-discount on|off
                                   adaptive: leave a connect-time package's wait behind the
                                   one sent just before it out of the delay spread (default on)
+  --playback-copies-start on|off  adaptive: wait for the first frame's second copy (a client
+                                  that sends each package twice) and then cover the earlier
+                                  of two delays (default off: measured, not kept)
   --playback-resent-delays on|off adaptive: count a retransmitted package's delay (its resend
                                   wait included) in the client's delay history (default off)
   --playback-start-lead G         adaptive: start G gaps' stretch below the worst delay, which
@@ -255,6 +258,10 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-follow-queue '" + v + "': expected on or off");
         options.playback_follow_queue = v == "on";
+      } else if (arg == "--playback-copies-start") {
+        const std::string v = value();
+        if (v != "on" && v != "off") throw Error("--playback-copies-start '" + v + "': expected on or off");
+        options.playback_copies_start = v == "on";
       } else if (arg == "--playback-burst-discount") {
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-burst-discount '" + v + "': expected on or off");

@@ -109,6 +109,9 @@ struct PlaybackSequence {
   std::optional<TimePoint> start;            ///< when offset 0 plays, once estimated
   std::optional<PlaybackSchedule> schedule;  ///< when each frame plays, once started
   std::optional<TimePoint> first_arrival;
+  /// Decided at frame 0 but not yet started: waiting for frame 0's second
+  /// copy (the client's redundancy) until then (RobotSessions::DecidePlaybacks).
+  std::optional<TimePoint> decide_by;
   std::size_t total;
   Duration duration;
   std::size_t received = 0;

@@ -32,7 +32,9 @@ class PlaybackConnectTest : public RobotSessionsTest {
     Request request;
   };
   // Delivers the packages in arrival order, each at its arrival time; returns
-  // the last one's immediate replies.
+  // the last one's immediate replies, and the delay reply of a playback start
+  // that waited for its frame 0's second copy (none comes here: it starts
+  // when the wait ends, with the start it would have taken at frame 0).
   std::map<CommandId, Reply> Deliver(std::vector<Arrival> arrivals) {
     std::stable_sort(arrivals.begin(), arrivals.end(),
                      [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
@@ -40,6 +42,11 @@ class PlaybackConnectTest : public RobotSessionsTest {
     for (const Arrival& a : arrivals) {
       clock_.Advance(a.at - clock_.Now());
       last = Handle(a.request);
+    }
+    if (const std::optional<TimePoint> next = sessions_->NextPlaybackDecision()) {
+      clock_.Set(std::max(*next, clock_.Now()));
+      EXPECT_TRUE(sessions_->DecidePlaybacks(clock_.Now()));
+      for (const auto& [id, reply] : Replies(kAlice)) last.emplace(id, reply);
     }
     return last;
   }

@@ -326,3 +326,43 @@ TEST(RobotDaemonTiming, SaysWhichTimingItsThreadRunsWith) {
 
 }  // namespace
 }  // namespace robotalk
+
+namespace robotalk {
+namespace {
+
+// Issue 23, eleventh session: with LogLateStarts (the server's --log-playback)
+// a command begun more than 1 ms after its start time is logged with what the
+// thread did before it, and a timed item handed over after its start too; one
+// begun within 1 ms is not.
+TEST_F(RobotDaemonTest, WithLateStartsLoggedACommandBegunMoreThanAMillisecondLateIsExplained) {
+  daemon_->LogLateStarts(true);
+  QueuedItem on_time = Motion(7, CommandType::kJointSetPoint, {0.1}, 0);
+  on_time.has_start_time = true;
+  on_time.start = clock_.Now() + milliseconds(5);
+  QueuedItem late = Motion(8, CommandType::kJointSetPoint, {0.2}, 0);
+  late.has_start_time = true;
+  late.start = clock_.Now() + milliseconds(20);
+  daemon_->Submit(std::move(on_time));
+  daemon_->Submit(std::move(late));
+  clock_.Advance(milliseconds(5) + std::chrono::microseconds(900));  // 0.9 ms after command 7's start
+  Run();
+  clock_.Advance(milliseconds(14) + std::chrono::microseconds(100) + milliseconds(2) +
+                 std::chrono::microseconds(500));
+  Run();  // 2.5 ms after command 8's start
+  std::vector<std::string> late_lines;
+  for (const std::string& line : out_.log)
+    if (line.find("late start") != std::string::npos) late_lines.push_back(line);
+  ASSERT_EQ(late_lines.size(), 1u);
+  EXPECT_THAT(late_lines[0], HasSubstr("command 8 ran 2.500 ms after its start"));
+  EXPECT_THAT(late_lines[0], HasSubstr("this one began at 2.500"));
+  // Handed over after its start.
+  QueuedItem handed_late = Motion(9, CommandType::kJointSetPoint, {0.3}, 0);
+  handed_late.has_start_time = true;
+  handed_late.start = clock_.Now() - milliseconds(3);
+  daemon_->Submit(std::move(handed_late));
+  Run();
+  EXPECT_THAT(out_.log, ::testing::Contains(HasSubstr("command 9 handed over 3.000 ms after its start")));
+}
+
+}  // namespace
+}  // namespace robotalk

@@ -160,6 +160,10 @@ struct ServerOptions {
   /// sent just before it is left out of its delay where that brings the
   /// spread within the gate (PlaybackEstimatorOptions::burst_wait_discount).
   bool playback_burst_discount = true;
+  /// Adaptive: wait for the first frame's second copy and then cover the
+  /// earlier of two delays (PlaybackEstimatorOptions::copies_start; off by
+  /// default: measured in docs/performance.md, issue 23's eleventh session).
+  bool playback_copies_start = false;
   /// Adaptive: a retransmitted package's one-way delay (its resend wait
   /// included) counts in the delay history too (SessionOptions::playback_resent_delays;
   /// off, the default: left out).
