@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <string>
 
 namespace robotalk {
@@ -23,7 +25,23 @@ TEST(Channels, ARobotNameIsLettersDigitsUnderscoreAndHyphen) {
   for (const char* bad : {"", "x.y", "a/b", "a b", "caf\xc3\xa9", "*", "a\n"}) {
     EXPECT_FALSE(IsValidRobotName(bad)) << bad;
   }
-  EXPECT_TRUE(IsValidRobotName(std::string(1000, 'r'))) << "no length limit of its own";
+}
+
+// LCM refuses a channel name over 63 characters (LCM_MAX_CHANNEL_NAME_LENGTH):
+// a robot whose name made its reply channel longer was "served" and could
+// never answer a hello (the client: "no answer to HELLO ... is a server
+// offering it?"). Every channel of a valid name fits.
+TEST(Channels, EveryChannelOfAValidRobotNameFitsLcmsChannelNameLimit) {
+  const std::string longest(31, 'r');
+  EXPECT_TRUE(IsValidRobotName(longest));
+  EXPECT_FALSE(IsValidRobotName(longest + "r")) << "32 characters: its reply channel would be 64";
+  EXPECT_FALSE(IsValidRobotName(std::string(1000, 'r')));
+  constexpr std::int64_t kWidest = std::numeric_limits<std::int64_t>::min();
+  for (const std::string& channel :
+       {ReplyChannel(longest, kWidest), HelloAnswerChannel(longest, kWidest), HelloChannel(longest),
+        RequestChannel(longest), ConfigChannel(longest), StateChannel(longest)}) {
+    EXPECT_LE(channel.size(), 63u) << channel;
+  }
 }
 
 TEST(Channels, ParsesWhatItBuilds) {

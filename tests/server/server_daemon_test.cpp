@@ -87,6 +87,22 @@ TEST(AnswerBudget, AllowsABurstThenRefillsAtItsRateUpToOneBurst) {
   EXPECT_FALSE(AnswerBudget{}.Take(t0, 0)) << "a budget of 0 answers none";
 }
 
+// Every way a robot is served goes through AddRobot: a name LCM's channels
+// cannot carry is refused there, naming the rule (before: "serving robot",
+// then every hello answer failed to publish).
+TEST(ServerDaemon, RefusesARobotWhoseNameNoChannelCanCarry) {
+  ManualClock clock;
+  MemoryTransport transport(std::make_shared<MemoryBus>());
+  ServerDaemon server(transport, clock);
+  RobotDaemon robot(std::string(40, 'a'), "fake", std::make_unique<FakeDriver>(PanRobot()), clock);
+  try {
+    server.AddRobot(robot, SessionOptions{});
+    ADD_FAILURE() << "a 40-character robot name was served";
+  } catch (const Error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("at most 31"));
+  }
+}
+
 // server.h (installed) cannot name channels.h's kAnnouncePeriod, which the
 // clients' waits are counted in: the two defaults must stay one value.
 TEST(ServerDaemon, AnnouncesEveryKAnnouncePeriodByDefault) {
