@@ -194,9 +194,8 @@ RobotClient::RobotClient(ClientOptions options) : impl_(std::make_unique<Impl>(s
 RobotClient::~RobotClient() = default;
 
 void RobotClient::Connect(const std::string& robot) {
-  if (!IsValidRobotName(robot)) {
-    throw ClientError("RobotClient::Connect: invalid robot name '" + robot +
-                      "' (letters, digits, _ and - only)");
+  if (const std::string why = RobotNameProblem(robot); !why.empty()) {
+    throw ClientError("RobotClient::Connect: invalid robot name '" + robot + "': " + why);
   }
   {
     std::lock_guard lock(impl_->mu_);

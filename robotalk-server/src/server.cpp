@@ -46,8 +46,8 @@ RobotSpec RobotSpec::Parse(const std::string& text) {
   RobotSpec spec;
   spec.name = text.substr(0, eq);
   spec.driver = text.substr(eq + 1, colon - eq - 1);
-  if (!IsValidRobotName(spec.name)) {
-    throw Error("--robot '" + text + "': robot name '" + spec.name + "' must be letters, digits, '_' or '-'");
+  if (const std::string why = RobotNameProblem(spec.name); !why.empty()) {
+    throw Error("--robot '" + text + "': robot name '" + spec.name + "': " + why);
   }
   if (spec.driver.empty()) throw Error("--robot '" + text + "': no driver given");
   // URDF path, then key=value options, comma separated.

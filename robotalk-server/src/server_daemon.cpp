@@ -93,6 +93,9 @@ ServerDaemon::~ServerDaemon() {
 
 void ServerDaemon::AddRobot(RobotDaemon& daemon, SessionOptions options) {
   const std::string& name = daemon.robot_name();
+  if (const std::string why = RobotNameProblem(name); !why.empty()) {
+    throw Error("ServerDaemon: robot name '" + name + "': " + why);
+  }
   if (robots_.count(name)) throw Error("ServerDaemon: robot name '" + name + "' is given twice");
   Robot robot{&daemon, nullptr, EncodeConfig(daemon.model()), ConfigHash(daemon.model()), {}};
   options.counters = [this] {

@@ -23,7 +23,6 @@ namespace {
 constexpr std::size_t kMaxFileBytes = std::size_t{4} * 1024 * 1024;
 
 // A robot name (channels.h) of at most 64 characters.
-bool IsListedRobotName(std::string_view s) { return s.size() <= 64 && IsValidRobotName(s); }
 
 std::vector<std::string_view> Fields(std::string_view line) {
   std::vector<std::string_view> out;
@@ -91,7 +90,7 @@ class LineParser {
         Fail("'" + std::string(f[i].substr(0, 80)) + "': expected <robot>=<rights>");
       }
       const std::string_view robot = f[i].substr(0, eq);
-      if (robot != "*" && !IsListedRobotName(robot)) {
+      if (robot != "*" && !IsValidRobotName(robot)) {
         Fail("robot '" + std::string(robot.substr(0, 80)) + "': not a robot name or '*'");
       }
       const Rights rights = ParseRights(robot, f[i].substr(eq + 1));

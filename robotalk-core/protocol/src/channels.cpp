@@ -36,14 +36,20 @@ std::optional<std::uint64_t> ParseHex64(std::string_view hex) {
 
 }  // namespace
 
-bool IsValidRobotName(std::string_view name) {
-  if (name.empty()) return false;
+bool IsValidRobotName(std::string_view name) { return RobotNameProblem(name).empty(); }
+
+std::string RobotNameProblem(std::string_view name) {
+  if (name.empty()) return "a robot name is not empty";
+  if (name.size() > kMaxRobotNameLength) {
+    return "a robot name has at most " + std::to_string(kMaxRobotNameLength) + " characters (this one " +
+           std::to_string(name.size()) + "): its channels must fit LCM's 63";
+  }
   for (const char c : name) {
     const bool ok =
         (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
-    if (!ok) return false;
+    if (!ok) return "a robot name is letters, digits, '_' or '-'";
   }
-  return true;
+  return "";
 }
 
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel) {

@@ -17,6 +17,7 @@
 
 #include <chrono>
 #include <cinttypes>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
@@ -53,10 +54,17 @@ inline std::string HelloAnswerChannel(const std::string& robot, std::int64_t cli
 inline std::string ConfigChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/CONFIG"; }
 inline std::string StateChannel(const std::string& robot) { return "ROBOTALK/" + robot + "/STATE"; }
 
-/// True when `name` may name a served robot: non-empty, only [A-Za-z0-9_-]
-/// (the server's --robot, RobotClient::Connect, access lists and known-servers
-/// files all check this one rule; an access list also caps it at 64).
+/// The longest robot name: LCM refuses a channel name over 63 characters
+/// (LCM_MAX_CHANNEL_NAME_LENGTH), and the longest channel,
+/// ROBOTALK/<robot>/REPLY/<16 hex digits>, leaves 31 for the name.
+inline constexpr std::size_t kMaxRobotNameLength = 31;
+/// True when `name` may name a served robot: 1 to kMaxRobotNameLength
+/// characters, only [A-Za-z0-9_-] (the server's --robot and AddRobot,
+/// RobotClient::Connect, access lists and known-servers files all check this
+/// one rule).
 bool IsValidRobotName(std::string_view name);
+/// What is wrong with `name` as a robot name ("" when it is valid), for errors.
+std::string RobotNameProblem(std::string_view name);
 
 /// The robot of "ROBOTALK/<robot>/REQUEST"; nullopt for any other channel.
 std::optional<std::string> RobotOfRequestChannel(std::string_view channel);
