@@ -168,9 +168,12 @@ TEST_F(RobotClientWireTest, WhenAPlaybackPackagesFirstCopyIsLostTheSecondKeepsIt
       if (i > 0) longest_gap = std::max(longest_gap, r.exec_time - result.replies[i - 1].exec_time);
     }
     if (copies == 2) {
+      // Not a timing test (a loaded machine wakes a thread 5 ms late): the
+      // bounds only tell a frame on time from one that waited for its
+      // retransmission (100 ms or more, the one-copy case below).
       EXPECT_EQ(ran, 6);
-      EXPECT_LE(worst, milliseconds(5));
-      EXPECT_LE(longest_gap, milliseconds(50 + 5 + 5)) << "every gap within 10 % (+ the wake-up)";
+      EXPECT_LE(worst, milliseconds(40));
+      EXPECT_LT(longest_gap, milliseconds(80)) << "no gap of a retransmission's length";
     } else {
       EXPECT_TRUE(ran < 6 || longest_gap >= milliseconds(80))
           << "one copy: the 4th frame came as its retransmission (ran " << ran << ", longest gap "
