@@ -157,7 +157,10 @@ at_rest "Ctrl-C on a goto whose terminal takes nothing still stops pioneer" "$tm
 # a reader that stalls`): a frame's reply line waits in its write, so the
 # CLI's thread never sees the Ctrl-C; the signal's own thread sends the STOP
 # (before: the sequence played on to its end, 0.3 m/s 2.5 s after Ctrl-C).
-printf '0.0 setspeed 0.3 0.0\n0.5 joint_setpoint pan 0.3\n1.0 joint_setpoint pan -0.3\n9.0 stop\n' >"$tmp/seq.txt"
+# A frame queued for 7 s (5 s after the Ctrl-C, past the CLI's 2 s take-over
+# bound and the session's 2 s expiry) must not run either: one STOP does not
+# cancel it, the CLI's exit (its session expiring) does.
+printf '0.0 setspeed 0.3 0.0\n0.5 joint_setpoint pan 0.3\n1.0 joint_setpoint pan -0.3\n7.0 setspeed 0.3 0.0\n12.0 stop\n' >"$tmp/seq.txt"
 mkfifo "$tmp/full_out"
 sleep 1000 <"$tmp/full_out" &  # holds the read end, reads nothing
 pids+=($!)
@@ -172,6 +175,10 @@ moves "a sequence whose stdout takes nothing: pioneer moves before Ctrl-C" "$tmp
 kill -INT "$seq_pid"
 sleep 2.5
 at_rest "Ctrl-C on a sequence whose stdout takes nothing still stops pioneer" "$tmp/watch4.json"
+ended() { [ ! -e "/proc/$1" ] || [ "$(cut -d')' -f2 "/proc/$1/stat" | cut -c2)" = Z ]; }  # gone, or a zombie
+check "the CLI stuck in its write ends by itself within 2 s of the Ctrl-C's STOP" ended "$seq_pid"
+sleep 4.0
+at_rest "the frame queued for 5 s after the Ctrl-C does not run" "$tmp/watch4.json"
 kill -9 "$seq_pid" 2>/dev/null
 
 echo "$pass passed, $failures failed"
