@@ -6,6 +6,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <regex>
 #include <utility>
@@ -92,6 +93,14 @@ StopOnInterrupt::StopOnInterrupt(RobotClient& client, std::stop_token interrupt)
         } catch (const std::exception&) {
           // StopNow, when the tool's thread gets there, says what failed.
         }
+        // A STOP does not cancel frames queued for later start times: the
+        // tool's thread does (delay mode's shadow STOPs) or its exit does (the
+        // session expires, the watchdog drops the queue). A thread still busy
+        // after kTakeOver (waiting in a write) would keep the session, and
+        // so those frames, alive: end the process instead.
+        std::unique_lock lock(mu);
+        cv.wait_for(lock, done, kTakeOver, [] { return false; });  // until the tool ends, at most kTakeOver
+        if (!done.stop_requested()) std::_Exit(Interrupter::ExitStatus(Interrupter::Signal()));
       }) {}
 
 std::string StopNow(RobotClient& client) {

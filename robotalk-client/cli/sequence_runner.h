@@ -71,10 +71,16 @@ std::string StopNow(RobotClient& client);
 /// a write to a stdout or stderr that takes nothing (a full pipe, a terminal
 /// stopped with Ctrl-S) waits for ever, and the CLI's heartbeats would keep
 /// the motion alive meanwhile. The tool's own StopNow and its lines follow
-/// when it gets there (a second STOP changes nothing). Destruction waits for
-/// a STOP being sent (the client's timeouts bound it).
+/// when it gets there (a second STOP changes nothing). If the tool has not
+/// finished (destroyed this) kTakeOver after the signal, the process ends
+/// with 128 + signal: its session then expires (the server's
+/// --session-timeout, 2 s) and the watchdog drops the frames it had queued
+/// for later, which one STOP does not cancel. Destruction waits for a STOP
+/// being sent (the client's timeouts bound it).
 class StopOnInterrupt {
  public:
+  static constexpr Duration kTakeOver = std::chrono::seconds(2);
+
   explicit StopOnInterrupt(RobotClient& client, std::stop_token interrupt = Interrupter::StopToken());
 
  private:

@@ -122,11 +122,12 @@ struct ServerDaemonOptions {
   /// own of the same size). Each costs an Ed25519 signature (~25 µs), so a
   /// flood of packages naming made-up sessions would otherwise buy that much
   /// of this thread per datagram; beyond the budget a package is counted
-  /// (`unknown_unanswered`) and not answered. 1,000 answers four times the
-  /// whole of a restarted server's sessions of one robot
-  /// (`--max-sessions-per-robot`) within a second, and a flood below that
-  /// rate as before, at ~2 % of a core at most (19.4 µs each,
-  /// robotalk-flood-bench). Open mode's answers are unsigned and unlimited.
+  /// (`unknown_unanswered`) and not answered. 1,000 answers about four times
+  /// the whole of a restarted server's sessions of one robot
+  /// (`--max-sessions-per-robot`, 256) within a second, and a flood below
+  /// that rate as before; both budgets full cost at most 2,000 signatures a
+  /// second, ~3.9 % of a core (19.4 µs each, robotalk-flood-bench), a full
+  /// burst ~39 ms of this thread. Open mode's answers are unsigned and unlimited.
   int unknown_answers_per_second = 1000;
 };
 

@@ -144,8 +144,10 @@ class RobotTracker::Impl {
       // changes nothing: neither the server id (its client would be dropped
       // as stale, over and over) nor the panic flag shown, nor silence. Only
       // a robot not heard for --robot-timeout takes any time again (a server
-      // host restarted with its clock).
-      if (auto known = robots_.find(r.name); known != robots_.end()) {
+      // host restarted with its clock). Signed announcements only: an
+      // unsigned one's time is anyone's, and one forged far ahead would
+      // otherwise shut out the real server until that timeout.
+      if (auto known = robots_.find(r.name); !heard.server_key.empty() && known != robots_.end()) {
         const Robot& k = known->second;
         const bool heard_lately = now - k.announced_at < FromSeconds(options_.robot_timeout_s);
         if (heard_lately && announcement.server_time <= k.announced_server_time) continue;

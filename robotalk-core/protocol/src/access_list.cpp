@@ -22,8 +22,6 @@ namespace {
 // A list of a few thousand clients is a few hundred KB; cap it well above.
 constexpr std::size_t kMaxFileBytes = std::size_t{4} * 1024 * 1024;
 
-// A robot name (channels.h) of at most 64 characters.
-
 std::vector<std::string_view> Fields(std::string_view line) {
   std::vector<std::string_view> out;
   std::size_t i = 0;
@@ -91,7 +89,7 @@ class LineParser {
       }
       const std::string_view robot = f[i].substr(0, eq);
       if (robot != "*" && !IsValidRobotName(robot)) {
-        Fail("robot '" + std::string(robot.substr(0, 80)) + "': not a robot name or '*'");
+        Fail("robot '" + std::string(robot.substr(0, 80)) + "': not '*' and " + RobotNameProblem(robot));
       }
       const Rights rights = ParseRights(robot, f[i].substr(eq + 1));
       if (!entry.robots.emplace(std::string(robot), rights).second) {

@@ -75,7 +75,9 @@ KnownServers KnownServers::Read(const std::filesystem::path& file) {
     if (!(words >> pin.network >> key) || (words >> extra)) {
       throw KeyError(at + "expected '<robot> <network> ed25519:<64 hex>', got '" + line + "'");
     }
-    if (!IsValidRobotName(pin.robot)) throw KeyError(at + "'" + pin.robot + "' is not a robot name");
+    if (const std::string why = RobotNameProblem(pin.robot); !why.empty()) {
+      throw KeyError(at + "'" + pin.robot + "': " + why);
+    }
     try {
       pin.key = PublicKey::Parse(key);
     } catch (const KeyError& e) {
