@@ -191,6 +191,43 @@ TEST_F(WebTrackerTest, ThousandsOfForgedRobotNamesKeepTheTrackedRobotsBoundedAnd
   EXPECT_TRUE(live) << "the served robot stays live";
 }
 
+// The final review of the eleventh session: the announcement order (taken
+// in server-time order, against keyed replays) applied to unsigned ones too,
+// so in open mode ONE forged ANNOUNCE of pioneer stamped far ahead shut the
+// real server's out for --robot-timeout, the forger's server id shown.
+TEST_F(WebTrackerTest, OneUnsignedAnnouncementStampedFarAheadDoesNotShutOutTheRealServer) {
+  WebOptions o;
+  o.lcm_url = kUrl;
+  RobotTracker tracker(o);
+  ASSERT_TRUE(WaitLive(tracker, "pioneer"));
+  std::string real;
+  const nlohmann::json first = tracker.Poll().robots;  // held: a range over a temporary's member dangles
+  for (const auto& r : first["robots"])
+    if (r["name"] == "pioneer") real = r["server_id"].get<std::string>();
+  ASSERT_FALSE(real.empty());
+  lcm::LCM bus(kUrl);
+  ASSERT_TRUE(bus.good());
+  std::this_thread::sleep_for(milliseconds(2500));  // past the server's start-up window (a known gap)
+  Announcement a;
+  a.server_id = 0x0BAD;
+  a.server_time = TimePoint(std::chrono::hours(24 * 365 * 100));
+  a.uptime = seconds(100);
+  a.robots.push_back({.name = "pioneer", .driver = "kinematic"});
+  const std::vector<std::uint8_t> bytes = EncodeAnnouncement(a);
+  bus.publish(kAnnounceChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+  // The real server announces every second: within 2 s it is shown again.
+  bool back = false;
+  for (int i = 0; i < 20 && !back; ++i) {
+    std::this_thread::sleep_for(milliseconds(100));
+    const nlohmann::json polled = tracker.Poll().robots;
+    for (const auto& r : polled["robots"]) {
+      if (r["name"] != "pioneer") continue;
+      if (i >= 2) back = r["server_id"].get<std::string>() == real;
+    }
+  }
+  EXPECT_TRUE(back) << "the forged far-ahead announcement kept the real server out";
+}
+
 // Announces `n` robots "ghost-0" ... no server answers for (one forged
 // ANNOUNCE datagram each), paced within the tracker's LCM queue.
 void AnnounceGhosts(lcm::LCM& bus, int n) {
