@@ -6,6 +6,8 @@
 //   robotalk-auth-bench [--benchmark_format=json ...]
 #include "robotalk/session_auth.h"
 
+#include "bench_keys.h"
+
 #include <benchmark/benchmark.h>
 
 #include <vector>
@@ -14,11 +16,7 @@ namespace {
 
 using namespace robotalk;
 
-KeyPair Identity(std::uint8_t v) {
-  std::array<std::uint8_t, 32> seed{};
-  seed.fill(v);
-  return KeyPair::FromSeed(seed);
-}
+using bench::Identity;
 
 struct Fixture {
   KeyPair client = Identity(1);

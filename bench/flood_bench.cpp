@@ -15,6 +15,8 @@
 
 #include "kinematic_driver.h"
 
+#include "bench_keys.h"
+
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -24,11 +26,7 @@ namespace {
 
 using namespace robotalk;
 
-KeyPair Identity(std::uint8_t v) {
-  std::array<std::uint8_t, 32> seed{};
-  seed.fill(v);
-  return KeyPair::FromSeed(seed);
-}
+using bench::Identity;
 
 RobotModel Pan() {
   RobotModelBuilder b("pan");

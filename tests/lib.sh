@@ -59,3 +59,11 @@ signal_server() {
   server_status=$?
   server_pid=""
 }
+# last_motion WATCH_JSON: "v w moving" of the last STATE sample in a `watch
+# --json` output ("none none none" when there is none).
+last_motion() {
+  python3 -c 'import json, sys
+lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
+s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
+print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
+}

@@ -13,13 +13,6 @@ server_bin=$1 cli=$2 models=$3
 . "$(dirname "$0")/../lib.sh" # $tmp, $server_pid, check
 urdf="$models/pioneer2dx_pantilt.urdf"
 
-# The last STATE sample in a `watch --json` output: "v w moving".
-last_motion() {
-  python3 -c 'import json, sys
-lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
-s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
-print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
-}
 
 # shutdown_case SIGNAL PORT SETSPEED_ROBOT GOTO_ROBOT
 shutdown_case() {

@@ -14,12 +14,6 @@ server_bin=$1 cli=$2 models=$3
 . "$(dirname "$0")/../lib.sh" # $tmp, $server_pid, check
 urdf="$models/pioneer2dx_pantilt.urdf"
 url="udpm://239.255.76.67:7719?ttl=0"
-last_motion() {
-  python3 -c 'import json, sys
-lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
-s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
-print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
-}
 # moves NAME WATCH_JSON / at_rest NAME WATCH_JSON: the last STATE sample of
 # a `watch --json` output shows pioneer moving / at rest (a check named NAME).
 moves() {

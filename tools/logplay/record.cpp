@@ -39,6 +39,7 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
     event.channel = e.channel;
     event.datalen = static_cast<std::int32_t>(e.bytes.size());
     event.data = const_cast<std::uint8_t*>(e.bytes.data());  // LCM's API is not const; it only reads
+    errno = 0;  // so that the message names this write's error, not an earlier one
     if (file.writeEvent(&event) != 0) {
       write_error = "record: writing '" + options.output + "' failed: " + std::strerror(errno ? errno : EIO);
       return;
