@@ -162,6 +162,15 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
     lift = std::min(steps_[k].start - tick_, ticks(rp.fast_double));
     const Eigen::Vector2d to = ZmpPoint(steps_[k].stance);
     u = ClampToPolygon(to + e, Corners(steps_[k].stance, g_), rp.ankle_margin) - to;
+    // The shift's target (it may hold an earlier regeneration's ankles) moves
+    // to this one's over at least 0.4 ankle_ramp (20 ms; the full ramp lost 4
+    // more ODE pushes of 384): moved in full in the ticks left before the
+    // lift, the reference jumped up to 10 cm in a tick (push_recovery_test,
+    // "TwoPushes"). Between two points inside the sole, so inside it.
+    const Eigen::Vector2d target = phases_[static_cast<size_t>(j)].to;
+    const double part = std::min(1.0, static_cast<double>(lift) / static_cast<double>(std::max<std::int64_t>(
+                                                                      1, ticks(0.4 * rp.ankle_ramp))));
+    u = target + part * (to + u - target) - to;
   }
   const std::int64_t soonest = in_air ? std::max(tick_ + late, steps_[k].start + ticks(rp.min_swing)) : land;
   // The error against the plan's own DCM (its preview state); a change of
