@@ -404,7 +404,7 @@ bool ServerDaemon::Gate(Robot& robot, const std::string& name, Request& request,
         std::to_string(request.session_id) + "; say hello and send it again";
     Log("robot '" + name + "': refused a panic of " + admission.who + " outside any session");
   }
-  bool answer = request.client_id != 0;
+  const bool answer = request.client_id != 0;
   if (answer && signer_ && !raised) {
     // Keyed: the answer costs a signature; within the budget only (see
     // ServerDaemonOptions::unknown_answers_per_second).
