@@ -84,8 +84,9 @@ class TtyProgress {
   bool on() const { return fd_ >= 0; }
   /// Writes what the terminal takes now, nothing more (a torn line at worst).
   void Show(const std::string& text) const {
-    if (fd_ >= 0) [[maybe_unused]]
-      const ssize_t n = write(fd_, text.data(), text.size());
+    if (fd_ < 0) return;
+    const ssize_t written = write(fd_, text.data(), text.size());
+    (void)written;  // what the terminal did not take is lost
   }
   void Clear() const { Show("\r\033[K"); }
 
