@@ -594,5 +594,61 @@ TEST(PushRecovery, TwoPushesCloseTogetherNeverMakeTheReferenceZmpJumpNorLeaveThe
   EXPECT_LT(std::max(worst_outside, traced.worst_outside), 1e-9) << "the reference ZMP inside the support";
 }
 
+TEST(PushRecovery, EveryRecoveryOptionKeepsTheReferenceZmpContinuousOnTwoClosePushes) {
+  // The options off by default (push_capture, push_stop_feet, push_step_timing)
+  // re-plan through other paths (CaptureStop, AdaptStep): the same two close
+  // pushes as above must not make their reference ZMP jump or leave the
+  // support either.
+  const GaitParams g = FastGait();
+  struct Variant {
+    const char* name;
+    RecoveryParams rp;
+  };
+  std::vector<Variant> variants;
+  auto add = [&](const char* name, auto set) {
+    RecoveryParams rp;
+    rp.swing_reach = 1.0;  // the driver's default (push_swing_reach)
+    set(rp);
+    variants.push_back({name, rp});
+  };
+  add("the driver's defaults", [](RecoveryParams&) {});
+  add("push_capture=true", [](RecoveryParams& rp) { rp.capture_stop = true; });
+  add("push_stop_feet=keep", [](RecoveryParams& rp) { rp.stop_feet = RecoveryParams::StopFeet::kKeep; });
+  add("push_stop_feet=still", [](RecoveryParams& rp) { rp.stop_feet = RecoveryParams::StopFeet::kStill; });
+  add("push_step_timing=push",
+      [](RecoveryParams& rp) { rp.step_timing = RecoveryParams::TimingMode::kPush; });
+  add("push_step_timing=threshold",
+      [](RecoveryParams& rp) { rp.step_timing = RecoveryParams::TimingMode::kThreshold; });
+  add("push_step_timing=always",
+      [](RecoveryParams& rp) { rp.step_timing = RecoveryParams::TimingMode::kAlways; });
+  for (const Variant& v : variants) {
+    double worst = 0, worst_outside = 0;
+    std::string where;
+    int runs = 0;
+    for (int dir = 0; dir < 8; ++dir) {
+      const Eigen::Vector2d u(std::cos(dir * std::numbers::pi / 4), std::sin(dir * std::numbers::pi / 4));
+      for (const double level : {20.0, 30.0}) {
+        for (int k = 0; k < 8; ++k) {
+          const double at = 3.0 + (k + 0.5) * g.step_period() / 8;
+          for (const double after : {0.05, 0.1, 0.15}) {
+            const CaptureResult r = WalkPushAndRecover(u * level, at, v.rp, u * level, at + after);
+            ++runs;
+            worst_outside = std::max(worst_outside, r.worst_outside);
+            if (r.worst_jump > worst) {
+              worst = r.worst_jump;
+              where = std::to_string(level) + " N s toward " + std::to_string(45 * dir) + " deg at " +
+                      std::to_string(at) + " s, again " + std::to_string(after) + " s later";
+            }
+          }
+        }
+      }
+    }
+    std::printf("%s: %d runs, the reference ZMP's largest step %.4f m/tick (%s), outside %.2g m\n", v.name,
+                runs, worst, where.c_str(), worst_outside);
+    EXPECT_LT(worst, 9e-3) << v.name << ": " << where;
+    EXPECT_LT(worst_outside, 1e-9) << v.name << ": the reference ZMP inside the support";
+  }
+}
+
 }  // namespace
 }  // namespace robotalk::walking
