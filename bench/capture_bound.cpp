@@ -13,7 +13,9 @@
 //   robotalk-capture-bound [--seed S] [--instants K] [--cycle S] [--shift S]
 //       [--steps N] [--min-swing S] [--double-support S] [--reach M]
 //       [--reach-back M] [--min-width M] [--max-width M] [--front M]
-//       [--back M] [--half-width M] [--push-time S] [--needed 1]
+//       [--back M] [--half-width M] [--swing-speed M_S] [--push-time S] [--needed 1]
+// (--swing-speed: the first landing within that speed times its swing from
+// where the foot is; off by default, as the brief's limits have it.)
 // Prints per instant the gait's phase and per direction the bound (N s) for
 // 1, 2, 3 and unlimited steps; then per direction the min / median over the
 // instants beside the goal and the ODE default's median (docs/ode_sim.md, "A
@@ -108,6 +110,8 @@ Args Parse(int argc, char** argv) {
       l.back = v;
     else if (k == "--half-width")
       l.half_width = v;
+    else if (k == "--swing-speed")
+      l.swing_speed = v;
     else {
       std::fprintf(stderr, "unknown argument %s\n", k.c_str());
       std::exit(2);
@@ -207,7 +211,8 @@ void Needed(const Args& a, const std::vector<double>& at) {
                         {"min_width (m; < 0 crosses)", &CaptureLimits::min_width, -0.40},
                         {"sole front (m)", &CaptureLimits::front, 1.0},
                         {"sole back (m)", &CaptureLimits::back, 1.0},
-                        {"sole half width (m)", &CaptureLimits::half_width, 1.0}};
+                        {"sole half width (m)", &CaptureLimits::half_width, 1.0},
+                        {"first swing speed (m/s)", &CaptureLimits::swing_speed, 20.0}};
   std::printf(
       "\nEach limit alone (the others the model's): the value that brings the bound to the goal\n"
       "at every instant (min) and at half of them (median); '-' none up to the search's end\n");
@@ -216,6 +221,7 @@ void Needed(const Args& a, const std::vector<double>& at) {
   std::printf("\n");
   for (const Knob& kn : knobs) {
     const double model = a.limits.*kn.field;
+    if (kn.field == &CaptureLimits::swing_speed && !(model > 0)) continue;  // unbounded already
     std::printf("%-28s %9.3f", kn.name, model);
     for (int k = 0; k < 8; k += 2) {
       for (int which = 0; which < 2; ++which) {
@@ -259,9 +265,10 @@ int main(int argc, char** argv) {
   std::printf(
       "LIPM w = %.3f/s, %.1f kg, a %.2f s push (%.4f m of DCM per N s); sole %.2f ahead / %.2f behind / "
       "+-%.2f m; reach %.2f ahead, %.2f behind, %.2f-%.2f m beside; soonest landing %.2f s after "
-      "lift-off, lift-off %.2f s after landing\n",
+      "lift-off, lift-off %.2f s after landing; first swing %.2f m/s (0: unbounded)\n",
       l.omega, kMass, a.push_time, DcmShiftPerImpulse(kMass, l.omega, a.push_time), l.front, l.back,
-      l.half_width, l.reach, l.reach_back, l.min_width, l.max_width, l.min_swing, l.double_support);
+      l.half_width, l.reach, l.reach_back, l.min_width, l.max_width, l.min_swing, l.double_support,
+      l.swing_speed);
   const int steps_shown[] = {1, 2, 3, a.steps};
   std::printf("\nper instant: the largest impulse (N s) any controller could capture, %d steps at most\n",
               a.steps);

@@ -133,6 +133,37 @@ TEST(Capturability, NoTwoStepTimingNorPlacementBeatsTheRegionAndTheSoonestFarthe
   EXPECT_FALSE(Captures(r.x.lo - 1e-3, -l.back, l.front, swing, back, ds, 2, l.omega));
 }
 
+TEST(Capturability, ASwingSpeedNarrowsTheFirstLandingToWhereTheFootCanGet) {
+  // Mid-swing, the left foot beside the right one, pushed forward: with the
+  // foot free to land anywhere in reach at once, the region is the soonest
+  // step's; with 1 m/s of swing the first landing lies within 1 m/s of its
+  // swing from the foot, so the bound is lower, but still above the sole.
+  const CaptureLimits l = Model();
+  CaptureSituation s;
+  s.swing = Side::kLeft;
+  s.feet[1] = {0, -0.09, 0};
+  s.feet[0] = {0.0, 0.09, 0};  // in the air, alongside
+  s.soonest = 0.05;
+  s.dcm = {0.08, -0.04};
+  const double free = CapturableShift(l, s, {1, 0}, kManyCaptureSteps);
+  const CaptureBox r = SingleSupportRegion(l, Side::kLeft, 0.05, kManyCaptureSteps);
+  EXPECT_NEAR(free, r.x.hi - 0.08, 1e-12);
+  CaptureLimits slow = l;
+  slow.swing_speed = 1.0;
+  const double bounded = CapturableShift(slow, s, {1, 0}, kManyCaptureSteps);
+  EXPECT_LT(bounded, free - 0.05);
+  EXPECT_GT(bounded, l.front - 0.08);
+  // One step: Koolen's front + u e^{-w T} with the landing u at most 1 m/s x
+  // T ahead of the foot (alongside the stance ankle), the best over T.
+  const double one = CapturableShift(slow, s, {1, 0}, 1);
+  double best = 0;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.05 + 0.005 * i;
+    best = std::max(best, l.front + std::min(l.reach, 1.0 * t) * std::exp(-l.omega * t));
+  }
+  EXPECT_NEAR(one + 0.08, best, 1e-9);
+}
+
 TEST(Capturability, InDoubleSupportEitherFootMayLiftAndAPushsShiftIsItsImpulseSpread) {
   const CaptureLimits l = Model();
   CaptureSituation s;

@@ -38,6 +38,9 @@ Interval StepBack(const Axis& a, const Interval& next, double e1, double ed) {
 
 Interval Shift(const Interval& i, double by) { return {i.lo + by, i.hi + by}; }
 
+// With a swing speed: the first landing's times scanned beyond the soonest.
+constexpr double kFirstLandingScan = 1.0, kFirstLandingStep = 0.005;  // s
+
 // How far from p along dir the box holds (p inside); 0 when p is outside.
 double ExitAlong(const CaptureBox& b, const Eigen::Vector2d& p, const Eigen::Vector2d& dir) {
   if (!b.Contains(p)) return 0;
@@ -52,7 +55,12 @@ double ExitAlong(const CaptureBox& b, const Eigen::Vector2d& p, const Eigen::Vec
 
 }  // namespace
 
-CaptureBox SingleSupportRegion(const CaptureLimits& l, Side swing, double first, int steps) {
+namespace {
+
+// SingleSupportRegion, the first landing's range (from the stance ankle)
+// narrowed to `first_reach` when given (the swing foot's speed).
+CaptureBox Region(const CaptureLimits& l, Side swing, double first, int steps,
+                  const CaptureBox* first_reach) {
   const double e_swing = std::exp(-l.omega * l.min_swing), ed = std::exp(-l.omega * l.double_support);
   // regions[s]: the region with the foot on side s in the air, just lifted,
   // k steps to go; built up from the sole (k = 0).
@@ -61,18 +69,52 @@ CaptureBox SingleSupportRegion(const CaptureLimits& l, Side swing, double first,
     regions[static_cast<int>(s)] = {{-l.back, l.front}, {-l.half_width, l.half_width}};
   }
   for (int k = 1; k <= steps; ++k) {
-    const double e1 = k == steps ? std::exp(-l.omega * std::max(first, 0.0)) : e_swing;
+    const bool last = k == steps;
+    const double e1 = last ? std::exp(-l.omega * std::max(first, 0.0)) : e_swing;
     CaptureBox next[2];
     for (Side s : {Side::kLeft, Side::kRight}) {
       // The foot on side s lands; then the other one swings from its region.
       const CaptureBox& after = regions[static_cast<int>(Other(s))];
-      next[static_cast<int>(s)] = {StepBack(AxisX(l), after.x, e1, ed),
-                                   StepBack(AxisY(l, s), after.y, e1, ed)};
+      Axis ax = AxisX(l), ay = AxisY(l, s);
+      if (last && first_reach && s == swing) {
+        ax.step_lo = std::max(ax.step_lo, first_reach->x.lo);
+        ax.step_hi = std::min(ax.step_hi, first_reach->x.hi);
+        ay.step_lo = std::max(ay.step_lo, first_reach->y.lo);
+        ay.step_hi = std::min(ay.step_hi, first_reach->y.hi);
+      }
+      next[static_cast<int>(s)] = {StepBack(ax, after.x, e1, ed), StepBack(ay, after.y, e1, ed)};
     }
     regions[0] = next[0];
     regions[1] = next[1];
   }
   return regions[static_cast<int>(swing)];
+}
+
+// The largest of `exit(region)` over the first landing's times from `first`
+// (its swing `swing_time` s long from where the foot is, `foot` from the
+// stance ankle) when the swing speed bounds it; else the soonest only.
+template <typename Exit>
+double OverFirstLandings(const CaptureLimits& l, Side swing, double first, double swing_time, int steps,
+                         const Eigen::Vector2d& foot, const Exit& exit) {
+  if (!(l.swing_speed > 0) || steps <= 0) return exit(Region(l, swing, first, steps, nullptr));
+  double best = 0;
+  for (double extra = 0; extra <= kFirstLandingScan + 1e-9; extra += kFirstLandingStep) {
+    const double r = l.swing_speed * (swing_time + extra);
+    const CaptureBox reach{{foot.x() - r, foot.x() + r}, {foot.y() - r, foot.y() + r}};
+    const Axis ax = AxisX(l), ay = AxisY(l, swing);
+    if (reach.x.hi < ax.step_lo || reach.x.lo > ax.step_hi || reach.y.hi < ay.step_lo ||
+        reach.y.lo > ay.step_hi) {
+      continue;  // no landing in reach yet
+    }
+    best = std::max(best, exit(Region(l, swing, first + extra, steps, &reach)));
+  }
+  return best;
+}
+
+}  // namespace
+
+CaptureBox SingleSupportRegion(const CaptureLimits& l, Side swing, double first, int steps) {
+  return Region(l, swing, first, steps, nullptr);
 }
 
 double CapturableShift(const CaptureLimits& l, const CaptureSituation& s, const Eigen::Vector2d& dir,
@@ -85,8 +127,10 @@ double CapturableShift(const CaptureLimits& l, const CaptureSituation& s, const 
   Eigen::Vector2d feet[2] = {to_local * s.feet[0].xy(), to_local * s.feet[1].xy()};
   if (!s.double_support) {
     const Eigen::Vector2d& at = feet[static_cast<int>(Other(s.swing))];
-    const CaptureBox r = SingleSupportRegion(l, s.swing, s.soonest, steps);
-    return ExitAlong({Shift(r.x, at.x()), Shift(r.y, at.y())}, p, d);
+    return OverFirstLandings(l, s.swing, s.soonest, s.soonest, steps, feet[static_cast<int>(s.swing)] - at,
+                             [&](const CaptureBox& r) {
+                               return ExitAlong({Shift(r.x, at.x()), Shift(r.y, at.y())}, p, d);
+                             });
   }
   // Double support: the box of both soles, or either foot lifts (no sooner
   // than s.soonest) and swings from its region.
@@ -98,16 +142,19 @@ double CapturableShift(const CaptureLimits& l, const CaptureSituation& s, const 
   const double er = std::exp(-l.omega * std::max(s.soonest, 0.0));
   for (Side lift : {Side::kLeft, Side::kRight}) {
     const Eigen::Vector2d& at = feet[static_cast<int>(Other(lift))];
-    const CaptureBox r = SingleSupportRegion(l, lift, l.min_swing, steps);
-    const Interval* target[2] = {&r.x, &r.y};
-    const Interval* box[2] = {&both.x, &both.y};
-    Interval got[2];
-    for (int i = 0; i < 2; ++i) {  // held in the box for s.soonest, then into the region
-      const Interval t = Shift(*target[i], at[i]);
-      got[i] = {std::min(box[i]->lo, box[i]->lo + (t.lo - box[i]->lo) * er),
-                std::max(box[i]->hi, box[i]->hi + (t.hi - box[i]->hi) * er)};
-    }
-    best = std::max(best, ExitAlong({got[0], got[1]}, p, d));
+    const auto exit = [&](const CaptureBox& r) {
+      const Interval* target[2] = {&r.x, &r.y};
+      const Interval* box[2] = {&both.x, &both.y};
+      Interval got[2];
+      for (int i = 0; i < 2; ++i) {  // held in the box for s.soonest, then into the region
+        const Interval t = Shift(*target[i], at[i]);
+        got[i] = {std::min(box[i]->lo, box[i]->lo + (t.lo - box[i]->lo) * er),
+                  std::max(box[i]->hi, box[i]->hi + (t.hi - box[i]->hi) * er)};
+      }
+      return ExitAlong({got[0], got[1]}, p, d);
+    };
+    best = std::max(best, OverFirstLandings(l, lift, l.min_swing, l.min_swing, steps,
+                                            feet[static_cast<int>(lift)] - at, exit));
   }
   return best;
 }

@@ -56,6 +56,12 @@ struct CaptureLimits {
   double reach = 0.45, reach_back = 0.30, min_width = 0.14, max_width = 0.40;
   double min_swing = 0.35;       ///< s from a lift-off to its landing, at the soonest
   double double_support = 0.10;  ///< s from a landing to the next lift-off, at the soonest
+  /// m/s, 0: off. The first landing (the foot in the air, or in double
+  /// support the first to lift) at most this far per s of its swing from
+  /// where that foot is (per axis: the box around that disc, so still an
+  /// upper bound); its time then scanned (5 ms) up to 1 s beyond the
+  /// soonest. Later steps are bounded by the reach box alone.
+  double swing_speed = 0;
 };
 
 struct Interval {
