@@ -14,6 +14,12 @@
 //       [--steps N] [--min-swing S] [--double-support S] [--reach M]
 //       [--reach-back M] [--min-width M] [--max-width M] [--front M]
 //       [--back M] [--half-width M] [--swing-speed M_S] [--push-time S] [--needed 1]
+//       [--com-height M]
+// (--com-height: the LIPM's and the gait's, default 0.73 m: the driver's
+// stance, measured 0.728 m and sinking 0.9 s into its start-up by
+// robotalk-walk-bench --stand, and within the one height range, 0.715-0.742
+// m, whose derived timing is the driver's printed 0.55 + 0.21 s; the pure
+// tests take 0.70 m.)
 // (--swing-speed: the first landing within that speed times its swing from
 // where the foot is; off by default, as the brief's limits have it.)
 // Prints per instant the gait's phase and per direction the bound (N s) for
@@ -22,6 +28,7 @@
 // steadier push measure", seed 1). --needed 1: for each goal direction and
 // each limit alone, the value that would bring the bound to the goal at
 // every instant and at half of them (information; nothing is changed).
+#include "robotalk/urdf_import.h"
 #include "walking/capturability.h"
 #include "walking/footstep_planner.h"
 #include "walking/gait_limits.h"
@@ -50,16 +57,27 @@ constexpr double kGoal[8] = {40, 0, 25, 0, 40, 0, 25, 0};
 constexpr double kOdeMedian[8] = {15, 10, 12.5, 10, 25, 12.5, 5, 10};
 
 // The derived gait of models/simple_humanoid.urdf (docs/ode_sim.md, "The
-// gait from the model"; as tests/drivers/push_recovery_test.cpp has it).
-GaitParams FastGait() {
-  GaitParams g;
-  g.step_forward = 0.22;
-  g.step_back = 0.11;
-  g.step_side = 0.16;
-  g.single_support = 0.55;
-  g.double_support = 0.21;
-  g.com_height = 0.70;
-  return g;
+// gait from the model"): its leg measured from the model and the gait
+// derived as the driver does, on the driver's sole and feet (0.15 / 0.09 /
+// 0.06 m, 0.18 m apart; gait_limits_test's figures) and `com_height`.
+GaitParams FastGait(double com_height) {
+  return [com_height] {
+    const RobotModel model = LoadUrdfFile(std::string(ROBOTALK_BENCH_MODELS) + "/simple_humanoid.urdf").model;
+    std::string why;
+    const LegGeometry leg = MeasureLeg(model, model.LinkIndex("left_foot"), -0.07, 0.78 * 0.93, &why);
+    if (!why.empty()) {
+      std::fprintf(stderr, "the leg: %s\n", why.c_str());
+      std::exit(1);
+    }
+    GaitParams base;
+    base.foot_front = 0.15;
+    base.foot_back = 0.09;
+    base.foot_half_width = 0.06;
+    base.zmp_x = (base.foot_front - base.foot_back) / 2;
+    base.foot_separation = 0.18;
+    base.com_height = com_height;
+    return DeriveGait(leg, base, kGravity);
+  }();
 }
 
 struct Args {
@@ -67,6 +85,7 @@ struct Args {
   int instants = 8;
   double cycle = 1.52, shift = 0, push_time = 0.1;
   int steps = kManyCaptureSteps;
+  double com_height = 0.73;  // m: the driver's stance (see --com-height)
   bool needed = false;
   CaptureLimits limits;
 };
@@ -74,11 +93,12 @@ struct Args {
 Args Parse(int argc, char** argv) {
   Args a;
   CaptureLimits& l = a.limits;
-  l.omega = std::sqrt(kGravity / FastGait().com_height);
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i];
     const double v = std::atof(argv[i + 1]);
-    if (k == "--seed")
+    if (k == "--com-height")
+      a.com_height = v;
+    else if (k == "--seed")
       a.seed = static_cast<unsigned>(v);
     else if (k == "--instants")
       a.instants = static_cast<int>(v);
@@ -117,7 +137,9 @@ Args Parse(int argc, char** argv) {
       std::exit(2);
     }
   }
-  if (a.instants < 1 || a.instants > 50 || !(a.cycle > 0) || a.steps < 0 || !(a.push_time >= 0)) {
+  l.omega = std::sqrt(kGravity / a.com_height);
+  if (!(a.com_height > 0) || a.instants < 1 || a.instants > 50 || !(a.cycle > 0) || a.steps < 0 ||
+      !(a.push_time >= 0)) {
     std::fprintf(stderr, "--instants in [1, 50], --cycle > 0, --steps >= 0, --push-time >= 0\n");
     std::exit(2);
   }
@@ -135,8 +157,7 @@ struct Instant {
 // does), stopped at each instant (ascending). The soonest landing or lift-off
 // follows the limits: min_swing after the lift-off, double_support after the
 // landing.
-std::vector<Instant> WalkTo(const std::vector<double>& at, const CaptureLimits& l) {
-  const GaitParams g = FastGait();
+std::vector<Instant> WalkTo(const std::vector<double>& at, const CaptureLimits& l, const GaitParams& g) {
   WalkPattern w(g, kTick, 5, kGravity);
   w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
   for (int i = 0; i < 1000; ++i) w.Tick();
@@ -202,7 +223,7 @@ struct Knob {
   double to;  // the far end of the search (the direction that helps)
 };
 
-void Needed(const Args& a, const std::vector<double>& at) {
+void Needed(const Args& a, const std::vector<double>& at, const GaitParams& gait) {
   const Knob knobs[] = {{"min_swing (s)", &CaptureLimits::min_swing, 0.0},
                         {"double_support (s)", &CaptureLimits::double_support, 0.0},
                         {"reach ahead (m)", &CaptureLimits::reach, 3.0},
@@ -229,7 +250,7 @@ void Needed(const Args& a, const std::vector<double>& at) {
           CaptureLimits l = a.limits;
           l.*kn.field = value;
           if (kn.field == &CaptureLimits::min_width) l.max_width = std::max(l.max_width, value);
-          const std::vector<double> b = PerInstant(l, WalkTo(at, l), k * 45.0, a.steps, a.push_time);
+          const std::vector<double> b = PerInstant(l, WalkTo(at, l, gait), k * 45.0, a.steps, a.push_time);
           const double fig = which == 0 ? *std::min_element(b.begin(), b.end()) : Median(b);
           return fig >= kGoal[k];
         };
@@ -261,7 +282,10 @@ int main(int argc, char** argv) {
   std::uniform_real_distribution<double> jitter(0, 1);
   std::vector<double> at(static_cast<size_t>(a.instants));
   for (int i = 0; i < a.instants; ++i) at[i] = 5.0 + a.shift + a.cycle * (i + jitter(rng)) / a.instants;
-  const std::vector<Instant> ins = WalkTo(at, l);
+  const GaitParams gait = FastGait(a.com_height);
+  const std::vector<Instant> ins = WalkTo(at, l, gait);
+  std::printf("gait: %.2f m steps, %.2f + %.2f s (single + double support), CoM %.3f m up\n",
+              gait.step_forward, gait.single_support, gait.double_support, a.com_height);
   std::printf(
       "LIPM w = %.3f/s, %.1f kg, a %.2f s push (%.4f m of DCM per N s); sole %.2f ahead / %.2f behind / "
       "+-%.2f m; reach %.2f ahead, %.2f behind, %.2f-%.2f m beside; soonest landing %.2f s after "
@@ -308,6 +332,6 @@ int main(int argc, char** argv) {
       std::printf("  %5s\n", "-");
     }
   }
-  if (a.needed) Needed(a, at);
+  if (a.needed) Needed(a, at, gait);
   return 0;
 }
