@@ -4,6 +4,7 @@
 // stance sole (the ankles push the DCM's error back within the sole), steps
 // where and when the adapter says, and is pushed (a change of velocity).
 #include "walking/step_timing.h"
+#include "walking/capturability.h"
 
 #include <gtest/gtest.h>
 
@@ -199,6 +200,59 @@ TEST(StepTiming, LandingSoonerWhereTheDcmNeedsCapturesPushesTheLocationAloneFall
   const Walk w = WalkAndPush(Push(90, 30), 0.25, true);
   EXPECT_FALSE(w.fell);
   EXPECT_LT(w.soonest_landing, kSwing);
+}
+
+// The capture bound (capturability.h) for this pendulum's limits at `at` s
+// into the third step's swing toward `deg`: the largest push (N s, an
+// impulse) any stepping strategy could recover.
+double CaptureBoundAt(double at, double deg) {
+  CaptureLimits l;
+  l.omega = kOmega;
+  l.front = kFront;
+  l.back = kBack;
+  l.half_width = kHalf;
+  l.min_swing = kMinSwing;
+  l.double_support = 0;  // instantaneous here
+  CaptureSituation s;
+  s.swing = Side::kLeft;  // the third step: the right foot carries, 2 steps on
+  s.feet[1] = {2 * kStep, -kWidth / 2, 0};
+  s.feet[0] = {kStep, kWidth / 2, 0};
+  s.soonest = std::max(0.0, kMinSwing - at);
+  s.dcm = s.feet[1].xy() + PeriodicStart() * std::exp(kOmega * at);
+  const double a = deg * std::numbers::pi / 180;
+  return CapturableShift(l, s, {std::cos(a), std::sin(a)}, kManyCaptureSteps) /
+         DcmShiftPerImpulse(kMass, kOmega, 0);
+}
+
+TEST(StepTiming, NoPushBeyondTheCaptureBoundIsSurvivedAndTimingGetsCloserThanLocationAlone) {
+  // At the 10 instants over a swing of the test above, per direction the
+  // largest push survived (5 N s levels, below the first that falls) with
+  // the landing's place alone and with its time: never beyond the bound;
+  // how close each comes is printed (docs/ode_sim.md, "How large a push any
+  // controller could survive").
+  double sums[3] = {0, 0, 0};
+  for (int k = 0; k < 8; ++k) {
+    std::printf("%5d deg: bound / place alone / place and time (N s):", 45 * k);
+    for (int i = 0; i < 10; ++i) {
+      const double at = 0.05 * i, bound = CaptureBoundAt(at, 45.0 * k);
+      double largest[2] = {0, 0};
+      for (int timing = 0; timing < 2; ++timing) {
+        for (double j = 5; j <= std::min(150.0, bound + 10) + 1e-9; j += 5) {
+          if (WalkAndPush(Push(45.0 * k, j), at, timing == 1).fell) break;
+          largest[timing] = j;
+        }
+        EXPECT_LE(largest[timing], bound) << 45 * k << " deg at " << at << " s, timing " << timing;
+      }
+      std::printf(" %.0f/%.0f/%.0f", bound, largest[0], largest[1]);
+      sums[0] += bound;
+      sums[1] += largest[0];
+      sums[2] += largest[1];
+    }
+    std::printf("\n");
+  }
+  std::printf("sums over the 80 pushes (N s): bound %.0f, place alone %.0f, place and time %.0f\n", sums[0],
+              sums[1], sums[2]);
+  EXPECT_GT(sums[2], sums[1]);
 }
 
 TEST(StepTiming, BadSettingsAreRefused) {
