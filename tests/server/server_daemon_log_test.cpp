@@ -271,5 +271,41 @@ TEST(LogWriterTest, AStderrThatTakesNothingBoundsTheQueueAndSaysWhatWasLostOnceI
   EXPECT_THAT(text, HasSubstr("test: after\n"));
 }
 
+// Review 12: a stderr whose description is non-blocking (one another
+// process set O_NONBLOCK on: ssh does on the stdio it shares, so does node
+// on a terminal) answers EAGAIN while its reader is merely behind. The
+// LogWriter took that for a write that failed and lost the lines (counted
+// as lost), though the reader took them a moment later; it now waits for
+// the descriptor to take more, as a blocking one makes it wait.
+TEST(LogWriterTest, ANonBlockingStderrWhoseReaderIsBehindLosesNothing) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  fcntl(fds[1], F_SETFL, fcntl(fds[1], F_GETFL) | O_NONBLOCK);
+  std::string text;
+  std::thread reader([&] {
+    std::this_thread::sleep_for(milliseconds(300));  // behind: the pipe (64 KiB) fills first
+    char buffer[4096];
+    for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+  });
+  {
+    LogWriter log("test: ", fds[1]);
+    std::vector<std::string> lines;
+    for (int i = 0; i < 200; ++i) lines.push_back("line " + std::to_string(i) + " " + std::string(1000, 'a'));
+    log.Write(lines);  // 200 kB: more than the pipe holds
+    std::vector<std::string> last{"last"};
+    while (!log.Write(last)) last = {"last"};  // until written (a lost "last" is written again)
+    EXPECT_EQ(log.dropped(), 0u);
+  }
+  close(fds[1]);  // the writer thread wrote everything: "last" came after the rest
+  reader.join();
+  close(fds[0]);
+  int lost = 0;
+  for (int i = 0; i < 200; ++i)
+    lost += text.find("test: line " + std::to_string(i) + " ") == std::string::npos;
+  EXPECT_EQ(lost, 0) << "of 200 lines; " << text.size() << " bytes read";
+  EXPECT_EQ(text.find("log lines lost"), std::string::npos);
+  EXPECT_NE(text.find("test: last\n"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace robotalk
