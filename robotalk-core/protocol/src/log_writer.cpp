@@ -1,5 +1,6 @@
 #include "robotalk/log_writer.h"
 
+#include <poll.h>
 #include <unistd.h>
 
 #include <pthread.h>
@@ -60,6 +61,13 @@ struct LogWriter::State {
       for (std::size_t at = 0; at < text.size();) {
         const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
         if (n < 0 && errno == EINTR) continue;
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+          // A non-blocking description (another process set O_NONBLOCK on
+          // the stderr it shares: ssh, node) whose reader is behind: wait
+          // for it as a blocking one makes this thread wait, never lose.
+          pollfd out{fd, POLLOUT, 0};
+          if (::poll(&out, 1, -1) >= 0 || errno == EINTR) continue;
+        }
         if (n <= 0) {  // closed, EPIPE, no space: these lines are lost, the next may not be
           failed = true;
           break;

@@ -11,7 +11,9 @@
 // once per spell, and nothing after. Lines then wait in a queue of at most
 // kMaxQueuedBytes; beyond it they are dropped, and the first write after
 // says how many ("N log lines lost: ..."), as it does for lines whose write
-// failed (a full disk, a pipe without a reader: EPIPE, never SIGPIPE).
+// failed (a full disk, a pipe without a reader: EPIPE, never SIGPIPE). A
+// non-blocking descriptor's EAGAIN is no failure: the writer thread waits
+// for it to take more (poll), as a blocking write waits.
 //
 // Thread safety: Write() from any thread. The writer's state outlives the
 // object: a destructor that cannot write what waits within kMaxWait leaves
