@@ -119,6 +119,10 @@ TEST(RequestCodec, RefusesAnAnnouncedRobotNameOutsideTheRobotNameRule) {
   Announcement driver{.server_id = 9, .url_hint = "u"};
   driver.robots.push_back({"pioneer", "ode\x1b[2J"});
   EXPECT_THROW(DecodeAnnouncement(EncodeAnnouncement(driver)), ProtocolError) << "a driver with an escape";
+  driver.robots[0].driver =
+      "ode\xc2\x9b"
+      "2J";  // U+009B, CSI: a terminal that takes C1 controls clears its screen
+  EXPECT_THROW(DecodeAnnouncement(EncodeAnnouncement(driver)), ProtocolError) << "a driver with a C1 CSI";
   Announcement url{.server_id = 9, .url_hint = "udpm://x\r\x1b[1A"};
   EXPECT_THROW(DecodeAnnouncement(EncodeAnnouncement(url)), ProtocolError) << "a url hint with an escape";
   Announcement ok{.server_id = 9, .url_hint = "udpm://239.255.76.67:7667?ttl=0"};
