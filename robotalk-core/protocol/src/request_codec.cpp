@@ -254,12 +254,13 @@ Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   };
   // Anyone's datagram: its texts reach terminals (`robotalk robots`), logs
   // and robotalk-web's and robotalk-ros2's tables. A name no server can
-  // serve (RobotNameProblem), or a control character (a terminal escape, a
-  // line break forging a log line), is refused here, for every reader.
+  // serve (RobotNameProblem), or a driver or URL hint not in printable ASCII
+  // (a terminal escape, C0 or UTF-8-encoded C1; a line break forging a log
+  // line), is refused here, for every reader.
   const auto printable = [&](const char* field, const std::string& text) {
     for (const char c : text) {
       const auto u = static_cast<unsigned char>(c);
-      if (u < 0x20 || u == 0x7f) fail(field, "a control character (byte " + std::to_string(u) + ")");
+      if (u < 0x20 || u >= 0x7f) fail(field, "not printable ASCII (byte " + std::to_string(u) + ")");
     }
   };
   printable("url_hint", m.url_hint);
