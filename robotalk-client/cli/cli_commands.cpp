@@ -43,10 +43,27 @@ void RejectOptions(const std::vector<std::string>& args) {
 int ExitStatus(const Reply& r) { return Succeeded(r.signal) ? 0 : 1; }
 
 void PrintReply(const Reply& r, std::ostream& out) {
+  // The message is the server's text (in open mode anyone's who forges a
+  // reply): one line, and no control character reaches the terminal (C0,
+  // DEL, C1 encoded in UTF-8 as 0xc2 0x80..0x9f): each written \xNN.
   std::string quoted = "\"";
-  for (char c : r.message) {
-    if (c == '"' || c == '\\') quoted += '\\';
-    quoted += c;
+  const std::string& m = r.message;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const auto u = static_cast<unsigned char>(m[i]);
+    const bool c1 = u == 0xc2 && i + 1 < m.size() && static_cast<unsigned char>(m[i + 1]) >= 0x80 &&
+                    static_cast<unsigned char>(m[i + 1]) <= 0x9f;
+    if (u < 0x20 || u == 0x7f || c1) {
+      char hex[16];
+      if (c1) {
+        std::snprintf(hex, sizeof hex, "\\x%02x\\x%02x", u, static_cast<unsigned char>(m[++i]));
+      } else {
+        std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      }
+      quoted += hex;
+      continue;
+    }
+    if (m[i] == '"' || m[i] == '\\') quoted += '\\';
+    quoted += m[i];
   }
   quoted += '"';
   out << r.id << ' ' << ToString(r.signal) << ' ' << quoted;
