@@ -310,5 +310,28 @@ TEST(LogWriterTest, ANonBlockingStderrWhoseReaderIsBehindLosesNothing) {
   EXPECT_NE(text.find("test: last\n"), std::string::npos);
 }
 
+// Review 12: a log line carries texts of anyone's (robotalk-ros2 logs a
+// refused JointTrajectory's joint name, from anyone on the DDS domain): a
+// line break in one forged a whole log line, a terminal escape reached the
+// terminal. Every line is written on one line, its control characters (C0,
+// DEL, C1 encoded in UTF-8) as \xNN; UTF-8 text is kept.
+TEST(LogWriterTest, ALinesControlCharactersAreWrittenEscapedOnOneLine) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  {
+    LogWriter log("test: ", fds[1]);
+    std::vector<std::string> lines{
+        "joint 'h\xc3\xa4nd\nrobotalk-server: robot 'bot': executed'\x1b]0;x\x07\xc2\x9b"};
+    ASSERT_TRUE(log.Write(lines));
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[4096];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+  close(fds[0]);
+  EXPECT_EQ(text,
+            "test: joint 'h\xc3\xa4nd\\x0arobotalk-server: robot 'bot': executed'\\x1b]0;x\\x07\\xc2\\x9b\n");
+}
+
 }  // namespace
 }  // namespace robotalk
