@@ -5,6 +5,7 @@
 #include "interrupt.h"
 #include "robotalk/channels.h"
 #include "robotalk/known_servers.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
@@ -44,27 +45,13 @@ int ExitStatus(const Reply& r) { return Succeeded(r.signal) ? 0 : 1; }
 
 void PrintReply(const Reply& r, std::ostream& out) {
   // The message is the server's text (in open mode anyone's who forges a
-  // reply): one line, and no control character reaches the terminal (C0,
-  // DEL, C1 encoded in UTF-8 as 0xc2 0x80..0x9f): each written \xNN.
+  // reply): quoted, on one line, no control character reaching the terminal.
   std::string quoted = "\"";
-  const std::string& m = r.message;
-  for (std::size_t i = 0; i < m.size(); ++i) {
-    const auto u = static_cast<unsigned char>(m[i]);
-    const bool c1 = u == 0xc2 && i + 1 < m.size() && static_cast<unsigned char>(m[i + 1]) >= 0x80 &&
-                    static_cast<unsigned char>(m[i + 1]) <= 0x9f;
-    if (u < 0x20 || u == 0x7f || c1) {
-      char hex[16];
-      if (c1) {
-        std::snprintf(hex, sizeof hex, "\\x%02x\\x%02x", u, static_cast<unsigned char>(m[++i]));
-      } else {
-        std::snprintf(hex, sizeof hex, "\\x%02x", u);
-      }
-      quoted += hex;
-      continue;
-    }
-    if (m[i] == '"' || m[i] == '\\') quoted += '\\';
-    quoted += m[i];
+  for (char c : r.message) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
   }
+  quoted = EscapeControls(quoted);
   quoted += '"';
   out << r.id << ' ' << ToString(r.signal) << ' ' << quoted;
   for (double v : r.values) {
