@@ -171,3 +171,19 @@ def test_a_damaged_log_is_read_with_its_damage_named(tmp_path: Path) -> None:
     info = robotalk.log_info(str(log))
     assert info["events"] == 3 and info["rejections"] == 1
     assert "2147483647 data bytes" in info["rejected"][0] and f"byte {2 * len(events[0])}" in info["rejected"][0]
+
+
+def test_a_logs_channel_names_come_back_in_printable_ascii(tmp_path: Path) -> None:
+    """Review 12: a log's channel names are anyone's bytes. One that is not
+    UTF-8 made log_info raise UnicodeDecodeError for the whole log, and one
+    with a terminal escape came back raw; now every byte outside printable
+    ASCII is written \\xNN and the event still counts."""
+    import struct
+    events = b""
+    for n, channel in enumerate((b"OTHER\xe9", b"OTHER\x1b]0;")):
+        events += struct.pack(">IqqII", 0xEDA1DA01, n, 1000 * (n + 1), len(channel), 1) + channel + b"x"
+    log = tmp_path / "hostile.lcmlog"
+    log.write_bytes(events)
+    info = robotalk.log_info(str(log))
+    assert info["events"] == 2
+    assert sorted(info["channels"]) == ["OTHER\\x1b]0;", "OTHER\\xe9"]

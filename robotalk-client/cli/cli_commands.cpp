@@ -5,6 +5,7 @@
 #include "interrupt.h"
 #include "robotalk/channels.h"
 #include "robotalk/known_servers.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
@@ -43,11 +44,14 @@ void RejectOptions(const std::vector<std::string>& args) {
 int ExitStatus(const Reply& r) { return Succeeded(r.signal) ? 0 : 1; }
 
 void PrintReply(const Reply& r, std::ostream& out) {
+  // The message is the server's text (in open mode anyone's who forges a
+  // reply): quoted, on one line, no control character reaching the terminal.
   std::string quoted = "\"";
   for (char c : r.message) {
     if (c == '"' || c == '\\') quoted += '\\';
     quoted += c;
   }
+  quoted = EscapeControls(quoted);
   quoted += '"';
   out << r.id << ' ' << ToString(r.signal) << ' ' << quoted;
   for (double v : r.values) {

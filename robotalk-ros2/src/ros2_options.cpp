@@ -1,5 +1,6 @@
 #include "ros2_options.h"
 
+#include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/sequence_file.h"
 
@@ -71,7 +72,8 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
       o.version = true;
     } else if (a == "--robot") {
       const std::string& name = value();
-      if (name.empty()) throw Error("--robot: the name is empty");
+      if (const std::string why = RobotNameProblem(name); !why.empty())
+        throw Error("--robot '" + name + "': " + why);
       o.robots.push_back(name);
     } else if (a == "--url") {
       o.lcm_url = value();

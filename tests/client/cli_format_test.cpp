@@ -1,10 +1,12 @@
 // The CLI's pure helpers: durations as people write them, progress bars, JSON.
+#include "cli_commands.h"
 #include "cli_support.h"
 #include "sequence_runner.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <sstream>
 
 namespace robotalk::cli {
 namespace {
@@ -21,6 +23,22 @@ TEST(TidyDurations, RewritesPrintfSecondsInsideMessages) {
   EXPECT_EQ(TidyDurations("GOTO (id 3): no reply within 5.000000 s"), "GOTO (id 3): no reply within 5 s");
   EXPECT_EQ(TidyDurations("waited 0.500000 s, then 1.250000 s"), "waited 0.5 s, then 1.25 s");
   EXPECT_EQ(TidyDurations("nothing to change: 5 s, 3.5 sec"), "nothing to change: 5 s, 3.5 sec");
+}
+
+// Review 12: a reply's message is the server's text (in open mode, anyone's
+// who forges a reply): `robotalk send` printed it quoted but raw, so a line
+// break forged a second reply line for the scripts that read them, and a
+// terminal escape (C0, or C1 CSI encoded in UTF-8) reached the terminal.
+// Control characters are now written \xNN; UTF-8 text is kept.
+TEST(PrintReply, WritesTheMessagesControlCharactersEscapedOnOneLine) {
+  std::ostringstream out;
+  PrintReply(Reply{.id = 7,
+                   .signal = Signal::kError,
+                   .message = "unknown joint '\xc3\xa4'\n8 SUCCESS \"\"\x1b]0;owned\x07\xc2\x9b"
+                              "2J"},
+             out);
+  EXPECT_EQ(out.str(),
+            "7 ERROR \"unknown joint '\xc3\xa4'\\x0a8 SUCCESS \\\"\\\"\\x1b]0;owned\\x07\\xc2\\x9b2J\"\n");
 }
 
 TEST(ProgressBar, FillsWithTheLaterOfTimeAndAnsweredFrames) {

@@ -95,6 +95,41 @@ TEST(RequestCodec, RefusesAnAnnouncementWithAZeroLengthStringOrAHostileCount) {
   EXPECT_THROW(DecodeAnnouncement(bytes), ProtocolError) << "truncated";
 }
 
+// Review 12: an ANNOUNCE is anyone's datagram, and its robot names reached
+// every reader as they came: `robotalk robots` printed a name carrying
+// terminal escapes to the operator's terminal, robotalk-ros2 logged it, and
+// robotalk-web's and robotalk-ros2's tables took names no server can serve
+// (longer than kMaxRobotNameLength, or not letters, digits, '_', '-'). The
+// decoder they all share refuses such an announcement naming the rule.
+TEST(RequestCodec, RefusesAnAnnouncedRobotNameOutsideTheRobotNameRule) {
+  for (const std::string& name : {std::string("pioneer\x1b]0;owned\x07"), std::string(32, 'a'), std::string(),
+                                  std::string("arm one"), std::string("arm\nrobotalk: fake line")}) {
+    Announcement a{.server_id = 9, .url_hint = "u"};
+    a.robots.push_back({"pioneer", "ode"});
+    a.robots.push_back({name, "ode"});
+    try {
+      DecodeAnnouncement(EncodeAnnouncement(a));
+      ADD_FAILURE() << "the robot name of " << name.size() << " characters was accepted";
+    } catch (const ProtocolError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("robot.name"));
+      EXPECT_THAT(e.what(), HasSubstr("a robot name"));
+    }
+  }
+  // Its other texts are printed beside the name: no control characters.
+  Announcement driver{.server_id = 9, .url_hint = "u"};
+  driver.robots.push_back({"pioneer", "ode\x1b[2J"});
+  EXPECT_THROW(DecodeAnnouncement(EncodeAnnouncement(driver)), ProtocolError) << "a driver with an escape";
+  driver.robots[0].driver =
+      "ode\xc2\x9b"
+      "2J";  // U+009B, CSI: a terminal that takes C1 controls clears its screen
+  EXPECT_THROW(DecodeAnnouncement(EncodeAnnouncement(driver)), ProtocolError) << "a driver with a C1 CSI";
+  Announcement url{.server_id = 9, .url_hint = "udpm://x\r\x1b[1A"};
+  EXPECT_THROW(DecodeAnnouncement(EncodeAnnouncement(url)), ProtocolError) << "a url hint with an escape";
+  Announcement ok{.server_id = 9, .url_hint = "udpm://239.255.76.67:7667?ttl=0"};
+  ok.robots.push_back({std::string(31, 'a'), "ode"});
+  EXPECT_EQ(DecodeAnnouncement(EncodeAnnouncement(ok)).robots.at(0).name, std::string(31, 'a'));
+}
+
 // Every reader of ANNOUNCE (the client, robotalk-web, robotalk-logplay) uses
 // this decoder: a hostile robot count must not reach LCM's, which would
 // allocate the array from it. (These were robotalk-web's tests of its own

@@ -33,5 +33,17 @@ TEST(Ros2Options, ADurationOutOfRangeOrNotPositiveIsNamed) {
   EXPECT_NE(ErrorOf({"--duration", "-1"}), "(no error)");
 }
 
+// Review 12: `--robot` took any name but the empty one; a name no server
+// can serve (32+ characters, a space) was tried and refused by every
+// connect, for ever, instead of refused at start naming the rule.
+TEST(Ros2Options, ARobotNameOutsideTheRobotNameRuleIsRefusedNamingIt) {
+  EXPECT_EQ(ParseRos2Options({"--robot", std::string(31, 'a')}).robots.at(0), std::string(31, 'a'));
+  EXPECT_NE(ErrorOf({"--robot", std::string(32, 'a')})
+                .find("--robot '" + std::string(32, 'a') + "': a robot name has at most 31 characters"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf({"--robot", "arm one"}).find("a robot name is letters, digits"), std::string::npos);
+  EXPECT_NE(ErrorOf({"--robot", ""}).find("--robot"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace robotalk::ros2

@@ -271,5 +271,67 @@ TEST(LogWriterTest, AStderrThatTakesNothingBoundsTheQueueAndSaysWhatWasLostOnceI
   EXPECT_THAT(text, HasSubstr("test: after\n"));
 }
 
+// Review 12: a stderr whose description is non-blocking (one another
+// process set O_NONBLOCK on: ssh does on the stdio it shares, so does node
+// on a terminal) answers EAGAIN while its reader is merely behind. The
+// LogWriter took that for a write that failed and lost the lines (counted
+// as lost), though the reader took them a moment later; it now waits for
+// the descriptor to take more, as a blocking one makes it wait.
+TEST(LogWriterTest, ANonBlockingStderrWhoseReaderIsBehindLosesNothing) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  fcntl(fds[1], F_SETFL, fcntl(fds[1], F_GETFL) | O_NONBLOCK);
+  std::string text;
+  std::thread reader([&] {
+    std::this_thread::sleep_for(milliseconds(300));  // behind: the pipe (64 KiB) fills first
+    char buffer[4096];
+    for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+  });
+  {
+    LogWriter log("test: ", fds[1]);
+    std::vector<std::string> lines;
+    for (int i = 0; i < 200; ++i) lines.push_back("line " + std::to_string(i) + " " + std::string(1000, 'a'));
+    log.Write(lines);  // 200 kB: more than the pipe holds
+    std::vector<std::string> last{"last"};
+    log.Write(last);
+    const auto deadline = std::chrono::steady_clock::now() + seconds(10);
+    for (std::vector<std::string> none; !log.Write(none) && std::chrono::steady_clock::now() < deadline;)
+      std::this_thread::sleep_for(milliseconds(10));  // until everything queued is written, or lost
+    EXPECT_EQ(log.dropped(), 0u);
+  }
+  close(fds[1]);  // the writer thread wrote everything: "last" came after the rest
+  reader.join();
+  close(fds[0]);
+  int lost = 0;
+  for (int i = 0; i < 200; ++i)
+    lost += text.find("test: line " + std::to_string(i) + " ") == std::string::npos;
+  EXPECT_EQ(lost, 0) << "of 200 lines; " << text.size() << " bytes read";
+  EXPECT_EQ(text.find("log lines lost"), std::string::npos);
+  EXPECT_NE(text.find("test: last\n"), std::string::npos);
+}
+
+// Review 12: a log line carries texts of anyone's (robotalk-ros2 logs a
+// refused JointTrajectory's joint name, from anyone on the DDS domain): a
+// line break in one forged a whole log line, a terminal escape reached the
+// terminal. Every line is written on one line, its control characters (C0,
+// DEL, C1 encoded in UTF-8) as \xNN; UTF-8 text is kept.
+TEST(LogWriterTest, ALinesControlCharactersAreWrittenEscapedOnOneLine) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  {
+    LogWriter log("test: ", fds[1]);
+    std::vector<std::string> lines{
+        "joint 'h\xc3\xa4nd\nrobotalk-server: robot 'bot': executed'\x1b]0;x\x07\xc2\x9b"};
+    ASSERT_TRUE(log.Write(lines));
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[4096];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+  close(fds[0]);
+  EXPECT_EQ(text,
+            "test: joint 'h\xc3\xa4nd\\x0arobotalk-server: robot 'bot': executed'\\x1b]0;x\\x07\\xc2\\x9b\n");
+}
+
 }  // namespace
 }  // namespace robotalk

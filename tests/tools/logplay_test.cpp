@@ -334,6 +334,37 @@ TEST_F(HostileLog, RefusesAPlaybackStartThatIsNotAFiniteTimeAndKeepsEveryValidFr
   }
 }
 
+// Review 12: a log's channel names and the texts of its messages are
+// anyone's bytes. `robotalk-logplay info` printed them raw (a channel
+// "ROBOTALK/a<ESC>]0;...<BEL>/HELLO" put its escape sequence on the
+// terminal, in the channel list and as the client's robot), and Python's
+// log_info raised UnicodeDecodeError for a whole log holding one channel
+// name that is not UTF-8. Now every byte outside printable ASCII is shown
+// as \xNN; the events still count.
+TEST_F(HostileLog, ChannelNamesAndStateTextsAreShownInPrintableAscii) {
+  const std::vector<std::uint8_t> hello = EncodeHello({.body = {.client_id = kClient}});
+  Write("ROBOTALK/a\x1b]0;owned\x07/HELLO", 10, hello);
+  Write("ROBOTALK/j\xe9/HELLO", 11, hello);
+  robotalk::StateSample state;
+  state.robot = "st\x1b[2Jate\xff";
+  state.server_time = TimePoint(std::chrono::seconds(1));
+  Write(StateChannel("pioneer"), 12, EncodeStateSample(state));
+  const SessionLog log = Read();
+  std::ostringstream out;
+  PrintInfo(log, path_, out);
+  const std::string info = out.str();
+  std::size_t bad = 0;
+  for (const char c : info) {
+    const auto u = static_cast<unsigned char>(c);
+    bad += (u < 0x20 && c != '\n') || u >= 0x7f;
+  }
+  EXPECT_EQ(bad, 0u) << "bytes outside printable ASCII in the info text";
+  EXPECT_NE(info.find("a\\x1b]0;owned\\x07"), std::string::npos) << info;
+  EXPECT_NE(info.find("j\\xe9"), std::string::npos) << info;
+  EXPECT_NE(info.find("st\\x1b[2Jate\\xff"), std::string::npos) << info;
+  EXPECT_EQ(log.events(), 3u);
+}
+
 TEST_F(HostileLog, RefusesLogTimestampsOutOfRangeAndNamesThem) {
   const auto p = Package(kClient, 1, 100, kDelay, {{1, CommandType::kGoto, 5'000'000, "", {1, 0, 0}}});
   Write(kRequest, std::numeric_limits<std::int64_t>::min(), p);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string_view>
 
 namespace robotalk::logplay {
 namespace {
@@ -44,6 +45,27 @@ std::int64_t MicrosFromDouble(double v, const std::string& field) {
   return static_cast<std::int64_t>(v);
 }
 
+// A log's texts are anyone's bytes: shown in printable ASCII, every other
+// byte as \xNN (a terminal escape never reaches a terminal; Python's
+// log_info never meets a string that is not UTF-8). RoboTalk's channels and
+// robot names are printable ASCII, unchanged.
+std::string Printable(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+      continue;
+    }
+    constexpr char kHex[] = "0123456789abcdef";
+    out += "\\x";
+    out += kHex[u >> 4];
+    out += kHex[u & 0xf];
+  }
+  return out;
+}
+
 }  // namespace
 
 std::int64_t ParseClientId(const std::string& text) {
@@ -57,8 +79,9 @@ std::int64_t ParseClientId(const std::string& text) {
   throw LogError("client id '" + text + "': expected 16 hex digits (as `info` prints) or a decimal id");
 }
 
-void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
+void SessionLog::Add(const std::string& logged_channel, std::int64_t log_time_us,
                      std::span<const std::uint8_t> bytes) {
+  const std::string channel = Printable(logged_channel);
   const std::uint64_t event = events_++;  // LCM's numbering: from 0
   ChannelStats& s = channels_[channel];
   ++s.messages;
@@ -103,7 +126,7 @@ void SessionLog::Add(const std::string& channel, std::int64_t log_time_us,
         break;  // the robot's description: nothing a session's timeline needs
     }
   } catch (const std::exception& e) {
-    reject(e.what());  // a log holds whatever was on the bus; count it, name it, go on
+    reject(Printable(e.what()));  // a log holds whatever was on the bus; count it, name it, go on
   }
 }
 
@@ -216,7 +239,7 @@ void SessionLog::AddAnnounce(std::span<const std::uint8_t> bytes) {
   for (const RobotAnnouncement& r : a.robots) {
     LoggedRobot& lr = robots_[{a.server_id, r.name}];
     lr.name = r.name;
-    lr.driver = r.driver;
+    lr.driver = Printable(r.driver);
     lr.server_id = a.server_id;
     lr.config_hash = r.config_hash;
     lr.total_dofs = r.total_dofs;
@@ -227,7 +250,7 @@ void SessionLog::AddAnnounce(std::span<const std::uint8_t> bytes) {
 void SessionLog::AddState(std::int64_t log_time_us, std::span<const std::uint8_t> bytes) {
   robotalk::StateSample s = DecodeStateSample(bytes);
   StateSample sample;
-  sample.robot = std::move(s.robot);
+  sample.robot = Printable(s.robot);
   sample.log_time_us = log_time_us;
   sample.server_time_us = ToWireMicros(s.server_time);
   sample.panic = s.panic;

@@ -106,8 +106,20 @@ class WebServer::Impl {
  private:
   void Accept() {
     acceptor_.async_accept([this](beast::error_code ec, tcp::socket socket) {
-      if (!ec) ReadRequest(std::make_shared<beast::tcp_stream>(std::move(socket)));
-      Accept();
+      if (ec == asio::error::operation_aborted) return;
+      if (!ec) {
+        ReadRequest(std::make_shared<beast::tcp_stream>(std::move(socket)));
+        Accept();
+        return;
+      }
+      // Out of descriptors (EMFILE, ENFILE; connections held open up to the
+      // limit) fails again at once: re-armed at once, this thread spun. The
+      // next try comes after a pause; the connections waiting meanwhile stay
+      // in the listen backlog.
+      accept_pause_.expires_after(std::chrono::milliseconds(100));
+      accept_pause_.async_wait([this](beast::error_code wait) {
+        if (!wait) Accept();
+      });
     });
   }
 
@@ -313,6 +325,7 @@ class WebServer::Impl {
   std::shared_ptr<asio::io_context> ioc_ = std::make_shared<asio::io_context>(1);
   tcp::acceptor acceptor_;
   asio::steady_timer tick_;
+  asio::steady_timer accept_pause_{*ioc_};  // after a failed accept (Accept)
   asio::signal_set signals_;
   std::chrono::steady_clock::duration period_{};
   std::chrono::steady_clock::time_point credit_at_{}, armed_at_{};  // of send_credit_; of the armed tick

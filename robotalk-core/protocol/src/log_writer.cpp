@@ -1,5 +1,6 @@
 #include "robotalk/log_writer.h"
 
+#include <poll.h>
 #include <unistd.h>
 
 #include <pthread.h>
@@ -60,6 +61,13 @@ struct LogWriter::State {
       for (std::size_t at = 0; at < text.size();) {
         const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
         if (n < 0 && errno == EINTR) continue;
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+          // A non-blocking description (another process set O_NONBLOCK on
+          // the stderr it shares: ssh, node) whose reader is behind: wait
+          // for it as a blocking one makes this thread wait, never lose.
+          pollfd out{fd, POLLOUT, 0};
+          if (::poll(&out, 1, -1) >= 0 || errno == EINTR) continue;
+        }
         if (n <= 0) {  // closed, EPIPE, no space: these lines are lost, the next may not be
           failed = true;
           break;
@@ -74,6 +82,29 @@ struct LogWriter::State {
     }
   }
 };
+
+std::string EscapeControls(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto u = static_cast<unsigned char>(text[i]);
+    const bool c1 = u == 0xc2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
+                    static_cast<unsigned char>(text[i + 1]) <= 0x9f;
+    if (u >= 0x20 && u != 0x7f && !c1) {
+      out += text[i];
+      continue;
+    }
+    constexpr char kHex[] = "0123456789abcdef";
+    for (int k = 0; k < (c1 ? 2 : 1); ++k) {
+      const auto b = static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]);
+      out += "\\x";
+      out += kHex[b >> 4];
+      out += kHex[b & 0xf];
+    }
+    if (c1) ++i;
+  }
+  return out;
+}
 
 LogWriter::LogWriter(std::string prefix, int fd) : state_(std::make_shared<State>()) {
   state_->prefix = std::move(prefix);
@@ -90,6 +121,7 @@ LogWriter::~LogWriter() {
 }
 
 bool LogWriter::Write(std::vector<std::string>& lines) {
+  for (std::string& line : lines) line = EscapeControls(line);  // one line each, before the lock
   State& s = *state_;
   std::unique_lock lock(s.mu);
   for (std::string& line : lines) {

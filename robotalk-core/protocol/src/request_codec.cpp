@@ -2,6 +2,7 @@
 // protocol_codec.cpp that knows the LCM wire structs.
 #include "protocol_codec.h"
 #include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk/request.h"
 #include "robotalk/transport.h"
@@ -251,6 +252,22 @@ Announcement DecodeAnnouncement(std::span<const std::uint8_t> bytes) {
   const auto fail = [](const char* field, const std::string& what) {
     throw ProtocolError(std::string("DecodeAnnouncement: ") + field + ": " + what);
   };
+  // Anyone's datagram: its texts reach terminals (`robotalk robots`), logs
+  // and robotalk-web's and robotalk-ros2's tables. A name no server can
+  // serve (RobotNameProblem), or a driver or URL hint not in printable ASCII
+  // (a terminal escape, C0 or UTF-8-encoded C1; a line break forging a log
+  // line), is refused here, for every reader.
+  const auto printable = [&](const char* field, const std::string& text) {
+    for (const char c : text) {
+      const auto u = static_cast<unsigned char>(c);
+      if (u < 0x20 || u >= 0x7f) fail(field, "not printable ASCII (byte " + std::to_string(u) + ")");
+    }
+  };
+  printable("url_hint", m.url_hint);
+  for (const auto& r : m.robots) {
+    if (const std::string why = RobotNameProblem(r.name); !why.empty()) fail("robot.name", why);
+    printable("robot.driver", r.driver);
+  }
   Announcement a;
   a.server_id = m.server_id;
   a.server_time = FromWireMicros(m.server_time_us, "announce: server_time_us");

@@ -12,6 +12,10 @@
 // kMaxQueuedBytes; beyond it they are dropped, and the first write after
 // says how many ("N log lines lost: ..."), as it does for lines whose write
 // failed (a full disk, a pipe without a reader: EPIPE, never SIGPIPE).
+// Each line is written on one line (EscapeControls: a line break in a text
+// of anyone's never forges a log line, an escape never reaches a terminal). A
+// non-blocking descriptor's EAGAIN is no failure: the writer thread waits
+// for it to take more (poll), as a blocking write waits.
 //
 // Thread safety: Write() from any thread. The writer's state outlives the
 // object: a destructor that cannot write what waits within kMaxWait leaves
@@ -25,9 +29,16 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace robotalk {
+
+/// `text` on one line with no terminal control: each C0 control character,
+/// DEL and C1 control encoded in UTF-8 (0xc2 0x80..0x9f) written as \xNN;
+/// everything else (UTF-8 text) kept. For texts of anyone's written to a
+/// terminal or a log (LogWriter's lines, the CLI's replies).
+std::string EscapeControls(std::string_view text);
 
 class LogWriter {
  public:
