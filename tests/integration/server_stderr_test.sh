@@ -86,6 +86,66 @@ check "full stderr: it exits 0 (status $server_status)" test "$server_status" -e
 sleep 0.3
 at_rest "full stderr: the last STATE sample shows pioneer at rest" "$tmp/watch2.json"
 
+# The same for the server's other start-up lines, which were written to
+# stderr directly (final review 11): the ode driver's walking note ("walks
+# with ..."), the --no-panic-latch warning, and start-up errors. With a
+# stderr that takes nothing (the same full pipe, $tmp/full) such a server
+# never served and SIGTERM did not end it; an error never ended it. Now every
+# line of the process goes through its one LogWriter: it serves, SIGTERM ends
+# it with 0, and an error ends it with its status within the writer's bound.
+# full_server NAME PORT ARGS...: a server on PORT, stderr the full pipe; it
+# must serve robot NAME (a query answered) within 10 s.
+full_server() {
+  local name=$1 port=$2
+  shift 2
+  url="udpm://239.255.76.67:$port?ttl=0"
+  "$server_bin" --url "$url" --duration 60 "$@" 2>"$tmp/full" &
+  server_pid=$!
+  served=1
+  for _ in $(seq 40); do
+    "$cli" --url "$url" --timeout 1 query "$name" base_pose >/dev/null 2>&1 && served=0 && break
+    sleep 0.25
+  done
+  check "full stderr, $*: the server serves '$name'" test "$served" -eq 0
+}
+full_server humanoid 7723 --robot "humanoid=ode:$models/simple_humanoid.urdf,walk=true"
+signal_server TERM
+check "full stderr, a walking humanoid: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
+check "full stderr, a walking humanoid: it exits 0 (status $server_status)" test "$server_status" -eq 0
+full_server pioneer 7724 --robot "pioneer=kinematic:$urdf" --no-panic-latch
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch5.json" 2>/dev/null &
+pids+=($!)
+"$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >/dev/null 2>&1 &
+pids+=($!)
+sleep 1.5
+moves "full stderr, --no-panic-latch: pioneer moves before the signal" "$tmp/watch5.json"
+signal_server TERM
+check "full stderr, --no-panic-latch: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
+check "full stderr, --no-panic-latch: it exits 0 (status $server_status)" test "$server_status" -eq 0
+sleep 0.3
+at_rest "full stderr, --no-panic-latch: the last STATE sample shows pioneer at rest" "$tmp/watch5.json"
+# errs STATUS WHAT ARGS...: a server that cannot start (ARGS) ends with STATUS
+# within 5 s whatever its stderr takes, and says why when stderr takes it.
+errs() {
+  local status=$1 what=$2 pid rc
+  shift 2
+  "$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" --duration 60 "$@" 2>"$tmp/full" &
+  pid=$!
+  for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+  kill -0 "$pid" 2>/dev/null && check "full stderr, $what: the server ends within 5 s" false
+  kill -9 "$pid" 2>/dev/null
+  wait "$pid"
+  rc=$?
+  check "full stderr, $what: exit status $status (status $rc)" test "$rc" -eq "$status"
+  "$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" --duration 60 "$@" 2>"$tmp/err.log"
+  rc=$?
+  check "$what: exit status $status (status $rc) and says why: $(head -c 300 "$tmp/err.log")" \
+    sh -c "test $rc -eq $status && grep -q 'robotalk-server: .*$what' '$tmp/err.log'"
+}
+errs 2 "unknown option" --robot "pioneer=kinematic:$urdf" --colour
+errs 1 "cannot open" --robot "pioneer=kinematic:/nonexistent.urdf"
+errs 1 "panic latch" --robot "pioneer=kinematic:$urdf" --panic-latch /nonexistent/dir/latch
+
 # The CLI's `send ... --hold`: its stderr stops taking lines after "holding
 # ... until Ctrl-C" (a full pipe); Ctrl-C must still STOP the robot (before:
 # it wrote "robotalk: " before it sent the STOP, and waited there; its
