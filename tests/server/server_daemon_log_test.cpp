@@ -271,5 +271,36 @@ TEST(LogWriterTest, AStderrThatTakesNothingBoundsTheQueueAndSaysWhatWasLostOnceI
   EXPECT_THAT(text, HasSubstr("test: after\n"));
 }
 
+
+// Lines whose write failed (a descriptor that refused them for a moment: a
+// non-blocking pipe that was full, a full disk) are counted and said by the
+// next write; a writer that ends with no write after says them in a last line
+// of its own (before: the count was dropped with the writer).
+TEST(LogWriterTest, LinesLostAndNotYetSaidAreSaidInALastLineWhenTheWriterEnds) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  fcntl(fds[0], F_SETFL, fcntl(fds[0], F_GETFL) | O_NONBLOCK);
+  fcntl(fds[1], F_SETFL, fcntl(fds[1], F_GETFL) | O_NONBLOCK);  // a full pipe refuses at once (EAGAIN)
+  const std::string chunk(4096, 'x');
+  while (write(fds[1], chunk.data(), chunk.size()) > 0) {
+  }
+  char buffer[4096];
+  const auto drain = [&] {
+    std::string text;
+    for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+    return text;
+  };
+  {
+    LogWriter log("test: ", fds[1]);
+    std::vector<std::string> lines{"refused", "refused too"};
+    log.Write(lines);  // the full pipe refuses them: two lines lost
+    drain();           // the pipe takes lines again; nothing else is written
+  }
+  const std::string text = drain();
+  EXPECT_THAT(text, HasSubstr("test: 2 log lines lost")) << text.substr(0, 300);
+  close(fds[0]);
+  close(fds[1]);
+}
+
 }  // namespace
 }  // namespace robotalk
