@@ -271,7 +271,6 @@ TEST(LogWriterTest, AStderrThatTakesNothingBoundsTheQueueAndSaysWhatWasLostOnceI
   EXPECT_THAT(text, HasSubstr("test: after\n"));
 }
 
-
 // Lines whose write failed (a descriptor that refused them for a moment: a
 // non-blocking pipe that was full, a full disk) are counted and said by the
 // next write; a writer that ends with no write after says them in a last line

@@ -1,0 +1,174 @@
+#include "robotalk/log_writer.h"
+
+#include <unistd.h>
+
+#include <pthread.h>
+#include <algorithm>
+#include <cerrno>
+#include <condition_variable>
+#include <csignal>
+#include <deque>
+#include <mutex>
+#include <thread>
+
+namespace robotalk {
+
+struct LogWriter::State {
+  std::string prefix;
+  int fd = 2;
+  std::mutex mu;
+  std::condition_variable work;                         // lines queued, or stop
+  std::condition_variable written;                      // a write ended
+  std::deque<std::string> queue;                        // GUARDED_BY(mu): prefixed lines, "\n" ended
+  std::size_t queued_bytes = 0;                         // GUARDED_BY(mu)
+  std::uint64_t queued = 0;                             // GUARDED_BY(mu): lines queued or dropped so far
+  std::uint64_t done = 0;                               // GUARDED_BY(mu): lines written or dropped so far
+  std::uint64_t dropped = 0;                            // GUARDED_BY(mu)
+  std::uint64_t dropped_unsaid = 0;                     // GUARDED_BY(mu): not yet said in a line
+  bool tell_lost = false;                               // GUARDED_BY(mu): say dropped_unsaid now (Flush)
+  bool writing = false;                                 // GUARDED_BY(mu)
+  std::chrono::steady_clock::time_point write_began{};  // GUARDED_BY(mu)
+  int writers = 0;                                      // GUARDED_BY(mu): LogWriters of this state
+  bool stop = false;                                    // GUARDED_BY(mu)
+
+  // Waits until `done()`, but at most kMaxWait, and not at all past kMaxWait
+  // of the write in progress: a descriptor that takes nothing costs kMaxWait
+  // once a spell. REQUIRES: `lock` holds mu.
+  template <class Done>
+  bool WaitFor(std::unique_lock<std::mutex>& lock, const Done& done) {
+    const auto entry = std::chrono::steady_clock::now();
+    while (!done()) {
+      const auto now = std::chrono::steady_clock::now();
+      auto until = entry + kMaxWait;
+      if (writing) until = std::min(until, write_began + kMaxWait);
+      if (now >= until) return false;
+      written.wait_until(lock, until);
+    }
+    return true;
+  }
+
+  void Run() {
+    std::unique_lock lock(mu);
+    for (;;) {
+      work.wait(lock, [&] { return stop || !queue.empty() || (tell_lost && dropped_unsaid > 0); });
+      if (queue.empty() && !(tell_lost && dropped_unsaid > 0)) return;  // stop, and everything written
+      tell_lost = false;
+      std::string text;
+      const std::uint64_t lost = dropped_unsaid;
+      if (lost > 0) {
+        text = prefix + std::to_string(lost) +
+               " log lines lost: the log refused them, or took nothing while more than " +
+               std::to_string(kMaxQueuedBytes >> 20) + " MiB waited\n";
+        dropped_unsaid = 0;
+      }
+      std::uint64_t lines = 0;
+      while (!queue.empty()) {
+        text += queue.front();
+        queue.pop_front();
+        ++lines;
+      }
+      queued_bytes = 0;
+      writing = true;
+      write_began = std::chrono::steady_clock::now();
+      lock.unlock();
+      bool failed = false;
+      for (std::size_t at = 0; at < text.size();) {
+        const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {  // closed, EPIPE, no space: these lines are lost, the next may not be
+          failed = true;
+          break;
+        }
+        at += static_cast<std::size_t>(n);
+      }
+      lock.lock();
+      if (failed) dropped_unsaid += lost + lines;  // said by the next write that succeeds
+      writing = false;
+      done += lines;
+      written.notify_all();
+    }
+  }
+};
+
+LogWriter::LogWriter(std::string prefix, int fd) : prefix_(prefix), state_(std::make_shared<State>()) {
+  state_->prefix = std::move(prefix);
+  state_->fd = fd;
+  state_->writers = 1;
+  // The thread blocks every signal: a descriptor whose reader went away
+  // answers EPIPE, never SIGPIPE; and it takes no signal a program waits for
+  // (SIGINT, SIGTERM), though it may start before the program blocks them.
+  sigset_t every, before;
+  sigfillset(&every);
+  pthread_sigmask(SIG_BLOCK, &every, &before);
+  std::thread([state = state_] { state->Run(); }).detach();
+  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+}
+
+LogWriter::LogWriter(std::string prefix, const LogWriter& shared)
+    : prefix_(std::move(prefix)), state_(shared.state_) {
+  std::lock_guard lock(state_->mu);
+  ++state_->writers;
+}
+
+LogWriter& LogWriter::Stderr() {
+  static LogWriter* const log = [] {
+    auto* writer = new LogWriter(std::string(program_invocation_short_name) + ": ", 2);
+    writer->prefix_.clear();  // the lines say who they are; the "lines lost" line names the program
+    return writer;
+  }();
+  return *log;
+}
+
+LogWriter::~LogWriter() {
+  Flush();  // what waits, and the count of lines lost, within kMaxWait of a write that hangs
+  std::lock_guard lock(state_->mu);
+  if (--state_->writers == 0) {
+    state_->stop = true;
+    state_->work.notify_all();
+  }
+}
+
+bool LogWriter::Write(std::vector<std::string>& lines) {
+  State& s = *state_;
+  std::unique_lock lock(s.mu);
+  for (std::string& line : lines) {
+    ++s.queued;
+    const std::size_t size = prefix_.size() + line.size() + 1;
+    if (s.queued_bytes + size > kMaxQueuedBytes) {
+      ++s.dropped;
+      ++s.dropped_unsaid;
+      ++s.done;
+      continue;
+    }
+    s.queue.push_back(prefix_ + line + "\n");
+    s.queued_bytes += size;
+  }
+  lines.clear();
+  const std::uint64_t mine = s.queued;
+  s.work.notify_one();
+  return s.WaitFor(lock, [&] { return s.done >= mine; });
+}
+
+bool LogWriter::Write(std::string line) {
+  std::vector<std::string> lines{std::move(line)};
+  return Write(lines);
+}
+
+bool LogWriter::Flush() {
+  State& s = *state_;
+  std::unique_lock lock(s.mu);
+  const std::uint64_t mine = s.queued;
+  if (s.dropped_unsaid > 0) {
+    s.tell_lost = true;
+    s.work.notify_one();
+  }
+  return s.WaitFor(lock, [&] { return s.done >= mine && !s.tell_lost && !s.writing; }) &&
+         s.dropped_unsaid == 0;
+}
+
+std::uint64_t LogWriter::dropped() const {
+  std::lock_guard lock(state_->mu);
+  return state_->dropped;
+}
+
+}  // namespace robotalk
