@@ -173,7 +173,39 @@ sleep 0.5
 kill -INT "$hold_pid"
 sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
 at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
+ended() { [ ! -e "/proc/$1" ] || [ "$(cut -d')' -f2 "/proc/$1/stat" | cut -c2)" = Z ]; }  # gone, or a zombie
+check "and the CLI ends within 2.5 s of the Ctrl-C (StopOnInterrupt::kTakeOver, 2 s)" ended "$hold_pid"
+wait "$hold_pid"
+hold_status=$?
+check "with the status of an interrupted run, 130 (status $hold_status)" test "$hold_status" -eq 130
 kill -9 "$hold_pid" 2>/dev/null
+
+# A SETSPEED without --hold lasts "only while this command runs": the CLI
+# exits after its reply and a note, and the watchdog stops the robot. With
+# a stderr (or stdout) that takes nothing the CLI waited in that note's
+# write for ever, its heartbeats keeping the robot moving (0.3 m/s 6 s
+# later, before). Its session now ends before it writes: the robot stops.
+"$cli" --url "$url" send pioneer stop >/dev/null 2>&1
+for out in stderr stdout; do
+  mkfifo "$tmp/full_$out"
+  sleep 1000 <"$tmp/full_$out" &  # holds the read end, reads nothing
+  pids+=($!)
+  exec 5>"$tmp/full_$out"
+  head -c 65536 /dev/zero >&5  # the pipe's capacity: full
+  if [ "$out" = stderr ]; then
+    "$cli" --url "$url" send pioneer setspeed 0.3 0.1 >/dev/null 2>&5 &
+  else
+    "$cli" --url "$url" send pioneer setspeed 0.3 0.1 >&5 2>/dev/null &
+  fi
+  speed_pid=$!
+  pids+=("$speed_pid")
+  exec 5>&-
+  sleep 1
+  moves "a SETSPEED without --hold whose $out takes nothing: pioneer moves" "$tmp/watch3.json"
+  sleep 3.5  # the session timeout (2 s) and the watchdog
+  at_rest "a SETSPEED without --hold whose $out takes nothing stops within the session timeout" "$tmp/watch3.json"
+  kill -9 "$speed_pid" 2>/dev/null
+done
 
 # The CLI's progress line while it waits for a task (`send ... goto`) on a
 # terminal that takes nothing (a pty nobody reads, its buffer full; a
@@ -229,8 +261,10 @@ moves "a sequence whose stdout takes nothing: pioneer moves before Ctrl-C" "$tmp
 kill -INT "$seq_pid"
 sleep 2.5
 at_rest "Ctrl-C on a sequence whose stdout takes nothing still stops pioneer" "$tmp/watch4.json"
-ended() { [ ! -e "/proc/$1" ] || [ "$(cut -d')' -f2 "/proc/$1/stat" | cut -c2)" = Z ]; }  # gone, or a zombie
 check "the CLI stuck in its write ends by itself within 2 s of the Ctrl-C's STOP" ended "$seq_pid"
+wait "$seq_pid"
+seq_status=$?
+check "with the status of an interrupted run, 130 (status $seq_status)" test "$seq_status" -eq 130
 sleep 4.0
 at_rest "the frame queued for 5 s after the Ctrl-C does not run" "$tmp/watch4.json"
 kill -9 "$seq_pid" 2>/dev/null
