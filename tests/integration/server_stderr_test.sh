@@ -127,16 +127,10 @@ at_rest "full stderr, --no-panic-latch: the last STATE sample shows pioneer at r
 # errs STATUS WHAT ARGS...: a server that cannot start (ARGS) ends with STATUS
 # within 5 s whatever its stderr takes, and says why when stderr takes it.
 errs() {
-  local status=$1 what=$2 pid rc
+  local status=$1 what=$2 rc
   shift 2
   "$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" --duration 60 "$@" 2>"$tmp/full" &
-  pid=$!
-  for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-  kill -0 "$pid" 2>/dev/null && check "full stderr, $what: the server ends within 5 s" false
-  kill -9 "$pid" 2>/dev/null
-  wait "$pid"
-  rc=$?
-  check "full stderr, $what: exit status $status (status $rc)" test "$rc" -eq "$status"
+  ends_within "full stderr, $what: the server" "$status" $!
   "$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" --duration 60 "$@" 2>"$tmp/err.log"
   rc=$?
   check "$what: exit status $status (status $rc) and says why: $(head -c 300 "$tmp/err.log")" \

@@ -126,16 +126,6 @@ kill -9 "$bridge3_pid" 2>/dev/null
 # nothing never ended it; --stats with a stdout that takes nothing held it
 # after its shutdown's STOPs, its sessions alive. They now wait at most
 # 0.2 s each (one LogWriter per descriptor), and the bridge exits.
-# ends_within WHAT STATUS PID: PID ends within 5 s with STATUS.
-ends_within() {
-  local rc
-  for _ in $(seq 50); do kill -0 "$3" 2>/dev/null || break; sleep 0.1; done
-  kill -0 "$3" 2>/dev/null && check "$1: the bridge ends within 5 s" false
-  kill -9 "$3" 2>/dev/null
-  wait "$3"
-  rc=$?
-  check "$1: exit status $2 (status $rc)" test "$rc" -eq "$2"
-}
 "$bridge" --colour 2>"$tmp/full" &
 ends_within "full stderr, an unknown option" 2 $!
 CYCLONEDDS_URI="<NoSuchElement/>" "$bridge" --robot pioneer --url "$url3" --duration 20 >/dev/null 2>"$tmp/full" &

@@ -43,16 +43,10 @@ kill -9 "$web_pid" 2>/dev/null
 # errs STATUS PATTERN ARGS...: robotalk-web that cannot start (ARGS) ends with
 # STATUS within 5 s whatever its stderr takes, and says why when it takes it.
 errs() {
-  local status=$1 pattern=$2 pid rc
+  local status=$1 pattern=$2 rc
   shift 2
   "$web" --lcm-url "$url" --port "$port" --node-modules "$tmp/modules" "$@" >"$tmp/full" 2>"$tmp/full" &
-  pid=$!
-  for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-  kill -0 "$pid" 2>/dev/null && check "full stderr, $*: robotalk-web ends within 5 s" false
-  kill -9 "$pid" 2>/dev/null
-  wait "$pid"
-  rc=$?
-  check "full stderr, $*: exit status $status (status $rc)" test "$rc" -eq "$status"
+  ends_within "full stderr, $*: robotalk-web" "$status" $!
   "$web" --lcm-url "$url" --port "$port" --node-modules "$tmp/modules" "$@" >/dev/null 2>"$tmp/err.log"
   rc=$?
   check "$*: exit status $status (status $rc)" test "$rc" -eq "$status"
