@@ -12,6 +12,8 @@
 #   start_pioneer LOG [ARGS...]  "$server_bin" serving the kinematic Pioneer of
 #                           "$models" with ARGS, stderr to LOG, in $server_pid;
 #                           returns once it serves (wait_for's status)
+#   ends_within WHAT STATUS PID  PID (a child of this shell) ends within 5 s
+#                           (else killed) with exit status STATUS: two checks
 #   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
 tmp=$(mktemp -d)
 export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
@@ -66,4 +68,15 @@ last_motion() {
 lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
 s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
 print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
+}
+ends_within() {  # ends_within WHAT STATUS PID
+  local rc
+  for _ in $(seq 50); do kill -0 "$3" 2>/dev/null || break; sleep 0.1; done
+  if kill -0 "$3" 2>/dev/null; then
+    check "$1: ends within 5 s" false
+    kill -9 "$3" 2>/dev/null
+  fi
+  wait "$3"
+  rc=$?
+  check "$1: exit status $2 (status $rc)" test "$rc" -eq "$2"
 }

@@ -4,11 +4,11 @@
 #include "base_controller.h"
 #include "robotalk/error.h"
 #include "robotalk/kinematics.h"
+#include "robotalk/log_writer.h"
 #include "walking_humanoid.h"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <utility>
 
@@ -439,16 +439,17 @@ std::unique_ptr<BaseController> MakeBaseController(const RobotModel& model, cons
     case BaseType::kFloating:
       if (options.walk) {
         // A model that cannot walk (no feet, no soles) moves kinematically
-        // instead: its GOTO/SETSPEED answers say why, and so does one line here.
+        // instead: its GOTO/SETSPEED answers say why, and so does one line here
+        // (through the process's writer of stderr: one that takes nothing
+        // must not keep the server from serving).
         std::string why;
         if (auto walker = WalkingHumanoid::Create(model, shapes, options, step, &why)) {
-          std::fprintf(stderr, "robotalk ode driver: '%s': walks with %s\n", model.name().c_str(),
-                       walker->gait_said().c_str());
+          LogWriter::Stderr().Write("robotalk ode driver: '" + model.name() + "': walks with " +
+                                    walker->gait_said());
           return walker;
         }
-        std::fprintf(stderr,
-                     "robotalk ode driver: '%s': walk=true ignored: %s; the root moves kinematically\n",
-                     model.name().c_str(), why.c_str());
+        LogWriter::Stderr().Write("robotalk ode driver: '" + model.name() + "': walk=true ignored: " + why +
+                                  "; the root moves kinematically");
         return std::make_unique<KinematicRoot>(model, options, step, why);
       }
       [[fallthrough]];

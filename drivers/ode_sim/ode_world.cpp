@@ -2,13 +2,17 @@
 
 #include "robotalk/error.h"
 #include "robotalk/kinematics.h"
+#include "robotalk/log_writer.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <numbers>
+#include <string>
 
 namespace robotalk::ode_detail {
 namespace {
@@ -16,12 +20,29 @@ namespace {
 constexpr int kMaxContactsPerGeom = 8;
 constexpr double kPi = std::numbers::pi;
 
+// ODE's own lines (dMessage, e.g. "LCP internal error" mid-step on the
+// robot's thread; dError and dDebug, after which ODE ends the process) go
+// through the process's one writer of stderr, as the server's do: ODE's
+// default handlers write to stderr directly, and one that takes nothing would
+// hold the robot's thread, its STOP included.
+void SayOde(const char* what, int number, const char* format, va_list args) {
+  char text[512];
+  std::vsnprintf(text, sizeof text, format, args);
+  LogWriter::Stderr().Write(std::string("robotalk ode driver: ") + what + " " + std::to_string(number) +
+                            ": " + text);
+}
+
 // ODE needs one library initialisation per process and per-thread data in
 // every thread that steps or collides (the server constructs drivers in one
 // thread and runs them in its RobotDaemon).
 void EnsureOdeThread() {
   static std::once_flag init;
-  std::call_once(init, [] { dInitODE2(0); });
+  std::call_once(init, [] {
+    dInitODE2(0);
+    dSetMessageHandler([](int n, const char* f, va_list a) { SayOde("ODE Message", n, f, a); });
+    dSetErrorHandler([](int n, const char* f, va_list a) { SayOde("ODE Error", n, f, a); });
+    dSetDebugHandler([](int n, const char* f, va_list a) { SayOde("ODE INTERNAL ERROR", n, f, a); });
+  });
   thread_local bool allocated = false;
   if (!allocated) {
     dAllocateODEDataForThread(dAllocateMaskAll);

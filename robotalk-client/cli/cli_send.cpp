@@ -174,7 +174,7 @@ bool HeldWhileAlive(CommandType t) { return Traits(t).keeps_moving; }
 
 int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::optional<double> at, bool hold,
             bool json) {
-  const auto client = ConnectClient(g, robot);
+  auto client = ConnectClient(g, robot);
   if (at) c.start_time = client->ServerNow() + FromSeconds(*at);
   const CommandType type = c.type;
   const bool motion = IsMotionCommand(type);
@@ -200,6 +200,17 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
     } catch (const std::exception&) {
     }
     return Interrupted(sig, note);
+  }
+  if (!hold || !Succeeded(r->signal) || !HeldWhileAlive(type)) {
+    // Nothing more for the robot: the session ends before a word is written.
+    // A stdout or stderr that takes nothing (a full pipe, a terminal stopped
+    // with Ctrl-S) waits for ever, and the heartbeats would keep a motion
+    // "kept only while this command runs" alive meanwhile (a SETSPEED drove
+    // on); now the watchdog stops it after --session-timeout, and a signal
+    // ends the tool at once.
+    stop_at_once.reset();
+    client.reset();
+    Interrupter::Defer(false);
   }
   PrintOne(*r, json);
   if (!Succeeded(r->signal) || !HeldWhileAlive(type)) {

@@ -1,6 +1,13 @@
 #include "dds_entities.h"
 
+#include "robotalk/log_writer.h"
+
+#include <dds/ddsrt/log.h>
+
 #include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
 
 namespace robotalk::ros2 {
 
@@ -56,7 +63,22 @@ std::string InterfaceConfig(const std::string& interface) {
          "\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>";
 }
 
+// Cyclone DDS's own lines (its configuration errors and warnings) through
+// the process's one writer of stderr, as the bridge's: its default sink
+// writes to stderr directly, and one that takes nothing held the bridge for
+// ever (an error never ended it).
+namespace {
+void SayDds(void*, const dds_log_data_t* data) {
+  std::string_view text(data->message, data->size);
+  if (data->hdrsize <= text.size()) text.remove_prefix(data->hdrsize);  // its time and thread
+  while (!text.empty() && text.back() == '\n') text.remove_suffix(1);
+  LogWriter::Stderr().Write("Cyclone DDS: " + std::string(text));
+}
+}  // namespace
+
 DdsParticipant::DdsParticipant(std::uint32_t domain, const std::string& config) {
+  static std::once_flag sink;
+  std::call_once(sink, [] { dds_set_log_sink(SayDds, nullptr); });
   if (!config.empty()) {
     const dds_entity_t d = dds_create_domain(domain, config.c_str());
     if (d < 0)

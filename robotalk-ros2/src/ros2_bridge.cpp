@@ -70,7 +70,7 @@ class LimitedLog {
     // cmd_vel timeout's stop, which logs first (the base drove on).
     if (!out_.empty()) writer_.Write(out_);
   }
-  LogWriter writer_{"robotalk-ros2: "};
+  LogWriter writer_{"robotalk-ros2: ", LogWriter::Stderr()};  // the process's one writer of stderr
   std::mutex mu_;
   LogLimiter limiter_;            // GUARDED_BY(mu_)
   std::vector<std::string> out_;  // GUARDED_BY(mu_)

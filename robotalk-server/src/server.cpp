@@ -6,9 +6,9 @@
 #include "robotalk/config_message.h"
 #include "robotalk/error.h"
 #include "robotalk/keys.h"
-#include "robotalk/log_writer.h"
 #include "robotalk/routed_lcm_transport.h"
 #include "server_daemon.h"
+#include "server_log.h"
 
 #include <algorithm>
 #include <atomic>
@@ -26,17 +26,17 @@ std::vector<std::unique_ptr<RobotDaemon>>& AbandonedRobots() {
   return *abandoned;
 }
 
-// The server's own lines (start-up) through a LogWriter of their own, never
-// destroyed: a stderr that takes nothing keeps neither the robots from being
-// served nor the server from its shutdown (robotalk-server takes SIGTERM on
-// the thread that writes these).
-void Say(std::string line) {
-  static LogWriter* const log = new LogWriter("robotalk-server: ");
-  std::vector<std::string> lines{std::move(line)};
-  log->Write(lines);
-}
+// The server's own lines (start-up): a stderr that takes nothing keeps
+// neither the robots from being served nor the server from its shutdown
+// (robotalk-server takes SIGTERM on the thread that writes these).
+void Say(std::string line) { ServerLog().Write(std::move(line)); }
 
 }  // namespace
+
+LogWriter& ServerLog() {
+  static LogWriter* const log = new LogWriter("robotalk-server: ", LogWriter::Stderr());
+  return *log;
+}
 
 RobotSpec RobotSpec::Parse(const std::string& text) {
   const auto eq = text.find('=');

@@ -31,8 +31,8 @@
 #include "robotalk/channels.h"
 #include "robotalk/clock.h"
 #include "robotalk/log_limiter.h"
-#include "robotalk/log_writer.h"
 #include "robotalk/transport.h"
+#include "server_log.h"
 #include "session_table.h"
 
 #include <algorithm>
@@ -241,7 +241,7 @@ class ServerDaemon {
   TimePoint next_announce_ = TimePoint::min();
   TimePoint next_watchdog_ = TimePoint::min();
   std::vector<std::string> log_pending_;  // written by WriteLog() after the publishes (audit lines before)
-  LogWriter log_writer_{"robotalk-server: "};  // stderr; a stderr that takes nothing never stops this thread
+  LogWriter& log_writer_ = ServerLog();   // stderr; a stderr that takes nothing never stops this thread
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -3,7 +3,7 @@
 
 #include "panic_latch.h"
 #include "robotalk/error.h"
-#include "robotalk/log_writer.h"
+#include "server_log.h"
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +13,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace robotalk {
@@ -129,10 +130,13 @@ double ParseNumber(const std::string& flag, const char* text, double min, double
   return v;
 }
 
-}  // namespace
+// A line of robotalk-server's own ("robotalk-server: " + line), errors
+// included: through the process's one writer of stderr (server_log.h), so a
+// stderr that takes nothing costs it LogWriter::kMaxWait at most, and an
+// error still ends it with its status.
+void Say(std::string line) { ServerLog().Write(std::move(line)); }
 
-int ServerMain(int argc, char** argv, const DriverRegistry& registry,
-               const SimulateCommand& simulate_command) {
+int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateCommand& simulate_command) {
   ServerOptions options;
   std::vector<RobotSpec> robots;
   double duration = -1;
@@ -281,38 +285,46 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
       } else if (arg == "--seed") {
         options.fault_seed = static_cast<std::uint64_t>(ParseNumber(arg, value(), 0, 1e18));
       } else {
-        std::cerr << "robotalk-server: unknown option '" << arg << "' (see --help)\n";
+        Say("unknown option '" + arg + "' (see --help)");
         return 2;
       }
     }
     if (robots.empty()) {
-      std::cerr << "robotalk-server: no --robot given\n" << kUsage;
+      Say("no --robot given");
+      // One Write of its lines (a line break inside a line is written as \x0a).
+      std::vector<std::string> usage;
+      for (std::string_view rest = kUsage; !rest.empty();) {
+        const std::size_t end = std::min(rest.find('\n'), rest.size());
+        usage.emplace_back(rest.substr(0, end));
+        rest.remove_prefix(std::min(end + 1, rest.size()));
+      }
+      LogWriter::Stderr().Write(usage);
       return 2;
     }
     if (no_panic_latch && (!options.panic_latch_path.empty() || !options.state_dir.empty())) {
       throw Error("--no-panic-latch contradicts --panic-latch / --state-dir");
     }
   } catch (const std::exception& e) {
-    std::cerr << "robotalk-server: " << e.what() << "\n";
+    Say(e.what());
     return 2;
   }
 
   if (!simulate.empty()) {
     if (!simulate_command) {
-      std::cerr << "robotalk-server: --simulate is not available in this server\n";
+      Say("--simulate is not available in this server");
       return 2;
     }
     return simulate_command(registry, robots, simulate, duration < 0 ? 10.0 : duration, sample_period);
   }
 
   if (no_panic_latch) {
-    std::cerr << "robotalk-server: WARNING: --no-panic-latch: a panic does not survive a restart of this "
-                 "server (a restarted server runs the next command)\n";
+    Say("WARNING: --no-panic-latch: a panic does not survive a restart of this server (a restarted server "
+        "runs the next command)");
   } else if (options.panic_latch_path.empty() && options.state_dir.empty()) {
     try {
       options.state_dir = PanicLatch::DefaultStateDir();
     } catch (const std::exception& e) {
-      std::cerr << "robotalk-server: error: " << e.what() << "\n";
+      Say(std::string("error: ") + e.what());
       return 1;
     }
   }
@@ -342,9 +354,9 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
     while (received <= 0) {
       if (server.serving() == 0) {
         server.Stop();
-        std::cerr << "robotalk-server: error: no robot left to serve:";
-        for (const std::string& why : server.refusals()) std::cerr << "\n  " << why;
-        std::cerr << "\n";
+        std::string line = "error: no robot left to serve:";
+        for (const std::string& why : server.refusals()) line += "\n  " + why;
+        Say(std::move(line));
         return 1;
       }
       auto wait = std::chrono::nanoseconds(std::chrono::milliseconds(100));
@@ -357,23 +369,30 @@ int ServerMain(int argc, char** argv, const DriverRegistry& registry,
       received = sigtimedwait(&signals, nullptr, &timeout);
     }
     if (received > 0) {
-      // Through a LogWriter: a stderr that takes nothing must not keep the robots from their STOP.
-      LogWriter log("robotalk-server: ");
-      std::vector<std::string> line{std::string(strsignal(received)) + ", stopping every robot"};
-      log.Write(line);
+      // A stderr that takes nothing must not keep the robots from their STOP.
+      Say(std::string(strsignal(received)) + ", stopping every robot");
     }
     server.Stop();
     if (!server.not_stopped().empty()) {
-      std::cerr << "robotalk-server: error: not stopped (a driver call hung):";
-      for (const std::string& robot : server.not_stopped()) std::cerr << " '" << robot << "'";
-      std::cerr << "\n";
+      std::string line = "error: not stopped (a driver call hung):";
+      for (const std::string& robot : server.not_stopped()) line += " '" + robot + "'";
+      Say(std::move(line));
       return 1;
     }
   } catch (const std::exception& e) {
-    std::cerr << "robotalk-server: error: " << e.what() << "\n";
+    Say(std::string("error: ") + e.what());
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int ServerMain(int argc, char** argv, const DriverRegistry& registry,
+               const SimulateCommand& simulate_command) {
+  const int status = Serve(argc, argv, registry, simulate_command);
+  LogWriter::Stderr().Flush();  // the count of lines lost, if any is unsaid (within kMaxWait)
+  return status;
 }
 
 }  // namespace robotalk

@@ -86,6 +86,60 @@ check "full stderr: it exits 0 (status $server_status)" test "$server_status" -e
 sleep 0.3
 at_rest "full stderr: the last STATE sample shows pioneer at rest" "$tmp/watch2.json"
 
+# The same for the server's other start-up lines, which were written to
+# stderr directly (final review 11): the ode driver's walking note ("walks
+# with ..."), the --no-panic-latch warning, and start-up errors. With a
+# stderr that takes nothing (the same full pipe, $tmp/full) such a server
+# never served and SIGTERM did not end it; an error never ended it. Now every
+# line of the process goes through its one LogWriter: it serves, SIGTERM ends
+# it with 0, and an error ends it with its status within the writer's bound.
+# full_server NAME PORT ARGS...: a server on PORT, stderr the full pipe; it
+# must serve robot NAME (a query answered) within 10 s.
+full_server() {
+  local name=$1 port=$2
+  shift 2
+  url="udpm://239.255.76.67:$port?ttl=0"
+  "$server_bin" --url "$url" --duration 60 "$@" 2>"$tmp/full" &
+  server_pid=$!
+  served=1
+  for _ in $(seq 40); do
+    "$cli" --url "$url" --timeout 1 query "$name" base_pose >/dev/null 2>&1 && served=0 && break
+    sleep 0.25
+  done
+  check "full stderr, $*: the server serves '$name'" test "$served" -eq 0
+}
+full_server humanoid 7723 --robot "humanoid=ode:$models/simple_humanoid.urdf,walk=true"
+signal_server TERM
+check "full stderr, a walking humanoid: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
+check "full stderr, a walking humanoid: it exits 0 (status $server_status)" test "$server_status" -eq 0
+full_server pioneer 7724 --robot "pioneer=kinematic:$urdf" --no-panic-latch
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch5.json" 2>/dev/null &
+pids+=($!)
+"$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >/dev/null 2>&1 &
+pids+=($!)
+sleep 1.5
+moves "full stderr, --no-panic-latch: pioneer moves before the signal" "$tmp/watch5.json"
+signal_server TERM
+check "full stderr, --no-panic-latch: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
+check "full stderr, --no-panic-latch: it exits 0 (status $server_status)" test "$server_status" -eq 0
+sleep 0.3
+at_rest "full stderr, --no-panic-latch: the last STATE sample shows pioneer at rest" "$tmp/watch5.json"
+# errs STATUS WHAT ARGS...: a server that cannot start (ARGS) ends with STATUS
+# within 5 s whatever its stderr takes, and says why when stderr takes it.
+errs() {
+  local status=$1 what=$2 rc
+  shift 2
+  "$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" --duration 60 "$@" 2>"$tmp/full" &
+  ends_within "full stderr, $what: the server" "$status" $!
+  "$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" --duration 60 "$@" 2>"$tmp/err.log"
+  rc=$?
+  check "$what: exit status $status (status $rc) and says why: $(head -c 300 "$tmp/err.log")" \
+    sh -c "test $rc -eq $status && grep -q 'robotalk-server: .*$what' '$tmp/err.log'"
+}
+errs 2 "unknown option" --robot "pioneer=kinematic:$urdf" --colour
+errs 1 "cannot open" --robot "pioneer=kinematic:/nonexistent.urdf"
+errs 1 "panic latch" --robot "pioneer=kinematic:$urdf" --panic-latch /nonexistent/dir/latch
+
 # The CLI's `send ... --hold`: its stderr stops taking lines after "holding
 # ... until Ctrl-C" (a full pipe); Ctrl-C must still STOP the robot (before:
 # it wrote "robotalk: " before it sent the STOP, and waited there; its
@@ -113,7 +167,39 @@ sleep 0.5
 kill -INT "$hold_pid"
 sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
 at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
+ended() { [ ! -e "/proc/$1" ] || [ "$(cut -d')' -f2 "/proc/$1/stat" | cut -c2)" = Z ]; }  # gone, or a zombie
+check "and the CLI ends within 2.5 s of the Ctrl-C (StopOnInterrupt::kTakeOver, 2 s)" ended "$hold_pid"
+wait "$hold_pid"
+hold_status=$?
+check "with the status of an interrupted run, 130 (status $hold_status)" test "$hold_status" -eq 130
 kill -9 "$hold_pid" 2>/dev/null
+
+# A SETSPEED without --hold lasts "only while this command runs": the CLI
+# exits after its reply and a note, and the watchdog stops the robot. With
+# a stderr (or stdout) that takes nothing the CLI waited in that note's
+# write for ever, its heartbeats keeping the robot moving (0.3 m/s 6 s
+# later, before). Its session now ends before it writes: the robot stops.
+"$cli" --url "$url" send pioneer stop >/dev/null 2>&1
+for out in stderr stdout; do
+  mkfifo "$tmp/full_$out"
+  sleep 1000 <"$tmp/full_$out" &  # holds the read end, reads nothing
+  pids+=($!)
+  exec 5>"$tmp/full_$out"
+  head -c 65536 /dev/zero >&5  # the pipe's capacity: full
+  if [ "$out" = stderr ]; then
+    "$cli" --url "$url" send pioneer setspeed 0.3 0.1 >/dev/null 2>&5 &
+  else
+    "$cli" --url "$url" send pioneer setspeed 0.3 0.1 >&5 2>/dev/null &
+  fi
+  speed_pid=$!
+  pids+=("$speed_pid")
+  exec 5>&-
+  sleep 1
+  moves "a SETSPEED without --hold whose $out takes nothing: pioneer moves" "$tmp/watch3.json"
+  sleep 3.5  # the session timeout (2 s) and the watchdog
+  at_rest "a SETSPEED without --hold whose $out takes nothing stops within the session timeout" "$tmp/watch3.json"
+  kill -9 "$speed_pid" 2>/dev/null
+done
 
 # The CLI's progress line while it waits for a task (`send ... goto`) on a
 # terminal that takes nothing (a pty nobody reads, its buffer full; a
@@ -169,8 +255,10 @@ moves "a sequence whose stdout takes nothing: pioneer moves before Ctrl-C" "$tmp
 kill -INT "$seq_pid"
 sleep 2.5
 at_rest "Ctrl-C on a sequence whose stdout takes nothing still stops pioneer" "$tmp/watch4.json"
-ended() { [ ! -e "/proc/$1" ] || [ "$(cut -d')' -f2 "/proc/$1/stat" | cut -c2)" = Z ]; }  # gone, or a zombie
 check "the CLI stuck in its write ends by itself within 2 s of the Ctrl-C's STOP" ended "$seq_pid"
+wait "$seq_pid"
+seq_status=$?
+check "with the status of an interrupted run, 130 (status $seq_status)" test "$seq_status" -eq 130
 sleep 4.0
 at_rest "the frame queued for 5 s after the Ctrl-C does not run" "$tmp/watch4.json"
 kill -9 "$seq_pid" 2>/dev/null

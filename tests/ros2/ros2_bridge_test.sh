@@ -121,6 +121,23 @@ for _ in $(seq 100); do kill -0 "$bridge3_pid" 2>/dev/null || break; sleep 0.1; 
 check "and it ends on SIGTERM within 10 s" sh -c "! kill -0 $bridge3_pid 2>/dev/null"
 kill -9 "$bridge3_pid" 2>/dev/null
 
+# Its other lines, written directly before: a start-up error (the bridge's
+# own, or Cyclone DDS's about its configuration) with a stderr that takes
+# nothing never ended it; --stats with a stdout that takes nothing held it
+# after its shutdown's STOPs, its sessions alive. They now wait at most
+# 0.2 s each (one LogWriter per descriptor), and the bridge exits.
+"$bridge" --colour 2>"$tmp/full" &
+ends_within "full stderr, an unknown option" 2 $!
+CYCLONEDDS_URI="<NoSuchElement/>" "$bridge" --robot pioneer --url "$url3" --duration 20 >/dev/null 2>"$tmp/full" &
+ends_within "full stderr, a DDS configuration it cannot use" 1 $!
+CYCLONEDDS_URI="<NoSuchElement/>" "$bridge" --robot pioneer --url "$url3" --duration 20 >/dev/null 2>"$tmp/dds_err.log"
+check "and it says why: $(head -c 300 "$tmp/dds_err.log")" grep -q "cannot join DDS domain" "$tmp/dds_err.log"
+"$bridge" --robot pioneer --url "$url3" --key "$tmp/bridge" --duration 20 --stats >"$tmp/full" 2>"$tmp/bridge4.log" &
+bridge4_pid=$!
+wait_for "$tmp/bridge4.log" "bridged" 100
+kill -TERM "$bridge4_pid"
+ends_within "full stdout, --stats" 0 "$bridge4_pid"
+
 # forged_then_real PORT N ROUNDS: a bridge of every announced robot (no
 # --robot) hears N forged names no server answers for (one ANNOUNCE datagram
 # each, ROUNDS times 0.5 s apart) before the real server starts; the real robot

@@ -333,5 +333,35 @@ TEST(LogWriterTest, ALinesControlCharactersAreWrittenEscapedOnOneLine) {
             "test: joint 'h\xc3\xa4nd\\x0arobotalk-server: robot 'bot': executed'\\x1b]0;x\\x07\\xc2\\x9b\n");
 }
 
+// Lines whose write failed (a descriptor that refused them for a moment: a
+// non-blocking pipe that was full, a full disk) are counted and said by the
+// next write; a writer that ends with no write after says them in a last line
+// of its own (before: the count was dropped with the writer).
+TEST(LogWriterTest, LinesLostAndNotYetSaidAreSaidInALastLineWhenTheWriterEnds) {
+  // The writer's descriptor is first a full disk (/dev/full: ENOSPC), then
+  // a pipe (dup2 onto the same number): the lines refused, then room again.
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  fcntl(fds[0], F_SETFL, fcntl(fds[0], F_GETFL) | O_NONBLOCK);
+  const int log_fd = open("/dev/full", O_WRONLY | O_CLOEXEC);
+  ASSERT_GE(log_fd, 0);
+  {
+    LogWriter log("test: ", log_fd);
+    std::vector<std::string> lines{"refused", "refused too"};
+    log.Write(lines);                         // the full disk refuses them: two lines lost
+    ASSERT_EQ(dup2(fds[1], log_fd), log_fd);  // room again; nothing else is written
+  }
+  char buffer[4096];
+  std::string text;
+  for (int i = 0; i < 100 && text.find('\n') == std::string::npos; ++i) {  // the writer's thread writes it
+    for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+    if (text.find('\n') == std::string::npos) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_THAT(text, HasSubstr("test: 2 log lines lost")) << text.substr(0, 300);
+  close(fds[0]);
+  close(fds[1]);
+  close(log_fd);
+}
+
 }  // namespace
 }  // namespace robotalk

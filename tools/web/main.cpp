@@ -2,15 +2,24 @@
 #include "robot_tracker.h"
 #include "robotalk/error.h"
 #include "web_install_dirs.h"
+#include "web_log.h"
 #include "web_options.h"
 #include "web_server.h"
 
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <string>
 
-int main(int argc, char** argv) {
-  using namespace robotalk::web;
+namespace robotalk::web {
+namespace {
+
+// Its lines go through WebLog() (stderr) and, for "open http://...", a
+// writer of stdout: a stdout or stderr that takes nothing (a full pipe, a
+// terminal stopped with Ctrl-S) holds it LogWriter::kMaxWait at most, so it
+// serves (and forwards the page's PANIC) all the same, and a start-up error
+// still ends it with its status.
+int Run(int argc, char** argv) {
   WebOptions options;
   try {
     const char* ros_package_path = std::getenv("ROS_PACKAGE_PATH");
@@ -19,7 +28,7 @@ int main(int argc, char** argv) {
     options = ParseWebOptions(std::vector<std::string>(argv + 1, argv + argc), dirs.www, dirs.node_modules,
                               ros_package_path ? ros_package_path : "");
   } catch (const robotalk::Error& e) {
-    std::cerr << "robotalk-web: " << e.what() << "\n";
+    WebLog().Write(e.what());
     return 2;
   }
   if (options.help) {
@@ -33,48 +42,58 @@ int main(int argc, char** argv) {
   namespace fs = std::filesystem;
   for (const char* module : {"three", "urdf-loader"}) {
     if (!fs::is_directory(fs::path(options.node_modules_dir) / module)) {
-      std::cerr << "robotalk-web: " << options.node_modules_dir << "/" << module
-                << " is missing: give --node-modules, or run scripts/setup.sh (npm ci in tools/web) "
-                   "before building and installing\n";
+      WebLog().Write(options.node_modules_dir + "/" + module +
+                     " is missing: give --node-modules, or run scripts/setup.sh (npm ci in tools/web) "
+                     "before building and installing");
       return 1;
     }
   }
   for (const auto& [name, path] : options.urdf) {
     if (!fs::is_regular_file(path)) {
-      std::cerr << "robotalk-web: --urdf " << name << "=" << path << ": no such file\n";
+      WebLog().Write("--urdf " + name + "=" + path + ": no such file");
       return 2;
     }
   }
   for (const std::string& dir : options.package_paths) {
-    if (!fs::is_directory(dir))
-      std::cerr << "robotalk-web: package path " << dir << ": no such folder (skipped)\n";
+    if (!fs::is_directory(dir)) WebLog().Write("package path " + dir + ": no such folder (skipped)");
   }
   try {
     RobotTracker tracker(options);
     WebServer server(options, tracker);
     for (const auto& [name, catalog] : server.meshes()) {  // the page notes the same under the robot's view
       if (!catalog.error.empty())
-        std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.error << "\n";
+        WebLog().Write("--urdf " + name + ": " + catalog.error);
       else if (!catalog.geometry_error.empty())
-        std::cerr << "robotalk-web: --urdf " << name << ": " << catalog.geometry_error
-                  << " (Foxglove's scene shows its inertia boxes)\n";
+        WebLog().Write("--urdf " + name + ": " + catalog.geometry_error +
+                       " (Foxglove's scene shows its inertia boxes)");
       std::size_t told = 0;
       for (const MeshEntry& m : catalog.meshes) {
         if (!m.error.empty() && ++told <= 5)
-          std::cerr << "robotalk-web: " << name << ": link '" << m.link << "': mesh " << m.uri << ": "
-                    << m.error << "\n";
+          WebLog().Write(name + ": link '" + m.link + "': mesh " + m.uri + ": " + m.error);
       }
       if (told > 0)
-        std::cerr << "robotalk-web: " << name << ": " << told << " of " << catalog.meshes.size()
-                  << " meshes not resolved; the page draws their links from the configuration, Foxglove's "
-                     "scene as inertia boxes\n";
+        WebLog().Write(name + ": " + std::to_string(told) + " of " + std::to_string(catalog.meshes.size()) +
+                       " meshes not resolved; the page draws their links from the configuration, Foxglove's "
+                       "scene as inertia boxes");
     }
-    std::cout << "robotalk-web: open http://" << (options.bind == "0.0.0.0" ? "127.0.0.1" : options.bind)
-              << ":" << server.port() << "/" << std::endl;
+    {
+      LogWriter out("robotalk-web: ", 1);  // stdout's one line
+      out.Write("open http://" + (options.bind == "0.0.0.0" ? std::string("127.0.0.1") : options.bind) + ":" +
+                std::to_string(server.port()) + "/");
+    }
     server.Run();
   } catch (const std::exception& e) {
-    std::cerr << "robotalk-web: " << e.what() << "\n";
+    WebLog().Write(e.what());
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+}  // namespace robotalk::web
+
+int main(int argc, char** argv) {
+  const int status = robotalk::web::Run(argc, argv);
+  robotalk::LogWriter::Stderr().Flush();  // the count of lines lost, if any is unsaid (within kMaxWait)
+  return status;
 }

@@ -1,6 +1,6 @@
 #include "ws_connection.h"
 
-#include "robotalk/log_writer.h"
+#include "web_log.h"
 
 #include <boost/asio.hpp>
 
@@ -67,15 +67,13 @@ void WsConnection::Close(const std::string& why) {
   beast::error_code ec;
   auto& socket = beast::get_lowest_layer(ws_).socket();
   const auto peer = socket.remote_endpoint(ec);
-  // Through a LogWriter (never destroyed): a stderr whose reader went away
-  // loses the line (EPIPE, not SIGPIPE: robotalk-web died here), and one that
-  // takes nothing holds this thread at most LogWriter::kMaxWait.
-  static LogWriter* const log = new LogWriter("robotalk-web: ");
-  std::vector<std::string> line{
+  // Through WebLog(): a stderr whose reader went away loses the line (EPIPE,
+  // not SIGPIPE: robotalk-web died here), and one that takes nothing holds
+  // this thread at most LogWriter::kMaxWait.
+  WebLog().Write(
       "closing the WebSocket of " +
       (ec ? std::string("a client") : peer.address().to_string() + ":" + std::to_string(peer.port())) + ": " +
-      why};
-  log->Write(line);
+      why);
   socket.close(ec);  // the write and read in flight end with an error; the owner drops it
 }
 

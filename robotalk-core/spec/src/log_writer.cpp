@@ -26,23 +26,38 @@ struct LogWriter::State {
   std::uint64_t done = 0;                               // GUARDED_BY(mu): lines written or dropped so far
   std::uint64_t dropped = 0;                            // GUARDED_BY(mu)
   std::uint64_t dropped_unsaid = 0;                     // GUARDED_BY(mu): not yet said in a line
+  bool tell_lost = false;                               // GUARDED_BY(mu): say dropped_unsaid now (Flush)
   bool writing = false;                                 // GUARDED_BY(mu)
   std::chrono::steady_clock::time_point write_began{};  // GUARDED_BY(mu)
+  int writers = 0;                                      // GUARDED_BY(mu): LogWriters of this state
   bool stop = false;                                    // GUARDED_BY(mu)
 
+  // Waits until `done()`, but at most kMaxWait, and not at all past kMaxWait
+  // of the write in progress: a descriptor that takes nothing costs kMaxWait
+  // once a spell. REQUIRES: `lock` holds mu.
+  template <class Done>
+  bool WaitFor(std::unique_lock<std::mutex>& lock, const Done& done) {
+    const auto entry = std::chrono::steady_clock::now();
+    while (!done()) {
+      const auto now = std::chrono::steady_clock::now();
+      auto until = entry + kMaxWait;
+      if (writing) until = std::min(until, write_began + kMaxWait);
+      if (now >= until) return false;
+      written.wait_until(lock, until);
+    }
+    return true;
+  }
+
   void Run() {
-    // A descriptor whose reader went away answers EPIPE, never SIGPIPE.
-    sigset_t pipe_signal;
-    sigemptyset(&pipe_signal);
-    sigaddset(&pipe_signal, SIGPIPE);
-    pthread_sigmask(SIG_BLOCK, &pipe_signal, nullptr);
     std::unique_lock lock(mu);
     for (;;) {
-      work.wait(lock, [&] { return stop || !queue.empty(); });
-      if (queue.empty()) return;  // stop, and everything written
+      work.wait(lock, [&] { return stop || !queue.empty() || (tell_lost && dropped_unsaid > 0); });
+      if (queue.empty() && !(tell_lost && dropped_unsaid > 0)) return;  // stop, and everything written
+      tell_lost = false;
       std::string text;
-      if (dropped_unsaid > 0) {
-        text = prefix + std::to_string(dropped_unsaid) +
+      const std::uint64_t lost = dropped_unsaid;
+      if (lost > 0) {
+        text = prefix + std::to_string(lost) +
                " log lines lost: the log refused them, or took nothing while more than " +
                std::to_string(kMaxQueuedBytes >> 20) + " MiB waited\n";
         dropped_unsaid = 0;
@@ -75,7 +90,7 @@ struct LogWriter::State {
         at += static_cast<std::size_t>(n);
       }
       lock.lock();
-      if (failed) dropped_unsaid += lines;  // said by the next write that succeeds
+      if (failed) dropped_unsaid += lost + lines;  // said by the next write that succeeds
       writing = false;
       done += lines;
       written.notify_all();
@@ -106,18 +121,42 @@ std::string EscapeControls(std::string_view text) {
   return out;
 }
 
-LogWriter::LogWriter(std::string prefix, int fd) : state_(std::make_shared<State>()) {
+LogWriter::LogWriter(std::string prefix, int fd) : prefix_(prefix), state_(std::make_shared<State>()) {
   state_->prefix = std::move(prefix);
   state_->fd = fd;
+  state_->writers = 1;
+  // The thread blocks every signal: a descriptor whose reader went away
+  // answers EPIPE, never SIGPIPE; and it takes no signal a program waits for
+  // (SIGINT, SIGTERM), though it may start before the program blocks them.
+  sigset_t every, before;
+  sigfillset(&every);
+  pthread_sigmask(SIG_BLOCK, &every, &before);
   std::thread([state = state_] { state->Run(); }).detach();
+  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+}
+
+LogWriter::LogWriter(std::string prefix, const LogWriter& shared)
+    : prefix_(std::move(prefix)), state_(shared.state_) {
+  std::lock_guard lock(state_->mu);
+  ++state_->writers;
+}
+
+LogWriter& LogWriter::Stderr() {
+  static LogWriter* const log = [] {
+    auto* writer = new LogWriter(std::string(program_invocation_short_name) + ": ", 2);
+    writer->prefix_.clear();  // the lines say who they are; the "lines lost" line names the program
+    return writer;
+  }();
+  return *log;
 }
 
 LogWriter::~LogWriter() {
-  std::vector<std::string> none;
-  Write(none);  // what waits, within kMaxWait of a write that hangs
+  Flush();  // what waits, and the count of lines lost, within kMaxWait of a write that hangs
   std::lock_guard lock(state_->mu);
-  state_->stop = true;
-  state_->work.notify_all();
+  if (--state_->writers == 0) {
+    state_->stop = true;
+    state_->work.notify_all();
+  }
 }
 
 bool LogWriter::Write(std::vector<std::string>& lines) {
@@ -126,30 +165,37 @@ bool LogWriter::Write(std::vector<std::string>& lines) {
   std::unique_lock lock(s.mu);
   for (std::string& line : lines) {
     ++s.queued;
-    const std::size_t size = s.prefix.size() + line.size() + 1;
+    const std::size_t size = prefix_.size() + line.size() + 1;
     if (s.queued_bytes + size > kMaxQueuedBytes) {
       ++s.dropped;
       ++s.dropped_unsaid;
       ++s.done;
       continue;
     }
-    s.queue.push_back(s.prefix + line + "\n");
+    s.queue.push_back(prefix_ + line + "\n");
     s.queued_bytes += size;
   }
   lines.clear();
   const std::uint64_t mine = s.queued;
   s.work.notify_one();
-  // Waits at most kMaxWait, and not at all past kMaxWait of the write in
-  // progress: a descriptor that takes nothing costs kMaxWait once a spell.
-  const auto entry = std::chrono::steady_clock::now();
-  while (s.done < mine) {
-    const auto now = std::chrono::steady_clock::now();
-    auto until = entry + kMaxWait;
-    if (s.writing) until = std::min(until, s.write_began + kMaxWait);
-    if (now >= until) return false;
-    s.written.wait_until(lock, until);
+  return s.WaitFor(lock, [&] { return s.done >= mine; });
+}
+
+bool LogWriter::Write(std::string line) {
+  std::vector<std::string> lines{std::move(line)};
+  return Write(lines);
+}
+
+bool LogWriter::Flush() {
+  State& s = *state_;
+  std::unique_lock lock(s.mu);
+  const std::uint64_t mine = s.queued;
+  if (s.dropped_unsaid > 0) {
+    s.tell_lost = true;
+    s.work.notify_one();
   }
-  return true;
+  return s.WaitFor(lock, [&] { return s.done >= mine && !s.tell_lost && !s.writing; }) &&
+         s.dropped_unsaid == 0;
 }
 
 std::uint64_t LogWriter::dropped() const {

@@ -16,10 +16,20 @@
 // of anyone's never forges a log line, an escape never reaches a terminal). A
 // non-blocking descriptor's EAGAIN is no failure: the writer thread waits
 // for it to take more (poll), as a blocking write waits.
+// Flush(), and the destruction of a writer, say a count not yet said in a
+// line of its own, within the same bound.
 //
-// Thread safety: Write() from any thread. The writer's state outlives the
-// object: a destructor that cannot write what waits within kMaxWait leaves
-// the writer thread blocked, and returns.
+// One writer per descriptor: LogWriter::Stderr() is the process's writer of
+// stderr, which every line a program or library writes to stderr goes
+// through (the server's, its drivers', robotalk-web's and robotalk-ros2's);
+// a LogWriter made from another shares its thread and queue and adds a
+// prefix of its own. A program's last words (an error before it exits) are
+// written the same way: a stderr that takes nothing loses them after
+// kMaxWait, and the program still exits with its status.
+//
+// Thread safety: Write() and Flush() from any thread. The writer's state
+// outlives the object: a destructor that cannot write what waits within
+// kMaxWait leaves the writer thread blocked, and returns.
 #pragma once
 
 #include "robotalk/clock.h"
@@ -45,8 +55,18 @@ class LogWriter {
   static constexpr Duration kMaxWait = std::chrono::milliseconds(200);
   static constexpr std::size_t kMaxQueuedBytes = std::size_t{4} << 20;
 
-  /// Each line is written as `prefix` + line + "\n" to `fd` (not owned).
+  /// A writer of its own (a thread and a queue): each line is written as
+  /// `prefix` + line + "\n" to `fd` (not owned).
   explicit LogWriter(std::string prefix, int fd = 2);
+  /// A writer through `shared`'s thread and queue (the same descriptor),
+  /// each line written as `prefix` + line + "\n".
+  LogWriter(std::string prefix, const LogWriter& shared);
+  /// The process's writer of stderr (fd 2), made at first use and never
+  /// destroyed. Its own lines have no prefix; its "N log lines lost" line
+  /// begins with the program's name ("robotalk-server: ").
+  static LogWriter& Stderr();
+  /// Flush(); the last LogWriter of a thread and queue ends the thread once
+  /// the queue is written.
   ~LogWriter();
   LogWriter(const LogWriter&) = delete;
   LogWriter& operator=(const LogWriter&) = delete;
@@ -55,11 +75,18 @@ class LogWriter {
   /// are written, or until the write in progress has run kMaxWait. Returns
   /// true when they were written.
   bool Write(std::vector<std::string>& lines);
+  /// The same for one line.
+  bool Write(std::string line);
+  /// Waits, as Write() does, until what is queued is written and the lines
+  /// lost but not yet said are said ("N log lines lost: ...") in a line of
+  /// their own. Returns true when nothing waits and nothing is left unsaid.
+  bool Flush();
   /// Lines dropped so far because the queue was full.
   std::uint64_t dropped() const;
 
  private:
   struct State;
+  std::string prefix_;
   std::shared_ptr<State> state_;
 };
 
