@@ -139,6 +139,11 @@ errs() {
 errs 2 "unknown option" --robot "pioneer=kinematic:$urdf" --colour
 errs 1 "cannot open" --robot "pioneer=kinematic:/nonexistent.urdf"
 errs 1 "panic latch" --robot "pioneer=kinematic:$urdf" --panic-latch /nonexistent/dir/latch
+# The usage after "no --robot given" is lines, not one line of \x0a escapes
+# (every LogWriter line is written on one line).
+"$server_bin" --url "udpm://239.255.76.67:7725?ttl=0" 2>"$tmp/usage.log"
+check "no --robot: the usage on lines of their own, no escaped line break" \
+  sh -c "grep -q '^usage: robotalk-server' '$tmp/usage.log' && ! grep -q 'x0a' '$tmp/usage.log'"
 
 # The CLI's `send ... --hold`: its stderr stops taking lines after "holding
 # ... until Ctrl-C" (a full pipe); Ctrl-C must still STOP the robot (before:
