@@ -44,7 +44,7 @@ py::dict Info(const std::string& path) {
     c["first_time"] = UnixSeconds(s.first_us);
     c["last_time"] = UnixSeconds(s.last_us);
     c["undecodable"] = s.undecodable;
-    channels[py::str(name)] = c;
+    channels[Text(name)] = c;  // anyone's channel name: maybe not UTF-8
   }
   out["channels"] = channels;
   out["servers"] = log.servers();

@@ -1,8 +1,10 @@
-// Helpers shared by the binding files: times (seconds as float or
+// Helpers shared by the binding files (and py_text.h, the one way a text
+// crosses into Python): times (seconds as float or
 // datetime.timedelta <-> std::chrono), numpy copies of vectors, and the one
 // way a binding waits for a reply (GIL released, signals checked).
 #pragma once
 
+#include "py_text.h"
 #include "robotalk/clock.h"
 #include "robotalk/command.h"
 #include "robotalk/robot_client.h"

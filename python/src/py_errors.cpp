@@ -31,6 +31,11 @@ struct Classes {
 };
 Classes classes;
 
+// `cls` with e's message as Text() decodes it. (PyErr_SetString decodes
+// strictly: a message holding a byte that is not UTF-8 raised the class
+// with its text lost, a UnicodeDecodeError as its context.)
+void Raise(PyObject* cls, const std::exception& e) { PyErr_SetObject(cls, Text(e.what()).ptr()); }
+
 PyObject* Make(py::module_& m, const char* name, py::handle bases, const char* doc) {
   const std::string full = std::string("robotalk.") + name;
   PyObject* cls = PyErr_NewExceptionWithDoc(full.c_str(), doc, bases.ptr(), nullptr);
@@ -77,29 +82,29 @@ void RegisterErrors(py::module_& m) {
     try {
       std::rethrow_exception(p);
     } catch (const UnknownOutcomeError& e) {
-      PyErr_SetString(classes.unknown_outcome, e.what());
+      Raise(classes.unknown_outcome, e);
     } catch (const TimeoutError& e) {
-      PyErr_SetString(classes.timeout, e.what());
+      Raise(classes.timeout, e);
     } catch (const PanicRefusedError& e) {
-      PyErr_SetString(classes.panic_refused, e.what());
+      Raise(classes.panic_refused, e);
     } catch (const ClientError& e) {
-      PyErr_SetString(classes.client, e.what());
+      Raise(classes.client, e);
     } catch (const ModelError& e) {
-      PyErr_SetString(classes.model, e.what());
+      Raise(classes.model, e);
     } catch (const UrdfError& e) {
-      PyErr_SetString(classes.urdf, e.what());
+      Raise(classes.urdf, e);
     } catch (const ProtocolError& e) {
-      PyErr_SetString(classes.protocol, e.what());
+      Raise(classes.protocol, e);
     } catch (const TransportError& e) {
-      PyErr_SetString(classes.transport, e.what());
+      Raise(classes.transport, e);
     } catch (const LookupError& e) {
-      PyErr_SetString(classes.lookup, e.what());
+      Raise(classes.lookup, e);
     } catch (const UsageError& e) {
-      PyErr_SetString(classes.usage, e.what());
+      Raise(classes.usage, e);
     } catch (const logplay::LogError& e) {
-      PyErr_SetString(classes.log, e.what());
+      Raise(classes.log, e);
     } catch (const Error& e) {
-      PyErr_SetString(classes.error, e.what());
+      Raise(classes.error, e);
     }
   });
 }

@@ -1,6 +1,7 @@
 // The Python exceptions of the robotalk package, mapped from the C++
 // hierarchy (robotalk/error.h, robotalk/client_errors.h, robotalk/sequence_file.h,
-// tools/logplay's LogError) with the same messages:
+// tools/logplay's LogError) with the same messages (decoded by Text(), py_text.h:
+// a byte that is not UTF-8 shows as \xNN):
 //
 //   RobotalkError(Exception)                    robotalk::Error
 //     ModelError, UrdfError, ProtocolError, TransportError, PanicRefusedError,
@@ -16,6 +17,8 @@
 // A robotalk exception never escapes as RuntimeError: the translator
 // registered here catches the most derived C++ class first.
 #pragma once
+
+#include "py_text.h"
 
 #include <pybind11/pybind11.h>
 

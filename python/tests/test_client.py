@@ -153,6 +153,42 @@ def test_errors_are_the_cpp_hierarchy_with_its_messages(server: Server) -> None:
         robotalk.Command("goto", values=[float("nan"), 0, 0])
 
 
+# Bytes that are not UTF-8 (two that never are, a truncated 3-byte sequence),
+# as a forger (or a server echoing a target) may put them in a reply, and
+# how they reach Python: backslash-escaped, never as UnicodeDecodeError.
+NOT_UTF8 = [(b"\xff\xfe", r"\xff\xfe"), (b"pa\xe2\x82", r"pa\xe2\x82")]
+
+
+def test_a_reply_message_not_utf8_reaches_python_escaped(robot: robotalk.RobotClient) -> None:
+    for target, shown in NOT_UTF8:
+        # The server echoes the target's bytes in its message: a reply's text from the wire.
+        reply = robot.set_joint(target, [0.1])  # type: ignore[arg-type]
+        assert reply.signal == "ERROR"
+        assert reply.message == f"JOINT_SETPOINT: robot 'pioneer' has no joint named '{shown}'"
+        assert f"'{reply.message}'" in repr(reply)
+        pending = robot.set_joint(target, [0.1], wait=False)  # type: ignore[arg-type]
+        assert f"JOINT_SETPOINT '{shown}'" in repr(pending)
+        assert pending.wait(5).message == reply.message
+        # A query whose data was asked for: SignalError, its text built from the reply's.
+        with pytest.raises(robotalk.SignalError) as e:
+            robot.joint_state(target)  # type: ignore[arg-type]
+        assert str(e.value) == f"JOINT_STATE '{shown}': ERROR: " + e.value.reply.message
+        assert shown in e.value.reply.message
+
+
+def test_an_error_naming_bytes_not_utf8_shows_them_escaped(server: Server) -> None:
+    # A RobotalkError's text holding such bytes: the class and the text, escaped
+    # (it was a UnicodeDecodeError, or the class with its text lost).
+    client = robotalk.RobotClient(server.url, connect_timeout=0.3)
+    try:
+        for name, shown in NOT_UTF8:
+            with pytest.raises(robotalk.ClientError) as e:
+                client.connect(name)  # type: ignore[arg-type]
+            assert f"'{shown}'" in str(e.value)
+    finally:
+        client.close()
+
+
 def test_panic_from_one_client_is_seen_by_another(server: Server) -> None:
     with robotalk.connect("pioneer", server.url) as a, robotalk.connect("pioneer", server.url) as b:
         a.panic()

@@ -187,3 +187,17 @@ def test_a_logs_channel_names_come_back_in_printable_ascii(tmp_path: Path) -> No
     info = robotalk.log_info(str(log))
     assert info["events"] == 2
     assert sorted(info["channels"]) == ["OTHER\\x1b]0;", "OTHER\\xe9"]
+
+
+def test_texts_not_utf8_cross_into_python_escaped() -> None:
+    # Every std::string the bindings hand to Python is decoded with
+    # backslashreplace (python/src/py_text.h): a command's target (as
+    # robotalk.extract returns them from a log), its text forms, and an
+    # exception's message, never UnicodeDecodeError.
+    for raw, shown in ((b"\xff\xfe", r"\xff\xfe"), (b"pa\xe2\x82", r"pa\xe2\x82")):
+        c = robotalk.Command("JOINT_SETPOINT", raw, [0.1])  # type: ignore[arg-type]
+        assert c.target == shown
+        assert str(c).startswith(f"joint_setpoint {shown} 0.1") and shown in repr(c)
+        with pytest.raises(robotalk.UsageError) as e:
+            robotalk.Command(raw)  # type: ignore[arg-type]
+        assert str(e.value).startswith(f"unknown command type '{shown}' (")
