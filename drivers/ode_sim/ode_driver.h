@@ -99,10 +99,12 @@ struct OdeDriverOptions {
   bool walk = false;
   /// With walk=true: the DCM stabilizer closes the balance loop from the
   /// measured CoM and contact forces (docs/ode_sim.md, "Balance feedback").
-  /// Off by default: measured, it keeps a walker up through an arm swing
-  /// that topples the open loop, but tracks the centre of pressure worse
-  /// (95th percentile 8.9 cm from the plan against 4.9) and survives smaller
-  /// pushes in four of eight directions while walking. Key "stabilizer".
+  /// Off by default. Measured at the derived gait (twelfth session): it keeps
+  /// a walker up through an arm swing that topples the open loop, tracks the
+  /// centre of pressure better (95th percentile 5.8 cm from the plan against
+  /// 12.2) and is no worse on walking pushes (132 against 124 of 384); not
+  /// the default until the checks a default needs have run (docs/ode_sim.md,
+  /// "The stabilizer against today's default"). Key "stabilizer".
   bool stabilizer = false;
   /// With the stabilizer: also move the foot in the air toward the capture
   /// point when the ankles saturate. Measured to make walking pushes worse
