@@ -1,6 +1,7 @@
 #include "robotalk/driver_support.h"
 
 #include "robotalk/error.h"
+#include "robotalk/sequence_file.h"  // NumberOf
 
 #include <cmath>
 #include <cstdio>
@@ -117,11 +118,10 @@ void OptionReader::Number(const std::string& key, double* out, Range range, cons
   known_.insert(key);
   auto it = options_.find(key);
   if (it == options_.end()) return;
-  const std::string& text = it->second;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  const bool parsed = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v);
-  if (!parsed || v < range.min || (!range.min_inclusive && v == range.min) || v > range.max ||
+  const std::optional<double> parsed = NumberOf(it->second);  // the one rule of every number option
+  if (!parsed || !std::isfinite(*parsed)) Fail(key, expected);
+  const double v = *parsed;
+  if (v < range.min || (!range.min_inclusive && v == range.min) || v > range.max ||
       (range.integer && v != std::floor(v))) {
     Fail(key, expected);
   }

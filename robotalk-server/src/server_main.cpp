@@ -4,6 +4,7 @@
 #include "panic_latch.h"
 #include "robotalk/error.h"
 #include "robotalk/log_writer.h"
+#include "robotalk/sequence_file.h"  // NumberOf
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -118,15 +120,15 @@ Serves one or more robots over LCM (see docs/protocol.md).
 On SIGINT or SIGTERM every robot is stopped before the server exits.
 )";
 
+// A number option in [min, max], read by the one rule (NumberOf).
 double ParseNumber(const std::string& flag, const char* text, double min, double max) {
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(v >= min && v <= max)) {
+  const std::optional<double> v = NumberOf(text);
+  if (!v || !(*v >= min && *v <= max)) {
     char range[64];
     std::snprintf(range, sizeof range, "[%g, %g]", min, max);
     throw Error(flag + ": '" + text + "' is not a number in " + range);
   }
-  return v;
+  return *v;
 }
 
 }  // namespace
