@@ -1,10 +1,12 @@
 #include "web_options.h"
 
+#include "robotalk/channels.h"  // kAnnounceHeardWithin
 #include "robotalk/error.h"
 #include "robotalk/sequence_file.h"  // ParseNumber, ParseSeconds
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace robotalk::web {
 namespace {
@@ -88,9 +90,12 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       if (o.rate_hz < 1 || o.rate_hz > 240) throw Error("--rate: " + args[i] + " Hz is outside 1-240");
     } else if (a == "--robot-timeout") {
       o.robot_timeout_s = ParseSeconds(value(), a);  // within what every time given as text may be
-      if (o.robot_timeout_s < 1.5)
-        throw Error("--robot-timeout: " + args[i] +
-                    " s is shorter than 1.5 s (servers announce every second)");
+      if (o.robot_timeout_s < ToSeconds(kAnnounceHeardWithin)) {
+        char shortest[32];
+        std::snprintf(shortest, sizeof shortest, "%g", ToSeconds(kAnnounceHeardWithin));
+        throw Error("--robot-timeout: " + args[i] + " s is shorter than " + shortest +
+                    " s (servers announce every second)");
+      }
     } else if (a == "--key") {
       o.key_file = value();
       if (o.key_file.empty()) throw Error("--key: the file name is empty");
