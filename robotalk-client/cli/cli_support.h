@@ -20,7 +20,7 @@ namespace robotalk::cli {
 /// construction to destruction (which wakes and joins it at once). With a
 /// `trusted_key` ("ed25519:<hex>", a keyed client's server) it counts only
 /// announcements signed by that key: anyone can send an unsigned one, or
-/// sign with a key of their own. It keeps at most 1024 robot names.
+/// sign with a key of their own. It keeps at most kMaxListedRobots (1024) robot names.
 ///
 /// Freshness (keyed, with `client_time`: the server time -> client time
 /// conversion of a synchronised client): a signed announcement proves the
