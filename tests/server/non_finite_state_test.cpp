@@ -47,15 +47,6 @@ class BrokenSensorDriver final : public testing::FakeDriver {
 // A waypoint of an interpolated package for the pan joint (0), due at `at`.
 QueuedItem Waypoint(CommandId id, TimePoint at, double q) { return testing::Waypoint(id, 0, at, {q}); }
 
-QueuedItem Query(CommandId id, QueryType type) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.is_query = true;
-  item.query = type;
-  item.command.id = id;
-  return item;
-}
-
 // A finite state that fits PanRobot: one dof, one root, all zeros.
 RobotState FittingState() {
   RobotState s;
@@ -95,10 +86,10 @@ TEST_F(NonFiniteStateTest, HaltsTheRobotInPanicNamingTheValueEvenWhenNobodyReads
 }
 
 TEST_F(NonFiniteStateTest, AQueryAnswersErrorNamingTheNonFiniteValue) {
-  driver_->inf_base_x = true;
+  fake_->inf_base_x = true;
   Run();
   clock_.Advance(milliseconds(1));
-  daemon_->Submit(Query(7, QueryType::kBasePose));
+  daemon_->Submit(testing::StateQuery(7, QueryType::kBasePose));
   const auto replies = Run();
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].reply.signal, Signal::kError);
@@ -194,10 +185,10 @@ TEST_F(NonFiniteStateTest, AStateThatDoesNotFitTheModelHaltsTheRobotAndIsNeverRe
   Run();
   const std::size_t samples_before = out_.num_samples;
   EXPECT_GE(samples_before, 1u);
-  driver_->lose_root = true;
+  fake_->lose_root = true;
   clock_.Advance(milliseconds(10));
   daemon_->Submit(Waypoint(1, clock_.Now() + milliseconds(500), 0.3));
-  daemon_->Submit(Query(2, QueryType::kBasePose));
+  daemon_->Submit(testing::StateQuery(2, QueryType::kBasePose));
   std::vector<DaemonOutput::Answer> replies = Run();
   EXPECT_TRUE(daemon_->in_panic());
   EXPECT_THAT(daemon_->fault(), HasSubstr("driver 'fake' reports a state that does not fit the model: "
