@@ -24,6 +24,7 @@
 // same phase at both ends), then STOP; falls, worst tilt and the centre of pressure from the
 // plan's ZMP while stepping.
 #include "ode_driver.h"
+#include "walk_bench_util.h"
 
 #include <algorithm>
 #include <chrono>
@@ -44,7 +45,7 @@ using WallClock = std::chrono::steady_clock;
 namespace {
 
 struct Args {
-  std::string model = std::string(ROBOTALK_BENCH_MODELS) + "/simple_humanoid.urdf";
+  std::string model = bench::DefaultWalkModel();
   int goals = 20;
   unsigned seed = 1;
   std::string trace;
@@ -56,7 +57,7 @@ struct Args {
   int verbose = 0;             // --verbose N: print the walk every N x 10 ms
   double stop_after = -1;      // --stop S: STOP each walk S s after its GOTO (then wait for standing)
   int speeds = 0;              // --speeds N: the steady SETSPEED table over N pairs of steps per direction
-  std::map<std::string, std::string> options = {{"walk", "true"}};
+  std::map<std::string, std::string> options = bench::DefaultWalkOptions();
 };
 
 Args Parse(int argc, char** argv) {
@@ -86,8 +87,7 @@ Args Parse(int argc, char** argv) {
     } else if (k == "--trace-goal") {
       a.trace_goal = std::atoi(v.c_str());
     } else if (k == "--option") {
-      const size_t eq = v.find('=');
-      a.options[v.substr(0, eq)] = eq == std::string::npos ? "" : v.substr(eq + 1);
+      bench::SetDriverOption(a.options, v);
     } else {
       std::fprintf(stderr, "unknown argument %s\n", k.c_str());
       std::exit(2);
@@ -226,10 +226,7 @@ int SpeedTable(const Args& args) {
       "direction    along_m/s  side_m/s  turn_rad/s  max_tilt  fell  CoP-to-plan  (SETSPEED answer)\n");
   int falls = 0;
   for (const Direction& dir : dirs) {
-    DriverRegistry registry;
-    RegisterOdeDriver(registry);
-    std::unique_ptr<Driver> d = registry.Create(
-        "ode", DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+    std::unique_ptr<Driver> d = bench::NewOdeDriver(args.model, args.options);
     auto* ode = static_cast<OdeDriver*>(d.get());
     std::vector<Completion> done;
     ode->Step(1500, done);
@@ -286,10 +283,7 @@ int SpeedTable(const Args& args) {
 int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   if (args.speeds > 0) return SpeedTable(args) == 0 ? 0 : 1;
-  DriverRegistry registry;
-  RegisterOdeDriver(registry);
-  std::unique_ptr<Driver> d = registry.Create(
-      "ode", DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
+  std::unique_ptr<Driver> d = bench::NewOdeDriver(args.model, args.options);
   auto* ode = static_cast<OdeDriver*>(d.get());
   if (!ode->walk_status()) {
     std::fprintf(stderr, "%s does not walk on the ode driver\n", args.model.c_str());

@@ -51,6 +51,7 @@
 //   stop             GOTO 1 m; STOP at t (the first shift of weight, a step, ...)
 // docs/ode_sim.md ("Walking", "Replanning") has the table.
 #include "ode_driver.h"
+#include "walk_bench_util.h"
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -74,7 +75,7 @@ using namespace robotalk;
 namespace {
 
 struct Args {
-  std::string model = std::string(ROBOTALK_BENCH_MODELS) + "/simple_humanoid.urdf";
+  std::string model = bench::DefaultWalkModel();
   std::string transition = "all";
   double from = 1.0, span = 2.0, after = 4.0;
   int every_ms = 20;
@@ -92,7 +93,7 @@ struct Args {
   double cycle = 1.52;                                    // --cycle S: the span its instants cover
   bool nudge = false;  // --nudge 1: every push direction one ulp larger (how chaotic a figure is)
   double shift = 0;    // --shift S: every instant S s later (how steady a figure is)
-  std::map<std::string, std::string> options = {{"walk", "true"}};
+  std::map<std::string, std::string> options = bench::DefaultWalkOptions();
 };
 
 Args Parse(int argc, char** argv) {
@@ -145,8 +146,7 @@ Args Parse(int argc, char** argv) {
     } else if (k == "--after") {
       a.after = std::atof(v.c_str());
     } else if (k == "--option") {
-      const size_t eq = v.find('=');
-      a.options[v.substr(0, eq)] = eq == std::string::npos ? "" : v.substr(eq + 1);
+      bench::SetDriverOption(a.options, v);
     } else {
       std::fprintf(stderr, "unknown argument %s\n", k.c_str());
       std::exit(2);
@@ -303,12 +303,7 @@ bool FellOnce(const Args& args, const Script& script, double t, double* tilt) {
   return !ok;
 }
 
-std::unique_ptr<Driver> NewDriver(const Args& args) {
-  DriverRegistry registry;
-  RegisterOdeDriver(registry);
-  return registry.Create("ode",
-                         DriverConfig{.robot_name = "", .urdf_path = args.model, .options = args.options});
-}
+std::unique_ptr<Driver> NewDriver(const Args& args) { return bench::NewOdeDriver(args.model, args.options); }
 
 // Pushes the pelvis with `j` N s toward `angle` (rad from ahead) over 0.1 s from now.
 void PushNow(Run& r, double angle, double j) {

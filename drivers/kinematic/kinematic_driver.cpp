@@ -35,10 +35,7 @@ KinematicDriverOptions KinematicDriverOptions::FromMap(const std::map<std::strin
   driver_support::OptionReader r("kinematic driver", options);
   constexpr driver_support::OptionReader::Range kPositive{.min = 0, .min_inclusive = false};
   r.Bool("merge_chains", &o.merge_chains);
-  double period_ms = ToSeconds(o.period) * 1000.0;
-  r.Number("period_ms", &period_ms, kPositive, "a number of milliseconds > 0");
-  o.period = FromSeconds(period_ms / 1000.0);
-  if (o.period <= Duration::zero()) r.Fail("period_ms", "a number of milliseconds > 0");
+  r.Milliseconds("period_ms", &o.period);
   r.Number("default_velocity", &o.default_velocity, kPositive, "a speed > 0 (rad/s or m/s)");
   r.Number("base_max_v", &o.base_max_v, kPositive, "a speed > 0 (m/s)");
   r.Number("base_max_omega", &o.base_max_omega, kPositive, "a yaw rate > 0 (rad/s)");
@@ -48,17 +45,12 @@ KinematicDriverOptions KinematicDriverOptions::FromMap(const std::map<std::strin
 }
 
 void KinematicDriverOptions::Validate() const {
-  auto check = [](const char* name, double v) {
-    if (!std::isfinite(v) || v <= 0)
-      throw Error(std::string("KinematicDriver: ") + name + " = " + Num(v) + ", expected > 0");
-  };
-  if (period <= Duration::zero()) {
-    throw Error("KinematicDriver: period = " + Num(ToSeconds(period)) + " s, expected > 0");
-  }
-  check("default_velocity", default_velocity);
-  check("base_max_v", base_max_v);
-  check("base_max_omega", base_max_omega);
-  check("goto_tolerance", goto_tolerance);
+  using driver_support::CheckPositive;
+  driver_support::CheckPeriod("KinematicDriver", period);
+  CheckPositive("KinematicDriver", "default_velocity", default_velocity);
+  CheckPositive("KinematicDriver", "base_max_v", base_max_v);
+  CheckPositive("KinematicDriver", "base_max_omega", base_max_omega);
+  CheckPositive("KinematicDriver", "goto_tolerance", goto_tolerance);
 }
 
 // ---------------------------------------------------------------- construction

@@ -23,8 +23,6 @@ std::vector<std::string> SplitPlus(const std::string& s) {
   return out;
 }
 
-using driver_support::Num;
-
 }  // namespace
 
 OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::string>& options) {
@@ -34,10 +32,7 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
   constexpr Range kNonNegative{.min = 0};
   driver_support::OptionReader r("ode driver", options);
   r.Number("step_hz", &o.step_hz, kPositive, "a rate > 0 (Hz)");
-  double period_ms = ToSeconds(o.period) * 1000.0;
-  r.Number("period_ms", &period_ms, kPositive, "a number of milliseconds > 0");
-  o.period = FromSeconds(period_ms / 1000.0);
-  if (o.period <= Duration::zero()) r.Fail("period_ms", "a number of milliseconds > 0");
+  r.Milliseconds("period_ms", &o.period);
   r.Number("gravity", &o.gravity, kNonNegative, "an acceleration >= 0 (m/s^2)");
   r.Number("friction", &o.friction, kNonNegative, "a friction coefficient >= 0");
   double seed = o.seed;
@@ -109,17 +104,14 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
 }
 
 void OdeDriverOptions::Validate() const {
-  auto positive = [](const char* name, double v) {
-    if (!std::isfinite(v) || v <= 0)
-      throw Error(std::string("OdeDriver: ") + name + " = " + Num(v) + ", expected > 0");
+  const auto positive = [](const char* name, double v) {
+    driver_support::CheckPositive("OdeDriver", name, v);
   };
-  auto non_negative = [](const char* name, double v) {
-    if (!std::isfinite(v) || v < 0)
-      throw Error(std::string("OdeDriver: ") + name + " = " + Num(v) + ", expected >= 0");
+  const auto non_negative = [](const char* name, double v) {
+    driver_support::CheckNonNegative("OdeDriver", name, v);
   };
   positive("step_hz", step_hz);
-  if (period <= Duration::zero())
-    throw Error("OdeDriver: period = " + Num(ToSeconds(period)) + " s, expected > 0");
+  driver_support::CheckPeriod("OdeDriver", period);
   non_negative("gravity", gravity);
   non_negative("friction", friction);
   positive("kp", kp);

@@ -91,12 +91,13 @@ std::string KeyColumn(const GlobalOptions& g, const AnnouncedRobot& r) {
 
 int RunRobots(const GlobalOptions& g, const std::vector<std::string>& in) {
   std::vector<std::string> args = in;
-  std::string listen = "1.5";
-  TakeOption(args, "--listen", &listen);
+  std::string listen;
+  const bool has_listen = TakeOption(args, "--listen", &listen);
   const bool json = TakeOption(args, "--json", nullptr);
   RejectOptions(args);
   if (!args.empty()) throw UsageError("robots takes no arguments");
-  const double seconds = ParseSeconds(listen, "--listen");
+  // By default long enough to hear every live server once.
+  const double seconds = has_listen ? ParseSeconds(listen, "--listen") : ToSeconds(kAnnounceHeardWithin);
   std::size_t unlisted = 0;
   const auto robots = ListRobots(MakeOptions(g), FromSeconds(seconds), &unlisted);
   if (unlisted > 0)

@@ -29,9 +29,6 @@ constexpr Duration kAnnounceWait = kAnnouncePeriod + std::chrono::milliseconds(2
 // The watch listens from here to kAnnounceWait: still more than one period.
 constexpr std::chrono::milliseconds kWatchAfter(100);
 
-// Robot names an AnnounceWatch keeps (anyone can announce any name).
-constexpr std::size_t kMaxHeardRobots = 1024;
-
 struct AnnounceWatch::Impl {
   std::string url;
   std::optional<PublicKey> trusted_key;             // keyed: only announcements this key signed count
@@ -67,7 +64,8 @@ struct AnnounceWatch::Impl {
     }
     std::lock_guard lock(mu);
     for (const auto& r : a.robots)
-      if (heard.size() < kMaxHeardRobots || heard.count(r.name)) heard[r.name] = std::max(heard[r.name], at);
+      // As many names as ListRobots lists (anyone can announce any name).
+      if (heard.size() < kMaxListedRobots || heard.count(r.name)) heard[r.name] = std::max(heard[r.name], at);
   }
   // LCM is opened on this thread, and only after kWatchAfter, so a Connect
   // that succeeds at once neither waits for it nor shares the CPU with a

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "cli_commands.h"
+#include "robotalk/channels.h"  // kAnnounceHeardWithin
 #include "robotalk/robot_client.h"
 
 #include <cstdint>
@@ -19,7 +20,7 @@ namespace robotalk::cli {
 /// construction to destruction (which wakes and joins it at once). With a
 /// `trusted_key` ("ed25519:<hex>", a keyed client's server) it counts only
 /// announcements signed by that key: anyone can send an unsigned one, or
-/// sign with a key of their own. It keeps at most 1024 robot names.
+/// sign with a key of their own. It keeps at most kMaxListedRobots (1024) robot names.
 ///
 /// Freshness (keyed, with `client_time`: the server time -> client time
 /// conversion of a synchronised client): a signed announcement proves the
@@ -31,8 +32,9 @@ namespace robotalk::cli {
 class AnnounceWatch {
  public:
   /// How old (by its signed server time) a keyed announcement may arrive:
-  /// one announce period (1 s) and slack for the network and the clock sync.
-  static constexpr Duration kAnnounceMaxAge = std::chrono::milliseconds(1500);
+  /// one announce period (1 s) and slack for the network and the clock sync
+  /// (kAnnounceHeardWithin, channels.h).
+  static constexpr Duration kAnnounceMaxAge = kAnnounceHeardWithin;
 
   explicit AnnounceWatch(const std::string& url, std::string trusted_key = "",
                          std::function<TimePoint(TimePoint server_time)> client_time = {});

@@ -1,6 +1,7 @@
 #include "robotalk/driver_support.h"
 
 #include "robotalk/error.h"
+#include "robotalk/sequence_file.h"  // NumberOf
 
 #include <cmath>
 #include <cstdio>
@@ -117,15 +118,23 @@ void OptionReader::Number(const std::string& key, double* out, Range range, cons
   known_.insert(key);
   auto it = options_.find(key);
   if (it == options_.end()) return;
-  const std::string& text = it->second;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  const bool parsed = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v);
-  if (!parsed || v < range.min || (!range.min_inclusive && v == range.min) || v > range.max ||
+  const std::optional<double> parsed = NumberOf(it->second);  // the one rule of every number option
+  if (!parsed || !std::isfinite(*parsed)) Fail(key, expected);
+  const double v = *parsed;
+  if (v < range.min || (!range.min_inclusive && v == range.min) || v > range.max ||
       (range.integer && v != std::floor(v))) {
     Fail(key, expected);
   }
   *out = v;
+}
+
+void OptionReader::Milliseconds(const std::string& key, Duration* out) {
+  constexpr const char* kExpected = "a number of milliseconds > 0";
+  double ms = ToSeconds(*out) * 1000.0;
+  Number(key, &ms, {.min = 0, .min_inclusive = false}, kExpected);
+  const Duration d = FromSeconds(ms / 1000.0);
+  if (d <= Duration::zero()) Fail(key, kExpected);
+  *out = d;
 }
 
 void OptionReader::Bool(const std::string& key, bool* out) {
@@ -152,6 +161,19 @@ void OptionReader::Finish() const {
     for (const std::string& k : known_) known += (known.empty() ? "" : ", ") + k;
     throw Error(driver_ + ": unknown option '" + key + "' (known: " + known + ")");
   }
+}
+
+void CheckPositive(const std::string& owner, const char* name, double v) {
+  if (!std::isfinite(v) || v <= 0) throw Error(owner + ": " + name + " = " + Num(v) + ", expected > 0");
+}
+
+void CheckNonNegative(const std::string& owner, const char* name, double v) {
+  if (!std::isfinite(v) || v < 0) throw Error(owner + ": " + name + " = " + Num(v) + ", expected >= 0");
+}
+
+void CheckPeriod(const std::string& owner, Duration period) {
+  if (period <= Duration::zero())
+    throw Error(owner + ": period = " + Num(ToSeconds(period)) + " s, expected > 0");
 }
 
 }  // namespace robotalk::driver_support

@@ -5,24 +5,14 @@
 #include "robotalk/sequence_file.h"
 
 #include <cmath>
-#include <cstdlib>
 
 namespace robotalk::ros2 {
 namespace {
 
-double ParseNumber(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-    throw Error(option + ": '" + text + "' is not a number");
-  }
-  return v;
-}
-
 std::uint32_t ParseDomain(const std::string& option, const std::string& text) {
   // DDS's port mapping leaves room for domain ids 0..232 (ROS 2's
   // "The ROS_DOMAIN_ID" concept page).
-  const double v = ParseNumber(option, text);
+  const double v = ParseNumber(text, option);
   if (v < 0 || v > 232 || v != std::floor(v))
     throw Error(option + ": '" + text + "' is not a DDS domain id (0..232)");
   return static_cast<std::uint32_t>(v);
@@ -86,7 +76,7 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
     } else if (a == "--dds-interface") {
       o.dds_interface = value();
     } else if (a == "--rate") {
-      const double hz = ParseNumber(a, value());
+      const double hz = ParseNumber(value(), a);
       if (hz < 1 || hz > 1000)
         throw Error("--rate: " + args[i] + " Hz is outside 1..1000 (the STATE stream's range)");
       o.period = FromSeconds(1.0 / hz);
@@ -103,7 +93,7 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
       }
       o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
     } else if (a == "--cmd-vel-timeout") {
-      const double s = ParseNumber(a, value());
+      const double s = ParseNumber(value(), a);
       if (s <= 0 || s > 60) throw Error("--cmd-vel-timeout: " + args[i] + " s is outside (0, 60]");
       o.cmd_vel_timeout = FromSeconds(s);
     } else if (a == "--read-only") {

@@ -3,6 +3,8 @@
 
 #include "panic_latch.h"
 #include "robotalk/error.h"
+#include "robotalk/log_writer.h"
+#include "robotalk/sequence_file.h"  // NumberOf
 #include "server_log.h"
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -119,15 +122,15 @@ Serves one or more robots over LCM (see docs/protocol.md).
 On SIGINT or SIGTERM every robot is stopped before the server exits.
 )";
 
+// A number option in [min, max], read by the one rule (NumberOf).
 double ParseNumber(const std::string& flag, const char* text, double min, double max) {
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(v >= min && v <= max)) {
+  const std::optional<double> v = NumberOf(text);
+  if (!v || !(*v >= min && *v <= max)) {
     char range[64];
     std::snprintf(range, sizeof range, "[%g, %g]", min, max);
     throw Error(flag + ": '" + text + "' is not a number in " + range);
   }
-  return v;
+  return *v;
 }
 
 // A line of robotalk-server's own ("robotalk-server: " + line), errors

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
+#include <cmath>
 #include <fstream>
 
 namespace robotalk::cli {
@@ -35,6 +37,25 @@ TEST(SequenceFile, ParsesCommandsCommentsAndBlankLines) {
   EXPECT_EQ(entries[2].command.type, CommandType::kSetSpeed);
   EXPECT_EQ(entries[3].command.type, CommandType::kStop);
   EXPECT_TRUE(entries[3].command.start_time.is_now());
+}
+
+// NumberOf is the rule every number option is read by (the CLI, the server,
+// robotalk-web, the ROS 2 bridge, the relay, the drivers' key=value options):
+// std::stod's, the whole word.
+TEST(NumberText, AWholeWordInADoublesRangeIsANumberAndNothingElseIs) {
+  EXPECT_EQ(NumberOf("0.25"), 0.25);
+  EXPECT_EQ(NumberOf("-1e3"), -1000.0);
+  EXPECT_EQ(NumberOf(" 5"), 5.0);  // blanks before it, as std::stod
+  EXPECT_EQ(NumberOf("0x10"), 16.0);
+  EXPECT_TRUE(std::isinf(*NumberOf("inf")));
+  EXPECT_TRUE(std::isnan(*NumberOf("nan")));
+  for (const char* bad : {"", " ", "5 ", "5x", "x5", "1,5", "1e999", "1e-400", "--"})
+    EXPECT_FALSE(NumberOf(bad).has_value()) << "'" << bad << "'";
+  errno = EINTR;
+  (void)NumberOf("1e999");
+  EXPECT_EQ(errno, EINTR) << "the caller's errno survives";
+  EXPECT_EQ(ParseNumber("2", "--n"), 2.0);
+  EXPECT_THROW(ParseNumber("inf", "--n"), UsageError);
 }
 
 TEST(SequenceFile, ErrorsNameTheLine) {

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <initializer_list>
 #include <new>
 #include <numbers>
@@ -563,6 +564,33 @@ TEST(KinematicDriver, RegistryRejectsUnknownOptionsAndBadValues) {
   config.options = {};
   config.urdf_path = "/nonexistent/robot.urdf";
   EXPECT_THROW(registry.Create("kinematic", config), UrdfError);
+}
+
+// The option and Validate() words every driver shares (driver_support.h:
+// OptionReader::Milliseconds, CheckPeriod, CheckPositive), exactly.
+TEST(KinematicDriver, BadOptionsAreNamedInTheWordsEveryDriverUses) {
+  const auto error_of = [](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  EXPECT_EQ(error_of([] {
+              KinematicDriverOptions::FromMap({{"period_ms", "1e-9"}});
+            }),
+            "kinematic driver: option period_ms='1e-9': expected a number of milliseconds > 0");
+  EXPECT_EQ(error_of([] {
+              KinematicDriverOptions::FromMap({{"period_ms", "0"}});
+            }),
+            "kinematic driver: option period_ms='0': expected a number of milliseconds > 0");
+  EXPECT_EQ(KinematicDriverOptions::FromMap({{"period_ms", "2.5"}}).period, std::chrono::microseconds(2500));
+  EXPECT_EQ(KinematicDriverOptions::FromMap({}).period, KinematicDriverOptions{}.period);
+  EXPECT_EQ(error_of([] { KinematicDriver d(TwoLinkArm(), {.period = Duration::zero()}); }),
+            "KinematicDriver: period = 0 s, expected > 0");
+  EXPECT_EQ(error_of([] { KinematicDriver d(TwoLinkArm(), {.goto_tolerance = -0.5}); }),
+            "KinematicDriver: goto_tolerance = -0.5, expected > 0");
 }
 
 TEST(KinematicDriver, ConstructorRejectsBadOptions) {

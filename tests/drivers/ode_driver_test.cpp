@@ -84,6 +84,34 @@ std::string Pioneer() { return ProjectModel("pioneer2dx_pantilt.urdf"); }
 
 // ---------------------------------------------------------------- registry and options
 
+// The option and Validate() words every driver shares (driver_support.h), exactly.
+TEST(OdeDriver, BadOptionsAreNamedInTheWordsEveryDriverUses) {
+  const auto error_of = [](const OdeDriverOptions& o) -> std::string {
+    try {
+      o.Validate();
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  OdeDriverOptions o;
+  o.gravity = -1;
+  EXPECT_EQ(error_of(o), "OdeDriver: gravity = -1, expected >= 0");
+  o = {};
+  o.step_hz = 0;
+  EXPECT_EQ(error_of(o), "OdeDriver: step_hz = 0, expected > 0");
+  o = {};
+  o.period = Duration::zero();
+  EXPECT_EQ(error_of(o), "OdeDriver: period = 0 s, expected > 0");
+  try {
+    OdeDriverOptions::FromMap({{"period_ms", "1e-9"}});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "ode driver: option period_ms='1e-9': expected a number of milliseconds > 0");
+  }
+  EXPECT_EQ(OdeDriverOptions::FromMap({{"period_ms", "4"}}).period, std::chrono::milliseconds(4));
+}
+
 TEST(OdeDriver, RegistryCreatesTheDriverAndRejectsUnknownOptions) {
   DriverRegistry registry;
   RegisterOdeDriver(registry);

@@ -45,5 +45,12 @@ TEST(Ros2Options, ARobotNameOutsideTheRobotNameRuleIsRefusedNamingIt) {
   EXPECT_NE(ErrorOf({"--robot", ""}).find("--robot"), std::string::npos);
 }
 
+// A number option is read by the one rule of every tool (robotalk::ParseNumber;
+// NumberText tests it): the same words as the CLI's and robotalk-web's.
+TEST(Ros2Options, ANumberOptionIsReadByTheOneRuleOfEveryTool) {
+  EXPECT_EQ(ErrorOf({"--rate", "50x"}), "--rate: '50x' is not a number");
+  EXPECT_EQ(ErrorOf({"--cmd-vel-timeout", "nan"}), "--cmd-vel-timeout: 'nan' is not finite");
+}
+
 }  // namespace
 }  // namespace robotalk::ros2

@@ -3,6 +3,7 @@
 // the fault names the driver, the call and the message, and no Execute runs
 // until the reset. And an Execute that overruns the driver-call bound: its
 // command answers ERROR as soon as the bound passes; its late result is dropped.
+#include "daemon_fixture.h"
 #include "fake_driver.h"
 #include "queued_items.h"
 #include "robot_daemon.h"
@@ -69,22 +70,17 @@ class ThrowingDriver : public FakeDriver {
   }
 };
 
-class DriverFaultTest : public ::testing::TestWithParam<const char*> {
+class DriverFaultTest
+    : public testing::DaemonOnManualClock<ThrowingDriver, ::testing::TestWithParam<const char*>> {
  protected:
-  DriverFaultTest() {
-    auto driver = std::make_unique<ThrowingDriver>(PanRobot());
-    fake_ = driver.get();
+  DriverFaultTest() : DaemonOnManualClock(RobotDaemonOptions{.driver_call_bound = milliseconds(200)}) {
     fake_->throw_in = GetParam();
-    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_,
-                                            RobotDaemonOptions{.driver_call_bound = milliseconds(200)});
-    daemon_->Preallocate(out_);
   }
   std::vector<DaemonOutput::Answer> Run() {
     clock_.Advance(milliseconds(10));  // one driver period: Update runs each time
-    daemon_->RunOnce(clock_.Now());
-    daemon_->TakeOutput(out_);
+    std::vector<DaemonOutput::Answer> replies = DaemonOnManualClock::Run();
     for (auto& line : out_.log) log_ += line + "\n";
-    return out_.replies;
+    return replies;
   }
   // Makes the robot reach the call under test, which throws.
   std::vector<DaemonOutput::Answer> TriggerTheCall() {
@@ -115,10 +111,6 @@ class DriverFaultTest : public ::testing::TestWithParam<const char*> {
     return Run();
   }
 
-  ManualClock clock_;
-  ThrowingDriver* fake_ = nullptr;
-  std::unique_ptr<RobotDaemon> daemon_;
-  DaemonOutput out_;
   std::string log_;
 };
 

@@ -4,6 +4,7 @@
 // and the state stream keeps coming, in panic, with what the driver said.
 #include "robot_daemon.h"
 
+#include "daemon_fixture.h"
 #include "fake_driver.h"
 #include "queued_items.h"
 #include "robotalk/request.h"
@@ -46,15 +47,6 @@ class BrokenSensorDriver final : public testing::FakeDriver {
 // A waypoint of an interpolated package for the pan joint (0), due at `at`.
 QueuedItem Waypoint(CommandId id, TimePoint at, double q) { return testing::Waypoint(id, 0, at, {q}); }
 
-QueuedItem Query(CommandId id, QueryType type) {
-  QueuedItem item;
-  item.client_id = kAlice;
-  item.is_query = true;
-  item.query = type;
-  item.command.id = id;
-  return item;
-}
-
 // A finite state that fits PanRobot: one dof, one root, all zeros.
 RobotState FittingState() {
   RobotState s;
@@ -63,25 +55,7 @@ RobotState FittingState() {
   return s;
 }
 
-class NonFiniteStateTest : public ::testing::Test {
- protected:
-  NonFiniteStateTest() {
-    auto driver = std::make_unique<BrokenSensorDriver>(testing::PanRobot());
-    driver_ = driver.get();
-    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_);
-    daemon_->Preallocate(out_);
-  }
-  std::vector<DaemonOutput::Answer> Run() {
-    daemon_->RunOnce(clock_.Now());
-    daemon_->TakeOutput(out_);
-    return out_.replies;
-  }
-
-  ManualClock clock_;
-  BrokenSensorDriver* driver_ = nullptr;
-  std::unique_ptr<RobotDaemon> daemon_;
-  DaemonOutput out_;
-};
+class NonFiniteStateTest : public testing::DaemonOnManualClock<BrokenSensorDriver> {};
 
 TEST(NonFiniteState, NamesTheJointAndDofOrTheBaseField) {
   const RobotModel model = testing::PanRobot();
@@ -100,11 +74,11 @@ TEST(NonFiniteState, NamesTheJointAndDofOrTheBaseField) {
 TEST_F(NonFiniteStateTest, HaltsTheRobotInPanicNamingTheValueEvenWhenNobodyReadsTheState) {
   Run();
   EXPECT_FALSE(daemon_->in_panic());
-  driver_->nan_position = true;
+  fake_->nan_position = true;
   clock_.Advance(milliseconds(10));  // the driver's next period
   Run();
   EXPECT_TRUE(daemon_->in_panic());
-  EXPECT_TRUE(driver_->halted);
+  EXPECT_TRUE(fake_->halted);
   EXPECT_THAT(daemon_->fault(),
               HasSubstr("driver 'fake' reports a non-finite state: joint 'pan' dof 0 position is NaN"));
   ASSERT_FALSE(out_.log.empty());
@@ -112,10 +86,10 @@ TEST_F(NonFiniteStateTest, HaltsTheRobotInPanicNamingTheValueEvenWhenNobodyReads
 }
 
 TEST_F(NonFiniteStateTest, AQueryAnswersErrorNamingTheNonFiniteValue) {
-  driver_->inf_base_x = true;
+  fake_->inf_base_x = true;
   Run();
   clock_.Advance(milliseconds(1));
-  daemon_->Submit(Query(7, QueryType::kBasePose));
+  daemon_->Submit(testing::StateQuery(7, QueryType::kBasePose));
   const auto replies = Run();
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].reply.signal, Signal::kError);
@@ -131,7 +105,7 @@ TEST_F(NonFiniteStateTest, AQueryAnswersErrorNamingTheNonFiniteValue) {
 
 TEST_F(NonFiniteStateTest, TheStateStreamSaysPanicAndCarriesTheValueAClientDecodes) {
   daemon_->SetStream(kAlice, milliseconds(10));
-  driver_->nan_position = true;
+  fake_->nan_position = true;
   Run();
   clock_.Advance(milliseconds(10));
   Run();
@@ -163,7 +137,7 @@ void ExpectEachAnsweredOnceInterrupted(const std::vector<DaemonOutput::Answer>& 
 
 TEST_F(NonFiniteStateTest, WaypointsArrivingAsTheSensorBreaksAreInterruptedOnceAndTheDaemonRuns) {
   Run();
-  driver_->nan_position = true;
+  fake_->nan_position = true;
   clock_.Advance(milliseconds(10));
   daemon_->Submit(Waypoint(1, clock_.Now() + milliseconds(500), 0.3));
   daemon_->Submit(Waypoint(2, clock_.Now() + milliseconds(900), 0.5));
@@ -179,7 +153,7 @@ TEST_F(NonFiniteStateTest, WaypointsArrivingAsTheSensorBreaksAreInterruptedOnceA
 
 TEST_F(NonFiniteStateTest, WaypointsArrivingWhenTheDriverCannotReadItsStateAreInterruptedOnce) {
   Run();
-  driver_->throw_on_read = true;
+  fake_->throw_on_read = true;
   clock_.Advance(milliseconds(1));  // within the period: read only for the waypoints
   daemon_->Submit(Waypoint(1, clock_.Now() + milliseconds(500), 0.3));
   std::vector<DaemonOutput::Answer> replies = Run();
@@ -211,10 +185,10 @@ TEST_F(NonFiniteStateTest, AStateThatDoesNotFitTheModelHaltsTheRobotAndIsNeverRe
   Run();
   const std::size_t samples_before = out_.num_samples;
   EXPECT_GE(samples_before, 1u);
-  driver_->lose_root = true;
+  fake_->lose_root = true;
   clock_.Advance(milliseconds(10));
   daemon_->Submit(Waypoint(1, clock_.Now() + milliseconds(500), 0.3));
-  daemon_->Submit(Query(2, QueryType::kBasePose));
+  daemon_->Submit(testing::StateQuery(2, QueryType::kBasePose));
   std::vector<DaemonOutput::Answer> replies = Run();
   EXPECT_TRUE(daemon_->in_panic());
   EXPECT_THAT(daemon_->fault(), HasSubstr("driver 'fake' reports a state that does not fit the model: "

@@ -42,14 +42,17 @@ inline QueuedItem Waypoint(CommandId id, int target, TimePoint at, std::vector<d
   return item;
 }
 
-inline QueuedItem JointStateQuery(CommandId id) {
+/// A state query of kItemClient (JOINT_STATE, BASE_POSE, ...).
+inline QueuedItem StateQuery(CommandId id, QueryType type) {
   QueuedItem item;
   item.client_id = kItemClient;
   item.is_query = true;
-  item.query = QueryType::kJointState;
+  item.query = type;
   item.command.id = id;
   return item;
 }
+
+inline QueuedItem JointStateQuery(CommandId id) { return StateQuery(id, QueryType::kJointState); }
 
 /// Every dof at 0, at rest.
 inline RobotState Rest(const RobotModel& m) {

@@ -1,5 +1,6 @@
 #include "robot_daemon.h"
 
+#include "daemon_fixture.h"
 #include "fake_driver.h"
 #include "queued_items.h"
 #include "support/test_clients.h"
@@ -43,20 +44,9 @@ using testing::PanRobot;
 
 using testing::kAlice;
 
-class RobotDaemonTest : public ::testing::Test {
+class RobotDaemonTest : public testing::DaemonOnManualClock<> {
  protected:
-  RobotDaemonTest() {
-    auto driver = std::make_unique<FakeDriver>(PanRobot());
-    fake_ = driver.get();
-    daemon_ = std::make_unique<RobotDaemon>("bot", "fake", std::move(driver), clock_,
-                                            RobotDaemonOptions{.driver_call_bound = milliseconds(200)});
-    daemon_->Preallocate(out_);
-  }
-  std::vector<DaemonOutput::Answer> Run() {
-    daemon_->RunOnce(clock_.Now());
-    daemon_->TakeOutput(out_);
-    return out_.replies;
-  }
+  RobotDaemonTest() : DaemonOnManualClock(RobotDaemonOptions{.driver_call_bound = milliseconds(200)}) {}
   // What RobotSessions does with a state query due now: answered on receipt
   // from the snapshot the RobotDaemon published (appended to `direct`), else queued.
   void Ask(QueuedItem query, std::vector<DaemonOutput::Answer>& direct) {
@@ -66,11 +56,6 @@ class RobotDaemonTest : public ::testing::Test {
     }
     daemon_->Submit(std::move(query));
   }
-
-  ManualClock clock_;
-  FakeDriver* fake_ = nullptr;
-  std::unique_ptr<RobotDaemon> daemon_;
-  DaemonOutput out_;
 };
 
 TEST_F(RobotDaemonTest, ContainsADriverThatThrowsAnswersErrorNamingItAndHoldsTheRobotInPanic) {

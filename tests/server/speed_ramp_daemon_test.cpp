@@ -6,6 +6,7 @@
 // acceleration between control periods, ramped vs step, in one run) is
 // printed by RandomFramesRampWithinTheLimitWhereAStepPackageJumps.
 #include "kinematic_driver.h"
+#include "queued_items.h"
 #include "robot_daemon.h"
 #include "support/test_clients.h"
 
@@ -41,27 +42,14 @@ RobotModel Rover(BaseType base = BaseType::kDifferential) {
 
 QueuedItem Speed(CommandId id, TimePoint at, double v, double omega,
                  Interpolation interpolation = Interpolation::kLinear, std::int64_t client = kAlice) {
-  QueuedItem item;
-  item.client_id = client;
-  item.command.id = id;
-  item.command.type = CommandType::kSetSpeed;
-  item.command.num_values = 2;
-  item.command.values[0] = v;
-  item.command.values[1] = omega;
-  item.has_start_time = true;
-  item.start = at;
+  QueuedItem item = testing::Waypoint(id, -1, at, {v, omega}, interpolation, client, CommandType::kSetSpeed);
   item.received = at - milliseconds(300);
-  item.interpolation = interpolation;
   return item;
 }
 
 QueuedItem Now(CommandId id, CommandType type, std::vector<double> values = {}, std::int64_t client = kBob) {
-  QueuedItem item;
+  QueuedItem item = testing::Motion(id, type, std::move(values));
   item.client_id = client;
-  item.command.id = id;
-  item.command.type = type;
-  item.command.num_values = static_cast<int>(values.size());
-  std::copy(values.begin(), values.end(), item.command.values.begin());
   return item;
 }
 

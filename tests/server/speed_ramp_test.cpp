@@ -3,6 +3,8 @@
 // continuous and never changes faster than the base's limit, MODIFIED when
 // the limit bites, splices, late frames, and End().
 #include "speed_ramp.h"
+
+#include "queued_items.h"
 #include "support/test_clients.h"
 
 #include <gmock/gmock.h>
@@ -22,17 +24,11 @@ using testing::kBob;
 using testing::kT0;
 constexpr Duration kPeriod = milliseconds(10);
 
+// A SETSPEED frame of a linear package, due at `at`, received 200 ms before.
 QueuedItem Frame(CommandId id, TimePoint at, std::vector<double> values, std::int64_t client = kAlice) {
-  QueuedItem item;
-  item.client_id = client;
-  item.command.id = id;
-  item.command.type = CommandType::kSetSpeed;
-  item.command.num_values = static_cast<int>(values.size());
-  std::copy(values.begin(), values.end(), item.command.values.begin());
-  item.has_start_time = true;
-  item.start = at;
+  QueuedItem item = testing::Waypoint(id, -1, at, std::move(values), Interpolation::kLinear, client,
+                                      CommandType::kSetSpeed);
   item.received = at - milliseconds(200);
-  item.interpolation = Interpolation::kLinear;
   return item;
 }
 

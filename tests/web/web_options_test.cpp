@@ -19,6 +19,13 @@ std::string ErrorOf(std::vector<std::string> args) {
   return "(no error)";
 }
 
+// A number option is read by the one rule of every tool (robotalk::ParseNumber;
+// NumberText tests it): the same words as the CLI's and the ROS 2 bridge's.
+TEST(WebOptions, ANumberOptionIsReadByTheOneRuleOfEveryTool) {
+  EXPECT_EQ(ErrorOf({"--port", "80x"}), "--port: '80x' is not a number");
+  EXPECT_EQ(ErrorOf({"--rate", "inf"}), "--rate: 'inf' is not finite");
+}
+
 TEST(WebOptions, DefaultsToLoopbackPort8080At30Hz) {
   const WebOptions o = Parse({});
   EXPECT_EQ(o.bind, "127.0.0.1");

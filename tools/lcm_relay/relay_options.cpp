@@ -2,6 +2,7 @@
 
 #include <robotalk/error.h>
 #include <robotalk/routed_lcm_transport.h>
+#include <robotalk/sequence_file.h>  // NumberOf
 #include <robotalk/traffic_layout.h>
 
 #include <cmath>
@@ -17,15 +18,10 @@ namespace {
 }
 
 double ParseDouble(const std::string& option, const std::string& value) {
-  std::size_t used = 0;
-  double x = 0.0;
-  try {
-    x = std::stod(value, &used);
-  } catch (const std::exception&) {
-    Bad(option, value, "not a number");
-  }
-  if (used != value.size() || !std::isfinite(x)) Bad(option, value, "not a finite number");
-  return x;
+  const std::optional<double> x = NumberOf(value);  // the one rule of every number option
+  if (!x) Bad(option, value, "not a number");
+  if (!std::isfinite(*x)) Bad(option, value, "not a finite number");
+  return *x;
 }
 
 double ParseProbability(const std::string& option, const std::string& value) {

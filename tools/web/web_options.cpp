@@ -1,22 +1,15 @@
 #include "web_options.h"
 
+#include "robotalk/channels.h"  // kAnnounceHeardWithin
 #include "robotalk/error.h"
-#include "robotalk/sequence_file.h"  // ParseSeconds
+#include "robotalk/sequence_file.h"  // ParseNumber, ParseSeconds
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
+#include <cstdio>
 
 namespace robotalk::web {
 namespace {
-
-double ParseNumber(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
-    throw Error(option + ": '" + text + "' is not a number");
-  return v;
-}
 
 void AppendPaths(const std::string& list, std::vector<std::string>& paths) {
   std::size_t start = 0;
@@ -86,20 +79,23 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       o.bind = value();
       if (o.bind.empty()) throw Error("--bind: empty address");
     } else if (a == "--port") {
-      const double p = ParseNumber(a, value());
+      const double p = ParseNumber(value(), a);
       if (p < 0 || p > 65535 || p != std::floor(p))
         throw Error("--port: " + args[i] + " is not a port (0-65535)");
       o.port = static_cast<int>(p);
     } else if (a == "--lcm-url") {
       o.lcm_url = value();
     } else if (a == "--rate") {
-      o.rate_hz = ParseNumber(a, value());
+      o.rate_hz = ParseNumber(value(), a);
       if (o.rate_hz < 1 || o.rate_hz > 240) throw Error("--rate: " + args[i] + " Hz is outside 1-240");
     } else if (a == "--robot-timeout") {
       o.robot_timeout_s = ParseSeconds(value(), a);  // within what every time given as text may be
-      if (o.robot_timeout_s < 1.5)
-        throw Error("--robot-timeout: " + args[i] +
-                    " s is shorter than 1.5 s (servers announce every second)");
+      if (o.robot_timeout_s < ToSeconds(kAnnounceHeardWithin)) {
+        char shortest[32];
+        std::snprintf(shortest, sizeof shortest, "%g", ToSeconds(kAnnounceHeardWithin));
+        throw Error("--robot-timeout: " + args[i] + " s is shorter than " + shortest +
+                    " s (servers announce every second)");
+      }
     } else if (a == "--key") {
       o.key_file = value();
       if (o.key_file.empty()) throw Error("--key: the file name is empty");

@@ -21,7 +21,6 @@ namespace {
 namespace msgs = robotalk_msgs;
 
 constexpr std::int32_t kFormatVersion = 1;
-constexpr int kMaxDofsPerJoint = 6;
 // LCM prefixes every encoded message with its 8-byte type fingerprint.
 constexpr std::size_t kFingerprintSize = 8;
 // header.hash follows the fingerprint and header.format_version (int32).
@@ -182,7 +181,7 @@ std::size_t ScanConfig(std::span<const std::uint8_t> bytes) {
     s.Skip(kJointBeforeNumDofs, "links, geometry, servo_types");
     const std::int8_t num_dofs = s.Int8("num_dofs");
     if (num_dofs < 0 || num_dofs > kMaxDofsPerJoint) {
-      s.Fail("num_dofs", std::to_string(num_dofs) + " is outside 0..6");
+      s.Fail("num_dofs", std::to_string(num_dofs) + " is outside 0.." + std::to_string(kMaxDofsPerJoint));
     }
     s.Skip(num_dofs * z.dof, "dofs");
     s.Skip(kJointAfterDofs, "mimic");
@@ -271,7 +270,8 @@ void CheckEnvelope(const msgs::robot_config_t& msg) {
     const std::string what = Element("joints", i);
     CheckWireName(j.name, what + ".name");
     if (j.num_dofs < 0 || j.num_dofs > kMaxDofsPerJoint) {
-      Protocol(kFrom, what + ".num_dofs = " + std::to_string(j.num_dofs) + " is outside 0..6");
+      Protocol(kFrom, what + ".num_dofs = " + std::to_string(j.num_dofs) + " is outside 0.." +
+                          std::to_string(kMaxDofsPerJoint));
     }
     if (static_cast<std::size_t>(j.num_dofs) != j.dofs.size()) {
       Protocol(kFrom, what + ".num_dofs = " + std::to_string(j.num_dofs) + " but dofs has " +

@@ -9,7 +9,6 @@
 namespace robotalk {
 namespace {
 
-constexpr int kMaxDofsPerJoint = 6;
 constexpr double kUnitTolerance = 1e-6;
 
 std::string Quote(std::string_view s) { return "'" + std::string(s) + "'"; }
@@ -143,7 +142,8 @@ void RobotModel::Validate() {
       Fail(name_, what + "outboard position " + Vec(joint.outboard) + " is not finite");
     if (!IsUnit(joint.rest)) Fail(name_, what + "rest rotation is not a unit quaternion");
     if (joint.dofs.size() > kMaxDofsPerJoint) {
-      Fail(name_, what + "has " + std::to_string(joint.dofs.size()) + " dofs; a joint has at most 6");
+      Fail(name_, what + "has " + std::to_string(joint.dofs.size()) + " dofs; a joint has at most " +
+                      std::to_string(kMaxDofsPerJoint));
     }
     for (size_t k = 0; k < joint.dofs.size(); ++k) ValidateDof(name_, joint, k, joint.dofs[k]);
     dof_offsets_[static_cast<size_t>(j)] = num_dofs_;

@@ -1,8 +1,10 @@
 #include "robotalk/sequence_file.h"
 
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace robotalk {
@@ -14,17 +16,23 @@ std::vector<std::string> SplitWords(const std::string& line) {
   return words;
 }
 
-double ParseNumber(const std::string& word, const std::string& what) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(word, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != word.size() || word.empty()) throw UsageError(what + ": '" + word + "' is not a number");
-  if (!std::isfinite(v)) throw UsageError(what + ": '" + word + "' is not finite");
+std::optional<double> NumberOf(const std::string& word) {
+  if (word.empty()) return std::nullopt;
+  const int saved = errno;  // as std::stod: the caller's errno survives
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(word.c_str(), &end);
+  const bool whole = end == word.c_str() + word.size() && errno != ERANGE;
+  errno = saved;
+  if (!whole) return std::nullopt;
   return v;
+}
+
+double ParseNumber(const std::string& word, const std::string& what) {
+  const std::optional<double> v = NumberOf(word);
+  if (!v) throw UsageError(what + ": '" + word + "' is not a number");
+  if (!std::isfinite(*v)) throw UsageError(what + ": '" + word + "' is not finite");
+  return *v;
 }
 
 double ParseSeconds(const std::string& word, const std::string& what) {

@@ -63,6 +63,10 @@ class OptionReader {
 
   /// A finite number in `range`; throws Error "<driver>: option k='v': expected <expected>".
   void Number(const std::string& key, double* out, Range range, const char* expected);
+  /// A time > 0 given in milliseconds (period_ms), kept exact to the
+  /// microsecond of a Duration; one that rounds to zero is refused as well:
+  /// "<driver>: option k='v': expected a number of milliseconds > 0".
+  void Milliseconds(const std::string& key, Duration* out);
   void Bool(const std::string& key, bool* out);
   /// Any text (the caller checks it); returns whether the key was given.
   bool Text(const std::string& key, std::string* out);
@@ -75,6 +79,14 @@ class OptionReader {
   const std::map<std::string, std::string>& options_;
   std::set<std::string> known_;
 };
+
+/// An options struct's Validate(): throws Error "<owner>: <name> = <v>,
+/// expected > 0" (">= 0") for a value that is not, NaN and infinities
+/// included; `owner` is the class ("KinematicDriver").
+void CheckPositive(const std::string& owner, const char* name, double v);
+void CheckNonNegative(const std::string& owner, const char* name, double v);
+/// Throws Error "<owner>: period = <s> s, expected > 0" for a control period that is not.
+void CheckPeriod(const std::string& owner, Duration period);
 
 /// After solving: SUCCESS within the solver's tolerance, else MODIFIED with the residual.
 DriverResult AnswerFrameSetPoint(const std::string& frame, const InverseKinematics::Result& result);

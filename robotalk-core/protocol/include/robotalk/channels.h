@@ -31,6 +31,12 @@ inline constexpr const char* kAnnounceChannel = "ROBOTALK/ANNOUNCE";
 /// How often a server announces (ServerOptions::announce_period's default);
 /// clients' waits for an announcement are counted in it.
 inline constexpr Duration kAnnouncePeriod = std::chrono::seconds(1);
+/// One announce period and half of one for the network, scheduling and the
+/// clock sync (1.5 s): every live server is heard within it. `robotalk
+/// robots` listens this long by default; robotalk-web's --robot-timeout is
+/// at least this; the CLI's AnnounceWatch refuses a signed announcement
+/// older than this on arrival.
+inline constexpr Duration kAnnounceHeardWithin = kAnnouncePeriod * 3 / 2;
 /// Subscription regex (LCM: whole-name match) for the REQUEST channel of every robot.
 inline constexpr const char* kAnyRequestChannelRegex = "ROBOTALK/[^/]+/REQUEST";
 /// Subscription regex for the HELLO channel of every robot.

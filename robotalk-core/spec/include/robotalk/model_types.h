@@ -113,7 +113,11 @@ struct Mimic {
   bool operator==(const Mimic&) const = default;
 };
 
-/// A joint with 0 (fixed) to 6 (free) dofs.
+/// The most dofs a joint has (a free joint): RobotModelBuilder refuses more,
+/// and so does the CONFIG decoder.
+inline constexpr int kMaxDofsPerJoint = 6;
+
+/// A joint with 0 (fixed) to kMaxDofsPerJoint (free) dofs.
 struct Joint {
   std::string name;
   int parent_link = -1;                                      ///< index into RobotModel::links()

@@ -47,7 +47,14 @@ std::string FormatCommandWords(const Command& command);
 /// "<what>: 'cubc' is not an interpolation (step, linear, cubic, quintic)".
 Interpolation ParseInterpolationWord(const std::string& word, const std::string& what);
 
-/// Parses a number (the whole word); throws UsageError naming `what`.
+/// The number a whole word spells (strtod's syntax, blanks before it
+/// allowed, as std::stod): nullopt when the word is empty, when anything is
+/// left after the number, or when it is out of a double's range (ERANGE).
+/// "inf" and "nan" are numbers here (the callers refuse them). The one rule
+/// every number option and text of RoboTalk is read by.
+std::optional<double> NumberOf(const std::string& word);
+/// Parses a finite number (NumberOf); throws UsageError naming `what`:
+/// "<what>: 'x' is not a number", "<what>: 'inf' is not finite".
 double ParseNumber(const std::string& word, const std::string& what);
 
 /// The most seconds a time given as text may be (a sequence file's start
