@@ -4,6 +4,12 @@
 # Usage: walk_bench_timeout_test.sh ROBOTALK_WALK_BENCH
 set -euo pipefail
 bench=$1
+# A flag without its value (a trailing --help, --every) is refused at once,
+# naming it (before: silently ignored, and the whole default run started).
+status=0
+err=$(timeout 20 "$bench" --seed 1 --help 2>&1 >/dev/null) || status=$?
+[ "$status" -eq 2 ] || { echo "FAIL: a trailing flag: exit status $status, expected 2"; exit 1; }
+grep -q -- "--help needs a value" <<<"$err" || { echo "FAIL: a trailing flag not named: $err"; exit 1; }
 status=0
 out=$("$bench" --goals 1 --goal 0.6,0,0.5 --timeout 2 2>&1) || status=$?
 echo "$out"

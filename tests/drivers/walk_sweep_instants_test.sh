@@ -6,6 +6,12 @@
 # Usage: walk_sweep_instants_test.sh ROBOTALK_WALK_SWEEP
 set -euo pipefail
 sweep=$1
+# A flag without its value (a trailing --help, --every) is refused at once,
+# naming it (before: silently ignored, and the whole default run started).
+status=0
+err=$(timeout 20 "$sweep" --seed 1 --help 2>&1 >/dev/null) || status=$?
+[ "$status" -eq 2 ] || { echo "FAIL: a trailing flag: exit status $status, expected 2"; exit 1; }
+grep -q -- "--help needs a value" <<<"$err" || { echo "FAIL: a trailing flag not named: $err"; exit 1; }
 out=$("$sweep" --push walking --instants 1 --levels 20 --after 3 --cycle 0.05 --stabilizer off 2>&1)
 echo "$out"
 at=$(sed -n 's/^push instants (s into the walk): //p' <<<"$out")
