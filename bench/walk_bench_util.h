@@ -5,6 +5,8 @@
 
 #include "ode_driver.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string>
@@ -21,6 +23,17 @@ inline std::map<std::string, std::string> DefaultWalkOptions() { return {{"walk"
 inline void SetDriverOption(std::map<std::string, std::string>& options, const std::string& key_value) {
   const std::size_t eq = key_value.find('=');
   options[key_value.substr(0, eq)] = eq == std::string::npos ? "" : key_value.substr(eq + 1);
+}
+
+/// Both tools read `--flag value` pairs: a flag left without its value (a
+/// trailing --help) ends the tool with status 2 naming it, rather than being
+/// ignored while the whole default run starts.
+inline void RequireFlagValuePairs(int argc, char** argv) {
+  if (argc > 1 && argc % 2 == 0) {
+    std::fprintf(stderr, "%s needs a value (every option is --flag value; see the header of %s's source)\n",
+                 argv[argc - 1], argv[0]);
+    std::exit(2);
+  }
 }
 
 /// A fresh ode driver (robot name "") of `model` with `options`; throws Error

@@ -98,6 +98,7 @@ struct Args {
 
 Args Parse(int argc, char** argv) {
   Args a;
+  bench::RequireFlagValuePairs(argc, argv);
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--transition") {
