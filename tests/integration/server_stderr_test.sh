@@ -268,5 +268,33 @@ sleep 4.0
 at_rest "the frame queued for 5 s after the Ctrl-C does not run" "$tmp/watch4.json"
 kill -9 "$seq_pid" 2>/dev/null
 
+# A sequence that ends in a SETSPEED, its stdout taking nothing, no Ctrl-C:
+# the SETSPEED lasts only while the command runs (as a single one without
+# --hold). Before, the CLI waited in a frame's reply line, its heartbeats
+# keeping the session and the base at 0.3 m/s for ever (gaps12, 6 s later);
+# the frames' lines are now written by a thread of their own, and the session
+# ends when the sequence has run, before the CLI waits for its output.
+"$cli" --url "$url" send pioneer stop >/dev/null 2>&1
+"$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch6.json" 2>/dev/null &
+pids+=($!)
+printf '0.0 setspeed 0.3 0.0\n0.3 joint_setpoint pan 0.3\n0.6 joint_setpoint pan -0.3\n' >"$tmp/seq_end.txt"
+for mode in delay direct playback; do
+  mkfifo "$tmp/full_seq_$mode"
+  sleep 1000 <"$tmp/full_seq_$mode" &  # holds the read end, reads nothing
+  pids+=($!)
+  exec 4>"$tmp/full_seq_$mode"
+  head -c 65536 /dev/zero >&4  # the pipe's capacity: full
+  "$cli" --url "$url" send pioneer --file "$tmp/seq_end.txt" --mode "$mode" >&4 2>/dev/null &
+  seq_pid=$!
+  pids+=("$seq_pid")
+  exec 4>&-
+  sleep 1.2
+  moves "a sequence ending in a SETSPEED, its stdout taking nothing ($mode): pioneer moves" "$tmp/watch6.json"
+  sleep 3.5  # the sequence's end, the session timeout (2 s) and the watchdog
+  at_rest "... and stops within the session timeout of the sequence's end ($mode)" "$tmp/watch6.json"
+  kill -9 "$seq_pid" 2>/dev/null
+  "$cli" --url "$url" send pioneer stop >/dev/null 2>&1
+done
+
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]
