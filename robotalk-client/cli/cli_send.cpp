@@ -3,6 +3,7 @@
 #include "cli_commands.h"
 #include "cli_support.h"
 #include "interrupt.h"
+#include "output_lines.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -14,6 +15,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace robotalk::cli {
@@ -94,13 +96,19 @@ class TtyProgress {
   int fd_ = -1;
 };
 
-void PrintOne(const Reply& r, bool json) {
+void PrintOne(const Reply& r, bool json, std::ostream& out = std::cout) {
   if (json) {
-    std::cout << ReplyJson(r) << '\n' << std::flush;
+    out << ReplyJson(r) << '\n' << std::flush;
   } else {
-    PrintReply(r, std::cout);
-    std::cout << std::flush;
+    PrintReply(r, out);
+    out << std::flush;
   }
+}
+
+std::string ReplyText(const Reply& r, bool json) {
+  std::ostringstream text;
+  PrintOne(r, json, text);
+  return text.str();
 }
 
 // After a signal: says what was stopped; returns 128 + signal.
@@ -138,20 +146,47 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
                  "(--interpolation cubic, or an 'interpolation' line, uses them)\n";
   }
 
-  const auto client = ConnectClient(g, robot);
+  auto client = ConnectClient(g, robot);
+  std::cout.flush();  // before the reply lines' own thread writes to stdout
+  OutputLines replies(STDOUT_FILENO);
   Interrupter::Defer(true);  // from here on a signal means: STOP what was sent
-  const StopOnInterrupt stop_at_once(*client);
+  std::optional<StopOnInterrupt> stop_at_once(std::in_place, *client);
+  // Nothing more for the robot: the session ends before the tool waits for
+  // its output (a stdout or stderr that takes nothing waits for ever; the
+  // heartbeats would keep the last frame's motion alive meanwhile), and a
+  // signal ends the tool at once.
+  const auto end_session = [&] {
+    stop_at_once.reset();
+    client.reset();
+    Interrupter::Defer(false);
+  };
   const TtyProgress progress;
   int status = 0;
-  const RunReport report = RunFrames(
-      *client, std::move(frames), options,
-      [&](std::size_t, const Reply& r) {
-        progress.Clear();
-        PrintOne(r, json);
-        status = std::max(status, ExitStatus(r));
-      },
-      [&](const RunProgress& p) { progress.Show("\r" + ProgressBar(p)); });
+  RunReport report;
+  try {
+    report = RunFrames(
+        *client, std::move(frames), options,
+        [&](std::size_t, const Reply& r) {
+          progress.Clear();
+          replies.Add(ReplyText(r, json));  // never waits for stdout
+          status = std::max(status, ExitStatus(r));
+        },
+        [&](const RunProgress& p) {
+          if (replies.idle()) progress.Show("\r" + ProgressBar(p));  // never inside a reply line
+        });
+  } catch (...) {
+    end_session();
+    replies.Finish();
+    throw;
+  }
   progress.Clear();
+  // After a signal the STOP has left; the tool ends within
+  // StopOnInterrupt::kTakeOver if its output takes nothing.
+  if (!report.signal) end_session();
+  if (const std::uint64_t lost = replies.Finish(); lost > 0) {
+    std::cerr << "robotalk: " << lost << " reply lines lost: stdout took no more\n";
+    status = std::max(status, 1);
+  }
   for (const auto& [index, why] : report.unknown_outcomes) {
     std::cerr << "robotalk: line " << entries[index].line << ": " << TidyDurations(why) << "\n";
   }

@@ -1,0 +1,88 @@
+#include "output_lines.h"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <pthread.h>
+#include <cerrno>
+#include <csignal>
+#include <thread>
+
+namespace robotalk::cli {
+
+void OutputLines::State::Run() {
+  std::unique_lock lock(mu);
+  for (;;) {
+    work.wait(lock, [&] { return stop || !queue.empty(); });
+    if (queue.empty()) return;  // stopped, nothing left
+    std::string text = std::move(queue.front());
+    queue.pop_front();
+    queued_bytes -= text.size();
+    writing = true;
+    lock.unlock();
+    bool ok = true;
+    for (std::size_t at = 0; at < text.size();) {
+      const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {  // a non-blocking stdout: wait for room
+        pollfd out{fd, POLLOUT, 0};
+        if (::poll(&out, 1, -1) >= 0 || errno == EINTR) continue;
+      }
+      if (n <= 0) {
+        ok = false;
+        break;
+      }
+      at += static_cast<std::size_t>(n);
+    }
+    lock.lock();
+    writing = false;
+    if (!ok) {  // its reader is gone (EPIPE) or it refused: the rest is lost too
+      failed = true;
+      lost += 1 + queue.size();
+      queue.clear();
+      queued_bytes = 0;
+    }
+    if (queue.empty()) idle.notify_all();
+  }
+}
+
+OutputLines::OutputLines(int fd) : state_(std::make_shared<State>()) {
+  state_->fd = fd;
+  sigset_t every, before;
+  sigfillset(&every);
+  pthread_sigmask(SIG_BLOCK, &every, &before);
+  std::thread([state = state_] { state->Run(); }).detach();
+  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+}
+
+OutputLines::~OutputLines() {
+  std::lock_guard lock(state_->mu);
+  state_->stop = true;
+  state_->work.notify_all();
+}
+
+void OutputLines::Add(std::string text) {
+  State& s = *state_;
+  std::lock_guard lock(s.mu);
+  if (s.failed || s.queued_bytes + text.size() > kMaxQueuedBytes) {
+    ++s.lost;
+    return;
+  }
+  s.queued_bytes += text.size();
+  s.queue.push_back(std::move(text));
+  s.work.notify_one();
+}
+
+bool OutputLines::idle() const {
+  std::lock_guard lock(state_->mu);
+  return state_->queue.empty() && !state_->writing;
+}
+
+std::uint64_t OutputLines::Finish() {
+  State& s = *state_;
+  std::unique_lock lock(s.mu);
+  s.idle.wait(lock, [&] { return s.queue.empty() && !s.writing; });
+  return s.lost;
+}
+
+}  // namespace robotalk::cli
