@@ -91,6 +91,41 @@ check "theta within 0.01 rad" within "$th0" "$th1" 0.01
 check "pan within 0.01 rad" within "$pan0" "$pan1" 0.01
 check "tilt within 0.01 rad" within "$tilt0" "$tilt1" 0.01
 
+# --- replay whose stdout and stderr take nothing ------------------------------
+# The window 0-2.5 s ends in "2.2 setspeed 0.2 -0.3": a servo command kept
+# only while the replay runs. With a stdout and a stderr that take nothing
+# (full pipes nobody reads) the replay must still end its session once its
+# frames have answered (before: it waited in its summary line, its heartbeats
+# keeping pioneer2 driving).
+rt send pioneer2 stop >/dev/null 2>&1
+"$cli" --url "$url" watch pioneer2 --json --period 0.05 --duration 20 >"$tmp/watch_full.json" 2>/dev/null &
+pids+=($!)
+mkfifo "$tmp/full_out"
+# Its reader takes the first line ("replaying ..."), then nothing: the pipe
+# is filled once that line is read, so the replay's later lines wait.
+python3 -c 'import sys, time
+with open(sys.argv[1], "rb", buffering=0) as f, open(sys.argv[2], "wb") as out:
+    out.write(f.readline())
+    out.flush()
+    time.sleep(1000)' "$tmp/full_out" "$tmp/replay_head.txt" &
+pids+=($!)
+exec 4>"$tmp/full_out"
+"$logplay" replay "$tmp/session.lcmlog" --robot pioneer2 --from pioneer --url "$url" --window 0:2.5 >"$tmp/full_out" 2>&4 &
+replay_pid=$!
+pids+=("$replay_pid")
+wait_for "$tmp/replay_head.txt" "replaying"
+head -c 65536 /dev/zero >&4  # the pipe's capacity: full
+exec 4>&-
+sleep 1.5
+read -r v w moving < <(last_motion "$tmp/watch_full.json")
+check "replay with full stdout and stderr: pioneer2 moves (v=$v moving=$moving)" \
+  python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
+sleep 5  # the window's end (2.2 s after its start), the session timeout (2 s), the watchdog
+read -r v w moving < <(last_motion "$tmp/watch_full.json")
+check "... and stops within the session timeout of its last frame (v=$v w=$w moving=$moving)" \
+  python3 -c "import sys; sys.exit(not (abs($v) < 0.01 and abs($w) < 0.01 and '$moving' == 'false'))"
+kill -9 "$replay_pid" 2>/dev/null
+
 # --- export -------------------------------------------------------------------
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 if "$py" -c 'import matplotlib' 2>/dev/null; then plot=""; else plot="--no-plot"; fi
