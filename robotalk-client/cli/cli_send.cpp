@@ -7,7 +7,6 @@
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -64,37 +63,6 @@ SequenceFlags TakeSequenceFlags(std::vector<std::string>& args) {
   if (f.options.mode == CommandMode::kDirect) f.options.paced = true;  // a handshake per frame, at its time
   return f;
 }
-
-// The progress line on a terminal, written through a description of its own
-// opened non-blocking: a terminal that takes nothing (stopped with Ctrl-S, a
-// pty nobody reads) loses progress lines, never the thread that must send
-// the STOP on Ctrl-C (before: it waited in the write, and its heartbeats kept
-// the session and so the motion alive). Other lines go to std::cerr as before.
-class TtyProgress {
- public:
-  TtyProgress() {
-    if (isatty(STDERR_FILENO) != 1) return;
-    if (const char* name = ttyname(STDERR_FILENO))
-      fd_ = open(name, O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  }
-  ~TtyProgress() {
-    if (fd_ >= 0) close(fd_);
-  }
-  TtyProgress(const TtyProgress&) = delete;
-  TtyProgress& operator=(const TtyProgress&) = delete;
-
-  bool on() const { return fd_ >= 0; }
-  /// Writes what the terminal takes now, nothing more (a torn line at worst).
-  void Show(const std::string& text) const {
-    if (fd_ < 0) return;
-    const ssize_t written = write(fd_, text.data(), text.size());
-    (void)written;  // what the terminal did not take is lost
-  }
-  void Clear() const { Show("\r\033[K"); }
-
- private:
-  int fd_ = -1;
-};
 
 void PrintOne(const Reply& r, bool json, std::ostream& out = std::cout) {
   if (json) {

@@ -1,5 +1,6 @@
 #include "output_lines.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
 
@@ -83,6 +84,22 @@ std::uint64_t OutputLines::Finish() {
   std::unique_lock lock(s.mu);
   s.idle.wait(lock, [&] { return s.queue.empty() && !s.writing; });
   return s.lost;
+}
+
+TtyProgress::TtyProgress() {
+  if (isatty(STDERR_FILENO) != 1) return;
+  if (const char* name = ttyname(STDERR_FILENO))
+    fd_ = open(name, O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+}
+
+TtyProgress::~TtyProgress() {
+  if (fd_ >= 0) close(fd_);
+}
+
+void TtyProgress::Show(const std::string& text) const {
+  if (fd_ < 0) return;
+  const ssize_t written = write(fd_, text.data(), text.size());
+  (void)written;  // what the terminal did not take is lost
 }
 
 }  // namespace robotalk::cli

@@ -12,7 +12,8 @@
 // SIGPIPE) and is detached: an OutputLines destroyed before its thread has
 // written everything leaves it to end with the process.
 //
-// Thread safety: Add() and Finish() from any thread.
+// Thread safety: Add() and Finish() from any thread. TtyProgress (below):
+// one thread.
 #pragma once
 
 #include <condition_variable>
@@ -55,6 +56,28 @@ class OutputLines {
     void Run();
   };
   std::shared_ptr<State> state_;
+};
+
+/// The progress line on a terminal (stderr when it is one), written through a
+/// description of its own opened non-blocking: a terminal that takes nothing
+/// (stopped with Ctrl-S, a pty nobody reads) loses progress lines, never the
+/// thread that sends frames or the STOP on Ctrl-C (before: it waited in the
+/// write, and its heartbeats kept the session and so the motion alive).
+class TtyProgress {
+ public:
+  TtyProgress();
+  ~TtyProgress();
+  TtyProgress(const TtyProgress&) = delete;
+  TtyProgress& operator=(const TtyProgress&) = delete;
+
+  /// Whether stderr is a terminal (the line is drawn).
+  bool on() const { return fd_ >= 0; }
+  /// Writes what the terminal takes now, nothing more (a torn line at worst).
+  void Show(const std::string& text) const;
+  void Clear() const { Show("\r\033[K"); }
+
+ private:
+  int fd_ = -1;
 };
 
 }  // namespace robotalk::cli

@@ -122,8 +122,8 @@ check "replay with full stdout and stderr: pioneer2 moves (v=$v moving=$moving)"
   python3 -c "import sys; sys.exit(not (abs($v) > 0.05 and '$moving' == 'true'))"
 sleep 5  # the window's end (2.2 s after its start), the session timeout (2 s), the watchdog
 read -r v w moving < <(last_motion "$tmp/watch_full.json")
-check "... and stops within the session timeout of its last frame (v=$v w=$w moving=$moving)" \
-  python3 -c "import sys; sys.exit(not (abs($v) < 0.01 and abs($w) < 0.01 and '$moving' == 'false'))"
+check "... and its base stops within the session timeout of its last frame (v=$v w=$w)" \
+  python3 -c "import sys; sys.exit(not (abs($v) < 0.01 and abs($w) < 0.01))"
 kill -9 "$replay_pid" 2>/dev/null
 
 # --- export -------------------------------------------------------------------
