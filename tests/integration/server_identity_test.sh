@@ -112,6 +112,7 @@ check "and says the replayed ones were stale: $(grep stale "$tmp/watch_replay.er
 status=$?
 check "a server that serves no robot exits 1 ($status): $(tail -2 "$tmp/second_server.log")" test "$status" -eq 1
 check "and names the server that serves it" grep -q "robot 'pioneer' is served by server" "$tmp/second_server.log"
+check "its refusals on lines of their own, no escaped line break" sh -c "! grep -q 'x0a' '$tmp/second_server.log'"
 
 # Item 4: the real server is gone; an impersonator with another key answers.
 kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
