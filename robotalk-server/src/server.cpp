@@ -26,11 +26,6 @@ std::vector<std::unique_ptr<RobotDaemon>>& AbandonedRobots() {
   return *abandoned;
 }
 
-// The server's own lines (start-up): a stderr that takes nothing keeps
-// neither the robots from being served nor the server from its shutdown
-// (robotalk-server takes SIGTERM on the thread that writes these).
-void Say(std::string line) { ServerLog().Write(std::move(line)); }
-
 }  // namespace
 
 LogWriter& ServerLog() {
@@ -80,14 +75,15 @@ SessionTableOptions TableOptions(const ServerOptions& options) {
     throw Error("keyed mode needs both --key (the server's secret key) and --clients (the access list)");
   }
   if (options.key_file.empty()) {
-    Say("open mode: any process on the LAN may command these robots "
+    SayServer(
+        "open mode: any process on the LAN may command these robots "
         "(--key and --clients turn on authentication; docs/security.md)");
     return table;
   }
   table.identity = std::make_shared<const KeyPair>(ReadSecretKeyFile(options.key_file));
   table.access = std::make_shared<const AccessList>(AccessList::ReadFile(options.clients_file));
-  Say("keyed mode: " + std::to_string(table.access->size()) + " client keys from " + options.clients_file +
-      "; server key " + table.identity->public_key.Fingerprint());
+  SayServer("keyed mode: " + std::to_string(table.access->size()) + " client keys from " +
+            options.clients_file + "; server key " + table.identity->public_key.Fingerprint());
   return table;
 }
 
@@ -185,7 +181,7 @@ class Server::Impl {
 
   void Start() {
     if (!options_.panic_latch_path.empty()) {
-      Say("panic latch " + options_.panic_latch_path + " (a panic survives a restart)");
+      SayServer("panic latch " + options_.panic_latch_path + " (a panic survives a restart)");
     }
     // The ServerDaemon writes a robot's "starts in PANIC" as it starts, so
     // that line comes before "serving robot" (tests and operators wait for it).
@@ -193,9 +189,10 @@ class Server::Impl {
     server_daemon_->Start();
     running_ = true;
     for (auto& robot : robots_) {
-      Say("serving robot '" + robot->robot_name() + "' (" + std::to_string(robot->model().links().size()) +
-          " links, " + std::to_string(robot->model().num_dofs()) + " dofs, config " +
-          Hex64(ConfigHash(robot->model())) + ") on '" + url_ + "'");
+      SayServer("serving robot '" + robot->robot_name() + "' (" +
+                std::to_string(robot->model().links().size()) + " links, " +
+                std::to_string(robot->model().num_dofs()) + " dofs, config " +
+                Hex64(ConfigHash(robot->model())) + ") on '" + url_ + "'");
     }
   }
 

@@ -8,9 +8,19 @@
 
 #include "robotalk/log_writer.h"
 
+#include <string>
+#include <utility>
+
 namespace robotalk {
 
 /// Never destroyed; Write() from any thread.
 LogWriter& ServerLog();
+
+/// One line of robotalk-server's own ("robotalk-server: " + line), errors
+/// included: a stderr that takes nothing costs the caller LogWriter::kMaxWait
+/// at most, and an error still ends the server with its status. A line is
+/// written on one line (a line break in it as \x0a): several lines, one
+/// ServerLog().Write(lines).
+inline void SayServer(std::string line) { ServerLog().Write(std::move(line)); }
 
 }  // namespace robotalk

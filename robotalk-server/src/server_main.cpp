@@ -133,12 +133,6 @@ double ParseNumber(const std::string& flag, const char* text, double min, double
   return *v;
 }
 
-// A line of robotalk-server's own ("robotalk-server: " + line), errors
-// included: through the process's one writer of stderr (server_log.h), so a
-// stderr that takes nothing costs it LogWriter::kMaxWait at most, and an
-// error still ends it with its status.
-void Say(std::string line) { ServerLog().Write(std::move(line)); }
-
 int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateCommand& simulate_command) {
   ServerOptions options;
   std::vector<RobotSpec> robots;
@@ -288,12 +282,12 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--seed") {
         options.fault_seed = static_cast<std::uint64_t>(ParseNumber(arg, value(), 0, 1e18));
       } else {
-        Say("unknown option '" + arg + "' (see --help)");
+        SayServer("unknown option '" + arg + "' (see --help)");
         return 2;
       }
     }
     if (robots.empty()) {
-      Say("no --robot given");
+      SayServer("no --robot given");
       // One Write of its lines (a line break inside a line is written as \x0a).
       std::vector<std::string> usage;
       for (std::string_view rest = kUsage; !rest.empty();) {
@@ -308,26 +302,27 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       throw Error("--no-panic-latch contradicts --panic-latch / --state-dir");
     }
   } catch (const std::exception& e) {
-    Say(e.what());
+    SayServer(e.what());
     return 2;
   }
 
   if (!simulate.empty()) {
     if (!simulate_command) {
-      Say("--simulate is not available in this server");
+      SayServer("--simulate is not available in this server");
       return 2;
     }
     return simulate_command(registry, robots, simulate, duration < 0 ? 10.0 : duration, sample_period);
   }
 
   if (no_panic_latch) {
-    Say("WARNING: --no-panic-latch: a panic does not survive a restart of this server (a restarted server "
+    SayServer(
+        "WARNING: --no-panic-latch: a panic does not survive a restart of this server (a restarted server "
         "runs the next command)");
   } else if (options.panic_latch_path.empty() && options.state_dir.empty()) {
     try {
       options.state_dir = PanicLatch::DefaultStateDir();
     } catch (const std::exception& e) {
-      Say(std::string("error: ") + e.what());
+      SayServer(std::string("error: ") + e.what());
       return 1;
     }
   }
@@ -357,9 +352,9 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
     while (received <= 0) {
       if (server.serving() == 0) {
         server.Stop();
-        std::string line = "error: no robot left to serve:";
-        for (const std::string& why : server.refusals()) line += "\n  " + why;
-        Say(std::move(line));
+        std::vector<std::string> lines{"error: no robot left to serve:"};
+        for (const std::string& why : server.refusals()) lines.push_back("  " + why);
+        ServerLog().Write(lines);
         return 1;
       }
       auto wait = std::chrono::nanoseconds(std::chrono::milliseconds(100));
@@ -373,17 +368,17 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
     }
     if (received > 0) {
       // A stderr that takes nothing must not keep the robots from their STOP.
-      Say(std::string(strsignal(received)) + ", stopping every robot");
+      SayServer(std::string(strsignal(received)) + ", stopping every robot");
     }
     server.Stop();
     if (!server.not_stopped().empty()) {
       std::string line = "error: not stopped (a driver call hung):";
       for (const std::string& robot : server.not_stopped()) line += " '" + robot + "'";
-      Say(std::move(line));
+      SayServer(std::move(line));
       return 1;
     }
   } catch (const std::exception& e) {
-    Say(std::string("error: ") + e.what());
+    SayServer(std::string("error: ") + e.what());
     return 1;
   }
   return 0;
