@@ -20,8 +20,9 @@
 // line of its own, within the same bound.
 //
 // One writer per descriptor: LogWriter::Stderr() is the process's writer of
-// stderr, which every line a program or library writes to stderr goes
-// through (the server's, its drivers', robotalk-web's and robotalk-ros2's);
+// stderr, which every line RoboTalk's serving programs write to stderr goes
+// through (the server's, its drivers', ODE's and Cyclone DDS's messages,
+// robotalk-web's and robotalk-ros2's; not LCM's own, nor --help's);
 // a LogWriter made from another shares its thread and queue and adds a
 // prefix of its own. A program's last words (an error before it exits) are
 // written the same way: a stderr that takes nothing loses them after
@@ -46,7 +47,8 @@ namespace robotalk {
 
 /// `text` on one line with no terminal control: each C0 control character,
 /// DEL and C1 control encoded in UTF-8 (0xc2 0x80..0x9f) written as \xNN;
-/// everything else (UTF-8 text) kept. For texts of anyone's written to a
+/// every other byte kept (UTF-8 text; a lone byte 0x80..0x9f too, which a
+/// terminal set to 8-bit controls would read as one). For texts of anyone's written to a
 /// terminal or a log (LogWriter's lines, the CLI's replies).
 std::string EscapeControls(std::string_view text);
 

@@ -49,7 +49,8 @@ Interpolation ParseInterpolationWord(const std::string& word, const std::string&
 
 /// The number a whole word spells (strtod's syntax, blanks before it
 /// allowed, as std::stod): nullopt when the word is empty, when anything is
-/// left after the number, or when it is out of a double's range (ERANGE).
+/// left after the number, or when it is out of a double's range (ERANGE:
+/// too large, and too small as well: "1e-400" is refused, not read as 0).
 /// "inf" and "nan" are numbers here (the callers refuse them). The one rule
 /// every number option and text of RoboTalk is read by.
 std::optional<double> NumberOf(const std::string& word);
