@@ -1,6 +1,7 @@
 #include "session_log.h"
 
 #include "robotalk/channels.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/request.h"
 
 #include <algorithm>
@@ -49,22 +50,7 @@ std::int64_t MicrosFromDouble(double v, const std::string& field) {
 // byte as \xNN (a terminal escape never reaches a terminal; Python's
 // log_info never meets a string that is not UTF-8). RoboTalk's channels and
 // robot names are printable ASCII, unchanged.
-std::string Printable(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u >= 0x20 && u < 0x7f) {
-      out += c;
-      continue;
-    }
-    constexpr char kHex[] = "0123456789abcdef";
-    out += "\\x";
-    out += kHex[u >> 4];
-    out += kHex[u & 0xf];
-  }
-  return out;
-}
+std::string Printable(std::string_view text) { return EscapeControls(text, /*ascii_only=*/true); }
 
 }  // namespace
 

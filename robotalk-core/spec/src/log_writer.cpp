@@ -98,14 +98,15 @@ struct LogWriter::State {
   }
 };
 
-std::string EscapeControls(std::string_view text) {
+std::string EscapeControls(std::string_view text, bool ascii_only) {
   std::string out;
   out.reserve(text.size());
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto u = static_cast<unsigned char>(text[i]);
-    const bool c1 = u == 0xc2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
+    const bool c1 = !ascii_only && u == 0xc2 && i + 1 < text.size() &&
+                    static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
                     static_cast<unsigned char>(text[i + 1]) <= 0x9f;
-    if (u >= 0x20 && u != 0x7f && !c1) {
+    if (u >= 0x20 && u != 0x7f && !c1 && (!ascii_only || u < 0x80)) {
       out += text[i];
       continue;
     }

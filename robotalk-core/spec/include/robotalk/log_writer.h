@@ -50,7 +50,9 @@ namespace robotalk {
 /// every other byte kept (UTF-8 text; a lone byte 0x80..0x9f too, which a
 /// terminal set to 8-bit controls would read as one). For texts of anyone's written to a
 /// terminal or a log (LogWriter's lines, the CLI's replies).
-std::string EscapeControls(std::string_view text);
+/// `ascii_only`: every byte outside printable ASCII written as \xNN (a text
+/// that must also be valid UTF-8, e.g. for Python: robotalk-logplay's).
+std::string EscapeControls(std::string_view text, bool ascii_only = false);
 
 class LogWriter {
  public:
