@@ -69,6 +69,20 @@ lines = [l for l in open(sys.argv[1]) if l.startswith("{")]
 s = json.loads(lines[-1]) if lines else {"base": [0, 0, 0, "none", "none"], "moving": "none"}
 print(s["base"][3], s["base"][4], str(s["moving"]).lower())' "$1"
 }
+# fails_whatever_stderr STATUS PATTERN WHAT CMD...: CMD, which cannot start,
+# ends with STATUS within 5 s when its stdout and stderr are $tmp/full (a
+# pipe that takes nothing), and with a stderr that takes everything it ends
+# with STATUS saying PATTERN (grep).
+fails_whatever_stderr() {
+  local status=$1 pattern=$2 what=$3 rc
+  shift 3
+  "$@" >"$tmp/full" 2>"$tmp/full" &
+  ends_within "full stderr, $what" "$status" $!
+  "$@" >/dev/null 2>"$tmp/err.log"
+  rc=$?
+  check "$what: exit status $status (status $rc) and says why: $(head -c 300 "$tmp/err.log")" \
+    sh -c 'test "$1" -eq "$2" && grep -q -- "$3" "$4"' _ "$rc" "$status" "$pattern" "$tmp/err.log"
+}
 ends_within() {  # ends_within WHAT STATUS PID
   local rc
   for _ in $(seq 50); do kill -0 "$3" 2>/dev/null || break; sleep 0.1; done

@@ -43,14 +43,10 @@ kill -9 "$web_pid" 2>/dev/null
 # errs STATUS PATTERN ARGS...: robotalk-web that cannot start (ARGS) ends with
 # STATUS within 5 s whatever its stderr takes, and says why when it takes it.
 errs() {
-  local status=$1 pattern=$2 rc
+  local status=$1 pattern=$2
   shift 2
-  "$web" --lcm-url "$url" --port "$port" --node-modules "$tmp/modules" "$@" >"$tmp/full" 2>"$tmp/full" &
-  ends_within "full stderr, $*: robotalk-web" "$status" $!
-  "$web" --lcm-url "$url" --port "$port" --node-modules "$tmp/modules" "$@" >/dev/null 2>"$tmp/err.log"
-  rc=$?
-  check "$*: exit status $status (status $rc)" test "$rc" -eq "$status"
-  check "$*: says why: $(head -c 300 "$tmp/err.log")" grep -q -- "$pattern" "$tmp/err.log"
+  fails_whatever_stderr "$status" "$pattern" "$*: robotalk-web" \
+    "$web" --lcm-url "$url" --port "$port" --node-modules "$tmp/modules" "$@"
 }
 errs 2 "unknown option '--colour'" --colour
 errs 2 "no such file" --urdf "arm=$tmp/none.urdf"
