@@ -115,7 +115,14 @@ TEST_F(RobotClientWireTest, WithTwoPlaybackCopiesEachPlaybackPackageTravelsTwice
   std::size_t doubled = 0;
   for (const auto& entry : copies) doubled += entry.second == 2;
   EXPECT_EQ(doubled, 6u) << "each playback package twice, nothing else";
-  for (CommandId id : frames) EXPECT_EQ(answers[id], 1) << "frame " << id << " answered once";
+  // Each frame answered; a second answer only for its package's second copy:
+  // a copy the server handles after the frame has run (the machine loaded:
+  // the clean clone's full suite, twelfth session) is answered with the
+  // stored reply, as a client's re-ask is.
+  for (CommandId id : frames) {
+    EXPECT_GE(answers[id], 1) << "frame " << id << " answered";
+    EXPECT_LE(answers[id], 2) << "frame " << id << " answered at most once per copy";
+  }
 
   o.playback_copies = 3;
   try {
