@@ -132,6 +132,7 @@ CYCLONEDDS_URI="<NoSuchElement/>" "$bridge" --robot pioneer --url "$url3" --dura
 ends_within "full stderr, a DDS configuration it cannot use" 1 $!
 CYCLONEDDS_URI="<NoSuchElement/>" "$bridge" --robot pioneer --url "$url3" --duration 20 >/dev/null 2>"$tmp/dds_err.log"
 check "and it says why: $(head -c 300 "$tmp/dds_err.log")" grep -q "cannot join DDS domain" "$tmp/dds_err.log"
+check "named once: robotalk-ros2's prefix not doubled" sh -c "! grep -q 'robotalk-ros2: robotalk-ros2:' '$tmp/dds_err.log'"
 "$bridge" --robot pioneer --url "$url3" --key "$tmp/bridge" --duration 20 --stats >"$tmp/full" 2>"$tmp/bridge4.log" &
 bridge4_pid=$!
 wait_for "$tmp/bridge4.log" "bridged" 100
