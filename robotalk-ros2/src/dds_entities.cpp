@@ -45,7 +45,7 @@ dds_entity_t CreateTopic(const DdsParticipant& participant, const dds_topic_desc
                          const std::string& topic) {
   const dds_entity_t t = dds_create_topic(participant.handle(), &type, topic.c_str(), nullptr, nullptr);
   if (t < 0) {
-    throw DdsError("robotalk-ros2: DDS topic '" + topic + "' (" + type.m_typename + "): " + Reason(t));
+    throw DdsError("DDS topic '" + topic + "' (" + type.m_typename + "): " + Reason(t));
   }
   return t;
 }
@@ -81,13 +81,12 @@ DdsParticipant::DdsParticipant(std::uint32_t domain, const std::string& config) 
   std::call_once(sink, [] { dds_set_log_sink(SayDds, nullptr); });
   if (!config.empty()) {
     const dds_entity_t d = dds_create_domain(domain, config.c_str());
-    if (d < 0)
-      throw DdsError("robotalk-ros2: DDS domain " + std::to_string(domain) + " config: " + Reason(d));
+    if (d < 0) throw DdsError("DDS domain " + std::to_string(domain) + " config: " + Reason(d));
   }
   participant_ = dds_create_participant(domain, nullptr, nullptr);
   if (participant_ < 0) {
-    throw DdsError("robotalk-ros2: cannot join DDS domain " + std::to_string(domain) + ": " +
-                   Reason(participant_) + " (check CYCLONEDDS_URI and the network interface)");
+    throw DdsError("cannot join DDS domain " + std::to_string(domain) + ": " + Reason(participant_) +
+                   " (check CYCLONEDDS_URI and the network interface)");
   }
 }
 
@@ -98,7 +97,7 @@ DdsWriter::DdsWriter(const DdsParticipant& participant, const dds_topic_descript
     : topic_(DdsTopicName(ros_topic)) {
   topic_entity_ = CreateTopic(participant, type, topic_);
   writer_ = dds_create_writer(participant.handle(), topic_entity_, MakeQos(qos).get(), nullptr);
-  if (writer_ < 0) throw DdsError("robotalk-ros2: DDS writer of '" + topic_ + "': " + Reason(writer_));
+  if (writer_ < 0) throw DdsError("DDS writer of '" + topic_ + "': " + Reason(writer_));
 }
 
 DdsWriter::~DdsWriter() {
@@ -108,7 +107,7 @@ DdsWriter::~DdsWriter() {
 
 void DdsWriter::Write(const void* sample) {
   const dds_return_t rc = dds_write(writer_, sample);
-  if (rc < 0) throw DdsError("robotalk-ros2: DDS write on '" + topic_ + "': " + Reason(rc));
+  if (rc < 0) throw DdsError("DDS write on '" + topic_ + "': " + Reason(rc));
 }
 
 int DdsWriter::matched_readers() const {
@@ -127,7 +126,7 @@ DdsReader::DdsReader(const DdsParticipant& participant, const dds_topic_descript
   reader_ = dds_create_reader(participant.handle(), topic_entity_, MakeQos(qos).get(), listener.get());
   if (reader_ < 0) {
     dds_delete(topic_entity_);
-    throw DdsError("robotalk-ros2: DDS reader of '" + topic_ + "': " + Reason(reader_));
+    throw DdsError("DDS reader of '" + topic_ + "': " + Reason(reader_));
   }
 }
 

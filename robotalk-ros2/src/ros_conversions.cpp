@@ -89,7 +89,7 @@ RobotFrames::RobotFrames(const RobotModel& model, std::string prefix, std::strin
 
 const std::vector<FrameTransform>& RobotFrames::Update(const StateSample& sample) {
   if (static_cast<int>(sample.positions.size()) != model_.num_dofs()) {
-    throw ProtocolError("robotalk-ros2: a STATE sample of robot '" + sample.robot + "' has " +
+    throw ProtocolError("a STATE sample of robot '" + sample.robot + "' has " +
                         std::to_string(sample.positions.size()) + " positions; its model has " +
                         std::to_string(model_.num_dofs()) + " dofs");
   }
