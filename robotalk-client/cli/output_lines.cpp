@@ -1,13 +1,9 @@
 #include "output_lines.h"
 
-#include <fcntl.h>
-#include <poll.h>
-#include <unistd.h>
+#include "robotalk/log_writer.h"  // WriteFully, DetachWithSignalsBlocked
 
-#include <pthread.h>
-#include <cerrno>
-#include <csignal>
-#include <thread>
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace robotalk::cli {
 
@@ -21,20 +17,7 @@ void OutputLines::State::Run() {
     queued_bytes -= text.size();
     writing = true;
     lock.unlock();
-    bool ok = true;
-    for (std::size_t at = 0; at < text.size();) {
-      const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {  // a non-blocking stdout: wait for room
-        pollfd out{fd, POLLOUT, 0};
-        if (::poll(&out, 1, -1) >= 0 || errno == EINTR) continue;
-      }
-      if (n <= 0) {
-        ok = false;
-        break;
-      }
-      at += static_cast<std::size_t>(n);
-    }
+    const bool ok = WriteFully(fd, text);
     lock.lock();
     writing = false;
     if (!ok) {  // its reader is gone (EPIPE) or it refused: the rest is lost too
@@ -49,11 +32,7 @@ void OutputLines::State::Run() {
 
 OutputLines::OutputLines(int fd) : state_(std::make_shared<State>()) {
   state_->fd = fd;
-  sigset_t every, before;
-  sigfillset(&every);
-  pthread_sigmask(SIG_BLOCK, &every, &before);
-  std::thread([state = state_] { state->Run(); }).detach();
-  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+  DetachWithSignalsBlocked([state = state_] { state->Run(); });
 }
 
 OutputLines::~OutputLines() {

@@ -72,23 +72,7 @@ struct LogWriter::State {
       writing = true;
       write_began = std::chrono::steady_clock::now();
       lock.unlock();
-      bool failed = false;
-      for (std::size_t at = 0; at < text.size();) {
-        const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-          // A non-blocking description (another process set O_NONBLOCK on
-          // the stderr it shares: ssh, node) whose reader is behind: wait
-          // for it as a blocking one makes this thread wait, never lose.
-          pollfd out{fd, POLLOUT, 0};
-          if (::poll(&out, 1, -1) >= 0 || errno == EINTR) continue;
-        }
-        if (n <= 0) {  // closed, EPIPE, no space: these lines are lost, the next may not be
-          failed = true;
-          break;
-        }
-        at += static_cast<std::size_t>(n);
-      }
+      const bool failed = !WriteFully(fd, text);  // closed, EPIPE, no space: lost, the next may not be
       lock.lock();
       if (failed) dropped_unsaid += lost + lines;  // said by the next write that succeeds
       writing = false;
@@ -97,6 +81,31 @@ struct LogWriter::State {
     }
   }
 };
+
+bool WriteFully(int fd, std::string_view text) {
+  for (std::size_t at = 0; at < text.size();) {
+    const ssize_t n = ::write(fd, text.data() + at, text.size() - at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      // A non-blocking description (another process set O_NONBLOCK on the
+      // stdio it shares: ssh, node) whose reader is behind: wait for it as a
+      // blocking one makes this thread wait, never lose.
+      pollfd out{fd, POLLOUT, 0};
+      if (::poll(&out, 1, -1) >= 0 || errno == EINTR) continue;
+    }
+    if (n <= 0) return false;
+    at += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+void DetachWithSignalsBlocked(std::function<void()> run) {
+  sigset_t every, before;
+  sigfillset(&every);
+  pthread_sigmask(SIG_BLOCK, &every, &before);
+  std::thread(std::move(run)).detach();
+  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+}
 
 std::string EscapeControls(std::string_view text, bool ascii_only) {
   std::string out;
@@ -129,11 +138,7 @@ LogWriter::LogWriter(std::string prefix, int fd) : prefix_(prefix), state_(std::
   // The thread blocks every signal: a descriptor whose reader went away
   // answers EPIPE, never SIGPIPE; and it takes no signal a program waits for
   // (SIGINT, SIGTERM), though it may start before the program blocks them.
-  sigset_t every, before;
-  sigfillset(&every);
-  pthread_sigmask(SIG_BLOCK, &every, &before);
-  std::thread([state = state_] { state->Run(); }).detach();
-  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+  DetachWithSignalsBlocked([state = state_] { state->Run(); });
 }
 
 LogWriter::LogWriter(std::string prefix, const LogWriter& shared)

@@ -38,12 +38,24 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace robotalk {
+
+/// Writes all of `text` to `fd`, through EINTR and, on a non-blocking
+/// descriptor, waiting for room (poll); false when the descriptor fails
+/// (closed, EPIPE, no space). For a thread of its own (it may wait for ever).
+bool WriteFully(int fd, std::string_view text);
+
+/// Runs `run` on a detached thread that blocks every signal: a descriptor
+/// whose reader went away answers it EPIPE, never SIGPIPE, and it takes no
+/// signal a program waits for (SIGINT, SIGTERM), though it may start before
+/// the program blocks them.
+void DetachWithSignalsBlocked(std::function<void()> run);
 
 /// `text` on one line with no terminal control: each C0 control character,
 /// DEL and C1 control encoded in UTF-8 (0xc2 0x80..0x9f) written as \xNN;
