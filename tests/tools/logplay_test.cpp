@@ -501,6 +501,12 @@ TEST(ReceiptOrder, HoldsAtMostItsByteBoundWritingTheOldestFirstAndCountsThem) {
   EXPECT_LE(order.held(), 64u) << "more than 64 MiB held";
   ASSERT_EQ(written.size(), 80u - order.held());
   for (std::size_t i = 0; i < written.size(); ++i) EXPECT_EQ(written[i], 1000 + static_cast<std::int64_t>(i));
+  EXPECT_EQ(order.held_bytes(), order.held() * mib.size());
+  EXPECT_EQ(order.early(), written.size()) << "each written before its hold was over, counted";
+  EXPECT_EQ(order.early_bytes(), written.size() * mib.size());
+  order.ReleaseAll(write);
+  EXPECT_EQ(written.size(), 80u) << "none dropped";
+  EXPECT_EQ(order.held_bytes(), 0u);
 }
 
 // The wall clock stepped back (an NTP step, a date set by hand) while
