@@ -227,6 +227,7 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
            "--session-timeout (default 2 s) after robotalk exits. Use --hold to keep it until Ctrl-C.\n";
     return ExitStatus(*r);
   }
+  stop_at_once->SignalIsTheEnd();  // Ctrl-C ends the hold: its status, not an interrupted run's
   std::cerr << "robotalk: holding " << ToString(type) << " on " << robot << " until Ctrl-C (then STOP)\n";
   while (!Interrupter::Signal()) Interrupter::WaitFor(std::chrono::seconds(1));
   // The STOP first, then the line: a stderr that takes nothing must not keep
