@@ -7,12 +7,10 @@
 # closes a new one is accepted.
 # Usage: web_ws_cap_test.sh ROBOTALK_WEB WWW_DIR (inside a private network namespace).
 set -u
-web=$1
-www=$2
 port=18433
 tmp=$(mktemp -d)
 . "$(dirname "$0")/bare_web.sh"
-start_bare_web "$web" "$www" "$port" 7723
+start_bare_web "$1" "$2" "$port" 7723  # ROBOTALK_WEB, WWW_DIR
 python3 - "$port" <<'PY'
 import base64, os, socket, sys
 port = int(sys.argv[1])
