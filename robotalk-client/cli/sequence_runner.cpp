@@ -114,9 +114,11 @@ StopOnInterrupt::StopOnInterrupt(RobotClient& client, std::stop_token interrupt)
         std::_Exit(status);
       }) {}
 
-std::string StopNow(RobotClient& client) {
+std::string StopNow(RobotClient& client, bool* succeeded) {
+  if (succeeded) *succeeded = false;
   try {
     const Reply r = client.Stop();
+    if (succeeded) *succeeded = Succeeded(r.signal);
     return "STOP sent to " + client.robot() + ": " + std::string(ToString(r.signal)) +
            (r.message.empty() ? "" : " (" + r.message + ")");
   } catch (const std::exception& e) {

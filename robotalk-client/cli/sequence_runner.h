@@ -64,8 +64,9 @@ RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const
 std::optional<Reply> AwaitReply(PendingReply& pending, const std::function<void(Duration)>& on_progress);
 
 /// Sends STOP now and waits for its reply (the client's timeout); returns a
-/// short account: "STOP sent to pioneer: SUCCESS". Never throws.
-std::string StopNow(RobotClient& client);
+/// short account: "STOP sent to pioneer: SUCCESS". Never throws. With
+/// `succeeded`, says whether the STOP was answered SUCCESS or MODIFIED.
+std::string StopNow(RobotClient& client, bool* succeeded = nullptr);
 
 /// While it lives, the first SIGINT/SIGTERM (`interrupt`) sends `client` a
 /// STOP at once from a thread of its own, whatever the tool's thread is doing:
