@@ -227,14 +227,16 @@ int SendOne(const GlobalOptions& g, const std::string& robot, Command c, std::op
            "--session-timeout (default 2 s) after robotalk exits. Use --hold to keep it until Ctrl-C.\n";
     return ExitStatus(*r);
   }
+  stop_at_once->SignalIsTheEnd();  // Ctrl-C ends the hold: its status, not an interrupted run's
   std::cerr << "robotalk: holding " << ToString(type) << " on " << robot << " until Ctrl-C (then STOP)\n";
   while (!Interrupter::Signal()) Interrupter::WaitFor(std::chrono::seconds(1));
   // The STOP first, then the line: a stderr that takes nothing must not keep
   // the robot moving (the CLI's heartbeats keep its session alive meanwhile).
-  const std::string stopped = StopNow(*client);
+  bool stop_succeeded = false;
+  const std::string stopped = StopNow(*client, &stop_succeeded);
   std::cerr << "robotalk: " << stopped << " (hold ended by " << Interrupter::Name(Interrupter::Signal())
             << ")\n";
-  return 0;
+  return stop_succeeded ? 0 : 1;  // as the take-over would (StopOnInterrupt::SignalIsTheEnd)
 }
 
 }  // namespace

@@ -76,7 +76,7 @@ std::string ProgressBar(const RunProgress& p, int width) {
 }
 
 StopOnInterrupt::StopOnInterrupt(RobotClient& client, std::stop_token interrupt)
-    : sender_([&client, interrupt](std::stop_token done) {
+    : sender_([this, &client, interrupt](std::stop_token done) {
         std::mutex mu;
         std::condition_variable_any cv;
         const std::stop_callback wake(interrupt, [&] {
@@ -88,8 +88,9 @@ StopOnInterrupt::StopOnInterrupt(RobotClient& client, std::stop_token interrupt)
           if (!cv.wait(lock, done, [&] { return interrupt.stop_requested(); }))
             return;  // the tool ended first
         }
+        std::optional<PendingReply> stop;
         try {
-          (void)client.Send(Command{.type = CommandType::kStop});  // not waited for: StopNow follows
+          stop = client.Send(Command{.type = CommandType::kStop});  // not waited for: StopNow follows
         } catch (const std::exception&) {
           // StopNow, when the tool's thread gets there, says what failed.
         }
@@ -100,12 +101,24 @@ StopOnInterrupt::StopOnInterrupt(RobotClient& client, std::stop_token interrupt)
         // so those frames, alive: end the process instead.
         std::unique_lock lock(mu);
         cv.wait_for(lock, done, kTakeOver, [] { return false; });  // until the tool ends, at most kTakeOver
-        if (!done.stop_requested()) std::_Exit(Interrupter::ExitStatus(Interrupter::Signal()));
+        if (done.stop_requested()) return;
+        int status = Interrupter::ExitStatus(Interrupter::Signal());
+        if (signal_ends_) {
+          std::optional<Reply> r;
+          try {
+            if (stop) r = stop->WaitFor(Duration(0));
+          } catch (const std::exception&) {
+          }
+          status = r && Succeeded(r->signal) ? 0 : 1;
+        }
+        std::_Exit(status);
       }) {}
 
-std::string StopNow(RobotClient& client) {
+std::string StopNow(RobotClient& client, bool* succeeded) {
+  if (succeeded) *succeeded = false;
   try {
     const Reply r = client.Stop();
+    if (succeeded) *succeeded = Succeeded(r.signal);
     return "STOP sent to " + client.robot() + ": " + std::string(ToString(r.signal)) +
            (r.message.empty() ? "" : " (" + r.message + ")");
   } catch (const std::exception& e) {

@@ -21,6 +21,7 @@
 #include "interrupt.h"
 #include "robotalk/robot_client.h"
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <optional>
@@ -63,8 +64,9 @@ RunReport RunFrames(RobotClient& client, std::vector<TimedCommand> frames, const
 std::optional<Reply> AwaitReply(PendingReply& pending, const std::function<void(Duration)>& on_progress);
 
 /// Sends STOP now and waits for its reply (the client's timeout); returns a
-/// short account: "STOP sent to pioneer: SUCCESS". Never throws.
-std::string StopNow(RobotClient& client);
+/// short account: "STOP sent to pioneer: SUCCESS". Never throws. With
+/// `succeeded`, says whether the STOP was answered SUCCESS or MODIFIED.
+std::string StopNow(RobotClient& client, bool* succeeded = nullptr);
 
 /// While it lives, the first SIGINT/SIGTERM (`interrupt`) sends `client` a
 /// STOP at once from a thread of its own, whatever the tool's thread is doing:
@@ -73,7 +75,7 @@ std::string StopNow(RobotClient& client);
 /// the motion alive meanwhile. The tool's own StopNow and its lines follow
 /// when it gets there (a second STOP changes nothing). If the tool has not
 /// finished (destroyed this) kTakeOver after the signal, the process ends
-/// with 128 + signal: its session then expires (the server's
+/// with 128 + signal (SignalIsTheEnd: the status of that end): its session then expires (the server's
 /// --session-timeout, 2 s) and the watchdog drops the frames it had queued
 /// for later, which one STOP does not cancel. Destruction waits for a STOP
 /// being sent (the client's timeouts bound it).
@@ -83,7 +85,14 @@ class StopOnInterrupt {
 
   explicit StopOnInterrupt(RobotClient& client, std::stop_token interrupt = Interrupter::StopToken());
 
+  /// From now on a signal is the command's normal end, not a cut (`send
+  /// --hold`: held until Ctrl-C, then STOP): the take-over then ends the
+  /// process with that end's status, 0 when its STOP was answered SUCCESS or
+  /// MODIFIED, else 1, not 128 + signal.
+  void SignalIsTheEnd() { signal_ends_ = true; }
+
  private:
+  std::atomic<bool> signal_ends_{false};  // before sender_, which reads it
   std::jthread sender_;
 };
 

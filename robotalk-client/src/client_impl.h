@@ -194,6 +194,20 @@ class RobotClient::Impl {
   // steady clock; else `now`.
   TimePoint ArrivalTime(TimePoint now) const;
   void OnConfig(std::span<const std::uint8_t> bytes);
+  /// Keyed mode, while a panic waits for its answer: an ANNOUNCE signed by
+  /// the trusted server key that serves this robot from another instance
+  /// than the session's says the session is gone (a restart), even when a
+  /// flood of packages naming made-up sessions keeps the server's signed
+  /// SESSION_UNKNOWN answers from reaching this client (their budget,
+  /// ServerDaemonOptions::unknown_answers_per_second). The waiting panic is
+  /// answered "session unknown": RobotClient::Panic says hello and sends it
+  /// again in a new session. At other times ANNOUNCE is not read (nothing
+  /// verified): a replayed ANNOUNCE of an older instance could otherwise
+  /// end live sessions.
+  void OnAnnounce(std::span<const std::uint8_t> bytes);
+  /// Fails the items of a lost session (outside mu_) and wakes the
+  /// ReadDaemon to say hello again.
+  void FailLost(const std::vector<CommandId>& lost);
   /// Keyed mode: the bytes of a STATE or CONFIG message received on
   /// `channel` without their signature suffix when signed by the trusted
   /// server key for the live session's instance; else nullopt (counted).

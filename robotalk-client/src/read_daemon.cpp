@@ -3,6 +3,7 @@
 #include "client_impl.h"
 
 #include "robotalk/config_message.h"
+#include "robotalk/heard_announcement.h"
 #include "robotalk/known_servers.h"
 
 #include "robotalk/routed_lcm_transport.h"
@@ -133,6 +134,10 @@ void RobotClient::Impl::AttachLocked(const std::string& robot) {
     subscriptions_.push_back(transport_->Subscribe(
         HelloAnswerChannel(robot, client_id_),
         [this](const std::string&, std::span<const std::uint8_t> b) { OnHelloAnswer(b); }));
+    if (identity_) {  // keyed: a restart heard while a panic waits (OnAnnounce)
+      subscriptions_.push_back(transport_->Subscribe(
+          kAnnounceChannel, [this](const std::string&, std::span<const std::uint8_t> b) { OnAnnounce(b); }));
+    }
   } catch (const TransportError& e) {
     throw ClientError("RobotClient::Connect: cannot subscribe to " + reply_channel + ": " + e.what());
   }
@@ -413,14 +418,6 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     const TimePoint arrived = ArrivalTime(now);
     bool notify = false;
     std::vector<CommandId> lost;
-    const auto fail_lost = [&] {
-      for (CommandId id : lost) {
-        cache_->Fail(id, "id " + std::to_string(id) +
-                             ": the server instance that had it restarted or forgot this client's session; "
-                             "it may or may not have run, and was not sent again");
-      }
-      if (!lost.empty()) WakeDaemon();  // say hello again at once
-    };
     bool accepted = false;
     {
       std::lock_guard lock(mu_);
@@ -435,7 +432,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     }
     if (!accepted) {
       cv_.notify_all();  // a panic answered outside its session
-      fail_lost();
+      FailLost(lost);
       return;
     }
     {
@@ -469,6 +466,40 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     std::lock_guard lock(mu_);
     daemon_error_ = std::current_exception();
   }
+}
+
+void RobotClient::Impl::FailLost(const std::vector<CommandId>& lost) {
+  for (CommandId id : lost) {
+    cache_->Fail(id, "id " + std::to_string(id) +
+                         ": the server instance that had it restarted or forgot this client's session; "
+                         "it may or may not have run, and was not sent again");
+  }
+  if (!lost.empty()) WakeDaemon();  // say hello again at once
+}
+
+void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
+  std::vector<CommandId> lost;
+  {
+    std::lock_guard lock(mu_);
+    if (ack_waited_.empty() || session_id_ == 0 || !trust_ || !trust_->trusted()) return;
+    // The key is compared before the signature is verified: others' cost nothing.
+    const std::optional<HeardAnnouncement> heard = HearAnnouncement(bytes, &*trust_->trusted());
+    if (!heard || heard->announcement.server_id == server_id_) return;
+    const std::vector<RobotAnnouncement>& robots = heard->announcement.robots;
+    if (std::none_of(robots.begin(), robots.end(),
+                     [&](const RobotAnnouncement& r) { return r.name == robot_; }))
+      return;
+    for (const std::int64_t sequence : ack_waited_) {
+      panic_answers_.try_emplace(
+          sequence, PanicAnswer{.refusal = "the server restarted (its signed ANNOUNCE names instance " +
+                                           Hex64(static_cast<std::uint64_t>(heard->announcement.server_id)) +
+                                           ") and has no session of this client",
+                                .session_unknown = true});
+    }
+    lost = LoseSession(clock_.Now());
+  }
+  cv_.notify_all();  // the waiting panic: sent again in a new session
+  FailLost(lost);
 }
 
 }  // namespace robotalk

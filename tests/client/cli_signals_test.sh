@@ -94,6 +94,18 @@ check "--hold sends STOP at the end" grep -q "STOP sent to pioneer: SUCCESS (hol
 sleep 0.3
 check "stopped after --hold" test "$(speed)" = 0
 
+# gaps13: a --hold whose STOP is not answered (its server paused) exits 1,
+# not 0 (before: 0 whatever its STOP's fate), as its take-over does.
+start_bg --timeout 1 send pioneer setspeed 0.1 0 --hold
+check "--hold moves the robot again" moving_soon
+kill -STOP "$server_pid"
+kill -INT "$bg"; wait "$bg"; status=$?
+kill -CONT "$server_pid"
+check "--hold whose STOP is not answered exits 1 (got $status)" test "$status" -eq 1
+check "and says its STOP failed" grep -q "STOP to pioneer failed" "$tmp/bg.err"
+sleep 2.5  # the session timeout: the watchdog stops what the CLI left
+rt send pioneer stop >/dev/null 2>&1
+
 # --- An unknown robot fails fast, naming the robots heard ---------------------
 t0=$(date +%s.%N)
 rt query piooner base_pose >"$tmp/unknown.out" 2>&1; status=$?

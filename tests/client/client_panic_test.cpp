@@ -18,7 +18,9 @@
 
 #include <stdlib.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -69,8 +71,9 @@ class ClientPanicTest : public ::testing::Test {
     server_ = std::make_unique<Server>(server_end_, o, std::vector<RobotSpec>{spec}, registry_, clock_);
     server_->Start();
   }
-  std::unique_ptr<RobotClient> Client(const std::string& key = "") {
+  std::unique_ptr<RobotClient> Client(const std::string& key = "", Duration heartbeat = {}) {
     ClientOptions o;
+    if (heartbeat.count() > 0) o.heartbeat_interval = heartbeat;
     o.transport = &client_end_;
     o.timeout = seconds(5);
     o.connect_timeout = seconds(5);
@@ -126,6 +129,67 @@ TEST_F(ClientPanicTest, AKeyedPanicAfterAServerRestartIsSentAgainInANewSessionAn
   EXPECT_NO_THROW(monitor->Panic());
   auto alice = Client("alice");
   EXPECT_EQ(alice->SetJoint("pan", {0.2}).signal, Signal::kPanic);
+}
+
+// Review 12's known gap, measured (gaps13): a forger floods a keyed server
+// with packages naming made-up sessions, with and without the panic flag,
+// 20 times each of the signed answers' budgets (1,000 SESSION_UNKNOWN
+// answers a second, and as many panic refusals), from before the server
+// restarts, and a keyed client whose session the new instance does not know
+// calls Panic(). The promise: a panic is never lost, a forged flood cannot
+// disable a robot. Before: the client learnt of the restart only when one
+// of its retransmissions fell within a budget (a chance of 1 in 20 each).
+TEST_F(ClientPanicTest, AKeyedPanicAfterARestartIsTakenDuringAFloodOfPackagesNamingMadeUpSessions) {
+  MakeKeys();
+  StartServer(/*keyed=*/true);
+  // Its heartbeats (every 250 ms by default) would also learn of the restart
+  // when one falls within the budget: the panic alone is measured here.
+  auto monitor = Client("monitor", seconds(30));
+  MemoryTransport forger(bus_);
+  std::atomic<bool> stop{false};
+  std::atomic<std::int64_t> forged{0};
+  std::thread flood([&] {
+    // One panic and one other package every 50 us, 40,000 a second, spread
+    // evenly (a burst once a millisecond would leave the server idle between
+    // bursts, its next token for whichever package comes first).
+    constexpr auto kStep = std::chrono::microseconds(50);
+    auto next = std::chrono::steady_clock::now();
+    for (std::int64_t i = 0; !stop; i += 2) {
+      for (std::int64_t k = i; k < i + 2; ++k) {
+        forger.Publish(RequestChannel(kRobot), EncodeRequest(Request{.client_id = 0x5000'0000 + k,
+                                                                     .session_id = 1'000'000 + k,
+                                                                     .sequence = 1,
+                                                                     .panic = k % 2 == 0}));
+      }
+      forged += 2;
+      next = std::max(next + kStep, std::chrono::steady_clock::now() - 20 * kStep);  // a bounded rate
+      std::this_thread::sleep_until(next);
+    }
+  });
+  server_.reset();
+  StartServer(/*keyed=*/true);  // the monitor's session is unknown to the new instance
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_EQ(monitor->stats().sessions_lost, 0u) << "the client learnt of the restart before its panic";
+  const std::int64_t forged_before = forged;
+  const auto start = std::chrono::steady_clock::now();
+  std::string error;
+  try {
+    monitor->Panic();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  const auto end = std::chrono::steady_clock::now();
+  const double rate = (forged - forged_before) / std::max(1e-3, ToSeconds(end - start));
+  stop = true;
+  flood.join();
+  std::printf(
+      "[ measured ] keyed Panic() after a restart, %.0f forged packages/s naming made-up sessions (half "
+      "panics; %zu dropped by the server's full queue): %s after %.3f s (%llu retransmissions)\n",
+      rate, server_end_.dropped(), error.empty() ? "taken" : error.c_str(), ToSeconds(end - start),
+      static_cast<unsigned long long>(monitor->stats().retransmissions));
+  EXPECT_EQ(error, "") << "the panic was lost to the flood";
+  auto alice = Client("alice");
+  EXPECT_EQ(alice->SetJoint("pan", {0.2}).signal, Signal::kPanic) << "the robot is not halted";
 }
 
 TEST_F(ClientPanicTest, AnOpenModePanicOutsideAnySessionIsTakenByTheServersExplicitAnswer) {

@@ -1,6 +1,8 @@
 #include "robotalk/state_sample.h"
 #include "protocol_codec.h"
+#include "robotalk/channels.h"
 #include "robotalk/error.h"
+#include "robotalk/request.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -90,6 +92,37 @@ TEST(StateSample, CarriesTheMotionOwnersLinkAndRefusesABadOne) {
   w = ToWire(Sample());
   w.link_round_trip_us = -1;
   EXPECT_THAT(FromWireError(w), HasSubstr("link_round_trip_us -1 is negative"));
+}
+
+// gaps13 (safety.md's Known gaps): a STATE's robot name was not checked by
+// the codec, so a forged one (200 characters; a terminal escape; a line
+// break) reached `watch`, robotalk-web, robotalk-ros2 and logplay, and the
+// codec's own error texts quoted it. Now the one rule of ANNOUNCE and the
+// commands (RobotNameProblem) refuses it in the decoder, naming the field
+// and never quoting the name.
+TEST(StateSample, RefusesARobotNameNoServerCanServeWithoutQuotingIt) {
+  for (const std::string& name :
+       {std::string(200, 'x'), std::string("bot\x1b[2J"), std::string("bot\nforged"),
+        std::string("r\xc3\xa9"
+                    "bot"),
+        std::string()}) {
+    auto w = ToWire(Sample());
+    w.robot = name;
+    const std::string error = FromWireError(w);
+    EXPECT_THAT(error, HasSubstr("robot: a robot name")) << "name of " << name.size() << " bytes";
+    if (!name.empty()) {
+      EXPECT_EQ(error.find(name), std::string::npos) << error;
+    }
+    try {
+      DecodeStateSample(Encode(w));
+      ADD_FAILURE() << "decoded a STATE naming a robot of " << name.size() << " bytes";
+    } catch (const ProtocolError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("a robot name"));
+    }
+  }
+  auto w = ToWire(Sample());
+  w.robot = std::string(kMaxRobotNameLength, 'a');
+  EXPECT_NO_THROW(FromWire(w)) << "the longest name a server serves";
 }
 
 TEST(StateSample, ChecksTheDofCountAgainstTheModel) {

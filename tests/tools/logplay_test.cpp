@@ -486,6 +486,29 @@ TEST(ReceiptOrder, HoldsAtMostItsBoundWritingTheOldestFirst) {
   EXPECT_EQ(order.held(), 2u);
 }
 
+// gaps13 (safety.md's Known gaps): the recorder's sort held up to 100,000
+// events whatever their size, so well-formed large messages (1 MiB each here)
+// arriving within the 0.25 s sort grew its memory by their bytes. Now it
+// holds 64 MiB at most by default: past that the oldest are written at once
+// (nothing dropped) and counted, so `record` can say which.
+TEST(ReceiptOrder, HoldsAtMostItsByteBoundWritingTheOldestFirstAndCountsThem) {
+  ReceiptOrder order;  // the recorder's defaults
+  std::vector<std::int64_t> written;
+  const auto write = [&](const ReceiptOrder::Event& e) { written.push_back(e.received_us); };
+  const std::vector<std::uint8_t> mib(1 << 20, 0x5a);
+  for (std::int64_t t = 0; t < 80; ++t) order.Add(1000 + t, "ROBOTALK/bot/CONFIG", mib);
+  order.Release(1000, write);  // none of them is due yet
+  EXPECT_LE(order.held(), 64u) << "more than 64 MiB held";
+  ASSERT_EQ(written.size(), 80u - order.held());
+  for (std::size_t i = 0; i < written.size(); ++i) EXPECT_EQ(written[i], 1000 + static_cast<std::int64_t>(i));
+  EXPECT_EQ(order.held_bytes(), order.held() * mib.size());
+  EXPECT_EQ(order.early(), written.size()) << "each written before its hold was over, counted";
+  EXPECT_EQ(order.early_bytes(), written.size() * mib.size());
+  order.ReleaseAll(write);
+  EXPECT_EQ(written.size(), 80u) << "none dropped";
+  EXPECT_EQ(order.held_bytes(), 0u);
+}
+
 // The wall clock stepped back (an NTP step, a date set by hand) while
 // recording: what came before the step is written at once and first, not
 // held until the clock catches up (an hour here: a recorder killed meanwhile

@@ -11,13 +11,8 @@ web=$1
 www=$2
 port=18431
 tmp=$(mktemp -d)
-mkdir -p "$tmp/node_modules/three" "$tmp/node_modules/urdf-loader"  # the page is not loaded: names suffice
-(ulimit -n 48 && exec "$web" --port "$port" --lcm-url "udpm://239.255.76.67:7721?ttl=0" --www "$www" \
-  --node-modules "$tmp/node_modules") >"$tmp/web.log" 2>&1 &
-pid=$!
-trap 'kill $pid 2>/dev/null; wait $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-for _ in $(seq 50); do grep -q "open http" "$tmp/web.log" && break; sleep 0.1; done
-grep -q "open http" "$tmp/web.log" || { echo "FAIL: robotalk-web did not start:"; cat "$tmp/web.log"; exit 1; }
+. "$(dirname "$0")/bare_web.sh"
+start_bare_web "$web" "$www" "$port" 7721 48
 python3 - "$pid" "$port" <<'PY'
 import socket, sys, time
 pid, port = int(sys.argv[1]), int(sys.argv[2])

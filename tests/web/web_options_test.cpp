@@ -34,21 +34,36 @@ TEST(WebOptions, DefaultsToLoopbackPort8080At30Hz) {
   EXPECT_EQ(o.www_dir, "/www");
   EXPECT_EQ(o.node_modules_dir, "/nm");
   EXPECT_TRUE(o.urdf.empty());
+  EXPECT_EQ(o.max_websockets, 64);
 }
 
 TEST(WebOptions, ParsesEveryOption) {
-  const WebOptions o = Parse({"--bind",          "0.0.0.0",
-                              "--port",          "0",
-                              "--lcm-url",       "udpm://239.255.76.67:7901?ttl=0",
-                              "--rate",          "60",
-                              "--urdf",          "pioneer=models/p.urdf",
-                              "--urdf",          "arm=/x/iiwa.urdf",
-                              "--robot-timeout", "5",
-                              "--www",           "w",
-                              "--node-modules",  "n",
-                              "--key",           "k",
-                              "--server-key",    "s.pub",
-                              "--version",       "-h"});
+  const WebOptions o = Parse({"--bind",
+                              "0.0.0.0",
+                              "--port",
+                              "0",
+                              "--lcm-url",
+                              "udpm://239.255.76.67:7901?ttl=0",
+                              "--rate",
+                              "60",
+                              "--urdf",
+                              "pioneer=models/p.urdf",
+                              "--urdf",
+                              "arm=/x/iiwa.urdf",
+                              "--robot-timeout",
+                              "5",
+                              "--www",
+                              "w",
+                              "--node-modules",
+                              "n",
+                              "--key",
+                              "k",
+                              "--server-key",
+                              "s.pub",
+                              "--max-websockets",
+                              "3",
+                              "--version",
+                              "-h"});
   EXPECT_EQ(o.bind, "0.0.0.0");
   EXPECT_EQ(o.port, 0);
   EXPECT_EQ(o.lcm_url, "udpm://239.255.76.67:7901?ttl=0");
@@ -60,6 +75,7 @@ TEST(WebOptions, ParsesEveryOption) {
   EXPECT_EQ(o.node_modules_dir, "n");
   EXPECT_EQ(o.key_file, "k");
   EXPECT_EQ(o.server_key_file, "s.pub");
+  EXPECT_EQ(o.max_websockets, 3);
   EXPECT_TRUE(o.version);
   EXPECT_TRUE(o.help);
 }
@@ -74,6 +90,9 @@ TEST(WebOptions, NamesTheBadArgument) {
   EXPECT_NE(ErrorOf({"--robot-timeout", "1"}).find("shorter than 1.5 s"), std::string::npos);
   EXPECT_EQ(ErrorOf({"--server-key", ""}), "--server-key: the file name is empty");
   EXPECT_EQ(ErrorOf({"--key"}), "--key: needs a value");
+  EXPECT_EQ(ErrorOf({"--max-websockets", "0"}), "--max-websockets: 0 is not a whole number from 1 to 4096");
+  EXPECT_EQ(ErrorOf({"--max-websockets", "2.5"}),
+            "--max-websockets: 2.5 is not a whole number from 1 to 4096");
   // Review 10: a timeout past what a time holds was accepted here and failed later naming no
   // option ("FromSeconds: 1e+12 s is out of range"); 5e9 s overflowed an int in the robot card's text.
   EXPECT_EQ(ErrorOf({"--robot-timeout", "1e12"}), "--robot-timeout 1e12 is out of range (at most 1e+09 s)");
@@ -82,8 +101,9 @@ TEST(WebOptions, NamesTheBadArgument) {
 
 TEST(WebOptions, HelpMentionsEveryOption) {
   const std::string usage = WebUsage();
-  for (const char* opt : {"--bind", "--port", "--lcm-url", "--rate", "--urdf", "--robot-timeout", "--www",
-                          "--node-modules", "--key", "--server-key", "--version", "--help"})
+  for (const char* opt :
+       {"--bind", "--port", "--lcm-url", "--rate", "--urdf", "--robot-timeout", "--www", "--node-modules",
+        "--key", "--server-key", "--max-websockets", "--version", "--help"})
     EXPECT_NE(usage.find(opt), std::string::npos) << opt;
 }
 

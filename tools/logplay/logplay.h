@@ -92,6 +92,9 @@ struct RecordResult {
   int signal = 0;  ///< the signal that stopped it, or 0
   /// Events dispatched too late to be written in receipt order (ReceiptOrder::late).
   std::uint64_t late = 0;
+  /// Events (and bytes) written before their 0.25 s sort was over because
+  /// the sort held more than its bound (ReceiptOrder::early): none dropped.
+  std::uint64_t early = 0, early_bytes = 0;
 };
 
 /// `record`: every channel of every lane of `options.url` (the split

@@ -3,6 +3,7 @@
 #include "interrupt.h"
 #include "logplay.h"
 #include "mcap_export.h"
+#include "receipt_order.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -219,6 +220,13 @@ int RunRecord(Args& a) {
     std::cerr
         << "robotalk-logplay: warning: " << r.late
         << " events were dispatched more than 0.25 s after their receipt and are written after later ones\n";
+  }
+  if (r.early > 0) {
+    std::cerr << "robotalk-logplay: warning: " << r.early << " events (" << r.early_bytes
+              << " bytes) were written before their 0.25 s sort was over: more than "
+              << (lp::ReceiptOrder::kMaxHeldBytes >> 20) << " MiB (or " << lp::ReceiptOrder::kMaxHeld
+              << " events) arrived within it; none was dropped, but they may precede "
+                 "events received before them\n";
   }
   return 0;
 }

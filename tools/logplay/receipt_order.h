@@ -8,7 +8,9 @@
 // keep their dispatch order.
 //
 // Pure (no clock, no I/O): times are given by the caller, in µs since the
-// UNIX epoch. Bounded: past `max_held` events the oldest is written at once.
+// UNIX epoch. Bounded: past `max_held` events or `max_held_bytes` of their
+// bytes the oldest are written at once, before their hold is over (never
+// dropped), and counted (early(), early_bytes()).
 // Thread safety: none.
 #pragma once
 
@@ -32,12 +34,17 @@ class ReceiptOrder {
     std::vector<std::uint8_t> bytes;
   };
 
-  explicit ReceiptOrder(std::int64_t hold_us = 250000, std::size_t max_held = 100000)
-      : hold_us_(hold_us), max_held_(max_held) {}
+  static constexpr std::size_t kMaxHeld = 100000;
+  static constexpr std::size_t kMaxHeldBytes = std::size_t{64} << 20;
+
+  explicit ReceiptOrder(std::int64_t hold_us = 250000, std::size_t max_held = kMaxHeld,
+                        std::size_t max_held_bytes = kMaxHeldBytes)
+      : hold_us_(hold_us), max_held_(max_held), max_held_bytes_(max_held_bytes) {}
 
   /// Holds a copy of one dispatched message.
   void Add(std::int64_t received_us, const std::string& channel, std::span<const std::uint8_t> bytes) {
     held_.emplace(Key{received_us, next_++}, Event{received_us, channel, {bytes.begin(), bytes.end()}});
+    held_bytes_ += bytes.size();
   }
 
   /// Calls `write(const Event&)` in receipt order for every event received
@@ -54,11 +61,20 @@ class ReceiptOrder {
     // lost them), and the order starts again: nothing after the step is late.
     if (!held_.empty() && held_.rbegin()->first.first > now_us + hold_us_) {
       auto stepped = held_.upper_bound(Key{now_us + hold_us_, UINT64_MAX});
-      for (auto it = stepped; it != held_.end(); ++it) write(it->second);
+      for (auto it = stepped; it != held_.end(); ++it) {
+        write(it->second);
+        held_bytes_ -= it->second.bytes.size();
+      }
       held_.erase(stepped, held_.end());
       last_written_us_ = INT64_MIN;
     }
-    while (!held_.empty() && (held_.begin()->first.first <= now_us - hold_us_ || held_.size() > max_held_)) {
+    while (!held_.empty()) {
+      const bool due = held_.begin()->first.first <= now_us - hold_us_;
+      if (!due && held_.size() <= max_held_ && held_bytes_ <= max_held_bytes_) break;
+      if (!due) {
+        ++early_;
+        early_bytes_ += held_.begin()->second.bytes.size();
+      }
       WriteFirst(write);
     }
   }
@@ -69,6 +85,11 @@ class ReceiptOrder {
   }
 
   std::size_t held() const { return held_.size(); }
+  std::size_t held_bytes() const { return held_bytes_; }
+  /// Events (and their bytes) written before their hold was over because
+  /// more than `max_held` events or `max_held_bytes` bytes were held.
+  std::uint64_t early() const { return early_; }
+  std::uint64_t early_bytes() const { return early_bytes_; }
   /// Events written after a later-received one (dispatched more than `hold` late).
   std::uint64_t late() const { return late_; }
 
@@ -81,12 +102,16 @@ class ReceiptOrder {
     if (first->first.first < last_written_us_) ++late_;
     last_written_us_ = std::max(last_written_us_, first->first.first);
     write(first->second);
+    held_bytes_ -= first->second.bytes.size();
     held_.erase(first);
   }
 
   const std::int64_t hold_us_;
   const std::size_t max_held_;
+  const std::size_t max_held_bytes_;
   std::map<Key, Event> held_;
+  std::size_t held_bytes_ = 0;  // of held_'s events
+  std::uint64_t early_ = 0, early_bytes_ = 0;
   std::uint64_t next_ = 0;
   std::int64_t last_written_us_ = INT64_MIN;
   std::uint64_t late_ = 0;

@@ -92,6 +92,8 @@ RecordResult Record(const RecordOptions& options, std::ostream& progress) {
   sub.reset();
   order.ReleaseAll(write);
   result.late = order.late();
+  result.early = order.early();
+  result.early_bytes = order.early_bytes();
   flush();
   if (!write_error.empty()) throw LogError(write_error);
   result.signal = cli::Interrupter::Signal();

@@ -9,6 +9,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <deque>
@@ -173,10 +174,9 @@ class FoxgloveEndpoint::Impl {
     }
   }
 
-  bool connected() const {
-    for (const auto& s : sessions_)
-      if (s->connection->open()) return true;
-    return false;
+  std::size_t connections() const {
+    return static_cast<std::size_t>(std::count_if(sessions_.begin(), sessions_.end(),
+                                                  [](const auto& s) { return s->connection->live(); }));
   }
 
  private:
@@ -387,6 +387,6 @@ void FoxgloveEndpoint::Accept(tcp::socket socket, http::request<http::string_bod
   impl_->Accept(std::move(socket), std::move(request));
 }
 void FoxgloveEndpoint::Update(const TrackerFrame& frame) { impl_->Update(frame); }
-bool FoxgloveEndpoint::connected() const { return impl_->connected(); }
+std::size_t FoxgloveEndpoint::connections() const { return impl_->connections(); }
 
 }  // namespace robotalk::web

@@ -31,6 +31,7 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 
+#include <cstddef>
 #include <functional>
 #include <map>
 #include <memory>
@@ -63,7 +64,9 @@ class FoxgloveEndpoint {
   /// state of each robot (to the subscribers of its channels).
   void Update(const TrackerFrame& frame);
   /// Whether any Foxglove client is connected (the tracker streams while one is).
-  bool connected() const;
+  bool connected() const { return connections() > 0; }
+  /// How many Foxglove clients are connected (WebOptions::max_websockets counts them).
+  std::size_t connections() const;
 
  private:
   class Impl;

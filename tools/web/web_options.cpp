@@ -50,6 +50,8 @@ std::string WebUsage() {
          "  --key FILE         keyed mode: this bridge's secret key (default: $ROBOTALK_KEY)\n"
          "  --server-key FILE  keyed mode: track only robots this server key announced\n"
          "  --robot-timeout S  a robot not announced for S seconds is shown as gone (default 3)\n"
+         "  --max-websockets N WebSocket clients (pages and Foxglove) open at once; one more\n"
+         "                     is refused with HTTP 503 (default 64, 1-4096)\n"
          "  --www DIR          the page's files (default: share/robotalk/web/www of this\n"
          "                     installation, else tools/web/www of the sources)\n"
          "  --node-modules DIR npm modules holding three and urdf-loader (default:\n"
@@ -96,6 +98,11 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
         throw Error("--robot-timeout: " + args[i] + " s is shorter than " + shortest +
                     " s (servers announce every second)");
       }
+    } else if (a == "--max-websockets") {
+      const double n = ParseNumber(value(), a);
+      if (n < 1 || n > 4096 || n != std::floor(n))
+        throw Error("--max-websockets: " + args[i] + " is not a whole number from 1 to 4096");
+      o.max_websockets = static_cast<int>(n);
     } else if (a == "--key") {
       o.key_file = value();
       if (o.key_file.empty()) throw Error("--key: the file name is empty");

@@ -45,6 +45,10 @@ struct WebOptions {
   std::string server_key_file;
   /// A robot is shown as gone when no announce named it for this long (s).
   double robot_timeout_s = 3.0;
+  /// WebSocket clients open at once, the page's and Foxglove's together
+  /// (each holds a descriptor and its queues); one more is refused with HTTP
+  /// 503 naming this limit (--max-websockets).
+  int max_websockets = 64;
   bool help = false;
   bool version = false;
 };

@@ -5,6 +5,7 @@
 #include "mesh_catalog.h"
 #include "robotalk/error.h"
 #include "web_files.h"
+#include "web_log.h"
 #include "ws_connection.h"
 
 #include <boost/asio.hpp>
@@ -130,6 +131,9 @@ class WebServer::Impl {
     http::async_read(*stream, *buffer, *req, [this, stream, buffer, req](beast::error_code ec, std::size_t) {
       if (ec) return;
       if (websocket::is_upgrade(*req) &&
+          OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets))
+        return RefuseWebSocket(stream, std::move(*req));
+      if (websocket::is_upgrade(*req) &&
           FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
         stream->expires_never();
         foxglove_->Accept(stream->release_socket(), std::move(*req));
@@ -148,6 +152,47 @@ class WebServer::Impl {
       }
       Respond(stream, std::move(*req));
     });
+  }
+
+  // The page's open WebSockets and Foxglove's: what --max-websockets bounds.
+  std::size_t OpenWebSockets() const {
+    return foxglove_->connections() +
+           static_cast<std::size_t>(
+               std::count_if(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->live(); }));
+  }
+
+  // One WebSocket more than --max-websockets: 503, the limit named, the
+  // connection closed; one line on stderr per second at most (a client
+  // retrying in a loop would otherwise fill it).
+  void RefuseWebSocket(std::shared_ptr<beast::tcp_stream> stream, http::request<http::string_body> req) {
+    const std::string why = std::to_string(options_.max_websockets) +
+                            " WebSocket clients (pages and Foxglove) are connected already, the "
+                            "--max-websockets limit; close one or raise the limit";
+    ++refused_websockets_;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= next_refusal_line_) {
+      next_refusal_line_ = now + std::chrono::seconds(1);
+      WebLog().Write("refused a WebSocket from " + Peer(*stream) + ": " + why + " (" +
+                     std::to_string(refused_websockets_) + " refused so far)");
+    }
+    http::response<http::string_body> res{http::status::service_unavailable, req.version()};
+    res.set(http::field::server, "robotalk-web");
+    res.set(http::field::content_type, "text/plain; charset=utf-8");
+    res.set(http::field::retry_after, "5");
+    res.body() = "robotalk-web: " + why + "\n";
+    res.keep_alive(false);
+    res.prepare_payload();
+    auto sp = std::make_shared<decltype(res)>(std::move(res));
+    http::async_write(*stream, *sp, [stream, sp](beast::error_code, std::size_t) {
+      beast::error_code ignored;
+      stream->socket().shutdown(tcp::socket::shutdown_both, ignored);
+    });
+  }
+
+  static std::string Peer(beast::tcp_stream& stream) {
+    beast::error_code ec;
+    const tcp::endpoint ep = stream.socket().remote_endpoint(ec);
+    return ec ? std::string("a client") : ep.address().to_string() + ":" + std::to_string(ep.port());
   }
 
   void Respond(std::shared_ptr<beast::tcp_stream> stream, http::request<http::string_body> req) {
@@ -333,6 +378,8 @@ class WebServer::Impl {
   bool armed_ = false;
   std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
   std::vector<std::shared_ptr<WsConnection>> sessions_;
+  std::uint64_t refused_websockets_ = 0;                       // past --max-websockets
+  std::chrono::steady_clock::time_point next_refusal_line_{};  // of RefuseWebSocket's stderr line
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
   std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start

@@ -35,8 +35,10 @@ void WsConnection::Start(http::request<http::string_body> request, std::vector<M
     if (!subprotocol.empty()) res.set(http::field::sec_websocket_protocol, subprotocol);
   }));
   ws_.read_message_max(max_message_);
+  accepting_ = true;
   ws_.async_accept(request,
                    [self = shared_from_this(), greeting = std::move(greeting)](beast::error_code ec) {
+                     self->accepting_ = false;
                      if (ec) return;
                      self->open_ = true;
                      for (const Message& m : greeting) self->Send(m, false, false);

@@ -42,6 +42,8 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
   void Start(boost::beast::http::request<boost::beast::http::string_body> request,
              std::vector<Message> greeting, const std::string& subprotocol = "");
   bool open() const { return open_; }
+  /// Open, or its upgrade being answered (what WebOptions::max_websockets counts).
+  bool live() const { return accepting_ || open_; }
   /// Queues one message (text or binary); a droppable one is dropped when the
   /// queue is full.
   void Send(const Message& m, bool binary, bool droppable);
@@ -59,6 +61,7 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
   std::deque<std::pair<Message, bool>> queue_;  // message, binary
   std::size_t queued_bytes_ = 0;                // of queue_'s messages
   bool open_ = false;
+  bool accepting_ = false;  // Start() until the upgrade's answer is written (or failed)
   std::uint64_t dropped_ = 0;
 };
 

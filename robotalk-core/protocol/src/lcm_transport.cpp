@@ -1,12 +1,19 @@
 #include "robotalk/lcm_transport.h"
 
+#include "robotalk/log_writer.h"
+
+#include <fcntl.h>
 #include <lcm/lcm.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <climits>
+#include <cstdio>
 #include <exception>
 #include <mutex>
+#include <string>
+#include <vector>
 
 namespace robotalk {
 
@@ -45,6 +52,68 @@ extern "C" void OnLcmMessage(const lcm_recv_buf_t* rbuf, const char* channel, vo
   }
 }
 
+// LCM writes why it cannot start (a bad URL, "LCM self test failed") to
+// stderr itself, with fprintf: a stderr that takes nothing (a full pipe, a
+// terminal stopped with Ctrl-S) held lcm_create, and with it the program's
+// start, for ever. While this lives, descriptor 2 is a non-blocking pipe of
+// its own (64 KiB; past that LCM's writes fail, never wait); Take() puts
+// stderr back and returns what was written, for the caller to say through
+// LogWriter (or in its error). Anything another thread wrote to stderr
+// meanwhile is taken too (said after, not lost). If it cannot be set up,
+// stderr stays as it was.
+class StderrCapture {
+ public:
+  StderrCapture() {
+    int p[2];
+    if (::pipe2(p, O_CLOEXEC | O_NONBLOCK) != 0) return;
+    std::fflush(stderr);
+    saved_ = ::fcntl(2, F_DUPFD_CLOEXEC, 3);
+    if (saved_ < 0 || ::dup2(p[1], 2) < 0) {
+      if (saved_ >= 0) ::close(saved_);
+      saved_ = -1;
+      ::close(p[0]);
+      ::close(p[1]);
+      return;
+    }
+    ::close(p[1]);
+    read_ = p[0];
+  }
+  ~StderrCapture() { Take(); }
+  StderrCapture(const StderrCapture&) = delete;
+  StderrCapture& operator=(const StderrCapture&) = delete;
+
+  std::string Take() {
+    if (saved_ < 0) return "";
+    std::fflush(stderr);
+    ::dup2(saved_, 2);
+    ::close(saved_);
+    saved_ = -1;
+    std::string text;
+    char buf[4096];
+    for (ssize_t n; (n = ::read(read_, buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(n));
+    ::close(read_);
+    return text;
+  }
+
+ private:
+  int saved_ = -1, read_ = -1;
+};
+
+// LCM's lines, one by one, trimmed; empty ones dropped.
+std::vector<std::string> LinesOf(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    if (!line.empty()) lines.push_back(std::move(line));
+    start = end + 1;
+  }
+  return lines;
+}
+
 }  // namespace
 
 namespace internal {
@@ -53,11 +122,26 @@ class LcmCore {
  public:
   explicit LcmCore(const LcmTransportOptions& options)
       : options_(options), url_(LcmTransport::EffectiveUrl(options)) {
-    lcm_ = lcm_create(url_.empty() ? nullptr : url_.c_str());
+    std::vector<std::string> said;
+    {
+      // One capture at a time: another's would save this one's pipe as stderr.
+      static std::mutex create_mu;
+      const std::lock_guard lock(create_mu);
+      StderrCapture capture;
+      lcm_ = lcm_create(url_.empty() ? nullptr : url_.c_str());
+      said = LinesOf(capture.Take());
+    }
     if (lcm_ == nullptr) {
+      std::string why;
+      for (const std::string& line : said) why += (why.empty() ? "" : "; ") + line;
       throw TransportError("LcmTransport: LCM could not start on " +
                            (url_.empty() ? std::string("its default URL") : "'" + url_ + "'") +
-                           " (bad URL, or no route for its multicast group?)");
+                           " (bad URL, or no route for its multicast group?)" +
+                           (why.empty() ? "" : ": LCM says: " + EscapeControls(why)));
+    }
+    if (!said.empty()) {  // LCM started, and said something: through the process's writer of stderr
+      for (std::string& line : said) line = "LCM: " + line;
+      LogWriter::Stderr().Write(said);
     }
   }
   ~LcmCore() { lcm_destroy(lcm_); }

@@ -1,6 +1,7 @@
 #include "protocol_codec.h"
 
 #include "robotalk/broadcast_signature.h"
+#include "robotalk/channels.h"
 #include "robotalk/error.h"
 #include "robotalk_msgs/command_t.hpp"
 #include "wire_scanner.h"
@@ -256,6 +257,12 @@ Reply FromWire(const robotalk_msgs::reply_t& w) {
 }
 
 StateSample FromWire(const robotalk_msgs::robot_state_t& w, int expected_dofs) {
+  // Anyone's datagram: its robot name reaches terminals (`watch`), logs and
+  // robotalk-web's, robotalk-ros2's and logplay's tables. The one rule of
+  // ANNOUNCE and the commands (RobotNameProblem) first, before any text
+  // quotes the name (StateLabel).
+  if (const std::string why = RobotNameProblem(w.robot); !why.empty())
+    throw ProtocolError("robot_state sample " + std::to_string(w.sample) + ": robot: " + why);
   const std::string label = StateLabel(w);
   CheckArraySize(label, "position", w.position.size(), w.num_dofs, "num_dofs");
   CheckArraySize(label, "velocity", w.velocity.size(), w.num_dofs, "num_dofs");

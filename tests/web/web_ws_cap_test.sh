@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# gaps13 (safety.md's Known gap): robotalk-web's WebSocket clients were not
+# bounded: each open /ws or Foxglove connection holds a descriptor and its
+# queues, so a client that opens many grew the bridge without limit. Now at
+# most --max-websockets (64 by default) are open at once, page and Foxglove
+# together; one more is refused with HTTP 503 naming the limit, and once one
+# closes a new one is accepted.
+# Usage: web_ws_cap_test.sh ROBOTALK_WEB WWW_DIR (inside a private network namespace).
+set -u
+port=18433
+tmp=$(mktemp -d)
+. "$(dirname "$0")/bare_web.sh"
+start_bare_web "$1" "$2" "$port" 7723  # ROBOTALK_WEB, WWW_DIR
+python3 - "$port" <<'PY'
+import base64, os, socket, sys
+port = int(sys.argv[1])
+LIMIT = 64  # robotalk-web's default --max-websockets
+
+def upgrade(path="/ws", protocol=None):
+    """Opens a WebSocket (standard library only); returns (socket, status line, whole answer head+body)."""
+    s = socket.create_connection(("127.0.0.1", port), timeout=3)
+    key = base64.b64encode(os.urandom(16)).decode()
+    extra = "Sec-WebSocket-Protocol: %s\r\n" % protocol if protocol else ""
+    s.sendall(("GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+               "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n%s\r\n" % (path, port, key, extra)).encode())
+    data = b""
+    while b"\r\n\r\n" not in data:
+        chunk = s.recv(4096)
+        if not chunk:
+            break
+        data += chunk
+    head = data.split(b"\r\n", 1)[0].decode(errors="replace")
+    if " 101 " not in head:  # a refusal: read its body to the end
+        s.settimeout(2)
+        try:
+            while True:
+                chunk = s.recv(4096)
+                if not chunk:
+                    break
+                data += chunk
+        except OSError:
+            pass
+    return s, head, data.decode(errors="replace")
+
+ok = True
+held = []
+for i in range(LIMIT):
+    # Every fourth a Foxglove client: the limit counts both kinds.
+    s, head, _ = upgrade("/", "foxglove.websocket.v1") if i % 4 == 3 else upgrade()
+    if " 101 " not in head:
+        print("FAIL: WebSocket %d of %d refused: %s" % (i + 1, LIMIT, head))
+        ok = False
+        break
+    held.append(s)
+print("%d WebSockets open" % len(held))
+for path, protocol in (("/ws", None), ("/", "foxglove.websocket.v1")):
+    s, head, answer = upgrade(path, protocol)
+    print("one more (%s): %s" % (protocol or "page", head))
+    if " 503 " not in head or "--max-websockets" not in answer or str(LIMIT) not in answer:
+        print("FAIL: one more than %d WebSockets is not refused 503 naming the limit:\n%s" % (LIMIT, answer))
+        ok = False
+    s.close()
+held.pop().close()
+import time
+accepted = False
+for _ in range(30):  # the bridge notices the close on its next read
+    time.sleep(0.1)
+    s, head, _ = upgrade()
+    if " 101 " in head:
+        accepted = True
+        held.append(s)
+        break
+    s.close()
+if not accepted:
+    print("FAIL: after one closed, a new WebSocket is still refused")
+    ok = False
+# The page itself (plain HTTP) still loads at the limit.
+s = socket.create_connection(("127.0.0.1", port), timeout=3)
+s.sendall(b"GET / HTTP/1.1\r\nHost: x\r\n\r\n")
+if not s.recv(20).startswith(b"HTTP/1.1 200"):
+    print("FAIL: the page does not load at the limit")
+    ok = False
+for s in held:
+    s.close()
+sys.exit(0 if ok else 1)
+PY
+rc=$?
+if [ $rc -eq 0 ] && ! grep -q "max-websockets" "$tmp/web.log"; then
+  echo "FAIL: no line on stderr says a WebSocket was refused:"; cat "$tmp/web.log"; rc=1
+fi
+exit $rc
