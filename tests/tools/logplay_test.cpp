@@ -2,6 +2,7 @@
 // packages encoded by the message layer in memory (no LCM), and hostile logs
 // written with LCM's log API in a temp dir.
 #include "logplay.h"
+#include "mcap_export.h"
 #include "receipt_order.h"
 #include "robotalk/channels.h"
 #include "robotalk/request.h"
@@ -382,6 +383,32 @@ TEST_F(HostileLog, RefusesLogTimestampsOutOfRangeAndNamesThem) {
   PrintInfo(log, "hostile.lcmlog", info);
   EXPECT_NE(info.str().find("2 log entries rejected"), std::string::npos) << info.str();
   EXPECT_NE(info.str().find("log timestamp"), std::string::npos) << info.str();
+}
+
+// Review 13: `robotalk-logplay export --mcap` named a log's channels and
+// robots in its warnings raw (an undecodable message's channel, a STATE's
+// robot with no logged configuration): a hostile log's terminal escapes and
+// line breaks reached the terminal, as `info`'s did before review 12. Every
+// warning line is now written in printable ASCII, one line each.
+TEST_F(HostileLog, ExportMcapsWarningsShowChannelsAndRobotsInPrintableAscii) {
+  robotalk::StateSample s;
+  s.robot = "a";
+  s.server_time = TimePoint(std::chrono::seconds(1));
+  s.sample = 1;
+  Write("ROBOTALK/a\x1b]0;owned\x07/STATE", 1'700'000'000'000'000, EncodeStateSample(s));
+  Write("ROBOTALK/b\x1b[2J\nrobotalk-logplay: forged\xc2\x9b/REQUEST", 1'700'000'000'000'001, {1, 2, 3});
+  file_.reset();  // closed: flushed
+  std::ostringstream warnings;
+  ExportMcap(path_, dir_ + "/hostile.mcap", warnings);
+  const std::string w = warnings.str();
+  EXPECT_NE(w.find("robot 'a\\x1b]0;owned\\x07'"), std::string::npos) << w;
+  EXPECT_NE(w.find("ROBOTALK/b\\x1b[2J\\x0arobotalk-logplay: forged\\xc2\\x9b/REQUEST"), std::string::npos)
+      << w;
+  for (const char c : w) {
+    if (c == '\n') continue;
+    EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "a byte outside printable ASCII: " << static_cast<int>(c) << "\n"
+                                       << w;
+  }
 }
 
 // A damaged log (review9): LCM's reader allocated what an event header
