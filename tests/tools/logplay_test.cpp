@@ -411,6 +411,33 @@ TEST_F(HostileLog, ExportMcapsWarningsShowChannelsAndRobotsInPrintableAscii) {
   }
 }
 
+// Review 13: a command's target is anyone's bytes in a log. `extract` wrote
+// it raw into the sequence file, whose words are split at blanks and cut at
+// '#': a target "pan 0.1<LF>0.000000 setspeed 5 0 #" became a SETSPEED line
+// of its own, "pan 0.9 #" turned a set-point of 0.1 into one of 0.9, and the
+// extract's re-parse check read both files as valid. A frame whose target the
+// sequence file cannot carry as one word is refused, named in printable
+// ASCII; nothing is written.
+TEST_F(HostileLog, ATargetASequenceFileCannotCarryAsOneWordIsRefusedByExtract) {
+  for (const std::string target : {"pan 0.1\n0.000000 setspeed 5 0 #", "pan 0.9 #", "pan\t0.9", "pan#"}) {
+    SCOPED_TRACE(target);
+    Restart();
+    Write(kRequest, 1'700'000'000'000'000,
+          Package(kClient, 1, 100, kDelay, {{1, CommandType::kJointSetPoint, 5'000'000, "pan", {0.2}}}));
+    Write(kRequest, 1'700'000'000'000'001,
+          Package(kClient, 2, 200, kDelay, {{2, CommandType::kJointSetPoint, 6'000'000, target, {0.1}}}));
+    const std::vector<TimedCommand> frames = ToFrames(Read().MakeTimeline({.client_id = kClient}), {});
+    try {
+      const std::string text = FormatSequence(frames, "extracted");
+      ADD_FAILURE() << "written:\n" << text;
+    } catch (const LogError& e) {
+      EXPECT_NE(std::string(e.what()).find("frame 2 JOINT_SETPOINT: target '" + Printable(target) + "'"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // A damaged log (review9): LCM's reader allocated what an event header
 // declared before reading it; a header declaring 2^31 - 1 data bytes made it
 // fread into a failed allocation (a segfault in every reader: robotalk-logplay
