@@ -162,7 +162,7 @@ int RunPanic(const GlobalOptions& g, const std::vector<std::string>& args) {
   try {
     client->Panic();
   } catch (const PanicRefusedError& e) {
-    std::cerr << "panic REFUSED by " << args[0] << ": " << e.what() << "\n";
+    std::cerr << "panic REFUSED by " << args[0] << ": " << ErrorText(e.what()) << "\n";
     ExitAfterOutput(1);
   }
   std::cout << "panic taken by " << args[0] << " (the robot is in panic)\n";

@@ -156,7 +156,7 @@ int SendFile(const GlobalOptions& g, const std::string& robot, const std::string
     status = std::max(status, 1);
   }
   for (const auto& [index, why] : report.unknown_outcomes) {
-    std::cerr << "robotalk: line " << entries[index].line << ": " << TidyDurations(why) << "\n";
+    std::cerr << "robotalk: line " << entries[index].line << ": " << ErrorText(why) << "\n";
   }
   if (!report.unknown_outcomes.empty()) {
     std::cerr << "robotalk: " << report.unknown_outcomes.size() << " of " << entries.size()

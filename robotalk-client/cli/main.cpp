@@ -130,10 +130,10 @@ int main(int argc, char** argv) {
     if (it == commands.end()) throw UsageError("unknown command '" + command + "'");
     return it->second(g, rest);
   } catch (const UsageError& e) {
-    std::cerr << "robotalk: " << e.what() << "\n(robotalk --help for usage)\n";
+    std::cerr << "robotalk: " << ErrorText(e.what()) << "\n(robotalk --help for usage)\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "robotalk: " << TidyDurations(e.what()) << "\n";
+    std::cerr << "robotalk: " << ErrorText(e.what()) << "\n";
     return 1;
   }
 }

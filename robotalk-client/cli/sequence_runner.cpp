@@ -1,6 +1,7 @@
 #include "sequence_runner.h"
 
 #include "interrupt.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 
 #include <algorithm>
 #include <cmath>
@@ -63,6 +64,8 @@ std::string TidyDurations(const std::string& message) {
   return out + message.substr(last);
 }
 
+std::string ErrorText(const std::string& message) { return EscapeControls(TidyDurations(message)); }
+
 std::string ProgressBar(const RunProgress& p, int width) {
   const double total_s = ToSeconds(p.duration);
   const double elapsed_s = std::clamp(ToSeconds(p.elapsed), 0.0, std::max(total_s, 0.0));
@@ -120,9 +123,9 @@ std::string StopNow(RobotClient& client, bool* succeeded) {
     const Reply r = client.Stop();
     if (succeeded) *succeeded = Succeeded(r.signal);
     return "STOP sent to " + client.robot() + ": " + std::string(ToString(r.signal)) +
-           (r.message.empty() ? "" : " (" + r.message + ")");
+           (r.message.empty() ? "" : " (" + ErrorText(r.message) + ")");
   } catch (const std::exception& e) {
-    return "STOP to " + client.robot() + " failed: " + TidyDurations(e.what());
+    return "STOP to " + client.robot() + " failed: " + ErrorText(e.what());
   }
 }
 

@@ -1,9 +1,14 @@
 #include "robotalk/sequence_file.h"
+#include "robotalk/urdf_import.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <clocale>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 namespace robotalk::cli {
@@ -56,6 +61,58 @@ TEST(NumberText, AWholeWordInADoublesRangeIsANumberAndNothingElseIs) {
   EXPECT_EQ(errno, EINTR) << "the caller's errno survives";
   EXPECT_EQ(ParseNumber("2", "--n"), 2.0);
   EXPECT_THROW(ParseNumber("inf", "--n"), UsageError);
+}
+
+// Review 13: NumberOf, and the <robotalk> block's xyz/rpy triples, were read
+// with strtod, which follows the process's LC_NUMERIC: in a program that sets
+// a locale whose decimal separator is a comma (Python after
+// locale.setlocale(locale.LC_ALL, "") in Germany or France) "0.25" was
+// refused as not a number, "0,25" taken as 0.25, and load_urdf refused every
+// shipped model with a <robotalk> block ("0.05 0 0.05 is not three finite
+// numbers"). RoboTalk's numbers are written with a point whatever the locale.
+class CommaLocale : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    old_ = std::setlocale(LC_NUMERIC, nullptr);
+    if (!std::setlocale(LC_NUMERIC, "de_DE.UTF-8")) {
+      // Not installed: made for this test, if the system has the sources.
+      dir_ = std::filesystem::temp_directory_path() / ("robotalk_locale_" + std::to_string(::getpid()));
+      std::filesystem::create_directories(dir_);
+      const std::string make =
+          "localedef -i de_DE -f UTF-8 '" + (dir_ / "de_DE.UTF-8").string() + "' >/dev/null 2>&1";
+      if (std::system(make.c_str()) == 0) {
+        ::setenv("LOCPATH", dir_.c_str(), 1);
+        std::setlocale(LC_NUMERIC, "de_DE.UTF-8");
+      }
+    }
+    if (std::string(std::localeconv()->decimal_point) != ",")
+      GTEST_SKIP() << "no locale with a decimal comma here";
+  }
+  void TearDown() override {
+    std::setlocale(LC_NUMERIC, old_.c_str());
+    if (!dir_.empty()) {
+      ::unsetenv("LOCPATH");
+      std::filesystem::remove_all(dir_);
+    }
+  }
+  std::string old_;
+  std::filesystem::path dir_;
+};
+
+TEST_F(CommaLocale, NumbersAreReadWithADecimalPointWhateverTheLocale) {
+  EXPECT_EQ(NumberOf("0.25"), 0.25);
+  EXPECT_FALSE(NumberOf("0,25").has_value());
+  EXPECT_EQ(ParseNumber("-1.5e-3", "--n"), -1.5e-3);
+  EXPECT_EQ(ErrorOf("0.5 setspeed 0.3 0\n"), "");
+  const UrdfImportResult r = ParseUrdf(R"(<robot name="r">
+  <link name="a"/><link name="b"/>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <robotalk version="1"><control_frame name="tool" link="b" servo="setpoint">
+    <origin xyz="0.05 0 0.05" rpy="0 0 1.5"/></control_frame></robotalk>
+</robot>)");
+  ASSERT_EQ(r.model.frames().size(), 1u);
+  EXPECT_DOUBLE_EQ(r.model.frame(0).pose_in_link.translation.x(), 0.05);
 }
 
 TEST(SequenceFile, ErrorsNameTheLine) {

@@ -465,6 +465,23 @@ TEST(ConfigCodec, FromMessageLeavesModelChecksToRobotModel) {
   EXPECT_THROW(FromMessage(msg), ModelError);
 }
 
+// Review 13: a CONFIG's names reached robotalk describe's table raw (a
+// forged CONFIG in open mode: anyone's terminal escapes). RobotModel refuses
+// them, so every reader of CONFIG does.
+TEST(ConfigCodec, FromMessageRefusesANameWithATerminalEscape) {
+  msgs::robot_config_t msg = ToMessage(EverythingModel());
+  std::string& name = msg.joints[1].name;  // the same length: the block offsets stand
+  ASSERT_GE(name.size(), 4u);
+  name.replace(name.size() - 4, 4, "\x1b[2J");
+  Reseal(msg);
+  try {
+    FromMessage(msg);
+    ADD_FAILURE() << "a joint name with a terminal escape was accepted";
+  } catch (const ModelError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("\\x1b[2J' holds a control character"));
+  }
+}
+
 TEST(ConfigCodec, ToMessageRefusesNamesLcmCannotCarry) {
   RobotModelBuilder b(std::string("nul\0name", 8));
   b.AddLink(Body("base"));

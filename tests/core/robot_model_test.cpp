@@ -129,6 +129,31 @@ TEST(RobotModel, RejectsDuplicateNames) {
   ExpectModelError(d, "duplicate control frame name 'tool'");
 }
 
+// Review 13: a name is shown wherever the model is (robotalk describe's
+// table, query lines, robotalk-ros2's log, logplay): a model from the wire
+// (CONFIG, in open mode anyone's) or from a URDF (&#x1b; is a valid XML
+// character reference to urdfdom's parser) put its terminal escapes and line
+// breaks on the terminal raw. Every name (robot, link, joint, control frame)
+// is refused with a control character (C0, DEL, C1 encoded in UTF-8), the
+// refusal naming it escaped; UTF-8 text is kept.
+TEST(RobotModel, RefusesANameWithAControlCharacterNamingItEscaped) {
+  RobotModelBuilder b = TwoLinkArm();
+  b.AddLink(Body("up\x1b]0;owned\x07per"));
+  ExpectModelError(b, "link name 'up\\x1b]0;owned\\x07per'", "control character");
+  RobotModelBuilder c = TwoLinkArm();
+  c.AddLink(Body("extra")).AddJoint(Revolute("el\nbow"), "base", "extra");
+  ExpectModelError(c, "joint name 'el\\x0abow'", "control character");
+  RobotModelBuilder d = TwoLinkArm();
+  d.AddControlFrame(ControlFrame{.name = "to\xc2\x9bol"}, "upper");
+  ExpectModelError(d, "control frame name 'to\\xc2\\x9bol'", "control character");
+  RobotModelBuilder e("arm\r");
+  e.AddLink(Body("base"));
+  ExpectModelError(e, "robot name 'arm\\x0d'", "control character");
+  RobotModelBuilder f("bra\xc3\xa7o");  // UTF-8 text is a name
+  f.AddLink(Body("\xc3\xa9paule"));
+  EXPECT_NO_THROW(f.Build());
+}
+
 TEST(RobotModel, RejectsAJointNamingAnUnknownLink) {
   RobotModelBuilder b = TwoLinkArm();
   b.AddJoint(Revolute("wrist"), "lower", "hand");

@@ -312,6 +312,13 @@ TEST(UrdfImport, RefusesDuplicateLinkNames) {
   EXPECT_REFUSED(Robot(Links({"a", "a"})), "duplicate link name 'a'");
 }
 
+// Review 13: an XML character reference puts a control character in a name
+// (urdfdom takes &#x1b;): refused, named escaped, as RobotModel refuses it.
+TEST(UrdfImport, RefusesANameWithATerminalEscape) {
+  EXPECT_REFUSED(Robot(Links({"a", "b"}) + JointXml("j&#x1b;]0;owned&#x7;", "fixed", "a", "b")),
+                 "joint name 'j\\x1b]0;owned\\x07'");
+}
+
 TEST(UrdfImport, RefusesDuplicateJointNames) {
   EXPECT_REFUSED(
       Robot(Links({"a", "b", "c"}) + JointXml("j", "fixed", "a", "b") + JointXml("j", "fixed", "a", "c")),

@@ -10,6 +10,9 @@
 //   forge_broadcast URL replay-announce ROBOT RECORD_S REPLAY_S
 //       records the ANNOUNCEs naming ROBOT for RECORD_S seconds (a keyed
 //       server's, signed), then sends them again, every 10 ms, for REPLAY_S.
+//   forge_broadcast URL refuse-hellos ROBOT SECONDS TEXT
+//       for SECONDS, answers every open-mode HELLO for ROBOT with a refusal
+//       whose reason is TEXT (no server behind it).
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
 #include "robotalk/request.h"
@@ -103,6 +106,23 @@ int main(int argc, char** argv) {
       lan->Publish(kAnnounceChannel, recorded[i % recorded.size()]);
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
+    return 0;
+  }
+  if (what == "refuse-hellos" && argc == 6) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[4]));
+    const std::string text = argv[5];
+    auto sub =
+        lan->Subscribe(HelloChannel(robot), [&](const std::string&, std::span<const std::uint8_t> bytes) {
+          try {
+            const Hello hello = DecodeHello(bytes);
+            HelloAnswer answer{.server_id = 1, .session_id = 0, .refusal = text};
+            answer.body.client_id = hello.body.client_id;
+            answer.body.client_nonce = hello.body.client_nonce;
+            lan->Publish(HelloAnswerChannel(robot, hello.body.client_id), EncodeHelloAnswer(answer));
+          } catch (const ProtocolError&) {
+          }
+        });
+    while (std::chrono::steady_clock::now() < until) lan->HandleFor(std::chrono::milliseconds(20));
     return 0;
   }
   std::fprintf(stderr, "forge_broadcast: unknown '%s'\n", what.c_str());

@@ -47,6 +47,17 @@ cat >"$tmp/negative_mass.urdf" <<'XML'
 XML
 bad "negative mass" "heavy" "$tmp/negative_mass.urdf"
 
+# Review 13: a name with a control character (an XML character reference) in
+# an error the importer writes before the model is built (an unknown child
+# link): the line named it raw, its terminal escape reaching the terminal.
+cat >"$tmp/escape.urdf" <<'XML'
+<robot name="x"><link name="a"/><link name="b"/>
+<joint name="j" type="fixed"><parent link="a"/><child link="gh&#x1b;]0;owned&#x7;ost"/></joint></robot>
+XML
+bad "a name with a terminal escape" 'gh\\x1b]0;owned\\x07ost' "$tmp/escape.urdf"
+check "a name with a terminal escape: no ESC or BEL reaches the terminal: $(cat -v "$tmp/err")" \
+  bash -c "! LC_ALL=C grep -q \$'\x1b\\|\x07' '$tmp/err'"
+
 # Limits (issue 9): a 100,000-deep file used to crash with SIGSEGV (rc 139).
 python3 -c "import sys; sys.stdout.write('<robot name=\"x\"><link name=\"a\"/>' + '<x>'*100000 + '</x>'*100000 + '</robot>')" >"$tmp/nested.urdf"
 bad "100,000-deep XML" "nested 100001 deep.*max_xml_depth" "$tmp/nested.urdf"

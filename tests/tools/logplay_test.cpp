@@ -2,6 +2,7 @@
 // packages encoded by the message layer in memory (no LCM), and hostile logs
 // written with LCM's log API in a temp dir.
 #include "logplay.h"
+#include "mcap_export.h"
 #include "receipt_order.h"
 #include "robotalk/channels.h"
 #include "robotalk/request.h"
@@ -386,6 +387,59 @@ TEST_F(HostileLog, RefusesLogTimestampsOutOfRangeAndNamesThem) {
   PrintInfo(log, "hostile.lcmlog", info);
   EXPECT_NE(info.str().find("2 log entries rejected"), std::string::npos) << info.str();
   EXPECT_NE(info.str().find("log timestamp"), std::string::npos) << info.str();
+}
+
+// Review 13: `robotalk-logplay export --mcap` named a log's channels and
+// robots in its warnings raw (an undecodable message's channel, a STATE's
+// robot with no logged configuration): a hostile log's terminal escapes and
+// line breaks reached the terminal, as `info`'s did before review 12. Every
+// warning line is now written in printable ASCII, one line each.
+TEST_F(HostileLog, ExportMcapsWarningsShowChannelsAndRobotsInPrintableAscii) {
+  robotalk::StateSample s;
+  s.robot = "a";
+  s.server_time = TimePoint(std::chrono::seconds(1));
+  s.sample = 1;
+  Write("ROBOTALK/a\x1b]0;owned\x07/STATE", 1'700'000'000'000'000, EncodeStateSample(s));
+  Write("ROBOTALK/b\x1b[2J\nrobotalk-logplay: forged\xc2\x9b/REQUEST", 1'700'000'000'000'001, {1, 2, 3});
+  file_.reset();  // closed: flushed
+  std::ostringstream warnings;
+  ExportMcap(path_, dir_ + "/hostile.mcap", warnings);
+  const std::string w = warnings.str();
+  EXPECT_NE(w.find("robot 'a\\x1b]0;owned\\x07'"), std::string::npos) << w;
+  EXPECT_NE(w.find("ROBOTALK/b\\x1b[2J\\x0arobotalk-logplay: forged\\xc2\\x9b/REQUEST"), std::string::npos)
+      << w;
+  for (const char c : w) {
+    if (c == '\n') continue;
+    EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "a byte outside printable ASCII: " << static_cast<int>(c) << "\n"
+                                       << w;
+  }
+}
+
+// Review 13: a command's target is anyone's bytes in a log. `extract` wrote
+// it raw into the sequence file, whose words are split at blanks and cut at
+// '#': a target "pan 0.1<LF>0.000000 setspeed 5 0 #" became a SETSPEED line
+// of its own, "pan 0.9 #" turned a set-point of 0.1 into one of 0.9, and the
+// extract's re-parse check read both files as valid. A frame whose target the
+// sequence file cannot carry as one word is refused, named in printable
+// ASCII; nothing is written.
+TEST_F(HostileLog, ATargetASequenceFileCannotCarryAsOneWordIsRefusedByExtract) {
+  for (const std::string target : {"pan 0.1\n0.000000 setspeed 5 0 #", "pan 0.9 #", "pan\t0.9", "pan#"}) {
+    SCOPED_TRACE(target);
+    Restart();
+    Write(kRequest, 1'700'000'000'000'000,
+          Package(kClient, 1, 100, kDelay, {{1, CommandType::kJointSetPoint, 5'000'000, "pan", {0.2}}}));
+    Write(kRequest, 1'700'000'000'000'001,
+          Package(kClient, 2, 200, kDelay, {{2, CommandType::kJointSetPoint, 6'000'000, target, {0.1}}}));
+    const std::vector<TimedCommand> frames = ToFrames(Read().MakeTimeline({.client_id = kClient}), {});
+    try {
+      const std::string text = FormatSequence(frames, "extracted");
+      ADD_FAILURE() << "written:\n" << text;
+    } catch (const LogError& e) {
+      EXPECT_NE(std::string(e.what()).find("frame 2 JOINT_SETPOINT: target '" + Printable(target) + "'"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 // A damaged log (review9): LCM's reader allocated what an event header

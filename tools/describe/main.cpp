@@ -2,6 +2,7 @@
 //   robotalk-describe [--json] [--strict] [--merge-chains] [--max-bytes N] [--max-depth N] FILE.urdf
 #include "describe_format.h"
 #include "robotalk/error.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 #include "robotalk/urdf_import.h"
 
 #include <cerrno>
@@ -95,16 +96,14 @@ int main(int argc, char** argv) {
     if (json) {
       robotalk::PrintModelJson(result.model, result.warnings, std::cout);
     } else {
-      for (const std::string& w : result.warnings) std::cerr << "warning: " << w << "\n";
+      for (const std::string& w : result.warnings)
+        std::cerr << "warning: " << robotalk::EscapeControls(w) << "\n";
       robotalk::PrintModelTable(result.model, std::cout);
     }
   } catch (const std::exception& e) {
-    // One line, whatever the message holds.
-    std::string message = e.what();
-    for (char& c : message) {
-      if (c == '\n') c = ' ';
-    }
-    std::cerr << "robotalk-describe: error: " << message << "\n";
+    // One line, no terminal control, whatever the message holds (a name of
+    // the file's, written with a character reference).
+    std::cerr << "robotalk-describe: error: " << robotalk::EscapeControls(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -1,6 +1,7 @@
 // robotalk-logplay: reading logs, frames and sequence files, info, CSV export.
 #include "logplay.h"
 #include "robotalk/channels.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -170,11 +171,22 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
   std::ostringstream out;
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);) out << "# " << line << "\n";
-  for (const TimedCommand& f : frames) {
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const TimedCommand& f = frames[i];
+    const std::string& target = f.command.target;
+    // The file's words are split at blanks and cut at '#': a logged target
+    // (anyone's bytes) that is not one such word would say something else.
+    if (!target.empty() && (SplitWords(target) != std::vector<std::string>{target} ||
+                            target.find('#') != std::string::npos || EscapeControls(target) != target)) {
+      throw LogError(
+          "frame " + std::to_string(i + 1) + " " + ToString(f.command.type) + ": target '" +
+          Printable(target) +
+          "' is not one word a sequence file can carry (blanks, '#' and control characters are not)");
+    }
     char offset[32];
     std::snprintf(offset, sizeof offset, "%.6f", ToSeconds(f.offset));
     out << offset << ' ' << Lower(ToString(f.command.type));
-    if (!f.command.target.empty()) out << ' ' << f.command.target;
+    if (!target.empty()) out << ' ' << target;
     for (double v : f.command.values) out << ' ' << Num(v);
     out << "\n";
   }

@@ -308,10 +308,11 @@ int main(int argc, char** argv) {
     if (command.size() > 1 && command[0] == '-') throw UsageError("unknown option '" + command + "'");
     throw UsageError("unknown command '" + command + "' (info, extract, replay, export, record)");
   } catch (const UsageError& e) {
-    std::cerr << "robotalk-logplay: " << e.what() << "\n(robotalk-logplay --help for usage)\n";
+    std::cerr << "robotalk-logplay: " << robotalk::cli::ErrorText(e.what())
+              << "\n(robotalk-logplay --help for usage)\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "robotalk-logplay: " << robotalk::cli::TidyDurations(e.what()) << "\n";
+    std::cerr << "robotalk-logplay: " << robotalk::cli::ErrorText(e.what()) << "\n";
     return 1;
   }
 }

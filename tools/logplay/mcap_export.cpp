@@ -222,13 +222,16 @@ McapExportResult ExportMcap(const std::string& log_path, const std::string& mcap
     exporter->result.log_bytes += e->data.size();
     exporter->Event(e->channel, e->timestamp_us, e->data);
   }
-  for (const std::string& d : file.damage()) warnings << "robotalk-logplay: damaged log: " << d << "\n";
+  // A log's channel and robot names are anyone's bytes: the warnings naming
+  // them are written Printable (as SessionLog shows them).
+  for (const std::string& d : file.damage())
+    warnings << "robotalk-logplay: damaged log: " << Printable(d) << "\n";
   try {
     exporter->Close();
   } catch (const Error& e) {
     throw LogError(std::string("export --mcap: ") + e.what());
   }
-  for (const std::string& w : exporter->warnings_) warnings << "robotalk-logplay: " << w << "\n";
+  for (const std::string& w : exporter->warnings_) warnings << "robotalk-logplay: " << Printable(w) << "\n";
   if (exporter->result.unposed > 0)
     warnings << "robotalk-logplay: " << exporter->result.unposed
              << " STATE samples not posed (no configuration logged before them)\n";

@@ -46,13 +46,9 @@ std::int64_t MicrosFromDouble(double v, const std::string& field) {
   return static_cast<std::int64_t>(v);
 }
 
-// A log's texts are anyone's bytes: shown in printable ASCII, every other
-// byte as \xNN (a terminal escape never reaches a terminal; Python's
-// log_info never meets a string that is not UTF-8). RoboTalk's channels and
-// robot names are printable ASCII, unchanged.
-std::string Printable(std::string_view text) { return EscapeControls(text, /*ascii_only=*/true); }
-
 }  // namespace
+
+std::string Printable(std::string_view text) { return EscapeControls(text, /*ascii_only=*/true); }
 
 std::int64_t ParseClientId(const std::string& text) {
   try {

@@ -41,9 +41,16 @@
 #include <set>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace robotalk::logplay {
+
+/// A log's texts are anyone's bytes: shown in printable ASCII, every other
+/// byte as \xNN (EscapeControls' ascii_only: a terminal escape never reaches
+/// a terminal; Python's log_info never meets a string that is not UTF-8).
+/// RoboTalk's channels and robot names are printable ASCII, unchanged.
+std::string Printable(std::string_view text);
 
 /// A log that cannot be used as asked (no such client, mixed clocks ...).
 class LogError : public Error {

@@ -1,6 +1,7 @@
 #include "robotalk/robot_model.h"
 
 #include "robotalk/error.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -28,6 +29,15 @@ std::string Vec(const Eigen::Vector3d& v) {
   return s.str();
 }
 
+// A name is shown wherever the model is (a terminal, a log): one with a
+// control character (EscapeControls' C0, DEL, C1 in UTF-8) is refused, named
+// escaped.
+std::string ControlProblem(std::string_view kind, std::string_view name) {
+  const std::string shown = EscapeControls(name);
+  if (shown == name) return {};
+  return std::string(kind) + " name " + Quote(shown) + " holds a control character";
+}
+
 template <typename T>
 std::unordered_map<std::string, int> IndexByName(const std::string& robot, const std::vector<T>& items,
                                                  const char* kind) {
@@ -35,6 +45,7 @@ std::unordered_map<std::string, int> IndexByName(const std::string& robot, const
   for (size_t i = 0; i < items.size(); ++i) {
     const std::string& name = items[i].name;
     if (name.empty()) Fail(robot, std::string(kind) + " #" + std::to_string(i) + " has an empty name");
+    if (const std::string why = ControlProblem(kind, name); !why.empty()) Fail(robot, why);
     if (!by_name.emplace(name, static_cast<int>(i)).second) {
       Fail(robot, "duplicate " + std::string(kind) + " name " + Quote(name));
     }
@@ -105,6 +116,8 @@ RobotModel::RobotModel(std::string name, std::vector<Link> links, std::vector<Jo
 
 void RobotModel::Validate() {
   if (name_.empty()) throw ModelError("RobotModel: the robot has an empty name");
+  if (const std::string why = ControlProblem("robot", name_); !why.empty())
+    throw ModelError("RobotModel: " + why);
   if (links_.empty()) Fail(name_, "has no links");
   link_by_name_ = IndexByName(name_, links_, "link");
   joint_by_name_ = IndexByName(name_, joints_, "joint");

@@ -7,6 +7,9 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <locale.h>
+#include <stdlib.h>  // strtod_l
+
 namespace robotalk {
 
 std::vector<std::string> SplitWords(const std::string& line) {
@@ -16,12 +19,17 @@ std::vector<std::string> SplitWords(const std::string& line) {
   return words;
 }
 
+double StrtodC(const char* text, char** end) {
+  static const locale_t c = newlocale(LC_NUMERIC_MASK, "C", static_cast<locale_t>(nullptr));
+  return strtod_l(text, end, c);
+}
+
 std::optional<double> NumberOf(const std::string& word) {
   if (word.empty()) return std::nullopt;
   const int saved = errno;  // as std::stod: the caller's errno survives
   errno = 0;
   char* end = nullptr;
-  const double v = std::strtod(word.c_str(), &end);
+  const double v = StrtodC(word.c_str(), &end);
   const bool whole = end == word.c_str() + word.size() && errno != ERANGE;
   errno = saved;
   if (!whole) return std::nullopt;

@@ -1,6 +1,7 @@
 #include "urdf_extensions.h"
 
 #include "robotalk/error.h"
+#include "robotalk/sequence_file.h"  // StrtodC
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -196,7 +197,7 @@ Eigen::Vector3d ParseTriple(const TiXmlElement& e, const char* attribute, const 
   for (int i = 0; i < 3; ++i) {
     char* end = nullptr;
     errno = 0;
-    v[i] = std::strtod(p, &end);
+    v[i] = StrtodC(p, &end);
     if (end == p || errno == ERANGE || !std::isfinite(v[i])) {
       Refuse(source, "<robotalk>: <" + std::string(e.Value()) + "> " + attribute + "=" + Quote(text) + At(e) +
                          " is not three finite numbers");

@@ -47,8 +47,14 @@ std::string FormatCommandWords(const Command& command);
 /// "<what>: 'cubc' is not an interpolation (step, linear, cubic, quintic)".
 Interpolation ParseInterpolationWord(const std::string& word, const std::string& what);
 
-/// The number a whole word spells (strtod's syntax, blanks before it
-/// allowed, as std::stod): nullopt when the word is empty, when anything is
+/// strtod in the C locale: a decimal point whatever the process's LC_NUMERIC
+/// (a program that sets a locale, as Python's locale.setlocale may, reads
+/// "0.25" as RoboTalk writes it). The one reader of a number's text
+/// (NumberOf; a URDF's <robotalk> triples).
+double StrtodC(const char* text, char** end);
+
+/// The number a whole word spells (strtod's syntax in the C locale, blanks
+/// before it allowed, as std::stod): nullopt when the word is empty, when anything is
 /// left after the number, or when it is out of a double's range (ERANGE:
 /// too large, and too small as well: "1e-400" is refused, not read as 0).
 /// "inf" and "nan" are numbers here (the callers refuse them). The one rule
