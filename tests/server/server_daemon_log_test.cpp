@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -361,6 +362,38 @@ TEST(LogWriterTest, LinesLostAndNotYetSaidAreSaidInALastLineWhenTheWriterEnds) {
   close(fds[0]);
   close(fds[1]);
   close(log_fd);
+}
+
+// Review 13: a process forked after its LogWriter started (robotalk-walk-sweep
+// forks a child per push; each child's ODE and driver notes go through
+// LogWriter::Stderr()) has no writer thread in the child: every line there
+// waited kMaxWait and was lost, and a fork while the writer thread held its
+// lock left the child's first Write waiting for ever. The child has a writer
+// of its own, which writes the child's lines, never the parent's again.
+TEST(LogWriterTest, AChildForkedAfterTheWriterStartedWritesItsOwnLinesOnce) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  std::string text;
+  {
+    LogWriter log("test: ", fds[1]);
+    ASSERT_TRUE(log.Write(std::string("parent before")));
+    std::fflush(nullptr);
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const bool written = log.Write(std::string("child"));
+      _exit(written && log.Flush() ? 0 : 1);
+    }
+    int status = -1;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the child's Write returned false";
+    ASSERT_TRUE(log.Write(std::string("parent after")));
+  }
+  close(fds[1]);
+  char buffer[4096];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+  close(fds[0]);
+  EXPECT_EQ(text, "test: parent before\ntest: child\ntest: parent after\n");
 }
 
 }  // namespace
