@@ -9,12 +9,74 @@
 #include <condition_variable>
 #include <csignal>
 #include <deque>
+#include <memory>
 #include <mutex>
+#include <new>
 #include <thread>
+#include <vector>
 
 namespace robotalk {
 
-struct LogWriter::State {
+namespace {
+
+// A writer's state as fork() sees it. A process that forks after a LogWriter
+// started (robotalk-walk-sweep's push children) has no writer thread in the
+// child, and may fork while that thread holds the lock: every writer's lock is
+// taken around fork() (its queue and counts consistent), and the child gets a
+// writer thread of its own, its lock and condition variables new (the
+// parent's waiters do not exist there), its queue empty (the parent's lines
+// are the parent's to write).
+struct ForkAware {
+  virtual ~ForkAware() = default;
+  virtual void LockForFork() = 0;
+  virtual void UnlockInParent() = 0;
+  virtual void RestartInChild(const std::shared_ptr<ForkAware>& self) = 0;
+};
+
+struct ForkRegistry {
+  std::mutex mu;
+  std::vector<std::weak_ptr<ForkAware>> writers;    // GUARDED_BY(mu)
+  std::vector<std::shared_ptr<ForkAware>> forking;  // from prepare to parent/child; mu held meanwhile
+};
+
+ForkRegistry& Forks() {
+  static ForkRegistry* const registry = [] {
+    auto* r = new ForkRegistry;  // never destroyed: a fork may come during static destruction
+    pthread_atfork(
+        [] {
+          ForkRegistry& f = Forks();
+          f.mu.lock();
+          for (const auto& weak : f.writers)
+            if (auto writer = weak.lock()) f.forking.push_back(std::move(writer));
+          for (const auto& writer : f.forking) writer->LockForFork();
+        },
+        [] {
+          ForkRegistry& f = Forks();
+          for (const auto& writer : f.forking) writer->UnlockInParent();
+          f.forking.clear();
+          f.mu.unlock();
+        },
+        [] {
+          ForkRegistry& f = Forks();
+          for (const auto& writer : f.forking) writer->RestartInChild(writer);
+          f.forking.clear();
+          f.mu.unlock();
+        });
+    return r;
+  }();
+  return *registry;
+}
+
+void RegisterForFork(const std::shared_ptr<ForkAware>& writer) {
+  ForkRegistry& f = Forks();
+  std::lock_guard lock(f.mu);
+  std::erase_if(f.writers, [](const std::weak_ptr<ForkAware>& w) { return w.expired(); });
+  f.writers.push_back(writer);
+}
+
+}  // namespace
+
+struct LogWriter::State : ForkAware {
   std::string prefix;
   int fd = 2;
   std::mutex mu;
@@ -80,6 +142,24 @@ struct LogWriter::State {
       written.notify_all();
     }
   }
+
+  void LockForFork() override { mu.lock(); }
+  void UnlockInParent() override { mu.unlock(); }
+  void RestartInChild(const std::shared_ptr<ForkAware>& self) override {
+    // New, not unlocked or destroyed: the parent's threads that held or
+    // waited on them do not exist here (glibc's broadcast could wait for them).
+    new (&mu) std::mutex;
+    new (&work) std::condition_variable;
+    new (&written) std::condition_variable;
+    queue.clear();
+    queued_bytes = 0;
+    done = queued;
+    dropped_unsaid = 0;
+    tell_lost = false;
+    writing = false;
+    if (stop) return;  // its last writer had ended: no thread to replace
+    DetachWithSignalsBlocked([state = std::static_pointer_cast<State>(self)] { state->Run(); });
+  }
 };
 
 bool WriteFully(int fd, std::string_view text) {
@@ -103,8 +183,11 @@ void DetachWithSignalsBlocked(std::function<void()> run) {
   sigset_t every, before;
   sigfillset(&every);
   pthread_sigmask(SIG_BLOCK, &every, &before);
+  struct Restore {  // the caller's mask back, also when the thread cannot start (it throws)
+    const sigset_t& mask;
+    ~Restore() { pthread_sigmask(SIG_SETMASK, &mask, nullptr); }
+  } restore{before};
   std::thread(std::move(run)).detach();
-  pthread_sigmask(SIG_SETMASK, &before, nullptr);
 }
 
 std::string EscapeControls(std::string_view text, bool ascii_only) {
@@ -138,6 +221,7 @@ LogWriter::LogWriter(std::string prefix, int fd) : prefix_(prefix), state_(std::
   // The thread blocks every signal: a descriptor whose reader went away
   // answers EPIPE, never SIGPIPE; and it takes no signal a program waits for
   // (SIGINT, SIGTERM), though it may start before the program blocks them.
+  RegisterForFork(state_);  // before its thread: a fork in between restarts it in the child too
   DetachWithSignalsBlocked([state = state_] { state->Run(); });
 }
 

@@ -28,7 +28,10 @@
 // written the same way: a stderr that takes nothing loses them after
 // kMaxWait, and the program still exits with its status.
 //
-// Thread safety: Write() and Flush() from any thread. The writer's state
+// Thread safety: Write() and Flush() from any thread. fork(): the child gets
+// a writer thread of its own for every writer, its queue empty (the parent's
+// lines are the parent's to write; pthread_atfork holds each writer's lock
+// around the fork). The writer's state
 // outlives the object: a destructor that cannot write what waits within
 // kMaxWait leaves the writer thread blocked, and returns.
 #pragma once
