@@ -661,7 +661,7 @@ TEST(PushRecovery, TwoPushesCloseTogetherNeverMakeTheReferenceZmpJumpNorLeaveThe
 TEST(PushRecovery, EveryRecoveryOptionKeepsTheReferenceZmpContinuousOnTwoClosePushes) {
   // The test above runs the pure RecoveryParams{}; the driver's defaults
   // (push_swing_reach) and the options off by default (push_capture,
-  // push_stop_feet, push_step_timing) re-plan through other paths
+  // push_stop_feet, push_step_timing, push_lift_reach) re-plan through other paths
   // (CaptureStop, AdaptStep): the same two close pushes must not make their
   // reference ZMP jump or leave the support either.
   struct Variant {
@@ -685,6 +685,7 @@ TEST(PushRecovery, EveryRecoveryOptionKeepsTheReferenceZmpContinuousOnTwoClosePu
       [](RecoveryParams& rp) { rp.step_timing = RecoveryParams::TimingMode::kThreshold; });
   add("push_step_timing=always",
       [](RecoveryParams& rp) { rp.step_timing = RecoveryParams::TimingMode::kAlways; });
+  add("push_lift_reach=1.5", [](RecoveryParams& rp) { rp.lift_reach = 1.5; });
   for (const Variant& v : variants) {
     const CloseSweep c = SweepTwoClosePushes(v.rp);
     std::printf("%s: %d runs, the reference ZMP's largest step %.4f m/tick (%s), outside %.2g m\n", v.name,
