@@ -132,6 +132,12 @@ struct OdeDriverOptions {
   /// equal in all 16 cells of the push sweep (seeds 1 and 2), the traces
   /// showing the moved landing reached. Key "push_swing_reach".
   double push_swing_reach = 1.0;
+  /// With push_recovery: a step the regeneration moves before it lifts (the
+  /// next to lift and the ones after it) lands at most this far per second
+  /// of its swing's horizontal move from where its foot stands before it
+  /// (RecoveryParams::lift_reach; docs/ode_sim.md, "Why the walker falls at
+  /// a quarter of the bound"), m/s; 0: off (the default). Key "push_lift_reach".
+  double push_lift_reach = 0;
   /// With push_recovery: the regeneration's footholds during the push's
   /// stop (RecoveryParams::stop_feet; docs/ode_sim.md, "Pushes and
   /// disturbances"): "move" as walking, "keep" the stop's landings stay

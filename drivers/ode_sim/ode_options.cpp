@@ -65,6 +65,7 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
   r.Bool("push_recovery", &o.push_recovery);
   r.Bool("push_capture", &o.push_capture);
   r.Number("push_swing_reach", &o.push_swing_reach, kNonNegative, "a speed >= 0 (m/s; 0: off)");
+  r.Number("push_lift_reach", &o.push_lift_reach, kNonNegative, "a speed >= 0 (m/s; 0: off)");
   if (r.Text("push_stop_feet", &o.push_stop_feet) && o.push_stop_feet != "move" &&
       o.push_stop_feet != "keep" && o.push_stop_feet != "still") {
     r.Fail("push_stop_feet", "move, keep or still");

@@ -198,6 +198,10 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error(
         "OdeDriver: push_swing_reach needs push_recovery=true (it bounds the regeneration's landings)");
   }
+  if (options.push_lift_reach > 0 && !options.push_recovery) {
+    throw Error(
+        "OdeDriver: push_lift_reach needs push_recovery=true (it bounds the regeneration's landings)");
+  }
   if (options.push_stop_feet != "move" && !options.push_recovery) {
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
@@ -222,6 +226,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   walking::RecoveryParams recovery;
   recovery.capture_stop = options.push_capture;
   recovery.swing_reach = options.push_swing_reach;
+  recovery.lift_reach = options.push_lift_reach;
   recovery.min_swing = options.push_min_swing;
   using TimingMode = walking::RecoveryParams::TimingMode;
   recovery.step_timing = options.push_step_timing == "push"        ? TimingMode::kPush

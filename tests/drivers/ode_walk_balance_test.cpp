@@ -318,6 +318,8 @@ TEST(OdeWalk, PushStepTimingReplansOnlyTheStepInTheAirAfterAPush) {
   EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
   EXPECT_FALSE(RefusalOfWalker({{"push_step_timing", "always"}}));
   EXPECT_TRUE(RefusalOfWalker({{"push_min_swing", "-0.1"}}));
+  EXPECT_TRUE(RefusalOfWalker({{"push_lift_reach", "-1"}}));
+  EXPECT_TRUE(RefusalOfWalker({{"push_lift_reach", "1"}, {"push_recovery", "false"}}));
 }
 
 // Push recovery's stop during a GOTO (on by default): the walk stops, the

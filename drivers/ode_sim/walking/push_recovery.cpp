@@ -224,6 +224,25 @@ bool WalkPattern::Regenerate(const Eigen::Vector2d& com, const Eigen::Vector2d& 
           if (to.norm() > far) now = at + to * (far / to.norm()) - plan.xy();
         }
       }
+      if (rp.lift_reach > 0 && !(i == k && in_air) && steps_[i].swing) {
+        // A step not yet in the air: within what its swing reaches from where
+        // its foot stands before it (the foot's earlier landing, moved with
+        // this regeneration's shift when it is one of its steps), then back
+        // inside the reach box (the legs' limits first).
+        Eigen::Vector2d from = steps_[i].from.xy();
+        if (i >= k + 2) from += shift[i - 2 - k];
+        const double moving =
+            0.8 * static_cast<double>(steps_[i].land - steps_[i].start) * tick_s_;  // (0.1 to 0.9)
+        const double far = std::max((plan.xy() - steps_[i].from.xy()).norm(), rp.lift_reach * moving);
+        const Eigen::Vector2d to = plan.xy() + now - from;
+        if (to.norm() > far) {
+          const Eigen::Vector2d v = from + to * (far / to.norm()) - on.xy();
+          const Eigen::Vector2d l(c * v.x() + s * v.y(), -s * v.x() + c * v.y());
+          const Eigen::Vector2d b(std::clamp(l.x(), -rp.reach_back, rp.reach),
+                                  side * std::clamp(side * l.y(), rp.min_width, rp.max_width));
+          now = on.xy() + Eigen::Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y()) - plan.xy();
+        }
+      }
       if (i == k) fits = (now - want).norm() < 1e-6;
       rest -= (now - total) / grow;
       total = now;
@@ -455,6 +474,7 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
     throw std::invalid_argument("PushRecovery: omega, tick and reach must be > 0, threshold >= 0");
   }
   if (!(p_.swing_reach >= 0)) throw std::invalid_argument("PushRecovery: swing_reach must be >= 0 (0: off)");
+  if (!(p_.lift_reach >= 0)) throw std::invalid_argument("PushRecovery: lift_reach must be >= 0 (0: off)");
   if (!(p_.stop_impulse >= 0) || (p_.stop_impulse > 0 && !(p_.stop_hold > 0))) {
     throw std::invalid_argument("PushRecovery: stop_impulse must be >= 0 (0: off) and stop_hold > 0");
   }

@@ -78,6 +78,15 @@ struct RecoveryParams {
   /// regeneration's swing_speed bounds only its own move, and moves 50 ms
   /// apart add up beyond what the legs follow.
   double swing_reach = 0;
+  /// m/s, 0: off (option push_lift_reach). A moved step not yet in the air
+  /// (the next to lift, and the ones the regeneration moves after it) lands
+  /// at most this far per second of its swing's horizontal move (0.8 of its
+  /// swing: from 0.1 to 0.9) from where its foot stands before it (or as far as its plan
+  /// had it): swing_reach bounds only the foot in the air, and a capture
+  /// step planned in double support asked the foot for 0.67 m in a 0.32 s
+  /// swing (2 m/s, peaks of 3.8) that the legs did not follow (docs/ode_sim.md,
+  /// "Why the walker falls at a quarter of the bound").
+  double lift_reach = 0;
   // A moved landing's ankle from its stance foot's ankle, in that foot's frame:
   double reach = 0.45;         ///< m: at most this far ahead
   double reach_back = 0.30;    ///< m: at most this far behind
