@@ -216,11 +216,13 @@ TEST(OdeWalk, PushSwingReachKeepsAMovedLandingWithinWhatTheSwingFootReaches) {
 // reference and the soles' heights the plan's); pushed, the named feedback
 // runs while the push's stop holds (forces: only the soles' force
 // difference height; all three: also the stabilizer's DCM, ankle and CoM
-// offsets) and afterwards returns to the plan. Bad settings are refused.
+// offsets) and afterwards returns to the plan. With the stabilizer off
+// (stabilizer=false: on by default, it would run all the time). Bad
+// settings are refused, and the stabilizer's part with the stabilizer on.
 TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
   for (const char* which : {"forces", "damping+stabilizer+forces"}) {
     const bool all = std::string(which) != "forces";
-    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}});
+    Walker w(ProjectModel("simple_humanoid.urdf"), {{"push_balance", which}, {"stabilizer", "false"}});
     w.Run(1.0);
     ASSERT_NE(w.Exec(CommandType::kSetSpeed, {1.0, 0.0}).signal, Signal::kError);
     double unpushed = 0, held = 0, dcm_held = 0, offsets_held = 0;
@@ -263,7 +265,7 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
     ASSERT_TRUE(bad) << "push_balance=" << wrong << " accepted";
     EXPECT_NE(bad->find("push_balance"), std::string::npos) << *bad;
   }
-  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "both"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "both"}, {"stabilizer", "false"}}));
   EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}}))
       << "the default push_balance (off) needs no push_recovery";
   EXPECT_TRUE(RefusalOfWalker({{"push_balance", ""}})) << "an empty push_balance";
@@ -271,7 +273,18 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
       RefusalOfWalker({{"push_balance", "damping"}, {"push_recovery", "false"}});
   ASSERT_TRUE(alone) << "push_balance without push_recovery accepted";
   EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
-  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}, {"stabilizer", "false"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "damping+forces"}})) << "no stabilizer part: accepted";
+  // The stabilizer's part only while the stop holds, with the stabilizer on always (the default): refused.
+  for (const char* both : {"stabilizer", "both", "forces+stabilizer"}) {
+    for (const char* stabilizer : {"", "true"}) {
+      std::map<std::string, std::string> options = {{"push_balance", both}};
+      if (*stabilizer != 0) options["stabilizer"] = stabilizer;
+      const std::optional<std::string> on = RefusalOfWalker(options);
+      ASSERT_TRUE(on) << "push_balance=" << both << " with the stabilizer on accepted";
+      EXPECT_NE(on->find("stabilizer=false"), std::string::npos) << *on;
+    }
+  }
 }
 
 // push_step_timing (off by default; docs/ode_sim.md, "Earlier and faster
