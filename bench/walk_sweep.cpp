@@ -9,6 +9,10 @@
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
 //                       [--after S] [--model URDF] [--option key=value]...
 // (--model: another humanoid, e.g. ../shared/robots/atlas.urdf --option base=floating.)
+// The phase sweep runs the driver's defaults (the stabilizer off; --option
+// stabilizer=true to run it); --push, --probe, --rtf and --arms set the
+// stabilizer per --stabilizer (on: true, off: false, both: each), whatever
+// the driver's default.
 //   robotalk-walk-sweep --push standing|walking|all [--stabilizer on|off|both]
 //     [--resolution N_S] [--seed S]: per direction (8, every 45 degrees, 0 = a
 //     push forward, counter-clockwise) the largest impulse on the pelvis

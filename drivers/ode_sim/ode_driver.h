@@ -99,12 +99,13 @@ struct OdeDriverOptions {
   bool walk = false;
   /// With walk=true: the DCM stabilizer closes the balance loop from the
   /// measured CoM and contact forces (docs/ode_sim.md, "Balance feedback").
-  /// Off by default. Measured at the derived gait (twelfth session): it keeps
-  /// a walker up through an arm swing that topples the open loop, tracks the
-  /// centre of pressure better (95th percentile 5.8 cm from the plan against
-  /// 12.2) and is no worse on walking pushes (132 against 124 of 384); not
-  /// the default until the checks a default needs have run (docs/ode_sim.md,
-  /// "The stabilizer against today's default"). Key "stabilizer".
+  /// Off by default. Measured at the derived gait: it keeps a walker up
+  /// through an arm swing that topples the open loop, tracks the centre of
+  /// pressure better and is no worse on the walking push sweep (twelfth
+  /// session); Atlas's seeded goals pass with it, but a GOTO pushed 8 N s
+  /// from the left early in its walk falls at 16 of 21 instants against the
+  /// open loop's 3 (thirteenth session; docs/ode_sim.md, "The stabilizer
+  /// against today's default"). Key "stabilizer".
   bool stabilizer = false;
   /// With the stabilizer: also move the foot in the air toward the capture
   /// point when the ankles saturate. Measured to make walking pushes worse
@@ -150,9 +151,10 @@ struct OdeDriverOptions {
   /// "stabilizer" (the DCM stabilizer) and "forces" (foot force difference
   /// control in double support, walking/foot_damping.h) joined by '+';
   /// "both" is damping+stabilizer. Afterwards their offsets return to the
-  /// plan (1 s, 0.5 s, 1 s). An option that is on anyway (foot_damping,
-  /// stabilizer) stays on; a value other than "off" without push_recovery
-  /// is refused. Off by default: "forces", measured better or equal in all 8
+  /// plan (1 s, 0.5 s, 1 s). foot_damping, on anyway, stays on; the
+  /// "stabilizer" part (or "both") with stabilizer=true is refused (it would
+  /// mean nothing); a value other than "off" without push_recovery is
+  /// refused. Off by default: "forces", measured better or equal in all 8
   /// directions at both seeds of the push sweep, is not shown by its traces
   /// to be the cause (its height stays under 1 mm; the runs diverge
   /// chaotically), so it stays an option. Key "push_balance".

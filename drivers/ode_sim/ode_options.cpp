@@ -139,6 +139,13 @@ void OdeDriverOptions::Validate() const {
   }
   if (solver != "step" && solver != "quickstep")
     throw Error("OdeDriver: solver = '" + solver + "', expected step or quickstep");
+  // push_balance's stabilizer runs it only while a push's stop holds: with
+  // the stabilizer on all the time it would mean nothing.
+  if (stabilizer && (push_balance == "both" || push_balance.find("stabilizer") != std::string::npos)) {
+    throw Error("OdeDriver: push_balance=" + push_balance +
+                " runs the stabilizer only while a push's stop holds, but stabilizer=true runs it "
+                "always: give stabilizer=false with it");
+  }
 }
 
 }  // namespace robotalk
