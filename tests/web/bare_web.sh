@@ -1,5 +1,5 @@
 # Sourced by the web tests that need robotalk-web serving but not its page
-# (web_fd_limit_test.sh, web_ws_cap_test.sh). REQUIRES: $tmp, a folder.
+# (web_fd_limit_test.sh, web_ws_cap_test.sh, web_http_cap_test.sh). REQUIRES: $tmp, a folder.
 # start_bare_web WEB WWW PORT LCM_PORT [NOFILE]: starts WEB on PORT (LCM on
 # udpm://239.255.76.67:LCM_PORT?ttl=0; `ulimit -n NOFILE` when given) in the
 # background, its pid in $pid and its output in $tmp/web.log, ended and $tmp
