@@ -113,9 +113,13 @@ if phase == "spare":
 sys.exit(0 if ok else 1)
 PY
 }
+said() {  # a line on stderr says connections were closed, naming the option
+  grep -q -- "--max-http-waiting" "$tmp/web.log" ||
+    { echo "FAIL ($1): no line on stderr names --max-http-waiting:"; cat "$tmp/web.log"; return 1; }
+}
 rc=0
 tmp=$(mktemp -d)
-(start_bare_web "$web" "$www" 18435 7725 64 && check 18435 out-of-descriptors) || rc=1
+(start_bare_web "$web" "$www" 18435 7725 64 && check 18435 out-of-descriptors && said out-of-descriptors) || rc=1
 tmp=$(mktemp -d)
-(start_bare_web "$web" "$www" 18437 7727 && check 18437 spare) || rc=1
+(start_bare_web "$web" "$www" 18437 7727 && check 18437 spare && said spare) || rc=1
 exit $rc
