@@ -114,7 +114,7 @@ sys.exit(0 if ok else 1)
 PY
 }
 said() {  # a line on stderr says connections were closed, naming the option
-  grep -q -- "--max-http-waiting" "$tmp/web.log" ||
+  grep -m1 -- "--max-http-waiting" "$tmp/web.log" ||
     { echo "FAIL ($1): no line on stderr names --max-http-waiting:"; cat "$tmp/web.log"; return 1; }
 }
 rc=0

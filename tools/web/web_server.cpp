@@ -110,7 +110,7 @@ class WebServer::Impl {
       if (ec == asio::error::operation_aborted) return;
       if (!ec) {
         while (waiting_.size() >= static_cast<std::size_t>(options_.max_http_waiting))
-          CloseWaiting("--max-http-waiting connections wait for a request already");
+          CloseWaiting("the limit reached");
         ReadRequest(std::make_shared<beast::tcp_stream>(std::move(socket)));
         Accept();
         return;
@@ -219,10 +219,11 @@ class WebServer::Impl {
     const auto now = std::chrono::steady_clock::now();
     if (now >= next_closed_waiting_line_) {
       next_closed_waiting_line_ = now + std::chrono::seconds(1);
-      WebLog().Write("closed the oldest HTTP connection waiting for a request of " + address.to_string() +
-                     " (" + std::to_string(most) + " of its " + std::to_string(waiting_.size() + 1) +
-                     "): " + why + " (" + std::to_string(options_.max_http_waiting) +
-                     ", --max-http-waiting; " + std::to_string(closed_waiting_) + " closed so far)");
+      WebLog().Write("closed the oldest HTTP connection waiting for a request from " + address.to_string() +
+                     ", which held " + std::to_string(most) + " of the " +
+                     std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
+                     std::to_string(options_.max_http_waiting) + "; " + std::to_string(closed_waiting_) +
+                     " closed so far)");
     }
     return true;
   }
