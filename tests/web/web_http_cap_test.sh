@@ -17,9 +17,11 @@ web=$1
 www=$2
 . "$(dirname "$0")/bare_web.sh"
 check() {  # check PORT PHASE
-  python3 - "$1" "$2" <<'PY'
-import base64, os, select, socket, sys, time
+  python3 - "$1" "$2" "$(dirname "$0")" <<'PY'
+import select, socket, sys, time
 port, phase = int(sys.argv[1]), sys.argv[2]
+sys.path.insert(0, sys.argv[3])
+import ws_upgrade
 LIMIT, FLOOD = 64, 120  # robotalk-web's default --max-http-waiting; idle connections opened
 ok = True
 
@@ -79,17 +81,13 @@ if not page.startswith("HTTP/1.1 200"):
     fail("the page does not load within 3 s")
 hello = "no answer"
 try:
-    s = socket.create_connection(("127.0.0.1", port), timeout=3)
-    key = base64.b64encode(os.urandom(16)).decode()
-    s.sendall(("GET /ws HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-               "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n\r\n" % key).encode())
-    data = b""
-    while b"hello" not in data:
+    s, hello, data = ws_upgrade.upgrade(port)
+    while "hello" not in data and " 101 " in hello:  # the page's first message
         chunk = s.recv(4096)
         if not chunk:
             break
-        data += chunk
-    hello = data.split(b"\r\n")[0].decode(errors="replace") + (" + hello" if b"hello" in data else "")
+        data += chunk.decode(errors="replace")
+    hello += " + hello" if "hello" in data else ""
     s.close()
 except OSError as e:
     hello = "%s: %s" % (type(e).__name__, e)
