@@ -12,6 +12,6 @@ start_bare_web() {
      --node-modules "$tmp/node_modules") >"$tmp/web.log" 2>&1 &
   pid=$!
   trap 'kill $pid 2>/dev/null; wait $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-  for _ in $(seq 50); do grep -q "open http" "$tmp/web.log" && break; sleep 0.1; done
+  for _ in $(seq 50); do grep -qs "open http" "$tmp/web.log" && break; sleep 0.1; done  # -s: not yet made
   grep -q "open http" "$tmp/web.log" || { echo "FAIL: robotalk-web did not start:"; cat "$tmp/web.log"; exit 1; }
 }
