@@ -202,8 +202,8 @@ class WebServer::Impl {
   }
 
   // Closes the oldest connection waiting for a request of the address that
-  // holds the most (an attacker's flood from one address never closes another
-  // address's, the operator's, while it has its own); false when none waits.
+  // holds the most (a flood from one address never closes a connection of an
+  // address holding fewer, the operator's); false when none waits.
   // One line on stderr per second at most, naming `why`.
   bool CloseWaiting(const char* why) {
     if (waiting_.empty()) return false;
