@@ -11,36 +11,15 @@ port=18433
 tmp=$(mktemp -d)
 . "$(dirname "$0")/bare_web.sh"
 start_bare_web "$1" "$2" "$port" 7723  # ROBOTALK_WEB, WWW_DIR
-python3 - "$port" <<'PY'
-import base64, os, socket, sys
+python3 - "$port" "$(dirname "$0")" <<'PY'
+import socket, sys
 port = int(sys.argv[1])
+sys.path.insert(0, sys.argv[2])
+import ws_upgrade
 LIMIT = 64  # robotalk-web's default --max-websockets
 
 def upgrade(path="/ws", protocol=None):
-    """Opens a WebSocket (standard library only); returns (socket, status line, whole answer head+body)."""
-    s = socket.create_connection(("127.0.0.1", port), timeout=3)
-    key = base64.b64encode(os.urandom(16)).decode()
-    extra = "Sec-WebSocket-Protocol: %s\r\n" % protocol if protocol else ""
-    s.sendall(("GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-               "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n%s\r\n" % (path, port, key, extra)).encode())
-    data = b""
-    while b"\r\n\r\n" not in data:
-        chunk = s.recv(4096)
-        if not chunk:
-            break
-        data += chunk
-    head = data.split(b"\r\n", 1)[0].decode(errors="replace")
-    if " 101 " not in head:  # a refusal: read its body to the end
-        s.settimeout(2)
-        try:
-            while True:
-                chunk = s.recv(4096)
-                if not chunk:
-                    break
-                data += chunk
-        except OSError:
-            pass
-    return s, head, data.decode(errors="replace")
+    return ws_upgrade.upgrade(port, path, protocol)
 
 ok = True
 held = []

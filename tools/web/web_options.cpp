@@ -52,6 +52,9 @@ std::string WebUsage() {
          "  --robot-timeout S  a robot not announced for S seconds is shown as gone (default 3)\n"
          "  --max-websockets N WebSocket clients (pages and Foxglove) open at once; one more\n"
          "                     is refused with HTTP 503 (default 64, 1-4096)\n"
+         "  --max-http-waiting N HTTP connections waiting for a request (idle, or a request\n"
+         "                     not yet whole) at once; one more closes the oldest of the\n"
+         "                     address holding most (default 64, 1-4096)\n"
          "  --www DIR          the page's files (default: share/robotalk/web/www of this\n"
          "                     installation, else tools/web/www of the sources)\n"
          "  --node-modules DIR npm modules holding three and urdf-loader (default:\n"
@@ -98,11 +101,11 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
         throw Error("--robot-timeout: " + args[i] + " s is shorter than " + shortest +
                     " s (servers announce every second)");
       }
-    } else if (a == "--max-websockets") {
+    } else if (a == "--max-websockets" || a == "--max-http-waiting") {
       const double n = ParseNumber(value(), a);
       if (n < 1 || n > 4096 || n != std::floor(n))
-        throw Error("--max-websockets: " + args[i] + " is not a whole number from 1 to 4096");
-      o.max_websockets = static_cast<int>(n);
+        throw Error(a + ": " + args[i] + " is not a whole number from 1 to 4096");
+      (a == "--max-websockets" ? o.max_websockets : o.max_http_waiting) = static_cast<int>(n);
     } else if (a == "--key") {
       o.key_file = value();
       if (o.key_file.empty()) throw Error("--key: the file name is empty");

@@ -49,6 +49,11 @@ struct WebOptions {
   /// (each holds a descriptor and its queues); one more is refused with HTTP
   /// 503 naming this limit (--max-websockets).
   int max_websockets = 64;
+  /// Plain HTTP connections waiting for a request (idle between requests, or
+  /// a request not yet whole) at once; each holds a descriptor for up to 30 s.
+  /// One more closes the oldest of the address holding the most, so a flood
+  /// of idle connections never keeps a new client out (--max-http-waiting).
+  int max_http_waiting = 64;
   bool help = false;
   bool version = false;
 };

@@ -109,14 +109,21 @@ class WebServer::Impl {
     acceptor_.async_accept([this](beast::error_code ec, tcp::socket socket) {
       if (ec == asio::error::operation_aborted) return;
       if (!ec) {
+        while (waiting_.size() >= static_cast<std::size_t>(options_.max_http_waiting))
+          CloseWaiting("the limit reached");
         ReadRequest(std::make_shared<beast::tcp_stream>(std::move(socket)));
         Accept();
         return;
       }
       // Out of descriptors (EMFILE, ENFILE; connections held open up to the
-      // limit) fails again at once: re-armed at once, this thread spun. The
-      // next try comes after a pause; the connections waiting meanwhile stay
-      // in the listen backlog.
+      // limit): a connection waiting for a request gives its descriptor to
+      // the next one in the backlog (a flood of idle connections never keeps
+      // the page and its PANIC button out); with none, the next try comes
+      // after a pause (re-armed at once, this thread spun), the connections
+      // waiting meanwhile stay in the listen backlog.
+      if ((ec == asio::error::no_descriptors || ec == boost::system::errc::too_many_files_open_in_system) &&
+          CloseWaiting("out of descriptors"))
+        return Accept();
       accept_pause_.expires_after(std::chrono::milliseconds(100));
       accept_pause_.async_wait([this](beast::error_code wait) {
         if (!wait) Accept();
@@ -128,30 +135,35 @@ class WebServer::Impl {
     auto buffer = std::make_shared<beast::flat_buffer>();
     auto req = std::make_shared<http::request<http::string_body>>();
     stream->expires_after(std::chrono::seconds(30));
-    http::async_read(*stream, *buffer, *req, [this, stream, buffer, req](beast::error_code ec, std::size_t) {
-      if (ec) return;
-      if (websocket::is_upgrade(*req) &&
-          OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets))
-        return RefuseWebSocket(stream, std::move(*req));
-      if (websocket::is_upgrade(*req) &&
-          FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
-        stream->expires_never();
-        foxglove_->Accept(stream->release_socket(), std::move(*req));
-        return;
-      }
-      if (websocket::is_upgrade(*req) &&
-          std::string_view(req->target().data(), req->target().size()) == "/ws") {
-        stream->expires_never();
-        auto session =
-            std::make_shared<WsConnection>(stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
-                                           [this](const std::shared_ptr<WsConnection>& s,
-                                                  const std::string& text, bool) { OnPageMessage(s, text); });
-        sessions_.push_back(session);
-        session->Start(std::move(*req), Greeting());
-        return;
-      }
-      Respond(stream, std::move(*req));
-    });
+    const std::uint64_t id = next_waiting_++;
+    waiting_[id] = {stream, RemoteAddress(*stream)};
+    http::async_read(*stream, *buffer, *req,
+                     [this, stream, buffer, req, id](beast::error_code ec, std::size_t) {
+                       waiting_.erase(id);
+                       if (ec) return;
+                       if (websocket::is_upgrade(*req) &&
+                           OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets))
+                         return RefuseWebSocket(stream, std::move(*req));
+                       if (websocket::is_upgrade(*req) &&
+                           FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
+                         stream->expires_never();
+                         foxglove_->Accept(stream->release_socket(), std::move(*req));
+                         return;
+                       }
+                       if (websocket::is_upgrade(*req) &&
+                           std::string_view(req->target().data(), req->target().size()) == "/ws") {
+                         stream->expires_never();
+                         auto session = std::make_shared<WsConnection>(
+                             stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
+                             [this](const std::shared_ptr<WsConnection>& s, const std::string& text, bool) {
+                               OnPageMessage(s, text);
+                             });
+                         sessions_.push_back(session);
+                         session->Start(std::move(*req), Greeting());
+                         return;
+                       }
+                       Respond(stream, std::move(*req));
+                     });
   }
 
   // The page's open WebSockets and Foxglove's: what --max-websockets bounds.
@@ -187,6 +199,39 @@ class WebServer::Impl {
       beast::error_code ignored;
       stream->socket().shutdown(tcp::socket::shutdown_both, ignored);
     });
+  }
+
+  // Closes the oldest connection waiting for a request of the address that
+  // holds the most (a flood from one address never closes a connection of an
+  // address holding fewer, the operator's); false when none waits.
+  // One line on stderr per second at most, naming `why`.
+  bool CloseWaiting(const char* why) {
+    if (waiting_.empty()) return false;
+    std::map<asio::ip::address, std::size_t> per_address;
+    std::size_t most = 0;
+    for (const auto& [id, w] : waiting_) most = std::max(most, ++per_address[w.address]);
+    auto it = waiting_.begin();
+    while (per_address[it->second.address] != most) ++it;
+    const asio::ip::address address = it->second.address;
+    if (const auto stream = it->second.stream.lock()) stream->close();
+    waiting_.erase(it);
+    ++closed_waiting_;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= next_closed_waiting_line_) {
+      next_closed_waiting_line_ = now + std::chrono::seconds(1);
+      WebLog().Write("closed the oldest HTTP connection waiting for a request from " + address.to_string() +
+                     ", which held " + std::to_string(most) + " of the " +
+                     std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
+                     std::to_string(options_.max_http_waiting) + "; " + std::to_string(closed_waiting_) +
+                     " closed so far)");
+    }
+    return true;
+  }
+
+  static asio::ip::address RemoteAddress(beast::tcp_stream& stream) {
+    beast::error_code ec;
+    const tcp::endpoint ep = stream.socket().remote_endpoint(ec);
+    return ec ? asio::ip::address() : ep.address();
   }
 
   static std::string Peer(beast::tcp_stream& stream) {
@@ -380,6 +425,15 @@ class WebServer::Impl {
   std::vector<std::shared_ptr<WsConnection>> sessions_;
   std::uint64_t refused_websockets_ = 0;                       // past --max-websockets
   std::chrono::steady_clock::time_point next_refusal_line_{};  // of RefuseWebSocket's stderr line
+  // Connections waiting for a request (ReadRequest), by age: what --max-http-waiting bounds.
+  struct Waiting {
+    std::weak_ptr<beast::tcp_stream> stream;
+    asio::ip::address address;
+  };
+  std::map<std::uint64_t, Waiting> waiting_;
+  std::uint64_t next_waiting_ = 0;
+  std::uint64_t closed_waiting_ = 0;                                  // by CloseWaiting
+  std::chrono::steady_clock::time_point next_closed_waiting_line_{};  // of CloseWaiting's stderr line
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
   std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start
