@@ -152,7 +152,7 @@ class RobotClient::Impl {
   client::ConfigStore configs_;                                  // GUARDED_BY(mu_)
   std::string last_config_error_;                                // GUARDED_BY(mu_)
   std::unordered_set<std::int64_t> clock_packages_;              // GUARDED_BY(mu_)
-  std::unordered_set<std::int64_t> ack_waited_;                  // GUARDED_BY(mu_): panics
+  std::unordered_map<std::int64_t, TimePoint> ack_waited_;       // GUARDED_BY(mu_): panics, when sent
   std::unordered_map<std::int64_t, PanicAnswer> panic_answers_;  // GUARDED_BY(mu_)
   std::exception_ptr daemon_error_;                              // GUARDED_BY(mu_)
   ClientStats stats_;                                            // GUARDED_BY(mu_)

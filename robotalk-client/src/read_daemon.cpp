@@ -203,7 +203,7 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     for (CommandId i : sent.ids) cache_->Expect(i);
     outstanding_.Add(sent.sequence, bytes, std::move(items), now);
     if (options.clock_query) clock_packages_.insert(sent.sequence);
-    if (options.panic) ack_waited_.insert(sent.sequence);
+    if (options.panic) ack_waited_.emplace(sent.sequence, now);
     last_send_ = now;
     ++stats_.packages_sent;
   }
@@ -477,26 +477,63 @@ void RobotClient::Impl::FailLost(const std::vector<CommandId>& lost) {
   if (!lost.empty()) WakeDaemon();  // say hello again at once
 }
 
+// A signed ANNOUNCE of this client's robot from another server instance,
+// while a panic waits, says the session is gone (a restart; a forged flood
+// may keep the new instance's SESSION_UNKNOWN answer from reaching us). It
+// is believed only for a panic that went unanswered for the retransmission
+// timeout: a replay of an earlier instance's ANNOUNCE (signed, so it passes)
+// must not end a live session whose server answers at once (final13: before,
+// a replay every 20 us made a taken panic look refused). The cheap checks
+// (decode, instance, robot) come before the signature's, which runs outside
+// mu_: a flood of forged ANNOUNCEs never holds the client's lock.
 void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
-  std::vector<CommandId> lost;
+  PublicKey key;
+  std::int64_t session = 0, server = 0;
+  std::string robot;
   {
     std::lock_guard lock(mu_);
     if (ack_waited_.empty() || session_id_ == 0 || !trust_ || !trust_->trusted()) return;
-    // The key is compared before the signature is verified: others' cost nothing.
-    const std::optional<HeardAnnouncement> heard = HearAnnouncement(bytes, &*trust_->trusted());
-    if (!heard || heard->announcement.server_id == server_id_) return;
-    const std::vector<RobotAnnouncement>& robots = heard->announcement.robots;
-    if (std::none_of(robots.begin(), robots.end(),
-                     [&](const RobotAnnouncement& r) { return r.name == robot_; }))
+    const TimePoint now = clock_.Now();
+    const Duration rto = outstanding_.retransmit_timeout();
+    if (std::none_of(ack_waited_.begin(), ack_waited_.end(),
+                     [&](const auto& waited) { return now - waited.second >= rto; }))
       return;
-    for (const std::int64_t sequence : ack_waited_) {
+    key = *trust_->trusted();
+    session = session_id_;
+    server = server_id_;
+    robot = robot_;
+  }
+  Announcement decoded;
+  try {
+    decoded = DecodeAnnouncement(bytes);
+  } catch (const ProtocolError&) {
+    return;
+  }
+  const auto names_robot = [&](const Announcement& a) {
+    return std::any_of(a.robots.begin(), a.robots.end(),
+                       [&](const RobotAnnouncement& r) { return r.name == robot; });
+  };
+  if (decoded.server_id == server || !names_robot(decoded)) return;
+  const std::optional<HeardAnnouncement> heard = HearAnnouncement(bytes, &key);
+  if (!heard || heard->announcement.server_id == server || !names_robot(heard->announcement)) return;
+  std::vector<CommandId> lost;
+  {
+    std::lock_guard lock(mu_);
+    if (session_id_ != session || server_id_ != server) return;  // the session changed meanwhile
+    const TimePoint now = clock_.Now();
+    const Duration rto = outstanding_.retransmit_timeout();
+    bool any = false;
+    for (const auto& [sequence, sent] : ack_waited_) {
+      if (now - sent < rto) continue;
+      any = true;
       panic_answers_.try_emplace(
           sequence, PanicAnswer{.refusal = "the server restarted (its signed ANNOUNCE names instance " +
                                            Hex64(static_cast<std::uint64_t>(heard->announcement.server_id)) +
                                            ") and has no session of this client",
                                 .session_unknown = true});
     }
-    lost = LoseSession(clock_.Now());
+    if (!any) return;
+    lost = LoseSession(now);
   }
   cv_.notify_all();  // the waiting panic: sent again in a new session
   FailLost(lost);

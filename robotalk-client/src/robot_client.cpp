@@ -423,18 +423,27 @@ std::vector<PendingReply> RobotClient::SendBatch(std::vector<Command> commands, 
 void RobotClient::Panic() {
   RequireConnected(*this, "Panic");
   const auto deadline = SteadyAfter(impl_->options_.timeout);
-  for (int attempt = 1;; ++attempt) {
+  std::string unknown;  // the last "session unknown" answer, if any
+  for (;;) {
     auto sent = impl_->SendPackage({}, {}, {.panic = true});
     const auto answer = impl_->WaitPanicAnswer(sent.sequence, deadline);
     if (!answer) {
       throw TimeoutError("RobotClient::Panic: panic package " + std::to_string(sent.sequence) +
                          " not answered by robot '" + robot() + "' within " +
-                         std::to_string(ToSeconds(impl_->options_.timeout)) + " s");
+                         std::to_string(ToSeconds(impl_->options_.timeout)) + " s" +
+                         (unknown.empty() ? ""
+                                          : " (each earlier attempt's session was unknown: " + unknown +
+                                                "); whether the robot is in panic is not known"));
     }
     if (answer->taken) return;
     // Keyed mode: the session was gone (a restarted server); the client says
-    // hello again and the panic goes out once more, in the new session.
-    if (answer->session_unknown && impl_->identity_ && attempt == 1) continue;
+    // hello again and the panic goes out once more, in the new session, as
+    // often as the timeout allows: "session unknown" says nothing of whether
+    // the robot is in panic, so it is never reported as a refusal.
+    if (answer->session_unknown && impl_->identity_) {
+      unknown = answer->refusal;
+      continue;
+    }
     throw PanicRefusedError(
         "RobotClient::Panic: robot '" + robot() +
         "' refused the panic (the robot is NOT in panic because of it): " + answer->refusal);
