@@ -144,7 +144,8 @@ void OdeDriverOptions::Validate() const {
   if (stabilizer && (push_balance == "both" || push_balance.find("stabilizer") != std::string::npos)) {
     throw Error("OdeDriver: push_balance=" + push_balance +
                 " runs the stabilizer only while a push's stop holds, but stabilizer=true runs it "
-                "always: give stabilizer=false with it");
+                "always: give stabilizer=false with it, or drop its stabilizer part (e.g. "
+                "push_balance=damping)");
   }
 }
 

@@ -64,7 +64,17 @@ std::string TidyDurations(const std::string& message) {
   return out + message.substr(last);
 }
 
-std::string ErrorText(const std::string& message) { return EscapeControls(TidyDurations(message)); }
+std::string ErrorText(const std::string& message) {
+  // A line break followed by an indent is kept (the client's own blocks: the
+  // "key has CHANGED" warning); every other control character is escaped, so
+  // a text of anyone's inside an error never begins a line of its own.
+  const std::string tidy = TidyDurations(message);
+  std::string out;
+  std::size_t start = 0;
+  for (std::size_t at; (at = tidy.find("\n  ", start)) != std::string::npos; start = at + 1)
+    out += EscapeControls(std::string_view(tidy).substr(start, at - start)) + "\n";
+  return out + EscapeControls(std::string_view(tidy).substr(start));
+}
 
 std::string ProgressBar(const RunProgress& p, int width) {
   const double total_s = ToSeconds(p.duration);

@@ -103,10 +103,12 @@ inline std::string FormatDuration(Duration d) { return FormatSeconds(ToSeconds(d
 /// Rewrites every "<number>.<digits> s" in a message to FormatSeconds form
 /// ("no reply within 5.000000 s" -> "no reply within 5 s").
 std::string TidyDurations(const std::string& message);
-/// An error's text as the tools print it: TidyDurations, on one line with
-/// its control characters as \xNN (EscapeControls). It may hold a server's
-/// text (in open mode anyone's: a hello's refusal, a STOP's reply message),
-/// as a reply's message does (PrintReply).
+/// An error's text as the tools print it: TidyDurations, its control
+/// characters as \xNN (EscapeControls), but a line break followed by two
+/// blanks kept (an indented continuation line, never one that looks like a
+/// line of its own). It may hold a server's text (in open mode anyone's: a
+/// hello's refusal, a STOP's reply message), as a reply's message does
+/// (PrintReply).
 std::string ErrorText(const std::string& message);
 
 /// A one-line progress bar "[#####.....]  12/40  3.2 s / 8 s" of `width` cells.

@@ -39,7 +39,7 @@ std::string ServerTrust::Check(const PublicKey& offered) const {
       const std::string line = pin_file_.string() + ":" + std::to_string(pin_line_);
       return "WARNING: " + where + ": the server's key has CHANGED.\n  pinned (" + line +
              "): " + trusted_->Fingerprint() + "\n  this server's key: " + offered.Fingerprint() +
-             "\nAnother process may be impersonating the server, or the server was given a new key. "
+             "\n  Another process may be impersonating the server, or the server was given a new key. "
              "If you know that it was, delete line " +
              std::to_string(pin_line_) + " of " + pin_file_.string() +
              " (the next connection pins the new key), or give the server's key with --server-key FILE.pub. "

@@ -83,5 +83,17 @@ TEST(Json, ARobotListNamesTheBaseTypeAndNullForAnUnsignedAnnouncement) {
       R"("panic":false,"clients":2,"server":"0000000000000001","server_key":null}])");
 }
 
+// final13: ErrorText escaped every line break, so the client's own
+// SSH-style "key has CHANGED" block reached the user as one line of \x0a.
+// An indented continuation line is kept; any other break, and every other
+// control character, is escaped (a server's text never begins a line).
+TEST(ErrorText, KeepsIndentedContinuationLinesAndEscapesEveryOtherBreak) {
+  EXPECT_EQ(ErrorText("WARNING: key has CHANGED.\n  pinned: rt:1\n  this server's key: rt:2"),
+            "WARNING: key has CHANGED.\n  pinned: rt:1\n  this server's key: rt:2");
+  EXPECT_EQ(ErrorText("no\nrobotalk: forged\x1b]0;x\x07"), "no\\x0arobotalk: forged\\x1b]0;x\\x07");
+  EXPECT_EQ(ErrorText("a\n  b\x1b\nc"), "a\n  b\\x1b\\x0ac");
+  EXPECT_EQ(ErrorText("no reply within 5.000000 s"), "no reply within 5 s");
+}
+
 }  // namespace
 }  // namespace robotalk::cli

@@ -158,7 +158,11 @@ struct LogWriter::State : ForkAware {
     tell_lost = false;
     writing = false;
     if (stop) return;  // its last writer had ended: no thread to replace
-    DetachWithSignalsBlocked([state = std::static_pointer_cast<State>(self)] { state->Run(); });
+    try {
+      DetachWithSignalsBlocked([state = std::static_pointer_cast<State>(self)] { state->Run(); });
+    } catch (...) {  // no thread to be had (a pids limit): the child's lines are lost, never its fork
+      stop = true;
+    }
   }
 };
 
