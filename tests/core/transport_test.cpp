@@ -9,8 +9,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <poll.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -338,6 +341,58 @@ TEST(LcmTransport, ThrowsNamingTheUrlWhenLcmCannotStart) {
 TEST(LcmTransport, ReportsItsUrl) {
   LcmTransport t(LcmTransportOptions{.url = "memq://"});
   EXPECT_EQ(t.url(), "memq://");
+}
+
+// final13: LcmTransport swapped descriptor 2 (the whole process's) for a
+// pipe while every transport started, so another thread's stderr lines
+// meanwhile were taken for LCM's ("LCM: ...", or inside a TransportError
+// as "LCM says: ..."): 42 of 52 in a probe. With a stderr that takes lines
+// it is left alone; each of the other thread's lines reaches it as written.
+TEST(LcmTransport, AnotherThreadsStderrLinesAreNeverTakenForLcmsWhileTransportsStart) {
+  char path[] = "/tmp/robotalk_stderr_XXXXXX";
+  const int file = mkstemp(path);
+  ASSERT_GE(file, 0);
+  std::fflush(stderr);
+  const int saved = dup(2);
+  ASSERT_EQ(dup2(file, 2), 2);
+  std::atomic<bool> stop{false};
+  std::atomic<int> written{0};
+  std::thread other([&] {
+    while (!stop && written < 100000) {
+      const std::string line = "other thread's line " + std::to_string(written.load()) + "\n";
+      if (write(2, line.data(), line.size()) != static_cast<ssize_t>(line.size())) break;
+      ++written;
+    }
+  });
+  while (written < 100) std::this_thread::yield();  // writing before the first start
+  int failed_with_other = 0;
+  for (int i = 0; i < 400 && !stop; ++i) {
+    LcmTransport ok(LcmTransportOptions{.url = "memq://"});
+    auto sub = ok.Subscribe("X", [](const std::string&, std::span<const std::uint8_t>) {});
+    try {
+      LcmTransport bad(LcmTransportOptions{.url = "nosuchprovider://x"});
+    } catch (const TransportError& e) {
+      failed_with_other += std::string(e.what()).find("other thread") != std::string::npos;
+    }
+  }
+  stop = true;
+  other.join();
+  std::fflush(stderr);
+  dup2(saved, 2);
+  close(saved);
+  std::string text;
+  char buffer[4096];
+  lseek(file, 0, SEEK_SET);
+  for (ssize_t n; (n = read(file, buffer, sizeof buffer)) > 0;)
+    text.append(buffer, static_cast<std::size_t>(n));
+  close(file);
+  unlink(path);
+  EXPECT_EQ(failed_with_other, 0) << "a TransportError held another thread's line";
+  EXPECT_EQ(text.find("LCM: other"), std::string::npos) << "another thread's line taken for LCM's";
+  int missing = 0;
+  for (int i = 0; i < written; ++i)
+    missing += text.find("other thread's line " + std::to_string(i) + "\n") == std::string::npos;
+  EXPECT_EQ(missing, 0) << "of " << written << " lines";
 }
 
 }  // namespace
