@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <lcm/lcm.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -52,18 +53,22 @@ extern "C" void OnLcmMessage(const lcm_recv_buf_t* rbuf, const char* channel, vo
   }
 }
 
-// LCM writes why it cannot start (a bad URL, "LCM self test failed") to
-// stderr itself, with fprintf: a stderr that takes nothing (a full pipe, a
-// terminal stopped with Ctrl-S) held lcm_create, and with it the program's
-// start, for ever. While this lives, descriptor 2 is a non-blocking pipe of
-// its own (64 KiB; past that LCM's writes fail, never wait); Take() puts
-// stderr back and returns what was written, for the caller to say through
-// LogWriter (or in its error). Anything another thread wrote to stderr
-// meanwhile is taken too (said after, not lost). If it cannot be set up,
-// stderr stays as it was.
+// LCM writes why it cannot start (a bad URL in lcm_create; "LCM self test
+// failed" in the first lcm_subscribe, where it starts receiving) to stderr
+// itself, with fprintf: a stderr that takes nothing (a full pipe, a terminal
+// stopped with Ctrl-S) held the program's start for ever. Only then, while
+// the call runs, descriptor 2 is a non-blocking pipe of its own (64 KiB;
+// past that LCM's writes fail, never wait); Take() puts stderr back and
+// returns what was written, for the caller to say through LogWriter (or in
+// its error). Anything another thread wrote to stderr meanwhile is taken too
+// (said after, not lost). A stderr that takes a line now is left alone (the
+// dup2 is the whole process's: other threads' lines must not be taken for
+// LCM's), and so is one it cannot set up.
 class StderrCapture {
  public:
   StderrCapture() {
+    pollfd out{2, POLLOUT, 0};
+    if (::poll(&out, 1, 0) == 1 && out.revents == POLLOUT) return;  // stderr takes a line now
     int p[2];
     if (::pipe2(p, O_CLOEXEC | O_NONBLOCK) != 0) return;
     std::fflush(stderr);
@@ -114,6 +119,32 @@ std::vector<std::string> LinesOf(const std::string& text) {
   return lines;
 }
 
+// Runs `call` (an LCM function that may write to stderr) under a
+// StderrCapture, one at a time (another's would save this one's pipe as
+// stderr); returns LCM's lines.
+template <class Call>
+std::vector<std::string> WithLcmStderr(const Call& call) {
+  static std::mutex capture_mu;
+  const std::lock_guard lock(capture_mu);
+  StderrCapture capture;
+  call();
+  return LinesOf(capture.Take());
+}
+
+// LCM's lines from a call that succeeded: through the process's writer of stderr.
+void SayLcmLines(std::vector<std::string> said) {
+  if (said.empty()) return;
+  for (std::string& line : said) line = "LCM: " + line;
+  LogWriter::Stderr().Write(said);
+}
+
+// LCM's lines from a call that failed, as the end of its error.
+std::string LcmSaid(const std::vector<std::string>& said) {
+  std::string why;
+  for (const std::string& line : said) why += (why.empty() ? "" : "; ") + line;
+  return why.empty() ? "" : ": LCM says: " + EscapeControls(why);
+}
+
 }  // namespace
 
 namespace internal {
@@ -122,27 +153,14 @@ class LcmCore {
  public:
   explicit LcmCore(const LcmTransportOptions& options)
       : options_(options), url_(LcmTransport::EffectiveUrl(options)) {
-    std::vector<std::string> said;
-    {
-      // One capture at a time: another's would save this one's pipe as stderr.
-      static std::mutex create_mu;
-      const std::lock_guard lock(create_mu);
-      StderrCapture capture;
-      lcm_ = lcm_create(url_.empty() ? nullptr : url_.c_str());
-      said = LinesOf(capture.Take());
-    }
+    const std::vector<std::string> said =
+        WithLcmStderr([&] { lcm_ = lcm_create(url_.empty() ? nullptr : url_.c_str()); });
     if (lcm_ == nullptr) {
-      std::string why;
-      for (const std::string& line : said) why += (why.empty() ? "" : "; ") + line;
       throw TransportError("LcmTransport: LCM could not start on " +
                            (url_.empty() ? std::string("its default URL") : "'" + url_ + "'") +
-                           " (bad URL, or no route for its multicast group?)" +
-                           (why.empty() ? "" : ": LCM says: " + EscapeControls(why)));
+                           " (bad URL, or no route for its multicast group?)" + LcmSaid(said));
     }
-    if (!said.empty()) {  // LCM started, and said something: through the process's writer of stderr
-      for (std::string& line : said) line = "LCM: " + line;
-      LogWriter::Stderr().Write(said);
-    }
+    SayLcmLines(said);
   }
   ~LcmCore() { lcm_destroy(lcm_); }
 
@@ -201,10 +219,14 @@ std::unique_ptr<Subscription> LcmTransport::Subscribe(const std::string& channel
   entry->handler = std::make_shared<const Handler>(std::move(handler));
   entry->error = &impl_->error_;
   entry->received_us = &impl_->received_us_;
-  lcm_subscription_t* sub = lcm_subscribe(impl_->lcm_, channel_regex.c_str(), &OnLcmMessage, entry.get());
+  lcm_subscription_t* sub = nullptr;
+  const std::vector<std::string> said = WithLcmStderr(
+      [&] { sub = lcm_subscribe(impl_->lcm_, channel_regex.c_str(), &OnLcmMessage, entry.get()); });
   if (sub == nullptr) {
-    throw TransportError("LcmTransport: cannot subscribe '" + channel_regex + "' on " + url());
+    throw TransportError("LcmTransport: cannot subscribe '" + channel_regex + "' on " + url() +
+                         LcmSaid(said));
   }
+  SayLcmLines(said);
   lcm_subscription_set_queue_capacity(sub, impl_->options_.queue_capacity);
   return std::make_unique<LcmSubscription>(impl_, sub, std::move(entry));
 }
