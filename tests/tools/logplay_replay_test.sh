@@ -136,6 +136,10 @@ check "commands.csv labels the delay session delay (issue 20)" \
   test "$(grep -c ',pioneer,[0-9]*,delay,' "$tmp/export/commands.csv")" -eq 7
 check "state.csv has the samples" test "$(grep -c '^pioneer,' "$tmp/export/state.csv")" -gt 40
 [ -z "$plot" ] && check "the PNG was written" test -s "$tmp/export/session.png"
+if [ -z "$plot" ]; then  # the plot's arguments are words, no shell's (before: a quote broke the command)
+  "$logplay" export "$tmp/session.lcmlog" -o "$tmp/it's here" >"$tmp/export_quote.out" 2>&1
+  check "export to a directory named with a quote writes the PNG too" test -s "$tmp/it's here/session.png"
+fi
 check "state.csv names the joints from the logged configuration (issue 21)" \
   grep -q '^robot,.*,omega,left_wheel_joint,right_wheel_joint,pan,tilt$' "$tmp/export/state.csv"
 check "joints.csv gives their units" grep -q '^pioneer,2,pan,rad,config$' "$tmp/export/joints.csv"
