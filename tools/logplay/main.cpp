@@ -7,9 +7,13 @@
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -253,6 +257,36 @@ int RunExportMcap(Args& a, const std::string& out) {
   return 0;
 }
 
+// Runs argv[0] (found in PATH) with `argv` and waits for it; true when it
+// exits 0. Its arguments are words, never a shell's (a directory named with
+// a quote stays one argument), and it starts with no signal blocked and
+// SIGINT/SIGTERM at their defaults: this tool blocks them for its
+// Interrupter, which std::system's child inherited (a Ctrl-C ended the tool,
+// the plot ran on).
+bool RunToEnd(const std::vector<std::string>& argv) {
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t none, defaults;
+  sigemptyset(&none);
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGINT);
+  sigaddset(&defaults, SIGTERM);
+  posix_spawnattr_setsigmask(&attr, &none);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, args[0], nullptr, &attr, args.data(), environ);
+  posix_spawnattr_destroy(&attr);
+  if (spawned != 0) return false;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
 int RunExport(Args& a) {
   if (auto mcap = a.One("--mcap")) return RunExportMcap(a, *mcap);
   const std::string dir = a.One("-o").value_or("logplay_export");
@@ -265,9 +299,11 @@ int RunExport(Args& a) {
   const std::string png = dir + "/session.png";
   // Debian's python3 (with python3-matplotlib), even when another python3 comes first in PATH.
   const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = python + " '" + PlotScript() + "' '" + dir + "/commands.csv' '" + dir +
-                              "/state.csv' '" + png + "' '" + dir + "/joints.csv'";
-  if (std::system(command.c_str()) != 0) {
+  const std::vector<std::string> argv{python, PlotScript(),       dir + "/commands.csv", dir + "/state.csv",
+                                      png,    dir + "/joints.csv"};
+  if (!RunToEnd(argv)) {
+    std::string command;
+    for (const std::string& a : argv) command += (command.empty() ? "" : " ") + a;
     std::cerr << "robotalk-logplay: the plot failed (needs python3-matplotlib): " << command << "\n";
     return 1;
   }
