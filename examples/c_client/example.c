@@ -22,10 +22,34 @@ static const double kFrameSpacing = 0.25; /* s between the sequence's frames */
 #define TRAJECTORY_POINTS 3
 static const double kPointSpacing = 0.2; /* s between the trajectory's waypoints */
 
+/* A server's text (a reply's message, an error naming what it sent) is
+   anyone's bytes in open mode: written with its control characters (C0,
+   DEL, C1 in UTF-8) as \xNN, it never forges a line nor reaches the
+   terminal as an escape, as the robotalk CLI writes it. */
+static void put_text(FILE* f, const char* s) {
+  for (; *s; ++s) {
+    const unsigned char u = (unsigned char)*s, next = (unsigned char)s[1];
+    if (u == 0xc2 && next >= 0x80 && next <= 0x9f) {
+      fprintf(f, "\\x%02x\\x%02x", u, next);
+      ++s;
+    } else if (u < 0x20 || u == 0x7f) {
+      fprintf(f, "\\x%02x", u);
+    } else {
+      fputc(u, f);
+    }
+  }
+}
+
 static void print_reply(const char* what, const rtc_reply* r) {
-  printf("reply %" PRId64 " %s: %s%s%s exec_us=%" PRId64 " late_ms=%.1f\n", r->id, what,
-         rtc_signal_name(r->signal), r->message[0] ? " " : "", r->message, r->exec_time_us,
-         r->lateness_us / 1000.0);
+  printf("reply %" PRId64 " %s: %s%s", r->id, what, rtc_signal_name(r->signal), r->message[0] ? " " : "");
+  put_text(stdout, r->message);
+  printf(" exec_us=%" PRId64 " late_ms=%.1f\n", r->exec_time_us, r->lateness_us / 1000.0);
+}
+
+static void print_error(const char* text) {
+  fputs("error: ", stderr);
+  put_text(stderr, text);
+  fputc('\n', stderr);
 }
 
 static int query(rtc_client* c, int8_t type, const char* target, rtc_reply* out) {
@@ -182,7 +206,7 @@ int main(int argc, char** argv) {
   if (key_file && !key_file[0]) key_file = NULL;
   rtc_client* c = rtc_connect_keyed(url, robot, key_file, server_key_file, 5.0, err, sizeof err);
   if (!c) {
-    fprintf(stderr, "error: %s\n", err);
+    print_error(err);
     return 1;
   }
   printf("connected: robot=%s server=%016" PRIx64 " layout=%s session=%016" PRIx64 " client=%016" PRIx64
@@ -190,7 +214,7 @@ int main(int argc, char** argv) {
          robot, (uint64_t)rtc_server_id(c), rtc_split_layout(c) ? "split" : "single",
          (uint64_t)rtc_session_id(c), (uint64_t)rtc_client_id(c), key_file ? " keyed" : "");
   int rc = run(c, delay_s, pause_s);
-  if (rc != 0 && rtc_error(c)[0]) fprintf(stderr, "error: %s\n", rtc_error(c));
+  if (rc != 0 && rtc_error(c)[0]) print_error(rtc_error(c));
   printf("%s\n", rc == 0 ? "done" : "failed");
   rtc_close(c);
   return rc == 0 ? 0 : 1;
