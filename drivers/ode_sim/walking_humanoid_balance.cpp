@@ -161,6 +161,8 @@ walking::WalkStatus WalkingHumanoid::status() const {
   s.push_stops = recovery_ ? recovery_->stops() : 0;
   s.push_captures = recovery_ ? recovery_->captures() : 0;
   s.push_timings = recovery_ ? recovery_->timings() : 0;
+  if (recovery_) s.push_impulse = com_estimate_->impulse();
+  s.push_holding = PushHolding();
   const Pose2 com = ToWorld({pattern_.com().x(), pattern_.com().y(), 0});
   s.com_plan = com.xy();
   const Eigen::Vector2d z = pattern_.zmp_ref();
