@@ -66,11 +66,15 @@ struct WalkStatus {
   Eigen::Vector2d com_offset = Eigen::Vector2d::Zero();   ///< CoM reference minus the plan's (world axes), m
   /// push_balance's forces: the left sole's target raised by half of it and the right's lowered, m
   double force_difference = 0;
-  int recoveries = 0;      ///< push recoveries so far (walking/push_recovery.h: the pattern regenerated)
-  int push_stops = 0;      ///< walks stopped by a push so far (push_recovery's stop and stand)
-  int push_captures = 0;   ///< push_capture=true: the capture stop's re-plans so far
-  int push_timings = 0;    ///< push_step_timing: the step timing's re-plans so far
-  bool saturated = false;  ///< the ZMP the stabilizer wanted lay outside the support
+  int recoveries = 0;     ///< push recoveries so far (walking/push_recovery.h: the pattern regenerated)
+  int push_stops = 0;     ///< walks stopped by a push so far (push_recovery's stop and stand)
+  int push_captures = 0;  ///< push_capture=true: the capture stop's re-plans so far
+  int push_timings = 0;   ///< push_step_timing: the step timing's re-plans so far
+  /// push_recovery: the push the DcmEstimator reads (its impulse(), world axes, m/s); past
+  /// stop_impulse it stops the walk, or holds the stop on
+  Eigen::Vector2d push_impulse = Eigen::Vector2d::Zero();
+  bool push_holding = false;  ///< push_recovery: a push's stop holds (the walk waits)
+  bool saturated = false;     ///< the ZMP the stabilizer wanted lay outside the support
 };
 
 }  // namespace robotalk::walking
