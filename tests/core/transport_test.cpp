@@ -6,9 +6,11 @@
 #include "robotalk/memory_transport.h"
 #include "robotalk_msgs/reply_t.hpp"
 
+#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <poll.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -393,6 +395,39 @@ TEST(LcmTransport, AnotherThreadsStderrLinesAreNeverTakenForLcmsWhileTransportsS
   for (int i = 0; i < written; ++i)
     missing += text.find("other thread's line " + std::to_string(i) + "\n") == std::string::npos;
   EXPECT_EQ(missing, 0) << "of " << written << " lines";
+}
+
+// final13b: the capture (a stderr that takes nothing) is one at a time for
+// every LCM call it wraps. A lock per call site let lcm_create's and
+// lcm_subscribe's captures run at once: one saved the other's pipe as
+// stderr, and descriptor 2 was left on a pipe whose reader was gone (8 of 10
+// runs of 30,000 each): every later line lost, or SIGPIPE.
+TEST(LcmTransport, CapturesOfAStderrThatTakesNothingNeverLeaveItReplaced) {
+  int full[2];
+  ASSERT_EQ(pipe2(full, O_NONBLOCK), 0);
+  std::string fill(1 << 20, 'x');
+  while (write(full[1], fill.data(), fill.size()) > 0) {
+  }
+  std::fflush(stderr);
+  const int saved = dup(2);
+  ASSERT_EQ(dup2(full[1], 2), 2);
+  struct stat before {};
+  fstat(2, &before);
+  LcmTransport subscriber(LcmTransportOptions{.url = "memq://"});
+  std::thread creates([] {
+    for (int i = 0; i < 20000; ++i) LcmTransport t(LcmTransportOptions{.url = "memq://"});
+  });
+  for (int i = 0; i < 20000; ++i)
+    subscriber.Subscribe("X", [](const std::string&, std::span<const std::uint8_t>) {});
+  creates.join();
+  struct stat after {};
+  const int fstat_after = fstat(2, &after);
+  dup2(saved, 2);
+  close(saved);
+  close(full[0]);
+  close(full[1]);
+  ASSERT_EQ(fstat_after, 0);
+  EXPECT_EQ(after.st_ino, before.st_ino) << "descriptor 2 was left on another file";
 }
 
 }  // namespace
