@@ -6,6 +6,7 @@
 #include "robotalk/channels.h"
 #include "robotalk/config_message.h"
 #include "robotalk/known_servers.h"
+#include "robotalk/log_writer.h"
 #include "robotalk/request.h"
 
 #include <cstdio>
@@ -84,7 +85,8 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
       return;  // another client's, or an answer to an earlier hello
     }
     if (answer.session_id == 0) {
-      hello_refusal_ = "robot '" + robot_ + "' refused this client's hello: " + answer.refusal;
+      hello_refusal_ =
+          "robot '" + robot_ + "' refused this client's hello: " + EscapeControls(answer.refusal);
       hello_due_ = false;
       handshake_.reset();  // the next hello is a new one
     } else if (identity_) {
@@ -238,7 +240,7 @@ bool RobotClient::Impl::NotePanicAnswer(const ReplyBatch& batch) {
       answer.taken = true;
       break;
     case PanicStatus::kRefused:
-      answer.refusal = batch.panic_refusal.empty() ? "no reason given" : batch.panic_refusal;
+      answer.refusal = batch.panic_refusal.empty() ? "no reason given" : EscapeControls(batch.panic_refusal);
       break;
     case PanicStatus::kNone:  // an answer to a panic package that does not say: never counted as taken
       answer.refusal = "the server's answer to the panic package does not say that it was taken";

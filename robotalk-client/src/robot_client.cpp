@@ -442,7 +442,11 @@ void RobotClient::Panic() {
     // the robot is in panic, so it is never reported as a refusal.
     if (answer->session_unknown && impl_->identity_) {
       unknown = answer->refusal;
-      continue;
+      if (std::chrono::steady_clock::now() < deadline) continue;
+      throw TimeoutError("RobotClient::Panic: robot '" + robot() + "' did not take the panic within " +
+                         std::to_string(ToSeconds(impl_->options_.timeout)) +
+                         " s: each attempt's session was unknown (" + unknown +
+                         "); whether the robot is in panic is not known");
     }
     throw PanicRefusedError(
         "RobotClient::Panic: robot '" + robot() +

@@ -282,7 +282,9 @@ bool RunToEnd(const std::vector<std::string>& argv) {
   posix_spawnattr_destroy(&attr);
   if (spawned != 0) return false;
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  for (;;) {
+    if (waitpid(pid, &status, 0) == pid) break;
+    if (errno != EINTR) return false;  // its status unknown (ECHILD: SIGCHLD ignored): no success
   }
   return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }

@@ -495,7 +495,9 @@ class RobotClient {
   // --- Panic -----------------------------------------------------------------
   /// Sends a panic package and waits for its acknowledgement (TimeoutError
   /// after `timeout`). Every command of every client is refused until
-  /// ResetPanic().
+  /// ResetPanic(). Throws PanicRefusedError when the server answered that it
+  /// did not take it; keyed, a session the server no longer knows (a restart)
+  /// is no refusal: it says hello and sends the panic again until `timeout`.
   void Panic();
   /// PANIC_RESET; returns its reply.
   Reply ResetPanic();

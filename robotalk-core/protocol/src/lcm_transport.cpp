@@ -122,9 +122,12 @@ std::vector<std::string> LinesOf(const std::string& text) {
 // Runs `call` (an LCM function that may write to stderr) under a
 // StderrCapture, one at a time (another's would save this one's pipe as
 // stderr); returns LCM's lines.
+// One for every capture (a static inside the template would be one per
+// call site: two captures at once save each other's pipe as stderr).
+std::mutex capture_mu;
+
 template <class Call>
 std::vector<std::string> WithLcmStderr(const Call& call) {
-  static std::mutex capture_mu;
   const std::lock_guard lock(capture_mu);
   StderrCapture capture;
   call();
