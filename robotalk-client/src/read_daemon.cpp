@@ -2,8 +2,8 @@
 // (replies -> ReturnCache, acks, clock samples, retransmission, heartbeats).
 #include "client_impl.h"
 
+#include "robotalk/broadcast_signature.h"
 #include "robotalk/config_message.h"
-#include "robotalk/heard_announcement.h"
 #include "robotalk/known_servers.h"
 
 #include "robotalk/routed_lcm_transport.h"
@@ -487,52 +487,49 @@ void RobotClient::Impl::FailLost(const std::vector<CommandId>& lost) {
 // (decode, instance, robot) come before the signature's, which runs outside
 // mu_: a flood of forged ANNOUNCEs never holds the client's lock.
 void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
+  // The panics unanswered for the retransmission timeout. REQUIRES: mu_.
+  const auto unanswered = [this](TimePoint now) {
+    std::vector<std::int64_t> sequences;
+    for (const auto& [sequence, sent] : ack_waited_)
+      if (now - sent >= outstanding_.retransmit_timeout()) sequences.push_back(sequence);
+    return sequences;
+  };
   PublicKey key;
   std::int64_t session = 0, server = 0;
   std::string robot;
   {
     std::lock_guard lock(mu_);
-    if (ack_waited_.empty() || session_id_ == 0 || !trust_ || !trust_->trusted()) return;
-    const TimePoint now = clock_.Now();
-    const Duration rto = outstanding_.retransmit_timeout();
-    if (std::none_of(ack_waited_.begin(), ack_waited_.end(),
-                     [&](const auto& waited) { return now - waited.second >= rto; }))
-      return;
+    if (session_id_ == 0 || !trust_ || !trust_->trusted() || unanswered(clock_.Now()).empty()) return;
     key = *trust_->trusted();
     session = session_id_;
     server = server_id_;
     robot = robot_;
   }
-  Announcement decoded;
+  Announcement heard;
   try {
-    decoded = DecodeAnnouncement(bytes);
+    heard = DecodeAnnouncement(bytes);
   } catch (const ProtocolError&) {
     return;
   }
-  const auto names_robot = [&](const Announcement& a) {
-    return std::any_of(a.robots.begin(), a.robots.end(),
-                       [&](const RobotAnnouncement& r) { return r.name == robot; });
-  };
-  if (decoded.server_id == server || !names_robot(decoded)) return;
-  const std::optional<HeardAnnouncement> heard = HearAnnouncement(bytes, &key);
-  if (!heard || heard->announcement.server_id == server || !names_robot(heard->announcement)) return;
+  if (heard.server_id == server ||
+      std::none_of(heard.robots.begin(), heard.robots.end(),
+                   [&](const RobotAnnouncement& r) { return r.name == robot; }) ||
+      VerifyBroadcast(kAnnounceChannel, bytes, key, nullptr) != BroadcastVerdict::kAuthentic)
+    return;
   std::vector<CommandId> lost;
   {
     std::lock_guard lock(mu_);
     if (session_id_ != session || server_id_ != server) return;  // the session changed meanwhile
     const TimePoint now = clock_.Now();
-    const Duration rto = outstanding_.retransmit_timeout();
-    bool any = false;
-    for (const auto& [sequence, sent] : ack_waited_) {
-      if (now - sent < rto) continue;
-      any = true;
+    const std::vector<std::int64_t> sequences = unanswered(now);
+    if (sequences.empty()) return;
+    for (const std::int64_t sequence : sequences) {
       panic_answers_.try_emplace(
           sequence, PanicAnswer{.refusal = "the server restarted (its signed ANNOUNCE names instance " +
-                                           Hex64(static_cast<std::uint64_t>(heard->announcement.server_id)) +
+                                           Hex64(static_cast<std::uint64_t>(heard.server_id)) +
                                            ") and has no session of this client",
                                 .session_unknown = true});
     }
-    if (!any) return;
     lost = LoseSession(now);
   }
   cv_.notify_all();  // the waiting panic: sent again in a new session
