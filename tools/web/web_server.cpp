@@ -180,13 +180,9 @@ class WebServer::Impl {
     const std::string why = std::to_string(options_.max_websockets) +
                             " WebSocket clients (pages and Foxglove) are connected already, the "
                             "--max-websockets limit; close one or raise the limit";
-    ++refused_websockets_;
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= next_refusal_line_) {
-      next_refusal_line_ = now + std::chrono::seconds(1);
+    if (refused_websockets_.Count())
       WebLog().Write("refused a WebSocket from " + Peer(*stream) + ": " + why + " (" +
-                     std::to_string(refused_websockets_) + " refused so far)");
-    }
+                     std::to_string(refused_websockets_.count) + " refused so far)");
     http::response<http::string_body> res{http::status::service_unavailable, req.version()};
     res.set(http::field::server, "robotalk-web");
     res.set(http::field::content_type, "text/plain; charset=utf-8");
@@ -215,15 +211,12 @@ class WebServer::Impl {
     const asio::ip::address address = it->second.address;
     if (const auto stream = it->second.stream.lock()) stream->close();
     waiting_.erase(it);
-    ++closed_waiting_;
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= next_closed_waiting_line_) {
-      next_closed_waiting_line_ = now + std::chrono::seconds(1);
+    if (closed_waiting_.Count()) {
       WebLog().Write("closed the oldest HTTP connection waiting for a request from " + address.to_string() +
                      ", which held " + std::to_string(most) + " of the " +
                      std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
-                     std::to_string(options_.max_http_waiting) + "; " + std::to_string(closed_waiting_) +
-                     " closed so far)");
+                     std::to_string(options_.max_http_waiting) + "; " +
+                     std::to_string(closed_waiting_.count) + " closed so far)");
     }
     return true;
   }
@@ -423,8 +416,19 @@ class WebServer::Impl {
   bool armed_ = false;
   std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
   std::vector<std::shared_ptr<WsConnection>> sessions_;
-  std::uint64_t refused_websockets_ = 0;                       // past --max-websockets
-  std::chrono::steady_clock::time_point next_refusal_line_{};  // of RefuseWebSocket's stderr line
+  // An event counted, its stderr line (with the count so far) at most once a second.
+  struct CountedLine {
+    std::uint64_t count = 0;
+    std::chrono::steady_clock::time_point next{};
+    bool Count() {  // true: write its line now
+      ++count;
+      const auto now = std::chrono::steady_clock::now();
+      if (now < next) return false;
+      next = now + std::chrono::seconds(1);
+      return true;
+    }
+  };
+  CountedLine refused_websockets_;  // past --max-websockets
   // Connections waiting for a request (ReadRequest), by age: what --max-http-waiting bounds.
   struct Waiting {
     std::weak_ptr<beast::tcp_stream> stream;
@@ -432,8 +436,7 @@ class WebServer::Impl {
   };
   std::map<std::uint64_t, Waiting> waiting_;
   std::uint64_t next_waiting_ = 0;
-  std::uint64_t closed_waiting_ = 0;                                  // by CloseWaiting
-  std::chrono::steady_clock::time_point next_closed_waiting_line_{};  // of CloseWaiting's stderr line
+  CountedLine closed_waiting_;  // by CloseWaiting
   Message robots_;
   std::map<std::string, std::pair<std::uint64_t, Message>> models_;
   std::map<std::string, MeshCatalog> meshes_;  // by robot, resolved once at start
