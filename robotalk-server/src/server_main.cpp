@@ -288,13 +288,7 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
     }
     if (robots.empty()) {
       SayServer("no --robot given");
-      // One Write of its lines (a line break inside a line is written as \x0a).
-      std::vector<std::string> usage;
-      for (std::string_view rest = kUsage; !rest.empty();) {
-        const std::size_t end = std::min(rest.find('\n'), rest.size());
-        usage.emplace_back(rest.substr(0, end));
-        rest.remove_prefix(std::min(end + 1, rest.size()));
-      }
+      std::vector<std::string> usage = SplitLines(kUsage);  // one Write of its lines
       LogWriter::Stderr().Write(usage);
       return 2;
     }

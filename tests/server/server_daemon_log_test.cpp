@@ -396,5 +396,11 @@ TEST(LogWriterTest, AChildForkedAfterTheWriterStartedWritesItsOwnLinesOnce) {
   EXPECT_EQ(text, "test: parent before\ntest: child\ntest: parent after\n");
 }
 
+TEST(SplitLines, KeepsEmptyLinesAndNoneAfterALastLineBreak) {
+  EXPECT_EQ(SplitLines("usage:\n\n  a\nb\n"), (std::vector<std::string>{"usage:", "", "  a", "b"}));
+  EXPECT_EQ(SplitLines("one"), (std::vector<std::string>{"one"}));
+  EXPECT_TRUE(SplitLines("").empty());
+}
+
 }  // namespace
 }  // namespace robotalk

@@ -107,14 +107,9 @@ class StderrCapture {
 // LCM's lines, one by one, trimmed; empty ones dropped.
 std::vector<std::string> LinesOf(const std::string& text) {
   std::vector<std::string> lines;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
+  for (std::string& line : SplitLines(text)) {
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
     if (!line.empty()) lines.push_back(std::move(line));
-    start = end + 1;
   }
   return lines;
 }

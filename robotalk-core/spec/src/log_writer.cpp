@@ -194,6 +194,16 @@ void DetachWithSignalsBlocked(std::function<void()> run) {
   std::thread(std::move(run)).detach();
 }
 
+std::vector<std::string> SplitLines(std::string_view text) {
+  std::vector<std::string> lines;
+  while (!text.empty()) {
+    const std::size_t end = std::min(text.find('\n'), text.size());
+    lines.emplace_back(text.substr(0, end));
+    text.remove_prefix(std::min(end + 1, text.size()));
+  }
+  return lines;
+}
+
 std::string EscapeControls(std::string_view text, bool ascii_only) {
   std::string out;
   out.reserve(text.size());

@@ -69,6 +69,11 @@ void DetachWithSignalsBlocked(std::function<void()> run);
 /// that must also be valid UTF-8, e.g. for Python: robotalk-logplay's).
 std::string EscapeControls(std::string_view text, bool ascii_only = false);
 
+/// `text`'s lines, without their line breaks (an empty line kept, none after
+/// a last "\n"): a multi-line text for LogWriter::Write, which writes a line
+/// break inside a line as \x0a.
+std::vector<std::string> SplitLines(std::string_view text);
+
 class LogWriter {
  public:
   static constexpr Duration kMaxWait = std::chrono::milliseconds(200);
