@@ -8,6 +8,7 @@
 #include <clocale>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -173,8 +174,17 @@ TEST(SequenceFile, TakesAnInterpolationLineAndAWaypointsVelocitiesAndAcceleratio
   EXPECT_EQ(back.values, c.values);
   EXPECT_EQ(back.velocities, c.velocities);
   EXPECT_EQ(back.accelerations, c.accelerations);
-  EXPECT_EQ(FormatCommandWords(file.entries[1].command),
-            "joint_setpoint pan 0.29999999999999999 velocity 0.40000000000000002");
+  EXPECT_EQ(FormatCommandWords(file.entries[1].command), "joint_setpoint pan 0.3 velocity 0.4");
+  // Each value the shortest text of its bits: exact, and as a person wrote it.
+  for (const double v : {1.0 / 3, -0.0, 2.2250738585072014e-308, 1.7976931348623157e308, 1e21, 123456.789}) {
+    SCOPED_TRACE(v);
+    const Command one{.type = CommandType::kJointSetPoint, .target = "pan", .values = {v}};
+    const std::string text = FormatCommandWords(one);
+    const double read = ParseCommandWords(SplitWords(text)).values.at(0);
+    EXPECT_EQ(std::memcmp(&read, &v, sizeof v), 0) << text;
+  }
+  EXPECT_EQ(FormatCommandWords({.type = CommandType::kGoto, .values = {1.0 / 3, 1e-7, 2.5}}),
+            "goto 0.3333333333333333 1e-07 2.5");
 }
 
 TEST(SequenceFile, ABadInterpolationOrRateNamesTheWordAndWhatIsAccepted) {

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -175,9 +176,12 @@ std::string FormatCommandWords(const Command& c) {
   if (!c.target.empty()) text += " " + c.target;
   const auto append = [&text](const std::vector<double>& values) {
     for (const double v : values) {
+      // The shortest text that reads back to the same bits ("0.3", not
+      // %.17g's "0.29999999999999999"): locale-free, as StrtodC reads it.
       char number[32];
-      std::snprintf(number, sizeof number, " %.17g", v);
-      text += number;
+      const std::to_chars_result r = std::to_chars(number, number + sizeof number, v);
+      text += ' ';
+      text.append(number, r.ptr);
     }
   };
   append(c.values);

@@ -40,7 +40,8 @@ class UsageError : public Error {
 /// one per position of a JOINT_SETPOINT, 6 for a FRAME_SETPOINT) and that
 /// every value is a finite number. Throws UsageError.
 Command ParseCommandWords(const std::vector<std::string>& words);
-/// The inverse: "joint_setpoint pan 0.5 velocity 0.1" (values exact to the last bit).
+/// The inverse: "joint_setpoint pan 0.5 velocity 0.1", each value the shortest
+/// text that reads back to the same bits.
 std::string FormatCommandWords(const Command& command);
 
 /// An interpolation's name, any case ("cubic"); throws UsageError
