@@ -64,6 +64,31 @@ TEST(NumberText, AWholeWordInADoublesRangeIsANumberAndNothingElseIs) {
   EXPECT_THROW(ParseNumber("inf", "--n"), UsageError);
 }
 
+// ParseNumberIn is the one reader of a number option (the server, robotalk-web,
+// the ROS 2 bridge, robotalk-fig11): whatever is wrong, the flag, the word and
+// what it accepts.
+TEST(NumberText, ANumberOptionOutsideItsRangeNamesTheFlagTheWordAndTheRange) {
+  EXPECT_EQ(ParseNumberIn("0.5", "--rate", {.min = 0.5, .max = 2}), 0.5);
+  EXPECT_EQ(ParseNumberIn("2", "--rate", {.min = 0.5, .max = 2}), 2.0);
+  EXPECT_EQ(ParseNumberIn("3e0", "--port", {.min = 0, .max = 65535, .whole = true}), 3.0);
+  const auto error = [](const std::string& word, const NumberRange& range) {
+    try {
+      ParseNumberIn(word, "--x", range);
+    } catch (const UsageError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(error("0.4", {.min = 0.5, .max = 2}), "--x: '0.4' is not a number in [0.5, 2]");
+  EXPECT_EQ(error("2.5", {.min = 0.5, .max = 2}), "--x: '2.5' is not a number in [0.5, 2]");
+  EXPECT_EQ(error("0", {.min = 0, .max = 60, .above_min = true}), "--x: '0' is not a number in (0, 60]");
+  EXPECT_EQ(error("2.5", {.min = 1, .max = 4096, .whole = true}),
+            "--x: '2.5' is not a whole number in [1, 4096]");
+  for (const char* bad : {"", "x", "5x", "nan", "inf", "-inf", "1e999"})
+    EXPECT_EQ(error(bad, {.min = 0, .max = 1e9}),
+              "--x: '" + std::string(bad) + "' is not a number in [0, 1e+09]");
+}
+
 // Review 13: NumberOf, and the <robotalk> block's xyz/rpy triples, were read
 // with strtod, which follows the process's LC_NUMERIC: in a program that sets
 // a locale whose decimal separator is a comma (Python after

@@ -44,6 +44,17 @@ double ParseNumber(const std::string& word, const std::string& what) {
   return *v;
 }
 
+double ParseNumberIn(const std::string& word, const std::string& flag, const NumberRange& range) {
+  const std::optional<double> v = NumberOf(word);
+  if (v && std::isfinite(*v) && (range.above_min ? *v > range.min : *v >= range.min) && *v <= range.max &&
+      (!range.whole || *v == std::floor(*v)))
+    return *v;
+  char bounds[80];
+  std::snprintf(bounds, sizeof bounds, "%c%g, %g]", range.above_min ? '(' : '[', range.min, range.max);
+  throw UsageError(flag + ": '" + word + "' is not a " + (range.whole ? "whole " : "") + "number in " +
+                   bounds);
+}
+
 double ParseSeconds(const std::string& word, const std::string& what) {
   const double s = ParseNumber(word, what);
   if (s < 0) throw UsageError(what + " " + word + " is negative");

@@ -18,6 +18,7 @@
 #include "robotalk/error.h"
 #include "robotalk/trajectory.h"
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +65,20 @@ std::optional<double> NumberOf(const std::string& word);
 /// Parses a finite number (NumberOf); throws UsageError naming `what`:
 /// "<what>: 'x' is not a number", "<what>: 'inf' is not finite".
 double ParseNumber(const std::string& word, const std::string& what);
+
+/// The values a number option accepts (ParseNumberIn).
+struct NumberRange {
+  double min = -std::numeric_limits<double>::max();
+  double max = std::numeric_limits<double>::max();
+  bool above_min = false;  ///< min itself refused: "(0, 60]"
+  bool whole = false;      ///< an integer: "3", "3.0" and "3e0", never "2.5"
+};
+/// A number option's value (the word after `flag`; an environment
+/// variable's): a finite number (NumberOf) in `range`. The one reader of a
+/// number option of every tool; throws UsageError naming the flag, the word
+/// and the range whatever is wrong with it: "--port: 'http' is not a whole
+/// number in [0, 65535]", "--rate: '0' is not a number in [1, 240]".
+double ParseNumberIn(const std::string& word, const std::string& flag, const NumberRange& range);
 
 /// The most seconds a time given as text may be (a sequence file's start
 /// times; the command lines' --timeout, --at, --delay, --listen ...): 1e9 s,
