@@ -227,6 +227,18 @@ TEST(Frames, AnExtractedSequenceParsesBackToTheSameCommands) {
   EXPECT_EQ(entries[2].command.type, CommandType::kStop);
 }
 
+// A frame without an interpolation (nullopt: the sequence's, as Python's
+// format_sequence may be given) takes the file's; it is no second one.
+TEST(Frames, AFrameWithoutAnInterpolationTakesTheFiles) {
+  const std::vector<TimedCommand> frames = {
+      {FromSeconds(0), {0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.1}}, Interpolation::kQuintic},
+      {FromSeconds(1), {0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.2}}}};
+  const SequenceFile file = ParseSequenceFile(FormatSequence(frames, ""), "extracted.txt");
+  EXPECT_EQ(file.interpolation, Interpolation::kQuintic);
+  EXPECT_EQ(file.entries.size(), 2u);
+  EXPECT_FALSE(ParseSequenceFile(FormatSequence({frames[1]}, ""), "extracted.txt").interpolation);
+}
+
 TEST(Options, ParseMapsWindowsAndClientIds) {
   EXPECT_EQ(ParseRename("pan=head_pan"), std::make_pair(std::string("pan"), std::string("head_pan")));
   EXPECT_THROW(ParseRename("pan"), cli::UsageError);

@@ -44,7 +44,8 @@ struct FrameOptions {
 std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions& options);
 
 /// A sequence file `robotalk send --file` plays: a comment header, the
-/// set-points' interpolation line (none for step), then one "<offset>
+/// set-points' interpolation line (none for step; a frame whose
+/// interpolation is nullopt takes the file's), then one "<offset>
 /// FormatCommandWords" line per frame. Throws LogError naming the frame for a
 /// target that is not one word of the file, and for set-points of two
 /// interpolations.

@@ -167,14 +167,13 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);) out << "# " << line << "\n";
   // The file has one interpolation line: that of its set-points (a GOTO's or
-  // a STOP's package interpolation moves nothing). Set-points of two are
-  // refused rather than written as one of them (replay keeps each).
+  // a STOP's package interpolation moves nothing; a frame without one takes
+  // the file's). Set-points of two are refused rather than written as one of
+  // them (replay keeps each).
   std::optional<std::size_t> first_setpoint;
-  const auto interpolation = [&frames](std::size_t i) {
-    return frames[i].interpolation.value_or(Interpolation::kStep);
-  };
+  const auto interpolation = [&frames](std::size_t i) { return *frames[i].interpolation; };
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    if (WaypointRateCount(frames[i].command.type, 1) == 0) continue;
+    if (WaypointRateCount(frames[i].command.type, 1) == 0 || !frames[i].interpolation) continue;
     if (!first_setpoint) {
       first_setpoint = i;
     } else if (interpolation(i) != interpolation(*first_setpoint)) {
