@@ -223,7 +223,10 @@ void BindLogs(py::module_& m) {
         "and scaled (speed=2: twice as fast). Play them with RobotClient.run_sequence().\n"
         "Raises LogError.");
   m.def("format_sequence", &lp::FormatSequence, py::arg("frames"), py::arg("header") = "",
-        "A sequence file's text (`robotalk send --file` plays it) for TimedCommands.");
+        "A sequence file's text (`robotalk send --file` plays it) for TimedCommands: their set-points'\n"
+        "interpolation line, then each command as robotalk send takes it (values exact, a waypoint's\n"
+        "velocities and accelerations). Raises LogError for a target that is not one word, or for\n"
+        "set-points of two interpolations.");
 }
 
 }  // namespace robotalk::python

@@ -4,18 +4,13 @@
 #include "robotalk/error.h"
 #include "robotalk/sequence_file.h"
 
-#include <cmath>
-
 namespace robotalk::ros2 {
 namespace {
 
 std::uint32_t ParseDomain(const std::string& option, const std::string& text) {
   // DDS's port mapping leaves room for domain ids 0..232 (ROS 2's
   // "The ROS_DOMAIN_ID" concept page).
-  const double v = ParseNumber(text, option);
-  if (v < 0 || v > 232 || v != std::floor(v))
-    throw Error(option + ": '" + text + "' is not a DDS domain id (0..232)");
-  return static_cast<std::uint32_t>(v);
+  return static_cast<std::uint32_t>(ParseNumberIn(text, option, {.min = 0, .max = 232, .whole = true}));
 }
 
 }  // namespace
@@ -76,10 +71,7 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
     } else if (a == "--dds-interface") {
       o.dds_interface = value();
     } else if (a == "--rate") {
-      const double hz = ParseNumber(value(), a);
-      if (hz < 1 || hz > 1000)
-        throw Error("--rate: " + args[i] + " Hz is outside 1..1000 (the STATE stream's range)");
-      o.period = FromSeconds(1.0 / hz);
+      o.period = FromSeconds(1.0 / ParseNumberIn(value(), a, {.min = 1, .max = 1000}));  // the STATE stream's
     } else if (a == "--frame-prefix") {
       o.frame_prefix = value();
     } else if (a == "--world-frame") {
@@ -93,9 +85,7 @@ Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::st
       }
       o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
     } else if (a == "--cmd-vel-timeout") {
-      const double s = ParseNumber(value(), a);
-      if (s <= 0 || s > 60) throw Error("--cmd-vel-timeout: " + args[i] + " s is outside (0, 60]");
-      o.cmd_vel_timeout = FromSeconds(s);
+      o.cmd_vel_timeout = FromSeconds(ParseNumberIn(value(), a, {.min = 0, .max = 60, .above_min = true}));
     } else if (a == "--read-only") {
       o.read_only = true;
     } else if (a == "--duration") {

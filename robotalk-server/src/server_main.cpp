@@ -122,17 +122,6 @@ Serves one or more robots over LCM (see docs/protocol.md).
 On SIGINT or SIGTERM every robot is stopped before the server exits.
 )";
 
-// A number option in [min, max], read by the one rule (NumberOf).
-double ParseNumber(const std::string& flag, const char* text, double min, double max) {
-  const std::optional<double> v = NumberOf(text);
-  if (!v || !(*v >= min && *v <= max)) {
-    char range[64];
-    std::snprintf(range, sizeof range, "[%g, %g]", min, max);
-    throw Error(flag + ": '" + text + "' is not a number in " + range);
-  }
-  return *v;
-}
-
 int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateCommand& simulate_command) {
   ServerOptions options;
   std::vector<RobotSpec> robots;
@@ -159,7 +148,7 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--simulate") {
         simulate = value();
       } else if (arg == "--sample-period") {
-        sample_period = ParseNumber(arg, value(), 0.001, 3600);
+        sample_period = ParseNumberIn(value(), arg, {0.001, 3600});
       } else if (arg == "--allow-duplicate-robots") {
         options.allow_duplicate_robots = true;
       } else if (arg == "--key") {
@@ -169,9 +158,9 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--no-precise-timing") {
         options.precise_timing = false;
       } else if (arg == "--max-sessions") {
-        options.max_sessions = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
+        options.max_sessions = static_cast<std::size_t>(ParseNumberIn(value(), arg, {1, 1e6}));
       } else if (arg == "--max-sessions-per-robot") {
-        options.max_sessions_per_robot = static_cast<std::size_t>(ParseNumber(arg, value(), 1, 1e6));
+        options.max_sessions_per_robot = static_cast<std::size_t>(ParseNumberIn(value(), arg, {1, 1e6}));
       } else if (arg == "--panic-latch") {
         options.panic_latch_path = value();
         if (options.panic_latch_path.empty()) throw Error("--panic-latch needs a file name");
@@ -181,11 +170,11 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--no-panic-latch") {
         no_panic_latch = true;
       } else if (arg == "--log-lines-per-second") {
-        options.log_lines_per_second = static_cast<int>(ParseNumber(arg, value(), 1, 1e6));
+        options.log_lines_per_second = static_cast<int>(ParseNumberIn(value(), arg, {1, 1e6}));
       } else if (arg == "--driver-call-bound") {
-        options.driver_call_bound = FromSeconds(ParseNumber(arg, value(), 0, 3600));
+        options.driver_call_bound = FromSeconds(ParseNumberIn(value(), arg, {0, 3600}));
       } else if (arg == "--max-acceleration") {
-        options.max_acceleration = ParseNumber(arg, value(), 1e-3, 1e6);
+        options.max_acceleration = ParseNumberIn(value(), arg, {1e-3, 1e6});
       } else if (arg == "--log-executions") {
         options.log_executions = true;
       } else if (arg == "--log-playback") {
@@ -195,21 +184,21 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--url") {
         options.lcm_url = value();
       } else if (arg == "--session-timeout") {
-        options.session_timeout = FromSeconds(ParseNumber(arg, value(), 0.05, 3600));
+        options.session_timeout = FromSeconds(ParseNumberIn(value(), arg, {0.05, 3600}));
       } else if (arg == "--max-queue") {
-        options.max_queue = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e7));
+        options.max_queue = static_cast<size_t>(ParseNumberIn(value(), arg, {1, 1e7}));
       } else if (arg == "--max-queued-total") {
-        options.max_queued_total = static_cast<size_t>(ParseNumber(arg, value(), 1, 1e8));
+        options.max_queued_total = static_cast<size_t>(ParseNumberIn(value(), arg, {1, 1e8}));
       } else if (arg == "--max-goto-distance") {
-        options.max_goto_distance = ParseNumber(arg, value(), 0, 1e7);
+        options.max_goto_distance = ParseNumberIn(value(), arg, {0, 1e7});
       } else if (arg == "--max-future") {
-        options.max_future = FromSeconds(ParseNumber(arg, value(), 0, 86400 * 7));
+        options.max_future = FromSeconds(ParseNumberIn(value(), arg, {0, 86400 * 7}));
       } else if (arg == "--max-late") {
         const std::string text = value();
         const std::size_t eq = text.find('=');
         const std::string limit = eq == std::string::npos ? text : text.substr(eq + 1);
-        const Duration d = limit == "never" ? Duration::max()
-                                            : FromSeconds(ParseNumber(arg, limit.c_str(), 1e-6, 86400 * 7));
+        const Duration d =
+            limit == "never" ? Duration::max() : FromSeconds(ParseNumberIn(limit, arg, {1e-6, 86400 * 7}));
         if (eq == std::string::npos) {
           options.max_late = d;
         } else if (eq == 0) {
@@ -224,9 +213,9 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
         const std::string limits = eq == std::string::npos ? text : text.substr(eq + 1);
         const std::size_t comma = limits.find(',');
         BaseAccelerationLimit limit;
-        limit.linear = ParseNumber(arg, limits.substr(0, comma).c_str(), 1e-3, 1e3);
+        limit.linear = ParseNumberIn(limits.substr(0, comma), arg, {1e-3, 1e3});
         if (comma != std::string::npos)
-          limit.angular = ParseNumber(arg, limits.substr(comma + 1).c_str(), 1e-3, 1e3);
+          limit.angular = ParseNumberIn(limits.substr(comma + 1), arg, {1e-3, 1e3});
         if (eq == std::string::npos) {
           options.base_acceleration = limit;
         } else {
@@ -235,9 +224,9 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--link-stop") {
         options.link_stop = true;
       } else if (arg == "--congestion-max-pause") {
-        options.congestion_max_pause = FromSeconds(ParseNumber(arg, value(), 0, 10));
+        options.congestion_max_pause = FromSeconds(ParseNumberIn(value(), arg, {0, 10}));
       } else if (arg == "--playback-min-frames") {
-        options.playback_min_frames = static_cast<size_t>(ParseNumber(arg, value(), 2, 1e6));
+        options.playback_min_frames = static_cast<size_t>(ParseNumberIn(value(), arg, {2, 1e6}));
       } else if (arg == "--playback-estimator") {
         options.playback_estimator = value();
         if (options.playback_estimator != "adaptive" && options.playback_estimator != "quick" &&
@@ -246,11 +235,11 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
                       "': expected adaptive, quick or paper");
         }
       } else if (arg == "--playback-stretch") {
-        options.playback_stretch = ParseNumber(arg, value(), 0, 1);
+        options.playback_stretch = ParseNumberIn(value(), arg, {0, 1});
       } else if (arg == "--playback-thin-stretch") {
-        options.playback_thin_stretch = ParseNumber(arg, value(), 0, 1);
+        options.playback_thin_stretch = ParseNumberIn(value(), arg, {0, 1});
       } else if (arg == "--playback-margin") {
-        options.playback_margin = FromSeconds(ParseNumber(arg, value(), 0, 1000) / 1000);
+        options.playback_margin = FromSeconds(ParseNumberIn(value(), arg, {0, 1000}) / 1000);
       } else if (arg == "--playback-queue-start") {
         const std::string v = value();
         if (v != "on" && v != "off") throw Error("--playback-queue-start '" + v + "': expected on or off");
@@ -272,15 +261,15 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
         if (v != "on" && v != "off") throw Error("--playback-resent-delays '" + v + "': expected on or off");
         options.playback_resent_delays = v == "on";
       } else if (arg == "--playback-start-lead") {
-        options.playback_start_lead = ParseNumber(arg, value(), 0, 100);
+        options.playback_start_lead = ParseNumberIn(value(), arg, {0, 100});
       } else if (arg == "--duration") {
-        duration = ParseNumber(arg, value(), 0, 1e9);
+        duration = ParseNumberIn(value(), arg, {0, 1e9});
       } else if (arg == "--inject-reply-drop") {
-        options.reply_drop_probability = ParseNumber(arg, value(), 0, 1);
+        options.reply_drop_probability = ParseNumberIn(value(), arg, {0, 1});
       } else if (arg == "--inject-reply-dup") {
-        options.reply_duplicate_probability = ParseNumber(arg, value(), 0, 1);
+        options.reply_duplicate_probability = ParseNumberIn(value(), arg, {0, 1});
       } else if (arg == "--seed") {
-        options.fault_seed = static_cast<std::uint64_t>(ParseNumber(arg, value(), 0, 1e18));
+        options.fault_seed = static_cast<std::uint64_t>(ParseNumberIn(value(), arg, {0, 1e18}));
       } else {
         SayServer("unknown option '" + arg + "' (see --help)");
         return 2;

@@ -8,6 +8,7 @@
 #include <clocale>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -61,6 +62,31 @@ TEST(NumberText, AWholeWordInADoublesRangeIsANumberAndNothingElseIs) {
   EXPECT_EQ(errno, EINTR) << "the caller's errno survives";
   EXPECT_EQ(ParseNumber("2", "--n"), 2.0);
   EXPECT_THROW(ParseNumber("inf", "--n"), UsageError);
+}
+
+// ParseNumberIn is the one reader of a number option (the server, robotalk-web,
+// the ROS 2 bridge, robotalk-fig11): whatever is wrong, the flag, the word and
+// what it accepts.
+TEST(NumberText, ANumberOptionOutsideItsRangeNamesTheFlagTheWordAndTheRange) {
+  EXPECT_EQ(ParseNumberIn("0.5", "--rate", {.min = 0.5, .max = 2}), 0.5);
+  EXPECT_EQ(ParseNumberIn("2", "--rate", {.min = 0.5, .max = 2}), 2.0);
+  EXPECT_EQ(ParseNumberIn("3e0", "--port", {.min = 0, .max = 65535, .whole = true}), 3.0);
+  const auto error = [](const std::string& word, const NumberRange& range) {
+    try {
+      ParseNumberIn(word, "--x", range);
+    } catch (const UsageError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(error("0.4", {.min = 0.5, .max = 2}), "--x: '0.4' is not a number in [0.5, 2]");
+  EXPECT_EQ(error("2.5", {.min = 0.5, .max = 2}), "--x: '2.5' is not a number in [0.5, 2]");
+  EXPECT_EQ(error("0", {.min = 0, .max = 60, .above_min = true}), "--x: '0' is not a number in (0, 60]");
+  EXPECT_EQ(error("2.5", {.min = 1, .max = 4096, .whole = true}),
+            "--x: '2.5' is not a whole number in [1, 4096]");
+  for (const char* bad : {"", "x", "5x", "nan", "inf", "-inf", "1e999"})
+    EXPECT_EQ(error(bad, {.min = 0, .max = 1e9}),
+              "--x: '" + std::string(bad) + "' is not a number in [0, 1e+09]");
 }
 
 // Review 13: NumberOf, and the <robotalk> block's xyz/rpy triples, were read
@@ -173,8 +199,17 @@ TEST(SequenceFile, TakesAnInterpolationLineAndAWaypointsVelocitiesAndAcceleratio
   EXPECT_EQ(back.values, c.values);
   EXPECT_EQ(back.velocities, c.velocities);
   EXPECT_EQ(back.accelerations, c.accelerations);
-  EXPECT_EQ(FormatCommandWords(file.entries[1].command),
-            "joint_setpoint pan 0.29999999999999999 velocity 0.40000000000000002");
+  EXPECT_EQ(FormatCommandWords(file.entries[1].command), "joint_setpoint pan 0.3 velocity 0.4");
+  // Each value the shortest text of its bits: exact, and as a person wrote it.
+  for (const double v : {1.0 / 3, -0.0, 2.2250738585072014e-308, 1.7976931348623157e308, 1e21, 123456.789}) {
+    SCOPED_TRACE(v);
+    const Command one{.type = CommandType::kJointSetPoint, .target = "pan", .values = {v}};
+    const std::string text = FormatCommandWords(one);
+    const double read = ParseCommandWords(SplitWords(text)).values.at(0);
+    EXPECT_EQ(std::memcmp(&read, &v, sizeof v), 0) << text;
+  }
+  EXPECT_EQ(FormatCommandWords({.type = CommandType::kGoto, .values = {1.0 / 3, 1e-7, 2.5}}),
+            "goto 0.3333333333333333 1e-07 2.5");
 }
 
 TEST(SequenceFile, ABadInterpolationOrRateNamesTheWordAndWhatIsAccepted) {

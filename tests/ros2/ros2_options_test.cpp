@@ -45,11 +45,12 @@ TEST(Ros2Options, ARobotNameOutsideTheRobotNameRuleIsRefusedNamingIt) {
   EXPECT_NE(ErrorOf({"--robot", ""}).find("--robot"), std::string::npos);
 }
 
-// A number option is read by the one rule of every tool (robotalk::ParseNumber;
-// NumberText tests it): the same words as the CLI's and robotalk-web's.
+// A number option is read by the one reader of every tool (robotalk::ParseNumberIn;
+// NumberText tests it): the same words as the server's and robotalk-web's.
 TEST(Ros2Options, ANumberOptionIsReadByTheOneRuleOfEveryTool) {
-  EXPECT_EQ(ErrorOf({"--rate", "50x"}), "--rate: '50x' is not a number");
-  EXPECT_EQ(ErrorOf({"--cmd-vel-timeout", "nan"}), "--cmd-vel-timeout: 'nan' is not finite");
+  EXPECT_EQ(ErrorOf({"--rate", "50x"}), "--rate: '50x' is not a number in [1, 1000]");
+  EXPECT_EQ(ErrorOf({"--cmd-vel-timeout", "nan"}), "--cmd-vel-timeout: 'nan' is not a number in (0, 60]");
+  EXPECT_EQ(ErrorOf({"--domain", "233"}), "--domain: '233' is not a whole number in [0, 232]");
 }
 
 }  // namespace

@@ -227,6 +227,18 @@ TEST(Frames, AnExtractedSequenceParsesBackToTheSameCommands) {
   EXPECT_EQ(entries[2].command.type, CommandType::kStop);
 }
 
+// A frame without an interpolation (nullopt: the sequence's, as Python's
+// format_sequence may be given) takes the file's; it is no second one.
+TEST(Frames, AFrameWithoutAnInterpolationTakesTheFiles) {
+  const std::vector<TimedCommand> frames = {
+      {FromSeconds(0), {0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.1}}, Interpolation::kQuintic},
+      {FromSeconds(1), {0, CommandType::kJointSetPoint, std::nullopt, "pan", {0.2}}}};
+  const SequenceFile file = ParseSequenceFile(FormatSequence(frames, ""), "extracted.txt");
+  EXPECT_EQ(file.interpolation, Interpolation::kQuintic);
+  EXPECT_EQ(file.entries.size(), 2u);
+  EXPECT_FALSE(ParseSequenceFile(FormatSequence({frames[1]}, ""), "extracted.txt").interpolation);
+}
+
 TEST(Options, ParseMapsWindowsAndClientIds) {
   EXPECT_EQ(ParseRename("pan=head_pan"), std::make_pair(std::string("pan"), std::string("head_pan")));
   EXPECT_THROW(ParseRename("pan"), cli::UsageError);
@@ -440,6 +452,83 @@ TEST_F(HostileLog, ATargetASequenceFileCannotCarryAsOneWordIsRefusedByExtract) {
           << e.what();
     }
   }
+}
+
+// Consolidate 14: `extract` wrote each frame's type, target and values
+// (%.10g) and nothing else, so a recorded waypoint lost its velocities and
+// accelerations, a value lost its last bits, and a cubic session came back
+// as a step one (no `interpolation` line). What it writes, read back with
+// the client's own parser (ParseSequenceFile, as `robotalk send --file`),
+// is every command as the log holds it.
+class ExtractedLog : public HostileLog {
+ protected:
+  // One delay-mode package of kClient: `commands` start 5 s, 6 s ... after 0.
+  void WritePackage(std::int64_t seq, Interpolation interpolation, std::vector<Command> commands) {
+    Request r{.client_id = kClient, .sequence = seq, .send_time = AtMicros(100 * seq), .mode = kDelay};
+    r.interpolation = interpolation;
+    for (Command& c : commands) {
+      c.id = seq * 10 + static_cast<std::int64_t>(r.commands.size());
+      c.start_time = StartTime::At(AtMicros(5'000'000 + (c.id - 10) * 1'000'000));
+      r.commands.push_back(std::move(c));
+    }
+    Write(kRequest, 1'700'000'000'000'000 + seq, EncodeRequest(r));
+  }
+};
+
+TEST_F(ExtractedLog, AWaypointsVelocitiesAccelerationsExactValuesAndInterpolationReadBack) {
+  const double third = 1.0 / 3;  // not exact in 10 digits
+  Command pan{.type = CommandType::kJointSetPoint, .target = "pan", .values = {third}};
+  pan.velocities = {0.5};
+  pan.accelerations = {-0.25};
+  Command tool{.type = CommandType::kFrameSetPoint, .target = "tool", .values = {0.1, 0.2, 0.3, 1, 0, 0, 0}};
+  tool.velocities = {0.01, 0.02, 0.03, 0, 0, third};
+  WritePackage(1, Interpolation::kCubic, {pan, tool});
+  WritePackage(2, Interpolation::kCubic, {Command{.type = CommandType::kGoto, .values = {1, 2, third}}});
+  const std::vector<TimedCommand> frames = ToFrames(Read().MakeTimeline({.client_id = kClient}), {});
+  ASSERT_EQ(frames.size(), 3u);
+  const std::string text = FormatSequence(frames, "extracted");
+  const SequenceFile file = ParseSequenceFile(text, "extracted.txt");
+  ASSERT_EQ(file.entries.size(), frames.size()) << text;
+  EXPECT_EQ(file.interpolation, Interpolation::kCubic) << text;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    SCOPED_TRACE(i);
+    const Command& back = file.entries[i].command;
+    const Command& logged = frames[i].command;
+    EXPECT_EQ(back.type, logged.type);
+    EXPECT_EQ(back.target, logged.target);
+    EXPECT_EQ(back.values, logged.values) << text;  // to the last bit
+    EXPECT_EQ(back.velocities, logged.velocities) << text;
+    EXPECT_EQ(back.accelerations, logged.accelerations) << text;
+    EXPECT_DOUBLE_EQ(file.entries[i].offset_s, ToSeconds(frames[i].offset));
+  }
+}
+
+// A sequence file has one interpolation: set-points recorded in packages of
+// two are refused (naming both), never written as one of them; replay keeps them.
+TEST_F(ExtractedLog, SetPointsOfTwoInterpolationsAreRefusedNamingThem) {
+  WritePackage(1, Interpolation::kCubic,
+               {Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.1}}});
+  WritePackage(2, Interpolation::kLinear,
+               {Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.2}}});
+  const std::vector<TimedCommand> frames = ToFrames(Read().MakeTimeline({.client_id = kClient}), {});
+  try {
+    const std::string text = FormatSequence(frames, "extracted");
+    ADD_FAILURE() << "written:\n" << text;
+  } catch (const LogError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 2 JOINT_SETPOINT: interpolation linear, frame 1's cubic"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A step package's GOTO beside cubic set-points: its interpolation means nothing, the file says cubic.
+TEST_F(ExtractedLog, TheInterpolationOfACommandThatIsNoSetPointDoesNotCount) {
+  WritePackage(1, Interpolation::kStep, {Command{.type = CommandType::kGoto, .values = {1, 0, 0}}});
+  WritePackage(2, Interpolation::kCubic,
+               {Command{.type = CommandType::kJointSetPoint, .target = "pan", .values = {0.2}}});
+  const std::vector<TimedCommand> frames = ToFrames(Read().MakeTimeline({.client_id = kClient}), {});
+  EXPECT_EQ(ParseSequenceFile(FormatSequence(frames, "extracted"), "extracted.txt").interpolation,
+            Interpolation::kCubic);
 }
 
 // A damaged log (review9): LCM's reader allocated what an event header

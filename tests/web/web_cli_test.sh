@@ -16,7 +16,7 @@ expect "--help prints the usage" 0 "usage: robotalk-web" -- --help
 expect "--help says it binds to loopback by default" 0 "default 127.0.0.1" -- --help
 expect "--version prints the version" 0 "^robotalk-web [0-9]" -- --version
 expect "an unknown option is named" 2 "unknown option '--colour'" -- --colour
-expect "a bad port is named" 2 "--port: 'x' is not a number" -- --port x
+expect "a bad port is named" 2 "--port: 'x' is not a whole number in \[0, 65535\]" -- --port x
 expect "a missing URDF file is named" 2 "--urdf arm=/nonexistent.urdf: no such file" -- --urdf arm=/nonexistent.urdf
 expect "--help offers --package-path and ROS_PACKAGE_PATH" 0 "package-path DIRS.*" -- --help
 expect "an empty --package-path is named" 2 "--package-path: ':' names no folder" -- --package-path :

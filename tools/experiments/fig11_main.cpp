@@ -14,6 +14,7 @@
 // 2 usage; 3 the run exceeded --max-seconds.
 #include "fig11_profile.h"
 #include "robotalk/robot_client.h"
+#include "robotalk/sequence_file.h"  // ParseNumberIn
 
 #include <unistd.h>
 #include <algorithm>
@@ -67,16 +68,6 @@ struct Options {
   Duration max_late = kMaxLateServerDefault;
 };
 
-double Number(const std::string& flag, const std::string& text, double lo, double hi) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !(v >= lo && v <= hi)) {
-    throw std::invalid_argument(flag + ": '" + text + "' is not a number in [" + std::to_string(lo) + ", " +
-                                std::to_string(hi) + "]");
-  }
-  return v;
-}
-
 Options Parse(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -101,13 +92,13 @@ Options Parse(int argc, char** argv) {
       if (!mode) throw std::invalid_argument("--mode: '" + m + "' is not direct, delay or playback");
       o.mode = *mode;
     } else if (a == "--delay") {
-      o.delay = Number(a, value(), 0, 3600);
+      o.delay = ParseNumberIn(value(), a, {0, 3600});
     } else if (a == "--length") {
-      o.length = Number(a, value(), 0.01, 1000);
+      o.length = ParseNumberIn(value(), a, {0.01, 1000});
     } else if (a == "--duration") {
-      o.duration = Number(a, value(), 0.8, 3600);
+      o.duration = ParseNumberIn(value(), a, {0.8, 3600});
     } else if (a == "--state-period") {
-      o.state_period = Number(a, value(), 0.001, 1);
+      o.state_period = ParseNumberIn(value(), a, {0.001, 1});
     } else if (a == "--out") {
       o.out = value();
     } else if (a == "--label") {
@@ -115,16 +106,16 @@ Options Parse(int argc, char** argv) {
     } else if (a == "--congestion") {
       o.congestion = value();
     } else if (a == "--retransmit-interval") {
-      o.retransmit_interval = Number(a, value(), 0.001, 3600);
+      o.retransmit_interval = ParseNumberIn(value(), a, {0.001, 3600});
     } else if (a == "--give-up") {
-      o.give_up = Number(a, value(), 0.1, 3600);
+      o.give_up = ParseNumberIn(value(), a, {0.1, 3600});
     } else if (a == "--max-seconds") {
-      o.max_seconds = Number(a, value(), 1, 86400);
+      o.max_seconds = ParseNumberIn(value(), a, {1, 86400});
     } else if (a == "--max-late") {
       const std::string v = value();
       o.max_late = v == "never"     ? kMaxLateNever
                    : v == "default" ? kMaxLateServerDefault
-                                    : FromSeconds(Number(a, v, 1e-6, 3600));
+                                    : FromSeconds(ParseNumberIn(v, a, {1e-6, 3600}));
     } else if (a == "--print-ideal") {
       o.print_ideal = value();
     } else {

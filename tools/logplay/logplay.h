@@ -43,8 +43,12 @@ struct FrameOptions {
 /// without a start time). Throws LogError when the window holds nothing.
 std::vector<TimedCommand> ToFrames(const Timeline& timeline, const FrameOptions& options);
 
-/// A sequence file `robotalk send --file` plays: a comment header, then one
-/// "<offset> <command> [target] values..." line per frame.
+/// A sequence file `robotalk send --file` plays: a comment header, the
+/// set-points' interpolation line (none for step; a frame whose
+/// interpolation is nullopt takes the file's), then one "<offset>
+/// FormatCommandWords" line per frame. Throws LogError naming the frame for a
+/// target that is not one word of the file, and for set-points of two
+/// interpolations.
 std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::string& header);
 
 /// `info`: channels, span, servers, robots, clients and their command streams.

@@ -6,23 +6,18 @@
 #include "sequence_runner.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
 namespace robotalk::logplay {
 namespace {
-
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 std::string Utc(std::int64_t us) {
   const std::time_t t = static_cast<std::time_t>(us / 1000000);
@@ -171,6 +166,27 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
   std::ostringstream out;
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);) out << "# " << line << "\n";
+  // The file has one interpolation line: that of its set-points (a GOTO's or
+  // a STOP's package interpolation moves nothing; a frame without one takes
+  // the file's). Set-points of two are refused rather than written as one of
+  // them (replay keeps each).
+  std::optional<std::size_t> first_setpoint;
+  const auto interpolation = [&frames](std::size_t i) { return *frames[i].interpolation; };
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (WaypointRateCount(frames[i].command.type, 1) == 0 || !frames[i].interpolation) continue;
+    if (!first_setpoint) {
+      first_setpoint = i;
+    } else if (interpolation(i) != interpolation(*first_setpoint)) {
+      throw LogError("frame " + std::to_string(i + 1) + " " + ToString(frames[i].command.type) +
+                     ": interpolation " + InterpolationName(interpolation(i)) + ", frame " +
+                     std::to_string(*first_setpoint + 1) + "'s " +
+                     InterpolationName(interpolation(*first_setpoint)) +
+                     ": a sequence file has one interpolation (replay keeps each; --window can take one "
+                     "stretch)");
+    }
+  }
+  if (first_setpoint && interpolation(*first_setpoint) != Interpolation::kStep)
+    out << "interpolation " << InterpolationName(interpolation(*first_setpoint)) << "\n";
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const TimedCommand& f = frames[i];
     const std::string& target = f.command.target;
@@ -185,10 +201,7 @@ std::string FormatSequence(const std::vector<TimedCommand>& frames, const std::s
     }
     char offset[32];
     std::snprintf(offset, sizeof offset, "%.6f", ToSeconds(f.offset));
-    out << offset << ' ' << Lower(ToString(f.command.type));
-    if (!target.empty()) out << ' ' << target;
-    for (double v : f.command.values) out << ' ' << Num(v);
-    out << "\n";
+    out << offset << ' ' << FormatCommandWords(f.command) << "\n";
   }
   return out.str();
 }

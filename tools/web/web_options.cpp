@@ -2,10 +2,9 @@
 
 #include "robotalk/channels.h"  // kAnnounceHeardWithin
 #include "robotalk/error.h"
-#include "robotalk/sequence_file.h"  // ParseNumber, ParseSeconds
+#include "robotalk/sequence_file.h"  // ParseNumberIn, ParseSeconds
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 
 namespace robotalk::web {
@@ -84,15 +83,11 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
       o.bind = value();
       if (o.bind.empty()) throw Error("--bind: empty address");
     } else if (a == "--port") {
-      const double p = ParseNumber(value(), a);
-      if (p < 0 || p > 65535 || p != std::floor(p))
-        throw Error("--port: " + args[i] + " is not a port (0-65535)");
-      o.port = static_cast<int>(p);
+      o.port = static_cast<int>(ParseNumberIn(value(), a, {.min = 0, .max = 65535, .whole = true}));
     } else if (a == "--lcm-url") {
       o.lcm_url = value();
     } else if (a == "--rate") {
-      o.rate_hz = ParseNumber(value(), a);
-      if (o.rate_hz < 1 || o.rate_hz > 240) throw Error("--rate: " + args[i] + " Hz is outside 1-240");
+      o.rate_hz = ParseNumberIn(value(), a, {.min = 1, .max = 240});
     } else if (a == "--robot-timeout") {
       o.robot_timeout_s = ParseSeconds(value(), a);  // within what every time given as text may be
       if (o.robot_timeout_s < ToSeconds(kAnnounceHeardWithin)) {
@@ -102,10 +97,8 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
                     " s (servers announce every second)");
       }
     } else if (a == "--max-websockets" || a == "--max-http-waiting") {
-      const double n = ParseNumber(value(), a);
-      if (n < 1 || n > 4096 || n != std::floor(n))
-        throw Error(a + ": " + args[i] + " is not a whole number from 1 to 4096");
-      (a == "--max-websockets" ? o.max_websockets : o.max_http_waiting) = static_cast<int>(n);
+      (a == "--max-websockets" ? o.max_websockets : o.max_http_waiting) =
+          static_cast<int>(ParseNumberIn(value(), a, {.min = 1, .max = 4096, .whole = true}));
     } else if (a == "--key") {
       o.key_file = value();
       if (o.key_file.empty()) throw Error("--key: the file name is empty");

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -41,6 +42,17 @@ double ParseNumber(const std::string& word, const std::string& what) {
   if (!v) throw UsageError(what + ": '" + word + "' is not a number");
   if (!std::isfinite(*v)) throw UsageError(what + ": '" + word + "' is not finite");
   return *v;
+}
+
+double ParseNumberIn(const std::string& word, const std::string& flag, const NumberRange& range) {
+  const std::optional<double> v = NumberOf(word);
+  if (v && std::isfinite(*v) && (range.above_min ? *v > range.min : *v >= range.min) && *v <= range.max &&
+      (!range.whole || *v == std::floor(*v)))
+    return *v;
+  char bounds[80];
+  std::snprintf(bounds, sizeof bounds, "%c%g, %g]", range.above_min ? '(' : '[', range.min, range.max);
+  throw UsageError(flag + ": '" + word + "' is not a " + (range.whole ? "whole " : "") + "number in " +
+                   bounds);
 }
 
 double ParseSeconds(const std::string& word, const std::string& what) {
@@ -175,9 +187,12 @@ std::string FormatCommandWords(const Command& c) {
   if (!c.target.empty()) text += " " + c.target;
   const auto append = [&text](const std::vector<double>& values) {
     for (const double v : values) {
+      // The shortest text that reads back to the same bits ("0.3", not
+      // %.17g's "0.29999999999999999"): locale-free, as StrtodC reads it.
       char number[32];
-      std::snprintf(number, sizeof number, " %.17g", v);
-      text += number;
+      const std::to_chars_result r = std::to_chars(number, number + sizeof number, v);
+      text += ' ';
+      text.append(number, r.ptr);
     }
   };
   append(c.values);

@@ -18,6 +18,7 @@
 #include "robotalk/error.h"
 #include "robotalk/trajectory.h"
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,7 +41,8 @@ class UsageError : public Error {
 /// one per position of a JOINT_SETPOINT, 6 for a FRAME_SETPOINT) and that
 /// every value is a finite number. Throws UsageError.
 Command ParseCommandWords(const std::vector<std::string>& words);
-/// The inverse: "joint_setpoint pan 0.5 velocity 0.1" (values exact to the last bit).
+/// The inverse: "joint_setpoint pan 0.5 velocity 0.1", each value the shortest
+/// text that reads back to the same bits.
 std::string FormatCommandWords(const Command& command);
 
 /// An interpolation's name, any case ("cubic"); throws UsageError
@@ -63,6 +65,20 @@ std::optional<double> NumberOf(const std::string& word);
 /// Parses a finite number (NumberOf); throws UsageError naming `what`:
 /// "<what>: 'x' is not a number", "<what>: 'inf' is not finite".
 double ParseNumber(const std::string& word, const std::string& what);
+
+/// The values a number option accepts (ParseNumberIn).
+struct NumberRange {
+  double min = -std::numeric_limits<double>::max();
+  double max = std::numeric_limits<double>::max();
+  bool above_min = false;  ///< min itself refused: "(0, 60]"
+  bool whole = false;      ///< an integer: "3", "3.0" and "3e0", never "2.5"
+};
+/// A number option's value (the word after `flag`; an environment
+/// variable's): a finite number (NumberOf) in `range`. The one reader of a
+/// number option of every tool; throws UsageError naming the flag, the word
+/// and the range whatever is wrong with it: "--port: 'http' is not a whole
+/// number in [0, 65535]", "--rate: '0' is not a number in [1, 240]".
+double ParseNumberIn(const std::string& word, const std::string& flag, const NumberRange& range);
 
 /// The most seconds a time given as text may be (a sequence file's start
 /// times; the command lines' --timeout, --at, --delay, --listen ...): 1e9 s,
