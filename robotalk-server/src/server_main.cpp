@@ -158,9 +158,11 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--no-precise-timing") {
         options.precise_timing = false;
       } else if (arg == "--max-sessions") {
-        options.max_sessions = static_cast<std::size_t>(ParseNumberIn(value(), arg, {1, 1e6}));
+        options.max_sessions =
+            static_cast<std::size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e6, .whole = true}));
       } else if (arg == "--max-sessions-per-robot") {
-        options.max_sessions_per_robot = static_cast<std::size_t>(ParseNumberIn(value(), arg, {1, 1e6}));
+        options.max_sessions_per_robot =
+            static_cast<std::size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e6, .whole = true}));
       } else if (arg == "--panic-latch") {
         options.panic_latch_path = value();
         if (options.panic_latch_path.empty()) throw Error("--panic-latch needs a file name");
@@ -170,7 +172,8 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--no-panic-latch") {
         no_panic_latch = true;
       } else if (arg == "--log-lines-per-second") {
-        options.log_lines_per_second = static_cast<int>(ParseNumberIn(value(), arg, {1, 1e6}));
+        options.log_lines_per_second =
+            static_cast<int>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e6, .whole = true}));
       } else if (arg == "--driver-call-bound") {
         options.driver_call_bound = FromSeconds(ParseNumberIn(value(), arg, {0, 3600}));
       } else if (arg == "--max-acceleration") {
@@ -186,9 +189,11 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--session-timeout") {
         options.session_timeout = FromSeconds(ParseNumberIn(value(), arg, {0.05, 3600}));
       } else if (arg == "--max-queue") {
-        options.max_queue = static_cast<size_t>(ParseNumberIn(value(), arg, {1, 1e7}));
+        options.max_queue =
+            static_cast<size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e7, .whole = true}));
       } else if (arg == "--max-queued-total") {
-        options.max_queued_total = static_cast<size_t>(ParseNumberIn(value(), arg, {1, 1e8}));
+        options.max_queued_total =
+            static_cast<size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e8, .whole = true}));
       } else if (arg == "--max-goto-distance") {
         options.max_goto_distance = ParseNumberIn(value(), arg, {0, 1e7});
       } else if (arg == "--max-future") {
@@ -226,7 +231,8 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--congestion-max-pause") {
         options.congestion_max_pause = FromSeconds(ParseNumberIn(value(), arg, {0, 10}));
       } else if (arg == "--playback-min-frames") {
-        options.playback_min_frames = static_cast<size_t>(ParseNumberIn(value(), arg, {2, 1e6}));
+        options.playback_min_frames =
+            static_cast<size_t>(ParseNumberIn(value(), arg, {.min = 2, .max = 1e6, .whole = true}));
       } else if (arg == "--playback-estimator") {
         options.playback_estimator = value();
         if (options.playback_estimator != "adaptive" && options.playback_estimator != "quick" &&
@@ -269,7 +275,8 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--inject-reply-dup") {
         options.reply_duplicate_probability = ParseNumberIn(value(), arg, {0, 1});
       } else if (arg == "--seed") {
-        options.fault_seed = static_cast<std::uint64_t>(ParseNumberIn(value(), arg, {0, 1e18}));
+        options.fault_seed =
+            static_cast<std::uint64_t>(ParseNumberIn(value(), arg, {.min = 0, .max = 1e18, .whole = true}));
       } else {
         SayServer("unknown option '" + arg + "' (see --help)");
         return 2;
