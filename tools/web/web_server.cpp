@@ -135,8 +135,7 @@ class WebServer::Impl {
     auto buffer = std::make_shared<beast::flat_buffer>();
     auto req = std::make_shared<http::request<http::string_body>>();
     stream->expires_after(std::chrono::seconds(30));
-    const std::uint64_t id = next_waiting_++;
-    waiting_[id] = {stream, RemoteAddress(*stream)};
+    const std::uint64_t id = Hold(stream);
     http::async_read(*stream, *buffer, *req,
                      [this, stream, buffer, req, id](beast::error_code ec, std::size_t) {
                        waiting_.erase(id);
@@ -197,8 +196,18 @@ class WebServer::Impl {
     });
   }
 
-  // Closes the oldest connection waiting for a request of the address that
-  // holds the most (a flood from one address never closes a connection of an
+  // Counts a plain HTTP connection among those --max-http-waiting bounds,
+  // until its id is erased from waiting_: while it waits for a request, and
+  // while its answer is written (a client that never reads a large answer
+  // holds its descriptor as long as one that never finishes its request).
+  std::uint64_t Hold(const std::shared_ptr<beast::tcp_stream>& stream) {
+    const std::uint64_t id = next_waiting_++;
+    waiting_[id] = {stream, RemoteAddress(*stream)};
+    return id;
+  }
+
+  // Closes the oldest connection waiting for a request or for its answer to
+  // be read, of the address that holds the most (a flood from one address never closes a connection of an
   // address holding fewer, the operator's); false when none waits.
   // One line on stderr per second at most, naming `why`.
   bool CloseWaiting(const char* why) {
@@ -212,11 +221,12 @@ class WebServer::Impl {
     if (const auto stream = it->second.stream.lock()) stream->close();
     waiting_.erase(it);
     if (closed_waiting_.Count()) {
-      WebLog().Write("closed the oldest HTTP connection waiting for a request from " + address.to_string() +
-                     ", which held " + std::to_string(most) + " of the " +
-                     std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
-                     std::to_string(options_.max_http_waiting) + "; " +
-                     std::to_string(closed_waiting_.count) + " closed so far)");
+      WebLog().Write(
+          "closed the oldest HTTP connection waiting for a request or for its answer to be read from " +
+          address.to_string() + ", which held " + std::to_string(most) + " of the " +
+          std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
+          std::to_string(options_.max_http_waiting) + "; " + std::to_string(closed_waiting_.count) +
+          " closed so far)");
     }
     return true;
   }
@@ -241,7 +251,9 @@ class WebServer::Impl {
       res.keep_alive(keep_alive);
       res.prepare_payload();
       auto sp = std::make_shared<decltype(res)>(std::move(res));
-      http::async_write(*stream, *sp, [this, stream, sp, keep_alive](beast::error_code ec, std::size_t) {
+      const std::uint64_t id = Hold(stream);
+      http::async_write(*stream, *sp, [this, stream, sp, keep_alive, id](beast::error_code ec, std::size_t) {
+        waiting_.erase(id);
         if (!ec && keep_alive) ReadRequest(stream);
       });
     };
@@ -429,7 +441,8 @@ class WebServer::Impl {
     }
   };
   CountedLine refused_websockets_;  // past --max-websockets
-  // Connections waiting for a request (ReadRequest), by age: what --max-http-waiting bounds.
+  // Connections waiting for a request (ReadRequest) or for their answer to be
+  // read (Respond), by age (Hold): what --max-http-waiting bounds.
   struct Waiting {
     std::weak_ptr<beast::tcp_stream> stream;
     asio::ip::address address;
