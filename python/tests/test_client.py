@@ -187,6 +187,8 @@ def test_a_signal_errors_text_shows_a_servers_control_characters_escaped(robot: 
     assert not any(ord(c) < 0x20 or 0x7F <= ord(c) <= 0x9F for c in str(e.value)), repr(str(e.value))
     assert r"pan\x1b[2J\x07\x0d\x0a  robotalk: forged\x7f\xc2\x9b" in str(e.value)
     assert target in e.value.reply.message
+    # The reply's repr (an interactive session prints it) escapes them too.
+    assert not any(ord(c) < 0x20 or 0x7F <= ord(c) <= 0x9F for c in repr(e.value.reply)), repr(e.value.reply)
 
 
 def test_an_error_naming_bytes_not_utf8_shows_them_escaped(server: Server) -> None:
