@@ -136,40 +136,66 @@ class WebServer::Impl {
     auto req = std::make_shared<http::request<http::string_body>>();
     stream->expires_after(std::chrono::seconds(30));
     const std::uint64_t id = Hold(stream);
-    http::async_read(*stream, *buffer, *req,
-                     [this, stream, buffer, req, id](beast::error_code ec, std::size_t) {
-                       waiting_.erase(id);
-                       if (ec) return;
-                       if (websocket::is_upgrade(*req) &&
-                           OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets))
-                         return RefuseWebSocket(stream, std::move(*req));
-                       if (websocket::is_upgrade(*req) &&
-                           FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
-                         stream->expires_never();
-                         foxglove_->Accept(stream->release_socket(), std::move(*req));
-                         return;
-                       }
-                       if (websocket::is_upgrade(*req) &&
-                           std::string_view(req->target().data(), req->target().size()) == "/ws") {
-                         stream->expires_never();
-                         auto session = std::make_shared<WsConnection>(
-                             stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
-                             [this](const std::shared_ptr<WsConnection>& s, const std::string& text, bool) {
-                               OnPageMessage(s, text);
-                             });
-                         sessions_.push_back(session);
-                         session->Start(std::move(*req), Greeting());
-                         return;
-                       }
-                       Respond(stream, std::move(*req));
-                     });
+    http::async_read(
+        *stream, *buffer, *req, [this, stream, buffer, req, id](beast::error_code ec, std::size_t) {
+          waiting_.erase(id);
+          if (ec) return;
+          const asio::ip::address address = RemoteAddress(*stream);
+          if (websocket::is_upgrade(*req) &&
+              OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets) &&
+              !CloseWebSocketFor(address))
+            return RefuseWebSocket(stream, std::move(*req));
+          if (websocket::is_upgrade(*req) &&
+              FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
+            stream->expires_never();
+            websockets_.push_back({foxglove_->Accept(stream->release_socket(), std::move(*req)), address});
+            return;
+          }
+          if (websocket::is_upgrade(*req) &&
+              std::string_view(req->target().data(), req->target().size()) == "/ws") {
+            stream->expires_never();
+            auto session = std::make_shared<WsConnection>(
+                stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
+                [this](const std::shared_ptr<WsConnection>& s, const std::string& text, bool) {
+                  OnPageMessage(s, text);
+                });
+            sessions_.push_back(session);
+            websockets_.push_back({session, address});
+            session->Start(std::move(*req), Greeting());
+            return;
+          }
+          Respond(stream, std::move(*req));
+        });
   }
 
   // The page's open WebSockets and Foxglove's: what --max-websockets bounds.
-  std::size_t OpenWebSockets() const {
-    return foxglove_->connections() +
-           static_cast<std::size_t>(
-               std::count_if(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->live(); }));
+  std::size_t OpenWebSockets() {
+    std::erase_if(websockets_, [](const WebSocket& w) {
+      const auto c = w.connection.lock();
+      return !c || !c->live();
+    });
+    return websockets_.size();
+  }
+
+  // At --max-websockets, a WebSocket asked for from `address`: closes the
+  // oldest of the address holding the most when `address` holds fewer (a
+  // flood from one address never keeps the operator's page, and its PANIC
+  // button, out), and says so on stderr once a second at most; false when
+  // `address` holds the most itself (it is refused).
+  bool CloseWebSocketFor(const asio::ip::address& address) {
+    std::map<asio::ip::address, std::size_t> per_address;
+    std::size_t most = 0;
+    for (const WebSocket& w : websockets_) most = std::max(most, ++per_address[w.address]);
+    if (per_address[address] >= most) return false;
+    const auto oldest = std::find_if(websockets_.begin(), websockets_.end(),
+                                     [&](const WebSocket& w) { return per_address[w.address] == most; });
+    const asio::ip::address holder = oldest->address;
+    const std::string why = "a WebSocket from " + address.to_string() + " at the --max-websockets limit (" +
+                            std::to_string(options_.max_websockets) + "), and " + holder.to_string() +
+                            " holds the most (" + std::to_string(most) + "); the oldest of them closed";
+    if (const auto c = oldest->connection.lock()) c->Close(why);
+    websockets_.erase(oldest);
+    return true;
   }
 
   // One WebSocket more than --max-websockets: 503, the limit named, the
@@ -428,6 +454,12 @@ class WebServer::Impl {
   bool armed_ = false;
   std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
   std::vector<std::shared_ptr<WsConnection>> sessions_;
+  // Every WebSocket, page and Foxglove, by age: what --max-websockets bounds.
+  struct WebSocket {
+    std::weak_ptr<WsConnection> connection;
+    asio::ip::address address;
+  };
+  std::vector<WebSocket> websockets_;
   // An event counted, its stderr line (with the count so far) at most once a second.
   struct CountedLine {
     std::uint64_t count = 0;
