@@ -98,4 +98,7 @@ rc=$?
 if [ $rc -eq 0 ] && ! grep -q "max-websockets" "$tmp/web.log"; then
   echo "FAIL: no line on stderr says a WebSocket was refused:"; cat "$tmp/web.log"; rc=1
 fi
+if [ $rc -eq 0 ] && ! grep -q "closed the oldest WebSocket of 127.0.0.1, which held the most (64), for one from 127.0.0.2" "$tmp/web.log"; then
+  echo "FAIL: no line on stderr says which WebSocket was closed for the page from 127.0.0.2:"; cat "$tmp/web.log"; rc=1
+fi
 exit $rc

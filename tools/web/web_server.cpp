@@ -180,7 +180,8 @@ class WebServer::Impl {
   // At --max-websockets, a WebSocket asked for from `address`: closes the
   // oldest of the address holding the most when `address` holds fewer (a
   // flood from one address never keeps the operator's page, and its PANIC
-  // button, out), and says so on stderr once a second at most; false when
+  // button, out), and says so on stderr once a second at most (an attacker
+  // with two addresses makes it close one of its own per new one); false when
   // `address` holds the most itself (it is refused).
   bool CloseWebSocketFor(const asio::ip::address& address) {
     std::map<asio::ip::address, std::size_t> per_address;
@@ -190,10 +191,12 @@ class WebServer::Impl {
     const auto oldest = std::find_if(websockets_.begin(), websockets_.end(),
                                      [&](const WebSocket& w) { return per_address[w.address] == most; });
     const asio::ip::address holder = oldest->address;
-    const std::string why = "a WebSocket from " + address.to_string() + " at the --max-websockets limit (" +
-                            std::to_string(options_.max_websockets) + "), and " + holder.to_string() +
-                            " holds the most (" + std::to_string(most) + "); the oldest of them closed";
-    if (const auto c = oldest->connection.lock()) c->Close(why);
+    if (closed_websockets_.Count())
+      WebLog().Write("closed the oldest WebSocket of " + holder.to_string() + ", which held the most (" +
+                     std::to_string(most) + "), for one from " + address.to_string() +
+                     " at the --max-websockets limit (" + std::to_string(options_.max_websockets) + "; " +
+                     std::to_string(closed_websockets_.count) + " closed so far)");
+    if (const auto c = oldest->connection.lock()) c->Close("", /*say=*/false);
     websockets_.erase(oldest);
     return true;
   }
@@ -473,6 +476,7 @@ class WebServer::Impl {
     }
   };
   CountedLine refused_websockets_;  // past --max-websockets
+  CountedLine closed_websockets_;   // by CloseWebSocketFor
   // Connections waiting for a request (ReadRequest) or for their answer to be
   // read (Respond), by age (Hold): what --max-http-waiting bounds.
   struct Waiting {
