@@ -106,6 +106,15 @@ local function zeroed(bytes, ...)
   for _, at in ipairs({ ... }) do bytes = bytes:sub(1, at - 1) .. string.rep('\0', 8) .. bytes:sub(at + 8) end
   return bytes
 end
+-- A text from the wire (anyone's in open mode) as an error names it: each
+-- control character (C0, DEL, C1 in UTF-8) as \xNN, so it never reaches a
+-- terminal as an escape nor forges a line (review14).
+function M.printable(text)
+  local function esc(c) return string.format('\\x%02x', c:byte()) end
+  text = text:gsub('\194[\128-\159]', function(c1) return esc(c1:sub(1, 1)) .. esc(c1:sub(2, 2)) end)
+  return (text:gsub('[\0-\31\127]', esc))
+end
+
 local function hex(raw) return (raw:gsub('.', function(c) return string.format('%02x', c:byte()) end)) end
 M.hex_of_raw = hex
 
@@ -246,7 +255,7 @@ function Client:say_hello(timeout_s)
     end
     self:handle_for(math.min(next_hello, deadline) - now)
   end
-  if self.refusal then return nil, "hello refused by '" .. self.robot .. "': " .. self.refusal end
+  if self.refusal then return nil, "hello refused by '" .. self.robot .. "': " .. M.printable(self.refusal) end
   self.last_new_package = M.now()
   return true
 end
@@ -409,7 +418,7 @@ function Client:load_config(timeout_s)
   local r, err = self:query(msgs.query_t.CONFIG, '', timeout_s)
   local result
   if r and r.signal ~= msgs.reply_t.SUCCESS then
-    err = 'CONFIG answered ' .. M.signal_name(r.signal) .. ': ' .. r.message
+    err = 'CONFIG answered ' .. M.signal_name(r.signal) .. ': ' .. M.printable(r.message)
   elseif r then
     local deadline = M.now() + timeout_s
     while heard.hash ~= r.message and M.now() < deadline do
@@ -420,7 +429,7 @@ function Client:load_config(timeout_s)
     if heard.hash == r.message then
       result = heard.config
     else
-      err = err or ('no robot_config_t with hash ' .. r.message .. ' on ' .. channel)
+      err = err or ('no robot_config_t with hash ' .. M.printable(r.message) .. ' on ' .. channel)
     end
   end
   self.main:unsubscribe(sub)
@@ -446,7 +455,7 @@ function M.connect(url, robot, timeout_s)
     local a = msgs.announce_t.decode(zeroed(data, OFF.announce_server))  -- robots[].config_hash still warns
     for _, r in ipairs(a.robots) do
       if r.name ~= robot then
-        heard[r.name] = true
+        heard[M.printable(r.name)] = true
       elseif a.protocol_version ~= M.PROTOCOL_VERSION then
         problem = string.format("'%s' speaks protocol %d; this client speaks %d", robot, a.protocol_version,
           M.PROTOCOL_VERSION)

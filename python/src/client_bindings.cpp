@@ -11,6 +11,7 @@
 // StateQueue (state_queue.h), never by calling Python on the ReadDaemon.
 #include "bindings.h"
 #include "py_errors.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 #include "robotalk/sequence_file.h"
 #include "state_queue.h"
 
@@ -140,9 +141,11 @@ class PyRobotClient {
     const QueryType t = ParseQuery(type);
     Reply r = RunQuery(Query{.type = t, .target = target}, true).cast<Reply>();
     if (!Succeeded(r.signal)) {
-      ThrowSignalError(std::string(ToString(t)) + (target.empty() ? "" : " '" + target + "'") + ": " +
-                           std::string(ToString(r.signal)) + (r.message.empty() ? "" : ": " + r.message),
-                       py::cast(r));
+      // Its text escaped (a traceback prints it); the reply keeps the server's.
+      ThrowSignalError(
+          EscapeControls(std::string(ToString(t)) + (target.empty() ? "" : " '" + target + "'") + ": " +
+                         std::string(ToString(r.signal)) + (r.message.empty() ? "" : ": " + r.message)),
+          py::cast(r));
     }
     return ToArray(r.values);
   }

@@ -2,6 +2,7 @@
 // TimedCommand, StateSample, SequenceResult, AnnouncedRobot, and the text
 // forms of commands (robotalk/sequence_file.h).
 #include "bindings.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 #include "robotalk/sequence_file.h"
 
 #include <pybind11/stl.h>
@@ -88,7 +89,7 @@ void BindValues(py::module_& m) {
           "A query's values (numpy); empty for a command.")
       .def("__repr__", [](const Reply& r) {
         std::string s = "<Reply " + std::to_string(r.id) + " " + std::string(ToString(r.signal));
-        if (!r.message.empty()) s += " '" + r.message + "'";
+        if (!r.message.empty()) s += " '" + EscapeControls(r.message) + "'";  // the server's text
         if (!r.values.empty()) s += " (" + std::to_string(r.values.size()) + " values)";
         return s + " late " + Ms(r.lateness) + ">";
       });

@@ -176,6 +176,21 @@ def test_a_reply_message_not_utf8_reaches_python_escaped(robot: robotalk.RobotCl
         assert shown in e.value.reply.message
 
 
+def test_a_signal_errors_text_shows_a_servers_control_characters_escaped(robot: robotalk.RobotClient) -> None:
+    # Review 14: the server echoes the target in its message (a reply's text
+    # from the wire, anyone's in open mode); SignalError's text, which a
+    # traceback prints, shows its control characters as \xNN; the reply it
+    # carries keeps them (it was the raw text: ESC, BEL, CR, a line break).
+    target = "pan\x1b[2J\a\r\n  robotalk: forged\x7f\u009b"
+    with pytest.raises(robotalk.SignalError) as e:
+        robot.joint_state(target)
+    assert not any(ord(c) < 0x20 or 0x7F <= ord(c) <= 0x9F for c in str(e.value)), repr(str(e.value))
+    assert r"pan\x1b[2J\x07\x0d\x0a  robotalk: forged\x7f\xc2\x9b" in str(e.value)
+    assert target in e.value.reply.message
+    # The reply's repr (an interactive session prints it) escapes them too.
+    assert not any(ord(c) < 0x20 or 0x7F <= ord(c) <= 0x9F for c in repr(e.value.reply)), repr(e.value.reply)
+
+
 def test_an_error_naming_bytes_not_utf8_shows_them_escaped(server: Server) -> None:
     # A RobotalkError's text holding such bytes: the class and the text, escaped
     # (it was a UnicodeDecodeError, or the class with its text lost).

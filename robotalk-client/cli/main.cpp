@@ -1,6 +1,7 @@
 // robotalk: command-line client of a RoboTalk server (docs/client.md).
 #include "cli_commands.h"
 #include "interrupt.h"
+#include "robotalk/log_writer.h"  // OpenStandardDescriptors
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -76,7 +77,8 @@ Exit status: 0 SUCCESS/MODIFIED, 1 any other signal or a timeout, 2 usage error,
 
 int main(int argc, char** argv) {
   using namespace robotalk::cli;
-  Interrupter::Install();  // first: every later thread inherits the blocked signals
+  robotalk::OpenStandardDescriptors();  // nothing of ours on descriptors 0-2
+  Interrupter::Install();               // before any thread: every later one inherits the blocked signals
   std::vector<std::string> args(argv + 1, argv + argc);
   if (std::find(args.begin(), args.end(), "--version") != args.end()) {
     std::cout << "robotalk " << ROBOTALK_VERSION << "\n";

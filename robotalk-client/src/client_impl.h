@@ -35,6 +35,16 @@
 
 namespace robotalk {
 
+namespace client {
+/// A server's answer as a failed call's exception names it: its signal and
+/// its message, the message's control characters as \xNN (EscapeControls):
+/// a server's text never reaches whoever prints the exception raw.
+std::string Answered(const Reply& reply);
+/// The model hash a CONFIG reply's message carries (hexadecimal, 1-16
+/// digits, nothing else); throws ProtocolError naming the message escaped.
+std::uint64_t ParseConfigHash(const Reply& reply, const std::string& call);
+}  // namespace client
+
 /// What a package says besides its items (docs/protocol.md, Modes).
 struct PackageOptions {
   bool panic = false;

@@ -281,8 +281,8 @@ void RobotClient::Impl::NoteResyncReplies(const std::vector<Reply>& replies) {
     resync_config_query_.reset();
     std::uint64_t hash = 0;
     try {
-      hash = std::stoull(r.message, nullptr, 16);
-    } catch (const std::exception&) {
+      hash = client::ParseConfigHash(r, "re-sync");
+    } catch (const ProtocolError&) {
       return;
     }
     if (model_ && ConfigHash(*model_) == hash) return;

@@ -303,8 +303,7 @@ Duration RobotClient::StartStateStream(Duration period, std::function<void(const
   impl_->SubscribeState(std::move(on_sample));
   const Reply r = Query(robotalk::Query{.type = QueryType::kStateStream, .period = period});
   if (r.signal != Signal::kSuccess) {
-    throw ClientError("RobotClient::StartStateStream: " + std::string(robotalk::ToString(r.signal)) + ": " +
-                      r.message);
+    throw ClientError("RobotClient::StartStateStream: " + client::Answered(r));
   }
   return r.values.empty() ? period : FromSeconds(r.values[0]);
 }

@@ -7,10 +7,12 @@
 #include "robotalk/channels.h"
 #include "robotalk/heard_announcement.h"
 #include "robotalk/keys.h"
+#include "robotalk/log_writer.h"  // EscapeControls
 #include "robotalk/request.h"
 #include "robotalk/routed_lcm_transport.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <set>
 #include <utility>
@@ -37,6 +39,25 @@ std::string Describe(const Query& q) {
 }
 
 }  // namespace
+
+namespace client {
+
+std::string Answered(const Reply& reply) {
+  return std::string(ToString(reply.signal)) + ": " + EscapeControls(reply.message);
+}
+
+std::uint64_t ParseConfigHash(const Reply& reply, const std::string& call) {
+  const std::string& m = reply.message;
+  const bool hex = !m.empty() && m.size() <= 16 && std::all_of(m.begin(), m.end(), [](char c) {
+    return std::isxdigit(static_cast<unsigned char>(c));
+  });
+  if (!hex)
+    throw ProtocolError(call + ": CONFIG reply message '" + EscapeControls(m) +
+                        "' is not a hexadecimal hash");
+  return std::stoull(m, nullptr, 16);
+}
+
+}  // namespace client
 
 // --- PendingReply ------------------------------------------------------------
 
@@ -267,17 +288,9 @@ void RobotClient::Connect(const std::string& robot) {
     } catch (const TimeoutError&) {
       break;
     }
-    if (!Succeeded(r.signal)) {
-      throw ClientError("RobotClient::Connect('" + robot + "'): CONFIG answered " +
-                        std::string(ToString(r.signal)) + ": " + r.message);
-    }
-    std::uint64_t hash = 0;
-    try {
-      hash = std::stoull(r.message, nullptr, 16);
-    } catch (const std::exception&) {
-      throw ProtocolError("RobotClient::Connect('" + robot + "'): CONFIG reply message '" + r.message +
-                          "' is not a hexadecimal hash");
-    }
+    const std::string call = "RobotClient::Connect('" + robot + "')";
+    if (!Succeeded(r.signal)) throw ClientError(call + ": CONFIG answered " + client::Answered(r));
+    const std::uint64_t hash = client::ParseConfigHash(r, call);
     model = impl_->WaitModel(hash, std::min(deadline, SteadyAfter(std::chrono::milliseconds(500))));
   }
   if (!model) {
@@ -309,11 +322,10 @@ const RobotModel& RobotClient::model() const {
 
 const RobotModel& RobotClient::ReloadModel() {
   Reply r = Query(QueryType::kConfig);
-  if (!Succeeded(r.signal)) {
-    throw ClientError("RobotClient::ReloadModel: CONFIG answered " + std::string(ToString(r.signal)) + ": " +
-                      r.message);
-  }
-  auto model = impl_->WaitModel(std::stoull(r.message, nullptr, 16), SteadyAfter(impl_->options_.timeout));
+  if (!Succeeded(r.signal))
+    throw ClientError("RobotClient::ReloadModel: CONFIG answered " + client::Answered(r));
+  auto model = impl_->WaitModel(client::ParseConfigHash(r, "RobotClient::ReloadModel"),
+                                SteadyAfter(impl_->options_.timeout));
   if (!model) throw TimeoutError("RobotClient::ReloadModel: no configuration received");
   std::lock_guard lock(impl_->mu_);
   impl_->model_ = model;

@@ -76,6 +76,7 @@ int Run(int argc, char** argv) {
 }  // namespace robotalk::ros2
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: nothing of ours on descriptors 0-2
   const int status = robotalk::ros2::Run(argc, argv);
   robotalk::LogWriter::Stderr().Flush();  // the count of lines lost, if any is unsaid (within kMaxWait)
   return status;

@@ -378,6 +378,7 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
 
 int ServerMain(int argc, char** argv, const DriverRegistry& registry,
                const SimulateCommand& simulate_command) {
+  OpenStandardDescriptors();  // first: nothing of ours on descriptors 0-2
   const int status = Serve(argc, argv, registry, simulate_command);
   LogWriter::Stderr().Flush();  // the count of lines lost, if any is unsaid (within kMaxWait)
   return status;

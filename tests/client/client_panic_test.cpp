@@ -300,10 +300,15 @@ class HandAnsweredPanicTest : public ClientPanicTest {
   // Answers every REQUEST package with `answer` (client, session and
   // sequence filled in) while `call` runs on another thread.
   void AnswerWhile(ReplyBatch answer, const std::function<void()>& call) {
+    AnswerWhile([&](const Request&) { return answer; }, call);
+  }
+  // The same with an answer made for each package.
+  void AnswerWhile(const std::function<ReplyBatch(const Request&)>& answer,
+                   const std::function<void()>& call) {
     auto sub = server_end_.Subscribe(
         RequestChannel(kRobot), [&](const std::string&, std::span<const std::uint8_t> bytes) {
           const Request r = DecodeRequest(bytes);
-          ReplyBatch b = answer;
+          ReplyBatch b = answer(r);
           b.client_id = r.client_id;
           b.session_id = r.session_id;
           b.ack_sequence = r.sequence;
@@ -340,6 +345,80 @@ TEST_F(HandAnsweredPanicTest, AnOpenModePanicAnsweredRefusedThrowsWithTheReason)
       ADD_FAILURE() << "a refused panic was reported as taken";
     } catch (const PanicRefusedError& e) {
       EXPECT_THAT(e.what(), HasSubstr("the reason the server gave"));
+    }
+  });
+}
+
+// Review 14: a server's text (a reply's message) embedded in the exception
+// of a call that failed, as the panic's refusal and the hello's are: escaped
+// (no control character reaches whoever prints e.what(), a terminal or a
+// log), and a CONFIG answer that is no hash is a RoboTalk error naming it,
+// not std::stoull's std::invalid_argument.
+class HandAnsweredTextTest : public HandAnsweredPanicTest {
+ protected:
+  // Every query answered `signal` with `message`.
+  void AnswerQueriesWhile(Signal signal, const std::string& message, const std::function<void()>& call) {
+    AnswerWhile(
+        [&](const Request& r) {
+          ReplyBatch b;
+          for (const robotalk::Query& q : r.queries)
+            b.replies.push_back(Reply{.id = q.id, .signal = signal, .message = message});
+          return b;
+        },
+        call);
+  }
+  static void ExpectNoControlCharacter(const std::string& text) {
+    for (const char c : text) {
+      const auto u = static_cast<unsigned char>(c);
+      EXPECT_FALSE(u < 0x20 || u == 0x7f) << "control character " << static_cast<int>(u) << " in: " << text;
+    }
+    EXPECT_EQ(text.find("\xc2\x9b"), std::string::npos) << "C1 CSI in: " << text;
+  }
+};
+
+const std::string kHostile =
+    "bad\x1b[31m red\a\n  robotalk: a forged line\r\xc2\x9b"
+    "2J";
+
+TEST_F(HandAnsweredTextTest, AServersMessageInAFailedCallsExceptionIsEscaped) {
+  StartServer(/*keyed=*/false);
+  auto client = Client();
+  server_.reset();
+  std::vector<std::string> texts;
+  AnswerQueriesWhile(Signal::kError, kHostile, [&] {
+    try {
+      client->StartStateStream(std::chrono::milliseconds(100), [](const StateSample&) {});
+      ADD_FAILURE() << "StartStateStream took an ERROR";
+    } catch (const ClientError& e) {
+      texts.push_back(e.what());
+    }
+    try {
+      client->ReloadModel();
+      ADD_FAILURE() << "ReloadModel took an ERROR";
+    } catch (const ClientError& e) {
+      texts.push_back(e.what());
+    }
+  });
+  ASSERT_EQ(texts.size(), 2u);
+  for (const std::string& text : texts) {
+    EXPECT_THAT(text, HasSubstr("bad\\x1b[31m red\\x07\\x0a  robotalk: a forged line\\x0d\\xc2\\x9b2J"));
+    ExpectNoControlCharacter(text);
+  }
+}
+
+TEST_F(HandAnsweredTextTest, AConfigAnswerThatIsNoHashIsARobotalkErrorNamingIt) {
+  StartServer(/*keyed=*/false);
+  auto client = Client();
+  server_.reset();
+  AnswerQueriesWhile(Signal::kSuccess, "not a hash\x1b[2J", [&] {
+    try {
+      client->ReloadModel();
+      ADD_FAILURE() << "ReloadModel took a CONFIG answer that is no hash";
+    } catch (const Error& e) {
+      EXPECT_THAT(e.what(), HasSubstr("not a hash\\x1b[2J"));
+      ExpectNoControlCharacter(e.what());
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not a RoboTalk error: " << e.what();
     }
   });
 }

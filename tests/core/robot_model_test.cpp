@@ -154,6 +154,42 @@ TEST(RobotModel, RefusesANameWithAControlCharacterNamingItEscaped) {
   EXPECT_NO_THROW(f.Build());
 }
 
+// Review 14: a name is text shown by a terminal, the page (JSON replaces
+// bytes that are not UTF-8 with U+FFFD: two names became one), Foxglove and
+// ROS 2 (a JointState whose names are not UTF-8). Every name must be UTF-8
+// (no overlong form, surrogate, lone continuation byte or truncated
+// character) and hold no line or paragraph separator (U+2028, U+2029) nor
+// bidirectional control (U+061C, U+200E, U+200F, U+202A-U+202E,
+// U+2066-U+2069: a name shown reordered, "Trojan Source"); the refusal names
+// it in printable ASCII. Other UTF-8 text is a name.
+TEST(RobotModel, RefusesANameThatIsNotUtf8TextOrHoldsALineSeparatorOrABidiControl) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"a\xff", "'a\\xff'"},                             // no UTF-8 byte
+      {"a\xc0\xaf", "'a\\xc0\\xaf'"},                    // overlong '/'
+      {"a\xe0\x80\xaf", "'a\\xe0\\x80\\xaf'"},           // overlong '/', 3 bytes
+      {"a\x80z", "'a\\x80z'"},                           // a lone continuation byte
+      {"a\x9b", "'a\\x9b'"},                             // a lone C1 CSI byte
+      {"a\xc3", "'a\\xc3'"},                             // truncated
+      {"a\xed\xa0\x80", "'a\\xed\\xa0\\x80'"},           // a surrogate
+      {"a\xf4\x90\x80\x80", "'a\\xf4\\x90\\x80\\x80'"},  // past U+10FFFF
+      {"a\xe2\x80\xa8z", "'a\\xe2\\x80\\xa8z'"},         // U+2028
+      {"a\xe2\x80\xaez", "'a\\xe2\\x80\\xaez'"},         // U+202E right-to-left override
+      {"a\xe2\x81\xa6z", "'a\\xe2\\x81\\xa6z'"},         // U+2066 left-to-right isolate
+      {"a\xe2\x80\x8fz", "'a\\xe2\\x80\\x8fz'"},         // U+200F right-to-left mark
+  };
+  for (const auto& [name, shown] : bad) {
+    RobotModelBuilder b = TwoLinkArm();
+    b.AddLink(Body(name));
+    ExpectModelError(b, ("link name " + shown).c_str());
+    RobotModelBuilder c = TwoLinkArm();
+    c.AddLink(Body("extra")).AddJoint(Revolute(name), "base", "extra");
+    ExpectModelError(c, ("joint name " + shown).c_str());
+  }
+  RobotModelBuilder f("\xe9\x96\xa2\xe7\xaf\x80");  // UTF-8 text is a name (BMP, 4 bytes, Hebrew)
+  f.AddLink(Body("\xf0\x9f\xa4\x96")).AddLink(Body("\xd7\x96\xd7\x95\xd7\xa2"));
+  EXPECT_NO_THROW(f.Build());
+}
+
 TEST(RobotModel, RejectsAJointNamingAnUnknownLink) {
   RobotModelBuilder b = TwoLinkArm();
   b.AddJoint(Revolute("wrist"), "lower", "hand");

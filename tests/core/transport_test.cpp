@@ -430,5 +430,33 @@ TEST(LcmTransport, CapturesOfAStderrThatTakesNothingNeverLeaveItReplaced) {
   EXPECT_EQ(after.st_ino, before.st_ino) << "descriptor 2 was left on another file";
 }
 
+// review14: a process whose descriptors 1 and 2 are closed (a library user
+// started with '>&- 2>&-'): the capture's pipe took them, it closed 2 while
+// LCM started, LCM's own descriptor (memq's pipe) took 2, and putting
+// "stderr" back replaced LCM's descriptor with the capture's pipe: the
+// transport never received again. A stderr that is closed is left alone.
+TEST(LcmTransport, AClosedStderrIsLeftAloneAndLcmKeepsItsDescriptors) {
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const int saved_out = fcntl(1, F_DUPFD_CLOEXEC, 10), saved_err = fcntl(2, F_DUPFD_CLOEXEC, 10);
+  ASSERT_GE(saved_out, 0);
+  ASSERT_GE(saved_err, 0);
+  close(1);
+  close(2);
+  int handled = 0;
+  {
+    LcmTransport t(LcmTransportOptions{.url = "memq://"});
+    auto sub = t.Subscribe("X", [&](const std::string&, std::span<const std::uint8_t>) { ++handled; });
+    const std::vector<std::uint8_t> bytes{1, 2, 3};
+    t.Publish("X", bytes);
+    for (int i = 0; i < 20 && handled == 0; ++i) t.HandleFor(std::chrono::milliseconds(50));
+  }
+  dup2(saved_out, 1);
+  dup2(saved_err, 2);
+  close(saved_out);
+  close(saved_err);
+  EXPECT_EQ(handled, 1) << "the transport lost its own descriptor to the capture";
+}
+
 }  // namespace
 }  // namespace robotalk

@@ -53,6 +53,37 @@ for _ in range(30):  # the bridge notices the close on its next read
 if not accepted:
     print("FAIL: after one closed, a new WebSocket is still refused")
     ok = False
+# review14: at the limit, the operator's page from another address (its PANIC
+# button) still gets its WebSocket: the oldest of the address holding the
+# most is closed for it; that address itself is still refused.
+s, head = ws_upgrade.page_websocket(port, source="127.0.0.2")
+print("at the limit, a page from 127.0.0.2: %s" % head)
+if " 101 " not in head or "hello" not in head:
+    print("FAIL: at the limit a page from another address gets no WebSocket (the PANIC button)")
+    ok = False
+else:
+    held.append(s)
+    time.sleep(0.3)
+    oldest = held[0]
+    oldest.settimeout(1)
+    closed = False
+    try:
+        while not closed:  # its frames first, then the end (or a reset); a timeout: still open
+            closed = oldest.recv(65536) == b""
+    except socket.timeout:
+        pass
+    except OSError:
+        closed = True
+    print("the oldest WebSocket of 127.0.0.1 closed for it: %s" % closed)
+    if not closed:
+        print("FAIL: the oldest WebSocket of the address holding the most was not closed")
+        ok = False
+    s, head, _ = upgrade()
+    print("then one more from 127.0.0.1 (holding the most): %s" % head)
+    if " 503 " not in head:
+        print("FAIL: the address holding the most is not refused at the limit")
+        ok = False
+    s.close()
 # The page itself (plain HTTP) still loads at the limit.
 s = socket.create_connection(("127.0.0.1", port), timeout=3)
 s.sendall(b"GET / HTTP/1.1\r\nHost: x\r\n\r\n")
@@ -66,5 +97,8 @@ PY
 rc=$?
 if [ $rc -eq 0 ] && ! grep -q "max-websockets" "$tmp/web.log"; then
   echo "FAIL: no line on stderr says a WebSocket was refused:"; cat "$tmp/web.log"; rc=1
+fi
+if [ $rc -eq 0 ] && ! grep -q "closed the oldest WebSocket of 127.0.0.1, which held the most (64), for one from 127.0.0.2" "$tmp/web.log"; then
+  echo "FAIL: no line on stderr says which WebSocket was closed for the page from 127.0.0.2:"; cat "$tmp/web.log"; rc=1
 fi
 exit $rc

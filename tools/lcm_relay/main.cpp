@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lcm_relay.h"
+#include "robotalk/log_writer.h"  // OpenStandardDescriptors
 
 #ifndef ROBOTALK_VERSION
 #define ROBOTALK_VERSION "unknown"
@@ -20,6 +21,7 @@ extern "C" void OnSignal(int) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: nothing of ours on descriptors 0-2
   using namespace robotalk::relay;
   RelayOptions options;
   try {

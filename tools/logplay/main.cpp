@@ -4,6 +4,7 @@
 #include "logplay.h"
 #include "mcap_export.h"
 #include "receipt_order.h"
+#include "robotalk/log_writer.h"  // OpenStandardDescriptors
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -316,6 +317,7 @@ int RunExport(Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: a recording never takes descriptor 1 or 2
   robotalk::cli::Interrupter::Install();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {

@@ -96,7 +96,7 @@ class FoxgloveEndpoint::Impl {
   Impl(std::shared_ptr<asio::io_context> ioc, PanicHandler panic, std::map<std::string, MeshCatalog> geometry)
       : ioc_(std::move(ioc)), panic_(std::move(panic)), geometry_(std::move(geometry)) {}
 
-  void Accept(tcp::socket socket, http::request<http::string_body> req) {
+  std::shared_ptr<WsConnection> Accept(tcp::socket socket, http::request<http::string_body> req) {
     auto connection = std::make_shared<WsConnection>(
         std::move(socket), kMaxClientMessage, kMaxQueuedStates,
         [this](const std::shared_ptr<WsConnection>& c, const std::string& data, bool text) {
@@ -117,6 +117,7 @@ class FoxgloveEndpoint::Impl {
     std::vector<WsConnection::Message> greeting;
     for (std::string& g : Greeting()) greeting.push_back(std::make_shared<const std::string>(std::move(g)));
     connection->Start(std::move(req), std::move(greeting), kSubprotocol);
+    return connection;
   }
 
   void Update(const TrackerFrame& frame) {
@@ -383,8 +384,9 @@ bool FoxgloveEndpoint::Offered(const http::request<http::string_body>& request) 
   return false;
 }
 
-void FoxgloveEndpoint::Accept(tcp::socket socket, http::request<http::string_body> request) {
-  impl_->Accept(std::move(socket), std::move(request));
+std::shared_ptr<WsConnection> FoxgloveEndpoint::Accept(tcp::socket socket,
+                                                       http::request<http::string_body> request) {
+  return impl_->Accept(std::move(socket), std::move(request));
 }
 void FoxgloveEndpoint::Update(const TrackerFrame& frame) { impl_->Update(frame); }
 std::size_t FoxgloveEndpoint::connections() const { return impl_->connections(); }

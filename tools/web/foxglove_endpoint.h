@@ -39,6 +39,8 @@
 
 namespace robotalk::web {
 
+class WsConnection;
+
 class FoxgloveEndpoint {
  public:
   /// Sends a panic to `robot` and calls `done` (any thread) with "" or why it failed.
@@ -57,9 +59,10 @@ class FoxgloveEndpoint {
 
   /// Whether an upgrade request offers kSubprotocol (Sec-WebSocket-Protocol).
   static bool Offered(const boost::beast::http::request<boost::beast::http::string_body>& request);
-  /// Takes a connection whose upgrade request offered kSubprotocol.
-  void Accept(boost::asio::ip::tcp::socket socket,
-              boost::beast::http::request<boost::beast::http::string_body> request);
+  /// Takes a connection whose upgrade request offered kSubprotocol; returns
+  /// its WebSocket (for WebOptions::max_websockets' count and closing).
+  std::shared_ptr<WsConnection> Accept(boost::asio::ip::tcp::socket socket,
+                                       boost::beast::http::request<boost::beast::http::string_body> request);
   /// One web-loop tick: new models (advertised, scenes sent) and the newest
   /// state of each robot (to the subscribers of its channels).
   void Update(const TrackerFrame& frame);

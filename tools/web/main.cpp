@@ -1,6 +1,7 @@
 // robotalk-web: shows every robot on the LCM bus in a browser (docs/web.md).
 #include "robot_tracker.h"
 #include "robotalk/error.h"
+#include "robotalk/log_writer.h"  // OpenStandardDescriptors
 #include "web_install_dirs.h"
 #include "web_log.h"
 #include "web_options.h"
@@ -93,6 +94,7 @@ int Run(int argc, char** argv) {
 }  // namespace robotalk::web
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: nothing of ours on descriptors 0-2
   const int status = robotalk::web::Run(argc, argv);
   robotalk::LogWriter::Stderr().Flush();  // the count of lines lost, if any is unsaid (within kMaxWait)
   return status;

@@ -135,42 +135,70 @@ class WebServer::Impl {
     auto buffer = std::make_shared<beast::flat_buffer>();
     auto req = std::make_shared<http::request<http::string_body>>();
     stream->expires_after(std::chrono::seconds(30));
-    const std::uint64_t id = next_waiting_++;
-    waiting_[id] = {stream, RemoteAddress(*stream)};
-    http::async_read(*stream, *buffer, *req,
-                     [this, stream, buffer, req, id](beast::error_code ec, std::size_t) {
-                       waiting_.erase(id);
-                       if (ec) return;
-                       if (websocket::is_upgrade(*req) &&
-                           OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets))
-                         return RefuseWebSocket(stream, std::move(*req));
-                       if (websocket::is_upgrade(*req) &&
-                           FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
-                         stream->expires_never();
-                         foxglove_->Accept(stream->release_socket(), std::move(*req));
-                         return;
-                       }
-                       if (websocket::is_upgrade(*req) &&
-                           std::string_view(req->target().data(), req->target().size()) == "/ws") {
-                         stream->expires_never();
-                         auto session = std::make_shared<WsConnection>(
-                             stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
-                             [this](const std::shared_ptr<WsConnection>& s, const std::string& text, bool) {
-                               OnPageMessage(s, text);
-                             });
-                         sessions_.push_back(session);
-                         session->Start(std::move(*req), Greeting());
-                         return;
-                       }
-                       Respond(stream, std::move(*req));
-                     });
+    const std::uint64_t id = Hold(stream);
+    http::async_read(
+        *stream, *buffer, *req, [this, stream, buffer, req, id](beast::error_code ec, std::size_t) {
+          waiting_.erase(id);
+          if (ec) return;
+          const asio::ip::address address = RemoteAddress(*stream);
+          if (websocket::is_upgrade(*req) &&
+              OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets) &&
+              !CloseWebSocketFor(address))
+            return RefuseWebSocket(stream, std::move(*req));
+          if (websocket::is_upgrade(*req) &&
+              FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
+            stream->expires_never();
+            websockets_.push_back({foxglove_->Accept(stream->release_socket(), std::move(*req)), address});
+            return;
+          }
+          if (websocket::is_upgrade(*req) &&
+              std::string_view(req->target().data(), req->target().size()) == "/ws") {
+            stream->expires_never();
+            auto session = std::make_shared<WsConnection>(
+                stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
+                [this](const std::shared_ptr<WsConnection>& s, const std::string& text, bool) {
+                  OnPageMessage(s, text);
+                });
+            sessions_.push_back(session);
+            websockets_.push_back({session, address});
+            session->Start(std::move(*req), Greeting());
+            return;
+          }
+          Respond(stream, std::move(*req));
+        });
   }
 
   // The page's open WebSockets and Foxglove's: what --max-websockets bounds.
-  std::size_t OpenWebSockets() const {
-    return foxglove_->connections() +
-           static_cast<std::size_t>(
-               std::count_if(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->live(); }));
+  std::size_t OpenWebSockets() {
+    std::erase_if(websockets_, [](const WebSocket& w) {
+      const auto c = w.connection.lock();
+      return !c || !c->live();
+    });
+    return websockets_.size();
+  }
+
+  // At --max-websockets, a WebSocket asked for from `address`: closes the
+  // oldest of the address holding the most when `address` holds fewer (a
+  // flood from one address never keeps the operator's page, and its PANIC
+  // button, out), and says so on stderr once a second at most (an attacker
+  // with two addresses makes it close one of its own per new one); false when
+  // `address` holds the most itself (it is refused).
+  bool CloseWebSocketFor(const asio::ip::address& address) {
+    std::map<asio::ip::address, std::size_t> per_address;
+    std::size_t most = 0;
+    for (const WebSocket& w : websockets_) most = std::max(most, ++per_address[w.address]);
+    if (per_address[address] >= most) return false;
+    const auto oldest = std::find_if(websockets_.begin(), websockets_.end(),
+                                     [&](const WebSocket& w) { return per_address[w.address] == most; });
+    const asio::ip::address holder = oldest->address;
+    if (closed_websockets_.Count())
+      WebLog().Write("closed the oldest WebSocket of " + holder.to_string() + ", which held the most (" +
+                     std::to_string(most) + "), for one from " + address.to_string() +
+                     " at the --max-websockets limit (" + std::to_string(options_.max_websockets) + "; " +
+                     std::to_string(closed_websockets_.count) + " closed so far)");
+    if (const auto c = oldest->connection.lock()) c->Close("", /*say=*/false);
+    websockets_.erase(oldest);
+    return true;
   }
 
   // One WebSocket more than --max-websockets: 503, the limit named, the
@@ -197,8 +225,18 @@ class WebServer::Impl {
     });
   }
 
-  // Closes the oldest connection waiting for a request of the address that
-  // holds the most (a flood from one address never closes a connection of an
+  // Counts a plain HTTP connection among those --max-http-waiting bounds,
+  // until its id is erased from waiting_: while it waits for a request, and
+  // while its answer is written (a client that never reads a large answer
+  // holds its descriptor as long as one that never finishes its request).
+  std::uint64_t Hold(const std::shared_ptr<beast::tcp_stream>& stream) {
+    const std::uint64_t id = next_waiting_++;
+    waiting_[id] = {stream, RemoteAddress(*stream)};
+    return id;
+  }
+
+  // Closes the oldest connection waiting for a request or for its answer to
+  // be read, of the address that holds the most (a flood from one address never closes a connection of an
   // address holding fewer, the operator's); false when none waits.
   // One line on stderr per second at most, naming `why`.
   bool CloseWaiting(const char* why) {
@@ -212,11 +250,12 @@ class WebServer::Impl {
     if (const auto stream = it->second.stream.lock()) stream->close();
     waiting_.erase(it);
     if (closed_waiting_.Count()) {
-      WebLog().Write("closed the oldest HTTP connection waiting for a request from " + address.to_string() +
-                     ", which held " + std::to_string(most) + " of the " +
-                     std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
-                     std::to_string(options_.max_http_waiting) + "; " +
-                     std::to_string(closed_waiting_.count) + " closed so far)");
+      WebLog().Write(
+          "closed the oldest HTTP connection waiting for a request or for its answer to be read from " +
+          address.to_string() + ", which held " + std::to_string(most) + " of the " +
+          std::to_string(waiting_.size() + 1) + " waiting: " + why + " (--max-http-waiting " +
+          std::to_string(options_.max_http_waiting) + "; " + std::to_string(closed_waiting_.count) +
+          " closed so far)");
     }
     return true;
   }
@@ -241,7 +280,9 @@ class WebServer::Impl {
       res.keep_alive(keep_alive);
       res.prepare_payload();
       auto sp = std::make_shared<decltype(res)>(std::move(res));
-      http::async_write(*stream, *sp, [this, stream, sp, keep_alive](beast::error_code ec, std::size_t) {
+      const std::uint64_t id = Hold(stream);
+      http::async_write(*stream, *sp, [this, stream, sp, keep_alive, id](beast::error_code ec, std::size_t) {
+        waiting_.erase(id);
         if (!ec && keep_alive) ReadRequest(stream);
       });
     };
@@ -416,6 +457,12 @@ class WebServer::Impl {
   bool armed_ = false;
   std::shared_ptr<std::atomic<bool>> sample_posted_ = std::make_shared<std::atomic<bool>>(false);
   std::vector<std::shared_ptr<WsConnection>> sessions_;
+  // Every WebSocket, page and Foxglove, by age: what --max-websockets bounds.
+  struct WebSocket {
+    std::weak_ptr<WsConnection> connection;
+    asio::ip::address address;
+  };
+  std::vector<WebSocket> websockets_;
   // An event counted, its stderr line (with the count so far) at most once a second.
   struct CountedLine {
     std::uint64_t count = 0;
@@ -429,7 +476,9 @@ class WebServer::Impl {
     }
   };
   CountedLine refused_websockets_;  // past --max-websockets
-  // Connections waiting for a request (ReadRequest), by age: what --max-http-waiting bounds.
+  CountedLine closed_websockets_;   // by CloseWebSocketFor
+  // Connections waiting for a request (ReadRequest) or for their answer to be
+  // read (Respond), by age (Hold): what --max-http-waiting bounds.
   struct Waiting {
     std::weak_ptr<beast::tcp_stream> stream;
     asio::ip::address address;

@@ -64,10 +64,14 @@ void WsConnection::Send(const Message& m, bool binary, bool droppable) {
   if (queue_.size() == 1) Write();
 }
 
-void WsConnection::Close(const std::string& why) {
+void WsConnection::Close(const std::string& why, bool say) {
   open_ = false;
   beast::error_code ec;
   auto& socket = beast::get_lowest_layer(ws_).socket();
+  if (!say) {
+    socket.close(ec);
+    return;
+  }
   const auto peer = socket.remote_endpoint(ec);
   // Through WebLog(): a stderr whose reader went away loses the line (EPIPE,
   // not SIGPIPE: robotalk-web died here), and one that takes nothing holds

@@ -48,11 +48,14 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
   /// queue is full.
   void Send(const Message& m, bool binary, bool droppable);
   std::uint64_t dropped() const { return dropped_; }
+  /// Closes it, saying so on stderr with `why` unless `say` is false (the
+  /// caller says it); the write and read in flight end with an error and its
+  /// owner drops it.
+  void Close(const std::string& why, bool say = true);
 
  private:
   void Write();
   void Read();
-  void Close(const std::string& why);
 
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
   std::size_t max_message_, max_droppable_;

@@ -63,14 +63,24 @@ extern "C" void OnLcmMessage(const lcm_recv_buf_t* rbuf, const char* channel, vo
 // its error). Anything another thread wrote to stderr meanwhile is taken too
 // (said after, not lost). A stderr that takes a line now is left alone (the
 // dup2 is the whole process's: other threads' lines must not be taken for
-// LCM's), and so is one it cannot set up.
+// LCM's), and so is one it cannot set up, and a closed one (a process
+// started with '2>&-'; the pipe's descriptors are kept above 2, so a closed 0
+// or 1 is never taken either: review14, LCM's own descriptor took 2 while it
+// started and the capture then put its pipe over it).
 class StderrCapture {
  public:
   StderrCapture() {
+    if (::fcntl(2, F_GETFD) == -1) return;  // closed: LCM's lines go nowhere, as any other
     pollfd out{2, POLLOUT, 0};
     if (::poll(&out, 1, 0) == 1 && out.revents == POLLOUT) return;  // stderr takes a line now
     int p[2];
     if (::pipe2(p, O_CLOEXEC | O_NONBLOCK) != 0) return;
+    for (int& fd : p) fd = AboveStdio(fd);
+    if (p[0] < 0 || p[1] < 0) {
+      for (const int fd : p)
+        if (fd >= 0) ::close(fd);
+      return;
+    }
     std::fflush(stderr);
     saved_ = ::fcntl(2, F_DUPFD_CLOEXEC, 3);
     if (saved_ < 0 || ::dup2(p[1], 2) < 0) {
@@ -86,6 +96,14 @@ class StderrCapture {
   ~StderrCapture() { Take(); }
   StderrCapture(const StderrCapture&) = delete;
   StderrCapture& operator=(const StderrCapture&) = delete;
+
+  // `fd` moved to a descriptor above 2 (closed, -1 when it cannot be).
+  static int AboveStdio(int fd) {
+    if (fd > 2) return fd;
+    const int moved = ::fcntl(fd, F_DUPFD_CLOEXEC, 3);
+    ::close(fd);
+    return moved;
+  }
 
   std::string Take() {
     if (saved_ < 0) return "";

@@ -1,5 +1,6 @@
 #include "robotalk/log_writer.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
 
@@ -202,6 +203,15 @@ std::vector<std::string> SplitLines(std::string_view text) {
     text.remove_prefix(std::min(end + 1, text.size()));
   }
   return lines;
+}
+
+void OpenStandardDescriptors() {
+  for (int fd = 0; fd <= 2; ++fd) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    // The lowest descriptor free is fd: those below it are open by now.
+    const int opened = ::open("/dev/null", O_RDWR);
+    if (opened >= 0 && opened != fd) ::close(opened);  // fd was taken meanwhile (another thread)
+  }
 }
 
 std::string EscapeControls(std::string_view text, bool ascii_only) {

@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace robotalk {
@@ -29,13 +30,46 @@ std::string Vec(const Eigen::Vector3d& v) {
   return s.str();
 }
 
-// A name is shown wherever the model is (a terminal, a log): one with a
-// control character (EscapeControls' C0, DEL, C1 in UTF-8) is refused, named
-// escaped.
+// The code points of `text` (UTF-8), or nullopt when it is not UTF-8: a
+// byte no character begins with, a lone continuation byte, a truncated
+// character, an overlong form, a surrogate, past U+10FFFF.
+std::optional<std::vector<char32_t>> CodePoints(std::string_view text) {
+  std::vector<char32_t> out;
+  for (std::size_t i = 0; i < text.size();) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    const int n = b < 0x80 ? 1 : (b & 0xe0) == 0xc0 ? 2 : (b & 0xf0) == 0xe0 ? 3 : (b & 0xf8) == 0xf0 ? 4 : 0;
+    if (n == 0 || i + static_cast<std::size_t>(n) > text.size()) return std::nullopt;
+    char32_t c = n == 1 ? b : b & (0x7f >> n);
+    for (int k = 1; k < n; ++k) {
+      const auto next = static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]);
+      if ((next & 0xc0) != 0x80) return std::nullopt;
+      c = (c << 6) | (next & 0x3f);
+    }
+    static constexpr char32_t kLeast[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (c < kLeast[n] || c > 0x10ffff || (c >= 0xd800 && c <= 0xdfff)) return std::nullopt;
+    out.push_back(c);
+    i += static_cast<std::size_t>(n);
+  }
+  return out;
+}
+
+// A name is shown wherever the model is (a terminal, a log, the page, ROS 2):
+// one with a control character (EscapeControls' C0, DEL, C1 in UTF-8), one
+// that is not UTF-8, or one with a line or paragraph separator or a
+// bidirectional control (it reorders the text it is shown in) is refused,
+// named escaped (in printable ASCII for the last two).
 std::string ControlProblem(std::string_view kind, std::string_view name) {
   const std::string shown = EscapeControls(name);
-  if (shown == name) return {};
-  return std::string(kind) + " name " + Quote(shown) + " holds a control character";
+  if (shown != name) return std::string(kind) + " name " + Quote(shown) + " holds a control character";
+  const std::string ascii = Quote(EscapeControls(name, /*ascii_only=*/true));
+  const auto points = CodePoints(name);
+  if (!points) return std::string(kind) + " name " + ascii + " is not UTF-8 text";
+  for (const char32_t c : *points) {
+    if (c == 0x2028 || c == 0x2029 || c == 0x061c || c == 0x200e || c == 0x200f ||
+        (c >= 0x202a && c <= 0x202e) || (c >= 0x2066 && c <= 0x2069))
+      return std::string(kind) + " name " + ascii + " holds a line separator or a bidirectional control";
+  }
+  return {};
 }
 
 template <typename T>

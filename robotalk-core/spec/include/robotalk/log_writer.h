@@ -60,6 +60,14 @@ bool WriteFully(int fd, std::string_view text);
 /// the program blocks them.
 void DetachWithSignalsBlocked(std::function<void()> run);
 
+/// Opens /dev/null on each of descriptors 0, 1 and 2 that is closed (a
+/// program started with `>&- 2>&-`): else the next files the program opens
+/// take them, and its output and log lines (LogWriter::Stderr() writes to
+/// descriptor 2) go into those (robotalk-server's went into its panic
+/// latch's lock file). A program's main calls it first, before it opens
+/// anything or starts a thread. Each that cannot be opened stays closed.
+void OpenStandardDescriptors();
+
 /// `text` on one line with no terminal control: each C0 control character,
 /// DEL and C1 control encoded in UTF-8 (0xc2 0x80..0x9f) written as \xNN;
 /// every other byte kept (UTF-8 text; a lone byte 0x80..0x9f too, which a

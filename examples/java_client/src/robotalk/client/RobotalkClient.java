@@ -53,6 +53,20 @@ public final class RobotalkClient implements AutoCloseable {
     public RobotalkException(String message) { super(message); }
   }
 
+  /**
+   * A text from the wire (anyone's in open mode) as an error names it: each control character (C0,
+   * DEL, C1) as \xNN, so it never reaches a terminal as an escape nor forges a line (review14).
+   */
+  static String printable(String text) {
+    StringBuilder out = new StringBuilder(text.length());
+    for (int i = 0; i < text.length(); i++) {
+      char c = text.charAt(i);
+      if (c < 0x20 || (c >= 0x7f && c <= 0x9f)) out.append(String.format("\\x%02x", (int) c));
+      else out.append(c);
+    }
+    return out.toString();
+  }
+
   /** A reply_t, or a synthetic UNKNOWN_OUTCOME when the server instance changed. */
   public static final int UNKNOWN_OUTCOME = -1;
   static final String[] SIGNALS = {"SUCCESS", "MODIFIED", "NA", "BUSY", "INTERRUPTED", "ERROR", "PANIC"};
@@ -185,7 +199,7 @@ public final class RobotalkClient implements AutoCloseable {
       if (a == null) continue;
       for (robotalk_msgs.robot_info_t r : a.robots) {
         if (!r.name.equals(robot)) {
-          if (!heard.contains(r.name)) heard.add(r.name);
+          if (!heard.contains(printable(r.name))) heard.add(printable(r.name));
         } else if (a.protocol_version != PROTOCOL_VERSION) {
           problem = "'" + robot + "' speaks protocol " + a.protocol_version + "; this client speaks " + PROTOCOL_VERSION;
         } else if (a.keyed) {
@@ -420,7 +434,7 @@ public final class RobotalkClient implements AutoCloseable {
       }
       handleFor(Math.min(nextHello, deadline) - now);
     }
-    if (sessionId == 0 || !refusal.isEmpty()) throw new RobotalkException("hello refused by '" + robot + "': " + refusal);
+    if (sessionId == 0 || !refusal.isEmpty()) throw new RobotalkException("hello refused by '" + robot + "': " + printable(refusal));
     lastNewPackageUs = nowUs();
   }
 
@@ -539,11 +553,11 @@ public final class RobotalkClient implements AutoCloseable {
     mainLcm.subscribe(java.util.regex.Pattern.quote(channel), sub);  // before asking
     try {
       reply_t r = query(query_t.CONFIG, "", timeoutS);
-      if (r.signal != reply_t.SUCCESS) throw new RobotalkException("CONFIG answered " + signalName(r.signal) + ": " + r.message);
+      if (r.signal != reply_t.SUCCESS) throw new RobotalkException("CONFIG answered " + signalName(r.signal) + ": " + printable(r.message));
       long deadline = nowUs() + (long) (timeoutS * 1e6);
       while (config == null || !String.format("%016x", config.header.hash).equals(r.message)) {
         if (nowUs() >= deadline)
-          throw new RobotalkException("no robot_config_t with hash " + r.message + " on " + channel);
+          throw new RobotalkException("no robot_config_t with hash " + printable(r.message) + " on " + channel);
         runTimers();
         handleFor(20_000);
       }
