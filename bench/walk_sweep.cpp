@@ -39,6 +39,16 @@
 //     (measured: not at all, 0 of 384 pushes changed). --shift S: every instant
 //     S s later (the run steps in 10 ms, so 0.01 moves each push by one step of
 //     the loop): how far a small change of phase moves them.
+//   robotalk-walk-sweep --push goto[,DEG,N_S] [--stabilizer on|off|both]: the pushed
+//     GOTO: a 1.5 m GOTO after 1 s standing, a 0.1 s push on the pelvis (DEG,N_S;
+//     default both sides, 90 and 270 at 8 N s) at 21 instants 2.50-3.50 s after
+//     the command (every 50 ms), each a fresh driver with the walking tests'
+//     seed 7 and their first 1 ms step (so the 3.00 s instant is
+//     OdeWalk.APushedGotoStopsStandsThenReplansAndStillArrives), run until the
+//     GOTO answers, the walker falls or 60 s pass. Prints per direction and
+//     setting the pattern by instant (F fell, . arrived: SUCCESS within 5 cm of
+//     the goal, s no answer in 60 s, x answered otherwise), the counts, each
+//     fall's time after its push, and with both settings McNemar's z.
 //   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
 //     after the start of the walk, default 5.5; standing 2); survived or not; --trace
 //     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them), a row every
@@ -506,6 +516,82 @@ int MultiInstantPushes(const Args& args) {
   return 0;
 }
 
+// --push goto[,DEG,N_S]: the pushed GOTO at 21 instants (see the header).
+int PushedGotos(const Args& args) {
+  std::vector<std::pair<double, double>> pushes = {{90, 8}, {270, 8}};  // (deg, N s)
+  if (args.push != "goto") {
+    const size_t a = args.push.find(','), b = args.push.rfind(',');
+    if (args.push.substr(0, a) != "goto" || a == std::string::npos || a == b) {
+      std::fprintf(stderr, "--push goto or goto,DEG,N_S\n");
+      return 2;
+    }
+    pushes = {
+        {std::atof(args.push.substr(a + 1, b - a - 1).c_str()), std::atof(args.push.substr(b + 1).c_str())}};
+  }
+  constexpr int kInstants = 21;
+  constexpr double kGoal = 1.5, kFirst = 2.5, kEvery = 0.05, kWait = 60, kArrived = 0.05;
+  std::printf(
+      "pushed GOTO (%.1f m; a 0.1 s push on the pelvis %.2f-%.2f s after the command every %.0f ms; driver "
+      "seed %s): F fell, . arrived (SUCCESS within %.0f cm), s no answer in %.0f s, x answered otherwise\n",
+      kGoal, kFirst, kFirst + (kInstants - 1) * kEvery, kEvery * 1000,
+      args.options.count("seed") ? args.options.at("seed").c_str() : "7", kArrived * 100, kWait);
+  for (const auto& [deg, j] : pushes) {
+    std::map<std::string, std::string> fell;  // per setting, the pattern's fell flags
+    for (Args s : Settings(args)) {
+      s.options.emplace("seed", "7");
+      std::string pattern, when;
+      for (int k = 0; k < kInstants; ++k) {
+        std::unique_ptr<Driver> d = NewDriver(s);
+        Run r{.ode = static_cast<OdeDriver*>(d.get()), .d = d.get()};
+        r.ode->Step(1, r.done);  // as the tests' Walker starts
+        r.ode->Step(1000, r.done);
+        const TimePoint t0 = r.ode->sim_time();
+        r.Exec(CommandType::kGoto, {kGoal, 0, 0});
+        bool ok = r.Until(t0, std::round((kFirst + k * kEvery) * 100) / 100);
+        const TimePoint pushed = r.ode->sim_time();
+        if (ok) PushNow(r, deg * std::numbers::pi / 180, j);
+        while (ok && r.done.empty() && r.ode->sim_time() - pushed < FromSeconds(kWait)) {
+          r.ode->Step(10, r.done);
+          ok = !r.ode->walk_status()->fallen;
+        }
+        const walking::Pose2 p = r.ode->walk_status()->pelvis;
+        char c = 'F';
+        if (ok) {
+          c = r.done.empty() ? 's' : 'x';
+          if (r.done.size() == 1 && r.done[0].signal == Signal::kSuccess &&
+              std::hypot(p.x - kGoal, p.y) < kArrived)
+            c = '.';
+        } else {
+          char t[16];
+          std::snprintf(t, sizeof t, " +%.2f", ToSeconds(r.ode->sim_time() - pushed));
+          when += t;
+        }
+        pattern += c;
+      }
+      const auto n = [&](char c) { return std::count(pattern.begin(), pattern.end(), c); };
+      std::printf(
+          "%s  %.0f deg %.1f N s, stabilizer %s: %ld fell, %ld arrived, %ld no answer, %ld otherwise%s%s\n",
+          pattern.c_str(), deg, j, s.options.at("stabilizer") == "true" ? "on" : "off", n('F'), n('.'),
+          n('s'), n('x'), when.empty() ? "" : "; fell after the push at", when.c_str());
+      std::fflush(stdout);
+      fell[s.options.at("stabilizer")] = pattern;
+    }
+    if (fell.size() == 2) {  // McNemar on the falls, instant by instant
+      int only_on = 0, only_off = 0;
+      for (int k = 0; k < kInstants; ++k) {
+        const bool on = fell["true"][k] == 'F', off = fell["false"][k] == 'F';
+        only_on += on && !off;
+        only_off += off && !on;
+      }
+      const double z = only_on + only_off > 0 ? (only_on - only_off) / std::sqrt(only_on + only_off) : 0.0;
+      std::printf(
+          "%*s  %.0f deg %.1f N s: fell only with the stabilizer %d, only without %d (McNemar z %.2f)\n",
+          kInstants, "", deg, j, only_on, only_off, z);
+    }
+  }
+  return 0;
+}
+
 // --probe standing|walking,DEG,N_S
 int Probe(const Args& args) {
   const size_t a = args.probe.find(','), b = args.probe.rfind(',');
@@ -601,6 +687,7 @@ int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   if (!args.probe.empty()) return Probe(args);
   if (args.rtf > 0) return Rtf(args);
+  if (args.push.rfind("goto", 0) == 0) return PushedGotos(args);
   if (!args.push.empty()) return args.instants > 0 ? MultiInstantPushes(args) : Pushes(args);
   if (args.arms) return ArmSwing(args);
   if (args.transition != "all" && !Transitions().count(args.transition)) {
