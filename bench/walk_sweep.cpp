@@ -9,8 +9,8 @@
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
 //                       [--after S] [--model URDF] [--option key=value]...
 // (--model: another humanoid, e.g. ../shared/robots/atlas.urdf --option base=floating.)
-// The phase sweep runs the driver's defaults (the stabilizer off; --option
-// stabilizer=true to run it); --push, --probe, --rtf and --arms set the
+// The phase sweep runs the driver's defaults (the stabilizer on since the
+// fourteenth session; --option stabilizer=false for the open loop); --push, --probe, --rtf and --arms set the
 // stabilizer per --stabilizer (on: true, off: false, both: each), whatever
 // the driver's default.
 //   robotalk-walk-sweep --push standing|walking|all [--stabilizer on|off|both]
