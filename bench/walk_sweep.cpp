@@ -9,8 +9,8 @@
 //   robotalk-walk-sweep [--transition NAME|all] [--from S] [--span S] [--every MS]
 //                       [--after S] [--model URDF] [--option key=value]...
 // (--model: another humanoid, e.g. ../shared/robots/atlas.urdf --option base=floating.)
-// The phase sweep runs the driver's defaults (the stabilizer off; --option
-// stabilizer=true to run it); --push, --probe, --rtf and --arms set the
+// The phase sweep runs the driver's defaults (the stabilizer on since the
+// fourteenth session; --option stabilizer=false for the open loop); --push, --probe, --rtf and --arms set the
 // stabilizer per --stabilizer (on: true, off: false, both: each), whatever
 // the driver's default.
 //   robotalk-walk-sweep --push standing|walking|all [--stabilizer on|off|both]
@@ -39,6 +39,17 @@
 //     (measured: not at all, 0 of 384 pushes changed). --shift S: every instant
 //     S s later (the run steps in 10 ms, so 0.01 moves each push by one step of
 //     the loop): how far a small change of phase moves them.
+//   robotalk-walk-sweep --push goto[,DEG,N_S] [--stabilizer on|off|both]: the pushed
+//     GOTO: a 1.5 m GOTO after 1 s standing, a 0.1 s push on the pelvis (DEG,N_S;
+//     default both sides, 90 and 270 at 8 N s) at 21 instants 2.50-3.50 s after
+//     the command (every 50 ms), each a fresh driver with the walking tests'
+//     seed 7 and their first 1 ms step (so the 3.00 s instant is
+//     OdeWalk.APushedGotoStopsStandsThenReplansAndStillArrives), run until the
+//     GOTO answers, the walker falls or 60 s pass. Prints per direction and
+//     setting the pattern by instant (F fell, . arrived: SUCCESS within 5 cm of
+//     the goal, s no answer in 60 s, x answered otherwise), the counts, each
+//     fall's time after its push, and with both settings McNemar's z.
+//     goto,DEG,N_S,AT: the one instant AT s after the command (--trace F as --probe's).
 //   robotalk-walk-sweep --probe standing|walking,DEG,N_S[,AT] [--trace F]: one push (at AT s
 //     after the start of the walk, default 5.5; standing 2); survived or not; --trace
 //     writes F.on.csv / F.off.csv (scripts/plot_walk_push.py plots them), a row every
@@ -226,7 +237,9 @@ struct Run {
     // Then each sole's lowest corner's height, largest one-contact force and pitch.
     for (int i = 0; i < 2; ++i)
       std::fprintf(trace, ",%.5f,%.1f,%.4f", s.foot_low[i], s.foot_peak_force[i], s.foot_pitch[i]);
-    std::fprintf(trace, ",%d\n", s.push_timings);  // then push_step_timing's re-plans
+    std::fprintf(trace, ",%d", s.push_timings);  // then push_step_timing's re-plans
+    // Then whether a push's stop holds and the push detector's input (m/s).
+    std::fprintf(trace, ",%d,%.4f,%.4f\n", s.push_holding ? 1 : 0, s.push_impulse.x(), s.push_impulse.y());
   }
   void Panic() {
     d->Halt(done);
@@ -244,6 +257,27 @@ struct Run {
     return true;
   }
 };
+
+// --trace F: F.on.csv or F.off.csv for setting `s` with its header (Run::Trace's
+// columns); nullptr without --trace; exits (status 1) when it cannot be written.
+std::FILE* OpenTrace(const std::string& base, const std::map<std::string, std::string>& s) {
+  if (base.empty()) return nullptr;
+  const std::string name = base + (s.at("stabilizer") == "true" ? ".on.csv" : ".off.csv");
+  std::FILE* trace = std::fopen(name.c_str(), "w");
+  if (!trace) {
+    std::fprintf(stderr, "cannot write %s\n", name.c_str());
+    std::exit(1);
+  }
+  std::fprintf(trace,
+               "t,com_x,com_y,com_plan_x,com_plan_y,dcm_x,dcm_y,dcm_ref_x,dcm_ref_y,cop_x,cop_y,zmp_ref_x,"
+               "zmp_ref_y,zmp_cmd_x,zmp_cmd_y,saturated,tilt,lfoot_x,lfoot_y,lfoot_th,lfoot_h,lfoot_f,"
+               "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y,lmeas_x,lmeas_y,lmeas_th,ltilt,"
+               "lcontacts,"
+               "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
+               "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
+               "rpitch,timings,holding,impulse_x,impulse_y\n");
+  return trace;
+}
 
 // SETSPEED's forward speed for "the gait's full speed": the driver clamps it.
 constexpr double kFullSpeed = 1.0;
@@ -506,6 +540,91 @@ int MultiInstantPushes(const Args& args) {
   return 0;
 }
 
+// --push goto[,DEG,N_S]: the pushed GOTO at 21 instants (see the header).
+int PushedGotos(const Args& args) {
+  std::vector<std::pair<double, double>> pushes = {{90, 8}, {270, 8}};  // (deg, N s)
+  int instants = 21;
+  double first = 2.5;
+  if (args.push != "goto") {
+    std::vector<double> v;  // goto,DEG,N_S[,AT]
+    for (size_t at = args.push.find(','); at != std::string::npos; at = args.push.find(',', at + 1))
+      v.push_back(std::atof(args.push.c_str() + at + 1));
+    if (args.push.substr(0, args.push.find(',')) != "goto" || v.size() < 2 || v.size() > 3) {
+      std::fprintf(stderr, "--push goto, goto,DEG,N_S or goto,DEG,N_S,AT\n");
+      return 2;
+    }
+    pushes = {{v[0], v[1]}};
+    if (v.size() == 3) instants = 1, first = v[2];
+  }
+  if (!args.trace.empty() && instants != 1) {
+    std::fprintf(stderr, "--trace with --push goto,DEG,N_S,AT (one instant)\n");
+    return 2;
+  }
+  constexpr double kGoal = 1.5, kEvery = 0.05, kWait = 60, kArrived = 0.05;
+  const int kInstants = instants;
+  const double kFirst = first;
+  std::printf(
+      "pushed GOTO (%.1f m; a 0.1 s push on the pelvis %.2f-%.2f s after the command every %.0f ms; driver "
+      "seed %s): F fell, . arrived (SUCCESS within %.0f cm), s no answer in %.0f s, x answered otherwise\n",
+      kGoal, kFirst, kFirst + (kInstants - 1) * kEvery, kEvery * 1000,
+      args.options.count("seed") ? args.options.at("seed").c_str() : "7", kArrived * 100, kWait);
+  for (const auto& [deg, j] : pushes) {
+    std::map<std::string, std::string> fell;  // per setting, the pattern's fell flags
+    for (Args s : Settings(args)) {
+      s.options.emplace("seed", "7");
+      std::string pattern, when;
+      for (int k = 0; k < kInstants; ++k) {
+        std::unique_ptr<Driver> d = NewDriver(s);
+        Run r{
+            .ode = static_cast<OdeDriver*>(d.get()), .d = d.get(), .trace = OpenTrace(args.trace, s.options)};
+        r.ode->Step(1, r.done);  // as the tests' Walker starts
+        r.ode->Step(1000, r.done);
+        const TimePoint t0 = r.ode->sim_time();
+        r.Exec(CommandType::kGoto, {kGoal, 0, 0});
+        bool ok = r.Until(t0, std::round((kFirst + k * kEvery) * 100) / 100);
+        const TimePoint pushed = r.ode->sim_time();
+        if (ok) PushNow(r, deg * std::numbers::pi / 180, j);
+        while (ok && r.done.empty() && r.ode->sim_time() - pushed < FromSeconds(kWait))
+          ok = r.Until(r.ode->sim_time(), 0.01);
+        if (r.trace) std::fclose(r.trace);
+        const walking::Pose2 p = r.ode->walk_status()->pelvis;
+        char c = 'F';
+        if (ok) {
+          c = r.done.empty() ? 's' : 'x';
+          if (r.done.size() == 1 && r.done[0].signal == Signal::kSuccess &&
+              std::hypot(p.x - kGoal, p.y) < kArrived)
+            c = '.';
+        } else {
+          char t[16];
+          std::snprintf(t, sizeof t, " +%.2f", ToSeconds(r.ode->sim_time() - pushed));
+          when += t;
+        }
+        pattern += c;
+      }
+      const auto n = [&](char c) { return std::count(pattern.begin(), pattern.end(), c); };
+      std::printf(
+          "%s  %.0f deg %.1f N s, stabilizer %s: %ld fell, %ld arrived, %ld no answer, %ld otherwise%s%s\n",
+          pattern.c_str(), deg, j, s.options.at("stabilizer") == "true" ? "on" : "off", n('F'), n('.'),
+          n('s'), n('x'), when.empty() ? "" : "; fell after the push at", when.c_str());
+      std::fflush(stdout);
+      fell[s.options.at("stabilizer")] = pattern;
+    }
+    if (fell.size() == 2) {  // McNemar on the falls, instant by instant
+      int only_on = 0, only_off = 0;
+      for (int k = 0; k < kInstants; ++k) {
+        const bool on = fell["true"][k] == 'F', off = fell["false"][k] == 'F';
+        only_on += on && !off;
+        only_off += off && !on;
+      }
+      const double z = only_on + only_off > 0 ? (only_on - only_off) / std::sqrt(only_on + only_off) : 0.0;
+      std::printf(
+          "%*s  %.0f deg %.1f N s: fell only with the stabilizer %d, only without %d (McNemar z %.2f)\n",
+          kInstants, "", deg, j, only_on, only_off, z);
+    }
+  }
+  return 0;
+}
+
 // --probe standing|walking,DEG,N_S
 int Probe(const Args& args) {
   const size_t a = args.probe.find(','), b = args.probe.rfind(',');
@@ -524,24 +643,7 @@ int Probe(const Args& args) {
     at = std::atof(rest.c_str());
   }
   for (const Args& s : Settings(args)) {
-    std::FILE* trace = nullptr;
-    if (!args.trace.empty()) {
-      const std::string name = args.trace + (s.options.at("stabilizer") == "true" ? ".on.csv" : ".off.csv");
-      trace = std::fopen(name.c_str(), "w");
-      if (!trace) {
-        std::fprintf(stderr, "cannot write %s\n", name.c_str());
-        return 1;
-      }
-      std::fprintf(
-          trace,
-          "t,com_x,com_y,com_plan_x,com_plan_y,dcm_x,dcm_y,dcm_ref_x,dcm_ref_y,cop_x,cop_y,zmp_ref_x,"
-          "zmp_ref_y,zmp_cmd_x,zmp_cmd_y,saturated,tilt,lfoot_x,lfoot_y,lfoot_th,lfoot_h,lfoot_f,"
-          "rfoot_x,rfoot_y,rfoot_th,rfoot_h,rfoot_f,offset_x,offset_y,lmeas_x,lmeas_y,lmeas_th,ltilt,"
-          "lcontacts,"
-          "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
-          "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
-          "rpitch,timings\n");
-    }
+    std::FILE* trace = OpenTrace(args.trace, s.options);
     const bool ok = SurvivesPush(s, walking, deg * std::numbers::pi / 180, j, at, trace);
     if (trace) std::fclose(trace);
     std::printf("%s %.0f deg %.2f N s at %.2f s, stabilizer %s: %s\n", walking ? "walking" : "standing", deg,
@@ -601,6 +703,7 @@ int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   if (!args.probe.empty()) return Probe(args);
   if (args.rtf > 0) return Rtf(args);
+  if (args.push.rfind("goto", 0) == 0) return PushedGotos(args);
   if (!args.push.empty()) return args.instants > 0 ? MultiInstantPushes(args) : Pushes(args);
   if (args.arms) return ArmSwing(args);
   if (args.transition != "all" && !Transitions().count(args.transition)) {

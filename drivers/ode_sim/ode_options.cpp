@@ -143,8 +143,8 @@ void OdeDriverOptions::Validate() const {
   // the stabilizer on all the time it would mean nothing.
   if (stabilizer && (push_balance == "both" || push_balance.find("stabilizer") != std::string::npos)) {
     throw Error("OdeDriver: push_balance=" + push_balance +
-                " runs the stabilizer only while a push's stop holds, but stabilizer=true runs it "
-                "always: give stabilizer=false with it, or drop its stabilizer part (e.g. "
+                " runs the stabilizer only while a push's stop holds, but stabilizer=true (the default) runs "
+                "it always: give stabilizer=false with it, or drop its stabilizer part (e.g. "
                 "push_balance=damping)");
   }
 }

@@ -279,7 +279,7 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
   EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}, {"stabilizer", "false"}}));
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "damping+forces"}})) << "no stabilizer part: accepted";
-  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}})) << "the stabilizer is off by default";
+  EXPECT_TRUE(RefusalOfWalker({{"push_balance", "stabilizer"}})) << "the stabilizer is on by default";
   // The stabilizer's part only while the stop holds, with the stabilizer on always: refused.
   for (const char* both : {"stabilizer", "both", "forces+stabilizer"}) {
     const std::optional<std::string> on = RefusalOfWalker({{"push_balance", both}, {"stabilizer", "true"}});
@@ -368,10 +368,10 @@ void PushAGotoAndExpectItStopsOnceStandsAndArrives(const std::map<std::string, s
 }
 
 TEST(OdeWalk, APushedGotoStopsStandsThenReplansAndStillArrives) {
-  PushAGotoAndExpectItStopsOnceStandsAndArrives({});  // the defaults: push_recovery on, stabilizer off
+  PushAGotoAndExpectItStopsOnceStandsAndArrives({{"stabilizer", "false"}});  // the open loop (named)
 }
 
-// The same with the DCM stabilizer (stabilizer=true), which stands down while
+// The same with the DCM stabilizer (stabilizer=true, the default), which stands down while
 // the stop holds (its offset back on the plan): before, its offset swung
 // between its bounds through the stop, the detector read that as a second
 // push and the walker fell (tilt 0.61 rad; docs/ode_sim.md, "Why a pushed

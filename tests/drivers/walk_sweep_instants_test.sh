@@ -12,6 +12,11 @@ status=0
 err=$(timeout 20 "$sweep" --seed 1 --help 2>&1 >/dev/null) || status=$?
 [ "$status" -eq 2 ] || { echo "FAIL: a trailing flag: exit status $status, expected 2"; exit 1; }
 grep -q -- "--help needs a value" <<<"$err" || { echo "FAIL: a trailing flag not named: $err"; exit 1; }
+# --push goto takes goto or goto,DEG,N_S (the pushed GOTO, docs/ode_sim.md).
+status=0
+err=$(timeout 20 "$sweep" --push goto,90 2>&1 >/dev/null) || status=$?
+[ "$status" -eq 2 ] || { echo "FAIL: --push goto,90: exit status $status, expected 2"; exit 1; }
+grep -q -- "goto,DEG,N_S" <<<"$err" || { echo "FAIL: --push goto,90 not explained: $err"; exit 1; }
 out=$("$sweep" --push walking --instants 1 --levels 20 --after 3 --cycle 0.05 --stabilizer off 2>&1)
 echo "$out"
 at=$(sed -n 's/^push instants (s into the walk): //p' <<<"$out")
