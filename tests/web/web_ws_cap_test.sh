@@ -84,6 +84,62 @@ else:
         print("FAIL: the address holding the most is not refused at the limit")
         ok = False
     s.close()
+# final14: an upgrade to a path that is no WebSocket of the bridge closes
+# nobody's (it used to close the oldest of the busiest address, then got 404).
+s, head, _ = ws_upgrade.upgrade(port, "/nope", None, source="127.0.0.3")
+print("at the limit, an upgrade to /nope from 127.0.0.3: %s" % head)
+s.close()
+time.sleep(0.3)
+s, head, _ = upgrade()
+print("then one more from 127.0.0.1: %s" % head)
+if " 503 " not in head:
+    print("FAIL: an upgrade to /nope closed a WebSocket at the limit")
+    ok = False
+s.close()
+
+
+def still_open(sock):
+    sock.settimeout(0.5)
+    try:
+        while True:  # frames first; the end (b"") or a reset: closed; a timeout: open
+            if sock.recv(65536) == b"":
+                return False
+    except socket.timeout:
+        return True
+    except OSError:
+        return False
+
+
+# final14: every address holding one WebSocket (the operator's page first, the
+# oldest), one more address is refused; the operator's is never closed for it.
+for h in held:
+    h.close()
+held = []
+time.sleep(0.5)
+operator, head = ws_upgrade.page_websocket(port, source="127.0.0.2")
+if operator is None or " 101 " not in head:
+    print("FAIL: the operator's page got no WebSocket once the others closed: %s" % head)
+    ok = False
+else:
+    for i in range(LIMIT - 1):
+        h, head, _ = ws_upgrade.upgrade(port, "/ws", None, source="127.0.1.%d" % (i + 1))
+        if " 101 " not in head:
+            print("FAIL: WebSocket %d , one an address, refused: %s" % (i + 2, head))
+            ok = False
+            break
+        held.append(h)
+    h, head, _ = ws_upgrade.upgrade(port, "/ws", None, source="127.0.2.1")
+    print("one WebSocket per address, %d addresses; one from another: %s" % (LIMIT, head))
+    if " 503 " not in head:
+        print("FAIL: with every address holding one, one more address was not refused 503")
+        ok = False
+    h.close()
+    alive = still_open(operator)
+    print("the operator's page still open: %s" % alive)
+    if not alive:
+        print("FAIL: the operator's page (its PANIC button) was closed for another address's WebSocket")
+        ok = False
+    operator.close()
 # The page itself (plain HTTP) still loads at the limit.
 s = socket.create_connection(("127.0.0.1", port), timeout=3)
 s.sendall(b"GET / HTTP/1.1\r\nHost: x\r\n\r\n")
