@@ -141,18 +141,20 @@ class WebServer::Impl {
           waiting_.erase(id);
           if (ec) return;
           const asio::ip::address address = RemoteAddress(*stream);
-          if (websocket::is_upgrade(*req) &&
-              OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets) &&
+          // Only an upgrade the bridge takes counts against the limit (another
+          // path's gets 404 from Respond and must close nobody's).
+          const bool foxglove = websocket::is_upgrade(*req) && FoxgloveEndpoint::Offered(*req);  // any path
+          const bool page = websocket::is_upgrade(*req) && !foxglove &&
+                            std::string_view(req->target().data(), req->target().size()) == "/ws";
+          if ((foxglove || page) && OpenWebSockets() >= static_cast<std::size_t>(options_.max_websockets) &&
               !CloseWebSocketFor(address))
             return RefuseWebSocket(stream, std::move(*req));
-          if (websocket::is_upgrade(*req) &&
-              FoxgloveEndpoint::Offered(*req)) {  // any path: Foxglove asks for "/"
+          if (foxglove) {
             stream->expires_never();
             websockets_.push_back({foxglove_->Accept(stream->release_socket(), std::move(*req)), address});
             return;
           }
-          if (websocket::is_upgrade(*req) &&
-              std::string_view(req->target().data(), req->target().size()) == "/ws") {
+          if (page) {
             stream->expires_never();
             auto session = std::make_shared<WsConnection>(
                 stream->release_socket(), kMaxPageMessage, kMaxQueuedFrames,
@@ -178,16 +180,18 @@ class WebServer::Impl {
   }
 
   // At --max-websockets, a WebSocket asked for from `address`: closes the
-  // oldest of the address holding the most when `address` holds fewer (a
-  // flood from one address never keeps the operator's page, and its PANIC
-  // button, out), and says so on stderr once a second at most (an attacker
-  // with two addresses makes it close one of its own per new one); false when
-  // `address` holds the most itself (it is refused).
+  // oldest of the address holding the most when that address holds two or
+  // more and `address` fewer (a flood from one address never keeps the
+  // operator's page, and its PANIC button, out), and says so on stderr once a
+  // second at most (an attacker with two addresses makes it close one of its
+  // own per new one); false, refused, when `address` holds the most itself or
+  // every address holds one: a lone WebSocket (an operator's open page) is
+  // never closed for another's.
   bool CloseWebSocketFor(const asio::ip::address& address) {
     std::map<asio::ip::address, std::size_t> per_address;
     std::size_t most = 0;
     for (const WebSocket& w : websockets_) most = std::max(most, ++per_address[w.address]);
-    if (per_address[address] >= most) return false;
+    if (most < 2 || per_address[address] >= most) return false;
     const auto oldest = std::find_if(websockets_.begin(), websockets_.end(),
                                      [&](const WebSocket& w) { return per_address[w.address] == most; });
     const asio::ip::address holder = oldest->address;
