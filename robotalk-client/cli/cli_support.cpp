@@ -52,15 +52,18 @@ struct AnnounceWatch::Impl {
     if (trusted_key && client_time) {
       // Signed, so the server time is the server's: it was alive then. A
       // recording replayed after the server stopped is that old.
-      at = std::min(now, client_time(a.server_time));
-      if (now - at > kAnnounceMaxAge) {
+      const TimePoint announced = client_time(a.server_time);
+      const std::optional<TimePoint> fresh = FreshAnnouncementTime(now, announced);
+      if (!fresh) {
         std::lock_guard lock(mu);
         if (stale++ == 0)
           std::cerr << "robotalk: refused an announcement signed by the server but "
-                    << FormatDuration(now - at) << " old (more than " << FormatDuration(kAnnounceMaxAge)
+                    << FormatDuration(now - announced) << " old (more than "
+                    << FormatDuration(kAnnounceMaxAge)
                     << "): replayed or delayed; it does not show the server is there\n";
         return;
       }
+      at = *fresh;
     }
     std::lock_guard lock(mu);
     for (const auto& r : a.robots)

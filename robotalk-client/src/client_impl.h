@@ -173,6 +173,7 @@ class RobotClient::Impl {
   // every package; lost when the server no longer knows it.
   std::int64_t session_id_ = 0;                   // GUARDED_BY(mu_); 0 = none yet
   std::int64_t server_id_ = 0;                    // GUARDED_BY(mu_); the instance that opened it
+  TimePoint session_opened_at_{};                 // GUARDED_BY(mu_); its hello answered (clock_)
   std::optional<SessionKeys> session_keys_;       // GUARDED_BY(mu_); keyed mode
   std::unique_ptr<ClientHandshake> handshake_;    // GUARDED_BY(mu_); keyed: the hello in flight
   Nonce hello_nonce_{};                           // GUARDED_BY(mu_)

@@ -135,6 +135,7 @@ void RobotClient::Impl::OnHelloAnswer(std::span<const std::uint8_t> bytes) {
       if (server_id_ != 0 && answer.server_id != server_id_) resync_ = true;
       session_id_ = answer.session_id;
       server_id_ = answer.server_id;
+      session_opened_at_ = clock_.Now();
       hello_due_ = false;
       handshake_.reset();
       trust_error_.clear();

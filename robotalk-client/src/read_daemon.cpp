@@ -4,6 +4,7 @@
 
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/config_message.h"
+#include "robotalk/heard_announcement.h"
 #include "robotalk/known_servers.h"
 
 #include "robotalk/routed_lcm_transport.h"
@@ -483,7 +484,15 @@ void RobotClient::Impl::FailLost(const std::vector<CommandId>& lost) {
 // is believed only for a panic that went unanswered for the retransmission
 // timeout: a replay of an earlier instance's ANNOUNCE (signed, so it passes)
 // must not end a live session whose server answers at once (final13: before,
-// a replay every 20 us made a taken panic look refused). The cheap checks
+// a replay every 20 us made a taken panic look refused). Nor one whose server
+// answers late (gaps14: its panic-latch fsync on slow storage): the ANNOUNCE
+// must be fresh by its signed server time on the synchronised clock (the
+// rule `robotalk watch` applies, FreshAnnouncementTime) and signed after this
+// session's hello was answered. Instance ids are random, not ordered: the
+// time orders them. An older instance announced before the live one
+// answered (it stopped before that one started), so no replay of it passes;
+// a newer one announces after. Unsynchronised, no ANNOUNCE is believed (the
+// new instance's SESSION_UNKNOWN answer remains). The cheap checks
 // (decode, instance, robot) come before the signature's, which runs outside
 // mu_: a flood of forged ANNOUNCEs never holds the client's lock.
 void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
@@ -521,6 +530,10 @@ void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
     std::lock_guard lock(mu_);
     if (session_id_ != session || server_id_ != server) return;  // the session changed meanwhile
     const TimePoint now = clock_.Now();
+    if (!clock_sync_.synced()) return;
+    const std::optional<TimePoint> alive =
+        FreshAnnouncementTime(now, clock_sync_.ClientTime(heard.server_time));
+    if (!alive || *alive <= session_opened_at_) return;  // replayed, or of an instance older than the session
     const std::vector<std::int64_t> sequences = unanswered(now);
     if (sequences.empty()) return;
     for (const std::int64_t sequence : sequences) {

@@ -26,6 +26,7 @@
 #include <future>
 #include <mutex>
 #include <optional>
+#include <regex>
 #include <thread>
 #include <vector>
 
@@ -87,6 +88,62 @@ class ClientPanicTest : public ::testing::Test {
     auto c = std::make_unique<RobotClient>(o);
     c->Connect(kRobot);
     return c;
+  }
+
+  // The running server's first ANNOUNCE (signed in keyed mode), or empty
+  // when none came within 5 s.
+  std::vector<std::uint8_t> RecordAnnounce() {
+    MemoryTransport recorder(bus_);
+    std::mutex mu;
+    std::vector<std::uint8_t> heard;
+    auto sub = recorder.Subscribe(kAnnounceChannel, [&](const std::string&, std::span<const std::uint8_t> b) {
+      std::lock_guard lock(mu);
+      if (heard.empty()) heard.assign(b.begin(), b.end());
+    });
+    for (int i = 0; i < 100; ++i) {
+      recorder.HandleFor(std::chrono::milliseconds(50));
+      std::lock_guard lock(mu);
+      if (!heard.empty()) break;
+    }
+    sub.reset();
+    std::lock_guard lock(mu);
+    return heard;
+  }
+
+  // Keyed instance A, its first ANNOUNCE recorded (empty when none came
+  // within 5 s), then instance B, live. In its start-up window the replay
+  // would make B give the robot up (a Known gap of its own, docs/safety.md):
+  // not what is measured here.
+  std::vector<std::uint8_t> RestartKeyedKeepingAnAnnounce() {
+    MakeKeys();
+    StartServer(/*keyed=*/true);
+    std::vector<std::uint8_t> announce = RecordAnnounce();
+    server_.reset();
+    StartServer(/*keyed=*/true, /*allow_duplicate_robots=*/true);
+    return announce;
+  }
+
+  // client.Panic() while `replayer` publishes `announce` every `every`
+  // (10 s at most): "" when taken, else what it threw.
+  static std::string PanicWhileReplaying(RobotClient& client, MemoryTransport& replayer,
+                                         const std::vector<std::uint8_t>& announce, Duration every) {
+    std::atomic<bool> stop{false};
+    std::thread replay([&] {
+      const auto end = std::chrono::steady_clock::now() + seconds(10);  // bounded
+      while (!stop && std::chrono::steady_clock::now() < end) {
+        replayer.Publish(kAnnounceChannel, announce);
+        std::this_thread::sleep_for(every);
+      }
+    });
+    std::string error;
+    try {
+      client.Panic();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    stop = true;
+    replay.join();
+    return error;
   }
 
   fs::path dir_;
@@ -203,46 +260,92 @@ TEST_F(ClientPanicTest, AKeyedPanicAfterARestartIsTakenDuringAFloodOfPackagesNam
 // it)" while the live server had taken both (3 of 5 runs, replayed every
 // 20 us). A panic the live server answers is never reported refused.
 TEST_F(ClientPanicTest, AReplayedOldAnnounceNeverMakesATakenPanicLookRefused) {
-  MakeKeys();
-  StartServer(/*keyed=*/true);
-  MemoryTransport recorder(bus_);
-  std::mutex mu;
-  std::vector<std::uint8_t> old_announce;
-  auto sub = recorder.Subscribe(kAnnounceChannel, [&](const std::string&, std::span<const std::uint8_t> b) {
-    std::lock_guard lock(mu);
-    if (old_announce.empty()) old_announce.assign(b.begin(), b.end());
-  });
-  for (int i = 0; i < 100; ++i) {
-    recorder.HandleFor(std::chrono::milliseconds(50));
-    std::lock_guard lock(mu);
-    if (!old_announce.empty()) break;
-  }
+  const std::vector<std::uint8_t> old_announce = RestartKeyedKeepingAnAnnounce();
   ASSERT_FALSE(old_announce.empty()) << "instance A announced nothing within 5 s";
-  sub.reset();
-  server_.reset();
-  // Instance B, live. In its start-up window the replay would make it give
-  // the robot up (a Known gap of its own, docs/safety.md): not what is
-  // measured here.
-  StartServer(/*keyed=*/true, /*allow_duplicate_robots=*/true);
   auto monitor = Client("monitor");
   MemoryTransport replayer(bus_);
+  const std::string error =
+      PanicWhileReplaying(*monitor, replayer, old_announce, std::chrono::microseconds(20));
+  EXPECT_EQ(error, "") << "a panic the live server took was reported otherwise";
+  auto alice = Client("alice");
+  EXPECT_EQ(alice->SetJoint("pan", {0.2}).signal, Signal::kPanic) << "the robot is not halted";
+}
+
+// gaps14 (review 14's gap): the replay above never reaches a panic the
+// live server answers at once; one it answers later than the retransmission
+// timeout (its panic-latch fsync on slow storage) did: the replayed
+// ANNOUNCE of the earlier instance, signed and in the client's robot, ended
+// the live session, and whatever it had outstanding became an unknown
+// outcome. Here the client is on a bus of its own behind a relay that holds
+// every panic package 600 ms. An announcement of an instance older than the
+// session (signed before its hello was answered) never ends it.
+TEST_F(ClientPanicTest, AReplayedOldAnnounceNeverEndsTheSessionOfAPanicAnsweredLate) {
+  const std::vector<std::uint8_t> old_announce = RestartKeyedKeepingAnAnnounce();
+  ASSERT_FALSE(old_announce.empty()) << "instance A announced nothing within 5 s";
+
+  // The relay: what the client says goes to the server's bus (a panic 600 ms
+  // late), everything else comes back.
+  auto client_bus = std::make_shared<MemoryBus>();
+  MemoryTransport near(client_bus), far(bus_), client_side(client_bus), replayer(client_bus);
+  const std::string from_client = "ROBOTALK/" + kRobot + "/(REQUEST|HELLO)";
+  std::mutex held_mu;
+  std::vector<
+      std::pair<std::chrono::steady_clock::time_point, std::pair<std::string, std::vector<std::uint8_t>>>>
+      held;  // GUARDED_BY(held_mu)
+  auto up = near.Subscribe(from_client, [&](const std::string& channel, std::span<const std::uint8_t> b) {
+    bool panic = false;
+    if (channel == RequestChannel(kRobot)) {
+      try {
+        panic = DecodeRequest(b).panic;
+      } catch (const std::exception&) {
+      }
+    }
+    if (!panic) {
+      far.Publish(channel, b);
+      return;
+    }
+    std::lock_guard lock(held_mu);
+    held.push_back({std::chrono::steady_clock::now() + std::chrono::milliseconds(600),
+                    {channel, std::vector<std::uint8_t>(b.begin(), b.end())}});
+  });
+  const std::regex client_channels(from_client);
+  auto down = far.Subscribe(".*", [&](const std::string& channel, std::span<const std::uint8_t> b) {
+    if (!std::regex_match(channel, client_channels)) near.Publish(channel, b);
+  });
   std::atomic<bool> stop{false};
-  std::thread replay([&] {
-    const auto end = std::chrono::steady_clock::now() + seconds(10);  // bounded
+  std::thread relay([&] {
+    const auto end = std::chrono::steady_clock::now() + seconds(30);  // bounded
     while (!stop && std::chrono::steady_clock::now() < end) {
-      replayer.Publish(kAnnounceChannel, old_announce);
-      std::this_thread::sleep_for(std::chrono::microseconds(20));
+      near.HandleFor(std::chrono::milliseconds(1));
+      far.HandleFor(std::chrono::milliseconds(1));
+      std::lock_guard lock(held_mu);
+      const auto now = std::chrono::steady_clock::now();
+      for (auto it = held.begin(); it != held.end();) {
+        if (it->first > now) {
+          ++it;
+          continue;
+        }
+        far.Publish(it->second.first, it->second.second);
+        it = held.erase(it);
+      }
     }
   });
-  std::string error;
-  try {
-    monitor->Panic();
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
+  ClientOptions o;
+  o.transport = &client_side;
+  o.timeout = seconds(5);
+  o.connect_timeout = seconds(5);
+  o.key_file = (dir_ / "monitor").string();
+  o.known_servers_file = (dir_ / "known_servers").string();
+  auto monitor = std::make_unique<RobotClient>(o);
+  monitor->Connect(kRobot);
+  const std::string error =
+      PanicWhileReplaying(*monitor, replayer, old_announce, std::chrono::milliseconds(1));
+  const std::uint64_t lost = monitor->stats().sessions_lost;
   stop = true;
-  replay.join();
+  monitor.reset();
+  relay.join();
   EXPECT_EQ(error, "") << "a panic the live server took was reported otherwise";
+  EXPECT_EQ(lost, 0u) << "a replayed announcement of an older instance ended the live session";
   auto alice = Client("alice");
   EXPECT_EQ(alice->SetJoint("pan", {0.2}).signal, Signal::kPanic) << "the robot is not halted";
 }

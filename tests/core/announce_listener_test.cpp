@@ -4,6 +4,7 @@
 
 #include "robotalk/broadcast_signature.h"
 #include "robotalk/channels.h"
+#include "robotalk/heard_announcement.h"
 #include "robotalk/memory_transport.h"
 #include "robotalk/request.h"
 
@@ -76,6 +77,21 @@ TEST(HearAnnouncement, WithoutAKeyEverythingThatDecodesAndIsNotForgedIsHeardWith
   EXPECT_EQ(NameOf(HearAnnouncement(bus.other_key)), "other-key");
   EXPECT_EQ(NameOf(HearAnnouncement(bus.forged)), "(dropped)");
   EXPECT_EQ(NameOf(HearAnnouncement(bus.garbage)), "(dropped)");
+}
+
+// The one freshness rule (`robotalk watch`, a keyed client's panic): a
+// signed announcement shows its server alive at its signed time, never later
+// than now; one more than kAnnounceHeardWithin old on arrival shows nothing.
+TEST(FreshAnnouncementTime, AnAnnouncementShowsItsServerAliveAtItsTimeUntilItIsTooOld) {
+  const TimePoint now = TimePoint{} + std::chrono::hours(1);
+  EXPECT_EQ(FreshAnnouncementTime(now, now - std::chrono::milliseconds(200)),
+            now - std::chrono::milliseconds(200));
+  EXPECT_EQ(FreshAnnouncementTime(now, now - kAnnounceHeardWithin), now - kAnnounceHeardWithin);
+  EXPECT_EQ(FreshAnnouncementTime(now, now - kAnnounceHeardWithin - std::chrono::microseconds(1)),
+            std::nullopt);
+  EXPECT_EQ(FreshAnnouncementTime(now, now - std::chrono::minutes(5)), std::nullopt)
+      << "a recording replayed";
+  EXPECT_EQ(FreshAnnouncementTime(now, now + std::chrono::minutes(5)), now) << "never later than now";
 }
 
 TEST(AnnounceListener, HearsOnItsOwnThreadWhatItsKeySignedAndCountsTheRest) {

@@ -11,6 +11,7 @@
 
 #include "echo_filter.h"
 #include "impaired_channel.h"
+#include "queue_bound.h"
 #include "relay_options.h"
 
 namespace robotalk::relay {
@@ -356,6 +357,66 @@ TEST(RelayOptions, DefaultsForwardEverythingUnimpairedWithSeedOne) {
   EXPECT_NE(DerivedSeed(1), 1u);
 }
 
+TEST(RelayOptions, TheReleaseQueueIsBoundedByDefaultAndTheBoundIsAnOption) {
+  EXPECT_EQ(Parse({}).queue.max_messages, kDefaultMaxQueueMessages);
+  EXPECT_EQ(Parse({}).queue.max_bytes, kDefaultMaxQueueBytes);
+  const RelayOptions o = Parse({"--max-queue", "10", "--max-queue-bytes=4096"});
+  EXPECT_EQ(o.queue.max_messages, 10u);
+  EXPECT_EQ(o.queue.max_bytes, 4096u);
+}
+
+// gaps14: the congestion model's backlog grows without bound when messages
+// arrive faster than the link serves them; the release queue holding them
+// is bounded in messages and bytes, what arrives past it dropped and counted.
+TEST(QueueBound, DropsAndCountsWhatWouldPassEitherLimitAndTakesMoreOnceReleased) {
+  QueueBound count({.max_messages = 3, .max_bytes = 1000});
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(count.TryAdmit(10));
+  EXPECT_FALSE(count.TryAdmit(10)) << "a fourth message";
+  EXPECT_FALSE(count.TryAdmit(0));
+  EXPECT_EQ(count.dropped(), 2u);
+  count.Release(10);
+  EXPECT_TRUE(count.TryAdmit(10)) << "room again once one left";
+  EXPECT_EQ(count.messages(), 3u);
+  EXPECT_EQ(count.bytes(), 30u);
+
+  QueueBound bytes({.max_messages = 100, .max_bytes = 100});
+  EXPECT_TRUE(bytes.TryAdmit(60));
+  EXPECT_FALSE(bytes.TryAdmit(41)) << "101 bytes";
+  EXPECT_TRUE(bytes.TryAdmit(40)) << "exactly 100";
+  EXPECT_FALSE(bytes.TryAdmit(static_cast<std::size_t>(-1))) << "no overflow of the sum";
+  EXPECT_EQ(bytes.dropped(), 2u);
+  EXPECT_EQ(bytes.bytes(), 100u);
+}
+
+// The congestion model with a bound: messages arriving twice as fast as the
+// link serves them keep at most the bound queued (the backlog of the model
+// alone grows linearly, CongestionBeyondTwiceTheSendIntervalGrowsTheBacklogLinearly).
+TEST(QueueBound, KeepsTheCongestedLinksBacklogBounded) {
+  ImpairmentParams p;
+  p.congestion_max = std::chrono::milliseconds(40);  // mean service 20 ms
+  ImpairedChannel channel(p, 7);
+  QueueBound bound({.max_messages = 50, .max_bytes = 1 << 20});
+  std::vector<TimePoint> queued;  // release times
+  std::size_t most = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const TimePoint now = TimePoint{} + std::chrono::milliseconds(10) * i;
+    std::erase_if(queued, [&](TimePoint at) {
+      if (at > now) return false;
+      bound.Release(100);
+      return true;
+    });
+    if (!bound.TryAdmit(100)) continue;
+    const Releases r = channel.Admit(now);
+    queued.push_back(r.at[0]);
+    most = std::max(most, queued.size());
+  }
+  EXPECT_LE(most, 50u);
+  EXPECT_GT(bound.dropped(), 1000u) << "about half of 5,000 past the link's rate";
+  EXPECT_LE(channel.link_free_at() - (TimePoint{} + std::chrono::milliseconds(10) * 4999),
+            std::chrono::seconds(2))
+      << "the backlog stays within the bound's worth of service (50 x 40 ms at most)";
+}
+
 TEST(RelayOptions, PerDirectionOptionsWinOverSharedOnesInAnyOrder) {
   const RelayOptions o =
       Parse({"--a2b-loss", "0.25", "--loss", "0.1", "--latency-ms=40", "--b2a-latency-ms", "5",
@@ -412,6 +473,10 @@ TEST(RelayOptions, RejectsBadValuesNamingTheOption) {
                                               {"--frobnicate", "1"},
                                               {"--c2d-loss", "0.1"},
                                               {"--seed", "-3"},
+                                              {"--max-queue", "0"},
+                                              {"--max-queue", "2.5"},
+                                              {"--max-queue-bytes", "-1"},
+                                              {"--a2b-max-queue", "10"},
                                               {"--loss"}}) {
     try {
       Parse(bad);

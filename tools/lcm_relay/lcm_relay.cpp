@@ -30,13 +30,14 @@ struct Message {
   std::vector<unsigned char> data;
   std::uint64_t fingerprint = 0;
   TimePoint arrival{};
+  int copies_queued = 0;  // guarded by the relay's mu: at 0 it leaves the QueueBound
 };
 
 struct Release {
   TimePoint at;
   std::uint64_t order;  // FIFO among equal release times
   int target;
-  std::shared_ptr<const Message> message;
+  std::shared_ptr<Message> message;
 };
 
 struct Later {
@@ -47,12 +48,15 @@ struct Later {
 
 // One direction: from `source` to the other side.
 struct Direction {
-  Direction(const DirectionOptions& o, std::uint64_t seed)
-      : channel(o.impairment, seed), filter(o.channels, std::regex::ECMAScript | std::regex::optimize) {}
+  Direction(const DirectionOptions& o, std::uint64_t seed, QueueLimits limits)
+      : channel(o.impairment, seed),
+        filter(o.channels, std::regex::ECMAScript | std::regex::optimize),
+        bound(limits) {}
   ImpairedChannel channel;
   std::regex filter;
   std::unordered_map<std::string, bool> match_cache;  // channel names are few
   DirectionStats stats;
+  QueueBound bound;  // its release queue: messages held, not yet released
 
   bool Matches(const std::string& name) {
     if (auto it = match_cache.find(name); it != match_cache.end()) return it->second;
@@ -74,7 +78,7 @@ struct LcmRelay::Impl {
 
   explicit Impl(const RelayOptions& o)
       : options(o),
-        directions{Direction(o.a2b, o.seed), Direction(o.b2a, DerivedSeed(o.seed))},
+        directions{Direction(o.a2b, o.seed, o.queue), Direction(o.b2a, DerivedSeed(o.seed), o.queue)},
         echo{EchoFilter(o.echo_window), EchoFilter(o.echo_window)} {
     const std::string urls[2] = {o.url_a, o.url_b};
     for (int side : {kSideA, kSideB}) {
@@ -125,11 +129,16 @@ struct LcmRelay::Impl {
         ++d.stats.filtered;
         return;
       }
+      // The queue full: dropped before the link (a router's full buffer).
+      if (!d.bound.TryAdmit(rbuf->data_size)) return;
       const Releases r = d.channel.Admit(now);
-      if (r.count == 0) return;
+      if (r.count == 0) {
+        d.bound.Release(rbuf->data_size);
+        return;
+      }
       auto message = std::make_shared<Message>(
           Message{channel, TargetLane(source, lane, channel),
-                  std::vector<unsigned char>(bytes, bytes + rbuf->data_size), fp, now});
+                  std::vector<unsigned char>(bytes, bytes + rbuf->data_size), fp, now, r.count});
       for (int i = 0; i < r.count; ++i) queue.push(Release{r.at[i], next_order++, 1 - source, message});
       lock.unlock();
       wake.notify_one();
@@ -180,6 +189,8 @@ struct LcmRelay::Impl {
       while (!queue.empty() && queue.top().at <= now) {
         due.push_back(queue.top());
         queue.pop();
+        Message& m = *due.back().message;
+        if (--m.copies_queued == 0) directions[1 - due.back().target].bound.Release(m.data.size());
         // Expect the echo before publishing: it can come back at once.
         echo[due.back().target].Expect(due.back().message->fingerprint, now);
       }
@@ -250,6 +261,8 @@ void LcmRelay::Run() {
 RelayStats LcmRelay::Stats() const {
   std::lock_guard lock(impl_->mu);
   RelayStats s{impl_->directions[kSideA].stats, impl_->directions[kSideB].stats};
+  s.a2b.queue_dropped = impl_->directions[kSideA].bound.dropped();
+  s.b2a.queue_dropped = impl_->directions[kSideB].bound.dropped();
   s.a2b.channel = impl_->directions[kSideA].channel.stats();
   s.b2a.channel = impl_->directions[kSideB].channel.stats();
   return s;
@@ -264,14 +277,15 @@ std::string FormatStats(const RelayStats& stats) {
     std::snprintf(
         buf, sizeof buf,
         "%s: received=%llu filtered=%llu lost=%llu duplicated=%llu reordered=%llu published=%llu "
-        "publish_errors=%llu unreleased=%llu echoes=%llu held=%llu mean_delay_ms=%.3f max_delay_ms=%.3f\n",
+        "publish_errors=%llu unreleased=%llu echoes=%llu held=%llu queue_dropped=%llu mean_delay_ms=%.3f "
+        "max_delay_ms=%.3f\n",
         name, static_cast<unsigned long long>(d.received), static_cast<unsigned long long>(d.filtered),
         static_cast<unsigned long long>(d.channel.lost),
         static_cast<unsigned long long>(d.channel.duplicated),
         static_cast<unsigned long long>(d.channel.reordered), static_cast<unsigned long long>(d.published),
         static_cast<unsigned long long>(d.publish_errors), static_cast<unsigned long long>(d.unreleased),
-        static_cast<unsigned long long>(d.echoes), static_cast<unsigned long long>(d.channel.held), mean_ms,
-        ToSeconds(d.max_delay) * 1e3);
+        static_cast<unsigned long long>(d.echoes), static_cast<unsigned long long>(d.channel.held),
+        static_cast<unsigned long long>(d.queue_dropped), mean_ms, ToSeconds(d.max_delay) * 1e3);
     out += buf;
   };
   line("a2b", stats.a2b);

@@ -28,8 +28,9 @@ struct DirectionStats {
   std::uint64_t echoes = 0;     ///< our own publications heard back on the source side
   std::uint64_t published = 0;  ///< copies published on the target side
   std::uint64_t publish_errors = 0;
-  std::uint64_t unreleased = 0;  ///< copies still queued when the relay stopped
-  Duration total_delay{0};       ///< sum over published copies of release - arrival
+  std::uint64_t unreleased = 0;     ///< copies still queued when the relay stopped
+  std::uint64_t queue_dropped = 0;  ///< dropped on arrival: the release queue was full (QueueBound)
+  Duration total_delay{0};          ///< sum over published copies of release - arrival
   Duration max_delay{0};
 };
 

@@ -36,6 +36,13 @@ Duration ParseMillis(const std::string& option, const std::string& value) {
   return FromSeconds(ms / 1000.0);
 }
 
+// A whole number in [1, 1e12] (a queue limit).
+std::size_t ParseCount(const std::string& option, const std::string& value) {
+  const double x = ParseDouble(option, value);
+  if (x < 1 || x > 1e12 || x != std::floor(x)) Bad(option, value, "must be a whole number in [1, 1e12]");
+  return static_cast<std::size_t>(x);
+}
+
 // Applies an impairment option (name without prefix) to one direction.
 // Returns false if `name` is not an impairment option.
 bool ApplyDirection(const std::string& option, const std::string& name, const std::string& value,
@@ -83,9 +90,10 @@ bool ApplyDirection(const std::string& option, const std::string& name, const st
 // Whether `name` (without "--") is an option that takes a value.
 bool TakesValue(std::string name) {
   if (name.rfind("a2b-", 0) == 0 || name.rfind("b2a-", 0) == 0) name = name.substr(4);
-  for (const char* known : {"a", "b", "seed", "duration", "echo-window-ms", "profile", "latency-ms",
-                            "jitter-ms", "jitter-dist", "loss", "dup", "reorder", "reorder-delay-ms",
-                            "congestion-max-ms", "outage-at-ms", "outage-ms", "channels"}) {
+  for (const char* known :
+       {"a", "b", "seed", "duration", "echo-window-ms", "profile", "latency-ms", "jitter-ms", "jitter-dist",
+        "loss", "dup", "reorder", "reorder-delay-ms", "congestion-max-ms", "outage-at-ms", "outage-ms",
+        "channels", "max-queue", "max-queue-bytes"}) {
     if (name == known) return true;
   }
   return false;
@@ -202,6 +210,10 @@ RelayOptions ParseRelayOptions(const std::vector<std::string>& args) {
       if (o.duration_s < 0) Bad(option, value, "must be seconds >= 0");
     } else if (name == "echo-window-ms") {
       o.echo_window = ParseMillis(option, value);
+    } else if (name == "max-queue") {
+      o.queue.max_messages = ParseCount(option, value);
+    } else if (name == "max-queue-bytes") {
+      o.queue.max_bytes = ParseCount(option, value);
     } else {
       if (!ApplyDirection(option, name, value, o.a2b)) Bad(option, value, "unknown option (see --help)");
       ApplyDirection(option, name, value, o.b2a);
@@ -246,6 +258,9 @@ side), both ways, through a seeded impaired channel per direction.
   --duration S            stop after S seconds (default 0: until SIGINT/SIGTERM)
   --stats                 print per-direction counters at exit
   --echo-window-ms MS     how long to recognise our own publications (default 2000)
+  --max-queue N           messages each direction holds for release at most (default
+                          65536); one more is dropped on arrival, counted (queue_dropped)
+  --max-queue-bytes B     the same in bytes (default 67108864, 64 MiB)
   --version               the version
 
   --profile NAME          preset impairments of both directions, which the options

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "impaired_channel.h"
+#include "queue_bound.h"
 
 namespace robotalk::relay {
 
@@ -25,6 +26,7 @@ struct RelayOptions {
   double duration_s = 0.0;  ///< 0: run until SIGINT/SIGTERM
   bool stats = false;       ///< print counters at exit
   Duration echo_window = std::chrono::seconds(2);
+  QueueLimits queue;  ///< --max-queue, --max-queue-bytes: each direction's release queue
   bool help = false;
   bool version = false;  ///< --version: print it and exit
 };

@@ -4,6 +4,8 @@
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
 
+#include <algorithm>
+
 namespace robotalk {
 
 std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> bytes,
@@ -24,6 +26,12 @@ std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> 
     return std::nullopt;
   }
   return heard;
+}
+
+std::optional<TimePoint> FreshAnnouncementTime(TimePoint now, TimePoint announced) {
+  const TimePoint at = std::min(now, announced);
+  if (now - at > kAnnounceHeardWithin) return std::nullopt;
+  return at;
 }
 
 }  // namespace robotalk

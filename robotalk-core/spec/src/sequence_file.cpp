@@ -1,11 +1,15 @@
 #include "robotalk/sequence_file.h"
 
+#include "robotalk/error.h"
+
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 #include <locale.h>
@@ -20,8 +24,29 @@ std::vector<std::string> SplitWords(const std::string& line) {
   return words;
 }
 
+// The C locale, made once by newlocale, which can fail (ENOMEM): then no
+// number is read (an Error naming it; a null locale_t given to strtod_l is
+// undefined behaviour, a crash in glibc), and the next call tries again.
 double StrtodC(const char* text, char** end) {
-  static const locale_t c = newlocale(LC_NUMERIC_MASK, "C", static_cast<locale_t>(nullptr));
+  static std::atomic<locale_t> made{static_cast<locale_t>(nullptr)};
+  locale_t c = made.load(std::memory_order_acquire);
+  if (!c) {
+    const int saved = errno;
+    locale_t fresh = newlocale(LC_NUMERIC_MASK, "C", static_cast<locale_t>(nullptr));
+    if (!fresh) {
+      const std::string why = std::strerror(errno);
+      errno = saved;
+      throw Error("cannot read a number: the C locale could not be made (newlocale: " + why + ")");
+    }
+    errno = saved;
+    locale_t expected = static_cast<locale_t>(nullptr);
+    if (made.compare_exchange_strong(expected, fresh, std::memory_order_acq_rel)) {
+      c = fresh;
+    } else {
+      freelocale(fresh);  // another thread made it first
+      c = expected;
+    }
+  }
   return strtod_l(text, end, c);
 }
 

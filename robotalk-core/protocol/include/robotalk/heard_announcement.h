@@ -6,6 +6,7 @@
 // is nullopt (anyone on the LAN can send one: dropping is the answer).
 #pragma once
 
+#include "robotalk/clock.h"
 #include "robotalk/keys.h"
 #include "robotalk/request.h"
 
@@ -28,5 +29,15 @@ struct HeardAnnouncement {
 /// cost no verification.
 std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> bytes,
                                                   const PublicKey* only = nullptr);
+
+/// The one freshness rule for a signed announcement (`robotalk watch`; a
+/// keyed client's panic, RobotClient): it proves its server was alive at its
+/// signed server time, not when it arrives (a captured one can be replayed
+/// later). `announced` is that time on the reader's clock (a synchronised
+/// client's ClientTime). Returns when it shows the server alive, never later
+/// than `now`; nullopt when that is more than kAnnounceHeardWithin (one
+/// announce period and slack for the network and the clock sync) before
+/// `now`: replayed or delayed, it does not show the server is there.
+std::optional<TimePoint> FreshAnnouncementTime(TimePoint now, TimePoint announced);
 
 }  // namespace robotalk

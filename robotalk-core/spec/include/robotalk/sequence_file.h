@@ -52,7 +52,8 @@ Interpolation ParseInterpolationWord(const std::string& word, const std::string&
 /// strtod in the C locale: a decimal point whatever the process's LC_NUMERIC
 /// (a program that sets a locale, as Python's locale.setlocale may, reads
 /// "0.25" as RoboTalk writes it). The one reader of a number's text
-/// (NumberOf; a URDF's <robotalk> triples).
+/// (NumberOf; a URDF's <robotalk> triples). Throws Error naming newlocale
+/// when the C locale cannot be made (ENOMEM); a later call tries again.
 double StrtodC(const char* text, char** end);
 
 /// The number a whole word spells (strtod's syntax in the C locale, blanks
@@ -60,7 +61,8 @@ double StrtodC(const char* text, char** end);
 /// left after the number, or when it is out of a double's range (ERANGE:
 /// too large, and too small as well: "1e-400" is refused, not read as 0).
 /// "inf" and "nan" are numbers here (the callers refuse them). The one rule
-/// every number option and text of RoboTalk is read by.
+/// every number option and text of RoboTalk is read by. Throws Error as
+/// StrtodC does when the C locale cannot be made.
 std::optional<double> NumberOf(const std::string& word);
 /// Parses a finite number (NumberOf); throws UsageError naming `what`:
 /// "<what>: 'x' is not a number", "<what>: 'inf' is not finite".
