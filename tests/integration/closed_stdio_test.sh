@@ -4,11 +4,13 @@
 # next files it opened for descriptors 1 and 2, and wrote its log lines into
 # them: robotalk-server's log went into its panic latch's lock file (any
 # file opened for writing while descriptor 2 was free could be the one).
-# Each of robotalk-server and robotalk-web, started so, must have /dev/null on descriptors 0-2 and write nothing into a file of
-# its own; the server serves, takes a panic and latches it.
-# Usage: closed_stdio_test.sh SERVER ROBOTALK WEB MODELS WWW (inside a private network namespace).
+# Each of robotalk-server, robotalk-web, the robotalk CLI (watch),
+# robotalk-lcm-relay and robotalk-logplay (record), started so, must have
+# /dev/null on descriptors 0-2; the server writes nothing into a file of its
+# own, serves, takes a panic and latches it; the recorder records.
+# Usage: closed_stdio_test.sh SERVER ROBOTALK WEB MODELS WWW RELAY LOGPLAY (inside a private network namespace).
 set -u
-server_bin=$1 cli=$2 web=$3 models=$4 www=$5
+server_bin=$1 cli=$2 web=$3 models=$4 www=$5 relay=$6 logplay=$7
 . "$(dirname "$0")/../lib.sh"
 url="udpm://239.255.76.67:7795?ttl=0"
 null_on_stdio() {  # null_on_stdio WHAT PID: descriptors 0, 1, 2 of PID are /dev/null
@@ -29,6 +31,19 @@ for _ in $(seq 50); do
 done
 check "robotalk-server started with stdout and stderr closed serves" test "$served" = 1
 null_on_stdio robotalk-server "$server_pid"
+# The CLI's watch and the recorder, while the server serves.
+"$cli" --url "$url" watch pioneer --duration 3 </dev/null >&- 2>&- &
+watch_pid=$!
+pids+=($watch_pid)
+"$logplay" record -o "$tmp/state.lcmlog" --lcm-url "$url" </dev/null >&- 2>&- &
+record_pid=$!
+pids+=($record_pid)
+sleep 1
+null_on_stdio "robotalk watch" "$watch_pid"
+null_on_stdio "robotalk-logplay record" "$record_pid"
+kill -INT "$record_pid"
+wait "$record_pid"
+check "robotalk-logplay record started so records the state stream" test -s "$tmp/state.lcmlog"
 check "its panic is taken" timeout 5 "$cli" --url "$url" panic pioneer
 signal_server TERM
 check "robotalk-server ends with 0 on SIGTERM (status $server_status)" test "$server_status" = 0
@@ -40,6 +55,10 @@ mkdir -p "$tmp/node_modules/three" "$tmp/node_modules/urdf-loader"
 "$web" --port 18451 --lcm-url "$url" --www "$www" --node-modules "$tmp/node_modules" </dev/null >&- 2>&- &
 pids+=($!)
 sleep 1
-null_on_stdio robotalk-web "${pids[0]}"
+null_on_stdio robotalk-web "$!"
+"$relay" --a "$url" --b "udpm://239.255.76.67:7995?ttl=0" --duration 3 </dev/null >&- 2>&- &
+pids+=($!)
+sleep 0.5
+null_on_stdio robotalk-lcm-relay "$!"
 echo "closed_stdio: $pass passed, $failures failed"
 [ "$failures" = 0 ]

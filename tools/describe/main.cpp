@@ -2,7 +2,7 @@
 //   robotalk-describe [--json] [--strict] [--merge-chains] [--max-bytes N] [--max-depth N] FILE.urdf
 #include "describe_format.h"
 #include "robotalk/error.h"
-#include "robotalk/log_writer.h"  // EscapeControls
+#include "robotalk/log_writer.h"  // EscapeControls, OpenStandardDescriptors
 #include "robotalk/urdf_import.h"
 
 #include <cerrno>
@@ -46,6 +46,7 @@ std::optional<unsigned long long> PositiveNumber(const char* text, unsigned long
 }  // namespace
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: nothing of ours on descriptors 0-2
   bool json = false;
   robotalk::UrdfImportOptions options;
   std::string path;

@@ -13,6 +13,7 @@
 // Exit status: 0 success; 1 the run failed (timeout, refused frames);
 // 2 usage; 3 the run exceeded --max-seconds.
 #include "fig11_profile.h"
+#include "robotalk/log_writer.h"  // OpenStandardDescriptors
 #include "robotalk/robot_client.h"
 #include "robotalk/sequence_file.h"  // ParseNumberIn
 
@@ -305,6 +306,7 @@ int Run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: nothing of ours on descriptors 0-2
   Options o;
   try {
     o = Parse(argc, argv);

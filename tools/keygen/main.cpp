@@ -3,6 +3,7 @@
 // name: one line to paste into the server's --clients list). Never
 // overwrites. docs/security.md.
 #include "robotalk/keys.h"
+#include "robotalk/log_writer.h"  // OpenStandardDescriptors
 
 #include <filesystem>
 #include <iostream>
@@ -35,6 +36,7 @@ int Fail(const std::string& message, int status = 1) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  robotalk::OpenStandardDescriptors();  // first: a key is never written to descriptor 1 or 2 of ours
   std::string out;
   std::string name;
   std::string fingerprint;
