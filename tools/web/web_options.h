@@ -47,12 +47,15 @@ struct WebOptions {
   double robot_timeout_s = 3.0;
   /// WebSocket clients open at once, the page's and Foxglove's together
   /// (each holds a descriptor and its queues); one more is refused with HTTP
-  /// 503 naming this limit (--max-websockets).
+  /// 503 naming this limit, unless its address holds fewer than the address
+  /// holding the most (2 or more), whose oldest is then closed
+  /// (--max-websockets).
   int max_websockets = 64;
   /// Plain HTTP connections waiting for a request (idle between requests, or
-  /// a request not yet whole) at once; each holds a descriptor for up to 30 s.
-  /// One more closes the oldest of the address holding the most, so a flood
-  /// of idle connections never keeps a new client out (--max-http-waiting).
+  /// a request not yet whole) or for their answer to be read, at once; each
+  /// holds a descriptor for up to 30 s. One more closes the oldest of the
+  /// address holding the most, so a flood of idle connections or slow
+  /// readers never keeps a new client out (--max-http-waiting).
   int max_http_waiting = 64;
   bool help = false;
   bool version = false;
