@@ -275,8 +275,9 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--inject-reply-dup") {
         options.reply_duplicate_probability = ParseNumberIn(value(), arg, {0, 1});
       } else if (arg == "--seed") {
-        options.fault_seed =
-            static_cast<std::uint64_t>(ParseNumberIn(value(), arg, {.min = 0, .max = 1e18, .whole = true}));
+        // Read as a double: whole numbers are exact below 2^53 only.
+        options.fault_seed = static_cast<std::uint64_t>(
+            ParseNumberIn(value(), arg, {.min = 0, .max = 0x1p53 - 1, .whole = true}));
       } else {
         SayServer("unknown option '" + arg + "' (see --help)");
         return 2;
