@@ -450,12 +450,15 @@ function M.connect(url, robot, timeout_s)
   until self.client_id ~= 0
   url = lcm_url_of(url)
   self.main = lcm.lcm.new(url)
-  local found, problem, heard = nil, nil, {}
+  -- The other robots heard, for the error: at most 32 of them (a flood of
+  -- ANNOUNCEs naming made-up robots costs no memory).
+  local found, problem, heard, heard_count = nil, nil, {}, 0
   local sub = self.main:subscribe('ROBOTALK/ANNOUNCE', self:guarded('ROBOTALK/ANNOUNCE', function(data)
     local a = msgs.announce_t.decode(zeroed(data, OFF.announce_server))  -- robots[].config_hash still warns
     for _, r in ipairs(a.robots) do
       if r.name ~= robot then
-        heard[M.printable(r.name)] = true
+        local name = M.printable(r.name)
+        if not heard[name] and heard_count < 32 then heard[name], heard_count = true, heard_count + 1 end
       elseif a.protocol_version ~= M.PROTOCOL_VERSION then
         problem = string.format("'%s' speaks protocol %d; this client speaks %d", robot, a.protocol_version,
           M.PROTOCOL_VERSION)

@@ -185,10 +185,14 @@ public final class RobotalkClient implements AutoCloseable {
     }
   }
 
+  private static final int MAX_HEARD = 32;
+
   private announce_t findRobot(double timeoutS) throws IOException, RobotalkException {
     lcm.lcm.LCMSubscriber sub = this::enqueue;
     mainLcm.subscribe("ROBOTALK/ANNOUNCE", sub);
-    List<String> heard = new ArrayList<>();
+    // The other robots heard, for the error: a set, and at most MAX_HEARD of
+    // them (a flood of ANNOUNCEs naming made-up robots costs no memory).
+    java.util.Set<String> heard = new java.util.TreeSet<>();
     long deadline = nowUs() + (long) (timeoutS * 1e6);
     String problem = null;
     announce_t found = null;
@@ -199,7 +203,7 @@ public final class RobotalkClient implements AutoCloseable {
       if (a == null) continue;
       for (robotalk_msgs.robot_info_t r : a.robots) {
         if (!r.name.equals(robot)) {
-          if (!heard.contains(printable(r.name))) heard.add(printable(r.name));
+          if (heard.size() < MAX_HEARD) heard.add(printable(r.name));
         } else if (a.protocol_version != PROTOCOL_VERSION) {
           problem = "'" + robot + "' speaks protocol " + a.protocol_version + "; this client speaks " + PROTOCOL_VERSION;
         } else if (a.keyed) {
