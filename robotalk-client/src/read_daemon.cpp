@@ -531,8 +531,12 @@ void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
     if (session_id_ != session || server_id_ != server) return;  // the session changed meanwhile
     const TimePoint now = clock_.Now();
     if (!clock_sync_.synced()) return;
-    const std::optional<TimePoint> alive =
-        FreshAnnouncementTime(now, clock_sync_.ClientTime(heard.server_time));
+    // Stamped further ahead than an announcement lives: of a clock ahead of
+    // the session's (an instance from before its host rebooted), never this
+    // session's server, whose stamps the clock sync maps to now.
+    const TimePoint announced = clock_sync_.ClientTime(heard.server_time);
+    if (announced > now + kAnnounceHeardWithin) return;
+    const std::optional<TimePoint> alive = FreshAnnouncementTime(now, announced);
     if (!alive || *alive <= session_opened_at_) return;  // replayed, or of an instance older than the session
     const std::vector<std::int64_t> sequences = unanswered(now);
     if (sequences.empty()) return;
