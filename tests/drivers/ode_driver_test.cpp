@@ -131,6 +131,25 @@ TEST(OdeDriver, RegistryCreatesTheDriverAndRejectsUnknownOptions) {
   EXPECT_EQ(OdeDriverOptions::FromMap({{"casters", "a+b"}}).casters, (std::vector<std::string>{"a", "b"}));
 }
 
+// final14b: with the stabilizer on by default, a driver string that asked
+// for push_balance's stabilizer part (valid before the flip) was refused at
+// start-up; without an explicit `stabilizer`, push_balance's part now takes
+// the stabilizer off (it runs only while a push's stop holds). Only an
+// explicit stabilizer=true with it is refused.
+TEST(OdeDriver, PushBalancesStabilizerPartTurnsTheDefaultStabilizerOffUnlessItIsGiven) {
+  for (const char* part : {"stabilizer", "both", "forces+stabilizer"}) {
+    const OdeDriverOptions o = OdeDriverOptions::FromMap({{"walk", "true"}, {"push_balance", part}});
+    EXPECT_FALSE(o.stabilizer) << "push_balance=" << part;
+    EXPECT_NO_THROW(o.Validate()) << "push_balance=" << part;
+    EXPECT_THROW(OdeDriverOptions::FromMap({{"walk", "true"}, {"push_balance", part}, {"stabilizer", "true"}})
+                     .Validate(),
+                 Error)
+        << "push_balance=" << part << " with stabilizer=true";
+  }
+  EXPECT_TRUE(OdeDriverOptions::FromMap({{"walk", "true"}, {"push_balance", "damping"}}).stabilizer)
+      << "a push_balance without a stabilizer part leaves the default";
+}
+
 TEST(OdeDriver, PioneerRestsOnTheGroundWithItsWheelsAndCaster) {
   Sim s(MakeDriver(Pioneer()));
   const OdeDriver::Stats st = s.d->stats();
