@@ -85,6 +85,12 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
       }
     }
   }
+  // push_balance's stabilizer part runs the stabilizer only while a push's
+  // stop holds: without an explicit `stabilizer`, it takes the default
+  // (always on) off; an explicit stabilizer=true with it is refused (Validate).
+  if (!options.contains("stabilizer") &&
+      (o.push_balance == "both" || o.push_balance.find("stabilizer") != std::string::npos))
+    o.stabilizer = false;
   r.Bool("foot_damping", &o.foot_damping);
   if (r.Text("gait", &o.gait) && o.gait != "fast" && o.gait != "slow") r.Fail("gait", "fast or slow");
   auto& go = o.gait_overrides;
@@ -143,9 +149,9 @@ void OdeDriverOptions::Validate() const {
   // the stabilizer on all the time it would mean nothing.
   if (stabilizer && (push_balance == "both" || push_balance.find("stabilizer") != std::string::npos)) {
     throw Error("OdeDriver: push_balance=" + push_balance +
-                " runs the stabilizer only while a push's stop holds, but stabilizer=true (the default) runs "
-                "it always: give stabilizer=false with it, or drop its stabilizer part (e.g. "
-                "push_balance=damping)");
+                " runs the stabilizer only while a push's stop holds, but stabilizer=true runs it always: "
+                "give stabilizer=false with it (or leave stabilizer out: push_balance's stabilizer part "
+                "turns the default off), or drop its stabilizer part (e.g. push_balance=damping)");
   }
 }
 

@@ -279,7 +279,8 @@ TEST(OdeWalk, PushBalanceRunsTheFeedbackOnlyWhileThePushsStopHolds) {
   EXPECT_NE(alone->find("push_recovery"), std::string::npos) << *alone;
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}, {"stabilizer", "false"}}));
   EXPECT_FALSE(RefusalOfWalker({{"push_balance", "damping+forces"}})) << "no stabilizer part: accepted";
-  EXPECT_TRUE(RefusalOfWalker({{"push_balance", "stabilizer"}})) << "the stabilizer is on by default";
+  EXPECT_FALSE(RefusalOfWalker({{"push_balance", "stabilizer"}}))
+      << "push_balance's stabilizer part turns the default stabilizer off";
   // The stabilizer's part only while the stop holds, with the stabilizer on always: refused.
   for (const char* both : {"stabilizer", "both", "forces+stabilizer"}) {
     const std::optional<std::string> on = RefusalOfWalker({{"push_balance", both}, {"stabilizer", "true"}});

@@ -483,7 +483,7 @@ CaptureResult WalkPushAndCapture(const Eigen::Vector2d& impulse_ns, double at, b
 }
 
 TEST(PushRecovery, TheCaptureStopLandsItsLastStepWhereTheDcmIsCaughtAndStands) {
-  // 15 N s (0.29 m/s; on ODE the default survives 5-40 N s by direction)
+  // 15 N s (0.29 m/s; on ODE the open loop survives 5-40 N s by direction)
   // from behind, from the front and from either side, at 8 instants over a
   // step. With the capture: measured 24 of 32 survived (every leftward one,
   // 6 of 8 forward, 7 of 8 backward, rightward 3 of 8: those 5 come while
