@@ -36,13 +36,13 @@ for bad in "--playback-queue-start|maybe|--playback-queue-start 'maybe': expecte
            "--playback-resent-delays|1|--playback-resent-delays '1': expected on or off" \
            "--playback-margin|-1|--playback-margin: '-1' is not a number in [0, 1000]" \
            "--playback-start-lead|x|--playback-start-lead: 'x' is not a number in [0, 100]" \
-           "--max-queue|2.5|--max-queue: '2.5' is not a whole number" \
+           "--max-queue|2.5|--max-queue: '2.5' is not a whole number in [1, 10000000]" \
            "--max-sessions|1.5|--max-sessions: '1.5' is not a whole number" \
            "--max-sessions-per-robot|3.9|--max-sessions-per-robot: '3.9' is not a whole number" \
            "--max-queued-total|1e2.5|--max-queued-total: '1e2.5' is not a whole number" \
            "--log-lines-per-second|0.5|--log-lines-per-second: '0.5' is not a whole number" \
            "--playback-min-frames|2.5|--playback-min-frames: '2.5' is not a whole number" \
-           "--seed|9007199254740993|--seed: '9007199254740993' is not a whole number in [0, 9.0072e+15]"; do
+           "--seed|9007199254740993|--seed: '9007199254740993' is not a whole number in [0, 9007199254740991]"; do
   IFS='|' read -r flag value why <<<"$bad"
   "$server" --robot "pioneer=kinematic:$models/pioneer2dx_pantilt.urdf" "$flag" "$value" \
     --simulate "$examples/speed_ramp.txt" >/dev/null 2>"$tmp/bad.err"

@@ -74,10 +74,14 @@ double ParseNumberIn(const std::string& word, const std::string& flag, const Num
   if (v && std::isfinite(*v) && (range.above_min ? *v > range.min : *v >= range.min) && *v <= range.max &&
       (!range.whole || *v == std::floor(*v)))
     return *v;
-  char bounds[80];
-  std::snprintf(bounds, sizeof bounds, "%c%g, %g]", range.above_min ? '(' : '[', range.min, range.max);
+  // A whole number's bounds to the digit (%g rounds 2^53 - 1 up to 9.0072e+15).
+  const auto bound = [&range](double b) {
+    char text[40];
+    std::snprintf(text, sizeof text, range.whole && std::fabs(b) <= 0x1p53 ? "%.0f" : "%g", b);
+    return std::string(text);
+  };
   throw UsageError(flag + ": '" + word + "' is not a " + (range.whole ? "whole " : "") + "number in " +
-                   bounds);
+                   (range.above_min ? "(" : "[") + bound(range.min) + ", " + bound(range.max) + "]");
 }
 
 double ParseSeconds(const std::string& word, const std::string& what) {
