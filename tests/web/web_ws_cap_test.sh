@@ -21,6 +21,18 @@ LIMIT = 64  # robotalk-web's default --max-websockets
 def upgrade(path="/ws", protocol=None):
     return ws_upgrade.upgrade(port, path, protocol)
 
+def refused_from_the_busiest(failure):
+    """One more WebSocket from 127.0.0.1 (holding the most) is refused 503;
+    else says FAIL: `failure`."""
+    s, head, _ = upgrade()
+    s.close()
+    print("then one more from 127.0.0.1 (holding the most): %s" % head)
+    if " 503 " not in head:
+        print("FAIL: " + failure)
+        return False
+    return True
+
+
 ok = True
 held = []
 for i in range(LIMIT):
@@ -78,24 +90,14 @@ else:
     if not closed:
         print("FAIL: the oldest WebSocket of the address holding the most was not closed")
         ok = False
-    s, head, _ = upgrade()
-    print("then one more from 127.0.0.1 (holding the most): %s" % head)
-    if " 503 " not in head:
-        print("FAIL: the address holding the most is not refused at the limit")
-        ok = False
-    s.close()
+    ok = refused_from_the_busiest("the address holding the most is not refused at the limit") and ok
 # final14: an upgrade to a path that is no WebSocket of the bridge closes
 # nobody's (it used to close the oldest of the busiest address, then got 404).
 s, head, _ = ws_upgrade.upgrade(port, "/nope", None, source="127.0.0.3")
 print("at the limit, an upgrade to /nope from 127.0.0.3: %s" % head)
 s.close()
 time.sleep(0.3)
-s, head, _ = upgrade()
-print("then one more from 127.0.0.1: %s" % head)
-if " 503 " not in head:
-    print("FAIL: an upgrade to /nope closed a WebSocket at the limit")
-    ok = False
-s.close()
+ok = refused_from_the_busiest("an upgrade to /nope closed a WebSocket at the limit") and ok
 
 
 def still_open(sock):
