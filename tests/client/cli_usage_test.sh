@@ -61,6 +61,9 @@ LCM_DEFAULT_URL=memq:// expect_msg 2 "--listen" robots --listen 1e12
 LCM_DEFAULT_URL=memq:// expect_msg 2 "--listen" robots --listen -1
 LCM_DEFAULT_URL=memq:// expect_msg 2 "--period" watch pioneer --period 1e12
 LCM_DEFAULT_URL=memq:// expect_msg 2 "--duration" watch pioneer --duration 1e12
+# A count is a whole number ('--count 2.5' was taken, read as "3 samples").
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--count: '2.5' is not a whole number" watch pioneer --count 2.5
+LCM_DEFAULT_URL=memq:// expect_msg 2 "--count: '0' is not a whole number" watch pioneer --count 0
 LCM_DEFAULT_URL=memq:// expect_msg 2 "--at" send pioneer stop --at 1e12
 seq=$(mktemp)
 printf '0 stop\n1e12 stop\n' > "$seq"
