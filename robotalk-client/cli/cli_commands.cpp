@@ -197,9 +197,10 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
     throw UsageError("usage: robotalk watch ROBOT [--period S] [--duration S] [--count N] [--json]");
   const double period_s = ParseSeconds(period, "--period");
   const double duration_s = has_duration ? ParseSeconds(duration, "--duration") : kMaxTextSeconds;
-  const double max_samples = has_count ? ParseNumber(count, "--count") : 1e18;
-  if (period_s < 0.001 || duration_s <= 0 || max_samples < 1) {
-    throw UsageError("watch: --period must be >= 0.001 s, --duration and --count positive");
+  const double max_samples =
+      has_count ? ParseNumberIn(count, "--count", {.min = 1, .max = 0x1p53 - 1, .whole = true}) : 1e18;
+  if (period_s < 0.001 || duration_s <= 0) {
+    throw UsageError("watch: --period must be >= 0.001 s and --duration positive");
   }
   const auto client = ConnectClient(g, args[0]);
   // With the STATE samples: is the server still there? Keyed: only its signed
