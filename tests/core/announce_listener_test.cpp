@@ -81,7 +81,8 @@ TEST(HearAnnouncement, WithoutAKeyEverythingThatDecodesAndIsNotForgedIsHeardWith
 
 // The one freshness rule (`robotalk watch`, a keyed client's panic): a
 // signed announcement shows its server alive at its signed time, never later
-// than now; one more than kAnnounceHeardWithin old on arrival shows nothing.
+// than now; one more than kAnnounceHeardWithin old on arrival, or stamped
+// more than that ahead, shows nothing.
 TEST(FreshAnnouncementTime, AnAnnouncementShowsItsServerAliveAtItsTimeUntilItIsTooOld) {
   const TimePoint now = TimePoint{} + std::chrono::hours(1);
   EXPECT_EQ(FreshAnnouncementTime(now, now - std::chrono::milliseconds(200)),
@@ -91,7 +92,16 @@ TEST(FreshAnnouncementTime, AnAnnouncementShowsItsServerAliveAtItsTimeUntilItIsT
             std::nullopt);
   EXPECT_EQ(FreshAnnouncementTime(now, now - std::chrono::minutes(5)), std::nullopt)
       << "a recording replayed";
-  EXPECT_EQ(FreshAnnouncementTime(now, now + std::chrono::minutes(5)), now) << "never later than now";
+  EXPECT_EQ(FreshAnnouncementTime(now, now + std::chrono::milliseconds(200)), now) << "never later than now";
+  EXPECT_EQ(FreshAnnouncementTime(now, now + kAnnounceHeardWithin), now) << "the clock sync's slack";
+  // Stamped further ahead than an announcement lives: signed by an instance
+  // whose clock ran ahead of this one's (its host's before a reboot), never
+  // by the server the reader is synchronised with; replayed, it would show
+  // that server alive for as long as the stamp is ahead (`robotalk watch`
+  // would never say the server is gone; final14b: a keyed panic refused).
+  EXPECT_EQ(FreshAnnouncementTime(now, now + kAnnounceHeardWithin + std::chrono::microseconds(1)),
+            std::nullopt);
+  EXPECT_EQ(FreshAnnouncementTime(now, now + std::chrono::minutes(5)), std::nullopt);
 }
 
 TEST(AnnounceListener, HearsOnItsOwnThreadWhatItsKeySignedAndCountsTheRest) {
