@@ -286,7 +286,7 @@ int RunWatch(const GlobalOptions& g, const std::vector<std::string>& in) {
   }
   if (const std::uint64_t stale = announces.Stale(); stale > 0) {
     std::cerr << "robotalk: refused " << stale
-              << " announcements signed by the server but stale (replayed or delayed)\n";
+              << " announcements signed by the server but stale (replayed, delayed or of another clock)\n";
   }
   if (const std::uint64_t refused = client->stats().broadcasts_refused; refused > 0) {
     std::cerr << "robotalk: dropped " << refused

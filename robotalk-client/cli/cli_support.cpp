@@ -58,9 +58,10 @@ struct AnnounceWatch::Impl {
         std::lock_guard lock(mu);
         if (stale++ == 0)
           std::cerr << "robotalk: refused an announcement signed by the server but "
-                    << FormatDuration(now - announced) << " old (more than "
-                    << FormatDuration(kAnnounceMaxAge)
-                    << "): replayed or delayed; it does not show the server is there\n";
+                    << (announced > now ? "stamped " + FormatDuration(announced - now) + " ahead"
+                                        : FormatDuration(now - announced) + " old")
+                    << " (more than " << FormatDuration(kAnnounceMaxAge)
+                    << "): replayed, delayed or of another clock; it does not show the server is there\n";
         return;
       }
       at = *fresh;

@@ -26,8 +26,9 @@ namespace robotalk::cli {
 /// conversion of a synchronised client): a signed announcement proves the
 /// server was alive at its signed `server_time`, not when it arrives (a
 /// captured one can be replayed later). It counts as heard at that time, and
-/// one older than kAnnounceMaxAge on arrival is refused as stale, counted
-/// (Stale()) and said once on stderr.
+/// one older than kAnnounceMaxAge on arrival, or stamped more than that
+/// ahead (FreshAnnouncementTime), is refused as stale, counted (Stale()) and
+/// said once on stderr.
 /// Thread safety: Heard(), LastHeard() and Stale() may be called from any thread.
 class AnnounceWatch {
  public:
@@ -45,7 +46,8 @@ class AnnounceWatch {
   std::set<std::string> Heard() const;
   /// When `robot` was last announced (steady clock), or nullopt.
   std::optional<TimePoint> LastHeard(const std::string& robot) const;
-  /// Signed announcements refused as stale (replayed or delayed).
+  /// Signed announcements refused as stale (replayed, delayed, or stamped
+  /// ahead by another clock).
   std::uint64_t Stale() const;
 
  private:

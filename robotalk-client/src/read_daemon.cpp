@@ -486,8 +486,9 @@ void RobotClient::Impl::FailLost(const std::vector<CommandId>& lost) {
 // must not end a live session whose server answers at once (final13: before,
 // a replay every 20 us made a taken panic look refused). Nor one whose server
 // answers late (gaps14: its panic-latch fsync on slow storage): the ANNOUNCE
-// must be fresh by its signed server time on the synchronised clock (the
-// rule `robotalk watch` applies, FreshAnnouncementTime) and signed after this
+// must be fresh by its signed server time on the synchronised clock, neither
+// too old nor stamped too far ahead (the rule `robotalk watch` applies,
+// FreshAnnouncementTime) and signed after this
 // session's hello was answered. Instance ids are random, not ordered: the
 // time orders them. An older instance announced before the live one
 // answered (it stopped before that one started), so no replay of it passes;
@@ -531,13 +532,11 @@ void RobotClient::Impl::OnAnnounce(std::span<const std::uint8_t> bytes) {
     if (session_id_ != session || server_id_ != server) return;  // the session changed meanwhile
     const TimePoint now = clock_.Now();
     if (!clock_sync_.synced()) return;
-    // Stamped further ahead than an announcement lives: of a clock ahead of
-    // the session's (an instance from before its host rebooted), never this
-    // session's server, whose stamps the clock sync maps to now.
-    const TimePoint announced = clock_sync_.ClientTime(heard.server_time);
-    if (announced > now + kAnnounceHeardWithin) return;
-    const std::optional<TimePoint> alive = FreshAnnouncementTime(now, announced);
-    if (!alive || *alive <= session_opened_at_) return;  // replayed, or of an instance older than the session
+    // Replayed, or stamped ahead by a clock that is not this session's
+    // server's, or of an instance older than the session: not believed.
+    const std::optional<TimePoint> alive =
+        FreshAnnouncementTime(now, clock_sync_.ClientTime(heard.server_time));
+    if (!alive || *alive <= session_opened_at_) return;
     const std::vector<std::int64_t> sequences = unanswered(now);
     if (sequences.empty()) return;
     for (const std::int64_t sequence : sequences) {

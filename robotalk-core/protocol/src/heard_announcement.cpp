@@ -29,6 +29,7 @@ std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> 
 }
 
 std::optional<TimePoint> FreshAnnouncementTime(TimePoint now, TimePoint announced) {
+  if (announced - now > kAnnounceHeardWithin) return std::nullopt;  // of a clock ahead of the reader's
   const TimePoint at = std::min(now, announced);
   if (now - at > kAnnounceHeardWithin) return std::nullopt;
   return at;

@@ -37,7 +37,11 @@ std::optional<HeardAnnouncement> HearAnnouncement(std::span<const std::uint8_t> 
 /// client's ClientTime). Returns when it shows the server alive, never later
 /// than `now`; nullopt when that is more than kAnnounceHeardWithin (one
 /// announce period and slack for the network and the clock sync) before
-/// `now`: replayed or delayed, it does not show the server is there.
+/// `now`: replayed or delayed, it does not show the server is there. Also
+/// nullopt when `announced` is more than kAnnounceHeardWithin after `now`:
+/// signed by an instance whose clock ran ahead of the one the reader is
+/// synchronised with (its host's before a reboot), never by that server;
+/// replayed, it would show a server alive for as long as its stamp is ahead.
 std::optional<TimePoint> FreshAnnouncementTime(TimePoint now, TimePoint announced);
 
 }  // namespace robotalk
