@@ -92,5 +92,64 @@ TEST(ClockSync, RejectsForgedTimesAtTheEndsOfTheRange) {
   EXPECT_EQ(s.offset(), kTrueOffset);
 }
 
+// Two hosts' steady clocks drift apart (tens of ppm without NTP). The best
+// sample of a long session must not stand for it: before, the offset from
+// the session's first (best) round trip stood for its whole life, 1.44 s
+// wrong after 2 h at 200 ppm, which turned a keyed client's panic path off
+// (FreshAnnouncementTime) and shifted every delay-mode start. Now a sample's
+// error bound grows with its age and only the recent samples count, so with
+// a sample every 10 s (the client's refresh) the offset follows the drift
+// within a few round trips' worth.
+TEST(ClockSync, FollowsAServerClockThatDriftsOverALongSession) {
+  ClockSync s;
+  constexpr double kDrift = 200e-6;  // the server's clock runs 200 ppm fast
+  const auto server_at = [&](TimePoint client) {
+    const Duration since = client - kT0;
+    return client + kTrueOffset +
+           std::chrono::duration_cast<Duration>(
+               std::chrono::duration<double, std::nano>(since.count() * kDrift));
+  };
+  // The session's first sample is the best it will ever see: 0.1 ms.
+  ASSERT_TRUE(s.AddSample(kT0, server_at(kT0 + std::chrono::microseconds(50)),
+                          server_at(kT0 + std::chrono::microseconds(50)),
+                          kT0 + std::chrono::microseconds(100)));
+  Duration worst{0};
+  std::uint32_t lcg = 7;
+  for (int k = 1; k <= 720; ++k) {  // every 10 s for 2 h
+    const TimePoint t1 = kT0 + std::chrono::seconds(10) * k;
+    lcg = lcg * 1664525u + 1013904223u;
+    const Duration one_way = std::chrono::microseconds(500 + lcg % 9500);  // 0.5-10 ms, symmetric
+    const TimePoint t2 = server_at(t1 + one_way);
+    ASSERT_TRUE(s.AddSample(t1, t2, t2, t1 + 2 * one_way));
+    const Duration error = s.ServerTime(t1 + 2 * one_way) - server_at(t1 + 2 * one_way);
+    worst = std::max(worst, error < Duration::zero() ? -error : error);
+  }
+  // Within what the recent samples allow: their round trips (up to 20 ms)
+  // and the drift over the window they span (8 samples, 80 s: 16 ms).
+  EXPECT_LT(worst, milliseconds(40)) << "worst offset error " << ToSeconds(worst) << " s";
+}
+
+// The first sample after a long quiet spell replaces a best sample grown
+// old, even when its round trip is longer: the old one's bound has grown by
+// the drift allowance over its age.
+TEST(ClockSync, AnOldBestSampleGivesWayToAFreshOneWhoseBoundIsTighter) {
+  ClockSync s;
+  ASSERT_TRUE(s.AddSample(kT0, kT0 + milliseconds(1) + kTrueOffset, kT0 + milliseconds(1) + kTrueOffset,
+                          kT0 + milliseconds(2)));
+  // An hour later (an allowance of 100 ppm: 360 ms of possible drift), a
+  // 10 ms round trip that says the offset moved by 100 ms.
+  const TimePoint t1 = kT0 + std::chrono::hours(1);
+  const Duration moved = kTrueOffset + milliseconds(100);
+  ASSERT_TRUE(
+      s.AddSample(t1, t1 + milliseconds(5) + moved, t1 + milliseconds(5) + moved, t1 + milliseconds(10)));
+  EXPECT_EQ(s.offset(), moved);
+  EXPECT_EQ(*s.best_round_trip(), milliseconds(10));
+  // A second later, a slower sample does not replace the fresh one.
+  const TimePoint t2 = t1 + std::chrono::seconds(1);
+  ASSERT_TRUE(s.AddSample(t2, t2 + milliseconds(25) + kTrueOffset, t2 + milliseconds(25) + kTrueOffset,
+                          t2 + milliseconds(50)));
+  EXPECT_EQ(s.offset(), moved);
+}
+
 }  // namespace
 }  // namespace robotalk::client
