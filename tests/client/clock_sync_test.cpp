@@ -96,10 +96,10 @@ TEST(ClockSync, RejectsForgedTimesAtTheEndsOfTheRange) {
 // sample of a long session must not stand for it: before, the offset from
 // the session's first (best) round trip stood for its whole life, 1.44 s
 // wrong after 2 h at 200 ppm, which turned a keyed client's panic path off
-// (FreshAnnouncementTime) and shifted every delay-mode start. Now a sample's
-// error bound grows with its age and only the recent samples count, so with
-// a sample every 10 s (the client's refresh) the offset follows the drift
-// within a few round trips' worth.
+// (FreshAnnouncementTime) and shifted every delay-mode start. Now the best
+// sample's error bound grows with its age, so with a sample every 10 s (the
+// client's refresh) the offset follows the drift within a few round trips'
+// worth.
 TEST(ClockSync, FollowsAServerClockThatDriftsOverALongSession) {
   ClockSync s;
   constexpr double kDrift = 200e-6;  // the server's clock runs 200 ppm fast
@@ -124,8 +124,9 @@ TEST(ClockSync, FollowsAServerClockThatDriftsOverALongSession) {
     const Duration error = s.ServerTime(t1 + 2 * one_way) - server_at(t1 + 2 * one_way);
     worst = std::max(worst, error < Duration::zero() ? -error : error);
   }
-  // Within what the recent samples allow: their round trips (up to 20 ms)
-  // and the drift over the window they span (8 samples, 80 s: 16 ms).
+  // Within what fresh samples allow: their round trips (up to 20 ms), and
+  // the drift (200 ppm, twice the allowance) over the ~100 s a sample can
+  // stand before a fresh one's bound (up to 10 ms) is tighter: 20 ms.
   EXPECT_LT(worst, milliseconds(40)) << "worst offset error " << ToSeconds(worst) << " s";
 }
 

@@ -340,6 +340,32 @@ TEST_F(RobotClientTest, PanicTimesOutWithoutAck) {
   EXPECT_THROW(client->Panic(), TimeoutError);
 }
 
+// Follows real time until Freeze(), then moves only when told to: the real
+// server takes time between a CLOCK query's receipt and its answer, so a
+// client clock standing still through Connect() would see a negative round
+// trip in every sample and never synchronise. (A thread setting a
+// ManualClock every 100 us lagged behind under load and failed Connect.)
+class FollowThenManualClock final : public Clock {
+ public:
+  TimePoint Now() const override {
+    if (frozen_.load()) return TimePoint(Duration(manual_.load()));
+    return start_ + std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - real_start_);
+  }
+  // A reader between the two stores sees real time, below the frozen
+  // value: the clock never goes back.
+  void Freeze() {
+    manual_.store((Now() + milliseconds(1)).time_since_epoch().count());
+    frozen_.store(true);
+  }
+  void Advance(Duration d) { manual_.fetch_add(d.count()); }
+
+ private:
+  const TimePoint start_{seconds(1000)};
+  const std::chrono::steady_clock::time_point real_start_ = std::chrono::steady_clock::now();
+  std::atomic<bool> frozen_{false};
+  std::atomic<Duration::rep> manual_{0};
+};
+
 // On a ManualClock: one heartbeat per idle interval the clock moves, none
 // while it stands still (no sleeping for the interval to pass).
 TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
@@ -353,36 +379,13 @@ TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
        .when = [repeated = Repeated()](const std::string& channel, std::span<const std::uint8_t> bytes) {
          return !repeated(channel, bytes) && IsHeartbeat(channel, bytes);
        }});
-  // Follows real time until Freeze(), then moves only when told to: the real
-  // server takes time between a CLOCK query's receipt and its answer, so a
-  // client clock standing still through Connect() would see a negative round
-  // trip in every sample and never synchronise. (A thread setting a
-  // ManualClock every 100 us lagged behind under load and failed Connect.)
-  class FollowThenManualClock final : public Clock {
-   public:
-    TimePoint Now() const override {
-      if (frozen_.load()) return TimePoint(Duration(manual_.load()));
-      return start_ + std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - real_start_);
-    }
-    // A reader between the two stores sees real time, below the frozen
-    // value: the clock never goes back.
-    void Freeze() {
-      manual_.store((Now() + milliseconds(1)).time_since_epoch().count());
-      frozen_.store(true);
-    }
-    void Advance(Duration d) { manual_.fetch_add(d.count()); }
-
-   private:
-    const TimePoint start_{seconds(1000)};
-    const std::chrono::steady_clock::time_point real_start_ = std::chrono::steady_clock::now();
-    std::atomic<bool> frozen_{false};
-    std::atomic<Duration::rep> manual_{0};
-  } clock;
+  FollowThenManualClock clock;
   ClientOptions o = Options();
   o.clock = &clock;
   // An interval far longer than Connect() takes (below), and no resend or
   // giving up within the few intervals the test moves the clock.
   o.heartbeat_interval = seconds(10);
+  o.clock_refresh_interval = std::chrono::hours(1);  // a CLOCK package would stand in for a heartbeat
   o.retransmit_interval = o.retransmit_max_interval = std::chrono::minutes(10);
   o.give_up_after = std::chrono::hours(1);
   o.max_idle_wait = milliseconds(1);  // re-read the manual clock often
@@ -402,6 +405,51 @@ TEST_F(RobotClientTest, IdleClientSendsAHeartbeatPerIdleIntervalOfItsClock) {
   std::this_thread::sleep_for(milliseconds(20));
   EXPECT_EQ(client->stats().heartbeats, 4u);
   EXPECT_EQ(received(), 4u);
+}
+
+// Two hosts' clocks drift apart: a connected client takes a fresh clock
+// sample every clock_refresh_interval of its clock, so its offset follows
+// (ClockSync ages the best sample; ClockSync.FollowsAServerClockThatDrifts*).
+// Before, the only samples were Connect's and a restart's.
+TEST_F(RobotClientTest, AConnectedClientAsksTheServersClockEveryRefreshInterval) {
+  ServerOptions so = DefaultServerOptions();
+  so.session_timeout = seconds(60);
+  StartServer(so);
+  const auto clock_queries = server_net_.Add(
+      {.channel_regex = kRequests,
+       .direction = Direction::kIncoming,
+       .when = [repeated = Repeated()](const std::string& channel, std::span<const std::uint8_t> bytes) {
+         if (repeated(channel, bytes)) return false;
+         try {
+           const Request r = DecodeRequest(bytes);
+           return std::any_of(r.queries.begin(), r.queries.end(),
+                              [](const Query& q) { return q.type == QueryType::kClock; });
+         } catch (const std::exception&) {
+           return false;
+         }
+       }});
+  FollowThenManualClock clock;
+  ClientOptions o = Options();
+  o.clock = &clock;
+  o.clock_refresh_interval = seconds(10);  // the default, said here
+  o.heartbeat_interval = std::chrono::minutes(10);
+  o.retransmit_interval = o.retransmit_max_interval = std::chrono::minutes(10);
+  o.give_up_after = std::chrono::hours(1);
+  o.max_idle_wait = milliseconds(1);
+  std::unique_ptr<RobotClient> client = Connected(o);
+  clock.Freeze();
+  ASSERT_LT(clock.Now() - TimePoint(seconds(1000)), seconds(5)) << "Connect() took half an interval";
+  const auto received = [&] { return server_net_.counts(clock_queries).matched; };
+  const std::uint64_t at_connect = received();
+  EXPECT_GE(at_connect, 1u) << "Connect's own rounds";
+  for (std::uint64_t k = 1; k <= 3; ++k) {
+    clock.Advance(seconds(10));
+    WaitUntil([&] { return received() >= at_connect + k; });
+    ASSERT_EQ(received(), at_connect + k) << "after " << k << " refresh intervals";
+  }
+  clock.Advance(seconds(10) - milliseconds(1));  // not yet an interval: nothing more is asked
+  std::this_thread::sleep_for(milliseconds(20));
+  EXPECT_EQ(received(), at_connect + 3);
 }
 
 // The server's own samples arrive validated; samples forged on the bus by

@@ -104,6 +104,11 @@ struct ClientOptions {
   Duration heartbeat_interval = std::chrono::milliseconds(250);
   /// CLOCK round trips at Connect(); the one with the smallest round trip wins.
   int clock_sync_rounds = 8;
+  /// While connected, one more CLOCK round trip this often (zero: never), so
+  /// the offset follows two hosts' clocks drifting apart: the best sample's
+  /// error bound grows by 100 ppm of its age and a fresh sample with a
+  /// tighter bound replaces it (docs/client.md, Clock synchronisation).
+  Duration clock_refresh_interval = std::chrono::seconds(10);
   /// LCM receive-queue capacity of the client's subscriptions (messages),
   /// when the client creates its own LcmTransport.
   int lcm_queue_capacity = 10000;
