@@ -155,6 +155,7 @@ class RobotClient::Impl {
   std::int64_t next_sequence_ = 1;                               // GUARDED_BY(mu_)
   CommandId next_id_ = 1;                                        // GUARDED_BY(mu_)
   TimePoint last_send_{};                                        // GUARDED_BY(mu_)
+  TimePoint last_clock_query_{};                                 // GUARDED_BY(mu_)
   std::string robot_;                                            // GUARDED_BY(mu_); set once by Attach
   std::string request_channel_;                                  // GUARDED_BY(mu_)
   bool connected_ = false;                                       // GUARDED_BY(mu_)
@@ -248,6 +249,8 @@ class RobotClient::Impl {
                           std::vector<CommandId>& lost);
   void LoadKeys();
   void Resync();  // after a new server instance: clock samples, configuration
+  // A CLOCK round trip whose reply nobody waits for: its ack is the sample.
+  void SendClockSample();
   void NoteResyncReplies(const std::vector<Reply>& replies);
   void AttachLocked(const std::string& robot);  // REQUIRES: mu_ held
   std::unique_ptr<Transport> own_transport_;

@@ -261,9 +261,7 @@ void RobotClient::Impl::Resync() {
     clock_sync_.Restart();
   }
   try {
-    for (int i = 0; i < 3; ++i) {
-      SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, {.clock_query = true});
-    }
+    for (int i = 0; i < 3; ++i) SendClockSample();
     const Sent sent = SendPackage({}, {robotalk::Query{.type = QueryType::kConfig}});
     std::lock_guard lock(mu_);
     resync_config_query_ = sent.ids.front();
@@ -272,6 +270,11 @@ void RobotClient::Impl::Resync() {
     throw ClientError(std::string("RobotClient: re-syncing with the new server instance failed: ") +
                       e.what());
   }
+}
+
+void RobotClient::Impl::SendClockSample() {
+  const Sent sent = SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, {.clock_query = true});
+  cache_->Forget(sent.ids.front());  // the reply is not kept: nobody collects it
 }
 
 void RobotClient::Impl::NoteResyncReplies(const std::vector<Reply>& replies) {

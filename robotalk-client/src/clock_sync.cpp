@@ -1,5 +1,8 @@
 #include "clock_sync.h"
 
+#include <algorithm>
+#include <chrono>
+
 namespace robotalk::client {
 namespace {
 
@@ -25,11 +28,18 @@ bool ClockSync::AddSample(TimePoint t1, TimePoint t2, TimePoint t3, TimePoint t4
   // The offset must also map the client's clock to a server time that exists.
   if (!sum || !CheckedAdd(t4.time_since_epoch(), *sum / 2)) return false;
   ++num_samples_;
-  // The sample with the smallest round trip bounds the offset most tightly:
-  // its error is at most half its round trip, whatever the path asymmetry.
-  if (!best_round_trip_ || round_trip < *best_round_trip_) {
-    best_round_trip_ = round_trip;
-    offset_ = *sum / 2;
+  // The sample with the smallest round trip bounds the offset most tightly
+  // (its error is at most half its round trip, whatever the path
+  // asymmetry), as of when it was taken; since then the clocks may have
+  // drifted apart by up to the allowance times its age.
+  const Sample fresh{.received = t4, .round_trip = round_trip, .offset = *sum / 2};
+  const auto bound = [&](const Sample& x) {
+    const double age_s = std::max(0.0, std::chrono::duration<double>(t4 - x.received).count());
+    return std::chrono::duration<double>(x.round_trip).count() / 2 + kDriftAllowance * age_s;
+  };
+  if (!best_ || bound(fresh) < bound(*best_)) {
+    best_ = fresh;
+    offset_ = fresh.offset;
   }
   return true;
 }

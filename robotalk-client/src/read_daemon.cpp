@@ -203,7 +203,10 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     stats_.playback_copies += static_cast<std::uint64_t>(copies - 1);
     for (CommandId i : sent.ids) cache_->Expect(i);
     outstanding_.Add(sent.sequence, bytes, std::move(items), now);
-    if (options.clock_query) clock_packages_.insert(sent.sequence);
+    if (options.clock_query) {
+      clock_packages_.insert(sent.sequence);
+      last_clock_query_ = now;
+    }
     if (options.panic) ack_waited_.emplace(sent.sequence, now);
     last_send_ = now;
     ++stats_.packages_sent;
@@ -342,6 +345,7 @@ void RobotClient::Impl::Tick(TimePoint now) {
   std::string channel;
   std::string hello_channel;
   bool resync = false;
+  bool refresh_clock = false;
   {
     std::lock_guard lock(mu_);
     if (robot_.empty()) return;
@@ -352,6 +356,12 @@ void RobotClient::Impl::Tick(TimePoint now) {
       resync = true;
       resync_ = false;
     }
+    // Two hosts' clocks drift apart: a fresh sample now and then keeps the
+    // offset right (ClockSync ages the best one). Not before Connect's own
+    // rounds have synchronised.
+    refresh_clock = !resync && session_id_ != 0 && clock_sync_.synced() &&
+                    options_.clock_refresh_interval > Duration::zero() &&
+                    now - last_clock_query_ >= options_.clock_refresh_interval;
     resends = outstanding_.TakeDue(now);
     for (const auto& r : resends) link_loss_.OnSend(r.sequence, now);
     // Every copy's ack has had time to come twice the retransmission
@@ -377,6 +387,7 @@ void RobotClient::Impl::Tick(TimePoint now) {
   for (const auto& r : resends) Publish(channel, r.bytes);
   if (!heartbeat.empty()) Publish(channel, heartbeat);
   if (resync) Resync();
+  if (refresh_clock) SendClockSample();
   for (const auto& e : expired) {
     const std::string why = "no answer from robot about package " + std::to_string(e.sequence) + " (" +
                             (e.acked ? "acknowledged" : "never acknowledged") + ") for " +
