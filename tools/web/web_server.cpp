@@ -373,6 +373,10 @@ class WebServer::Impl {
       robots_ = std::make_shared<const std::string>(robots);
       Broadcast(robots_, false);
     }
+    // Only the robots the tracker has (its table is bounded; a forgotten one
+    // is not sent to the next page, nor kept).
+    std::erase_if(models_,
+                  [modelled = ModelledRobots(f)](const auto& m) { return !modelled.count(m.first); });
     for (const TrackerFrame::Model& m : f.models) {
       auto& known = models_[m.robot];
       if (known.second != m.message) {
