@@ -229,8 +229,13 @@ function Client:on_reply(data)
   end
   if session ~= self.session_raw then return end  -- an older session's late answer
   if p then p.acked = true end
+  -- Filed only under an id of the package being waited for: a reply under any
+  -- other id (a forger's, naming ids this client never used) is dropped, and
+  -- exchange() takes its replies out, so the table holds one package's at most.
+  local waited = {}
+  for _, id in ipairs(self.pending and self.pending.ids or {}) do waited[id] = true end
   for _, r in ipairs(m.replies) do
-    if not self.replies[r.id] then self.replies[r.id] = r end  -- a second copy: ignored
+    if waited[r.id] and not self.replies[r.id] then self.replies[r.id] = r end  -- a second copy: ignored
   end
 end
 
@@ -326,6 +331,7 @@ function Client:exchange(pkg, timeout_s)
     if missing == 0 then break end
     if M.now() >= deadline then
       self.pending = nil
+      for _, id in ipairs(p.ids) do self.replies[id] = nil end
       return nil, string.format('%d of %d replies missing after %.1f s', missing, #p.ids, timeout_s)
     end
     local ok, err = self:run_timers()
@@ -334,7 +340,7 @@ function Client:exchange(pkg, timeout_s)
   end
   self.pending = nil
   local out = {}
-  for i, id in ipairs(p.ids) do out[i] = self.replies[id] end
+  for i, id in ipairs(p.ids) do out[i], self.replies[id] = self.replies[id], nil end
   return out
 end
 

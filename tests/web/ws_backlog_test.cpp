@@ -145,5 +145,29 @@ TEST(WsBacklog, AClientThatReadsGetsEveryMessageOfALargeBurst) {
   EXPECT_TRUE(p.server->open());
 }
 
+// review15: the robots list changes as often as anyone announces a made-up
+// robot, and each change was queued for every page as a message it must
+// receive: a page that did not keep up was closed after 64 MiB of lists
+// (tests/web/robots_list_flood.sh: 1,571 lists, 63 MiB, in about 35 s), its
+// PANIC button dead. A list (or a model) supersedes the one still queued.
+TEST(WsBacklog, ANewerMessageOfTheSameKindTakesTheQueuedOnesPlaceSoAClientBehindIsNotClosed) {
+  Pair p(false);
+  ASSERT_TRUE(p.RunUntil([&] { return p.server && p.server->open(); })) << "no WebSocket opened";
+  // 10,000 lists of 64 KiB (625 MiB) and as many models of one robot, to a client that reads nothing.
+  for (int i = 0; i < 10000 && p.server->open(); ++i) {
+    p.server->Send(std::make_shared<const std::string>(64 << 10, static_cast<char>('a' + i % 26)), false,
+                   false, "robots");
+    p.server->Send(std::make_shared<const std::string>("{\"type\":\"model\"}"), false, false, "model pan");
+    if (i % 100 == 0) p.ioc.run_for(std::chrono::milliseconds(1));
+  }
+  p.ioc.run_for(std::chrono::milliseconds(50));
+  EXPECT_TRUE(p.server->open()) << "closed for lists and models it was behind on";
+  // Messages of no kind still count, and still close a client that reads none of them.
+  const auto small = std::make_shared<const std::string>("{\"op\":\"status\"}");
+  for (int i = 0; i < 10000 && p.server->open(); ++i) p.server->Send(small, false, false);
+  EXPECT_TRUE(p.RunUntil([&] { return !p.server->open(); }))
+      << "a client that read none of 10,000 answers is served";
+}
+
 }  // namespace
 }  // namespace robotalk::web

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <deque>
 #include <map>
+#include <set>
 #include <vector>
 
 namespace robotalk::web {
@@ -147,6 +148,7 @@ class FoxgloveEndpoint::Impl {
       }
       for (auto& s : sessions_) SendScene(*s, r);
     }
+    Forget(frame);
     for (const json& pose : frame.poses) {
       const auto it = robots_.find(pose.value("robot", ""));
       if (it == robots_.end() || it->second.generation != pose.value("generation", std::uint64_t{0}))
@@ -190,6 +192,35 @@ class FoxgloveEndpoint::Impl {
     PutLe(b, static_cast<std::uint64_t>(std::max<std::int64_t>(0, time_ns)), 8);
     b += payload;
     return b;
+  }
+
+  // A robot the tracker no longer has (forgotten: silent long enough, or its
+  // place taken by a new name) is unadvertised, its subscriptions dropped and
+  // its messages freed: the robots kept follow the tracker's bounded table
+  // (before: every name ever modelled, a stream of made-up robots grew it).
+  void Forget(const TrackerFrame& frame) {
+    const std::set<std::string> modelled = ModelledRobots(frame);
+    json gone = json::array();
+    for (auto it = robots_.begin(); it != robots_.end();) {
+      if (modelled.count(it->first)) {
+        ++it;
+        continue;
+      }
+      for (std::size_t i = 0; i < fg::kRobotTopics.size(); ++i) {
+        const std::uint32_t channel = it->second.first_id + static_cast<std::uint32_t>(i);
+        gone.push_back(channel);
+        for (auto& s : sessions_) {
+          const auto sub = s->subscription_of_channel.find(channel);
+          if (sub == s->subscription_of_channel.end()) continue;
+          s->subscriptions.erase(sub->second);
+          s->subscription_of_channel.erase(sub);
+        }
+      }
+      it = robots_.erase(it);
+    }
+    if (gone.empty()) return;
+    const std::string unadvertise = JsonText(json{{"op", "unadvertise"}, {"channelIds", gone}});
+    for (auto& s : sessions_) s->SendText(unadvertise);
   }
 
   // Written once per model and mesh URL base, sent to each subscriber once.

@@ -4,9 +4,10 @@
 // subprotocol is handed here by WebServer; the page's /ws stays as it was.
 //
 // Per connection it sends serverInfo, advertises the channels of every robot
-// with a model (foxglove_messages.h; more as robots appear) and, when the
-// bridge was given a panic handler, one service "/robotalk/panic"
-// (request {"robot": NAME}). It reads subscribe / unsubscribe and service
+// with a model (foxglove_messages.h; more as robots appear; unadvertised
+// when the tracker forgets them, so it keeps only the robots of the
+// tracker's bounded table) and, when the bridge was given a panic handler,
+// one service "/robotalk/panic" (request {"robot": NAME}). It reads subscribe / unsubscribe and service
 // calls; anything else gets a status message naming it. Each robot's state
 // reaches a subscriber at the web loop's rate (--rate, decimated by the
 // tracker); a subscriber of /ROBOT/scene gets the current scene at once, and

@@ -350,6 +350,12 @@ nlohmann::json RobotTracker::Impl::RobotJson(const Robot& r, const ConnectSchedu
           {"urdf", urdf}};
 }
 
+std::set<std::string> ModelledRobots(const TrackerFrame& frame) {
+  std::set<std::string> names;
+  for (const TrackerFrame::Model& m : frame.models) names.insert(m.robot);
+  return names;
+}
+
 TrackerFrame RobotTracker::Impl::Poll() {
   TrackerFrame frame;
   std::vector<std::shared_ptr<RobotClient>> drop;  // destroyed outside the lock (joins threads)

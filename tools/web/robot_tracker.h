@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,11 @@ struct TrackerFrame {
   /// Samples received from LCM since the last Poll(), over every robot.
   std::uint64_t samples_received = 0;
 };
+
+/// The robots `frame` has a model of: every robot the tracker has a model of
+/// (it lists each in every frame), so one missing was forgotten. The web
+/// loop's caches of robots (page models, Foxglove channels) keep only these.
+std::set<std::string> ModelledRobots(const TrackerFrame& frame);
 
 class RobotTracker {
  public:

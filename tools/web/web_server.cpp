@@ -356,8 +356,10 @@ class WebServer::Impl {
     return g;
   }
 
-  void Broadcast(const Message& m, bool droppable) {
-    for (auto& s : sessions_) s->Send(m, false, droppable);
+  // `supersedes`: WsConnection::Send's (the robots list, a robot's model: a
+  // page behind holds the newest of each, however often they change).
+  void Broadcast(const Message& m, bool droppable, const std::string& supersedes = "") {
+    for (auto& s : sessions_) s->Send(m, false, droppable, supersedes);
   }
 
   void Tick() {
@@ -371,13 +373,17 @@ class WebServer::Impl {
     const std::string robots = JsonText(f.robots);
     if (!robots_ || *robots_ != robots) {
       robots_ = std::make_shared<const std::string>(robots);
-      Broadcast(robots_, false);
+      Broadcast(robots_, false, "robots");
     }
+    // Only the robots the tracker has (its table is bounded; a forgotten one
+    // is not sent to the next page, nor kept).
+    std::erase_if(models_,
+                  [modelled = ModelledRobots(f)](const auto& m) { return !modelled.count(m.first); });
     for (const TrackerFrame::Model& m : f.models) {
       auto& known = models_[m.robot];
       if (known.second != m.message) {
         known = {m.generation, m.message};
-        Broadcast(m.message, false);
+        Broadcast(m.message, false, "model " + m.robot);
       }
     }
     for (std::string& s : f.states) Broadcast(std::make_shared<const std::string>(std::move(s)), true);

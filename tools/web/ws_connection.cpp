@@ -4,6 +4,9 @@
 
 #include <boost/asio.hpp>
 
+#include <algorithm>
+#include <iterator>
+
 namespace robotalk::web {
 namespace {
 
@@ -46,8 +49,18 @@ void WsConnection::Start(http::request<http::string_body> request, std::vector<M
                    });
 }
 
-void WsConnection::Send(const Message& m, bool binary, bool droppable) {
+void WsConnection::Send(const Message& m, bool binary, bool droppable, const std::string& supersedes) {
   if (!open_) return;
+  if (!supersedes.empty()) {
+    const auto older = std::find_if(std::next(queue_.begin(), queue_.empty() ? 0 : 1), queue_.end(),
+                                    [&](const Queued& q) { return q.supersedes == supersedes; });
+    if (older != queue_.end()) {
+      queued_bytes_ = queued_bytes_ - older->message->size() + m->size();
+      older->message = m;
+      older->binary = binary;
+      return;
+    }
+  }
   if (droppable && queue_.size() >= max_droppable_) {
     ++dropped_;
     return;
@@ -59,7 +72,7 @@ void WsConnection::Send(const Message& m, bool binary, bool droppable) {
           " MiB");
     return;
   }
-  queue_.emplace_back(m, binary);
+  queue_.push_back({m, binary, supersedes});
   queued_bytes_ += m->size();
   if (queue_.size() == 1) Write();
 }
@@ -84,14 +97,14 @@ void WsConnection::Close(const std::string& why, bool say) {
 }
 
 void WsConnection::Write() {
-  ws_.binary(queue_.front().second);
-  ws_.async_write(asio::buffer(*queue_.front().first),
+  ws_.binary(queue_.front().binary);
+  ws_.async_write(asio::buffer(*queue_.front().message),
                   [self = shared_from_this()](beast::error_code ec, std::size_t) {
                     if (ec) {
                       self->open_ = false;
                       return;
                     }
-                    self->queued_bytes_ -= self->queue_.front().first->size();
+                    self->queued_bytes_ -= self->queue_.front().message->size();
                     self->queue_.pop_front();
                     if (!self->queue_.empty()) self->Write();
                   });

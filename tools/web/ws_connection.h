@@ -45,8 +45,12 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
   /// Open, or its upgrade being answered (what WebOptions::max_websockets counts).
   bool live() const { return accepting_ || open_; }
   /// Queues one message (text or binary); a droppable one is dropped when the
-  /// queue is full.
-  void Send(const Message& m, bool binary, bool droppable);
+  /// queue is full. A non-empty `supersedes` names what the message is the
+  /// newest of (the robots list, one robot's model): it takes the place of a
+  /// queued one of the same name not yet being written, so a client behind
+  /// holds one of each, whatever the rate they change at (anyone announcing
+  /// made-up robots changes the list).
+  void Send(const Message& m, bool binary, bool droppable, const std::string& supersedes = "");
   std::uint64_t dropped() const { return dropped_; }
   /// Closes it, saying so on stderr with `why` unless `say` is false (the
   /// caller says it); the write and read in flight end with an error and its
@@ -61,8 +65,13 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
   std::size_t max_message_, max_droppable_;
   OnMessage on_message_;
   boost::beast::flat_buffer in_;
-  std::deque<std::pair<Message, bool>> queue_;  // message, binary
-  std::size_t queued_bytes_ = 0;                // of queue_'s messages
+  struct Queued {
+    Message message;
+    bool binary = false;
+    std::string supersedes;  // Send's: "" for none
+  };
+  std::deque<Queued> queue_;      // the front is being written
+  std::size_t queued_bytes_ = 0;  // of queue_'s messages
   bool open_ = false;
   bool accepting_ = false;  // Start() until the upgrade's answer is written (or failed)
   std::uint64_t dropped_ = 0;

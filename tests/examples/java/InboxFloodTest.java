@@ -9,76 +9,15 @@
 // then floods the client's REPLY channel with 40,000 well-formed reply
 // packages of 2 KiB (other sessions' replies) while the program is idle; the
 // heap may grow by at most 32 MiB. Exit 0 pass, 1 fail.
-import java.io.ByteArrayOutputStream;
-import java.io.DataOutputStream;
-import java.io.IOException;
 import lcm.lcm.LCM;
-import lcm.lcm.LCMEncodable;
 import robotalk.client.RobotalkClient;
-import robotalk_msgs.announce_t;
-import robotalk_msgs.hello_answer_t;
-import robotalk_msgs.hello_t;
 import robotalk_msgs.reply_package_t;
 import robotalk_msgs.reply_t;
-import robotalk_msgs.robot_info_t;
 
 public final class InboxFloodTest {
-  static byte[] encode(LCMEncodable m) throws IOException {
-    ByteArrayOutputStream bytes = new ByteArrayOutputStream();
-    m.encode(new DataOutputStream(bytes));
-    return bytes.toByteArray();
-  }
-
-  static long usedHeap() throws InterruptedException {
-    Runtime rt = Runtime.getRuntime();
-    for (int i = 0; i < 3; ++i) {
-      System.gc();
-      Thread.sleep(50);
-    }
-    return rt.totalMemory() - rt.freeMemory();
-  }
-
   public static void main(String[] args) throws Exception {
     String url = args[0];
-    LCM server = new LCM(url);
-    server.subscribe("ROBOTALK/fake/HELLO", (lcm, channel, ins) -> {
-      try {
-        hello_t h = new hello_t(ins);
-        hello_answer_t a = new hello_answer_t();
-        a.protocol_version = RobotalkClient.PROTOCOL_VERSION;
-        a.client_id = h.client_id;
-        a.client_nonce = h.client_nonce;
-        a.server_id = 7;
-        a.session_id = 99;
-        a.refusal = "";
-        byte[] b = encode(a);
-        lcm.publish(String.format("ROBOTALK/fake/HELLO/%016x", h.client_id), b, 0, b.length);
-      } catch (IOException e) {
-        throw new RuntimeException(e);
-      }
-    });
-    announce_t an = new announce_t();
-    an.protocol_version = RobotalkClient.PROTOCOL_VERSION;
-    an.server_id = 7;
-    an.url_hint = "";
-    robot_info_t fake = new robot_info_t();
-    fake.name = "fake";
-    fake.driver = "none";
-    an.robots = new robot_info_t[] {fake};
-    an.num_robots = 1;
-    byte[] announce = encode(an);
-    Thread announcer = new Thread(() -> {
-      try {
-        for (int i = 0; i < 60; ++i) {
-          server.publish("ROBOTALK/ANNOUNCE", announce, 0, announce.length);
-          Thread.sleep(50);
-        }
-      } catch (Exception e) {
-        throw new RuntimeException(e);
-      }
-    });
-    announcer.setDaemon(true);
-    announcer.start();
+    LCM server = FakeRobotServer.start(url);
 
     try (RobotalkClient c = new RobotalkClient(url, "fake", 3.0)) {
       reply_t r = new reply_t();
@@ -92,16 +31,16 @@ public final class InboxFloodTest {
       p.panic_refusal = "";
       p.replies = new reply_t[] {r};
       p.num_replies = 1;
-      byte[] flood = encode(p);
+      byte[] flood = FakeRobotServer.encode(p);
       String replies = String.format("ROBOTALK/fake/REPLY/%016x", c.clientId());
-      long before = usedHeap();
+      long before = FakeRobotServer.usedHeap();
       int sent = 40_000;
       for (int i = 0; i < sent; ++i) {
         server.publish(replies, flood, 0, flood.length);
         if (i % 200 == 199) Thread.sleep(2);  // within what the socket buffers take
       }
       Thread.sleep(1000);  // the program is busy elsewhere: nothing drains the inbox
-      long grown = usedHeap() - before;
+      long grown = FakeRobotServer.usedHeap() - before;
       System.out.printf("%d reply packages of %d bytes while idle: heap grew %.1f MiB%n", sent, flood.length,
           grown / 1048576.0);
       c.pause(0.2);  // the next call drains what was kept

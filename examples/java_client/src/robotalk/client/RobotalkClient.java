@@ -6,8 +6,8 @@
 // layout, single or split), opens a session with a hello, numbers packages
 // 1, 2, 3 ..., retransmits a package with the same sequence until it is
 // acknowledged (fixed 300 ms timeout, 10 tries) and, once acknowledged, every
-// second until each item has its final reply; files replies by id (a second
-// copy is ignored); sends a heartbeat every 250 ms so the server's watchdog
+// second until each item has its final reply; files replies by id, only ids
+// of a package still pending (a second copy is ignored); sends a heartbeat every 250 ms so the server's watchdog
 // keeps the session; says hello again after SESSION_UNKNOWN (nothing in that
 // package ran) and sends the package again in the new session.
 // Not done here: keyed mode (a keyed server is refused with an error), RFC 6298
@@ -300,7 +300,19 @@ public final class RobotalkClient implements AutoCloseable {
     refusal = m.keyed ? "the server answered in keyed mode" : m.session_id == 0 ? m.refusal : "";
   }
 
-  private void fileReply(reply_t r) { replies.putIfAbsent(r.id, r); }  // a second copy: ignored
+  // Filed only under the id of an item of a package still pending (sent, not all its replies in): a reply
+  // under any other id (a forger's, naming ids this client never used) is dropped, so the map never holds
+  // more than this client sent. A second copy: ignored.
+  private void fileReply(reply_t r) {
+    for (Pending p : pending.values()) {
+      for (long id : p.ids) {
+        if (id == r.id) {
+          replies.putIfAbsent(r.id, r);
+          return;
+        }
+      }
+    }
+  }
 
   /** The items of an acknowledged package whose session is gone: may or may not have run; never re-sent. */
   private void unknownOutcome(Pending p, String why) {
