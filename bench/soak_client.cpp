@@ -10,7 +10,8 @@
 //                                                                   TIMEOUT or CLIENT_ERROR
 //   {"ev":"seq","after":11,"frames":8}    a playback sequence whose frames got ids above 11
 //   {"ev":"seq_failed","after":11,"frames":8,"outcome":"UNKNOWN_OUTCOME","msg":"..."}
-//   {"ev":"status","id":13,"outcome":"BUSY","msg":"..."}  COMMAND_STATUS of a timed-out sequence's ids
+//   {"ev":"status","id":13,"outcome":"BUSY","kind":"not_ended","msg":"..."}  COMMAND_STATUS of a timed-out
+//   sequence's ids
 //   {"ev":"notsent","what":"...","msg":"..."}   a call that threw before anything was sent
 //   {"ev":"panic"|"reset"|"samples"|"end", ...}
 //
@@ -20,6 +21,7 @@
 // Every loop is bounded by --seconds (and each wait by the client's timeouts).
 #include "bench_util.h"
 #include "robotalk/channels.h"
+#include "robotalk/command_status.h"
 #include "robotalk/robot_client.h"
 
 #include <atomic>
@@ -205,20 +207,25 @@ void Mark(Soak& s) {
   }
 }
 
-// COMMAND_STATUS of ids (first, last): BUSY means the server still holds
-// the command, unanswered; otherwise its final reply.
+// COMMAND_STATUS of ids (first, last): "kind" not_ended means the server
+// still holds the command, unanswered; not_received that this session never
+// got it; ended that "outcome" is its final reply's signal.
 void AskStatus(Soak& s, CommandId first, CommandId last) {
   for (CommandId id = first; id < last; ++id) {
-    std::string outcome, msg;
+    std::string outcome, msg, kind = "failed";
     try {
       const Reply r = s.client.CommandStatus(id);
       outcome = ToString(r.signal);
       msg = r.message;
+      const CommandStatusKind k = CommandStatusOf(r, id);
+      kind = k == CommandStatusKind::kNotEnded      ? "not_ended"
+             : k == CommandStatusKind::kNotReceived ? "not_received"
+                                                    : "ended";
     } catch (const Error& e) {
       outcome = "STATUS_FAILED";
       msg = e.what();
     }
-    s.report.Line({{"ev", "status"}, {"id", id}, {"outcome", outcome}, {"msg", Short(msg)}});
+    s.report.Line({{"ev", "status"}, {"id", id}, {"outcome", outcome}, {"kind", kind}, {"msg", Short(msg)}});
   }
 }
 

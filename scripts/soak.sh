@@ -217,12 +217,11 @@ for c, info in clients.items():
                 continue
             known += 1
             out = st["outcome"]
-            if "never received in this session" in st["msg"]:
+            if st["kind"] == "not_received":
                 bump(unknown, label + ", status: not in this session (not run)")
-            elif out == "BUSY" and "has not ended" in st["msg"]:
-                # BUSY "command N has not ended": still waiting or running. A
-                # frame that ended BUSY (refused, e.g. "GOTO in progress")
-                # keeps its own message: refused, below.
+            elif st["kind"] == "not_ended":
+                # Still waiting or running. A frame that ended BUSY (refused,
+                # e.g. "GOTO in progress") is "ended": refused, below.
                 count["lost"] += 1
                 violations.append("LOST: client %s playback frame %d was accepted, never ran and was never answered "
                                   "(COMMAND_STATUS: %s)" % (c, cid, st["msg"]))
@@ -232,7 +231,7 @@ for c, info in clients.items():
                 bump(unknown, label + ", status %s (not run)" % out)
         bump(unknown, label + " (not run)", g[2] - g[3] - known)
         pst = info["status"].get(g[0] + 1)
-        if pst is not None and pst["outcome"] == "BUSY" and "has not ended" in pst["msg"]:
+        if pst is not None and pst["kind"] == "not_ended":
             count["playback_unanswered"] += 1
 
     # Start-time order per client and actuator, over the servo commands whose

@@ -58,6 +58,7 @@ from ._robotalk import (
     UrdfError,
     UsageError,
     _RobotClient,
+    command_status_kind,
     extract,
     format_sequence,
     log_info,
@@ -76,7 +77,7 @@ __all__ = [
     "RobotalkWarning", "RootLink", "SIGNALS", "SequenceResult", "SignalError", "StateSample",
     "StateStream", "TimedCommand", "TimeoutError", "TransportError", "UnknownOutcomeError",
     "UrdfError", "UsageError", "connect", "extract", "format_sequence", "load_urdf",
-    "log_info", "log_states", "parse_sequence", "parse_urdf", "robots",
+    "command_status_kind", "log_info", "log_states", "parse_sequence", "parse_urdf", "robots",
 ]
 
 #: The seven return signals, as Reply.signal names them.

@@ -2,6 +2,7 @@
 // TimedCommand, StateSample, SequenceResult, AnnouncedRobot, and the text
 // forms of commands (robotalk/sequence_file.h).
 #include "bindings.h"
+#include "robotalk/command_status.h"
 #include "robotalk/log_writer.h"  // EscapeControls
 #include "robotalk/sequence_file.h"
 
@@ -184,6 +185,25 @@ void BindValues(py::module_& m) {
       py::arg("text"), py::arg("source") = "<string>",
       "The frames of a sequence file's text (docs/client.md, 'Sequence files'): one\n"
       "'<offset s> <command> [target] values...' per line. Raises UsageError naming the line.");
+
+  m.def(
+      "command_status_kind",
+      [](const Reply& answer, CommandId id) {
+        switch (CommandStatusOf(answer, id)) {
+          case CommandStatusKind::kNotEnded:
+            return "NOT_ENDED";
+          case CommandStatusKind::kNotReceived:
+            return "NOT_RECEIVED";
+          case CommandStatusKind::kEnded:
+            break;
+        }
+        return "ENDED";
+      },
+      py::arg("answer"), py::arg("id"),
+      "What RobotClient.command_status(id)'s answer says became of command `id`: 'ENDED' (the\n"
+      "answer is its own final reply, whatever the signal), 'NOT_ENDED' (BUSY: it waits or runs)\n"
+      "or 'NOT_RECEIVED' (NA: this session never received it, or its reply left the cache). A\n"
+      "command that ended BUSY or NA keeps its own reply: only this tells the two apart.");
 
   py::class_<StateSample>(m, "StateSample",
                           "One sample of a robot's broadcast state (the state stream): server time,\n"

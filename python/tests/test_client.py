@@ -119,6 +119,18 @@ def test_non_blocking_calls_return_a_future_like_reply(robot: robotalk.RobotClie
     assert len(query.wait(5).values) == 5
 
 
+def test_command_status_kind_tells_a_waiting_command_from_one_that_ended(robot: robotalk.RobotClient) -> None:
+    ended = robot.set_joint("pan", [0.1])
+    assert robotalk.command_status_kind(robot.command_status(ended.id), ended.id) == "ENDED"
+    waiting = robot.set_joint("tilt", [-0.1], start=robot.server_now() + 30, wait=False)
+    status = robot.command_status(waiting.id)
+    assert status.signal == "BUSY" and robotalk.command_status_kind(status, waiting.id) == "NOT_ENDED"
+    never = waiting.id + 1000
+    status = robot.command_status(never)
+    assert status.signal == "NA" and robotalk.command_status_kind(status, never) == "NOT_RECEIVED"
+    robot.stop()
+
+
 def test_queries_return_numpy_arrays(robot: robotalk.RobotClient) -> None:
     robot.set_joint("pan", [0.25])
     settle(robot, "pan", 0.25)

@@ -2,6 +2,7 @@
 #include "cli_commands.h"
 #include "interrupt.h"
 #include "robotalk/log_writer.h"  // OpenStandardDescriptors
+#include "robotalk/option_reader.h"
 #include "robotalk/sequence_file.h"
 #include "sequence_runner.h"
 
@@ -94,32 +95,29 @@ int main(int argc, char** argv) {
     GlobalOptions g;
     if (const char* env = std::getenv("LCM_DEFAULT_URL")) g.url = env;
     std::vector<std::string> rest;
-    for (std::size_t i = 0; i < args.size(); ++i) {
-      if (args[i] == "--url" || args[i] == "--timeout" || args[i] == "--key" || args[i] == "--server-key" ||
-          args[i] == "--known-servers" || args[i] == "--max-late") {
-        if (i + 1 == args.size()) throw UsageError(args[i] + " needs a value");
-        if (args[i] == "--url") {
-          g.url = args[++i];
-        } else if (args[i] == "--key") {
-          g.key_file = args[++i];
-        } else if (args[i] == "--server-key") {
-          g.server_key = args[++i];
-        } else if (args[i] == "--known-servers") {
-          g.known_servers = args[++i];
-        } else if (args[i] == "--max-late") {
-          const std::string& v = args[++i];
-          const double s = v == "never" ? 0 : ParseSeconds(v, "--max-late");
-          if (v != "never" && !(s > 0))
-            throw UsageError("--max-late " + v + ": expected seconds > 0 or never");
-          g.max_late = v == "never" ? robotalk::kMaxLateNever : robotalk::FromSeconds(s);
-        } else {
-          g.timeout_s = ParseSeconds(args[++i], "--timeout");
-          if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");
-        }
-      } else if (rest.empty() && args[i].size() > 1 && args[i][0] == '-') {
-        throw UsageError("unknown option '" + args[i] + "'");
+    robotalk::OptionReader r(args);
+    while (r.Next()) {
+      if (r.Is("--url")) {
+        g.url = r.Value();
+      } else if (r.Is("--key")) {
+        g.key_file = r.Value();
+      } else if (r.Is("--server-key")) {
+        g.server_key = r.Value();
+      } else if (r.Is("--known-servers")) {
+        g.known_servers = r.Value();
+      } else if (r.Is("--max-late")) {
+        const std::string& v = r.Value();
+        const double s = v == "never" ? 0 : ParseSeconds(v, "--max-late");
+        if (v != "never" && !(s > 0)) throw UsageError("--max-late " + v + ": expected seconds > 0 or never");
+        g.max_late = v == "never" ? robotalk::kMaxLateNever : robotalk::FromSeconds(s);
+      } else if (r.Is("--timeout")) {
+        g.timeout_s = ParseSeconds(r.Value(), "--timeout");
+        if (g.timeout_s <= 0) throw UsageError("--timeout must be positive");
+      } else if (rest.empty() && r.word().size() > 1 && r.word()[0] == '-') {
+        // Not r.Unknown(): every usage error of the CLI ends "(robotalk --help for usage)".
+        throw UsageError("unknown option '" + r.word() + "'");
       } else {
-        rest.push_back(args[i]);
+        rest.push_back(r.word());
       }
     }
     if (rest.empty()) throw UsageError("missing command");

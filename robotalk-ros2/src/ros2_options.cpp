@@ -2,6 +2,7 @@
 
 #include "robotalk/channels.h"
 #include "robotalk/error.h"
+#include "robotalk/option_reader.h"
 #include "robotalk/sequence_file.h"
 
 namespace robotalk::ros2 {
@@ -45,57 +46,56 @@ std::string Ros2Usage() {
 Ros2Options ParseRos2Options(const std::vector<std::string>& args, const std::string& ros_domain_id) {
   Ros2Options o;
   if (!ros_domain_id.empty()) o.domain = ParseDomain("ROS_DOMAIN_ID", ros_domain_id);
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw Error(a + ": needs a value");
-      return args[++i];
-    };
-    if (a == "-h" || a == "--help") {
+  OptionReader r(args);
+  while (r.Next()) {
+    const std::string& a = r.word();
+    if (r.IsHelp()) {
       o.help = true;
-    } else if (a == "--version") {
+    } else if (r.IsVersion()) {
       o.version = true;
     } else if (a == "--robot") {
-      const std::string& name = value();
+      const std::string& name = r.Value();
       if (const std::string why = RobotNameProblem(name); !why.empty())
         throw Error("--robot '" + name + "': " + why);
       o.robots.push_back(name);
     } else if (a == "--url") {
-      o.lcm_url = value();
+      o.lcm_url = r.Value();
     } else if (a == "--key") {
-      o.key_file = value();
+      o.key_file = r.Value();
     } else if (a == "--server-key") {
-      o.server_key_file = value();
+      o.server_key_file = r.Value();
     } else if (a == "--domain") {
-      o.domain = ParseDomain(a, value());
+      o.domain = ParseDomain(a, r.Value());
     } else if (a == "--dds-interface") {
-      o.dds_interface = value();
+      o.dds_interface = r.Value();
     } else if (a == "--rate") {
-      o.period = FromSeconds(1.0 / ParseNumberIn(value(), a, {.min = 1, .max = 1000}));  // the STATE stream's
+      o.period =
+          FromSeconds(1.0 / ParseNumberIn(r.Value(), a, {.min = 1, .max = 1000}));  // the STATE stream's
     } else if (a == "--frame-prefix") {
-      o.frame_prefix = value();
+      o.frame_prefix = r.Value();
     } else if (a == "--world-frame") {
-      o.world_frame = value();
+      o.world_frame = r.Value();
       if (o.world_frame.empty()) throw Error("--world-frame: the name is empty");
     } else if (a == "--urdf") {
-      const std::string& v = value();
+      const std::string& v = r.Value();
       const auto eq = v.find('=');
       if (eq == std::string::npos || eq == 0 || eq + 1 == v.size()) {
         throw Error("--urdf: '" + v + "' is not NAME=FILE");
       }
       o.urdf[v.substr(0, eq)] = v.substr(eq + 1);
     } else if (a == "--cmd-vel-timeout") {
-      o.cmd_vel_timeout = FromSeconds(ParseNumberIn(value(), a, {.min = 0, .max = 60, .above_min = true}));
+      o.cmd_vel_timeout = FromSeconds(ParseNumberIn(r.Value(), a, {.min = 0, .max = 60, .above_min = true}));
     } else if (a == "--read-only") {
       o.read_only = true;
     } else if (a == "--duration") {
-      const double s = ParseSeconds(value(), a);  // at most kMaxTextSeconds: FromSeconds cannot overflow
-      if (s <= 0) throw Error("--duration: " + args[i] + " s is not positive");
+      const std::string& text = r.Value();
+      const double s = ParseSeconds(text, a);  // at most kMaxTextSeconds: FromSeconds cannot overflow
+      if (s <= 0) throw Error("--duration: " + text + " s is not positive");
       o.duration = FromSeconds(s);
     } else if (a == "--stats") {
       o.stats = true;
     } else {
-      throw Error("unknown option '" + a + "' (see --help)");
+      r.Unknown();
     }
   }
   return o;

@@ -4,6 +4,7 @@
 #include "robot_sessions.h"
 #include "robot_sessions_text.h"
 #include "robotalk/channels.h"
+#include "robotalk/command_status.h"
 
 namespace robotalk {
 
@@ -97,14 +98,10 @@ void RobotSessions::AdmitQuery(Session& s, const Query& q, TimePoint now, std::v
 // ended, BUSY while it waits or runs, NA when this session never got it.
 Reply RobotSessions::CommandStatus(const Session& s, const Query& q, TimePoint now) const {
   const std::optional<std::optional<Reply>> known = s.replies.Lookup(q.about);
-  if (!known) {
-    return MakeReply(q.id, Signal::kNa,
-                     "command " + std::to_string(q.about) +
-                         " was never received in this session (or is older than its reply cache)",
-                     now);
-  }
+  if (!known)
+    return MakeReply(q.id, Signal::kNa, CommandStatusText(CommandStatusKind::kNotReceived, q.about), now);
   if (!*known)
-    return MakeReply(q.id, Signal::kBusy, "command " + std::to_string(q.about) + " has not ended", now);
+    return MakeReply(q.id, Signal::kBusy, CommandStatusText(CommandStatusKind::kNotEnded, q.about), now);
   Reply r = **known;
   r.id = q.id;
   return r;

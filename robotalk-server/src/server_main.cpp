@@ -4,6 +4,7 @@
 #include "panic_latch.h"
 #include "robotalk/error.h"
 #include "robotalk/log_writer.h"
+#include "robotalk/option_reader.h"
 #include "robotalk/sequence_file.h"  // NumberOf
 #include "server_log.h"
 
@@ -130,76 +131,73 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
   double sample_period = 0.01;
   bool no_panic_latch = false;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&]() -> const char* {
-        if (i + 1 >= argc) throw Error(arg + " needs a value");
-        return argv[++i];
-      };
-      if (arg == "-h" || arg == "--help") {
+    OptionReader r(argc, argv);
+    while (r.Next()) {
+      const std::string& arg = r.word();
+      if (r.IsHelp()) {
         std::cout << kUsage;
         return 0;
-      } else if (arg == "--version") {
+      } else if (r.IsVersion()) {
         std::cout << "robotalk-server " << ROBOTALK_VERSION << "\n";
         return 0;
       } else if (arg == "--list-drivers") {
         for (const std::string& name : registry.names()) std::cout << name << "\n";
         return 0;
       } else if (arg == "--simulate") {
-        simulate = value();
+        simulate = r.Value();
       } else if (arg == "--sample-period") {
-        sample_period = ParseNumberIn(value(), arg, {0.001, 3600});
+        sample_period = ParseNumberIn(r.Value(), arg, {0.001, 3600});
       } else if (arg == "--allow-duplicate-robots") {
         options.allow_duplicate_robots = true;
       } else if (arg == "--key") {
-        options.key_file = value();
+        options.key_file = r.Value();
       } else if (arg == "--clients") {
-        options.clients_file = value();
+        options.clients_file = r.Value();
       } else if (arg == "--no-precise-timing") {
         options.precise_timing = false;
       } else if (arg == "--max-sessions") {
         options.max_sessions =
-            static_cast<std::size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e6, .whole = true}));
+            static_cast<std::size_t>(ParseNumberIn(r.Value(), arg, {.min = 1, .max = 1e6, .whole = true}));
       } else if (arg == "--max-sessions-per-robot") {
         options.max_sessions_per_robot =
-            static_cast<std::size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e6, .whole = true}));
+            static_cast<std::size_t>(ParseNumberIn(r.Value(), arg, {.min = 1, .max = 1e6, .whole = true}));
       } else if (arg == "--panic-latch") {
-        options.panic_latch_path = value();
+        options.panic_latch_path = r.Value();
         if (options.panic_latch_path.empty()) throw Error("--panic-latch needs a file name");
       } else if (arg == "--state-dir") {
-        options.state_dir = value();
+        options.state_dir = r.Value();
         if (options.state_dir.empty()) throw Error("--state-dir needs a directory name");
       } else if (arg == "--no-panic-latch") {
         no_panic_latch = true;
       } else if (arg == "--log-lines-per-second") {
         options.log_lines_per_second =
-            static_cast<int>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e6, .whole = true}));
+            static_cast<int>(ParseNumberIn(r.Value(), arg, {.min = 1, .max = 1e6, .whole = true}));
       } else if (arg == "--driver-call-bound") {
-        options.driver_call_bound = FromSeconds(ParseNumberIn(value(), arg, {0, 3600}));
+        options.driver_call_bound = FromSeconds(ParseNumberIn(r.Value(), arg, {0, 3600}));
       } else if (arg == "--max-acceleration") {
-        options.max_acceleration = ParseNumberIn(value(), arg, {1e-3, 1e6});
+        options.max_acceleration = ParseNumberIn(r.Value(), arg, {1e-3, 1e6});
       } else if (arg == "--log-executions") {
         options.log_executions = true;
       } else if (arg == "--log-playback") {
         options.log_playback = true;
       } else if (arg == "--robot") {
-        robots.push_back(RobotSpec::Parse(value()));
+        robots.push_back(RobotSpec::Parse(r.Value()));
       } else if (arg == "--url") {
-        options.lcm_url = value();
+        options.lcm_url = r.Value();
       } else if (arg == "--session-timeout") {
-        options.session_timeout = FromSeconds(ParseNumberIn(value(), arg, {0.05, 3600}));
+        options.session_timeout = FromSeconds(ParseNumberIn(r.Value(), arg, {0.05, 3600}));
       } else if (arg == "--max-queue") {
         options.max_queue =
-            static_cast<size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e7, .whole = true}));
+            static_cast<size_t>(ParseNumberIn(r.Value(), arg, {.min = 1, .max = 1e7, .whole = true}));
       } else if (arg == "--max-queued-total") {
         options.max_queued_total =
-            static_cast<size_t>(ParseNumberIn(value(), arg, {.min = 1, .max = 1e8, .whole = true}));
+            static_cast<size_t>(ParseNumberIn(r.Value(), arg, {.min = 1, .max = 1e8, .whole = true}));
       } else if (arg == "--max-goto-distance") {
-        options.max_goto_distance = ParseNumberIn(value(), arg, {0, 1e7});
+        options.max_goto_distance = ParseNumberIn(r.Value(), arg, {0, 1e7});
       } else if (arg == "--max-future") {
-        options.max_future = FromSeconds(ParseNumberIn(value(), arg, {0, 86400 * 7}));
+        options.max_future = FromSeconds(ParseNumberIn(r.Value(), arg, {0, 86400 * 7}));
       } else if (arg == "--max-late") {
-        const std::string text = value();
+        const std::string text = r.Value();
         const std::size_t eq = text.find('=');
         const std::string limit = eq == std::string::npos ? text : text.substr(eq + 1);
         const Duration d =
@@ -212,7 +210,7 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
           options.robot_max_late[text.substr(0, eq)] = d;
         }
       } else if (arg == "--max-base-acceleration") {
-        const std::string text = value();
+        const std::string text = r.Value();
         const std::size_t eq = text.find('=');
         if (eq == 0) throw Error("--max-base-acceleration: '" + text + "' names no robot (NAME=LIN[,ANG])");
         const std::string limits = eq == std::string::npos ? text : text.substr(eq + 1);
@@ -229,58 +227,57 @@ int Serve(int argc, char** argv, const DriverRegistry& registry, const SimulateC
       } else if (arg == "--link-stop") {
         options.link_stop = true;
       } else if (arg == "--congestion-max-pause") {
-        options.congestion_max_pause = FromSeconds(ParseNumberIn(value(), arg, {0, 10}));
+        options.congestion_max_pause = FromSeconds(ParseNumberIn(r.Value(), arg, {0, 10}));
       } else if (arg == "--playback-min-frames") {
         options.playback_min_frames =
-            static_cast<size_t>(ParseNumberIn(value(), arg, {.min = 2, .max = 1e6, .whole = true}));
+            static_cast<size_t>(ParseNumberIn(r.Value(), arg, {.min = 2, .max = 1e6, .whole = true}));
       } else if (arg == "--playback-estimator") {
-        options.playback_estimator = value();
+        options.playback_estimator = r.Value();
         if (options.playback_estimator != "adaptive" && options.playback_estimator != "quick" &&
             options.playback_estimator != "paper") {
           throw Error("--playback-estimator '" + options.playback_estimator +
                       "': expected adaptive, quick or paper");
         }
       } else if (arg == "--playback-stretch") {
-        options.playback_stretch = ParseNumberIn(value(), arg, {0, 1});
+        options.playback_stretch = ParseNumberIn(r.Value(), arg, {0, 1});
       } else if (arg == "--playback-thin-stretch") {
-        options.playback_thin_stretch = ParseNumberIn(value(), arg, {0, 1});
+        options.playback_thin_stretch = ParseNumberIn(r.Value(), arg, {0, 1});
       } else if (arg == "--playback-margin") {
-        options.playback_margin = FromSeconds(ParseNumberIn(value(), arg, {0, 1000}) / 1000);
+        options.playback_margin = FromSeconds(ParseNumberIn(r.Value(), arg, {0, 1000}) / 1000);
       } else if (arg == "--playback-queue-start") {
-        const std::string v = value();
+        const std::string v = r.Value();
         if (v != "on" && v != "off") throw Error("--playback-queue-start '" + v + "': expected on or off");
         options.playback_queue_start = v == "on";
       } else if (arg == "--playback-follow-queue") {
-        const std::string v = value();
+        const std::string v = r.Value();
         if (v != "on" && v != "off") throw Error("--playback-follow-queue '" + v + "': expected on or off");
         options.playback_follow_queue = v == "on";
       } else if (arg == "--playback-copies-start") {
-        const std::string v = value();
+        const std::string v = r.Value();
         if (v != "on" && v != "off") throw Error("--playback-copies-start '" + v + "': expected on or off");
         options.playback_copies_start = v == "on";
       } else if (arg == "--playback-burst-discount") {
-        const std::string v = value();
+        const std::string v = r.Value();
         if (v != "on" && v != "off") throw Error("--playback-burst-discount '" + v + "': expected on or off");
         options.playback_burst_discount = v == "on";
       } else if (arg == "--playback-resent-delays") {
-        const std::string v = value();
+        const std::string v = r.Value();
         if (v != "on" && v != "off") throw Error("--playback-resent-delays '" + v + "': expected on or off");
         options.playback_resent_delays = v == "on";
       } else if (arg == "--playback-start-lead") {
-        options.playback_start_lead = ParseNumberIn(value(), arg, {0, 100});
+        options.playback_start_lead = ParseNumberIn(r.Value(), arg, {0, 100});
       } else if (arg == "--duration") {
-        duration = ParseNumberIn(value(), arg, {0, 1e9});
+        duration = ParseNumberIn(r.Value(), arg, {0, 1e9});
       } else if (arg == "--inject-reply-drop") {
-        options.reply_drop_probability = ParseNumberIn(value(), arg, {0, 1});
+        options.reply_drop_probability = ParseNumberIn(r.Value(), arg, {0, 1});
       } else if (arg == "--inject-reply-dup") {
-        options.reply_duplicate_probability = ParseNumberIn(value(), arg, {0, 1});
+        options.reply_duplicate_probability = ParseNumberIn(r.Value(), arg, {0, 1});
       } else if (arg == "--seed") {
         // Read as a double: whole numbers are exact below 2^53 only.
         options.fault_seed = static_cast<std::uint64_t>(
-            ParseNumberIn(value(), arg, {.min = 0, .max = 0x1p53 - 1, .whole = true}));
+            ParseNumberIn(r.Value(), arg, {.min = 0, .max = 0x1p53 - 1, .whole = true}));
       } else {
-        SayServer("unknown option '" + arg + "' (see --help)");
-        return 2;
+        r.Unknown();
       }
     }
     if (robots.empty()) {

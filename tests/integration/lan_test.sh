@@ -13,13 +13,8 @@ if [ -z "${LAN_INNER:-}" ]; then
 fi
 # shellcheck source=../../examples/lan.sh
 . "$here/../../examples/lan.sh"
-tmp=$(mktemp -d)
-trap 'lan_teardown; rm -rf "$tmp"' EXIT
-pass=0 failures=0
-check() {  # check NAME COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi
-}
+. "$here/../lib.sh"  # $tmp, check, $pass, $failures
+trap 'lan_teardown; cleanup' EXIT
 lan_setup || { echo "FAIL: could not create the hosts"; exit 1; }
 rt() { local h=$1; shift; on "$h" "$cli" --url "$LAN_URL" "$@"; }
 

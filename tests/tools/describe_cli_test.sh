@@ -73,6 +73,10 @@ check "--max-depth 0 is a usage error" test $? -eq 2
 check "no argument is a usage error" test $? -eq 2
 "$describe" --bogus x.urdf >/dev/null 2>&1
 check "unknown option is a usage error" test $? -eq 2
+# A known option without its value is named so (before: "unknown option '--name'").
+"$describe" "$models/pioneer2dx_pantilt.urdf" --name >/dev/null 2>"$tmp/err"
+check "a trailing --name is a usage error" test $? -eq 2
+check "a trailing --name needs a value: $(head -1 "$tmp/err")" grep -q -- "^robotalk-describe: --name needs a value" "$tmp/err"
 
 echo "$pass passed, $failures failed"
 [ "$failures" -eq 0 ]

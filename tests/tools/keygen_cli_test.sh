@@ -43,8 +43,13 @@ check "open secret key error names mode 0644" grep -q "mode 0644" "$tmp/err"
 "$keygen" >/dev/null 2>"$tmp/err"
 check "no --out exits 2 (a usage error, as every tool)" test $? -eq 2
 check "no --out says so" grep -q -- "--out FILE is required" "$tmp/err"
-"$keygen" --frobnicate >/dev/null 2>&1
+"$keygen" --frobnicate >/dev/null 2>"$tmp/err"
 check "unknown option exits 2 (a usage error, as every tool)" test $? -eq 2
+check "unknown option named as every tool names it" grep -q -- "unknown option '--frobnicate' (see --help)" "$tmp/err"
+# A known option without its value is named so (before: "unknown or incomplete option '--out'").
+"$keygen" --out >/dev/null 2>"$tmp/err"
+check "a trailing --out exits 2" test $? -eq 2
+check "a trailing --out needs a value: $(cat "$tmp/err")" grep -q -- "^robotalk-keygen: --out needs a value" "$tmp/err"
 "$keygen" --out "$tmp/bad" --name "two words" >/dev/null 2>&1
 check "bad name exits 1" test $? -eq 1
 check "bad name writes nothing" test ! -e "$tmp/bad"

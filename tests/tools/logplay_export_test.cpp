@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -105,6 +107,24 @@ TEST_F(Export, GivesEachRobotItsOwnColumnsAndIgnoresABrokenConfiguration) {
   EXPECT_EQ(state[0], "robot,log_time_us,server_time_us,panic,moving,x,y,theta,v,omega,wheel_joint,lift,q0");
   EXPECT_EQ(state[1], "rover,10,1000000,0,0,0,0,0,0,0,1,2,");
   EXPECT_EQ(state[2], "other,11,1000000,0,0,0,0,0,0,0,,,7");
+}
+
+// Reproducer (failed before one number writer): the CSV wrote %.10g, so
+// 1/3 came back as 0.3333333333 and 0.1 + 0.2 as 0.3: not the logged values.
+TEST_F(Export, WritesEveryNumberSoItReadsBackToTheSameValue) {
+  SessionLog log;
+  LoggedConfigs configs;
+  const double third = 1.0 / 3, sum = 0.1 + 0.2;
+  log.Add(StateChannel("rover"), 10, State("rover", {third, sum}));
+  std::ostringstream warnings;
+  ExportCsv(log, configs, dir_.string(), warnings);
+  const std::string row = Lines(dir_ / "state.csv")[1];
+  ASSERT_EQ(std::count(row.begin(), row.end(), ','), 11) << row;
+  const std::string cells = row.substr(row.rfind(',', row.rfind(',') - 1) + 1);
+  const std::size_t comma = cells.find(',');
+  EXPECT_EQ(std::strtod(cells.substr(0, comma).c_str(), nullptr), third) << row;
+  EXPECT_EQ(std::strtod(cells.substr(comma + 1).c_str(), nullptr), sum) << row;
+  EXPECT_EQ(cells, "0.3333333333333333,0.30000000000000004");  // and the shortest such text
 }
 
 }  // namespace

@@ -4,10 +4,7 @@
 #   simulate_cli_test.sh SERVER MODELS_DIR EXAMPLES_DIR
 set -u
 server=$1 models=$2 examples=$3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0 failures=0
-check() { local name=$1; shift; if "$@"; then pass=$((pass + 1)); else echo "FAIL: $name"; failures=$((failures + 1)); fi; }
+. "$(dirname "$0")/../lib.sh"  # $tmp, check, $pass, $failures
 for run in a b; do
   "$server" --robot "pioneer=ode:$models/pioneer2dx_pantilt.urdf,seed=5" --simulate "$examples/demo_arcs.txt" \
     --duration 8 --sample-period 0.05 >"$tmp/$run.csv" 2>"$tmp/$run.err"

@@ -88,12 +88,12 @@ TEST(WebOptions, NamesTheBadArgument) {
   EXPECT_EQ(ErrorOf({"--colour"}), "unknown option '--colour' (see --help)");
   EXPECT_EQ(ErrorOf({"--port", "http"}), "--port: 'http' is not a whole number in [0, 65535]");
   EXPECT_EQ(ErrorOf({"--port", "70000"}), "--port: '70000' is not a whole number in [0, 65535]");
-  EXPECT_EQ(ErrorOf({"--port"}), "--port: needs a value");
+  EXPECT_EQ(ErrorOf({"--port"}), "--port needs a value");
   EXPECT_EQ(ErrorOf({"--urdf", "pioneer"}), "--urdf: 'pioneer' is not NAME=PATH");
   EXPECT_EQ(ErrorOf({"--rate", "0"}), "--rate: '0' is not a number in [1, 240]");
   EXPECT_NE(ErrorOf({"--robot-timeout", "1"}).find("shorter than 1.5 s"), std::string::npos);
   EXPECT_EQ(ErrorOf({"--server-key", ""}), "--server-key: the file name is empty");
-  EXPECT_EQ(ErrorOf({"--key"}), "--key: needs a value");
+  EXPECT_EQ(ErrorOf({"--key"}), "--key needs a value");
   EXPECT_EQ(ErrorOf({"--max-websockets", "0"}), "--max-websockets: '0' is not a whole number in [1, 4096]");
   EXPECT_EQ(ErrorOf({"--max-websockets", "2.5"}),
             "--max-websockets: '2.5' is not a whole number in [1, 4096]");
@@ -125,7 +125,7 @@ TEST(WebOptions, TakesPackagePathsFromTheOptionThenRosPackagePath) {
   EXPECT_EQ(o.package_paths, (std::vector<std::string>{"/a", "/b", "/c", "/ros/one", "/ros/two"}));
   EXPECT_TRUE(ParseWebOptions({}, "/www", "/nm").package_paths.empty());
   EXPECT_EQ(ErrorOf({"--package-path", ":"}), "--package-path: ':' names no folder");
-  EXPECT_EQ(ErrorOf({"--package-path"}), "--package-path: needs a value");
+  EXPECT_EQ(ErrorOf({"--package-path"}), "--package-path needs a value");
 }
 
 }  // namespace

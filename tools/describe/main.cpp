@@ -3,6 +3,7 @@
 #include "describe_format.h"
 #include "robotalk/error.h"
 #include "robotalk/log_writer.h"  // EscapeControls, OpenStandardDescriptors
+#include "robotalk/option_reader.h"
 #include "robotalk/urdf_import.h"
 
 #include <cerrno>
@@ -50,43 +51,49 @@ int main(int argc, char** argv) {
   bool json = false;
   robotalk::UrdfImportOptions options;
   std::string path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--json") {
-      json = true;
-    } else if (arg == "--strict") {
-      options.strict = true;
-    } else if (arg == "--merge-chains") {
-      options.merge_massless_chains = true;
-    } else if (arg == "--name" && i + 1 < argc) {
-      options.robot_name = argv[++i];
-    } else if ((arg == "--max-bytes" || arg == "--max-depth") && i + 1 < argc) {
-      const bool bytes = arg == "--max-bytes";
-      const auto v = PositiveNumber(argv[++i], bytes ? SIZE_MAX : INT_MAX);
-      if (!v) {
-        std::cerr << "robotalk-describe: " << arg << " '" << argv[i] << "' is not a positive integer\n";
+  try {
+    robotalk::OptionReader r(argc, argv);
+    while (r.Next()) {
+      const std::string& arg = r.word();
+      if (arg == "--json") {
+        json = true;
+      } else if (arg == "--strict") {
+        options.strict = true;
+      } else if (arg == "--merge-chains") {
+        options.merge_massless_chains = true;
+      } else if (arg == "--name") {
+        options.robot_name = r.Value();
+      } else if (arg == "--max-bytes" || arg == "--max-depth") {
+        const bool bytes = arg == "--max-bytes";
+        const std::string& text = r.Value();
+        const auto v = PositiveNumber(text.c_str(), bytes ? SIZE_MAX : INT_MAX);
+        if (!v) {
+          std::cerr << "robotalk-describe: " << arg << " '" << text << "' is not a positive integer\n";
+          return 2;
+        }
+        if (bytes) {
+          options.max_file_bytes = static_cast<std::size_t>(*v);
+        } else {
+          options.max_xml_depth = static_cast<int>(*v);
+        }
+      } else if (r.IsVersion()) {
+        std::cout << "robotalk-describe " << ROBOTALK_VERSION << "\n";
+        return 0;
+      } else if (r.IsHelp()) {
+        std::cout << kUsage;
+        return 0;
+      } else if (!arg.empty() && arg[0] == '-') {
+        r.Unknown();
+      } else if (path.empty()) {
+        path = arg;
+      } else {
+        std::cerr << "robotalk-describe: more than one file given ('" << path << "', '" << arg << "')\n";
         return 2;
       }
-      if (bytes) {
-        options.max_file_bytes = static_cast<std::size_t>(*v);
-      } else {
-        options.max_xml_depth = static_cast<int>(*v);
-      }
-    } else if (arg == "--version") {
-      std::cout << "robotalk-describe " << ROBOTALK_VERSION << "\n";
-      return 0;
-    } else if (arg == "-h" || arg == "--help") {
-      std::cout << kUsage;
-      return 0;
-    } else if (!arg.empty() && arg[0] == '-') {
-      std::cerr << "robotalk-describe: unknown option '" << arg << "'\n" << kUsage;
-      return 2;
-    } else if (path.empty()) {
-      path = arg;
-    } else {
-      std::cerr << "robotalk-describe: more than one file given ('" << path << "', '" << arg << "')\n";
-      return 2;
     }
+  } catch (const robotalk::UsageError& e) {
+    std::cerr << "robotalk-describe: " << e.what() << "\n" << kUsage;
+    return 2;
   }
   if (path.empty()) {
     std::cerr << kUsage;

@@ -14,6 +14,7 @@
 // 2 usage; 3 the run exceeded --max-seconds.
 #include "fig11_profile.h"
 #include "robotalk/log_writer.h"  // OpenStandardDescriptors
+#include "robotalk/option_reader.h"
 #include "robotalk/robot_client.h"
 #include "robotalk/sequence_file.h"  // ParseNumberIn
 
@@ -71,56 +72,53 @@ struct Options {
 
 Options Parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  OptionReader r(argc, argv);
+  while (r.Next()) {
+    const std::string& a = r.word();
+    if (r.IsHelp()) {
       std::cout << kUsage;
       std::exit(0);
-    } else if (a == "--version") {
+    } else if (r.IsVersion()) {
       std::cout << "robotalk-fig11 " << ROBOTALK_VERSION << "\n";
       std::exit(0);
     } else if (a == "--url") {
-      o.url = value();
+      o.url = r.Value();
     } else if (a == "--robot") {
-      o.robot = value();
+      o.robot = r.Value();
     } else if (a == "--mode") {
-      const std::string m = value();
+      const std::string m = r.Value();
       auto mode = ParseCommandMode(m);
       if (!mode) throw std::invalid_argument("--mode: '" + m + "' is not direct, delay or playback");
       o.mode = *mode;
     } else if (a == "--delay") {
-      o.delay = ParseNumberIn(value(), a, {0, 3600});
+      o.delay = ParseNumberIn(r.Value(), a, {0, 3600});
     } else if (a == "--length") {
-      o.length = ParseNumberIn(value(), a, {0.01, 1000});
+      o.length = ParseNumberIn(r.Value(), a, {0.01, 1000});
     } else if (a == "--duration") {
-      o.duration = ParseNumberIn(value(), a, {0.8, 3600});
+      o.duration = ParseNumberIn(r.Value(), a, {0.8, 3600});
     } else if (a == "--state-period") {
-      o.state_period = ParseNumberIn(value(), a, {0.001, 1});
+      o.state_period = ParseNumberIn(r.Value(), a, {0.001, 1});
     } else if (a == "--out") {
-      o.out = value();
+      o.out = r.Value();
     } else if (a == "--label") {
-      o.label = value();
+      o.label = r.Value();
     } else if (a == "--congestion") {
-      o.congestion = value();
+      o.congestion = r.Value();
     } else if (a == "--retransmit-interval") {
-      o.retransmit_interval = ParseNumberIn(value(), a, {0.001, 3600});
+      o.retransmit_interval = ParseNumberIn(r.Value(), a, {0.001, 3600});
     } else if (a == "--give-up") {
-      o.give_up = ParseNumberIn(value(), a, {0.1, 3600});
+      o.give_up = ParseNumberIn(r.Value(), a, {0.1, 3600});
     } else if (a == "--max-seconds") {
-      o.max_seconds = ParseNumberIn(value(), a, {1, 86400});
+      o.max_seconds = ParseNumberIn(r.Value(), a, {1, 86400});
     } else if (a == "--max-late") {
-      const std::string v = value();
+      const std::string v = r.Value();
       o.max_late = v == "never"     ? kMaxLateNever
                    : v == "default" ? kMaxLateServerDefault
                                     : FromSeconds(ParseNumberIn(v, a, {1e-6, 3600}));
     } else if (a == "--print-ideal") {
-      o.print_ideal = value();
+      o.print_ideal = r.Value();
     } else {
-      throw std::invalid_argument("unknown option '" + a + "'");
+      r.Unknown();
     }
   }
   if (o.print_ideal.empty() && o.out.empty()) throw std::invalid_argument("--out PREFIX is required");

@@ -4,6 +4,7 @@
 // overwrites. docs/security.md.
 #include "robotalk/keys.h"
 #include "robotalk/log_writer.h"  // OpenStandardDescriptors
+#include "robotalk/option_reader.h"
 
 #include <filesystem>
 #include <iostream>
@@ -40,24 +41,27 @@ int main(int argc, char** argv) {
   std::string out;
   std::string name;
   std::string fingerprint;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](std::string& into) {
-      if (i + 1 >= argc) return false;
-      into = argv[++i];
-      return true;
-    };
-    if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage;
-      return 0;
+  try {
+    robotalk::OptionReader r(argc, argv);
+    while (r.Next()) {
+      if (r.IsHelp()) {
+        std::cout << kUsage;
+        return 0;
+      } else if (r.IsVersion()) {
+        std::cout << "robotalk-keygen " << ROBOTALK_VERSION << "\n";
+        return 0;
+      } else if (r.Is("--out")) {
+        out = r.Value();
+      } else if (r.Is("--name")) {
+        name = r.Value();
+      } else if (r.Is("--fingerprint")) {
+        fingerprint = r.Value();
+      } else {
+        r.Unknown();
+      }
     }
-    if (arg == "--version") {
-      std::cout << "robotalk-keygen " << ROBOTALK_VERSION << "\n";
-      return 0;
-    }
-    const bool ok = (arg == "--out" && value(out)) || (arg == "--name" && value(name)) ||
-                    (arg == "--fingerprint" && value(fingerprint));
-    if (!ok) return Fail("unknown or incomplete option '" + arg + "' (see --help)", 2);
+  } catch (const robotalk::UsageError& e) {
+    return Fail(e.what(), 2);
   }
   try {
     if (!fingerprint.empty()) {

@@ -1,6 +1,7 @@
 #include "relay_options.h"
 
 #include <robotalk/error.h>
+#include <robotalk/option_reader.h>
 #include <robotalk/routed_lcm_transport.h>
 #include <robotalk/sequence_file.h>  // NumberOf
 #include <robotalk/traffic_layout.h>
@@ -156,30 +157,34 @@ RelayOptions ParseRelayOptions(const std::vector<std::string>& args) {
     std::string option, value;
   };
   std::vector<Item> items;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (arg == "--help" || arg == "-h") {
-      o.help = true;
-      return o;
+  try {  // the reader's UsageError as this function's invalid_argument, as Bad's
+    OptionReader r(args);
+    while (r.Next()) {
+      const std::string& arg = r.word();
+      if (r.IsHelp()) {
+        o.help = true;
+        return o;
+      }
+      if (r.IsVersion()) {
+        o.version = true;
+        return o;
+      }
+      if (arg == "--stats") {
+        o.stats = true;
+        continue;
+      }
+      if (arg.rfind("--", 0) != 0) Bad(arg, "", "unexpected argument (options start with --)");
+      const auto eq = arg.find('=');
+      if (eq != std::string::npos) {
+        if (!TakesValue(arg.substr(2, eq - 2))) ThrowUnknownOption(arg.substr(0, eq));  // without its value
+        items.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
+      } else {
+        if (!TakesValue(arg.substr(2))) r.Unknown();
+        items.push_back({arg, r.Value()});
+      }
     }
-    if (arg == "--version") {
-      o.version = true;
-      return o;
-    }
-    if (arg == "--stats") {
-      o.stats = true;
-      continue;
-    }
-    if (arg.rfind("--", 0) != 0) Bad(arg, "", "unexpected argument (options start with --)");
-    const auto eq = arg.find('=');
-    if (!TakesValue(arg.substr(2, eq == std::string::npos ? std::string::npos : eq - 2)))
-      throw std::invalid_argument("unknown option '" + arg.substr(0, eq) + "'");
-    if (eq != std::string::npos) {
-      items.push_back({arg.substr(0, eq), arg.substr(eq + 1)});
-    } else {
-      if (i + 1 >= args.size()) Bad(arg, "", "needs a value");
-      items.push_back({arg, args[++i]});
-    }
+  } catch (const UsageError& e) {
+    throw std::invalid_argument(e.what());  // the words every tool says
   }
   // A profile first: every other impairment option overrides its part.
   for (const auto& [option, value] : items) {

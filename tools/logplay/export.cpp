@@ -4,6 +4,7 @@
 #include "logplay.h"
 #include "robotalk/channels.h"
 #include "robotalk/config_message.h"
+#include "robotalk/sequence_file.h"  // FormatNumber
 
 #include <algorithm>
 #include <filesystem>
@@ -43,7 +44,7 @@ void WriteCommands(const SessionLog& log, std::ostream& out) {
         << (c.reply ? std::string(ToString(c.reply->signal)) : "") << ','
         << (c.reply ? std::to_string(ToWireMicros(c.reply->exec_time)) : "") << ',';
     for (std::size_t i = 0; i < c.command.values.size(); ++i)
-      out << (i ? " " : "") << Num(c.command.values[i]);
+      out << (i ? " " : "") << FormatNumber(c.command.values[i]);
     out << "\n";
   }
 }
@@ -119,10 +120,10 @@ std::vector<std::string> ExportCsv(const SessionLog& log, const LoggedConfigs& c
   std::vector<std::string> cells(names.size());
   for (const StateSample& s : log.states()) {
     state << s.robot << ',' << s.log_time_us << ',' << s.server_time_us << ',' << s.panic << ',' << s.moving;
-    for (double b : s.base) state << ',' << Num(b);
+    for (double b : s.base) state << ',' << FormatNumber(b);
     std::fill(cells.begin(), cells.end(), std::string());
     const std::vector<std::size_t>& columns = layout.at({s.robot, s.position.size()});
-    for (std::size_t d = 0; d < s.position.size(); ++d) cells[columns[d]] = Num(s.position[d]);
+    for (std::size_t d = 0; d < s.position.size(); ++d) cells[columns[d]] = FormatNumber(s.position[d]);
     for (const std::string& c : cells) state << ',' << c;
     state << "\n";
   }

@@ -58,8 +58,6 @@ void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out
 /// packages of each interpolation; "" when all are step (info, replay).
 std::string DescribeInterpolations(const std::vector<Interpolation>& each);
 
-/// A number as info, extract and export write it (%.10g).
-std::string Num(double v);
 /// "direct", "delay", "playback".
 const char* ModeName(RequestMode mode);
 

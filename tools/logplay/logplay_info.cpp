@@ -95,12 +95,6 @@ std::string DescribeInterpolations(const std::vector<Interpolation>& each) {
   return text;
 }
 
-std::string Num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
 const char* ModeName(RequestMode mode) {
   switch (mode) {
     case RequestMode::kDirect:
@@ -259,7 +253,7 @@ void PrintInfo(const SessionLog& log, const std::string& path, std::ostream& out
     std::snprintf(line, sizeof line, "state %s: %d samples; final base x %.4f y %.4f theta %.4f",
                   robot.c_str(), counts[robot], s->base[0], s->base[1], s->base[2]);
     out << line << "; q";
-    for (double q : s->position) out << ' ' << Num(q);
+    for (double q : s->position) out << ' ' << FormatNumber(q);
     out << "\n";
   }
 }

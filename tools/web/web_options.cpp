@@ -2,6 +2,7 @@
 
 #include "robotalk/channels.h"  // kAnnounceHeardWithin
 #include "robotalk/error.h"
+#include "robotalk/option_reader.h"
 #include "robotalk/sequence_file.h"  // ParseNumberIn, ParseSeconds
 
 #include <algorithm>
@@ -72,53 +73,51 @@ WebOptions ParseWebOptions(const std::vector<std::string>& args, const std::stri
   WebOptions o;
   o.www_dir = default_www;
   o.node_modules_dir = default_modules;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw Error(a + ": needs a value");
-      return args[++i];
-    };
-    if (a == "-h" || a == "--help") {
+  OptionReader r(args);
+  while (r.Next()) {
+    const std::string& a = r.word();
+    if (r.IsHelp()) {
       o.help = true;
-    } else if (a == "--version") {
+    } else if (r.IsVersion()) {
       o.version = true;
     } else if (a == "--bind") {
-      o.bind = value();
+      o.bind = r.Value();
       if (o.bind.empty()) throw Error("--bind: empty address");
     } else if (a == "--port") {
-      o.port = static_cast<int>(ParseNumberIn(value(), a, {.min = 0, .max = 65535, .whole = true}));
+      o.port = static_cast<int>(ParseNumberIn(r.Value(), a, {.min = 0, .max = 65535, .whole = true}));
     } else if (a == "--lcm-url") {
-      o.lcm_url = value();
+      o.lcm_url = r.Value();
     } else if (a == "--rate") {
-      o.rate_hz = ParseNumberIn(value(), a, {.min = 1, .max = 240});
+      o.rate_hz = ParseNumberIn(r.Value(), a, {.min = 1, .max = 240});
     } else if (a == "--robot-timeout") {
-      o.robot_timeout_s = ParseSeconds(value(), a);  // within what every time given as text may be
+      const std::string& text = r.Value();
+      o.robot_timeout_s = ParseSeconds(text, a);  // within what every time given as text may be
       if (o.robot_timeout_s < ToSeconds(kAnnounceHeardWithin)) {
         char shortest[32];
         std::snprintf(shortest, sizeof shortest, "%g", ToSeconds(kAnnounceHeardWithin));
-        throw Error("--robot-timeout: " + args[i] + " s is shorter than " + shortest +
+        throw Error("--robot-timeout: " + text + " s is shorter than " + shortest +
                     " s (servers announce every second)");
       }
     } else if (a == "--max-websockets" || a == "--max-http-waiting") {
       (a == "--max-websockets" ? o.max_websockets : o.max_http_waiting) =
-          static_cast<int>(ParseNumberIn(value(), a, {.min = 1, .max = 4096, .whole = true}));
+          static_cast<int>(ParseNumberIn(r.Value(), a, {.min = 1, .max = 4096, .whole = true}));
     } else if (a == "--key") {
-      o.key_file = value();
+      o.key_file = r.Value();
       if (o.key_file.empty()) throw Error("--key: the file name is empty");
     } else if (a == "--server-key") {
-      o.server_key_file = value();
+      o.server_key_file = r.Value();
       if (o.server_key_file.empty()) throw Error("--server-key: the file name is empty");
     } else if (a == "--urdf") {
-      auto [name, path] = ParseUrdfOption(value());
+      auto [name, path] = ParseUrdfOption(r.Value());
       o.urdf[name] = path;
     } else if (a == "--package-path") {
-      AppendPackagePaths(value(), o.package_paths);
+      AppendPackagePaths(r.Value(), o.package_paths);
     } else if (a == "--www") {
-      o.www_dir = value();
+      o.www_dir = r.Value();
     } else if (a == "--node-modules") {
-      o.node_modules_dir = value();
+      o.node_modules_dir = r.Value();
     } else {
-      throw Error("unknown option '" + a + "' (see --help)");
+      r.Unknown();
     }
   }
   AppendPaths(ros_package_path, o.package_paths);

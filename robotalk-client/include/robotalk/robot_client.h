@@ -431,8 +431,10 @@ class RobotClient {
   Reply Query(robotalk::Query query);
   /// What became of command `id` of this client's current session (after an
   /// UnknownOutcomeError from giving up): its own final reply once it ended,
-  /// BUSY while it waits or runs, NA when the session never received it. A
-  /// session lost to a server restart cannot be asked (docs/protocol.md, Sessions).
+  /// BUSY while it waits or runs, NA when the session never received it;
+  /// CommandStatusOf(reply, id) (robotalk/command_status.h) tells those from a command
+  /// that ended BUSY or NA. A session lost to a server restart cannot be asked
+  /// (docs/protocol.md, Sessions).
   Reply CommandStatus(CommandId id);
   /// The server's refusal counters (values; the message names them).
   Reply ServerCounters();

@@ -211,18 +211,17 @@ Command ParseCommandWords(const std::vector<std::string>& words) {
   return c;
 }
 
+std::string FormatNumber(double value) {
+  char number[32];  // the longest shortest form, "-2.2250738585072014e-308", is 24
+  const std::to_chars_result r = std::to_chars(number, number + sizeof number, value);
+  return std::string(number, r.ptr);
+}
+
 std::string FormatCommandWords(const Command& c) {
   std::string text = Word(c.type);
   if (!c.target.empty()) text += " " + c.target;
   const auto append = [&text](const std::vector<double>& values) {
-    for (const double v : values) {
-      // The shortest text that reads back to the same bits ("0.3", not
-      // %.17g's "0.29999999999999999"): locale-free, as StrtodC reads it.
-      char number[32];
-      const std::to_chars_result r = std::to_chars(number, number + sizeof number, v);
-      text += ' ';
-      text.append(number, r.ptr);
-    }
+    for (const double v : values) text += ' ' + FormatNumber(v);
   };
   append(c.values);
   if (!c.velocities.empty()) text += " velocity";

@@ -41,9 +41,16 @@ class UsageError : public Error {
 /// one per position of a JOINT_SETPOINT, 6 for a FRAME_SETPOINT) and that
 /// every value is a finite number. Throws UsageError.
 Command ParseCommandWords(const std::vector<std::string>& words);
-/// The inverse: "joint_setpoint pan 0.5 velocity 0.1", each value the shortest
-/// text that reads back to the same bits.
+/// The inverse: "joint_setpoint pan 0.5 velocity 0.1", each value as
+/// FormatNumber writes it.
 std::string FormatCommandWords(const Command& command);
+
+/// The shortest text that reads back (NumberOf) to the same bits: "0.3", not
+/// %.17g's "0.29999999999999999"; "0.3333333333333333", not %.10g's
+/// "0.3333333333" (another number). Locale-free. The one writer of a number
+/// RoboTalk writes to be read again (command words, sequence files, logplay's
+/// CSV).
+std::string FormatNumber(double value);
 
 /// An interpolation's name, any case ("cubic"); throws UsageError
 /// "<what>: 'cubc' is not an interpolation (step, linear, cubic, quintic)".
