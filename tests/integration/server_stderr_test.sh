@@ -212,8 +212,11 @@ for out in stderr stdout; do
   exec 5>&-
   t0=$(date +%s%N)
   poll_until "$(deadline 1 "$t0")" is_moving "$tmp/watch3.json"
+  c0=$(date +%s%N)
   moves "a SETSPEED without --hold whose $out takes nothing: pioneer moves" "$tmp/watch3.json"
-  poll_until "$(deadline 4.5 "$t0")" is_at_rest "$tmp/watch3.json"  # the session timeout (2 s) and the watchdog
+  # the session timeout (2 s) and the watchdog: at the latest when the old
+  # 'sleep 1; moves ...; sleep 3.5' looked (the check's own time included)
+  poll_until "$(deadline 3.5 $(($(deadline 1 "$t0") + $(date +%s%N) - c0)))" is_at_rest "$tmp/watch3.json"
   at_rest "a SETSPEED without --hold whose $out takes nothing stops within the session timeout" "$tmp/watch3.json"
   kill -9 "$speed_pid" 2>/dev/null
 done
@@ -308,9 +311,11 @@ for mode in delay direct playback; do
   exec 4>&-
   t0=$(date +%s%N)
   poll_until "$(deadline 1.2 "$t0")" is_moving "$tmp/watch6.json"
+  c0=$(date +%s%N)
   moves "a sequence ending in a SETSPEED, its stdout taking nothing ($mode): pioneer moves" "$tmp/watch6.json"
-  # the sequence's end, the session timeout (2 s) and the watchdog
-  poll_until "$(deadline 4.7 "$t0")" is_at_rest "$tmp/watch6.json"
+  # the sequence's end, the session timeout (2 s) and the watchdog: at the
+  # latest when the old 'sleep 1.2; moves ...; sleep 3.5' looked
+  poll_until "$(deadline 3.5 $(($(deadline 1.2 "$t0") + $(date +%s%N) - c0)))" is_at_rest "$tmp/watch6.json"
   at_rest "... and stops within the session timeout of the sequence's end ($mode)" "$tmp/watch6.json"
   kill -9 "$seq_pid" 2>/dev/null
   "$cli" --url "$url" send pioneer stop >/dev/null 2>&1
