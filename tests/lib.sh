@@ -15,6 +15,11 @@
 #   ends_within WHAT STATUS PID  PID (a child of this shell) ends within 5 s
 #                           (else killed) with exit status STATUS: two checks
 #   ROBOTALK_KNOWN_SERVERS  keyed clients pin server keys in $tmp, not in ~/.robotalk
+#   deadline SECONDS [FROM]  the clock (date +%s%N) SECONDS after FROM (a deadline or
+#                           a `date +%s%N`; now by default)
+#   poll_until DEADLINE COMMAND...  runs COMMAND every 0.1 s until it succeeds
+#                           (status 0) or once more at or after DEADLINE (status 1):
+#                           a `sleep N; check ... COMMAND` that ends when COMMAND holds
 tmp=$(mktemp -d)
 export ROBOTALK_KNOWN_SERVERS="$tmp/known_servers"
 server_pid="" client_pid=""
@@ -38,6 +43,17 @@ wait_for() {  # wait_for FILE PATTERN [TRIES [PAUSE]]
   local _
   for _ in $(seq "${3:-50}"); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep "${4:-0.1}"; done
   return 1
+}
+deadline() {  # deadline SECONDS [FROM]
+  echo $((${2:-$(date +%s%N)} + $(awk -v s="$1" 'BEGIN { printf "%d", s * 1e9 }')))
+}
+poll_until() {  # poll_until DEADLINE COMMAND...
+  local end=$1
+  shift
+  until "$@"; do
+    [ "$(date +%s%N)" -lt "$end" ] || return 1
+    sleep 0.1
+  done
 }
 start_pioneer() {  # start_pioneer LOG [ARGS...]
   local log=$1

@@ -18,6 +18,17 @@ run() {  # run NAME ARGS...: the example's exit status in $tmp/NAME.status
   timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/$name.out" 2>"$tmp/$name.err"
   echo $? >"$tmp/$name.status"
 }
+# The three refused ones open no session (the impostor waits out its 5 s hello
+# timeout): they run meanwhile, in the background; each is waited for before
+# its checks.
+declare -A job=()
+run unlisted env -u ROBOTALK_KEY "$example" --key "$tmp/mallory" &
+job[unlisted]=$!
+run impostor env -u ROBOTALK_KEY "$example" --key "$tmp/alice" --server-key "$tmp/mallory.pub" &
+job[impostor]=$!
+run nokey env -u ROBOTALK_KEY "$example" &
+job[nokey]=$!
+pids+=("${job[@]}")
 
 run pinned env -u ROBOTALK_KEY "$example" --key "$tmp/alice" --server-key "$tmp/server.pub"
 check "with a listed key and the server's key it exits 0" grep -qx 0 "$tmp/pinned.status"
@@ -36,18 +47,18 @@ fingerprint=$("$keygen" --fingerprint "$tmp/server.pub" | grep -o 'rt:[0-9a-f:]*
 check "... naming the server key it trusted ($fingerprint)" \
   grep -q "trusting server key $fingerprint (not pinned" "$tmp/tofu.err"
 
-run unlisted env -u ROBOTALK_KEY "$example" --key "$tmp/mallory"
+wait "${job[unlisted]}"
 check "an unlisted key exits 1" grep -qx 1 "$tmp/unlisted.status"
 check "... saying the hello was refused for its key" \
   grep -q "error: hello refused by 'pioneer': .*key not in the access list" "$tmp/unlisted.err"
 
-run impostor env -u ROBOTALK_KEY "$example" --key "$tmp/alice" --server-key "$tmp/mallory.pub"
+wait "${job[impostor]}"
 check "another server key: exits 1" grep -qx 1 "$tmp/impostor.status"
 check "... naming the key that answered and the one expected" \
   grep -q "error: no answer to hello from 'pioneer' .*answer signed by $fingerprint, expected server key rt:" \
   "$tmp/impostor.err"
 
-run nokey env -u ROBOTALK_KEY "$example"
+wait "${job[nokey]}"
 check "no key: exits 1" grep -qx 1 "$tmp/nokey.status"
 check "... saying the server requires keys and how to give one" \
   grep -q "requires keys (keyed mode, docs/security.md); give this client one (--key FILE or ROBOTALK_KEY)" \

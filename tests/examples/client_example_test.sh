@@ -28,6 +28,12 @@ within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v != "" && v >= l
 
 start_pioneer "$tmp/server.log" --url "$url" --duration 90 "${server_flags[@]}"
 
+# A robot nobody announces (checked below) waits out the example's connect
+# timeout (5 s) listening to announcements: it runs meanwhile, not after.
+timeout 30 "$@" --url "$url" --robot piooner >"$tmp/out2" 2>"$tmp/err2" &
+unknown_pid=$!
+pids+=("$unknown_pid")
+
 # --- the example: connect, configuration, GOTO, timed sequence, replies ------
 timeout 60 "$@" --url "$url" --robot pioneer >"$tmp/out" 2>"$tmp/err"
 status=$?
@@ -83,7 +89,7 @@ pose=$("$cli" --url "$url" --timeout 5 query pioneer base_pose 2>&1)
 check "the robot is at the goal for the CLI too ($pose)" within "$(echo "$pose" | awk '{print $(NF-4)}')" 0.48 0.52
 
 # --- a robot nobody announces: the error lists the robots heard --------------
-timeout 30 "$@" --url "$url" --robot piooner >"$tmp/out2" 2>"$tmp/err2"
+wait "$unknown_pid"
 status=$?
 check "an unknown robot exits 1 (got $status)" test "$status" -eq 1
 check "the error names the robot and lists those heard" grep -q "no robot 'piooner'.*heard: pioneer" "$tmp/err2"

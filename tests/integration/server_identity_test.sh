@@ -87,6 +87,7 @@ watch_a_stopped_server() {
   kill -KILL "$watch_pid" 2>/dev/null  # still watching after 6 s: the forger kept it
   wait "$watch_pid"
   status=$?
+  kill "$forge_pid" 2>/dev/null  # the watch's verdict is in: the rest of the forgery (up to 8 s) tells nothing
   wait "$forge_pid"
   kill -CONT "$server_pid"
 }

@@ -24,6 +24,16 @@ at_rest() {
   read -r v w moving < <(last_motion "$2")
   check "$1 (v=$v w=$w moving=$moving)" python3 -c "import sys; sys.exit(not ($v == 0 and $w == 0 and '$moving' == 'false'))"
 }
+# is_moving / is_at_rest WATCH_JSON: the same without a check, for poll_until
+# (which ends a wait once it holds; the check that follows decides).
+is_moving() {
+  read -r v w moving < <(last_motion "$1")
+  [ "$moving" = true ] && awk -v v="$v" 'BEGIN { exit !(v > 0.05 || v < -0.05) }'
+}
+is_at_rest() {
+  read -r v w moving < <(last_motion "$1")
+  [ "$moving" = false ] && awk -v v="$v" -v w="$w" 'BEGIN { exit !(v == 0 && w == 0) }'
+}
 
 # stderr's reader copies lines to server.log until the server serves, then exits.
 mkfifo "$tmp/stderr"
@@ -43,7 +53,7 @@ wait "$reader"  # stderr's reader is gone: the pipe has none
 pids+=($!)
 "$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold.out" 2>&1 &
 pids+=($!)
-sleep 1.5  # the SETSPEED and its audit line: a write to a pipe without a reader
+poll_until "$(deadline 1.5)" is_moving "$tmp/watch.json"  # the SETSPEED and its audit line: a write to a pipe without a reader
 check "the server lives on after a log line to a stderr without a reader" kill -0 "$server_pid"
 check "it still answers: $("$cli" --url "$url" --timeout 3 query pioneer base_pose 2>&1 | head -c 300)" \
   "$cli" --url "$url" --timeout 3 query pioneer base_pose
@@ -78,7 +88,7 @@ check "a server whose stderr takes nothing serves" test "$served" -eq 0
 pids+=($!)
 "$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >"$tmp/hold2.out" 2>&1 &
 pids+=($!)
-sleep 1.5
+poll_until "$(deadline 1.5)" is_moving "$tmp/watch2.json"
 moves "full stderr: pioneer moves before the signal" "$tmp/watch2.json"
 signal_server TERM
 check "full stderr: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
@@ -117,7 +127,7 @@ full_server pioneer 7724 --robot "pioneer=kinematic:$urdf" --no-panic-latch
 pids+=($!)
 "$cli" --url "$url" send pioneer setspeed 0.3 0.1 --hold >/dev/null 2>&1 &
 pids+=($!)
-sleep 1.5
+poll_until "$(deadline 1.5)" is_moving "$tmp/watch5.json"
 moves "full stderr, --no-panic-latch: pioneer moves before the signal" "$tmp/watch5.json"
 signal_server TERM
 check "full stderr, --no-panic-latch: the server ends within 10 s of SIGTERM" test "$server_ended" -eq 1
@@ -166,9 +176,10 @@ check "the CLI holds the SETSPEED" test -e "$tmp/holding"
 head -c 65536 /dev/zero >"$tmp/cli_err"  # the pipe's capacity: its stderr takes nothing now
 sleep 0.5
 kill -INT "$hold_pid"
-sleep 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
-at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
 ended() { [ ! -e "/proc/$1" ] || [ "$(cut -d')' -f2 "/proc/$1/stat" | cut -c2)" = Z ]; }  # gone, or a zombie
+# 2.5 s: past the session timeout (2 s): the STOP, not the watchdog, if anything
+poll_until "$(deadline 2.5)" eval 'is_at_rest "$tmp/watch3.json" && ended "$hold_pid"'
+at_rest "Ctrl-C on a --hold whose stderr takes nothing still stops pioneer" "$tmp/watch3.json"
 check "and the CLI ends within 2.5 s of the Ctrl-C (StopOnInterrupt::kTakeOver, 2 s)" ended "$hold_pid"
 wait "$hold_pid"
 hold_status=$?
@@ -199,9 +210,13 @@ for out in stderr stdout; do
   speed_pid=$!
   pids+=("$speed_pid")
   exec 5>&-
-  sleep 1
+  t0=$(date +%s%N)
+  poll_until "$(deadline 1 "$t0")" is_moving "$tmp/watch3.json"
+  c0=$(date +%s%N)
   moves "a SETSPEED without --hold whose $out takes nothing: pioneer moves" "$tmp/watch3.json"
-  sleep 3.5  # the session timeout (2 s) and the watchdog
+  # the session timeout (2 s) and the watchdog: at the latest when the old
+  # 'sleep 1; moves ...; sleep 3.5' looked (the check's own time included)
+  poll_until "$(deadline 3.5 $(($(deadline 1 "$t0") + $(date +%s%N) - c0)))" is_at_rest "$tmp/watch3.json"
   at_rest "a SETSPEED without --hold whose $out takes nothing stops within the session timeout" "$tmp/watch3.json"
   kill -9 "$speed_pid" 2>/dev/null
 done
@@ -216,8 +231,12 @@ signal_server TERM
 start_pioneer "$tmp/server.log" --url "$url" --duration 60
 "$cli" --url "$url" watch pioneer --json --period 0.05 --duration 30 >"$tmp/watch4.json" 2>/dev/null &
 pids+=($!)
-python3 -c 'import os, pty, signal, subprocess, sys, time
-cli, url, out = sys.argv[1:4]
+python3 -c 'import json, os, pty, signal, subprocess, sys, time
+cli, url, out, watch = sys.argv[1:5]
+def at_rest():  # the last STATE sample of the watch at rest (at_rest, below, checks it)
+    lines = [l for l in open(watch) if l.startswith("{")]
+    s = json.loads(lines[-1]) if lines else None
+    return s is not None and s["base"][3] == 0 and s["base"][4] == 0 and not s["moving"]
 master, slave = pty.openpty()
 fill = os.open(os.ttyname(slave), os.O_WRONLY | os.O_NONBLOCK | os.O_NOCTTY)
 total, chunk = 0, 4096
@@ -230,11 +249,13 @@ goto = subprocess.Popen([cli, "--url", url, "send", "pioneer", "goto", "6", "0",
                         stdout=subprocess.DEVNULL, stderr=slave, start_new_session=True)
 time.sleep(2.0)  # moving, its progress line due every 50 ms after 0.3 s
 goto.send_signal(signal.SIGINT)
-time.sleep(2.5)  # past the session timeout (2 s): the STOP, not the watchdog, if anything
+end = time.monotonic() + 2.5  # past the session timeout (2 s): the STOP, not the watchdog, if anything
+while not at_rest() and time.monotonic() < end:
+    time.sleep(0.1)
 with open(out, "w") as f:
     f.write("filled %d bytes; the CLI %s\n" % (total, "ended" if goto.poll() is not None else "still runs"))
 goto.kill()
-goto.wait()' "$cli" "$url" "$tmp/pty.out"
+goto.wait()' "$cli" "$url" "$tmp/pty.out" "$tmp/watch4.json"
 cat "$tmp/pty.out"
 at_rest "Ctrl-C on a goto whose terminal takes nothing still stops pioneer" "$tmp/watch4.json"
 
@@ -288,9 +309,13 @@ for mode in delay direct playback; do
   seq_pid=$!
   pids+=("$seq_pid")
   exec 4>&-
-  sleep 1.2
+  t0=$(date +%s%N)
+  poll_until "$(deadline 1.2 "$t0")" is_moving "$tmp/watch6.json"
+  c0=$(date +%s%N)
   moves "a sequence ending in a SETSPEED, its stdout taking nothing ($mode): pioneer moves" "$tmp/watch6.json"
-  sleep 3.5  # the sequence's end, the session timeout (2 s) and the watchdog
+  # the sequence's end, the session timeout (2 s) and the watchdog: at the
+  # latest when the old 'sleep 1.2; moves ...; sleep 3.5' looked
+  poll_until "$(deadline 3.5 $(($(deadline 1.2 "$t0") + $(date +%s%N) - c0)))" is_at_rest "$tmp/watch6.json"
   at_rest "... and stops within the session timeout of the sequence's end ($mode)" "$tmp/watch6.json"
   kill -9 "$seq_pid" 2>/dev/null
   "$cli" --url "$url" send pioneer stop >/dev/null 2>&1

@@ -69,17 +69,30 @@ cmake -S "$tmp/vars" -B "$tmp/vars/build" -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/v
 check "find_package(robotalk) names the moved types jar" \
   grep -qF "ROBOTALK_LCMTYPES_JAR=$prefix/share/java/robotalk_lcmtypes.jar" "$tmp/vars.log"
 lcm_jar=$(grep -o 'ROBOTALK_LCM_JAR=.*' "$tmp/vars.log" | cut -d= -f2-)
+# The three are built at once, and run at once (each on a port of its own).
+declare -A job=()
 for lang in c java lua; do
-  cmake -S "$source/examples/${lang}_client" -B "$tmp/$lang" -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/$lang.log" 2>&1 &&
-    cmake --build "$tmp/$lang" >>"$tmp/$lang.log" 2>&1
+  { cmake -S "$source/examples/${lang}_client" -B "$tmp/$lang" -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/$lang.log" 2>&1 &&
+    cmake --build "$tmp/$lang" >>"$tmp/$lang.log" 2>&1; } &
+  job[$lang]=$!
+  pids+=("${job[$lang]}")
+done
+for lang in c java lua; do
+  wait "${job[$lang]}"
   check "examples/${lang}_client builds against the moved installation" test $? -eq 0
 done
-run_example() {  # run_example NAME PORT COMMAND...
+run_example() {  # run_example NAME PORT COMMAND...: starts it; ran NAME checks it
   local name=$1 port=$2
   shift 2
   "$source/tests/examples/client_example_test.sh" "$bin/robotalk-server" "$bin/robotalk" \
-    "$prefix/share/robotalk/models" "$port" default "$@" >"$tmp/run_$name.log" 2>&1
-  check "the $name example runs against the moved robotalk-server" test $? -eq 0
+    "$prefix/share/robotalk/models" "$port" default "$@" >"$tmp/run_$name.log" 2>&1 &
+  job[run_$name]=$!
+  pids+=("${job[run_$name]}")
+}
+ran() {  # ran NAME: the example NAME started by run_example passed
+  [ -n "${job[run_$1]:-}" ] || return 0
+  wait "${job[run_$1]}"
+  check "the $1 example runs against the moved robotalk-server" test $? -eq 0
 }
 run_example c 7772 "$tmp/c/robotalk_c_example"
 if command -v java >/dev/null && command -v javac >/dev/null; then
@@ -95,6 +108,7 @@ if [ -x "$tmp/lua/run_example.sh" ]; then
 else
   echo "SKIP: the Lua example (no lua5.2 or LCM Lua module: scripts/setup.sh installs them)"
 fi
+for name in c java lua; do ran "$name"; done
 
 if [ "$failures" -ne 0 ]; then
   for f in "$tmp"/web.out "$tmp"/spy.args "$tmp"/vars.log "$tmp"/{c,java,lua}.log "$tmp"/run_*.log; do
