@@ -394,6 +394,24 @@ TEST(OdeWalk, APushedGotoWhoseStopStepLandsLateStillArrivesWithTheStabilizer) {
   PushAGotoAndExpectItStopsOnceStandsAndArrives({}, 2.80);
 }
 
+// The event-driven stop's options (push_stop_wait, push_stop_land) are
+// checked as the other push options: a negative wait, either without
+// push_recovery, the landing's wait without a wait are refused, naming the key.
+TEST(OdeWalk, PushStopWaitAndPushStopLandAreCheckedAsThePushOptionsAre) {
+  const std::optional<std::string> negative = RefusalOfWalker({{"push_stop_wait", "-0.1"}});
+  ASSERT_TRUE(negative) << "push_stop_wait=-0.1 accepted";
+  EXPECT_NE(negative->find("push_stop_wait"), std::string::npos) << *negative;
+  const std::optional<std::string> land =
+      RefusalOfWalker({{"push_stop_land", "true"}, {"push_stop_wait", "0"}});
+  ASSERT_TRUE(land) << "push_stop_land without a wait accepted";
+  EXPECT_NE(land->find("push_stop_wait"), std::string::npos) << *land;
+  EXPECT_TRUE(RefusalOfWalker({{"push_stop_land", "true"}, {"push_recovery", "false"}}));
+  EXPECT_TRUE(RefusalOfWalker({{"push_stop_wait", "0.5"}, {"push_recovery", "false"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_land", "true"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_wait", "0"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}})) << "the default wait needs no push_recovery";
+}
+
 // Foot damping (option foot_damping, walking/foot_damping.h): walking at
 // full speed, each loaded sole's centre of pressure stays nearer the share
 // of the ZMP it was given than with stiff ankles, and the soles roll less
