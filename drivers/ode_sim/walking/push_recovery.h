@@ -113,9 +113,9 @@ struct RecoveryParams {
   // `stop_wait` s per lift (0: off, the timed pattern); the plan's CoM
   // state becomes the measured one when a lift that waited goes
   // (`wait_reanchor`): the preview plans on from there.
-  double stop_wait = 0.3;     ///< s
-  double wait_share = 0.8;    ///< of the weight
-  double wait_margin = 0;     ///< m (measured on ODE: 0.03 saved none of the pushed GOTO's falls, 0 one)
+  double stop_wait = 0.3;   ///< s
+  double wait_share = 0.8;  ///< of the weight
+  double wait_margin = 0;   ///< m (the pushed GOTO from the left on ODE: 0.03: 7 of 21 fell, 0: 5, timed: 6)
   double touch_share = 0.15;  ///< of the weight: a landed foot has touched down (0: landings never wait)
   bool wait_reanchor = true;
   // The capture stop (CaptureStop below; option push_capture): the stop's
