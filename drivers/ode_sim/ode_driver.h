@@ -180,8 +180,9 @@ struct OdeDriverOptions {
   /// step's foot lifts only once the foot it leaves the weight on carries
   /// 0.8 of the weight and the measured DCM is inside that sole, waiting at
   /// most this long per lift, then the plan goes on from the measured CoM
-  /// state; s, 0: off (the timed stop). Key "push_stop_wait".
-  double push_stop_wait = 0.3;
+  /// state; s, 0: off (the timed stop; the default: measured, the walking
+  /// push sweep is worse with it). Key "push_stop_wait".
+  double push_stop_wait = 0;
   /// With push_stop_wait: the shift of weight onto a landed foot also waits
   /// (at most push_stop_wait) until that foot carries 0.15 of the weight
   /// (RecoveryParams::touch_share); off by default (measured worse:

@@ -202,8 +202,7 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error(
         "OdeDriver: push_lift_reach needs push_recovery=true (it bounds the regeneration's landings)");
   }
-  if (options.push_stop_wait > 0 && options.push_stop_wait != OdeDriverOptions{}.push_stop_wait &&
-      !options.push_recovery) {  // (the default is accepted without it)
+  if (options.push_stop_wait > 0 && !options.push_recovery) {
     throw Error("OdeDriver: push_stop_wait needs push_recovery=true (it gates the push recovery's stop)");
   }
   if (options.push_stop_land && !options.push_recovery) {

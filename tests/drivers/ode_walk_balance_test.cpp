@@ -389,13 +389,13 @@ TEST(OdeWalk, APushedGotoStopsStandsThenReplansAndStillArrivesWithTheStabilizer)
 // down 220 ms late and the timed pattern lifted the other foot 30 ms later,
 // the body still moving toward the new stance foot's outer edge; it rolled
 // over it (tilt 0.6 rad +1.56 s after the push). Disabled: it still falls
-// with the event-driven stop (push_stop_wait, walk15): the lift waits 24 ms
+// with the event-driven stop (push_stop_wait=0.3, walk15; off by default): the lift waits 24 ms
 // for the DCM, the robot survives the stop's last step (tilt 0.116 rad) but
 // rocks from foot to foot through the hold, the detector reads a second push
 // at +4.45 s and it falls at +6.13 s (docs/ode_sim.md, "The event-driven
 // stop"). Run it with --gtest_also_run_disabled_tests.
 TEST(OdeWalk, DISABLED_APushedGotoWhoseStopStepLandsLateStillArrivesWithTheStabilizer) {
-  PushAGotoAndExpectItStopsOnceStandsAndArrives({}, 2.80);
+  PushAGotoAndExpectItStopsOnceStandsAndArrives({{"push_stop_wait", "0.3"}}, 2.80);
 }
 
 // The event-driven stop's options (push_stop_wait, push_stop_land) are
@@ -412,7 +412,8 @@ TEST(OdeWalk, PushStopWaitAndPushStopLandAreCheckedAsThePushOptionsAre) {
   refused_naming({{"push_stop_land", "true"}, {"push_stop_wait", "0"}}, "push_stop_wait");
   refused_naming({{"push_stop_land", "true"}, {"push_recovery", "false"}}, "push_recovery");
   refused_naming({{"push_stop_wait", "0.5"}, {"push_recovery", "false"}}, "push_recovery");
-  EXPECT_FALSE(RefusalOfWalker({{"push_stop_land", "true"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_land", "true"}, {"push_stop_wait", "0.3"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_wait", "0.3"}}));
   EXPECT_FALSE(RefusalOfWalker({{"push_stop_wait", "0"}}));
   EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}})) << "the default wait needs no push_recovery";
 }

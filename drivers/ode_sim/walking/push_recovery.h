@@ -113,7 +113,7 @@ struct RecoveryParams {
   // `stop_wait` s per lift (0: off, the timed pattern); the plan's CoM
   // state becomes the measured one when a lift that waited goes
   // (`wait_reanchor`): the preview plans on from there.
-  double stop_wait = 0.3;   ///< s
+  double stop_wait = 0;     ///< s (the driver's push_stop_wait, off by default)
   double wait_share = 0.8;  ///< of the weight
   double wait_margin = 0;   ///< m (the pushed GOTO from the left on ODE: 0.03: 7 of 21 fell, 0: 5, timed: 6)
   double touch_share = 0.15;  ///< of the weight: a landed foot has touched down (0: landings never wait)
