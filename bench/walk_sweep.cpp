@@ -239,7 +239,8 @@ struct Run {
       std::fprintf(trace, ",%.5f,%.1f,%.4f", s.foot_low[i], s.foot_peak_force[i], s.foot_pitch[i]);
     std::fprintf(trace, ",%d", s.push_timings);  // then push_step_timing's re-plans
     // Then whether a push's stop holds and the push detector's input (m/s).
-    std::fprintf(trace, ",%d,%.4f,%.4f\n", s.push_holding ? 1 : 0, s.push_impulse.x(), s.push_impulse.y());
+    std::fprintf(trace, ",%d,%.4f,%.4f", s.push_holding ? 1 : 0, s.push_impulse.x(), s.push_impulse.y());
+    std::fprintf(trace, ",%.3f\n", s.push_waited);  // then the event-driven stop's waits so far (s)
   }
   void Panic() {
     d->Halt(done);
@@ -275,7 +276,7 @@ std::FILE* OpenTrace(const std::string& base, const std::map<std::string, std::s
                "lcontacts,"
                "rmeas_x,rmeas_y,rmeas_th,rtilt,rcontacts,steps,recoveries,push_stops,lroll,lankle_roll,"
                "lankle_pitch,rroll,rankle_roll,rankle_pitch,force_difference,llow,lpeak,lpitch,rlow,rpeak,"
-               "rpitch,timings,holding,impulse_x,impulse_y\n");
+               "rpitch,timings,holding,impulse_x,impulse_y,waited\n");
   return trace;
 }
 

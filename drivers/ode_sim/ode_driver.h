@@ -175,6 +175,19 @@ struct OdeDriverOptions {
   /// lift-off when the regeneration or the step timing lands it sooner
   /// (RecoveryParams::min_swing), s. Key "push_min_swing".
   double push_min_swing = 0.35;
+  /// With push_recovery: the event-driven stop (RecoveryParams::stop_wait;
+  /// docs/ode_sim.md, "The event-driven stop"): while a push's stop holds, a
+  /// step's foot lifts only once the foot it leaves the weight on carries
+  /// 0.8 of the weight and the measured DCM is inside that sole, waiting at
+  /// most this long per lift, then the plan goes on from the measured CoM
+  /// state; s, 0: off (the timed stop; the default: measured, the walking
+  /// push sweep is worse with it). Key "push_stop_wait".
+  double push_stop_wait = 0;
+  /// With push_stop_wait: the shift of weight onto a landed foot also waits
+  /// (at most push_stop_wait) until that foot carries 0.15 of the weight
+  /// (RecoveryParams::touch_share); off by default (measured worse:
+  /// docs/ode_sim.md, "The event-driven stop"). Key "push_stop_land".
+  bool push_stop_land = false;
   /// With walk=true: foot damping (walking/foot_damping.h; docs/ode_sim.md,
   /// "Balance feedback", "Foot damping"): each foot's ankle roll and pitch
   /// yield to the error between its measured and desired centre of pressure

@@ -75,6 +75,8 @@ OdeDriverOptions OdeDriverOptions::FromMap(const std::map<std::string, std::stri
     r.Fail("push_step_timing", "off, push, threshold or always");
   }
   r.Number("push_min_swing", &o.push_min_swing, kNonNegative, "a time >= 0 (s)");
+  r.Number("push_stop_wait", &o.push_stop_wait, kNonNegative, "a time >= 0 (s; 0: off)");
+  r.Bool("push_stop_land", &o.push_stop_land);
   if (r.Text("push_balance", &o.push_balance) && o.push_balance != "off" && o.push_balance != "both") {
     const std::vector<std::string> parts = SplitPlus(o.push_balance);
     if (parts.empty()) r.Fail("push_balance", "off, both, or damping, stabilizer and forces joined by '+'");

@@ -70,6 +70,8 @@ struct WalkStatus {
   int push_stops = 0;     ///< walks stopped by a push so far (push_recovery's stop and stand)
   int push_captures = 0;  ///< push_capture=true: the capture stop's re-plans so far
   int push_timings = 0;   ///< push_step_timing: the step timing's re-plans so far
+  double push_waited =
+      0;  ///< push_stop_wait: s the push's stops' lifts waited so far (the event-driven stop)
   /// push_recovery: the push the DcmEstimator reads (its impulse(), world axes, m/s); past
   /// stop_impulse it stops the walk, or holds the stop on
   Eigen::Vector2d push_impulse = Eigen::Vector2d::Zero();

@@ -202,6 +202,16 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
     throw Error(
         "OdeDriver: push_lift_reach needs push_recovery=true (it bounds the regeneration's landings)");
   }
+  if (options.push_stop_wait > 0 && !options.push_recovery) {
+    throw Error("OdeDriver: push_stop_wait needs push_recovery=true (it gates the push recovery's stop)");
+  }
+  if (options.push_stop_land && !options.push_recovery) {
+    throw Error("OdeDriver: push_stop_land needs push_recovery=true (it gates the push recovery's stop)");
+  }
+  if (options.push_stop_land && options.push_stop_wait <= 0) {
+    throw Error(
+        "OdeDriver: push_stop_land needs push_stop_wait > 0 (it is the event-driven stop's other wait)");
+  }
   if (options.push_stop_feet != "move" && !options.push_recovery) {
     throw Error("OdeDriver: push_stop_feet=" + options.push_stop_feet +
                 " needs push_recovery=true (it changes the push recovery's regeneration)");
@@ -228,6 +238,9 @@ std::unique_ptr<WalkingHumanoid> WalkingHumanoid::Create(const RobotModel& model
   recovery.swing_reach = options.push_swing_reach;
   recovery.lift_reach = options.push_lift_reach;
   recovery.min_swing = options.push_min_swing;
+  recovery.stop_wait = options.push_stop_wait;
+  if (!options.push_stop_land) recovery.touch_share = 0;  // every landing "touched": no landing waits
+  w->weight_ = model.total_mass() * gravity;
   using TimingMode = walking::RecoveryParams::TimingMode;
   recovery.step_timing = options.push_step_timing == "push"        ? TimingMode::kPush
                          : options.push_step_timing == "threshold" ? TimingMode::kThreshold
@@ -552,6 +565,7 @@ void WalkingHumanoid::Control(std::vector<Completion>& completed) {
       recovery_ && tick_ >= settle_ticks_ ? recovery_->Watch(pattern_, com_estimate_->impulse()) : Walk::kOn;
   if (mode_ == Mode::kGoto && walk == Walk::kResume) PlanGoto();
   if (mode_ == Mode::kSpeed && walk != Walk::kHold) KeepSpeedStepsQueued();
+  if (recovery_ && tick_ >= settle_ticks_) GateLift();
   pattern_.Tick();
   Balance();
   AdjustStep();

@@ -216,6 +216,8 @@ class WalkingHumanoid final : public BaseController {
   Eigen::Vector2d com_world_prev_ = Eigen::Vector2d::Zero(), com_velocity_ = Eigen::Vector2d::Zero();
   bool zmp_valid_ = false;
   void AdjustStep();
+  void GateLift();
+  double weight_ = 0;       // N: the model's mass under gravity
   int adjusted_step_ = -1;  // started_steps() of the step AdjustStep() moves
   Eigen::Vector2d step_target_ = Eigen::Vector2d::Zero(), step_applied_ = Eigen::Vector2d::Zero();
   double foot_force_[2] = {0, 0};

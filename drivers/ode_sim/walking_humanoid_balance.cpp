@@ -138,6 +138,28 @@ void WalkingHumanoid::Balance() {
   com_offset_->Update(balance_, at, pattern_.com(), pattern_.zmp_ref(), zmp_valid_ ? &cop : nullptr, step_);
 }
 
+// The event-driven stop (options.push_stop_wait; walking/push_recovery.h,
+// stop_wait): while a push's stop holds, a step lifts only once the foot it
+// leaves the weight on carries it and the measured DCM is inside that sole
+// (both measured: the foot's contact force, its pose, the estimator's DCM),
+// at most push_stop_wait s late; the plan then goes on from the measured CoM
+// state, read from that foot and put on its plan. Before pattern_.Tick().
+void WalkingHumanoid::GateLift() {
+  if (!PushHolding()) return;
+  const walking::Footstep* lift = pattern_.lifting_next();
+  const walking::Footstep* land = lift ? nullptr : pattern_.landing_next();
+  if (lift == nullptr && land == nullptr) return;
+  const Side stance = lift ? walking::Other(lift->side) : land->side;  // the foot that stays, or lands
+  const Pose2 measured = MeasuredFoot(stance), plan = pattern_.foot(stance);
+  const double force = foot_force_[static_cast<int>(stance)];
+  const bool ready =
+      lift ? walking::LiftReady(measured, g_, com_estimate_->dcm(), force, weight_, recovery_->params())
+           : walking::LandReady(force, weight_, recovery_->params());
+  if (recovery_->GateLift(pattern_, ready, walking::Relocate(measured, plan, com_estimate_->com()),
+                          walking::Relocate(measured, plan, com_estimate_->com_velocity(), true)))
+    com_offset_->Reset();
+}
+
 // Step adjustment: while the ankles cannot hold the DCM (the stabilizer's
 // ZMP saturated) the foot in the air is moved toward where the DCM will be
 // at its touch-down, at most kAdjustRate fast (its swing stays smooth) and
@@ -170,6 +192,7 @@ walking::WalkStatus WalkingHumanoid::status() const {
   s.push_stops = recovery_ ? recovery_->stops() : 0;
   s.push_captures = recovery_ ? recovery_->captures() : 0;
   s.push_timings = recovery_ ? recovery_->timings() : 0;
+  s.push_waited = recovery_ ? recovery_->waited() : 0;
   if (recovery_) s.push_impulse = com_estimate_->impulse();
   s.push_holding = PushHolding();
   const Pose2 com = ToWorld({pattern_.com().x(), pattern_.com().y(), 0});

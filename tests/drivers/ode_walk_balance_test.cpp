@@ -341,11 +341,13 @@ TEST(OdeWalk, PushStepTimingReplansOnlyTheStepInTheAirAfterAPush) {
 // robot stands through the hold, then the GOTO re-plans from where the push
 // left it and still ends at its goal with SUCCESS (no reply before the hold
 // is over), and no CoM offset while it holds.
-void PushAGotoAndExpectItStopsOnceStandsAndArrives(const std::map<std::string, std::string>& options) {
+// `at`: the push's instant, s after the command.
+void PushAGotoAndExpectItStopsOnceStandsAndArrives(const std::map<std::string, std::string>& options,
+                                                   double at = 3.0) {
   Walker w(ProjectModel("simple_humanoid.urdf"), options);
   w.Run(1.0);
   ASSERT_TRUE(w.Exec(CommandType::kGoto, {1.5, 0, 0}).in_progress);
-  w.Run(3.0);
+  w.Run(at);
   ASSERT_TRUE(w.driver->walk_status()->stepping);
   const TimePoint pushed_at = w.driver->sim_time();
   w.driver->PushForTesting(Eigen::Vector3d(0, 8 / 0.1, 0), FromSeconds(0.1));  // 8 N s toward the left
@@ -379,6 +381,41 @@ TEST(OdeWalk, APushedGotoStopsStandsThenReplansAndStillArrives) {
 // GOTO fell with the stabilizer").
 TEST(OdeWalk, APushedGotoStopsStandsThenReplansAndStillArrivesWithTheStabilizer) {
   PushAGotoAndExpectItStopsOnceStandsAndArrives({{"stabilizer", "true"}});
+}
+
+// The same pushed 2.80 s after the command, one of the instants where the
+// stabilized GOTO fell (stab14, docs/ode_sim.md, "Why the stabilized GOTO
+// still falls at 2.75-2.95 s from the left"): the stop's last step touched
+// down 220 ms late and the timed pattern lifted the other foot 30 ms later,
+// the body still moving toward the new stance foot's outer edge; it rolled
+// over it (tilt 0.6 rad +1.56 s after the push). Disabled: it still falls
+// with the event-driven stop (push_stop_wait=0.3, walk15; off by default): the lift waits 24 ms
+// for the DCM, the robot survives the stop's last step (tilt 0.116 rad) but
+// rocks from foot to foot through the hold, the detector reads a second push
+// at +4.45 s and it falls at +6.13 s (docs/ode_sim.md, "The event-driven
+// stop"). Run it with --gtest_also_run_disabled_tests.
+TEST(OdeWalk, DISABLED_APushedGotoWhoseStopStepLandsLateStillArrivesWithTheStabilizer) {
+  PushAGotoAndExpectItStopsOnceStandsAndArrives({{"push_stop_wait", "0.3"}}, 2.80);
+}
+
+// The event-driven stop's options (push_stop_wait, push_stop_land) are
+// checked as the other push options: a negative wait, either without
+// push_recovery, the landing's wait without a wait are refused, naming the key.
+TEST(OdeWalk, PushStopWaitAndPushStopLandAreCheckedAsThePushOptionsAre) {
+  // Refused, the refusal naming `key`.
+  const auto refused_naming = [](const std::map<std::string, std::string>& options, const std::string& key) {
+    const std::optional<std::string> why = RefusalOfWalker(options);
+    ASSERT_TRUE(why) << "accepted; expected a refusal naming " << key;
+    EXPECT_NE(why->find(key), std::string::npos) << *why;
+  };
+  refused_naming({{"push_stop_wait", "-0.1"}}, "push_stop_wait");
+  refused_naming({{"push_stop_land", "true"}, {"push_stop_wait", "0"}}, "push_stop_wait");
+  refused_naming({{"push_stop_land", "true"}, {"push_recovery", "false"}}, "push_recovery");
+  refused_naming({{"push_stop_wait", "0.5"}, {"push_recovery", "false"}}, "push_recovery");
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_land", "true"}, {"push_stop_wait", "0.3"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_wait", "0.3"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_stop_wait", "0"}}));
+  EXPECT_FALSE(RefusalOfWalker({{"push_recovery", "false"}})) << "the default wait needs no push_recovery";
 }
 
 // Foot damping (option foot_damping, walking/foot_damping.h): walking at

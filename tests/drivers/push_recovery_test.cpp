@@ -804,5 +804,100 @@ TEST(PushRecovery, NoPushBeyondTheCaptureBoundIsSurvivedAndTheRecoveryStopsWellS
   }
 }
 
+// The event-driven stop (RecoveryParams::stop_wait; issue 26, item 2's
+// promise): during a push's stop every landing (the shift of weight onto the
+// landed foot) and every lift waits while the measured foot is not ready
+// (here: never ready, so each waits the full stop_wait). Pushed at 12
+// instants over one step: the reference ZMP never jumps (no steeper than
+// the timed stop's own shifts) and never leaves the planned support; a foot
+// that waits to lift stays down and a foot that waits to land stays at its
+// landing; a wait changes nothing of the reference for the single support
+// ahead (what the preview counts on; a landing's wait holds the reference
+// on the stance foot from now instead of shifting); the stop ends standing with the feet
+// side by side, each event late by the wait.
+TEST(PushRecovery, TheEventDrivenStopWaitsForTheFeetKeepingTheReferenceContinuousAndInside) {
+  const GaitParams g = FastGait();
+  constexpr double kTick = 0.001, kG = 9.81, kWait = 0.2;
+  const auto ticks = [](double s) { return static_cast<std::int64_t>(std::llround(s / kTick)); };
+  for (int k = 0; k < 12; ++k) {
+    const double at = 3.0 + k * g.step_period() / 12;
+    const std::string what = "stop at " + std::to_string(at) + " s";
+    double stood[2] = {0, 0}, worst_jump[2] = {0, 0}, total_waited = 0;
+    for (const bool wait : {false, true}) {
+      RecoveryParams p;
+      p.stop_wait = wait ? kWait : 0;
+      WalkPattern w(g, kTick, 5, kG);
+      PushRecovery rec(std::sqrt(kG / g.com_height), kTick, p);
+      w.Reset({}, Eigen::Vector2d(g.ankle_x + g.zmp_x, 0));
+      Eigen::Vector2d ref = w.zmp_ref();
+      bool stopped = false;
+      int lifts_waited = 0, landings_waited = 0, checked_ahead = 0;
+      bool waiting = false;
+      for (int i = 0; i < ticks(at + 8.0) && !(stopped && w.standing()); ++i) {
+        if (!stopped) {
+          while (w.planned_ahead() < g.start_lead + 2 * g.step_period()) {
+            const WalkPattern::Splice sp = w.AppendPoint();
+            const Side next = sp.side_free ? Side::kLeft : sp.next;
+            const Pose2 ce = StepBy(sp.centre, g.step_forward, 0, 0, next, g);
+            w.Append({Footstep{next, FootAt(ce, next, g)}}, {ce});
+          }
+        }
+        const bool push = !stopped && w.time() >= at;
+        rec.Watch(w, Eigen::Vector2d(push ? 1.0 : 0.0, 0));  // past stop_impulse: the push's stop
+        stopped = stopped || push;
+        const Footstep* lift = w.lifting_next();
+        const Footstep* land = lift ? nullptr : w.landing_next();
+        const WalkPattern before = w;
+        const double waited = rec.waited();
+        rec.GateLift(w, false, w.com(), w.com_velocity());
+        const bool waits = rec.waited() > waited;
+        if (waits && !waiting) {  // an event starts to wait
+          lifts_waited += lift ? 1 : 0;
+          landings_waited += land ? 1 : 0;
+        }
+        waiting = waits;
+        if (waits) {
+          if (checked_ahead < 2 && lift) {  // the single support ahead is what it was
+            ++checked_ahead;
+            WalkPattern a = before, b = w;
+            for (std::int64_t t = 0; t < ticks(g.single_support); ++t) {
+              a.Tick();
+              b.Tick();
+              ASSERT_LT((a.zmp_ref() - b.zmp_ref()).norm(), 1e-12) << what << ", " << t << " ticks ahead";
+            }
+          }
+        }
+        w.Tick();
+        if (lift && waits) {
+          EXPECT_EQ(w.foot_height(lift->side), 0) << what << ": a foot that waits to lift stays down";
+        }
+        if (land && waits) {
+          EXPECT_LT(w.foot_height(land->side), 1e-4)
+              << what << ": a foot that waits to land is at its landing";
+        }
+        worst_jump[wait ? 1 : 0] = std::max(worst_jump[wait ? 1 : 0], (w.zmp_ref() - ref).norm());
+        ref = w.zmp_ref();
+        ASSERT_TRUE(w.InSupport(w.zmp_ref(), 0)) << what << ", t=" << w.time();
+      }
+      ASSERT_TRUE(w.standing()) << what;
+      stood[wait ? 1 : 0] = w.time();
+      const Pose2 l = w.foot(Side::kLeft), r = w.foot(Side::kRight);
+      EXPECT_NEAR(std::hypot(l.x - r.x, l.y - r.y), g.foot_separation, 1e-6) << what << ": feet side by side";
+      if (!wait) {
+        EXPECT_EQ(rec.waited(), 0) << what;
+        continue;
+      }
+      EXPECT_GE(landings_waited, 1) << what;
+      EXPECT_GE(lifts_waited, 1) << what;
+      EXPECT_NEAR(rec.waited(), kWait * (lifts_waited + landings_waited), 1.5 * kTick)
+          << what << ": each waits in full";
+      total_waited = rec.waited();
+    }
+    EXPECT_LE(worst_jump[1], worst_jump[0] + 1e-9) << what << ": the reference ZMP never jumps";
+    // Each wait delays the rest of the stop by as long.
+    EXPECT_NEAR(stood[1] - stood[0], total_waited, 2 * kTick) << what;
+  }
+}
+
 }  // namespace
 }  // namespace robotalk::walking

@@ -486,6 +486,9 @@ PushRecovery::PushRecovery(double omega, double tick, RecoveryParams params)
     t.max_width = p_.max_width;
     timing_.emplace(omega, t);
   }
+  if (!(p_.stop_wait >= 0) || !(p_.wait_share >= 0 && p_.wait_share <= 1) || !(p_.wait_margin >= 0)) {
+    throw std::invalid_argument("PushRecovery: stop_wait and wait_margin must be >= 0, wait_share in [0, 1]");
+  }
   if (!(p_.capture_margin >= 0) || !(p_.capture_shift > 0) || !(p_.capture_hold >= 0) ||
       !(p_.capture_tidy_beyond >= 0)) {
     throw std::invalid_argument(
@@ -536,6 +539,36 @@ bool PushRecovery::Update(WalkPattern& pattern, const Eigen::Vector2d& com, cons
   if (!pattern.Regenerate(c, v, p_, hold_ > 0)) return false;
   since_ = 0;
   ++count_;
+  return true;
+}
+
+bool LiftReady(const Pose2& stance, const GaitParams& g, const Eigen::Vector2d& dcm, double force,
+               double weight, const RecoveryParams& p) {
+  return force >= p.wait_share * weight && InFoot(stance, g, dcm, p.wait_margin);
+}
+
+bool LandReady(double force, double weight, const RecoveryParams& p) {
+  return force >= p.touch_share * weight;
+}
+
+bool PushRecovery::GateLift(WalkPattern& pattern, bool ready, const Eigen::Vector2d& com,
+                            const Eigen::Vector2d& com_vel) {
+  const bool lift = pattern.lifting_next() != nullptr;
+  if (p_.stop_wait <= 0 || hold_ <= 0 || (!lift && pattern.landing_next() == nullptr)) return false;
+  if (!ready && waiting_ < p_.stop_wait - 0.5 * tick_) {
+    if (lift) {
+      pattern.DelayLift(1);
+    } else {
+      pattern.DelayShift(1);
+    }
+    waiting_ += tick_;
+    waited_total_ += tick_;
+    return false;
+  }
+  const bool waited = waiting_ > 0;
+  waiting_ = 0;
+  if (!waited || !p_.wait_reanchor) return false;
+  pattern.Reanchor(com, com_vel);
   return true;
 }
 

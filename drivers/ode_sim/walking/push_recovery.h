@@ -106,6 +106,18 @@ struct RecoveryParams {
   // walk goes on. 0: off.
   double stop_impulse = 0.1;  ///< m/s
   double stop_hold = 3.0;     ///< s
+  // The event-driven stop (LiftGate below; driver option push_stop_wait):
+  // while a push's stop holds, a step's foot lifts only once the foot it
+  // leaves the weight on carries at least `wait_share` of the weight and the
+  // measured DCM is `wait_margin` inside that foot's sole, waiting at most
+  // `stop_wait` s per lift (0: off, the timed pattern); the plan's CoM
+  // state becomes the measured one when a lift that waited goes
+  // (`wait_reanchor`): the preview plans on from there.
+  double stop_wait = 0;     ///< s (the driver's push_stop_wait, off by default)
+  double wait_share = 0.8;  ///< of the weight
+  double wait_margin = 0;   ///< m (the pushed GOTO from the left on ODE: 0.03: 7 of 21 fell, 0: 5, timed: 6)
+  double touch_share = 0.15;  ///< of the weight: a landed foot has touched down (0: landings never wait)
+  bool wait_reanchor = true;
   // The capture stop (CaptureStop below; option push_capture): the stop's
   // last step lands where the measured DCM is caught, the plan re-anchored
   // on the measured CoM state, re-planned every `interval` until it lands.
@@ -141,6 +153,14 @@ struct RecoveryParams {
   double timing_sooner = 0.02;
 };
 
+/// The event-driven stop's test: the foot that stays down (`stance`, its
+/// measured ankle point and yaw) carries `force` >= wait_share of `weight`
+/// (N) and the measured DCM `dcm` lies wait_margin inside its sole.
+bool LiftReady(const Pose2& stance, const GaitParams& g, const Eigen::Vector2d& dcm, double force,
+               double weight, const RecoveryParams& p);
+/// ... and for a landing: the foot that lands carries `force` >= touch_share of `weight`.
+bool LandReady(double force, double weight, const RecoveryParams& p);
+
 class PushRecovery {
  public:
   /// omega = sqrt(g / z_c) > 0, tick > 0 (s), else std::invalid_argument.
@@ -170,6 +190,17 @@ class PushRecovery {
   /// the middle: WalkPattern::StopSoon, continuous at any phase) and holds
   /// stop_hold s; a push while holding holds on.
   Walk Watch(WalkPattern& pattern, const Eigen::Vector2d& impulse);
+  /// The event-driven stop (stop_wait > 0), one tick before pattern.Tick():
+  /// while the stop holds and a step lifts at the next tick, it lifts a
+  /// tick later unless `ready` (LiftReady for its stance foot) or it has
+  /// waited stop_wait s; a foot that lands at the next tick: the shift of
+  /// weight onto it starts a tick later unless `ready` (LandReady for it)
+  /// or it has waited stop_wait s. When an event that waited goes, with wait_reanchor,
+  /// the plan's CoM state becomes `com`, `com_vel` (measured, plan frame).
+  /// Returns true when it re-anchored.
+  bool GateLift(WalkPattern& pattern, bool ready, const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel);
+  /// s the stop's lifts have waited so far (GateLift).
+  double waited() const { return waited_total_; }
   /// Walks stopped by a push so far.
   int stops() const { return stops_; }
   /// Watch's stop holds: from a push's stop until the walk goes on (the
@@ -195,6 +226,7 @@ class PushRecovery {
   bool pushed_ = false;                      // a push read; no step it re-planned has landed yet
   bool adapted_ = false;                     // ... and one was re-planned
   int timed_ = 0;
+  double waiting_ = 0, waited_total_ = 0;  // s this lift has waited; all lifts
 };
 
 }  // namespace robotalk::walking

@@ -234,6 +234,63 @@ Pose2 WalkPattern::StopSoon() {
   return centre;
 }
 
+const Footstep* WalkPattern::lifting_next() const {
+  for (const Scheduled& s : steps_) {
+    if (s.start == tick_ + 1) return s.swing ? &s.step : nullptr;
+  }
+  return nullptr;
+}
+
+const Footstep* WalkPattern::landing_next() const {
+  for (const Scheduled& s : steps_) {
+    if (s.land == tick_ + 1) return s.swing ? &s.step : nullptr;
+  }
+  return nullptr;
+}
+
+bool WalkPattern::DelayLift(std::int64_t ticks) {
+  return ticks > 0 && lifting_next() != nullptr && DelayFrom(tick_ + 1, ticks);
+}
+
+bool WalkPattern::DelayShift(std::int64_t ticks) {
+  return ticks > 0 && landing_next() != nullptr && DelayFrom(tick_ + 1, ticks);
+}
+
+// Everything from the boundary `at` on (the phases from it, the steps that
+// lift from it) `ticks` later; the reference holds its value at `at`
+// meanwhile: the phase ending there lasts longer when it holds still (a
+// single support, an earlier wait; a foot landing at `at` lands as late, its
+// swing's last thousandths stretched), else a phase that holds still and whose
+// next swing is the same (SpliceAt: the side is forced) comes in between.
+bool WalkPattern::DelayFrom(std::int64_t at, std::int64_t ticks) {
+  size_t j = 0;  // the first phase from `at` on
+  while (j < phases_.size() && phases_[j].start < at) ++j;
+  if (j == 0 || phases_[j - 1].end != at) return false;  // (no boundary there)
+  for (size_t i = j; i < phases_.size(); ++i) {
+    phases_[i].start += ticks;
+    phases_[i].end += ticks;
+  }
+  for (Scheduled& s : steps_) {
+    if (s.land == at) s.land += ticks;  // DelayShift: the foot ends its swing as late (at its landing)
+    if (s.start < at) continue;
+    s.start += ticks;
+    s.land += ticks;
+  }
+  Phase& before = phases_[j - 1];
+  if ((before.to - before.from).norm() < 1e-12) {
+    before.end += ticks;
+  } else {
+    const Phase wait{.start = at,
+                     .end = at + ticks,
+                     .from = before.to,
+                     .to = before.to,
+                     .kind = before.kind,
+                     .next = before.next};
+    phases_.insert(phases_.begin() + static_cast<std::ptrdiff_t>(j), wait);
+  }
+  return true;
+}
+
 Eigen::Vector2d WalkPattern::AdjustLanding(const Eigen::Vector2d& offset, double reach) {
   size_t k = 0;
   while (k < steps_.size() && !(steps_[k].start <= tick_ && tick_ < steps_[k].land)) ++k;

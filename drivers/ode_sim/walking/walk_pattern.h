@@ -130,6 +130,34 @@ class WalkPattern {
   /// measured one. False (nothing changed) when no step can still move.
   bool CaptureStop(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel, const RecoveryParams& p);
 
+  /// The step whose foot lifts at the next Tick() (its single support
+  /// starts then, with a swing), or null.
+  const Footstep* lifting_next() const;
+  /// The event-driven stop (push_recovery.h, stop_wait): the step that
+  /// lifts at the next Tick() lifts `ticks` later, and everything after it
+  /// (its landing, the later steps, the end shift) moves as late. The
+  /// reference holds its value at the lift (the stance foot's ZMP point,
+  /// where the step's single support held it) for those ticks: continuous,
+  /// inside the stance sole, and unchanged for the step's single support
+  /// ahead (it first differs where the step's single support ended). False
+  /// (nothing changed) when no step lifts at the next tick.
+  bool DelayLift(std::int64_t ticks);
+  /// The step whose foot lands at the next Tick() (its shift of weight
+  /// follows), or null.
+  const Footstep* landing_next() const;
+  /// The event-driven stop's other wait: the foot that lands at the next
+  /// Tick() lands `ticks` later (the end of its swing stretched: it is a
+  /// hair above its landing, which no longer moves), the shift of weight
+  /// onto it and everything after it as late; the reference
+  /// holds on the stance foot's ZMP point meanwhile (its single support
+  /// lasts longer: continuous, inside the stance sole). False (nothing
+  /// changed) when no foot lands at the next tick.
+  bool DelayShift(std::int64_t ticks);
+  /// The plan's CoM state becomes the measured CoM and velocity (plan
+  /// frame), its acceleration such that its ZMP is the reference's now: the
+  /// preview plans on from the measured state.
+  void Reanchor(const Eigen::Vector2d& com, const Eigen::Vector2d& com_vel) { SetComState(com, com_vel); }
+
   /// True when no step is scheduled or running and the end shift is over.
   bool standing() const;
   /// Standing and the planned CoM at rest over the reference ZMP: within
@@ -224,7 +252,8 @@ class WalkPattern {
   void MoveLanding(Scheduled& st, const Eigen::Vector2d& by, std::int64_t land);
   void Rebuild(size_t k, std::int64_t land, std::int64_t lift, const Eigen::Vector2d& u,
                const std::vector<Eigen::Vector2d>& shift, const RecoveryParams& rp);
-  const Scheduled* Swinging() const;  // the step in single support now, or null
+  const Scheduled* Swinging() const;                    // the step in single support now, or null
+  bool DelayFrom(std::int64_t at, std::int64_t ticks);  // DelayLift's and DelayShift's move
 
   GaitParams g_;
   double tick_s_;
