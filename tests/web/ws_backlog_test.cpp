@@ -12,8 +12,10 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <sys/socket.h>
 #include <unistd.h>
@@ -35,6 +37,8 @@ struct Pair {
   std::shared_ptr<WsConnection> server;
   std::atomic<bool> reading{false}, done{false};
   std::atomic<std::size_t> received{0};
+  std::mutex mu;
+  std::vector<std::string> texts;  // GUARDED_BY(mu): the messages read, in order, their first 32 bytes
   std::atomic<int> client_fd{-1};  // shut down at the end: a blocking read returns
   std::thread client;
 
@@ -72,6 +76,11 @@ struct Pair {
         beast::error_code ec;
         ws.read(in, ec);
         if (ec) return;
+        {
+          std::lock_guard lock(mu);
+          const std::string text = beast::buffers_to_string(in.data());
+          texts.push_back(text.substr(0, 32));
+        }
         received += in.size();
         in.consume(in.size());
       }
@@ -167,6 +176,29 @@ TEST(WsBacklog, ANewerMessageOfTheSameKindTakesTheQueuedOnesPlaceSoAClientBehind
   for (int i = 0; i < 10000 && p.server->open(); ++i) p.server->Send(small, false, false);
   EXPECT_TRUE(p.RunUntil([&] { return !p.server->open(); }))
       << "a client that read none of 10,000 answers is served";
+}
+
+// A newer list takes the older one's place in the queue but never jumps
+// ahead of what was queued after it: a page behind got the new server
+// instance's robots list before the panic result queued after the old list,
+// and stamped that result with the new instance ("PANIC sent and
+// acknowledged" about an instance that never acknowledged it; final15).
+TEST(WsBacklog, ASupersedingMessageKeepsItsOrderAgainstEveryOtherMessage) {
+  Pair p(true);
+  ASSERT_TRUE(p.RunUntil([&] { return p.server && p.server->open(); })) << "no WebSocket opened";
+  const auto text = [](const char* t) { return std::make_shared<const std::string>(t); };
+  // No io_context turn between the sends: the first is being written, the rest queued.
+  p.server->Send(text("first"), false, false);
+  p.server->Send(text("list of instance 1"), false, false, "robots");
+  p.server->Send(text("panic result"), false, false);
+  p.server->Send(text("list of instance 2"), false, false, "robots");
+  ASSERT_TRUE(p.RunUntil([&] {
+    std::lock_guard lock(p.mu);
+    return p.texts.size() >= 3;
+  }));
+  p.ioc.run_for(std::chrono::milliseconds(50));
+  std::lock_guard lock(p.mu);
+  EXPECT_EQ(p.texts, (std::vector<std::string>{"first", "panic result", "list of instance 2"}));
 }
 
 }  // namespace
