@@ -55,9 +55,12 @@ void WsConnection::Send(const Message& m, bool binary, bool droppable, const std
     const auto older = std::find_if(std::next(queue_.begin(), queue_.empty() ? 0 : 1), queue_.end(),
                                     [&](const Queued& q) { return q.supersedes == supersedes; });
     if (older != queue_.end()) {
-      queued_bytes_ = queued_bytes_ - older->message->size() + m->size();
-      older->message = m;
-      older->binary = binary;
+      // The older goes; the newer is queued last like any message, so it
+      // never arrives before what was queued after the older one.
+      queued_bytes_ -= older->message->size();
+      queue_.erase(older);
+      queue_.push_back({m, binary, supersedes});
+      queued_bytes_ += m->size();
       return;
     }
   }

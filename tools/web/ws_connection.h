@@ -46,10 +46,11 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
   bool live() const { return accepting_ || open_; }
   /// Queues one message (text or binary); a droppable one is dropped when the
   /// queue is full. A non-empty `supersedes` names what the message is the
-  /// newest of (the robots list, one robot's model): it takes the place of a
-  /// queued one of the same name not yet being written, so a client behind
-  /// holds one of each, whatever the rate they change at (anyone announcing
-  /// made-up robots changes the list).
+  /// newest of (the robots list, one robot's model): a queued one of the same
+  /// name not yet being written is dropped and this one queued last, so a
+  /// client behind holds one of each, whatever the rate they change at
+  /// (anyone announcing made-up robots changes the list), and gets every
+  /// message in the order sent.
   void Send(const Message& m, bool binary, bool droppable, const std::string& supersedes = "");
   std::uint64_t dropped() const { return dropped_; }
   /// Closes it, saying so on stderr with `why` unless `say` is false (the
