@@ -22,6 +22,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <deque>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -57,6 +58,9 @@ struct PackageOptions {
   bool ask_for_delay = false;
   /// A CLOCK query: the ack of a package sent once is a clock sample.
   bool clock_query = false;
+  /// Nobody collects its replies: they are neither filed nor counted as
+  /// ignored (the clock samples' own).
+  bool replies_unwaited = false;
   /// How its timed set-points join into trajectories (request.h).
   Interpolation interpolation = Interpolation::kStep;
   /// The package's deadline (Request::max_late); nullopt: ClientOptions::max_late.
@@ -148,14 +152,18 @@ class RobotClient::Impl {
   std::shared_ptr<client::ReturnCache> cache_;
 
   mutable std::mutex mu_;
-  std::condition_variable cv_;                                   // panic answers, sessions, configurations
-  client::OutstandingPackages outstanding_;                      // GUARDED_BY(mu_)
-  client::LinkLoss link_loss_;                                   // GUARDED_BY(mu_)
-  client::ClockSync clock_sync_;                                 // GUARDED_BY(mu_)
-  std::int64_t next_sequence_ = 1;                               // GUARDED_BY(mu_)
-  CommandId next_id_ = 1;                                        // GUARDED_BY(mu_)
-  TimePoint last_send_{};                                        // GUARDED_BY(mu_)
-  TimePoint last_clock_query_{};                                 // GUARDED_BY(mu_)
+  std::condition_variable cv_;               // panic answers, sessions, configurations
+  client::OutstandingPackages outstanding_;  // GUARDED_BY(mu_)
+  client::LinkLoss link_loss_;               // GUARDED_BY(mu_)
+  client::ClockSync clock_sync_;             // GUARDED_BY(mu_)
+  std::int64_t next_sequence_ = 1;           // GUARDED_BY(mu_)
+  CommandId next_id_ = 1;                    // GUARDED_BY(mu_)
+  TimePoint last_send_{};                    // GUARDED_BY(mu_)
+  TimePoint last_clock_query_{};             // GUARDED_BY(mu_)
+  // Ids of items whose replies nobody collects (PackageOptions::
+  // replies_unwaited), newest last; bounded: a lost reply's id goes in time.
+  static constexpr std::size_t kMaxUnwaitedIds = 16;
+  std::deque<CommandId> unwaited_ids_;                           // GUARDED_BY(mu_)
   std::string robot_;                                            // GUARDED_BY(mu_); set once by Attach
   std::string request_channel_;                                  // GUARDED_BY(mu_)
   bool connected_ = false;                                       // GUARDED_BY(mu_)

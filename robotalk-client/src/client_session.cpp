@@ -273,8 +273,8 @@ void RobotClient::Impl::Resync() {
 }
 
 void RobotClient::Impl::SendClockSample() {
-  const Sent sent = SendPackage({}, {robotalk::Query{.type = QueryType::kClock}}, {.clock_query = true});
-  cache_->Forget(sent.ids.front());  // the reply is not kept: nobody collects it
+  SendPackage({}, {robotalk::Query{.type = QueryType::kClock}},
+              {.clock_query = true, .replies_unwaited = true});
 }
 
 void RobotClient::Impl::NoteResyncReplies(const std::vector<Reply>& replies) {

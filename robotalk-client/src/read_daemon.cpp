@@ -201,7 +201,14 @@ RobotClient::Impl::Sent RobotClient::Impl::SendPackage(std::vector<Command> comm
     if (options.mode == RequestMode::kPlayback) copies = PlaybackCopies(now, options.playback_headroom);
     link_loss_.OnSend(sent.sequence, now, copies);
     stats_.playback_copies += static_cast<std::uint64_t>(copies - 1);
-    for (CommandId i : sent.ids) cache_->Expect(i);
+    for (CommandId i : sent.ids) {
+      if (!options.replies_unwaited) {
+        cache_->Expect(i);
+        continue;
+      }
+      unwaited_ids_.push_back(i);
+      if (unwaited_ids_.size() > kMaxUnwaitedIds) unwaited_ids_.pop_front();
+    }
     outstanding_.Add(sent.sequence, bytes, std::move(items), now);
     if (options.clock_query) {
       clock_packages_.insert(sent.sequence);
@@ -362,6 +369,7 @@ void RobotClient::Impl::Tick(TimePoint now) {
     refresh_clock = !resync && session_id_ != 0 && clock_sync_.synced() &&
                     options_.clock_refresh_interval > Duration::zero() &&
                     now - last_clock_query_ >= options_.clock_refresh_interval;
+    if (refresh_clock) last_clock_query_ = now;  // once per interval, even when the send fails
     resends = outstanding_.TakeDue(now);
     for (const auto& r : resends) link_loss_.OnSend(r.sequence, now);
     // Every copy's ack has had time to come twice the retransmission
@@ -461,7 +469,8 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
             !info.retransmitted) {
           // Only a never-resent package gives an unambiguous t1; t4 is the
           // socket's stamp, so a starved read thread does not skew the offset.
-          clock_sync_.AddSample(info.first_send, batch.server_receive, batch.server_send, arrived);
+          if (clock_sync_.AddSample(info.first_send, batch.server_receive, batch.server_send, arrived))
+            ++stats_.clock_samples;
         }
         notify = NotePanicAnswer(batch);
       }
@@ -469,8 +478,20 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
     }
     if (notify) cv_.notify_all();
     NoteResyncReplies(batch.replies);
+    std::vector<const Reply*> to_file;  // not the replies nobody waits for (SendClockSample's)
+    {
+      std::lock_guard lock(mu_);
+      for (const Reply& r : batch.replies) {
+        const auto unwaited = std::find(unwaited_ids_.begin(), unwaited_ids_.end(), r.id);
+        if (unwaited == unwaited_ids_.end()) {
+          to_file.push_back(&r);
+        } else {
+          unwaited_ids_.erase(unwaited);  // its first copy; a duplicate is filed as ignored
+        }
+      }
+    }
     std::uint64_t filed = 0, ignored = 0;
-    for (const Reply& r : batch.replies) (cache_->Put(r) ? filed : ignored)++;
+    for (const Reply* r : to_file) (cache_->Put(*r) ? filed : ignored)++;
     std::lock_guard lock(mu_);
     stats_.replies_filed += filed;
     stats_.replies_ignored += ignored;

@@ -453,6 +453,23 @@ TEST_F(RobotClientTest, AConnectedClientAsksTheServersClockEveryRefreshInterval)
   EXPECT_EQ(received(), at_connect + 3);
 }
 
+// On real clocks: each refresh's round trip is a sample the clock sync
+// takes (not only a package the server sees), and its reply, which nobody
+// collects, is not counted among the ignored (duplicates, unknown ids).
+TEST_F(RobotClientTest, EachClockRefreshIsASampleAndItsReplyIsNotCountedIgnored) {
+  StartServer();
+  ClientOptions o = Options();
+  o.clock_refresh_interval = milliseconds(50);
+  std::unique_ptr<RobotClient> client = Connected(o);
+  const std::uint64_t at_connect = client->stats().clock_samples;
+  EXPECT_GE(at_connect, 1u) << "Connect's own rounds";
+  EXPECT_TRUE(WaitUntil([&] { return client->stats().clock_samples >= at_connect + 5; }))
+      << client->stats().clock_samples - at_connect << " samples after Connect";
+  EXPECT_EQ(client->stats().replies_ignored, 0u);
+  EXPECT_LT(std::chrono::abs(client->ServerTime(client_clock_.Now()) - server_clock_.Now()), milliseconds(50))
+      << "the offset after the refreshes";
+}
+
 // The server's own samples arrive validated; samples forged on the bus by
 // another endpoint are validated the same way: the bad ones are dropped and
 // counted, the good ones delivered as sent.

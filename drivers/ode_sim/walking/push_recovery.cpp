@@ -554,7 +554,11 @@ bool LandReady(double force, double weight, const RecoveryParams& p) {
 bool PushRecovery::GateLift(WalkPattern& pattern, bool ready, const Eigen::Vector2d& com,
                             const Eigen::Vector2d& com_vel) {
   const bool lift = pattern.lifting_next() != nullptr;
-  if (p_.stop_wait <= 0 || hold_ <= 0 || (!lift && pattern.landing_next() == nullptr)) return false;
+  if (p_.stop_wait <= 0) return false;
+  if (hold_ <= 0 || (!lift && pattern.landing_next() == nullptr)) {
+    waiting_ = 0;  // a wait the hold's end or a re-plan cut short: the next event waits afresh
+    return false;
+  }
   if (!ready && waiting_ < p_.stop_wait - 0.5 * tick_) {
     if (lift) {
       pattern.DelayLift(1);

@@ -106,11 +106,13 @@ struct RecoveryParams {
   // walk goes on. 0: off.
   double stop_impulse = 0.1;  ///< m/s
   double stop_hold = 3.0;     ///< s
-  // The event-driven stop (LiftGate below; driver option push_stop_wait):
+  // The event-driven stop (GateLift below; driver option push_stop_wait):
   // while a push's stop holds, a step's foot lifts only once the foot it
   // leaves the weight on carries at least `wait_share` of the weight and the
-  // measured DCM is `wait_margin` inside that foot's sole, waiting at most
-  // `stop_wait` s per lift (0: off, the timed pattern); the plan's CoM
+  // measured DCM is `wait_margin` inside that foot's sole, and (touch_share
+  // > 0; the driver's push_stop_land) the shift onto a landing foot waits
+  // until it carries `touch_share`: at most `stop_wait` s per lift or
+  // landing (0: off, the timed pattern); the plan's CoM
   // state becomes the measured one when a lift that waited goes
   // (`wait_reanchor`): the preview plans on from there.
   double stop_wait = 0;     ///< s (the driver's push_stop_wait, off by default)

@@ -356,7 +356,7 @@ std::vector<AnnouncedRobot> ListRobots(const ClientOptions& options, Duration li
 
 /// Client counters, for diagnostics and tests.
 struct ClientStats {
-  std::uint64_t packages_sent = 0;  ///< first sends (heartbeats included)
+  std::uint64_t packages_sent = 0;  ///< first sends (heartbeats and clock samples included)
   std::uint64_t retransmissions = 0;
   std::uint64_t heartbeats = 0;
   std::uint64_t replies_filed = 0;
@@ -378,6 +378,9 @@ struct ClientStats {
   /// Messages the link lost (either way), as the client counts them: a
   /// package's copies minus its acks, once every ack had time to come.
   std::uint64_t messages_lost = 0;
+  /// Clock samples taken (CLOCK round trips that counted: Connect's, a
+  /// restart's, and one every ClientOptions::clock_refresh_interval).
+  std::uint64_t clock_samples = 0;
 };
 
 class RobotClient {
