@@ -145,7 +145,7 @@ void WalkingHumanoid::Balance() {
 // at most push_stop_wait s late; the plan then goes on from the measured CoM
 // state, read from that foot and put on its plan. Before pattern_.Tick().
 void WalkingHumanoid::GateLift() {
-  if (!PushHolding()) return;
+  if (recovery_->params().stop_wait <= 0 || !PushHolding()) return;  // off (the default): nothing measured
   const walking::Footstep* lift = pattern_.lifting_next();
   const walking::Footstep* land = lift ? nullptr : pattern_.landing_next();
   if (lift == nullptr && land == nullptr) return;

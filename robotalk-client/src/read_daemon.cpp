@@ -455,6 +455,7 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
       FailLost(lost);
       return;
     }
+    std::vector<const Reply*> to_file;  // not the replies nobody waits for (SendClockSample's)
     {
       std::lock_guard lock(mu_);
       if (batch.ack_sequence > 0) {
@@ -474,14 +475,8 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
         }
         notify = NotePanicAnswer(batch);
       }
-      for (const Reply& r : batch.replies) outstanding_.OnReply(r.id, now);
-    }
-    if (notify) cv_.notify_all();
-    NoteResyncReplies(batch.replies);
-    std::vector<const Reply*> to_file;  // not the replies nobody waits for (SendClockSample's)
-    {
-      std::lock_guard lock(mu_);
       for (const Reply& r : batch.replies) {
+        outstanding_.OnReply(r.id, now);
         const auto unwaited = std::find(unwaited_ids_.begin(), unwaited_ids_.end(), r.id);
         if (unwaited == unwaited_ids_.end()) {
           to_file.push_back(&r);
@@ -490,6 +485,8 @@ void RobotClient::Impl::OnReplyPackage(std::span<const std::uint8_t> bytes) {
         }
       }
     }
+    if (notify) cv_.notify_all();
+    NoteResyncReplies(batch.replies);
     std::uint64_t filed = 0, ignored = 0;
     for (const Reply* r : to_file) (cache_->Put(*r) ? filed : ignored)++;
     std::lock_guard lock(mu_);

@@ -10,6 +10,8 @@ import robotalk.client.RobotalkClient;
 import robotalk_msgs.announce_t;
 import robotalk_msgs.hello_answer_t;
 import robotalk_msgs.hello_t;
+import robotalk_msgs.reply_package_t;
+import robotalk_msgs.reply_t;
 import robotalk_msgs.robot_info_t;
 
 final class FakeRobotServer {
@@ -19,6 +21,24 @@ final class FakeRobotServer {
     ByteArrayOutputStream bytes = new ByteArrayOutputStream();
     m.encode(new DataOutputStream(bytes));
     return bytes.toByteArray();
+  }
+
+  /**
+   * A flood's reply package to `client`: one reply `r` of 2,000 characters
+   * (its id the caller's), under the given server instance and session.
+   */
+  static reply_package_t floodPackage(long client, long server, long session, reply_t r) {
+    r.message = new String(new char[2000]).replace('\0', 'x');
+    r.values = new double[0];
+    reply_package_t p = new reply_package_t();
+    p.protocol_version = RobotalkClient.PROTOCOL_VERSION;
+    p.client_id = client;
+    p.server_id = server;
+    p.session_id = session;
+    p.panic_refusal = "";
+    p.replies = new reply_t[] {r};
+    p.num_replies = 1;
+    return p;
   }
 
   /** The heap in use after a few collections, bytes. */

@@ -21,16 +21,8 @@ public final class InboxFloodTest {
 
     try (RobotalkClient c = new RobotalkClient(url, "fake", 3.0)) {
       reply_t r = new reply_t();
-      r.message = new String(new char[2000]).replace('\0', 'x');
-      r.values = new double[0];
-      reply_package_t p = new reply_package_t();
-      p.protocol_version = RobotalkClient.PROTOCOL_VERSION;
-      p.client_id = c.clientId();
-      p.server_id = 8;  // another instance's, another session's: never filed
-      p.session_id = 1234;
-      p.panic_refusal = "";
-      p.replies = new reply_t[] {r};
-      p.num_replies = 1;
+      // Another instance's, another session's: never filed.
+      reply_package_t p = FakeRobotServer.floodPackage(c.clientId(), 8, 1234, r);
       byte[] flood = FakeRobotServer.encode(p);
       String replies = String.format("ROBOTALK/fake/REPLY/%016x", c.clientId());
       long before = FakeRobotServer.usedHeap();

@@ -26,16 +26,8 @@ public final class ReplyFloodTest {
       Thread flooder = new Thread(() -> {
         try {
           reply_t r = new reply_t();
-          r.message = new String(new char[2000]).replace('\0', 'x');
-          r.values = new double[0];
-          reply_package_t p = new reply_package_t();
-          p.protocol_version = RobotalkClient.PROTOCOL_VERSION;
-          p.client_id = c.clientId();
-          p.server_id = c.serverId();  // the client's session: filed
-          p.session_id = c.sessionId();
-          p.panic_refusal = "";
-          p.replies = new reply_t[] {r};
-          p.num_replies = 1;
+          // The client's own session: filed.
+          reply_package_t p = FakeRobotServer.floodPackage(c.clientId(), c.serverId(), c.sessionId(), r);
           for (int i = 0; i < sent; ++i) {
             r.id = 1_000_000 + i;  // never one of the client's
             byte[] b = FakeRobotServer.encode(p);
